@@ -1,0 +1,55 @@
+// scene/error.h: SceneError, the one exception bad input becomes, and JsonPath, which names
+// where in a file the problem is (`objects[3].radius`).
+#pragma once
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+
+namespace shadowlab::scene {
+
+class JsonPath {
+public:
+    JsonPath() = default;
+    JsonPath operator/(const std::string& key) const {
+        JsonPath p = *this;
+        if (!p.text_.empty()) p.text_.push_back('.');
+        p.text_.append(key);
+        return p;
+    }
+    JsonPath operator/(std::size_t index) const {
+        JsonPath p = *this;
+        p.text_.push_back('[');
+        p.text_.append(std::to_string(index));
+        p.text_.push_back(']');
+        return p;
+    }
+    const std::string& str() const { return text_; }
+    bool empty() const { return text_.empty(); }
+
+private:
+    std::string text_;
+};
+
+// "FILE: PATH: WHAT", or "FILE: WHAT" when the problem is not at a JSON path.
+class SceneError : public std::runtime_error {
+public:
+    SceneError(const std::filesystem::path& file, const JsonPath& path, const std::string& what)
+        : std::runtime_error(file.string() + ": " + (path.empty() ? "" : path.str() + ": ") + what),
+          file_(file), path_(path.str()) {}
+    const std::filesystem::path& file() const { return file_; }
+    const std::string& jsonPath() const { return path_; }
+
+private:
+    std::filesystem::path file_;
+    std::string path_;
+};
+
+// Any other problem a user can cause (an unreadable frame, a bad command-line value):
+// the message is complete and the program prints it as is.
+class InputError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+}  // namespace shadowlab::scene

@@ -1,0 +1,444 @@
+// scene/loader.cpp: the JSON scene reader. Every value is checked where it is read, and the
+// first problem becomes one SceneError that names the file, the JSON path and what is wrong.
+#include "scene/loader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "scene/error.h"
+#include "scene/mesh_loader.h"
+
+namespace shadowlab::scene {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+// Edit distance, to suggest the key a user probably meant ("radus" -> "radius").
+std::size_t editDistance(const std::string& a, const std::string& b) {
+    std::vector<std::size_t> row(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+        std::size_t diag = row[0];
+        row[0] = i;
+        for (std::size_t j = 1; j <= b.size(); ++j) {
+            const std::size_t up = row[j];
+            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] != b[j - 1] ? 1 : 0)});
+            diag = up;
+        }
+    }
+    return row[b.size()];
+}
+
+std::string describe(const Json& v) {
+    std::string s = v.dump();
+    if (s.size() > 60) s = s.substr(0, 57) + "...";
+    return s;
+}
+
+const char* typeName(const Json& v) {
+    switch (v.type()) {
+        case Json::value_t::null: return "null";
+        case Json::value_t::boolean: return "a boolean";
+        case Json::value_t::string: return "a string";
+        case Json::value_t::array: return "an array";
+        case Json::value_t::object: return "an object";
+        default: return "a number";
+    }
+}
+
+// Reads typed values out of one scene file's JSON with full checking.
+class Reader {
+public:
+    explicit Reader(fs::path file) : file_(std::move(file)) {}
+
+    [[noreturn]] void fail(const JsonPath& path, const std::string& what) const {
+        throw SceneError(file_, path, what);
+    }
+
+    void expectObject(const Json& node, const JsonPath& path) const {
+        if (!node.is_object()) fail(path, std::string("expected an object, got ") + typeName(node));
+    }
+
+    // Rejects keys that are not in `allowed`, suggesting the nearest allowed one.
+    void checkKeys(const Json& node, const JsonPath& path, std::initializer_list<const char*> allowed) const {
+        expectObject(node, path);
+        for (const auto& [key, value] : node.items()) {
+            if (std::any_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; }))
+                continue;
+            std::string best;
+            std::size_t bestDistance = 3;  // suggest only close matches
+            std::string list;
+            for (const char* a : allowed) {
+                list += (list.empty() ? "" : ", ") + std::string(a);
+                if (const std::size_t d = editDistance(key, a); d < bestDistance) {
+                    bestDistance = d;
+                    best = a;
+                }
+            }
+            fail(path / key, "unknown key" + (best.empty() ? "" : " (did you mean '" + best + "'?)") +
+                                 "; allowed here: " + list);
+        }
+    }
+
+    const Json& require(const Json& node, const JsonPath& path, const char* key) const {
+        const auto it = node.find(key);
+        if (it == node.end()) fail(path / key, "is required");
+        return *it;
+    }
+
+    double number(const Json& v, const JsonPath& path) const {
+        if (!v.is_number()) fail(path, std::string("expected a number, got ") + typeName(v));
+        const double d = v.get<double>();
+        if (!std::isfinite(d)) fail(path, "must be finite, got " + describe(v));
+        return d;
+    }
+    double number(const Json& node, const JsonPath& path, const char* key, double fallback) const {
+        const auto it = node.find(key);
+        return it == node.end() ? fallback : number(*it, path / key);
+    }
+    double positive(const Json& v, const JsonPath& path) const {
+        const double d = number(v, path);
+        if (!(d > 0.0)) fail(path, "must be > 0, got " + describe(v));
+        return d;
+    }
+    double unitInterval(const Json& v, const JsonPath& path) const {
+        const double d = number(v, path);
+        if (d < 0.0 || d > 1.0) fail(path, "must be in 0..1, got " + describe(v));
+        return d;
+    }
+
+    int integer(const Json& v, const JsonPath& path, long long lo, long long hi) const {
+        if (!v.is_number_integer() && !(v.is_number_float() && std::floor(v.get<double>()) == v.get<double>()))
+            fail(path, std::string("expected an integer, got ") + (v.is_number() ? describe(v) : typeName(v)));
+        const double d = v.get<double>();
+        if (d < double(lo) || d > double(hi))
+            fail(path, "must be in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got " + describe(v));
+        return int(d);
+    }
+
+    std::string string(const Json& v, const JsonPath& path) const {
+        if (!v.is_string()) fail(path, std::string("expected a string, got ") + typeName(v));
+        return v.get<std::string>();
+    }
+
+    bool boolean(const Json& v, const JsonPath& path) const {
+        if (!v.is_boolean()) fail(path, std::string("expected true or false, got ") + typeName(v));
+        return v.get<bool>();
+    }
+
+    template <int N>
+    glm::vec<N, double> vector(const Json& v, const JsonPath& path) const {
+        if (!v.is_array() || v.size() != N)
+            fail(path, "expected an array of " + std::to_string(N) + " numbers, got " + describe(v));
+        glm::vec<N, double> out;
+        for (int i = 0; i < N; ++i) out[i] = number(v[i], path / std::size_t(i));
+        return out;
+    }
+    Vec3 vec3(const Json& node, const JsonPath& path, const char* key, const Vec3& fallback) const {
+        const auto it = node.find(key);
+        return it == node.end() ? fallback : vector<3>(*it, path / key);
+    }
+    Vec3 direction(const Json& v, const JsonPath& path) const {
+        const Vec3 d = vector<3>(v, path);
+        const double len = glm::length(d);
+        if (!(len > 0.0) || !std::isfinite(len)) fail(path, "must be a non-zero direction, got " + describe(v));
+        return d / len;
+    }
+    Vec3 color(const Json& node, const JsonPath& path, const char* key, const Vec3& fallback) const {
+        const Vec3 c = vec3(node, path, key, fallback);
+        if (c.x < 0 || c.y < 0 || c.z < 0) fail(path / key, "color components must be >= 0, got " + describe(node[key]));
+        return c;
+    }
+
+    const fs::path& file() const { return file_; }
+
+private:
+    fs::path file_;
+};
+
+Camera readCamera(const Reader& r, const Json& node, const JsonPath& path) {
+    r.checkKeys(node, path, {"position", "look_at", "up", "fov_y", "resolution", "near", "far"});
+    Camera c;
+    c.position = r.vector<3>(r.require(node, path, "position"), path / "position");
+    c.lookAt = r.vector<3>(r.require(node, path, "look_at"), path / "look_at");
+    if (glm::length(c.lookAt - c.position) == 0.0)
+        r.fail(path / "look_at", "must differ from camera.position");
+    if (node.contains("up")) c.up = r.direction(node["up"], path / "up");
+    c.fovYDegrees = r.number(node, path, "fov_y", c.fovYDegrees);
+    if (!(c.fovYDegrees > 0.0 && c.fovYDegrees < 180.0))
+        r.fail(path / "fov_y", "must be in (0, 180) degrees, got " + describe(node["fov_y"]));
+    if (node.contains("resolution")) {
+        const Json& res = node["resolution"];
+        if (!res.is_array() || res.size() != 2)
+            r.fail(path / "resolution", "expected [width, height], got " + describe(res));
+        c.width = r.integer(res[0], path / "resolution" / 0, 1, kMaxResolution);
+        c.height = r.integer(res[1], path / "resolution" / 1, 1, kMaxResolution);
+        if (static_cast<long long>(c.width) * c.height > kMaxPixels)
+            r.fail(path / "resolution", "is absurd: " + std::to_string(c.width) + "x" + std::to_string(c.height) +
+                                            " is more than " + std::to_string(kMaxPixels) + " pixels");
+    }
+    if (node.contains("near")) c.near = r.positive(node["near"], path / "near");
+    if (node.contains("far")) c.far = r.positive(node["far"], path / "far");
+    if (!(c.far > c.near)) r.fail(path / "far", "must be greater than near");
+    return c;
+}
+
+Light readLight(const Reader& r, const Json& node, const JsonPath& path) {
+    r.checkKeys(node, path, {"type", "direction", "position", "color", "intensity", "radius", "cone_angle", "name"});
+    Light l;
+    const std::string type = r.string(r.require(node, path, "type"), path / "type");
+    if (type == "directional") {
+        l.type = LightType::Directional;
+        l.direction = r.direction(r.require(node, path, "direction"), path / "direction");
+        for (const char* key : {"position", "radius", "cone_angle"})
+            if (node.contains(key)) r.fail(path / key, "does not apply to a directional light");
+    } else if (type == "point" || type == "spot") {
+        l.type = type == "point" ? LightType::Point : LightType::Spot;
+        l.position = r.vector<3>(r.require(node, path, "position"), path / "position");
+        if (node.contains("radius")) {
+            l.radius = r.number(node["radius"], path / "radius");
+            if (l.radius < 0.0) r.fail(path / "radius", "must be >= 0, got " + describe(node["radius"]));
+        }
+        if (l.type == LightType::Spot) {
+            l.direction = r.direction(r.require(node, path, "direction"), path / "direction");
+            l.coneAngleDegrees = r.number(r.require(node, path, "cone_angle"), path / "cone_angle");
+            if (!(l.coneAngleDegrees > 0.0 && l.coneAngleDegrees < 90.0))
+                r.fail(path / "cone_angle", "must be in (0, 90) degrees (half-angle), got " + describe(node["cone_angle"]));
+        } else {
+            for (const char* key : {"direction", "cone_angle"})
+                if (node.contains(key)) r.fail(path / key, "does not apply to a point light");
+        }
+    } else {
+        r.fail(path / "type", "unknown light type '" + type + "' (expected directional, point or spot)");
+    }
+    l.color = r.color(node, path, "color", l.color);
+    if (node.contains("intensity")) {
+        l.intensity = r.number(node["intensity"], path / "intensity");
+        if (l.intensity < 0.0) r.fail(path / "intensity", "must be >= 0, got " + describe(node["intensity"]));
+    }
+    return l;
+}
+
+Object readObject(const Reader& r, const Json& node, const JsonPath& path,
+                  const std::map<std::string, int>& materials) {
+    r.expectObject(node, path);
+    Object o;
+    const std::string type = r.string(r.require(node, path, "type"), path / "type");
+    if (type == "sphere") {
+        r.checkKeys(node, path, {"type", "name", "material", "center", "radius"});
+        Sphere s;
+        s.center = r.vector<3>(r.require(node, path, "center"), path / "center");
+        s.radius = r.positive(r.require(node, path, "radius"), path / "radius");
+        o.shape = s;
+    } else if (type == "quad") {
+        r.checkKeys(node, path, {"type", "name", "material", "center", "normal", "size"});
+        Quad q;
+        q.center = r.vector<3>(r.require(node, path, "center"), path / "center");
+        q.normal = r.direction(r.require(node, path, "normal"), path / "normal");
+        const Json& size = r.require(node, path, "size");
+        q.size = r.vector<2>(size, path / "size");
+        for (int i = 0; i < 2; ++i)
+            if (!(q.size[i] > 0.0)) r.fail(path / "size" / std::size_t(i), "must be > 0, got " + describe(size[i]));
+        quadAxes(q.normal, q.uAxis, q.vAxis);
+        o.shape = q;
+    } else if (type == "box") {
+        r.checkKeys(node, path, {"type", "name", "material", "min", "max"});
+        Box b;
+        b.min = r.vector<3>(r.require(node, path, "min"), path / "min");
+        b.max = r.vector<3>(r.require(node, path, "max"), path / "max");
+        for (int i = 0; i < 3; ++i)
+            if (!(b.max[i] > b.min[i]))
+                r.fail(path / "max", "must be greater than min on every axis (axis " + std::to_string(i) + ")");
+        o.shape = b;
+    } else if (type == "mesh") {
+        r.checkKeys(node, path, {"type", "name", "material", "file", "translate", "rotate", "scale"});
+        const std::string file = r.string(r.require(node, path, "file"), path / "file");
+        if (file.empty()) r.fail(path / "file", "must name a mesh file");
+        const Vec3 translate = r.vec3(node, path, "translate", Vec3(0.0));
+        const Vec3 rotate = r.vec3(node, path, "rotate", Vec3(0.0));
+        Vec3 scale(1.0);
+        if (node.contains("scale")) {
+            const Json& s = node["scale"];
+            scale = s.is_array() ? r.vector<3>(s, path / "scale") : Vec3(r.number(s, path / "scale"));
+            if (!(scale.x > 0 && scale.y > 0 && scale.z > 0))
+                r.fail(path / "scale", "must be > 0, got " + describe(s));
+        }
+        Mesh m;
+        const fs::path base = r.file().has_parent_path() ? r.file().parent_path() : fs::path(".");
+        m.file = fs::path(file).is_absolute() ? fs::path(file) : base / file;
+        m.geometry = loadMesh(m.file, objectTransform(translate, rotate, scale), r.file(), path / "file");
+        o.shape = m;
+    } else {
+        r.fail(path / "type", "unknown object type '" + type + "' (expected sphere, quad, box or mesh)");
+    }
+    o.name = node.contains("name") ? r.string(node["name"], path / "name") : path.str();
+    const std::string material = r.string(r.require(node, path, "material"), path / "material");
+    const auto it = materials.find(material);
+    if (it == materials.end()) {
+        std::string known;
+        for (const auto& [name, index] : materials) known += (known.empty() ? "" : ", ") + name;
+        r.fail(path / "material", "no material named '" + material + "' (defined: " +
+                                      (known.empty() ? "none" : known) + ")");
+    }
+    o.material = it->second;
+    return o;
+}
+
+ShadowDefaults readShadow(const Reader& r, const Json& node, const JsonPath& path) {
+    r.checkKeys(node, path, {"shadow_map_size", "depth_bias", "slope_bias", "filter", "ray_bias", "precision", "samples"});
+    ShadowDefaults d;
+    if (node.contains("shadow_map_size"))
+        d.shadowMapSize = r.integer(node["shadow_map_size"], path / "shadow_map_size", 16, 16384);
+    if (node.contains("depth_bias")) {
+        d.depthBias = r.number(node["depth_bias"], path / "depth_bias");
+        if (*d.depthBias < 0) r.fail(path / "depth_bias", "must be >= 0 (world units)");
+    }
+    if (node.contains("slope_bias")) {
+        d.slopeBias = r.number(node["slope_bias"], path / "slope_bias");
+        if (*d.slopeBias < 0) r.fail(path / "slope_bias", "must be >= 0 (texels)");
+    }
+    if (node.contains("filter")) {
+        d.filter = r.string(node["filter"], path / "filter");
+        if (*d.filter != "none" && *d.filter != "pcf2x2")
+            r.fail(path / "filter", "expected none or pcf2x2, got '" + *d.filter + "'");
+    }
+    if (node.contains("ray_bias")) {
+        const Json& v = node["ray_bias"];
+        if (v.is_string()) {
+            if (v.get<std::string>() != "robust") r.fail(path / "ray_bias", "expected a number or \"robust\"");
+            d.robustRayOffset = true;
+        } else {
+            d.rayBias = r.number(v, path / "ray_bias");
+            if (*d.rayBias < 0) r.fail(path / "ray_bias", "must be >= 0 (world units)");
+        }
+    }
+    if (node.contains("precision")) {
+        d.precision = r.string(node["precision"], path / "precision");
+        if (*d.precision != "float" && *d.precision != "double")
+            r.fail(path / "precision", "expected float or double, got '" + *d.precision + "'");
+    }
+    if (node.contains("samples")) d.samples = r.integer(node["samples"], path / "samples", 1, 65536);
+    return d;
+}
+
+// "line L, column C" for a byte offset, so a syntax error points at the place in an editor.
+std::string lineColumn(const std::string& text, std::size_t byte) {
+    std::size_t line = 1, column = 1;
+    for (std::size_t i = 0; i < byte && i < text.size(); ++i) {
+        if (text[i] == '\n') { ++line; column = 1; } else { ++column; }
+    }
+    return "line " + std::to_string(line) + ", column " + std::to_string(column);
+}
+
+Scene parseScene(const fs::path& file, const std::string& text) {
+    const Reader r(file);
+    const JsonPath root;
+    Json doc;
+    try {
+        doc = Json::parse(text);
+    } catch (const Json::parse_error& e) {
+        std::string what = e.what();
+        // nlohmann's message starts "[json.exception.parse_error.101] parse error at line..."
+        if (const auto pos = what.find("] "); pos != std::string::npos) what = what.substr(pos + 2);
+        throw SceneError(file, root, "invalid JSON near " + lineColumn(text, e.byte == 0 ? 0 : e.byte - 1) + ": " + what);
+    } catch (const Json::exception& e) {
+        // Number overflow (1e999) and the like: nlohmann reports no position for these.
+        std::string what = e.what();
+        if (const auto pos = what.find("] "); pos != std::string::npos) what = what.substr(pos + 2);
+        throw SceneError(file, root, "invalid JSON: " + what + " (numbers must be finite)");
+    }
+    r.checkKeys(doc, root, {"camera", "background", "ambient", "materials", "lights", "objects", "shadow", "description"});
+
+    Scene scene;
+    scene.file = file;
+    scene.camera = readCamera(r, r.require(doc, root, "camera"), root / "camera");
+    scene.background = r.color(doc, root, "background", scene.background);
+    if (doc.contains("ambient")) scene.ambient = r.unitInterval(doc["ambient"], root / "ambient");
+    if (doc.contains("description")) r.string(doc["description"], root / "description");
+
+    std::map<std::string, int> materialIndex;
+    const Json& materials = r.require(doc, root, "materials");
+    r.expectObject(materials, root / "materials");
+    if (materials.empty()) r.fail(root / "materials", "must define at least one material");
+    for (const auto& [name, node] : materials.items()) {
+        const JsonPath path = root / "materials" / name;
+        r.checkKeys(node, path, {"albedo", "opacity"});
+        Material m;
+        m.name = name;
+        m.albedo = r.color(node, path, "albedo", m.albedo);
+        if (m.albedo.x > 1 || m.albedo.y > 1 || m.albedo.z > 1)
+            r.fail(path / "albedo", "albedo components must be in 0..1 (energy conserving)");
+        if (node.contains("opacity")) m.opacity = r.unitInterval(node["opacity"], path / "opacity");
+        materialIndex[name] = int(scene.materials.size());
+        scene.materials.push_back(m);
+    }
+
+    const Json& lights = r.require(doc, root, "lights");
+    if (!lights.is_array()) r.fail(root / "lights", std::string("expected an array, got ") + typeName(lights));
+    if (lights.empty()) r.fail(root / "lights", "must hold at least one light (a shadow needs a light)");
+    for (std::size_t i = 0; i < lights.size(); ++i)
+        scene.lights.push_back(readLight(r, lights[i], root / "lights" / i));
+
+    const Json& objects = r.require(doc, root, "objects");
+    if (!objects.is_array()) r.fail(root / "objects", std::string("expected an array, got ") + typeName(objects));
+    if (objects.empty()) r.fail(root / "objects", "must hold at least one object");
+    if (objects.size() > 1000000) r.fail(root / "objects", "has more than 1,000,000 objects");
+    for (std::size_t i = 0; i < objects.size(); ++i)
+        scene.objects.push_back(readObject(r, objects[i], root / "objects" / i, materialIndex));
+
+    if (doc.contains("shadow")) scene.shadow = readShadow(r, doc["shadow"], root / "shadow");
+    return scene;
+}
+
+}  // namespace
+
+Scene loadScene(const fs::path& file) {
+    std::error_code ec;
+    if (!fs::exists(file, ec)) throw SceneError(file, {}, "no such file");
+    if (fs::is_directory(file, ec)) throw SceneError(file, {}, "is a folder, not a scene file");
+    std::string ext = file.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+    if (ext == ".gltf" || ext == ".glb" || ext == ".obj")
+        throw SceneError(file, {}, "a model file cannot be a scene yet: reference it from a JSON scene "
+                                   "as {\"type\": \"mesh\", \"file\": \"" + file.filename().string() + "\"}");
+    const auto size = fs::file_size(file, ec);
+    if (ec) throw SceneError(file, {}, "cannot read: " + ec.message());
+    if (size > 256u * 1024 * 1024) throw SceneError(file, {}, "is larger than 256 MiB; not a scene file");
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw SceneError(file, {}, "cannot open for reading");
+    std::ostringstream text;
+    text << in.rdbuf();
+    return parseScene(file, text.str());
+}
+
+fs::path scenesDirectory() {
+    if (const char* env = std::getenv("SHADOWLAB_SCENES")) return env;
+    return SHADOWLAB_SCENES_DIR;
+}
+
+fs::path findScene(const std::string& nameOrPath) {
+    std::error_code ec;
+    const fs::path asGiven(nameOrPath);
+    if (fs::is_regular_file(asGiven, ec)) return asGiven;
+    const fs::path dir = scenesDirectory();
+    for (const fs::path& candidate : {dir / nameOrPath, dir / (nameOrPath + ".json")})
+        if (fs::is_regular_file(candidate, ec)) return candidate;
+    std::set<std::string> names;
+    for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
+        if (it->path().extension() == ".json")
+            names.insert(fs::relative(it->path(), dir, ec).replace_extension().string());
+    std::string list;
+    for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+    throw InputError(nameOrPath + ": no such scene file, and no shipped scene of that name (shipped: " +
+                     (list.empty() ? "none found in " + dir.string() : list) + ")");
+}
+
+}  // namespace shadowlab::scene

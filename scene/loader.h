@@ -1,0 +1,24 @@
+// scene/loader.h: reads a scene file (JSON now; glTF/GLB scenes come with the mesh loaders),
+// validates every value and throws SceneError(file, jsonPath, what) on the first problem.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "scene/scene.h"
+
+namespace shadowlab::scene {
+
+Scene loadScene(const std::filesystem::path& file);
+
+// A path as given, or the name of a shipped scene ("seed", "extreme/grazing-1deg") looked up
+// in the scenes folder. Throws InputError listing the shipped names when nothing matches.
+std::filesystem::path findScene(const std::string& nameOrPath);
+std::filesystem::path scenesDirectory();
+
+// Largest image the loaders accept on either side, and in total pixels. Above this a render
+// would need more memory than the machines we target have (see docs/decisions.md).
+inline constexpr int kMaxResolution = 16384;
+inline constexpr long long kMaxPixels = 64LL * 1024 * 1024;
+
+}  // namespace shadowlab::scene

@@ -1,0 +1,303 @@
+// scene/mesh_loader.cpp: tinyobjloader / tinygltf readers feeding one TriangleMesh format.
+#include "scene/mesh_loader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <tiny_gltf.h>
+#include <tiny_obj_loader.h>
+
+namespace shadowlab::scene {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+[[noreturn]] void fail(const fs::path& sceneFile, const JsonPath& path, const fs::path& mesh,
+                       const std::string& what) {
+    throw SceneError(sceneFile, path, mesh.string() + ": " + what);
+}
+
+bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// tinyobjloader reads "nan" or "inf" coordinates as 0 without a word; find them first so a
+// broken export is reported rather than silently reshaped.
+void checkObjVertices(const fs::path& file, const fs::path& sceneFile, const JsonPath& path) {
+    std::ifstream in(file);
+    std::string line;
+    for (std::size_t lineNo = 1; std::getline(in, line); ++lineNo) {
+        if (line.size() < 2 || line[0] != 'v' || (line[1] != ' ' && line[1] != '\t')) continue;
+        std::istringstream fields(line.substr(2));
+        std::string token;
+        for (int i = 0; i < 3 && fields >> token; ++i) {
+            char* end = nullptr;
+            const double v = std::strtod(token.c_str(), &end);
+            if (end == token.c_str() || *end != '\0' || !std::isfinite(v))
+                fail(sceneFile, path, file, "line " + std::to_string(lineNo) + ": vertex coordinate '" +
+                                                token + "' is not a finite number");
+        }
+    }
+}
+
+void loadObj(const fs::path& file, TriangleMesh& mesh, const fs::path& sceneFile,
+             const JsonPath& path) {
+    checkObjVertices(file, sceneFile, path);
+    tinyobj::ObjReaderConfig config;
+    config.triangulate = true;
+    config.vertex_color = false;
+    config.mtl_search_path = file.parent_path().string();
+    tinyobj::ObjReader reader;
+    if (!reader.ParseFromFile(file.string(), config))
+        fail(sceneFile, path, file, "not a readable OBJ file: " + reader.Error());
+    const auto& attrib = reader.GetAttrib();
+    const std::size_t vertexCount = attrib.vertices.size() / 3;
+    const std::size_t normalCount = attrib.normals.size() / 3;
+    bool allHaveNormals = normalCount > 0;
+    std::size_t faces = 0;
+    for (const auto& shape : reader.GetShapes()) {
+        for (const auto& idx : shape.mesh.indices) {
+            if (idx.vertex_index < 0 || std::size_t(idx.vertex_index) >= vertexCount)
+                fail(sceneFile, path, file,
+                     "face index " + std::to_string(idx.vertex_index + 1) + " is out of range (" +
+                         std::to_string(vertexCount) + " vertices)");
+            if (idx.normal_index < 0 || std::size_t(idx.normal_index) >= normalCount)
+                allHaveNormals = false;
+        }
+        faces += shape.mesh.num_face_vertices.size();
+    }
+    if (faces == 0) fail(sceneFile, path, file, "has no faces");
+    // One output vertex per OBJ corner keeps per-corner normals; fine for the sizes we load.
+    for (const auto& shape : reader.GetShapes()) {
+        for (const auto& idx : shape.mesh.indices) {
+            const Vec3 p(attrib.vertices[3 * idx.vertex_index], attrib.vertices[3 * idx.vertex_index + 1],
+                         attrib.vertices[3 * idx.vertex_index + 2]);
+            if (!finite(p)) fail(sceneFile, path, file, "vertex " + std::to_string(idx.vertex_index + 1) + " is not finite");
+            mesh.indices.push_back(std::uint32_t(mesh.positions.size()));
+            mesh.positions.push_back(p);
+            if (allHaveNormals)
+                mesh.normals.emplace_back(attrib.normals[3 * idx.normal_index],
+                                          attrib.normals[3 * idx.normal_index + 1],
+                                          attrib.normals[3 * idx.normal_index + 2]);
+        }
+    }
+    if (!allHaveNormals) mesh.normals.clear();
+}
+
+// Reads one accessor as doubles (`components` per element); validates every bound.
+std::vector<double> readAccessor(const tinygltf::Model& model, int accessorIndex, int components,
+                                 const fs::path& file, const fs::path& sceneFile, const JsonPath& path) {
+    if (accessorIndex < 0 || std::size_t(accessorIndex) >= model.accessors.size())
+        fail(sceneFile, path, file, "accessor " + std::to_string(accessorIndex) + " does not exist");
+    const auto& acc = model.accessors[accessorIndex];
+    if (acc.bufferView < 0 || std::size_t(acc.bufferView) >= model.bufferViews.size())
+        fail(sceneFile, path, file, "accessor " + std::to_string(accessorIndex) + " has no buffer view");
+    const auto& view = model.bufferViews[acc.bufferView];
+    if (view.buffer < 0 || std::size_t(view.buffer) >= model.buffers.size())
+        fail(sceneFile, path, file, "buffer view " + std::to_string(acc.bufferView) + " names a missing buffer");
+    const auto& buffer = model.buffers[view.buffer];
+    const int compSize = tinygltf::GetComponentSizeInBytes(acc.componentType);
+    const int nComp = tinygltf::GetNumComponentsInType(acc.type);
+    if (compSize <= 0 || nComp != components)
+        fail(sceneFile, path, file, "accessor " + std::to_string(accessorIndex) + " has an unexpected type");
+    const std::size_t stride = view.byteStride ? view.byteStride : std::size_t(compSize) * nComp;
+    const std::size_t begin = view.byteOffset + acc.byteOffset;
+    const std::size_t needed = acc.count == 0 ? 0 : begin + stride * (acc.count - 1) + std::size_t(compSize) * nComp;
+    if (needed > buffer.data.size() || view.byteOffset + view.byteLength > buffer.data.size())
+        fail(sceneFile, path, file, "accessor " + std::to_string(accessorIndex) + " reads past the end of its buffer");
+    std::vector<double> out(acc.count * nComp);
+    const unsigned char* base = buffer.data.data() + begin;
+    for (std::size_t i = 0; i < acc.count; ++i) {
+        for (int c = 0; c < nComp; ++c) {
+            const unsigned char* p = base + i * stride + std::size_t(c) * compSize;
+            double v = 0;
+            switch (acc.componentType) {
+                case TINYGLTF_COMPONENT_TYPE_FLOAT: { float f; std::memcpy(&f, p, 4); v = f; break; }
+                case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { std::uint32_t u; std::memcpy(&u, p, 4); v = u; break; }
+                case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { std::uint16_t u; std::memcpy(&u, p, 2); v = u; break; }
+                case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: v = *p; break;
+                default: fail(sceneFile, path, file, "accessor " + std::to_string(accessorIndex) + " has an unsupported component type");
+            }
+            out[i * nComp + c] = v;
+        }
+    }
+    return out;
+}
+
+glm::dmat4 nodeMatrix(const tinygltf::Node& node) {
+    if (node.matrix.size() == 16) {
+        glm::dmat4 m;
+        for (int i = 0; i < 16; ++i) m[i / 4][i % 4] = node.matrix[i];
+        return m;
+    }
+    glm::dmat4 m(1.0);
+    if (node.translation.size() == 3)
+        m = glm::translate(m, Vec3(node.translation[0], node.translation[1], node.translation[2]));
+    if (node.rotation.size() == 4) {
+        const glm::dquat q(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]);
+        m = m * glm::mat4_cast(q);
+    }
+    if (node.scale.size() == 3) m = glm::scale(m, Vec3(node.scale[0], node.scale[1], node.scale[2]));
+    return m;
+}
+
+// glTF textures are not needed for shadows: accept any image, even a missing one.
+bool ignoreImage(tinygltf::Image*, const int, std::string*, std::string*, int, int,
+                 const unsigned char*, int, void*) {
+    return true;
+}
+
+void appendGltfMesh(const tinygltf::Model& model, int meshIndex, const glm::dmat4& world,
+                    TriangleMesh& out, const fs::path& file, const fs::path& sceneFile,
+                    const JsonPath& path) {
+    if (meshIndex < 0 || std::size_t(meshIndex) >= model.meshes.size())
+        fail(sceneFile, path, file, "node names mesh " + std::to_string(meshIndex) + ", which does not exist");
+    const glm::dmat3 normalMatrix = glm::transpose(glm::inverse(glm::dmat3(world)));
+    for (const auto& prim : model.meshes[meshIndex].primitives) {
+        if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != -1) continue;  // points/lines cast nothing
+        const auto pos = prim.attributes.find("POSITION");
+        if (pos == prim.attributes.end()) fail(sceneFile, path, file, "a primitive has no POSITION");
+        const std::vector<double> p = readAccessor(model, pos->second, 3, file, sceneFile, path);
+        const std::size_t count = p.size() / 3;
+        std::vector<double> n;
+        if (const auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
+            n = readAccessor(model, it->second, 3, file, sceneFile, path);
+            if (n.size() != p.size()) n.clear();
+        }
+        std::vector<double> idx;
+        if (prim.indices >= 0) {
+            idx = readAccessor(model, prim.indices, 1, file, sceneFile, path);
+        } else {
+            idx.resize(count);
+            for (std::size_t i = 0; i < count; ++i) idx[i] = double(i);
+        }
+        const std::uint32_t base = std::uint32_t(out.positions.size());
+        const bool keepNormals = !n.empty() && (out.positions.empty() || !out.normals.empty());
+        if (!keepNormals) out.normals.clear();
+        for (std::size_t i = 0; i < count; ++i) {
+            const Vec3 v = Vec3(world * glm::dvec4(p[3 * i], p[3 * i + 1], p[3 * i + 2], 1.0));
+            if (!finite(v)) fail(sceneFile, path, file, "a vertex is not finite");
+            out.positions.push_back(v);
+            if (keepNormals) out.normals.push_back(normalMatrix * Vec3(n[3 * i], n[3 * i + 1], n[3 * i + 2]));
+        }
+        for (std::size_t i = 0; i + 2 < idx.size(); i += 3) {
+            for (int k = 0; k < 3; ++k) {
+                if (idx[i + k] >= double(count))
+                    fail(sceneFile, path, file, "index " + std::to_string(std::uint64_t(idx[i + k])) +
+                                                    " is out of range (" + std::to_string(count) + " vertices)");
+                out.indices.push_back(base + std::uint32_t(idx[i + k]));
+            }
+        }
+    }
+}
+
+void loadGltf(const fs::path& file, TriangleMesh& mesh, const fs::path& sceneFile,
+              const JsonPath& path) {
+    tinygltf::TinyGLTF loader;
+    loader.SetImageLoader(ignoreImage, nullptr);
+    tinygltf::Model model;
+    std::string err, warn;
+    std::string ext = file.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+    const bool ok = ext == ".glb" ? loader.LoadBinaryFromFile(&model, &err, &warn, file.string())
+                                  : loader.LoadASCIIFromFile(&model, &err, &warn, file.string());
+    if (!ok) fail(sceneFile, path, file, "not a readable glTF file: " + (err.empty() ? warn : err));
+
+    // Walk the default scene's node tree so each node that uses a mesh places it once.
+    std::vector<int> roots;
+    const int sceneIndex = model.defaultScene >= 0 ? model.defaultScene : 0;
+    if (std::size_t(sceneIndex) < model.scenes.size()) roots = model.scenes[sceneIndex].nodes;
+    else for (std::size_t i = 0; i < model.nodes.size(); ++i) roots.push_back(int(i));
+    std::vector<std::pair<int, glm::dmat4>> stack;
+    for (int r : roots) stack.emplace_back(r, glm::dmat4(1.0));
+    std::size_t visited = 0;
+    while (!stack.empty()) {
+        auto [nodeIndex, parent] = stack.back();
+        stack.pop_back();
+        if (nodeIndex < 0 || std::size_t(nodeIndex) >= model.nodes.size() || ++visited > 1000000)
+            fail(sceneFile, path, file, "the node hierarchy is invalid (bad index or a cycle)");
+        const auto& node = model.nodes[nodeIndex];
+        const glm::dmat4 world = parent * nodeMatrix(node);
+        if (node.mesh >= 0) appendGltfMesh(model, node.mesh, world, mesh, file, sceneFile, path);
+        for (int child : node.children) stack.emplace_back(child, world);
+    }
+    if (mesh.indices.empty()) fail(sceneFile, path, file, "has no triangles");
+}
+
+}  // namespace
+
+glm::dmat4 objectTransform(const Vec3& translate, const Vec3& rotateDegrees, const Vec3& scale) {
+    glm::dmat4 m = glm::translate(glm::dmat4(1.0), translate);
+    m = glm::rotate(m, glm::radians(rotateDegrees.z), Vec3(0, 0, 1));
+    m = glm::rotate(m, glm::radians(rotateDegrees.y), Vec3(0, 1, 0));
+    m = glm::rotate(m, glm::radians(rotateDegrees.x), Vec3(1, 0, 0));
+    return glm::scale(m, scale);
+}
+
+void finalizeMesh(TriangleMesh& mesh) {
+    // Drop triangles with zero area (or non-finite arithmetic) so no NaN normal reaches a backend.
+    std::vector<std::uint32_t> kept;
+    kept.reserve(mesh.indices.size());
+    for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+        const Vec3& a = mesh.positions[mesh.indices[t]];
+        const Vec3& b = mesh.positions[mesh.indices[t + 1]];
+        const Vec3& c = mesh.positions[mesh.indices[t + 2]];
+        const double area2 = glm::length(glm::cross(b - a, c - a));
+        if (!(area2 > 0.0) || !std::isfinite(area2)) {
+            ++mesh.droppedDegenerate;
+            continue;
+        }
+        kept.insert(kept.end(), {mesh.indices[t], mesh.indices[t + 1], mesh.indices[t + 2]});
+    }
+    mesh.indices = std::move(kept);
+
+    bool normalsOk = mesh.normals.size() == mesh.positions.size();
+    if (normalsOk)
+        for (Vec3& n : mesh.normals) {
+            const double len = glm::length(n);
+            if (!(len > 0.0) || !std::isfinite(len)) { normalsOk = false; break; }
+            n /= len;
+        }
+    if (!normalsOk) {
+        // Area-weighted vertex normals: the unnormalized cross product weighs by area.
+        mesh.normals.assign(mesh.positions.size(), Vec3(0.0));
+        for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
+            const auto i0 = mesh.indices[t], i1 = mesh.indices[t + 1], i2 = mesh.indices[t + 2];
+            const Vec3 fn = glm::cross(mesh.positions[i1] - mesh.positions[i0],
+                                       mesh.positions[i2] - mesh.positions[i0]);
+            mesh.normals[i0] += fn; mesh.normals[i1] += fn; mesh.normals[i2] += fn;
+        }
+        for (Vec3& n : mesh.normals) {
+            const double len = glm::length(n);
+            n = len > 0.0 ? n / len : Vec3(0, 1, 0);  // unused vertex: any unit vector
+        }
+    }
+}
+
+std::shared_ptr<const TriangleMesh> loadMesh(const fs::path& meshFile, const glm::dmat4& transform,
+                                             const fs::path& sceneFile, const JsonPath& path) {
+    std::error_code ec;
+    if (!fs::is_regular_file(meshFile, ec)) fail(sceneFile, path, meshFile, "no such file");
+    if (fs::file_size(meshFile, ec) == 0) fail(sceneFile, path, meshFile, "is empty (0 bytes)");
+    auto mesh = std::make_shared<TriangleMesh>();
+    std::string ext = meshFile.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+    if (ext == ".obj") loadObj(meshFile, *mesh, sceneFile, path);
+    else if (ext == ".gltf" || ext == ".glb") loadGltf(meshFile, *mesh, sceneFile, path);
+    else fail(sceneFile, path, meshFile, "unknown mesh type '" + ext + "' (use .obj, .gltf or .glb)");
+
+    const glm::dmat3 normalMatrix = glm::transpose(glm::inverse(glm::dmat3(transform)));
+    for (Vec3& p : mesh->positions) p = Vec3(transform * glm::dvec4(p, 1.0));
+    for (Vec3& n : mesh->normals) n = normalMatrix * n;
+    finalizeMesh(*mesh);
+    if (mesh->indices.empty())
+        fail(sceneFile, path, meshFile, "has no triangles left after dropping " +
+                                            std::to_string(mesh->droppedDegenerate) + " degenerate ones");
+    return mesh;
+}
+
+}  // namespace shadowlab::scene

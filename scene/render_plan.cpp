@@ -1,0 +1,68 @@
+// scene/render_plan.cpp: decides what each render leaves out, with the reason for each choice.
+#include "scene/render_plan.h"
+
+#include <sstream>
+
+namespace shadowlab::scene {
+
+namespace {
+
+bool isConvex(const Shape& shape) {
+    return std::holds_alternative<Sphere>(shape) || std::holds_alternative<Box>(shape) ||
+           std::holds_alternative<Quad>(shape);
+}
+
+
+}  // namespace
+
+RenderPlan makeRenderPlan(const Scene& scene, const RenderSettings& /*settings*/) {
+    RenderPlan plan;
+    plan.anyHitShadowRays = scene.allOpaque();
+    for (const Object& o : scene.objects)
+        if (std::holds_alternative<Mesh>(o.shape)) plan.needsTriangleBvh = true;
+    for (const Object& o : scene.objects)
+        if (!scene.materialOf(o).opaque()) plan.needsTransmittanceMap = true;
+
+    // A convex object never shadows its own lit points (a ray leaving a convex surface with
+    // N·L > 0 cannot re-enter it), so a scene of one convex object needs no shadow test at all.
+    const bool canShadow =
+        scene.objects.size() > 1 || (scene.objects.size() == 1 && !isConvex(scene.objects[0].shape));
+    for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+        const Light& light = scene.lights[i];
+        LightPlan lp;
+        lp.light = int(i);
+        lp.needsShadowTest = canShadow;
+        lp.reason = canShadow ? "objects can cast shadows"
+                              : (scene.objects.empty() ? "the scene has no objects"
+                                                       : "a single convex object cannot shadow itself");
+        if (light.type == LightType::Point && lp.needsShadowTest) plan.needsCubeMap = true;
+        if (light.radius > 0.0 && light.type != LightType::Directional) plan.hasAreaLights = true;
+        plan.lights.push_back(lp);
+    }
+    return plan;
+}
+
+std::string RenderPlan::explain() const {
+    std::ostringstream s;
+    s << "shadow rays: "
+      << (anyHitShadowRays ? "any-hit, stop at the first blocker (every material is opaque)"
+                           : "go on to the light multiplying transmittances (semi-transparent materials)")
+      << "\n";
+    s << "triangle BVH: "
+      << (needsTriangleBvh ? "built (the scene has meshes)"
+                           : "not built (spheres, quads and boxes are intersected analytically)")
+      << "\n";
+    s << "point-light cube map: " << (needsCubeMap ? "needed" : "not needed (no shadowed point light)")
+      << "\n";
+    s << "transmittance map: "
+      << (needsTransmittanceMap ? "needed (semi-transparent casters)" : "not needed (all casters opaque)")
+      << "\n";
+    s << "area lights: " << (hasAreaLights ? "yes, soft shadows are sampled" : "none, shadows are hard")
+      << "\n";
+    for (const LightPlan& lp : lights)
+        s << "light " << lp.light << ": shadow pass "
+          << (lp.needsShadowTest ? "rendered" : "skipped") << " (" << lp.reason << ")\n";
+    return s.str();
+}
+
+}  // namespace shadowlab::scene

@@ -1,0 +1,34 @@
+// scene/render_plan.h: what this scene needs, decided once from Scene + settings, so that
+// each backend leaves out the work the scene does not need. `--explain` prints it.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "scene/scene.h"
+#include "scene/settings.h"
+
+namespace shadowlab::scene {
+
+struct LightPlan {
+    int light = 0;              // index into Scene::lights
+    bool needsShadowTest = true;  // false: no object can cast onto a lit receiver for this light
+    std::string reason;         // why, in words
+};
+
+struct RenderPlan {
+    // Shadow rays may stop at the first hit: every material is opaque.
+    bool anyHitShadowRays = true;
+    // A triangle BVH is built only when the scene has meshes; spheres, quads, boxes stay analytic.
+    bool needsTriangleBvh = false;
+    bool needsCubeMap = false;            // a point light is shadowed (raster)
+    bool needsTransmittanceMap = false;   // semi-transparent casters (raster)
+    bool hasAreaLights = false;
+    std::vector<LightPlan> lights;
+
+    std::string explain() const;  // human-readable, one decision per line with its reason
+};
+
+RenderPlan makeRenderPlan(const Scene& scene, const RenderSettings& settings);
+
+}  // namespace shadowlab::scene

@@ -1,0 +1,54 @@
+// scene/scene.cpp: bounds and small queries on the scene model.
+#include "scene/scene.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace shadowlab::scene {
+
+double Bounds::maxAbsCoordinate() const {
+    if (empty()) return 0.0;
+    const Vec3 a = glm::max(glm::abs(min), glm::abs(max));
+    return std::max({a.x, a.y, a.z});
+}
+
+void quadAxes(const Vec3& normal, Vec3& uAxis, Vec3& vAxis) {
+    // Project world X onto the plane; if the normal is nearly X, project world Z instead.
+    const Vec3 ref = std::abs(normal.x) > 0.9 ? Vec3(0, 0, 1) : Vec3(1, 0, 0);
+    uAxis = glm::normalize(ref - glm::dot(ref, normal) * normal);
+    vAxis = glm::cross(normal, uAxis);
+}
+
+Bounds boundsOf(const Shape& shape) {
+    Bounds b;
+    if (const auto* s = std::get_if<Sphere>(&shape)) {
+        b.extend(s->center - Vec3(s->radius));
+        b.extend(s->center + Vec3(s->radius));
+    } else if (const auto* q = std::get_if<Quad>(&shape)) {
+        const Vec3 du = 0.5 * q->size.x * q->uAxis;
+        const Vec3 dv = 0.5 * q->size.y * q->vAxis;
+        for (double su : {-1.0, 1.0})
+            for (double sv : {-1.0, 1.0}) b.extend(q->center + su * du + sv * dv);
+    } else if (const auto* box = std::get_if<Box>(&shape)) {
+        b.extend(box->min);
+        b.extend(box->max);
+    } else if (const auto* m = std::get_if<Mesh>(&shape)) {
+        if (m->geometry)
+            for (const Vec3& p : m->geometry->positions) b.extend(p);
+    }
+    return b;
+}
+
+bool Scene::allOpaque() const {
+    for (const Object& o : objects)
+        if (!materialOf(o).opaque()) return false;
+    return true;
+}
+
+Bounds Scene::bounds() const {
+    Bounds b;
+    for (const Object& o : objects) b.extend(boundsOf(o.shape));
+    return b;
+}
+
+}  // namespace shadowlab::scene

@@ -1,0 +1,146 @@
+// scene/scene.h: the validated scene every backend renders; loaded in double precision.
+// Nothing here knows about Vulkan or ray tracing: backends read this and write a Frame.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace shadowlab::scene {
+
+using Vec2 = glm::dvec2;
+using Vec3 = glm::dvec3;
+
+// Pinhole camera, vertical field of view; pixel (x, y) is sampled at its center and row 0 is
+// the top of the image (see camera.h for the shared ray/projection math).
+struct Camera {
+    Vec3 position{0, 2, 6};
+    Vec3 lookAt{0, 0.7, 0};
+    Vec3 up{0, 1, 0};
+    double fovYDegrees = 40.0;
+    int width = 1280;
+    int height = 720;
+    double near = 0.1;
+    double far = 100.0;
+};
+
+struct Material {
+    std::string name;
+    Vec3 albedo{0.8, 0.8, 0.8};
+    // < 1 makes the material semi-transparent to shadow rays: each object a shadow ray
+    // crosses multiplies the light by (1 - opacity) once. The camera never sees through it.
+    double opacity = 1.0;
+    bool opaque() const { return opacity >= 1.0; }
+};
+
+enum class LightType { Directional, Point, Spot };
+
+struct Light {
+    LightType type = LightType::Directional;
+    Vec3 direction{0, -1, 0};  // the way light travels (unit length); directional and spot
+    Vec3 position{0, 0, 0};    // point and spot
+    Vec3 color{1, 1, 1};
+    double intensity = 1.0;
+    double radius = 0.0;           // point/spot: > 0 makes a spherical area light (soft shadows)
+    double coneAngleDegrees = 0.0; // spot: half-angle of the cone
+};
+
+struct Sphere {
+    Vec3 center;
+    double radius = 1.0;
+};
+
+// A rectangle centered at `center` with unit normal `normal`. Its edges run along `uAxis`
+// (size.x) and `vAxis` (size.y); see quadAxes() for how they follow from the normal.
+// Quads are two-sided: they block light and are seen from both sides.
+struct Quad {
+    Vec3 center;
+    Vec3 normal{0, 1, 0};
+    Vec2 size{1, 1};
+    Vec3 uAxis{1, 0, 0};
+    Vec3 vAxis{0, 0, 1};
+};
+
+struct Box {
+    Vec3 min;
+    Vec3 max;
+};
+
+// A triangle mesh already transformed into world space (double precision). Loaded from
+// OBJ/glTF by mesh_loader.h; `normals` is per vertex, computed when the file has none.
+struct TriangleMesh {
+    std::vector<Vec3> positions;
+    std::vector<Vec3> normals;
+    std::vector<std::uint32_t> indices;  // three per triangle
+    std::size_t droppedDegenerate = 0;   // triangles removed on load (zero area / non-finite)
+    std::size_t triangleCount() const { return indices.size() / 3; }
+};
+
+struct Mesh {
+    std::filesystem::path file;  // as resolved against the scene file's folder
+    std::shared_ptr<const TriangleMesh> geometry;
+};
+
+using Shape = std::variant<Sphere, Quad, Box, Mesh>;
+
+struct Object {
+    std::string name;  // "objects[3]" unless the file names it
+    Shape shape;
+    int material = 0;  // index into Scene::materials
+};
+
+// Per-scene defaults for the render settings (the optional "shadow" block). Every field is
+// optional: absent means "use the program's scene-scaled default".
+struct ShadowDefaults {
+    std::optional<int> shadowMapSize;
+    std::optional<double> depthBias;     // world units
+    std::optional<double> slopeBias;     // shadow-map texels
+    std::optional<std::string> filter;   // "none" | "pcf2x2"
+    std::optional<double> rayBias;       // world units; absent: scene-scaled
+    std::optional<bool> robustRayOffset; // "ray_bias": "robust"
+    std::optional<std::string> precision;
+    std::optional<int> samples;
+};
+
+struct Bounds {
+    Vec3 min{std::numeric_limits<double>::infinity()};
+    Vec3 max{-std::numeric_limits<double>::infinity()};
+    bool empty() const { return !(min.x <= max.x); }
+    void extend(const Vec3& p) { min = glm::min(min, p); max = glm::max(max, p); }
+    void extend(const Bounds& b) { if (!b.empty()) { extend(b.min); extend(b.max); } }
+    Vec3 center() const { return 0.5 * (min + max); }
+    Vec3 extent() const { return max - min; }
+    double diagonal() const { return empty() ? 0.0 : glm::length(max - min); }
+    // Largest absolute coordinate: what float rounding of a position scales with.
+    double maxAbsCoordinate() const;
+};
+
+struct Scene {
+    std::filesystem::path file;  // where it was loaded from (for messages and metadata)
+    Camera camera;
+    Vec3 background{0.05, 0.05, 0.08};
+    double ambient = 0.05;
+    std::vector<Material> materials;
+    std::vector<Light> lights;
+    std::vector<Object> objects;
+    ShadowDefaults shadow;
+
+    const Material& materialOf(const Object& o) const { return materials[o.material]; }
+    bool allOpaque() const;
+    Bounds bounds() const;  // of every object
+};
+
+Bounds boundsOf(const Shape& shape);
+// The quad's edge directions: uAxis is world X projected onto the quad's plane, or world Z
+// when the normal is (anti)parallel to X; vAxis = normal × uAxis. Fixed so that both
+// backends and the tests agree on which way `size` runs.
+void quadAxes(const Vec3& normal, Vec3& uAxis, Vec3& vAxis);
+
+}  // namespace shadowlab::scene

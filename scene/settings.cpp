@@ -1,0 +1,119 @@
+// scene/settings.cpp: command line over the scene's "shadow" block over scene-scaled defaults.
+#include "scene/settings.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "scene/error.h"
+
+namespace shadowlab::scene {
+
+namespace {
+
+ShadowFilter parseFilter(const std::string& text, const std::string& where) {
+    if (text == "none") return ShadowFilter::None;
+    if (text == "pcf2x2") return ShadowFilter::Pcf2x2;
+    throw InputError(where + ": expected none|pcf2x2, got '" + text + "'");
+}
+
+Precision parsePrecision(const std::string& text, const std::string& where) {
+    if (text == "float") return Precision::Float;
+    if (text == "double") return Precision::Double;
+    throw InputError(where + ": expected float|double, got '" + text + "'");
+}
+
+}  // namespace
+
+double defaultRayBias(const Scene& scene) {
+    // The lesson's bias (1e-4) was for a scene of unit size. Scale it with the scene's extent,
+    // and never below what float rounding of the coordinates needs (about 2^-23 relative, with
+    // a 16x margin for the arithmetic of a hit point).
+    const Bounds b = scene.bounds();
+    const double extent = std::max(b.diagonal(), 1e-30);
+    return std::max(1e-4 * extent, 16.0 * 1.1920929e-7 * b.maxAbsCoordinate());
+}
+
+double defaultDepthBias(const Scene& scene, int shadowMapSize) {
+    // An orthographic map fitted to the bounding sphere spans its diameter (the bounds'
+    // diagonal): one texel is diagonal / size in world units.
+    return 0.5 * scene.bounds().diagonal() / std::max(shadowMapSize, 1);
+}
+
+RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& o) {
+    RenderSettings s;
+    const ShadowDefaults& d = scene.shadow;
+
+    s.raster.shadowMapSize = o.shadowMapSize.value_or(d.shadowMapSize.value_or(2048));
+    if (s.raster.shadowMapSize < 16 || s.raster.shadowMapSize > 16384)
+        throw InputError("--shadow-map-size: must be in 16..16384, got " +
+                         std::to_string(s.raster.shadowMapSize));
+    // Default bias: half a texel of constant bias and one texel of slope bias.
+    s.raster.depthBias =
+        o.depthBias.value_or(d.depthBias.value_or(defaultDepthBias(scene, s.raster.shadowMapSize)));
+    s.raster.slopeBias = o.slopeBias.value_or(d.slopeBias.value_or(1.0));
+    if (!std::isfinite(s.raster.depthBias) || s.raster.depthBias < 0.0)
+        throw InputError("--depth-bias: must be a finite value >= 0 (world units)");
+    if (!std::isfinite(s.raster.slopeBias) || s.raster.slopeBias < 0.0)
+        throw InputError("--slope-bias: must be a finite value >= 0 (texels)");
+    s.raster.filter = o.filter ? parseFilter(*o.filter, "--filter")
+                               : parseFilter(d.filter.value_or("pcf2x2"), "shadow.filter");
+    s.raster.device = o.device.value_or("");
+    s.raster.validate = o.validate;
+
+    if (o.rayBias) {
+        if (*o.rayBias == "robust") {
+            s.raytrace.robustOffset = true;
+        } else {
+            std::size_t used = 0;
+            double v = 0;
+            try {
+                v = std::stod(*o.rayBias, &used);
+            } catch (const std::exception&) {
+                used = 0;
+            }
+            if (used != o.rayBias->size() || !std::isfinite(v) || v < 0.0)
+                throw InputError("--ray-bias: expected a number >= 0 or 'robust', got '" +
+                                 *o.rayBias + "'");
+            s.raytrace.rayBias = v;
+        }
+    } else if (d.robustRayOffset.value_or(false)) {
+        s.raytrace.robustOffset = true;
+    } else {
+        s.raytrace.rayBias = d.rayBias.value_or(defaultRayBias(scene));
+    }
+    s.raytrace.precision = o.precision ? parsePrecision(*o.precision, "--precision")
+                                       : parsePrecision(d.precision.value_or("float"), "shadow.precision");
+    s.raytrace.samples = o.samples.value_or(d.samples.value_or(16));
+    if (s.raytrace.samples < 1 || s.raytrace.samples > 65536)
+        throw InputError("--samples: must be in 1..65536, got " + std::to_string(s.raytrace.samples));
+    s.raytrace.threads = o.threads.value_or(0);
+    if (s.raytrace.threads < 0 || s.raytrace.threads > 1024)
+        throw InputError("--threads: must be in 0..1024 (0 = all), got " +
+                         std::to_string(s.raytrace.threads));
+    return s;
+}
+
+RaytraceSettings referenceSettings(const RaytraceSettings& base) {
+    RaytraceSettings r = base;
+    r.precision = Precision::Double;
+    r.robustOffset = true;
+    r.rayBias = 0.0;
+    // Area lights: enough samples that the reference's own noise stays below the error it
+    // reports (see docs/decisions.md); point lights need one.
+    r.samples = std::max(base.samples, 256);
+    return r;
+}
+
+const char* toString(ShadowFilter f) { return f == ShadowFilter::None ? "none" : "pcf2x2"; }
+const char* toString(Precision p) { return p == Precision::Float ? "float" : "double"; }
+const char* toString(Backend b) {
+    switch (b) {
+        case Backend::Raster: return "raster";
+        case Backend::Raytrace: return "raytrace";
+        case Backend::Reference: return "reference";
+    }
+    return "?";
+}
+
+}  // namespace shadowlab::scene

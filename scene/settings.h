@@ -1,0 +1,68 @@
+// scene/settings.h: what a user can tune for one render, resolved from the command line,
+// then the scene's "shadow" block, then scene-scaled defaults (resolveSettings()).
+// Biases are in world units or shadow-map texels, never in a driver's depth-bias units.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "scene/scene.h"
+
+namespace shadowlab::scene {
+
+enum class Backend { Raster, Raytrace, Reference };
+enum class ShadowFilter { None, Pcf2x2 };  // nearest texel; hardware 2x2 compare filtering
+enum class Precision { Float, Double };
+
+struct RasterSettings {
+    int shadowMapSize = 2048;   // texels per side
+    double depthBias = 0.0;     // world units along the light direction 
+    double slopeBias = 0.0;     // texels: bias += slopeBias * texelWorldSize * tan(angle to light)
+    ShadowFilter filter = ShadowFilter::Pcf2x2;
+    std::string device;         // "" = lavapipe if present, else the first device; index or name substring
+    bool validate = false;      // enable VK_LAYER_KHRONOS_validation and count its messages
+};
+
+struct RaytraceSettings {
+    double rayBias = 0.0;       // world units along the normal (the lesson's bias)
+    bool robustOffset = false;  // offset by a bound on the hit point's rounding error instead
+    Precision precision = Precision::Float;
+    int samples = 1;            // shadow samples per pixel for area lights
+    int threads = 0;            // 0 = all hardware threads
+};
+
+struct RenderSettings {
+    RasterSettings raster;
+    RaytraceSettings raytrace;
+};
+
+// What the command line asked for; unset fields fall back to the scene's "shadow" block, then
+// to the defaults of resolveSettings().
+struct SettingsOverrides {
+    std::optional<int> shadowMapSize;
+    std::optional<double> depthBias;
+    std::optional<double> slopeBias;
+    std::optional<std::string> filter;
+    std::optional<std::string> rayBias;  // a number or "robust"
+    std::optional<std::string> precision;
+    std::optional<int> samples;
+    std::optional<int> threads;
+    std::optional<std::string> device;
+    bool validate = false;
+};
+
+// Scene-scaled defaults (see docs/decisions.md): the lesson's constant ray bias, and half a
+// shadow-map texel of constant depth bias for a map fitted to the scene's bounding sphere.
+double defaultRayBias(const Scene& scene);
+double defaultDepthBias(const Scene& scene, int shadowMapSize);
+// Throws InputError naming the option (e.g. "--filter: expected none|pcf2x2, got 'x'").
+RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& overrides);
+
+// The reference: the ray tracer in double precision with robust offsets and no tunable bias.
+RaytraceSettings referenceSettings(const RaytraceSettings& base);
+
+const char* toString(ShadowFilter f);
+const char* toString(Precision p);
+const char* toString(Backend b);
+
+}  // namespace shadowlab::scene

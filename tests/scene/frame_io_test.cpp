@@ -1,0 +1,108 @@
+// tests/scene/frame_io_test.cpp: Frames survive an EXR round trip with every AOV and the
+// metadata; PNGs are sRGB-encoded; writes are atomic; bad frames give clear errors.
+#include "scene/frame_io.h"
+
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+
+#include "scene/error.h"
+#include "tests/scene/test_files.h"
+
+namespace shadowlab::scene {
+namespace {
+
+using test::TempDir;
+
+Frame patternFrame(bool withBlocker) {
+    Frame f = Frame::allocate(5, 3, withBlocker);
+    for (std::size_t i = 0; i < f.pixelCount(); ++i) {
+        f.beauty[3 * i] = 0.1f * i;
+        f.beauty[3 * i + 1] = 0.5f;
+        f.beauty[3 * i + 2] = 2.0f;  // EXR is linear float: values above 1 survive
+        f.visibility[i] = (i % 3) / 2.0f;
+        f.objectId[i] = float(i % 4);
+        f.ndotl[i] = -0.25f + 0.1f * i;
+        f.depth[i] = 1000.0f + i;
+        if (withBlocker) f.blockerId[i] = float((i + 1) % 3);
+    }
+    f.attributes["backend"] = "raytrace";
+    f.attributes["ray_bias"] = "0.0001";
+    f.timingsMs = {{"setup", 1.5}, {"primary", 20.25}, {"shadow", 7.0}};
+    return f;
+}
+
+TEST(FrameIo, ExrRoundTripKeepsEveryChannelAttributeAndTimingInOrder) {
+    TempDir dir;
+    for (bool withBlocker : {false, true}) {
+        const Frame f = patternFrame(withBlocker);
+        const auto file = dir.path() / "f.exr";
+        writeFrame(f, file);
+        const Frame g = readFrame(file);
+        ASSERT_EQ(g.width, 5);
+        ASSERT_EQ(g.height, 3);
+        EXPECT_EQ(g.beauty, f.beauty);
+        EXPECT_EQ(g.visibility, f.visibility);
+        EXPECT_EQ(g.objectId, f.objectId);
+        EXPECT_EQ(g.ndotl, f.ndotl);
+        EXPECT_EQ(g.depth, f.depth);
+        EXPECT_EQ(g.blockerId, f.blockerId);
+        EXPECT_EQ(g.attributes.at("backend"), "raytrace");
+        EXPECT_EQ(g.attributes.at("ray_bias"), "0.0001");
+        EXPECT_EQ(g.timingsMs, f.timingsMs);
+        EXPECT_DOUBLE_EQ(g.totalTimeMs(), 28.75);
+    }
+}
+
+TEST(FrameIo, PngIsSrgbEncodedBeauty) {
+    TempDir dir;
+    Frame f = Frame::allocate(2, 1, false);
+    f.beauty = {0.0f, 0.0f, 0.0f, 0.5f, 1.0f, 0.2140f};  // linear 0.2140 is sRGB ~0.5
+    const auto file = dir.path() / "b.png";
+    writeFrame(f, file);
+    auto in = OIIO::ImageInput::open(file.string());
+    ASSERT_TRUE(in);
+    EXPECT_EQ(in->spec().nchannels, 3);
+    unsigned char px[6];
+    ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, px));
+    EXPECT_EQ(px[0], 0);
+    // sRGB(0.5) = 1.055·0.5^(1/2.4) − 0.055 = 0.7354 -> 188
+    EXPECT_EQ(px[3], 188);
+    EXPECT_EQ(px[4], 255);
+    EXPECT_NEAR(px[5], 128, 1);
+}
+
+TEST(FrameIo, WritesLeaveNoTemporaryFilesBehind) {
+    TempDir dir;
+    writeFrame(patternFrame(false), dir.path() / "a.exr");
+    writeFrame(patternFrame(false), dir.path() / "a.exr");  // replaces in place
+    writeTextAtomic(dir.path() / "m.json", "{}\n");
+    EXPECT_EQ(dir.fileCount(), 2u);
+}
+
+TEST(FrameIo, ReadingAnImageWithoutTheAovsNamesTheMissingChannel) {
+    TempDir dir;
+    Frame f = Frame::allocate(2, 2, false);
+    writeFrame(f, dir.path() / "beauty.png");
+    try {
+        readFrame(dir.path() / "beauty.png");
+        FAIL();
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("missing channel 'visibility'"), std::string::npos) << e.what();
+    }
+}
+
+TEST(FrameIo, ReadingGarbageOrNothingGivesAnInputError) {
+    TempDir dir;
+    const auto garbage = dir.write("garbage.exr", "this is not an image at all");
+    EXPECT_THROW(readFrame(garbage), InputError);
+    EXPECT_THROW(readFrame(dir.path() / "absent.exr"), InputError);
+}
+
+TEST(FrameIo, UnknownExtensionIsRejectedAndNothingIsWritten) {
+    TempDir dir;
+    EXPECT_THROW(writeFrame(patternFrame(false), dir.path() / "f.tiff"), InputError);
+    EXPECT_EQ(dir.fileCount(), 0u);
+}
+
+}  // namespace
+}  // namespace shadowlab::scene

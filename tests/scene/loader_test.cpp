@@ -1,0 +1,154 @@
+// tests/scene/loader_test.cpp: the JSON loader accepts the shipped scenes and gives one clear
+// error, with the JSON path, for each kind of bad input.
+#include "scene/loader.h"
+
+#include <gtest/gtest.h>
+
+#include "scene/error.h"
+#include "tests/scene/test_files.h"
+
+namespace shadowlab::scene {
+namespace {
+
+using test::TempDir;
+
+// A valid scene; each bad case below replaces one piece of it.
+const std::string kCamera =
+    R"("camera": {"position": [0, 2, 6], "look_at": [0, 0.7, 0], "fov_y": 40, "resolution": [64, 36]})";
+const std::string kMaterials = R"("materials": {"matte": {"albedo": [0.8, 0.8, 0.8]}})";
+const std::string kLights = R"("lights": [{"type": "directional", "direction": [-1, -2, -1]}])";
+const std::string kObjects =
+    R"("objects": [{"type": "sphere", "center": [0, 1, 0], "radius": 1, "material": "matte"},
+                   {"type": "quad", "center": [0, 0, 0], "normal": [0, 1, 0], "size": [20, 20], "material": "matte"}])";
+
+std::string sceneText(const std::string& camera = kCamera, const std::string& materials = kMaterials,
+                      const std::string& lights = kLights, const std::string& objects = kObjects,
+                      const std::string& extra = "") {
+    return "{" + camera + ",\n" + materials + ",\n" + lights + ",\n" + objects + extra + "}";
+}
+
+TEST(SceneLoader, LoadsAValidSceneWithEveryValueInPlace) {
+    TempDir dir;
+    const Scene s = loadScene(dir.write("ok.json", sceneText()));
+    EXPECT_EQ(s.camera.width, 64);
+    EXPECT_EQ(s.camera.height, 36);
+    ASSERT_EQ(s.lights.size(), 1u);
+    // Directions are normalized on load: (-1,-2,-1)/sqrt(6).
+    EXPECT_NEAR(s.lights[0].direction.y, -2.0 / std::sqrt(6.0), 1e-15);
+    ASSERT_EQ(s.objects.size(), 2u);
+    EXPECT_DOUBLE_EQ(std::get<Sphere>(s.objects[0].shape).radius, 1.0);
+    const Bounds b = s.bounds();
+    EXPECT_DOUBLE_EQ(b.min.x, -10.0);
+    EXPECT_DOUBLE_EQ(b.max.y, 2.0);
+    EXPECT_TRUE(s.allOpaque());
+}
+
+TEST(SceneLoader, LoadsEveryShippedScene) {
+    std::size_t count = 0;
+    for (const auto& e : std::filesystem::recursive_directory_iterator(scenesDirectory())) {
+        if (e.path().extension() != ".json") continue;
+        SCOPED_TRACE(e.path().string());
+        EXPECT_NO_THROW(loadScene(e.path()));
+        ++count;
+    }
+    EXPECT_GE(count, 1u);
+}
+
+TEST(SceneLoader, FindsShippedScenesByNameAndListsThemWhenNoneMatches) {
+    EXPECT_EQ(findScene("seed").filename(), "seed.json");
+    try {
+        findScene("no-such-scene");
+        FAIL() << "expected an error";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("seed"), std::string::npos) << e.what();
+    }
+}
+
+struct BadCase {
+    const char* name;
+    std::string text;
+    std::string path;      // expected JSON path in the error ("" when none)
+    std::string mentions;  // a phrase the message must contain
+};
+
+class BadScene : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(BadScene, GivesOneErrorNamingFileAndPath) {
+    const BadCase& c = GetParam();
+    TempDir dir;
+    const auto file = dir.write(std::string(c.name) + ".json", c.text);
+    try {
+        loadScene(file);
+        FAIL() << "loaded a bad scene: " << c.name;
+    } catch (const SceneError& e) {
+        const std::string what = e.what();
+        EXPECT_EQ(e.jsonPath(), c.path) << what;
+        EXPECT_NE(what.find(file.string()), std::string::npos) << what;
+        EXPECT_NE(what.find(c.mentions), std::string::npos) << what;
+    }
+}
+
+std::string withObjects(const std::string& objects) { return sceneText(kCamera, kMaterials, kLights, "\"objects\": " + objects); }
+std::string withLights(const std::string& lights) { return sceneText(kCamera, kMaterials, lights, kObjects); }
+std::string withCamera(const std::string& camera) { return sceneText(camera, kMaterials, kLights, kObjects); }
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, BadScene,
+    ::testing::Values(
+        BadCase{"syntax", R"({"camera": {"position": [0, 2, 6],, }})", "", "invalid JSON near line 1"},
+        BadCase{"truncated", sceneText().substr(0, 80), "", "invalid JSON"},
+        BadCase{"not_an_object", "[1, 2, 3]", "", "expected an object"},
+        BadCase{"unknown_top_key", sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "lightz": [])"),
+                "lightz", "unknown key"},
+        BadCase{"unknown_key_suggests", withObjects(R"([{"type": "sphere", "center": [0,1,0], "radus": 1, "material": "matte"}])"),
+                "objects[0].radus", "did you mean 'radius'"},
+        BadCase{"wrong_type", withObjects(R"([{"type": "sphere", "center": [0,1,0], "radius": "one", "material": "matte"}])"),
+                "objects[0].radius", "expected a number, got a string"},
+        BadCase{"infinite", withObjects(R"([{"type": "sphere", "center": [0,1e999,0], "radius": 1, "material": "matte"}])"),
+                "", "number overflow parsing '1e999'"},
+        BadCase{"nan_token", withObjects(R"([{"type": "sphere", "center": [0,NaN,0], "radius": 1, "material": "matte"}])"),
+                "", "invalid JSON"},
+        BadCase{"zero_direction", withLights(R"("lights": [{"type": "directional", "direction": [0, 0, 0]}])"),
+                "lights[0].direction", "non-zero direction"},
+        BadCase{"negative_radius", withObjects(R"([{"type": "sphere", "center": [0,1,0], "radius": -1, "material": "matte"}])"),
+                "objects[0].radius", "must be > 0"},
+        BadCase{"zero_quad_size", withObjects(R"([{"type": "quad", "center": [0,0,0], "normal": [0,1,0], "size": [20, 0], "material": "matte"}])"),
+                "objects[0].size[1]", "must be > 0"},
+        BadCase{"inverted_box", withObjects(R"([{"type": "box", "min": [0,0,0], "max": [1,-1,1], "material": "matte"}])"),
+                "objects[0].max", "greater than min"},
+        BadCase{"missing_material", withObjects(R"([{"type": "sphere", "center": [0,1,0], "radius": 1, "material": "gold"}])"),
+                "objects[0].material", "no material named 'gold'"},
+        BadCase{"absurd_resolution", withCamera(R"("camera": {"position": [0,2,6], "look_at": [0,0,0], "resolution": [100000, 100000]})"),
+                "camera.resolution[0]", "must be in 1..16384"},
+        BadCase{"zero_resolution", withCamera(R"("camera": {"position": [0,2,6], "look_at": [0,0,0], "resolution": [0, 10]})"),
+                "camera.resolution[0]", "must be in 1..16384"},
+        BadCase{"missing_mesh_file", withObjects(R"([{"type": "mesh", "file": "nowhere.obj", "material": "matte"}])"),
+                "objects[0].file", "no such file"},
+        BadCase{"unknown_object_type", withObjects(R"([{"type": "torus", "material": "matte"}])"),
+                "objects[0].type", "unknown object type 'torus'"},
+        BadCase{"unknown_light_type", withLights(R"("lights": [{"type": "laser", "direction": [0, -1, 0]}])"),
+                "lights[0].type", "unknown light type"},
+        BadCase{"no_lights", withLights(R"("lights": [])"), "lights", "at least one light"},
+        BadCase{"missing_camera", "{" + kMaterials + "," + kLights + "," + kObjects + "}", "camera", "is required"},
+        BadCase{"camera_at_target", withCamera(R"("camera": {"position": [1,1,1], "look_at": [1,1,1]})"),
+                "camera.look_at", "must differ"},
+        BadCase{"fov_out_of_range", withCamera(R"("camera": {"position": [0,2,6], "look_at": [0,0,0], "fov_y": 180})"),
+                "camera.fov_y", "(0, 180)"},
+        BadCase{"far_before_near", withCamera(R"("camera": {"position": [0,2,6], "look_at": [0,0,0], "near": 5, "far": 1})"),
+                "camera.far", "greater than near"},
+        BadCase{"opacity_out_of_range", sceneText(kCamera, R"("materials": {"matte": {"opacity": 1.5}})"),
+                "materials.matte.opacity", "must be in 0..1"},
+        BadCase{"spot_without_cone", withLights(R"("lights": [{"type": "spot", "position": [0,5,0], "direction": [0,-1,0]}])"),
+                "lights[0].cone_angle", "is required"},
+        BadCase{"bad_shadow_filter", sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"filter": "blur"})"),
+                "shadow.filter", "expected none or pcf2x2"}),
+    [](const ::testing::TestParamInfo<BadCase>& info) { return std::string(info.param.name); });
+
+TEST(SceneLoader, RejectsAMissingFileAndAFolder) {
+    TempDir dir;
+    EXPECT_THROW(loadScene(dir.path() / "absent.json"), SceneError);
+    EXPECT_THROW(loadScene(dir.path()), SceneError);
+}
+
+}  // namespace
+}  // namespace shadowlab::scene

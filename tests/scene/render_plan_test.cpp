@@ -1,0 +1,66 @@
+// tests/scene/render_plan_test.cpp: the plan leaves out what the scene does not need.
+#include "scene/render_plan.h"
+
+#include <gtest/gtest.h>
+
+namespace shadowlab::scene {
+namespace {
+
+Scene sphereOnPlane() {
+    Scene s;
+    s.materials.push_back({"m"});
+    s.lights.push_back({});
+    s.objects.push_back({"ball", Sphere{{0, 1, 0}, 1.0}, 0});
+    Quad q;
+    q.size = {20, 20};
+    s.objects.push_back({"ground", q, 0});
+    return s;
+}
+
+TEST(RenderPlan, OpaqueAnalyticSceneUsesAnyHitAndNoTriangleBvh) {
+    const RenderPlan p = makeRenderPlan(sphereOnPlane(), {});
+    EXPECT_TRUE(p.anyHitShadowRays);
+    EXPECT_FALSE(p.needsTriangleBvh);
+    EXPECT_FALSE(p.needsCubeMap);
+    EXPECT_FALSE(p.needsTransmittanceMap);
+    ASSERT_EQ(p.lights.size(), 1u);
+    EXPECT_TRUE(p.lights[0].needsShadowTest);
+    EXPECT_NE(p.explain().find("any-hit"), std::string::npos);
+}
+
+TEST(RenderPlan, SemiTransparentMaterialTurnsAnyHitOff) {
+    Scene s = sphereOnPlane();
+    s.materials.push_back({"glass", {0.9, 0.9, 0.9}, 0.3});
+    s.objects[0].material = 1;
+    const RenderPlan p = makeRenderPlan(s, {});
+    EXPECT_FALSE(p.anyHitShadowRays);
+    EXPECT_TRUE(p.needsTransmittanceMap);
+}
+
+TEST(RenderPlan, ASingleConvexObjectNeedsNoShadowPass) {
+    Scene s = sphereOnPlane();
+    s.objects.pop_back();
+    const RenderPlan p = makeRenderPlan(s, {});
+    EXPECT_FALSE(p.lights[0].needsShadowTest);
+    EXPECT_NE(p.explain().find("skipped"), std::string::npos);
+}
+
+TEST(RenderPlan, CubeMapOnlyForAShadowedPointLight) {
+    Scene s = sphereOnPlane();
+    Light point;
+    point.type = LightType::Point;
+    point.position = {0, 5, 0};
+    s.lights.push_back(point);
+    EXPECT_TRUE(makeRenderPlan(s, {}).needsCubeMap);
+    s.objects.pop_back();
+    EXPECT_FALSE(makeRenderPlan(s, {}).needsCubeMap);
+}
+
+TEST(RenderPlan, MeshesNeedTheTriangleBvh) {
+    Scene s = sphereOnPlane();
+    s.objects.push_back({"mesh", Mesh{}, 0});
+    EXPECT_TRUE(makeRenderPlan(s, {}).needsTriangleBvh);
+}
+
+}  // namespace
+}  // namespace shadowlab::scene

@@ -1,0 +1,84 @@
+// tests/scene/settings_test.cpp: command line over the scene's "shadow" block over defaults,
+// scene-scaled defaults, and clear errors for bad values.
+#include "scene/settings.h"
+
+#include <gtest/gtest.h>
+
+#include "scene/error.h"
+
+namespace shadowlab::scene {
+namespace {
+
+Scene unitScene(double scale) {
+    Scene s;
+    s.materials.push_back({"m"});
+    s.objects.push_back({"ball", Sphere{{0, scale, 0}, scale}, 0});
+    return s;
+}
+
+TEST(Settings, DefaultRayBiasScalesWithTheScene) {
+    // Bounds of a sphere of radius r: a cube of side 2r, diagonal 2r·sqrt(3).
+    const double small = defaultRayBias(unitScene(1e-3));
+    const double large = defaultRayBias(unitScene(1e4));
+    EXPECT_NEAR(small, 1e-4 * 2e-3 * std::sqrt(3.0), 1e-12);
+    EXPECT_NEAR(large / small, 1e7, 1e-3);
+}
+
+TEST(Settings, DefaultRayBiasCoversFloatRoundingFarFromTheOrigin) {
+    Scene s = unitScene(1.0);
+    std::get<Sphere>(s.objects[0].shape).center = {1e7, 0, 0};
+    // A unit sphere 1e7 away: float spacing there is 1e7·2^-23 ≈ 1.19, far above 1e-4·extent.
+    EXPECT_GT(defaultRayBias(s), 1e7 * 1.1920929e-7);
+}
+
+TEST(Settings, CommandLineBeatsTheSceneWhichBeatsTheDefault) {
+    Scene s = unitScene(1.0);
+    s.shadow.shadowMapSize = 512;
+    s.shadow.filter = "none";
+    SettingsOverrides o;
+    RenderSettings r = resolveSettings(s, o);
+    EXPECT_EQ(r.raster.shadowMapSize, 512);
+    EXPECT_EQ(r.raster.filter, ShadowFilter::None);
+    EXPECT_NEAR(r.raster.depthBias, 0.5 * 2 * std::sqrt(3.0) / 512, 1e-15);  // half a texel
+    o.shadowMapSize = 1024;
+    o.rayBias = "robust";
+    r = resolveSettings(s, o);
+    EXPECT_EQ(r.raster.shadowMapSize, 1024);
+    EXPECT_TRUE(r.raytrace.robustOffset);
+}
+
+TEST(Settings, BadValuesNameTheOption) {
+    const Scene s = unitScene(1.0);
+    auto expectError = [&](SettingsOverrides o, const std::string& option) {
+        try {
+            resolveSettings(s, o);
+            FAIL() << option;
+        } catch (const InputError& e) {
+            EXPECT_EQ(std::string(e.what()).rfind(option, 0), 0u) << e.what();
+        }
+    };
+    SettingsOverrides o;
+    o.shadowMapSize = -4; expectError(o, "--shadow-map-size"); o = {};
+    o.shadowMapSize = 1 << 20; expectError(o, "--shadow-map-size"); o = {};
+    o.rayBias = "tiny"; expectError(o, "--ray-bias"); o = {};
+    o.rayBias = "-1"; expectError(o, "--ray-bias"); o = {};
+    o.rayBias = "1e-3x"; expectError(o, "--ray-bias"); o = {};
+    o.filter = "gauss"; expectError(o, "--filter"); o = {};
+    o.precision = "half"; expectError(o, "--precision"); o = {};
+    o.depthBias = -1.0; expectError(o, "--depth-bias"); o = {};
+    o.samples = 0; expectError(o, "--samples"); o = {};
+    o.threads = -2; expectError(o, "--threads");
+}
+
+TEST(Settings, ReferenceIsDoubleRobustAndUnbiased) {
+    RaytraceSettings base;
+    base.rayBias = 0.5;
+    base.precision = Precision::Float;
+    const RaytraceSettings r = referenceSettings(base);
+    EXPECT_EQ(r.precision, Precision::Double);
+    EXPECT_TRUE(r.robustOffset);
+    EXPECT_EQ(r.rayBias, 0.0);
+}
+
+}  // namespace
+}  // namespace shadowlab::scene
