@@ -11,7 +11,10 @@
 namespace shadowlab::scene {
 
 enum class Backend { Raster, Raytrace, Reference };
-enum class ShadowFilter { None, Pcf2x2 };  // nearest texel; hardware 2x2 compare filtering
+// none: nearest texel; pcf2x2: bilinear 2x2 compare filtering; pcf: mean of pcfSize x pcfSize
+// compare taps one texel apart; poisson: 16 compare taps on a per-pixel rotated Poisson disk of
+// diameter pcfSize texels (raster/ implements them; see docs/raster.md).
+enum class ShadowFilter { None, Pcf2x2, Pcf, Poisson };
 enum class Precision { Float, Double };
 
 struct RasterSettings {
@@ -19,6 +22,9 @@ struct RasterSettings {
     double depthBias = 0.0;     // world units along the light direction 
     double slopeBias = 0.0;     // texels: bias += slopeBias * texelWorldSize * tan(angle to light)
     ShadowFilter filter = ShadowFilter::Pcf2x2;
+    int pcfSize = 3;            // pcf: taps per side; poisson: kernel diameter in texels (1..15)
+    double normalOffset = 0.0;  // texels: the receiver moves along its normal by this x texel world size
+    bool fitLightFrustum = false;  // fit each light's map to the casters of visible receivers (else the scene's bounding sphere)
     std::string device;         // "" = lavapipe if present, else the first device; index or name substring
     bool validate = false;      // enable VK_LAYER_KHRONOS_validation and count its messages
 };
@@ -43,6 +49,9 @@ struct SettingsOverrides {
     std::optional<double> depthBias;
     std::optional<double> slopeBias;
     std::optional<std::string> filter;
+    std::optional<int> pcfSize;          // --pcf-size
+    std::optional<double> normalOffset;  // --normal-offset (texels)
+    std::optional<bool> fitLightFrustum; // --fit-light-frustum
     std::optional<std::string> rayBias;  // a number or "robust"
     std::optional<std::string> precision;
     std::optional<int> samples;

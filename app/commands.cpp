@@ -1,0 +1,301 @@
+// app/commands.cpp: what each subcommand does, in terms of the libraries. Inputs are loaded and
+// validated completely before anything is written, so bad input leaves no file behind.
+#include "app/commands.h"
+
+#include <algorithm>
+#include <chrono>
+#include <functional>
+#include <cstdio>
+#include <iostream>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include "compare/compare.h"
+#include "compare/report.h"
+#include "compare/sweep.h"
+#include "compare/sweep_report.h"
+#include "raster/renderer.h"
+#include "raytrace/renderer.h"
+#include "scene/error.h"
+#include "scene/frame_io.h"
+#include "scene/loader.h"
+#include "scene/render_plan.h"
+
+namespace shadowlab::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+// A scene ready to render: loaded, validated, settings resolved, plan made.
+struct Prepared {
+    scene::Scene scene;
+    scene::RenderSettings settings;
+    scene::RenderPlan plan;
+};
+
+void applyResolution(scene::Scene& s, const std::string& text) {
+    int w = 0, h = 0;
+    char x = 0, extra = 0;
+    if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X'))
+        throw scene::InputError("--resolution: expected WxH (e.g. 640x360), got '" + text + "'");
+    if (w < 1 || h < 1 || w > scene::kMaxResolution || h > scene::kMaxResolution ||
+        static_cast<long long>(w) * h > scene::kMaxPixels)
+        throw scene::InputError("--resolution: " + text + " is outside 1x1.." +
+                                std::to_string(scene::kMaxResolution) + " per side and " +
+                                std::to_string(scene::kMaxPixels) + " pixels in all");
+    s.camera.width = w;
+    s.camera.height = h;
+}
+
+Prepared prepare(const SceneOptions& o) {
+    Prepared p{scene::loadScene(scene::findScene(o.scene)), {}, {}};
+    if (o.resolution) applyResolution(p.scene, *o.resolution);
+    p.settings = scene::resolveSettings(p.scene, o.settings);
+    p.plan = scene::makeRenderPlan(p.scene, p.settings);
+    if (o.explain) std::cerr << "render plan for " << p.scene.file.string() << ":\n" << p.plan.explain();
+    return p;
+}
+
+// Progress on stderr: long work says what it is doing and how long it took.
+class Stage {
+public:
+    explicit Stage(std::string what) : what_(std::move(what)), start_(Clock::now()) {
+        std::cerr << "shadowlab: " << what_ << " ..." << std::flush;
+        if (!isatty(STDERR_FILENO)) std::cerr << "\n";
+    }
+    void done(const std::string& note = "") {
+        const double s = std::chrono::duration<double>(Clock::now() - start_).count();
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "%.2f s", s);
+        if (isatty(STDERR_FILENO)) std::cerr << " " << buf;
+        else std::cerr << "shadowlab: " << what_ << ": " << buf;
+        std::cerr << (note.empty() ? "" : ", " + note) << "\n";
+    }
+
+private:
+    std::string what_;
+    Clock::time_point start_;
+};
+
+void checkValidation(const scene::Frame& frame, const scene::RasterSettings& settings) {
+    if (!settings.validate) return;
+    const auto it = frame.attributes.find("validation_messages");
+    if (it == frame.attributes.end() || it->second != "0")
+        throw std::runtime_error("the Vulkan validation layer reported " +
+                                 (it == frame.attributes.end() ? std::string("an unknown number of") : it->second) +
+                                 " message(s) (printed above)");
+}
+
+scene::Frame renderBackend(const Prepared& p, const std::string& backend) {
+    scene::Frame f;
+    if (backend == "raster") {
+        f = raster::render(p.scene, p.plan, p.settings.raster);
+        checkValidation(f, p.settings.raster);
+    } else if (backend == "raytrace") {
+        f = raytrace::render(p.scene, p.plan, p.settings.raytrace);
+    } else {
+        f = raytrace::renderReference(p.scene, p.plan, p.settings.raytrace);
+    }
+    f.attributes["scene"] = p.scene.file.string();
+    f.attributes["version"] = SHADOWLAB_VERSION;
+    return f;
+}
+
+Json timingsJson(const scene::Frame& f) {
+    Json t = Json::object();
+    for (const auto& [stage, ms] : f.timingsMs) t[stage] = ms;
+    t["total"] = f.totalTimeMs();
+    return t;
+}
+
+// Sweep progress: a bar with ETA on a terminal, one plain line per configuration otherwise.
+std::function<void(const compare::SweepProgress&)> sweepProgressPrinter() {
+    const bool tty = isatty(STDERR_FILENO);
+    return [tty](const compare::SweepProgress& pr) {
+        const std::string what = pr.row ? pr.row->config.label() : "";
+        const std::string outcome = pr.row && !pr.row->error.empty() ? "failed: " + pr.row->error
+                                    : pr.row ? "mismatch " + std::to_string(100.0 * pr.row->rate("mismatch_rate")).substr(0, 5) + "%"
+                                             : "";
+        const int eta = int(pr.etaSeconds + 0.5);
+        char line[512];
+        std::snprintf(line, sizeof line, "[%zu/%zu] %s: %s, ETA %dm%02ds", pr.done, pr.total, what.c_str(),
+                      outcome.c_str(), eta / 60, eta % 60);
+        if (tty) {
+            const int width = 24;
+            const int filled = int(width * double(pr.done) / double(std::max<std::size_t>(pr.total, 1)));
+            std::cerr << "\r\033[K[" << std::string(filled, '#') << std::string(width - filled, '.') << "] " << line
+                      << (pr.done == pr.total ? "\n" : "") << std::flush;
+        } else {
+            std::cerr << "shadowlab: sweep " << line << "\n";
+        }
+    };
+}
+
+}  // namespace
+
+int render(const RenderOptions& o) {
+    std::string ext = o.output.extension().string();
+    if (ext != ".exr" && ext != ".png")
+        throw scene::InputError(o.output.string() + ": unknown output type '" + ext + "' (use .exr or .png)");
+    const Prepared p = prepare(o.common);
+    // Only once the input is known to be good may the output's folder be created.
+    if (o.output.has_parent_path()) fs::create_directories(o.output.parent_path());
+    Stage stage("rendering " + p.scene.file.filename().string() + " with " + o.backend);
+    const scene::Frame frame = renderBackend(p, o.backend);
+    scene::writeFrame(frame, o.output);
+    stage.done(std::to_string(frame.width) + "x" + std::to_string(frame.height) + " -> " + o.output.string());
+    if (o.common.json) {
+        Json j = {{"backend", o.backend}, {"output", o.output.string()}, {"timings_ms", timingsJson(frame)},
+                  {"attributes", frame.attributes}};
+        std::cout << j.dump(2) << "\n";
+    }
+    return 0;
+}
+
+int compareFiles(const CompareOptions& o) {
+    if (o.output.extension() != ".png")
+        throw scene::InputError(o.output.string() + ": the difference image must be a .png");
+    const scene::Frame method = scene::readFrame(o.method);
+    const scene::Frame reference = scene::readFrame(o.reference);
+    const compare::Comparison c = compare::compareFrames(method, reference);
+    scene::writePngDisplay(o.output, c.width, c.height, c.diffRgb);
+    if (o.json)
+        std::cout << compare::toJson(c.metrics).dump(2) << "\n";
+    else
+        std::cout << compare::summaryLine(c.metrics) << "\n";
+    return 0;
+}
+
+int info(bool validate) {
+    std::cout << "shadowlab " << SHADOWLAB_VERSION << "\n";
+    std::cout << "scenes: " << scene::scenesDirectory().string() << "\n";
+    std::cout << raster::describeDevices(validate);
+    return 0;
+}
+
+int run(const RunOptions& o) {
+    const Prepared p = prepare(o.common);
+    fs::create_directories(o.outputDir);
+    const fs::path dir = o.outputDir;
+    int status = 0;
+
+    Json metrics = {{"scene", p.scene.file.string()},
+                    {"resolution", {p.scene.camera.width, p.scene.camera.height}},
+                    {"version", SHADOWLAB_VERSION}};
+    compare::ReportInput report;
+    report.sceneName = p.scene.file.stem().string();
+    report.scenePath = p.scene.file.string();
+    report.planText = p.plan.explain();
+    for (const scene::Object& object : p.scene.objects) report.objectNames.push_back(object.name);
+
+    Stage refStage("reference (double precision, robust offsets)");
+    const scene::Frame reference = renderBackend(p, "reference");
+    scene::writeFrame(reference, dir / "reference.exr");
+    scene::writePngLinear(dir / "reference.png", reference.width, reference.height, reference.beauty);
+    refStage.done();
+    metrics["reference"] = {{"timings_ms", timingsJson(reference)}, {"attributes", reference.attributes}};
+    report.reference = {"reference", "reference.png", reference};
+
+    for (const std::string backend : {"raytrace", "raster"}) {
+        if (backend == "raster" && o.skipRaster) continue;
+        Stage stage(backend == "raster" ? "raster (Vulkan shadow map)" : "raytrace (shadow rays)");
+        scene::Frame frame;
+        try {
+            frame = renderBackend(p, backend);
+        } catch (const std::exception& e) {
+            // One backend failing (no Vulkan driver, say) must not lose the other's results.
+            std::cerr << "\nshadowlab: error: " << backend << " backend failed: " << e.what() << "\n";
+            metrics["methods"][backend] = {{"error", e.what()}};
+            report.failures.push_back({backend, e.what()});
+            status = 1;
+            continue;
+        }
+        scene::writeFrame(frame, dir / (backend + ".exr"));
+        scene::writePngLinear(dir / (backend + ".png"), frame.width, frame.height, frame.beauty);
+        const compare::Comparison c = compare::compareFrames(frame, reference);
+        scene::writePngDisplay(dir / ("diff-" + backend + ".png"), c.width, c.height, c.diffRgb);
+        stage.done(compare::summaryLine(c.metrics));
+        metrics["methods"][backend] = {{"metrics", compare::toJson(c.metrics)},
+                                       {"timings_ms", timingsJson(frame)},
+                                       {"attributes", frame.attributes}};
+        report.methods.push_back({backend, backend + ".png", "diff-" + backend + ".png", frame, c.metrics});
+    }
+
+    if (!o.skipSweep) {
+        // A small sweep at half resolution puts error against run time and the bias windows into
+        // the report. It starts fresh: rows of an earlier build must not mix with this one's.
+        compare::SweepGrid grid = compare::defaultGrid(p.scene, true);
+        grid.resolution = std::to_string(std::max(16, p.scene.camera.width / 2)) + "x" +
+                          std::to_string(std::max(16, p.scene.camera.height / 2));
+        for (compare::SweepConfig& c : grid.configs) {
+            if (o.skipRaster && c.backend == "raster") c.backend.clear();
+            c.overrides.threads = o.common.settings.threads;
+            c.overrides.device = o.common.settings.device;
+            c.overrides.validate = o.common.settings.validate;
+        }
+        std::erase_if(grid.configs, [](const compare::SweepConfig& c) { return c.backend.empty(); });
+        fs::remove_all(dir / "sweep");
+        compare::SweepOptions options;
+        options.outputDir = dir / "sweep";
+        options.progress = sweepProgressPrinter();
+        Stage stage("quick sweep of " + std::to_string(grid.configs.size()) + " configurations at " + *grid.resolution);
+        const compare::SweepResult result = compare::runSweep(p.scene, grid, options);
+        const compare::SweepReportInput input =
+            compare::makeSweepReportInput(report.sceneName, report.scenePath, result);
+        compare::writeSweepReport(dir / "sweep", input);
+        report.sweep = compare::summarizeSweep(input, "sweep/report.html");
+        stage.done("sweep/report.html");
+        metrics["sweep"] = {{"configurations", result.rows.size()}, {"report", "sweep/report.html"},
+                            {"results", "sweep/results.csv"}};
+    }
+
+    scene::writeTextAtomic(dir / "metrics.json", metrics.dump(2) + "\n");
+    compare::writeReport(dir, report);
+    std::cerr << "shadowlab: wrote " << (dir / "report.html").string() << "\n";
+    if (o.common.json) std::cout << metrics.dump(2) << "\n";
+    return status;
+}
+
+int sweep(const SweepOptions& o) {
+    const Prepared p = prepare(o.common);
+    compare::SweepGrid grid = o.grid ? compare::loadGrid(*o.grid, p.scene) : compare::defaultGrid(p.scene, o.quick);
+    if (o.repetitions) grid.repetitions = *o.repetitions;
+    if (o.common.resolution) grid.resolution = o.common.resolution;
+    // Settings given on the command line apply to every configuration that does not vary them.
+    const scene::SettingsOverrides& base = o.common.settings;
+    for (compare::SweepConfig& c : grid.configs) {
+        auto& v = c.overrides;
+        if (!v.shadowMapSize) v.shadowMapSize = base.shadowMapSize;
+        if (!v.depthBias) v.depthBias = base.depthBias;
+        if (!v.slopeBias) v.slopeBias = base.slopeBias;
+        if (!v.filter) v.filter = base.filter;
+        if (!v.rayBias) v.rayBias = base.rayBias;
+        if (!v.precision) v.precision = base.precision;
+        if (!v.samples) v.samples = base.samples;
+        v.threads = base.threads;
+        v.device = base.device;
+        v.validate = base.validate;
+    }
+
+    compare::SweepOptions options;
+    options.outputDir = o.outputDir;
+    options.resume = o.resume;
+    options.progress = sweepProgressPrinter();
+    std::cerr << "shadowlab: sweep of " << grid.configs.size() << " configurations, " << grid.repetitions
+              << " timed frames each, into " << o.outputDir.string() << "\n";
+    const compare::SweepResult result = compare::runSweep(p.scene, grid, options);
+    compare::writeSweepReport(o.outputDir, compare::makeSweepReportInput(p.scene.file.stem().string(),
+                                                                         p.scene.file.string(), result));
+    std::size_t failed = 0;
+    for (const auto& r : result.rows) failed += r.error.empty() ? 0 : 1;
+    std::cerr << "shadowlab: wrote " << (o.outputDir / "report.html").string() << ", results.csv and results.json ("
+              << result.rows.size() << " rows" << (failed ? ", " + std::to_string(failed) + " failed" : "") << ")\n";
+    if (o.common.json) std::cout << compare::rowsToJson(result.rows).dump(2) << "\n";
+    return failed ? 1 : 0;
+}
+
+}  // namespace shadowlab::app

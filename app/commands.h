@@ -1,0 +1,57 @@
+// app/commands.h: the subcommands of `shadowlab`, each taking its parsed options. They call the
+// libraries and throw on failure; main.cpp maps exceptions to messages and exit codes.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "scene/settings.h"
+
+namespace shadowlab::app {
+
+// Options every rendering command shares.
+struct SceneOptions {
+    std::string scene;                    // path or shipped name
+    std::optional<std::string> resolution;  // "WxH" overrides the scene's camera
+    scene::SettingsOverrides settings;
+    bool explain = false;                 // print the RenderPlan before rendering
+    bool json = false;                    // machine-readable results on stdout
+};
+
+struct RenderOptions {
+    SceneOptions common;
+    std::string backend = "raytrace";
+    std::filesystem::path output;
+};
+
+struct RunOptions {
+    SceneOptions common;
+    std::filesystem::path outputDir;
+    bool skipRaster = false;
+    bool skipSweep = false;
+};
+
+struct SweepOptions {
+    SceneOptions common;
+    std::filesystem::path outputDir;
+    std::optional<std::filesystem::path> grid;  // JSON grid file; default grid otherwise
+    bool resume = false;
+    bool quick = false;
+    std::optional<int> repetitions;
+};
+
+struct CompareOptions {
+    std::filesystem::path method;
+    std::filesystem::path reference;
+    std::filesystem::path output;
+    bool json = false;
+};
+
+int render(const RenderOptions& options);
+int run(const RunOptions& options);
+int compareFiles(const CompareOptions& options);
+int info(bool validate);
+int sweep(const SweepOptions& options);
+
+}  // namespace shadowlab::app

@@ -1,0 +1,411 @@
+// bench/raytrace_bench.cpp: our float tracer against Embree 3 on the same rays: primary rays
+// (closest hit, one per pixel center) and shadow rays (any hit, toward a directional light,
+// from the primary hits). Scenes: the seed scene (analytic sphere + quad; Embree uses its
+// sphere-point and quad primitives), Sponza (triangles) when the file is present, and a
+// generated terrain of about one million triangles (hills under a low sun, long shadows).
+// Prints Google Benchmark's table, then Mrays/s and the ratio ours / Embree per case.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "raytrace/shadow_ray.h"
+#include "raytrace/tracer.h"
+#include "scene/camera.h"
+#include "scene/loader.h"
+#include "scene/mesh_loader.h"
+
+#ifdef SHADOWLAB_HAVE_EMBREE
+#include <embree3/rtcore.h>
+#endif
+
+namespace {
+
+using namespace shadowlab;
+using Real = float;
+using V = raytrace::Vec3T<Real>;
+
+// Where Sponza is looked for; the environment variable SHADOWLAB_SPONZA overrides it.
+const char* kDefaultSponzaPath = "/work/shared/scenes/Sponza/Sponza.gltf";
+constexpr int kWidth = 1280, kHeight = 720;
+constexpr std::size_t kBlock = 1024;  // rays per parallel task, same for both tracers
+
+struct Workload {
+    std::string name;
+    scene::Scene scene;
+    std::unique_ptr<raytrace::Tracer<Real>> tracer;
+    double ourSetupMs = 0;
+    std::vector<raytrace::Ray<Real>> primary;
+    std::vector<raytrace::Ray<Real>> shadow;  // origins offset by the robust bound
+#ifdef SHADOWLAB_HAVE_EMBREE
+    RTCDevice device = nullptr;
+    RTCScene embree = nullptr;
+    double embreeSetupMs = 0;
+#endif
+};
+
+// A height field of kTerrainCells² quads (two triangles each) over [−50, 50]², with smooth
+// hills and sharp ridges so that shadow rays cross much of the terrain before they leave it.
+constexpr int kTerrainCells = 708;  // 2·708² = 1,002,528 triangles
+scene::Scene terrainScene() {
+    auto mesh = std::make_shared<scene::TriangleMesh>();
+    const int n = kTerrainCells + 1;
+    auto height = [](double x, double z) {
+        return 3.0 * std::sin(0.11 * x) * std::cos(0.13 * z) + 1.5 * std::sin(0.37 * x + 0.5 * z) +
+               4.0 * std::abs(std::sin(0.05 * (x - 2 * z)));
+    };
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            const double x = -50 + 100.0 * i / kTerrainCells, z = -50 + 100.0 * j / kTerrainCells;
+            mesh->positions.emplace_back(x, height(x, z), z);
+        }
+    for (int j = 0; j < kTerrainCells; ++j)
+        for (int i = 0; i < kTerrainCells; ++i) {
+            const std::uint32_t a = std::uint32_t(j * n + i), b = a + 1, c = a + std::uint32_t(n),
+                                d = c + 1;
+            for (std::uint32_t v : {a, c, b, b, c, d}) mesh->indices.push_back(v);
+        }
+    scene::Scene s;
+    s.file = "generated-terrain";
+    s.camera.position = {-45, 14, -45};
+    s.camera.lookAt = {10, 0, 10};
+    s.camera.fovYDegrees = 60;
+    scene::Light sun;
+    sun.direction = glm::normalize(scene::Vec3(0.6, -0.25, 0.3));  // about 14° above the horizon
+    s.lights.push_back(sun);
+    s.materials.push_back(scene::Material{"matte"});
+    scene::Object o;
+    o.name = "terrain";
+    o.shape = scene::Mesh{"generated-terrain", mesh};
+    s.objects.push_back(o);
+    return s;
+}
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Rays are made once, by our tracer, and given to both: primary rays through pixel centers,
+// shadow rays from every primary hit that faces the light.
+void makeRays(Workload& w) {
+    scene::Camera cam = w.scene.camera;
+    cam.width = kWidth;
+    cam.height = kHeight;
+    const scene::CameraBasis basis = scene::cameraBasis(cam);
+    const V eye(basis.position);
+    for (int y = 0; y < kHeight; ++y)
+        for (int x = 0; x < kWidth; ++x)
+            w.primary.emplace_back(eye, V(scene::pixelDirection(basis, x, y)));
+    scene::RaytraceSettings robust;
+    robust.robustOffset = true;
+    const scene::Vec3 toLight = -w.scene.lights.at(0).direction;
+    const V l(toLight);
+    for (const auto& ray : w.primary) {
+        raytrace::Hit<Real> h;
+        if (!w.tracer->closestHit(ray, std::numeric_limits<Real>::infinity(), false, h)) continue;
+        const raytrace::SurfacePoint<Real> sp = w.tracer->surfacePoint(ray, h, true);
+        if (glm::dot(sp.ns, l) <= 0) continue;
+        w.shadow.emplace_back(raytrace::shadowOrigin(sp, l, robust), l);
+    }
+}
+
+#ifdef SHADOWLAB_HAVE_EMBREE
+void addEmbreeQuads(RTCDevice device, RTCScene scene, const std::vector<scene::Vec3>& corners) {
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_QUAD);
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                          RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                          corners.size()));
+    for (std::size_t i = 0; i < corners.size(); ++i)
+        for (int k = 0; k < 3; ++k) v[3 * i + k] = float(corners[i][k]);
+    auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+        g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT4, 4 * sizeof(unsigned), corners.size() / 4));
+    for (std::size_t i = 0; i < corners.size(); ++i) idx[i] = unsigned(i);
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(scene, g);
+    rtcReleaseGeometry(g);
+}
+
+void buildEmbree(Workload& w) {
+    const auto t0 = std::chrono::steady_clock::now();
+    w.device = rtcNewDevice(nullptr);
+    w.embree = rtcNewScene(w.device);
+    for (const scene::Object& o : w.scene.objects) {
+        if (const auto* s = std::get_if<scene::Sphere>(&o.shape)) {
+            RTCGeometry g = rtcNewGeometry(w.device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+            auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+                g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), 1));
+            v[0] = float(s->center.x), v[1] = float(s->center.y), v[2] = float(s->center.z);
+            v[3] = float(s->radius);
+            rtcCommitGeometry(g);
+            rtcAttachGeometry(w.embree, g);
+            rtcReleaseGeometry(g);
+        } else if (const auto* q = std::get_if<scene::Quad>(&o.shape)) {
+            const scene::Vec3 du = 0.5 * q->size.x * q->uAxis, dv = 0.5 * q->size.y * q->vAxis;
+            addEmbreeQuads(w.device, w.embree,
+                           {q->center - du - dv, q->center + du - dv, q->center + du + dv,
+                            q->center - du + dv});
+        } else if (const auto* b = std::get_if<scene::Box>(&o.shape)) {
+            const scene::Vec3 lo = b->min, hi = b->max;
+            auto c = [&](int i) {
+                return scene::Vec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
+            };
+            const int faces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1},
+                                     {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
+            std::vector<scene::Vec3> corners;
+            for (const auto& f : faces)
+                for (int k : f) corners.push_back(c(k));
+            addEmbreeQuads(w.device, w.embree, corners);
+        } else if (const auto* m = std::get_if<scene::Mesh>(&o.shape)) {
+            const scene::TriangleMesh& tm = *m->geometry;
+            RTCGeometry g = rtcNewGeometry(w.device, RTC_GEOMETRY_TYPE_TRIANGLE);
+            auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+                g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), tm.positions.size()));
+            for (std::size_t i = 0; i < tm.positions.size(); ++i)
+                for (int k = 0; k < 3; ++k) v[3 * i + k] = float(tm.positions[i][k]);
+            auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+                g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), tm.triangleCount()));
+            for (std::size_t i = 0; i < tm.indices.size(); ++i) idx[i] = tm.indices[i];
+            rtcCommitGeometry(g);
+            rtcAttachGeometry(w.embree, g);
+            rtcReleaseGeometry(g);
+        }
+    }
+    rtcCommitScene(w.embree);
+    w.embreeSetupMs = msSince(t0);
+}
+
+std::size_t embreePrimary(const Workload& w) {
+    std::atomic<std::size_t> hits{0};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, w.primary.size(), kBlock), [&](auto r) {
+        RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        std::size_t local = 0;
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const auto& ray = w.primary[i];
+            RTCRayHit rh{};
+            rh.ray.org_x = ray.o.x, rh.ray.org_y = ray.o.y, rh.ray.org_z = ray.o.z;
+            rh.ray.dir_x = ray.d.x, rh.ray.dir_y = ray.d.y, rh.ray.dir_z = ray.d.z;
+            rh.ray.tnear = 0.0f;
+            rh.ray.tfar = std::numeric_limits<float>::infinity();
+            rh.ray.mask = ~0u;
+            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            rtcIntersect1(w.embree, &ctx, &rh);
+            local += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+        }
+        hits += local;
+    });
+    return hits;
+}
+
+std::size_t embreeShadow(const Workload& w) {
+    std::atomic<std::size_t> blocked{0};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, w.shadow.size(), kBlock), [&](auto r) {
+        RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        std::size_t local = 0;
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const auto& ray = w.shadow[i];
+            RTCRay rr{};
+            rr.org_x = ray.o.x, rr.org_y = ray.o.y, rr.org_z = ray.o.z;
+            rr.dir_x = ray.d.x, rr.dir_y = ray.d.y, rr.dir_z = ray.d.z;
+            rr.tnear = 0.0f;
+            rr.tfar = std::numeric_limits<float>::infinity();
+            rr.mask = ~0u;
+            rtcOccluded1(w.embree, &ctx, &rr);
+            local += rr.tfar < 0;
+        }
+        blocked += local;
+    });
+    return blocked;
+}
+#endif
+
+std::size_t ourPrimary(const Workload& w) {
+    std::atomic<std::size_t> hits{0};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, w.primary.size(), kBlock), [&](auto r) {
+        std::size_t local = 0;
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            raytrace::Hit<Real> h;
+            local += w.tracer->closestHit(w.primary[i], std::numeric_limits<Real>::infinity(), false, h);
+        }
+        hits += local;
+    });
+    return hits;
+}
+
+std::size_t ourShadow(const Workload& w, bool conservative) {
+    std::atomic<std::size_t> blocked{0};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, w.shadow.size(), kBlock), [&](auto r) {
+        std::size_t local = 0;
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            int b;
+            local += w.tracer->anyHit(w.shadow[i], std::numeric_limits<Real>::infinity(), conservative, b);
+        }
+        blocked += local;
+    });
+    return blocked;
+}
+
+// Collects items/s of every repetition per benchmark name while printing the usual table, so
+// the summary can give the median and the spread (run with --benchmark_repetitions=N and
+// --benchmark_enable_random_interleaving=true to spread a busy machine's load over all cases).
+class RatioReporter : public benchmark::ConsoleReporter {
+public:
+    std::map<std::string, std::vector<double>> itemsPerSecond;
+    void ReportRuns(const std::vector<Run>& runs) override {
+        for (const Run& r : runs) {
+            if (r.run_type != Run::RT_Iteration) continue;
+            const auto it = r.counters.find("items_per_second");
+            // Keyed by the registered name, without the "/min_time:.../real_time" suffixes.
+            if (it != r.counters.end()) itemsPerSecond[r.run_name.function_name].push_back(it->second);
+        }
+        ConsoleReporter::ReportRuns(runs);
+    }
+    // Median, min and max in Mrays/s; zeros when the case did not run.
+    std::array<double, 3> stats(const std::string& name) {
+        std::vector<double> v = itemsPerSecond[name];
+        if (v.empty()) return {0, 0, 0};
+        std::sort(v.begin(), v.end());
+        const std::size_t n = v.size();
+        const double median = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+        return {median / 1e6, v.front() / 1e6, v.back() / 1e6};
+    }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    benchmark::Initialize(&argc, argv);
+    std::vector<std::unique_ptr<Workload>> workloads;
+
+    auto add = [&](const std::string& name, scene::Scene s) {
+        auto w = std::make_unique<Workload>();
+        w->name = name;
+        w->scene = std::move(s);
+        const auto t0 = std::chrono::steady_clock::now();
+        w->tracer = std::make_unique<raytrace::Tracer<Real>>(w->scene);
+        w->ourSetupMs = msSince(t0);
+        makeRays(*w);
+#ifdef SHADOWLAB_HAVE_EMBREE
+        buildEmbree(*w);
+#endif
+        workloads.push_back(std::move(w));
+    };
+    add("seed", scene::loadScene(scene::findScene("seed")));
+    const char* env = std::getenv("SHADOWLAB_SPONZA");
+    const std::string sponza = env && *env ? env : kDefaultSponzaPath;
+    const char* kSponzaPath = sponza.c_str();
+    if (std::filesystem::exists(kSponzaPath)) {
+        scene::Scene s;
+        s.file = kSponzaPath;
+        s.camera.position = {-11, 1.5, -0.5};
+        s.camera.lookAt = {5, 4, 0.5};
+        s.camera.fovYDegrees = 60;
+        scene::Light sun;
+        sun.direction = glm::normalize(scene::Vec3(0.15, -1, 0.1));
+        s.lights.push_back(sun);
+        s.materials.push_back(scene::Material{"matte"});
+        scene::Object o;
+        o.name = "sponza";
+        o.shape = scene::Mesh{kSponzaPath, scene::loadMesh(kSponzaPath, glm::dmat4(1.0), kSponzaPath, {})};
+        s.objects.push_back(o);
+        add("sponza", std::move(s));
+    } else {
+        std::printf("Sponza: %s is absent (set SHADOWLAB_SPONZA to its .gltf); only the seed "
+                    "scene is measured.\n", kSponzaPath);
+    }
+    add("terrain", terrainScene());
+#ifndef SHADOWLAB_HAVE_EMBREE
+    std::printf("Embree 3 was not found at configure time: our tracer is measured alone.\n");
+#endif
+
+    for (const auto& wp : workloads) {
+        const Workload* w = wp.get();
+        auto reg = [&](const std::string& n, std::size_t count, auto fn) {
+            benchmark::RegisterBenchmark((w->name + "/" + n).c_str(), [w, count, fn](benchmark::State& st) {
+                for (auto _ : st) benchmark::DoNotOptimize(fn(*w));
+                st.SetItemsProcessed(std::int64_t(st.iterations()) * std::int64_t(count));
+            })->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->MinTime(0.5);
+        };
+        reg("primary/ours", w->primary.size(), [](const Workload& x) { return ourPrimary(x); });
+        reg("shadow/ours", w->shadow.size(), [](const Workload& x) { return ourShadow(x, false); });
+        reg("shadow/ours_conservative", w->shadow.size(), [](const Workload& x) { return ourShadow(x, true); });
+#ifdef SHADOWLAB_HAVE_EMBREE
+        reg("primary/embree", w->primary.size(), [](const Workload& x) { return embreePrimary(x); });
+        reg("shadow/embree", w->shadow.size(), [](const Workload& x) { return embreeShadow(x); });
+#endif
+    }
+#ifdef SL_STATS
+    for (const auto& wp : workloads) {
+        for (int pass = 0; pass < 2; ++pass) {
+            raytrace::gNodeVisits = raytrace::gLeafVisits = raytrace::gRays = 0;
+            const auto& rays = pass == 0 ? wp->primary : wp->shadow;
+            for (const auto& r : rays) {
+                raytrace::Hit<Real> h;
+                int b;
+                if (pass == 0) wp->tracer->closestHit(r, std::numeric_limits<Real>::infinity(), false, h);
+                else wp->tracer->anyHit(r, std::numeric_limits<Real>::infinity(), false, b);
+            }
+            std::printf("STATS %s %s: nodes/ray %.2f leaves/ray %.2f\n", wp->name.c_str(), pass ? "shadow" : "primary",
+                        double(raytrace::gNodeVisits) / double(rays.size()), double(raytrace::gLeafVisits) / double(rays.size()));
+        }
+    }
+#endif
+    RatioReporter reporter;
+    benchmark::RunSpecifiedBenchmarks(&reporter);
+
+    std::printf("\nMrays/s: median (min-max) over the repetitions; ratio = ours / Embree medians\n");
+    std::printf("%-8s %-8s %8s %20s %20s %7s %s\n", "scene", "rays", "count", "ours", "embree",
+                "ratio", "agreement");
+    for (const auto& wp : workloads) {
+        const Workload& w = *wp;
+        for (const char* kind : {"primary", "shadow"}) {
+            const bool prim = std::string(kind) == "primary";
+            const std::size_t count = prim ? w.primary.size() : w.shadow.size();
+            const auto ours = reporter.stats(w.name + "/" + kind + "/ours");
+            char oursText[64];
+            std::snprintf(oursText, sizeof oursText, "%.2f (%.2f-%.2f)", ours[0], ours[1], ours[2]);
+#ifdef SHADOWLAB_HAVE_EMBREE
+            const auto emb = reporter.stats(w.name + "/" + kind + "/embree");
+            char embText[64];
+            std::snprintf(embText, sizeof embText, "%.2f (%.2f-%.2f)", emb[0], emb[1], emb[2]);
+            const std::size_t a = prim ? ourPrimary(w) : ourShadow(w, false);
+            const std::size_t b = prim ? embreePrimary(w) : embreeShadow(w);
+            std::printf("%-8s %-8s %8zu %20s %20s %7.3f hits ours %zu, embree %zu\n", w.name.c_str(),
+                        kind, count, oursText, embText, emb[0] > 0 ? ours[0] / emb[0] : 0.0, a, b);
+#else
+            std::printf("%-8s %-8s %8zu %20s %20s %7s\n", w.name.c_str(), kind, count, oursText, "-", "-");
+#endif
+        }
+        std::printf("%-8s setup: ours %.1f ms", w.name.c_str(), w.ourSetupMs);
+#ifdef SHADOWLAB_HAVE_EMBREE
+        std::printf(", embree %.1f ms", w.embreeSetupMs);
+#endif
+        const std::size_t tris = w.tracer->triangleCount();
+        std::printf(" (%zu triangles", tris);
+        if (tris > 0)
+            std::printf(", BVH + mesh %.1f bytes/triangle", double(w.tracer->meshBytes()) / double(tris));
+        std::printf(")\n");
+    }
+#ifdef SHADOWLAB_HAVE_EMBREE
+    for (auto& wp : workloads) {
+        rtcReleaseScene(wp->embree);
+        rtcReleaseDevice(wp->device);
+    }
+#endif
+    benchmark::Shutdown();
+    return 0;
+}

@@ -1,0 +1,423 @@
+// compare/compare.cpp: per-pixel classification of a method Frame against the reference,
+// the metrics derived from the classes, and the difference image.
+#include "compare/compare.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "compare/text.h"
+#include "scene/error.h"
+#include "scene/frame_io.h"
+
+namespace shadowlab::compare {
+
+namespace {
+
+using scene::Frame;
+using scene::InputError;
+
+void countValue(NonFinite& n, float v) {
+    if (std::isnan(v)) ++n.nan;
+    else if (std::isinf(v)) ++n.inf;
+}
+
+NonFinite countChannel(const std::vector<float>& values) {
+    NonFinite n;
+    for (const float v : values) countValue(n, v);
+    return n;
+}
+
+void checkChannel(const std::string& which, const char* channel, std::size_t actual,
+                  std::size_t expected, bool optional) {
+    if (optional && actual == 0) return;
+    if (actual != expected)
+        throw InputError(which + " frame: channel '" + channel + "' has " + std::to_string(actual) +
+                         " values, expected " + std::to_string(expected) +
+                         (actual == 0 ? " (missing)" : ""));
+}
+
+void checkFrame(const std::string& which, const Frame& f) {
+    if (f.width <= 0 || f.height <= 0)
+        throw InputError(which + " frame is empty (" + std::to_string(f.width) + "x" +
+                         std::to_string(f.height) + ")");
+    const std::size_t n = f.pixelCount();
+    checkChannel(which, "beauty", f.beauty.size(), 3 * n, which == "method");
+    checkChannel(which, "visibility", f.visibility.size(), n, false);
+    checkChannel(which, "object_id", f.objectId.size(), n, false);
+    checkChannel(which, "ndotl", f.ndotl.size(), n, false);
+    checkChannel(which, "Z", f.depth.size(), n, true);
+    checkChannel(which, "blocker_id", f.blockerId.size(), n, true);
+}
+
+// Object ids round to the nearest integer (thresholds.h, kObjectIdRounding).
+long long roundId(float id) { return static_cast<long long>(std::floor(id + kObjectIdRounding)); }
+
+Timing timingOf(const Frame& f) { return {f.totalTimeMs(), f.timingsMs}; }
+
+std::string attribute(const Frame& f, const std::string& key) {
+    const auto it = f.attributes.find(key);
+    return it == f.attributes.end() ? std::string() : it->second;
+}
+
+float srgbLuminance(float r, float g, float b) {
+    // Rec. 709 luminance of the linear color, then the sRGB curve, so the gray ramp of the
+    // diff image looks like the reference image does on screen.
+    auto finite = [](float v) { return std::isfinite(v) ? v : 0.0f; };
+    const float y = 0.2126f * finite(r) + 0.7152f * finite(g) + 0.0722f * finite(b);
+    return scene::linearToSrgb(y);
+}
+
+// Reference shadow state used by the edge detector: -1 where the reference has no shadow
+// answer (background, facing away, non-finite), else 1 shadowed / 0 lit.
+std::vector<signed char> referenceShadowState(const Frame& r) {
+    const std::size_t n = r.pixelCount();
+    std::vector<signed char> s(n, -1);
+    for (std::size_t i = 0; i < n; ++i) {
+        const float v = r.visibility[i], id = r.objectId[i], nl = r.ndotl[i];
+        if (!std::isfinite(v) || !std::isfinite(id) || !std::isfinite(nl)) continue;
+        if (roundId(id) == 0 || !(nl > kMinNdotL)) continue;
+        s[i] = v <= kVisibilityTolerance ? 1 : 0;
+    }
+    return s;
+}
+
+// Pixels on a reference shadow boundary: a 4-neighbour on the SAME object has the other state.
+// Neighbours on another object are silhouettes or contacts, where a missing contact shadow is
+// bias error (peter-panning), not aliasing.
+std::vector<unsigned char> shadowEdges(const Frame& r, const std::vector<signed char>& state) {
+    const int w = r.width, h = r.height;
+    std::vector<unsigned char> edge(state.size(), 0);
+    auto idAt = [&](std::size_t i) { return roundId(r.objectId[i]); };
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const std::size_t i = std::size_t(y) * w + x;
+            if (state[i] < 0) continue;
+            auto differs = [&](std::size_t j) {
+                return state[j] >= 0 && state[j] != state[i] && idAt(j) == idAt(i);
+            };
+            if ((x > 0 && differs(i - 1)) || (x + 1 < w && differs(i + 1)) ||
+                (y > 0 && differs(i - w)) || (y + 1 < h && differs(i + w)))
+                edge[i] = 1;
+        }
+    return edge;
+}
+
+// Square (Chebyshev) dilation by `radius`, separable: rows, then columns.
+std::vector<unsigned char> dilate(const std::vector<unsigned char>& mask, int w, int h,
+                                  int radius) {
+    if (radius <= 0) return mask;
+    std::vector<unsigned char> rows(mask.size(), 0), out(mask.size(), 0);
+    for (int y = 0; y < h; ++y) {
+        int last = -1000000000;  // x of the last set pixel seen on this row, scanning right
+        for (int x = 0; x < w; ++x) {
+            if (mask[std::size_t(y) * w + x]) last = x;
+            if (x - last <= radius) rows[std::size_t(y) * w + x] = 1;
+        }
+        last = 1000000000;
+        for (int x = w - 1; x >= 0; --x) {
+            if (mask[std::size_t(y) * w + x]) last = x;
+            if (last - x <= radius) rows[std::size_t(y) * w + x] = 1;
+        }
+    }
+    for (int x = 0; x < w; ++x) {
+        int last = -1000000000;
+        for (int y = 0; y < h; ++y) {
+            if (rows[std::size_t(y) * w + x]) last = y;
+            if (y - last <= radius) out[std::size_t(y) * w + x] = 1;
+        }
+        last = 1000000000;
+        for (int y = h - 1; y >= 0; --y) {
+            if (rows[std::size_t(y) * w + x]) last = y;
+            if (last - y <= radius) out[std::size_t(y) * w + x] = 1;
+        }
+    }
+    return out;
+}
+
+// Densest square window of wrong pixels, by a summed-area table; ties keep the first (top-left).
+ErrorHotspot findHotspot(const std::vector<PixelClass>& classes, int w, int h, int size) {
+    ErrorHotspot best;
+    if (size <= 0) size = std::clamp(std::min(w, h) / 6, 16, 96);
+    size = std::min({size, w, h});
+    best.size = size;
+    if (size <= 0) return best;
+    const std::size_t sw = std::size_t(w) + 1;
+    std::vector<std::size_t> sat(sw * (std::size_t(h) + 1), 0);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const PixelClass c = classes[std::size_t(y) * w + x];
+            const std::size_t wrong = c == PixelClass::FalseShadow || c == PixelClass::MissedShadow;
+            sat[(y + 1) * sw + x + 1] = wrong + sat[y * sw + x + 1] + sat[(y + 1) * sw + x] - sat[y * sw + x];
+        }
+    for (int y = 0; y + size <= h; ++y)
+        for (int x = 0; x + size <= w; ++x) {
+            const std::size_t a = sat[y * sw + x], b = sat[y * sw + x + size];
+            const std::size_t c = sat[(y + size) * sw + x], d = sat[(y + size) * sw + x + size];
+            const std::size_t count = d + a - b - c;
+            if (count > best.wrongPixels) {
+                best.wrongPixels = count;
+                best.x = x;
+                best.y = y;
+            }
+        }
+    return best;
+}
+
+double rate(std::size_t part, std::size_t whole) {
+    return whole == 0 ? 0.0 : static_cast<double>(part) / static_cast<double>(whole);
+}
+
+nlohmann::json toJson(const NonFinite& n) { return {{"nan", n.nan}, {"inf", n.inf}}; }
+
+nlohmann::json toJson(const FrameHealth& h) {
+    return {{"beauty", toJson(h.beauty)},     {"visibility", toJson(h.visibility)},
+            {"object_id", toJson(h.objectId)}, {"ndotl", toJson(h.ndotl)},
+            {"Z", toJson(h.depth)},            {"blocker_id", toJson(h.blockerId)},
+            {"total", h.total()}};
+}
+
+nlohmann::json toJson(const Timing& t) {
+    nlohmann::json stages = nlohmann::json::array();
+    for (const auto& [name, ms] : t.stagesMs) stages.push_back({{"stage", name}, {"ms", ms}});
+    return {{"total_ms", t.totalMs}, {"stages", stages}};
+}
+
+}  // namespace
+
+const char* toString(PixelClass c) {
+    switch (c) {
+        case PixelClass::AgreeLit: return "agree-lit";
+        case PixelClass::AgreeShadow: return "agree-shadow";
+        case PixelClass::FalseShadow: return "false-shadow";
+        case PixelClass::MissedShadow: return "missed-shadow";
+        case PixelClass::NotCounted: return "not-counted";
+        case PixelClass::Invalid: return "invalid";
+    }
+    return "?";
+}
+
+std::size_t FrameHealth::total() const {
+    return beauty.total() + visibility.total() + objectId.total() + ndotl.total() + depth.total() +
+           blockerId.total();
+}
+
+FrameHealth measureHealth(const Frame& f) {
+    return {countChannel(f.beauty), countChannel(f.visibility), countChannel(f.objectId),
+            countChannel(f.ndotl),  countChannel(f.depth),      countChannel(f.blockerId)};
+}
+
+PixelClass classifyCounted(float vMethod, float vReference) {
+    if (vReference - vMethod > kVisibilityTolerance) return PixelClass::FalseShadow;
+    if (vMethod - vReference > kVisibilityTolerance) return PixelClass::MissedShadow;
+    return vReference > kVisibilityTolerance ? PixelClass::AgreeLit : PixelClass::AgreeShadow;
+}
+
+std::array<float, 3> diffColor(PixelClass c, float refR, float refG, float refB) {
+    using C = DiffColors;
+    switch (c) {
+        case PixelClass::AgreeLit: {
+            const float g = C::kLitBase + C::kLitScale * srgbLuminance(refR, refG, refB);
+            return {g, g, g};
+        }
+        case PixelClass::AgreeShadow: {
+            const float g = C::kShadowBase + C::kShadowScale * srgbLuminance(refR, refG, refB);
+            return {g, g, g};
+        }
+        case PixelClass::FalseShadow: return C::kFalseShadow;
+        case PixelClass::MissedShadow: return C::kMissedShadow;
+        case PixelClass::NotCounted: return C::kNotCounted;
+        case PixelClass::Invalid: return C::kInvalid;
+    }
+    return C::kInvalid;
+}
+
+Comparison compareFrames(const Frame& method, const Frame& reference,
+                         const CompareOptions& options) {
+    checkFrame("method", method);
+    checkFrame("reference", reference);
+    if (method.width != reference.width || method.height != reference.height)
+        throw InputError("frame sizes differ: method is " + std::to_string(method.width) + "x" +
+                         std::to_string(method.height) + ", reference is " +
+                         std::to_string(reference.width) + "x" + std::to_string(reference.height));
+    if (options.edgeRadius < 0)
+        throw InputError("edge radius must be >= 0, got " + std::to_string(options.edgeRadius));
+
+    const int w = reference.width, h = reference.height;
+    const std::size_t n = reference.pixelCount();
+    Comparison out;
+    out.width = w;
+    out.height = h;
+    out.classes.assign(n, PixelClass::NotCounted);
+    out.diffRgb.assign(3 * n, 0.0f);
+    Metrics& m = out.metrics;
+    m.width = w;
+    m.height = h;
+    m.totalPixels = n;
+    m.hasBlockerIds = !method.blockerId.empty();
+    m.edgeRadius = options.edgeRadius;
+
+    const auto refState = referenceShadowState(reference);
+    const auto edges = shadowEdges(reference, refState);
+    m.referenceShadowEdgePixels = static_cast<std::size_t>(std::count(edges.begin(), edges.end(), 1));
+    const auto nearEdge = dilate(edges, w, h, options.edgeRadius);
+
+    std::map<long long, ObjectErrors> perObject;
+    double sumAbs = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const float vm = method.visibility[i], vr = reference.visibility[i];
+        const float idm = method.objectId[i], idr = reference.objectId[i];
+        const float nm = method.ndotl[i], nr = reference.ndotl[i];
+        PixelClass c = PixelClass::NotCounted;
+        const bool idsFinite = std::isfinite(idm) && std::isfinite(idr);
+        if (idsFinite && roundId(idm) != roundId(idr)) ++m.silhouetteMismatch;
+
+        if (!idsFinite || !std::isfinite(vm) || !std::isfinite(vr) || !std::isfinite(nm) ||
+            !std::isfinite(nr)) {
+            c = PixelClass::Invalid;
+        } else if (roundId(idm) != roundId(idr) || roundId(idr) == 0) {
+            c = PixelClass::NotCounted;
+        } else if (!(nm > kMinNdotL) || !(nr > kMinNdotL)) {
+            if ((nm > kMinNdotL) != (nr > kMinNdotL)) ++m.ndotlSignMismatch;
+            c = PixelClass::NotCounted;
+        } else {
+            c = classifyCounted(vm, vr);
+            ++m.counted;
+            sumAbs += std::fabs(double(vm) - double(vr));
+            const bool shM = vm <= kVisibilityTolerance, shR = vr <= kVisibilityTolerance;
+            m.shadowedMethod += shM;
+            m.shadowedReference += shR;
+            m.shadowedIntersection += shM && shR;
+            m.shadowedUnion += shM || shR;
+            ObjectErrors& obj = perObject[roundId(idr)];
+            ++obj.counted;
+            if (c == PixelClass::FalseShadow) {
+                ++m.falseShadow;
+                ++obj.falseShadow;
+                if (m.hasBlockerIds && std::isfinite(method.blockerId[i]) &&
+                    roundId(method.blockerId[i]) == roundId(idr)) {
+                    ++m.selfShadowAcne;
+                    ++obj.selfShadowAcne;
+                }
+                if (nearEdge[i]) ++m.falseShadowNearEdge;
+            } else if (c == PixelClass::MissedShadow) {
+                ++m.missedShadow;
+                ++obj.missedShadow;
+                if (nearEdge[i]) ++m.missedShadowNearEdge;
+            } else if (c == PixelClass::AgreeLit) {
+                ++m.agreeLit;
+            } else {
+                ++m.agreeShadow;
+            }
+        }
+        if (c == PixelClass::NotCounted) ++m.notCounted;
+        if (c == PixelClass::Invalid) ++m.invalid;
+        out.classes[i] = c;
+        const auto rgb = diffColor(c, reference.beauty[3 * i], reference.beauty[3 * i + 1],
+                                   reference.beauty[3 * i + 2]);
+        std::copy(rgb.begin(), rgb.end(), out.diffRgb.begin() + 3 * std::ptrdiff_t(i));
+    }
+
+    const std::size_t wrong = m.falseShadow + m.missedShadow;
+    m.falseShadowRate = rate(m.falseShadow, m.counted);
+    m.missedShadowRate = rate(m.missedShadow, m.counted);
+    m.mismatchRate = rate(wrong, m.counted);
+    m.meanAbsVisibilityError = m.counted ? sumAbs / double(m.counted) : 0.0;
+    m.shadowIoU = m.shadowedUnion ? double(m.shadowedIntersection) / double(m.shadowedUnion) : 1.0;
+    m.silhouetteMismatchRate = rate(m.silhouetteMismatch, m.totalPixels);
+    m.selfShadowAcneRate = rate(m.selfShadowAcne, m.counted);
+    m.aliasingPixels = m.falseShadowNearEdge + m.missedShadowNearEdge;
+    m.biasErrorPixels = wrong - m.aliasingPixels;
+    m.aliasingRate = rate(m.aliasingPixels, m.counted);
+    m.biasErrorRate = rate(m.biasErrorPixels, m.counted);
+    for (auto& [id, obj] : perObject) {
+        obj.objectId = static_cast<int>(id);
+        m.perObject.push_back(obj);
+    }
+    m.hotspot = findHotspot(out.classes, w, h, options.hotspotSize);
+    m.methodBackend = attribute(method, "backend");
+    m.referenceBackend = attribute(reference, "backend");
+    m.methodTiming = timingOf(method);
+    m.referenceTiming = timingOf(reference);
+    m.methodHealth = measureHealth(method);
+    m.referenceHealth = measureHealth(reference);
+    return out;
+}
+
+nlohmann::json toJson(const Metrics& m) {
+    nlohmann::json perObject = nlohmann::json::array();
+    for (const auto& o : m.perObject)
+        perObject.push_back({{"object_id", o.objectId},
+                             {"counted", o.counted},
+                             {"false_shadow", o.falseShadow},
+                             {"missed_shadow", o.missedShadow},
+                             {"self_shadow_acne", o.selfShadowAcne}});
+    nlohmann::json j = {
+        {"width", m.width},
+        {"height", m.height},
+        {"total_pixels", m.totalPixels},
+        {"counted", m.counted},
+        {"agree_lit", m.agreeLit},
+        {"agree_shadow", m.agreeShadow},
+        {"false_shadow", m.falseShadow},
+        {"missed_shadow", m.missedShadow},
+        {"not_counted", m.notCounted},
+        {"invalid", m.invalid},
+        {"false_shadow_rate", m.falseShadowRate},
+        {"missed_shadow_rate", m.missedShadowRate},
+        {"mismatch_rate", m.mismatchRate},
+        {"mean_abs_visibility_error", m.meanAbsVisibilityError},
+        {"shadowed_method", m.shadowedMethod},
+        {"shadowed_reference", m.shadowedReference},
+        {"shadowed_intersection", m.shadowedIntersection},
+        {"shadowed_union", m.shadowedUnion},
+        {"shadow_iou", m.shadowIoU},
+        {"silhouette_mismatch", m.silhouetteMismatch},
+        {"silhouette_mismatch_rate", m.silhouetteMismatchRate},
+        {"ndotl_sign_mismatch", m.ndotlSignMismatch},
+        {"has_blocker_ids", m.hasBlockerIds},
+        {"edge_radius", m.edgeRadius},
+        {"reference_shadow_edge_pixels", m.referenceShadowEdgePixels},
+        {"false_shadow_near_edge", m.falseShadowNearEdge},
+        {"missed_shadow_near_edge", m.missedShadowNearEdge},
+        {"aliasing_pixels", m.aliasingPixels},
+        {"bias_error_pixels", m.biasErrorPixels},
+        {"aliasing_rate", m.aliasingRate},
+        {"bias_error_rate", m.biasErrorRate},
+        {"per_object", perObject},
+        {"hotspot", {{"x", m.hotspot.x}, {"y", m.hotspot.y}, {"size", m.hotspot.size},
+                     {"wrong_pixels", m.hotspot.wrongPixels}}},
+        {"method_backend", m.methodBackend},
+        {"reference_backend", m.referenceBackend},
+        {"method_timing", toJson(m.methodTiming)},
+        {"reference_timing", toJson(m.referenceTiming)},
+        {"method_non_finite", toJson(m.methodHealth)},
+        {"reference_non_finite", toJson(m.referenceHealth)},
+    };
+    // Without blocker ids self-shadow acne is unknown, not zero.
+    if (m.hasBlockerIds) {
+        j["self_shadow_acne"] = m.selfShadowAcne;
+        j["self_shadow_acne_rate"] = m.selfShadowAcneRate;
+    } else {
+        j["self_shadow_acne"] = nullptr;
+        j["self_shadow_acne_rate"] = nullptr;
+    }
+    return j;
+}
+
+std::string summaryLine(const Metrics& m) {
+    std::string s = "counted " + formatCount(m.counted) + " px: false shadow " +
+                    formatPercent(m.falseShadowRate);
+    if (m.hasBlockerIds) s += " (self acne " + formatPercent(m.selfShadowAcneRate) + ")";
+    s += ", missed " + formatPercent(m.missedShadowRate) + ", mismatch " +
+         formatPercent(m.mismatchRate) + ", IoU " + formatFixed(m.shadowIoU, 3) + ", silhouette " +
+         formatPercent(m.silhouetteMismatchRate) + ", " + formatDuration(m.methodTiming.totalMs) +
+         " (reference " + formatDuration(m.referenceTiming.totalMs) + ")";
+    const std::size_t bad = m.methodHealth.total() + m.referenceHealth.total();
+    if (bad > 0)
+        s += ", NON-FINITE values: method " + formatCount(m.methodHealth.total()) + ", reference " +
+             formatCount(m.referenceHealth.total());
+    return s;
+}
+
+}  // namespace shadowlab::compare

@@ -1,0 +1,159 @@
+// compare/compare.h: classifies each pixel of a method Frame against a reference Frame of the
+// same scene and camera (DESIGN.md "Compare"), measures the shadow error and draws the
+// difference image. See docs/compare.md for the rules and the colors.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "compare/thresholds.h"
+#include "scene/frame.h"
+
+namespace shadowlab::compare {
+
+// What a pixel is, in the order of DESIGN.md's table. Invalid is ours: a non-finite value in
+// a channel the rule reads (visibility, object_id, ndotl) of either frame.
+enum class PixelClass : unsigned char {
+    AgreeLit,
+    AgreeShadow,
+    FalseShadow,   // V_R − V_M > τ: acne, over-darkening (red)
+    MissedShadow,  // V_M − V_R > τ: light leak, peter-panning (blue)
+    NotCounted,    // silhouette mismatch, N·L ≤ 0, background (neutral gray)
+    Invalid,       // NaN/Inf in the method or the reference (magenta)
+};
+inline constexpr int kPixelClassCount = 6;
+const char* toString(PixelClass c);
+
+// Display-encoded (0..1) colors of the difference image. Lit and shadowed agreement show the
+// reference's luminance (desaturated, so a red or blue object in the scene cannot be mistaken
+// for an error class) mapped into two separate bands: lit bright, shadow dark. Not-counted is
+// a flat gray between the two bands, so silhouettes stay visible but carry no texture.
+struct DiffColors {
+    static constexpr std::array<float, 3> kFalseShadow{1.0f, 0.08f, 0.05f};
+    static constexpr std::array<float, 3> kMissedShadow{0.10f, 0.40f, 1.0f};
+    static constexpr std::array<float, 3> kNotCounted{0.42f, 0.42f, 0.42f};
+    static constexpr std::array<float, 3> kInvalid{1.0f, 0.0f, 1.0f};
+    // gray = base + scale · Y, Y = sRGB-encoded luminance of the reference beauty in 0..1.
+    static constexpr float kLitBase = 0.62f, kLitScale = 0.33f;        // 0.62 .. 0.95
+    static constexpr float kShadowBase = 0.06f, kShadowScale = 0.16f;  // 0.06 .. 0.22
+};
+// The diff color of one pixel given its class and the reference's linear beauty there.
+std::array<float, 3> diffColor(PixelClass c, float refR, float refG, float refB);
+
+// Pure rule of the table, for one pixel; exposed so tests and sweeps share it.
+// `counted` is false when the ids differ, either is 0, or N·L ≤ 0 in either frame.
+PixelClass classifyCounted(float vMethod, float vReference);
+
+struct NonFinite {
+    std::size_t nan = 0;
+    std::size_t inf = 0;
+    std::size_t total() const { return nan + inf; }
+};
+
+// Non-finite values per channel of one Frame; a stability check reads these.
+struct FrameHealth {
+    NonFinite beauty, visibility, objectId, ndotl, depth, blockerId;
+    std::size_t total() const;
+};
+FrameHealth measureHealth(const scene::Frame& frame);
+
+struct Timing {
+    double totalMs = 0.0;
+    std::vector<std::pair<std::string, double>> stagesMs;  // in the order they ran
+};
+
+// Errors on one receiver object (the object seen at the pixel).
+struct ObjectErrors {
+    int objectId = 0;  // index + 1
+    std::size_t counted = 0;
+    std::size_t falseShadow = 0;
+    std::size_t missedShadow = 0;
+    std::size_t selfShadowAcne = 0;
+};
+
+// The square window of the image with the most wrong (false + missed shadow) pixels; the
+// report zooms into it so single-pixel acne is visible at a glance.
+struct ErrorHotspot {
+    int x = 0, y = 0;  // top-left pixel
+    int size = 0;      // side in pixels; 0 when the image is empty
+    std::size_t wrongPixels = 0;
+};
+
+struct Metrics {
+    int width = 0, height = 0;
+    std::size_t totalPixels = 0;
+
+    // Classes; counted = agreeLit + agreeShadow + falseShadow + missedShadow.
+    std::size_t counted = 0;
+    std::size_t agreeLit = 0, agreeShadow = 0, falseShadow = 0, missedShadow = 0;
+    std::size_t notCounted = 0;  // includes silhouette mismatch, facing away, background
+    std::size_t invalid = 0;     // non-finite in either frame; not counted
+
+    // Rates over counted pixels (0 when nothing counts).
+    double falseShadowRate = 0.0, missedShadowRate = 0.0;
+    double mismatchRate = 0.0;            // (falseShadow + missedShadow) / counted
+    double meanAbsVisibilityError = 0.0;  // mean |V_M − V_R| over counted pixels
+
+    // Shadowed sets (V ≤ τ) over counted pixels; IoU = 1 when both are empty.
+    std::size_t shadowedMethod = 0, shadowedReference = 0;
+    std::size_t shadowedIntersection = 0, shadowedUnion = 0;
+    double shadowIoU = 1.0;
+
+    // Pixels where the object ids differ (either may be background), over all pixels.
+    std::size_t silhouetteMismatch = 0;
+    double silhouetteMismatchRate = 0.0;
+    // Same object, but one frame has N·L > 0 and the other not (shading normals disagree).
+    std::size_t ndotlSignMismatch = 0;
+
+    // Self-shadow acne: false-shadow pixels whose method blocker id is the pixel's own object.
+    // Needs the method's blocker ids (the reference's is 0 on any false-shadow pixel anyway).
+    bool hasBlockerIds = false;
+    std::size_t selfShadowAcne = 0;
+    double selfShadowAcneRate = 0.0;  // over counted
+
+    // Edge-aware split of the wrong pixels: within edgeRadius pixels of a reference shadow
+    // boundary they are aliasing (a resolution problem), elsewhere bias error.
+    int edgeRadius = kDefaultEdgeRadiusPixels;
+    std::size_t referenceShadowEdgePixels = 0;
+    std::size_t falseShadowNearEdge = 0, missedShadowNearEdge = 0;
+    std::size_t aliasingPixels = 0;   // falseShadowNearEdge + missedShadowNearEdge
+    std::size_t biasErrorPixels = 0;  // wrong pixels away from any reference shadow edge
+    double aliasingRate = 0.0, biasErrorRate = 0.0;  // over counted
+
+    std::vector<ObjectErrors> perObject;  // objects with any counted pixel, by id
+    ErrorHotspot hotspot;
+
+    std::string methodBackend, referenceBackend;  // Frame attribute "backend", if any
+    Timing methodTiming, referenceTiming;
+    FrameHealth methodHealth, referenceHealth;
+};
+
+struct CompareOptions {
+    int edgeRadius = kDefaultEdgeRadiusPixels;
+    int hotspotSize = 0;  // side of the hotspot window; 0 = min(width, height) / 6 in 16..96
+};
+
+struct Comparison {
+    Metrics metrics;
+    int width = 0, height = 0;
+    std::vector<float> diffRgb;               // display-encoded 0..1, 3 per pixel, row 0 on top
+    std::vector<PixelClass> classes;          // one per pixel
+};
+
+// Throws scene::InputError when the sizes differ or a channel has the wrong length (naming
+// which frame and which channel).
+Comparison compareFrames(const scene::Frame& method, const scene::Frame& reference,
+                         const CompareOptions& options = {});
+
+nlohmann::json toJson(const Metrics& metrics);
+// One line for a terminal, e.g.
+// "counted 301234 px: false shadow 0.82% (self acne 0.80%), missed 0.10%, IoU 0.981, ..."
+std::string summaryLine(const Metrics& metrics);
+
+}  // namespace shadowlab::compare

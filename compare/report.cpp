@@ -1,0 +1,580 @@
+// compare/report.cpp: renders the `shadowlab run` report as one self-contained HTML page and
+// writes the paragraph that says in words what the comparison found.
+#include "compare/report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <sstream>
+
+#include "compare/svg_plot.h"
+#include "compare/text.h"
+#include "compare/thresholds.h"
+#include "scene/frame_io.h"
+
+namespace shadowlab::compare {
+
+namespace {
+
+std::string methodTitle(const std::string& label) {
+    if (label == "raster") return "The shadow map (raster)";
+    if (label == "raytrace") return "The ray tracer (raytrace)";
+    return "The " + label + " method";
+}
+
+std::string shortTitle(const std::string& label) {
+    if (label == "raster") return "the shadow map";
+    if (label == "raytrace") return "the ray tracer";
+    return label;
+}
+
+std::string objectName(const ReportInput& in, int id) {
+    if (id >= 1 && std::size_t(id) <= in.objectNames.size() && !in.objectNames[id - 1].empty())
+        return in.objectNames[id - 1];
+    return "object " + std::to_string(id);
+}
+
+// The object carrying more than half of a class, or "" when none does.
+template <typename Count>
+std::string dominantObject(const ReportInput& in, const Metrics& m, std::size_t total, Count count) {
+    if (total == 0) return "";
+    for (const auto& o : m.perObject)
+        if (double(count(o)) > kMostlyShare * double(total)) return objectName(in, o.objectId);
+    return "";
+}
+
+std::string ratio(double a, double b) {
+    // "3.2× faster" style wording of a/b for run times.
+    if (!(a > 0.0) || !(b > 0.0)) return "";
+    const double r = b / a;
+    if (r >= 1.05) return formatFixed(r, r >= 10 ? 0 : 1) + "× faster than";
+    if (r <= 1 / 1.05) return formatFixed(1 / r, 1 / r >= 10 ? 0 : 1) + "× slower than";
+    return "about as fast as";
+}
+
+std::string healthText(const FrameHealth& h) {
+    std::vector<std::string> parts;
+    auto add = [&](const char* name, const NonFinite& n) {
+        if (n.total() == 0) return;
+        std::string s = std::string(name) + ": ";
+        if (n.nan) s += formatCount(n.nan) + " NaN";
+        if (n.nan && n.inf) s += ", ";
+        if (n.inf) s += formatCount(n.inf) + " Inf";
+        parts.push_back(s);
+    };
+    add("beauty", h.beauty);
+    add("visibility", h.visibility);
+    add("object_id", h.objectId);
+    add("ndotl", h.ndotl);
+    add("Z", h.depth);
+    add("blocker_id", h.blockerId);
+    std::string out;
+    for (std::size_t i = 0; i < parts.size(); ++i) out += (i ? "; " : "") + parts[i];
+    return out;
+}
+
+std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
+    const Metrics& m = rm.metrics;
+    const std::string who = methodTitle(rm.label);
+    std::string s;
+    if (m.counted == 0) {
+        s = who + " has no pixel to compare: no visible point faces the light in both frames "
+                  "on the same object.";
+    } else if (m.falseShadow + m.missedShadow == 0) {
+        s = who + " matches the reference on all " + formatCount(m.counted) +
+            " counted pixels (mean |ΔV| " + formatFixed(m.meanAbsVisibilityError, 4) + ").";
+    } else {
+        s = who + " disagrees with the reference on " + formatPercent(m.mismatchRate) + " of the " +
+            formatCount(m.counted) + " counted pixels: ";
+        std::vector<std::string> parts;
+        if (m.falseShadow > 0) {
+            std::string f = formatPercent(m.falseShadowRate) + " false shadow";
+            if (m.hasBlockerIds && double(m.selfShadowAcne) > kMostlyShare * double(m.falseShadow)) {
+                f += ", mostly self-shadow acne";
+                const std::string on = dominantObject(in, m, m.selfShadowAcne,
+                                                      [](const ObjectErrors& o) { return o.selfShadowAcne; });
+                if (!on.empty()) f += " on " + on;
+            } else {
+                if (m.hasBlockerIds && m.selfShadowAcne > 0)
+                    f += " (" + formatPercent(double(m.selfShadowAcne) / double(m.falseShadow)) +
+                         " of it self-shadow acne)";
+                const std::string on = dominantObject(in, m, m.falseShadow,
+                                                      [](const ObjectErrors& o) { return o.falseShadow; });
+                if (!on.empty()) f += ", mostly on " + on;
+            }
+            parts.push_back(f);
+        } else {
+            parts.push_back("no false shadow");
+        }
+        if (m.missedShadow > 0) {
+            std::string f = formatPercent(m.missedShadowRate) + " missed shadow (light leaking or peter-panning";
+            const std::string on = dominantObject(in, m, m.missedShadow,
+                                                  [](const ObjectErrors& o) { return o.missedShadow; });
+            f += on.empty() ? ")" : ", mostly on " + on + ")";
+            parts.push_back(f);
+        } else {
+            parts.push_back("no missed shadow");
+        }
+        s += parts[0] + " and " + parts[1] + ".";
+        const std::size_t wrong = m.falseShadow + m.missedShadow;
+        const double nearShare = double(m.aliasingPixels) / double(wrong);
+        if (nearShare > kMostlyShare)
+            s += " Most wrong pixels (" + formatPercent(nearShare) + ") lie within " +
+                 std::to_string(m.edgeRadius) + " px of a reference shadow edge: edge aliasing rather than bias.";
+        else if (m.aliasingPixels > 0)
+            s += " " + formatPercent(1.0 - nearShare) + " of the wrong pixels lie away from shadow edges (bias error), the rest within " +
+                 std::to_string(m.edgeRadius) + " px of one (aliasing).";
+        s += " Its shadowed area overlaps the reference's with IoU " + formatFixed(m.shadowIoU, 3) + ".";
+    }
+    if (m.silhouetteMismatchRate > kNotableSilhouetteRate)
+        s += " Silhouettes differ on " + formatPercent(m.silhouetteMismatchRate) +
+             " of the image (not counted).";
+    const double t = m.methodTiming.totalMs, tr = m.referenceTiming.totalMs;
+    if (t > 0.0) {
+        s += " It took " + formatDuration(t);
+        const std::string r = ratio(t, tr);
+        s += r.empty() ? "." : ", " + r + " the reference.";
+    }
+    if (m.methodHealth.total() > 0)
+        s += " Warning: it produced non-finite values (" + healthText(m.methodHealth) + ").";
+    return s;
+}
+
+// ---- HTML pieces ----------------------------------------------------------------------
+
+const char* kCss = R"CSS(
+:root { --ink:#1f2933; --muted:#616e7c; --line:#e4e7eb; --bg:#f5f7fa; --card:#fff;
+        --false:#ff140d; --missed:#1a66ff; }
+* { box-sizing: border-box; }
+body { margin: 0; background: var(--bg); color: var(--ink);
+       font: 14px/1.5 system-ui, -apple-system, "Segoe UI", Roboto, sans-serif; }
+main { max-width: 1360px; margin: 0 auto; padding: 24px 28px 48px; }
+header h1 { margin: 0; font-size: 24px; font-weight: 650; }
+header .sub { color: var(--muted); margin-top: 2px; }
+h2 { font-size: 17px; margin: 28px 0 10px; font-weight: 650; }
+section.card, .findings { background: var(--card); border: 1px solid var(--line); border-radius: 8px;
+       padding: 16px 18px; }
+.findings { margin-top: 16px; border-left: 4px solid #3e4c59; font-size: 15px; }
+.findings p { margin: 0 0 6px; }
+.failure { background: #fff5f5; border: 1px solid #ffc9c9; color: #a51111; border-radius: 8px;
+       padding: 10px 14px; margin-top: 12px; }
+.grid { display: grid; gap: 14px; }
+figure { margin: 0; }
+figure img { width: 100%; height: auto; display: block; border-radius: 4px; background: #222; }
+figure figcaption { font-weight: 600; margin-bottom: 6px; }
+figure figcaption span { font-weight: 400; color: var(--muted); }
+img.upscale, .crop img { image-rendering: pixelated; }
+.imgwrap { position: relative; }
+.hot { position: absolute; border: 2px solid #ffd43b; box-shadow: 0 0 0 1px #000; pointer-events: none; }
+.crops { display: grid; grid-template-columns: 1fr 1fr; gap: 6px; margin-top: 8px; }
+.crop { position: relative; width: 100%; aspect-ratio: 1 / 1; overflow: hidden; border-radius: 4px;
+        background: #222; }
+.crop img { position: absolute; max-width: none; }
+.small { color: var(--muted); font-size: 12px; }
+.settings { margin-top: 4px; font-family: ui-monospace, "SFMono-Regular", Menlo, monospace; }
+.legend { list-style: none; padding: 0; margin: 0; }
+.legend li { display: flex; align-items: flex-start; gap: 8px; margin: 0 0 8px; }
+.sw { flex: none; width: 16px; height: 16px; border-radius: 3px; border: 1px solid #0003; margin-top: 2px; }
+table { border-collapse: collapse; width: 100%; background: var(--card); }
+th, td { padding: 6px 10px; border-bottom: 1px solid var(--line); text-align: right;
+         font-variant-numeric: tabular-nums; }
+th:first-child, td:first-child { text-align: left; }
+thead th { background: #f0f4f8; font-weight: 600; }
+td .rate { color: var(--muted); margin-left: 6px; }
+tr.key td { font-weight: 600; }
+.plotrow { display: grid; grid-template-columns: minmax(0, 660px) minmax(0, 1fr); gap: 18px; align-items: start; }
+svg.plot { max-width: 100%; height: auto; border: 1px solid var(--line); border-radius: 8px; }
+details { margin-top: 10px; }
+summary { cursor: pointer; font-weight: 600; }
+ul.sweeplines { margin: 0 0 8px; padding-left: 18px; }
+ul.sweeplines li { margin-bottom: 6px; }
+pre { background: #f0f4f8; padding: 10px 12px; border-radius: 6px; overflow-x: auto; font-size: 12px; }
+a { color: #1864ab; }
+)CSS";
+
+std::string swatch(const std::array<float, 3>& c) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "#%02x%02x%02x", int(std::lround(c[0] * 255)),
+                  int(std::lround(c[1] * 255)), int(std::lround(c[2] * 255)));
+    return buf;
+}
+
+std::string swatchGradient(float base, float scale) {
+    const float lo = base, hi = base + scale;
+    return "background: linear-gradient(90deg," + swatch({lo, lo, lo}) + "," + swatch({hi, hi, hi}) + ")";
+}
+
+std::string figure(const std::string& caption, const std::string& note, const std::string& png,
+                   const FrameInfo& f, const ErrorHotspot* hot) {
+    std::ostringstream o;
+    // Small frames are magnified with hard pixel edges; large ones scale down smoothly so a
+    // single red pixel still tints its neighbourhood instead of vanishing.
+    const bool upscale = f.width > 0 && f.width <= 440;
+    o << "<figure><figcaption>" << escapeHtml(caption);
+    if (!note.empty()) o << " <span>" << escapeHtml(note) << "</span>";
+    o << "</figcaption><div class=\"imgwrap\"><a href=\"" << escapeHtml(png) << "\"><img src=\""
+      << escapeHtml(png) << "\" alt=\"" << escapeHtml(caption) << "\""
+      << (upscale ? " class=\"upscale\"" : "");
+    if (f.width > 0) o << " width=\"" << f.width << "\" height=\"" << f.height << "\"";
+    o << "></a>";
+    if (hot && hot->wrongPixels > 0 && f.width > 0 && f.height > 0) {
+        o << "<div class=\"hot\" title=\"zoomed below\" style=\"left:" << formatFixed(100.0 * hot->x / f.width, 3)
+          << "%;top:" << formatFixed(100.0 * hot->y / f.height, 3) << "%;width:"
+          << formatFixed(100.0 * hot->size / f.width, 3) << "%;height:"
+          << formatFixed(100.0 * hot->size / f.height, 3) << "%\"></div>";
+    }
+    o << "</div></figure>\n";
+    return o.str();
+}
+
+// The settings a frame was rendered with, on one line under its image: every attribute except
+// those already shown elsewhere (backend is the caption, scene and version are in the header).
+std::string settingsLine(const FrameInfo& f) {
+    std::string line;
+    for (const auto& [key, value] : f.attributes) {
+        if (key == "backend" || key == "scene" || key == "version") continue;
+        const std::string v = value.size() > 48 ? value.substr(0, 45) + "..." : value;
+        line += (line.empty() ? "" : " · ") + key + " " + v;
+    }
+    return line.empty() ? "" : "<div class=\"small settings\">" + escapeHtml(line) + "</div>";
+}
+
+// A square crop of `png` showing the hotspot window, scaled up with hard pixel edges. Pure CSS:
+// the container is square, so percentages of its width also work for the vertical offset.
+std::string crop(const std::string& png, const FrameInfo& f, const ErrorHotspot& hot, const std::string& alt) {
+    std::ostringstream o;
+    const double s = hot.size;
+    o << "<div class=\"crop\"><img src=\"" << escapeHtml(png) << "\" alt=\"" << escapeHtml(alt)
+      << "\" style=\"width:" << formatFixed(100.0 * f.width / s, 3) << "%;left:"
+      << formatFixed(-100.0 * hot.x / s, 3) << "%;top:" << formatFixed(-100.0 * hot.y / s, 3)
+      << "%\"></div>";
+    return o.str();
+}
+
+std::string countCell(std::size_t n, double r, bool showRate = true) {
+    std::string s = "<td>" + formatCount(n);
+    if (showRate) s += "<span class=\"rate\">" + formatPercent(r) + "</span>";
+    return s + "</td>";
+}
+
+std::string legendHtml() {
+    using C = DiffColors;
+    std::ostringstream o;
+    o << "<ul class=\"legend\">"
+      << "<li><span class=\"sw\" style=\"background:" << swatch(C::kFalseShadow)
+      << "\"></span><span><b>False shadow</b>: the method is dark where the reference is lit "
+         "(acne, over-darkening). Red speckles on a lit surface are acne.</span></li>"
+      << "<li><span class=\"sw\" style=\"background:" << swatch(C::kMissedShadow)
+      << "\"></span><span><b>Missed shadow</b>: the method is lit where the reference is dark "
+         "(light leaking, peter-panning). Blue areas along a contact are a detached shadow.</span></li>"
+      << "<li><span class=\"sw\" style=\"" << swatchGradient(C::kLitBase, C::kLitScale)
+      << "\"></span><span><b>Agree, lit</b>: the reference image, gray and dimmed.</span></li>"
+      << "<li><span class=\"sw\" style=\"" << swatchGradient(C::kShadowBase, C::kShadowScale)
+      << "\"></span><span><b>Agree, shadow</b>: darker.</span></li>"
+      << "<li><span class=\"sw\" style=\"background:" << swatch(C::kNotCounted)
+      << "\"></span><span><b>Not counted</b>: background, surfaces facing away from the light, "
+         "or a different object in the two frames (silhouettes).</span></li>"
+      << "<li><span class=\"sw\" style=\"background:" << swatch(C::kInvalid)
+      << "\"></span><span><b>Invalid</b>: NaN or infinity in either frame.</span></li>"
+      << "</ul><p class=\"small\">A pixel counts when both frames see the same object there and "
+         "it faces the light (N·L &gt; 0) in both. Visibilities V disagree when |V<sub>method</sub> − "
+         "V<sub>reference</sub>| &gt; "
+      << formatShort(kVisibilityTolerance) << ". The yellow square marks the region with the most "
+         "errors, zoomed under each difference image.</p>";
+    return o.str();
+}
+
+std::string metricsTable(const ReportInput& in) {
+    std::ostringstream o;
+    o << "<table class=\"metrics\"><thead><tr><th>metric</th>";
+    for (const auto& m : in.methods) o << "<th>" << escapeHtml(m.label) << "</th>";
+    o << "</tr></thead><tbody>\n";
+    auto row = [&](const std::string& name, auto cell, const char* cls = "") {
+        o << "<tr" << (*cls ? std::string(" class=\"") + cls + "\"" : std::string()) << "><td>" << name << "</td>";
+        for (const auto& rm : in.methods) o << cell(rm.metrics);
+        o << "</tr>\n";
+    };
+    auto plain = [](const std::string& s) { return "<td>" + s + "</td>"; };
+    row("counted pixels", [&](const Metrics& m) { return countCell(m.counted, double(m.counted) / std::max<double>(1, m.totalPixels)); });
+    row("mismatch", [&](const Metrics& m) { return countCell(m.falseShadow + m.missedShadow, m.mismatchRate); }, "key");
+    row("<span style=\"color:var(--false)\">■</span> false shadow", [&](const Metrics& m) { return countCell(m.falseShadow, m.falseShadowRate); });
+    row("&nbsp;&nbsp;of which self-shadow acne", [&](const Metrics& m) {
+        return m.hasBlockerIds ? countCell(m.selfShadowAcne, m.selfShadowAcneRate) : plain("n/a");
+    });
+    row("<span style=\"color:var(--missed)\">■</span> missed shadow", [&](const Metrics& m) { return countCell(m.missedShadow, m.missedShadowRate); });
+    row("agree, lit", [&](const Metrics& m) { return countCell(m.agreeLit, double(m.agreeLit) / std::max<double>(1, m.counted)); });
+    row("agree, shadow", [&](const Metrics& m) { return countCell(m.agreeShadow, double(m.agreeShadow) / std::max<double>(1, m.counted)); });
+    row("mean |V<sub>M</sub> − V<sub>R</sub>|", [&](const Metrics& m) { return plain(formatFixed(m.meanAbsVisibilityError, 4)); });
+    row("IoU of shadowed areas", [&](const Metrics& m) { return plain(formatFixed(m.shadowIoU, 4)); }, "key");
+    row("wrong near a shadow edge (aliasing)", [&](const Metrics& m) { return countCell(m.aliasingPixels, m.aliasingRate); });
+    row("wrong away from edges (bias)", [&](const Metrics& m) { return countCell(m.biasErrorPixels, m.biasErrorRate); });
+    row("silhouette mismatch <span class=\"small\">(of all pixels)</span>", [&](const Metrics& m) { return countCell(m.silhouetteMismatch, m.silhouetteMismatchRate); });
+    row("N·L sign differs", [&](const Metrics& m) { return countCell(m.ndotlSignMismatch, 0, false); });
+    row("non-finite values", [&](const Metrics& m) {
+        const std::string t = healthText(m.methodHealth);
+        return plain(t.empty() ? "0" : "<b style=\"color:#c92a2a\">" + escapeHtml(t) + "</b>");
+    });
+    row("run time", [&](const Metrics& m) { return plain(formatDuration(m.methodTiming.totalMs)); }, "key");
+    o << "</tbody></table>\n";
+    return o.str();
+}
+
+std::string timingTable(const ReportInput& in) {
+    std::vector<std::pair<std::string, const FrameInfo*>> cols;
+    cols.push_back({in.reference.label.empty() ? "reference" : in.reference.label, &in.reference.frame});
+    for (const auto& m : in.methods) cols.push_back({m.label, &m.frame});
+    std::vector<std::string> stages;  // union, in first-seen order
+    for (const auto& [label, f] : cols)
+        for (const auto& [stage, ms] : f->timingsMs)
+            if (std::find(stages.begin(), stages.end(), stage) == stages.end()) stages.push_back(stage);
+    std::ostringstream o;
+    o << "<table class=\"timings\"><thead><tr><th>stage</th>";
+    for (const auto& c : cols) o << "<th>" << escapeHtml(c.first) << "</th>";
+    o << "</tr></thead><tbody>\n";
+    for (const auto& stage : stages) {
+        o << "<tr><td>" << escapeHtml(stage) << "</td>";
+        for (const auto& c : cols) {
+            const auto it = std::find_if(c.second->timingsMs.begin(), c.second->timingsMs.end(),
+                                         [&](const auto& t) { return t.first == stage; });
+            o << "<td>" << (it == c.second->timingsMs.end() ? "–" : formatDuration(it->second)) << "</td>";
+        }
+        o << "</tr>\n";
+    }
+    o << "<tr class=\"key\"><td>total</td>";
+    for (const auto& c : cols) o << "<td>" << formatDuration(c.second->totalTimeMs()) << "</td>";
+    o << "</tr></tbody></table>\n";
+    return o.str();
+}
+
+std::string errorTimeSvg(const ReportInput& in) {
+    std::vector<SweepPoint> points;
+    for (const auto& rm : in.methods)
+        points.push_back({rm.label, rm.metrics.methodTiming.totalMs, rm.metrics.mismatchRate, rm.label});
+    ErrorTimeOptions o;
+    o.errorName = "mismatch rate (false + missed)";
+    o.logError = false;  // two points, one of them often at zero error
+    o.fronts = false;
+    o.labels = true;
+    return renderSvg(errorTimePlot(points, in.reference.frame.totalTimeMs(), o));
+}
+
+// The quick sweep `run` includes: its error-time plot beside its findings and the recommended
+// shadow block, and a link to its own report for the images and the table.
+std::string sweepSection(const SweepSummary& sw) {
+    std::ostringstream o;
+    o << "<h2>Quick sweep</h2>\n<p class=\"small\">" << formatCount(sw.configurations) << " configurations";
+    if (!sw.resolution.empty()) o << " at " << escapeHtml(sw.resolution);
+    if (sw.failed > 0) o << ", " << formatCount(sw.failed) << " failed";
+    o << "; each point is one setting, the lines are each backend's Pareto front (nothing is both faster and "
+         "more accurate).</p>\n<div class=\"plotrow\"><div>"
+      << sw.errorTimeSvg << "</div><div><ul class=\"sweeplines\">";
+    for (const auto& line : sw.lines) o << "<li>" << escapeHtml(line) << "</li>";
+    o << "</ul>";
+    if (!sw.shadowBlockJson.empty())
+        o << "<p>Recommended <code>\"shadow\"</code> block for the scene file:</p><pre>"
+          << escapeHtml(sw.shadowBlockJson) << "</pre>";
+    if (!sw.href.empty())
+        o << "<p><a href=\"" << escapeHtml(sw.href) << "\">The sweep's own report</a>: every configuration, "
+             "best and worst images, bias plots.</p>";
+    o << "</div></div>\n";
+    return o.str();
+}
+
+std::string perObjectTable(const ReportInput& in) {
+    std::set<int> ids;
+    for (const auto& rm : in.methods)
+        for (const auto& o : rm.metrics.perObject) ids.insert(o.objectId);
+    if (ids.empty()) return "";
+    std::ostringstream o;
+    o << "<table class=\"objects\"><thead><tr><th>receiver</th>";
+    for (const auto& rm : in.methods)
+        o << "<th>" << escapeHtml(rm.label) << " counted</th><th>false</th><th>self acne</th><th>missed</th>";
+    o << "</tr></thead><tbody>\n";
+    for (const int id : ids) {
+        o << "<tr><td>" << escapeHtml(objectName(in, id)) << "</td>";
+        for (const auto& rm : in.methods) {
+            const auto it = std::find_if(rm.metrics.perObject.begin(), rm.metrics.perObject.end(),
+                                         [&](const ObjectErrors& e) { return e.objectId == id; });
+            if (it == rm.metrics.perObject.end()) {
+                o << "<td>–</td><td>–</td><td>–</td><td>–</td>";
+                continue;
+            }
+            o << "<td>" << formatCount(it->counted) << "</td><td>" << formatCount(it->falseShadow)
+              << "</td><td>" << (rm.metrics.hasBlockerIds ? formatCount(it->selfShadowAcne) : "n/a")
+              << "</td><td>" << formatCount(it->missedShadow) << "</td>";
+        }
+        o << "</tr>\n";
+    }
+    o << "</tbody></table>\n";
+    return o.str();
+}
+
+std::string attributesHtml(const std::string& label, const FrameInfo& f) {
+    std::ostringstream o;
+    o << "<h3 style=\"font-size:14px;margin:12px 0 4px\">" << escapeHtml(label) << "</h3><table><tbody>";
+    for (const auto& [k, v] : f.attributes)
+        o << "<tr><td>" << escapeHtml(k) << "</td><td style=\"text-align:left\"><code>" << escapeHtml(v)
+          << "</code></td></tr>";
+    if (f.attributes.empty()) o << "<tr><td class=\"small\">no metadata</td><td></td></tr>";
+    o << "</tbody></table>";
+    return o.str();
+}
+
+}  // namespace
+
+FrameInfo::FrameInfo(const scene::Frame& frame)
+    : width(frame.width), height(frame.height), attributes(frame.attributes),
+      timingsMs(frame.timingsMs) {}
+
+double FrameInfo::totalTimeMs() const {
+    double total = 0.0;
+    for (const auto& [stage, ms] : timingsMs) total += ms;
+    return total;
+}
+
+std::string describeFindings(const ReportInput& in) {
+    std::vector<std::string> lines;
+    for (const auto& rm : in.methods) lines.push_back(describeMethod(in, rm));
+    // Which method is closer, when there are several to rank.
+    if (in.methods.size() >= 2) {
+        const auto best = std::min_element(in.methods.begin(), in.methods.end(), [](const auto& a, const auto& b) {
+            return a.metrics.mismatchRate < b.metrics.mismatchRate;
+        });
+        const auto worst = std::max_element(in.methods.begin(), in.methods.end(), [](const auto& a, const auto& b) {
+            return a.metrics.mismatchRate < b.metrics.mismatchRate;
+        });
+        if (worst->metrics.mismatchRate > best->metrics.mismatchRate) {
+            std::string t = "Overall, " + shortTitle(best->label) + " is closer to the reference (" +
+                            formatPercent(best->metrics.mismatchRate) + " against " +
+                            formatPercent(worst->metrics.mismatchRate) + " wrong)";
+            const std::string r = ratio(best->metrics.methodTiming.totalMs, worst->metrics.methodTiming.totalMs);
+            if (!r.empty()) t += " and " + r + " " + shortTitle(worst->label);
+            lines.push_back(t + ".");
+        }
+    }
+    for (const auto& f : in.failures)
+        lines.push_back("The " + f.label + " backend failed: " + f.message);
+    if (in.reference.frame.width > 0) {
+        // Reference health is checked once here rather than per method.
+        for (const auto& rm : in.methods)
+            if (rm.metrics.referenceHealth.total() > 0) {
+                lines.push_back("Warning: the reference itself has non-finite values (" +
+                                healthText(rm.metrics.referenceHealth) + "); its verdicts there are void.");
+                break;
+            }
+    }
+    if (lines.empty()) return "Nothing to compare: no method produced a frame.";
+    std::string s;
+    for (const auto& line : lines) {
+        if (!s.empty()) s += '\n';
+        s += line;
+    }
+    return s;
+}
+
+std::string renderReportHtml(const ReportInput& in) {
+    const std::string title = "shadowlab — " + (in.sceneName.empty() ? std::string("report") : in.sceneName);
+    std::ostringstream o;
+    o << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+      << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
+      << "<title>" << escapeHtml(title) << "</title>\n<style>" << kCss << "</style>\n</head>\n<body>\n<main>\n";
+
+    // Header.
+    const FrameInfo& ref = in.reference.frame;
+    o << "<header><h1>" << escapeHtml(title) << "</h1><div class=\"sub\">";
+    if (!in.scenePath.empty()) o << "<code>" << escapeHtml(in.scenePath) << "</code> · ";
+    if (ref.width > 0) o << ref.width << "×" << ref.height << " px · ";
+    const auto version = ref.attributes.find("version");
+    if (version != ref.attributes.end()) o << "shadowlab " << escapeHtml(version->second) << " · ";
+    o << "shadow error of each method against a double-precision ray-traced reference</div></header>\n";
+
+    // Findings in words.
+    o << "<div class=\"findings\">";
+    std::istringstream lines(describeFindings(in));
+    for (std::string line; std::getline(lines, line);) o << "<p>" << escapeHtml(line) << "</p>";
+    o << "</div>\n";
+    for (const auto& f : in.failures)
+        o << "<div class=\"failure\"><b>" << escapeHtml(f.label) << " failed:</b> " << escapeHtml(f.message) << "</div>\n";
+
+    // Images over difference images, one column per frame.
+    const std::size_t cols = 1 + in.methods.size();
+    const std::string gridStyle = "grid-template-columns: repeat(" + std::to_string(cols) + ", minmax(0, 1fr))";
+    o << "<h2>Images</h2>\n<div class=\"grid\" style=\"" << gridStyle << "\">\n";
+    o << "<div>"
+      << figure(in.reference.label.empty() ? "reference" : in.reference.label,
+                formatDuration(ref.totalTimeMs()), in.reference.png, ref, nullptr)
+      << settingsLine(ref) << "</div>\n";
+    for (const auto& rm : in.methods)
+        o << "<div>" << figure(rm.label, formatDuration(rm.frame.totalTimeMs()), rm.png, rm.frame, nullptr)
+          << settingsLine(rm.frame) << "</div>\n";
+    o << "</div>\n";
+
+    o << "<h2>Difference to the reference</h2>\n<div class=\"grid\" style=\"" << gridStyle << "\">\n";
+    o << "<div>" << legendHtml() << "</div>\n";
+    for (const auto& rm : in.methods) {
+        const Metrics& m = rm.metrics;
+        o << "<div>"
+          << figure(rm.label + " vs reference",
+                    formatPercent(m.falseShadowRate) + " false, " + formatPercent(m.missedShadowRate) + " missed",
+                    rm.diffPng, rm.frame, &m.hotspot);
+        if (m.hotspot.wrongPixels > 0 && m.hotspot.size > 0 && rm.frame.width > 0) {
+            o << "<div class=\"crops\">" << crop(rm.png, rm.frame, m.hotspot, rm.label + " zoom")
+              << crop(rm.diffPng, rm.frame, m.hotspot, rm.label + " difference zoom") << "</div>"
+              << "<div class=\"small\">Zoom into the " << m.hotspot.size << "×" << m.hotspot.size << " px region at (" << m.hotspot.x
+              << ", " << m.hotspot.y << ") with the most errors (" << formatCount(m.hotspot.wrongPixels)
+              << " px): " << escapeHtml(rm.label) << " image, then its difference.</div>";
+        }
+        o << "</div>\n";
+    }
+    o << "</div>\n";
+
+    if (!in.methods.empty()) {
+        o << "<h2>Metrics</h2>\n" << metricsTable(in);
+        o << "<p class=\"small\">Rates are over counted pixels unless noted. Aliasing counts wrong pixels within "
+          << in.methods.front().metrics.edgeRadius
+          << " px of a shadow edge in the reference; bias error counts the rest.</p>\n";
+    }
+
+    o << "<h2>Error against run time</h2>\n<div class=\"plotrow\"><div>" << errorTimeSvg(in)
+      << "</div><div>" << timingTable(in)
+      << "<p class=\"small\">Stage timings in milliseconds as each backend recorded them.</p></div></div>\n";
+
+    if (in.sweep) o << sweepSection(*in.sweep);
+
+    const std::string objects = perObjectTable(in);
+    if (!objects.empty()) o << "<h2>Errors per receiving object</h2>\n" << objects;
+
+    o << "<h2>Settings</h2>\n<details><summary>Frame metadata (backend, settings, versions)</summary>"
+      << attributesHtml(in.reference.label.empty() ? "reference" : in.reference.label, ref);
+    for (const auto& rm : in.methods) o << attributesHtml(rm.label, rm.frame);
+    o << "</details>\n";
+    if (!in.planText.empty())
+        o << "<details><summary>Render plan</summary><pre>" << escapeHtml(in.planText) << "</pre></details>\n";
+
+    o << "</main>\n</body>\n</html>\n";
+    return o.str();
+}
+
+void writeReport(const std::filesystem::path& dir, const ReportInput& input) {
+    scene::writeTextAtomic(dir / "report.html", renderReportHtml(input));
+}
+
+namespace html {
+
+const char* css() { return kCss; }
+
+std::string figure(const std::string& caption, const std::string& note, const std::string& png,
+                   const FrameInfo& frame, const ErrorHotspot* hotspot) {
+    return compare::figure(caption, note, png, frame, hotspot);
+}
+
+std::string zoomCrop(const std::string& png, const FrameInfo& frame, const ErrorHotspot& hotspot,
+                     const std::string& alt) {
+    return compare::crop(png, frame, hotspot, alt);
+}
+
+std::string diffLegend() { return legendHtml(); }
+
+}  // namespace html
+
+}  // namespace shadowlab::compare

@@ -1,0 +1,103 @@
+// compare/sweep.h: renders a grid of settings for both backends, times each (setup separated
+// from per-frame time, median of several runs after a warm-up), measures each against a cached
+// reference and appends one row per configuration as it finishes. A stopped sweep resumes
+// where it left off: finished rows are never lost or duplicated (see docs/sweep.md).
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "scene/frame.h"
+#include "scene/scene.h"
+#include "scene/settings.h"
+
+namespace shadowlab::compare {
+
+// One point of the grid: a backend and the settings that differ from the scene's defaults.
+struct SweepConfig {
+    std::string backend;  // "raster" | "raytrace"
+    scene::SettingsOverrides overrides;
+    // The bias parameter this configuration samples, for bias-window plots: "depth" (world
+    // units), "slope" (texels), "ray" (world units); empty when it samples none.
+    std::string biasKind;
+    double biasValue = std::numeric_limits<double>::quiet_NaN();
+
+    // Canonical text of backend + overrides, identical across runs: the resume key.
+    std::string key() const;
+    // Short text for tables and plot tooltips, e.g. "map 1024, none, depth 0.01, slope 0".
+    std::string label() const;
+};
+
+struct SweepGrid {
+    std::vector<SweepConfig> configs;
+    int repetitions = 3;                    // timed frames per configuration (after one warm-up)
+    std::optional<std::string> resolution;  // "WxH" for every render of the sweep
+};
+
+// The grid `sweep` runs without --grid: shadow-map size × filter at default bias, a constant
+// and a slope depth-bias series, and a ray-bias series in float plus robust offsets in float and
+// double. `quick` is the smaller grid `run` includes in its report.
+SweepGrid defaultGrid(const scene::Scene& scene, bool quick);
+// A grid file (JSON, see docs/sweep.md). Throws scene::SceneError naming the file and the JSON
+// path of a bad value.
+SweepGrid loadGrid(const std::filesystem::path& file, const scene::Scene& scene);
+
+struct SweepRow {
+    SweepConfig config;
+    std::string key;
+    int repetitions = 0;
+    double setupMs = 0.0;                  // median over the runs
+    double frameMs = 0.0;                  // median per-frame time (total − setup)
+    double frameMsMin = 0.0, frameMsMax = 0.0;
+    nlohmann::json metrics;                // compare::toJson of the last run, or null on error
+    nlohmann::json settings;               // the settings applied (Frame attributes)
+    std::string error;                     // non-empty when the configuration failed
+    std::string image, diffImage;          // file names under DIR/images/
+
+    double rate(const char* name) const;   // a metrics rate, NaN when absent
+};
+
+// Renders one configuration; the default calls the raster or raytrace backend.
+using RenderFn = std::function<scene::Frame(const scene::Scene&, const scene::RenderSettings&,
+                                            const std::string& backend)>;
+scene::Frame renderWithBackend(const scene::Scene& scene, const scene::RenderSettings& settings,
+                               const std::string& backend);
+
+struct SweepProgress {
+    std::size_t done = 0, total = 0, skipped = 0;  // skipped: already in the journal (resume)
+    const SweepRow* row = nullptr;                 // the row just finished
+    double elapsedSeconds = 0.0, etaSeconds = 0.0;
+};
+
+struct SweepOptions {
+    std::filesystem::path outputDir;
+    bool resume = false;
+    bool writeImages = true;
+    RenderFn render = renderWithBackend;
+    std::function<void(const SweepProgress&)> progress;
+};
+
+struct SweepResult {
+    std::vector<SweepRow> rows;  // in grid order
+    scene::Frame reference;
+    double referenceMs = 0.0;
+};
+
+// Writes DIR/reference.exr (cached: reused when it matches the scene and resolution),
+// DIR/results.jsonl (the journal, one line per finished row, fsync'ed), and regenerates
+// DIR/results.csv and DIR/results.json after every row. Throws scene::InputError when DIR
+// already holds a sweep and `resume` is false, or holds one of another scene.
+SweepResult runSweep(const scene::Scene& scene, const SweepGrid& grid, const SweepOptions& options);
+
+// Reads the rows of a journal; a torn last line (a kill in the middle of a write) is ignored.
+std::vector<SweepRow> readJournal(const std::filesystem::path& file);
+std::string rowsToCsv(const std::vector<SweepRow>& rows);
+nlohmann::json rowsToJson(const std::vector<SweepRow>& rows);
+
+}  // namespace shadowlab::compare

@@ -1,0 +1,78 @@
+// compare/text.cpp: number formatting and HTML escaping for the report, plots and summaries.
+#include "compare/text.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace shadowlab::compare {
+
+namespace {
+
+std::string printf1(const char* format, double value) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, format, value);
+    return buf;
+}
+
+}  // namespace
+
+std::string formatCount(std::size_t n) {
+    std::string digits = std::to_string(n);
+    std::string out;
+    const int len = static_cast<int>(digits.size());
+    for (int i = 0; i < len; ++i) {
+        if (i > 0 && (len - i) % 3 == 0) out += ',';
+        out += digits[static_cast<std::size_t>(i)];
+    }
+    return out;
+}
+
+std::string formatPercent(double rate) {
+    if (!std::isfinite(rate)) return "n/a";
+    if (rate == 0.0) return "0%";
+    const double p = rate * 100.0;
+    const double a = std::fabs(p);
+    if (rate == 1.0) return "100%";
+    if (a >= 10.0) return printf1("%.1f%%", p);
+    if (a >= 0.01) return printf1("%.2f%%", p);
+    // Below 0.01% keep two significant digits so a single wrong pixel in a large image still
+    // reads as non-zero.
+    return printf1("%.2g%%", p);
+}
+
+std::string formatDuration(double ms) {
+    if (!std::isfinite(ms)) return "n/a";
+    if (ms >= 1000.0) return printf1("%.3g s", ms / 1000.0);
+    if (ms >= 100.0) return printf1("%.0f ms", ms);
+    return printf1("%.3g ms", ms);
+}
+
+std::string formatFixed(double value, int decimals) {
+    if (!std::isfinite(value)) return "n/a";
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.*f", decimals, value);
+    return buf;
+}
+
+std::string formatShort(double value) {
+    if (!std::isfinite(value)) return "n/a";
+    return printf1("%.3g", value);
+}
+
+std::string escapeHtml(const std::string& text) {
+    std::string out;
+    out.reserve(text.size());
+    for (const char c : text) {
+        switch (c) {
+            case '&': out += "&amp;"; break;
+            case '<': out += "&lt;"; break;
+            case '>': out += "&gt;"; break;
+            case '"': out += "&quot;"; break;
+            case '\'': out += "&#39;"; break;
+            default: out += c;
+        }
+    }
+    return out;
+}
+
+}  // namespace shadowlab::compare

@@ -1,0 +1,49 @@
+// compare/thresholds.h: every tolerance compare/ uses, each with the reason for its value.
+#pragma once
+
+namespace shadowlab::compare {
+
+// τ: visibilities disagree when they differ by more than half the 0..1 range, so a slightly
+// wider or narrower penumbra (soft shadows, PCF) is not counted as a wrong shadow, while a hard
+// lit/shadowed flip (|ΔV| = 1) always is. A pixel is "shadowed" when V ≤ τ (IoU, classes).
+inline constexpr float kVisibilityTolerance = 0.5f;
+
+// Object ids are integers (index + 1) stored in float channels, exact up to 2^24. Two ids match
+// when they round to the same integer: a backend that stores ids through a half-float or a
+// normalized format still matches, while a different object (ids differ by ≥ 1) never does.
+// Id 0 (background) never counts as a match.
+inline constexpr float kObjectIdRounding = 0.5f;
+
+// A pixel counts only where N·L > 0 in BOTH frames. The reference decides whether the pixel
+// faces the light; the method must agree, because a method that computed N·L ≤ 0 shades the
+// pixel black whatever its shadow test says, so its visibility there is not a shadow answer.
+// Zero, not an epsilon: pixels facing the light at grazing angles are exactly where acne lives
+// and must stay counted. Pixels where the two disagree on the sign are reported separately
+// (Metrics::ndotlSignMismatch) so nothing is hidden.
+inline constexpr float kMinNdotL = 0.0f;
+
+// Edge-aware error: a wrong pixel within this many pixels (Chebyshev distance) of a
+// reference shadow boundary counts as aliasing (texel-sized stair steps of a shadow map are
+// one or two pixels wide at typical map/screen ratios) rather than as bias error.
+inline constexpr int kDefaultEdgeRadiusPixels = 2;
+
+// Bias window: a bias is acceptable when both its false- and missed-shadow rates are at most
+// this share of the counted pixels. 0.1% is about 500 pixels of a 1280×720 view of a floor:
+// scattered that thinly, acne and leak pixels stop being visible at 1:1, while a real acne
+// pattern or a detached contact shadow is well above it.
+inline constexpr double kBiasWindowMaxRate = 0.001;
+
+// Sweep summary: "good enough" for the fastest-configuration sentence is a mismatch of at most
+// 1% of the counted pixels. A typical contact shadow's rim, or a shadow map's stair steps along
+// a long edge, stays below it; a visible acne pattern or a detached shadow does not.
+inline constexpr double kSweepGoodMismatchRate = 0.01;
+
+// Findings paragraph: an object or cause is named as "mostly" responsible when it holds more
+// than half of a class, i.e. when it is the majority, not merely the largest share.
+inline constexpr double kMostlyShare = 0.5;
+// Findings paragraph: silhouettes are mentioned when they differ on more than 0.2% of the
+// image. Below that it is the usual one-pixel rim where rasterization's coverage rule and a
+// ray through the pixel center disagree (a sphere 600 px across has a rim of ~1900 pixels).
+inline constexpr double kNotableSilhouetteRate = 0.002;
+
+}  // namespace shadowlab::compare

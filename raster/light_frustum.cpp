@@ -1,0 +1,250 @@
+// raster/light_frustum.cpp: orthographic and perspective light frusta.
+#include "raster/light_frustum.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <vector>
+
+#include "raster/tolerances.h"
+#include "scene/camera.h"
+
+namespace shadowlab::raster {
+
+using scene::Vec3;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+void setBasis(LightFrustum& f, const Vec3& direction) {
+    f.direction = glm::normalize(direction);
+    // Any axis not parallel to the light makes a basis; world Y unless the light is vertical.
+    const Vec3 ref = std::abs(f.direction.y) < 0.99 ? Vec3(0, 1, 0) : Vec3(1, 0, 0);
+    f.right = glm::normalize(glm::cross(f.direction, ref));
+    f.up = glm::cross(f.right, f.direction);
+}
+
+std::array<Vec3, 8> corners(const scene::Bounds& b) {
+    std::array<Vec3, 8> c;
+    for (int k = 0; k < 8; ++k)
+        c[k] = Vec3((k & 1) ? b.max.x : b.min.x, (k & 2) ? b.max.y : b.min.y, (k & 4) ? b.max.z : b.min.z);
+    return c;
+}
+
+struct Plane {
+    Vec3 n;      // inward normal
+    double d;    // inside: dot(n, p) + d >= 0
+};
+
+// Sutherland–Hodgman: the part of convex polygon `poly` on the inner side of `plane`.
+std::vector<Vec3> clipPolygon(const std::vector<Vec3>& poly, const Plane& plane) {
+    std::vector<Vec3> out;
+    for (std::size_t i = 0; i < poly.size(); ++i) {
+        const Vec3& a = poly[i];
+        const Vec3& b = poly[(i + 1) % poly.size()];
+        const double da = glm::dot(plane.n, a) + plane.d, db = glm::dot(plane.n, b) + plane.d;
+        if (da >= 0) out.push_back(a);
+        if ((da >= 0) != (db >= 0)) out.push_back(a + (b - a) * (da / (da - db)));
+    }
+    return out;
+}
+
+// The vertices of box ∩ camera frustum (between view depths nearD and farD); none when disjoint.
+std::vector<Vec3> clipBoxToFrustum(const scene::Bounds& box, const scene::CameraBasis& cam, double nearD, double farD) {
+    const Vec3 e = cam.position;
+    const double tx = cam.tanHalfFovY * cam.aspect, ty = cam.tanHalfFovY;
+    const Plane planes[] = {
+        {cam.forward, -glm::dot(cam.forward, e) - nearD},
+        {-cam.forward, glm::dot(cam.forward, e) + farD},
+        {tx * cam.forward - cam.right, -glm::dot(tx * cam.forward - cam.right, e)},
+        {tx * cam.forward + cam.right, -glm::dot(tx * cam.forward + cam.right, e)},
+        {ty * cam.forward - cam.up, -glm::dot(ty * cam.forward - cam.up, e)},
+        {ty * cam.forward + cam.up, -glm::dot(ty * cam.forward + cam.up, e)},
+    };
+    const std::array<Vec3, 8> c = corners(box);
+    // Faces as corner indices (bit 0: x, bit 1: y, bit 2: z), each in order around the face.
+    const int faces[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
+    std::vector<Vec3> out;
+    for (const auto& face : faces) {
+        std::vector<Vec3> poly{c[face[0]], c[face[1]], c[face[2]], c[face[3]]};
+        for (const Plane& p : planes) {
+            poly = clipPolygon(poly, p);
+            if (poly.empty()) break;
+        }
+        out.insert(out.end(), poly.begin(), poly.end());
+    }
+    // The frustum's own corners inside the box are vertices too (a camera inside the box).
+    for (const double z : {nearD, farD})
+        for (const double sx : {-1.0, 1.0})
+            for (const double sy : {-1.0, 1.0}) {
+                const Vec3 p = e + z * (cam.forward + sx * tx * cam.right + sy * ty * cam.up);
+                if (glm::all(glm::greaterThanEqual(p, box.min)) && glm::all(glm::lessThanEqual(p, box.max)))
+                    out.push_back(p);
+            }
+    return out;
+}
+
+}  // namespace
+
+double LightFrustum::texelWorldSize() const {
+    return perspective ? 2.0 * tanHalfFov / mapSize : 2.0 * halfWidth / mapSize;
+}
+
+LightFrustum fitDirectionalLight(const scene::Bounds& bounds, const Vec3& direction, int mapSize) {
+    LightFrustum f;
+    f.center = bounds.empty() ? Vec3(0.0) : bounds.center();
+    const double radius = bounds.empty() ? 0.0 : 0.5 * bounds.diagonal();
+    // A point-like scene still needs a non-zero depth range; scale the floor with the position
+    // so it stays representable.
+    const double floor = 1e-6 * std::max(1.0, bounds.empty() ? 0.0 : bounds.maxAbsCoordinate());
+    f.halfWidth = std::max(radius, floor) * kLightFrustumMargin;
+    f.nearDepth = -f.halfWidth;
+    f.farDepth = f.halfWidth;
+    setBasis(f, direction);
+    f.mapSize = std::max(mapSize, 1);
+    return f;
+}
+
+LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const Vec3& direction, int mapSize) {
+    const scene::Bounds sceneBounds = scene.bounds();
+    LightFrustum f = fitDirectionalLight(sceneBounds, direction, mapSize);
+    if (sceneBounds.empty()) return f;
+
+    // Receivers: the scene box clipped to the camera frustum (far plane pulled in to the
+    // scene's farthest corner). Each face of the box is clipped against the frustum's six
+    // planes; the clipped polygons' vertices are the vertices of box ∩ frustum.
+    const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
+    double farthest = 0.0;
+    for (const Vec3& c : corners(sceneBounds)) farthest = std::max(farthest, glm::dot(c - cam.position, cam.forward));
+    const double nearD = scene.camera.near, farD = std::min(scene.camera.far, farthest);
+    if (!(farD > nearD)) return f;  // the scene is behind the camera
+    const std::vector<Vec3> receivers = clipBoxToFrustum(sceneBounds, cam, nearD, farD);
+    if (receivers.empty()) return f;  // the camera sees none of the scene
+
+    // Receivers' extent across the light and their farthest depth along it.
+    double minU = INFINITY, maxU = -INFINITY, minV = INFINITY, maxV = -INFINITY, maxDepth = -INFINITY;
+    for (const Vec3& c : receivers) {
+        const Vec3 d = c - f.center;
+        minU = std::min(minU, glm::dot(d, f.right));
+        maxU = std::max(maxU, glm::dot(d, f.right));
+        minV = std::min(minV, glm::dot(d, f.up));
+        maxV = std::max(maxV, glm::dot(d, f.up));
+        maxDepth = std::max(maxDepth, glm::dot(d, f.direction));
+    }
+    // Casters: every object whose extent across the light overlaps the receivers'; the map
+    // must reach back to the nearest of them.
+    double minDepth = INFINITY;
+    for (const scene::Object& o : scene.objects) {
+        const scene::Bounds b = scene::boundsOf(o.shape);
+        if (b.empty()) continue;
+        double oMinU = INFINITY, oMaxU = -INFINITY, oMinV = INFINITY, oMaxV = -INFINITY, oMinDepth = INFINITY;
+        for (const Vec3& c : corners(b)) {
+            const Vec3 d = c - f.center;
+            oMinU = std::min(oMinU, glm::dot(d, f.right));
+            oMaxU = std::max(oMaxU, glm::dot(d, f.right));
+            oMinV = std::min(oMinV, glm::dot(d, f.up));
+            oMaxV = std::max(oMaxV, glm::dot(d, f.up));
+            oMinDepth = std::min(oMinDepth, glm::dot(d, f.direction));
+        }
+        if (oMaxU < minU || oMinU > maxU || oMaxV < minV || oMinV > maxV) continue;
+        minDepth = std::min(minDepth, oMinDepth);
+    }
+    if (!(minDepth < maxDepth)) return f;
+
+    // Square texels: the larger extent sets the half-width; the map is centered on the
+    // receivers across the light. Same margin as the bounding-sphere fit.
+    const double half = 0.5 * std::max(maxU - minU, maxV - minV) * kLightFrustumMargin;
+    const double pad = (kLightFrustumMargin - 1.0) * (maxDepth - minDepth);
+    if (!(half > 0.0) || half >= f.halfWidth) return f;  // no gain over the bounding sphere
+    f.center = f.center + 0.5 * (minU + maxU) * f.right + 0.5 * (minV + maxV) * f.up;
+    f.halfWidth = half;
+    f.nearDepth = minDepth - pad;
+    f.farDepth = maxDepth + pad;
+    return f;
+}
+
+LightFrustum fitSpotLight(const scene::Bounds& bounds, const Vec3& position, const Vec3& direction,
+                          double coneDegrees, int mapSize) {
+    LightFrustum f;
+    f.perspective = true;
+    setBasis(f, direction);
+    f.position = position;
+    f.mapSize = std::max(mapSize, 1);
+    const double half = std::min(coneDegrees * kSpotFovMargin, kMaxSpotHalfAngleDegrees) * kPi / 180.0;
+    f.tanHalfFov = std::tan(half);
+    const Vec3 c = bounds.empty() ? position + f.direction : bounds.center();
+    const double radius = bounds.empty() ? 1.0 : 0.5 * bounds.diagonal() * kLightFrustumMargin;
+    const double along = glm::dot(c - position, f.direction);
+    f.far = std::max(along + radius, 1e-6);
+    f.near = std::max(along - radius, f.far * kSpotMinNearOverFar);
+    return f;
+}
+
+glm::dmat4 LightFrustum::toClip(const Vec3& origin) const {
+    glm::dmat4 m(0.0);
+    if (!perspective) {
+        // x = (q − c')·right / h, y = (q − c')·up / h, z = ((q − c')·dir − nearDepth) / range,
+        // with q = p − origin and c' = center − origin: the large parts cancel in double.
+        const Vec3 c = center - origin;
+        const double h = halfWidth, range = depthRange();
+        for (int k = 0; k < 3; ++k) {
+            m[k][0] = right[k] / h;
+            m[k][1] = up[k] / h;
+            m[k][2] = direction[k] / range;
+        }
+        m[3][0] = -glm::dot(c, right) / h;
+        m[3][1] = -glm::dot(c, up) / h;
+        m[3][2] = -(glm::dot(c, direction) + nearDepth) / range;
+        m[3][3] = 1.0;
+        return m;
+    }
+    // Perspective with d = (q − o')·dir: x = (q − o')·right / t, y = (q − o')·up / t, w = d,
+    // z = A·(d − near), A = far/(far − near), so z/w = far/(far − near)·(1 − near/d).
+    const Vec3 o = position - origin;
+    const double a = far / (far - near);
+    for (int k = 0; k < 3; ++k) {
+        m[k][0] = right[k] / tanHalfFov;
+        m[k][1] = up[k] / tanHalfFov;
+        m[k][2] = a * direction[k];
+        m[k][3] = direction[k];
+    }
+    m[3][0] = -glm::dot(o, right) / tanHalfFov;
+    m[3][1] = -glm::dot(o, up) / tanHalfFov;
+    m[3][2] = -a * (glm::dot(o, direction) + near);
+    m[3][3] = -glm::dot(o, direction);
+    return m;
+}
+
+glm::dmat4 LightFrustum::toTexture(const Vec3& origin) const {
+    // u = 0.5·x + 0.5·w, v = 0.5·y + 0.5·w (divided by w in the shader): Vulkan's viewport puts
+    // clip y = −w on framebuffer row 0, which is texture row 0, so v needs no flip.
+    // (x, y, z, w) -> (0.5x + 0.5w, 0.5y + 0.5w, z, w); column 3 multiplies w.
+    glm::dmat4 b(0.0);
+    b[0][0] = 0.5;
+    b[1][1] = 0.5;
+    b[2][2] = 1.0;
+    b[3][0] = 0.5;
+    b[3][1] = 0.5;
+    b[3][3] = 1.0;
+    return b * toClip(origin);
+}
+
+std::string LightFrustum::describe() const {
+    char buf[320];
+    if (perspective)
+        std::snprintf(buf, sizeof buf,
+                      "perspective position=(%.9g,%.9g,%.9g) direction=(%.9g,%.9g,%.9g) half_fov_deg=%.9g near=%.9g far=%.9g",
+                      position.x, position.y, position.z, direction.x, direction.y, direction.z,
+                      std::atan(tanHalfFov) * 180.0 / kPi, near, far);
+    else
+        std::snprintf(buf, sizeof buf,
+                      "orthographic center=(%.9g,%.9g,%.9g) half_width=%.9g direction=(%.9g,%.9g,%.9g) depth=%.9g..%.9g",
+                      center.x, center.y, center.z, halfWidth, direction.x, direction.y, direction.z, nearDepth,
+                      farDepth);
+    return buf;
+}
+
+}  // namespace shadowlab::raster

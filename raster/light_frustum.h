@@ -1,0 +1,62 @@
+// raster/light_frustum.h: the projection of each light's shadow map: orthographic for a
+// directional light (fitted to the scene's bounding sphere, or to the casters of what the
+// camera sees), perspective for a spot light; and the texel size the biases scale with.
+#pragma once
+
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "scene/scene.h"
+
+namespace shadowlab::raster {
+
+struct LightFrustum {
+    bool perspective = false;  // spot light
+    scene::Vec3 direction;     // unit, the way the light travels (the map looks along it)
+    scene::Vec3 right;         // unit, the map's +u axis
+    scene::Vec3 up;            // unit, the map's +v axis (v grows with framebuffer rows)
+    int mapSize = 1;           // texels per side
+    // Orthographic: the map spans center ± halfWidth across, and depth 0..1 runs from
+    // center − halfWidth·direction to center + halfWidth·direction... unless fitted, where
+    // nearDepth/farDepth (along direction, relative to center) bound it.
+    scene::Vec3 center;
+    double halfWidth = 1;
+    double nearDepth = -1, farDepth = 1;  // along direction from center; default ±halfWidth
+    // Perspective: from `position`, half-angle atan(tanHalfFov), depth from near to far along
+    // `direction`.
+    scene::Vec3 position;
+    double tanHalfFov = 1;
+    double near = 0.1, far = 1;
+
+    // Orthographic: world size of one texel. Perspective: per unit of distance along the axis.
+    double texelWorldSize() const;
+    // World units per unit of orthographic depth (0..1).
+    double depthRange() const { return farDepth - nearDepth; }
+
+    // For positions given relative to `origin`: clip coordinates of the light's view, x, y in
+    // −w..w across the map, z in 0..w from near to far.
+    glm::dmat4 toClip(const scene::Vec3& origin) const;
+    // The same with x, y mapped to texture coordinates: (u, v) = (x/w, y/w) in 0..1.
+    glm::dmat4 toTexture(const scene::Vec3& origin) const;
+    std::string describe() const;
+};
+
+// The sphere around `bounds` (center = box center, radius = half its diagonal), seen along
+// `direction`. An empty or point-like bounds gets a tiny but valid frustum.
+LightFrustum fitDirectionalLight(const scene::Bounds& bounds, const scene::Vec3& direction, int mapSize);
+
+// A map covering only what can shadow what the camera sees: the receivers are the scene's
+// bounds clipped to the camera frustum (its far plane pulled in to the scene); across the light
+// the map covers their extent, and in depth it reaches back toward the light to the nearest
+// object whose extent across the light overlaps theirs. Falls back to fitDirectionalLight()
+// when the camera sees none of the scene.
+LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const scene::Vec3& direction, int mapSize);
+
+// Spot light at `position` shining along `direction` with cone half-angle `coneDegrees`: the
+// map's field of view is the cone plus a 2% margin; near and far enclose the scene's bounding
+// sphere (near no closer than 1/1000 of far, which bounds the depth precision lost).
+LightFrustum fitSpotLight(const scene::Bounds& bounds, const scene::Vec3& position, const scene::Vec3& direction,
+                          double coneDegrees, int mapSize);
+
+}  // namespace shadowlab::raster

@@ -1,0 +1,243 @@
+// raster/lit_pass.cpp: the camera pass and the readback of its targets.
+#include "raster/lit_pass.h"
+
+#include <cstring>
+
+#include "raster/pipeline.h"
+#include "raster/vulkan_error.h"
+#include "shaders/spirv.h"
+
+namespace shadowlab::raster {
+
+LitPipeline createLitPipeline(const Context& ctx) {
+    requireFormat(ctx, kLitColorFormat,
+                  VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_TRANSFER_SRC_BIT, "the lit pass targets");
+    requireFormat(ctx, kLitDepthFormat, VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT, "the camera depth buffer");
+    VkDevice device = ctx.device.get();
+    const VkDescriptorSetLayoutBinding bindings[] = {
+        {.binding = 0, .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .descriptorCount = 1,
+         .stageFlags = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT},
+        {.binding = 1, .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, .descriptorCount = 1,
+         .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
+        {.binding = 2, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
+         .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
+        {.binding = 3, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
+         .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
+    };
+    const VkDescriptorSetLayoutCreateInfo setInfo{
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
+        .bindingCount = 4,
+        .pBindings = bindings,
+    };
+    LitPipeline p;
+    VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &setLayout));
+    p.setLayout = DescriptorSetLayoutHandle(device, setLayout);
+    const VkPipelineLayoutCreateInfo layoutInfo{
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
+        .setLayoutCount = 1,
+        .pSetLayouts = &setLayout,
+    };
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    VK_CHECK(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &layout));
+    p.layout = PipelineLayoutHandle(device, layout);
+    p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{
+                                                 .vertexShader = shaders::litVertSpirv(),
+                                                 .fragmentShader = shaders::litFragSpirv(),
+                                                 .layout = layout,
+                                                 .colorFormats = {kLitColorFormat, kLitColorFormat},
+                                                 .depthFormat = kLitDepthFormat,
+                                                 // Reversed Z: nearer is larger.
+                                                 .depthCompare = VK_COMPARE_OP_GREATER,
+                                             });
+    return p;
+}
+
+LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32_t height) {
+    const std::uint32_t limit = ctx.properties.limits.maxImageDimension2D;
+    if (width > limit || height > limit)
+        throw RasterError("image " + std::to_string(width) + "x" + std::to_string(height) +
+                          " exceeds the device's limit of " + std::to_string(limit) + " per side (" +
+                          ctx.deviceReport.name + ")");
+    // Two RGBA32F targets, D32 depth, and two RGBA32F readback buffers.
+    requireDeviceMemory(ctx, VkDeviceSize(width) * height * (2 * 16 + 4 + 2 * 16),
+                        "a " + std::to_string(width) + "x" + std::to_string(height) + " image");
+    LitTargets t;
+    t.width = width;
+    t.height = height;
+    const VkImageUsageFlags colorUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    t.beauty = createImage(ctx, kLitColorFormat, width, height, 1, colorUsage, VK_IMAGE_ASPECT_COLOR_BIT,
+                           VK_IMAGE_VIEW_TYPE_2D);
+    t.aovs = createImage(ctx, kLitColorFormat, width, height, 1, colorUsage, VK_IMAGE_ASPECT_COLOR_BIT,
+                         VK_IMAGE_VIEW_TYPE_2D);
+    t.depth = createImage(ctx, kLitDepthFormat, width, height, 1, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
+                          VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_VIEW_TYPE_2D);
+    return t;
+}
+
+LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, const shaders::LitUniforms& uniforms,
+                              const std::vector<glm::vec4>& albedos, const ShadowMaps& maps) {
+    VkDevice device = ctx.device.get();
+    LitBindings b;
+    // A depth-compare sampler: result = (ref <= stored), i.e. "receiver depth - bias <= stored
+    // depth" is lit. Outside the map the border is depth 1 (far), so there everything is lit.
+    // NEAREST for every filter: lit.frag does the filtering (lavapipe has no linear filtering
+    // of D32_SFLOAT, and shader-side weights are the same on every driver).
+    const VkFilter texFilter = VK_FILTER_NEAREST;
+    const VkSamplerCreateInfo samplerInfo{
+        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
+        .magFilter = texFilter,
+        .minFilter = texFilter,
+        .mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
+        .addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER,
+        .addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER,
+        .addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .compareEnable = VK_TRUE,
+        .compareOp = VK_COMPARE_OP_LESS_OR_EQUAL,
+        .minLod = 0.0f,
+        .maxLod = 0.0f,
+        .borderColor = VK_BORDER_COLOR_FLOAT_OPAQUE_WHITE,
+    };
+    VkSampler sampler = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateSampler(device, &samplerInfo, nullptr, &sampler));
+    b.sampler = SamplerHandle(device, sampler);
+    // The blocker ids: the same NEAREST addressing, no compare; 0 (no blocker) outside.
+    VkSamplerCreateInfo idSamplerInfo = samplerInfo;
+    idSamplerInfo.compareEnable = VK_FALSE;
+    idSamplerInfo.compareOp = VK_COMPARE_OP_NEVER;
+    idSamplerInfo.borderColor = VK_BORDER_COLOR_INT_TRANSPARENT_BLACK;
+    VkSampler idSampler = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateSampler(device, &idSamplerInfo, nullptr, &idSampler));
+    b.idSampler = SamplerHandle(device, idSampler);
+    b.uniforms = uploadBuffer(ctx, &uniforms, sizeof uniforms, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+    b.albedos = uploadBuffer(ctx, albedos, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+
+    const VkDescriptorPoolSize sizes[] = {
+        {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
+        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
+        {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 2},
+    };
+    const VkDescriptorPoolCreateInfo poolInfo{
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
+        .maxSets = 1,
+        .poolSizeCount = 3,
+        .pPoolSizes = sizes,
+    };
+    VkDescriptorPool pool = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateDescriptorPool(device, &poolInfo, nullptr, &pool));
+    b.pool = DescriptorPoolHandle(device, pool);
+    const VkDescriptorSetLayout setLayout = pipeline.setLayout.get();
+    const VkDescriptorSetAllocateInfo allocInfo{
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
+        .descriptorPool = pool,
+        .descriptorSetCount = 1,
+        .pSetLayouts = &setLayout,
+    };
+    VK_CHECK(vkAllocateDescriptorSets(device, &allocInfo, &b.set));
+
+    const VkDescriptorBufferInfo uniformInfo{b.uniforms.buffer.get(), 0, VK_WHOLE_SIZE};
+    const VkDescriptorBufferInfo albedoInfo{b.albedos.buffer.get(), 0, VK_WHOLE_SIZE};
+    const VkDescriptorImageInfo imageInfo{sampler, maps.depth.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    const VkDescriptorImageInfo idInfo{idSampler, maps.ids.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    const VkWriteDescriptorSet writes[] = {
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 0, .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .pBufferInfo = &uniformInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 1, .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, .pBufferInfo = &albedoInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 2, .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &imageInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 3, .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &idInfo},
+    };
+    vkUpdateDescriptorSets(device, 4, writes, 0, nullptr);
+    return b;
+}
+
+void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const LitBindings& bindings,
+                   const LitTargets& targets, const DrawGeometry& geometry, const glm::vec3& background) {
+    const VkPipelineStageFlags2 colorStage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+    const VkPipelineStageFlags2 depthStages =
+        VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
+    transition(commands,
+               {{targets.beauty.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, colorStage,
+                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT},
+                {targets.aovs.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, colorStage,
+                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT},
+                {targets.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+                 VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, depthStages,
+                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT}});
+    const VkRenderingAttachmentInfo colors[] = {
+        {.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+         .imageView = targets.beauty.view.get(),
+         .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+         .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+         .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+         .clearValue = {.color = {.float32 = {background.r, background.g, background.b, 0.0f}}}},
+        {.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+         .imageView = targets.aovs.view.get(),
+         .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+         .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+         .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+         .clearValue = {.color = {.float32 = {0.0f, 0.0f, 0.0f, 0.0f}}}},
+    };
+    const VkRenderingAttachmentInfo depth{
+        .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+        .imageView = targets.depth.view.get(),
+        .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+        .storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
+        .clearValue = {.depthStencil = {0.0f, 0}},  // reversed Z: 0 is the far plane
+    };
+    const VkRenderingInfo rendering{
+        .sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
+        .renderArea = {{0, 0}, {targets.width, targets.height}},
+        .layerCount = 1,
+        .colorAttachmentCount = 2,
+        .pColorAttachments = colors,
+        .pDepthAttachment = &depth,
+    };
+    vkCmdBeginRendering(commands, &rendering);
+    if (geometry.indexCount > 0) {
+        vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.pipeline.get());
+        setViewport(commands, targets.width, targets.height);
+        vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.layout.get(), 0, 1,
+                                &bindings.set, 0, nullptr);
+        const VkDeviceSize offset = 0;
+        vkCmdBindVertexBuffers(commands, 0, 1, &geometry.vertices, &offset);
+        vkCmdBindIndexBuffer(commands, geometry.indices, 0, VK_INDEX_TYPE_UINT32);
+        vkCmdDrawIndexed(commands, geometry.indexCount, 1, 0, 0, 0);
+    }
+    vkCmdEndRendering(commands);
+    transition(commands,
+               {{targets.beauty.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                 VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, colorStage, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                 VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT},
+                {targets.aovs.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                 VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, colorStage, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                 VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT}});
+}
+
+Readback createReadback(const Context& ctx, const LitTargets& targets) {
+    const VkDeviceSize bytes = VkDeviceSize(targets.width) * targets.height * 4 * sizeof(float);
+    Readback r;
+    r.beauty = createReadbackBuffer(ctx, bytes);
+    r.aovs = createReadbackBuffer(ctx, bytes);
+    return r;
+}
+
+void recordReadback(VkCommandBuffer commands, const LitTargets& targets, const Readback& readback) {
+    const VkBufferImageCopy region{
+        .imageSubresource = {.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT, .mipLevel = 0, .baseArrayLayer = 0,
+                             .layerCount = 1},
+        .imageExtent = {targets.width, targets.height, 1},
+    };
+    vkCmdCopyImageToBuffer(commands, targets.beauty.image.get(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                           readback.beauty.buffer.get(), 1, &region);
+    vkCmdCopyImageToBuffer(commands, targets.aovs.image.get(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                           readback.aovs.buffer.get(), 1, &region);
+    transferToHostBarrier(commands);
+}
+
+}  // namespace shadowlab::raster

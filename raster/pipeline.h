@@ -1,0 +1,35 @@
+// raster/pipeline.h: graphics pipelines for dynamic rendering (no render pass objects): the
+// shadow and lit passes describe what differs, this builds the rest the same way for both.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "raster/context.h"
+
+namespace shadowlab::raster {
+
+ShaderModuleHandle createShaderModule(const Context& ctx, std::span<const std::uint32_t> spirv);
+
+struct PipelineDesc {
+    std::span<const std::uint32_t> vertexShader;
+    std::span<const std::uint32_t> fragmentShader;  // empty: depth only
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    bool usesNormal = true;  // declare vertex location 1; the validation layer warns about unused inputs
+    std::vector<VkFormat> colorFormats;
+    VkFormat depthFormat = VK_FORMAT_D32_SFLOAT;
+    VkCompareOp depthCompare = VK_COMPARE_OP_LESS;
+};
+
+// Triangle lists, no culling (quads are two-sided, and both faces must cast), depth test and
+// write on, no blending, viewport and scissor dynamic.
+PipelineHandle createGraphicsPipeline(const Context& ctx, const PipelineDesc& desc);
+
+// Throws RasterError naming the device and the format when it lacks `features` (optimal tiling).
+void requireFormat(const Context& ctx, VkFormat format, VkFormatFeatureFlags features, const char* purpose);
+
+// Viewport and scissor covering width x height.
+void setViewport(VkCommandBuffer commands, std::uint32_t width, std::uint32_t height);
+
+}  // namespace shadowlab::raster

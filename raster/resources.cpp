@@ -1,0 +1,175 @@
+// raster/resources.cpp: buffer and image creation, staging uploads, layout transitions.
+#include "raster/resources.h"
+
+#include <cstring>
+
+#include "raster/vulkan_error.h"
+
+namespace shadowlab::raster {
+
+void requireDeviceMemory(const Context& ctx, VkDeviceSize bytes, const std::string& what) {
+    VkDeviceSize largest = 0;
+    for (std::uint32_t i = 0; i < ctx.memoryProperties.memoryHeapCount; ++i)
+        if (ctx.memoryProperties.memoryHeaps[i].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
+            largest = std::max(largest, ctx.memoryProperties.memoryHeaps[i].size);
+    constexpr VkDeviceSize kMiB = 1024 * 1024;
+    if (bytes > largest)
+        throw RasterError(what + " needs " + std::to_string(bytes / kMiB) + " MiB of device memory, but the largest heap of " +
+                          ctx.deviceReport.name + " has " + std::to_string(largest / kMiB) +
+                          " MiB; use a smaller resolution or --shadow-map-size");
+}
+
+Buffer createBuffer(const Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage,
+                    VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred) {
+    VkDevice device = ctx.device.get();
+    const VkBufferCreateInfo info{
+        .sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO,
+        .size = size,
+        .usage = usage,
+        .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
+    };
+    Buffer b;
+    b.size = size;
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateBuffer(device, &info, nullptr, &buffer));
+    b.buffer = BufferHandle(device, buffer);
+    VkMemoryRequirements req{};
+    vkGetBufferMemoryRequirements(device, buffer, &req);
+    const VkMemoryAllocateInfo alloc{
+        .sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
+        .allocationSize = req.size,
+        .memoryTypeIndex = ctx.memoryType(req.memoryTypeBits, required, preferred),
+    };
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    VK_CHECK(vkAllocateMemory(device, &alloc, nullptr, &memory));
+    b.memory = MemoryHandle(device, memory);
+    VK_CHECK(vkBindBufferMemory(device, buffer, memory, 0));
+    if (required & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT)
+        VK_CHECK(vkMapMemory(device, memory, 0, VK_WHOLE_SIZE, 0, &b.mapped));
+    return b;
+}
+
+Buffer uploadBuffer(const Context& ctx, const void* bytes, std::size_t size, VkBufferUsageFlags usage) {
+    const VkDeviceSize n = std::max<VkDeviceSize>(size, 4);  // zero-sized buffers are invalid
+    Buffer staging = createBuffer(ctx, n, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                  VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    if (size > 0) std::memcpy(staging.mapped, bytes, size);
+    Buffer target = createBuffer(ctx, n, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                 VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    VkCommandBuffer commands = ctx.beginCommands();
+    const VkBufferCopy region{.size = n};
+    vkCmdCopyBuffer(commands, staging.buffer.get(), target.buffer.get(), 1, &region);
+    // The submit waits on a fence, and a fence signal makes all of the batch's writes available;
+    // later submits see them without a barrier (Vulkan spec, "Fence signal operation").
+    ctx.submitAndWait(commands);
+    return target;
+}
+
+Buffer createReadbackBuffer(const Context& ctx, VkDeviceSize size) {
+    return createBuffer(ctx, size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT,
+                        VK_MEMORY_PROPERTY_HOST_CACHED_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+}
+
+void invalidate(const Context& ctx, const Buffer& buffer) {
+    const VkMappedMemoryRange range{
+        .sType = VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE,
+        .memory = buffer.memory.get(),
+        .offset = 0,
+        .size = VK_WHOLE_SIZE,
+    };
+    VK_CHECK(vkInvalidateMappedMemoryRanges(ctx.device.get(), 1, &range));
+}
+
+ImageViewHandle createView(const Context& ctx, VkImage image, VkFormat format, VkImageAspectFlags aspect,
+                           VkImageViewType viewType, std::uint32_t firstLayer, std::uint32_t layerCount) {
+    const VkImageViewCreateInfo info{
+        .sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO,
+        .image = image,
+        .viewType = viewType,
+        .format = format,
+        .subresourceRange = {.aspectMask = aspect, .baseMipLevel = 0, .levelCount = 1,
+                             .baseArrayLayer = firstLayer, .layerCount = layerCount},
+    };
+    VkImageView view = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateImageView(ctx.device.get(), &info, nullptr, &view));
+    return ImageViewHandle(ctx.device.get(), view);
+}
+
+Image createImage(const Context& ctx, VkFormat format, std::uint32_t width, std::uint32_t height,
+                  std::uint32_t layers, VkImageUsageFlags usage, VkImageAspectFlags aspect,
+                  VkImageViewType viewType) {
+    VkDevice device = ctx.device.get();
+    const VkImageCreateInfo info{
+        .sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO,
+        .imageType = VK_IMAGE_TYPE_2D,
+        .format = format,
+        .extent = {width, height, 1},
+        .mipLevels = 1,
+        .arrayLayers = layers,
+        .samples = VK_SAMPLE_COUNT_1_BIT,
+        .tiling = VK_IMAGE_TILING_OPTIMAL,
+        .usage = usage,
+        .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
+        .initialLayout = VK_IMAGE_LAYOUT_UNDEFINED,
+    };
+    Image img;
+    VkImage image = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateImage(device, &info, nullptr, &image));
+    img.image = ImageHandle(device, image);
+    VkMemoryRequirements req{};
+    vkGetImageMemoryRequirements(device, image, &req);
+    const VkMemoryAllocateInfo alloc{
+        .sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
+        .allocationSize = req.size,
+        .memoryTypeIndex = ctx.memoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT),
+    };
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    VK_CHECK(vkAllocateMemory(device, &alloc, nullptr, &memory));
+    img.memory = MemoryHandle(device, memory);
+    VK_CHECK(vkBindImageMemory(device, image, memory, 0));
+    img.view = createView(ctx, image, format, aspect, viewType, 0, layers);
+    return img;
+}
+
+void transition(VkCommandBuffer commands, const std::vector<ImageTransition>& transitions) {
+    std::vector<VkImageMemoryBarrier2> barriers;
+    for (const ImageTransition& t : transitions)
+        barriers.push_back(VkImageMemoryBarrier2{
+            .sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2,
+            .srcStageMask = t.srcStage,
+            .srcAccessMask = t.srcAccess,
+            .dstStageMask = t.dstStage,
+            .dstAccessMask = t.dstAccess,
+            .oldLayout = t.from,
+            .newLayout = t.to,
+            .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+            .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+            .image = t.image,
+            .subresourceRange = {.aspectMask = t.aspect, .baseMipLevel = 0, .levelCount = 1,
+                                 .baseArrayLayer = 0, .layerCount = t.layers},
+        });
+    const VkDependencyInfo dependency{
+        .sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO,
+        .imageMemoryBarrierCount = std::uint32_t(barriers.size()),
+        .pImageMemoryBarriers = barriers.data(),
+    };
+    vkCmdPipelineBarrier2(commands, &dependency);
+}
+
+void transferToHostBarrier(VkCommandBuffer commands) {
+    const VkMemoryBarrier2 barrier{
+        .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2,
+        .srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT,
+        .srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT,
+        .dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT,
+        .dstAccessMask = VK_ACCESS_2_HOST_READ_BIT,
+    };
+    const VkDependencyInfo dependency{
+        .sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO,
+        .memoryBarrierCount = 1,
+        .pMemoryBarriers = &barrier,
+    };
+    vkCmdPipelineBarrier2(commands, &dependency);
+}
+
+}  // namespace shadowlab::raster

@@ -1,0 +1,74 @@
+// raster/resources.h: buffers and images with their memory, staging uploads, and the image
+// layout barriers (synchronization2) the passes share.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "raster/context.h"
+
+namespace shadowlab::raster {
+
+struct Buffer {
+    BufferHandle buffer;
+    // Freed before the buffer is destroyed (reverse creation order); Vulkan allows freeing
+    // bound memory as long as the resource is not used again.
+    MemoryHandle memory;
+    void* mapped = nullptr;  // host-visible buffers stay mapped until the memory is freed
+    VkDeviceSize size = 0;
+};
+
+struct Image {
+    ImageHandle image;
+    MemoryHandle memory;
+    ImageViewHandle view;  // of every layer (2D or 2D array)
+};
+
+// Throws RasterError when `bytes` cannot fit in the device's largest device-local heap, naming
+// `what` and both sizes, instead of a bare VK_ERROR_OUT_OF_DEVICE_MEMORY later.
+void requireDeviceMemory(const Context& ctx, VkDeviceSize bytes, const std::string& what);
+
+Buffer createBuffer(const Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage,
+                    VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred = 0);
+
+// A device-local buffer holding `bytes`, filled through a host-visible staging buffer (one
+// submit, waited for). `usage` gets TRANSFER_DST added.
+Buffer uploadBuffer(const Context& ctx, const void* bytes, std::size_t size, VkBufferUsageFlags usage);
+
+template <typename T>
+Buffer uploadBuffer(const Context& ctx, const std::vector<T>& data, VkBufferUsageFlags usage) {
+    return uploadBuffer(ctx, data.data(), data.size() * sizeof(T), usage);
+}
+
+// A host-visible buffer the device writes and the host reads (cached when the device has it).
+Buffer createReadbackBuffer(const Context& ctx, VkDeviceSize size);
+// Makes device writes visible to the host for non-coherent memory; a no-op on coherent memory.
+void invalidate(const Context& ctx, const Buffer& buffer);
+
+Image createImage(const Context& ctx, VkFormat format, std::uint32_t width, std::uint32_t height,
+                  std::uint32_t layers, VkImageUsageFlags usage, VkImageAspectFlags aspect,
+                  VkImageViewType viewType);
+ImageViewHandle createView(const Context& ctx, VkImage image, VkFormat format, VkImageAspectFlags aspect,
+                           VkImageViewType viewType, std::uint32_t firstLayer, std::uint32_t layerCount);
+
+// One image layout transition with its execution and memory dependency.
+struct ImageTransition {
+    VkImage image;
+    VkImageAspectFlags aspect;
+    std::uint32_t layers;
+    VkImageLayout from, to;
+    VkPipelineStageFlags2 srcStage;
+    VkAccessFlags2 srcAccess;
+    VkPipelineStageFlags2 dstStage;
+    VkAccessFlags2 dstAccess;
+};
+void transition(VkCommandBuffer commands, const std::vector<ImageTransition>& transitions);
+
+// Makes transfer writes visible to host reads after the fence wait (a fence alone only orders
+// device accesses; the Vulkan spec asks for this barrier before the host reads).
+void transferToHostBarrier(VkCommandBuffer commands);
+
+}  // namespace shadowlab::raster

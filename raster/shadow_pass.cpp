@@ -1,0 +1,171 @@
+// raster/shadow_pass.cpp: the depth-only pass from the lights.
+#include "raster/shadow_pass.h"
+
+#include <cstring>
+
+#include "raster/pipeline.h"
+#include "raster/vulkan_error.h"
+#include "shaders/interface.h"
+#include "shaders/spirv.h"
+
+namespace shadowlab::raster {
+
+ShadowPipeline createShadowPipeline(const Context& ctx) {
+    requireFormat(ctx, kShadowMapFormat,
+                  VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT,
+                  "the shadow map");
+    requireFormat(ctx, kBlockerIdFormat, VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT,
+                  "the blocker-id map");
+    const VkPushConstantRange push{
+        .stageFlags = VK_SHADER_STAGE_VERTEX_BIT, .offset = 0, .size = sizeof(shaders::ShadowPush)};
+    const VkPipelineLayoutCreateInfo layoutInfo{
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
+        .pushConstantRangeCount = 1,
+        .pPushConstantRanges = &push,
+    };
+    ShadowPipeline p;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    VK_CHECK(vkCreatePipelineLayout(ctx.device.get(), &layoutInfo, nullptr, &layout));
+    p.layout = PipelineLayoutHandle(ctx.device.get(), layout);
+    p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{
+                                                 .vertexShader = shaders::shadowVertSpirv(),
+                                                 .fragmentShader = shaders::shadowFragSpirv(),
+                                                 .layout = layout,
+                                                 .usesNormal = false,
+                                                 .colorFormats = {kBlockerIdFormat},
+                                                 .depthFormat = kShadowMapFormat,
+                                                 .depthCompare = VK_COMPARE_OP_LESS,
+                                             });
+    return p;
+}
+
+ShadowMaps createShadowMaps(const Context& ctx, std::uint32_t size, std::uint32_t layers) {
+    if (size > ctx.properties.limits.maxImageDimension2D)
+        throw RasterError("shadow map size " + std::to_string(size) + " exceeds the device's limit of " +
+                          std::to_string(ctx.properties.limits.maxImageDimension2D) + " (" +
+                          ctx.deviceReport.name + ")");
+    // D32 depth and R32 ids per texel and layer.
+    requireDeviceMemory(ctx, VkDeviceSize(size) * size * layers * 8,
+                        std::to_string(layers) + " shadow map(s) of " + std::to_string(size) + "x" + std::to_string(size));
+    ShadowMaps m;
+    m.size = size;
+    m.layers = layers;
+    m.depth = createImage(ctx, kShadowMapFormat, size, size, layers,
+                          VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                              VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                          VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_VIEW_TYPE_2D_ARRAY);
+    m.ids = createImage(ctx, kBlockerIdFormat, size, size, layers,
+                        VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                        VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D_ARRAY);
+    for (std::uint32_t i = 0; i < layers; ++i) {
+        m.layerViews.push_back(createView(ctx, m.depth.image.get(), kShadowMapFormat, VK_IMAGE_ASPECT_DEPTH_BIT,
+                                          VK_IMAGE_VIEW_TYPE_2D, i, 1));
+        m.idLayerViews.push_back(createView(ctx, m.ids.image.get(), kBlockerIdFormat, VK_IMAGE_ASPECT_COLOR_BIT,
+                                            VK_IMAGE_VIEW_TYPE_2D, i, 1));
+    }
+    return m;
+}
+
+void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, const ShadowMaps& maps,
+                      const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices) {
+    transition(commands, {{maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, maps.layers,
+                           VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                           VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
+                           VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                           VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                               VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT},
+                          {maps.ids.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, maps.layers, VK_IMAGE_LAYOUT_UNDEFINED,
+                           VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
+                           VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT}});
+    for (std::uint32_t layer = 0; layer < maps.layers; ++layer) {
+        const VkRenderingAttachmentInfo depth{
+            .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+            .imageView = maps.layerViews[layer].get(),
+            .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+            .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+            .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+            .clearValue = {.depthStencil = {1.0f, 0}},
+        };
+        const VkRenderingAttachmentInfo ids{
+            .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+            .imageView = maps.idLayerViews[layer].get(),
+            .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+            .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+            .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+            .clearValue = {.color = {.uint32 = {0, 0, 0, 0}}},
+        };
+        const VkRenderingInfo rendering{
+            .sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
+            .renderArea = {{0, 0}, {maps.size, maps.size}},
+            .layerCount = 1,
+            .colorAttachmentCount = 1,
+            .pColorAttachments = &ids,
+            .pDepthAttachment = &depth,
+        };
+        vkCmdBeginRendering(commands, &rendering);
+        if (layer < lightMatrices.size() && geometry.indexCount > 0) {
+            vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.pipeline.get());
+            setViewport(commands, maps.size, maps.size);
+            const shaders::ShadowPush push{.lightMatrix = lightMatrices[layer]};
+            vkCmdPushConstants(commands, pipeline.layout.get(), VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof push, &push);
+            const VkDeviceSize offset = 0;
+            vkCmdBindVertexBuffers(commands, 0, 1, &geometry.vertices, &offset);
+            vkCmdBindIndexBuffer(commands, geometry.indices, 0, VK_INDEX_TYPE_UINT32);
+            vkCmdDrawIndexed(commands, geometry.indexCount, 1, 0, 0, 0);
+        }
+        vkCmdEndRendering(commands);
+    }
+    transition(commands, {{maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, maps.layers,
+                           VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                           VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                           VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                           VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT,
+                           VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT},
+                          {maps.ids.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, maps.layers,
+                           VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                           VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                           VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT,
+                           VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT}});
+}
+
+namespace {
+
+// Copies one layer of `image` (in SHADER_READ_ONLY_OPTIMAL, left so) into host memory.
+void readLayer(const Context& ctx, const ShadowMaps& maps, VkImage image, VkImageAspectFlags aspect,
+               std::uint32_t layer, void* out) {
+    if (layer >= maps.layers) throw std::out_of_range("shadow map has no layer " + std::to_string(layer));
+    const VkDeviceSize bytes = VkDeviceSize(maps.size) * maps.size * 4;  // D32 and R32: 4 bytes a texel
+    Buffer buffer = createReadbackBuffer(ctx, bytes);
+    VkCommandBuffer commands = ctx.beginCommands();
+    transition(commands, {{image, aspect, maps.layers, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                           VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                           VK_ACCESS_2_NONE, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT}});
+    const VkBufferImageCopy region{
+        .imageSubresource = {.aspectMask = aspect, .mipLevel = 0, .baseArrayLayer = layer, .layerCount = 1},
+        .imageExtent = {maps.size, maps.size, 1},
+    };
+    vkCmdCopyImageToBuffer(commands, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buffer.buffer.get(), 1, &region);
+    transition(commands, {{image, aspect, maps.layers, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                           VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE,
+                           VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT}});
+    transferToHostBarrier(commands);
+    ctx.submitAndWait(commands);
+    invalidate(ctx, buffer);
+    std::memcpy(out, buffer.mapped, bytes);
+}
+
+}  // namespace
+
+std::vector<float> readShadowMap(const Context& ctx, const ShadowMaps& maps, std::uint32_t layer) {
+    std::vector<float> depths(std::size_t(maps.size) * maps.size);
+    readLayer(ctx, maps, maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, layer, depths.data());
+    return depths;
+}
+
+std::vector<std::uint32_t> readBlockerIds(const Context& ctx, const ShadowMaps& maps, std::uint32_t layer) {
+    std::vector<std::uint32_t> ids(std::size_t(maps.size) * maps.size);
+    readLayer(ctx, maps, maps.ids.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layer, ids.data());
+    return ids;
+}
+
+}  // namespace shadowlab::raster

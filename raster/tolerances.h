@@ -1,0 +1,42 @@
+// raster/tolerances.h: the raster backend's few non-derived constants, each with its reason.
+#pragma once
+
+namespace shadowlab::raster {
+
+// Sphere tessellation: the chord of each UV-sphere segment may deviate from the true sphere by
+// at most this fraction of a pixel at the sphere's nearest distance to the camera, so that the
+// silhouette (and the shadow the sphere casts) differs from the analytic sphere by well under
+// a pixel, which is what "agrees except on silhouettes" allows.
+inline constexpr double kSphereChordErrorPixels = 0.25;
+// Bounds on the number of segments around a sphere (rings = segments / 2). 16 keeps even a
+// far-away sphere round in the shadow map; 256 caps the cost of a sphere filling the view
+// (256 x 128 segments is 65k triangles per sphere).
+inline constexpr int kMinSphereSegments = 16;
+inline constexpr int kMaxSphereSegments = 256;
+
+// The light frustum encloses the scene's bounding sphere enlarged by this factor, so that the
+// vertices touching the sphere (a tessellated sphere's poles, a quad's corners) stay strictly
+// inside the near and far planes and the map's outer texels after float rounding.
+inline constexpr double kLightFrustumMargin = 1.01;
+
+// A spot light's map covers its cone plus 2% of the half-angle, so the cone's rim is not on
+// the map's outermost texels (where filter taps would fall outside). Half-angles are capped at
+// 85°: a perspective map wider than that spends almost all texels near its edges.
+inline constexpr double kSpotFovMargin = 1.02;
+inline constexpr double kMaxSpotHalfAngleDegrees = 85.0;
+// A spot map's near plane is never closer than far/1000: with standard D32 depth the depth
+// resolution at distance d is about 6e-8·d²/near, so this keeps it near 6e-5·far at the far
+// plane, well below a texel at any sensible map size.
+inline constexpr double kSpotMinNearOverFar = 1e-3;
+
+// The slope bias grows with tan(theta), which is infinite at grazing light; clamping it at
+// 10 (theta ~ 84°) keeps the bias finite where a receiver is nearly edge-on to the light and
+// its N·L shading is close to zero anyway (a common clamp: Microsoft's "Common Techniques to
+// Improve Shadow Depth Maps" and most engines use a similar bound).
+inline constexpr double kMaxSlopeTan = 10.0;
+
+// Largest pcf kernel (taps per side; the Poisson diameter in texels): 15x15 = 225 taps per
+// pixel and light is already slow on lavapipe, and wider penumbrae want a different filter.
+inline constexpr int kMaxPcfSize = 15;
+
+}  // namespace shadowlab::raster

@@ -1,0 +1,112 @@
+// raytrace/bvh4.cpp: collapse of the binary SAH tree into 4-wide nodes.
+#include "raytrace/bvh4.h"
+
+#include <array>
+#include <limits>
+#include <stdexcept>
+
+#include "raytrace/tolerances.h"
+
+namespace shadowlab::raytrace {
+
+static_assert(kBvhMaxLeafCount < 16, "a leaf ref keeps its count in four bits");
+
+namespace {
+
+float surfaceArea(const BvhNode& n) {
+    const float x = n.hi[0] - n.lo[0], y = n.hi[1] - n.lo[1], z = n.hi[2] - n.lo[2];
+    return 2 * (x * y + y * z + z * x);
+}
+
+struct Collapser {
+    const std::vector<BvhNode>& bin;
+    const std::vector<std::uint32_t>& binPrims;
+    std::vector<Bvh4Node>& out;
+    std::vector<std::uint32_t>& prims;
+
+    std::uint32_t refOf(std::uint32_t b) {
+        const BvhNode& n = bin[b];
+        if (n.count == 0) return collapse(b);
+        // Leaves are laid out in traversal order, each starting on a multiple of
+        // Bvh4::kLeafAlign slots, so a leaf is whole packets of four triangles.
+        const std::uint32_t first = std::uint32_t(prims.size());
+        prims.insert(prims.end(), binPrims.begin() + n.offset, binPrims.begin() + n.offset + n.count);
+        while (prims.size() % Bvh4::kLeafAlign != 0) prims.push_back(Bvh4::kEmpty);
+        return Bvh4::leafRef(first, n.count);
+    }
+
+    // Makes the 4-wide node for binary interior node b and returns its index.
+    std::uint32_t collapse(std::uint32_t b) {
+        std::array<std::uint32_t, 4> kids{};
+        int n = 2;
+        kids[0] = b + 1;
+        kids[1] = bin[b].offset;
+        while (n < 4) {
+            // Open the interior child with the largest surface area: it is the one a ray
+            // enters most often, so flattening it saves the most node visits (SAH argument).
+            int best = -1;
+            float bestArea = -1;
+            for (int i = 0; i < n; ++i) {
+                if (bin[kids[i]].count > 0) continue;
+                const float a = surfaceArea(bin[kids[i]]);
+                if (a > bestArea) {
+                    bestArea = a;
+                    best = i;
+                }
+            }
+            if (best < 0) break;
+            const std::uint32_t k = kids[best];
+            // Its two children take its place, in order, so siblings stay spatially sorted.
+            for (int i = n; i > best + 1; --i) kids[i] = kids[i - 1];
+            kids[best] = k + 1;
+            kids[best + 1] = bin[k].offset;
+            ++n;
+        }
+        const std::uint32_t index = std::uint32_t(out.size());
+        out.emplace_back();
+        for (int c = 0; c < 4; ++c) {
+            Bvh4Node& node = out[index];
+            if (c < n) {
+                for (int k = 0; k < 3; ++k) {
+                    node.bounds[k][c] = bin[kids[c]].lo[k];
+                    node.bounds[3 + k][c] = bin[kids[c]].hi[k];
+                }
+            } else {
+                for (int k = 0; k < 3; ++k) {
+                    node.bounds[k][c] = std::numeric_limits<float>::infinity();
+                    node.bounds[3 + k][c] = -std::numeric_limits<float>::infinity();
+                }
+                node.ref[c] = Bvh4::kEmpty;
+            }
+        }
+        for (int c = 0; c < n; ++c) {
+            const std::uint32_t r = refOf(kids[c]);  // may grow `out`: index, not reference
+            out[index].ref[c] = r;
+        }
+        return index;
+    }
+};
+
+}  // namespace
+
+Bvh4 Bvh4::collapse(const Bvh& binary) {
+    Bvh4 bvh;
+    if (binary.empty()) return bvh;
+    // Padding adds at most kLeafAlign − 1 slots per leaf, and a leaf holds at least one.
+    if (binary.primitives().size() >= kMaxSlots / kLeafAlign)
+        throw std::length_error("Bvh4: more than 2^26 primitives in one mesh");
+    const std::vector<BvhNode>& bin = binary.nodes();
+    bvh.nodes_.reserve(bin.size() / 3 + 1);
+    bvh.primitives_.reserve(binary.primitives().size() * 3 / 2);
+    Collapser c{bin, binary.primitives(), bvh.nodes_, bvh.primitives_};
+    bvh.root_ = c.refOf(0);
+    bvh.nodes_.shrink_to_fit();
+    bvh.primitives_.shrink_to_fit();
+    return bvh;
+}
+
+Bvh4 Bvh4::build(const std::vector<scene::Bounds>& primitiveBounds) {
+    return collapse(Bvh::build(primitiveBounds));
+}
+
+}  // namespace shadowlab::raytrace

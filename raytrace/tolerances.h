@@ -1,0 +1,43 @@
+// raytrace/tolerances.h: every constant of the ray tracer that is not derived from the scene
+// or from rounding-error bounds, each with the reason for its value. Biases are not here: they
+// are settings (scene/settings.h), and the robust offsets are derived, not chosen.
+#pragma once
+
+namespace shadowlab::raytrace {
+
+// Tiles of 16x16 pixels: 256 rays per task make TBB's per-task overhead (a few µs at most)
+// negligible, and a 160x90 test image still splits into 60 tasks for load balance.
+inline constexpr int kTileSize = 16;
+
+// BVH build. Binned SAH (Wald, "On fast Construction of SAH-based Bounding Volume
+// Hierarchies", RT'07) with 16 bins per axis: between pbrt-v4's 12 buckets and the 32 some
+// builders use; more bins buy little tree quality for a linear increase in build time.
+#ifndef SL_BINS
+#define SL_BINS 16
+#endif
+inline constexpr int kBvhBins = SL_BINS;
+// Leaves are intersected in SSE packets of this many triangles (triangle4.h): the SAH counts a
+// leaf's cost in packets, so leaves fill whole packets when that is cheaper.
+inline constexpr unsigned kBvhLeafBlock = 4;
+// A node with this many primitives or fewer is always a leaf: they fit one packet, tested at
+// the cost of one, so a split cannot save a test.
+inline constexpr unsigned kBvhMinSplitCount = 4;
+// Leaves never hold more than this (two packets), even when SAH prefers a leaf: bounds the
+// worst case of a ray that hits a big leaf of coincident triangles.
+inline constexpr unsigned kBvhMaxLeafCount = 8;
+// Cost of visiting a (binary) node relative to one packet test, in the SAH. A binary node
+// becomes half of a 4-wide node's box test after the collapse; pbrt-v4 uses 1/2 relative to
+// one triangle for its binary tree. 1.0 (a packet costs about two scalar triangles, a 4-wide
+// box test about one) measured best on Sponza (docs/performance.md).
+#ifndef SL_TC
+#define SL_TC 1.0
+#endif
+inline constexpr double kBvhTraversalCost = SL_TC;
+// Below this depth splits use SAH; deeper, the build halves by count. Keeps any tree within
+// 48 + log2(2^32) = 80 levels, below the traversal stack of 128.
+inline constexpr int kBvhSahMaxDepth = 48;
+
+// Seed of the per-pixel random streams for area-light samples, so renders are reproducible.
+inline constexpr unsigned long long kSampleSeed = 0x5eed5eedULL;
+
+}  // namespace shadowlab::raytrace

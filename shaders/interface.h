@@ -1,0 +1,67 @@
+// shaders/interface.h: the uniform and push-constant layouts shared by the GLSL shaders and
+// raster/ (C++). Only vec4 and mat4 members, so std140 and C++ (glm) layouts are identical.
+#ifndef SHADOWLAB_SHADERS_INTERFACE_H
+#define SHADOWLAB_SHADERS_INTERFACE_H
+
+// Shadowed lights one lit pass handles; a UBO array needs a fixed size, and eight directional
+// lights is far more than any scene we ship (the renderer throws above it).
+#define SHADOWLAB_MAX_LIGHTS 8
+
+// Filter codes in LightData.params.y (floats: the interface has vec4s only); the values
+// follow scene::ShadowFilter.
+#define SHADOWLAB_FILTER_NONE 0
+#define SHADOWLAB_FILTER_PCF2X2 1
+#define SHADOWLAB_FILTER_PCF 2
+#define SHADOWLAB_FILTER_POISSON 3
+
+// Light kinds in LightData.kind.x.
+#define SHADOWLAB_LIGHT_DIRECTIONAL 0
+#define SHADOWLAB_LIGHT_SPOT 1
+
+#ifdef __cplusplus
+#include <glm/glm.hpp>
+namespace shadowlab::shaders {
+using vec4 = glm::vec4;
+using mat4 = glm::mat4;
+#endif
+
+// Push constants of the shadow (depth-only) pass.
+struct ShadowPush {
+    mat4 lightMatrix;  // camera-relative world position -> light clip space (z 0..1, light side 0)
+};
+
+struct LightData {
+    // Camera-relative world position -> homogeneous shadow-map coordinates: (u, v) = xy / w in
+    // 0..1. Directional: orthographic, w = 1 and z = depth 0..1 (linear along the light).
+    mat4 toShadow;
+    vec4 toLight;    // directional: xyz unit vector toward the light; spot: xyz camera-relative
+                     // position. w: shadow-map layer, -1 = no shadow test
+    vec4 radiance;   // rgb: color * intensity; w: intensity * mean of color (the visibility weight)
+    vec4 bias;       // x: depth bias (world), y: slope bias (texels), z: texel world size
+                     // (spot: per unit of distance along its axis), w: directional: shadow-map
+                     // depth per world unit
+    vec4 params;     // x: max tan(theta) for the slope bias, y: filter code, z: normal offset
+                     // (texels), w: pcf size (taps per side / Poisson diameter in texels)
+    vec4 kind;       // x: SHADOWLAB_LIGHT_*, y: spot: cos(cone half-angle), z: spot: near,
+                     // w: spot: far (distances along its axis)
+    vec4 axis;       // spot: xyz unit direction the light travels; w: unused
+};
+
+// The lit pass's uniform buffer.
+struct LitUniforms {
+    mat4 viewProj;    // camera-relative world position -> clip (reversed Z)
+    vec4 forward;     // xyz: camera forward (view depth = dot(position, forward)); w: ambient
+    vec4 background;  // rgb: background color; w: unused
+    vec4 counts;      // x: number of lights; yzw: unused
+    LightData lights[SHADOWLAB_MAX_LIGHTS];
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(ShadowPush) == 64, "ShadowPush must match std430 push constants");
+static_assert(sizeof(LightData) == 64 + 6 * 16, "LightData must match std140");
+static_assert(sizeof(LitUniforms) == 64 + 3 * 16 + SHADOWLAB_MAX_LIGHTS * sizeof(LightData),
+              "LitUniforms must match std140");
+}  // namespace shadowlab::shaders
+#endif
+
+#endif  // SHADOWLAB_SHADERS_INTERFACE_H

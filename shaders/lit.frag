@@ -1,0 +1,171 @@
+// shaders/lit.frag: shading of scene/shading.h with a shadow-map test per light, and the
+// Frame's AOVs. Biases are applied here in world units, so they mean the same on every driver
+// and depth format (the hardware depth-bias state is not used).
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#include "interface.h"
+
+layout(set = 0, binding = 0, std140) uniform Uniforms { LitUniforms u; };
+layout(set = 0, binding = 1, std430) readonly buffer Albedos { vec4 albedo[]; };  // per object
+// NEAREST depth-compare sampler: each tap returns "ref <= stored" for one texel.
+layout(set = 0, binding = 2) uniform sampler2DArrayShadow shadowMaps;
+// The object nearest the light in each texel (0 = none), same layout as shadowMaps.
+layout(set = 0, binding = 3) uniform usampler2DArray blockerIds;
+
+layout(location = 0) in vec3 inPosition;  // camera-relative world position
+layout(location = 1) in vec3 inNormal;
+layout(location = 2) flat in uint inObjectId;
+
+layout(location = 0) out vec4 outBeauty;  // rgb: linear color; a: visibility
+layout(location = 1) out vec4 outAovs;    // x: object id; y: N·L (max over lights); z: view depth; w: blocker id
+
+const float kPi = 3.14159265358979323846;
+
+// 16 points in the unit disk at least 0.43 apart (dart throwing with a fixed seed).
+const vec2 kPoisson[16] = vec2[](
+    vec2(-0.6984, -0.6662), vec2(-0.8384, 0.4904), vec2(-0.9425, -0.0572), vec2(0.0215, 0.1584),
+    vec2(0.5386, -0.0345), vec2(-0.0932, 0.9513), vec2(0.6755, 0.7325), vec2(0.4978, -0.7298),
+    vec2(0.0952, -0.9609), vec2(-0.0199, -0.4177), vec2(-0.5116, 0.0720), vec2(0.1606, 0.5888),
+    vec2(-0.3732, 0.5695), vec2(0.9588, -0.1544), vec2(0.8339, 0.2965), vec2(-0.3374, -0.9138));
+
+// Per-pixel rotation for the Poisson disk: interleaved gradient noise (Jimenez, "Next
+// Generation Post Processing in Call of Duty: Advanced Warfare", 2014), which spreads the
+// rotations so that neighbouring pixels sample differently.
+float interleavedGradientNoise(vec2 pixel) {
+    return fract(52.9829189 * fract(dot(pixel, vec2(0.06711056, 0.00583715))));
+}
+
+// One compare tap; records the object stored there when it shadows and none was found yet.
+float tap(vec2 uv, float layer, float ref, inout uint blocker) {
+    const float lit = texture(shadowMaps, vec4(uv, layer, ref));
+    if (lit < 0.5 && blocker == 0u) blocker = texture(blockerIds, vec3(uv, layer)).r;
+    return lit;
+}
+
+// Where the receiver is, in the light's map, and how its depth is compared.
+struct Receiver {
+    vec2 uv;          // map coordinates of the (normal-offset) point
+    float axial;      // spot: distance along the light's axis; directional: its linear depth 0..1
+    float biasWorld;  // depthBias + slopeBias·texel·tan(θ): the bias of a tap at the point
+    float slopeStep;  // what one texel of tap distance adds to the bias (slopeBias·texel·tan(θ))
+};
+
+// The compare reference for a receiver biased by `bias` world units toward the light.
+float reference(LightData light, Receiver r, float bias) {
+    if (int(light.kind.x) == SHADOWLAB_LIGHT_SPOT) {
+        // Perspective depth of a point at distance d along the axis: far/(far−near)·(1 − near/d);
+        // the bias is subtracted from d, so it stays in world units at every distance.
+        const float near = light.kind.z, far = light.kind.w;
+        return far / (far - near) * (1.0 - near / max(r.axial - bias, near));
+    }
+    return r.axial - bias * light.bias.w;  // orthographic depth is linear: bias / depth range
+}
+
+// Visibility 0..1 of `light` at camera-relative position p with unit normal n (facing the
+// viewer), N·L = ndotl > 0. `blocker` gets the id of the object that shadowed, if any.
+float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, inout uint blocker) {
+    const bool spot = int(light.kind.x) == SHADOWLAB_LIGHT_SPOT;
+    // World size of a texel at p: constant for an orthographic map, growing with distance
+    // along the axis for a perspective one.
+    const float texel = light.bias.z * (spot ? dot(p - light.toLight.xyz, light.axis.xyz) : 1.0);
+    // Normal offset: look the map up from a point moved off the surface along its normal.
+    const vec3 q = p + n * (light.params.z * texel);
+    // bias_world = depthBias + slopeBias * texel * min(tan(theta), maxTan), cos(theta) = N·L.
+    const float tanTheta = min(sqrt(max(1.0 - ndotl * ndotl, 0.0)) / ndotl, light.params.x);
+    Receiver r;
+    r.slopeStep = light.bias.y * texel * tanTheta;
+    r.biasWorld = light.bias.x + r.slopeStep;
+    const vec4 s = light.toShadow * vec4(q, 1.0);
+    r.uv = s.xy / s.w;
+    r.axial = spot ? dot(q - light.toLight.xyz, light.axis.xyz) : s.z;
+    const float layer = light.toLight.w;
+    const int filterCode = int(light.params.y);
+    const float size = float(textureSize(shadowMaps, 0).x);
+    if (filterCode == SHADOWLAB_FILTER_NONE) return tap(r.uv, layer, reference(light, r, r.biasWorld), blocker);
+    if (filterCode == SHADOWLAB_FILTER_PCF2X2) {
+        // The bilinear mix of the four comparisons around the point: what a LINEAR compare
+        // sampler does in hardware, done here because lavapipe cannot filter D32_SFLOAT
+        // linearly, and so the weights are the same on every driver. One gather at the corner
+        // shared by the four texels, where its footprint cannot round to a neighbour. Its four
+        // texel centers lie up to √2 texels from the point (nearest: √2/2), so the slope term
+        // covers one more texel than for `none`.
+        const vec2 t = r.uv * size - 0.5;  // texel-center coordinates
+        const vec2 i0 = floor(t);
+        const vec2 f = t - i0;
+        const vec3 corner = vec3((i0 + 1.0) / size, layer);
+        // Components: x = (i0, j0+1), y = (i0+1, j0+1), z = (i0+1, j0), w = (i0, j0).
+        const vec4 g = textureGather(shadowMaps, corner, reference(light, r, r.biasWorld + r.slopeStep));
+        if (blocker == 0u && min(min(g.x, g.y), min(g.z, g.w)) < 0.5) {
+            const uvec4 ids = textureGather(blockerIds, corner);
+            blocker = g.w < 0.5 ? ids.w : g.z < 0.5 ? ids.z : g.x < 0.5 ? ids.x : ids.y;
+        }
+        return mix(mix(g.w, g.z, f.x), mix(g.x, g.y, f.x), f.y);
+    }
+    // Wide kernels: a tap d texels from the point compares against a surface that a plane
+    // tilted by θ has moved d·texel·tan(θ) along the light, so each tap's slope term grows
+    // with its distance (a per-tap receiver-plane bias; without it wide kernels make acne).
+    const int taps = clamp(int(light.params.w), 1, 15);
+    float sum = 0.0;
+    if (filterCode == SHADOWLAB_FILTER_PCF) {
+        // taps x taps texels one texel apart, centered on the point.
+        const float c = 0.5 * float(taps - 1);
+        for (int j = 0; j < taps; ++j)
+            for (int i = 0; i < taps; ++i) {
+                const vec2 o = vec2(i, j) - c;
+                sum += tap(r.uv + o / size, layer, reference(light, r, r.biasWorld + r.slopeStep * length(o)), blocker);
+            }
+        return sum / float(taps * taps);
+    }
+    // Poisson: 16 taps on a disk of diameter `taps` texels, rotated per pixel.
+    const float angle = 2.0 * kPi * interleavedGradientNoise(gl_FragCoord.xy);
+    const mat2 rotation = mat2(cos(angle), sin(angle), -sin(angle), cos(angle));
+    const float radius = 0.5 * float(taps);
+    for (int k = 0; k < 16; ++k) {
+        const vec2 o = rotation * kPoisson[k] * radius;
+        sum += tap(r.uv + o / size, layer, reference(light, r, r.biasWorld + r.slopeStep * length(o)), blocker);
+    }
+    return sum / 16.0;
+}
+
+void main() {
+    vec3 n = normalize(inNormal);
+    // Two-sided surfaces: the normal faces the viewer (the ray tracer's rule: flip when N·ray > 0).
+    if (dot(n, inPosition) > 0.0) n = -n;
+
+    const vec3 albedoColor = albedo[inObjectId - 1u].rgb;
+    vec3 color = u.forward.w * albedoColor;
+    float weightSum = 0.0;
+    float weightedVisibility = 0.0;
+    uint blocker = 0u;
+    const int lightCount = int(u.counts.x);
+    float maxNdotL = lightCount > 0 ? -1.0 : 0.0;
+    for (int i = 0; i < lightCount; ++i) {
+        const LightData light = u.lights[i];
+        vec3 l;
+        float irradiance;  // relative to radiance: 1 for directional lights
+        if (int(light.kind.x) == SHADOWLAB_LIGHT_SPOT) {
+            // scene/shading.h: intensity / (4π d²), dark outside the cone.
+            const vec3 toLight = light.toLight.xyz - inPosition;
+            const float d2 = dot(toLight, toLight);
+            l = toLight * inversesqrt(d2);
+            irradiance = dot(-l, light.axis.xyz) < light.kind.y ? 0.0 : 1.0 / (4.0 * kPi * d2);
+        } else {
+            l = light.toLight.xyz;
+            irradiance = 1.0;
+        }
+        const float ndotl = dot(n, l);
+        maxNdotL = max(maxNdotL, ndotl);
+        if (!(ndotl > 0.0) || !(irradiance > 0.0)) continue;  // no light: visibility 0, weight 0
+        uint lightBlocker = 0u;
+        const float v = light.toLight.w >= 0.0 ? shadowTest(light, inPosition, n, ndotl, lightBlocker) : 1.0;
+        if (blocker == 0u) blocker = lightBlocker;  // the first light that found one, as raytrace/
+        // The visibility AOV weighs each light by what it would add unshadowed (as raytrace/).
+        const float w = light.radiance.w * irradiance * ndotl;
+        weightSum += w;
+        weightedVisibility += w * v;
+        color += albedoColor * light.radiance.rgb * (irradiance * ndotl * v);
+    }
+    const float visibility = weightSum > 0.0 ? weightedVisibility / weightSum : 0.0;
+    outBeauty = vec4(color, visibility);
+    outAovs = vec4(float(inObjectId), maxNdotL, dot(inPosition, u.forward.xyz), float(blocker));
+}

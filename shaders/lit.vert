@@ -1,0 +1,22 @@
+// shaders/lit.vert: the camera pass; passes the camera-relative position on so that the
+// fragment shader can find its place in every shadow map.
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#include "interface.h"
+
+layout(set = 0, binding = 0, std140) uniform Uniforms { LitUniforms u; };
+
+layout(location = 0) in vec3 inPosition;  // camera-relative world position
+layout(location = 1) in vec3 inNormal;
+layout(location = 2) in uint inObjectId;
+
+layout(location = 0) out vec3 outPosition;
+layout(location = 1) out vec3 outNormal;
+layout(location = 2) flat out uint outObjectId;
+
+void main() {
+    outPosition = inPosition;
+    outNormal = inNormal;
+    outObjectId = inObjectId;
+    gl_Position = u.viewProj * vec4(inPosition, 1.0);
+}

@@ -1,0 +1,18 @@
+// shaders/spirv.cpp: hands out the SPIR-V arrays glslangValidator generated (--vn).
+#include "shaders/spirv.h"
+
+#include <cstdint>
+
+#include "lit_frag.spv.h"
+#include "lit_vert.spv.h"
+#include "shadow_frag.spv.h"
+#include "shadow_vert.spv.h"
+
+namespace shadowlab::shaders {
+
+std::span<const std::uint32_t> shadowVertSpirv() { return kShadowVertSpv; }
+std::span<const std::uint32_t> shadowFragSpirv() { return kShadowFragSpv; }
+std::span<const std::uint32_t> litVertSpirv() { return kLitVertSpv; }
+std::span<const std::uint32_t> litFragSpirv() { return kLitFragSpv; }
+
+}  // namespace shadowlab::shaders

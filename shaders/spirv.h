@@ -1,0 +1,14 @@
+// shaders/spirv.h: the SPIR-V of each shader stage, compiled at build time and embedded.
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+namespace shadowlab::shaders {
+
+std::span<const std::uint32_t> shadowVertSpirv();
+std::span<const std::uint32_t> shadowFragSpirv();
+std::span<const std::uint32_t> litVertSpirv();
+std::span<const std::uint32_t> litFragSpirv();
+
+}  // namespace shadowlab::shaders

@@ -1,0 +1,141 @@
+// tests/app/app_test.cpp: runs the `shadowlab` program as a user would: the main job on the
+// seed scene writes every output with sane metrics; bad input gets one clear error, a non-zero
+// exit and writes nothing.
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <sys/wait.h>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "tests/scene/test_files.h"
+
+namespace shadowlab {
+namespace {
+
+using test::TempDir;
+
+struct Result {
+    int exitCode = -1;
+    std::string out;
+    std::string err;
+};
+
+std::string quote(const std::string& s) {
+    std::string q = "'";
+    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+std::string slurp(const std::filesystem::path& p) {
+    std::ifstream in(p);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+Result shadowlab(const std::vector<std::string>& args) {
+    TempDir io;
+    std::string cmd = quote(SHADOWLAB_EXE);
+    for (const auto& a : args) cmd += " " + quote(a);
+    cmd += " >" + quote((io.path() / "out").string()) + " 2>" + quote((io.path() / "err").string());
+    const int status = std::system(cmd.c_str());
+    Result r;
+    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurp(io.path() / "out");
+    r.err = slurp(io.path() / "err");
+    return r;
+}
+
+TEST(App, RunOnTheSeedSceneWritesEveryOutputWithSaneMetrics) {
+    TempDir dir;
+    const auto out = dir.path() / "seed";
+    const Result r = shadowlab({"run", "seed", "-o", out.string(), "--resolution", "192x108",
+                                "--shadow-map-size", "1024", "--validate"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    for (const char* f : {"raster.exr", "raytrace.exr", "reference.exr", "raster.png", "raytrace.png",
+                          "reference.png", "diff-raster.png", "diff-raytrace.png", "metrics.json", "report.html"})
+        EXPECT_TRUE(std::filesystem::is_regular_file(out / f)) << f;
+
+    const auto metrics = nlohmann::json::parse(slurp(out / "metrics.json"));
+    for (const char* method : {"raster", "raytrace"}) {
+        SCOPED_TRACE(method);
+        const auto& m = metrics.at("methods").at(method).at("metrics");
+        // The seed scene is mostly lit plane and sphere: most pixels count, and a method at its
+        // default settings agrees with the reference almost everywhere.
+        EXPECT_GT(m.at("counted").get<double>(), 0.5 * 192 * 108);
+        EXPECT_LT(m.at("mismatch_rate").get<double>(), 0.05);
+        EXPECT_GT(m.at("shadow_iou").get<double>(), 0.8);
+        EXPECT_GT(metrics.at("methods").at(method).at("timings_ms").at("total").get<double>(), 0.0);
+    }
+    const std::string html = slurp(out / "report.html");
+    for (const char* f : {"reference.png", "diff-raster.png", "diff-raytrace.png"})
+        EXPECT_NE(html.find(f), std::string::npos) << f;
+}
+
+TEST(App, RenderWritesTheRequestedFrame) {
+    TempDir dir;
+    const auto exr = dir.path() / "rt.exr";
+    const Result r = shadowlab({"render", "seed", "--backend", "raytrace", "--resolution", "32x18", "-o", exr.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_TRUE(std::filesystem::is_regular_file(exr));
+    const Result c = shadowlab({"compare", exr.string(), exr.string(), "-o", (dir.path() / "d.png").string(), "--json"});
+    ASSERT_EQ(c.exitCode, 0) << c.err;
+    const auto j = nlohmann::json::parse(c.out);
+    EXPECT_EQ(j.at("false_shadow").get<double>(), 0.0);  // a frame agrees with itself
+    EXPECT_EQ(j.at("missed_shadow").get<double>(), 0.0);
+}
+
+struct BadRun {
+    const char* name;
+    std::vector<std::string> args;  // "OUT" is replaced by an output path in a fresh folder
+    std::string mentions;
+};
+
+class BadInput : public ::testing::TestWithParam<BadRun> {};
+
+TEST_P(BadInput, OneClearErrorNonZeroExitNothingWritten) {
+    TempDir dir;
+    const auto scene = dir.write("bad.json", R"({"camera": {"position": [0,2,6], "look_at": [0,0,0]},
+        "materials": {"m": {}}, "lights": [{"type": "directional", "direction": [0,0,0]}],
+        "objects": [{"type": "sphere", "center": [0,1,0], "radius": 1, "material": "m"}]})");
+    std::vector<std::string> args;
+    for (const auto& a : GetParam().args)
+        args.push_back(a == "OUT" ? (dir.path() / "out" / "x.exr").string()
+                       : a == "OUTDIR" ? (dir.path() / "out").string()
+                       : a == "BAD" ? scene.string() : a);
+    const std::size_t before = dir.fileCount();
+    const Result r = shadowlab(args);
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_NE(r.err.find(GetParam().mentions), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("terminate"), std::string::npos) << r.err;  // no crash, no abort
+    EXPECT_EQ(dir.fileCount(), before) << "something was written";
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, BadInput,
+    ::testing::Values(
+        BadRun{"bad_scene_run", {"run", "BAD", "-o", "OUTDIR"}, "lights[0].direction: must be a non-zero direction"},
+        BadRun{"bad_scene_render", {"render", "BAD", "-o", "OUT"}, "lights[0].direction"},
+        BadRun{"unknown_scene", {"run", "no-such-scene", "-o", "OUTDIR"}, "no shipped scene of that name"},
+        BadRun{"zero_resolution", {"run", "seed", "--resolution", "0x10", "-o", "OUTDIR"}, "--resolution"},
+        BadRun{"huge_resolution", {"run", "seed", "--resolution", "100000x100000", "-o", "OUTDIR"}, "--resolution"},
+        BadRun{"negative_map", {"run", "seed", "--shadow-map-size", "-5", "-o", "OUTDIR"}, "--shadow-map-size"},
+        BadRun{"bad_ray_bias", {"run", "seed", "--ray-bias", "lots", "-o", "OUTDIR"}, "--ray-bias"},
+        BadRun{"bad_backend", {"render", "seed", "--backend", "magic", "-o", "OUT"}, "--backend"},
+        BadRun{"bad_extension", {"render", "seed", "-o", "frame.tiff"}, "unknown output type"},
+        BadRun{"missing_frames", {"compare", "a.exr", "b.exr", "-o", "OUT.png"}, "no such file"}),
+    [](const ::testing::TestParamInfo<BadRun>& info) { return std::string(info.param.name); });
+
+TEST(App, HelpOnEverySubcommandNamesItsOptions) {
+    for (const auto& [cmd, option] : std::vector<std::pair<std::string, std::string>>{
+             {"run", "--output"}, {"render", "--backend"}, {"compare", "--json"}, {"info", "--validate"}}) {
+        const Result r = shadowlab({cmd, "--help"});
+        EXPECT_EQ(r.exitCode, 0) << cmd;
+        EXPECT_NE(r.out.find(option), std::string::npos) << cmd << ": " << r.out;
+    }
+}
+
+}  // namespace
+}  // namespace shadowlab

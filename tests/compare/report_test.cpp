@@ -1,0 +1,166 @@
+// tests/compare/report_test.cpp: report.html is written, self-contained, balanced, names only
+// the image files it was given, and shows the metrics; the findings paragraph says what the
+// metrics say.
+#include "compare/report.h"
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "compare/text.h"
+#include "tests/compare/synthetic.h"
+
+namespace shadowlab::compare {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::size_t count(const std::string& s, const std::string& what) {
+    std::size_t n = 0;
+    for (auto p = s.find(what); p != std::string::npos; p = s.find(what, p + 1)) ++n;
+    return n;
+}
+
+// A run of the synthetic scene: reference, a ray tracer with terminator acne and a shadow
+// map with acne, a detached shadow and jaggies.
+ReportInput syntheticRun() {
+    test::SyntheticOptions o;
+    o.width = 120;
+    o.height = 68;
+    scene::Frame ref = test::syntheticFrame(o);
+    ref.timingsMs = {{"render", 900.0}};
+    ref.attributes = {{"backend", "reference"}, {"version", "0.1.0"}};
+    test::SyntheticOptions ro = o;
+    ro.acne = ro.shiftShadow = ro.jaggies = true;
+    scene::Frame raster = test::syntheticFrame(ro);
+    raster.timingsMs = {{"setup", 40.0}, {"shadow_pass", 3.0}};
+    raster.attributes = {{"backend", "raster"}, {"depth_bias", "0.002"}};
+    test::SyntheticOptions to = o;
+    to.rayAcne = true;
+    scene::Frame ray = test::syntheticFrame(to);
+    ray.timingsMs = {{"render", 120.0}};
+
+    ReportInput in;
+    in.sceneName = "synthetic <test>";
+    in.scenePath = "scenes/synthetic.json";
+    in.planText = "any-hit shadow rays: all objects opaque";
+    in.objectNames = {"the plane", "the sphere"};
+    in.reference = {"reference", "reference.png", ref};
+    in.methods.push_back({"raytrace", "raytrace.png", "diff-raytrace.png", ray, compareFrames(ray, ref).metrics});
+    in.methods.push_back({"raster", "raster.png", "diff-raster.png", raster, compareFrames(raster, ref).metrics});
+    return in;
+}
+
+TEST(Report, NamesOnlyTheGivenImageFilesAndNothingRemote) {
+    const ReportInput in = syntheticRun();
+    const std::string html = renderReportHtml(in);
+    const std::set<std::string> given = {"reference.png", "raytrace.png", "diff-raytrace.png",
+                                         "raster.png", "diff-raster.png"};
+    std::set<std::string> seen;
+    const std::regex ref(R"((src|href)="([^"]*)\")");
+    for (auto it = std::sregex_iterator(html.begin(), html.end(), ref); it != std::sregex_iterator(); ++it) {
+        const std::string target = (*it)[2];
+        EXPECT_TRUE(given.count(target)) << "unexpected link target " << target;
+        seen.insert(target);
+    }
+    EXPECT_EQ(seen, given);  // every image is shown
+    EXPECT_EQ(html.find("<script"), std::string::npos);
+    EXPECT_EQ(html.find("<link"), std::string::npos);
+    EXPECT_EQ(html.find("url("), std::string::npos);
+}
+
+TEST(Report, IsBalancedEnoughToParse) {
+    const std::string html = renderReportHtml(syntheticRun());
+    EXPECT_EQ(html.rfind("<!DOCTYPE html>", 0), 0u);
+    for (const std::string tag : {"div", "table", "tr", "figure", "svg", "section", "details", "p", "ul", "li", "g", "text"})
+        EXPECT_EQ(count(html, "<" + tag + ">") + count(html, "<" + tag + " "), count(html, "</" + tag + ">")) << tag;
+    EXPECT_NE(html.find("</html>"), std::string::npos);
+    // The scene name is escaped, not markup.
+    EXPECT_NE(html.find("synthetic &lt;test&gt;"), std::string::npos);
+    EXPECT_EQ(html.find("<test>"), std::string::npos);
+}
+
+TEST(Report, ShowsEachMethodsMetricsAndTimings) {
+    const ReportInput in = syntheticRun();
+    const std::string html = renderReportHtml(in);
+    for (const auto& m : in.methods) {
+        const Metrics& k = m.metrics;
+        EXPECT_NE(html.find(">" + formatCount(k.counted) + "<"), std::string::npos) << m.label;
+        EXPECT_NE(html.find(">" + formatCount(k.falseShadow) + "<"), std::string::npos) << m.label;
+        EXPECT_NE(html.find(formatPercent(k.falseShadowRate)), std::string::npos) << m.label;
+        EXPECT_NE(html.find(formatPercent(k.missedShadowRate)), std::string::npos) << m.label;
+        EXPECT_NE(html.find(formatFixed(k.shadowIoU, 4)), std::string::npos) << m.label;
+    }
+    EXPECT_NE(html.find("shadow_pass"), std::string::npos);  // a stage timing row
+    EXPECT_NE(html.find(formatDuration(43.0)), std::string::npos);  // raster total 40 + 3
+    EXPECT_NE(html.find("reference 900 ms"), std::string::npos);     // the plot's marker
+    EXPECT_NE(html.find("any-hit shadow rays"), std::string::npos);  // the plan
+    EXPECT_EQ(count(html, "<svg"), 1u);
+}
+
+TEST(Report, FindingsNameTheDominantErrorAndWhere) {
+    const ReportInput in = syntheticRun();
+    // Construction: the shadow map's lit floor gets 8% acne speckles blocked by the floor
+    // itself, far more than its detached-shadow errors; the ray tracer only has acne on the
+    // sphere's terminator.
+    const std::string text = describeFindings(in);
+    std::istringstream lines(text);
+    std::string ray, raster, overall;
+    std::getline(lines, ray);
+    std::getline(lines, raster);
+    std::getline(lines, overall);
+    EXPECT_NE(ray.find("The ray tracer"), std::string::npos) << ray;
+    EXPECT_NE(ray.find("self-shadow acne on the sphere"), std::string::npos) << ray;
+    EXPECT_NE(raster.find("The shadow map"), std::string::npos) << raster;
+    EXPECT_NE(raster.find("self-shadow acne on the plane"), std::string::npos) << raster;
+    EXPECT_NE(raster.find("missed shadow"), std::string::npos) << raster;
+    EXPECT_NE(raster.find(formatPercent(in.methods[1].metrics.falseShadowRate)), std::string::npos) << raster;
+    EXPECT_NE(overall.find("the ray tracer is closer"), std::string::npos) << overall;
+}
+
+TEST(Report, FindingsSayAnExactMatchAndAFailure) {
+    ReportInput in = syntheticRun();
+    in.methods.resize(1);
+    test::SyntheticOptions o;
+    o.width = 120;
+    o.height = 68;
+    const scene::Frame f = test::syntheticFrame(o);
+    in.methods[0].metrics = compareFrames(f, f).metrics;
+    in.failures.push_back({"raster", "no Vulkan device"});
+    const std::string text = describeFindings(in);
+    EXPECT_NE(text.find("matches the reference on all"), std::string::npos) << text;
+    EXPECT_NE(text.find("The raster backend failed: no Vulkan device"), std::string::npos) << text;
+    EXPECT_NE(renderReportHtml(in).find("no Vulkan device"), std::string::npos);
+}
+
+TEST(Report, WriteReportWritesReportHtmlAndNoTemporaryFile) {
+    const fs::path dir = fs::path(::testing::TempDir()) / "compare_report_test";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const ReportInput in = syntheticRun();
+    writeReport(dir, in);
+    std::ifstream file(dir / "report.html");
+    std::stringstream text;
+    text << file.rdbuf();
+    EXPECT_EQ(text.str(), renderReportHtml(in));
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);
+    fs::remove_all(dir);
+}
+
+TEST(FrameInfo, KeepsSizeMetadataAndTimingsOfAFrame) {
+    scene::Frame f = scene::Frame::allocate(7, 3, false);
+    f.attributes["backend"] = "raster";
+    f.timingsMs = {{"a", 1.0}, {"b", 2.5}};
+    const FrameInfo info = f;
+    EXPECT_EQ(info.width, 7);
+    EXPECT_EQ(info.height, 3);
+    EXPECT_EQ(info.attributes.at("backend"), "raster");
+    EXPECT_DOUBLE_EQ(info.totalTimeMs(), 3.5);
+}
+
+}  // namespace
+}  // namespace shadowlab::compare

@@ -1,0 +1,164 @@
+// tests/raster/context_test.cpp: device selection (pure, on made-up device lists) and the
+// real device list of this machine (lavapipe, with the validation layer).
+#include "raster/context.h"
+
+#include <cstdlib>
+#include <optional>
+
+#include <gtest/gtest.h>
+
+#include "raster/vulkan_error.h"
+
+namespace shadowlab::raster {
+namespace {
+
+DeviceReport device(int index, const std::string& name, bool lavapipe, bool usable = true) {
+    DeviceReport d;
+    d.index = index;
+    d.name = name;
+    d.type = lavapipe ? "cpu" : "discrete-gpu";
+    d.driverName = lavapipe ? "llvmpipe" : "vendor";
+    d.lavapipe = lavapipe;
+    d.usable = usable;
+    d.unusableReason = usable ? "" : "Vulkan 1.2.0 < 1.3";
+    return d;
+}
+
+const std::vector<DeviceReport> kDevices = {device(0, "Fancy GPU 9000", false),
+                                            device(1, "llvmpipe (LLVM 15.0.6, 256 bits)", true),
+                                            device(2, "Old GPU", false, false)};
+
+TEST(SelectDevice, DefaultIsLavapipeEvenWhenNotFirst) { EXPECT_EQ(selectDevice(kDevices, ""), 1u); }
+
+TEST(SelectDevice, DefaultFallsBackToTheFirstUsableDevice) {
+    EXPECT_EQ(selectDevice({device(0, "Old GPU", false, false), device(1, "Fancy GPU", false)}, ""), 1u);
+}
+
+TEST(SelectDevice, IndexSelectsThatDevice) { EXPECT_EQ(selectDevice(kDevices, "0"), 0u); }
+
+TEST(SelectDevice, NameSubstringIsCaseInsensitive) { EXPECT_EQ(selectDevice(kDevices, "fancy"), 0u); }
+
+TEST(SelectDevice, UnmatchedSelectorListsEveryDevice) {
+    for (const std::string selector : {"7", "radeon"}) {
+        try {
+            selectDevice(kDevices, selector);
+            FAIL() << "expected RasterError for " << selector;
+        } catch (const RasterError& e) {
+            const std::string what = e.what();
+            EXPECT_NE(what.find("'" + selector + "'"), std::string::npos) << what;
+            for (const DeviceReport& d : kDevices) EXPECT_NE(what.find(d.name), std::string::npos) << what;
+        }
+    }
+}
+
+TEST(SelectDevice, UnusableDeviceIsRefusedWithTheReason) {
+    try {
+        selectDevice(kDevices, "old");
+        FAIL() << "expected RasterError";
+    } catch (const RasterError& e) {
+        EXPECT_NE(std::string(e.what()).find("1.2.0 < 1.3"), std::string::npos) << e.what();
+    }
+}
+
+TEST(SelectDevice, NoUsableDeviceNamesThePackage) {
+    try {
+        selectDevice({device(0, "Old GPU", false, false)}, "");
+        FAIL() << "expected RasterError";
+    } catch (const RasterError& e) {
+        EXPECT_NE(std::string(e.what()).find("mesa-vulkan-drivers"), std::string::npos) << e.what();
+    }
+}
+
+// Sets an environment variable for the scope of a test, restoring the old value.
+class ScopedEnv {
+public:
+    ScopedEnv(const char* name, const char* value) : name_(name) {
+        if (const char* old = std::getenv(name)) old_ = old;
+        setenv(name, value, 1);
+    }
+    ~ScopedEnv() {
+        if (old_) setenv(name_, old_->c_str(), 1);
+        else unsetenv(name_);
+    }
+
+private:
+    const char* name_;
+    std::optional<std::string> old_;
+};
+
+TEST(Devices, NoDriverNamesTheMesaPackage) {
+    // The loader reads its driver list on every instance creation; pointing it at a missing
+    // manifest is a machine without an ICD.
+    const ScopedEnv icd("VK_ICD_FILENAMES", "/nonexistent/shadowlab_icd.json");
+    const ScopedEnv drivers("VK_DRIVER_FILES", "/nonexistent/shadowlab_icd.json");
+    try {
+        enumerateDevices(false);
+        FAIL() << "expected RasterError";
+    } catch (const RasterError& e) {
+        EXPECT_NE(std::string(e.what()).find("mesa-vulkan-drivers"), std::string::npos) << e.what();
+    }
+}
+
+TEST(Devices, MissingValidationLayerNamesItsPackage) {
+    // VK_LAYER_PATH replaces the loader's search path for explicit layers.
+    const ScopedEnv layers("VK_LAYER_PATH", "/nonexistent/shadowlab_layers");
+    try {
+        enumerateDevices(true);
+        FAIL() << "expected RasterError";
+    } catch (const RasterError& e) {
+        EXPECT_NE(std::string(e.what()).find("vulkan-validationlayers"), std::string::npos) << e.what();
+    }
+    EXPECT_NO_THROW(enumerateDevices(false));  // without validation the layer is not needed
+}
+
+TEST(Devices, ThisMachineHasLavapipeAsTheDefault) {
+    const std::vector<DeviceReport> devices = enumerateDevices(true);
+    ASSERT_FALSE(devices.empty());
+    int defaults = 0;
+    for (const DeviceReport& d : devices) {
+        defaults += d.isDefault;
+        if (d.isDefault) {
+            EXPECT_TRUE(d.lavapipe);
+            EXPECT_TRUE(d.usable) << d.unusableReason;
+            EXPECT_GE(d.apiVersion, VK_API_VERSION_1_3);
+        }
+    }
+    EXPECT_EQ(defaults, 1);
+    const std::string text = describeDevices(false);
+    EXPECT_NE(text.find("Vulkan instance version: 1."), std::string::npos) << text;
+    EXPECT_NE(text.find("[default]"), std::string::npos) << text;
+    EXPECT_NE(text.find("lavapipe"), std::string::npos) << text;
+}
+
+TEST(Devices, ValidatedContextCreationAndDestructionIsClean) {
+    ValidationLog log;
+    log.echo = true;
+    {
+        const Context ctx(ContextOptions{.device = "", .validate = true, .log = &log});
+        EXPECT_TRUE(ctx.deviceReport.lavapipe);
+        EXPECT_NE(ctx.queue, VK_NULL_HANDLE);
+    }
+    EXPECT_EQ(log.count.load(), 0);
+}
+
+TEST(Devices, AnUnvalidatedInstanceDoesNotBreakALivingValidatedOne) {
+    // The function pointers are shared; a second instance without the debug-utils extension
+    // must not take away the messenger's destroy function from the first.
+    ValidationLog log;
+    {
+        const Context validated(ContextOptions{.validate = true, .log = &log});
+        EXPECT_FALSE(enumerateDevices(false).empty());
+    }  // destroys the messenger through the shared pointer
+    EXPECT_EQ(log.count.load(), 0);
+}
+
+TEST(Devices, SelectingByIndexAndByNameGivesTheSameDevice) {
+    ValidationLog log;
+    const Context byIndex(ContextOptions{.device = "0", .validate = true, .log = &log});
+    const Context byName(ContextOptions{.device = byIndex.deviceReport.name.substr(0, 5), .validate = true, .log = &log});
+    EXPECT_EQ(byIndex.deviceReport.name, byName.deviceReport.name);
+    EXPECT_EQ(log.count.load(), 0);
+}
+
+}  // namespace
+}  // namespace shadowlab::raster

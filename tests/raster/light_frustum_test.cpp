@@ -1,0 +1,170 @@
+// tests/raster/light_frustum_test.cpp: the directional light's orthographic frustum encloses the
+// scene and maps depth along the light from 0 (light side) to 1.
+#include "raster/light_frustum.h"
+
+#include <gtest/gtest.h>
+
+#include "raster/tolerances.h"
+#include "tests/raster/test_scenes.h"
+
+namespace shadowlab::raster {
+namespace {
+
+using test::Vec3;
+
+glm::dvec4 apply(const glm::dmat4& m, const Vec3& p) { return m * glm::dvec4(p, 1.0); }
+
+TEST(LightFrustum, EnclosesEveryCornerOfTheBounds) {
+    scene::Bounds b;
+    b.extend(Vec3(-4, -1, -2));
+    b.extend(Vec3(3, 5, 7));
+    const Vec3 origin(10, -3, 2);
+    for (const Vec3 dir : {Vec3(0, -1, 0), glm::normalize(Vec3(-1, -2, -1)), Vec3(1, 0, 0)}) {
+        const LightFrustum f = fitDirectionalLight(b, dir, 1024);
+        const glm::dmat4 m = f.toClip(origin);
+        for (int k = 0; k < 8; ++k) {
+            const Vec3 corner((k & 1) ? b.max.x : b.min.x, (k & 2) ? b.max.y : b.min.y, (k & 4) ? b.max.z : b.min.z);
+            const glm::dvec4 c = apply(m, corner - origin);
+            EXPECT_LT(std::abs(c.x), 1.0);
+            EXPECT_LT(std::abs(c.y), 1.0);
+            EXPECT_GT(c.z, 0.0);
+            EXPECT_LT(c.z, 1.0);
+            EXPECT_EQ(c.w, 1.0);
+        }
+    }
+}
+
+TEST(LightFrustum, DepthGrowsAlongTheLightAndSpansTheDiameter) {
+    scene::Bounds b;
+    b.extend(Vec3(-1, -1, -1));
+    b.extend(Vec3(1, 1, 1));
+    const Vec3 dir = glm::normalize(Vec3(1, -2, 0.5));
+    const LightFrustum f = fitDirectionalLight(b, dir, 512);
+    const double h = std::sqrt(3.0) * kLightFrustumMargin;  // half the box diagonal, with the margin
+    EXPECT_NEAR(f.halfWidth, h, 1e-12);
+    EXPECT_NEAR(f.texelWorldSize(), 2.0 * h / 512, 1e-12);
+    const glm::dmat4 m = f.toClip(Vec3(0));
+    EXPECT_NEAR(apply(m, Vec3(0)).z, 0.5, 1e-12);           // the center is mid-depth
+    EXPECT_NEAR(apply(m, -h * dir).z, 0.0, 1e-12);          // toward the light: depth 0
+    EXPECT_NEAR(apply(m, h * dir).z, 1.0, 1e-12);           // away from it: depth 1
+    EXPECT_NEAR(apply(m, 0.3 * dir).z - 0.5, 0.3 / (2 * h), 1e-12);  // 1 / depthRange per world unit
+    // Moving across the light does not change depth.
+    EXPECT_NEAR(apply(m, f.right + f.up).z, 0.5, 1e-12);
+}
+
+TEST(LightFrustum, TextureMatrixMapsTheCenterToTheMapCenterAndRightToU) {
+    scene::Bounds b;
+    b.extend(Vec3(0, 0, 0));
+    b.extend(Vec3(2, 2, 2));
+    const LightFrustum f = fitDirectionalLight(b, Vec3(0, -1, 0), 256);
+    const glm::dmat4 t = f.toTexture(Vec3(1, 1, 1));  // origin at the center: positions relative to it
+    const glm::dvec4 c = apply(t, Vec3(0));
+    EXPECT_NEAR(c.x, 0.5, 1e-12);
+    EXPECT_NEAR(c.y, 0.5, 1e-12);
+    const glm::dvec4 r = apply(t, f.halfWidth * f.right);
+    EXPECT_NEAR(r.x, 1.0, 1e-12);
+    EXPECT_NEAR(r.y, 0.5, 1e-12);
+    EXPECT_NEAR(glm::dot(f.right, f.direction), 0.0, 1e-12);
+    EXPECT_NEAR(glm::dot(f.up, f.direction), 0.0, 1e-12);
+    // Right-handed like a camera: it looks down its −z axis, which is the light's direction.
+    EXPECT_NEAR(glm::length(glm::cross(f.right, f.up) + f.direction), 0.0, 1e-12);
+}
+
+TEST(LightFrustum, PointLikeBoundsStillGetAValidFrustum) {
+    scene::Bounds b;
+    b.extend(Vec3(5, 5, 5));
+    const LightFrustum f = fitDirectionalLight(b, Vec3(0, -1, 0), 64);
+    EXPECT_GT(f.halfWidth, 0.0);
+    EXPECT_TRUE(std::isfinite(f.toClip(Vec3(0))[0][0]));
+}
+
+TEST(LightFrustum, SpotMapSeesItsConeWithPerspectiveDepthFromNearToFar) {
+    scene::Bounds b;
+    b.extend(Vec3(-5, 0, -5));
+    b.extend(Vec3(5, 2, 5));
+    const Vec3 pos(1, 6, -1), dir = glm::normalize(Vec3(0.2, -1, 0.1));
+    const double cone = 30.0;
+    const LightFrustum f = fitSpotLight(b, pos, dir, cone, 512);
+    ASSERT_TRUE(f.perspective);
+    const Vec3 origin(2, 1, 3);
+    const glm::dmat4 m = f.toClip(origin);
+    // On the axis at distance d: x = y = 0, z/w = far/(far − near)·(1 − near/d), w = d.
+    for (const double d : {f.near, 0.5 * (f.near + f.far), f.far}) {
+        const glm::dvec4 c = apply(m, pos + d * dir - origin);
+        EXPECT_NEAR(c.x / c.w, 0.0, 1e-12);
+        EXPECT_NEAR(c.y / c.w, 0.0, 1e-12);
+        EXPECT_NEAR(c.w, d, 1e-9);
+        EXPECT_NEAR(c.z / c.w, f.far / (f.far - f.near) * (1.0 - f.near / d), 1e-12);
+    }
+    // The cone's rim lies inside the map, just (the 2% margin) short of its edge.
+    const double a = cone * test::kPi / 180.0;
+    const glm::dvec4 rim = apply(m, pos + 3.0 * (std::cos(a) * dir + std::sin(a) * f.right) - origin);
+    EXPECT_LT(std::abs(rim.x / rim.w), 1.0);
+    EXPECT_GT(std::abs(rim.x / rim.w), 0.95);
+    // Near and far enclose the scene's bounding sphere along the axis (near: unless that
+    // is closer than far/1000, as here where the light is inside the sphere).
+    const double along = glm::dot(b.center() - pos, dir), radius = 0.5 * b.diagonal();
+    EXPECT_LE(f.near, std::max(along - radius, f.far * kSpotMinNearOverFar) + 1e-9);
+    EXPECT_GE(f.far, along + radius - 1e-9);
+    // Texel size per unit distance: the map spans 2·tan(half fov) at distance 1.
+    EXPECT_NEAR(f.texelWorldSize(), 2.0 * std::tan(a * 1.02) / 512, 1e-12);
+}
+
+TEST(LightFrustum, SpotNearPlaneStaysAFractionOfFarWhenTheLightIsInsideTheScene) {
+    scene::Bounds b;
+    b.extend(Vec3(-5, 0, -5));
+    b.extend(Vec3(5, 5, 5));
+    const LightFrustum f = fitSpotLight(b, Vec3(0, 2, 0), Vec3(0, -1, 0), 45.0, 256);
+    EXPECT_NEAR(f.near, f.far * kSpotMinNearOverFar, 1e-12);
+}
+
+// A camera at (0, 2, 6) looking at the origin over a 200 x 200 plane with a small sphere.
+scene::Scene bigPlaneScene() {
+    test::SphereOverPlane p;
+    p.planeSize = 200.0;
+    p.eye = Vec3(0, 2, 6);
+    p.lookAt = Vec3(0, 0, 0);
+    scene::Scene s = test::makeScene(p);
+    s.camera.far = 30.0;  // the visible part of the plane ends 30 units away
+    return s;
+}
+
+TEST(LightFrustum, FittedToReceiversIsSmallerAndStillCoversEveryVisiblePoint) {
+    const scene::Scene s = bigPlaneScene();
+    const Vec3 dir = glm::normalize(Vec3(-1, -2, -1));
+    const LightFrustum sphere = fitDirectionalLight(s.bounds(), dir, 1024);
+    const LightFrustum fitted = fitDirectionalLightToReceivers(s, dir, 1024);
+    EXPECT_LT(fitted.halfWidth, 0.5 * sphere.halfWidth);
+    // Every plane point the camera sees (pixel rays up to the far plane) maps inside the map.
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    const glm::dmat4 m = fitted.toClip(Vec3(0));
+    int seen = 0;
+    for (int y = 0; y < s.camera.height; y += 3)
+        for (int x = 0; x < s.camera.width; x += 3) {
+            const Vec3 d = test::pixelRay(cam, x, y);
+            if (d.y >= 0) continue;
+            const double t = -cam.position.y / d.y;
+            if (t * glm::dot(d, cam.forward) > s.camera.far) continue;  // beyond the far plane
+            const glm::dvec4 c = apply(m, cam.position + t * d);
+            ++seen;
+            ASSERT_LE(std::abs(c.x), 1.0);
+            ASSERT_LE(std::abs(c.y), 1.0);
+            ASSERT_GE(c.z, 0.0);
+            ASSERT_LE(c.z, 1.0);
+        }
+    EXPECT_GT(seen, 100);
+    // And the sphere, which casts onto visible receivers, is inside too.
+    const glm::dvec4 top = apply(m, Vec3(0, 1.5, 0));
+    EXPECT_GE(top.z, 0.0);
+}
+
+TEST(LightFrustum, FittedFallsBackToTheBoundingSphereWhenTheCameraSeesNothing) {
+    scene::Scene s = bigPlaneScene();
+    s.camera.lookAt = Vec3(0, 10, 6);  // straight up, away from everything
+    s.camera.up = Vec3(0, 0, -1);
+    const Vec3 dir(0, -1, 0);
+    EXPECT_EQ(fitDirectionalLightToReceivers(s, dir, 256).halfWidth, fitDirectionalLight(s.bounds(), dir, 256).halfWidth);
+}
+
+}  // namespace
+}  // namespace shadowlab::raster

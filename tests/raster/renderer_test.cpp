@@ -1,0 +1,590 @@
+// tests/raster/renderer_test.cpp: whole raster renders of the sphere-over-plane scene on
+// lavapipe with the validation layer on, judged against closed-form visibility and shadows.
+// Set SHADOWLAB_TEST_PNG_DIR to also write each render's beauty image there for a look.
+#include "raster/renderer.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "scene/frame_io.h"
+#include "tests/raster/test_scenes.h"
+
+namespace shadowlab::raster {
+namespace {
+
+using namespace test;
+using scene::ShadowFilter;
+
+const char* f_name(ShadowFilter f) {
+    switch (f) {
+        case ShadowFilter::None: return "none";
+        case ShadowFilter::Pcf2x2: return "pcf2x2";
+        case ShadowFilter::Pcf: return "pcf";
+        case ShadowFilter::Poisson: return "poisson";
+    }
+    return "?";
+}
+
+void maybeWritePng(const scene::Frame& f, const std::string& name) {
+    if (const char* dir = std::getenv("SHADOWLAB_TEST_PNG_DIR"))
+        scene::writePngLinear(std::filesystem::path(dir) / (name + ".png"), f.width, f.height, f.beauty);
+}
+
+scene::Frame renderValidated(const scene::Scene& s, const scene::RasterSettings& settings, const std::string& name) {
+    scene::Frame f = render(s, planFor(s, settings), settings);
+    EXPECT_EQ(f.attributes["validation_messages"], "0") << "validation messages were printed above";
+    maybeWritePng(f, name);
+    return f;
+}
+
+std::size_t at(const scene::Frame& f, int x, int y) { return std::size_t(y) * f.width + x; }
+
+TEST(RasterRender, SphereOverPlaneRendersWithoutValidationMessages) {
+    const SphereOverPlane p;
+    const scene::Scene s = makeScene(p);
+    const scene::Frame f = renderValidated(s, validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2), "basic");
+    ASSERT_EQ(f.width, p.width);
+    ASSERT_EQ(f.height, p.height);
+    const auto [lo, hi] = std::minmax_element(f.beauty.begin(), f.beauty.end());
+    EXPECT_LT(*lo + 0.1f, *hi) << "the image is (nearly) constant";
+    bool seen[3] = {false, false, false};
+    for (float id : f.objectId) {
+        ASSERT_TRUE(id == 0.0f || id == 1.0f || id == 2.0f) << "object id " << id;
+        seen[int(id)] = true;
+    }
+    EXPECT_TRUE(seen[0] && seen[1] && seen[2]) << "background, sphere and plane must all be visible";
+    EXPECT_EQ(f.attributes.at("backend"), "raster");
+    EXPECT_NE(f.attributes.at("device").find("llvmpipe"), std::string::npos);
+    ASSERT_EQ(f.timingsMs.size(), 4u);
+    EXPECT_EQ(f.timingsMs[0].first, "setup");
+    EXPECT_EQ(f.timingsMs[1].first, "shadow_pass");
+    EXPECT_EQ(f.timingsMs[2].first, "lit_pass");
+    EXPECT_EQ(f.timingsMs[3].first, "readback");
+}
+
+TEST(RasterRender, BackgroundPixelsHaveTheBackgroundColorAndZeroAovs) {
+    const SphereOverPlane p;
+    const scene::Scene s = makeScene(p);
+    const scene::Frame f = renderValidated(s, validatedSettings(256, 0.01, 1.0, ShadowFilter::None), "background");
+    std::size_t background = 0;
+    for (std::size_t i = 0; i < f.pixelCount(); ++i) {
+        if (f.objectId[i] != 0.0f) continue;
+        ++background;
+        for (int c = 0; c < 3; ++c) ASSERT_EQ(f.beauty[3 * i + c], float(s.background[c]));
+        ASSERT_EQ(f.visibility[i], 0.0f);
+        ASSERT_EQ(f.depth[i], 0.0f);
+        ASSERT_EQ(f.ndotl[i], 0.0f);
+    }
+    EXPECT_GT(background, 0u);
+}
+
+TEST(RasterRender, PointUnderSphereIsShadowedAndPointFarAwayIsLit) {
+    // Light straight down: the sphere's shadow on y = 0 is the disk x² + z² < r² below it.
+    const SphereOverPlane p;
+    const scene::Scene s = makeScene(p);
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    const scene::Frame f = renderValidated(s, validatedSettings(512, 0.01, 1.0, ShadowFilter::None), "under");
+
+    const Vec3 under(0.0, 0.0, 0.3);  // 0.3 < r = 0.5 from the axis: inside the disk
+    const Vec3 far(2.5, 0.0, 0.3);    // 2.5 > r: outside
+    ASSERT_TRUE(planePointShadowed(p, under));
+    ASSERT_FALSE(planePointShadowed(p, far));
+    for (const auto& [q, shadowed] : {std::pair{under, true}, std::pair{far, false}}) {
+        const auto [x, y] = projectToPixel(cam, q);
+        ASSERT_TRUE(x >= 0 && x < f.width && y >= 0 && y < f.height);
+        // The chosen point must be what that pixel sees (not hidden behind the sphere).
+        ASSERT_EQ(primaryHit(p, cam, x, y).id, 2);
+        const std::size_t i = at(f, x, y);
+        EXPECT_EQ(f.objectId[i], 2.0f);
+        EXPECT_NEAR(f.ndotl[i], 1.0f, 1e-5f);  // plane normal (0,1,0) · L (0,1,0)
+        EXPECT_EQ(f.visibility[i], shadowed ? 0.0f : 1.0f) << "pixel " << x << "," << y;
+        // Shading: ambient·albedo in shadow; + albedo·intensity·N·L when lit.
+        const float expected = shadowed ? 0.05f * 0.8f : 0.05f * 0.8f + 0.8f * 3.0f;
+        EXPECT_NEAR(f.beauty[3 * i], expected, 1e-4f);
+        // View depth: distance along the camera's forward axis.
+        const Vec3 hit = primaryHit(p, cam, x, y).p;
+        EXPECT_NEAR(f.depth[i], glm::dot(hit - cam.position, cam.forward), 1e-3);
+    }
+}
+
+// Counts, over plane pixels that the closed form says face the light, those the raster calls
+// shadowed although the closed form says lit (false shadow) and the reverse (missed shadow).
+struct ShadowErrors {
+    int counted = 0, analyticShadowed = 0, falseShadow = 0, missedShadow = 0;
+    // Shadowed pixels whose receiver lies less than `bias` behind the caster along the light
+    // (so a constant depth bias of that size lights them), counted only where the answer is
+    // clear: more than 5% of the bias away from the boundary.
+    int predictedLeak = 0, predictedKept = 0, leakedOfPredicted = 0, keptOfPredicted = 0;
+};
+
+ShadowErrors shadowErrors(const SphereOverPlane& p, const scene::Scene& s, const scene::Frame& f, double bias = 0.0) {
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    ShadowErrors e;
+    for (int y = 0; y < f.height; ++y)
+        for (int x = 0; x < f.width; ++x) {
+            const PrimaryHit h = primaryHit(p, cam, x, y);
+            const std::size_t i = at(f, x, y);
+            if (h.id != 2 || f.objectId[i] != 2.0f) continue;  // plane in both
+            ++e.counted;
+            const bool shadowed = planePointShadowed(p, h.p);
+            e.analyticShadowed += shadowed;
+            if (!shadowed && f.visibility[i] < 0.5f) ++e.falseShadow;
+            if (shadowed && f.visibility[i] > 0.5f) ++e.missedShadow;
+            const double behind = depthBehindCaster(p, h.p);
+            if (shadowed && behind < 0.95 * bias) {
+                ++e.predictedLeak;
+                e.leakedOfPredicted += f.visibility[i] > 0.5f;
+            } else if (shadowed && behind > 1.05 * bias) {
+                ++e.predictedKept;
+                e.keptOfPredicted += f.visibility[i] < 0.5f;
+            }
+        }
+    return e;
+}
+
+TEST(RasterRender, ZeroBiasAtGrazingLightGivesAcneOnTheLitPlane) {
+    // Light 10° above the horizon: across one texel the plane's light depth changes by
+    // texel·tan(80°) ≈ 5.7 texels' worth, so without bias about half the plane compares
+    // against its own, nearer texel center and shadows itself.
+    SphereOverPlane p;
+    p.lightDirection = lightFromElevation(10.0);
+    const scene::Scene s = makeScene(p);
+    const scene::Frame f = renderValidated(s, validatedSettings(512, 0.0, 0.0, ShadowFilter::None), "acne");
+    const ShadowErrors e = shadowErrors(p, s, f);
+    ASSERT_GT(e.counted, 5000);
+    EXPECT_GT(e.falseShadow, e.counted / 5) << "expected widespread acne, got " << e.falseShadow << " of " << e.counted;
+}
+
+TEST(RasterRender, HugeDepthBiasShrinksTheContactShadow) {
+    // The sphere rests on the plane, light from 60° elevation. A constant bias b lights every
+    // receiver less than b behind the caster's light-facing surface along the light; with
+    // b = 2r that is the shadow near the contact point (the plane is at most
+    // 2r/sin(60°) ≈ 2.3r behind the sphere, at the shadow's far tip). The closed form says
+    // which pixels: they must leak, and the others must stay shadowed.
+    SphereOverPlane p;
+    p.center = Vec3(0, 0.5, 0);
+    p.lightDirection = lightFromElevation(60.0);
+    p.width = 320;
+    p.height = 180;
+    const scene::Scene s = makeScene(p);
+    const double bias = 2.0 * p.radius;
+    const scene::Frame f = renderValidated(s, validatedSettings(1024, bias, 0.0, ShadowFilter::None), "huge-bias");
+    const ShadowErrors e = shadowErrors(p, s, f, bias);
+    ASSERT_GT(e.analyticShadowed, 200);
+    // About half of the visible shadow is near enough to the contact (the closed form below
+    // says exactly which pixels).
+    EXPECT_GT(e.missedShadow, e.analyticShadowed / 3)
+        << "expected much of the shadow to leak, got " << e.missedShadow << " of " << e.analyticShadowed;
+    EXPECT_GT(e.leakedOfPredicted, e.predictedLeak * 95 / 100) << e.leakedOfPredicted << " of " << e.predictedLeak;
+    EXPECT_GT(e.keptOfPredicted, e.predictedKept * 95 / 100) << e.keptOfPredicted << " of " << e.predictedKept;
+}
+
+TEST(RasterRender, SaneBiasHasFewFalseAndMissedShadows) {
+    // Half a texel of constant bias plus one texel of slope bias (the program's default).
+    for (double elevation : {10.0, 40.0}) {
+        SphereOverPlane p;
+        p.center = Vec3(0, 0.5, 0);
+        p.width = 320;
+        p.height = 180;
+        p.lightDirection = lightFromElevation(elevation);
+        const scene::Scene s = makeScene(p);
+        const int size = 1024;
+        const double texel = s.bounds().diagonal() / size;
+        const scene::Frame f = renderValidated(s, validatedSettings(size, 0.5 * texel, 1.0, ShadowFilter::Pcf2x2),
+                                               "sane-" + std::to_string(int(elevation)));
+        const ShadowErrors e = shadowErrors(p, s, f);
+        ASSERT_GT(e.analyticShadowed, 200);
+        // Only the shadow's outline may differ (a band about a texel wide).
+        EXPECT_LT(e.falseShadow, e.counted / 100) << "elevation " << elevation;
+        EXPECT_LT(e.missedShadow, e.analyticShadowed / 10) << "elevation " << elevation;
+    }
+}
+
+TEST(RasterRender, ObjectIdsMatchClosedFormPrimaryVisibilityExceptOnSilhouettes) {
+    const SphereOverPlane p;
+    const scene::Scene s = makeScene(p);
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    const scene::Frame f = renderValidated(s, validatedSettings(256, 0.01, 1.0, ShadowFilter::None), "ids");
+    int differ = 0;
+    for (int y = 0; y < f.height; ++y)
+        for (int x = 0; x < f.width; ++x)
+            differ += f.objectId[at(f, x, y)] != float(primaryHit(p, cam, x, y).id);
+    EXPECT_LT(differ, int(f.pixelCount() / 100)) << differ << " of " << f.pixelCount() << " pixels differ";
+}
+
+TEST(RasterRender, FarFromOriginSceneKeepsItsPrecision) {
+    // The same scene moved 1e6 units away: camera-relative vertices keep the silhouettes where
+    // they were (float world coordinates there would be 0.0625 apart, over a pixel wide).
+    SphereOverPlane p;
+    const Vec3 offset(1.0e6, 0.0, -1.0e6);
+    SphereOverPlane moved = p;
+    moved.center += offset;
+    moved.eye += offset;
+    moved.lookAt += offset;
+    scene::Scene s = makeScene(moved);
+    std::get<scene::Quad>(s.objects[1].shape).center += offset;
+    const scene::CameraBasis cam = scene::cameraBasis(makeScene(p).camera);
+    const scene::Frame f = renderValidated(s, validatedSettings(256, 0.01, 1.0, ShadowFilter::None), "far");
+    int differ = 0;
+    for (int y = 0; y < f.height; ++y)
+        for (int x = 0; x < f.width; ++x)
+            differ += f.objectId[at(f, x, y)] != float(primaryHit(p, cam, x, y).id);
+    EXPECT_LT(differ, int(f.pixelCount() / 100));
+}
+
+TEST(RasterRender, RecordsSettingsAndTexelSize) {
+    const SphereOverPlane p;
+    const scene::Scene s = makeScene(p);
+    const scene::Frame f = renderValidated(s, validatedSettings(256, 0.02, 1.5, ShadowFilter::None), "attrs");
+    EXPECT_EQ(f.attributes.at("shadow_map_size"), "256");
+    EXPECT_EQ(f.attributes.at("normal_offset"), "0");
+    EXPECT_EQ(f.attributes.at("light_frustum_fit"), "bounding-sphere");
+    EXPECT_EQ(f.attributes.at("filter"), "none");
+    EXPECT_EQ(std::stod(f.attributes.at("depth_bias")), 0.02);
+    EXPECT_EQ(std::stod(f.attributes.at("slope_bias")), 1.5);
+    // An orthographic map over the bounding sphere (diameter = the bounds' diagonal, 1% margin).
+    EXPECT_NEAR(std::stod(f.attributes.at("texel_world_size")), 1.01 * s.bounds().diagonal() / 256, 1e-9);
+    EXPECT_FALSE(f.attributes.at("light_frustum").empty());
+    // Lavapipe has timestamps on its graphics queue.
+    EXPECT_GE(std::stod(f.attributes.at("gpu_shadow_pass_ms")), 0.0);
+    EXPECT_GT(std::stod(f.attributes.at("gpu_lit_pass_ms")), 0.0);
+}
+
+// Plane pixels (in both the closed form and the render) more than `band` world units across
+// the light from the sphere's shadow outline must have exactly the closed-form visibility;
+// returns how many pixels (of those nearer) are fractional. The outline: plane points whose ray
+// toward the light passes exactly r from the center, so |(c − q) × L| − r is the distance
+// across the light.
+struct EdgeStats {
+    int exactWrong = 0, fractional = 0, farFromEdge = 0;
+};
+
+EdgeStats edgeStats(const SphereOverPlane& p, const scene::Scene& s, const scene::Frame& f, double band) {
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    const Vec3 l = -glm::normalize(p.lightDirection);
+    EdgeStats e;
+    for (int y = 0; y < f.height; ++y)
+        for (int x = 0; x < f.width; ++x) {
+            const PrimaryHit h = primaryHit(p, cam, x, y);
+            const std::size_t i = at(f, x, y);
+            if (h.id != 2 || f.objectId[i] != 2.0f) continue;
+            const float v = f.visibility[i];
+            if (v > 0.0f && v < 1.0f) ++e.fractional;
+            const double across = glm::length(glm::cross(p.center - h.p, l)) - p.radius;
+            if (std::abs(across) <= band) continue;
+            ++e.farFromEdge;
+            const float expected = planePointShadowed(p, h.p) ? 0.0f : 1.0f;
+            if (v != expected) ++e.exactWrong;
+        }
+    return e;
+}
+
+scene::RasterSettings filterSettings(ShadowFilter filter, int pcfSize) {
+    scene::RasterSettings r = validatedSettings(256, 0.02, 1.0, filter);
+    r.pcfSize = pcfSize;
+    return r;
+}
+
+TEST(RasterFilters, PcfOfSizeOneIsTheNearestTexel) {
+    // One tap at offset 0 is the `none` filter, pixel for pixel.
+    SphereOverPlane p;
+    p.lightDirection = lightFromElevation(60.0);
+    const scene::Scene s = makeScene(p);
+    const scene::Frame none = renderValidated(s, filterSettings(ShadowFilter::None, 1), "filter-none");
+    const scene::Frame pcf1 = renderValidated(s, filterSettings(ShadowFilter::Pcf, 1), "filter-pcf1");
+    EXPECT_EQ(none.visibility, pcf1.visibility);
+    EXPECT_EQ(pcf1.attributes.at("filter"), "pcf");
+    EXPECT_EQ(pcf1.attributes.at("pcf_size"), "1");
+}
+
+TEST(RasterFilters, FiltersSoftenOnlyABandAroundTheShadowOutline) {
+    // Light from 60° over a floating sphere: the plane is far behind the sphere, so biases do
+    // not matter and every pixel's answer is decided by the taps' positions across the light.
+    // Taps reach at most (N−1)/2 texels (pcf) or N/2 texels (poisson) from the point, plus half a
+    // texel of nearest-texel rounding: outside a band of N/2 + 1.5 texels around the outline
+    // the visibility must be exactly 0 or 1, and inside it filtering makes fractions.
+    SphereOverPlane p;
+    p.lightDirection = lightFromElevation(60.0);
+    p.width = 320;
+    p.height = 180;
+    const scene::Scene s = makeScene(p);
+    const double texel = 1.01 * s.bounds().diagonal() / 256;
+    struct Case {
+        ShadowFilter filter;
+        int size;
+        double reach;  // texels
+    };
+    int previousFractional = -1;
+    for (const Case c : {Case{ShadowFilter::Pcf2x2, 2, 1.0}, Case{ShadowFilter::Pcf, 3, 1.5},
+                         Case{ShadowFilter::Pcf, 5, 2.5}, Case{ShadowFilter::Poisson, 7, 3.5}}) {
+        const scene::Frame f = renderValidated(s, filterSettings(c.filter, c.size),
+                                               std::string("filter-") + f_name(c.filter) + std::to_string(c.size));
+        const EdgeStats e = edgeStats(p, s, f, (c.reach + 1.5) * texel);
+        EXPECT_GT(e.farFromEdge, 10000);
+        EXPECT_EQ(e.exactWrong, 0) << f.attributes.at("filter") << " " << c.size;
+        EXPECT_GT(e.fractional, 100) << f.attributes.at("filter") << " " << c.size;
+        EXPECT_GT(e.fractional, previousFractional) << "a wider kernel must widen the penumbra";
+        previousFractional = e.fractional;
+    }
+}
+
+TEST(RasterFilters, NoneHasNoFractionalVisibility) {
+    SphereOverPlane p;
+    p.lightDirection = lightFromElevation(60.0);
+    const scene::Scene s = makeScene(p);
+    const scene::Frame f = renderValidated(s, filterSettings(ShadowFilter::None, 3), "filter-none-only");
+    for (float v : f.visibility) ASSERT_TRUE(v == 0.0f || v == 1.0f) << v;
+}
+
+TEST(RasterNormalOffset, NormalOffsetRemovesAcneWithoutDepthBias) {
+    // Light 30° above the plane, no depth or slope bias. Without offset the plane shadows itself
+    // on about half its pixels. Moving the lookup point δ = k·texel along the normal puts it
+    // δ/cos(θ) in front of the plane along the light, while the stored depth of a neighbouring
+    // texel center differs from the plane's by at most (√2/2)·texel·tan(θ) (nearest texel, half a
+    // diagonal away): k > (√2/2)·sin(θ) ≈ 0.61 suffices at θ = 60°; k = 1.5 leaves margin.
+    SphereOverPlane p;
+    p.lightDirection = lightFromElevation(30.0);
+    p.width = 320;
+    p.height = 180;
+    const scene::Scene s = makeScene(p);
+    scene::RasterSettings settings = validatedSettings(512, 0.0, 0.0, ShadowFilter::None);
+    const ShadowErrors without = shadowErrors(p, s, renderValidated(s, settings, "no-offset"));
+    settings.normalOffset = 1.5;
+    const scene::Frame f = renderValidated(s, settings, "normal-offset");
+    const ShadowErrors with = shadowErrors(p, s, f);
+    EXPECT_GT(without.falseShadow, without.counted / 5);
+    EXPECT_LT(with.falseShadow, with.counted / 1000) << with.falseShadow << " of " << with.counted;
+    ASSERT_GT(with.analyticShadowed, 200);
+    EXPECT_LT(with.missedShadow, with.analyticShadowed / 20);
+    EXPECT_EQ(f.attributes.at("normal_offset"), "1.5");
+}
+
+TEST(RasterBlockerId, ShadowedPlanePixelsNameTheSphereAndAcneNamesThePlaneItself) {
+    // Light straight down: the plane's shadowed pixels are blocked by the sphere (id 1), lit
+    // ones by nothing (0). With zero bias at grazing light the false shadows are the plane
+    // shadowing itself (id 2): self-shadow acne.
+    {
+        const SphereOverPlane p;
+        const scene::Scene s = makeScene(p);
+        const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+        const scene::Frame f = renderValidated(s, validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2), "blocker");
+        ASSERT_EQ(f.blockerId.size(), f.pixelCount());
+        int shadowedChecked = 0;
+        for (int y = 0; y < f.height; ++y)
+            for (int x = 0; x < f.width; ++x) {
+                const std::size_t i = at(f, x, y);
+                const PrimaryHit h = primaryHit(p, cam, x, y);
+                if (h.id != 2 || f.objectId[i] != 2.0f) continue;
+                if (f.visibility[i] == 0.0f) {
+                    EXPECT_EQ(f.blockerId[i], 1.0f);
+                    ++shadowedChecked;
+                }
+                if (f.visibility[i] == 1.0f) {
+                    EXPECT_EQ(f.blockerId[i], 0.0f);
+                }
+            }
+        EXPECT_GT(shadowedChecked, 50);
+    }
+    {
+        SphereOverPlane p;
+        p.lightDirection = lightFromElevation(10.0);
+        const scene::Scene s = makeScene(p);
+        const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+        const scene::Frame f = renderValidated(s, validatedSettings(512, 0.0, 0.0, ShadowFilter::None), "blocker-acne");
+        int acne = 0, selfBlocked = 0;
+        for (int y = 0; y < f.height; ++y)
+            for (int x = 0; x < f.width; ++x) {
+                const std::size_t i = at(f, x, y);
+                const PrimaryHit h = primaryHit(p, cam, x, y);
+                if (h.id != 2 || f.objectId[i] != 2.0f || planePointShadowed(p, h.p)) continue;
+                if (f.visibility[i] < 0.5f) {
+                    ++acne;
+                    selfBlocked += f.blockerId[i] == 2.0f;
+                }
+            }
+        ASSERT_GT(acne, 1000);
+        EXPECT_EQ(selfBlocked, acne);
+    }
+}
+
+TEST(RasterSpotLight, PerspectiveShadowMatchesTheClosedForm) {
+    // A spot 4 units above the plane pointing down, cone 40°, over a floating sphere. Closed
+    // form: a plane point inside the cone is shadowed when the segment to the light meets the
+    // sphere; its irradiance is I/(4π d²) (scene/shading.h).
+    SphereOverPlane p;
+    p.width = 320;
+    p.height = 180;
+    scene::Scene s = makeScene(p);
+    const Vec3 lightPos(0.3, 4.0, 0.2);
+    const double cone = 40.0;
+    s.lights[0].type = scene::LightType::Spot;
+    s.lights[0].position = lightPos;
+    s.lights[0].direction = Vec3(0, -1, 0);
+    s.lights[0].coneAngleDegrees = cone;
+    s.lights[0].intensity = 300.0;
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    const scene::Frame f = renderValidated(s, validatedSettings(1024, 0.01, 1.0, ShadowFilter::Pcf2x2), "spot");
+    const double cosCone = std::cos(cone * kPi / 180.0);
+    int counted = 0, shadowed = 0, wrong = 0, dark = 0;
+    for (int y = 0; y < f.height; ++y)
+        for (int x = 0; x < f.width; ++x) {
+            const std::size_t i = at(f, x, y);
+            const PrimaryHit h = primaryHit(p, cam, x, y);
+            if (h.id != 2 || f.objectId[i] != 2.0f) continue;
+            const Vec3 toLight = lightPos - h.p;
+            const double cosAngle = glm::dot(-glm::normalize(toLight), Vec3(0, -1, 0));
+            if (cosAngle < cosCone - 0.01) {  // well outside the cone: no light at all
+                ++dark;
+                EXPECT_EQ(f.visibility[i], 0.0f);
+                EXPECT_NEAR(f.beauty[3 * i], 0.05 * 0.8, 1e-5);
+                continue;
+            }
+            if (cosAngle < cosCone + 0.01) continue;  // the rim
+            ++counted;
+            const auto t = raySphere(h.p, toLight, p.center, p.radius);
+            const bool inShadow = t && *t < 1.0;
+            shadowed += inShadow;
+            if ((f.visibility[i] > 0.5f) == inShadow) ++wrong;
+            if (!inShadow && f.visibility[i] == 1.0f) {
+                const double d2 = glm::dot(toLight, toLight);
+                const double ndotl = toLight.y / std::sqrt(d2);
+                EXPECT_NEAR(f.beauty[3 * i], 0.8 * 300.0 / (4 * kPi * d2) * ndotl + 0.05 * 0.8, 2e-4);
+            }
+        }
+    EXPECT_GT(dark, 1000);
+    EXPECT_GT(counted, 5000);
+    EXPECT_GT(shadowed, 300);
+    EXPECT_LT(wrong, shadowed / 20) << wrong << " of " << counted << " pixels in the cone are wrong";
+    EXPECT_NE(f.attributes.at("light_frustum").find("perspective"), std::string::npos);
+}
+
+TEST(RasterFittedFrustum, FittedMapIsFinerAndKeepsShadowsFromCastersOutsideTheView) {
+    // A large plane seen from close by, and a second sphere behind the camera that shadows
+    // the visible plane: the fitted map covers only what matters, so its texels are smaller,
+    // and the unseen caster still casts.
+    SphereOverPlane p;
+    p.planeSize = 40.0;
+    p.lightDirection = glm::normalize(Vec3(0.0, -1.0, -2.0));  // travels away from the camera
+    p.width = 320;
+    p.height = 180;
+    scene::Scene s = makeScene(p);
+    scene::Object behind = s.objects[0];
+    // Behind the camera at (0, 4, 6) (it looks toward −z); its shadow lands at about (0, 0, 0.5),
+    // in view, apart from the first sphere's at (0, 0, −2).
+    const Vec3 behindCenter(0.0, 3.5, 7.5);
+    behind.shape = scene::Sphere{behindCenter, 0.8};
+    behind.name = "objects[2]";
+    s.objects.push_back(behind);
+    scene::RasterSettings settings = validatedSettings(1024, 0.0, 1.0, ShadowFilter::None);
+    settings.depthBias = 0.5 * s.bounds().diagonal() / 1024;
+    const scene::Frame sphereFit = renderValidated(s, settings, "fit-sphere");
+    settings.fitLightFrustum = true;
+    const scene::Frame fitted = renderValidated(s, settings, "fit-receivers");
+    EXPECT_EQ(fitted.attributes.at("light_frustum_fit"), "receivers");
+    EXPECT_LT(std::stod(fitted.attributes.at("texel_world_size")),
+              0.75 * std::stod(sphereFit.attributes.at("texel_world_size")));
+    // Closed form with both spheres.
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    const Vec3 l = -glm::normalize(p.lightDirection);
+    int counted = 0, shadowed = 0, shadowedByBehind = 0, wrong = 0;
+    for (int y = 0; y < fitted.height; ++y)
+        for (int x = 0; x < fitted.width; ++x) {
+            const std::size_t i = at(fitted, x, y);
+            const PrimaryHit h = primaryHit(p, cam, x, y);
+            if (h.id != 2 || fitted.objectId[i] != 2.0f) continue;
+            const bool byFirst = raySphere(h.p, l, p.center, p.radius).has_value();
+            const bool byBehind = raySphere(h.p, l, behindCenter, 0.8).has_value();
+            ++counted;
+            shadowed += byFirst || byBehind;
+            shadowedByBehind += byBehind;
+            if ((fitted.visibility[i] > 0.5f) == (byFirst || byBehind)) ++wrong;
+        }
+    ASSERT_GT(shadowedByBehind, 100) << "the test needs the unseen sphere's shadow in view";
+    EXPECT_LT(wrong, shadowed / 20) << wrong << " wrong of " << counted;
+}
+
+TEST(RasterRender, TwoLightsWeighVisibilityByTheirUnshadowedIrradiance) {
+    // Light A straight down (intensity 3) is blocked under the sphere; light B from 40°
+    // elevation (intensity 1) reaches the point under the sphere. There the visibility is
+    // w_B / (w_A + w_B) with w = intensity·N·L (docs/decisions.md), and the color is
+    // ambient·albedo + albedo·1·N·L_B; N·L is the larger of the two.
+    SphereOverPlane p;
+    scene::Scene s = makeScene(p);
+    scene::Light b = s.lights[0];
+    b.direction = lightFromElevation(40.0);
+    b.intensity = 1.0;
+    s.lights.push_back(b);
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    const scene::Frame f = renderValidated(s, validatedSettings(512, 0.01, 1.0, ShadowFilter::None), "two-lights");
+    const Vec3 under(0.0, 0.0, 0.3);
+    ASSERT_TRUE(planePointShadowed(p, under));
+    SphereOverPlane pb = p;
+    pb.lightDirection = b.direction;
+    ASSERT_FALSE(planePointShadowed(pb, under));
+    const auto [x, y] = projectToPixel(cam, under);
+    ASSERT_EQ(primaryHit(p, cam, x, y).id, 2);
+    const std::size_t i = at(f, x, y);
+    const double ndotlB = std::sin(40.0 * kPi / 180.0);
+    EXPECT_NEAR(f.visibility[i], ndotlB / (3.0 + ndotlB), 1e-5);
+    EXPECT_NEAR(f.ndotl[i], 1.0, 1e-5);
+    EXPECT_NEAR(f.beauty[3 * i], 0.05 * 0.8 + 0.8 * ndotlB, 1e-4);
+    EXPECT_EQ(f.attributes.at("shadow_maps"), "2");
+}
+
+TEST(RasterRender, BadPcfSizeIsRejected) {
+    const scene::Scene s = makeScene(SphereOverPlane{});
+    scene::RasterSettings settings = filterSettings(ShadowFilter::Pcf, 0);
+    EXPECT_THROW(render(s, planFor(s, settings), settings), RasterError);
+    settings.pcfSize = 16;
+    EXPECT_THROW(render(s, planFor(s, settings), settings), RasterError);
+}
+
+TEST(RasterRender, ImageTooLargeForTheDeviceIsAClearError) {
+    // 16384² pixels need 68 bytes each (two RGBA32F targets, D32 depth, two RGBA32F readback
+    // buffers): 17 GiB, more than lavapipe's 2 GiB heap.
+    SphereOverPlane p;
+    p.width = 16384;
+    p.height = 16384;
+    const scene::Scene s = makeScene(p);
+    const scene::RasterSettings settings = validatedSettings(256, 0.01, 1.0, ShadowFilter::None);
+    try {
+        render(s, planFor(s, settings), settings);
+        FAIL() << "expected RasterError";
+    } catch (const RasterError& e) {
+        EXPECT_NE(std::string(e.what()).find("MiB of device memory"), std::string::npos) << e.what();
+    }
+}
+
+TEST(RasterRender, PointLightIsRejectedWithAClearMessage) {
+    scene::Scene s = makeScene(SphereOverPlane{});
+    s.lights[0].type = scene::LightType::Point;
+    s.lights[0].position = Vec3(0, 5, 0);
+    const scene::RasterSettings settings = validatedSettings(256, 0.01, 1.0, ShadowFilter::None);
+    try {
+        render(s, planFor(s, settings), settings);
+        FAIL() << "expected RasterError";
+    } catch (const RasterError& e) {
+        EXPECT_NE(std::string(e.what()).find("not supported by the raster backend yet"), std::string::npos)
+            << e.what();
+    }
+}
+
+TEST(RasterRender, UnmatchedDeviceGivesAnErrorListingTheDevices) {
+    const scene::Scene s = makeScene(SphereOverPlane{});
+    scene::RasterSettings settings = validatedSettings(256, 0.01, 1.0, ShadowFilter::None);
+    settings.device = "no-such-gpu-xyz";
+    try {
+        render(s, planFor(s, settings), settings);
+        FAIL() << "expected RasterError";
+    } catch (const RasterError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("no-such-gpu-xyz"), std::string::npos) << what;
+        EXPECT_NE(what.find("llvmpipe"), std::string::npos) << what;  // the device list
+    }
+}
+
+}  // namespace
+}  // namespace shadowlab::raster

@@ -1,0 +1,259 @@
+// tests/raytrace/renderer_test.cpp: whole frames against closed-form answers: the reference is
+// exact on sphere-over-plane, the float method with no bias shows acne, a huge bias lifts the
+// contact shadow, any-hit and closest-hit shadow rays agree, AOVs and metadata are filled.
+#include "raytrace/renderer.h"
+
+#include <gtest/gtest.h>
+
+#include "scene/settings.h"
+#include "tests/raytrace/test_scenes.h"
+
+namespace shadowlab::raytrace {
+namespace {
+
+using test::Analytic;
+using test::Vec3;
+
+TEST(ReferenceRender, SeedSceneVisibilityEqualsClosedFormAwayFromShadowEdge) {
+    const scene::Scene s = test::sphereOverPlane();
+    const scene::Frame f = renderReference(s, test::planFor(s), test::biasSettings(0, scene::Precision::Float));
+    ASSERT_EQ(f.width, 160);
+    ASSERT_EQ(f.height, 90);
+    int judged = 0, shadowed = 0, wrong = 0, skipped = 0;
+    for (int y = 0; y < f.height; ++y) {
+        for (int x = 0; x < f.width; ++x) {
+            const std::size_t i = std::size_t(y) * f.width + x;
+            const Analytic a = test::analyticPixel(s, {}, x, y);
+            if (a.nearEdge) {
+                ++skipped;
+                continue;
+            }
+            const int expectedId = a.kind == Analytic::Background ? 0 : (a.kind == Analytic::Sphere ? 1 : 2);
+            ASSERT_EQ(int(f.objectId[i]), expectedId) << "pixel " << x << "," << y;
+            if (a.kind == Analytic::Background) continue;
+            ++judged;
+            if (!a.lit) ++shadowed;
+            const float expected = a.lit ? 1.0f : 0.0f;
+            if (f.visibility[i] != expected) {
+                ++wrong;
+                ADD_FAILURE() << "pixel " << x << "," << y << " visibility " << f.visibility[i]
+                              << " expected " << expected;
+                if (wrong > 10) return;
+            }
+        }
+    }
+    // The scene must exercise both answers, and the margin must skip only a thin edge.
+    EXPECT_GT(shadowed, 200);
+    EXPECT_GT(judged - shadowed, 5000);
+    EXPECT_LT(skipped, 50);
+    EXPECT_EQ(f.attributes.at("backend"), "reference");
+    EXPECT_EQ(f.attributes.at("precision"), "double");
+    EXPECT_EQ(f.attributes.at("ray_bias"), "robust");
+}
+
+// Counts plane pixels that are lit in closed form but have visibility 0 in the frame.
+int falseShadowsOnPlane(const scene::Scene& s, const test::Placement& at, const scene::Frame& f,
+                        int& litPlanePixels) {
+    int acne = 0;
+    litPlanePixels = 0;
+    for (int y = 0; y < f.height; ++y)
+        for (int x = 0; x < f.width; ++x) {
+            const Analytic a = test::analyticPixel(s, at, x, y, 0.0, 1e-6);
+            if (a.kind != Analytic::Plane || a.nearEdge || !a.lit) continue;
+            // The tilted square's in-plane orientation follows quadAxes(), not the local frame
+            // of the closed form: near its far edge the two may see different things.
+            if (f.objectId[std::size_t(y) * f.width + x] != 2.0f) continue;
+            ++litPlanePixels;
+            if (f.visibility[std::size_t(y) * f.width + x] == 0.0f) ++acne;
+        }
+    return acne;
+}
+
+TEST(MethodRender, FloatWithZeroBiasShowsAcneOnTheLitPlaneAndReferenceDoesNot) {
+    // The seed scene tilted 25° and moved ~1000 from the origin: the plane is no longer a
+    // float grid plane, so the rounded o + t·d lands below it about half the time and its
+    // shadow ray hits the plane itself. (An axis-aligned plane hides acne: o.y + t·d.y rounds
+    // to the plane's own float y.)
+    test::Placement at;
+    at.offset = Vec3(1000.3, 200.7, -800.1);
+    at.rotation = test::rotation(Vec3(1, 0.5, 0.2), 25);
+    const scene::Scene s = test::sphereOverPlane(at);
+    const scene::RenderPlan plan = test::planFor(s);
+    const scene::Frame method = render(s, plan, test::biasSettings(0.0, scene::Precision::Float));
+    int lit = 0;
+    const int acne = falseShadowsOnPlane(s, at, method, lit);
+    ASSERT_GT(lit, 5000);
+    EXPECT_GT(acne, lit / 10) << acne << " of " << lit << " lit plane pixels are dark";
+    // Self-shadowing: the blocker is the plane itself (object index 1, id 2), apart from a few
+    // pixels at the shadow's edge, which float geometry ~1000 from the origin moves by ~1e-4.
+    int selfBlocked = 0;
+    for (std::size_t i = 0; i < method.pixelCount(); ++i)
+        if (method.objectId[i] == 2.0f && method.blockerId[i] == 2.0f) ++selfBlocked;
+    EXPECT_GE(selfBlocked, acne * 9 / 10);
+
+    const scene::Frame ref = renderReference(s, plan, test::biasSettings(0.0, scene::Precision::Float));
+    EXPECT_EQ(falseShadowsOnPlane(s, at, ref, lit), 0);
+    // The method in float with robust offsets is acne-free too.
+    scene::RaytraceSettings robust = test::biasSettings(0.0, scene::Precision::Float);
+    robust.robustOffset = true;
+    EXPECT_EQ(falseShadowsOnPlane(s, at, render(s, plan, robust), lit), 0);
+}
+
+TEST(MethodRender, HugeBiasLiftsTheContactShadowExactlyAsTheShiftedOriginPredicts) {
+    // Bias 1.5·r moves the plane's shadow-ray origins to y = 1.5: points within 0.87 of the
+    // contact start inside the sphere (still blocked), the rest of the shadow's far end sees
+    // the light over the sphere. Closed form: the same ray test from p + 1.5·n.
+    const scene::Scene s = test::sphereOverPlane();
+    const scene::RenderPlan plan = test::planFor(s);
+    const double bias = 1.5;
+    for (scene::Precision precision : {scene::Precision::Double, scene::Precision::Float}) {
+        const scene::Frame f = render(s, plan, test::biasSettings(bias, precision));
+        int shadowedTruly = 0, liftedExpected = 0, liftedSeen = 0, mismatches = 0;
+        for (int y = 0; y < f.height; ++y)
+            for (int x = 0; x < f.width; ++x) {
+                const std::size_t i = std::size_t(y) * f.width + x;
+                const Analytic truth = test::analyticPixel(s, {}, x, y, 0.0, 1e-4);
+                const Analytic biased = test::analyticPixel(s, {}, x, y, bias, 1e-4);
+                if (truth.kind != Analytic::Plane || truth.nearEdge || biased.nearEdge) continue;
+                if (!truth.lit) {
+                    ++shadowedTruly;
+                    if (biased.lit) ++liftedExpected;
+                    if (f.visibility[i] == 1.0f) ++liftedSeen;
+                }
+                if (f.visibility[i] != (biased.lit ? 1.0f : 0.0f)) ++mismatches;
+            }
+        SCOPED_TRACE(scene::toString(precision));
+        EXPECT_GT(shadowedTruly, 200);
+        EXPECT_GT(liftedExpected, shadowedTruly / 5);  // the scene shows a big missed shadow
+        EXPECT_EQ(liftedSeen, liftedExpected);
+        EXPECT_EQ(mismatches, 0);
+        EXPECT_EQ(f.attributes.at("ray_bias"), "1.5");
+    }
+}
+
+TEST(MeshRender, FlatConvexMeshIsAcneFreeInTheReferenceAndAcneRiddenInFloatWithoutBias) {
+    // A flat-shaded icosphere (no vertex normals: N is the face normal) replaces the seed's
+    // sphere. Convex, with the plane below it: every mesh pixel facing the light is lit.
+    scene::Scene s = test::sphereOverPlane({}, 128, 72);
+    auto mesh = test::icosphere(Vec3(0.37, 1.01, -0.23), 1.0, 3);
+    mesh->normals.clear();
+    s.objects[0].shape = scene::Mesh{"icosphere", mesh};
+    const scene::RenderPlan plan = test::planFor(s);
+    const scene::Frame ref = renderReference(s, plan, test::biasSettings(0, scene::Precision::Float));
+    const scene::Frame method = render(s, plan, test::biasSettings(0, scene::Precision::Float));
+    EXPECT_EQ(ref.attributes.at("triangles"), "1280");  // 20·4³ faces
+    int facing = 0, refDark = 0, acne = 0;
+    for (std::size_t i = 0; i < ref.pixelCount(); ++i) {
+        if (ref.objectId[i] != 1.0f || !(ref.ndotl[i] > 1e-3f)) continue;
+        ++facing;
+        if (ref.visibility[i] != 1.0f) ++refDark;
+        if (method.objectId[i] == 1.0f && method.visibility[i] == 0.0f) ++acne;
+    }
+    EXPECT_GT(facing, 400);
+    EXPECT_EQ(refDark, 0);
+    EXPECT_GT(acne, facing / 10) << acne << " of " << facing;
+}
+
+scene::Scene busyOpaqueScene() {
+    scene::Scene s = test::sphereOverPlane({}, 96, 64);
+    test::addBox(s, Vec3(-2.5, 0, -1.5), Vec3(-1.5, 1.2, -0.5));
+    test::addSphere(s, Vec3(1.6, 0.5, 0.8), 0.5);
+    test::addQuad(s, Vec3(1.5, 2.2, -1), Vec3(0.3, -1, 0.2), 1.0, 0.7);
+    scene::Light point;
+    point.type = scene::LightType::Point;
+    point.position = Vec3(2, 4, 2);
+    point.intensity = 200;
+    s.lights.push_back(point);
+    scene::Light area = point;
+    area.position = Vec3(-2, 3.5, 3);
+    area.radius = 0.4;
+    s.lights.push_back(area);
+    return s;
+}
+
+TEST(MethodRender, AnyHitAndClosestHitShadowRaysAgreeOnOpaqueScenes) {
+    const scene::Scene s = busyOpaqueScene();
+    scene::RenderPlan anyHitPlan = test::planFor(s);
+    ASSERT_TRUE(anyHitPlan.anyHitShadowRays);
+    scene::RenderPlan closestPlan = anyHitPlan;
+    closestPlan.anyHitShadowRays = false;
+    for (scene::Precision precision : {scene::Precision::Float, scene::Precision::Double}) {
+        for (bool robust : {false, true}) {
+            scene::RaytraceSettings rs = test::biasSettings(robust ? 0.0 : 1e-4, precision);
+            rs.robustOffset = robust;
+            rs.samples = 9;
+            const scene::Frame a = render(s, anyHitPlan, rs);
+            const scene::Frame c = render(s, closestPlan, rs);
+            ASSERT_EQ(a.attributes.at("shadow_rays"), "any-hit");
+            ASSERT_EQ(c.attributes.at("shadow_rays"), "closest-hit");
+            int partial = 0, zero = 0;
+            for (std::size_t i = 0; i < a.pixelCount(); ++i) {
+                ASSERT_EQ(a.visibility[i], c.visibility[i]) << "pixel " << i;
+                ASSERT_EQ(a.beauty[3 * i], c.beauty[3 * i]);
+                if (a.visibility[i] > 0 && a.visibility[i] < 1) ++partial;
+                if (a.visibility[i] == 0 && a.objectId[i] > 0) ++zero;
+            }
+            EXPECT_GT(partial, 20);  // the area light's penumbra is in view
+            EXPECT_GT(zero, 20);
+        }
+    }
+}
+
+TEST(MethodRender, FramesDoNotDependOnTheThreadCount) {
+    // Area-light samples come from per-pixel random streams, so the schedule cannot change them.
+    const scene::Scene s = busyOpaqueScene();
+    scene::RaytraceSettings rs = test::biasSettings(1e-4, scene::Precision::Float);
+    rs.samples = 16;
+    rs.threads = 1;
+    const scene::Frame one = render(s, test::planFor(s), rs);
+    rs.threads = 2;
+    const scene::Frame two = render(s, test::planFor(s), rs);
+    EXPECT_EQ(one.attributes.at("threads"), "1");
+    EXPECT_EQ(two.attributes.at("threads"), "2");
+    EXPECT_EQ(one.visibility, two.visibility);
+    EXPECT_EQ(one.beauty, two.beauty);
+    EXPECT_EQ(one.blockerId, two.blockerId);
+}
+
+TEST(MethodRender, FillsEveryAovAndTheMetadata) {
+    const scene::Scene s = test::sphereOverPlane({}, 64, 36);
+    scene::RaytraceSettings rs = test::biasSettings(1e-4, scene::Precision::Float);
+    rs.threads = 1;
+    const scene::Frame f = render(s, test::planFor(s), rs);
+    ASSERT_EQ(f.pixelCount(), 64u * 36u);
+    ASSERT_EQ(f.blockerId.size(), f.pixelCount());
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    for (int y = 0; y < f.height; ++y)
+        for (int x = 0; x < f.width; ++x) {
+            const std::size_t i = std::size_t(y) * f.width + x;
+            const Analytic a = test::analyticPixel(s, {}, x, y);
+            if (a.nearEdge) continue;
+            if (a.kind == Analytic::Background) {
+                EXPECT_EQ(f.objectId[i], 0.0f);
+                EXPECT_EQ(f.depth[i], 0.0f);
+                EXPECT_FLOAT_EQ(f.beauty[3 * i], float(s.background.x));
+                continue;
+            }
+            // Depth along the camera axis and N·L from the closed-form point and normal.
+            const double depth = glm::dot(a.p - cam.position, cam.forward);
+            EXPECT_NEAR(f.depth[i], depth, 1e-4 * depth);
+            const Vec3 L = -s.lights[0].direction;
+            EXPECT_NEAR(f.ndotl[i], glm::dot(a.n, L), 1e-4);
+            // Shading: albedo·(ambient + intensity·N·L·V).
+            const double v = f.visibility[i];
+            const double expected = 0.8 * (s.ambient + 3.0 * std::max(0.0, glm::dot(a.n, L)) * v);
+            EXPECT_NEAR(f.beauty[3 * i], expected, 1e-4);
+            if (v == 1.0f) {
+                EXPECT_EQ(f.blockerId[i], 0.0f);
+            }
+        }
+    for (const char* stage : {"setup", "primary", "shadow"}) EXPECT_GE(f.timing(stage), 0.0);
+    EXPECT_EQ(f.timingsMs.size(), 3u);
+    EXPECT_EQ(f.attributes.at("backend"), "raytrace");
+    EXPECT_EQ(f.attributes.at("precision"), "float");
+    EXPECT_EQ(f.attributes.at("threads"), "1");
+    EXPECT_EQ(f.attributes.at("samples"), "1");
+}
+
+}  // namespace
+}  // namespace shadowlab::raytrace
