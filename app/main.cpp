@@ -23,7 +23,13 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
                    "raster: constant depth bias in world units (default: half a shadow-map texel)");
     cmd.add_option("--slope-bias", s.slopeBias,
                    "raster: slope-scaled bias in texels, times tan(angle to light) (default 1)");
-    cmd.add_option("--filter", s.filter, "raster: shadow-map filter none|pcf2x2 (default pcf2x2)");
+    cmd.add_option("--filter", s.filter,
+                   "raster: shadow-map filter none|pcf2x2|pcf|poisson (default pcf2x2: bilinear 2x2 PCF)");
+    cmd.add_option("--pcf-size", s.pcfSize, "raster: pcf taps per side, or poisson kernel diameter in texels (default 3)");
+    cmd.add_option("--normal-offset", s.normalOffset,
+                   "raster: move receivers along their normal by this many texels (default 0)");
+    cmd.add_flag("--fit-light-frustum", s.fitLightFrustum,
+                 "raster: fit each light's map to the casters of visible receivers, not the scene's bounds");
     cmd.add_option("--device", s.device, "raster: Vulkan device index or name part (default: lavapipe)");
     cmd.add_option("--ray-bias", s.rayBias,
                    "raytrace: shadow-ray offset along the normal in world units, or 'robust' "

@@ -293,7 +293,8 @@ Object readObject(const Reader& r, const Json& node, const JsonPath& path,
 }
 
 ShadowDefaults readShadow(const Reader& r, const Json& node, const JsonPath& path) {
-    r.checkKeys(node, path, {"shadow_map_size", "depth_bias", "slope_bias", "filter", "ray_bias", "precision", "samples"});
+    r.checkKeys(node, path, {"shadow_map_size", "depth_bias", "slope_bias", "filter", "pcf_size", "normal_offset",
+                             "fit_light_frustum", "ray_bias", "precision", "samples"});
     ShadowDefaults d;
     if (node.contains("shadow_map_size"))
         d.shadowMapSize = r.integer(node["shadow_map_size"], path / "shadow_map_size", 16, 16384);
@@ -307,9 +308,16 @@ ShadowDefaults readShadow(const Reader& r, const Json& node, const JsonPath& pat
     }
     if (node.contains("filter")) {
         d.filter = r.string(node["filter"], path / "filter");
-        if (*d.filter != "none" && *d.filter != "pcf2x2")
-            r.fail(path / "filter", "expected none or pcf2x2, got '" + *d.filter + "'");
+        if (*d.filter != "none" && *d.filter != "pcf2x2" && *d.filter != "pcf" && *d.filter != "poisson")
+            r.fail(path / "filter", "expected none, pcf2x2, pcf or poisson, got '" + *d.filter + "'");
     }
+    if (node.contains("pcf_size")) d.pcfSize = r.integer(node["pcf_size"], path / "pcf_size", 1, 15);
+    if (node.contains("normal_offset")) {
+        d.normalOffset = r.number(node["normal_offset"], path / "normal_offset");
+        if (*d.normalOffset < 0) r.fail(path / "normal_offset", "must be >= 0 (texels)");
+    }
+    if (node.contains("fit_light_frustum"))
+        d.fitLightFrustum = r.boolean(node["fit_light_frustum"], path / "fit_light_frustum");
     if (node.contains("ray_bias")) {
         const Json& v = node["ray_bias"];
         if (v.is_string()) {
@@ -398,6 +406,68 @@ Scene parseScene(const fs::path& file, const std::string& text) {
     return scene;
 }
 
+// A glTF/GLB file as the whole scene (DESIGN.md): its geometry as one mesh object, its first
+// perspective camera and its KHR_lights_punctual lights; a framed camera and a default sun
+// where it has none (docs/decisions.md).
+Scene loadModelScene(const fs::path& file) {
+    constexpr double kPi = 3.14159265358979323846;
+    GltfExtras extras;
+    Scene scene;
+    scene.file = file;
+    scene.materials.push_back({"model", {0.8, 0.8, 0.8}, 1.0});
+    Mesh mesh;
+    mesh.file = file;
+    mesh.geometry = loadMesh(file, glm::dmat4(1.0), file, JsonPath(), &extras);
+    scene.objects.push_back({file.stem().string(), mesh, 0});
+    const Bounds b = scene.bounds();
+    const double radius = std::max(0.5 * b.diagonal(), 1e-9);
+
+    Camera& cam = scene.camera;
+    if (!extras.cameras.empty()) {
+        const GltfCamera& c = extras.cameras.front();
+        cam.position = c.position;
+        cam.lookAt = c.position + c.forward;
+        cam.up = c.up;
+        cam.fovYDegrees = std::clamp(c.yfovRadians * 180.0 / kPi, 1.0, 170.0);
+        cam.near = c.znear > 0 ? c.znear : radius * 1e-3;
+        cam.far = c.zfar > cam.near ? c.zfar : glm::length(c.position - b.center()) + 4.0 * radius;
+        if (c.aspect > 0) cam.height = std::clamp(int(std::lround(cam.width / c.aspect)), 1, kMaxResolution);
+    } else {
+        // Framed: the bounding sphere fills the vertical field of view from above and in front.
+        cam.fovYDegrees = 40.0;
+        const double distance = 1.15 * radius / std::sin(0.5 * cam.fovYDegrees * kPi / 180.0);
+        cam.lookAt = b.center();
+        cam.position = b.center() + distance * glm::normalize(Vec3(0.55, 0.45, 1.0));
+        cam.near = std::max(distance - 2.0 * radius, distance * 1e-3);
+        cam.far = distance + 2.0 * radius;
+    }
+    for (const GltfLight& l : extras.lights) {
+        Light light;
+        light.color = l.color;
+        if (l.type == "directional") {
+            light.type = LightType::Directional;
+            light.direction = l.direction;
+            light.intensity = l.intensity;
+        } else {
+            light.type = l.type == "spot" ? LightType::Spot : LightType::Point;
+            light.position = l.position;
+            light.direction = l.direction;
+            // glTF point intensity is in candela (irradiance I/d²); ours is I/(4π d²).
+            light.intensity = 4.0 * kPi * l.intensity;
+            if (light.type == LightType::Spot)
+                light.coneAngleDegrees = std::clamp(l.outerConeRadians * 180.0 / kPi, 0.1, 89.9);
+        }
+        scene.lights.push_back(light);
+    }
+    if (scene.lights.empty()) {
+        Light sun;  // from above, left and in front of the default framing
+        sun.direction = glm::normalize(Vec3(-0.4, -1.0, -0.6));
+        sun.intensity = 1.4;
+        scene.lights.push_back(sun);
+    }
+    return scene;
+}
+
 }  // namespace
 
 Scene loadScene(const fs::path& file) {
@@ -406,8 +476,9 @@ Scene loadScene(const fs::path& file) {
     if (fs::is_directory(file, ec)) throw SceneError(file, {}, "is a folder, not a scene file");
     std::string ext = file.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-    if (ext == ".gltf" || ext == ".glb" || ext == ".obj")
-        throw SceneError(file, {}, "a model file cannot be a scene yet: reference it from a JSON scene "
+    if (ext == ".gltf" || ext == ".glb") return loadModelScene(file);
+    if (ext == ".obj")
+        throw SceneError(file, {}, "an OBJ file has no camera or light: reference it from a JSON scene "
                                    "as {\"type\": \"mesh\", \"file\": \"" + file.filename().string() + "\"}");
     const auto size = fs::file_size(file, ec);
     if (ec) throw SceneError(file, {}, "cannot read: " + ec.message());

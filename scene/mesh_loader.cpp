@@ -195,8 +195,43 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, const glm::dmat
     }
 }
 
+// A node's camera and KHR_lights_punctual light, placed by the node's world transform (glTF
+// cameras and lights look down their local −Z with +Y up).
+void collectCameraAndLight(const tinygltf::Model& model, const tinygltf::Node& node,
+                           const glm::dmat4& world, GltfExtras& out) {
+    const Vec3 origin(world * glm::dvec4(0, 0, 0, 1));
+    const Vec3 forward = glm::normalize(Vec3(world * glm::dvec4(0, 0, -1, 0)));
+    const Vec3 up = glm::normalize(Vec3(world * glm::dvec4(0, 1, 0, 0)));
+    if (node.camera >= 0 && std::size_t(node.camera) < model.cameras.size() &&
+        model.cameras[node.camera].type == "perspective" && finite(forward) && finite(up)) {
+        const auto& pc = model.cameras[node.camera].perspective;
+        GltfCamera c;
+        c.position = origin;
+        c.forward = forward;
+        c.up = up;
+        c.yfovRadians = pc.yfov;
+        c.znear = pc.znear;
+        c.zfar = pc.zfar;
+        c.aspect = pc.aspectRatio;
+        out.cameras.push_back(c);
+    }
+    const auto ext = node.extensions.find("KHR_lights_punctual");
+    if (ext == node.extensions.end() || !ext->second.Has("light")) return;
+    const int index = ext->second.Get("light").GetNumberAsInt();
+    if (index < 0 || std::size_t(index) >= model.lights.size()) return;
+    const tinygltf::Light& l = model.lights[index];
+    GltfLight light;
+    light.type = l.type;
+    light.position = origin;
+    light.direction = forward;
+    if (l.color.size() == 3) light.color = Vec3(l.color[0], l.color[1], l.color[2]);
+    light.intensity = l.intensity;
+    light.outerConeRadians = l.spot.outerConeAngle;
+    out.lights.push_back(light);
+}
+
 void loadGltf(const fs::path& file, TriangleMesh& mesh, const fs::path& sceneFile,
-              const JsonPath& path) {
+              const JsonPath& path, GltfExtras* extras) {
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader(ignoreImage, nullptr);
     tinygltf::Model model;
@@ -223,6 +258,7 @@ void loadGltf(const fs::path& file, TriangleMesh& mesh, const fs::path& sceneFil
         const auto& node = model.nodes[nodeIndex];
         const glm::dmat4 world = parent * nodeMatrix(node);
         if (node.mesh >= 0) appendGltfMesh(model, node.mesh, world, mesh, file, sceneFile, path);
+        if (extras) collectCameraAndLight(model, node, world, *extras);
         for (int child : node.children) stack.emplace_back(child, world);
     }
     if (mesh.indices.empty()) fail(sceneFile, path, file, "has no triangles");
@@ -279,7 +315,8 @@ void finalizeMesh(TriangleMesh& mesh) {
 }
 
 std::shared_ptr<const TriangleMesh> loadMesh(const fs::path& meshFile, const glm::dmat4& transform,
-                                             const fs::path& sceneFile, const JsonPath& path) {
+                                             const fs::path& sceneFile, const JsonPath& path,
+                                             GltfExtras* extras) {
     std::error_code ec;
     if (!fs::is_regular_file(meshFile, ec)) fail(sceneFile, path, meshFile, "no such file");
     if (fs::file_size(meshFile, ec) == 0) fail(sceneFile, path, meshFile, "is empty (0 bytes)");
@@ -287,7 +324,7 @@ std::shared_ptr<const TriangleMesh> loadMesh(const fs::path& meshFile, const glm
     std::string ext = meshFile.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
     if (ext == ".obj") loadObj(meshFile, *mesh, sceneFile, path);
-    else if (ext == ".gltf" || ext == ".glb") loadGltf(meshFile, *mesh, sceneFile, path);
+    else if (ext == ".gltf" || ext == ".glb") loadGltf(meshFile, *mesh, sceneFile, path, extras);
     else fail(sceneFile, path, meshFile, "unknown mesh type '" + ext + "' (use .obj, .gltf or .glb)");
 
     const glm::dmat3 normalMatrix = glm::transpose(glm::inverse(glm::dmat3(transform)));

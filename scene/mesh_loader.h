@@ -5,6 +5,8 @@
 
 #include <filesystem>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -13,12 +15,30 @@
 
 namespace shadowlab::scene {
 
+// What a glTF file holds besides triangles: its perspective cameras and KHR_lights_punctual
+// lights, in the file's world space (not moved by the object transform).
+struct GltfCamera {
+    Vec3 position, forward, up;
+    double yfovRadians = 0.0, znear = 0.0, zfar = 0.0, aspect = 0.0;  // zfar/aspect 0: unset
+};
+struct GltfLight {
+    std::string type;  // "directional" | "point" | "spot"
+    Vec3 position, direction, color{1, 1, 1};
+    double intensity = 1.0;         // lux (directional) or candela (point, spot)
+    double outerConeRadians = 0.0;  // spot
+};
+struct GltfExtras {
+    std::vector<GltfCamera> cameras;
+    std::vector<GltfLight> lights;
+};
+
 // Reads `meshFile` and applies `transform` (object to world). Errors name `sceneFile` and
-// `path` (the JSON path of the object's "file" key) as well as the mesh file.
+// `path` (the JSON path of the object's "file" key) as well as the mesh file. For glTF files,
+// `extras` (when given) receives the file's cameras and lights.
 std::shared_ptr<const TriangleMesh> loadMesh(const std::filesystem::path& meshFile,
                                              const glm::dmat4& transform,
                                              const std::filesystem::path& sceneFile,
-                                             const JsonPath& path);
+                                             const JsonPath& path, GltfExtras* extras = nullptr);
 
 // translate · Rz · Ry · Rx · scale, angles in degrees (a rotation about X is applied first).
 glm::dmat4 objectTransform(const Vec3& translate, const Vec3& rotateDegrees, const Vec3& scale);

@@ -102,7 +102,10 @@ struct ShadowDefaults {
     std::optional<int> shadowMapSize;
     std::optional<double> depthBias;     // world units
     std::optional<double> slopeBias;     // shadow-map texels
-    std::optional<std::string> filter;   // "none" | "pcf2x2"
+    std::optional<std::string> filter;   // "none" | "pcf2x2" | "pcf" | "poisson"
+    std::optional<int> pcfSize;          // texels
+    std::optional<double> normalOffset;  // texels
+    std::optional<bool> fitLightFrustum;
     std::optional<double> rayBias;       // world units; absent: scene-scaled
     std::optional<bool> robustRayOffset; // "ray_bias": "robust"
     std::optional<std::string> precision;

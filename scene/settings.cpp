@@ -14,7 +14,9 @@ namespace {
 ShadowFilter parseFilter(const std::string& text, const std::string& where) {
     if (text == "none") return ShadowFilter::None;
     if (text == "pcf2x2") return ShadowFilter::Pcf2x2;
-    throw InputError(where + ": expected none|pcf2x2, got '" + text + "'");
+    if (text == "pcf") return ShadowFilter::Pcf;
+    if (text == "poisson") return ShadowFilter::Poisson;
+    throw InputError(where + ": expected none|pcf2x2|pcf|poisson, got '" + text + "'");
 }
 
 Precision parsePrecision(const std::string& text, const std::string& where) {
@@ -58,6 +60,13 @@ RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& o) {
         throw InputError("--slope-bias: must be a finite value >= 0 (texels)");
     s.raster.filter = o.filter ? parseFilter(*o.filter, "--filter")
                                : parseFilter(d.filter.value_or("pcf2x2"), "shadow.filter");
+    s.raster.pcfSize = o.pcfSize.value_or(d.pcfSize.value_or(3));
+    if (s.raster.pcfSize < 1 || s.raster.pcfSize > 15)
+        throw InputError("--pcf-size: must be in 1..15 texels, got " + std::to_string(s.raster.pcfSize));
+    s.raster.normalOffset = o.normalOffset.value_or(d.normalOffset.value_or(0.0));
+    if (!std::isfinite(s.raster.normalOffset) || s.raster.normalOffset < 0.0)
+        throw InputError("--normal-offset: must be a finite value >= 0 (texels)");
+    s.raster.fitLightFrustum = o.fitLightFrustum.value_or(d.fitLightFrustum.value_or(false));
     s.raster.device = o.device.value_or("");
     s.raster.validate = o.validate;
 
@@ -105,7 +114,15 @@ RaytraceSettings referenceSettings(const RaytraceSettings& base) {
     return r;
 }
 
-const char* toString(ShadowFilter f) { return f == ShadowFilter::None ? "none" : "pcf2x2"; }
+const char* toString(ShadowFilter f) {
+    switch (f) {
+        case ShadowFilter::None: return "none";
+        case ShadowFilter::Pcf2x2: return "pcf2x2";
+        case ShadowFilter::Pcf: return "pcf";
+        case ShadowFilter::Poisson: return "poisson";
+    }
+    return "?";
+}
 const char* toString(Precision p) { return p == Precision::Float ? "float" : "double"; }
 const char* toString(Backend b) {
     switch (b) {
