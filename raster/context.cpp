@@ -42,10 +42,13 @@ VKAPI_ATTR VkBool32 VKAPI_CALL onDebugMessage(VkDebugUtilsMessageSeverityFlagBit
     const bool counted = severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT ||
                          (severity == VK_DEBUG_UTILS_MESSAGE_SEVERITY_INFO_BIT_EXT &&
                           (types & VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT));
-    // The layer announces itself once per instance with an INFO/VALIDATION "status" message; it
-    // reports no problem, so it is not counted.
-    const bool banner = data && data->pMessageIdName &&
-                        std::strcmp(data->pMessageIdName, "UNASSIGNED-khronos-validation-createinstance-status-message") == 0;
+    // Two INFO messages report no problem with our use of Vulkan, so they are not counted: the
+    // layer's start-up banner, and, on a fresh machine, the note that its own shader-validation
+    // cache file does not exist yet (~/.cache/shader_validation_cache-0.bin).
+    const bool banner =
+        data && data->pMessageIdName && severity == VK_DEBUG_UTILS_MESSAGE_SEVERITY_INFO_BIT_EXT &&
+        (std::strcmp(data->pMessageIdName, "UNASSIGNED-khronos-validation-createinstance-status-message") == 0 ||
+         std::strcmp(data->pMessageIdName, "UNASSIGNED-cache-file-error") == 0);
     if (!counted || banner || !userData) return VK_FALSE;
     auto* log = static_cast<ValidationLog*>(userData);
     const char* level = severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT     ? "error"
