@@ -2,7 +2,7 @@
 # tools/setup.sh: makes this checkout ready to run on Debian 12: installs the missing packages
 # of tools/debian-packages.txt (apt-get, as root or through sudo), configures a Release build in
 # build/ and builds TARGET (default: everything). Quiet when there is nothing to do.
-# Usage: tools/setup.sh [TARGET...]
+# Usage: tools/setup.sh [TARGET...] | tools/setup.sh --packages-only
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${SHADOWLAB_BUILD_DIR:-$root/build}"
@@ -27,6 +27,8 @@ if ((${#missing[@]})); then
     "${sudo[@]}" apt-get update -q >&2
     "${sudo[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}" >&2
 fi
+
+[ "${1:-}" = "--packages-only" ] && exit 0
 
 if [ ! -f "$build/build.ninja" ]; then
     say "configuring a Release build in $build"
