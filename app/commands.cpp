@@ -13,6 +13,7 @@
 
 #include "compare/compare.h"
 #include "compare/report.h"
+#include "compare/stability.h"
 #include "compare/sweep.h"
 #include "compare/sweep_report.h"
 #include "raster/renderer.h"
@@ -296,6 +297,50 @@ int sweep(const SweepOptions& o) {
               << result.rows.size() << " rows" << (failed ? ", " + std::to_string(failed) + " failed" : "") << ")\n";
     if (o.common.json) std::cout << compare::rowsToJson(result.rows).dump(2) << "\n";
     return failed ? 1 : 0;
+}
+
+int stability(const StabilityCommandOptions& o) {
+    // Every case is loaded and checked before anything renders or is written.
+    std::vector<fs::path> files;
+    if (o.scenes.empty()) {
+        for (const auto& e : fs::directory_iterator(scene::scenesDirectory() / "extreme"))
+            if (e.path().extension() == ".json") files.push_back(e.path());
+        std::sort(files.begin(), files.end());
+    } else {
+        for (const std::string& name : o.scenes) files.push_back(scene::findScene(name));
+    }
+    std::vector<scene::Scene> scenes;
+    for (const fs::path& f : files) scenes.push_back(scene::loadScene(f));
+    scene::Scene probe;
+    applyResolution(probe, o.resolution);
+
+    compare::StabilityOptions options;
+    options.width = probe.camera.width;
+    options.height = probe.camera.height;
+    options.shadowMapSize = o.shadowMapSize;
+    options.search = !o.noSearch;
+    options.quick = !o.fullGrid;
+    options.validate = o.validate;
+
+    std::vector<compare::StabilityCase> cases;
+    for (std::size_t i = 0; i < scenes.size(); ++i) {
+        const std::string name = files[i].stem().string();
+        Stage stage("stability case " + std::to_string(i + 1) + "/" + std::to_string(scenes.size()) + " " + name);
+        cases.push_back(compare::runStabilityCase(scenes[i], options, name, compare::readDescription(files[i])));
+        stage.done(compare::suitePassed({cases.back()}) ? "ok" : "FAILED");
+    }
+    compare::writeStabilityReport(o.outputDir, cases);
+    std::cerr << "shadowlab: wrote " << (o.outputDir / "stability.html").string() << "\n";
+    if (o.json) {
+        Json all = Json::array();
+        for (const auto& c : cases) all.push_back(compare::toJson(c));
+        std::cout << all.dump(2) << "\n";
+    }
+    if (!compare::suitePassed(cases)) {
+        std::cerr << "shadowlab: stability: at least one case failed (see the report)\n";
+        return 1;
+    }
+    return 0;
 }
 
 }  // namespace shadowlab::app

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "scene/settings.h"
 
@@ -41,6 +42,17 @@ struct SweepOptions {
     std::optional<int> repetitions;
 };
 
+struct StabilityCommandOptions {
+    std::vector<std::string> scenes;  // paths or shipped names; empty: every scenes/extreme case
+    std::filesystem::path outputDir;
+    std::string resolution = "160x90";
+    std::optional<int> shadowMapSize;
+    bool noSearch = false;  // skip the bias search and best-settings renders
+    bool fullGrid = false;  // the full default grid for the bias search (slower)
+    bool validate = false;
+    bool json = false;
+};
+
 struct CompareOptions {
     std::filesystem::path method;
     std::filesystem::path reference;
@@ -53,5 +65,6 @@ int run(const RunOptions& options);
 int compareFiles(const CompareOptions& options);
 int info(bool validate);
 int sweep(const SweepOptions& options);
+int stability(const StabilityCommandOptions& options);
 
 }  // namespace shadowlab::app

@@ -80,6 +80,21 @@ int main(int argc, char** argv) {
     sweepCmd->add_option("--repetitions", sweepOptions.repetitions, "Timed frames per configuration (default 3)")
         ->check(CLI::Range(1, 100));
 
+    shadowlab::app::StabilityCommandOptions stabilityOptions;
+    auto* stabilityCmd = app.add_subcommand(
+        "stability", "Run stiff and extreme cases through the reference and both backends (defaults and best "
+                     "bias): acne and leak rates, bias windows or 'stiff', NaN/Inf, analytic check; exits 1 "
+                     "when the reference misses an analytic answer or a backend gives NaN/Inf or fails");
+    stabilityCmd->add_option("SCENES", stabilityOptions.scenes,
+                             "Scene files or shipped names (default: every scenes/extreme case)");
+    stabilityCmd->add_option("-o,--output", stabilityOptions.outputDir, "Output folder (created)")->required();
+    stabilityCmd->add_option("--resolution", stabilityOptions.resolution, "Render size WxH (default 160x90)");
+    stabilityCmd->add_option("--shadow-map-size", stabilityOptions.shadowMapSize, "raster: map size for every case");
+    stabilityCmd->add_flag("--no-search", stabilityOptions.noSearch, "Skip the bias search (defaults only)");
+    stabilityCmd->add_flag("--full", stabilityOptions.fullGrid, "Search biases over the full default grid");
+    stabilityCmd->add_flag("--validate", stabilityOptions.validate, "Vulkan validation on every raster render");
+    stabilityCmd->add_flag("--json", stabilityOptions.json, "Print the cases as JSON on stdout");
+
     shadowlab::app::CompareOptions compareOptions;
     auto* compareCmd = app.add_subcommand("compare", "Classify a method's shadows against a reference Frame "
                                                      "and write the difference image");
@@ -104,6 +119,7 @@ int main(int argc, char** argv) {
         if (*compareCmd) return shadowlab::app::compareFiles(compareOptions);
         if (*infoCmd) return shadowlab::app::info(infoValidate);
         if (*sweepCmd) return shadowlab::app::sweep(sweepOptions);
+        if (*stabilityCmd) return shadowlab::app::stability(stabilityOptions);
     } catch (const shadowlab::scene::SceneError& e) {
         std::cerr << "shadowlab: error: " << e.what() << "\n";
         return 2;

@@ -128,9 +128,25 @@ INSTANTIATE_TEST_SUITE_P(
         BadRun{"missing_frames", {"compare", "a.exr", "b.exr", "-o", "OUT.png"}, "no such file"}),
     [](const ::testing::TestParamInfo<BadRun>& info) { return std::string(info.param.name); });
 
+TEST(App, StabilityRunsTheNamedCasesAndWritesItsReport) {
+    TempDir dir;
+    const auto out = dir.path() / "stability";
+    const Result r = shadowlab({"stability", "extreme/straight-down", "extreme/far-1e5", "-o", out.string(),
+                                "--resolution", "48x27", "--no-search", "--json"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    for (const char* f : {"stability.html", "stability.csv", "stability.json"})
+        EXPECT_TRUE(std::filesystem::is_regular_file(out / f)) << f;
+    EXPECT_EQ(nlohmann::json::parse(r.out).size(), 2u);
+    // A bad case name is refused before anything is written.
+    const auto bad = dir.path() / "bad";
+    EXPECT_EQ(shadowlab({"stability", "extreme/no-such-case", "-o", bad.string()}).exitCode, 2);
+    EXPECT_FALSE(std::filesystem::exists(bad));
+}
+
 TEST(App, HelpOnEverySubcommandNamesItsOptions) {
     for (const auto& [cmd, option] : std::vector<std::pair<std::string, std::string>>{
-             {"run", "--output"}, {"render", "--backend"}, {"compare", "--json"}, {"info", "--validate"}}) {
+             {"run", "--output"}, {"render", "--backend"}, {"compare", "--json"}, {"info", "--validate"},
+             {"sweep", "--resume"}, {"stability", "--no-search"}}) {
         const Result r = shadowlab({cmd, "--help"});
         EXPECT_EQ(r.exitCode, 0) << cmd;
         EXPECT_NE(r.out.find(option), std::string::npos) << cmd << ": " << r.out;
