@@ -162,7 +162,12 @@ int compareFiles(const CompareOptions& o) {
         throw scene::InputError(o.output.string() + ": the difference image must be a .png");
     const scene::Frame method = scene::readFrame(o.method);
     const scene::Frame reference = scene::readFrame(o.reference);
-    const compare::Comparison c = compare::compareFrames(method, reference);
+    compare::Comparison c;
+    try {
+        c = compare::compareFrames(method, reference);
+    } catch (const scene::InputError& e) {
+        throw scene::InputError(o.method.string() + " vs " + o.reference.string() + ": " + e.what());
+    }
     scene::writePngDisplay(o.output, c.width, c.height, c.diffRgb);
     if (o.json)
         std::cout << compare::toJson(c.metrics).dump(2) << "\n";
