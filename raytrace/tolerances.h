@@ -12,10 +12,7 @@ inline constexpr int kTileSize = 16;
 // BVH build. Binned SAH (Wald, "On fast Construction of SAH-based Bounding Volume
 // Hierarchies", RT'07) with 16 bins per axis: between pbrt-v4's 12 buckets and the 32 some
 // builders use; more bins buy little tree quality for a linear increase in build time.
-#ifndef SL_BINS
-#define SL_BINS 16
-#endif
-inline constexpr int kBvhBins = SL_BINS;
+inline constexpr int kBvhBins = 16;
 // Leaves are intersected in SSE packets of this many triangles (triangle4.h): the SAH counts a
 // leaf's cost in packets, so leaves fill whole packets when that is cheaper.
 inline constexpr unsigned kBvhLeafBlock = 4;
@@ -29,10 +26,7 @@ inline constexpr unsigned kBvhMaxLeafCount = 8;
 // becomes half of a 4-wide node's box test after the collapse; pbrt-v4 uses 1/2 relative to
 // one triangle for its binary tree. 1.0 (a packet costs about two scalar triangles, a 4-wide
 // box test about one) measured best on Sponza (docs/performance.md).
-#ifndef SL_TC
-#define SL_TC 1.0
-#endif
-inline constexpr double kBvhTraversalCost = SL_TC;
+inline constexpr double kBvhTraversalCost = 1.0;
 // Below this depth splits use SAH; deeper, the build halves by count. Keeps any tree within
 // 48 + log2(2^32) = 80 levels, below the traversal stack of 128.
 inline constexpr int kBvhSahMaxDepth = 48;

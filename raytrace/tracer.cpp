@@ -63,16 +63,16 @@ Tracer<Real>::Tracer(const scene::Scene& scene) {
             std::vector<scene::Bounds> triBounds(g.triangleCount());
             for (std::size_t t = 0; t < triBounds.size(); ++t)
                 for (int k = 0; k < 3; ++k) triBounds[t].extend(g.positions[g.indices[3 * t + k]]);
-            d.bvh = Bvh4::build(triBounds);
+            d.bvh = Bvh8::build(triBounds);
             const std::vector<std::uint32_t>& slots = d.bvh.primitives();
             if constexpr (std::is_same_v<Real, float>) {
-                d.packets.resize(slots.size() / Bvh4::kLeafAlign);
+                d.packets.resize(slots.size() / WideRef::kLeafAlign);
                 for (std::size_t s = 0; s < slots.size(); ++s) {
                     TrianglePacket& pk = d.packets[s / 4];
                     for (int k = 0; k < 3; ++k)
                         for (int a = 0; a < 3; ++a)
                             pk.v[3 * k + a][s % 4] =
-                                slots[s] == Bvh4::kEmpty
+                                slots[s] == WideRef::kEmpty
                                     ? std::numeric_limits<float>::quiet_NaN()
                                     : d.positions[d.indices[3 * std::size_t(slots[s]) + k]][a];
                 }
@@ -80,7 +80,7 @@ Tracer<Real>::Tracer(const scene::Scene& scene) {
                 d.slotVertices.reserve(3 * slots.size());
                 for (std::uint32_t tri : slots)
                     for (int k = 0; k < 3; ++k)
-                        d.slotVertices.push_back(tri == Bvh4::kEmpty
+                        d.slotVertices.push_back(tri == WideRef::kEmpty
                                                      ? Vec(0)
                                                      : d.positions[d.indices[3 * std::size_t(tri) + k]]);
             }

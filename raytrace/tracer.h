@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "raytrace/bvh4.h"
+#include "raytrace/wide_bvh.h"
 #include "raytrace/intersect.h"
 #include "raytrace/real.h"
 #include "raytrace/triangle4.h"
@@ -91,7 +91,7 @@ private:
         std::vector<Vec> positions;
         std::vector<Vec> normals;  // per vertex, may be empty
         std::vector<std::uint32_t> indices;
-        Bvh4 bvh;
+        Bvh8 bvh;
         // The triangles' vertices again in BVH slot order, so a leaf reads contiguous memory
         // with no index indirection: float keeps SSE packets of four triangles (one per four
         // slots), double keeps three vertices per slot; the other vector stays empty.

@@ -1,6 +1,6 @@
-// tests/raytrace/bvh4_test.cpp: the 4-wide BVH's structure, its traversal against the binary
-// tree and brute force, its SSE box test against the scalar one, and the memory per triangle.
-#include "raytrace/bvh4.h"
+// tests/raytrace/wide_bvh_test.cpp: the 4- and 8-wide BVHs' structure, their traversal against
+// the binary tree and brute force, the SSE box test against the scalar one, memory per triangle.
+#include "raytrace/wide_bvh.h"
 
 #include <cmath>
 #include <limits>
@@ -36,28 +36,36 @@ Soup triangleSoup(int count, std::mt19937_64& g) {
     return s;
 }
 
-bool boxContains(const Bvh4Node& n, int c, const scene::Bounds& b) {
+template <typename Node>
+bool boxContains(const Node& n, int c, const scene::Bounds& b) {
     for (int k = 0; k < 3; ++k)
         if (!(n.bounds[k][c] <= b.min[k] && b.max[k] <= n.bounds[3 + k][c])) return false;
     return true;
 }
 
-TEST(Bvh4, ChildBoxesBoundTheirSubtreesAndEveryPrimitiveIsInOneAlignedLeaf) {
+template <typename B>
+class WideBvhTest : public ::testing::Test {};
+using Widths = ::testing::Types<Bvh4, Bvh8>;
+TYPED_TEST_SUITE(WideBvhTest, Widths);
+
+TYPED_TEST(WideBvhTest, ChildBoxesBoundTheirSubtreesAndEveryPrimitiveIsInOneAlignedLeaf) {
+    using W = TypeParam;  // the width under test
+    constexpr int N = TypeParam::kWidth;
     std::mt19937_64 g(3);
     const Soup soup = triangleSoup(5000, g);
     const Bvh binary = Bvh::build(soup.bounds);
-    const Bvh4 bvh = Bvh4::collapse(binary);
+    const TypeParam bvh = TypeParam::collapse(binary);
     ASSERT_FALSE(bvh.empty());
-    ASSERT_FALSE(Bvh4::isLeaf(bvh.root()));
+    ASSERT_FALSE(W::isLeaf(bvh.root()));
     std::vector<int> seen(soup.bounds.size(), 0);
     std::size_t children = 0, interior = 0, partialWithInteriorChild = 0;
     std::vector<std::uint32_t> stack = {bvh.root()};
     while (!stack.empty()) {
         const std::uint32_t ref = stack.back();
         stack.pop_back();
-        if (Bvh4::isLeaf(ref)) {
-            const std::uint32_t first = Bvh4::leafFirst(ref), count = Bvh4::leafCount(ref);
-            EXPECT_EQ(first % Bvh4::kLeafAlign, 0u);
+        if (W::isLeaf(ref)) {
+            const std::uint32_t first = W::leafFirst(ref), count = W::leafCount(ref);
+            EXPECT_EQ(first % W::kLeafAlign, 0u);
             EXPECT_LE(count, 8u);
             for (std::uint32_t s = first; s < first + count; ++s) {
                 const std::uint32_t p = bvh.primitives()[s];
@@ -65,20 +73,20 @@ TEST(Bvh4, ChildBoxesBoundTheirSubtreesAndEveryPrimitiveIsInOneAlignedLeaf) {
                 ++seen[p];
             }
             // Padding up to the next packet boundary holds no primitive.
-            for (std::uint32_t s = first + count; s % Bvh4::kLeafAlign != 0; ++s)
-                EXPECT_EQ(bvh.primitives()[s], Bvh4::kEmpty);
+            for (std::uint32_t s = first + count; s % W::kLeafAlign != 0; ++s)
+                EXPECT_EQ(bvh.primitives()[s], W::kEmpty);
             continue;
         }
         ++interior;
-        const Bvh4Node& n = bvh.nodes()[ref];
+        const auto& n = bvh.nodes()[ref];
         int used = 0, interiorKids = 0;
         for (std::uint32_t r : n.ref) {
-            used += r != Bvh4::kEmpty;
-            interiorKids += r != Bvh4::kEmpty && !Bvh4::isLeaf(r);
+            used += r != W::kEmpty;
+            interiorKids += r != W::kEmpty && !W::isLeaf(r);
         }
-        partialWithInteriorChild += used < 4 && interiorKids > 0;
-        for (int c = 0; c < 4; ++c) {
-            if (n.ref[c] == Bvh4::kEmpty) {
+        partialWithInteriorChild += used < N && interiorKids > 0;
+        for (int c = 0; c < N; ++c) {
+            if (n.ref[c] == W::kEmpty) {
                 // An unused child's box is empty: lo > hi on every axis.
                 for (int k = 0; k < 3; ++k) EXPECT_GT(n.bounds[k][c], n.bounds[3 + k][c]);
                 continue;
@@ -90,31 +98,31 @@ TEST(Bvh4, ChildBoxesBoundTheirSubtreesAndEveryPrimitiveIsInOneAlignedLeaf) {
             while (!sub.empty()) {
                 const std::uint32_t r = sub.back();
                 sub.pop_back();
-                if (Bvh4::isLeaf(r)) {
-                    for (std::uint32_t s = Bvh4::leafFirst(r); s < Bvh4::leafFirst(r) + Bvh4::leafCount(r); ++s)
+                if (W::isLeaf(r)) {
+                    for (std::uint32_t s = W::leafFirst(r); s < W::leafFirst(r) + W::leafCount(r); ++s)
                         ASSERT_TRUE(boxContains(n, c, soup.bounds[bvh.primitives()[s]]));
                 } else {
                     for (std::uint32_t rr : bvh.nodes()[r].ref)
-                        if (rr != Bvh4::kEmpty) sub.push_back(rr);
+                        if (rr != W::kEmpty) sub.push_back(rr);
                 }
             }
             stack.push_back(n.ref[c]);
         }
     }
     for (int s : seen) ASSERT_EQ(s, 1);
-    // The collapse really is 4-wide: a node with fewer than four children has only leaves
-    // below it (otherwise an interior child could have been opened), and the node count is
-    // well below the binary tree's L − 1 interior nodes (at best a third of them).
+    // The collapse really is N-wide: a node with fewer than N children has only leaves below it
+    // (otherwise an interior child could have been opened), and the node count is well below
+    // the binary tree's L − 1 interior nodes (at best 1/(N − 1) of them).
     EXPECT_EQ(partialWithInteriorChild, 0u);
     std::size_t binaryInterior = 0;
     for (const BvhNode& n : binary.nodes()) binaryInterior += n.count == 0;
     EXPECT_EQ(interior, bvh.nodes().size());
-    EXPECT_LT(double(interior), 0.5 * double(binaryInterior));
-    EXPECT_GE(3 * interior, binaryInterior);
-    EXPECT_GT(double(children) / double(interior), 3.0);
+    EXPECT_LT(double(interior), (N == 4 ? 0.5 : 0.45) * double(binaryInterior));
+    EXPECT_GE((N - 1) * interior, binaryInterior);
+    EXPECT_GT(double(children) / double(interior), N == 4 ? 3.0 : 3.3);
 }
 
-TEST(Bvh4, EmptyAndSingleLeafTrees) {
+TEST(WideBvh, EmptyAndSingleLeafTrees) {
     EXPECT_TRUE(Bvh4::build({}).empty());
     scene::Bounds b;
     b.extend(Vec3(0, 0, 0));
@@ -136,14 +144,15 @@ TEST(Bvh4, EmptyAndSingleLeafTrees) {
 
 // The SSE box test returns, bit for bit, the scalar intersectBounds answer for each child,
 // including rays parallel to slabs and origins on slab planes (0·inf = NaN slab values).
-TEST(Bvh4, SseChildBoxTestEqualsTheScalarSlabTest) {
+TYPED_TEST(WideBvhTest, SseChildBoxTestEqualsTheScalarSlabTest) {
+    constexpr int N = TypeParam::kWidth;
     std::mt19937_64 g(9);
     std::uniform_real_distribution<float> u(-4, 4);
     std::uniform_int_distribution<int> pick(0, 3);
-    Bvh4Node n{};
+    WideNode<N> n{};
     int disagreements = 0, entered = 0, tests = 0;
     for (int trial = 0; trial < 20000; ++trial) {
-        for (int c = 0; c < 4; ++c)
+        for (int c = 0; c < N; ++c)
             for (int k = 0; k < 3; ++k) {
                 const float a = std::round(u(g)), b = std::round(u(g));  // integers: origins land on planes
                 n.bounds[k][c] = std::min(a, b);
@@ -154,9 +163,9 @@ TEST(Bvh4, SseChildBoxTestEqualsTheScalarSlabTest) {
             if (pick(g) == 0) d[k] = pick(g) < 2 ? 0.0f : -0.0f;  // parallel to a slab
         const Ray<float> ray(o, d);
         const float tMax = trial % 2 ? std::numeric_limits<float>::infinity() : 3.0f;
-        float tn[4];
-        const int mask = detail::ChildBoxTest<float>(ray)(n, tMax, tn);
-        for (int c = 0; c < 4; ++c) {
+        float tn[N];
+        const int mask = detail::ChildBoxTest<float, N>(ray)(n, tMax, tn);
+        for (int c = 0; c < N; ++c) {
             const float lo[3] = {n.bounds[0][c], n.bounds[1][c], n.bounds[2][c]};
             const float hi[3] = {n.bounds[3][c], n.bounds[4][c], n.bounds[5][c]};
             const bool scalar = intersectBounds(ray, lo, hi, tMax);
@@ -171,19 +180,20 @@ TEST(Bvh4, SseChildBoxTestEqualsTheScalarSlabTest) {
 }
 
 template <typename Real>
-class Bvh4Traversal : public ::testing::Test {};
+class WideBvhTraversal : public ::testing::Test {};
 using Reals = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(Bvh4Traversal, Reals);
+TYPED_TEST_SUITE(WideBvhTraversal, Reals);
 
-// Closest and any hit through the 4-wide tree equal the binary tree's and brute force's: same
+// Closest and any hit through the 8-wide tree (and closest through the 4-wide one) equal the binary tree's and brute force's: same
 // t, same triangle, on random rays with and without a finite tMax.
-TYPED_TEST(Bvh4Traversal, ClosestAndAnyHitEqualTheBinaryTreeAndBruteForce) {
+TYPED_TEST(WideBvhTraversal, ClosestAndAnyHitEqualTheBinaryTreeAndBruteForce) {
     using Real = TypeParam;
     using V = Vec3T<Real>;
     std::mt19937_64 g(21);
     const Soup soup = triangleSoup(3000, g);
     const Bvh binary = Bvh::build(soup.bounds);
-    const Bvh4 wide = Bvh4::collapse(binary);
+    const Bvh8 wide = Bvh8::collapse(binary);
+    const Bvh4 wide4 = Bvh4::collapse(binary);
     std::vector<V> p(soup.p.begin(), soup.p.end());
     std::uniform_real_distribution<double> u(-14, 14);
     int hits = 0;
@@ -207,13 +217,19 @@ TYPED_TEST(Bvh4Traversal, ClosestAndAnyHitEqualTheBinaryTreeAndBruteForce) {
         binary.traverse(ray, tBin, false, [&](std::uint32_t slot, Real& tm) {
             return test(binary.primitives()[slot], tm, bin);
         });
-        auto wideWalk = [&](bool anyHit, Real& tm, int& best) {
-            return wide.traverse(ray, tm, anyHit, [&](std::uint32_t first, std::uint32_t count, Real& t) {
+        auto walk = [&](const auto& tree, bool anyHit, Real& tm, int& best) {
+            return tree.traverse(ray, tm, anyHit, [&](std::uint32_t first, std::uint32_t count, Real& t) {
                 bool any = false;
-                for (std::uint32_t s = first; s < first + count; ++s) any |= test(wide.primitives()[s], t, best);
+                for (std::uint32_t s = first; s < first + count; ++s) any |= test(tree.primitives()[s], t, best);
                 return any;
             });
         };
+        auto wideWalk = [&](bool anyHit, Real& tm, int& best) { return walk(wide, anyHit, tm, best); };
+        Real t4 = tMax;
+        int w4 = -1;
+        walk(wide4, false, t4, w4);
+        ASSERT_EQ(w4, brute) << "ray " << r;
+        ASSERT_EQ(t4, tBrute) << "ray " << r;
         Real tWide = tMax;
         int w = -1;
         const bool found = wideWalk(false, tWide, w);
@@ -232,7 +248,7 @@ TYPED_TEST(Bvh4Traversal, ClosestAndAnyHitEqualTheBinaryTreeAndBruteForce) {
 // The memory bound: vertices, normals, indices, BVH and the slot-ordered triangle
 // copies together stay under 100 bytes per triangle on a closed mesh with normals (the common
 // case: about half a vertex per triangle).
-TEST(Bvh4, FloatTracerHoldsUnder100BytesPerTriangle) {
+TEST(WideBvh, FloatTracerHoldsUnder100BytesPerTriangle) {
     scene::Scene s;
     test::addMaterial(s, "matte");
     const auto mesh = test::icosphere(Vec3(0), 1.0, 5);  // 20·4⁵ = 20,480 triangles

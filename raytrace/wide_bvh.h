@@ -1,6 +1,6 @@
-// raytrace/bvh4.h: a 4-wide BVH collapsed from the binary SAH tree (bvh.h): 128-byte nodes whose
-// four child boxes are tested at once with SSE, traversed nearest child first with a stack that
-// skips entries farther than the current hit.
+// raytrace/wide_bvh.h: an N-wide BVH (N = 4 or 8) collapsed from the binary SAH tree (bvh.h):
+// nodes hold N child boxes tested four at a time with SSE, traversed nearest child first for
+// closest hit with a stack that skips entries beyond the current hit, any order for any hit.
 #pragma once
 
 #include <cstdint>
@@ -9,25 +9,27 @@
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#include <xmmintrin.h>
 #endif
 
 #include "raytrace/bvh.h"
 
 namespace shadowlab::raytrace {
 
-// Four children in structure-of-arrays order: bounds[r][c] is row r (lo x, lo y, lo z, hi x,
-// hi y, hi z) of child c, so one row of the four children is one 16-byte SSE load. Unused
-// children have empty boxes (lo = +inf, hi = −inf) that no ray enters.
-struct alignas(64) Bvh4Node {
-    float bounds[6][4];
-    std::uint32_t ref[4];  // Bvh4::kEmpty, an interior node index, or a leaf (Bvh4::leafRef)
+// N children in structure-of-arrays order: bounds[r][c] is row r (lo x, lo y, lo z, hi x,
+// hi y, hi z) of child c, so a row of four children is one 16-byte SSE load. Unused children
+// have empty boxes (lo = +inf, hi = −inf) that no ray enters.
+template <int N>
+struct alignas(64) WideNode {
+    float bounds[6][N];
+    std::uint32_t ref[N];  // kEmpty, an interior node index, or a leaf (WideBvh::leafRef)
 };
-static_assert(sizeof(Bvh4Node) == 128, "Bvh4Node must stay two cache lines");
+static_assert(sizeof(WideNode<4>) == 128, "4-wide node: two cache lines");
+static_assert(sizeof(WideNode<8>) == 256, "8-wide node: four cache lines");
 
-class Bvh4 {
-public:
-    // A child reference: node index (< 2^28), or a leaf with its primitive count (1..15) in the
-    // top four bits and its first slot below, or kEmpty.
+// A child reference: node index (< 2^28), or a leaf with its primitive count (1..15) in the top
+// four bits and its first slot below, or kEmpty.
+struct WideRef {
     static constexpr std::uint32_t kEmpty = 0xFFFFFFFFu;
     static constexpr std::uint32_t kMaxSlots = 1u << 28;
     // Every leaf starts on a multiple of four slots (padding slots hold kEmpty), so the
@@ -39,16 +41,25 @@ public:
     static constexpr bool isLeaf(std::uint32_t ref) { return (ref >> 28) != 0; }
     static constexpr std::uint32_t leafCount(std::uint32_t ref) { return ref >> 28; }
     static constexpr std::uint32_t leafFirst(std::uint32_t ref) { return ref & (kMaxSlots - 1); }
+};
+
+template <int N>
+class WideBvh : public WideRef {
+    static_assert(N == 4 || N == 8, "the SSE box test handles four children at a time");
+
+public:
+    using Node = WideNode<N>;
+    static constexpr int kWidth = N;
 
     // Builds the binary SAH tree (Bvh::build) and collapses it. Throws std::length_error past
-    // kMaxSlots primitives.
-    static Bvh4 build(const std::vector<scene::Bounds>& primitiveBounds);
-    // Collapses a binary tree: each 4-wide node takes a binary node's children and keeps
-    // opening its interior child of largest surface area until it has four (the usual
-    // collapse, e.g. Embree's BVHNBuilder; pbrt-v4 stays binary). The binary leaves are kept.
-    static Bvh4 collapse(const Bvh& binary);
+    // 2^26 primitives in one tree.
+    static WideBvh build(const std::vector<scene::Bounds>& primitiveBounds);
+    // Collapses a binary tree: each wide node takes a binary node's children and keeps opening
+    // its interior child of largest surface area until it has N (the usual collapse, as
+    // Embree's BVHNBuilder does; pbrt-v4 stays binary). The binary leaves are kept as they are.
+    static WideBvh collapse(const Bvh& binary);
 
-    const std::vector<Bvh4Node>& nodes() const { return nodes_; }
+    const std::vector<Node>& nodes() const { return nodes_; }
     // primitives()[slot] = primitive index, or kEmpty for padding; the slots of a leaf are
     // contiguous and start on a multiple of kLeafAlign. Differs from the binary tree's order.
     const std::vector<std::uint32_t>& primitives() const { return primitives_; }
@@ -57,35 +68,44 @@ public:
     bool empty() const { return root_ == kEmpty; }
     // Memory held by nodes and the slot → primitive table.
     std::size_t bytes() const {
-        return nodes_.capacity() * sizeof(Bvh4Node) + primitives_.capacity() * sizeof(std::uint32_t);
+        return nodes_.capacity() * sizeof(Node) + primitives_.capacity() * sizeof(std::uint32_t);
     }
 
-    // Visits leaves nearest box first. `leaf(first, count, tMax)` tests slots first … first +
-    // count − 1, shortens tMax to a hit and returns true when it hit. With anyHit the walk stops
-    // at the first leaf that reports a hit. Box tests are those of intersectBounds (same
-    // widening, same NaN rule), four at a time in float.
+    // Visits leaves; `leaf(first, count, tMax)` tests slots first … first + count − 1, shortens
+    // tMax to a hit and returns true when it hit. Closest hit (anyHit false) visits children
+    // nearest entry first; with anyHit the walk stops at the first leaf that reports a hit and
+    // children are taken in stored order (sorting cost more than it saved on shadow rays, see
+    // docs/raytrace.md). Box tests are intersectBounds' (same widening, same NaN rule).
     template <typename Real, typename LeafFn>
     bool traverse(const Ray<Real>& ray, Real& tMax, bool anyHit, LeafFn&& leaf) const;
 
 private:
-    std::vector<Bvh4Node> nodes_;
+    std::vector<Node> nodes_;
     std::vector<std::uint32_t> primitives_;
     std::uint32_t root_ = kEmpty;
 };
 
+using Bvh4 = WideBvh<4>;
+using Bvh8 = WideBvh<8>;
+using Bvh4Node = WideNode<4>;
+using Bvh8Node = WideNode<8>;
+
+extern template class WideBvh<4>;
+extern template class WideBvh<8>;
+
 namespace detail {
 
-// Box test of a node's four children, the same arithmetic as intersectBounds per child: near
-// and far planes picked by the direction's sign, tFar widened by 1 + 2γ(3), NaN slab values
+// Box test of a node's children, the same arithmetic as intersectBounds per child: near and
+// far planes picked by the direction's sign, tFar widened by 1 + 2γ(3), NaN slab values
 // ignored. Writes each child's entry distance and returns the mask of children entered.
-template <typename Real>
+template <typename Real, int N>
 struct ChildBoxTest {
     const Ray<Real>& ray;
     explicit ChildBoxTest(const Ray<Real>& r) : ray(r) {}
-    int operator()(const Bvh4Node& n, Real tMax, Real tNear[4]) const {
+    int operator()(const WideNode<N>& n, Real tMax, Real tNear[N]) const {
         constexpr Real kWiden = 1 + 2 * gamma<Real>(3);
         int mask = 0;
-        for (int c = 0; c < 4; ++c) {
+        for (int c = 0; c < N; ++c) {
             Real tn = 0, tf = tMax;
             for (int i = 0; i < 3; ++i) {
                 const int nearRow = ray.dirIsNeg[i] ? 3 + i : i;
@@ -106,8 +126,8 @@ struct ChildBoxTest {
 // SSE2 is part of x86-64 itself, so this path needs no -m flag and runs on every x86-64 CPU.
 // _mm_max_ps(a, b) is `a > b ? a : b` and _mm_min_ps(a, b) is `a < b ? a : b`, NaN in a giving
 // b: exactly the scalar expressions above, so the float results are bit for bit the same.
-template <>
-struct ChildBoxTest<float> {
+template <int N>
+struct ChildBoxTest<float, N> {
     __m128 o[3], inv[3], widen;
     int nearRow[3], farRow[3];
     explicit ChildBoxTest(const Ray<float>& r) {
@@ -119,104 +139,94 @@ struct ChildBoxTest<float> {
         }
         widen = _mm_set1_ps(1 + 2 * gamma<float>(3));
     }
-    int operator()(const Bvh4Node& n, float tMax, float tNear[4]) const {
-        __m128 tn = _mm_setzero_ps(), tf = _mm_set1_ps(tMax);
-        for (int i = 0; i < 3; ++i) {
-            const __m128 a = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.bounds[nearRow[i]]), o[i]), inv[i]);
-            const __m128 b = _mm_mul_ps(
-                _mm_mul_ps(_mm_sub_ps(_mm_load_ps(n.bounds[farRow[i]]), o[i]), inv[i]), widen);
-            tn = _mm_max_ps(a, tn);
-            tf = _mm_min_ps(b, tf);
+    int operator()(const WideNode<N>& n, float tMax, float tNear[N]) const {
+        int mask = 0;
+        for (int q = 0; q < N; q += 4) {
+            __m128 tn = _mm_setzero_ps(), tf = _mm_set1_ps(tMax);
+            for (int i = 0; i < 3; ++i) {
+                const __m128 a =
+                    _mm_mul_ps(_mm_sub_ps(_mm_load_ps(&n.bounds[nearRow[i]][q]), o[i]), inv[i]);
+                const __m128 b = _mm_mul_ps(
+                    _mm_mul_ps(_mm_sub_ps(_mm_load_ps(&n.bounds[farRow[i]][q]), o[i]), inv[i]), widen);
+                tn = _mm_max_ps(a, tn);
+                tf = _mm_min_ps(b, tf);
+            }
+            _mm_storeu_ps(tNear + q, tn);
+            mask |= _mm_movemask_ps(_mm_cmple_ps(tn, tf)) << q;
         }
-        _mm_storeu_ps(tNear, tn);
-        return _mm_movemask_ps(_mm_cmple_ps(tn, tf));
+        return mask;
     }
 };
 #endif
 
 }  // namespace detail
 
-#ifndef SL_UNSORTED
-#define SL_UNSORTED 0
-#endif
-#ifdef SL_STATS
-inline thread_local std::uint64_t gNodeVisits = 0, gLeafVisits = 0, gRays = 0;
-#endif
-inline constexpr bool kAnyHitUnsorted = SL_UNSORTED == 1;
+template <int N>
 template <typename Real, typename LeafFn>
-bool Bvh4::traverse(const Ray<Real>& ray, Real& tMax, bool anyHit, LeafFn&& leaf) const {
+bool WideBvh<N>::traverse(const Ray<Real>& ray, Real& tMax, bool anyHit, LeafFn&& leaf) const {
     if (root_ == kEmpty) return false;
-    // Each node pushes at most three entries and the binary build caps the depth at 80 levels
-    // (tolerances.h), and a 4-wide level consumes at least one binary level: 3·80 + 1 < 256.
-    constexpr int kStackSize = 256;
+    // Each node pushes at most N − 1 entries; the binary build caps the depth at 80 levels
+    // (tolerances.h) and a wide level consumes at least one binary level: (N − 1)·80 + 1 fits.
+    constexpr int kStackSize = 82 * N;
     struct Entry {
         std::uint32_t ref;
         Real tNear;  // entry distance when pushed: a later, nearer hit makes the entry useless
     };
     Entry stack[kStackSize];
     int top = 0;
-    const detail::ChildBoxTest<Real> boxes(ray);
+    const detail::ChildBoxTest<Real, N> boxes(ray);
     std::uint32_t ref = root_;
     bool hit = false;
-#ifdef SL_STATS
-    ++gRays;
-#endif
     for (;;) {
-#ifdef SL_STATS
-        ++(isLeaf(ref) ? gLeafVisits : gNodeVisits);
-#endif
         if (isLeaf(ref)) {
             if (leaf(leafFirst(ref), leafCount(ref), tMax)) {
                 hit = true;
                 if (anyHit) return true;
             }
         } else {
-            const Bvh4Node& node = nodes_[ref];
-            Real tn[4];
+            const Node& node = nodes_[ref];
+            Real tn[N];
             int mask = boxes(node, tMax, tn);
             if (mask != 0) {
-                if ((mask & (mask - 1)) == 0) {  // one child: no stack traffic
-                    ref = node.ref[__builtin_ctz(unsigned(mask))];
+                int c = __builtin_ctz(unsigned(mask));
+                mask &= mask - 1;
+                if (mask == 0) {  // one child: no stack traffic
+                    ref = node.ref[c];
                     continue;
                 }
-                if (anyHit && kAnyHitUnsorted) {
-                    int c = __builtin_ctz(unsigned(mask));
-                    mask &= mask - 1;
-                    const std::uint32_t first = node.ref[c];
+                if (anyHit) {
+                    // Any hit: the first child in stored order, the others pushed. Their node
+                    // lines are prefetched now, as they will be read soon.
+                    ref = node.ref[c];
                     while (mask != 0) {
                         c = __builtin_ctz(unsigned(mask));
                         mask &= mask - 1;
                         stack[top++] = Entry{node.ref[c], tn[c]};
-#if defined(__SSE2__) && defined(SL_PREFETCH)
+#if defined(__SSE2__)
                         if (!isLeaf(node.ref[c])) {
                             const char* p = reinterpret_cast<const char*>(&nodes_[node.ref[c]]);
-                            _mm_prefetch(p, _MM_HINT_T0);
-                            _mm_prefetch(p + 64, _MM_HINT_T0);
+                            for (std::size_t line = 0; line < sizeof(Node); line += 64)
+                                _mm_prefetch(p + line, _MM_HINT_T0);
                         }
 #endif
                     }
-                    ref = first;
                     continue;
                 }
-                // Sort the entered children by entry distance (at most four: insertion sort),
-                // push all but the nearest farthest first, descend into the nearest.
-                Entry e[4];
-                int n = 0;
+                // Closest hit: sort the entered children by entry distance (insertion sort of
+                // at most N), push all but the nearest farthest first, descend into the nearest.
+                Entry e[N];
+                e[0] = Entry{node.ref[c], tn[c]};
+                int n = 1;
                 while (mask != 0) {
-                    const int c = __builtin_ctz(unsigned(mask));
+                    c = __builtin_ctz(unsigned(mask));
                     mask &= mask - 1;
-                    Entry x{node.ref[c], tn[c]};
+                    const Entry x{node.ref[c], tn[c]};
                     int k = n++;
                     while (k > 0 && e[k - 1].tNear > x.tNear) {
                         e[k] = e[k - 1];
                         --k;
                     }
                     e[k] = x;
-                }
-                if (anyHit && SL_UNSORTED == 2) {
-                    for (int k = 0; k < n - 1; ++k) stack[top++] = e[k];
-                    ref = e[n - 1].ref;
-                    continue;
                 }
                 for (int k = n - 1; k > 0; --k) stack[top++] = e[k];
                 ref = e[0].ref;

@@ -1,5 +1,5 @@
-// raytrace/bvh4.cpp: collapse of the binary SAH tree into 4-wide nodes.
-#include "raytrace/bvh4.h"
+// raytrace/wide_bvh.cpp: collapse of the binary SAH tree into N-wide nodes.
+#include "raytrace/wide_bvh.h"
 
 #include <array>
 #include <limits>
@@ -18,30 +18,31 @@ float surfaceArea(const BvhNode& n) {
     return 2 * (x * y + y * z + z * x);
 }
 
+template <int N>
 struct Collapser {
     const std::vector<BvhNode>& bin;
     const std::vector<std::uint32_t>& binPrims;
-    std::vector<Bvh4Node>& out;
+    std::vector<WideNode<N>>& out;
     std::vector<std::uint32_t>& prims;
 
     std::uint32_t refOf(std::uint32_t b) {
         const BvhNode& n = bin[b];
         if (n.count == 0) return collapse(b);
-        // Leaves are laid out in traversal order, each starting on a multiple of
-        // Bvh4::kLeafAlign slots, so a leaf is whole packets of four triangles.
+        // Leaves are laid out in traversal order, each starting on a multiple of kLeafAlign
+        // slots, so a leaf is whole packets of four triangles.
         const std::uint32_t first = std::uint32_t(prims.size());
         prims.insert(prims.end(), binPrims.begin() + n.offset, binPrims.begin() + n.offset + n.count);
-        while (prims.size() % Bvh4::kLeafAlign != 0) prims.push_back(Bvh4::kEmpty);
-        return Bvh4::leafRef(first, n.count);
+        while (prims.size() % WideRef::kLeafAlign != 0) prims.push_back(WideRef::kEmpty);
+        return WideRef::leafRef(first, n.count);
     }
 
-    // Makes the 4-wide node for binary interior node b and returns its index.
+    // Makes the wide node for binary interior node b and returns its index.
     std::uint32_t collapse(std::uint32_t b) {
-        std::array<std::uint32_t, 4> kids{};
+        std::array<std::uint32_t, N> kids{};
         int n = 2;
         kids[0] = b + 1;
         kids[1] = bin[b].offset;
-        while (n < 4) {
+        while (n < N) {
             // Open the interior child with the largest surface area: it is the one a ray
             // enters most often, so flattening it saves the most node visits (SAH argument).
             int best = -1;
@@ -64,20 +65,13 @@ struct Collapser {
         }
         const std::uint32_t index = std::uint32_t(out.size());
         out.emplace_back();
-        for (int c = 0; c < 4; ++c) {
-            Bvh4Node& node = out[index];
-            if (c < n) {
-                for (int k = 0; k < 3; ++k) {
-                    node.bounds[k][c] = bin[kids[c]].lo[k];
-                    node.bounds[3 + k][c] = bin[kids[c]].hi[k];
-                }
-            } else {
-                for (int k = 0; k < 3; ++k) {
-                    node.bounds[k][c] = std::numeric_limits<float>::infinity();
-                    node.bounds[3 + k][c] = -std::numeric_limits<float>::infinity();
-                }
-                node.ref[c] = Bvh4::kEmpty;
+        WideNode<N>& node = out[index];
+        for (int c = 0; c < N; ++c) {
+            for (int k = 0; k < 3; ++k) {
+                node.bounds[k][c] = c < n ? bin[kids[c]].lo[k] : std::numeric_limits<float>::infinity();
+                node.bounds[3 + k][c] = c < n ? bin[kids[c]].hi[k] : -std::numeric_limits<float>::infinity();
             }
+            node.ref[c] = WideRef::kEmpty;
         }
         for (int c = 0; c < n; ++c) {
             const std::uint32_t r = refOf(kids[c]);  // may grow `out`: index, not reference
@@ -89,24 +83,29 @@ struct Collapser {
 
 }  // namespace
 
-Bvh4 Bvh4::collapse(const Bvh& binary) {
-    Bvh4 bvh;
+template <int N>
+WideBvh<N> WideBvh<N>::collapse(const Bvh& binary) {
+    WideBvh bvh;
     if (binary.empty()) return bvh;
     // Padding adds at most kLeafAlign − 1 slots per leaf, and a leaf holds at least one.
     if (binary.primitives().size() >= kMaxSlots / kLeafAlign)
-        throw std::length_error("Bvh4: more than 2^26 primitives in one mesh");
+        throw std::length_error("WideBvh: more than 2^26 primitives in one mesh");
     const std::vector<BvhNode>& bin = binary.nodes();
-    bvh.nodes_.reserve(bin.size() / 3 + 1);
+    bvh.nodes_.reserve(bin.size() / (N - 1) + 1);
     bvh.primitives_.reserve(binary.primitives().size() * 3 / 2);
-    Collapser c{bin, binary.primitives(), bvh.nodes_, bvh.primitives_};
+    Collapser<N> c{bin, binary.primitives(), bvh.nodes_, bvh.primitives_};
     bvh.root_ = c.refOf(0);
     bvh.nodes_.shrink_to_fit();
     bvh.primitives_.shrink_to_fit();
     return bvh;
 }
 
-Bvh4 Bvh4::build(const std::vector<scene::Bounds>& primitiveBounds) {
+template <int N>
+WideBvh<N> WideBvh<N>::build(const std::vector<scene::Bounds>& primitiveBounds) {
     return collapse(Bvh::build(primitiveBounds));
 }
+
+template class WideBvh<4>;
+template class WideBvh<8>;
 
 }  // namespace shadowlab::raytrace
