@@ -183,6 +183,37 @@ LightFrustum fitSpotLight(const scene::Bounds& bounds, const Vec3& position, con
     return f;
 }
 
+Vec3 cubeFaceDirection(int face) {
+    Vec3 d(0.0);
+    d[face / 2] = (face % 2) ? -1.0 : 1.0;
+    return d;
+}
+
+double cubeFaceTanHalfFov(int mapSize) {
+    // The face's 90° edge sits at tan = 1, i.e. (size/2)/t texels from the center; ask for
+    // margin more texels: (size/2)(1 − 1/t) = margin  =>  t = size / (size − 2·margin).
+    const double size = std::max(mapSize, 1);
+    const double usable = size - 2.0 * kPointFaceMarginTexels;
+    return usable <= 0.5 * size ? 2.0 : size / usable;
+}
+
+LightFrustum fitPointLightFace(const scene::Bounds& bounds, const Vec3& position, int face, int mapSize) {
+    LightFrustum f;
+    f.perspective = true;
+    setBasis(f, cubeFaceDirection(face));
+    f.position = position;
+    f.mapSize = std::max(mapSize, 1);
+    f.tanHalfFov = cubeFaceTanHalfFov(mapSize);
+    const Vec3 c = bounds.empty() ? position : bounds.center();
+    const double radius = bounds.empty() ? 1.0 : 0.5 * bounds.diagonal() * kLightFrustumMargin;
+    // Any direction may hold geometry, so the range is the distance band of the bounding sphere,
+    // not its extent along this face's axis: one near/far serves all six faces (the shader has one).
+    const double dist = glm::length(c - position);
+    f.far = std::max(dist + radius, 1e-6);
+    f.near = std::max(dist - radius, f.far * kSpotMinNearOverFar);
+    return f;
+}
+
 glm::dmat4 LightFrustum::toClip(const Vec3& origin) const {
     glm::dmat4 m(0.0);
     if (!perspective) {

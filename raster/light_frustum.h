@@ -59,4 +59,17 @@ LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const sce
 LightFrustum fitSpotLight(const scene::Bounds& bounds, const scene::Vec3& position, const scene::Vec3& direction,
                           double coneDegrees, int mapSize);
 
+// The six faces of a point light's cube map, in this order: +X, −X, +Y, −Y, +Z, −Z (each
+// face's `direction`; its right and up axes come from the same rule as every other frustum, and
+// shaders/lit.frag rebuilds them the same way).
+inline constexpr int kCubeFaces = 6;
+scene::Vec3 cubeFaceDirection(int face);
+// tan of each face's half field of view: 1 (90°) widened by kPointFaceMarginTexels texels, and
+// never more than 2 for tiny maps.
+double cubeFaceTanHalfFov(int mapSize);
+// Face `face` of the cube map of a point light at `position`: a perspective frustum whose near
+// and far enclose the scene's bounding sphere (the same for all six faces, near no closer than
+// far · kSpotMinNearOverFar).
+LightFrustum fitPointLightFace(const scene::Bounds& bounds, const scene::Vec3& position, int face, int mapSize);
+
 }  // namespace shadowlab::raster

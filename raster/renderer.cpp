@@ -39,11 +39,6 @@ bool needsShadowTest(const scene::RenderPlan& plan, std::size_t light) {
 }
 
 void checkSupported(const scene::Scene& scene, const scene::RasterSettings& settings) {
-    for (std::size_t i = 0; i < scene.lights.size(); ++i)
-        if (scene.lights[i].type == scene::LightType::Point)
-            throw RasterError("lights[" + std::to_string(i) +
-                              "] is a point light: not supported by the raster backend yet (it needs a cube "
-                              "shadow map); render this scene with --backend raytrace");
     if (scene.lights.size() > SHADOWLAB_MAX_LIGHTS)
         throw RasterError("the scene has " + std::to_string(scene.lights.size()) +
                           " lights; the raster backend handles at most " + std::to_string(SHADOWLAB_MAX_LIGHTS));
@@ -75,9 +70,11 @@ scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, co
     const auto width = std::uint32_t(scene.camera.width);
     const auto height = std::uint32_t(scene.camera.height);
 
-    scene::Frame frame = scene::Frame::allocate(int(width), int(height), true);
+    // The pixels are allocated at readback, after the device has accepted the image size.
+    scene::Frame frame;
     ValidationLog log;
     std::vector<LightFrustum> frusta;
+    std::vector<double> usedDepthBias;  // per shadow-mapped light (spot, directional)
     std::size_t triangles = 0;
     int sphereSegmentsUsed = 0;
     {
@@ -107,27 +104,52 @@ scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, co
         for (std::size_t i = 0; i < scene.lights.size(); ++i) {
             const scene::Light& light = scene.lights[i];
             const bool spot = light.type == scene::LightType::Spot;
+            const bool point = light.type == scene::LightType::Point;
             shaders::LightData& l = uniforms.lights[i];
             const double meanColor = (light.color.r + light.color.g + light.color.b) / 3.0;
             l.radiance = glm::vec4(glm::vec3(light.color * light.intensity), float(light.intensity * meanColor));
             float layer = -1.0f;
             LightFrustum f;
             if (needsShadowTest(plan, i)) {
-                if (spot)
+                if (point) {
+                    // Six layers, +X −X +Y −Y +Z −Z; the shader picks the face and builds its
+                    // projection itself, so toShadow stays unused.
+                    layer = float(lightMatrices.size());
+                    for (int face = 0; face < kCubeFaces; ++face) {
+                        f = fitPointLightFace(bounds, light.position, face, settings.shadowMapSize);
+                        lightMatrices.push_back(glm::mat4(f.toClip(origin)));
+                        frusta.push_back(f);
+                    }
+                    l.bias = glm::vec4(float(settings.depthBias), float(settings.slopeBias), float(f.texelWorldSize()), 0.0f);
+                } else if (spot)
                     f = fitSpotLight(bounds, light.position, light.direction, light.coneAngleDegrees,
                                      settings.shadowMapSize);
                 else if (settings.fitLightFrustum)
                     f = fitDirectionalLightToReceivers(scene, light.direction, settings.shadowMapSize);
                 else
                     f = fitDirectionalLight(bounds, light.direction, settings.shadowMapSize);
-                layer = float(lightMatrices.size());
-                lightMatrices.push_back(glm::mat4(f.toClip(origin)));
-                l.toShadow = glm::mat4(f.toTexture(origin));
-                l.bias = glm::vec4(float(settings.depthBias), float(settings.slopeBias), float(f.texelWorldSize()),
-                                   spot ? 0.0f : float(1.0 / f.depthRange()));
-                frusta.push_back(f);
+                if (!point) {
+                    layer = float(lightMatrices.size());
+                    lightMatrices.push_back(glm::mat4(f.toClip(origin)));
+                    l.toShadow = glm::mat4(f.toTexture(origin));
+                    // The default constant bias is half a texel of the bounding-sphere map
+                    // (scene::defaultDepthBias); a fitted map's texel is smaller, so the default
+                    // becomes half of *its* texel. A bias the user gave is kept as given.
+                    const double depthBias = settings.depthBiasIsDefault && settings.fitLightFrustum && !spot
+                                                 ? 0.5 * f.texelWorldSize()
+                                                 : settings.depthBias;
+                    usedDepthBias.push_back(depthBias);
+                    l.bias = glm::vec4(float(depthBias), float(settings.slopeBias), float(f.texelWorldSize()),
+                                       spot ? 0.0f : float(1.0 / f.depthRange()));
+                    frusta.push_back(f);
+                }
             }
-            if (spot) {
+            if (point) {
+                l.toLight = glm::vec4(glm::vec3(light.position - origin), layer);
+                // Without a shadow test f is default; near/far are then unused.
+                l.kind = glm::vec4(float(SHADOWLAB_LIGHT_POINT), float(cubeFaceTanHalfFov(settings.shadowMapSize)),
+                                   float(f.near), float(f.far));
+            } else if (spot) {
                 constexpr double kPi = 3.14159265358979323846;
                 l.toLight = glm::vec4(glm::vec3(light.position - origin), layer);
                 l.kind = glm::vec4(float(SHADOWLAB_LIGHT_SPOT), float(std::cos(light.coneAngleDegrees * kPi / 180.0)),
@@ -198,6 +220,10 @@ scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, co
         ctx.submitAndWait(commands);
         invalidate(ctx, readback.beauty);
         invalidate(ctx, readback.aovs);
+        scene::Frame pixels = scene::Frame::allocate(int(width), int(height), true);
+        pixels.attributes = std::move(frame.attributes);
+        pixels.timingsMs = std::move(frame.timingsMs);
+        frame = std::move(pixels);
         const auto* beauty = static_cast<const float*>(readback.beauty.mapped);
         const auto* aovs = static_cast<const float*>(readback.aovs.mapped);
         for (std::size_t i = 0; i < frame.pixelCount(); ++i) {
@@ -228,7 +254,21 @@ scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, co
         frame.attributes["pcf_size"] = std::to_string(settings.pcfSize);
     frame.attributes["normal_offset"] = formatNumber(settings.normalOffset);
     frame.attributes["light_frustum_fit"] = settings.fitLightFrustum ? "receivers" : "bounding-sphere";
-    frame.attributes["depth_bias"] = formatNumber(settings.depthBias);
+    // The constant bias actually used: one value, or one per light (';') when a default was
+    // re-derived per fitted map and the maps differ.
+    std::string depthBias = formatNumber(settings.depthBias);
+    if (!usedDepthBias.empty()) {
+        depthBias = formatNumber(usedDepthBias[0]);
+        for (std::size_t i = 1; i < usedDepthBias.size(); ++i)
+            if (usedDepthBias[i] != usedDepthBias[0]) {
+                depthBias.clear();
+                for (std::size_t k = 0; k < usedDepthBias.size(); ++k)
+                    depthBias += (k ? ";" : "") + formatNumber(usedDepthBias[k]);
+                break;
+            }
+    }
+    frame.attributes["depth_bias"] = depthBias;
+    frame.attributes["depth_bias_default"] = settings.depthBiasIsDefault ? "true" : "false";
     frame.attributes["slope_bias"] = formatNumber(settings.slopeBias);
     frame.attributes["max_slope_tan"] = formatNumber(kMaxSlopeTan);
     frame.attributes["triangles"] = std::to_string(triangles);

@@ -12,14 +12,15 @@
 namespace shadowlab::raster {
 
 // Renders on a headless Vulkan 1.3 device (lavapipe unless settings.device names another):
-// one depth pass per directional or spot light whose plan says it needs a shadow test, then
+// one depth pass per directional or spot light, six (a cube map) per point light, for each
+// light whose plan says it needs a shadow test, then
 // the lit camera pass, then the readback. Fills every Frame AOV including blockerId, the
 // timings "setup", "shadow_pass", "lit_pass", "readback" and the attributes backend, device,
-// shadow_map_size, filter, pcf_size, depth_bias, slope_bias, normal_offset, texel_world_size,
+// shadow_map_size, filter, pcf_size, depth_bias (the value used, see depthBiasIsDefault),
+// depth_bias_default, slope_bias, normal_offset, texel_world_size,
 // light_frustum, light_frustum_fit, triangles, sphere_segments and, with settings.validate,
 // validation_messages (the count; each is printed to stderr). Throws RasterError (no loader,
-// driver or device; point lights, which need a cube map the raster backend does not have yet;
-// bad settings) or VulkanError (a failed call). Call it from one thread at a time: the Vulkan
+// driver or device; bad settings) or VulkanError (a failed call). Call it from one thread at a time: the Vulkan
 // function pointers it loads are shared by the process.
 scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan,
                     const scene::RasterSettings& settings);

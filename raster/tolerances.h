@@ -29,6 +29,13 @@ inline constexpr double kMaxSpotHalfAngleDegrees = 85.0;
 // plane, well below a texel at any sensible map size.
 inline constexpr double kSpotMinNearOverFar = 1e-3;
 
+// A point light's cube map is six perspective maps, one per axis direction. Each face's field of
+// view is widened past 90° so that it reaches this many texels beyond its face's edge: a filter
+// tap or normal offset near an edge then still reads real depths of the same face instead of
+// clamped edge texels, which is what makes seams free of false shadows. 12 = the widest kernel's
+// half-width (kMaxPcfSize / 2 = 7.5 texels) plus 4 texels of normal offset.
+inline constexpr double kPointFaceMarginTexels = 12.0;
+
 // The slope bias grows with tan(theta), which is infinite at grazing light; clamping it at
 // 10 (theta ~ 84°) keeps the bias finite where a receiver is nearly edge-on to the light and
 // its N·L shading is close to zero anyway (a common clamp: Microsoft's "Common Techniques to

@@ -53,6 +53,7 @@ RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& o) {
     // Default bias: half a texel of constant bias and one texel of slope bias.
     s.raster.depthBias =
         o.depthBias.value_or(d.depthBias.value_or(defaultDepthBias(scene, s.raster.shadowMapSize)));
+    s.raster.depthBiasIsDefault = !o.depthBias && !d.depthBias;
     s.raster.slopeBias = o.slopeBias.value_or(d.slopeBias.value_or(1.0));
     if (!std::isfinite(s.raster.depthBias) || s.raster.depthBias < 0.0)
         throw InputError("--depth-bias: must be a finite value >= 0 (world units)");

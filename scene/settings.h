@@ -20,6 +20,9 @@ enum class Precision { Float, Double };
 struct RasterSettings {
     int shadowMapSize = 2048;   // texels per side
     double depthBias = 0.0;     // world units along the light direction 
+    // True when depthBias is defaultDepthBias() (no option, no scene value): the raster backend
+    // then re-derives it as half a texel of each fitted map (fitLightFrustum), see docs/raster.md.
+    bool depthBiasIsDefault = false;
     double slopeBias = 0.0;     // texels: bias += slopeBias * texelWorldSize * tan(angle to light)
     ShadowFilter filter = ShadowFilter::Pcf2x2;
     int pcfSize = 3;            // pcf: taps per side; poisson: kernel diameter in texels (1..15)

@@ -17,6 +17,7 @@
 // Light kinds in LightData.kind.x.
 #define SHADOWLAB_LIGHT_DIRECTIONAL 0
 #define SHADOWLAB_LIGHT_SPOT 1
+#define SHADOWLAB_LIGHT_POINT 2
 
 #ifdef __cplusplus
 #include <glm/glm.hpp>
@@ -34,16 +35,18 @@ struct LightData {
     // Camera-relative world position -> homogeneous shadow-map coordinates: (u, v) = xy / w in
     // 0..1. Directional: orthographic, w = 1 and z = depth 0..1 (linear along the light).
     mat4 toShadow;
-    vec4 toLight;    // directional: xyz unit vector toward the light; spot: xyz camera-relative
-                     // position. w: shadow-map layer, -1 = no shadow test
+    vec4 toLight;    // directional: xyz unit vector toward the light; spot, point: xyz
+                     // camera-relative position. w: shadow-map layer (point: of its +X face,
+                     // the six faces +X −X +Y −Y +Z −Z follow), -1 = no shadow test
     vec4 radiance;   // rgb: color * intensity; w: intensity * mean of color (the visibility weight)
     vec4 bias;       // x: depth bias (world), y: slope bias (texels), z: texel world size
-                     // (spot: per unit of distance along its axis), w: directional: shadow-map
+                     // (spot, point: per unit of distance along its axis), w: directional: shadow-map
                      // depth per world unit
     vec4 params;     // x: max tan(theta) for the slope bias, y: filter code, z: normal offset
                      // (texels), w: pcf size (taps per side / Poisson diameter in texels)
-    vec4 kind;       // x: SHADOWLAB_LIGHT_*, y: spot: cos(cone half-angle), z: spot: near,
-                     // w: spot: far (distances along its axis)
+    vec4 kind;       // x: SHADOWLAB_LIGHT_*, y: spot: cos(cone half-angle); point: tan of each
+                     // cube face's half field of view, z: spot, point: near, w: spot, point: far
+                     // (distances along the map's axis)
     vec4 axis;       // spot: xyz unit direction the light travels; w: unused
 };
 

@@ -52,7 +52,7 @@ struct Receiver {
 
 // The compare reference for a receiver biased by `bias` world units toward the light.
 float reference(LightData light, Receiver r, float bias) {
-    if (int(light.kind.x) == SHADOWLAB_LIGHT_SPOT) {
+    if (int(light.kind.x) != SHADOWLAB_LIGHT_DIRECTIONAL) {
         // Perspective depth of a point at distance d along the axis: far/(far−near)·(1 − near/d);
         // the bias is subtracted from d, so it stays in world units at every distance.
         const float near = light.kind.z, far = light.kind.w;
@@ -64,10 +64,26 @@ float reference(LightData light, Receiver r, float bias) {
 // Visibility 0..1 of `light` at camera-relative position p with unit normal n (facing the
 // viewer), N·L = ndotl > 0. `blocker` gets the id of the object that shadowed, if any.
 float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, inout uint blocker) {
-    const bool spot = int(light.kind.x) == SHADOWLAB_LIGHT_SPOT;
+    const int kind = int(light.kind.x);
+    const bool perspective = kind != SHADOWLAB_LIGHT_DIRECTIONAL;
+    const bool point = kind == SHADOWLAB_LIGHT_POINT;
+    vec3 axis = light.axis.xyz;
+    float layer = light.toLight.w;
+    if (point) {
+        // The cube face is the major axis of the direction from the light (+X −X +Y −Y +Z −Z,
+        // as raster/light_frustum.h cubeFaceDirection). Each face map reaches a few texels past
+        // its edge, so the normal offset and the filter taps below stay inside this one face.
+        const vec3 d = p - light.toLight.xyz;
+        const vec3 a = abs(d);
+        const int k = a.x >= a.y && a.x >= a.z ? 0 : a.y >= a.z ? 1 : 2;
+        const bool negative = d[k] < 0.0;
+        axis = vec3(0.0);
+        axis[k] = negative ? -1.0 : 1.0;
+        layer += float(2 * k + (negative ? 1 : 0));
+    }
     // World size of a texel at p: constant for an orthographic map, growing with distance
     // along the axis for a perspective one.
-    const float texel = light.bias.z * (spot ? dot(p - light.toLight.xyz, light.axis.xyz) : 1.0);
+    const float texel = light.bias.z * (perspective ? dot(p - light.toLight.xyz, axis) : 1.0);
     // Normal offset: look the map up from a point moved off the surface along its normal.
     const vec3 q = p + n * (light.params.z * texel);
     // bias_world = depthBias + slopeBias * texel * min(tan(theta), maxTan), cos(theta) = N·L.
@@ -75,10 +91,20 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, inout uint blocke
     Receiver r;
     r.slopeStep = light.bias.y * texel * tanTheta;
     r.biasWorld = light.bias.x + r.slopeStep;
-    const vec4 s = light.toShadow * vec4(q, 1.0);
-    r.uv = s.xy / s.w;
-    r.axial = spot ? dot(q - light.toLight.xyz, light.axis.xyz) : s.z;
-    const float layer = light.toLight.w;
+    if (point) {
+        // The face's perspective map, as LightFrustum::toTexture: the basis is setBasis()'s rule
+        // (right = direction × (world Y, or X for a vertical direction), up = right × direction).
+        const vec3 ref = abs(axis.y) < 0.99 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
+        const vec3 right = normalize(cross(axis, ref));
+        const vec3 up = cross(right, axis);
+        const vec3 d = q - light.toLight.xyz;
+        r.axial = dot(d, axis);
+        r.uv = 0.5 + 0.5 * vec2(dot(d, right), dot(d, up)) / (r.axial * light.kind.y);
+    } else {
+        const vec4 s = light.toShadow * vec4(q, 1.0);
+        r.uv = s.xy / s.w;
+        r.axial = perspective ? dot(q - light.toLight.xyz, axis) : s.z;
+    }
     const int filterCode = int(light.params.y);
     const float size = float(textureSize(shadowMaps, 0).x);
     if (filterCode == SHADOWLAB_FILTER_NONE) return tap(r.uv, layer, reference(light, r, r.biasWorld), blocker);
@@ -143,12 +169,13 @@ void main() {
         const LightData light = u.lights[i];
         vec3 l;
         float irradiance;  // relative to radiance: 1 for directional lights
-        if (int(light.kind.x) == SHADOWLAB_LIGHT_SPOT) {
-            // scene/shading.h: intensity / (4π d²), dark outside the cone.
+        if (int(light.kind.x) != SHADOWLAB_LIGHT_DIRECTIONAL) {
+            // scene/shading.h: intensity / (4π d²); a spot is dark outside its cone.
             const vec3 toLight = light.toLight.xyz - inPosition;
             const float d2 = dot(toLight, toLight);
             l = toLight * inversesqrt(d2);
-            irradiance = dot(-l, light.axis.xyz) < light.kind.y ? 0.0 : 1.0 / (4.0 * kPi * d2);
+            const bool outsideCone = int(light.kind.x) == SHADOWLAB_LIGHT_SPOT && dot(-l, light.axis.xyz) < light.kind.y;
+            irradiance = outsideCone ? 0.0 : 1.0 / (4.0 * kPi * d2);
         } else {
             l = light.toLight.xyz;
             irradiance = 1.0;

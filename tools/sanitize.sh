@@ -14,9 +14,18 @@ if [ ! -f "$build/build.ninja" ]; then
         -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined" >&2
 fi
 cmake --build "$build" -j "$(nproc)" >&2
-# Leaks are reported by LeakSanitizer at exit; Mesa's llvmpipe keeps a few process-lifetime
-# allocations (its JIT and shader cache) that are not ours, listed in tools/lsan.supp.
-export ASAN_OPTIONS="halt_on_error=1:abort_on_error=0:detect_leaks=1:strict_string_checks=1"
+# Leaks are reported by LeakSanitizer at exit; Mesa's llvmpipe, the Vulkan loader and the
+# validation layer keep a few process-lifetime allocations that are not ours (tools/lsan.supp).
+# The loader dlclose()s the driver and the layer before LeakSanitizer runs, which leaves their
+# frames as "<unknown module>" that no suppression can name; preloading them keeps them mapped.
+preload=""
+for lib in libvulkan.so.1 libvulkan_lvp.so libVkLayer_khronos_validation.so; do
+    path=$(ldconfig -p | awk -v l="$lib" '$1 == l && /x86-64|x86_64/ {print $NF; exit}')
+    [ -z "$path" ] && path=$(ls /usr/lib/*/"$lib" 2>/dev/null | head -n 1)
+    [ -n "$path" ] && preload="$preload $path"
+done
+export LD_PRELOAD="${preload# }"
+export ASAN_OPTIONS="halt_on_error=1:abort_on_error=0:detect_leaks=1:verify_asan_link_order=0"
 export LSAN_OPTIONS="suppressions=$root/tools/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 cd "$build"

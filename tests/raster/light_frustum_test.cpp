@@ -166,5 +166,33 @@ TEST(LightFrustum, FittedFallsBackToTheBoundingSphereWhenTheCameraSeesNothing) {
     EXPECT_EQ(fitDirectionalLightToReceivers(s, dir, 256).halfWidth, fitDirectionalLight(s.bounds(), dir, 256).halfWidth);
 }
 
+TEST(CubeFaces, EachFaceReachesTheMarginPastItsEdgeAndLooksAlongItsAxis) {
+    for (const int size : {64, 512, 2048}) {
+        const double t = cubeFaceTanHalfFov(size);
+        // The 90° edge (tan = 1) lies (size/2)·(1 − 1/t) texels inside the face's border.
+        EXPECT_NEAR(0.5 * size * (1.0 - 1.0 / t), kPointFaceMarginTexels, 1e-9) << size;
+        const scene::Bounds bounds{Vec3(-3), Vec3(3)};
+        const Vec3 light(0.5, 1.0, -0.25);
+        for (int face = 0; face < kCubeFaces; ++face) {
+            const LightFrustum f = fitPointLightFace(bounds, light, face, size);
+            const Vec3 axis = cubeFaceDirection(face);
+            EXPECT_DOUBLE_EQ(glm::dot(f.direction, axis), 1.0);
+            // A point on the face's axis maps to the map center; one on the 90° edge (axis +
+            // right) maps margin texels inside the border.
+            const glm::dvec4 c = f.toTexture(Vec3(0)) * glm::dvec4(light + 2.0 * axis, 1.0);
+            EXPECT_NEAR(c.x / c.w, 0.5, 1e-12);
+            EXPECT_NEAR(c.y / c.w, 0.5, 1e-12);
+            const glm::dvec4 e = f.toTexture(Vec3(0)) * glm::dvec4(light + 2.0 * axis + 2.0 * f.right, 1.0);
+            EXPECT_NEAR((1.0 - e.x / e.w) * size, kPointFaceMarginTexels, 1e-6);
+            // The whole scene lies between near and far.
+            EXPECT_LE(f.near, 1e-3 * f.far + 1e-12);
+            EXPECT_GE(f.far, glm::length(Vec3(3) - light));
+        }
+        // The six axes are distinct: +X −X +Y −Y +Z −Z.
+        for (int a = 0; a < kCubeFaces; ++a)
+            for (int b = a + 1; b < kCubeFaces; ++b) EXPECT_LT(glm::dot(cubeFaceDirection(a), cubeFaceDirection(b)), 0.5);
+    }
+}
+
 }  // namespace
 }  // namespace shadowlab::raster

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <cstdio>
 #include <filesystem>
 
 #include <gtest/gtest.h>
@@ -18,16 +19,6 @@ namespace {
 using namespace test;
 using scene::ShadowFilter;
 
-const char* f_name(ShadowFilter f) {
-    switch (f) {
-        case ShadowFilter::None: return "none";
-        case ShadowFilter::Pcf2x2: return "pcf2x2";
-        case ShadowFilter::Pcf: return "pcf";
-        case ShadowFilter::Poisson: return "poisson";
-    }
-    return "?";
-}
-
 void maybeWritePng(const scene::Frame& f, const std::string& name) {
     if (const char* dir = std::getenv("SHADOWLAB_TEST_PNG_DIR"))
         scene::writePngLinear(std::filesystem::path(dir) / (name + ".png"), f.width, f.height, f.beauty);
@@ -38,6 +29,13 @@ scene::Frame renderValidated(const scene::Scene& s, const scene::RasterSettings&
     EXPECT_EQ(f.attributes["validation_messages"], "0") << "validation messages were printed above";
     maybeWritePng(f, name);
     return f;
+}
+
+// The attributes print numbers with %.9g; compare against the same rounding.
+std::string formatForTest(double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.9g", v);
+    return buf;
 }
 
 std::size_t at(const scene::Frame& f, int x, int y) { return std::size_t(y) * f.width + x; }
@@ -203,6 +201,112 @@ TEST(RasterRender, SaneBiasHasFewFalseAndMissedShadows) {
     }
 }
 
+TEST(RasterBias, BiasSeriesAtGrazingLightTradeAcneForMissedOrDisplacedShadow) {
+    // Light 5° above the plane (tan θ ≈ 11.4 at the plane, past the slope clamp of 10), the
+    // sphere resting on it. For each bias kind alone, a growing series: the plane's false
+    // shadows (acne) never increase and the missed shadow (the contact region leaking) never
+    // decreases, and both change substantially end to end. With the nearest filter each pixel's
+    // answer is a compare of one stored depth against the receiver depth minus the bias, so
+    // for depth and slope bias the counts are monotone pixel by pixel; the normal offset moves
+    // the lookup point, so its counts get a small slack.
+    SphereOverPlane p;
+    p.center = Vec3(0, 0.5, 0);
+    p.width = 320;
+    p.height = 180;
+    p.lightDirection = lightFromElevation(5.0);
+    const scene::Scene s = makeScene(p);
+    const int size = 512;
+    // The bounding-sphere map's texel: 2 · 1.01 · half the diagonal / size.
+    const double texel = 1.01 * s.bounds().diagonal() / size;
+    enum Kind { Depth, Slope, NormalOffset };
+    auto series = [&](Kind kind, const std::vector<double>& steps) {
+        std::vector<ShadowErrors> out;
+        for (const double k : steps) {
+            scene::RasterSettings settings = validatedSettings(size, 0.0, 0.0, ShadowFilter::None);
+            if (kind == Depth) settings.depthBias = k * texel;
+            if (kind == Slope) settings.slopeBias = k;
+            if (kind == NormalOffset) settings.normalOffset = k;
+            out.push_back(shadowErrors(p, s, renderValidated(s, settings, "bias-series")));
+        }
+        return out;
+    };
+    for (const Kind kind : {Depth, Slope}) {
+        const std::vector<ShadowErrors> e = series(kind, {0.0, 1.0, 4.0, 16.0, 64.0});
+        for (std::size_t i = 1; i < e.size(); ++i) {
+            EXPECT_LE(e[i].falseShadow, e[i - 1].falseShadow) << "kind " << kind << " step " << i;
+            EXPECT_GE(e[i].missedShadow, e[i - 1].missedShadow) << "kind " << kind << " step " << i;
+        }
+        ASSERT_GT(e[0].analyticShadowed, 500);
+        EXPECT_GT(e[0].falseShadow, e[0].counted / 5) << "kind " << kind << ": no acne at zero bias";
+        EXPECT_LT(e.back().falseShadow, e[0].counted / 1000) << "kind " << kind;
+        EXPECT_GT(e.back().missedShadow, e[0].missedShadow + e[0].analyticShadowed / 10) << "kind " << kind;
+    }
+    // The normal offset at grazing light moves the lookup point mostly *across* the light
+    // (the normal is 85° from it), so past the offset that removes acne ((√2/2)·sin 85° ≈ 0.7
+    // texel, see NormalOffsetRemovesAcneWithoutDepthBias) it does not make the shadow leak: it
+    // displaces the shadow away from the light, which shows as false shadow growing with the
+    // offset while the missed shadow does not grow. That is its trade, asserted as such.
+    const std::vector<ShadowErrors> e = series(NormalOffset, {0.0, 0.25, 0.5, 1.0, 2.0, 4.0});
+    EXPECT_GT(e[0].falseShadow, e[0].counted / 5);
+    EXPECT_LT(e[1].falseShadow, e[0].falseShadow);
+    EXPECT_LT(e[2].falseShadow, e[0].counted / 1000) << "acne gone at 0.5 texel";
+    for (std::size_t i = 3; i < e.size(); ++i) {
+        EXPECT_GT(e[i].falseShadow, e[i - 1].falseShadow) << "displacement grows, step " << i;
+        EXPECT_LE(e[i].missedShadow, e[0].missedShadow) << "no leak, step " << i;
+    }
+}
+
+TEST(RasterFittedFrustum, DefaultDepthBiasBecomesHalfTheFittedTexel) {
+    // resolveSettings() marks a bias nobody gave as the default; with a fitted map the backend
+    // uses half of that map's texel instead of half a bounding-sphere texel. A given bias stays.
+    SphereOverPlane p;
+    p.lightDirection = lightFromElevation(40.0);
+    const scene::Scene s = makeScene(p);
+    scene::SettingsOverrides o;
+    o.shadowMapSize = 256;
+    o.fitLightFrustum = true;
+    o.validate = true;
+    scene::RenderSettings rs = scene::resolveSettings(s, o);
+    ASSERT_TRUE(rs.raster.depthBiasIsDefault);
+    EXPECT_DOUBLE_EQ(rs.raster.depthBias, 0.5 * s.bounds().diagonal() / 256);
+    scene::Frame f = renderValidated(s, rs.raster, "default-bias-fitted");
+    const double texel = std::stod(f.attributes.at("texel_world_size"));
+    EXPECT_DOUBLE_EQ(std::stod(f.attributes.at("depth_bias")), std::stod(formatForTest(0.5 * texel)));
+    EXPECT_LT(0.5 * texel, 0.75 * rs.raster.depthBias);  // smaller than the bounding-sphere default
+    EXPECT_EQ(f.attributes.at("depth_bias_default"), "true");
+    // A given bias is kept.
+    o.depthBias = 0.03;
+    rs = scene::resolveSettings(s, o);
+    EXPECT_FALSE(rs.raster.depthBiasIsDefault);
+    f = renderValidated(s, rs.raster, "given-bias-fitted");
+    EXPECT_EQ(f.attributes.at("depth_bias"), "0.03");
+}
+
+TEST(RasterFittedFrustum, DoublingAnUnrelatedFarExtentKeepsTheTexelSize) {
+    // A small sphere far off to the side (out of view, casting nothing into it) stretches the
+    // scene's bounds; moving it twice as far doubles that extent. The fitted map covers only the
+    // receivers in view and their casters, so its texel must not change; the bounding-sphere
+    // map's texel grows with the bounds (the control: the test can tell them apart).
+    auto texelWith = [](double farX, bool fit) {
+        SphereOverPlane p;
+        scene::Scene s = makeScene(p);
+        scene::Object far;
+        far.name = "far";
+        far.shape = scene::Sphere{Vec3(farX, 0.5, 0), 0.5};
+        s.objects.push_back(far);
+        scene::RasterSettings settings = validatedSettings(256, 0.01, 1.0, ShadowFilter::None);
+        settings.fitLightFrustum = fit;
+        s.lights[0].direction = glm::normalize(Vec3(0.3, -1, 0.2));
+        const scene::Frame f = renderValidated(s, settings, "fit-far");
+        return std::stod(f.attributes.at("texel_world_size"));
+    };
+    const double fitted = texelWith(50.0, true), fittedFarther = texelWith(100.0, true);
+    EXPECT_NEAR(fittedFarther, fitted, 1e-9 * fitted);
+    const double plain = texelWith(50.0, false), plainFarther = texelWith(100.0, false);
+    EXPECT_GT(plainFarther, 1.8 * plain);
+    EXPECT_LT(fitted, 0.5 * plain);
+}
+
 TEST(RasterRender, ObjectIdsMatchClosedFormPrimaryVisibilityExceptOnSilhouettes) {
     const SphereOverPlane p;
     const scene::Scene s = makeScene(p);
@@ -321,7 +425,7 @@ TEST(RasterFilters, FiltersSoftenOnlyABandAroundTheShadowOutline) {
     for (const Case c : {Case{ShadowFilter::Pcf2x2, 2, 1.0}, Case{ShadowFilter::Pcf, 3, 1.5},
                          Case{ShadowFilter::Pcf, 5, 2.5}, Case{ShadowFilter::Poisson, 7, 3.5}}) {
         const scene::Frame f = renderValidated(s, filterSettings(c.filter, c.size),
-                                               std::string("filter-") + f_name(c.filter) + std::to_string(c.size));
+                                               std::string("filter-") + scene::toString(c.filter) + std::to_string(c.size));
         const EdgeStats e = edgeStats(p, s, f, (c.reach + 1.5) * texel);
         EXPECT_GT(e.farFromEdge, 10000);
         EXPECT_EQ(e.exactWrong, 0) << f.attributes.at("filter") << " " << c.size;
@@ -329,6 +433,34 @@ TEST(RasterFilters, FiltersSoftenOnlyABandAroundTheShadowOutline) {
         EXPECT_GT(e.fractional, previousFractional) << "a wider kernel must widen the penumbra";
         previousFractional = e.fractional;
     }
+}
+
+TEST(RasterFilters, Pcf2x2LiesBetweenTheHardResultsOfTheNeighbouringTexels) {
+    // pcf2x2 is the bilinear mix of the compare results of the four texels around the lookup
+    // point, and the hard (none) result is the compare of the nearest of those four, whose
+    // bilinear weight is at least 1/4 (both fractions ≤ 1/2 from it). With slope bias 0 both
+    // filters compare against the same reference, so per pixel: hard lit ⇒ pcf ≥ 1/4, hard
+    // shadowed ⇒ pcf ≤ 3/4, and a pcf of exactly 0 or 1 (all four agree) equals the hard one.
+    // A few pixels may see float rounding pick a different nearest texel: at most 0.1%.
+    SphereOverPlane p;
+    p.lightDirection = lightFromElevation(40.0);
+    p.width = 320;
+    p.height = 180;
+    const scene::Scene s = makeScene(p);
+    const scene::Frame hard = renderValidated(s, validatedSettings(256, 0.02, 0.0, ShadowFilter::None), "between-hard");
+    const scene::Frame soft = renderValidated(s, validatedSettings(256, 0.02, 0.0, ShadowFilter::Pcf2x2), "between-pcf");
+    int outside = 0, fractional = 0, shadowed = 0;
+    for (std::size_t i = 0; i < hard.pixelCount(); ++i) {
+        if (hard.objectId[i] != 2.0f || hard.ndotl[i] <= 0.0f) continue;
+        const float h = hard.visibility[i], v = soft.visibility[i];
+        fractional += v > 0.0f && v < 1.0f;
+        shadowed += h == 0.0f;
+        const bool ok = h == 1.0f ? v >= 0.25f - 1e-4f : v <= 0.75f + 1e-4f;
+        outside += !ok;
+    }
+    EXPECT_GT(shadowed, 1000);
+    EXPECT_GT(fractional, 100) << "the shadow outline should give fractional pcf values";
+    EXPECT_LE(outside, int(hard.pixelCount() / 1000)) << outside << " pixels outside the neighbours' range";
 }
 
 TEST(RasterFilters, NoneHasNoFractionalVisibility) {
@@ -558,17 +690,134 @@ TEST(RasterRender, ImageTooLargeForTheDeviceIsAClearError) {
     }
 }
 
-TEST(RasterRender, PointLightIsRejectedWithAClearMessage) {
-    scene::Scene s = makeScene(SphereOverPlane{});
+TEST(RasterPointLight, SphereCastsTheTangentConeShadow) {
+    // A point light straight above the sphere: the shadow is the cone from the light tangent to
+    // the sphere, half-angle asin(r / (h − c_y)), cut by the plane y = 0: a disk of radius
+    // h·tan(half-angle) around the light's foot. The plane is wide enough that its outer parts
+    // are seen through the side faces of the cube map, not only the −Y face.
+    SphereOverPlane p;
+    p.width = 320;
+    p.height = 180;
+    scene::Scene s = makeScene(p);
+    const double h = 2.5;
     s.lights[0].type = scene::LightType::Point;
-    s.lights[0].position = Vec3(0, 5, 0);
-    const scene::RasterSettings settings = validatedSettings(256, 0.01, 1.0, ShadowFilter::None);
-    try {
-        render(s, planFor(s, settings), settings);
-        FAIL() << "expected RasterError";
-    } catch (const RasterError& e) {
-        EXPECT_NE(std::string(e.what()).find("not supported by the raster backend yet"), std::string::npos)
-            << e.what();
+    s.lights[0].position = Vec3(0, h, 0);
+    s.lights[0].intensity = 300.0;
+    const double alpha = std::asin(p.radius / (h - p.center.y));
+    const double shadowRadius = h * std::tan(alpha);
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    const scene::Frame f = renderValidated(s, validatedSettings(1024, 0.01, 1.0, ShadowFilter::None), "point_sphere");
+    // One texel of the −Y face at the plane is 2·t/1024·h ≈ 0.005; skip a band of 0.03 around the rim.
+    const double band = 0.03;
+    int inside = 0, outside = 0, wrong = 0, sideFaces = 0;
+    for (int y = 0; y < f.height; ++y)
+        for (int x = 0; x < f.width; ++x) {
+            const std::size_t i = at(f, x, y);
+            const PrimaryHit hit = primaryHit(p, cam, x, y);
+            if (hit.id != 2 || f.objectId[i] != 2.0f) continue;
+            const double rho = std::hypot(hit.p.x, hit.p.z);
+            if (std::abs(rho - shadowRadius) < band) continue;
+            const bool shadowed = rho < shadowRadius;
+            (shadowed ? inside : outside) += 1;
+            if (std::max(std::abs(hit.p.x), std::abs(hit.p.z)) > h) ++sideFaces;
+            if ((f.visibility[i] < 0.5f) != shadowed) ++wrong;
+            if (!shadowed && f.visibility[i] == 1.0f) {
+                const Vec3 toLight = s.lights[0].position - hit.p;
+                const double d2 = glm::dot(toLight, toLight);
+                EXPECT_NEAR(f.beauty[3 * i], 0.8 * 300.0 / (4 * kPi * d2) * (toLight.y / std::sqrt(d2)) + 0.05 * 0.8,
+                            2e-4);
+            }
+        }
+    EXPECT_GT(inside, 500);
+    EXPECT_GT(outside, 5000);
+    EXPECT_GT(sideFaces, 1000) << "the view should reach the side faces";
+    EXPECT_EQ(wrong, 0) << wrong << " plane pixels disagree with the tangent-cone shadow";
+    EXPECT_EQ(f.attributes.at("shadow_maps"), "6");
+}
+
+TEST(RasterPointLight, OffAxisSphereShadowOnASideFaceMatchesTheSegmentTest) {
+    // The light beside the sphere, so its shadow lies in the +X face and nothing is symmetric
+    // about that face's axes (a mirrored or transposed face lookup would misplace it). Closed
+    // form: a plane point is shadowed when the segment to the light meets the sphere.
+    SphereOverPlane p;
+    p.width = 320;
+    p.height = 180;
+    p.center = Vec3(1.2, 0.7, 0.3);
+    p.lookAt = Vec3(1.0, 0.3, 0.3);
+    scene::Scene s = makeScene(p);
+    const Vec3 lightPos(0.0, 1.5, -0.1);
+    s.lights[0].type = scene::LightType::Point;
+    s.lights[0].position = lightPos;
+    s.lights[0].intensity = 100.0;
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    const scene::Frame f = renderValidated(s, validatedSettings(1024, 0.01, 1.0, ShadowFilter::None), "point_off_axis");
+    int shadowed = 0, plusX = 0, counted = 0, wrong = 0;
+    for (int y = 0; y < f.height; ++y)
+        for (int x = 0; x < f.width; ++x) {
+            const std::size_t i = at(f, x, y);
+            const PrimaryHit hit = primaryHit(p, cam, x, y);
+            if (hit.id != 2 || f.objectId[i] != 2.0f) continue;
+            const Vec3 toLight = lightPos - hit.p;
+            // Skip the rim: plane points whose segment passes within 0.01 of the sphere's surface.
+            const Vec3 c = p.center - hit.p;
+            const double t = std::clamp(glm::dot(c, toLight) / glm::dot(toLight, toLight), 0.0, 1.0);
+            const double dist = glm::length(c - t * toLight);
+            if (std::abs(dist - p.radius) < 0.01) continue;
+            const bool inShadow = dist < p.radius;
+            ++counted;
+            if (inShadow) {
+                ++shadowed;
+                const Vec3 d = -toLight;
+                if (d.x > std::abs(d.y) && d.x > std::abs(d.z)) ++plusX;
+            }
+            if ((f.visibility[i] < 0.5f) != inShadow) ++wrong;
+        }
+    EXPECT_GT(counted, 5000);
+    EXPECT_GT(shadowed, 1000);
+    EXPECT_GT(plusX, shadowed / 2) << "the shadow should lie mostly in the +X face";
+    EXPECT_LE(wrong, counted / 1000) << wrong << " of " << counted << " plane pixels disagree with the segment test";
+}
+
+TEST(RasterPointLight, CubeMapSeamsMakeNoFalseShadows) {
+    // A lone plane under (then over) a point light close to it: its pixels are seen through
+    // five faces each time and through every boundary between them (the −Y or +Y face meets the
+    // four side faces at |x| = h or |z| = h, the side faces meet each other on |x| = |z|).
+    // Nothing casts, so every pixel the light reaches must be fully lit, with every filter.
+    for (const double side : {1.0, -1.0}) {
+        for (const ShadowFilter filter : {ShadowFilter::None, ShadowFilter::Pcf2x2, ShadowFilter::Pcf, ShadowFilter::Poisson}) {
+            SphereOverPlane p;
+            p.center = Vec3(0, -100, 0);  // keeps primaryHit() off the sphere we remove
+            p.eye = Vec3(0, 4 * side, 6);
+            p.lookAt = Vec3(0, 0.5 * side, 0);
+            scene::Scene s = makeScene(p);
+            s.objects.erase(s.objects.begin());  // the plane is now object 1
+            const double h = 1.2;
+            s.lights[0].type = scene::LightType::Point;
+            s.lights[0].position = Vec3(0.1, h * side, -0.2);
+            s.lights[0].intensity = 50.0;
+            scene::RasterSettings settings = validatedSettings(512, 0.01, 1.0, filter);
+            settings.pcfSize = 5;
+            const std::string name = std::string("point_seams_") + (side > 0 ? "floor_" : "ceiling_") + scene::toString(filter);
+            const scene::Frame f = renderValidated(s, settings, name);
+            const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+            int counted = 0, falseShadow = 0, nearSeam = 0;
+            for (int y = 0; y < f.height; ++y)
+                for (int x = 0; x < f.width; ++x) {
+                    const std::size_t i = at(f, x, y);
+                    if (primaryHit(p, cam, x, y).id != 2 || f.objectId[i] != 1.0f) continue;
+                    ++counted;
+                    const Vec3 d = primaryHit(p, cam, x, y).p - s.lights[0].position;
+                    // Within 0.1 of a boundary between faces (where two axes are equally major).
+                    const double ax = std::abs(d.x), ay = std::abs(d.y), az = std::abs(d.z);
+                    const double m = std::max({ax, ay, az});
+                    const double second = ax + ay + az - m - std::min({ax, ay, az});
+                    if (m - second < 0.1) ++nearSeam;
+                    if (f.visibility[i] != 1.0f) ++falseShadow;
+                }
+            EXPECT_GT(counted, 5000) << name;
+            EXPECT_GT(nearSeam, 300) << name << ": the view should cross the face boundaries";
+            EXPECT_EQ(falseShadow, 0) << name << ": " << falseShadow << " of " << counted << " pixels falsely shadowed";
+        }
     }
 }
 
