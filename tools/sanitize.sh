@@ -20,8 +20,8 @@ cmake --build "$build" -j "$(nproc)" >&2
 # frames as "<unknown module>" that no suppression can name; preloading them keeps them mapped.
 preload=""
 for lib in libvulkan.so.1 libvulkan_lvp.so libVkLayer_khronos_validation.so; do
-    path=$(ldconfig -p | awk -v l="$lib" '$1 == l && /x86-64|x86_64/ {print $NF; exit}')
-    [ -z "$path" ] && path=$(ls /usr/lib/*/"$lib" 2>/dev/null | head -n 1)
+    # (no early exit in awk: with pipefail, ldconfig's SIGPIPE would end the script)
+    path=$(ldconfig -p | awk -v l="$lib" '$1 == l && !found {print $NF; found = 1}' || true)
     [ -n "$path" ] && preload="$preload $path"
 done
 export LD_PRELOAD="${preload# }"
