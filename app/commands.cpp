@@ -16,11 +16,14 @@
 #include "compare/stability.h"
 #include "compare/sweep.h"
 #include "compare/sweep_report.h"
+#include "raster/memory.h"
 #include "raster/renderer.h"
+#include "raytrace/memory.h"
 #include "raytrace/renderer.h"
 #include "scene/error.h"
 #include "scene/frame_io.h"
 #include "scene/loader.h"
+#include "scene/memory.h"
 #include "scene/render_plan.h"
 
 namespace shadowlab::app {
@@ -113,6 +116,22 @@ Json timingsJson(const scene::Frame& f) {
     return t;
 }
 
+// An upper estimate of the memory rendering `backend` takes (see scene/memory.h), without the
+// program itself and the Frame's writing.
+std::uint64_t backendMemory(const Prepared& p, const std::string& backend) {
+    return backend == "raster" ? raster::estimateMemoryBytes(p.scene, p.plan, p.settings.raster)
+                               : raytrace::estimateMemoryBytes(p.scene, p.plan);
+}
+
+// "peak memory 412 MiB (estimated at most 530 MiB)", and the same figures for --json.
+std::string memoryLine(std::uint64_t estimate) {
+    return "peak memory " + std::to_string(scene::peakResidentBytes() / scene::kMiB) + " MiB (estimated at most " +
+           std::to_string(estimate / scene::kMiB) + " MiB)";
+}
+Json memoryJson(std::uint64_t estimate) {
+    return {{"peak_mib", scene::peakResidentBytes() / scene::kMiB}, {"estimate_mib", estimate / scene::kMiB}};
+}
+
 // Sweep progress: a bar with ETA on a terminal, one plain line per configuration otherwise.
 std::function<void(const compare::SweepProgress&)> sweepProgressPrinter() {
     const bool tty = isatty(STDERR_FILENO);
@@ -143,15 +162,19 @@ int render(const RenderOptions& o) {
     if (ext != ".exr" && ext != ".png")
         throw scene::InputError(o.output.string() + ": unknown output type '" + ext + "' (use .exr or .png)");
     const Prepared p = prepare(o.common);
+    const std::uint64_t estimate = scene::kProgramBytes + backendMemory(p, o.backend) + scene::frameWriteBytes(p.scene);
+    scene::checkMemory(estimate, "rendering " + std::to_string(p.scene.camera.width) + "x" +
+                                     std::to_string(p.scene.camera.height) + " with " + o.backend);
     // Only once the input is known to be good may the output's folder be created.
     if (o.output.has_parent_path()) fs::create_directories(o.output.parent_path());
     Stage stage("rendering " + p.scene.file.filename().string() + " with " + o.backend);
     const scene::Frame frame = renderBackend(p, o.backend);
     scene::writeFrame(frame, o.output);
-    stage.done(std::to_string(frame.width) + "x" + std::to_string(frame.height) + " -> " + o.output.string());
+    stage.done(std::to_string(frame.width) + "x" + std::to_string(frame.height) + " -> " + o.output.string() +
+               ", " + memoryLine(estimate));
     if (o.common.json) {
         Json j = {{"backend", o.backend}, {"output", o.output.string()}, {"timings_ms", timingsJson(frame)},
-                  {"attributes", frame.attributes}};
+                  {"attributes", frame.attributes}, {"memory", memoryJson(estimate)}};
         std::cout << j.dump(2) << "\n";
     }
     return 0;
@@ -185,8 +208,17 @@ int info(bool validate) {
 
 int run(const RunOptions& o) {
     const Prepared p = prepare(o.common);
+    // The reference, the ray-traced and the raster Frames are all held until the report is
+    // written, with a difference image for each method (the half-size sweep needs less).
+    const std::uint64_t pixels = std::uint64_t(p.scene.camera.width) * std::uint64_t(p.scene.camera.height);
+    const std::uint64_t estimate = scene::kProgramBytes + backendMemory(p, "raytrace") + scene::frameBytes(p.scene) +
+                                   (o.skipRaster ? 0 : backendMemory(p, "raster")) + scene::frameWriteBytes(p.scene) +
+                                   2 * pixels * 3 * sizeof(float);
+    scene::checkMemory(estimate, "run at " + std::to_string(p.scene.camera.width) + "x" +
+                                     std::to_string(p.scene.camera.height));
     fs::create_directories(o.outputDir);
     const fs::path dir = o.outputDir;
+    scene::removeStaleTemporaries(dir);  // what an earlier run that was killed left behind
     int status = 0;
 
     Json metrics = {{"scene", p.scene.file.string()},
@@ -233,7 +265,9 @@ int run(const RunOptions& o) {
 
     if (!o.skipSweep) {
         // A small sweep at half resolution puts error against run time and the bias windows into
-        // the report. It starts fresh: rows of an earlier build must not mix with this one's.
+        // the report. It starts fresh in a temporary folder (rows of an earlier build must not mix
+        // with this one's) that replaces sweep/ in one step when it is complete, so a run killed
+        // in the middle leaves the old sweep/ whole.
         compare::SweepGrid grid = compare::defaultGrid(p.scene, true);
         grid.resolution = std::to_string(std::max(16, p.scene.camera.width / 2)) + "x" +
                           std::to_string(std::max(16, p.scene.camera.height / 2));
@@ -244,24 +278,25 @@ int run(const RunOptions& o) {
             c.overrides.validate = o.common.settings.validate;
         }
         std::erase_if(grid.configs, [](const compare::SweepConfig& c) { return c.backend.empty(); });
-        fs::remove_all(dir / "sweep");
         compare::SweepOptions options;
-        options.outputDir = dir / "sweep";
+        options.outputDir = scene::temporarySibling(dir / "sweep");
         options.progress = sweepProgressPrinter();
         Stage stage("quick sweep of " + std::to_string(grid.configs.size()) + " configurations at " + *grid.resolution);
         const compare::SweepResult result = compare::runSweep(p.scene, grid, options);
         const compare::SweepReportInput input =
             compare::makeSweepReportInput(report.sceneName, report.scenePath, result);
-        compare::writeSweepReport(dir / "sweep", input);
+        compare::writeSweepReport(options.outputDir, input);
+        scene::replaceDirectory(options.outputDir, dir / "sweep");
         report.sweep = compare::summarizeSweep(input, "sweep/report.html");
         stage.done("sweep/report.html");
         metrics["sweep"] = {{"configurations", result.rows.size()}, {"report", "sweep/report.html"},
                             {"results", "sweep/results.csv"}};
     }
 
+    metrics["memory"] = memoryJson(estimate);
     scene::writeTextAtomic(dir / "metrics.json", metrics.dump(2) + "\n");
     compare::writeReport(dir, report);
-    std::cerr << "shadowlab: wrote " << (dir / "report.html").string() << "\n";
+    std::cerr << "shadowlab: wrote " << (dir / "report.html").string() << "; " << memoryLine(estimate) << "\n";
     if (o.common.json) std::cout << metrics.dump(2) << "\n";
     return status;
 }

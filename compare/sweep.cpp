@@ -145,21 +145,6 @@ std::string jsonNumber(const Json& metrics, const char* name) {
     return number(metrics[name].get<double>());
 }
 
-// A kill in the middle of an atomic write leaves its temporary file (".name.tmp-PID-N.ext",
-// see scene/frame_io.cpp). Remove those whose writer is gone, so a resumed folder is clean.
-void removeStaleTemporaries(const fs::path& dir) {
-    std::error_code ec;
-    for (const fs::path& folder : {dir, dir / "images"}) {
-        for (auto it = fs::directory_iterator(folder, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
-            const std::string name = it->path().filename().string();
-            const auto mark = name.find(".tmp-");
-            if (name.empty() || name[0] != '.' || mark == std::string::npos) continue;
-            const long pid = std::strtol(name.c_str() + mark + 5, nullptr, 10);
-            if (pid > 0 && ::kill(pid_t(pid), 0) != 0 && errno == ESRCH) fs::remove(it->path(), ec);
-        }
-    }
-}
-
 }  // namespace
 
 std::string SweepConfig::key() const {
@@ -497,7 +482,8 @@ SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const
         if (old != identity)
             throw scene::InputError(dir.string() + ": holds a sweep of another scene or resolution (" +
                                     (old.is_null() ? std::string("unreadable sweep.json") : old.dump()) + ")");
-        removeStaleTemporaries(dir);
+        scene::removeStaleTemporaries(dir);
+        scene::removeStaleTemporaries(dir / "images");
         done = readJournal(journal);
         // Failed configurations run again on resume (the failure may have been the machine's).
         done.erase(std::remove_if(done.begin(), done.end(), [](const SweepRow& r) { return !r.error.empty(); }),

@@ -5,13 +5,21 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <sstream>
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <fcntl.h>
+#include <system_error>
 #include <unistd.h>
 
 #include <OpenImageIO/imageio.h>
 
 #include "scene/error.h"
+#include "scene/loader.h"
 
 namespace shadowlab::scene {
 
@@ -26,12 +34,53 @@ using OIIO::TypeDesc;
 constexpr const char* kAttrPrefix = "shadowlab:";
 constexpr const char* kTimingsAttr = "shadowlab:timings_ms";
 
-// A sibling of `file` with the same extension (OpenImageIO picks the format by extension).
-fs::path temporarySibling(const fs::path& file) {
-    static std::atomic<unsigned> counter{0};
-    const fs::path dir = file.has_parent_path() ? file.parent_path() : fs::path(".");
-    return dir / ("." + file.stem().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
-                  std::to_string(counter++) + file.extension().string());
+// Checks an OpenEXR header's structure before OpenEXR reads it: OpenEXR 3.1 believes the size an
+// attribute declares and allocates it (a 1.6 GB "opaque attribute" in a 2 kB file, found by
+// fuzzing). Layout from "The OpenEXR File Layout" (openexr.com): magic 20000630, a version word
+// (bit 11: deep data, bit 12: multi-part), then attributes (name\0 type\0 int32 size, value)
+// until an empty name. A Frame is a single-part scanline or tiled image.
+void checkExrHeader(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    const auto fileSize = static_cast<std::int64_t>(fs::file_size(file));
+    auto readU32 = [&](std::uint32_t& v) {
+        unsigned char b[4];
+        if (!in.read(reinterpret_cast<char*>(b), 4)) return false;
+        v = b[0] | (b[1] << 8) | (b[2] << 16) | (std::uint32_t(b[3]) << 24);
+        return true;
+    };
+    std::uint32_t magic = 0, version = 0;
+    if (!readU32(magic) || magic != 20000630u)
+        throw InputError(file.string() + ": not an OpenEXR file, so it has no 'visibility' channel "
+                                         "(missing channel 'visibility': is this a Frame written by "
+                                         "`shadowlab render -o X.exr`?)");
+    auto bad = [&](const std::string& what) { return InputError(file.string() + ": damaged OpenEXR header: " + what); };
+    if (!readU32(version)) throw bad("truncated");
+    if (version & 0x1800u)
+        throw InputError(file.string() + ": a deep or multi-part OpenEXR file is not a Frame written by shadowlab");
+    const std::size_t maxName = (version & 0x400u) ? 255 : 31;
+    auto readName = [&](std::string& name) {
+        name.clear();
+        for (char c; in.get(c);) {
+            if (c == '\0') return true;
+            if (name.size() == maxName) throw bad("an attribute name is longer than " + std::to_string(maxName) + " bytes");
+            name.push_back(c);
+        }
+        throw bad("truncated");
+    };
+    for (int count = 0;; ++count) {
+        std::string name, type;
+        readName(name);
+        if (name.empty()) return;  // the end of the header
+        if (count == 10000) throw bad("more than 10000 attributes");
+        readName(type);
+        std::uint32_t size = 0;
+        if (!readU32(size)) throw bad("truncated");
+        const std::int64_t end = std::int64_t(in.tellg()) + std::int64_t(std::int32_t(size));
+        if (std::int32_t(size) < 0 || end > fileSize)
+            throw bad("attribute '" + name + "' declares " + std::to_string(std::int32_t(size)) +
+                      " bytes, more than the file holds");
+        in.seekg(end);
+    }
 }
 
 // Runs `write(tmp)` and renames tmp onto `file`; removes tmp if anything fails.
@@ -103,6 +152,43 @@ void writePng8(const fs::path& file, int width, int height, const std::vector<fl
 
 }  // namespace
 
+fs::path temporarySibling(const fs::path& file) {
+    static std::atomic<unsigned> counter{0};
+    const fs::path dir = file.has_parent_path() ? file.parent_path() : fs::path(".");
+    // (appended piece by piece: GCC 12 warns falsely, -Wrestrict, on the chained operator+)
+    std::string name = ".";
+    name += file.stem().string();
+    name += ".tmp-";
+    name += std::to_string(::getpid());
+    name += '-';
+    name += std::to_string(counter++);
+    name += file.extension().string();
+    return dir / name;
+}
+
+void removeStaleTemporaries(const fs::path& dir) {
+    std::error_code ec;
+    for (auto it = fs::directory_iterator(dir, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+        const std::string name = it->path().filename().string();
+        const auto mark = name.find(".tmp-");
+        if (name.empty() || name[0] != '.' || mark == std::string::npos) continue;
+        const long pid = std::strtol(name.c_str() + mark + 5, nullptr, 10);
+        std::error_code ignored;
+        if (pid > 0 && ::kill(pid_t(pid), 0) != 0 && errno == ESRCH) fs::remove_all(it->path(), ignored);
+    }
+}
+
+void replaceDirectory(const fs::path& fresh, const fs::path& target) {
+    if (!fs::exists(target)) {
+        fs::rename(fresh, target);
+        return;
+    }
+    if (::renameat2(AT_FDCWD, fresh.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) != 0)
+        throw std::system_error(errno, std::generic_category(),
+                                "cannot put " + fresh.string() + " in place of " + target.string());
+    fs::remove_all(fresh);  // now the old folder
+}
+
 float linearToSrgb(float c) {
     c = std::clamp(c, 0.0f, 1.0f);
     return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
@@ -166,14 +252,18 @@ void writeFrame(const Frame& frame, const fs::path& file) {
 
 Frame readFrame(const fs::path& file) {
     if (!fs::exists(file)) throw InputError(file.string() + ": no such file");
+    checkExrHeader(file);
     auto in = ImageInput::open(file.string());
     if (!in) throw InputError(file.string() + ": not a readable image: " + OIIO::geterror());
     const ImageSpec spec = in->spec();
     if (spec.width <= 0 || spec.height <= 0 || spec.depth > 1)
         throw InputError(file.string() + ": not a 2D image");
-    if (std::int64_t(spec.width) * spec.height * spec.nchannels > (std::int64_t(1) << 31))
-        throw InputError(file.string() + ": image too large (" + std::to_string(spec.width) + "x" +
-                         std::to_string(spec.height) + ")");
+    // The same bound as a render's (kMaxPixels), and reading by bands of rows below, keep the
+    // memory a Frame file can make us allocate to the Frame itself plus one band.
+    if (std::int64_t(spec.width) * spec.height > kMaxPixels || spec.nchannels > 64)
+        throw InputError(file.string() + ": image too large for a Frame (" + std::to_string(spec.width) + "x" +
+                         std::to_string(spec.height) + ", " + std::to_string(spec.nchannels) +
+                         " channels; at most " + std::to_string(kMaxPixels) + " pixels and 64 channels)");
 
     auto channelIndex = [&](const std::string& name, bool required) {
         const auto it = std::find(spec.channelnames.begin(), spec.channelnames.end(), name);
@@ -189,23 +279,28 @@ Frame readFrame(const fs::path& file) {
               iId = channelIndex("object_id", true), iN = channelIndex("ndotl", true),
               iZ = channelIndex("Z", true), iBl = channelIndex("blocker_id", false);
 
-    std::vector<float> pixels(std::size_t(spec.width) * spec.height * spec.nchannels);
-    if (!in->read_image(0, 0, 0, spec.nchannels, TypeDesc::FLOAT, pixels.data()))
-        throw InputError(file.string() + ": read failed: " + in->geterror());
-
     Frame f = Frame::allocate(spec.width, spec.height, iBl >= 0);
-    const std::size_t n = f.pixelCount();
     const int c = spec.nchannels;
-    for (std::size_t i = 0; i < n; ++i) {
-        const float* p = &pixels[i * c];
-        f.beauty[3 * i] = p[iR];
-        f.beauty[3 * i + 1] = p[iG];
-        f.beauty[3 * i + 2] = p[iB];
-        f.visibility[i] = p[iV];
-        f.objectId[i] = p[iId];
-        f.ndotl[i] = p[iN];
-        f.depth[i] = p[iZ];
-        if (iBl >= 0) f.blockerId[i] = p[iBl];
+    constexpr int kBandRows = 64;
+    std::vector<float> band(std::size_t(spec.width) * std::min(kBandRows, spec.height) * c);
+    for (int y0 = 0; y0 < spec.height; y0 += kBandRows) {
+        const int y1 = std::min(spec.height, y0 + kBandRows);
+        if (!in->read_scanlines(0, 0, spec.y + y0, spec.y + y1, 0, 0, c, TypeDesc::FLOAT, band.data()))
+            throw InputError(file.string() + ": read failed: " + in->geterror());
+        const std::size_t first = std::size_t(y0) * spec.width;
+        const std::size_t count = std::size_t(y1 - y0) * spec.width;
+        for (std::size_t k = 0; k < count; ++k) {
+            const std::size_t i = first + k;
+            const float* p = &band[k * c];
+            f.beauty[3 * i] = p[iR];
+            f.beauty[3 * i + 1] = p[iG];
+            f.beauty[3 * i + 2] = p[iB];
+            f.visibility[i] = p[iV];
+            f.objectId[i] = p[iId];
+            f.ndotl[i] = p[iN];
+            f.depth[i] = p[iZ];
+            if (iBl >= 0) f.blockerId[i] = p[iBl];
+        }
     }
     const std::string prefix = kAttrPrefix;
     for (const auto& attr : spec.extra_attribs) {

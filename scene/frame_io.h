@@ -24,6 +24,19 @@ void writePngDisplay(const std::filesystem::path& file, int width, int height,
 // Writes `text` to `file` through a temporary name and a rename.
 void writeTextAtomic(const std::filesystem::path& file, const std::string& text);
 
+// A fresh temporary name beside `file` (".stem.tmp-PID-N.ext"), the scheme every atomic write
+// here uses; a folder gets the same kind of name (".name.tmp-PID-N").
+std::filesystem::path temporarySibling(const std::filesystem::path& file);
+
+// Removes the temporaries in `dir` (files or folders named as above) whose writing process is
+// gone: what a kill in the middle of an atomic write leaves behind.
+void removeStaleTemporaries(const std::filesystem::path& dir);
+
+// Puts the folder `fresh` in place of `target` in one atomic step (Linux renameat2 with
+// RENAME_EXCHANGE when `target` exists, then the old one is removed): a reader sees the old
+// folder or the new one, never neither nor a mix.
+void replaceDirectory(const std::filesystem::path& fresh, const std::filesystem::path& target);
+
 float linearToSrgb(float linear);
 
 }  // namespace shadowlab::scene

@@ -70,7 +70,8 @@ public:
     // Rejects keys that are not in `allowed`, suggesting the nearest allowed one.
     void checkKeys(const Json& node, const JsonPath& path, std::initializer_list<const char*> allowed) const {
         expectObject(node, path);
-        for (const auto& [key, value] : node.items()) {
+        for (const auto& item : node.items()) {
+            const std::string& key = item.key();  // (a named variable: lambdas may capture it)
             if (std::any_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; }))
                 continue;
             std::string best;

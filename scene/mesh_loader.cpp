@@ -249,12 +249,21 @@ void loadGltf(const fs::path& file, TriangleMesh& mesh, const fs::path& sceneFil
     else for (std::size_t i = 0; i < model.nodes.size(); ++i) roots.push_back(int(i));
     std::vector<std::pair<int, glm::dmat4>> stack;
     for (int r : roots) stack.emplace_back(r, glm::dmat4(1.0));
-    std::size_t visited = 0;
+    // glTF nodes form a forest (glTF 2.0 spec, 3.5.3: a node has at most one parent and no
+    // cycles), so a walk reaches each node once; a second visit means a cycle or a shared child,
+    // which would otherwise loop forever or grow exponentially (found by fuzzing).
+    std::vector<char> visited(model.nodes.size(), 0);
     while (!stack.empty()) {
         auto [nodeIndex, parent] = stack.back();
         stack.pop_back();
-        if (nodeIndex < 0 || std::size_t(nodeIndex) >= model.nodes.size() || ++visited > 1000000)
-            fail(sceneFile, path, file, "the node hierarchy is invalid (bad index or a cycle)");
+        if (nodeIndex < 0 || std::size_t(nodeIndex) >= model.nodes.size())
+            fail(sceneFile, path, file, "the node hierarchy names node " + std::to_string(nodeIndex) +
+                                            ", which does not exist (" + std::to_string(model.nodes.size()) +
+                                            " nodes)");
+        if (visited[nodeIndex]++)
+            fail(sceneFile, path, file, "node " + std::to_string(nodeIndex) +
+                                            " is reached twice in the node hierarchy (a cycle, or a node "
+                                            "with two parents); glTF nodes must form trees");
         const auto& node = model.nodes[nodeIndex];
         const glm::dmat4 world = parent * nodeMatrix(node);
         if (node.mesh >= 0) appendGltfMesh(model, node.mesh, world, mesh, file, sceneFile, path);

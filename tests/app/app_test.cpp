@@ -38,8 +38,15 @@ std::string slurp(const std::filesystem::path& p) {
 Result shadowlab(const std::vector<std::string>& args) {
     TempDir io;
     std::string cmd = quote(SHADOWLAB_EXE);
-    for (const auto& a : args) cmd += " " + quote(a);
-    cmd += " >" + quote((io.path() / "out").string()) + " 2>" + quote((io.path() / "err").string());
+    // (appended piece by piece: GCC 12 warns falsely, -Wrestrict, on " " + std::string)
+    for (const auto& a : args) {
+        cmd += ' ';
+        cmd += quote(a);
+    }
+    cmd += " >";
+    cmd += quote((io.path() / "out").string());
+    cmd += " 2>";
+    cmd += quote((io.path() / "err").string());
     const int status = std::system(cmd.c_str());
     Result r;
     r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -85,6 +92,36 @@ TEST(App, RenderWritesTheRequestedFrame) {
     const auto j = nlohmann::json::parse(c.out);
     EXPECT_EQ(j.at("false_shadow").get<double>(), 0.0);  // a frame agrees with itself
     EXPECT_EQ(j.at("missed_shadow").get<double>(), 0.0);
+}
+
+TEST(App, MemoryIsEstimatedBeforeRenderingAndBoundsThePeak) {
+    TempDir dir;
+    // The estimate is an upper bound of the measured peak (both reported with --json).
+    const Result ok = shadowlab({"render", "seed", "--backend", "raytrace", "--resolution", "960x540", "-o",
+                                 (dir.path() / "ok.exr").string(), "--json"});
+    ASSERT_EQ(ok.exitCode, 0) << ok.err;
+    const auto memory = nlohmann::json::parse(ok.out).at("memory");
+    EXPECT_GT(memory.at("peak_mib").get<double>(), 0.0);
+    EXPECT_LE(memory.at("peak_mib").get<double>(), memory.at("estimate_mib").get<double>());
+
+    // A job larger than the memory the machine offers is refused before anything is written.
+    ::setenv("SHADOWLAB_MEMORY_LIMIT_MB", "200", 1);
+    const std::size_t before = dir.fileCount();
+    for (const std::vector<std::string>& args :
+         {std::vector<std::string>{"render", "seed", "--backend", "raytrace", "--resolution", "1920x1080", "-o",
+                                   (dir.path() / "out" / "big.exr").string()},
+          std::vector<std::string>{"run", "seed", "--resolution", "1920x1080", "-o", (dir.path() / "out").string()}}) {
+        const Result r = shadowlab(args);
+        EXPECT_EQ(r.exitCode, 2) << r.err;
+        EXPECT_NE(r.err.find("needs about"), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("only 200 MiB are available (SHADOWLAB_MEMORY_LIMIT_MB)"), std::string::npos) << r.err;
+    }
+    EXPECT_EQ(dir.fileCount(), before) << "something was written";
+    ::setenv("SHADOWLAB_MEMORY_LIMIT_MB", "lots", 1);
+    const Result bad = shadowlab({"render", "seed", "--resolution", "16x9", "-o", (dir.path() / "x.exr").string()});
+    EXPECT_EQ(bad.exitCode, 2);
+    EXPECT_NE(bad.err.find("SHADOWLAB_MEMORY_LIMIT_MB: expected a positive whole number"), std::string::npos) << bad.err;
+    ::unsetenv("SHADOWLAB_MEMORY_LIMIT_MB");
 }
 
 struct BadRun {

@@ -3,20 +3,16 @@
 // kill as they were.
 #include <chrono>
 #include <csignal>
-#include <fcntl.h>
 #include <fstream>
 #include <map>
 #include <set>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <thread>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "tests/app/subprocess.h"
 #include "tests/scene/test_files.h"
-
-extern char** environ;
 
 namespace shadowlab {
 namespace {
@@ -38,29 +34,6 @@ std::vector<Json> journalRows(const std::filesystem::path& file) {
     return rows;
 }
 
-pid_t spawnSweep(const std::vector<std::string>& args) {
-    std::vector<char*> argv;
-    std::string exe = SHADOWLAB_EXE;
-    argv.push_back(exe.data());
-    std::vector<std::string> copy = args;
-    for (auto& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
-    pid_t pid = -1;
-    const int rc = posix_spawn(&pid, exe.c_str(), &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    return rc == 0 ? pid : -1;
-}
-
-int waitFor(pid_t pid) {
-    int status = 0;
-    waitpid(pid, &status, 0);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 TEST(SweepResume, KilledSweepResumesWithEveryRowExactlyOnce) {
     TempDir dir;
     const auto out = dir.path() / "sweep";
@@ -73,20 +46,20 @@ TEST(SweepResume, KilledSweepResumesWithEveryRowExactlyOnce) {
     for (std::size_t killAfter : {2u, 5u}) {
         std::vector<std::string> a = args;
         if (std::filesystem::exists(journal)) a.push_back("--resume");
-        const pid_t pid = spawnSweep(a);
+        const pid_t pid = test::spawnShadowlab(a);
         ASSERT_GT(pid, 0);
         const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(3);
         while (journalRows(journal).size() < killAfter && std::chrono::steady_clock::now() < deadline)
             std::this_thread::sleep_for(std::chrono::milliseconds(5));
         kill(pid, SIGKILL);
-        waitFor(pid);
+        test::waitFor(pid);
         for (const Json& row : journalRows(journal)) beforeKill[row.at("key").get<std::string>()] = row;
         ASSERT_GE(beforeKill.size(), killAfter) << "the sweep did not get far enough before the deadline";
     }
 
-    const pid_t pid = spawnSweep([&] { auto a = args; a.push_back("--resume"); return a; }());
+    const pid_t pid = test::spawnShadowlab([&] { auto a = args; a.push_back("--resume"); return a; }());
     ASSERT_GT(pid, 0);
-    ASSERT_EQ(waitFor(pid), 0);
+    ASSERT_EQ(test::waitFor(pid), 0);
 
     const std::vector<Json> rows = journalRows(journal);
     std::set<std::string> keys;
@@ -94,8 +67,11 @@ TEST(SweepResume, KilledSweepResumesWithEveryRowExactlyOnce) {
     // Every row finished before a kill is still there, untouched (same measured times).
     for (const auto& [key, row] : beforeKill) {
         ASSERT_TRUE(keys.count(key)) << key;
-        for (const Json& r : rows)
-            if (r.at("key") == key) EXPECT_EQ(r.at("frame_ms"), row.at("frame_ms")) << key;
+        for (const Json& r : rows) {
+            if (r.at("key") == key) {
+                EXPECT_EQ(r.at("frame_ms"), row.at("frame_ms")) << key;
+            }
+        }
     }
     // results.json holds the same rows, and results.csv one line per row plus the header.
     std::ifstream jsonIn(out / "results.json");
@@ -115,9 +91,9 @@ TEST(SweepResume, ASecondSweepIntoTheSameFolderWithoutResumeIsRefused) {
     const auto out = dir.path() / "sweep";
     std::filesystem::create_directories(out);
     std::ofstream(out / "results.jsonl") << "";
-    const pid_t pid = spawnSweep({"sweep", "seed", "-o", out.string(), "--quick", "--resolution", "16x9"});
+    const pid_t pid = test::spawnShadowlab({"sweep", "seed", "-o", out.string(), "--quick", "--resolution", "16x9"});
     ASSERT_GT(pid, 0);
-    EXPECT_EQ(waitFor(pid), 2);
+    EXPECT_EQ(test::waitFor(pid), 2);
     EXPECT_FALSE(std::filesystem::exists(out / "results.csv"));
 }
 

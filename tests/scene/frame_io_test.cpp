@@ -91,6 +91,24 @@ TEST(FrameIo, ReadingAnImageWithoutTheAovsNamesTheMissingChannel) {
     }
 }
 
+TEST(FrameIo, AnExrHeaderThatDeclaresMoreThanTheFileHoldsIsRefusedBeforeOpenExrReadsIt) {
+    // magic 20000630, version 2, then one attribute "x" of type "opaque" declaring 1.6 GB in a
+    // 30-byte file: OpenEXR 3.1 would allocate the 1.6 GB (found by fuzzing).
+    const std::string bytes = std::string("\x76\x2f\x31\x01\x02\x00\x00\x00", 8) + std::string("x\0opaque\0", 9) +
+                              std::string("\x00\x00\x00\x64", 4) + "tail";
+    TempDir dir;
+    try {
+        readFrame(dir.write("huge-attribute.exr", bytes));
+        FAIL() << "accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("attribute 'x' declares 1677721600 bytes"), std::string::npos) << e.what();
+    }
+    // Multi-part files (version bit 12) are not Frames.
+    std::string multipart = bytes;
+    multipart[5] = 0x10;
+    EXPECT_THROW(readFrame(dir.write("multipart.exr", multipart)), InputError);
+}
+
 TEST(FrameIo, ReadingGarbageOrNothingGivesAnInputError) {
     TempDir dir;
     const auto garbage = dir.write("garbage.exr", "this is not an image at all");

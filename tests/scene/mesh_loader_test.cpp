@@ -76,6 +76,39 @@ TEST(MeshLoader, BadMeshesGiveClearErrors) {
     expectError(dir.write("garbage.gltf", "\x01\x02 not json"), "not a readable glTF");
 }
 
+// One triangle in an embedded buffer, placed by the node hierarchy `nodes` (a JSON array).
+std::string oneTriangleGltf(const std::string& nodes, const std::string& sceneRoots) {
+    return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": )" + sceneRoots +
+           R"(}], "nodes": )" + nodes + R"(,
+      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+      "buffers": [{"byteLength": 44, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAA="}],
+      "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
+      "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+                    {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}]})";
+}
+
+TEST(MeshLoader, GltfNodeHierarchyMustBeAForest) {
+    test::TempDir dir;
+    // A tree: the mesh node under a translated parent is placed once, moved by its parent.
+    const auto tree = load(dir.write("tree.gltf", oneTriangleGltf(
+        R"([{"children": [1], "translation": [5, 0, 0]}, {"mesh": 0}])", "[0]")));
+    ASSERT_EQ(tree->triangleCount(), 1u);
+    for (const Vec3& p : tree->positions) EXPECT_GE(p.x, 5.0);
+    // A cycle (found by fuzzing: it used to loop until a million visits) and a node with two
+    // parents (exponential with depth) are refused at once, naming the node.
+    auto expectRefused = [&](const std::string& name, const std::string& nodes, const std::string& roots) {
+        try {
+            (void)load(dir.write(name, oneTriangleGltf(nodes, roots)));
+            ADD_FAILURE() << name << ": no error";
+        } catch (const SceneError& e) {
+            EXPECT_NE(std::string(e.what()).find("reached twice"), std::string::npos) << e.what();
+        }
+    };
+    expectRefused("cycle.gltf", R"([{"children": [0], "mesh": 0}])", "[0]");
+    expectRefused("two-parents.gltf", R"([{"children": [2]}, {"children": [2]}, {"mesh": 0}])", "[0, 1]");
+    expectRefused("root-twice.gltf", R"([{"mesh": 0}])", "[0, 0]");
+}
+
 TEST(MeshLoader, GltfBoxFromSharedScenesHasTwelveTriangles) {
     const std::filesystem::path box = std::filesystem::path(SHADOWLAB_SHARED_SCENES) / "Box" / "Box.gltf";
     if (!std::filesystem::exists(box)) GTEST_SKIP() << "absent: " << box;

@@ -1,0 +1,44 @@
+// fuzz/targets.h: what each fuzz target feeds its input to, shared by the libFuzzer targets and
+// the FuzzRegression tests that replay their findings. Each input is a file (the loaders read
+// files); its name decides how it is read.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include <glm/glm.hpp>
+
+#include "scene/error.h"
+#include "scene/frame_io.h"
+#include "scene/loader.h"
+#include "scene/mesh_loader.h"
+
+namespace shadowlab::fuzz {
+
+// The file name an input of `target` is written under ("scene_json", "obj", "gltf", "exr").
+inline std::string inputName(std::string_view target, const std::uint8_t* data, std::size_t size) {
+    if (target == "scene_json") return "scene.json";
+    if (target == "obj") return "mesh.obj";
+    if (target == "gltf")  // GLB when it starts with the binary container's magic
+        return size >= 4 && std::memcmp(data, "glTF", 4) == 0 ? "model.glb" : "model.gltf";
+    return "frame.exr";
+}
+
+// Reads `file` the way the program reads input of `target`. Bad input throws SceneError or
+// InputError; anything else escaping is a defect.
+inline void readAs(std::string_view target, const std::filesystem::path& file) {
+    if (target == "scene_json" || target == "gltf") {  // a .gltf/.glb is a scene of its own
+        (void)scene::loadScene(file);
+    } else if (target == "obj") {
+        (void)scene::loadMesh(file, glm::dmat4(1.0), file.parent_path() / "scene.json",
+                              scene::JsonPath() / "objects" / 0 / "file");
+    } else {
+        (void)scene::readFrame(file);
+    }
+}
+
+}  // namespace shadowlab::fuzz

@@ -1,0 +1,19 @@
+// raytrace/memory.cpp: the ray tracer's memory estimate (see raytrace/memory.h).
+#include "raytrace/memory.h"
+
+#include <variant>
+
+#include "scene/memory.h"
+
+namespace shadowlab::raytrace {
+
+std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::RenderPlan& plan) {
+    std::uint64_t triangles = 0;
+    if (plan.needsTriangleBvh)
+        for (const scene::Object& o : scene.objects)
+            if (const auto* m = std::get_if<scene::Mesh>(&o.shape)) triangles += m->geometry->triangleCount();
+    constexpr std::uint64_t kAllowance = 64 * scene::kMiB;  // threads' stacks, tiles, the program
+    return kAllowance + scene::frameBytes(scene) + triangles * 100;
+}
+
+}  // namespace shadowlab::raytrace

@@ -1,0 +1,54 @@
+// scene/memory.cpp: measured and available memory (Linux: getrusage, /proc/meminfo).
+#include "scene/memory.h"
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <sys/resource.h>
+
+#include "scene/error.h"
+#include "scene/scene.h"
+
+namespace shadowlab::scene {
+
+std::uint64_t frameBytes(const Scene& scene) {
+    // beauty (3 floats), visibility, object id, N·L, Z and blocker id: 8 floats a pixel.
+    return std::uint64_t(scene.camera.width) * std::uint64_t(scene.camera.height) * 8 * sizeof(float);
+}
+
+std::uint64_t frameWriteBytes(const Scene& scene) { return 2 * frameBytes(scene); }
+
+std::uint64_t peakResidentBytes() {
+    rusage usage{};
+    if (::getrusage(RUSAGE_SELF, &usage) != 0) return 0;
+    return std::uint64_t(usage.ru_maxrss) * 1024;  // Linux reports kilobytes
+}
+
+std::uint64_t availableMemoryBytes() {
+    if (const char* limit = std::getenv("SHADOWLAB_MEMORY_LIMIT_MB"); limit && *limit) {
+        char* end = nullptr;
+        const unsigned long long mb = std::strtoull(limit, &end, 10);
+        if (end && *end == '\0' && mb > 0) return mb * kMiB;
+        throw InputError(std::string("SHADOWLAB_MEMORY_LIMIT_MB: expected a positive whole number of MiB, got '") +
+                         limit + "'");
+    }
+    std::ifstream meminfo("/proc/meminfo");
+    for (std::string line; std::getline(meminfo, line);) {
+        std::istringstream fields(line);
+        std::string key;
+        std::uint64_t kb = 0;
+        if (fields >> key >> kb && key == "MemAvailable:") return kb * 1024;
+    }
+    return 0;
+}
+
+void checkMemory(std::uint64_t needed, const std::string& what) {
+    const std::uint64_t available = availableMemoryBytes();
+    if (available == 0 || needed <= available) return;
+    throw InputError(what + " needs about " + std::to_string(needed / kMiB) + " MiB, but only " +
+                     std::to_string(available / kMiB) + " MiB are available" +
+                     (std::getenv("SHADOWLAB_MEMORY_LIMIT_MB") ? " (SHADOWLAB_MEMORY_LIMIT_MB)" : " (MemAvailable)") +
+                     "; lower --resolution (or --shadow-map-size for raster)");
+}
+
+}  // namespace shadowlab::scene

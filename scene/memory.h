@@ -1,0 +1,37 @@
+// scene/memory.h: how much memory a render takes, measured and estimated beforehand, so the
+// program refuses a job the machine cannot hold with one clear message instead of being killed
+// half-way by the kernel. Each backend adds its own part (raster::estimateMemoryBytes,
+// raytrace::estimateMemoryBytes); docs/reliability.md has the measured figures.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace shadowlab::scene {
+
+struct Scene;
+
+inline constexpr std::uint64_t kMiB = 1024 * 1024;
+
+// The bytes Frame::allocate takes for the scene's camera resolution (every AOV, blocker ids).
+std::uint64_t frameBytes(const Scene& scene);
+
+// What writing that Frame to EXR adds while it runs: an interleaved copy for OpenImageIO and
+// OpenEXR's own line buffers, measured at about 1.75 Frames (docs/reliability.md); counted as 2.
+std::uint64_t frameWriteBytes(const Scene& scene);
+
+// The program and its libraries before any render (measured: 126 MiB resident), rounded up.
+inline constexpr std::uint64_t kProgramBytes = 160 * kMiB;
+
+// The most memory this process has held so far (resident set; getrusage's ru_maxrss).
+std::uint64_t peakResidentBytes();
+
+// What a job may use: SHADOWLAB_MEMORY_LIMIT_MB when set (for containers whose limit the kernel
+// does not show in /proc/meminfo), else MemAvailable from /proc/meminfo; 0 when unknown.
+std::uint64_t availableMemoryBytes();
+
+// Throws InputError when `needed` exceeds availableMemoryBytes(): "WHAT needs about N MiB, but
+// only M MiB are available ...", with what to lower.
+void checkMemory(std::uint64_t needed, const std::string& what);
+
+}  // namespace shadowlab::scene
