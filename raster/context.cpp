@@ -382,6 +382,19 @@ VkCommandBuffer Context::beginCommands() const {
     return commands;
 }
 
+// How long one submission may take before the device counts as hung: 10 minutes, far above the
+// largest frame lavapipe is allowed (its 2 GiB heap caps the images), or SHADOWLAB_GPU_TIMEOUT_S.
+static std::uint64_t gpuTimeoutNanoseconds() {
+    double seconds = 600.0;
+    if (const char* text = std::getenv("SHADOWLAB_GPU_TIMEOUT_S"); text && *text) {
+        char* end = nullptr;
+        seconds = std::strtod(text, &end);
+        if (!end || *end != '\0' || !(seconds > 0.0) || seconds > 1e6)
+            throw RasterError(std::string("SHADOWLAB_GPU_TIMEOUT_S: expected seconds > 0, got '") + text + "'");
+    }
+    return std::uint64_t(seconds * 1e9);
+}
+
 void Context::submitAndWait(VkCommandBuffer commands) const {
     VK_CHECK(vkEndCommandBuffer(commands));
     const VkFenceCreateInfo fenceInfo{.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
@@ -398,7 +411,8 @@ void Context::submitAndWait(VkCommandBuffer commands) const {
         .pCommandBufferInfos = &commandInfo,
     };
     VK_CHECK(vkQueueSubmit2(queue, 1, &submit, fence.get()));
-    VK_CHECK(vkWaitForFences(device.get(), 1, &f, VK_TRUE, UINT64_MAX));
+    // A device that hangs or is lost must end in an error, not a wait forever.
+    VK_CHECK(vkWaitForFences(device.get(), 1, &f, VK_TRUE, gpuTimeoutNanoseconds()));
     vkFreeCommandBuffers(device.get(), commandPool.get(), 1, &commands);
 }
 

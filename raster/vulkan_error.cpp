@@ -36,9 +36,25 @@ std::string toString(VkResult result) {
     }
 }
 
+std::string explain(VkResult result) {
+    switch (result) {
+        case VK_ERROR_DEVICE_LOST:
+            return "the Vulkan device was lost during the render (a driver crash or a GPU reset); nothing was "
+                   "written: try again, or use --backend raytrace";
+        case VK_ERROR_OUT_OF_DEVICE_MEMORY:
+        case VK_ERROR_OUT_OF_HOST_MEMORY:
+            return "the Vulkan device ran out of memory; lower --resolution or --shadow-map-size";
+        case VK_TIMEOUT:
+            return "the Vulkan device did not finish in time: it hung or was lost (SHADOWLAB_GPU_TIMEOUT_S sets "
+                   "the limit)";
+        default: return "";
+    }
+}
+
 VulkanError::VulkanError(VkResult result, const char* call, const char* file, int line)
-    : RasterError(std::string(call) + " failed with " + toString(result) + " at " + file + ":" +
-                  std::to_string(line)),
+    : RasterError((explain(result).empty() ? "" : explain(result) + " (") + call + " failed with " +
+                  toString(result) + " at " + file + ":" + std::to_string(line) +
+                  (explain(result).empty() ? "" : ")")),
       result_(result) {}
 
 }  // namespace shadowlab::raster

@@ -16,7 +16,7 @@ public:
     using std::runtime_error::runtime_error;
 };
 
-// A Vulkan call returned an error.
+// A Vulkan call returned an error. The message leads with explain(result) where there is one.
 class VulkanError : public RasterError {
 public:
     VulkanError(VkResult result, const char* call, const char* file, int line);
@@ -28,6 +28,10 @@ private:
 
 // "VK_ERROR_OUT_OF_DEVICE_MEMORY", or the number for codes this build does not know.
 std::string toString(VkResult result);
+
+// What a user should read for the failures a render can meet at run time (device lost, out of
+// memory, a timeout), and what to do; empty for the others (programming errors).
+std::string explain(VkResult result);
 
 }  // namespace shadowlab::raster
 

@@ -32,6 +32,25 @@ TEST(VulkanError, UnknownResultsPrintTheirNumber) {
     EXPECT_EQ(toString(VK_ERROR_DEVICE_LOST), "VK_ERROR_DEVICE_LOST");
 }
 
+TEST(VulkanError, FailuresAUserCanMeetLeadWithWhatHappenedAndWhatToDo) {
+    auto message = [](VkResult r) {
+        try {
+            VK_CHECK(failWith(r));
+        } catch (const VulkanError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    const std::string lost = message(VK_ERROR_DEVICE_LOST);
+    EXPECT_EQ(lost.rfind("the Vulkan device was lost during the render", 0), 0u) << lost;
+    EXPECT_NE(lost.find("--backend raytrace"), std::string::npos) << lost;
+    EXPECT_NE(lost.find("failed with VK_ERROR_DEVICE_LOST"), std::string::npos) << lost;
+    EXPECT_NE(message(VK_ERROR_OUT_OF_DEVICE_MEMORY).find("lower --resolution or --shadow-map-size"), std::string::npos);
+    EXPECT_NE(message(VK_TIMEOUT).find("did not finish in time"), std::string::npos);
+    // Programming errors keep the plain form: the call, the result, the place.
+    EXPECT_EQ(message(VK_ERROR_FORMAT_NOT_SUPPORTED).rfind("failWith(", 0), 0u);
+}
+
 TEST(VulkanError, IsARasterError) {
     // app/ maps RasterError (all raster failures) to one message and exit code 1.
     EXPECT_THROW(VK_CHECK(failWith(VK_ERROR_INITIALIZATION_FAILED)), RasterError);
