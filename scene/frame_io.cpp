@@ -75,10 +75,34 @@ void checkExrHeader(const fs::path& file) {
         readName(type);
         std::uint32_t size = 0;
         if (!readU32(size)) throw bad("truncated");
-        const std::int64_t end = std::int64_t(in.tellg()) + std::int64_t(std::int32_t(size));
+        const std::int64_t start = std::int64_t(in.tellg());
+        const std::int64_t end = start + std::int64_t(std::int32_t(size));
         if (std::int32_t(size) < 0 || end > fileSize)
             throw bad("attribute '" + name + "' declares " + std::to_string(std::int32_t(size)) +
                       " bytes, more than the file holds");
+        // OpenEXR reads these by their contents rather than their declared size, so their
+        // contents must agree with it (a channel name longer than allowed misaligned the rest
+        // of a fuzzed header into another 1.8 GB attribute).
+        auto mismatch = [&] { return bad("attribute '" + name + "' (" + type + ") does not match its declared size"); };
+        if (type == "chlist") {
+            for (std::string channel;;) {
+                readName(channel);
+                if (channel.empty()) break;
+                char fields[16];  // pixel type, pLinear + 3 reserved bytes, x and y sampling
+                if (!in.read(fields, 16) || std::int64_t(in.tellg()) > end) throw mismatch();
+            }
+            if (std::int64_t(in.tellg()) != end) throw mismatch();
+        } else if (type == "preview") {  // width, height, then width * height RGBA bytes
+            std::uint32_t w = 0, h = 0;
+            if (size < 8 || !readU32(w) || !readU32(h) || std::uint64_t(w) * h * 4 + 8 != size) throw mismatch();
+        } else if (type == "stringvector") {  // (int32 length, bytes) pairs
+            while (std::int64_t(in.tellg()) < end) {
+                std::uint32_t length = 0;
+                if (!readU32(length) || std::int32_t(length) < 0 || std::int64_t(in.tellg()) + length > end)
+                    throw mismatch();
+                in.seekg(length, std::ios::cur);
+            }
+        }
         in.seekg(end);
     }
 }

@@ -1,7 +1,7 @@
 // tests/scene/fuzz_regression_test.cpp: replays every input the fuzzers ever crashed on
 // (tests/scene/fuzz_regressions/TARGET/) and their seed corpus (fuzz/corpus/TARGET/) through the
-// same readers. Each must either load or be refused with the project's own error naming the file;
-// a crash, a sanitizer report or any other exception fails the test.
+// same readers. A finding is bad input and must be refused with the project's own error naming the
+// file; a seed may load or be refused so; a crash, a sanitizer report or any other exception fails.
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -21,17 +21,19 @@ namespace fs = std::filesystem;
 struct Replay {
     std::string target;
     fs::path input;
+    bool finding = false;  // a kept crasher: bad input, so it must be refused
 };
 
 std::vector<Replay> replays() {
     std::vector<Replay> all;
     for (const char* target : {"scene_json", "obj", "gltf", "exr"})
-        for (const fs::path& root : {fs::path(SHADOWLAB_SOURCE_DIR) / "tests/scene/fuzz_regressions" / target,
-                                    fs::path(SHADOWLAB_SOURCE_DIR) / "fuzz/corpus" / target})
+        for (const bool finding : {true, false}) {
+            const fs::path root = fs::path(SHADOWLAB_SOURCE_DIR) /
+                                  (finding ? "tests/scene/fuzz_regressions" : "fuzz/corpus") / target;
             if (fs::is_directory(root))
                 for (const auto& entry : fs::directory_iterator(root))
-                    if (entry.is_regular_file() && entry.path().filename() != "README.md")
-                        all.push_back({target, entry.path()});
+                    if (entry.is_regular_file()) all.push_back({target, entry.path(), finding});
+        }
     return all;
 }
 
@@ -56,6 +58,7 @@ TEST(FuzzRegression, EveryKeptInputLoadsOrGetsAClearError) {
         const fs::path file = dir.write("case/" + fuzz::inputName(r.target, data, bytes.size()), bytes);
         try {
             fuzz::readAs(r.target, file);
+            EXPECT_FALSE(r.finding) << "a kept finding loaded without an error";
         } catch (const scene::SceneError& e) {
             EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
         } catch (const scene::InputError& e) {
