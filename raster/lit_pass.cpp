@@ -79,15 +79,16 @@ LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32
     t.width = width;
     t.height = height;
     const VkImageUsageFlags colorUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    t.hostReadable = canReadImagesOnHost(ctx, kLitColorFormat, colorUsage);
     t.beauty = createImage(ctx, kLitColorFormat, width, height, 1, colorUsage, VK_IMAGE_ASPECT_COLOR_BIT,
-                           VK_IMAGE_VIEW_TYPE_2D);
+                           VK_IMAGE_VIEW_TYPE_2D, t.hostReadable);
     t.aovs = createImage(ctx, kLitColorFormat, width, height, 1, colorUsage, VK_IMAGE_ASPECT_COLOR_BIT,
-                         VK_IMAGE_VIEW_TYPE_2D);
+                         VK_IMAGE_VIEW_TYPE_2D, t.hostReadable);
     t.depth = createImage(ctx, kLitDepthFormat, width, height, 1, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
                           VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_VIEW_TYPE_2D);
     for (std::uint32_t i = 0; i < lightTargets; ++i)
         t.lights.push_back(createImage(ctx, kLitColorFormat, width, height, 1, colorUsage, VK_IMAGE_ASPECT_COLOR_BIT,
-                                       VK_IMAGE_VIEW_TYPE_2D));
+                                       VK_IMAGE_VIEW_TYPE_2D, t.hostReadable));
     return t;
 }
 
@@ -181,8 +182,9 @@ void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const 
     std::vector<VkRenderingAttachmentInfo> colors;
     for (const Image* image : colorImages) {
         before.push_back({image->image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-                          VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE,
-                          colorStage, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT});
+                          VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                          targets.hostReadable ? VK_PIPELINE_STAGE_2_HOST_BIT : VK_PIPELINE_STAGE_2_COPY_BIT,
+                          VK_ACCESS_2_NONE, colorStage, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT});
         const bool isBeauty = image == &targets.beauty;
         colors.push_back({.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
                           .imageView = image->view.get(),
@@ -228,9 +230,16 @@ void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const 
     vkCmdEndRendering(commands);
     std::vector<ImageTransition> after;
     for (const Image* image : colorImages)
-        after.push_back({image->image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                         VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, colorStage, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-                         VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT});
+        if (targets.hostReadable)  // host access to a linear image needs GENERAL (Vulkan spec)
+            after.push_back({image->image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1,
+                             VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL, colorStage,
+                             VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
+                             VK_ACCESS_2_HOST_READ_BIT});
+        else
+            after.push_back({image->image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1,
+                             VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                             colorStage, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
+                             VK_ACCESS_2_TRANSFER_READ_BIT});
     transition(commands, after);
 }
 

@@ -42,6 +42,9 @@ struct LitTargets {
     Image depth;   // reversed Z (cleared to 0 = far)
     // With lightTargets: light i's visibility in component i % 4 of lights[i / 4].
     std::vector<Image> lights;
+    // Color targets are linear images in host-visible memory, read in place after the pass
+    // (lavapipe); otherwise they are copied into readback buffers.
+    bool hostReadable = false;
     std::uint32_t width = 0;
     std::uint32_t height = 0;
 };
@@ -62,7 +65,8 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
                               const std::vector<glm::vec4>& albedos, const ShadowMaps& maps);
 
 // Records the pass; background pixels keep `background` (rgb, visibility 0) and zero AOVs.
-// Leaves every color target in TRANSFER_SRC_OPTIMAL for recordReadback().
+// Leaves every color target in TRANSFER_SRC_OPTIMAL for recordReadback(), or, for host-readable
+// targets, in GENERAL and visible to host reads once the submission has finished.
 void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const LitBindings& bindings,
                    const LitTargets& targets, const DrawGeometry& geometry, const glm::vec3& background);
 

@@ -73,6 +73,10 @@ struct Renderer::Impl {
          ValidationLog& log);
     void render(scene::Frame& frame, scene::ChannelMask channels, const ValidationLog& log);
     void readPixels(scene::Frame& frame, scene::ChannelMask channels) const;
+    void invalidateMemory(VkDeviceMemory memory) const {
+        const VkMappedMemoryRange range{.sType = VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE, .memory = memory, .size = VK_WHOLE_SIZE};
+        VK_CHECK(vkInvalidateMappedMemoryRanges(ctx.device.get(), 1, &range));
+    }
 
     scene::RasterSettings settings;
     std::uint32_t width = 0;
@@ -207,7 +211,9 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     const auto layers = std::max<std::uint32_t>(1, std::uint32_t(lightMatrices.size()));
     maps = createShadowMaps(ctx, mapSize, layers);
     targets = createLitTargets(ctx, width, height, lightCount > 1 ? kLightTargets : 0);
-    readback = createReadback(ctx, targets);
+    if (!targets.hostReadable) readback = createReadback(ctx, targets);
+    // How the targets reach the Frame: read in place (lavapipe) or copied into buffers first.
+    attributes["readback"] = targets.hostReadable ? "in-place" : "copy";
     // GPU timestamps around each pass, where the queue has them (a bonus to the CPU clock,
     // which also counts submission and the fence wait).
     timestamps = ctx.properties.limits.timestampComputeAndGraphics == VK_TRUE;
@@ -315,13 +321,21 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
 
     // --- readback of the targets holding what was asked for ---
     const auto readStart = Clock::now();
-    commands = ctx.beginCommands();
-    recordReadback(commands, targets, readback, ReadbackSelection{.beauty = wantBeauty, .aovs = wantAovs, .lights = wantLights});
-    ctx.submitAndWait(commands);
-    if (wantBeauty) invalidate(ctx, readback.beauty);
-    if (wantAovs) invalidate(ctx, readback.aovs);
-    if (wantLights)
-        for (const Buffer& b : readback.lights) invalidate(ctx, b);
+    if (targets.hostReadable) {
+        // The lit pass's barrier made the writes visible to the host; coherent memory needs no
+        // invalidation, the rest does.
+        for (const Image* image : {&targets.beauty, &targets.aovs}) invalidateMemory(image->memory.get());
+        for (const Image& image : targets.lights) invalidateMemory(image.memory.get());
+    } else {
+        commands = ctx.beginCommands();
+        recordReadback(commands, targets, readback,
+                       ReadbackSelection{.beauty = wantBeauty, .aovs = wantAovs, .lights = wantLights});
+        ctx.submitAndWait(commands);
+        if (wantBeauty) invalidate(ctx, readback.beauty);
+        if (wantAovs) invalidate(ctx, readback.aovs);
+        if (wantLights)
+            for (const Buffer& b : readback.lights) invalidate(ctx, b);
+    }
     readPixels(frame, channels);
     frame.timingsMs.emplace_back("readback", msSince(readStart));
     if (timestamps) {
@@ -336,8 +350,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
 }
 
 // Rows come out top first, as the Frame wants them. Only the channels asked for are filled:
-// one pass over each read-back target, in parallel over blocks of pixels (on a 1920x1080 frame
-// this loop, not the device's copy, was most of the readback).
+// one pass over each target, in parallel over blocks of rows.
 void Renderer::Impl::readPixels(scene::Frame& frame, scene::ChannelMask channels) const {
     using namespace scene;
     frame.width = int(width);
@@ -362,30 +375,50 @@ void Renderer::Impl::readPixels(scene::Frame& frame, scene::ChannelMask channels
     std::vector<float*> lights;
     frame.lightVisibility.resize((channels & kChannelLightVisibility) && !targets.lights.empty() ? lightCount : 0);
     for (std::vector<float>& v : frame.lightVisibility) lights.push_back(output(v, kChannelLightVisibility));
-    const auto* beauty = static_cast<const float*>(readback.beauty.mapped);
-    const auto* aovs = static_cast<const float*>(readback.aovs.mapped);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1u << 15), [&](const tbb::blocked_range<std::size_t>& r) {
-        if (rgb || visibility)
-            for (std::size_t i = r.begin(); i < r.end(); ++i) {
-                const float* p = beauty + 4 * i;
-                if (rgb) {
-                    rgb[3 * i + 0] = p[0];
-                    rgb[3 * i + 1] = p[1];
-                    rgb[3 * i + 2] = p[2];
+    // Where each target's rows are: the targets themselves (host-readable) or their buffers.
+    struct Rows {
+        const char* base;
+        std::size_t pitch;
+        const float* row(std::size_t y) const { return reinterpret_cast<const float*>(base + y * pitch); }
+    };
+    const std::size_t tightPitch = std::size_t(width) * 4 * sizeof(float);
+    auto rows = [&](const Image& image, const Buffer* buffer) {
+        return targets.hostReadable ? Rows{static_cast<const char*>(image.mapped), std::size_t(image.rowPitch)}
+                                    : Rows{static_cast<const char*>(buffer->mapped), tightPitch};
+    };
+    const Rows beauty = rows(targets.beauty, &readback.beauty);
+    const Rows aovs = rows(targets.aovs, &readback.aovs);
+    std::vector<Rows> lightRows;
+    for (std::size_t t = 0; t < targets.lights.size(); ++t)
+        lightRows.push_back(rows(targets.lights[t], targets.hostReadable ? nullptr : &readback.lights[t]));
+    const std::size_t w = width;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, height, 16), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t y = r.begin(); y < r.end(); ++y) {
+            const std::size_t o = y * w;  // first pixel of the row in the Frame
+            if (rgb || visibility) {
+                const float* p = beauty.row(y);
+                for (std::size_t x = 0; x < w; ++x) {
+                    if (rgb) {
+                        rgb[3 * (o + x) + 0] = p[4 * x + 0];
+                        rgb[3 * (o + x) + 1] = p[4 * x + 1];
+                        rgb[3 * (o + x) + 2] = p[4 * x + 2];
+                    }
+                    if (visibility) visibility[o + x] = p[4 * x + 3];
                 }
-                if (visibility) visibility[i] = p[3];
             }
-        if (objectId || ndotl || depth || blockerId)
-            for (std::size_t i = r.begin(); i < r.end(); ++i) {
-                const float* p = aovs + 4 * i;
-                if (objectId) objectId[i] = p[0];
-                if (ndotl) ndotl[i] = p[1];
-                if (depth) depth[i] = p[2];
-                if (blockerId) blockerId[i] = p[3];
+            if (objectId || ndotl || depth || blockerId) {
+                const float* p = aovs.row(y);
+                for (std::size_t x = 0; x < w; ++x) {
+                    if (objectId) objectId[o + x] = p[4 * x + 0];
+                    if (ndotl) ndotl[o + x] = p[4 * x + 1];
+                    if (depth) depth[o + x] = p[4 * x + 2];
+                    if (blockerId) blockerId[o + x] = p[4 * x + 3];
+                }
             }
-        for (std::size_t l = 0; l < lights.size(); ++l) {
-            const auto* p = static_cast<const float*>(readback.lights[l / 4].mapped) + l % 4;
-            for (std::size_t i = r.begin(); i < r.end(); ++i) lights[l][i] = p[4 * i];
+            for (std::size_t l = 0; l < lights.size(); ++l) {
+                const float* p = lightRows[l / 4].row(y) + l % 4;
+                for (std::size_t x = 0; x < w; ++x) lights[l][o + x] = p[4 * x];
+            }
         }
     });
 }
