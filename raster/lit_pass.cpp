@@ -48,11 +48,12 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant) {
     const VkSpecializationMapEntry entries[4] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}, {3, 12, 4}};
     const VkSpecializationInfo specialization{
         .mapEntryCount = 4, .pMapEntries = entries, .dataSize = sizeof constants, .pData = constants};
-    std::vector<VkFormat> colorFormats{kLitColorFormat, kLitColorFormat};
-    colorFormats.insert(colorFormats.end(), variant.lightTargets, kLitColorFormat);
+    std::vector<VkFormat> colorFormats{kLitColorFormat};
+    if (variant.aovTarget) colorFormats.insert(colorFormats.end(), 1 + variant.lightTargets, kLitColorFormat);
     p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{
                                                  .vertexShader = shaders::litVertSpirv(),
-                                                 .fragmentShader = variant.lightTargets > 0
+                                                 .fragmentShader = !variant.aovTarget ? shaders::litFragBeautySpirv()
+                                                                   : variant.lightTargets > 0
                                                                        ? shaders::litFragLightsSpirv()
                                                                        : shaders::litFragSpirv(),
                                                  .fragmentSpecialization = &specialization,
@@ -171,12 +172,16 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
 }
 
 void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const LitBindings& bindings,
-                   const LitTargets& targets, const DrawGeometry& geometry, const glm::vec3& background) {
+                   const LitTargets& targets, const DrawGeometry& geometry, const glm::vec3& background,
+                   bool beautyOnly) {
     const VkPipelineStageFlags2 colorStage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
     const VkPipelineStageFlags2 depthStages =
         VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
-    std::vector<const Image*> colorImages{&targets.beauty, &targets.aovs};
-    for (const Image& l : targets.lights) colorImages.push_back(&l);
+    std::vector<const Image*> colorImages{&targets.beauty};
+    if (!beautyOnly) {
+        colorImages.push_back(&targets.aovs);
+        for (const Image& l : targets.lights) colorImages.push_back(&l);
+    }
     // The previous frame's copy read them: the barrier orders this frame's writes after it.
     std::vector<ImageTransition> before;
     std::vector<VkRenderingAttachmentInfo> colors;

@@ -22,6 +22,7 @@ inline constexpr VkFormat kLitDepthFormat = VK_FORMAT_D32_SFLOAT;
 struct LitVariant {
     scene::ShadowFilter filter = scene::ShadowFilter::Pcf2x2;  // of every light
     bool blockerIds = true;         // look up blocker ids (the blocker-id maps must be rendered)
+    bool aovTarget = true;          // false: the beauty target only (no AOVs, no per-light targets)
     std::uint32_t lightTargets = 0;  // 0, or kLightTargets: per-light visibility targets
     std::uint32_t lightCount = 1;    // = LitUniforms::counts.x
     std::uint32_t lightKinds = 7;    // bit (1 << SHADOWLAB_LIGHT_*) for each kind in the scene
@@ -67,8 +68,10 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
 // Records the pass; background pixels keep `background` (rgb, visibility 0) and zero AOVs.
 // Leaves every color target in TRANSFER_SRC_OPTIMAL for recordReadback(), or, for host-readable
 // targets, in GENERAL and visible to host reads once the submission has finished.
+// With beautyOnly (a pipeline made without aovTarget) only the beauty target is attached.
 void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const LitBindings& bindings,
-                   const LitTargets& targets, const DrawGeometry& geometry, const glm::vec3& background);
+                   const LitTargets& targets, const DrawGeometry& geometry, const glm::vec3& background,
+                   bool beautyOnly = false);
 
 struct Readback {
     Buffer beauty;

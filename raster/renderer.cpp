@@ -99,9 +99,10 @@ struct Renderer::Impl {
     Readback readback;
     bool timestamps = false;
     QueryPoolHandle queries;
-    // Made on first use: with and without blocker ids (index 1 and 0).
+    // Made on first use. Shadow: without and with blocker ids (index 0, 1). Lit: beauty target
+    // only, all targets without blocker ids, all with (index 0, 1, 2).
     ShadowPipeline shadowPipelines[2];
-    LitPipeline litPipelines[2];
+    LitPipeline litPipelines[3];
     LitBindings bindings;  // allocated with the first lit pipeline's (identical) set layout
     shaders::LitUniforms uniforms{};
     std::vector<glm::vec4> albedos;
@@ -278,7 +279,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
 
     // --- setup still owed: the pipelines this frame needs (shader compilation) ---
     ShadowPipeline& shadowPipeline = shadowPipelines[wantIds ? 1 : 0];
-    LitPipeline& litPipeline = litPipelines[wantIds ? 1 : 0];
+    const bool beautyOnly = !wantAovs && !wantLights;  // the beauty target holds visibility too
+    LitPipeline& litPipeline = litPipelines[beautyOnly ? 0 : wantIds ? 2 : 1];
     double setup = pendingSetupMs;  // 0 for a frame that creates nothing
     pendingSetupMs = 0.0;
     if (!shadowPipeline.pipeline || !litPipeline.pipeline) {
@@ -287,6 +289,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
         if (!litPipeline.pipeline)
             litPipeline = createLitPipeline(ctx, LitVariant{.filter = settings.filter,
                                                             .blockerIds = wantIds,
+                                                            .aovTarget = !beautyOnly,
                                                             .lightTargets = std::uint32_t(targets.lights.size()),
                                                             .lightCount = std::uint32_t(lightCount),
                                                             .lightKinds = lightKinds});
@@ -314,7 +317,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     const auto litStart = Clock::now();
     commands = ctx.beginCommands();
     stamp(commands, 2);
-    recordLitPass(commands, litPipeline, bindings, targets, draw, background);
+    recordLitPass(commands, litPipeline, bindings, targets, draw, background, beautyOnly);
     stamp(commands, 3);
     ctx.submitAndWait(commands);
     frame.timingsMs.emplace_back("lit_pass", msSince(litStart));

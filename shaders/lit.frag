@@ -18,7 +18,11 @@ layout(location = 1) in vec3 inNormal;
 layout(location = 2) flat in uint inObjectId;
 
 layout(location = 0) out vec4 outBeauty;  // rgb: linear color; a: visibility
+#ifndef SHADOWLAB_BEAUTY_ONLY
+// (The lit_beauty.frag variant, for frames that want only beauty and visibility, has no AOV
+// target: one RGBA32F target less to write.)
 layout(location = 1) out vec4 outAovs;    // x: object id; y: N·L (max over lights); z: view depth; w: blocker id
+#endif
 #ifdef SHADOWLAB_LIGHT_OUTPUTS
 // Per-light visibility (the lit_lights.frag variant, for scenes with more than one light):
 // light i in component i % 4 of target i / 4; 0 where the light does not reach (N·L <= 0,
@@ -228,7 +232,9 @@ void main() {
     }
     const float visibility = weightSum > 0.0 ? weightedVisibility / weightSum : 0.0;
     outBeauty = vec4(color, visibility);
+#ifndef SHADOWLAB_BEAUTY_ONLY
     outAovs = vec4(float(inObjectId), maxNdotL, dot(inPosition, u.forward.xyz), float(blocker));
+#endif
 #ifdef SHADOWLAB_LIGHT_OUTPUTS
     outLights0 = lightVisibility[0];
     outLights1 = lightVisibility[1];
