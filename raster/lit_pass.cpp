@@ -67,7 +67,7 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant) {
 }
 
 LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32_t height,
-                            std::uint32_t lightTargets) {
+                            std::uint32_t lightTargets, bool readInPlace) {
     const std::uint32_t limit = ctx.properties.limits.maxImageDimension2D;
     if (width > limit || height > limit)
         throw RasterError("image " + std::to_string(width) + "x" + std::to_string(height) +
@@ -80,7 +80,7 @@ LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32
     t.width = width;
     t.height = height;
     const VkImageUsageFlags colorUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-    t.hostReadable = canReadImagesOnHost(ctx, kLitColorFormat, colorUsage);
+    t.hostReadable = readInPlace && canReadImagesOnHost(ctx, kLitColorFormat, colorUsage);
     t.beauty = createImage(ctx, kLitColorFormat, width, height, 1, colorUsage, VK_IMAGE_ASPECT_COLOR_BIT,
                            VK_IMAGE_VIEW_TYPE_2D, t.hostReadable);
     t.aovs = createImage(ctx, kLitColorFormat, width, height, 1, colorUsage, VK_IMAGE_ASPECT_COLOR_BIT,

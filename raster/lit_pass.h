@@ -49,8 +49,9 @@ struct LitTargets {
     std::uint32_t width = 0;
     std::uint32_t height = 0;
 };
+// readInPlace: make the color targets host-readable where the device allows it.
 LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32_t height,
-                            std::uint32_t lightTargets = 0);
+                            std::uint32_t lightTargets = 0, bool readInPlace = true);
 
 // The lit pass's descriptor set: uniforms, per-object albedo, shadow maps behind a NEAREST
 // depth-compare sampler (lit.frag builds the filters from its taps), blocker ids.

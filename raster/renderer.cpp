@@ -70,7 +70,7 @@ const char* filterName(scene::ShadowFilter f) {
 
 struct Renderer::Impl {
     Impl(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settingsIn,
-         ValidationLog& log);
+         const RendererOptions& options, ValidationLog& log);
     void render(scene::Frame& frame, scene::ChannelMask channels, const ValidationLog& log);
     void readPixels(scene::Frame& frame, scene::ChannelMask channels) const;
     void invalidateMemory(VkDeviceMemory memory) const {
@@ -109,7 +109,7 @@ struct Renderer::Impl {
 };
 
 Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settingsIn,
-                     ValidationLog& log)
+                     const RendererOptions& options, ValidationLog& log)
     : settings(settingsIn),
       ctx((checkSupported(scene, settingsIn),
            ContextOptions{.device = settingsIn.device, .validate = settingsIn.validate, .log = &log})) {
@@ -211,7 +211,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     const auto mapSize = lightMatrices.empty() ? 1u : std::uint32_t(settings.shadowMapSize);
     const auto layers = std::max<std::uint32_t>(1, std::uint32_t(lightMatrices.size()));
     maps = createShadowMaps(ctx, mapSize, layers);
-    targets = createLitTargets(ctx, width, height, lightCount > 1 ? kLightTargets : 0);
+    targets = createLitTargets(ctx, width, height, lightCount > 1 ? kLightTargets : 0, options.readTargetsInPlace);
     if (!targets.hostReadable) readback = createReadback(ctx, targets);
     // How the targets reach the Frame: read in place (lavapipe) or copied into buffers first.
     attributes["readback"] = targets.hostReadable ? "in-place" : "copy";
@@ -426,8 +426,9 @@ void Renderer::Impl::readPixels(scene::Frame& frame, scene::ChannelMask channels
     });
 }
 
-Renderer::Renderer(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settings)
-    : log_(std::make_shared<ValidationLog>()), impl_(std::make_unique<Impl>(scene, plan, settings, *log_)) {}
+Renderer::Renderer(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settings,
+                   const RendererOptions& options)
+    : log_(std::make_shared<ValidationLog>()), impl_(std::make_unique<Impl>(scene, plan, settings, options, *log_)) {}
 Renderer::~Renderer() = default;
 Renderer::Renderer(Renderer&&) noexcept = default;
 Renderer& Renderer::operator=(Renderer&&) noexcept = default;

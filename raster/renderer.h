@@ -22,9 +22,16 @@ struct ValidationLog;
 // first render() that needs them (the blocker-id variant only when blocker ids are asked for).
 // The first frame's "setup" timing is the constructor's time plus any pipeline creation; later
 // frames have "setup" 0 unless they had to create a pipeline. Call from one thread at a time.
+struct RendererOptions {
+    // Read the targets in place where the device's memory is the host's (lavapipe); false
+    // copies them into readback buffers first, as on other devices (tests compare the two).
+    bool readTargetsInPlace = true;
+};
+
 class Renderer {
 public:
-    Renderer(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settings);
+    Renderer(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settings,
+             const RendererOptions& options = {});
     ~Renderer();
     Renderer(Renderer&&) noexcept;
     Renderer& operator=(Renderer&&) noexcept;

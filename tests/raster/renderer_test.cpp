@@ -764,6 +764,35 @@ TEST(RasterRenderer, ChannelsNotAskedForAreLeftOutAndTheRestIsUnchanged) {
     }
 }
 
+TEST(RasterRenderer, ReadingTheTargetsInPlaceAndCopyingThemGiveTheSameFrame) {
+    // lavapipe reads the lit targets in place; other devices copy them into buffers. Both paths,
+    // on lavapipe, for every channel set, with several lights (per-light targets too).
+    SphereOverPlane p;
+    scene::Scene s = makeScene(p);
+    scene::Light b = s.lights[0];
+    b.direction = lightFromElevation(40.0);
+    s.lights.push_back(b);
+    const scene::RasterSettings settings = validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2);
+    Renderer inPlace(s, planFor(s, settings), settings);
+    Renderer copied(s, planFor(s, settings), settings, RendererOptions{.readTargetsInPlace = false});
+    for (scene::ChannelMask channels : {scene::kAllChannels, scene::kChannelBeauty,
+                                        scene::kChannelVisibility | scene::kChannelDepth}) {
+        const scene::Frame a = inPlace.render(channels);
+        const scene::Frame c = copied.render(channels);
+        EXPECT_EQ(a.attributes.at("readback"), "in-place");
+        EXPECT_EQ(c.attributes.at("readback"), "copy");
+        EXPECT_EQ(a.beauty, c.beauty);
+        EXPECT_EQ(a.visibility, c.visibility);
+        EXPECT_EQ(a.objectId, c.objectId);
+        EXPECT_EQ(a.ndotl, c.ndotl);
+        EXPECT_EQ(a.depth, c.depth);
+        EXPECT_EQ(a.blockerId, c.blockerId);
+        EXPECT_EQ(a.lightVisibility, c.lightVisibility);
+    }
+    EXPECT_EQ(inPlace.validationMessages(), 0);
+    EXPECT_EQ(copied.validationMessages(), 0);
+}
+
 TEST(RasterRender, BadPcfSizeIsRejected) {
     const scene::Scene s = makeScene(SphereOverPlane{});
     scene::RasterSettings settings = filterSettings(ShadowFilter::Pcf, 0);
