@@ -94,10 +94,11 @@ void checkValidation(const scene::Frame& frame, const scene::RasterSettings& set
                                  " message(s) (printed above)");
 }
 
-scene::Frame renderBackend(const Prepared& p, const std::string& backend) {
+scene::Frame renderBackend(const Prepared& p, const std::string& backend,
+                           scene::ChannelMask channels = scene::kAllChannels) {
     scene::Frame f;
     if (backend == "raster") {
-        f = raster::render(p.scene, p.plan, p.settings.raster);
+        f = raster::render(p.scene, p.plan, p.settings.raster, channels);
         checkValidation(f, p.settings.raster);
     } else if (backend == "raytrace") {
         f = raytrace::render(p.scene, p.plan, p.settings.raytrace);
@@ -168,7 +169,9 @@ int render(const RenderOptions& o) {
     // Only once the input is known to be good may the output's folder be created.
     if (o.output.has_parent_path()) fs::create_directories(o.output.parent_path());
     Stage stage("rendering " + p.scene.file.filename().string() + " with " + o.backend);
-    const scene::Frame frame = renderBackend(p, o.backend);
+    // A PNG holds the beauty only: the raster backend then reads back nothing else.
+    const scene::Frame frame =
+        renderBackend(p, o.backend, ext == ".png" ? scene::kChannelBeauty : scene::kAllChannels);
     scene::writeFrame(frame, o.output);
     stage.done(std::to_string(frame.width) + "x" + std::to_string(frame.height) + " -> " + o.output.string() +
                ", " + memoryLine(estimate));

@@ -1,16 +1,22 @@
-// bench/raster_bench.cpp: times raster::render per stage on the seed scene and Sponza at
-// 1920x1080 with a 2048 shadow map, cold (empty Mesa shader cache) first frame vs warm frames.
+// bench/raster_bench.cpp: our raster frame (raster::Renderer) against a bare two-pass lavapipe
+// renderer (bench/bare_renderer.h) on the seed scene and Sponza at 1920x1080 with a 2048² map,
+// in one process: per-stage medians of interleaved repetitions, cold (empty Mesa shader cache)
+// and warm first frames, and, when LP_NUM_THREADS is not set, the whole run once with
+// LP_NUM_THREADS=2 and once with 1 (child processes: lavapipe reads it at device creation).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <exception>
 #include <filesystem>
 #include <map>
 #include <string>
 #include <vector>
 
+#include "bare_renderer.h"
 #include "raster/renderer.h"
+#include "scene/frame_io.h"
 #include "scene/loader.h"
 #include "scene/render_plan.h"
 #include "scene/settings.h"
@@ -18,68 +24,68 @@
 namespace {
 
 using namespace shadowlab;
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
 
 constexpr int kWidth = 1920;
 constexpr int kHeight = 1080;
 constexpr int kShadowMapSize = 2048;
 constexpr const char* kSponzaPath = "/work/shared/scenes/Sponza/Sponza.gltf";
 
-// Reference figures from the issue: a bare lavapipe pass measured earlier on this kind of
-// machine (Mesa 22.3.6, 2 threads), not in this run.
-constexpr double kIssueBaselineSphereMs = 37.0;   // 20k-triangle sphere on a plane
-constexpr double kIssueBaselineSponzaMs = 210.0;  // Sponza, 1920x1080, 2048^2 map
+double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
-struct Sample {
-    std::map<std::string, double> ms;  // stage -> ms, plus "total", "per_frame", gpu_* keys
-};
-
-double attributeMs(const scene::Frame& frame, const std::string& key) {
-    auto it = frame.attributes.find(key);
-    if (it == frame.attributes.end()) return -1.0;
-    try {
-        return std::stod(it->second);
-    } catch (const std::exception&) {
-        return -1.0;
-    }
+// Process CPU time (all threads, lavapipe's included), ms: less disturbed than wall time when
+// other work shares the cores.
+double cpuMs() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
 }
 
-Sample renderOnce(const scene::Scene& s, const scene::RenderPlan& plan,
-                  const scene::RasterSettings& settings, std::string* triangles) {
-    const auto t0 = std::chrono::steady_clock::now();
-    scene::Frame frame = raster::render(s, plan, settings);
-    const auto t1 = std::chrono::steady_clock::now();
-    Sample out;
-    out.ms["total"] = std::chrono::duration<double, std::milli>(t1 - t0).count();
-    for (const auto& [name, ms] : frame.timingsMs) out.ms[name] = ms;
-    out.ms["per_frame"] = out.ms["total"] - out.ms["setup"];
-    out.ms["gpu_shadow_pass"] = attributeMs(frame, "gpu_shadow_pass_ms");
-    out.ms["gpu_lit_pass"] = attributeMs(frame, "gpu_lit_pass_ms");
-    if (triangles) {
-        auto it = frame.attributes.find("triangles");
-        *triangles = it == frame.attributes.end() ? "?" : it->second;
-    }
-    return out;
-}
-
-struct Stats {
-    double median = 0, min = 0, max = 0;
-};
-
-Stats stats(std::vector<double> v) {
+double median(std::vector<double> v) {
+    if (v.empty()) return -1.0;
     std::sort(v.begin(), v.end());
-    Stats st;
-    if (v.empty()) return st;
-    st.min = v.front();
-    st.max = v.back();
-    const size_t n = v.size();
-    st.median = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-    return st;
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-// Returns the median per-frame time of the warm frames, or a negative value on failure.
-double benchScene(const std::string& label, const std::filesystem::path& file, int repeats,
-                  bool firstInProcess, double baselineMs, const char* baselineWhat) {
-    std::printf("\n=== %s (%s) ===\n", label.c_str(), file.string().c_str());
+struct Series {
+    std::map<std::string, std::vector<double>> ms;  // stage -> one value per repetition
+    void add(const std::string& stage, double v) { ms[stage].push_back(v); }
+    double med(const std::string& stage) const {
+        const auto it = ms.find(stage);
+        return it == ms.end() ? -1.0 : median(it->second);
+    }
+    std::pair<double, double> range(const std::string& stage) const {
+        const auto it = ms.find(stage);
+        if (it == ms.end() || it->second.empty()) return {-1, -1};
+        const auto [lo, hi] = std::minmax_element(it->second.begin(), it->second.end());
+        return {*lo, *hi};
+    }
+};
+
+void addOurs(Series& s, const scene::Frame& f) {
+    for (const char* stage : {"shadow_pass", "lit_pass", "readback"}) s.add(stage, f.timing(stage));
+    s.add("per_frame", f.totalTimeMs() - f.timing("setup"));
+}
+
+void addBare(Series& s, const bench::BareTimings& t) {
+    s.add("shadow_pass", t.shadowPass);
+    s.add("lit_pass", t.litPass);
+    s.add("readback", t.readback);
+    s.add("per_frame", t.perFrame());
+}
+
+// A fresh, empty Mesa shader cache, so that the next device's pipelines compile from scratch.
+void freshShaderCache(std::vector<fs::path>& made) {
+    char dirTemplate[] = "/tmp/shadowlab_raster_bench_cache_XXXXXX";
+    if (const char* dir = mkdtemp(dirTemplate)) {
+        setenv("MESA_SHADER_CACHE_DIR", dir, 1);
+        made.emplace_back(dir);
+    }
+}
+
+void benchScene(const std::string& label, const fs::path& file, int repeats, std::vector<fs::path>& caches) {
     scene::Scene s = scene::loadScene(file);
     s.camera.width = kWidth;
     s.camera.height = kHeight;
@@ -88,41 +94,93 @@ double benchScene(const std::string& label, const std::filesystem::path& file, i
     const scene::RenderSettings settings = scene::resolveSettings(s, overrides);
     const scene::RenderPlan plan = scene::makeRenderPlan(s, settings);
 
-    std::string triangles;
-    const Sample first = renderOnce(s, plan, settings.raster, &triangles);
-    std::printf("triangles: %s, %dx%d, shadow map %d\n", triangles.c_str(), kWidth, kHeight,
-                kShadowMapSize);
-    std::printf("first frame (%s): total %.1f ms (setup %.1f, per-frame %.1f)\n",
-                firstInProcess ? "cold: first render of the process, empty shader cache"
-                               : "warm-up, not counted",
-                first.ms.at("total"), first.ms.at("setup"), first.ms.at("per_frame"));
+    // Cold first frames: construction + first frame with an empty shader cache. Ours and the
+    // bare renderer compile different shaders, so both are cold in the same cache.
+    freshShaderCache(caches);
+    auto t0 = Clock::now();
+    raster::Renderer ours(s, plan, settings.raster);
+    scene::Frame frame = ours.render();
+    const double oursCold = msSince(t0);
+    std::vector<std::uint8_t> rgba;
+    t0 = Clock::now();
+    bench::BareRenderer bare(s, settings.raster);
+    bare.render(rgba);
+    const double bareCold = msSince(t0);
 
-    std::vector<Sample> samples;
-    for (int i = 0; i < repeats; ++i) samples.push_back(renderOnce(s, plan, settings.raster, nullptr));
-
-    const char* keys[] = {"setup", "shadow_pass", "lit_pass", "readback", "per_frame", "total",
-                          "gpu_shadow_pass", "gpu_lit_pass"};
-    std::printf("warm frames (N=%d):\n", repeats);
-    std::printf("  %-18s %10s %10s %10s\n", "stage (ms)", "median", "min", "max");
-    double perFrameMedian = -1.0;
-    for (const char* key : keys) {
-        std::vector<double> v;
-        for (const auto& smp : samples) {
-            auto it = smp.ms.find(key);
-            if (it != smp.ms.end() && it->second >= 0.0) v.push_back(it->second);
-        }
-        if (v.empty()) {
-            std::printf("  %-18s %10s\n", key, "n/a");
-            continue;
-        }
-        const Stats st = stats(v);
-        std::printf("  %-18s %10.1f %10.1f %10.1f\n", key, st.median, st.min, st.max);
-        if (std::string(key) == "per_frame") perFrameMedian = st.median;
+    std::printf("\n=== %s: %s triangles, %dx%d, shadow map %d, filter %s, bare PCF: %s ===\n", label.c_str(),
+                frame.attributes["triangles"].c_str(), kWidth, kHeight, kShadowMapSize,
+                frame.attributes["filter"].c_str(), bare.pcfKind().c_str());
+    if (const char* dir = std::getenv("SHADOWLAB_BENCH_PNG_DIR")) {
+        scene::writePngLinear(fs::path(dir) / (label + "-ours.png"), frame.width, frame.height, frame.beauty);
+        std::vector<float> rgb(std::size_t(kWidth) * kHeight * 3);
+        for (std::size_t i = 0; i < rgb.size() / 3; ++i)
+            for (int c = 0; c < 3; ++c) rgb[3 * i + c] = float(rgba[4 * i + c]) / 255.0f;
+        scene::writePngDisplay(fs::path(dir) / (label + "-bare.png"), kWidth, kHeight, rgb);
     }
-    std::printf("  per-frame median %.1f ms vs %.0f ms (%s): ratio ours/that = %.2f\n"
-                "  [against the issue's recorded baseline, not measured in this run]\n",
-                perFrameMedian, baselineMs, baselineWhat, perFrameMedian / baselineMs);
-    return perFrameMedian;
+
+    // Warm frames, interleaved so that both see the same machine: ours with every channel
+    // (what compare reads), ours with the beauty only (`render -o x.png`), the bare renderer.
+    // Each keeps its frame between repetitions, as the bare renderer keeps its image.
+    Series all, beauty, fresh, base;
+    scene::Frame allFrame, beautyFrame;
+    for (int i = 0; i < repeats; ++i) {
+        double c = cpuMs();
+        ours.render(allFrame, scene::kAllChannels);
+        all.add("cpu_per_frame", cpuMs() - c);
+        addOurs(all, allFrame);
+        c = cpuMs();
+        ours.render(beautyFrame, scene::kChannelBeauty);
+        beauty.add("cpu_per_frame", cpuMs() - c);
+        addOurs(beauty, beautyFrame);
+        addOurs(fresh, ours.render(scene::kAllChannels));  // a new Frame every time
+        c = cpuMs();
+        const bench::BareTimings t = bare.render(rgba);
+        base.add("cpu_per_frame", cpuMs() - c);
+        addBare(base, t);
+    }
+
+    // Warm first frames: a new renderer (new device) whose shaders are now in the cache.
+    t0 = Clock::now();
+    {
+        raster::Renderer again(s, plan, settings.raster);
+        again.render();
+    }
+    const double oursWarmFirst = msSince(t0);
+    t0 = Clock::now();
+    {
+        bench::BareRenderer again(s, settings.raster);
+        again.render(rgba);
+    }
+    const double bareWarmFirst = msSince(t0);
+
+    std::printf("median of %d warm frames, ms (min-max)\n", repeats);
+    std::printf("  %-12s %22s %22s %22s %9s %9s\n", "stage", "ours (all channels)", "ours (beauty only)",
+                "bare baseline", "all/bare", "bty/bare");
+    for (const char* stage : {"shadow_pass", "lit_pass", "readback", "per_frame", "cpu_per_frame"}) {
+        auto cell = [&](const Series& x) {
+            char buf[64];
+            const auto [lo, hi] = x.range(stage);
+            std::snprintf(buf, sizeof buf, "%.1f (%.1f-%.1f)", x.med(stage), lo, hi);
+            return std::string(buf);
+        };
+        std::printf("  %-12s %22s %22s %22s %9.2f %9.2f\n", stage, cell(all).c_str(), cell(beauty).c_str(),
+                    cell(base).c_str(), all.med(stage) / base.med(stage), beauty.med(stage) / base.med(stage));
+    }
+    std::printf("  ours (all channels) into a new Frame each time: per_frame %.1f, readback %.1f\n",
+                fresh.med("per_frame"), fresh.med("readback"));
+    std::printf("  setup (construction): ours %.1f, bare %.1f\n", ours.setupMs(), bare.setupMs());
+    std::printf("  first frame incl. setup: cold ours %.1f, bare %.1f; warm ours %.1f, bare %.1f\n", oursCold,
+                bareCold, oursWarmFirst, bareWarmFirst);
+    std::printf("  gpu timestamps: first frame shadow %s, lit %s; last warm frame (all channels) shadow %s, lit %s\n",
+                frame.attributes["gpu_shadow_pass_ms"].c_str(), frame.attributes["gpu_lit_pass_ms"].c_str(),
+                allFrame.attributes["gpu_shadow_pass_ms"].c_str(), allFrame.attributes["gpu_lit_pass_ms"].c_str());
+    const char* threads = std::getenv("LP_NUM_THREADS");
+    std::printf("ROW | %s | %s | %.1f | %.1f | %.1f | %.2f | %.2f | %.2f | %.1f | %.1f | %.1f / %.1f | %.1f / %.1f |\n",
+                label.c_str(), threads ? threads : "?", all.med("per_frame"), beauty.med("per_frame"),
+                base.med("per_frame"), all.med("per_frame") / base.med("per_frame"),
+                beauty.med("per_frame") / base.med("per_frame"),
+                all.med("cpu_per_frame") / base.med("cpu_per_frame"), all.med("lit_pass"), base.med("lit_pass"),
+                oursCold, bareCold, oursWarmFirst, bareWarmFirst);
 }
 
 }  // namespace
@@ -130,36 +188,37 @@ double benchScene(const std::string& label, const std::filesystem::path& file, i
 int main(int argc, char** argv) {
     int repeats = 5;
     if (argc > 1) repeats = std::max(1, std::atoi(argv[1]));
-
-    // A fresh, empty shader cache makes the process's first frame a cold one; it must be set
-    // before the first Vulkan instance is created, which is inside the first render.
-    char cacheTemplate[] = "/tmp/shadowlab_raster_bench_cache_XXXXXX";
-    const char* cacheDir = mkdtemp(cacheTemplate);
-    if (cacheDir) setenv("MESA_SHADER_CACHE_DIR", cacheDir, 1);
-    const char* threads = std::getenv("LP_NUM_THREADS");
-    std::printf("raster_bench: MESA_SHADER_CACHE_DIR=%s LP_NUM_THREADS=%s repeats=%d\n",
-                cacheDir ? cacheDir : "(mkdtemp failed, default cache)", threads ? threads : "(unset)",
-                repeats);
-
+    if (!std::getenv("LP_NUM_THREADS")) {
+        // Both thread counts, each in its own process.
+        int rc = 0;
+        for (const char* threads : {"2", "1"}) {
+            const std::string command = std::string("LP_NUM_THREADS=") + threads + " '" + argv[0] + "' " +
+                                        std::to_string(repeats);
+            std::printf("\n##### %s\n", command.c_str());
+            std::fflush(stdout);
+            rc |= std::system(command.c_str());
+        }
+        return rc == 0 ? 0 : 1;
+    }
+    std::printf("raster_bench: LP_NUM_THREADS=%s repeats=%d\n", std::getenv("LP_NUM_THREADS"), repeats);
+    std::vector<fs::path> caches;
     int rc = 0;
     try {
-        benchScene("seed", scene::findScene("seed"), repeats, true, kIssueBaselineSphereMs,
-                   "20k-tri sphere on plane");
+        benchScene("seed", scene::findScene("seed"), repeats, caches);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "seed scene failed: %s\n", e.what());
         rc = 1;
     }
-    if (!std::filesystem::exists(kSponzaPath)) {
+    if (!fs::exists(kSponzaPath)) {
         std::printf("\n=== Sponza: SKIPPED, file absent: %s ===\n", kSponzaPath);
     } else {
         try {
-            benchScene("Sponza", kSponzaPath, repeats, false, kIssueBaselineSponzaMs,
-                       "Sponza 1920x1080, 2048^2 map");
+            benchScene("Sponza", kSponzaPath, repeats, caches);
         } catch (const std::exception& e) {
             std::fprintf(stderr, "Sponza failed: %s\n", e.what());
             rc = 1;
         }
     }
-    if (cacheDir) std::filesystem::remove_all(cacheDir);
+    for (const fs::path& dir : caches) fs::remove_all(dir);
     return rc;
 }

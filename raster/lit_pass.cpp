@@ -9,7 +9,7 @@
 
 namespace shadowlab::raster {
 
-LitPipeline createLitPipeline(const Context& ctx) {
+LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant) {
     requireFormat(ctx, kLitColorFormat,
                   VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_TRANSFER_SRC_BIT, "the lit pass targets");
     requireFormat(ctx, kLitDepthFormat, VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT, "the camera depth buffer");
@@ -41,11 +41,24 @@ LitPipeline createLitPipeline(const Context& ctx) {
     VkPipelineLayout layout = VK_NULL_HANDLE;
     VK_CHECK(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &layout));
     p.layout = PipelineLayoutHandle(device, layout);
+    // lit.frag's constant_id 0: the filter code, 1: blocker ids (a bool is 32 bits wide),
+    // 2: the light count, 3: the light kinds.
+    const std::int32_t constants[4] = {std::int32_t(variant.filter), variant.blockerIds ? 1 : 0,
+                                       std::int32_t(variant.lightCount), std::int32_t(variant.lightKinds)};
+    const VkSpecializationMapEntry entries[4] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}, {3, 12, 4}};
+    const VkSpecializationInfo specialization{
+        .mapEntryCount = 4, .pMapEntries = entries, .dataSize = sizeof constants, .pData = constants};
+    std::vector<VkFormat> colorFormats{kLitColorFormat};
+    if (variant.aovTarget) colorFormats.insert(colorFormats.end(), 1 + variant.lightTargets, kLitColorFormat);
     p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{
                                                  .vertexShader = shaders::litVertSpirv(),
-                                                 .fragmentShader = shaders::litFragSpirv(),
+                                                 .fragmentShader = !variant.aovTarget ? shaders::litFragBeautySpirv()
+                                                                   : variant.lightTargets > 0
+                                                                       ? shaders::litFragLightsSpirv()
+                                                                       : shaders::litFragSpirv(),
+                                                 .fragmentSpecialization = &specialization,
                                                  .layout = layout,
-                                                 .colorFormats = {kLitColorFormat, kLitColorFormat},
+                                                 .colorFormats = colorFormats,
                                                  .depthFormat = kLitDepthFormat,
                                                  // Reversed Z: nearer is larger.
                                                  .depthCompare = VK_COMPARE_OP_GREATER,
@@ -53,25 +66,30 @@ LitPipeline createLitPipeline(const Context& ctx) {
     return p;
 }
 
-LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32_t height) {
+LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32_t height,
+                            std::uint32_t lightTargets, bool readInPlace) {
     const std::uint32_t limit = ctx.properties.limits.maxImageDimension2D;
     if (width > limit || height > limit)
         throw RasterError("image " + std::to_string(width) + "x" + std::to_string(height) +
                           " exceeds the device's limit of " + std::to_string(limit) + " per side (" +
                           ctx.deviceReport.name + ")");
-    // Two RGBA32F targets, D32 depth, and two RGBA32F readback buffers.
-    requireDeviceMemory(ctx, VkDeviceSize(width) * height * (2 * 16 + 4 + 2 * 16),
+    // Two (plus lightTargets) RGBA32F targets, D32 depth, and as many RGBA32F readback buffers.
+    requireDeviceMemory(ctx, VkDeviceSize(width) * height * ((2 + lightTargets) * 16 * 2 + 4),
                         "a " + std::to_string(width) + "x" + std::to_string(height) + " image");
     LitTargets t;
     t.width = width;
     t.height = height;
     const VkImageUsageFlags colorUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    t.hostReadable = readInPlace && canReadImagesOnHost(ctx, kLitColorFormat, colorUsage);
     t.beauty = createImage(ctx, kLitColorFormat, width, height, 1, colorUsage, VK_IMAGE_ASPECT_COLOR_BIT,
-                           VK_IMAGE_VIEW_TYPE_2D);
+                           VK_IMAGE_VIEW_TYPE_2D, t.hostReadable);
     t.aovs = createImage(ctx, kLitColorFormat, width, height, 1, colorUsage, VK_IMAGE_ASPECT_COLOR_BIT,
-                         VK_IMAGE_VIEW_TYPE_2D);
+                         VK_IMAGE_VIEW_TYPE_2D, t.hostReadable);
     t.depth = createImage(ctx, kLitDepthFormat, width, height, 1, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
                           VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_VIEW_TYPE_2D);
+    for (std::uint32_t i = 0; i < lightTargets; ++i)
+        t.lights.push_back(createImage(ctx, kLitColorFormat, width, height, 1, colorUsage, VK_IMAGE_ASPECT_COLOR_BIT,
+                                       VK_IMAGE_VIEW_TYPE_2D, t.hostReadable));
     return t;
 }
 
@@ -154,34 +172,39 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
 }
 
 void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const LitBindings& bindings,
-                   const LitTargets& targets, const DrawGeometry& geometry, const glm::vec3& background) {
+                   const LitTargets& targets, const DrawGeometry& geometry, const glm::vec3& background,
+                   bool beautyOnly) {
     const VkPipelineStageFlags2 colorStage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
     const VkPipelineStageFlags2 depthStages =
         VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
-    transition(commands,
-               {{targets.beauty.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, colorStage,
-                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT},
-                {targets.aovs.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, colorStage,
-                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT},
-                {targets.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-                 VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE, depthStages,
-                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT}});
-    const VkRenderingAttachmentInfo colors[] = {
-        {.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
-         .imageView = targets.beauty.view.get(),
-         .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-         .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
-         .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
-         .clearValue = {.color = {.float32 = {background.r, background.g, background.b, 0.0f}}}},
-        {.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
-         .imageView = targets.aovs.view.get(),
-         .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-         .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
-         .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
-         .clearValue = {.color = {.float32 = {0.0f, 0.0f, 0.0f, 0.0f}}}},
-    };
+    std::vector<const Image*> colorImages{&targets.beauty};
+    if (!beautyOnly) {
+        colorImages.push_back(&targets.aovs);
+        for (const Image& l : targets.lights) colorImages.push_back(&l);
+    }
+    // The previous frame's copy read them: the barrier orders this frame's writes after it.
+    std::vector<ImageTransition> before;
+    std::vector<VkRenderingAttachmentInfo> colors;
+    for (const Image* image : colorImages) {
+        before.push_back({image->image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+                          VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                          targets.hostReadable ? VK_PIPELINE_STAGE_2_HOST_BIT : VK_PIPELINE_STAGE_2_COPY_BIT,
+                          VK_ACCESS_2_NONE, colorStage, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT});
+        const bool isBeauty = image == &targets.beauty;
+        colors.push_back({.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+                          .imageView = image->view.get(),
+                          .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                          .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+                          .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+                          .clearValue = {.color = {.float32 = {isBeauty ? background.r : 0.0f,
+                                                               isBeauty ? background.g : 0.0f,
+                                                               isBeauty ? background.b : 0.0f, 0.0f}}}});
+    }
+    before.push_back({targets.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+                      VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, depthStages,
+                      VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, depthStages,
+                      VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT});
+    transition(commands, before);
     const VkRenderingAttachmentInfo depth{
         .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
         .imageView = targets.depth.view.get(),
@@ -194,8 +217,8 @@ void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const 
         .sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
         .renderArea = {{0, 0}, {targets.width, targets.height}},
         .layerCount = 1,
-        .colorAttachmentCount = 2,
-        .pColorAttachments = colors,
+        .colorAttachmentCount = std::uint32_t(colors.size()),
+        .pColorAttachments = colors.data(),
         .pDepthAttachment = &depth,
     };
     vkCmdBeginRendering(commands, &rendering);
@@ -210,13 +233,19 @@ void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const 
         vkCmdDrawIndexed(commands, geometry.indexCount, 1, 0, 0, 0);
     }
     vkCmdEndRendering(commands);
-    transition(commands,
-               {{targets.beauty.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                 VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, colorStage, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-                 VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT},
-                {targets.aovs.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                 VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, colorStage, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-                 VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT}});
+    std::vector<ImageTransition> after;
+    for (const Image* image : colorImages)
+        if (targets.hostReadable)  // host access to a linear image needs GENERAL (Vulkan spec)
+            after.push_back({image->image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1,
+                             VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL, colorStage,
+                             VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
+                             VK_ACCESS_2_HOST_READ_BIT});
+        else
+            after.push_back({image->image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1,
+                             VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                             colorStage, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
+                             VK_ACCESS_2_TRANSFER_READ_BIT});
+    transition(commands, after);
 }
 
 Readback createReadback(const Context& ctx, const LitTargets& targets) {
@@ -224,19 +253,27 @@ Readback createReadback(const Context& ctx, const LitTargets& targets) {
     Readback r;
     r.beauty = createReadbackBuffer(ctx, bytes);
     r.aovs = createReadbackBuffer(ctx, bytes);
+    for (std::size_t i = 0; i < targets.lights.size(); ++i) r.lights.push_back(createReadbackBuffer(ctx, bytes));
     return r;
 }
 
-void recordReadback(VkCommandBuffer commands, const LitTargets& targets, const Readback& readback) {
+void recordReadback(VkCommandBuffer commands, const LitTargets& targets, const Readback& readback,
+                    const ReadbackSelection& selection) {
     const VkBufferImageCopy region{
         .imageSubresource = {.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT, .mipLevel = 0, .baseArrayLayer = 0,
                              .layerCount = 1},
         .imageExtent = {targets.width, targets.height, 1},
     };
-    vkCmdCopyImageToBuffer(commands, targets.beauty.image.get(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                           readback.beauty.buffer.get(), 1, &region);
-    vkCmdCopyImageToBuffer(commands, targets.aovs.image.get(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                           readback.aovs.buffer.get(), 1, &region);
+    if (selection.beauty)
+        vkCmdCopyImageToBuffer(commands, targets.beauty.image.get(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                               readback.beauty.buffer.get(), 1, &region);
+    if (selection.aovs)
+        vkCmdCopyImageToBuffer(commands, targets.aovs.image.get(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                               readback.aovs.buffer.get(), 1, &region);
+    if (selection.lights)
+        for (std::size_t i = 0; i < targets.lights.size(); ++i)
+            vkCmdCopyImageToBuffer(commands, targets.lights[i].image.get(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                   readback.lights[i].buffer.get(), 1, &region);
     transferToHostBarrier(commands);
 }
 

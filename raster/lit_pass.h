@@ -16,21 +16,42 @@ namespace shadowlab::raster {
 inline constexpr VkFormat kLitColorFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 inline constexpr VkFormat kLitDepthFormat = VK_FORMAT_D32_SFLOAT;
 
+// What is fixed when the lit pipeline is created (lit.frag's specialization constants and
+// variant): lavapipe executes every branch of a shader, so run-time switches cost as much as
+// the work they skip.
+struct LitVariant {
+    scene::ShadowFilter filter = scene::ShadowFilter::Pcf2x2;  // of every light
+    bool blockerIds = true;         // look up blocker ids (the blocker-id maps must be rendered)
+    bool aovTarget = true;          // false: the beauty target only (no AOVs, no per-light targets)
+    std::uint32_t lightTargets = 0;  // 0, or kLightTargets: per-light visibility targets
+    std::uint32_t lightCount = 1;    // = LitUniforms::counts.x
+    std::uint32_t lightKinds = 7;    // bit (1 << SHADOWLAB_LIGHT_*) for each kind in the scene
+};
+// Per-light visibility targets: four lights in each RGBA32F target, SHADOWLAB_MAX_LIGHTS in all.
+inline constexpr std::uint32_t kLightTargets = (SHADOWLAB_MAX_LIGHTS + 3) / 4;
+
 struct LitPipeline {
     DescriptorSetLayoutHandle setLayout;
     PipelineLayoutHandle layout;
     PipelineHandle pipeline;
 };
-LitPipeline createLitPipeline(const Context& ctx);
+LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant = {});
 
 struct LitTargets {
     Image beauty;  // rgb: linear color, a: visibility
     Image aovs;    // x: object id, y: N·L, z: view depth, w: blocker id
     Image depth;   // reversed Z (cleared to 0 = far)
+    // With lightTargets: light i's visibility in component i % 4 of lights[i / 4].
+    std::vector<Image> lights;
+    // Color targets are linear images in host-visible memory, read in place after the pass
+    // (lavapipe); otherwise they are copied into readback buffers.
+    bool hostReadable = false;
     std::uint32_t width = 0;
     std::uint32_t height = 0;
 };
-LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32_t height);
+// readInPlace: make the color targets host-readable where the device allows it.
+LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32_t height,
+                            std::uint32_t lightTargets = 0, bool readInPlace = true);
 
 // The lit pass's descriptor set: uniforms, per-object albedo, shadow maps behind a NEAREST
 // depth-compare sampler (lit.frag builds the filters from its taps), blocker ids.
@@ -46,15 +67,26 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
                               const std::vector<glm::vec4>& albedos, const ShadowMaps& maps);
 
 // Records the pass; background pixels keep `background` (rgb, visibility 0) and zero AOVs.
-// Leaves both color targets in TRANSFER_SRC_OPTIMAL for recordReadback().
+// Leaves every color target in TRANSFER_SRC_OPTIMAL for recordReadback(), or, for host-readable
+// targets, in GENERAL and visible to host reads once the submission has finished.
+// With beautyOnly (a pipeline made without aovTarget) only the beauty target is attached.
 void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const LitBindings& bindings,
-                   const LitTargets& targets, const DrawGeometry& geometry, const glm::vec3& background);
+                   const LitTargets& targets, const DrawGeometry& geometry, const glm::vec3& background,
+                   bool beautyOnly = false);
 
 struct Readback {
     Buffer beauty;
     Buffer aovs;
+    std::vector<Buffer> lights;  // one per LitTargets::lights
 };
 Readback createReadback(const Context& ctx, const LitTargets& targets);
-void recordReadback(VkCommandBuffer commands, const LitTargets& targets, const Readback& readback);
+// Copies the targets that are asked for (the others are left alone, which saves their copy).
+struct ReadbackSelection {
+    bool beauty = true;
+    bool aovs = true;
+    bool lights = true;
+};
+void recordReadback(VkCommandBuffer commands, const LitTargets& targets, const Readback& readback,
+                    const ReadbackSelection& selection = {});
 
 }  // namespace shadowlab::raster

@@ -11,9 +11,13 @@ namespace {
 // Measured on lavapipe (Mesa 22.3): a 16x9 raster render of the seed scene peaks 108 MiB above
 // a ray-traced one, nearly all of it the driver and LLVM; the allowance is rounded up.
 constexpr std::uint64_t kDriverAllowance = 160 * scene::kMiB;
-// The lit pass writes two RGBA32F targets (beauty, AOVs) over a D32 depth buffer and reads the
-// color targets back through host-visible buffers of the same size.
-constexpr std::uint64_t kLitBytesPerPixel = 2 * 16 + 4 + 2 * 16;
+// The lit pass writes two RGBA32F targets (beauty, AOVs), and with more than one light one more
+// for each four lights' visibility, over a D32 depth buffer; devices that cannot read the targets
+// in place copy them into host-visible buffers of the same size (counted, as an upper bound).
+std::uint64_t litBytesPerPixel(std::size_t lights) {
+    const std::uint64_t targets = 2 + (lights > 1 ? (lights + 3) / 4 : 0);
+    return targets * 16 * 2 + 4;
+}
 // A tessellated sphere (raster/geometry.cpp) stays well under this many triangles.
 constexpr std::uint64_t kSphereTriangles = 1 << 16;
 constexpr std::uint64_t kBytesPerTriangle = 3 * 32 + 3 * 4;  // vertices (position, normal, id) + indices
@@ -32,7 +36,7 @@ std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::Render
         else if (std::holds_alternative<scene::Sphere>(o.shape)) triangles += kSphereTriangles;
         else triangles += 12;
     }
-    return kDriverAllowance + scene::frameBytes(scene) + pixels * kLitBytesPerPixel +
+    return kDriverAllowance + scene::frameBytes(scene) + pixels * litBytesPerPixel(scene.lights.size()) +
            layers * texels * (4 + 4) + triangles * kBytesPerTriangle;
 }
 

@@ -33,6 +33,7 @@ PipelineHandle createGraphicsPipeline(const Context& ctx, const PipelineDesc& de
             .stage = VK_SHADER_STAGE_FRAGMENT_BIT,
             .module = fragment.get(),
             .pName = "main",
+            .pSpecializationInfo = desc.fragmentSpecialization,
         });
     }
 

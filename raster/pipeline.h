@@ -15,6 +15,7 @@ ShaderModuleHandle createShaderModule(const Context& ctx, std::span<const std::u
 struct PipelineDesc {
     std::span<const std::uint32_t> vertexShader;
     std::span<const std::uint32_t> fragmentShader;  // empty: depth only
+    const VkSpecializationInfo* fragmentSpecialization = nullptr;  // the fragment stage's constants
     VkPipelineLayout layout = VK_NULL_HANDLE;
     bool usesNormal = true;  // declare vertex location 1; the validation layer warns about unused inputs
     std::vector<VkFormat> colorFormats;

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <map>
+#include <memory>
 
 #include "raster/context.h"
 #include "raster/geometry.h"
@@ -14,6 +16,9 @@
 #include "raster/shadow_pass.h"
 #include "raster/tolerances.h"
 #include "scene/camera.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 namespace shadowlab::raster {
 
@@ -63,197 +68,174 @@ const char* filterName(scene::ShadowFilter f) {
 
 }  // namespace
 
-scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settings) {
-    checkSupported(scene, settings);
+struct Renderer::Impl {
+    Impl(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settingsIn,
+         const RendererOptions& options, ValidationLog& log);
+    void render(scene::Frame& frame, scene::ChannelMask channels, const ValidationLog& log);
+    void readPixels(scene::Frame& frame, scene::ChannelMask channels) const;
+    void invalidateMemory(VkDeviceMemory memory) const {
+        const VkMappedMemoryRange range{.sType = VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE, .memory = memory, .size = VK_WHOLE_SIZE};
+        VK_CHECK(vkInvalidateMappedMemoryRanges(ctx.device.get(), 1, &range));
+    }
+
+    scene::RasterSettings settings;
+    std::uint32_t width = 0;
+    std::uint32_t height = 0;
+    std::size_t lightCount = 0;
+    std::uint32_t lightKinds = 0;  // bit 1 << SHADOWLAB_LIGHT_* per kind present
+    glm::vec3 background{0.0f};
+    std::map<std::string, std::string> attributes;  // what every frame of this scene records
+    std::vector<glm::mat4> lightMatrices;           // one per shadow-map layer
+    double setupMs = 0.0;
+    double pendingSetupMs = 0.0;  // setup not yet reported in a frame (the constructor's)
+
+    // Vulkan objects in creation order (destroyed in reverse); the context first.
+    Context ctx;
+    Buffer vertexBuffer;
+    Buffer indexBuffer;
+    DrawGeometry draw;
+    ShadowMaps maps;
+    LitTargets targets;
+    Readback readback;
+    bool timestamps = false;
+    QueryPoolHandle queries;
+    // Made on first use. Shadow: without and with blocker ids (index 0, 1). Lit: beauty target
+    // only, all targets without blocker ids, all with (index 0, 1, 2).
+    ShadowPipeline shadowPipelines[2];
+    LitPipeline litPipelines[3];
+    LitBindings bindings;  // allocated with the first lit pipeline's (identical) set layout
+    shaders::LitUniforms uniforms{};
+    std::vector<glm::vec4> albedos;
+};
+
+Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settingsIn,
+                     const RendererOptions& options, ValidationLog& log)
+    : settings(settingsIn),
+      ctx((checkSupported(scene, settingsIn),
+           ContextOptions{.device = settingsIn.device, .validate = settingsIn.validate, .log = &log})) {
+    const auto setupStart = Clock::now();
     const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
     const scene::Vec3 origin = cam.position;  // camera-relative rendering
-    const auto width = std::uint32_t(scene.camera.width);
-    const auto height = std::uint32_t(scene.camera.height);
+    width = std::uint32_t(scene.camera.width);
+    height = std::uint32_t(scene.camera.height);
+    lightCount = scene.lights.size();
+    background = glm::vec3(scene.background);
+    attributes["device"] = ctx.deviceReport.name;
 
-    // The pixels are allocated at readback, after the device has accepted the image size.
-    scene::Frame frame;
-    ValidationLog log;
+    const SceneGeometry geometry = tessellateScene(scene, origin);
+    const std::size_t triangles = geometry.triangleCount();
+    const int sphereSegmentsUsed = geometry.maxSphereSegments;
+    // Device-local, uploaded once for every frame of this Renderer.
+    vertexBuffer = uploadBuffer(ctx, geometry.vertices, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+    indexBuffer = uploadBuffer(ctx, geometry.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+    draw = DrawGeometry{vertexBuffer.buffer.get(), indexBuffer.buffer.get(), std::uint32_t(geometry.indices.size())};
+
     std::vector<LightFrustum> frusta;
     std::vector<double> usedDepthBias;  // per shadow-mapped light (spot, directional)
-    std::size_t triangles = 0;
-    int sphereSegmentsUsed = 0;
-    {
-        // --- setup: instance, device, pipelines, geometry upload ---
-        const auto setupStart = Clock::now();
-        const Context ctx(ContextOptions{.device = settings.device, .validate = settings.validate, .log = &log});
-        frame.attributes["device"] = ctx.deviceReport.name;
-
-        const SceneGeometry geometry = tessellateScene(scene, origin);
-        triangles = geometry.triangleCount();
-        sphereSegmentsUsed = geometry.maxSphereSegments;
-        const Buffer vertexBuffer = uploadBuffer(ctx, geometry.vertices, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
-        const Buffer indexBuffer = uploadBuffer(ctx, geometry.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
-        const DrawGeometry draw{vertexBuffer.buffer.get(), indexBuffer.buffer.get(),
-                                std::uint32_t(geometry.indices.size())};
-
-        // One shadow-map layer per light that needs a shadow test.
-        const scene::Bounds bounds = scene.bounds();
-        shaders::LitUniforms uniforms{};
-        const glm::dmat4 viewProj = scene::projectionMatrix(cam, scene.camera.near, scene.camera.far) *
-                                    scene::viewMatrix(cam, origin);
-        uniforms.viewProj = glm::mat4(viewProj);
-        uniforms.forward = glm::vec4(glm::vec3(cam.forward), float(scene.ambient));
-        uniforms.background = glm::vec4(glm::vec3(scene.background), 0.0f);
-        uniforms.counts = glm::vec4(float(scene.lights.size()), 0, 0, 0);
-        std::vector<glm::mat4> lightMatrices;
-        for (std::size_t i = 0; i < scene.lights.size(); ++i) {
-            const scene::Light& light = scene.lights[i];
-            const bool spot = light.type == scene::LightType::Spot;
-            const bool point = light.type == scene::LightType::Point;
-            shaders::LightData& l = uniforms.lights[i];
-            const double meanColor = (light.color.r + light.color.g + light.color.b) / 3.0;
-            l.radiance = glm::vec4(glm::vec3(light.color * light.intensity), float(light.intensity * meanColor));
-            float layer = -1.0f;
-            LightFrustum f;
-            if (needsShadowTest(plan, i)) {
-                if (point) {
-                    // Six layers, +X −X +Y −Y +Z −Z; the shader picks the face and builds its
-                    // projection itself, so toShadow stays unused.
-                    layer = float(lightMatrices.size());
-                    for (int face = 0; face < kCubeFaces; ++face) {
-                        f = fitPointLightFace(bounds, light.position, face, settings.shadowMapSize);
-                        lightMatrices.push_back(glm::mat4(f.toClip(origin)));
-                        frusta.push_back(f);
-                    }
-                    l.bias = glm::vec4(float(settings.depthBias), float(settings.slopeBias), float(f.texelWorldSize()), 0.0f);
-                } else if (spot)
-                    f = fitSpotLight(bounds, light.position, light.direction, light.coneAngleDegrees,
-                                     settings.shadowMapSize);
-                else if (settings.fitLightFrustum)
-                    f = fitDirectionalLightToReceivers(scene, light.direction, settings.shadowMapSize);
-                else
-                    f = fitDirectionalLight(bounds, light.direction, settings.shadowMapSize);
-                if (!point) {
-                    layer = float(lightMatrices.size());
+    // One shadow-map layer per light that needs a shadow test.
+    const scene::Bounds bounds = scene.bounds();
+    const glm::dmat4 viewProj = scene::projectionMatrix(cam, scene.camera.near, scene.camera.far) *
+                                scene::viewMatrix(cam, origin);
+    uniforms.viewProj = glm::mat4(viewProj);
+    uniforms.forward = glm::vec4(glm::vec3(cam.forward), float(scene.ambient));
+    uniforms.background = glm::vec4(glm::vec3(scene.background), 0.0f);
+    uniforms.counts = glm::vec4(float(scene.lights.size()), 0, 0, 0);
+    for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+        const scene::Light& light = scene.lights[i];
+        const bool spot = light.type == scene::LightType::Spot;
+        const bool point = light.type == scene::LightType::Point;
+        lightKinds |= 1u << (point  ? SHADOWLAB_LIGHT_POINT
+                             : spot ? SHADOWLAB_LIGHT_SPOT
+                                    : SHADOWLAB_LIGHT_DIRECTIONAL);
+        shaders::LightData& l = uniforms.lights[i];
+        const double meanColor = (light.color.r + light.color.g + light.color.b) / 3.0;
+        l.radiance = glm::vec4(glm::vec3(light.color * light.intensity), float(light.intensity * meanColor));
+        float layer = -1.0f;
+        LightFrustum f;
+        if (needsShadowTest(plan, i)) {
+            if (point) {
+                // Six layers, +X −X +Y −Y +Z −Z; the shader picks the face and builds its
+                // projection itself, so toShadow stays unused.
+                layer = float(lightMatrices.size());
+                for (int face = 0; face < kCubeFaces; ++face) {
+                    f = fitPointLightFace(bounds, light.position, face, settings.shadowMapSize);
                     lightMatrices.push_back(glm::mat4(f.toClip(origin)));
-                    l.toShadow = glm::mat4(f.toTexture(origin));
-                    // The default constant bias is half a texel of the bounding-sphere map
-                    // (scene::defaultDepthBias); a fitted map's texel is smaller, so the default
-                    // becomes half of *its* texel. A bias the user gave is kept as given.
-                    const double depthBias = settings.depthBiasIsDefault && settings.fitLightFrustum && !spot
-                                                 ? 0.5 * f.texelWorldSize()
-                                                 : settings.depthBias;
-                    usedDepthBias.push_back(depthBias);
-                    l.bias = glm::vec4(float(depthBias), float(settings.slopeBias), float(f.texelWorldSize()),
-                                       spot ? 0.0f : float(1.0 / f.depthRange()));
                     frusta.push_back(f);
                 }
+                l.bias = glm::vec4(float(settings.depthBias), float(settings.slopeBias), float(f.texelWorldSize()), 0.0f);
+            } else if (spot)
+                f = fitSpotLight(bounds, light.position, light.direction, light.coneAngleDegrees,
+                                 settings.shadowMapSize);
+            else if (settings.fitLightFrustum)
+                f = fitDirectionalLightToReceivers(scene, light.direction, settings.shadowMapSize);
+            else
+                f = fitDirectionalLight(bounds, light.direction, settings.shadowMapSize);
+            if (!point) {
+                layer = float(lightMatrices.size());
+                lightMatrices.push_back(glm::mat4(f.toClip(origin)));
+                l.toShadow = glm::mat4(f.toTexture(origin));
+                // The default constant bias is half a texel of the bounding-sphere map
+                // (scene::defaultDepthBias); a fitted map's texel is smaller, so the default
+                // becomes half of *its* texel. A bias the user gave is kept as given.
+                const double depthBias = settings.depthBiasIsDefault && settings.fitLightFrustum && !spot
+                                             ? 0.5 * f.texelWorldSize()
+                                             : settings.depthBias;
+                usedDepthBias.push_back(depthBias);
+                l.bias = glm::vec4(float(depthBias), float(settings.slopeBias), float(f.texelWorldSize()),
+                                   spot ? 0.0f : float(1.0 / f.depthRange()));
+                frusta.push_back(f);
             }
-            if (point) {
-                l.toLight = glm::vec4(glm::vec3(light.position - origin), layer);
-                // Without a shadow test f is default; near/far are then unused.
-                l.kind = glm::vec4(float(SHADOWLAB_LIGHT_POINT), float(cubeFaceTanHalfFov(settings.shadowMapSize)),
-                                   float(f.near), float(f.far));
-            } else if (spot) {
-                constexpr double kPi = 3.14159265358979323846;
-                l.toLight = glm::vec4(glm::vec3(light.position - origin), layer);
-                l.kind = glm::vec4(float(SHADOWLAB_LIGHT_SPOT), float(std::cos(light.coneAngleDegrees * kPi / 180.0)),
-                                   float(f.near), float(f.far));
-                l.axis = glm::vec4(glm::vec3(glm::normalize(light.direction)), 0.0f);
-            } else {
-                l.toLight = glm::vec4(glm::vec3(-light.direction), layer);
-                l.kind = glm::vec4(float(SHADOWLAB_LIGHT_DIRECTIONAL), 0, 0, 0);
-            }
-            l.params = glm::vec4(float(kMaxSlopeTan), float(int(settings.filter)), float(settings.normalOffset),
-                                 float(settings.pcfSize));
         }
-        std::vector<glm::vec4> albedos;
-        for (const scene::Object& o : scene.objects)
-            albedos.emplace_back(glm::vec3(scene.materialOf(o).albedo), 1.0f);
+        if (point) {
+            l.toLight = glm::vec4(glm::vec3(light.position - origin), layer);
+            // Without a shadow test f is default; near/far are then unused.
+            l.kind = glm::vec4(float(SHADOWLAB_LIGHT_POINT), float(cubeFaceTanHalfFov(settings.shadowMapSize)),
+                               float(f.near), float(f.far));
+        } else if (spot) {
+            constexpr double kPi = 3.14159265358979323846;
+            l.toLight = glm::vec4(glm::vec3(light.position - origin), layer);
+            l.kind = glm::vec4(float(SHADOWLAB_LIGHT_SPOT), float(std::cos(light.coneAngleDegrees * kPi / 180.0)),
+                               float(f.near), float(f.far));
+            l.axis = glm::vec4(glm::vec3(glm::normalize(light.direction)), 0.0f);
+        } else {
+            l.toLight = glm::vec4(glm::vec3(-light.direction), layer);
+            l.kind = glm::vec4(float(SHADOWLAB_LIGHT_DIRECTIONAL), 0, 0, 0);
+        }
+        l.params = glm::vec4(float(kMaxSlopeTan), float(int(settings.filter)), float(settings.normalOffset),
+                             float(settings.pcfSize));
+    }
+    for (const scene::Object& o : scene.objects)
+        albedos.emplace_back(glm::vec3(scene.materialOf(o).albedo), 1.0f);
 
-        // Without a shadowed light a 1x1 cleared layer keeps the descriptor valid.
-        const auto mapSize = lightMatrices.empty() ? 1u : std::uint32_t(settings.shadowMapSize);
-        const auto layers = std::max<std::uint32_t>(1, std::uint32_t(lightMatrices.size()));
-        const ShadowPipeline shadowPipeline = createShadowPipeline(ctx);
-        const ShadowMaps maps = createShadowMaps(ctx, mapSize, layers);
-        const LitPipeline litPipeline = createLitPipeline(ctx);
-        const LitTargets targets = createLitTargets(ctx, width, height);
-        const LitBindings bindings = createLitBindings(ctx, litPipeline, uniforms, albedos, maps);
-        const Readback readback = createReadback(ctx, targets);
-        // GPU timestamps around each pass, where the queue has them (a bonus to the CPU clock,
-        // which also counts submission and the fence wait).
-        const bool timestamps = ctx.properties.limits.timestampComputeAndGraphics == VK_TRUE;
-        QueryPoolHandle queries;
-        if (timestamps) {
-            const VkQueryPoolCreateInfo queryInfo{
-                .sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO,
-                .queryType = VK_QUERY_TYPE_TIMESTAMP,
-                .queryCount = 4,
-            };
-            VkQueryPool pool = VK_NULL_HANDLE;
-            VK_CHECK(vkCreateQueryPool(ctx.device.get(), &queryInfo, nullptr, &pool));
-            queries = QueryPoolHandle(ctx.device.get(), pool);
-        }
-        auto stamp = [&](VkCommandBuffer cb, std::uint32_t query) {
-            if (timestamps) vkCmdWriteTimestamp2(cb, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries.get(), query);
+    // Without a shadowed light a 1x1 cleared layer keeps the descriptor valid.
+    const auto mapSize = lightMatrices.empty() ? 1u : std::uint32_t(settings.shadowMapSize);
+    const auto layers = std::max<std::uint32_t>(1, std::uint32_t(lightMatrices.size()));
+    maps = createShadowMaps(ctx, mapSize, layers);
+    targets = createLitTargets(ctx, width, height, lightCount > 1 ? kLightTargets : 0, options.readTargetsInPlace);
+    if (!targets.hostReadable) readback = createReadback(ctx, targets);
+    // How the targets reach the Frame: read in place (lavapipe) or copied into buffers first.
+    attributes["readback"] = targets.hostReadable ? "in-place" : "copy";
+    // GPU timestamps around each pass, where the queue has them (a bonus to the CPU clock,
+    // which also counts submission and the fence wait).
+    timestamps = ctx.properties.limits.timestampComputeAndGraphics == VK_TRUE;
+    if (timestamps) {
+        const VkQueryPoolCreateInfo queryInfo{
+            .sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO,
+            .queryType = VK_QUERY_TYPE_TIMESTAMP,
+            .queryCount = 4,
         };
-        frame.timingsMs.emplace_back("setup", msSince(setupStart));
+        VkQueryPool pool = VK_NULL_HANDLE;
+        VK_CHECK(vkCreateQueryPool(ctx.device.get(), &queryInfo, nullptr, &pool));
+        queries = QueryPoolHandle(ctx.device.get(), pool);
+    }
 
-        // --- shadow pass ---
-        const auto shadowStart = Clock::now();
-        VkCommandBuffer commands = ctx.beginCommands();
-        if (timestamps) vkCmdResetQueryPool(commands, queries.get(), 0, 4);
-        stamp(commands, 0);
-        recordShadowPass(commands, shadowPipeline, maps, draw, lightMatrices);
-        stamp(commands, 1);
-        ctx.submitAndWait(commands);
-        frame.timingsMs.emplace_back("shadow_pass", msSince(shadowStart));
-
-        // --- lit pass ---
-        const auto litStart = Clock::now();
-        commands = ctx.beginCommands();
-        stamp(commands, 2);
-        recordLitPass(commands, litPipeline, bindings, targets, draw, glm::vec3(scene.background));
-        stamp(commands, 3);
-        ctx.submitAndWait(commands);
-        frame.timingsMs.emplace_back("lit_pass", msSince(litStart));
-
-        // --- readback: rows come out top first, as the Frame wants them ---
-        const auto readStart = Clock::now();
-        commands = ctx.beginCommands();
-        recordReadback(commands, targets, readback);
-        ctx.submitAndWait(commands);
-        invalidate(ctx, readback.beauty);
-        invalidate(ctx, readback.aovs);
-        scene::Frame pixels = scene::Frame::allocate(int(width), int(height), true);
-        pixels.attributes = std::move(frame.attributes);
-        pixels.timingsMs = std::move(frame.timingsMs);
-        frame = std::move(pixels);
-        const auto* beauty = static_cast<const float*>(readback.beauty.mapped);
-        const auto* aovs = static_cast<const float*>(readback.aovs.mapped);
-        for (std::size_t i = 0; i < frame.pixelCount(); ++i) {
-            frame.beauty[3 * i + 0] = beauty[4 * i + 0];
-            frame.beauty[3 * i + 1] = beauty[4 * i + 1];
-            frame.beauty[3 * i + 2] = beauty[4 * i + 2];
-            frame.visibility[i] = beauty[4 * i + 3];
-            frame.objectId[i] = aovs[4 * i + 0];
-            frame.ndotl[i] = aovs[4 * i + 1];
-            frame.depth[i] = aovs[4 * i + 2];
-            frame.blockerId[i] = aovs[4 * i + 3];
-        }
-        frame.timingsMs.emplace_back("readback", msSince(readStart));
-        if (timestamps) {
-            std::uint64_t ticks[4] = {};
-            VK_CHECK(vkGetQueryPoolResults(ctx.device.get(), queries.get(), 0, 4, sizeof ticks, ticks,
-                                           sizeof(std::uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
-            const double msPerTick = double(ctx.properties.limits.timestampPeriod) * 1e-6;
-            frame.attributes["gpu_shadow_pass_ms"] = formatNumber(double(ticks[1] - ticks[0]) * msPerTick);
-            frame.attributes["gpu_lit_pass_ms"] = formatNumber(double(ticks[3] - ticks[2]) * msPerTick);
-        }
-    }  // the context is destroyed here; validation messages raised by that still count
-
-    frame.attributes["backend"] = "raster";
-    frame.attributes["shadow_map_size"] = std::to_string(settings.shadowMapSize);
-    frame.attributes["filter"] = filterName(settings.filter);
+    attributes["backend"] = "raster";
+    attributes["shadow_map_size"] = std::to_string(settings.shadowMapSize);
+    attributes["filter"] = filterName(settings.filter);
     if (settings.filter == scene::ShadowFilter::Pcf || settings.filter == scene::ShadowFilter::Poisson)
-        frame.attributes["pcf_size"] = std::to_string(settings.pcfSize);
-    frame.attributes["normal_offset"] = formatNumber(settings.normalOffset);
-    frame.attributes["light_frustum_fit"] = settings.fitLightFrustum ? "receivers" : "bounding-sphere";
+        attributes["pcf_size"] = std::to_string(settings.pcfSize);
+    attributes["normal_offset"] = formatNumber(settings.normalOffset);
+    attributes["light_frustum_fit"] = settings.fitLightFrustum ? "receivers" : "bounding-sphere";
     // The constant bias actually used: one value, or one per light (';') when a default was
     // re-derived per fitted map and the maps differ.
     std::string depthBias = formatNumber(settings.depthBias);
@@ -267,13 +249,13 @@ scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, co
                 break;
             }
     }
-    frame.attributes["depth_bias"] = depthBias;
-    frame.attributes["depth_bias_default"] = settings.depthBiasIsDefault ? "true" : "false";
-    frame.attributes["slope_bias"] = formatNumber(settings.slopeBias);
-    frame.attributes["max_slope_tan"] = formatNumber(kMaxSlopeTan);
-    frame.attributes["triangles"] = std::to_string(triangles);
-    frame.attributes["sphere_segments"] = std::to_string(sphereSegmentsUsed);
-    frame.attributes["shadow_maps"] = std::to_string(frusta.size());
+    attributes["depth_bias"] = depthBias;
+    attributes["depth_bias_default"] = settings.depthBiasIsDefault ? "true" : "false";
+    attributes["slope_bias"] = formatNumber(settings.slopeBias);
+    attributes["max_slope_tan"] = formatNumber(kMaxSlopeTan);
+    attributes["triangles"] = std::to_string(triangles);
+    attributes["sphere_segments"] = std::to_string(sphereSegmentsUsed);
+    attributes["shadow_maps"] = std::to_string(frusta.size());
     if (!frusta.empty()) {
         std::string texel, frustum;
         for (std::size_t i = 0; i < frusta.size(); ++i) {
@@ -281,10 +263,195 @@ scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, co
             texel += (i ? ";" : "") + formatNumber(frusta[i].texelWorldSize()) + (frusta[i].perspective ? "*d" : "");
             frustum += (i ? "; " : "") + frusta[i].describe();
         }
-        frame.attributes["texel_world_size"] = texel;
-        frame.attributes["light_frustum"] = frustum;
+        attributes["texel_world_size"] = texel;
+        attributes["light_frustum"] = frustum;
+    }
+    setupMs = msSince(setupStart);
+    pendingSetupMs = setupMs;
+}
+
+void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, const ValidationLog& log) {
+    using namespace scene;
+    const bool wantIds = (channels & kChannelBlockerId) != 0;
+    const bool wantAovs = (channels & (kChannelObjectId | kChannelNdotL | kChannelDepth | kChannelBlockerId)) != 0;
+    const bool wantBeauty = (channels & (kChannelBeauty | kChannelVisibility)) != 0;
+    const bool wantLights = (channels & kChannelLightVisibility) != 0 && !targets.lights.empty();
+
+    // --- setup still owed: the pipelines this frame needs (shader compilation) ---
+    ShadowPipeline& shadowPipeline = shadowPipelines[wantIds ? 1 : 0];
+    const bool beautyOnly = !wantAovs && !wantLights;  // the beauty target holds visibility too
+    LitPipeline& litPipeline = litPipelines[beautyOnly ? 0 : wantIds ? 2 : 1];
+    double setup = pendingSetupMs;  // 0 for a frame that creates nothing
+    pendingSetupMs = 0.0;
+    if (!shadowPipeline.pipeline || !litPipeline.pipeline) {
+        const auto pipelineStart = Clock::now();
+        if (!shadowPipeline.pipeline) shadowPipeline = createShadowPipeline(ctx, wantIds);
+        if (!litPipeline.pipeline)
+            litPipeline = createLitPipeline(ctx, LitVariant{.filter = settings.filter,
+                                                            .blockerIds = wantIds,
+                                                            .aovTarget = !beautyOnly,
+                                                            .lightTargets = std::uint32_t(targets.lights.size()),
+                                                            .lightCount = std::uint32_t(lightCount),
+                                                            .lightKinds = lightKinds});
+        if (bindings.set == VK_NULL_HANDLE) bindings = createLitBindings(ctx, litPipeline, uniforms, albedos, maps);
+        setup += msSince(pipelineStart);
+    }
+
+    frame.attributes = attributes;
+    frame.timingsMs.assign(1, {"setup", setup});
+    auto stamp = [&](VkCommandBuffer cb, std::uint32_t query) {
+        if (timestamps) vkCmdWriteTimestamp2(cb, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries.get(), query);
+    };
+
+    // --- shadow pass ---
+    const auto shadowStart = Clock::now();
+    VkCommandBuffer commands = ctx.beginCommands();
+    if (timestamps) vkCmdResetQueryPool(commands, queries.get(), 0, 4);
+    stamp(commands, 0);
+    recordShadowPass(commands, shadowPipeline, maps, draw, lightMatrices, wantIds);
+    stamp(commands, 1);
+    ctx.submitAndWait(commands);
+    frame.timingsMs.emplace_back("shadow_pass", msSince(shadowStart));
+
+    // --- lit pass ---
+    const auto litStart = Clock::now();
+    commands = ctx.beginCommands();
+    stamp(commands, 2);
+    recordLitPass(commands, litPipeline, bindings, targets, draw, background, beautyOnly);
+    stamp(commands, 3);
+    ctx.submitAndWait(commands);
+    frame.timingsMs.emplace_back("lit_pass", msSince(litStart));
+
+    // --- readback of the targets holding what was asked for ---
+    const auto readStart = Clock::now();
+    if (targets.hostReadable) {
+        // The lit pass's barrier made the writes visible to the host; coherent memory needs no
+        // invalidation, the rest does.
+        for (const Image* image : {&targets.beauty, &targets.aovs}) invalidateMemory(image->memory.get());
+        for (const Image& image : targets.lights) invalidateMemory(image.memory.get());
+    } else {
+        commands = ctx.beginCommands();
+        recordReadback(commands, targets, readback,
+                       ReadbackSelection{.beauty = wantBeauty, .aovs = wantAovs, .lights = wantLights});
+        ctx.submitAndWait(commands);
+        if (wantBeauty) invalidate(ctx, readback.beauty);
+        if (wantAovs) invalidate(ctx, readback.aovs);
+        if (wantLights)
+            for (const Buffer& b : readback.lights) invalidate(ctx, b);
+    }
+    readPixels(frame, channels);
+    frame.timingsMs.emplace_back("readback", msSince(readStart));
+    if (timestamps) {
+        std::uint64_t ticks[4] = {};
+        VK_CHECK(vkGetQueryPoolResults(ctx.device.get(), queries.get(), 0, 4, sizeof ticks, ticks,
+                                       sizeof(std::uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+        const double msPerTick = double(ctx.properties.limits.timestampPeriod) * 1e-6;
+        frame.attributes["gpu_shadow_pass_ms"] = formatNumber(double(ticks[1] - ticks[0]) * msPerTick);
+        frame.attributes["gpu_lit_pass_ms"] = formatNumber(double(ticks[3] - ticks[2]) * msPerTick);
     }
     if (settings.validate) frame.attributes["validation_messages"] = std::to_string(log.count.load());
+}
+
+// Rows come out top first, as the Frame wants them. Only the channels asked for are filled:
+// one pass over each target, in parallel over blocks of rows.
+void Renderer::Impl::readPixels(scene::Frame& frame, scene::ChannelMask channels) const {
+    using namespace scene;
+    frame.width = int(width);
+    frame.height = int(height);
+    const std::size_t n = frame.pixelCount();
+    // A reused frame keeps its vectors' memory: no new pages to fault in and zero (on a
+    // 1920x1080 frame that cost more than the copy and this loop together).
+    auto output = [n, channels](std::vector<float>& v, ChannelMask bit, std::size_t perPixel = 1) -> float* {
+        if (!(channels & bit)) {
+            v.clear();
+            return nullptr;
+        }
+        v.resize(perPixel * n);
+        return v.data();
+    };
+    float* const rgb = output(frame.beauty, kChannelBeauty, 3);
+    float* const visibility = output(frame.visibility, kChannelVisibility);
+    float* const objectId = output(frame.objectId, kChannelObjectId);
+    float* const ndotl = output(frame.ndotl, kChannelNdotL);
+    float* const depth = output(frame.depth, kChannelDepth);
+    float* const blockerId = output(frame.blockerId, kChannelBlockerId);
+    std::vector<float*> lights;
+    frame.lightVisibility.resize((channels & kChannelLightVisibility) && !targets.lights.empty() ? lightCount : 0);
+    for (std::vector<float>& v : frame.lightVisibility) lights.push_back(output(v, kChannelLightVisibility));
+    // Where each target's rows are: the targets themselves (host-readable) or their buffers.
+    struct Rows {
+        const char* base;
+        std::size_t pitch;
+        const float* row(std::size_t y) const { return reinterpret_cast<const float*>(base + y * pitch); }
+    };
+    const std::size_t tightPitch = std::size_t(width) * 4 * sizeof(float);
+    auto rows = [&](const Image& image, const Buffer* buffer) {
+        return targets.hostReadable ? Rows{static_cast<const char*>(image.mapped), std::size_t(image.rowPitch)}
+                                    : Rows{static_cast<const char*>(buffer->mapped), tightPitch};
+    };
+    const Rows beauty = rows(targets.beauty, &readback.beauty);
+    const Rows aovs = rows(targets.aovs, &readback.aovs);
+    std::vector<Rows> lightRows;
+    for (std::size_t t = 0; t < targets.lights.size(); ++t)
+        lightRows.push_back(rows(targets.lights[t], targets.hostReadable ? nullptr : &readback.lights[t]));
+    const std::size_t w = width;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, height, 16), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t y = r.begin(); y < r.end(); ++y) {
+            const std::size_t o = y * w;  // first pixel of the row in the Frame
+            if (rgb || visibility) {
+                const float* p = beauty.row(y);
+                for (std::size_t x = 0; x < w; ++x) {
+                    if (rgb) {
+                        rgb[3 * (o + x) + 0] = p[4 * x + 0];
+                        rgb[3 * (o + x) + 1] = p[4 * x + 1];
+                        rgb[3 * (o + x) + 2] = p[4 * x + 2];
+                    }
+                    if (visibility) visibility[o + x] = p[4 * x + 3];
+                }
+            }
+            if (objectId || ndotl || depth || blockerId) {
+                const float* p = aovs.row(y);
+                for (std::size_t x = 0; x < w; ++x) {
+                    if (objectId) objectId[o + x] = p[4 * x + 0];
+                    if (ndotl) ndotl[o + x] = p[4 * x + 1];
+                    if (depth) depth[o + x] = p[4 * x + 2];
+                    if (blockerId) blockerId[o + x] = p[4 * x + 3];
+                }
+            }
+            for (std::size_t l = 0; l < lights.size(); ++l) {
+                const float* p = lightRows[l / 4].row(y) + l % 4;
+                for (std::size_t x = 0; x < w; ++x) lights[l][o + x] = p[4 * x];
+            }
+        }
+    });
+}
+
+Renderer::Renderer(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settings,
+                   const RendererOptions& options)
+    : log_(std::make_shared<ValidationLog>()), impl_(std::make_unique<Impl>(scene, plan, settings, options, *log_)) {}
+Renderer::~Renderer() = default;
+Renderer::Renderer(Renderer&&) noexcept = default;
+Renderer& Renderer::operator=(Renderer&&) noexcept = default;
+
+scene::Frame Renderer::render(scene::ChannelMask channels) {
+    scene::Frame frame;
+    impl_->render(frame, channels, *log_);
+    return frame;
+}
+void Renderer::render(scene::Frame& frame, scene::ChannelMask channels) { impl_->render(frame, channels, *log_); }
+double Renderer::setupMs() const { return impl_->setupMs; }
+int Renderer::validationMessages() const { return log_->count.load(); }
+
+scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settings,
+                    scene::ChannelMask channels) {
+    std::shared_ptr<const ValidationLog> log;
+    scene::Frame frame;
+    {
+        Renderer renderer(scene, plan, settings);
+        log = renderer.validationLog();
+        frame = renderer.render(channels);
+    }  // the device is destroyed here; validation messages raised by that still count
+    if (settings.validate) frame.attributes["validation_messages"] = std::to_string(log->count.load());
     return frame;
 }
 

@@ -2,6 +2,8 @@
 // Frame, and list the Vulkan devices for `shadowlab info`.
 #pragma once
 
+#include <memory>
+
 #include "raster/devices.h"
 #include "raster/vulkan_error.h"
 #include "scene/frame.h"
@@ -10,6 +12,46 @@
 #include "scene/settings.h"
 
 namespace shadowlab::raster {
+
+struct ValidationLog;
+
+// A reusable raster renderer for one scene and its settings: the constructor does the setup
+// once (instance, device, tessellation, geometry upload into device-local buffers, shadow maps,
+// targets, readback buffers, uniforms); render() then runs the two passes and the readback of
+// the channels asked for, and can be called any number of times. Pipelines are made on the
+// first render() that needs them (the blocker-id variant only when blocker ids are asked for).
+// The first frame's "setup" timing is the constructor's time plus any pipeline creation; later
+// frames have "setup" 0 unless they had to create a pipeline. Call from one thread at a time.
+struct RendererOptions {
+    // Read the targets in place where the device's memory is the host's (lavapipe); false
+    // copies them into readback buffers first, as on other devices (tests compare the two).
+    bool readTargetsInPlace = true;
+};
+
+class Renderer {
+public:
+    Renderer(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settings,
+             const RendererOptions& options = {});
+    ~Renderer();
+    Renderer(Renderer&&) noexcept;
+    Renderer& operator=(Renderer&&) noexcept;
+
+    // The two passes and the readback of `channels` (scene/frame.h). Vectors of channels not
+    // asked for are left empty; lightVisibility is filled only for scenes with > 1 light.
+    scene::Frame render(scene::ChannelMask channels = scene::kAllChannels);
+    // The same into `frame`, reusing its vectors' memory (a loop over frames allocates nothing).
+    void render(scene::Frame& frame, scene::ChannelMask channels = scene::kAllChannels);
+    double setupMs() const;  // the constructor's time
+    // Validation messages counted so far (settings.validate); messages raised when the Renderer
+    // is destroyed are not in any frame: raster::render() adds them to its frame.
+    int validationMessages() const;
+    std::shared_ptr<const ValidationLog> validationLog() const { return log_; }
+
+private:
+    struct Impl;
+    std::shared_ptr<ValidationLog> log_;  // outlives the device, which can still report
+    std::unique_ptr<Impl> impl_;
+};
 
 // Renders on a headless Vulkan 1.3 device (lavapipe unless settings.device names another):
 // one depth pass per directional or spot light, six (a cube map) per point light, for each
@@ -22,7 +64,8 @@ namespace shadowlab::raster {
 // validation_messages (the count; each is printed to stderr). Throws RasterError (no loader,
 // driver or device; bad settings) or VulkanError (a failed call). Call it from one thread at a time: the Vulkan
 // function pointers it loads are shared by the process.
+// One frame from a Renderer made for it (setup included in the "setup" timing).
 scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan,
-                    const scene::RasterSettings& settings);
+                    const scene::RasterSettings& settings, scene::ChannelMask channels = scene::kAllChannels);
 
 }  // namespace shadowlab::raster

@@ -95,9 +95,19 @@ ImageViewHandle createView(const Context& ctx, VkImage image, VkFormat format, V
     return ImageViewHandle(ctx.device.get(), view);
 }
 
+bool canReadImagesOnHost(const Context& ctx, VkFormat format, VkImageUsageFlags usage) {
+    if (!ctx.deviceReport.lavapipe) return false;
+    VkFormatProperties props{};
+    vkGetPhysicalDeviceFormatProperties(ctx.physicalDevice, format, &props);
+    VkFormatFeatureFlags needed = 0;
+    if (usage & VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT) needed |= VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT;
+    if (usage & VK_IMAGE_USAGE_TRANSFER_SRC_BIT) needed |= VK_FORMAT_FEATURE_TRANSFER_SRC_BIT;
+    return (props.linearTilingFeatures & needed) == needed;
+}
+
 Image createImage(const Context& ctx, VkFormat format, std::uint32_t width, std::uint32_t height,
                   std::uint32_t layers, VkImageUsageFlags usage, VkImageAspectFlags aspect,
-                  VkImageViewType viewType) {
+                  VkImageViewType viewType, bool hostReadable) {
     VkDevice device = ctx.device.get();
     const VkImageCreateInfo info{
         .sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO,
@@ -107,7 +117,7 @@ Image createImage(const Context& ctx, VkFormat format, std::uint32_t width, std:
         .mipLevels = 1,
         .arrayLayers = layers,
         .samples = VK_SAMPLE_COUNT_1_BIT,
-        .tiling = VK_IMAGE_TILING_OPTIMAL,
+        .tiling = hostReadable ? VK_IMAGE_TILING_LINEAR : VK_IMAGE_TILING_OPTIMAL,
         .usage = usage,
         .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
         .initialLayout = VK_IMAGE_LAYOUT_UNDEFINED,
@@ -121,12 +131,24 @@ Image createImage(const Context& ctx, VkFormat format, std::uint32_t width, std:
     const VkMemoryAllocateInfo alloc{
         .sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
         .allocationSize = req.size,
-        .memoryTypeIndex = ctx.memoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT),
+        .memoryTypeIndex = hostReadable ? ctx.memoryType(req.memoryTypeBits,
+                                                         VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT,
+                                                         VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
+                                        : ctx.memoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT),
     };
     VkDeviceMemory memory = VK_NULL_HANDLE;
     VK_CHECK(vkAllocateMemory(device, &alloc, nullptr, &memory));
     img.memory = MemoryHandle(device, memory);
     VK_CHECK(vkBindImageMemory(device, image, memory, 0));
+    if (hostReadable) {
+        const VkImageSubresource subresource{.aspectMask = aspect, .mipLevel = 0, .arrayLayer = 0};
+        VkSubresourceLayout layout{};
+        vkGetImageSubresourceLayout(device, image, &subresource, &layout);
+        void* base = nullptr;
+        VK_CHECK(vkMapMemory(device, memory, 0, VK_WHOLE_SIZE, 0, &base));
+        img.mapped = static_cast<const char*>(base) + layout.offset;
+        img.rowPitch = layout.rowPitch;
+    }
     img.view = createView(ctx, image, format, aspect, viewType, 0, layers);
     return img;
 }

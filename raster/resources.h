@@ -25,6 +25,10 @@ struct Image {
     ImageHandle image;
     MemoryHandle memory;
     ImageViewHandle view;  // of every layer (2D or 2D array)
+    // Host-readable images only (linear tiling, host-visible memory, mapped): the first texel
+    // of layer 0 and the bytes from one row to the next.
+    const void* mapped = nullptr;
+    VkDeviceSize rowPitch = 0;
 };
 
 // Throws RasterError when `bytes` cannot fit in the device's largest device-local heap, naming
@@ -48,9 +52,15 @@ Buffer createReadbackBuffer(const Context& ctx, VkDeviceSize size);
 // Makes device writes visible to the host for non-coherent memory; a no-op on coherent memory.
 void invalidate(const Context& ctx, const Buffer& buffer);
 
+// With hostReadable: linear tiling in host-visible memory, mapped (one layer, color only; see
+// canReadImagesOnHost()).
 Image createImage(const Context& ctx, VkFormat format, std::uint32_t width, std::uint32_t height,
                   std::uint32_t layers, VkImageUsageFlags usage, VkImageAspectFlags aspect,
-                  VkImageViewType viewType);
+                  VkImageViewType viewType, bool hostReadable = false);
+// Whether `format` can be a color attachment with linear tiling and live in host-visible memory
+// that is the device's own: true on lavapipe, whose "device memory" is host memory, so the host
+// can read rendered targets in place instead of copying them into a buffer first.
+bool canReadImagesOnHost(const Context& ctx, VkFormat format, VkImageUsageFlags usage);
 ImageViewHandle createView(const Context& ctx, VkImage image, VkFormat format, VkImageAspectFlags aspect,
                            VkImageViewType viewType, std::uint32_t firstLayer, std::uint32_t layerCount);
 

@@ -10,7 +10,7 @@
 
 namespace shadowlab::raster {
 
-ShadowPipeline createShadowPipeline(const Context& ctx) {
+ShadowPipeline createShadowPipeline(const Context& ctx, bool blockerIds) {
     requireFormat(ctx, kShadowMapFormat,
                   VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT,
                   "the shadow map");
@@ -29,10 +29,12 @@ ShadowPipeline createShadowPipeline(const Context& ctx) {
     p.layout = PipelineLayoutHandle(ctx.device.get(), layout);
     p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{
                                                  .vertexShader = shaders::shadowVertSpirv(),
-                                                 .fragmentShader = shaders::shadowFragSpirv(),
+                                                 .fragmentShader = blockerIds ? shaders::shadowFragSpirv()
+                                                                              : std::span<const std::uint32_t>(),
                                                  .layout = layout,
                                                  .usesNormal = false,
-                                                 .colorFormats = {kBlockerIdFormat},
+                                                 .colorFormats = blockerIds ? std::vector<VkFormat>{kBlockerIdFormat}
+                                                                            : std::vector<VkFormat>{},
                                                  .depthFormat = kShadowMapFormat,
                                                  .depthCompare = VK_COMPARE_OP_LESS,
                                              });
@@ -67,16 +69,20 @@ ShadowMaps createShadowMaps(const Context& ctx, std::uint32_t size, std::uint32_
 }
 
 void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, const ShadowMaps& maps,
-                      const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices) {
+                      const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices,
+                      bool blockerIds) {
+    // Source stage: the previous frame's lit pass sampled both arrays (a reused Renderer).
     transition(commands, {{maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, maps.layers,
                            VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                           VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
+                           VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_NONE,
                            VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
                            VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
                                VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT},
                           {maps.ids.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, maps.layers, VK_IMAGE_LAYOUT_UNDEFINED,
-                           VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
-                           VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT}});
+                           blockerIds ? VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                           VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_NONE,
+                           blockerIds ? VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT : VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                           blockerIds ? VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT : VK_ACCESS_2_NONE}});
     for (std::uint32_t layer = 0; layer < maps.layers; ++layer) {
         const VkRenderingAttachmentInfo depth{
             .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
@@ -98,8 +104,8 @@ void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, 
             .sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
             .renderArea = {{0, 0}, {maps.size, maps.size}},
             .layerCount = 1,
-            .colorAttachmentCount = 1,
-            .pColorAttachments = &ids,
+            .colorAttachmentCount = blockerIds ? 1u : 0u,
+            .pColorAttachments = blockerIds ? &ids : nullptr,
             .pDepthAttachment = &depth,
         };
         vkCmdBeginRendering(commands, &rendering);
@@ -115,17 +121,19 @@ void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, 
         }
         vkCmdEndRendering(commands);
     }
-    transition(commands, {{maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, maps.layers,
+    std::vector<ImageTransition> after{{maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, maps.layers,
                            VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                            VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
                            VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
                            VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT,
-                           VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT},
-                          {maps.ids.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, maps.layers,
-                           VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                           VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-                           VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT,
-                           VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT}});
+                           VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT}};
+    if (blockerIds)
+        after.push_back({maps.ids.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, maps.layers,
+                         VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                         VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                         VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT,
+                         VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT});
+    transition(commands, after);
 }
 
 namespace {

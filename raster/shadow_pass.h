@@ -19,7 +19,8 @@ struct ShadowPipeline {
     PipelineLayoutHandle layout;
     PipelineHandle pipeline;
 };
-ShadowPipeline createShadowPipeline(const Context& ctx);
+// Without blockerIds: depth only, no fragment shader (much cheaper on lavapipe).
+ShadowPipeline createShadowPipeline(const Context& ctx, bool blockerIds = true);
 
 struct ShadowMaps {
     Image depth;                             // size x size x layers; view: 2D array for sampling
@@ -40,9 +41,12 @@ struct DrawGeometry {
 
 // Records: every layer cleared to depth 1 (far: lit) and id 0, and layer i drawn with
 // lightMatrices[i] (layers past the end of lightMatrices are only cleared), then both arrays
-// made readable by fragment shaders (SHADER_READ_ONLY_OPTIMAL).
+// made readable by fragment shaders (SHADER_READ_ONLY_OPTIMAL). Without blockerIds (the
+// pipeline made so) the id array is not rendered, only moved to SHADER_READ_ONLY_OPTIMAL with
+// undefined contents, for a lit pass that does not read it.
 void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, const ShadowMaps& maps,
-                      const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices);
+                      const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices,
+                      bool blockerIds = true);
 
 // Diagnostics and tests: the depths of one layer after recordShadowPass() has run, row 0 first.
 std::vector<float> readShadowMap(const Context& ctx, const ShadowMaps& maps, std::uint32_t layer);

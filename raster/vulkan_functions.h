@@ -47,6 +47,7 @@
     X(vkCreateImage)                            \
     X(vkDestroyImage)                           \
     X(vkGetImageMemoryRequirements)             \
+    X(vkGetImageSubresourceLayout)              \
     X(vkBindImageMemory)                        \
     X(vkCreateImageView)                        \
     X(vkDestroyImageView)                       \

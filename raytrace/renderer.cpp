@@ -53,6 +53,9 @@ scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan,
     const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
     const int width = cam.width, height = cam.height;
     scene::Frame frame = scene::Frame::allocate(width, height, true);
+    // Per-light visibility only when it adds something: with one light it is `visibility`.
+    if (scene.lights.size() > 1)
+        frame.lightVisibility.assign(scene.lights.size(), std::vector<float>(frame.pixelCount(), 0.0f));
     tbb::task_arena arena(settings.threads > 0 ? settings.threads
                                                : tbb::task_arena::automatic);
     const bool robust = settings.robustOffset;
@@ -131,6 +134,7 @@ scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan,
                 v = r.transmittance;
                 if (blocker == 0 && r.blocker >= 0) blocker = r.blocker + 1;
             }
+            if (!frame.lightVisibility.empty()) frame.lightVisibility[li][i] = float(v);
             // The visibility AOV weighs each light by what it would add unshadowed.
             const double w = ls.irradiance * ndotl * (light.color.r + light.color.g + light.color.b) / 3.0;
             weightSum += w;

@@ -10,6 +10,19 @@
 
 namespace shadowlab::scene {
 
+// Which Frame channels a render is asked for (a bit mask). A backend fills at least these;
+// the vectors of channels not asked for may stay empty. `render -o x.png` needs the beauty
+// only; compare needs visibility, object id, N·L, Z (and blocker ids where a backend has them).
+using ChannelMask = unsigned;
+inline constexpr ChannelMask kChannelBeauty = 1u << 0;
+inline constexpr ChannelMask kChannelVisibility = 1u << 1;
+inline constexpr ChannelMask kChannelObjectId = 1u << 2;
+inline constexpr ChannelMask kChannelNdotL = 1u << 3;
+inline constexpr ChannelMask kChannelDepth = 1u << 4;
+inline constexpr ChannelMask kChannelBlockerId = 1u << 5;
+inline constexpr ChannelMask kChannelLightVisibility = 1u << 6;  // per light, > 1 light only
+inline constexpr ChannelMask kAllChannels = (1u << 7) - 1;
+
 struct Frame {
     int width = 0;
     int height = 0;
@@ -21,6 +34,11 @@ struct Frame {
     // Object id (index + 1) of the first blocker the shadow test found, 0 = none. Empty when
     // the backend cannot tell.
     std::vector<float> blockerId;
+    // Per-light visibility (0..1, the shadow test of light i alone; 0 where light i does not
+    // reach the point: N·L <= 0 or outside a spot's cone), one vector per light in scene order.
+    // Only when the scene has more than one light (with one it equals `visibility`); written to
+    // EXR as channels visibility.0, visibility.1, ...
+    std::vector<std::vector<float>> lightVisibility;
     // Metadata written as EXR header attributes: "backend", "scene", "version", settings...
     std::map<std::string, std::string> attributes;
     // Stage timings in milliseconds, in the order they ran ("setup", "shadow_pass", ...).

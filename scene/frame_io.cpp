@@ -213,6 +213,8 @@ void replaceDirectory(const fs::path& fresh, const fs::path& target) {
     fs::remove_all(fresh);  // now the old folder
 }
 
+std::string lightVisibilityChannel(std::size_t light) { return "visibility." + std::to_string(light); }
+
 float linearToSrgb(float c) {
     c = std::clamp(c, 0.0f, 1.0f);
     return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
@@ -246,17 +248,26 @@ void writeFrame(const Frame& frame, const fs::path& file) {
         throw InputError(file.string() + ": unknown output type '" + ext + "' (use .exr or .png)");
 
     const bool withBlocker = !frame.blockerId.empty();
-    const int channels = withBlocker ? 8 : 7;
+    const std::size_t n = frame.pixelCount();
+    for (const std::vector<float>* v : {&frame.visibility, &frame.objectId, &frame.ndotl, &frame.depth})
+        if (v->size() != n)
+            throw std::invalid_argument(file.string() + ": the frame lacks an AOV an EXR needs (rendered for a PNG?)");
+    for (const std::vector<float>& v : frame.lightVisibility)
+        if (v.size() != n) throw std::invalid_argument(file.string() + ": a per-light visibility has the wrong size");
+    const std::size_t lights = frame.lightVisibility.size();
+    const int channels = (withBlocker ? 8 : 7) + int(lights);
     ImageSpec spec(frame.width, frame.height, channels, TypeDesc::FLOAT);
     spec.channelnames = {"R", "G", "B", "visibility", "object_id", "ndotl", "Z"};
     if (withBlocker) spec.channelnames.push_back("blocker_id");
+    // Per-light visibility, light i as "visibility.<i>" (an EXR layer "visibility").
+    for (std::size_t l = 0; l < lights; ++l) spec.channelnames.push_back(lightVisibilityChannel(l));
     spec.alpha_channel = -1;
     spec.z_channel = 6;
     spec.attribute("compression", "zip");
     for (const auto& [key, value] : frame.attributes) spec.attribute(kAttrPrefix + key, value);
     spec.attribute(kTimingsAttr, encodeTimings(frame.timingsMs));
 
-    const std::size_t n = frame.pixelCount();
+    const int firstLight = withBlocker ? 8 : 7;
     std::vector<float> pixels(n * channels);
     for (std::size_t i = 0; i < n; ++i) {
         float* p = &pixels[i * channels];
@@ -268,6 +279,7 @@ void writeFrame(const Frame& frame, const fs::path& file) {
         p[5] = frame.ndotl[i];
         p[6] = frame.depth[i];
         if (withBlocker) p[7] = frame.blockerId[i];
+        for (std::size_t l = 0; l < lights; ++l) p[firstLight + l] = frame.lightVisibility[l][i];
     }
     writeAtomically(file, [&](const fs::path& tmp) {
         writeImage(tmp, spec, pixels.data(), TypeDesc::FLOAT);
@@ -303,7 +315,16 @@ Frame readFrame(const fs::path& file) {
               iId = channelIndex("object_id", true), iN = channelIndex("ndotl", true),
               iZ = channelIndex("Z", true), iBl = channelIndex("blocker_id", false);
 
+    // visibility.0, visibility.1, ... up to the first index that is missing.
+    std::vector<int> iLights;
+    for (std::size_t l = 0;; ++l) {
+        const int idx = channelIndex(lightVisibilityChannel(l), false);
+        if (idx < 0) break;
+        iLights.push_back(idx);
+    }
+
     Frame f = Frame::allocate(spec.width, spec.height, iBl >= 0);
+    f.lightVisibility.assign(iLights.size(), std::vector<float>(f.pixelCount()));
     const int c = spec.nchannels;
     constexpr int kBandRows = 64;
     std::vector<float> band(std::size_t(spec.width) * std::min(kBandRows, spec.height) * c);
@@ -324,6 +345,7 @@ Frame readFrame(const fs::path& file) {
             f.ndotl[i] = p[iN];
             f.depth[i] = p[iZ];
             if (iBl >= 0) f.blockerId[i] = p[iBl];
+            for (std::size_t l = 0; l < iLights.size(); ++l) f.lightVisibility[l][i] = p[iLights[l]];
         }
     }
     const std::string prefix = kAttrPrefix;

@@ -4,13 +4,18 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "scene/frame.h"
 
 namespace shadowlab::scene {
 
+// An EXR needs every AOV (beauty, visibility, object id, N·L, Z; blocker ids and per-light
+// visibility when present); a frame rendered with fewer channels is std::invalid_argument.
 void writeFrame(const Frame& frame, const std::filesystem::path& file);
+// The EXR channel of light `light`'s visibility: "visibility.<light>".
+std::string lightVisibilityChannel(std::size_t light);
 // Throws InputError naming the file and what is wrong (missing channel, unreadable...).
 Frame readFrame(const std::filesystem::path& file);
 

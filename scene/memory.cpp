@@ -12,8 +12,10 @@
 namespace shadowlab::scene {
 
 std::uint64_t frameBytes(const Scene& scene) {
-    // beauty (3 floats), visibility, object id, N·L, Z and blocker id: 8 floats a pixel.
-    return std::uint64_t(scene.camera.width) * std::uint64_t(scene.camera.height) * 8 * sizeof(float);
+    // beauty (3 floats), visibility, object id, N·L, Z and blocker id: 8 floats a pixel, and one
+    // visibility per light when there is more than one.
+    const std::uint64_t floats = 8 + (scene.lights.size() > 1 ? scene.lights.size() : 0);
+    return std::uint64_t(scene.camera.width) * std::uint64_t(scene.camera.height) * floats * sizeof(float);
 }
 
 std::uint64_t frameWriteBytes(const Scene& scene) { return 2 * frameBytes(scene); }

@@ -13,7 +13,7 @@ struct Scene;
 
 inline constexpr std::uint64_t kMiB = 1024 * 1024;
 
-// The bytes Frame::allocate takes for the scene's camera resolution (every AOV, blocker ids).
+// The bytes a Frame of the scene's camera resolution takes (every AOV, blocker ids, per-light visibility).
 std::uint64_t frameBytes(const Scene& scene);
 
 // What writing that Frame to EXR adds while it runs: an interleaved copy for OpenImageIO and

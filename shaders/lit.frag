@@ -3,6 +3,7 @@
 // and depth format (the hardware depth-bias state is not used).
 #version 450
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #include "interface.h"
 
 layout(set = 0, binding = 0, std140) uniform Uniforms { LitUniforms u; };
@@ -17,7 +18,36 @@ layout(location = 1) in vec3 inNormal;
 layout(location = 2) flat in uint inObjectId;
 
 layout(location = 0) out vec4 outBeauty;  // rgb: linear color; a: visibility
+#ifndef SHADOWLAB_BEAUTY_ONLY
+// (The lit_beauty.frag variant, for frames that want only beauty and visibility, has no AOV
+// target: one RGBA32F target less to write.)
 layout(location = 1) out vec4 outAovs;    // x: object id; y: N·L (max over lights); z: view depth; w: blocker id
+#endif
+#ifdef SHADOWLAB_LIGHT_OUTPUTS
+// Per-light visibility (the lit_lights.frag variant, for scenes with more than one light):
+// light i in component i % 4 of target i / 4; 0 where the light does not reach (N·L <= 0,
+// outside a spot's cone), as the total's weights.
+layout(location = 2) out vec4 outLights0;
+layout(location = 3) out vec4 outLights1;
+#endif
+
+// Specialization constants, set per pipeline by raster/lit_pass.cpp. lavapipe (llvmpipe) runs
+// every branch of a fragment shader for all lanes under an execution mask instead of jumping
+// over it, so a filter chosen at run time paid for the texture taps of all four filters and
+// the blocker-id lookups on every pixel. Fixed at pipeline creation, the dead paths are gone.
+layout(constant_id = 0) const int kFilter = SHADOWLAB_FILTER_PCF2X2;  // the filter of every light
+layout(constant_id = 1) const bool kBlockerIds = true;  // look up and write the blocker ids
+// The number of lights (u.counts.x holds the same), so the light loop unrolls and each light's
+// uniforms are loaded from a constant index; and the light kinds present (bit 1 << kind), so
+// the spot and point-light paths are left out of scenes without such lights.
+layout(constant_id = 2) const int kLightCount = SHADOWLAB_MAX_LIGHTS;
+layout(constant_id = 3) const int kLightKinds = 7;
+const bool kAnyPerspective =
+    (kLightKinds & ((1 << SHADOWLAB_LIGHT_SPOT) | (1 << SHADOWLAB_LIGHT_POINT))) != 0;
+
+// Constant false for a kind the scene lacks, which removes its code.
+bool isKind(LightData light, int kind) { return (kLightKinds & (1 << kind)) != 0 && int(light.kind.x) == kind; }
+bool isPerspective(LightData light) { return kAnyPerspective && int(light.kind.x) != SHADOWLAB_LIGHT_DIRECTIONAL; }
 
 const float kPi = 3.14159265358979323846;
 
@@ -38,7 +68,7 @@ float interleavedGradientNoise(vec2 pixel) {
 // One compare tap; records the object stored there when it shadows and none was found yet.
 float tap(vec2 uv, float layer, float ref, inout uint blocker) {
     const float lit = texture(shadowMaps, vec4(uv, layer, ref));
-    if (lit < 0.5 && blocker == 0u) blocker = texture(blockerIds, vec3(uv, layer)).r;
+    if (kBlockerIds && lit < 0.5 && blocker == 0u) blocker = texture(blockerIds, vec3(uv, layer)).r;
     return lit;
 }
 
@@ -52,7 +82,7 @@ struct Receiver {
 
 // The compare reference for a receiver biased by `bias` world units toward the light.
 float reference(LightData light, Receiver r, float bias) {
-    if (int(light.kind.x) != SHADOWLAB_LIGHT_DIRECTIONAL) {
+    if (isPerspective(light)) {
         // Perspective depth of a point at distance d along the axis: far/(far−near)·(1 − near/d);
         // the bias is subtracted from d, so it stays in world units at every distance.
         const float near = light.kind.z, far = light.kind.w;
@@ -64,9 +94,8 @@ float reference(LightData light, Receiver r, float bias) {
 // Visibility 0..1 of `light` at camera-relative position p with unit normal n (facing the
 // viewer), N·L = ndotl > 0. `blocker` gets the id of the object that shadowed, if any.
 float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, inout uint blocker) {
-    const int kind = int(light.kind.x);
-    const bool perspective = kind != SHADOWLAB_LIGHT_DIRECTIONAL;
-    const bool point = kind == SHADOWLAB_LIGHT_POINT;
+    const bool perspective = isPerspective(light);
+    const bool point = isKind(light, SHADOWLAB_LIGHT_POINT);
     vec3 axis = light.axis.xyz;
     float layer = light.toLight.w;
     if (point) {
@@ -105,7 +134,7 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, inout uint blocke
         r.uv = s.xy / s.w;
         r.axial = perspective ? dot(q - light.toLight.xyz, axis) : s.z;
     }
-    const int filterCode = int(light.params.y);
+    const int filterCode = kFilter;  // light.params.y holds the same code
     const float size = float(textureSize(shadowMaps, 0).x);
     if (filterCode == SHADOWLAB_FILTER_NONE) return tap(r.uv, layer, reference(light, r, r.biasWorld), blocker);
     if (filterCode == SHADOWLAB_FILTER_PCF2X2) {
@@ -121,7 +150,7 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, inout uint blocke
         const vec3 corner = vec3((i0 + 1.0) / size, layer);
         // Components: x = (i0, j0+1), y = (i0+1, j0+1), z = (i0+1, j0), w = (i0, j0).
         const vec4 g = textureGather(shadowMaps, corner, reference(light, r, r.biasWorld + r.slopeStep));
-        if (blocker == 0u && min(min(g.x, g.y), min(g.z, g.w)) < 0.5) {
+        if (kBlockerIds && blocker == 0u && min(min(g.x, g.y), min(g.z, g.w)) < 0.5) {
             const uvec4 ids = textureGather(blockerIds, corner);
             blocker = g.w < 0.5 ? ids.w : g.z < 0.5 ? ids.z : g.x < 0.5 ? ids.x : ids.y;
         }
@@ -163,18 +192,21 @@ void main() {
     float weightSum = 0.0;
     float weightedVisibility = 0.0;
     uint blocker = 0u;
-    const int lightCount = int(u.counts.x);
+    const int lightCount = kLightCount;
     float maxNdotL = lightCount > 0 ? -1.0 : 0.0;
-    for (int i = 0; i < lightCount; ++i) {
+#ifdef SHADOWLAB_LIGHT_OUTPUTS
+    vec4 lightVisibility[2] = vec4[](vec4(0.0), vec4(0.0));
+#endif
+    [[unroll]] for (int i = 0; i < lightCount; ++i) {
         const LightData light = u.lights[i];
         vec3 l;
         float irradiance;  // relative to radiance: 1 for directional lights
-        if (int(light.kind.x) != SHADOWLAB_LIGHT_DIRECTIONAL) {
+        if (isPerspective(light)) {
             // scene/shading.h: intensity / (4π d²); a spot is dark outside its cone.
             const vec3 toLight = light.toLight.xyz - inPosition;
             const float d2 = dot(toLight, toLight);
             l = toLight * inversesqrt(d2);
-            const bool outsideCone = int(light.kind.x) == SHADOWLAB_LIGHT_SPOT && dot(-l, light.axis.xyz) < light.kind.y;
+            const bool outsideCone = isKind(light, SHADOWLAB_LIGHT_SPOT) && dot(-l, light.axis.xyz) < light.kind.y;
             irradiance = outsideCone ? 0.0 : 1.0 / (4.0 * kPi * d2);
         } else {
             l = light.toLight.xyz;
@@ -182,17 +214,29 @@ void main() {
         }
         const float ndotl = dot(n, l);
         maxNdotL = max(maxNdotL, ndotl);
-        if (!(ndotl > 0.0) || !(irradiance > 0.0)) continue;  // no light: visibility 0, weight 0
-        uint lightBlocker = 0u;
-        const float v = light.toLight.w >= 0.0 ? shadowTest(light, inPosition, n, ndotl, lightBlocker) : 1.0;
-        if (blocker == 0u) blocker = lightBlocker;  // the first light that found one, as raytrace/
-        // The visibility AOV weighs each light by what it would add unshadowed (as raytrace/).
-        const float w = light.radiance.w * irradiance * ndotl;
-        weightSum += w;
-        weightedVisibility += w * v;
-        color += albedoColor * light.radiance.rgb * (irradiance * ndotl * v);
+        // No light (N·L <= 0, outside a spot's cone): visibility 0, weight 0. (An if, not a
+        // continue, so that the loop unrolls.)
+        if (ndotl > 0.0 && irradiance > 0.0) {
+            uint lightBlocker = 0u;
+            const float v = light.toLight.w >= 0.0 ? shadowTest(light, inPosition, n, ndotl, lightBlocker) : 1.0;
+            if (blocker == 0u) blocker = lightBlocker;  // the first light that found one, as raytrace/
+#ifdef SHADOWLAB_LIGHT_OUTPUTS
+            lightVisibility[i / 4][i % 4] = v;
+#endif
+            // The visibility AOV weighs each light by what it would add unshadowed (as raytrace/).
+            const float w = light.radiance.w * irradiance * ndotl;
+            weightSum += w;
+            weightedVisibility += w * v;
+            color += albedoColor * light.radiance.rgb * (irradiance * ndotl * v);
+        }
     }
     const float visibility = weightSum > 0.0 ? weightedVisibility / weightSum : 0.0;
     outBeauty = vec4(color, visibility);
+#ifndef SHADOWLAB_BEAUTY_ONLY
     outAovs = vec4(float(inObjectId), maxNdotL, dot(inPosition, u.forward.xyz), float(blocker));
+#endif
+#ifdef SHADOWLAB_LIGHT_OUTPUTS
+    outLights0 = lightVisibility[0];
+    outLights1 = lightVisibility[1];
+#endif
 }

@@ -4,6 +4,8 @@
 #include <cstdint>
 
 #include "lit_frag.spv.h"
+#include "lit_frag_beauty.spv.h"
+#include "lit_frag_lights.spv.h"
 #include "lit_vert.spv.h"
 #include "shadow_frag.spv.h"
 #include "shadow_vert.spv.h"
@@ -14,5 +16,7 @@ std::span<const std::uint32_t> shadowVertSpirv() { return kShadowVertSpv; }
 std::span<const std::uint32_t> shadowFragSpirv() { return kShadowFragSpv; }
 std::span<const std::uint32_t> litVertSpirv() { return kLitVertSpv; }
 std::span<const std::uint32_t> litFragSpirv() { return kLitFragSpv; }
+std::span<const std::uint32_t> litFragLightsSpirv() { return kLitFragLightsSpv; }
+std::span<const std::uint32_t> litFragBeautySpirv() { return kLitFragBeautySpv; }
 
 }  // namespace shadowlab::shaders

@@ -10,5 +10,9 @@ std::span<const std::uint32_t> shadowVertSpirv();
 std::span<const std::uint32_t> shadowFragSpirv();
 std::span<const std::uint32_t> litVertSpirv();
 std::span<const std::uint32_t> litFragSpirv();
+// lit.frag compiled with SHADOWLAB_LIGHT_OUTPUTS: two more targets with per-light visibility.
+std::span<const std::uint32_t> litFragLightsSpirv();
+// lit.frag compiled with SHADOWLAB_BEAUTY_ONLY: the beauty target only.
+std::span<const std::uint32_t> litFragBeautySpirv();
 
 }  // namespace shadowlab::shaders

@@ -666,6 +666,133 @@ TEST(RasterRender, TwoLightsWeighVisibilityByTheirUnshadowedIrradiance) {
     EXPECT_EQ(f.attributes.at("shadow_maps"), "2");
 }
 
+TEST(RasterRender, TwoLightsKeepEachLightsVisibilityAndCombineThem) {
+    // Light A straight down (intensity 3), light B from 40° elevation (intensity 1), hard
+    // shadows (filter none). On the plane (N = +Y) light i's visibility is 1 where the ray from
+    // the point toward it misses the sphere and 0 where it meets it (closed form), and the total
+    // is the shading rule's weighted mean (w_A v_A + w_B v_B) / (w_A + w_B), w = intensity·N·L:
+    // w_A = 3, w_B = sin 40°.
+    SphereOverPlane p;
+    p.width = 320;
+    p.height = 180;
+    scene::Scene s = makeScene(p);
+    scene::Light b = s.lights[0];
+    b.direction = lightFromElevation(40.0);
+    b.intensity = 1.0;
+    s.lights.push_back(b);
+    SphereOverPlane pb = p;
+    pb.lightDirection = b.direction;
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    const scene::Frame f = renderValidated(s, validatedSettings(1024, 0.01, 1.0, ShadowFilter::None), "per-light");
+    ASSERT_EQ(f.lightVisibility.size(), 2u);
+    const double wA = 3.0, wB = std::sin(40.0 * kPi / 180.0);
+    std::size_t plane = 0, wrong[2] = {0, 0}, shadowed[2] = {0, 0};
+    for (int y = 0; y < f.height; ++y)
+        for (int x = 0; x < f.width; ++x) {
+            const PrimaryHit hit = primaryHit(p, cam, x, y);
+            const std::size_t i = at(f, x, y);
+            if (hit.id != 2 || f.objectId[i] != 2.0f) continue;
+            ++plane;
+            const float vA = f.lightVisibility[0][i], vB = f.lightVisibility[1][i];
+            ASSERT_TRUE((vA == 0.0f || vA == 1.0f) && (vB == 0.0f || vB == 1.0f)) << "hard shadows are 0 or 1";
+            ASSERT_NEAR(f.visibility[i], (wA * vA + wB * vB) / (wA + wB), 1e-6) << "pixel " << x << "," << y;
+            const bool shadowA = planePointShadowed(p, hit.p), shadowB = planePointShadowed(pb, hit.p);
+            shadowed[0] += shadowA;
+            shadowed[1] += shadowB;
+            wrong[0] += (vA == 0.0f) != shadowA;
+            wrong[1] += (vB == 0.0f) != shadowB;
+        }
+    ASSERT_GT(plane, 5000u);
+    for (int l = 0; l < 2; ++l) {
+        EXPECT_GT(shadowed[l], 100u) << "light " << l << " must shadow part of the plane in view";
+        // Only texels on the shadow's outline may differ from the closed form.
+        EXPECT_LT(double(wrong[l]), 0.1 * double(shadowed[l])) << "light " << l;
+    }
+}
+
+TEST(RasterRender, OneLightKeepsNoPerLightVisibility) {
+    const scene::Scene s = makeScene(SphereOverPlane{});
+    const scene::Frame f = renderValidated(s, validatedSettings(256, 0.01, 1.0, ShadowFilter::None), "one-light");
+    EXPECT_TRUE(f.lightVisibility.empty());
+}
+
+TEST(RasterRenderer, RepeatedFramesAreIdenticalAndPayTheSetupOnce) {
+    // A Renderer renders the same scene again: the same pixels, "setup" only in the first frame.
+    const scene::Scene s = makeScene(SphereOverPlane{});
+    const scene::RasterSettings settings = validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2);
+    Renderer renderer(s, planFor(s, settings), settings);
+    const scene::Frame first = renderer.render();
+    const scene::Frame second = renderer.render();
+    EXPECT_GT(first.timing("setup"), 0.0);
+    EXPECT_EQ(second.timing("setup"), 0.0);
+    EXPECT_GE(renderer.setupMs(), 0.0);
+    EXPECT_EQ(first.beauty, second.beauty);
+    EXPECT_EQ(first.visibility, second.visibility);
+    EXPECT_EQ(first.objectId, second.objectId);
+    EXPECT_EQ(first.blockerId, second.blockerId);
+    EXPECT_EQ(second.attributes.at("validation_messages"), "0");
+    EXPECT_EQ(renderer.validationMessages(), 0);
+}
+
+TEST(RasterRenderer, ChannelsNotAskedForAreLeftOutAndTheRestIsUnchanged) {
+    // Beauty only (`render -o x.png`): the depth-only shadow pass and the lit variant without
+    // blocker ids must give exactly the pixels of a full render; the other AOVs stay empty.
+    // Visibility + ids without blocker ids: the same visibility too.
+    SphereOverPlane p;
+    scene::Scene s = makeScene(p);
+    scene::Light b = s.lights[0];
+    b.direction = lightFromElevation(40.0);
+    s.lights.push_back(b);
+    for (ShadowFilter filter : {ShadowFilter::None, ShadowFilter::Pcf2x2, ShadowFilter::Pcf, ShadowFilter::Poisson}) {
+        scene::RasterSettings settings = validatedSettings(512, 0.01, 1.0, filter);
+        settings.pcfSize = 3;
+        Renderer renderer(s, planFor(s, settings), settings);
+        const scene::Frame all = renderer.render(scene::kAllChannels);
+        const scene::Frame beauty = renderer.render(scene::kChannelBeauty);
+        const scene::Frame noIds = renderer.render(scene::kChannelVisibility | scene::kChannelObjectId |
+                                                   scene::kChannelLightVisibility);
+        ASSERT_EQ(all.beauty.size(), 3 * all.pixelCount());
+        EXPECT_EQ(beauty.beauty, all.beauty) << "filter " << int(filter);
+        EXPECT_TRUE(beauty.visibility.empty() && beauty.objectId.empty() && beauty.ndotl.empty() &&
+                    beauty.depth.empty() && beauty.blockerId.empty() && beauty.lightVisibility.empty());
+        EXPECT_EQ(noIds.visibility, all.visibility) << "filter " << int(filter);
+        EXPECT_EQ(noIds.objectId, all.objectId);
+        EXPECT_EQ(noIds.lightVisibility, all.lightVisibility);
+        EXPECT_TRUE(noIds.beauty.empty() && noIds.blockerId.empty() && noIds.depth.empty());
+        EXPECT_GT(std::count(all.blockerId.begin(), all.blockerId.end(), 1.0f), 0) << "the sphere blocks somewhere";
+        EXPECT_EQ(renderer.validationMessages(), 0);
+    }
+}
+
+TEST(RasterRenderer, ReadingTheTargetsInPlaceAndCopyingThemGiveTheSameFrame) {
+    // lavapipe reads the lit targets in place; other devices copy them into buffers. Both paths,
+    // on lavapipe, for every channel set, with several lights (per-light targets too).
+    SphereOverPlane p;
+    scene::Scene s = makeScene(p);
+    scene::Light b = s.lights[0];
+    b.direction = lightFromElevation(40.0);
+    s.lights.push_back(b);
+    const scene::RasterSettings settings = validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2);
+    Renderer inPlace(s, planFor(s, settings), settings);
+    Renderer copied(s, planFor(s, settings), settings, RendererOptions{.readTargetsInPlace = false});
+    for (scene::ChannelMask channels : {scene::kAllChannels, scene::kChannelBeauty,
+                                        scene::kChannelVisibility | scene::kChannelDepth}) {
+        const scene::Frame a = inPlace.render(channels);
+        const scene::Frame c = copied.render(channels);
+        EXPECT_EQ(a.attributes.at("readback"), "in-place");
+        EXPECT_EQ(c.attributes.at("readback"), "copy");
+        EXPECT_EQ(a.beauty, c.beauty);
+        EXPECT_EQ(a.visibility, c.visibility);
+        EXPECT_EQ(a.objectId, c.objectId);
+        EXPECT_EQ(a.ndotl, c.ndotl);
+        EXPECT_EQ(a.depth, c.depth);
+        EXPECT_EQ(a.blockerId, c.blockerId);
+        EXPECT_EQ(a.lightVisibility, c.lightVisibility);
+    }
+    EXPECT_EQ(inPlace.validationMessages(), 0);
+    EXPECT_EQ(copied.validationMessages(), 0);
+}
+
 TEST(RasterRender, BadPcfSizeIsRejected) {
     const scene::Scene s = makeScene(SphereOverPlane{});
     scene::RasterSettings settings = filterSettings(ShadowFilter::Pcf, 0);

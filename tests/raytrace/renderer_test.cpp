@@ -51,6 +51,42 @@ TEST(ReferenceRender, SeedSceneVisibilityEqualsClosedFormAwayFromShadowEdge) {
     EXPECT_EQ(f.attributes.at("ray_bias"), "robust");
 }
 
+TEST(ReferenceRender, TwoLightsKeepEachLightsVisibilityAndCombineThem) {
+    // The seed scene plus light B along (1, -1, 0) (intensity 1). On the plane (N = +Y), light
+    // i's visibility is 1 where the ray toward it misses the sphere (closed form), else 0; the
+    // total is (w_A v_A + w_B v_B) / (w_A + w_B), w = intensity·N·L: w_A = 3·2/√6, w_B = 1/√2.
+    scene::Scene s = test::sphereOverPlane();
+    test::addDirectional(s, Vec3(1, -1, 0), 1.0);
+    const scene::Frame f = renderReference(s, test::planFor(s), test::biasSettings(0, scene::Precision::Float));
+    ASSERT_EQ(f.lightVisibility.size(), 2u);
+    const Vec3 lB = glm::normalize(Vec3(-1, 1, 0));
+    const double wA = 3.0 * 2.0 / std::sqrt(6.0), wB = lB.y;
+    int judged = 0, shadowed[2] = {0, 0};
+    for (int y = 0; y < f.height; ++y)
+        for (int x = 0; x < f.width; ++x) {
+            const std::size_t i = std::size_t(y) * f.width + x;
+            const Analytic a = test::analyticPixel(s, {}, x, y);
+            if (a.kind != Analytic::Plane || a.nearEdge) continue;
+            double rel = 0;
+            const bool blockedB = test::rayMeetsSphere(a.p, lB, Vec3(0, 1, 0), 1.0, rel);
+            if (std::abs(rel) < 1e-9) continue;  // tangent to the sphere toward B: not judged
+            ++judged;
+            const float vA = a.lit ? 1.0f : 0.0f, vB = blockedB ? 0.0f : 1.0f;
+            shadowed[0] += !a.lit;
+            shadowed[1] += blockedB;
+            ASSERT_EQ(f.lightVisibility[0][i], vA) << "pixel " << x << "," << y;
+            ASSERT_EQ(f.lightVisibility[1][i], vB) << "pixel " << x << "," << y;
+            ASSERT_NEAR(f.visibility[i], (wA * vA + wB * vB) / (wA + wB), 1e-6) << "pixel " << x << "," << y;
+        }
+    EXPECT_GT(judged, 5000);
+    EXPECT_GT(shadowed[0], 200);
+    EXPECT_GT(shadowed[1], 200);
+    // One light: no per-light channels (they would equal `visibility`).
+    const scene::Scene one = test::sphereOverPlane();
+    EXPECT_TRUE(renderReference(one, test::planFor(one), test::biasSettings(0, scene::Precision::Float))
+                    .lightVisibility.empty());
+}
+
 // Counts plane pixels that are lit in closed form but have visibility 0 in the frame.
 int falseShadowsOnPlane(const scene::Scene& s, const test::Placement& at, const scene::Frame& f,
                         int& litPlanePixels) {

@@ -2,6 +2,9 @@
 // metadata; PNGs are sRGB-encoded; writes are atomic; bad frames give clear errors.
 #include "scene/frame_io.h"
 
+#include <algorithm>
+#include <filesystem>
+
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
@@ -51,6 +54,37 @@ TEST(FrameIo, ExrRoundTripKeepsEveryChannelAttributeAndTimingInOrder) {
         EXPECT_EQ(g.timingsMs, f.timingsMs);
         EXPECT_DOUBLE_EQ(g.totalTimeMs(), 28.75);
     }
+}
+
+TEST(FrameIo, ExrRoundTripKeepsPerLightVisibilityAsVisibilityDotIndexChannels) {
+    TempDir dir;
+    Frame f = patternFrame(true);
+    f.lightVisibility = {std::vector<float>(f.pixelCount()), std::vector<float>(f.pixelCount()),
+                         std::vector<float>(f.pixelCount())};
+    for (std::size_t l = 0; l < 3; ++l)
+        for (std::size_t i = 0; i < f.pixelCount(); ++i) f.lightVisibility[l][i] = float((i + l) % 5) / 4.0f;
+    const auto file = dir.path() / "lights.exr";
+    writeFrame(f, file);
+    const Frame g = readFrame(file);
+    EXPECT_EQ(g.lightVisibility, f.lightVisibility);
+    EXPECT_EQ(g.visibility, f.visibility);
+    EXPECT_EQ(g.blockerId, f.blockerId);
+    auto in = OIIO::ImageInput::open(file.string());
+    ASSERT_TRUE(in);
+    const std::vector<std::string> names = in->spec().channelnames;
+    for (const char* name : {"visibility", "visibility.0", "visibility.1", "visibility.2"})
+        EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
+    // A frame without them writes none and reads back none.
+    writeFrame(patternFrame(true), file);
+    EXPECT_TRUE(readFrame(file).lightVisibility.empty());
+}
+
+TEST(FrameIo, ExrOfAFrameRenderedForBeautyOnlyIsRejected) {
+    TempDir dir;
+    Frame f = patternFrame(false);
+    f.visibility.clear();
+    EXPECT_THROW(writeFrame(f, dir.path() / "x.exr"), std::invalid_argument);
+    EXPECT_FALSE(std::filesystem::exists(dir.path() / "x.exr"));
 }
 
 TEST(FrameIo, PngIsSrgbEncodedBeauty) {
