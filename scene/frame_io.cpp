@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <cerrno>
 #include <csignal>
@@ -67,6 +68,10 @@ void checkExrHeader(const fs::path& file) {
         }
         throw bad("truncated");
     };
+    auto printable = [](std::string t) {  // a damaged name may hold any byte
+        for (char& ch : t) if (ch < 0x20 || ch > 0x7e) ch = '?';
+        return t;
+    };
     for (int count = 0;; ++count) {
         std::string name, type;
         readName(name);
@@ -78,12 +83,23 @@ void checkExrHeader(const fs::path& file) {
         const std::int64_t start = std::int64_t(in.tellg());
         const std::int64_t end = start + std::int64_t(std::int32_t(size));
         if (std::int32_t(size) < 0 || end > fileSize)
-            throw bad("attribute '" + name + "' declares " + std::to_string(std::int32_t(size)) +
+            throw bad("attribute '" + printable(name) + "' declares " + std::to_string(std::int32_t(size)) +
                       " bytes, more than the file holds");
         // OpenEXR reads these by their contents rather than their declared size, so their
         // contents must agree with it (a channel name longer than allowed misaligned the rest
         // of a fuzzed header into another 1.8 GB attribute).
-        auto mismatch = [&] { return bad("attribute '" + name + "' (" + type + ") does not match its declared size"); };
+        auto mismatch = [&] {
+            return bad("attribute '" + printable(name) + "' (" + printable(type) + ") does not match its declared size");
+        };
+        // Types of a fixed size, which OpenEXR reads whatever size is declared (a v2f declared as
+        // 12 bytes misaligned a fuzzed header). Sizes from OpenEXR's attribute types.
+        static const std::map<std::string, std::uint32_t> kFixedSize = {
+            {"box2i", 16}, {"box2f", 16}, {"chromaticities", 32}, {"compression", 1}, {"double", 8},
+            {"envmap", 1}, {"float", 4}, {"int", 4}, {"keycode", 28}, {"lineOrder", 1}, {"m33f", 36},
+            {"m33d", 72}, {"m44f", 64}, {"m44d", 128}, {"rational", 8}, {"tiledesc", 9}, {"timecode", 8},
+            {"v2i", 8}, {"v2f", 8}, {"v2d", 16}, {"v3i", 12}, {"v3f", 12}, {"v3d", 24}, {"deepImageState", 1}};
+        if (const auto fixed = kFixedSize.find(type); fixed != kFixedSize.end() && fixed->second != size)
+            throw mismatch();
         if (type == "chlist") {
             for (std::string channel;;) {
                 readName(channel);
