@@ -93,6 +93,7 @@ struct OccluderCache {
     struct Entry {
         std::uint64_t tracer = 0;
         std::uint32_t blas = 0, packet = 0;
+        bool valid = false;  // the previous any-hit ray in this tree was blocked, by `packet`
     };
     Entry entries[kEntries];
 };
@@ -289,7 +290,11 @@ bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& 
         if (anyHit && occluderCacheOn.load(std::memory_order_relaxed)) {
             const std::uint32_t blas = std::uint32_t(&m - meshes_.data());
             cached = &occluderCache.entries[blas % OccluderCache::kEntries];
-            if (cached->tracer == id_ && cached->blas == blas) {
+            if (cached->tracer != id_ || cached->blas != blas) {
+                cached->tracer = id_;
+                cached->blas = blas;
+                cached->valid = false;
+            } else if (cached->valid) {
                 const Triangle4Ray r4(ray);
                 const TrianglePacket& pk = m.packets[cached->packet];
                 int cand = triangle4Candidates(r4, pk, tBest, 0xF);
@@ -305,10 +310,6 @@ bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& 
                     ++occluderCacheHitCount;
                     return true;
                 }
-            } else {
-                cached->tracer = id_;
-                cached->blas = blas;
-                cached->packet = 0;
             }
         }
 #if defined(SHADOWLAB_AVX_BOX_TEST)
@@ -320,9 +321,12 @@ bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& 
         const bool found = traverseFloat<detail::ChildBoxTest<float, 8>>(m.bvh, m.packets, ray, tBest,
                                                                         conservative, anyHit, sh);
 #endif
-        if (found) {
-            record(sh.slot, sh.t, sh.b0, sh.b1, sh.b2);
-            if (cached) cached->packet = sh.slot / 4;
+        if (found) record(sh.slot, sh.t, sh.b0, sh.b1, sh.b2);
+        if (cached) {
+            // Only a ray that was blocked leaves a packet to try: after an unblocked ray the
+            // next one goes straight to the walk, so mostly-lit scenes pay nothing for the cache.
+            cached->valid = found;
+            cached->packet = sh.slot / 4;
         }
         return found;
     } else {
