@@ -1,5 +1,7 @@
 // raytrace/tracer.h: the scene converted to Real (float for the method, double for the
-// reference) with one BVH per mesh, and the queries every pass is built from: closest hit,
+// reference) with one BVH per geometry (meshes placed once merged in world space per object,
+// meshes placed several times shared in object space under a top-level tree of their
+// instances), and the queries every pass is built from: closest hit,
 // any hit, per-object hits and the surface point (position, error bound, normals) of a hit.
 #pragma once
 
@@ -44,7 +46,7 @@ class Tracer {
 public:
     using Vec = Vec3T<Real>;
 
-    // Converts every object to Real and builds a BVH per mesh (the "setup" stage).
+    // Converts every object to Real and builds the mesh trees (the "setup" stage).
     explicit Tracer(const scene::Scene& scene);
 
     // Nearest hit with 0 < t < tMax. Conservative: reject hits whose t could be <= 0 under
