@@ -24,6 +24,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "raytrace/shadow_ray.h"
 #include "raytrace/tracer.h"
@@ -92,7 +93,7 @@ scene::Scene terrainScene() {
     s.materials.push_back(scene::Material{"matte"});
     scene::Object o;
     o.name = "terrain";
-    o.shape = scene::Mesh{"generated-terrain", mesh};
+    o.shape = scene::Mesh::single("generated-terrain", mesh);
     s.objects.push_back(o);
     return s;
 }
@@ -172,7 +173,7 @@ void buildEmbree(Workload& w) {
                 for (int k : f) corners.push_back(c(k));
             addEmbreeQuads(w.device, w.embree, corners);
         } else if (const auto* m = std::get_if<scene::Mesh>(&o.shape)) {
-            const scene::TriangleMesh& tm = *m->geometry;
+            const scene::TriangleMesh tm = scene::flattenInstances(m->instances);
             RTCGeometry g = rtcNewGeometry(w.device, RTC_GEOMETRY_TYPE_TRIANGLE);
             auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
                 g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), tm.positions.size()));
@@ -262,6 +263,17 @@ std::size_t ourShadow(const Workload& w, bool conservative) {
     return blocked;
 }
 
+// Runs fn with the AVX box test and the occluder cache switched as asked, then back on.
+template <typename Fn>
+std::size_t variant(bool avx, bool cache, Fn fn) {
+    raytrace::detail::setUseAvx(avx);
+    raytrace::setOccluderCache(cache);
+    const std::size_t n = fn();
+    raytrace::detail::setUseAvx(true);
+    raytrace::setOccluderCache(true);
+    return n;
+}
+
 // Collects items/s of every repetition per benchmark name while printing the usual table, so
 // the summary can give the median and the spread (run with --benchmark_repetitions=N and
 // --benchmark_enable_random_interleaving=true to spread a busy machine's load over all cases).
@@ -323,7 +335,7 @@ int main(int argc, char** argv) {
         s.materials.push_back(scene::Material{"matte"});
         scene::Object o;
         o.name = "sponza";
-        o.shape = scene::Mesh{kSponzaPath, scene::loadMesh(kSponzaPath, glm::dmat4(1.0), kSponzaPath, {})};
+        o.shape = scene::Mesh::single(kSponzaPath, scene::loadMesh(kSponzaPath, glm::dmat4(1.0), kSponzaPath, {}));
         s.objects.push_back(o);
         add("sponza", std::move(s));
     } else {
@@ -346,6 +358,10 @@ int main(int argc, char** argv) {
         reg("primary/ours", w->primary.size(), [](const Workload& x) { return ourPrimary(x); });
         reg("shadow/ours", w->shadow.size(), [](const Workload& x) { return ourShadow(x, false); });
         reg("shadow/ours_conservative", w->shadow.size(), [](const Workload& x) { return ourShadow(x, true); });
+        // The same walk without the AVX box test and/or the occluder cache, for the record.
+        reg("primary/ours_sse", w->primary.size(), [](const Workload& x) { return variant(false, true, [&] { return ourPrimary(x); }); });
+        reg("shadow/ours_nocache", w->shadow.size(), [](const Workload& x) { return variant(true, false, [&] { return ourShadow(x, false); }); });
+        reg("shadow/ours_sse_nocache", w->shadow.size(), [](const Workload& x) { return variant(false, false, [&] { return ourShadow(x, false); }); });
 #ifdef SHADOWLAB_HAVE_EMBREE
         reg("primary/embree", w->primary.size(), [](const Workload& x) { return embreePrimary(x); });
         reg("shadow/embree", w->shadow.size(), [](const Workload& x) { return embreeShadow(x); });
@@ -355,33 +371,61 @@ int main(int argc, char** argv) {
     benchmark::RunSpecifiedBenchmarks(&reporter);
 
     std::printf("\nMrays/s: median (min-max) over the repetitions; ratio = ours / Embree medians\n");
-    std::printf("%-8s %-8s %8s %20s %20s %7s %s\n", "scene", "rays", "count", "ours", "embree",
+    std::printf("%-8s %-22s %8s %20s %20s %7s %s\n", "scene", "rays", "count", "ours", "embree",
                 "ratio", "agreement");
     for (const auto& wp : workloads) {
         const Workload& w = *wp;
-        for (const char* kind : {"primary", "shadow"}) {
+        const std::vector<std::pair<const char*, const char*>> rows = {
+            {"primary", "ours"}, {"primary", "ours_sse"}, {"shadow", "ours"},
+            {"shadow", "ours_nocache"}, {"shadow", "ours_sse_nocache"}};
+        for (const auto& [kind, who] : rows) {
             const bool prim = std::string(kind) == "primary";
             const std::size_t count = prim ? w.primary.size() : w.shadow.size();
-            const auto ours = reporter.stats(w.name + "/" + kind + "/ours");
+            const auto ours = reporter.stats(w.name + "/" + kind + "/" + who);
             char oursText[64];
             std::snprintf(oursText, sizeof oursText, "%.2f (%.2f-%.2f)", ours[0], ours[1], ours[2]);
+            const bool avx = std::string(who).find("sse") == std::string::npos;
+            const bool cache = std::string(who).find("nocache") == std::string::npos;
+            const std::size_t a = variant(avx, cache, [&] { return prim ? ourPrimary(w) : ourShadow(w, false); });
+            const std::string label = std::string(kind) + "/" + who;
 #ifdef SHADOWLAB_HAVE_EMBREE
             const auto emb = reporter.stats(w.name + "/" + kind + "/embree");
             char embText[64];
             std::snprintf(embText, sizeof embText, "%.2f (%.2f-%.2f)", emb[0], emb[1], emb[2]);
-            const std::size_t a = prim ? ourPrimary(w) : ourShadow(w, false);
             const std::size_t b = prim ? embreePrimary(w) : embreeShadow(w);
-            std::printf("%-8s %-8s %8zu %20s %20s %7.3f hits ours %zu, embree %zu\n", w.name.c_str(),
-                        kind, count, oursText, embText, emb[0] > 0 ? ours[0] / emb[0] : 0.0, a, b);
+            std::printf("%-8s %-22s %8zu %20s %20s %7.3f hits ours %zu, embree %zu\n", w.name.c_str(),
+                        label.c_str(), count, oursText, embText, emb[0] > 0 ? ours[0] / emb[0] : 0.0, a, b);
 #else
-            std::printf("%-8s %-8s %8zu %20s %20s %7s\n", w.name.c_str(), kind, count, oursText, "-", "-");
+            std::printf("%-8s %-22s %8zu %20s %20s %7s hits ours %zu\n", w.name.c_str(), label.c_str(), count,
+                        oursText, "-", "-", a);
 #endif
+        }
+        if (w.tracer->triangleCount() > 0) {
+            // Setup (conversion, BVH build, collapse, packets) with 1 thread and with all,
+            // wall time, median of 3 each: what the parallel build buys.
+            auto setupMs = [&](int threads) {
+                tbb::task_arena arena(threads);
+                std::vector<double> ms;
+                for (int i = 0; i < 3; ++i) {
+                    arena.execute([&] {
+                        const auto t0 = std::chrono::steady_clock::now();
+                        const raytrace::Tracer<Real> t(w.scene);
+                        ms.push_back(msSince(t0));
+                    });
+                }
+                std::sort(ms.begin(), ms.end());
+                return ms[1];
+            };
+            const int all = tbb::this_task_arena::max_concurrency();
+            std::printf("%-8s setup median of 3: ours 1 thread %.1f ms, %d threads %.1f ms\n", w.name.c_str(),
+                        setupMs(1), all, setupMs(all));
         }
         std::printf("%-8s setup: ours %.1f ms", w.name.c_str(), w.ourSetupMs);
 #ifdef SHADOWLAB_HAVE_EMBREE
         std::printf(", embree %.1f ms", w.embreeSetupMs);
 #endif
-        const std::size_t tris = w.tracer->triangleCount();
+        // Memory per unique (stored) triangle: an instanced mesh counts once.
+        const std::size_t tris = w.tracer->uniqueTriangleCount();
         std::printf(" (%zu triangles", tris);
         if (tris > 0)
             std::printf(", BVH + mesh %.1f bytes/triangle", double(w.tracer->meshBytes()) / double(tris));

@@ -87,18 +87,25 @@ void addBox(Builder& b, const scene::Box& box) {
         }
 }
 
+// Instances are expanded here (a copy per placement at upload): the raster backend draws one
+// vertex buffer, and its cost is per placed triangle anyway.
 void addMesh(Builder& b, const scene::Object& o, const scene::Mesh& m) {
-    if (!m.geometry)
-        throw RasterError(o.name + ": mesh " + m.file.string() + " has no loaded geometry");
-    const scene::TriangleMesh& g = *m.geometry;
-    std::uint32_t base = 0;
-    for (std::size_t i = 0; i < g.positions.size(); ++i) {
-        const Vec3 n = i < g.normals.size() ? g.normals[i] : Vec3(0, 1, 0);
-        const std::uint32_t v = b.vertex(g.positions[i], n);
-        if (i == 0) base = v;
+    for (const scene::MeshInstance& inst : m.instances) {
+        if (!inst.geometry)
+            throw RasterError(o.name + ": mesh " + m.file.string() + " has no loaded geometry");
+        const scene::TriangleMesh& g = *inst.geometry;
+        const glm::dmat3 nm = scene::normalMatrix(inst.transform);
+        std::uint32_t base = 0;
+        for (std::size_t i = 0; i < g.positions.size(); ++i) {
+            const Vec3 n = i < g.normals.size() ? glm::normalize(nm * g.normals[i]) : Vec3(0, 1, 0);
+            const std::uint32_t v = b.vertex(scene::transformPoint(inst.transform, g.positions[i]), n);
+            if (i == 0) base = v;
+        }
+        for (std::size_t t = 0; t + 2 < g.indices.size(); t += 3)
+            b.triangle(base + g.indices[t], base + g.indices[t + 1], base + g.indices[t + 2]);
     }
-    for (std::size_t t = 0; t + 2 < g.indices.size(); t += 3)
-        b.triangle(base + g.indices[t], base + g.indices[t + 1], base + g.indices[t + 2]);
+    if (m.instances.empty())
+        throw RasterError(o.name + ": mesh " + m.file.string() + " has no loaded geometry");
 }
 
 }  // namespace

@@ -32,7 +32,7 @@ std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::Render
     const std::uint64_t texels = std::uint64_t(settings.shadowMapSize) * std::uint64_t(settings.shadowMapSize);
     std::uint64_t triangles = 0;
     for (const scene::Object& o : scene.objects) {
-        if (const auto* m = std::get_if<scene::Mesh>(&o.shape)) triangles += m->geometry->triangleCount();
+        if (const auto* m = std::get_if<scene::Mesh>(&o.shape)) triangles += m->triangleCount();
         else if (std::holds_alternative<scene::Sphere>(o.shape)) triangles += kSphereTriangles;
         else triangles += 12;
     }

@@ -11,7 +11,7 @@ std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::Render
     std::uint64_t triangles = 0;
     if (plan.needsTriangleBvh)
         for (const scene::Object& o : scene.objects)
-            if (const auto* m = std::get_if<scene::Mesh>(&o.shape)) triangles += m->geometry->triangleCount();
+            if (const auto* m = std::get_if<scene::Mesh>(&o.shape)) triangles += m->triangleCount();
     constexpr std::uint64_t kAllowance = 64 * scene::kMiB;  // threads' stacks, tiles, the program
     return kAllowance + scene::frameBytes(scene) + triangles * 100;
 }

@@ -31,6 +31,20 @@ inline constexpr double kBvhTraversalCost = 1.0;
 // 48 + log2(2^32) = 80 levels, below the traversal stack of 128.
 inline constexpr int kBvhSahMaxDepth = 48;
 
+// Parallel build (TBB): ranges of at least this many primitives bin and bound in parallel
+// chunks and build their two halves as two tasks; smaller ones run sequentially, where a task
+// (a few µs) would cost more than the work. The tree does not depend on it (bvh.cpp).
+inline constexpr unsigned kBvhParallelCount = 4096;
+inline constexpr unsigned kBvhParallelGrain = 1024;
+
+// An instance's world box (the top-level tree over a mesh object's instances) is its object-
+// space box's eight corners transformed, widened by this fraction of (largest |coordinate| +
+// diagonal). The ray is transformed into object space with rounding, so the box test in world
+// space and the triangle tests in object space see slightly different rays; the pad (2^-16,
+// over 100x the float rounding of a transform, ~3·2^-24 relative) keeps the world test from
+// culling a hit the object-space test finds. The object-space trees decide every hit.
+inline constexpr double kInstanceBoxPad = 0x1.0p-16;
+
 // Seed of the per-pixel random streams for area-light samples, so renders are reproducible.
 inline constexpr unsigned long long kSampleSeed = 0x5eed5eedULL;
 

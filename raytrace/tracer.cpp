@@ -3,11 +3,15 @@
 #include "raytrace/tracer.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+
+#include "raytrace/tolerances.h"
 
 namespace shadowlab::raytrace {
 
@@ -18,11 +22,101 @@ Vec3T<Real> toReal(const scene::Vec3& v) {
     return Vec3T<Real>(Real(v.x), Real(v.y), Real(v.z));
 }
 
+// Points and vectors through a 4x3 affine matrix in the order pbrt-v4's Transform uses, whose
+// error bound γ(3)·(|m00·x| + |m01·y| + |m02·z| + |m03|) per component this order satisfies.
+template <typename Real>
+Vec3T<Real> applyPoint(const glm::mat<4, 3, Real, glm::defaultp>& m, const Vec3T<Real>& p) {
+    Vec3T<Real> r;
+    for (int k = 0; k < 3; ++k) r[k] = (m[0][k] * p.x + m[1][k] * p.y) + (m[2][k] * p.z + m[3][k]);
+    return r;
+}
+template <typename Real>
+Vec3T<Real> applyVector(const glm::mat<4, 3, Real, glm::defaultp>& m, const Vec3T<Real>& v) {
+    Vec3T<Real> r;
+    for (int k = 0; k < 3; ++k) r[k] = (m[0][k] * v.x + m[1][k] * v.y) + m[2][k] * v.z;
+    return r;
+}
+
+// The float mesh walk: 8-wide nodes with the box test BoxTest, leaves of SSE packets whose
+// candidate lanes the scalar watertight test decides in slot order. Fills the last hit.
+struct SlotHit {
+    float t = 0, b0 = 0, b1 = 0, b2 = 0;
+    std::uint32_t slot = 0;
+};
+
+template <typename BoxTest>
+inline bool traverseFloat(const Bvh8& bvh, const std::vector<TrianglePacket>& packets,
+                          const Ray<float>& ray, float& tBest, bool conservative, bool anyHit,
+                          SlotHit& out) {
+    const Triangle4Ray r4(ray);
+    return bvh.traverseWith<BoxTest>(ray, tBest, anyHit,
+                                     [&](std::uint32_t first, std::uint32_t count, float& tm) {
+        bool any = false;
+        for (std::uint32_t base = first; base < first + count; base += 4) {
+            const TrianglePacket& pk = packets[base / 4];
+            const std::uint32_t lanes = std::min<std::uint32_t>(4, first + count - base);
+            int cand = triangle4Candidates(r4, pk, tm, (1 << lanes) - 1);
+            // The scalar test decides, lane by lane in slot order as before.
+            while (cand != 0) {
+                const int l = __builtin_ctz(unsigned(cand));
+                cand &= cand - 1;
+                float t, b0, b1, b2;
+                if (!intersectTriangle(ray, pk.vertex(l, 0), pk.vertex(l, 1), pk.vertex(l, 2), tm,
+                                       conservative, t, b0, b1, b2))
+                    continue;
+                tm = t;
+                out = SlotHit{t, b0, b1, b2, base + std::uint32_t(l)};
+                if (anyHit) return true;
+                any = true;
+            }
+        }
+        return any;
+    });
+}
+
+#if defined(SHADOWLAB_AVX_BOX_TEST)
+// The same walk compiled for AVX: `flatten` inlines everything it calls (the walk, the leaf
+// test, the SSE packet filter, the scalar triangle test) into this one function, so the AVX
+// code exists only here and runs only after detail::useAvx() said the CPU has AVX. Target
+// "avx" enables no FMA, so the float results are the SSE path's, bit for bit.
+__attribute__((target("avx"), flatten)) bool traverseFloatAvx(
+    const Bvh8& bvh, const std::vector<TrianglePacket>& packets, const Ray<float>& ray,
+    float& tBest, bool conservative, bool anyHit, SlotHit& out) {
+    return traverseFloat<detail::ChildBoxTestAvx8>(bvh, packets, ray, tBest, conservative, anyHit, out);
+}
+#endif
+
+// Per thread: for a few trees, the packet that last blocked an any-hit ray. Keyed by the
+// tracer's unique id (never reused, unlike an address) and the tree's index.
+struct OccluderCache {
+    static constexpr int kEntries = 8;
+    struct Entry {
+        std::uint64_t tracer = 0;
+        std::uint32_t blas = 0, packet = 0;
+        bool valid = false;  // the previous any-hit ray in this tree was blocked, by `packet`
+    };
+    Entry entries[kEntries];
+};
+thread_local OccluderCache occluderCache;
+thread_local std::uint64_t occluderCacheHitCount = 0;
+std::atomic<bool> occluderCacheOn{true};
+std::atomic<std::uint64_t> nextTracerId{1};
+
 }  // namespace
 
+void setOccluderCache(bool on) { occluderCacheOn.store(on); }
+bool occluderCacheEnabled() { return occluderCacheOn.load(); }
+std::uint64_t occluderCacheHits() { return occluderCacheHitCount; }
+
 template <typename Real>
-Tracer<Real>::Tracer(const scene::Scene& scene) {
+Tracer<Real>::Tracer(const scene::Scene& scene) : id_(nextTracerId.fetch_add(1)) {
     objects_.reserve(scene.objects.size());
+    // How often each geometry is placed in the whole scene: once means copied to world space,
+    // more means one bottom-level tree shared by its instances.
+    std::map<const scene::TriangleMesh*, int> uses, blasOf;
+    for (const scene::Object& obj : scene.objects)
+        if (const auto* m = std::get_if<scene::Mesh>(&obj.shape))
+            for (const scene::MeshInstance& inst : m->instances) ++uses[inst.geometry.get()];
     for (std::size_t i = 0; i < scene.objects.size(); ++i) {
         const scene::Object& obj = scene.objects[i];
         const double opacity = scene.materialOf(obj).opacity;
@@ -48,46 +142,209 @@ Tracer<Real>::Tracer(const scene::Scene& scene) {
             objects_.push_back({ShapeKind::Box, int(boxes_.size()), opacity});
             boxes_.push_back({toReal<Real>(b->min), toReal<Real>(b->max)});
         } else if (const auto* m = std::get_if<scene::Mesh>(&obj.shape)) {
-            if (!m->geometry)
-                throw std::invalid_argument(obj.name + ": mesh '" + m->file.string() +
-                                            "' has no geometry loaded");
-            const scene::TriangleMesh& g = *m->geometry;
-            MeshData d;
-            d.positions.reserve(g.positions.size());
-            for (const scene::Vec3& p : g.positions) d.positions.push_back(toReal<Real>(p));
-            if (g.normals.size() == g.positions.size()) {
-                d.normals.reserve(g.normals.size());
-                for (const scene::Vec3& n : g.normals) d.normals.push_back(toReal<Real>(n));
-            }
-            d.indices = g.indices;
-            std::vector<scene::Bounds> triBounds(g.triangleCount());
-            for (std::size_t t = 0; t < triBounds.size(); ++t)
-                for (int k = 0; k < 3; ++k) triBounds[t].extend(g.positions[g.indices[3 * t + k]]);
-            d.bvh = Bvh8::build(triBounds);
-            const std::vector<std::uint32_t>& slots = d.bvh.primitives();
-            if constexpr (std::is_same_v<Real, float>) {
-                d.packets.resize(slots.size() / WideRef::kLeafAlign);
-                for (std::size_t s = 0; s < slots.size(); ++s) {
-                    TrianglePacket& pk = d.packets[s / 4];
-                    for (int k = 0; k < 3; ++k)
-                        for (int a = 0; a < 3; ++a)
-                            pk.v[3 * k + a][s % 4] =
-                                slots[s] == WideRef::kEmpty
-                                    ? std::numeric_limits<float>::quiet_NaN()
-                                    : d.positions[d.indices[3 * std::size_t(slots[s]) + k]][a];
-                }
-            } else {
-                d.slotVertices.reserve(3 * slots.size());
-                for (std::uint32_t tri : slots)
-                    for (int k = 0; k < 3; ++k)
-                        d.slotVertices.push_back(tri == WideRef::kEmpty
-                                                     ? Vec(0)
-                                                     : d.positions[d.indices[3 * std::size_t(tri) + k]]);
-            }
-            triangles_ += g.triangleCount();
-            objects_.push_back({ShapeKind::Mesh, int(meshes_.size()), opacity});
-            meshes_.push_back(std::move(d));
+            objects_.push_back({ShapeKind::Mesh, int(meshObjects_.size()), opacity});
+            meshObjects_.push_back(buildMeshObject(obj, *m, uses, blasOf));
         }
+    }
+}
+
+template <typename Real>
+typename Tracer<Real>::MeshObjectData Tracer<Real>::buildMeshObject(
+    const scene::Object& obj, const scene::Mesh& m,
+    const std::map<const scene::TriangleMesh*, int>& uses,
+    std::map<const scene::TriangleMesh*, int>& blasOf) {
+    if (m.instances.empty())
+        throw std::invalid_argument(obj.name + ": mesh '" + m.file.string() + "' has no geometry loaded");
+    MeshObjectData mo;
+    // Meshes placed once are copied into world space and merged per object: one tree, no
+    // transform per ray (docs/raytrace.md, "Instances").
+    std::vector<scene::Vec3> positions, normals;
+    std::vector<std::uint32_t> indices;
+    bool allNormals = true;
+    std::vector<scene::Bounds> instanceBounds;
+    for (const scene::MeshInstance& inst : m.instances) {
+        if (!inst.geometry)
+            throw std::invalid_argument(obj.name + ": mesh '" + m.file.string() + "' has no geometry loaded");
+        const scene::TriangleMesh& g = *inst.geometry;
+        triangles_ += g.triangleCount();
+        if (uses.at(&g) == 1) {
+            const std::uint32_t base = std::uint32_t(positions.size());
+            for (const scene::Vec3& p : g.positions) positions.push_back(scene::transformPoint(inst.transform, p));
+            allNormals = allNormals && g.normals.size() == g.positions.size();
+            if (allNormals) {
+                const glm::dmat3 nm = scene::normalMatrix(inst.transform);
+                for (const scene::Vec3& n : g.normals) normals.push_back(glm::normalize(nm * n));
+            }
+            for (std::uint32_t i : g.indices) indices.push_back(base + i);
+            continue;
+        }
+        auto [it, added] = blasOf.emplace(&g, int(meshes_.size()));
+        if (added) buildMesh(g.positions, g.normals, g.indices);
+        InstanceData in;
+        in.blas = it->second;
+        const glm::dmat4 toWorld(inst.transform);
+        const glm::dmat4 toObject = glm::inverse(toWorld);
+        in.toWorld = Affine(inst.transform);
+        in.toObject = Affine(glm::dmat4x3(toObject));
+        in.normalToWorld = glm::mat<3, 3, Real, glm::defaultp>(scene::normalMatrix(inst.transform));
+        for (int c = 0; c < 4; ++c) {
+            in.absToWorld[c] = glm::abs(in.toWorld[c]);
+            in.absToObject[c] = glm::abs(in.toObject[c]);
+        }
+        // R = toObject·toWorld − I with the stored (Real) matrices, evaluated in long double
+        // (products of two floats are exact; of two doubles nearly so), plus γ(4) of the
+        // magnitudes in long double as the bound on that evaluation's own rounding.
+        using L = long double;
+        const L gammaL4 = 4 * (std::numeric_limits<L>::epsilon() / 2) / (1 - 4 * (std::numeric_limits<L>::epsilon() / 2));
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 3; ++r) {
+                L sum = c == 3 ? L(in.toObject[3][r]) : 0, mag = c == 3 ? std::abs(L(in.toObject[3][r])) : 0;
+                for (int k = 0; k < 3; ++k) {
+                    const L prod = L(in.toObject[k][r]) * L(in.toWorld[c][k]);
+                    sum += prod;
+                    mag += std::abs(prod);
+                }
+                if (c == r) sum -= 1;
+                in.inverseError[c][r] = roundUp<Real>(double((std::abs(sum) + gammaL4 * (mag + 1)) * (1 + 4 * gammaL4)));
+            }
+        // World box of the placed mesh, padded so that rounding in the ray's transform never
+        // culls an instance at its silhouette (the object-space test decides; tolerances.h).
+        scene::Bounds local, world;
+        for (const scene::Vec3& p : g.positions) local.extend(p);
+        for (int k = 0; k < 8; ++k)
+            world.extend(scene::transformPoint(inst.transform, scene::Vec3((k & 1) ? local.max.x : local.min.x,
+                                                                           (k & 2) ? local.max.y : local.min.y,
+                                                                           (k & 4) ? local.max.z : local.min.z)));
+        const double pad = kInstanceBoxPad * (world.maxAbsCoordinate() + world.diagonal());
+        world.min -= scene::Vec3(pad);
+        world.max += scene::Vec3(pad);
+        instanceBounds.push_back(world);
+        mo.instances.push_back(in);
+    }
+    if (!indices.empty()) {
+        if (!allNormals) normals.clear();
+        mo.flat = buildMesh(positions, normals, indices);
+    }
+    if (!mo.instances.empty()) mo.top = Bvh8::build(instanceBounds);
+    return mo;
+}
+
+template <typename Real>
+int Tracer<Real>::buildMesh(const std::vector<scene::Vec3>& positions,
+                            const std::vector<scene::Vec3>& normals,
+                            const std::vector<std::uint32_t>& indices) {
+    MeshData d;
+    d.positions.reserve(positions.size());
+    for (const scene::Vec3& p : positions) d.positions.push_back(toReal<Real>(p));
+    if (normals.size() == positions.size()) {
+        d.normals.reserve(normals.size());
+        for (const scene::Vec3& n : normals) d.normals.push_back(toReal<Real>(n));
+    }
+    d.indices = indices;
+    std::vector<scene::Bounds> triBounds(indices.size() / 3);
+    for (std::size_t t = 0; t < triBounds.size(); ++t)
+        for (int k = 0; k < 3; ++k) triBounds[t].extend(positions[indices[3 * t + k]]);
+    d.bvh = Bvh8::build(triBounds);
+    const std::vector<std::uint32_t>& slots = d.bvh.primitives();
+    if constexpr (std::is_same_v<Real, float>) {
+        d.packets.resize(slots.size() / WideRef::kLeafAlign);
+        for (std::size_t s = 0; s < slots.size(); ++s) {
+            TrianglePacket& pk = d.packets[s / 4];
+            for (int k = 0; k < 3; ++k)
+                for (int a = 0; a < 3; ++a)
+                    pk.v[3 * k + a][s % 4] =
+                        slots[s] == WideRef::kEmpty
+                            ? std::numeric_limits<float>::quiet_NaN()
+                            : d.positions[d.indices[3 * std::size_t(slots[s]) + k]][a];
+        }
+    } else {
+        d.slotVertices.reserve(3 * slots.size());
+        for (std::uint32_t tri : slots)
+            for (int k = 0; k < 3; ++k)
+                d.slotVertices.push_back(tri == WideRef::kEmpty
+                                             ? Vec(0)
+                                             : d.positions[d.indices[3 * std::size_t(tri) + k]]);
+    }
+    uniqueTriangles_ += triBounds.size();
+    meshes_.push_back(std::move(d));
+    return int(meshes_.size()) - 1;
+}
+
+template <typename Real>
+bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& tBest,
+                                 bool conservative, bool anyHit, Hit<Real>& hit) const {
+    auto record = [&](std::uint32_t slot, Real t, Real b0, Real b1, Real b2) {
+        hit.t = t;
+        hit.prim = int(m.bvh.primitives()[slot]);
+        hit.b0 = b0;
+        hit.b1 = b1;
+        hit.b2 = b2;
+    };
+    if constexpr (std::is_same_v<Real, float>) {
+        SlotHit sh;
+        // Any hit: first the packet that blocked this thread's previous any-hit ray in this
+        // tree (docs/raytrace.md, "Occluder cache"). Neighbouring shadow rays are mostly
+        // blocked by the same triangles, so this often answers without a walk; a hit there is
+        // a hit of the same exact test, so the boolean answer cannot change.
+        OccluderCache::Entry* cached = nullptr;
+        if (anyHit && occluderCacheOn.load(std::memory_order_relaxed)) {
+            const std::uint32_t blas = std::uint32_t(&m - meshes_.data());
+            cached = &occluderCache.entries[blas % OccluderCache::kEntries];
+            if (cached->tracer != id_ || cached->blas != blas) {
+                cached->tracer = id_;
+                cached->blas = blas;
+                cached->valid = false;
+            } else if (cached->valid) {
+                const Triangle4Ray r4(ray);
+                const TrianglePacket& pk = m.packets[cached->packet];
+                int cand = triangle4Candidates(r4, pk, tBest, 0xF);
+                while (cand != 0) {
+                    const int l = __builtin_ctz(unsigned(cand));
+                    cand &= cand - 1;
+                    float t, b0, b1, b2;
+                    if (!intersectTriangle(ray, pk.vertex(l, 0), pk.vertex(l, 1), pk.vertex(l, 2), tBest,
+                                           conservative, t, b0, b1, b2))
+                        continue;
+                    tBest = t;
+                    record(4 * cached->packet + std::uint32_t(l), t, b0, b1, b2);
+                    ++occluderCacheHitCount;
+                    return true;
+                }
+            }
+        }
+#if defined(SHADOWLAB_AVX_BOX_TEST)
+        const bool found = detail::useAvx()
+                               ? traverseFloatAvx(m.bvh, m.packets, ray, tBest, conservative, anyHit, sh)
+                               : traverseFloat<detail::ChildBoxTest<float, 8>>(m.bvh, m.packets, ray, tBest,
+                                                                              conservative, anyHit, sh);
+#else
+        const bool found = traverseFloat<detail::ChildBoxTest<float, 8>>(m.bvh, m.packets, ray, tBest,
+                                                                        conservative, anyHit, sh);
+#endif
+        if (found) record(sh.slot, sh.t, sh.b0, sh.b1, sh.b2);
+        if (cached) {
+            // Only a ray that was blocked leaves a packet to try: after an unblocked ray the
+            // next one goes straight to the walk, so mostly-lit scenes pay nothing for the cache.
+            cached->valid = found;
+            cached->packet = sh.slot / 4;
+        }
+        return found;
+    } else {
+        return m.bvh.traverse(ray, tBest, anyHit,
+                              [&](std::uint32_t first, std::uint32_t count, Real& tm) {
+            bool any = false;
+            for (std::uint32_t slot = first; slot < first + count; ++slot) {
+                const Vec* v = &m.slotVertices[3 * std::size_t(slot)];
+                Real t, b0, b1, b2;
+                if (!intersectTriangle(ray, v[0], v[1], v[2], tm, conservative, t, b0, b1, b2))
+                    continue;
+                tm = t;
+                record(slot, t, b0, b1, b2);
+                if (anyHit) return true;
+                any = true;
+            }
+            return any;
+        });
     }
 }
 
@@ -130,58 +387,32 @@ bool Tracer<Real>::intersectObject(int object, const Ray<Real>& ray, Real tMax, 
             return true;
         }
         case ShapeKind::Mesh: {
-            const MeshData& m = meshes_[od.index];
+            const MeshObjectData& mo = meshObjects_[od.index];
             Real tBest = tMax;
-            auto record = [&](std::uint32_t slot, Real t, Real b0, Real b1, Real b2) {
-                hit.t = t;
+            bool found = false;
+            if (mo.flat >= 0 && intersectMesh(meshes_[mo.flat], ray, tBest, conservative, anyHit, hit)) {
                 hit.object = object;
-                hit.prim = int(m.bvh.primitives()[slot]);
-                hit.b0 = b0;
-                hit.b1 = b1;
-                hit.b2 = b2;
-            };
-            if constexpr (std::is_same_v<Real, float>) {
-                const Triangle4Ray r4(ray);
-                return m.bvh.traverse(ray, tBest, anyHit,
-                                      [&](std::uint32_t first, std::uint32_t count, Real& tm) {
-                    bool any = false;
-                    for (std::uint32_t base = first; base < first + count; base += 4) {
-                        const TrianglePacket& pk = m.packets[base / 4];
-                        const std::uint32_t lanes = std::min<std::uint32_t>(4, first + count - base);
-                        int cand = triangle4Candidates(r4, pk, tm, (1 << lanes) - 1);
-                        // The scalar test decides, lane by lane in slot order as before.
-                        while (cand != 0) {
-                            const int l = __builtin_ctz(unsigned(cand));
-                            cand &= cand - 1;
-                            Real t, b0, b1, b2;
-                            if (!intersectTriangle(ray, pk.vertex(l, 0), pk.vertex(l, 1),
-                                                   pk.vertex(l, 2), tm, conservative, t, b0, b1, b2))
-                                continue;
-                            tm = t;
-                            record(base + std::uint32_t(l), t, b0, b1, b2);
-                            if (anyHit) return true;
-                            any = true;
-                        }
-                    }
-                    return any;
-                });
-            } else {
-                return m.bvh.traverse(ray, tBest, anyHit,
-                                      [&](std::uint32_t first, std::uint32_t count, Real& tm) {
-                    bool any = false;
-                    for (std::uint32_t slot = first; slot < first + count; ++slot) {
-                        const Vec* v = &m.slotVertices[3 * std::size_t(slot)];
-                        Real t, b0, b1, b2;
-                        if (!intersectTriangle(ray, v[0], v[1], v[2], tm, conservative, t, b0, b1, b2))
-                            continue;
-                        tm = t;
-                        record(slot, t, b0, b1, b2);
-                        if (anyHit) return true;
-                        any = true;
-                    }
-                    return any;
-                });
+                hit.instance = -1;
+                if (anyHit) return true;
+                found = true;
             }
+            if (mo.instances.empty()) return found;
+            const std::vector<std::uint32_t>& slots = mo.top.primitives();
+            return mo.top.traverse(ray, tBest, anyHit,
+                                   [&](std::uint32_t first, std::uint32_t count, Real& tm) {
+                bool any = false;
+                for (std::uint32_t slot = first; slot < first + count; ++slot) {
+                    const InstanceData& in = mo.instances[slots[slot]];
+                    // The ray in object space: t keeps its meaning (affine map, d not normalized).
+                    const Ray<Real> local(applyPoint(in.toObject, ray.o), applyVector(in.toObject, ray.d));
+                    if (!intersectMesh(meshes_[in.blas], local, tm, conservative, anyHit, hit)) continue;
+                    hit.object = object;
+                    hit.instance = int(slots[slot]);
+                    if (anyHit) return true;
+                    any = true;
+                }
+                return any;
+            }) || found;
         }
     }
     return false;
@@ -279,32 +510,61 @@ SurfacePoint<Real> Tracer<Real>::surfacePoint(const Ray<Real>& ray, const Hit<Re
             break;
         }
         case ShapeKind::Mesh: {
-            const MeshData& m = meshes_[od.index];
+            const MeshObjectData& mo = meshObjects_[od.index];
+            const InstanceData* in = hit.instance >= 0 ? &mo.instances[hit.instance] : nullptr;
+            const MeshData& m = meshes_[in ? in->blas : mo.flat];
             const std::uint32_t* ix = &m.indices[3 * std::size_t(hit.prim)];
             const Vec& p0 = m.positions[ix[0]];
             const Vec& p1 = m.positions[ix[1]];
             const Vec& p2 = m.positions[ix[2]];
+            Vec po(0), poError(0);  // robust: the point in the triangles' own space, and its bound
             if (robust) {
                 // Barycentric interpolation: error ≤ γ(7)·Σ|b_i·p_i| (pbrt-v4
                 // Triangle::InteractionFromIntersection, derived in pbrt-v3 §3.9.4).
-                sp.p = hit.b0 * p0 + hit.b1 * p1 + hit.b2 * p2;
-                sp.pError = gamma<Real>(7) * (glm::abs(hit.b0 * p0) + glm::abs(hit.b1 * p1) +
-                                              glm::abs(hit.b2 * p2));
+                po = hit.b0 * p0 + hit.b1 * p1 + hit.b2 * p2;
+                poError = gamma<Real>(7) * (glm::abs(hit.b0 * p0) + glm::abs(hit.b1 * p1) +
+                                            glm::abs(hit.b2 * p2));
+                sp.p = po;
+                sp.pError = poError;
+                if (in) {
+                    // To world space with pbrt-v4's bound for a point that carries an error
+                    // (Transform::operator()(Point3fi), pbrt-v3 §3.9.3): (1 + γ(3))·|M|·e +
+                    // γ(3)·(|M|·|p| + |t|). The exact surface is the stored M applied exactly.
+                    sp.p = applyPoint(in->toWorld, po);
+                    const Vec mErr = applyVector(in->absToWorld, poError);
+                    sp.pError = (1 + gamma<Real>(3)) * mErr +
+                                gamma<Real>(3) * applyPoint(in->absToWorld, glm::abs(po));
+                }
             }
-            sp.ng = glm::normalize(glm::cross(p1 - p0, p2 - p0));
-            if (!m.normals.empty()) {
-                const Vec n = hit.b0 * m.normals[ix[0]] + hit.b1 * m.normals[ix[1]] +
-                              hit.b2 * m.normals[ix[2]];
-                const Real len = glm::length(n);
-                sp.ns = len > 0 ? n / len : sp.ng;
-                if (glm::dot(sp.ns, sp.ng) < 0) sp.ns = -sp.ns;  // winding decides the side
-            } else {
-                sp.ns = sp.ng;
+            Vec ng = glm::cross(p1 - p0, p2 - p0);
+            Vec ns(0);
+            if (!m.normals.empty())
+                ns = hit.b0 * m.normals[ix[0]] + hit.b1 * m.normals[ix[1]] + hit.b2 * m.normals[ix[2]];
+            if (in) {  // normals by the inverse transpose
+                ng = in->normalToWorld * ng;
+                ns = in->normalToWorld * ns;
+            }
+            sp.ng = glm::normalize(ng);
+            const Real len = glm::length(ns);
+            sp.ns = len > 0 ? ns / len : sp.ng;
+            if (glm::dot(sp.ns, sp.ng) < 0) sp.ns = -sp.ns;  // winding decides the side
+            if (robust && in) {
+                sp.errorAlongNormal = glm::dot(glm::abs(sp.ng), sp.pError);
+                // A shadow ray from o ≈ p is taken back to object space as toObject·o, which
+                // differs from the exact preimage of o by at most e = γ(3)·(|toObject|·|o| +
+                // |t'|) (the product's rounding) + |R|·|x| (toObject is not exactly toWorld's
+                // inverse; x ≈ po the preimage). That moves the origin by |M|·e in world space,
+                // so the offset grows by that much along the normal; the factor 2 covers
+                // |o| ≥ |p| by the offset itself and the rounding of these bounds.
+                const Vec e = Real(2) * (gamma<Real>(3) * applyPoint(in->absToObject, glm::abs(sp.p)) +
+                                         applyPoint(in->inverseError, glm::abs(po)));
+                sp.errorAlongNormal += glm::dot(glm::abs(sp.ng), applyVector(in->absToWorld, e));
             }
             break;
         }
     }
-    if (robust && od.kind != ShapeKind::Quad && od.kind != ShapeKind::Box)
+    if (robust && od.kind != ShapeKind::Quad && od.kind != ShapeKind::Box &&
+        !(od.kind == ShapeKind::Mesh && hit.instance >= 0))
         sp.errorAlongNormal = glm::dot(glm::abs(sp.ng), sp.pError);
     // Two-sided surfaces: the normals face the side the ray came from.
     if (glm::dot(sp.ng, ray.d) > 0) {
@@ -321,6 +581,8 @@ std::size_t Tracer<Real>::meshBytes() const {
         n += m.positions.capacity() * sizeof(Vec) + m.normals.capacity() * sizeof(Vec) +
              m.indices.capacity() * sizeof(std::uint32_t) + m.bvh.bytes() +
              m.packets.capacity() * sizeof(TrianglePacket) + m.slotVertices.capacity() * sizeof(Vec);
+    for (const MeshObjectData& mo : meshObjects_)
+        n += mo.instances.capacity() * sizeof(InstanceData) + mo.top.bytes();
     return n;
 }
 

@@ -1,9 +1,12 @@
 // raytrace/tracer.h: the scene converted to Real (float for the method, double for the
-// reference) with one BVH per mesh, and the queries every pass is built from: closest hit,
+// reference) with one BVH per geometry (meshes placed once merged in world space per object,
+// meshes placed several times shared in object space under a top-level tree of their
+// instances), and the queries every pass is built from: closest hit,
 // any hit, per-object hits and the surface point (position, error bound, normals) of a hit.
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <vector>
 
 #include "raytrace/wide_bvh.h"
@@ -19,6 +22,7 @@ struct Hit {
     Real t = std::numeric_limits<Real>::infinity();
     int object = -1;  // index into Scene::objects
     int prim = 0;     // mesh: triangle index; box: face (axis + 3 on the max side)
+    int instance = -1;  // mesh: the instance hit (index in its object), -1 for world-space triangles
     Real b0 = 0, b1 = 0, b2 = 0;  // mesh: barycentrics
 };
 
@@ -42,7 +46,7 @@ class Tracer {
 public:
     using Vec = Vec3T<Real>;
 
-    // Converts every object to Real and builds a BVH per mesh (the "setup" stage).
+    // Converts every object to Real and builds the mesh trees (the "setup" stage).
     explicit Tracer(const scene::Scene& scene);
 
     // Nearest hit with 0 < t < tMax. Conservative: reject hits whose t could be <= 0 under
@@ -62,10 +66,16 @@ public:
     int objectCount() const { return int(objects_.size()); }
     ShapeKind kind(int object) const { return objects_[object].kind; }
     double opacity(int object) const { return objects_[object].opacity; }
+    // Placed triangles: an instanced mesh counts once per instance (what the scene shows).
     std::size_t triangleCount() const { return triangles_; }
-    // Bytes held for meshes: vertices, normals, indices, BVH nodes, slot table and the
-    // slot-ordered triangle copies (capacities, so what is really allocated).
+    // Triangles stored: an instanced mesh counts once (what memory is spent on).
+    std::size_t uniqueTriangleCount() const { return uniqueTriangles_; }
+    // Bytes held for meshes: vertices, normals, indices, BVH nodes, slot table, the
+    // slot-ordered triangle copies, instances and their top-level trees (capacities, so what is
+    // really allocated). Per triangle, divide by uniqueTriangleCount().
     std::size_t meshBytes() const;
+    // Bottom-level structures built (world-space meshes plus one per instanced geometry).
+    std::size_t blasCount() const { return meshes_.size(); }
 
 private:
     struct ObjectData {
@@ -87,6 +97,8 @@ private:
     struct BoxData {
         Vec lo, hi;
     };
+    // A bottom-level structure: triangles with their BVH, in world space (every mesh used
+    // once, its instances merged per object) or in object space (a mesh placed several times).
     struct MeshData {
         std::vector<Vec> positions;
         std::vector<Vec> normals;  // per vertex, may be empty
@@ -99,13 +111,49 @@ private:
         std::vector<Vec> slotVertices;
     };
 
+    // Object space → world space and back in Real, 4x3 (m[column][row]); applied as pbrt-v4's
+    // Transform applies a point, (m00·x + m01·y) + (m02·z + m03), which its γ(3) bound assumes.
+    using Affine = glm::mat<4, 3, Real, glm::defaultp>;
+    struct InstanceData {
+        int blas;  // into meshes_
+        Affine toWorld, toObject;
+        glm::mat<3, 3, Real, glm::defaultp> normalToWorld;  // inverse transpose of toWorld's linear part
+        // Robust offsets (docs/raytrace.md, "Instances"): |toWorld|, |toObject| and a bound on
+        // |toObject·toWorld − I| (the stored inverse is not the exact inverse of the stored
+        // transform), linear part and translation.
+        Affine absToWorld, absToObject, inverseError;
+    };
+    struct MeshObjectData {
+        int flat = -1;  // the object's meshes used once, merged in world space; -1 if none
+        std::vector<InstanceData> instances;
+        Bvh8 top;  // over the instances' world boxes
+    };
+
+    MeshObjectData buildMeshObject(const scene::Object& obj, const scene::Mesh& m,
+                                   const std::map<const scene::TriangleMesh*, int>& uses,
+                                   std::map<const scene::TriangleMesh*, int>& blasOf);
+    bool intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& tMax, bool conservative,
+                       bool anyHit, Hit<Real>& hit) const;
+    int buildMesh(const std::vector<scene::Vec3>& positions, const std::vector<scene::Vec3>& normals,
+                  const std::vector<std::uint32_t>& indices);
+
     std::vector<ObjectData> objects_;
     std::vector<SphereData> spheres_;
     std::vector<QuadData> quads_;
     std::vector<BoxData> boxes_;
     std::vector<MeshData> meshes_;
+    std::vector<MeshObjectData> meshObjects_;
     std::size_t triangles_ = 0;
+    std::size_t uniqueTriangles_ = 0;
+    std::uint64_t id_;  // unique per tracer, keys the per-thread occluder cache
 };
+
+// Float any-hit queries first test the packet that blocked the same thread's previous any-hit
+// ray in the same tree (on by default; docs/raytrace.md, "Occluder cache"). Off only to measure
+// or test without it; answers are the same either way.
+void setOccluderCache(bool on);
+bool occluderCacheEnabled();
+std::uint64_t occluderCacheHits();  // answered by the cache on this thread so far (for tests)
 
 extern template class Tracer<float>;
 extern template class Tracer<double>;

@@ -2,6 +2,7 @@
 #include "raytrace/wide_bvh.h"
 
 #include <array>
+#include <atomic>
 #include <limits>
 #include <stdexcept>
 
@@ -107,5 +108,27 @@ WideBvh<N> WideBvh<N>::build(const std::vector<scene::Bounds>& primitiveBounds) 
 
 template class WideBvh<4>;
 template class WideBvh<8>;
+
+namespace detail {
+
+namespace {
+std::atomic<bool>& avxSwitch() {
+    static std::atomic<bool> on{hasAvx()};
+    return on;
+}
+}  // namespace
+
+bool hasAvx() {
+#if defined(SHADOWLAB_AVX_BOX_TEST)
+    static const bool has = __builtin_cpu_supports("avx");
+    return has;
+#else
+    return false;
+#endif
+}
+bool useAvx() { return avxSwitch().load(std::memory_order_relaxed); }
+void setUseAvx(bool on) { avxSwitch().store(on && hasAvx(), std::memory_order_relaxed); }
+
+}  // namespace detail
 
 }  // namespace shadowlab::raytrace

@@ -11,6 +11,12 @@
 #include <emmintrin.h>
 #include <xmmintrin.h>
 #endif
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+// An AVX 8-wide child-box test behind runtime dispatch (target attributes, no -m flag: the
+// program still runs on plain x86-64; see docs/raytrace.md, "AVX").
+#define SHADOWLAB_AVX_BOX_TEST 1
+#endif
 
 #include "raytrace/bvh.h"
 
@@ -78,6 +84,9 @@ public:
     // docs/raytrace.md). Box tests are intersectBounds' (same widening, same NaN rule).
     template <typename Real, typename LeafFn>
     bool traverse(const Ray<Real>& ray, Real& tMax, bool anyHit, LeafFn&& leaf) const;
+    // The same walk with a chosen child-box test (BoxTest(ray), box(node, tMax, tNear) → mask).
+    template <typename BoxTest, typename Real, typename LeafFn>
+    bool traverseWith(const Ray<Real>& ray, Real& tMax, bool anyHit, LeafFn&& leaf) const;
 
 private:
     std::vector<Node> nodes_;
@@ -159,11 +168,56 @@ struct ChildBoxTest<float, N> {
 };
 #endif
 
+#if defined(SHADOWLAB_AVX_BOX_TEST)
+// All eight children in one AVX pass, the same operations in the same order as the SSE test
+// (_mm256_max_ps / _mm256_min_ps have _mm_max_ps' NaN rule; no FMA: the target is "avx" only,
+// so nothing can be contracted), hence bit for bit the same masks and entry distances. Usable
+// only where the CPU has AVX (hasAvx()) and only from functions compiled for it.
+struct ChildBoxTestAvx8 {
+    __m256 o[3], inv[3], widen;
+    int nearRow[3], farRow[3];
+    __attribute__((target("avx"))) explicit ChildBoxTestAvx8(const Ray<float>& r) {
+        for (int i = 0; i < 3; ++i) {
+            o[i] = _mm256_set1_ps(r.o[i]);
+            inv[i] = _mm256_set1_ps(r.invDir[i]);
+            nearRow[i] = r.dirIsNeg[i] ? 3 + i : i;
+            farRow[i] = r.dirIsNeg[i] ? i : 3 + i;
+        }
+        widen = _mm256_set1_ps(1 + 2 * gamma<float>(3));
+    }
+    __attribute__((target("avx"))) int operator()(const WideNode<8>& n, float tMax, float tNear[8]) const {
+        __m256 tn = _mm256_setzero_ps(), tf = _mm256_set1_ps(tMax);
+        for (int i = 0; i < 3; ++i) {
+            const __m256 a =
+                _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[nearRow[i]]), o[i]), inv[i]);
+            const __m256 b = _mm256_mul_ps(
+                _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[farRow[i]]), o[i]), inv[i]), widen);
+            tn = _mm256_max_ps(a, tn);
+            tf = _mm256_min_ps(b, tf);
+        }
+        _mm256_storeu_ps(tNear, tn);
+        return _mm256_movemask_ps(_mm256_cmp_ps(tn, tf, _CMP_LE_OQ));
+    }
+};
+#endif
+
+// Whether this CPU runs the AVX box test (checked once), and whether the tracer uses it:
+// on by default where available; tests and the bench switch it off to compare with SSE.
+bool hasAvx();
+bool useAvx();
+void setUseAvx(bool on);  // no effect (stays off) without AVX
+
 }  // namespace detail
 
 template <int N>
 template <typename Real, typename LeafFn>
 bool WideBvh<N>::traverse(const Ray<Real>& ray, Real& tMax, bool anyHit, LeafFn&& leaf) const {
+    return traverseWith<detail::ChildBoxTest<Real, N>>(ray, tMax, anyHit, leaf);
+}
+
+template <int N>
+template <typename BoxTest, typename Real, typename LeafFn>
+bool WideBvh<N>::traverseWith(const Ray<Real>& ray, Real& tMax, bool anyHit, LeafFn&& leaf) const {
     if (root_ == kEmpty) return false;
     // Each node pushes at most N − 1 entries; the binary build caps the depth at 80 levels
     // (tolerances.h) and a wide level consumes at least one binary level: (N − 1)·80 + 1 fits.
@@ -174,7 +228,7 @@ bool WideBvh<N>::traverse(const Ray<Real>& ray, Real& tMax, bool anyHit, LeafFn&
     };
     Entry stack[kStackSize];
     int top = 0;
-    const detail::ChildBoxTest<Real, N> boxes(ray);
+    const BoxTest boxes(ray);
     std::uint32_t ref = root_;
     bool hit = false;
     for (;;) {

@@ -229,7 +229,7 @@ Light readLight(const Reader& r, const Json& node, const JsonPath& path) {
 }
 
 Object readObject(const Reader& r, const Json& node, const JsonPath& path,
-                  const std::map<std::string, int>& materials) {
+                  const std::map<std::string, int>& materials, MeshCache& meshCache) {
     r.expectObject(node, path);
     Object o;
     const std::string type = r.string(r.require(node, path, "type"), path / "type");
@@ -275,7 +275,8 @@ Object readObject(const Reader& r, const Json& node, const JsonPath& path,
         Mesh m;
         const fs::path base = r.file().has_parent_path() ? r.file().parent_path() : fs::path(".");
         m.file = fs::path(file).is_absolute() ? fs::path(file) : base / file;
-        m.geometry = loadMesh(m.file, objectTransform(translate, rotate, scale), r.file(), path / "file");
+        m.instances = loadMeshInstances(m.file, objectTransform(translate, rotate, scale), r.file(),
+                                        path / "file", nullptr, &meshCache);
         o.shape = m;
     } else {
         r.fail(path / "type", "unknown object type '" + type + "' (expected sphere, quad, box or mesh)");
@@ -400,8 +401,9 @@ Scene parseScene(const fs::path& file, const std::string& text) {
     if (!objects.is_array()) r.fail(root / "objects", std::string("expected an array, got ") + typeName(objects));
     if (objects.empty()) r.fail(root / "objects", "must hold at least one object");
     if (objects.size() > 1000000) r.fail(root / "objects", "has more than 1,000,000 objects");
+    MeshCache meshCache;  // objects naming the same file share its geometry
     for (std::size_t i = 0; i < objects.size(); ++i)
-        scene.objects.push_back(readObject(r, objects[i], root / "objects" / i, materialIndex));
+        scene.objects.push_back(readObject(r, objects[i], root / "objects" / i, materialIndex, meshCache));
 
     if (doc.contains("shadow")) scene.shadow = readShadow(r, doc["shadow"], root / "shadow");
     return scene;
@@ -418,7 +420,7 @@ Scene loadModelScene(const fs::path& file) {
     scene.materials.push_back({"model", {0.8, 0.8, 0.8}, 1.0});
     Mesh mesh;
     mesh.file = file;
-    mesh.geometry = loadMesh(file, glm::dmat4(1.0), file, JsonPath(), &extras);
+    mesh.instances = loadMeshInstances(file, glm::dmat4(1.0), file, JsonPath(), &extras);
     scene.objects.push_back({file.stem().string(), mesh, 0});
     const Bounds b = scene.bounds();
     const double radius = std::max(0.5 * b.diagonal(), 1e-9);

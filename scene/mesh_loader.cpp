@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -151,12 +152,11 @@ bool ignoreImage(tinygltf::Image*, const int, std::string*, std::string*, int, i
     return true;
 }
 
-void appendGltfMesh(const tinygltf::Model& model, int meshIndex, const glm::dmat4& world,
-                    TriangleMesh& out, const fs::path& file, const fs::path& sceneFile,
-                    const JsonPath& path) {
+// One glTF mesh (all its triangle primitives) in the mesh's own space.
+void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& out,
+                    const fs::path& file, const fs::path& sceneFile, const JsonPath& path) {
     if (meshIndex < 0 || std::size_t(meshIndex) >= model.meshes.size())
         fail(sceneFile, path, file, "node names mesh " + std::to_string(meshIndex) + ", which does not exist");
-    const glm::dmat3 normalMatrix = glm::transpose(glm::inverse(glm::dmat3(world)));
     for (const auto& prim : model.meshes[meshIndex].primitives) {
         if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != -1) continue;  // points/lines cast nothing
         const auto pos = prim.attributes.find("POSITION");
@@ -179,10 +179,10 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, const glm::dmat
         const bool keepNormals = !n.empty() && (out.positions.empty() || !out.normals.empty());
         if (!keepNormals) out.normals.clear();
         for (std::size_t i = 0; i < count; ++i) {
-            const Vec3 v = Vec3(world * glm::dvec4(p[3 * i], p[3 * i + 1], p[3 * i + 2], 1.0));
+            const Vec3 v(p[3 * i], p[3 * i + 1], p[3 * i + 2]);
             if (!finite(v)) fail(sceneFile, path, file, "a vertex is not finite");
             out.positions.push_back(v);
-            if (keepNormals) out.normals.push_back(normalMatrix * Vec3(n[3 * i], n[3 * i + 1], n[3 * i + 2]));
+            if (keepNormals) out.normals.emplace_back(n[3 * i], n[3 * i + 1], n[3 * i + 2]);
         }
         for (std::size_t i = 0; i + 2 < idx.size(); i += 3) {
             for (int k = 0; k < 3; ++k) {
@@ -230,7 +230,13 @@ void collectCameraAndLight(const tinygltf::Model& model, const tinygltf::Node& n
     out.lights.push_back(light);
 }
 
-void loadGltf(const fs::path& file, TriangleMesh& mesh, const fs::path& sceneFile,
+// Placements of the file's geometries; `geometry` is still mutable while loading.
+struct RawInstance {
+    std::shared_ptr<TriangleMesh> geometry;
+    glm::dmat4 transform;
+};
+
+void loadGltf(const fs::path& file, std::vector<RawInstance>& out, const fs::path& sceneFile,
               const JsonPath& path, GltfExtras* extras) {
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader(ignoreImage, nullptr);
@@ -242,13 +248,15 @@ void loadGltf(const fs::path& file, TriangleMesh& mesh, const fs::path& sceneFil
                                   : loader.LoadASCIIFromFile(&model, &err, &warn, file.string());
     if (!ok) fail(sceneFile, path, file, "not a readable glTF file: " + (err.empty() ? warn : err));
 
-    // Walk the default scene's node tree so each node that uses a mesh places it once.
+    // Walk the default scene's node tree (depth first, in document order) so each node that
+    // uses a mesh places it once; a mesh used by several nodes is read once and shared.
     std::vector<int> roots;
     const int sceneIndex = model.defaultScene >= 0 ? model.defaultScene : 0;
     if (std::size_t(sceneIndex) < model.scenes.size()) roots = model.scenes[sceneIndex].nodes;
     else for (std::size_t i = 0; i < model.nodes.size(); ++i) roots.push_back(int(i));
+    std::vector<std::shared_ptr<TriangleMesh>> meshes(model.meshes.size());
     std::vector<std::pair<int, glm::dmat4>> stack;
-    for (int r : roots) stack.emplace_back(r, glm::dmat4(1.0));
+    for (auto r = roots.rbegin(); r != roots.rend(); ++r) stack.emplace_back(*r, glm::dmat4(1.0));
     // glTF nodes form a forest (glTF 2.0 spec, 3.5.3: a node has at most one parent and no
     // cycles), so a walk reaches each node once; a second visit means a cycle or a shared child,
     // which would otherwise loop forever or grow exponentially (found by fuzzing).
@@ -266,11 +274,73 @@ void loadGltf(const fs::path& file, TriangleMesh& mesh, const fs::path& sceneFil
                                             "with two parents); glTF nodes must form trees");
         const auto& node = model.nodes[nodeIndex];
         const glm::dmat4 world = parent * nodeMatrix(node);
-        if (node.mesh >= 0) appendGltfMesh(model, node.mesh, world, mesh, file, sceneFile, path);
+        if (node.mesh >= 0) {
+            if (std::size_t(node.mesh) >= model.meshes.size())
+                fail(sceneFile, path, file, "node names mesh " + std::to_string(node.mesh) + ", which does not exist");
+            auto& geometry = meshes[node.mesh];
+            if (!geometry) {
+                geometry = std::make_shared<TriangleMesh>();
+                appendGltfMesh(model, node.mesh, *geometry, file, sceneFile, path);
+            }
+            out.push_back({geometry, world});
+        }
         if (extras) collectCameraAndLight(model, node, world, *extras);
-        for (int child : node.children) stack.emplace_back(child, world);
+        for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.emplace_back(*c, world);
     }
-    if (mesh.indices.empty()) fail(sceneFile, path, file, "has no triangles");
+}
+
+// A transform that can place a mesh: finite, invertible linear part (a glTF node may scale by
+// 0 to hide a mesh; such a placement is dropped like a degenerate triangle).
+bool invertible(const glm::dmat4& m) {
+    const double det = glm::determinant(glm::dmat3(m));
+    if (!(std::abs(det) > 0) || !std::isfinite(det)) return false;
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 3; ++r)
+            if (!std::isfinite(m[c][r])) return false;
+    return true;
+}
+
+// The file's instances with `transform` not yet applied (what the cache keeps).
+std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path& sceneFile,
+                                       const JsonPath& path, GltfExtras* extras) {
+    std::error_code ec;
+    if (!fs::is_regular_file(meshFile, ec)) fail(sceneFile, path, meshFile, "no such file");
+    if (fs::file_size(meshFile, ec) == 0) fail(sceneFile, path, meshFile, "is empty (0 bytes)");
+    std::vector<RawInstance> raw;
+    std::string ext = meshFile.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+    if (ext == ".obj") {
+        raw.push_back({std::make_shared<TriangleMesh>(), glm::dmat4(1.0)});
+        loadObj(meshFile, *raw.back().geometry, sceneFile, path);
+    } else if (ext == ".gltf" || ext == ".glb") {
+        loadGltf(meshFile, raw, sceneFile, path, extras);
+    } else {
+        fail(sceneFile, path, meshFile, "unknown mesh type '" + ext + "' (use .obj, .gltf or .glb)");
+    }
+    // Degenerate triangles are judged in object space: an invertible affine map keeps a
+    // triangle's area zero or non-zero.
+    std::vector<TriangleMesh*> finalized;
+    std::size_t dropped = 0, triangles = 0;
+    std::vector<MeshInstance> out;
+    for (RawInstance& r : raw) {
+        if (std::find(finalized.begin(), finalized.end(), r.geometry.get()) == finalized.end()) {
+            finalizeMesh(*r.geometry);
+            finalized.push_back(r.geometry.get());
+            dropped += r.geometry->droppedDegenerate;
+            triangles += r.geometry->triangleCount();
+        }
+        if (r.geometry->indices.empty()) continue;
+        if (!invertible(r.transform)) {
+            dropped += r.geometry->triangleCount();
+            continue;
+        }
+        out.push_back({r.geometry, affineOf(r.transform)});
+    }
+    if (triangles == 0 && dropped == 0) fail(sceneFile, path, meshFile, "has no triangles");
+    if (out.empty())
+        fail(sceneFile, path, meshFile, "has no triangles left after dropping " +
+                                            std::to_string(dropped) + " degenerate ones");
+    return out;
 }
 
 }  // namespace
@@ -323,27 +393,62 @@ void finalizeMesh(TriangleMesh& mesh) {
     }
 }
 
+std::vector<MeshInstance> loadMeshInstances(const fs::path& meshFile, const glm::dmat4& transform,
+                                            const fs::path& sceneFile, const JsonPath& path,
+                                            GltfExtras* extras, MeshCache* cache) {
+    std::vector<MeshInstance> instances;
+    std::string key;
+    if (cache) {
+        std::error_code ec;
+        const fs::path canonical = fs::weakly_canonical(meshFile, ec);
+        key = (ec ? meshFile : canonical).string();
+        if (const auto it = cache->files.find(key); it != cache->files.end()) instances = it->second;
+    }
+    if (instances.empty()) {
+        instances = readMeshFile(meshFile, sceneFile, path, extras);
+        if (cache) cache->files.emplace(key, instances);
+    }
+    std::vector<MeshInstance> out;
+    for (MeshInstance& inst : instances) {
+        const glm::dmat4 m = transform * glm::dmat4(inst.transform);
+        if (!invertible(m)) continue;
+        // The placed mesh must stay finite: its box's corners bound every placed vertex.
+        Bounds b;
+        for (const Vec3& p : inst.geometry->positions) b.extend(p);
+        for (int corner = 0; corner < 8; ++corner) {
+            const Vec3 c((corner & 1) ? b.max.x : b.min.x, (corner & 2) ? b.max.y : b.min.y,
+                         (corner & 4) ? b.max.z : b.min.z);
+            if (!finite(Vec3(m * glm::dvec4(c, 1.0))))
+                fail(sceneFile, path, meshFile, "a vertex is not finite once placed");
+        }
+        out.push_back({inst.geometry, affineOf(m)});
+    }
+    if (out.empty()) fail(sceneFile, path, meshFile, "the object's transform is not invertible");
+    return out;
+}
+
+TriangleMesh flattenInstances(const std::vector<MeshInstance>& instances) {
+    TriangleMesh out;
+    bool normals = true;
+    for (const MeshInstance& inst : instances) normals = normals && !inst.geometry->normals.empty();
+    for (const MeshInstance& inst : instances) {
+        const TriangleMesh& g = *inst.geometry;
+        const glm::dmat3 nm = normalMatrix(inst.transform);
+        const std::uint32_t base = std::uint32_t(out.positions.size());
+        for (const Vec3& p : g.positions) out.positions.push_back(transformPoint(inst.transform, p));
+        if (normals)
+            for (const Vec3& n : g.normals) out.normals.push_back(glm::normalize(nm * n));
+        for (std::uint32_t i : g.indices) out.indices.push_back(base + i);
+        out.droppedDegenerate += g.droppedDegenerate;
+    }
+    return out;
+}
+
 std::shared_ptr<const TriangleMesh> loadMesh(const fs::path& meshFile, const glm::dmat4& transform,
                                              const fs::path& sceneFile, const JsonPath& path,
                                              GltfExtras* extras) {
-    std::error_code ec;
-    if (!fs::is_regular_file(meshFile, ec)) fail(sceneFile, path, meshFile, "no such file");
-    if (fs::file_size(meshFile, ec) == 0) fail(sceneFile, path, meshFile, "is empty (0 bytes)");
-    auto mesh = std::make_shared<TriangleMesh>();
-    std::string ext = meshFile.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-    if (ext == ".obj") loadObj(meshFile, *mesh, sceneFile, path);
-    else if (ext == ".gltf" || ext == ".glb") loadGltf(meshFile, *mesh, sceneFile, path, extras);
-    else fail(sceneFile, path, meshFile, "unknown mesh type '" + ext + "' (use .obj, .gltf or .glb)");
-
-    const glm::dmat3 normalMatrix = glm::transpose(glm::inverse(glm::dmat3(transform)));
-    for (Vec3& p : mesh->positions) p = Vec3(transform * glm::dvec4(p, 1.0));
-    for (Vec3& n : mesh->normals) n = normalMatrix * n;
-    finalizeMesh(*mesh);
-    if (mesh->indices.empty())
-        fail(sceneFile, path, meshFile, "has no triangles left after dropping " +
-                                            std::to_string(mesh->droppedDegenerate) + " degenerate ones");
-    return mesh;
+    return std::make_shared<TriangleMesh>(
+        flattenInstances(loadMeshInstances(meshFile, transform, sceneFile, path, extras)));
 }
 
 }  // namespace shadowlab::scene

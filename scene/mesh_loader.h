@@ -1,9 +1,11 @@
-// scene/mesh_loader.h: OBJ and glTF/GLB triangle meshes into world space (double precision).
+// scene/mesh_loader.h: OBJ and glTF/GLB triangle meshes (double precision) in object space,
+// each placed by a transform; a mesh that several glTF nodes or objects use is read once.
 // Non-finite vertices, out-of-range indices and unreadable files are errors; degenerate
 // triangles are dropped and counted; missing normals are computed (area-weighted).
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -32,9 +34,28 @@ struct GltfExtras {
     std::vector<GltfLight> lights;
 };
 
-// Reads `meshFile` and applies `transform` (object to world). Errors name `sceneFile` and
-// `path` (the JSON path of the object's "file" key) as well as the mesh file. For glTF files,
-// `extras` (when given) receives the file's cameras and lights.
+// Each mesh file read once per scene: objects that name the same file share its geometries
+// (the key is the file's canonical path).
+struct MeshCache {
+    std::map<std::string, std::vector<MeshInstance>> files;
+};
+
+// Reads `meshFile`: one instance for an OBJ file, one per node that uses a mesh for glTF (the
+// node hierarchy applied; a glTF mesh used by several nodes is one shared geometry), each then
+// placed by `transform` (object to world). Errors name `sceneFile` and `path` (the JSON path of
+// the object's "file" key) as well as the mesh file. For glTF files, `extras` (when given and
+// the file is not already in `cache`) receives the file's cameras and lights.
+std::vector<MeshInstance> loadMeshInstances(const std::filesystem::path& meshFile,
+                                            const glm::dmat4& transform,
+                                            const std::filesystem::path& sceneFile,
+                                            const JsonPath& path, GltfExtras* extras = nullptr,
+                                            MeshCache* cache = nullptr);
+
+// Copies every instance into one world-space mesh (positions transformed, normals by the
+// inverse transpose): for tools and tests that want one flat triangle list.
+TriangleMesh flattenInstances(const std::vector<MeshInstance>& instances);
+
+// loadMeshInstances, flattened.
 std::shared_ptr<const TriangleMesh> loadMesh(const std::filesystem::path& meshFile,
                                              const glm::dmat4& transform,
                                              const std::filesystem::path& sceneFile,

@@ -33,10 +33,18 @@ Bounds boundsOf(const Shape& shape) {
         b.extend(box->min);
         b.extend(box->max);
     } else if (const auto* m = std::get_if<Mesh>(&shape)) {
-        if (m->geometry)
-            for (const Vec3& p : m->geometry->positions) b.extend(p);
+        for (const MeshInstance& inst : m->instances)
+            if (inst.geometry)
+                for (const Vec3& p : inst.geometry->positions) b.extend(transformPoint(inst.transform, p));
     }
     return b;
+}
+
+std::size_t Mesh::triangleCount() const {
+    std::size_t n = 0;
+    for (const MeshInstance& inst : instances)
+        if (inst.geometry) n += inst.geometry->triangleCount();
+    return n;
 }
 
 bool Scene::allOpaque() const {

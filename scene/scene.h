@@ -73,8 +73,9 @@ struct Box {
     Vec3 max;
 };
 
-// A triangle mesh already transformed into world space (double precision). Loaded from
-// OBJ/glTF by mesh_loader.h; `normals` is per vertex, computed when the file has none.
+// A triangle mesh in its own object space (double precision), shared (shared_ptr<const>) by
+// every object and glTF node that places it. Loaded from OBJ/glTF by mesh_loader.h; `normals`
+// is per vertex, computed when the file has none.
 struct TriangleMesh {
     std::vector<Vec3> positions;
     std::vector<Vec3> normals;
@@ -83,9 +84,34 @@ struct TriangleMesh {
     std::size_t triangleCount() const { return indices.size() / 3; }
 };
 
+// Object space to world space: an affine 4x3 matrix (three rows; columns 0..2 the linear part,
+// column 3 the translation), double. Normals go by the inverse transpose of the linear part.
+using Affine = glm::dmat4x3;
+inline Vec3 transformPoint(const Affine& m, const Vec3& p) { return m * glm::dvec4(p, 1.0); }
+inline Vec3 transformVector(const Affine& m, const Vec3& v) { return m * glm::dvec4(v, 0.0); }
+inline glm::dmat3 normalMatrix(const Affine& m) { return glm::transpose(glm::inverse(glm::dmat3(m))); }
+inline Affine affineOf(const glm::dmat4& m) { return Affine(m); }
+
+// One placement of a geometry: the same `geometry` pointer in several instances (other nodes
+// of the glTF file, other objects naming the same file) is one mesh in memory, placed several
+// times (docs/decisions.md, "Mesh instancing").
+struct MeshInstance {
+    std::shared_ptr<const TriangleMesh> geometry;
+    Affine transform{1.0};
+};
+
+// A mesh object: one scene object (one object id) whatever its file holds. An OBJ file is one
+// instance; a glTF file is one instance per node that uses a mesh (its node hierarchy applied,
+// then the object's translate/rotate/scale).
 struct Mesh {
     std::filesystem::path file;  // as resolved against the scene file's folder
-    std::shared_ptr<const TriangleMesh> geometry;
+    std::vector<MeshInstance> instances;
+    std::size_t triangleCount() const;  // placed triangles (an instanced triangle counts each time)
+    // One instance of `geometry` (tests and generated meshes).
+    static Mesh single(std::filesystem::path file, std::shared_ptr<const TriangleMesh> geometry,
+                       const Affine& transform = Affine(1.0)) {
+        return Mesh{std::move(file), {MeshInstance{std::move(geometry), transform}}};
+    }
 };
 
 using Shape = std::variant<Sphere, Quad, Box, Mesh>;

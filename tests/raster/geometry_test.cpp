@@ -103,7 +103,7 @@ TEST(Tessellate, MeshIsTakenAsIsWithObjectIds) {
     mesh->positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1, 0)};
     mesh->normals = {Vec3(0, 0, 1), Vec3(0, 0, 1), Vec3(0, 0, 1), Vec3(0, 0, 1)};
     mesh->indices = {0, 1, 2, 1, 3, 2};
-    scene::Scene s = oneObject(scene::Mesh{"m.obj", mesh});
+    scene::Scene s = oneObject(scene::Mesh::single("m.obj", mesh));
     s.objects.insert(s.objects.begin(), s.objects[0]);  // two copies: ids 1 and 2
     const SceneGeometry g = tessellateScene(s, Vec3(0));
     ASSERT_EQ(g.triangleCount(), 4u);
@@ -114,7 +114,7 @@ TEST(Tessellate, MeshIsTakenAsIsWithObjectIds) {
 }
 
 TEST(Tessellate, MeshWithoutGeometryIsAnError) {
-    EXPECT_THROW(tessellateScene(oneObject(scene::Mesh{"missing.obj", nullptr}), Vec3(0)), std::runtime_error);
+    EXPECT_THROW(tessellateScene(oneObject(scene::Mesh::single("missing.obj", nullptr)), Vec3(0)), std::runtime_error);
 }
 
 TEST(Tessellate, PositionsAreCameraRelativeAndKeepSmallOffsetsFarFromTheOrigin) {

@@ -173,7 +173,7 @@ TEST(MeshRender, FlatConvexMeshIsAcneFreeInTheReferenceAndAcneRiddenInFloatWitho
     scene::Scene s = test::sphereOverPlane({}, 128, 72);
     auto mesh = test::icosphere(Vec3(0.37, 1.01, -0.23), 1.0, 3);
     mesh->normals.clear();
-    s.objects[0].shape = scene::Mesh{"icosphere", mesh};
+    s.objects[0].shape = scene::Mesh::single("icosphere", mesh);
     const scene::RenderPlan plan = test::planFor(s);
     const scene::Frame ref = renderReference(s, plan, test::biasSettings(0, scene::Precision::Float));
     const scene::Frame method = render(s, plan, test::biasSettings(0, scene::Precision::Float));

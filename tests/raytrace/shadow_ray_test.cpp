@@ -5,6 +5,8 @@
 
 #include <random>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include <gtest/gtest.h>
 
 #include "raytrace/renderer.h"
@@ -208,11 +210,27 @@ void countSelfHits(int kind, double scale, double distance, std::mt19937_64& g, 
         if (kind == 1) test::addQuad(s, center, randomUnit(g), a, b);
         if (kind == 2) test::addBox(s, center - Vec3(a, b, c) / 2.0, center + Vec3(a, b, c) / 2.0);
         if (kind == 3) test::addMesh(s, test::icosphere(center, a, 2));
+        glm::dmat4 placement(1.0);
+        if (kind == 4) {
+            // Instanced: a unit icosphere placed twice (so it is traced in object space), the
+            // first time scaled by a, b, c on its axes, turned about a random axis and moved to
+            // center; the second placement is far away and only makes the mesh multi-use.
+            placement = glm::translate(glm::dmat4(1.0), center) *
+                        glm::dmat4(test::rotation(randomUnit(g), 180 * u(g))) *
+                        glm::scale(glm::dmat4(1.0), Vec3(a, b, c));
+            const auto ball = test::icosphere(Vec3(0), 1.0, 2);
+            scene::Mesh mesh;
+            mesh.instances = {{ball, scene::Affine(placement)},
+                              {ball, scene::Affine(glm::translate(glm::dmat4(1.0), center + Vec3(1e6 * scale)) *
+                                                   glm::scale(glm::dmat4(1.0), Vec3(scale)))}};
+            s.objects.push_back({"objects[0]", mesh, 0});
+        }
         const Tracer<Real> tracer(s);
         for (int point = 0; point < 40; ++point) {
             // Aim at a point inside the object (or on the quad) from far outside it.
             Vec3 aim = center;
             if (kind == 0 || kind == 3) aim += 0.9 * a * std::abs(u(g)) * randomUnit(g);
+            if (kind == 4) aim = Vec3(placement * glm::dvec4(0.9 * std::abs(u(g)) * randomUnit(g), 1.0));
             if (kind == 2) aim += 0.45 * Vec3(a * u(g), b * u(g), c * u(g));
             if (kind == 1) {
                 const scene::Quad& q = std::get<scene::Quad>(s.objects[0].shape);
@@ -247,12 +265,13 @@ void countSelfHits(int kind, double scale, double distance, std::mt19937_64& g, 
 }
 
 template <typename Real>
-void expectNoRobustSelfHits() {
-    const char* names[] = {"sphere", "quad", "box", "triangle mesh"};
+void expectNoRobustSelfHits(int firstKind = 0, int lastKind = 3,
+                            std::vector<double> scales = {1e-8, 1e-4, 1.0, 1e4, 1e8}) {
+    const char* names[] = {"sphere", "quad", "box", "triangle mesh", "instanced mesh"};
     std::mt19937_64 g(12345);
-    for (int kind = 0; kind < 4; ++kind) {
+    for (int kind = firstKind; kind <= lastKind; ++kind) {
         SelfHits total;
-        for (double scale : {1e-8, 1e-4, 1.0, 1e4, 1e8}) {
+        for (double scale : scales) {
             for (double distance : {1.0, 1000.0}) {
                 SelfHits h;
                 countSelfHits<Real>(kind, scale, distance, g, h);
@@ -274,6 +293,14 @@ TEST(RobustOffset, NoSelfHitsOnSpheresQuadsBoxesMeshesFrom1eMinus8To1e8InDouble)
 
 TEST(RobustOffset, NoSelfHitsOnSpheresQuadsBoxesMeshesFrom1eMinus8To1e8InFloat) {
     expectNoRobustSelfHits<float>();
+}
+
+// The instance transform is part of the error bound (docs/raytrace.md, "Instances"): scale
+// 1e-3 and 1e4 (non-uniform within 0.1..2 of that), any rotation, placed 1x and 1000x its size
+// from the origin (and 1e-8, 1, 1e8 as for the other shapes).
+TEST(RobustOffset, NoSelfHitsOnInstancedMeshesScaledRotatedAndMovedInDoubleAndFloat) {
+    expectNoRobustSelfHits<double>(4, 4, {1e-8, 1e-3, 1.0, 1e4, 1e8});
+    expectNoRobustSelfHits<float>(4, 4, {1e-8, 1e-3, 1.0, 1e4, 1e8});
 }
 
 }  // namespace

@@ -250,7 +250,7 @@ inline void addMesh(scene::Scene& s, std::shared_ptr<const scene::TriangleMesh> 
                     int material = 0) {
     scene::Object o;
     o.name = "objects[" + std::to_string(s.objects.size()) + "]";
-    o.shape = scene::Mesh{"generated", std::move(geometry)};
+    o.shape = scene::Mesh::single("generated", std::move(geometry));
     o.material = material;
     s.objects.push_back(o);
 }

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <limits>
+#include <cstring>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -260,6 +261,110 @@ TEST(WideBvh, FloatTracerHoldsUnder100BytesPerTriangle) {
     const double bytes = double(tracer.meshBytes());
     EXPECT_GT(bytes, floor + 36.0 * 20480);  // plus at least one float copy per triangle
     EXPECT_LT(bytes / 20480.0, 100.0) << bytes / 20480.0 << " bytes per triangle";
+}
+
+#if defined(SHADOWLAB_AVX_BOX_TEST)
+// Runs the AVX test from a function compiled for AVX (only called when the CPU has it).
+__attribute__((target("avx"))) int avxBoxTest(const Ray<float>& ray, const Bvh8Node& n, float tMax,
+                                              float tn[8]) {
+    return detail::ChildBoxTestAvx8(ray)(n, tMax, tn);
+}
+#endif
+
+// The AVX 8-wide child-box test gives the SSE test's mask and entry distances bit for bit, on
+// the same adversarial boxes as above (integer planes, origins on them, axis-parallel rays).
+TEST(WideBvh, AvxChildBoxTestEqualsTheSseTestBitForBit) {
+#if defined(SHADOWLAB_AVX_BOX_TEST)
+    if (!detail::hasAvx()) GTEST_SKIP() << "this CPU has no AVX";
+    std::mt19937_64 g(77);
+    std::uniform_real_distribution<float> u(-4, 4);
+    std::uniform_int_distribution<int> pick(0, 3);
+    Bvh8Node n{};
+    int differ = 0, entered = 0;
+    for (int trial = 0; trial < 40000; ++trial) {
+        for (int c = 0; c < 8; ++c)
+            for (int k = 0; k < 3; ++k) {
+                const float a = std::round(u(g)), b = std::round(u(g));
+                n.bounds[k][c] = std::min(a, b);
+                n.bounds[3 + k][c] = std::max(a, b);
+            }
+        if (trial % 5 == 0)  // unused children: empty boxes
+            for (int k = 0; k < 3; ++k) {
+                n.bounds[k][7] = std::numeric_limits<float>::infinity();
+                n.bounds[3 + k][7] = -std::numeric_limits<float>::infinity();
+            }
+        Vec3T<float> o(std::round(u(g)), std::round(u(g)), std::round(u(g))), d(u(g), u(g), u(g));
+        for (int k = 0; k < 3; ++k)
+            if (pick(g) == 0) d[k] = pick(g) < 2 ? 0.0f : -0.0f;
+        const Ray<float> ray(o, d);
+        const float tMax = trial % 2 ? std::numeric_limits<float>::infinity() : 3.0f;
+        float tnSse[8], tnAvx[8];
+        const int sse = detail::ChildBoxTest<float, 8>(ray)(n, tMax, tnSse);
+        const int avx = avxBoxTest(ray, n, tMax, tnAvx);
+        differ += sse != avx;
+        for (int c = 0; c < 8; ++c)
+            if (sse & (1 << c)) differ += std::memcmp(&tnSse[c], &tnAvx[c], sizeof(float)) != 0;
+        entered += __builtin_popcount(unsigned(sse));
+    }
+    EXPECT_EQ(differ, 0);
+    EXPECT_GT(entered, 40000);  // the test does enter boxes (about a third of 320,000)
+#else
+    GTEST_SKIP() << "not an x86-64 GCC build";
+#endif
+}
+
+// The float tracer gives the same closest hits (t, triangle, bits) and any-hit answers with the
+// AVX box test or the SSE one, and with or without the occluder cache: on random rays through a
+// triangle soup and on coherent rays (a grid of parallel rays, like a tile's shadow rays),
+// where the cache must answer most blocked rays.
+TEST(WideBvh, TracerAnswersAreTheSameWithAvxOrSseAndWithOrWithoutTheOccluderCache) {
+    std::mt19937_64 g(31);
+    const Soup soup = triangleSoup(20000, g);
+    auto mesh = std::make_shared<scene::TriangleMesh>();
+    for (const Vec3& p : soup.p) mesh->positions.push_back(p);
+    for (std::uint32_t i = 0; i < soup.p.size(); ++i) mesh->indices.push_back(i);
+    scene::Scene s;
+    test::addMaterial(s, "matte");
+    test::addMesh(s, mesh);
+    const Tracer<float> tracer(s);
+    std::uniform_real_distribution<double> u(-14, 14);
+    std::vector<Ray<float>> rays;
+    for (int r = 0; r < 10000; ++r) {
+        const Vec3 from(u(g), u(g), u(g)), to(u(g) / 2, u(g) / 2, u(g) / 2);
+        rays.emplace_back(Vec3T<float>(from), Vec3T<float>(to - from));
+    }
+    for (int y = 0; y < 100; ++y)
+        for (int x = 0; x < 100; ++x)
+            rays.emplace_back(Vec3T<float>(-12.0f + 0.05f * x, -12.0f + 0.05f * y, -14.0f), Vec3T<float>(0.3f, 0.4f, 1.0f));
+    int hits = 0, differ = 0;
+    std::uint64_t cacheAnswers = 0;
+    for (std::size_t r = 0; r < rays.size(); ++r) {
+        const Ray<float>& ray = rays[r];
+        const float tMax = r % 3 == 0 ? 0.6f : std::numeric_limits<float>::infinity();
+        Hit<float> h[4];
+        bool found[4], any[4];
+        for (int config = 0; config < 4; ++config) {
+            detail::setUseAvx(config & 1);
+            setOccluderCache(config & 2);
+            found[config] = tracer.closestHit(ray, tMax, r % 2 == 0, h[config]);
+            int blocker = -1;
+            const std::uint64_t before = occluderCacheHits();
+            any[config] = tracer.anyHit(ray, tMax, r % 2 == 0, blocker);
+            cacheAnswers += occluderCacheHits() - before;
+        }
+        hits += found[0];
+        for (int config = 1; config < 4; ++config)
+            differ += found[0] != found[config] || any[0] != any[config] ||
+                      (found[0] && (std::memcmp(&h[0].t, &h[config].t, sizeof(float)) != 0 ||
+                                    h[0].prim != h[config].prim));
+        differ += any[0] != found[0];  // any hit exactly when a closest hit exists
+    }
+    detail::setUseAvx(true);
+    setOccluderCache(true);
+    EXPECT_EQ(differ, 0);
+    EXPECT_GT(hits, 3000);
+    // The grid's blocked rays: most are answered by the previous ray's triangle packet.
+    EXPECT_GT(cacheAnswers, 2000u);
 }
 
 }  // namespace

@@ -157,7 +157,7 @@ TEST(SceneLoader, AGltfFileIsASceneWithAFramedCameraAndADefaultSun) {
     // (a unit cube: radius sqrt(3)/2) and adds one directional light.
     const Scene s = loadScene(scenesDirectory() / "models" / "Box" / "Box.gltf");
     ASSERT_EQ(s.objects.size(), 1u);
-    EXPECT_EQ(std::get<Mesh>(s.objects[0].shape).geometry->triangleCount(), 12u);
+    EXPECT_EQ(std::get<Mesh>(s.objects[0].shape).triangleCount(), 12u);
     ASSERT_EQ(s.lights.size(), 1u);
     EXPECT_EQ(s.lights[0].type, LightType::Directional);
     EXPECT_LT(s.lights[0].direction.y, 0.0);  // the sun shines down

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "scene/loader.h"
+#include "tests/scene/gltf_files.h"
 #include "tests/scene/test_files.h"
 
 namespace shadowlab::scene {
@@ -119,6 +121,82 @@ TEST(MeshLoader, GltfBoxFromSharedScenesHasTwelveTriangles) {
     for (const Vec3& p : mesh->positions) b.extend(p);
     EXPECT_NEAR(b.extent().x, 1.0, 1e-6);
     EXPECT_NEAR(b.extent().y, 1.0, 1e-6);
+}
+
+// Node 0 moves the box to x = −2; node 1 turns it 90° about +Y and moves it to x = 1; node 2,
+// a child of node 1, scales it by 2 and lifts it by 1 in node 1's frame.
+const char* kThreeNodes = R"([{"mesh": 0, "translation": [-2, 0, 0]},
+  {"mesh": 0, "translation": [1, 0, 0], "rotation": [0, 0.7071067811865476, 0, 0.7071067811865476], "children": [2]},
+  {"mesh": 0, "translation": [0, 1, 0], "scale": [2, 2, 2]}])";
+
+TEST(MeshInstancing, AGltfMeshUsedByThreeNodesIsOneGeometryPlacedThreeTimes) {
+    TempDir dir;
+    const auto file = dir.write("three.gltf", test::boxGltf(kThreeNodes, "[0, 1]"));
+    const std::vector<MeshInstance> inst =
+        loadMeshInstances(file, glm::dmat4(1.0), "scene.json", JsonPath() / "objects" / 0 / "file");
+    ASSERT_EQ(inst.size(), 3u);
+    // One mesh in memory: the same pointer three times and no other owner.
+    EXPECT_EQ(inst[0].geometry.get(), inst[1].geometry.get());
+    EXPECT_EQ(inst[1].geometry.get(), inst[2].geometry.get());
+    EXPECT_EQ(inst[0].geometry.use_count(), 3);
+    EXPECT_EQ(inst[0].geometry->triangleCount(), 12u);
+    // Object space: the box's own corners, untouched by any node.
+    EXPECT_EQ(inst[0].geometry->positions[7], Vec3(1, 0.5, 0.25));
+    // Corner (1, 0, 0) by hand. Node 0: (−1, 0, 0). Node 1: R_y(90°) maps (x, y, z) to
+    // (z, y, −x), so (0, 0, −1), then + (1, 0, 0): (1, 0, −1). Node 2 inside node 1: scale 2 and
+    // lift: (2, 1, 0); rotate: (0, 1, −2); move: (1, 1, −2). Nodes come in document order.
+    EXPECT_LT(glm::length(transformPoint(inst[0].transform, Vec3(1, 0, 0)) - Vec3(-1, 0, 0)), 1e-12);
+    EXPECT_LT(glm::length(transformPoint(inst[1].transform, Vec3(1, 0, 0)) - Vec3(1, 0, -1)), 1e-12);
+    EXPECT_LT(glm::length(transformPoint(inst[2].transform, Vec3(1, 0, 0)) - Vec3(1, 1, -2)), 1e-12);
+    // The flattened copy is 36 world-space triangles.
+    const TriangleMesh flat = flattenInstances(inst);
+    EXPECT_EQ(flat.triangleCount(), 36u);
+}
+
+TEST(MeshInstancing, ObjectsNamingTheSameFileShareItsGeometryAndKeepOneIdEach) {
+    TempDir dir;
+    dir.write("three.gltf", test::boxGltf(kThreeNodes, "[0, 1]"));
+    dir.write("t.obj", kTetrahedron);
+    const auto sceneFile = dir.write("s.json", R"({
+      "camera": {"position": [0, 2, 8], "look_at": [0, 0, 0]},
+      "materials": {"m": {}}, "lights": [{"type": "directional", "direction": [0, -1, 0]}],
+      "objects": [
+        {"type": "mesh", "file": "three.gltf", "material": "m"},
+        {"type": "sphere", "center": [0, 5, 0], "radius": 1, "material": "m"},
+        {"type": "mesh", "file": "three.gltf", "translate": [0, 0, 4], "rotate": [0, 30, 0], "scale": 0.5, "material": "m"},
+        {"type": "mesh", "file": "t.obj", "material": "m"},
+        {"type": "mesh", "file": "./t.obj", "scale": 3, "material": "m"}]})");
+    const Scene s = loadScene(sceneFile);
+    // One object per JSON entry, in file order: ids stay what they were before instancing.
+    ASSERT_EQ(s.objects.size(), 5u);
+    const Mesh& a = std::get<Mesh>(s.objects[0].shape);
+    const Mesh& b = std::get<Mesh>(s.objects[2].shape);
+    ASSERT_EQ(a.instances.size(), 3u);
+    ASSERT_EQ(b.instances.size(), 3u);
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(a.instances[i].geometry.get(), b.instances[0].geometry.get());
+    EXPECT_EQ(a.triangleCount(), 36u);
+    // Object 2's node 0 instance: the object transform after the node's: corner (1, 0, 0) →
+    // (−1, 0, 0) by the node, then ·0.5 → (−0.5, 0, 0), R_y(30°) → (−0.5·cos30, 0, 0.5·sin30),
+    // + (0, 0, 4).
+    const double c = std::cos(glm::radians(30.0)), sn = std::sin(glm::radians(30.0));
+    EXPECT_LT(glm::length(transformPoint(b.instances[0].transform, Vec3(1, 0, 0)) -
+                          Vec3(-0.5 * c, 0, 4 + 0.5 * sn)), 1e-12);
+    // The same OBJ named two ways is read once.
+    EXPECT_EQ(std::get<Mesh>(s.objects[3].shape).instances[0].geometry.get(),
+              std::get<Mesh>(s.objects[4].shape).instances[0].geometry.get());
+}
+
+TEST(MeshInstancing, ANodeScaledToZeroIsDroppedAndAllDroppedIsAnError) {
+    TempDir dir;
+    const auto some = dir.write("some.gltf", test::boxGltf(R"([{"mesh": 0}, {"mesh": 0, "scale": [0, 1, 1]}])", "[0, 1]"));
+    EXPECT_EQ(loadMeshInstances(some, glm::dmat4(1.0), "scene.json", JsonPath()).size(), 1u);
+    const auto none = dir.write("none.gltf", test::boxGltf(R"([{"mesh": 0, "scale": [0, 0, 0]}])", "[0]"));
+    try {
+        loadMeshInstances(none, glm::dmat4(1.0), "scene.json", JsonPath() / "objects" / 0 / "file");
+        FAIL();
+    } catch (const SceneError& e) {
+        EXPECT_NE(std::string(e.what()).find("degenerate"), std::string::npos) << e.what();
+    }
 }
 
 }  // namespace
