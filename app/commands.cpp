@@ -16,6 +16,7 @@
 #include "compare/stability.h"
 #include "compare/sweep.h"
 #include "compare/sweep_report.h"
+#include "raster/debug_views.h"
 #include "raster/renderer.h"
 #include "raytrace/renderer.h"
 #include "scene/error.h"
@@ -142,9 +143,30 @@ int render(const RenderOptions& o) {
     std::string ext = o.output.extension().string();
     if (ext != ".exr" && ext != ".png")
         throw scene::InputError(o.output.string() + ": unknown output type '" + ext + "' (use .exr or .png)");
+    if (o.view && (o.backend != "raster" || ext != ".png"))
+        throw scene::InputError("--view " + *o.view + ": needs --backend raster and a .png output (a view is a "
+                                "display image of the shadow maps), got --backend " + o.backend + " and '" + ext + "'");
     const Prepared p = prepare(o.common);
     // Only once the input is known to be good may the output's folder be created.
     if (o.output.has_parent_path()) fs::create_directories(o.output.parent_path());
+    if (o.view) {
+        Stage stage("rendering the " + *o.view + " view of " + p.scene.file.filename().string());
+        raster::RenderDebug debug;
+        debug.captureShadowMaps = *o.view == "shadow-map";
+        const scene::Frame frame = raster::render(p.scene, p.plan, p.settings.raster, &debug);
+        checkValidation(frame, p.settings.raster);
+        const raster::DisplayImage img = *o.view == "shadow-map" ? raster::shadowMapView(debug)
+                                         : *o.view == "cascades" ? raster::cascadeView(frame, debug)
+                                                                 : raster::texelDensityView(frame, p.scene, debug);
+        scene::writePngDisplay(o.output, img.width, img.height, img.rgb);
+        stage.done(std::to_string(img.width) + "x" + std::to_string(img.height) + " -> " + o.output.string());
+        if (o.common.json) {
+            Json j = {{"backend", o.backend}, {"view", *o.view}, {"output", o.output.string()},
+                      {"timings_ms", timingsJson(frame)}, {"attributes", frame.attributes}};
+            std::cout << j.dump(2) << "\n";
+        }
+        return 0;
+    }
     Stage stage("rendering " + p.scene.file.filename().string() + " with " + o.backend);
     const scene::Frame frame = renderBackend(p, o.backend);
     scene::writeFrame(frame, o.output);
@@ -279,6 +301,7 @@ int sweep(const SweepOptions& o) {
         if (!v.depthBias) v.depthBias = base.depthBias;
         if (!v.slopeBias) v.slopeBias = base.slopeBias;
         if (!v.filter) v.filter = base.filter;
+        if (!v.cascades) v.cascades = base.cascades;
         if (!v.rayBias) v.rayBias = base.rayBias;
         if (!v.precision) v.precision = base.precision;
         if (!v.samples) v.samples = base.samples;

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 
+#include "raster/cascades.h"
 #include "raster/context.h"
 #include "raster/geometry.h"
 #include "raster/light_frustum.h"
@@ -63,7 +64,10 @@ const char* filterName(scene::ShadowFilter f) {
 
 }  // namespace
 
-scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settings) {
+static_assert(SHADOWLAB_MAX_CASCADES == scene::kMaxCascades, "shaders/interface.h and scene/settings.h disagree");
+
+scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settings,
+                    RenderDebug* debug) {
     checkSupported(scene, settings);
     const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
     const scene::Vec3 origin = cam.position;  // camera-relative rendering
@@ -75,6 +79,10 @@ scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, co
     ValidationLog log;
     std::vector<LightFrustum> frusta;
     std::vector<double> usedDepthBias;  // per shadow-mapped light (spot, directional)
+    std::vector<int> layerLight;        // per layer: the light it belongs to
+    std::vector<std::string> layerLabels;
+    std::vector<double> cascadeSplits, cascadeTexels;
+    int cascadesUsed = 1;
     std::size_t triangles = 0;
     int sphereSegmentsUsed = 0;
     {
@@ -110,6 +118,7 @@ scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, co
             l.radiance = glm::vec4(glm::vec3(light.color * light.intensity), float(light.intensity * meanColor));
             float layer = -1.0f;
             LightFrustum f;
+            CascadeSet cascades;  // filled for a cascaded directional light
             if (needsShadowTest(plan, i)) {
                 if (point) {
                     // Six layers, +X −X +Y −Y +Z −Z; the shader picks the face and builds its
@@ -119,16 +128,52 @@ scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, co
                         f = fitPointLightFace(bounds, light.position, face, settings.shadowMapSize);
                         lightMatrices.push_back(glm::mat4(f.toClip(origin)));
                         frusta.push_back(f);
+                        static const char* const kFaces[] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
+                        layerLight.push_back(int(i));
+                        layerLabels.push_back("L" + std::to_string(i) + " " + kFaces[face]);
                     }
                     l.bias = glm::vec4(float(settings.depthBias), float(settings.slopeBias), float(f.texelWorldSize()), 0.0f);
                 } else if (spot)
                     f = fitSpotLight(bounds, light.position, light.direction, light.coneAngleDegrees,
                                      settings.shadowMapSize);
-                else if (settings.fitLightFrustum)
+                else if (settings.cascades > 1 &&
+                         !(cascades = fitCascades(scene, light.direction, settings.cascades, settings.shadowMapSize))
+                              .frusta.empty()) {
+                    // Cascaded: one layer per slice; the shader picks the cascade by view depth
+                    // (lit.frag cascadeOf). Cascades are fitted to their slices, so
+                    // fitLightFrustum does not apply. A default constant bias is half of each
+                    // cascade's texel, as for a fitted map.
+                    layer = float(lightMatrices.size());
+                    cascadesUsed = int(cascades.frusta.size());
+                    cascadeSplits = cascades.splits;
+                    cascadeTexels.clear();
+                    for (std::size_t c = 0; c < cascades.frusta.size(); ++c) {
+                        const LightFrustum& cf = cascades.frusta[c];
+                        const double depthBias = settings.depthBiasIsDefault ? 0.5 * cf.texelWorldSize() : settings.depthBias;
+                        lightMatrices.push_back(glm::mat4(cf.toClip(origin)));
+                        frusta.push_back(cf);
+                        usedDepthBias.push_back(depthBias);
+                        cascadeTexels.push_back(cf.texelWorldSize());
+                        layerLight.push_back(int(i));
+                        layerLabels.push_back("L" + std::to_string(i) + " C" + std::to_string(c));
+                        shaders::CascadeData& cd = uniforms.cascades[i * SHADOWLAB_MAX_CASCADES + c];
+                        cd.toShadow = glm::mat4(cf.toTexture(origin));
+                        cd.params = glm::vec4(float(cascades.splits[c + 1]), float(cf.texelWorldSize()),
+                                              float(1.0 / cf.depthRange()), float(depthBias));
+                    }
+                    // Cascade 0 also fills the light's own map fields (what count <= 1 would use).
+                    f = cascades.frusta[0];
+                    l.toShadow = uniforms.cascades[i * SHADOWLAB_MAX_CASCADES].toShadow;
+                    l.bias = glm::vec4(float(usedDepthBias[usedDepthBias.size() - cascades.frusta.size()]),
+                                       float(settings.slopeBias), float(f.texelWorldSize()),
+                                       float(1.0 / f.depthRange()));
+                } else if (settings.fitLightFrustum)
                     f = fitDirectionalLightToReceivers(scene, light.direction, settings.shadowMapSize);
                 else
                     f = fitDirectionalLight(bounds, light.direction, settings.shadowMapSize);
-                if (!point) {
+                if (!point && cascades.frusta.empty()) {
+                    layerLight.push_back(int(i));
+                    layerLabels.push_back("L" + std::to_string(i));
                     layer = float(lightMatrices.size());
                     lightMatrices.push_back(glm::mat4(f.toClip(origin)));
                     l.toShadow = glm::mat4(f.toTexture(origin));
@@ -157,7 +202,8 @@ scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, co
                 l.axis = glm::vec4(glm::vec3(glm::normalize(light.direction)), 0.0f);
             } else {
                 l.toLight = glm::vec4(glm::vec3(-light.direction), layer);
-                l.kind = glm::vec4(float(SHADOWLAB_LIGHT_DIRECTIONAL), 0, 0, 0);
+                l.kind = glm::vec4(float(SHADOWLAB_LIGHT_DIRECTIONAL),
+                                   cascades.frusta.empty() ? 0.0f : float(cascades.frusta.size()), 0, 0);
             }
             l.params = glm::vec4(float(kMaxSlopeTan), float(int(settings.filter)), float(settings.normalOffset),
                                  float(settings.pcfSize));
@@ -203,6 +249,11 @@ scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, co
         stamp(commands, 1);
         ctx.submitAndWait(commands);
         frame.timingsMs.emplace_back("shadow_pass", msSince(shadowStart));
+        if (debug && debug->captureShadowMaps) {
+            debug->layerDepths.clear();
+            for (std::uint32_t k = 0; k < std::uint32_t(lightMatrices.size()); ++k)
+                debug->layerDepths.push_back(readShadowMap(ctx, maps, k));
+        }
 
         // --- lit pass ---
         const auto litStart = Clock::now();
@@ -284,7 +335,23 @@ scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, co
         frame.attributes["texel_world_size"] = texel;
         frame.attributes["light_frustum"] = frustum;
     }
+    frame.attributes["cascades"] = std::to_string(cascadesUsed);
+    if (!cascadeSplits.empty()) {
+        std::string splits, texels;
+        for (std::size_t k = 0; k < cascadeSplits.size(); ++k) splits += (k ? ";" : "") + formatNumber(cascadeSplits[k]);
+        for (std::size_t k = 0; k < cascadeTexels.size(); ++k) texels += (k ? ";" : "") + formatNumber(cascadeTexels[k]);
+        frame.attributes["cascade_splits"] = splits;
+        frame.attributes["cascade_texel_world_size"] = texels;
+    }
     if (settings.validate) frame.attributes["validation_messages"] = std::to_string(log.count.load());
+    if (debug) {
+        debug->frusta = frusta;
+        debug->layerLight = layerLight;
+        debug->layerLabels = layerLabels;
+        debug->mapSize = frusta.empty() ? 1u : std::uint32_t(settings.shadowMapSize);
+        debug->cascadeSplits = cascadeSplits;
+        debug->cascadeTexels = cascadeTexels;
+    }
     return frame;
 }
 

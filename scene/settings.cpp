@@ -68,6 +68,10 @@ RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& o) {
     if (!std::isfinite(s.raster.normalOffset) || s.raster.normalOffset < 0.0)
         throw InputError("--normal-offset: must be a finite value >= 0 (texels)");
     s.raster.fitLightFrustum = o.fitLightFrustum.value_or(d.fitLightFrustum.value_or(false));
+    s.raster.cascades = o.cascades.value_or(d.cascades.value_or(1));
+    if (s.raster.cascades < 1 || s.raster.cascades > kMaxCascades)
+        throw InputError("--cascades: must be in 1.." + std::to_string(kMaxCascades) + ", got " +
+                         std::to_string(s.raster.cascades));
     s.raster.device = o.device.value_or("");
     s.raster.validate = o.validate;
 

@@ -153,6 +153,25 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, inout uint blocke
     return sum / 16.0;
 }
 
+// Cascaded shadow maps: a directional light with kind.y > 1 cascades uses the cascade whose slice
+// holds p's view depth (the Frame's Z, same expression); that cascade's map, texel size, depth
+// scale and constant bias replace the light's, and its layer follows the light's first one.
+LightData cascadeOf(LightData light, int lightIndex, vec3 p) {
+    const int first = lightIndex * SHADOWLAB_MAX_CASCADES;
+    const int count = min(int(light.kind.y), SHADOWLAB_MAX_CASCADES);
+    const float z = dot(p, u.forward.xyz);
+    int c = 0;
+    for (int k = 0; k + 1 < count; ++k)
+        if (z > u.cascades[first + k].params.x) c = k + 1;
+    const CascadeData cascade = u.cascades[first + c];
+    light.toShadow = cascade.toShadow;
+    light.toLight.w += float(c);
+    light.bias.x = cascade.params.w;
+    light.bias.z = cascade.params.y;
+    light.bias.w = cascade.params.z;
+    return light;
+}
+
 void main() {
     vec3 n = normalize(inNormal);
     // Two-sided surfaces: the normal faces the viewer (the ray tracer's rule: flip when N·ray > 0).
@@ -166,7 +185,8 @@ void main() {
     const int lightCount = int(u.counts.x);
     float maxNdotL = lightCount > 0 ? -1.0 : 0.0;
     for (int i = 0; i < lightCount; ++i) {
-        const LightData light = u.lights[i];
+        LightData light = u.lights[i];
+        if (int(light.kind.x) == SHADOWLAB_LIGHT_DIRECTIONAL && light.kind.y > 1.5) light = cascadeOf(light, i, inPosition);
         vec3 l;
         float irradiance;  // relative to radiance: 1 for directional lights
         if (int(light.kind.x) != SHADOWLAB_LIGHT_DIRECTIONAL) {
