@@ -24,7 +24,8 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
     cmd.add_option("--slope-bias", s.slopeBias,
                    "raster: slope-scaled bias in texels, times tan(angle to light) (default 1)");
     cmd.add_option("--filter", s.filter,
-                   "raster: shadow-map filter none|pcf2x2|pcf|poisson (default pcf2x2: bilinear 2x2 PCF)");
+                   "raster: shadow-map filter none|pcf2x2|pcf|poisson|pcss (default pcf2x2: bilinear 2x2 PCF; pcss: "
+                   "soft shadows sized by a spot/point light's radius)");
     cmd.add_option("--pcf-size", s.pcfSize, "raster: pcf taps per side, or poisson kernel diameter in texels (default 3)");
     cmd.add_option("--normal-offset", s.normalOffset,
                    "raster: move receivers along their normal by this many texels (default 0)");

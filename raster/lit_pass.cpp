@@ -23,10 +23,13 @@ LitPipeline createLitPipeline(const Context& ctx) {
          .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
         {.binding = 3, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
+        // The shadow maps' raw depths (no compare), for the PCSS blocker search.
+        {.binding = 4, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
+         .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
     };
     const VkDescriptorSetLayoutCreateInfo setInfo{
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
-        .bindingCount = 4,
+        .bindingCount = 5,
         .pBindings = bindings,
     };
     LitPipeline p;
@@ -109,13 +112,20 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
     VkSampler idSampler = VK_NULL_HANDLE;
     VK_CHECK(vkCreateSampler(device, &idSamplerInfo, nullptr, &idSampler));
     b.idSampler = SamplerHandle(device, idSampler);
+    // Raw depths for the PCSS blocker search: no compare; depth 1 (nothing) outside the map.
+    VkSamplerCreateInfo depthSamplerInfo = samplerInfo;
+    depthSamplerInfo.compareEnable = VK_FALSE;
+    depthSamplerInfo.compareOp = VK_COMPARE_OP_NEVER;
+    VkSampler depthSampler = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateSampler(device, &depthSamplerInfo, nullptr, &depthSampler));
+    b.depthSampler = SamplerHandle(device, depthSampler);
     b.uniforms = uploadBuffer(ctx, &uniforms, sizeof uniforms, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
     b.albedos = uploadBuffer(ctx, albedos, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
 
     const VkDescriptorPoolSize sizes[] = {
         {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
         {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
-        {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 2},
+        {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 3},
     };
     const VkDescriptorPoolCreateInfo poolInfo{
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
@@ -139,6 +149,7 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
     const VkDescriptorBufferInfo albedoInfo{b.albedos.buffer.get(), 0, VK_WHOLE_SIZE};
     const VkDescriptorImageInfo imageInfo{sampler, maps.depth.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkDescriptorImageInfo idInfo{idSampler, maps.ids.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    const VkDescriptorImageInfo depthInfo{depthSampler, maps.depth.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkWriteDescriptorSet writes[] = {
         {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 0, .descriptorCount = 1,
          .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .pBufferInfo = &uniformInfo},
@@ -148,8 +159,10 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
          .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &imageInfo},
         {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 3, .descriptorCount = 1,
          .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &idInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 4, .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &depthInfo},
     };
-    vkUpdateDescriptorSets(device, 4, writes, 0, nullptr);
+    vkUpdateDescriptorSets(device, 5, writes, 0, nullptr);
     return b;
 }
 

@@ -37,6 +37,7 @@ LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32
 struct LitBindings {
     SamplerHandle sampler;    // depth compare, for the shadow maps
     SamplerHandle idSampler;  // plain NEAREST, for the blocker ids
+    SamplerHandle depthSampler;  // plain NEAREST, the maps' raw depths (PCSS blocker search)
     Buffer uniforms;
     Buffer albedos;
     DescriptorPoolHandle pool;

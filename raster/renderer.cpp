@@ -58,6 +58,7 @@ const char* filterName(scene::ShadowFilter f) {
         case scene::ShadowFilter::Pcf2x2: return "pcf2x2";
         case scene::ShadowFilter::Pcf: return "pcf";
         case scene::ShadowFilter::Poisson: return "poisson";
+        case scene::ShadowFilter::Pcss: return "pcss";
     }
     return "?";
 }
@@ -190,6 +191,7 @@ scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, co
                 }
             }
             if (point) {
+                l.axis = glm::vec4(0.0f, 0.0f, 0.0f, float(2.0 * light.radius));  // w: light size (PCSS)
                 l.toLight = glm::vec4(glm::vec3(light.position - origin), layer);
                 // Without a shadow test f is default; near/far are then unused.
                 l.kind = glm::vec4(float(SHADOWLAB_LIGHT_POINT), float(cubeFaceTanHalfFov(settings.shadowMapSize)),
@@ -199,7 +201,7 @@ scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, co
                 l.toLight = glm::vec4(glm::vec3(light.position - origin), layer);
                 l.kind = glm::vec4(float(SHADOWLAB_LIGHT_SPOT), float(std::cos(light.coneAngleDegrees * kPi / 180.0)),
                                    float(f.near), float(f.far));
-                l.axis = glm::vec4(glm::vec3(glm::normalize(light.direction)), 0.0f);
+                l.axis = glm::vec4(glm::vec3(glm::normalize(light.direction)), float(2.0 * light.radius));
             } else {
                 l.toLight = glm::vec4(glm::vec3(-light.direction), layer);
                 l.kind = glm::vec4(float(SHADOWLAB_LIGHT_DIRECTIONAL),
@@ -301,7 +303,8 @@ scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, co
     frame.attributes["backend"] = "raster";
     frame.attributes["shadow_map_size"] = std::to_string(settings.shadowMapSize);
     frame.attributes["filter"] = filterName(settings.filter);
-    if (settings.filter == scene::ShadowFilter::Pcf || settings.filter == scene::ShadowFilter::Poisson)
+    if (settings.filter == scene::ShadowFilter::Pcf || settings.filter == scene::ShadowFilter::Poisson ||
+        settings.filter == scene::ShadowFilter::Pcss)
         frame.attributes["pcf_size"] = std::to_string(settings.pcfSize);
     frame.attributes["normal_offset"] = formatNumber(settings.normalOffset);
     frame.attributes["light_frustum_fit"] = settings.fitLightFrustum ? "receivers" : "bounding-sphere";

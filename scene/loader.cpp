@@ -309,8 +309,9 @@ ShadowDefaults readShadow(const Reader& r, const Json& node, const JsonPath& pat
     }
     if (node.contains("filter")) {
         d.filter = r.string(node["filter"], path / "filter");
-        if (*d.filter != "none" && *d.filter != "pcf2x2" && *d.filter != "pcf" && *d.filter != "poisson")
-            r.fail(path / "filter", "expected none, pcf2x2, pcf or poisson, got '" + *d.filter + "'");
+        if (*d.filter != "none" && *d.filter != "pcf2x2" && *d.filter != "pcf" && *d.filter != "poisson" &&
+            *d.filter != "pcss")
+            r.fail(path / "filter", "expected none, pcf2x2, pcf, poisson or pcss, got '" + *d.filter + "'");
     }
     if (node.contains("pcf_size")) d.pcfSize = r.integer(node["pcf_size"], path / "pcf_size", 1, 15);
     if (node.contains("normal_offset")) {

@@ -16,7 +16,8 @@ ShadowFilter parseFilter(const std::string& text, const std::string& where) {
     if (text == "pcf2x2") return ShadowFilter::Pcf2x2;
     if (text == "pcf") return ShadowFilter::Pcf;
     if (text == "poisson") return ShadowFilter::Poisson;
-    throw InputError(where + ": expected none|pcf2x2|pcf|poisson, got '" + text + "'");
+    if (text == "pcss") return ShadowFilter::Pcss;
+    throw InputError(where + ": expected none|pcf2x2|pcf|poisson|pcss, got '" + text + "'");
 }
 
 Precision parsePrecision(const std::string& text, const std::string& where) {
@@ -125,6 +126,7 @@ const char* toString(ShadowFilter f) {
         case ShadowFilter::Pcf2x2: return "pcf2x2";
         case ShadowFilter::Pcf: return "pcf";
         case ShadowFilter::Poisson: return "poisson";
+        case ShadowFilter::Pcss: return "pcss";
     }
     return "?";
 }

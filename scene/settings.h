@@ -14,7 +14,9 @@ enum class Backend { Raster, Raytrace, Reference };
 // none: nearest texel; pcf2x2: bilinear 2x2 compare filtering; pcf: mean of pcfSize x pcfSize
 // compare taps one texel apart; poisson: 16 compare taps on a per-pixel rotated Poisson disk of
 // diameter pcfSize texels (raster/ implements them; see docs/raster.md).
-enum class ShadowFilter { None, Pcf2x2, Pcf, Poisson };
+// pcss: percentage-closer soft shadows for spot and point lights with a radius (Fernando 2005): a
+// blocker search, then a Poisson filter as wide as the penumbra; elsewhere it is `poisson`.
+enum class ShadowFilter { None, Pcf2x2, Pcf, Poisson, Pcss };
 enum class Precision { Float, Double };
 
 // Cascaded shadow maps: at most this many cascades per directional light. Four is what engines

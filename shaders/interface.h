@@ -15,6 +15,7 @@
 #define SHADOWLAB_FILTER_PCF2X2 1
 #define SHADOWLAB_FILTER_PCF 2
 #define SHADOWLAB_FILTER_POISSON 3
+#define SHADOWLAB_FILTER_PCSS 4
 
 // Light kinds in LightData.kind.x.
 #define SHADOWLAB_LIGHT_DIRECTIONAL 0
@@ -50,7 +51,8 @@ struct LightData {
                      // cube face's half field of view; directional: number of cascades (0 or 1:
                      // one map, described by this struct), z: spot, point: near, w: spot, point: far
                      // (distances along the map's axis)
-    vec4 axis;       // spot: xyz unit direction the light travels; w: unused
+    vec4 axis;       // spot: xyz unit direction the light travels; w: spot, point: light size
+                     // (diameter, world units; 0 = a point), for PCSS
 };
 
 // One cascade of a directional light's cascaded shadow map; its layer is the light's layer
