@@ -16,6 +16,7 @@
 #include "compare/stability.h"
 #include "compare/sweep.h"
 #include "compare/sweep_report.h"
+#include "raster/debug_views.h"
 #include "raster/memory.h"
 #include "raster/renderer.h"
 #include "raytrace/memory.h"
@@ -162,12 +163,42 @@ int render(const RenderOptions& o) {
     std::string ext = o.output.extension().string();
     if (ext != ".exr" && ext != ".png")
         throw scene::InputError(o.output.string() + ": unknown output type '" + ext + "' (use .exr or .png)");
+    if (o.view && (o.backend != "raster" || ext != ".png"))
+        throw scene::InputError("--view " + *o.view + ": needs --backend raster and a .png output (a view is a "
+                                "display image of the shadow maps), got --backend " + o.backend + " and '" + ext + "'");
     const Prepared p = prepare(o.common);
-    const std::uint64_t estimate = scene::kProgramBytes + backendMemory(p, o.backend) + scene::frameWriteBytes(p.scene);
-    scene::checkMemory(estimate, "rendering " + std::to_string(p.scene.camera.width) + "x" +
-                                     std::to_string(p.scene.camera.height) + " with " + o.backend);
+    // A view writes a display image, not the Frame; the shadow-map view holds every layer's depths.
+    const std::uint64_t estimate =
+        scene::kProgramBytes + backendMemory(p, o.backend) +
+        (o.view ? raster::debugViewBytes(p.scene, p.plan, p.settings.raster, *o.view == "shadow-map")
+                : scene::frameWriteBytes(p.scene));
+    scene::checkMemory(estimate, o.view ? "rendering the " + *o.view + " view of " +
+                                              std::to_string(p.scene.camera.width) + "x" +
+                                              std::to_string(p.scene.camera.height)
+                                        : "rendering " + std::to_string(p.scene.camera.width) + "x" +
+                                              std::to_string(p.scene.camera.height) + " with " + o.backend);
     // Only once the input is known to be good may the output's folder be created.
     if (o.output.has_parent_path()) fs::create_directories(o.output.parent_path());
+    if (o.view) {
+        Stage stage("rendering the " + *o.view + " view of " + p.scene.file.filename().string());
+        raster::RenderDebug debug;
+        debug.captureShadowMaps = *o.view == "shadow-map";
+        const scene::Frame frame = raster::render(p.scene, p.plan, p.settings.raster, &debug);
+        checkValidation(frame, p.settings.raster);
+        const raster::DisplayImage img = *o.view == "shadow-map" ? raster::shadowMapView(debug)
+                                         : *o.view == "cascades" ? raster::cascadeView(frame, debug)
+                                                                 : raster::texelDensityView(frame, p.scene, debug);
+        scene::writePngDisplay(o.output, img.width, img.height, img.rgb);
+        stage.done(std::to_string(img.width) + "x" + std::to_string(img.height) + " -> " + o.output.string() +
+                   ", " + memoryLine(estimate));
+        if (o.common.json) {
+            Json j = {{"backend", o.backend}, {"view", *o.view}, {"output", o.output.string()},
+                      {"timings_ms", timingsJson(frame)}, {"attributes", frame.attributes},
+                      {"memory", memoryJson(estimate)}};
+            std::cout << j.dump(2) << "\n";
+        }
+        return 0;
+    }
     Stage stage("rendering " + p.scene.file.filename().string() + " with " + o.backend);
     // A PNG holds the beauty only: the raster backend then reads back nothing else.
     const scene::Frame frame =
@@ -317,6 +348,7 @@ int sweep(const SweepOptions& o) {
         if (!v.depthBias) v.depthBias = base.depthBias;
         if (!v.slopeBias) v.slopeBias = base.slopeBias;
         if (!v.filter) v.filter = base.filter;
+        if (!v.cascades) v.cascades = base.cascades;
         if (!v.rayBias) v.rayBias = base.rayBias;
         if (!v.precision) v.precision = base.precision;
         if (!v.samples) v.samples = base.samples;

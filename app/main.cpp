@@ -24,12 +24,15 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
     cmd.add_option("--slope-bias", s.slopeBias,
                    "raster: slope-scaled bias in texels, times tan(angle to light) (default 1)");
     cmd.add_option("--filter", s.filter,
-                   "raster: shadow-map filter none|pcf2x2|pcf|poisson (default pcf2x2: bilinear 2x2 PCF)");
+                   "raster: shadow-map filter none|pcf2x2|pcf|poisson|pcss (default pcf2x2: bilinear 2x2 PCF; pcss: "
+                   "soft shadows sized by a spot/point light's radius)");
     cmd.add_option("--pcf-size", s.pcfSize, "raster: pcf taps per side, or poisson kernel diameter in texels (default 3)");
     cmd.add_option("--normal-offset", s.normalOffset,
                    "raster: move receivers along their normal by this many texels (default 0)");
     cmd.add_flag("--fit-light-frustum", s.fitLightFrustum,
                  "raster: fit each light's map to the casters of visible receivers, not the scene's bounds");
+    cmd.add_option("--cascades", s.cascades,
+                   "raster: cascaded shadow maps per directional light, 1..4 (default 1: one map)");
     cmd.add_option("--device", s.device, "raster: Vulkan device index or name part (default: lavapipe)");
     cmd.add_option("--ray-bias", s.rayBias,
                    "raytrace: shadow-ray offset along the normal in world units, or 'robust' "
@@ -67,6 +70,11 @@ int main(int argc, char** argv) {
     renderCmd->add_option("--backend", renderOptions.backend, "raster|raytrace|reference (default raytrace)")
         ->check(CLI::IsMember({"raster", "raytrace", "reference"}));
     renderCmd->add_option("-o,--output", renderOptions.output, "Output file, .exr or .png")->required();
+    renderCmd->add_option("--view", renderOptions.view,
+                          "raster debug view instead of the beauty image (.png only): shadow-map (every map "
+                          "layer as depth), cascades (beauty tinted by cascade), texel-density (shadow texel vs "
+                          "screen pixel size)")
+        ->check(CLI::IsMember({"shadow-map", "cascades", "texel-density"}));
 
     shadowlab::app::SweepOptions sweepOptions;
     auto* sweepCmd = app.add_subcommand("sweep", "Render a grid of settings for both backends, time each and "

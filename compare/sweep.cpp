@@ -62,6 +62,7 @@ Json overridesToJson(const scene::SettingsOverrides& o) {
     if (o.pcfSize) j["pcf_size"] = *o.pcfSize;
     if (o.normalOffset) j["normal_offset"] = *o.normalOffset;
     if (o.fitLightFrustum) j["fit_light_frustum"] = *o.fitLightFrustum;
+    if (o.cascades) j["cascades"] = *o.cascades;
     return j;
 }
 
@@ -77,6 +78,7 @@ scene::SettingsOverrides overridesFromJson(const Json& j) {
     if (j.contains("pcf_size")) o.pcfSize = j["pcf_size"].get<int>();
     if (j.contains("normal_offset")) o.normalOffset = j["normal_offset"].get<double>();
     if (j.contains("fit_light_frustum")) o.fitLightFrustum = j["fit_light_frustum"].get<bool>();
+    if (j.contains("cascades")) o.cascades = j["cascades"].get<int>();
     return o;
 }
 
@@ -161,6 +163,7 @@ std::string SweepConfig::key() const {
     if (o.pcfSize) k += ";pcf_size=" + std::to_string(*o.pcfSize);
     if (o.normalOffset) k += ";normal_offset=" + number(*o.normalOffset);
     if (o.fitLightFrustum) k += std::string(";fit_light_frustum=") + (*o.fitLightFrustum ? "1" : "0");
+    if (o.cascades) k += ";cascades=" + std::to_string(*o.cascades);
     return k;
 }
 
@@ -177,6 +180,7 @@ std::string SweepConfig::label() const {
     if (o.pcfSize) parts.push_back("pcf size " + std::to_string(*o.pcfSize));
     if (o.normalOffset) parts.push_back("normal offset " + number(*o.normalOffset));
     if (o.fitLightFrustum) parts.push_back(*o.fitLightFrustum ? "fitted frustum" : "bounds frustum");
+    if (o.cascades) parts.push_back(std::to_string(*o.cascades) + (*o.cascades == 1 ? " cascade" : " cascades"));
     std::string s = backend + ":";
     for (std::size_t i = 0; i < parts.size(); ++i) s += (i ? ", " : " ") + parts[i];
     if (parts.empty()) s += " defaults";
@@ -207,6 +211,18 @@ SweepGrid defaultGrid(const scene::Scene& scene, bool quick) {
     const std::vector<int> sizes = quick ? std::vector<int>{512, 2048} : std::vector<int>{512, 1024, 2048, 4096};
     for (int size : sizes)
         for (const char* filter : {"none", "pcf2x2"}) g.configs.push_back(raster(size, filter));
+    // Cascades against one map, where a directional light is shadowed: 3 cascades at the largest
+    // quick size and at 1024 (the rows above are the 1-cascade side of the comparison). Three is
+    // where the near slice gets most of its gain on our scenes (docs/raster.md); the fourth adds a
+    // depth pass for a far slice that rarely needs it.
+    bool directional = false;
+    for (const scene::Light& l : scene.lights) directional = directional || l.type == scene::LightType::Directional;
+    if (directional)
+        for (int size : quick ? std::vector<int>{2048} : std::vector<int>{1024, 2048}) {
+            SweepConfig c = raster(size, "pcf2x2");
+            c.overrides.cascades = 3;
+            g.configs.push_back(c);
+        }
 
     // Constant depth bias alone (slope 0), then slope bias alone (constant 0): each series shows
     // one parameter's acne-to-leak trade-off and its bias window.
@@ -313,7 +329,7 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
         if (!block.is_object()) throw SceneError(file, path, "expected an object of axes");
         const bool isRaster = std::string(backend) == "raster";
         const std::vector<const char*> names = isRaster
-            ? std::vector<const char*>{"shadow_map_size", "filter", "depth_bias", "slope_bias"}
+            ? std::vector<const char*>{"shadow_map_size", "filter", "cascades", "depth_bias", "slope_bias"}
             : std::vector<const char*>{"ray_bias", "precision", "samples"};
         for (const auto& [key, value] : block.items())
             if (std::none_of(names.begin(), names.end(), [&](const char* n) { return key == n; }))
@@ -345,6 +361,11 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
                         if (!v.is_string() || (v.get<std::string>() != "none" && v.get<std::string>() != "pcf2x2"))
                             throw SceneError(file, at, "expected \"none\" or \"pcf2x2\", got " + v.dump());
                         c.overrides.filter = v.get<std::string>();
+                    } else if (n == "cascades") {
+                        if (!v.is_number_integer() || v.get<long long>() < 1 || v.get<long long>() > scene::kMaxCascades)
+                            throw SceneError(file, at, "expected an integer in 1.." + std::to_string(scene::kMaxCascades) +
+                                                           " (cascaded shadow maps per directional light), got " + v.dump());
+                        c.overrides.cascades = v.get<int>();
                     } else if (n == "depth_bias") {
                         c.overrides.depthBias = num(0.0);
                         c.biasKind = "depth";
@@ -441,7 +462,7 @@ std::string rowsToCsv(const std::vector<SweepRow>& rows) {
                                      "shadow_iou", "self_shadow_acne_rate", "aliasing_rate", "bias_error_rate",
                                      "silhouette_mismatch_rate", "invalid"};
     std::ostringstream s;
-    s << "key,backend,label,shadow_map_size,filter,depth_bias,slope_bias,ray_bias,precision,samples,"
+    s << "key,backend,label,shadow_map_size,filter,cascades,depth_bias,slope_bias,ray_bias,precision,samples,"
          "bias_kind,bias_value,repetitions,setup_ms,frame_ms,frame_ms_min,frame_ms_max";
     for (const char* m : kMetrics) s << "," << m;
     s << ",error\n";
@@ -449,6 +470,7 @@ std::string rowsToCsv(const std::vector<SweepRow>& rows) {
         const auto& o = r.config.overrides;
         s << csvField(r.key) << "," << r.config.backend << "," << csvField(r.config.label()) << ","
           << (o.shadowMapSize ? std::to_string(*o.shadowMapSize) : "") << "," << o.filter.value_or("") << ","
+          << (o.cascades ? std::to_string(*o.cascades) : "") << ","
           << (o.depthBias ? number(*o.depthBias) : "") << "," << (o.slopeBias ? number(*o.slopeBias) : "") << ","
           << o.rayBias.value_or("") << "," << o.precision.value_or("") << ","
           << (o.samples ? std::to_string(*o.samples) : "") << "," << r.config.biasKind << ","

@@ -19,6 +19,8 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
+}  // namespace
+
 void setBasis(LightFrustum& f, const Vec3& direction) {
     f.direction = glm::normalize(direction);
     // Any axis not parallel to the light makes a basis; world Y unless the light is vertical.
@@ -26,6 +28,8 @@ void setBasis(LightFrustum& f, const Vec3& direction) {
     f.right = glm::normalize(glm::cross(f.direction, ref));
     f.up = glm::cross(f.right, f.direction);
 }
+
+namespace {
 
 std::array<Vec3, 8> corners(const scene::Bounds& b) {
     std::array<Vec3, 8> c;
@@ -108,11 +112,12 @@ LightFrustum fitDirectionalLight(const scene::Bounds& bounds, const Vec3& direct
     return f;
 }
 
-LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const Vec3& direction, int mapSize) {
-    const scene::Bounds sceneBounds = scene.bounds();
-    LightFrustum f = fitDirectionalLight(sceneBounds, direction, mapSize);
-    if (sceneBounds.empty()) return f;
+std::vector<Vec3> visibleReceiverPoints(const scene::Scene& scene) {
+    return visibleReceiverPoints(scene, scene.bounds());
+}
 
+std::vector<Vec3> visibleReceiverPoints(const scene::Scene& scene, const scene::Bounds& sceneBounds) {
+    if (sceneBounds.empty()) return {};
     // Receivers: the scene box clipped to the camera frustum (far plane pulled in to the
     // scene's farthest corner). Each face of the box is clipped against the frustum's six
     // planes; the clipped polygons' vertices are the vertices of box ∩ frustum.
@@ -120,22 +125,12 @@ LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const Vec
     double farthest = 0.0;
     for (const Vec3& c : corners(sceneBounds)) farthest = std::max(farthest, glm::dot(c - cam.position, cam.forward));
     const double nearD = scene.camera.near, farD = std::min(scene.camera.far, farthest);
-    if (!(farD > nearD)) return f;  // the scene is behind the camera
-    const std::vector<Vec3> receivers = clipBoxToFrustum(sceneBounds, cam, nearD, farD);
-    if (receivers.empty()) return f;  // the camera sees none of the scene
+    if (!(farD > nearD)) return {};  // the scene is behind the camera
+    return clipBoxToFrustum(sceneBounds, cam, nearD, farD);
+}
 
-    // Receivers' extent across the light and their farthest depth along it.
-    double minU = INFINITY, maxU = -INFINITY, minV = INFINITY, maxV = -INFINITY, maxDepth = -INFINITY;
-    for (const Vec3& c : receivers) {
-        const Vec3 d = c - f.center;
-        minU = std::min(minU, glm::dot(d, f.right));
-        maxU = std::max(maxU, glm::dot(d, f.right));
-        minV = std::min(minV, glm::dot(d, f.up));
-        maxV = std::max(maxV, glm::dot(d, f.up));
-        maxDepth = std::max(maxDepth, glm::dot(d, f.direction));
-    }
-    // Casters: every object whose extent across the light overlaps the receivers'; the map
-    // must reach back to the nearest of them.
+double nearestCasterDepth(const scene::Scene& scene, const LightFrustum& f, double minU, double maxU, double minV,
+                          double maxV) {
     double minDepth = INFINITY;
     for (const scene::Object& o : scene.objects) {
         const scene::Bounds b = scene::boundsOf(o.shape);
@@ -152,6 +147,29 @@ LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const Vec
         if (oMaxU < minU || oMinU > maxU || oMaxV < minV || oMinV > maxV) continue;
         minDepth = std::min(minDepth, oMinDepth);
     }
+    return minDepth;
+}
+
+LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const Vec3& direction, int mapSize) {
+    const scene::Bounds sceneBounds = scene.bounds();
+    LightFrustum f = fitDirectionalLight(sceneBounds, direction, mapSize);
+    if (sceneBounds.empty()) return f;
+    const std::vector<Vec3> receivers = visibleReceiverPoints(scene);
+    if (receivers.empty()) return f;  // the camera sees none of the scene
+
+    // Receivers' extent across the light and their farthest depth along it.
+    double minU = INFINITY, maxU = -INFINITY, minV = INFINITY, maxV = -INFINITY, maxDepth = -INFINITY;
+    for (const Vec3& c : receivers) {
+        const Vec3 d = c - f.center;
+        minU = std::min(minU, glm::dot(d, f.right));
+        maxU = std::max(maxU, glm::dot(d, f.right));
+        minV = std::min(minV, glm::dot(d, f.up));
+        maxV = std::max(maxV, glm::dot(d, f.up));
+        maxDepth = std::max(maxDepth, glm::dot(d, f.direction));
+    }
+    // Casters: every object whose extent across the light overlaps the receivers'; the map
+    // must reach back to the nearest of them.
+    const double minDepth = nearestCasterDepth(scene, f, minU, maxU, minV, maxV);
     if (!(minDepth < maxDepth)) return f;
 
     // Square texels: the larger extent sets the half-width; the map is centered on the

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -52,6 +53,24 @@ LightFrustum fitDirectionalLight(const scene::Bounds& bounds, const scene::Vec3&
 // object whose extent across the light overlaps theirs. Falls back to fitDirectionalLight()
 // when the camera sees none of the scene.
 LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const scene::Vec3& direction, int mapSize);
+
+// The map's basis for light travelling along `direction`: right = direction × (world Y, or X for
+// a vertical light), up = right × direction. Fixed in the world, so texel grids are too.
+void setBasis(LightFrustum& f, const scene::Vec3& direction);
+
+// The vertices of the scene's bounds clipped to the camera frustum (its far plane pulled in to the
+// scene's farthest corner): the convex hull of every receiver the camera can see. Empty when the
+// camera sees none of the scene.
+std::vector<scene::Vec3> visibleReceiverPoints(const scene::Scene& scene);
+// The same for any box in the scene (an object's bounds): the part of it the camera frustum holds.
+std::vector<scene::Vec3> visibleReceiverPoints(const scene::Scene& scene, const scene::Bounds& box);
+
+// The smallest depth along f.direction (relative to f.center) of any object whose bounding box's
+// extent across the light (f.right, f.up, relative to f.center) overlaps [minU, maxU] × [minV,
+// maxV]: how far toward the light a map covering that rectangle must reach to catch every
+// caster. +infinity when no object overlaps.
+double nearestCasterDepth(const scene::Scene& scene, const LightFrustum& f, double minU, double maxU, double minV,
+                          double maxV);
 
 // Spot light at `position` shining along `direction` with cone half-angle `coneDegrees`: the
 // map's field of view is the cone plus a 2% margin; near and far enclose the scene's bounding

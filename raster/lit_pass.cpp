@@ -23,10 +23,13 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant) {
          .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
         {.binding = 3, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
+        // The shadow maps' raw depths (no compare), for the PCSS blocker search.
+        {.binding = 4, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
+         .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
     };
     const VkDescriptorSetLayoutCreateInfo setInfo{
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
-        .bindingCount = 4,
+        .bindingCount = 5,
         .pBindings = bindings,
     };
     LitPipeline p;
@@ -42,12 +45,13 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant) {
     VK_CHECK(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &layout));
     p.layout = PipelineLayoutHandle(device, layout);
     // lit.frag's constant_id 0: the filter code, 1: blocker ids (a bool is 32 bits wide),
-    // 2: the light count, 3: the light kinds.
-    const std::int32_t constants[4] = {std::int32_t(variant.filter), variant.blockerIds ? 1 : 0,
-                                       std::int32_t(variant.lightCount), std::int32_t(variant.lightKinds)};
-    const VkSpecializationMapEntry entries[4] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}, {3, 12, 4}};
+    // 2: the light count, 3: the light kinds, 4: the cascade count.
+    const std::int32_t constants[5] = {std::int32_t(variant.filter), variant.blockerIds ? 1 : 0,
+                                       std::int32_t(variant.lightCount), std::int32_t(variant.lightKinds),
+                                       std::int32_t(variant.cascades)};
+    const VkSpecializationMapEntry entries[5] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}, {3, 12, 4}, {4, 16, 4}};
     const VkSpecializationInfo specialization{
-        .mapEntryCount = 4, .pMapEntries = entries, .dataSize = sizeof constants, .pData = constants};
+        .mapEntryCount = 5, .pMapEntries = entries, .dataSize = sizeof constants, .pData = constants};
     std::vector<VkFormat> colorFormats{kLitColorFormat};
     if (variant.aovTarget) colorFormats.insert(colorFormats.end(), 1 + variant.lightTargets, kLitColorFormat);
     p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{
@@ -127,13 +131,20 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
     VkSampler idSampler = VK_NULL_HANDLE;
     VK_CHECK(vkCreateSampler(device, &idSamplerInfo, nullptr, &idSampler));
     b.idSampler = SamplerHandle(device, idSampler);
+    // Raw depths for the PCSS blocker search: no compare; depth 1 (nothing) outside the map.
+    VkSamplerCreateInfo depthSamplerInfo = samplerInfo;
+    depthSamplerInfo.compareEnable = VK_FALSE;
+    depthSamplerInfo.compareOp = VK_COMPARE_OP_NEVER;
+    VkSampler depthSampler = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateSampler(device, &depthSamplerInfo, nullptr, &depthSampler));
+    b.depthSampler = SamplerHandle(device, depthSampler);
     b.uniforms = uploadBuffer(ctx, &uniforms, sizeof uniforms, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
     b.albedos = uploadBuffer(ctx, albedos, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
 
     const VkDescriptorPoolSize sizes[] = {
         {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
         {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
-        {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 2},
+        {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 3},
     };
     const VkDescriptorPoolCreateInfo poolInfo{
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
@@ -157,6 +168,7 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
     const VkDescriptorBufferInfo albedoInfo{b.albedos.buffer.get(), 0, VK_WHOLE_SIZE};
     const VkDescriptorImageInfo imageInfo{sampler, maps.depth.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkDescriptorImageInfo idInfo{idSampler, maps.ids.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    const VkDescriptorImageInfo depthInfo{depthSampler, maps.depth.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkWriteDescriptorSet writes[] = {
         {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 0, .descriptorCount = 1,
          .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .pBufferInfo = &uniformInfo},
@@ -166,8 +178,10 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
          .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &imageInfo},
         {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 3, .descriptorCount = 1,
          .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &idInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 4, .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &depthInfo},
     };
-    vkUpdateDescriptorSets(device, 4, writes, 0, nullptr);
+    vkUpdateDescriptorSets(device, 5, writes, 0, nullptr);
     return b;
 }
 

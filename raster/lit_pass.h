@@ -26,6 +26,7 @@ struct LitVariant {
     std::uint32_t lightTargets = 0;  // 0, or kLightTargets: per-light visibility targets
     std::uint32_t lightCount = 1;    // = LitUniforms::counts.x
     std::uint32_t lightKinds = 7;    // bit (1 << SHADOWLAB_LIGHT_*) for each kind in the scene
+    std::uint32_t cascades = 1;      // cascades of the cascaded directional lights (1: none cascaded)
 };
 // Per-light visibility targets: four lights in each RGBA32F target, SHADOWLAB_MAX_LIGHTS in all.
 inline constexpr std::uint32_t kLightTargets = (SHADOWLAB_MAX_LIGHTS + 3) / 4;
@@ -58,6 +59,7 @@ LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32
 struct LitBindings {
     SamplerHandle sampler;    // depth compare, for the shadow maps
     SamplerHandle idSampler;  // plain NEAREST, for the blocker ids
+    SamplerHandle depthSampler;  // plain NEAREST, the maps' raw depths (PCSS blocker search)
     Buffer uniforms;
     Buffer albedos;
     DescriptorPoolHandle pool;

@@ -1,6 +1,7 @@
 // raster/memory.cpp: the raster backend's memory estimate (see raster/memory.h).
 #include "raster/memory.h"
 
+#include <algorithm>
 #include <variant>
 
 #include "scene/memory.h"
@@ -26,9 +27,7 @@ constexpr std::uint64_t kBytesPerTriangle = 3 * 32 + 3 * 4;  // vertices (positi
 std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::RenderPlan& plan,
                                   const scene::RasterSettings& settings) {
     const std::uint64_t pixels = std::uint64_t(scene.camera.width) * std::uint64_t(scene.camera.height);
-    std::uint64_t layers = 0;
-    for (const scene::LightPlan& lp : plan.lights)
-        if (lp.needsShadowTest) layers += scene.lights[lp.light].type == scene::LightType::Point ? 6 : 1;
+    const std::uint64_t layers = shadowMapLayers(scene, plan, settings);
     const std::uint64_t texels = std::uint64_t(settings.shadowMapSize) * std::uint64_t(settings.shadowMapSize);
     std::uint64_t triangles = 0;
     for (const scene::Object& o : scene.objects) {
@@ -38,6 +37,31 @@ std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::Render
     }
     return kDriverAllowance + scene::frameBytes(scene) + pixels * litBytesPerPixel(scene.lights.size()) +
            layers * texels * (4 + 4) + triangles * kBytesPerTriangle;
+}
+
+std::uint64_t shadowMapLayers(const scene::Scene& scene, const scene::RenderPlan& plan,
+                              const scene::RasterSettings& settings) {
+    std::uint64_t layers = 0;
+    for (const scene::LightPlan& lp : plan.lights) {
+        if (!lp.needsShadowTest) continue;
+        // A point light's cube map has six layers; a directional light one per cascade (at
+        // most: fitCascades may fall back to one map).
+        const scene::LightType type = scene.lights[lp.light].type;
+        layers += type == scene::LightType::Point         ? 6
+                  : type == scene::LightType::Directional ? std::uint64_t(std::max(1, settings.cascades))
+                                                          : 1;
+    }
+    return layers;
+}
+
+std::uint64_t debugViewBytes(const scene::Scene& scene, const scene::RenderPlan& plan,
+                             const scene::RasterSettings& settings, bool captureShadowMaps) {
+    if (captureShadowMaps) {
+        const std::uint64_t texels = std::uint64_t(settings.shadowMapSize) * std::uint64_t(settings.shadowMapSize);
+        return shadowMapLayers(scene, plan, settings) * texels * (4 + 12 + 3);
+    }
+    const std::uint64_t pixels = std::uint64_t(scene.camera.width) * std::uint64_t(scene.camera.height);
+    return pixels * (12 + 4);
 }
 
 }  // namespace shadowlab::raster

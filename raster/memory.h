@@ -11,10 +11,22 @@
 namespace shadowlab::raster {
 
 // The Frame, the lit pass's color and depth targets and their readback copies, the shadow maps
-// (depth + blocker id, one layer per directional or spot light, six per point light) and the
+// (depth + blocker id, shadowMapLayers() layers) and the
 // geometry buffers, plus a fixed allowance for the driver (llvmpipe's compiled shaders, LLVM). The program
 // itself and writing the Frame are the caller's part (scene/memory.h).
 std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::RenderPlan& plan,
                                   const scene::RasterSettings& settings);
+
+// The shadow-map layers a render has at most: one per directional or spot light that needs a
+// shadow test, settings.cascades for a directional one with cascades, six per point light.
+std::uint64_t shadowMapLayers(const scene::Scene& scene, const scene::RenderPlan& plan,
+                              const scene::RasterSettings& settings);
+
+// What `render --view` holds on the host besides estimateMemoryBytes() (it writes no EXR): with
+// captureShadowMaps every layer's depths (4 bytes a texel) and the tiled display image (at most
+// 12 bytes a texel, gaps included as a quarter more); otherwise a display image and a cascade
+// index per camera pixel.
+std::uint64_t debugViewBytes(const scene::Scene& scene, const scene::RenderPlan& plan,
+                             const scene::RasterSettings& settings, bool captureShadowMaps);
 
 }  // namespace shadowlab::raster

@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 
+#include "raster/cascades.h"
 #include "raster/context.h"
 #include "raster/geometry.h"
 #include "raster/light_frustum.h"
@@ -62,16 +63,19 @@ const char* filterName(scene::ShadowFilter f) {
         case scene::ShadowFilter::Pcf2x2: return "pcf2x2";
         case scene::ShadowFilter::Pcf: return "pcf";
         case scene::ShadowFilter::Poisson: return "poisson";
+        case scene::ShadowFilter::Pcss: return "pcss";
     }
     return "?";
 }
 
 }  // namespace
 
+static_assert(SHADOWLAB_MAX_CASCADES == scene::kMaxCascades, "shaders/interface.h and scene/settings.h disagree");
+
 struct Renderer::Impl {
     Impl(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settingsIn,
          const RendererOptions& options, ValidationLog& log);
-    void render(scene::Frame& frame, scene::ChannelMask channels, const ValidationLog& log);
+    void render(scene::Frame& frame, scene::ChannelMask channels, const ValidationLog& log, RenderDebug* debug);
     void readPixels(scene::Frame& frame, scene::ChannelMask channels) const;
     void invalidateMemory(VkDeviceMemory memory) const {
         const VkMappedMemoryRange range{.sType = VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE, .memory = memory, .size = VK_WHOLE_SIZE};
@@ -86,6 +90,14 @@ struct Renderer::Impl {
     glm::vec3 background{0.0f};
     std::map<std::string, std::string> attributes;  // what every frame of this scene records
     std::vector<glm::mat4> lightMatrices;           // one per shadow-map layer
+    // Per layer, for RenderDebug: its frustum, the light it belongs to and a short label.
+    std::vector<LightFrustum> frusta;
+    std::vector<int> layerLight;
+    std::vector<std::string> layerLabels;
+    // Cascades (the same for every cascaded directional light: they depend on the camera only):
+    // the split depths and each cascade's texel world size; empty without cascades.
+    std::vector<double> cascadeSplits, cascadeTexels;
+    int cascadesUsed = 1;  // lit.frag's cascade count (specialization constant)
     double setupMs = 0.0;
     double pendingSetupMs = 0.0;  // setup not yet reported in a frame (the constructor's)
 
@@ -130,7 +142,6 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     indexBuffer = uploadBuffer(ctx, geometry.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
     draw = DrawGeometry{vertexBuffer.buffer.get(), indexBuffer.buffer.get(), std::uint32_t(geometry.indices.size())};
 
-    std::vector<LightFrustum> frusta;
     std::vector<double> usedDepthBias;  // per shadow-mapped light (spot, directional)
     // One shadow-map layer per light that needs a shadow test.
     const scene::Bounds bounds = scene.bounds();
@@ -152,6 +163,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
         l.radiance = glm::vec4(glm::vec3(light.color * light.intensity), float(light.intensity * meanColor));
         float layer = -1.0f;
         LightFrustum f;
+        CascadeSet cascades;  // filled for a cascaded directional light
         if (needsShadowTest(plan, i)) {
             if (point) {
                 // Six layers, +X −X +Y −Y +Z −Z; the shader picks the face and builds its
@@ -161,16 +173,52 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
                     f = fitPointLightFace(bounds, light.position, face, settings.shadowMapSize);
                     lightMatrices.push_back(glm::mat4(f.toClip(origin)));
                     frusta.push_back(f);
+                    static const char* const kFaces[] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
+                    layerLight.push_back(int(i));
+                    layerLabels.push_back("L" + std::to_string(i) + " " + kFaces[face]);
                 }
                 l.bias = glm::vec4(float(settings.depthBias), float(settings.slopeBias), float(f.texelWorldSize()), 0.0f);
             } else if (spot)
                 f = fitSpotLight(bounds, light.position, light.direction, light.coneAngleDegrees,
                                  settings.shadowMapSize);
-            else if (settings.fitLightFrustum)
+            else if (settings.cascades > 1 &&
+                     !(cascades = fitCascades(scene, light.direction, settings.cascades, settings.shadowMapSize))
+                          .frusta.empty()) {
+                // Cascaded: one layer per slice; the shader picks the cascade by view depth
+                // (lit.frag cascadeOf). Cascades are fitted to their slices, so
+                // fitLightFrustum does not apply. A default constant bias is half of each
+                // cascade's texel, as for a fitted map.
+                layer = float(lightMatrices.size());
+                cascadesUsed = int(cascades.frusta.size());
+                cascadeSplits = cascades.splits;
+                cascadeTexels.clear();
+                for (std::size_t c = 0; c < cascades.frusta.size(); ++c) {
+                    const LightFrustum& cf = cascades.frusta[c];
+                    const double depthBias = settings.depthBiasIsDefault ? 0.5 * cf.texelWorldSize() : settings.depthBias;
+                    lightMatrices.push_back(glm::mat4(cf.toClip(origin)));
+                    frusta.push_back(cf);
+                    usedDepthBias.push_back(depthBias);
+                    cascadeTexels.push_back(cf.texelWorldSize());
+                    layerLight.push_back(int(i));
+                    layerLabels.push_back("L" + std::to_string(i) + " C" + std::to_string(c));
+                    shaders::CascadeData& cd = uniforms.cascades[i * SHADOWLAB_MAX_CASCADES + c];
+                    cd.toShadow = glm::mat4(cf.toTexture(origin));
+                    cd.params = glm::vec4(float(cascades.splits[c + 1]), float(cf.texelWorldSize()),
+                                          float(1.0 / cf.depthRange()), float(depthBias));
+                }
+                // Cascade 0 also fills the light's own map fields (what count <= 1 would use).
+                f = cascades.frusta[0];
+                l.toShadow = uniforms.cascades[i * SHADOWLAB_MAX_CASCADES].toShadow;
+                l.bias = glm::vec4(float(usedDepthBias[usedDepthBias.size() - cascades.frusta.size()]),
+                                   float(settings.slopeBias), float(f.texelWorldSize()),
+                                   float(1.0 / f.depthRange()));
+            } else if (settings.fitLightFrustum)
                 f = fitDirectionalLightToReceivers(scene, light.direction, settings.shadowMapSize);
             else
                 f = fitDirectionalLight(bounds, light.direction, settings.shadowMapSize);
-            if (!point) {
+            if (!point && cascades.frusta.empty()) {
+                layerLight.push_back(int(i));
+                layerLabels.push_back("L" + std::to_string(i));
                 layer = float(lightMatrices.size());
                 lightMatrices.push_back(glm::mat4(f.toClip(origin)));
                 l.toShadow = glm::mat4(f.toTexture(origin));
@@ -187,6 +235,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
             }
         }
         if (point) {
+            l.axis = glm::vec4(0.0f, 0.0f, 0.0f, float(2.0 * light.radius));  // w: light size (PCSS)
             l.toLight = glm::vec4(glm::vec3(light.position - origin), layer);
             // Without a shadow test f is default; near/far are then unused.
             l.kind = glm::vec4(float(SHADOWLAB_LIGHT_POINT), float(cubeFaceTanHalfFov(settings.shadowMapSize)),
@@ -196,10 +245,11 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
             l.toLight = glm::vec4(glm::vec3(light.position - origin), layer);
             l.kind = glm::vec4(float(SHADOWLAB_LIGHT_SPOT), float(std::cos(light.coneAngleDegrees * kPi / 180.0)),
                                float(f.near), float(f.far));
-            l.axis = glm::vec4(glm::vec3(glm::normalize(light.direction)), 0.0f);
+            l.axis = glm::vec4(glm::vec3(glm::normalize(light.direction)), float(2.0 * light.radius));
         } else {
             l.toLight = glm::vec4(glm::vec3(-light.direction), layer);
-            l.kind = glm::vec4(float(SHADOWLAB_LIGHT_DIRECTIONAL), 0, 0, 0);
+            l.kind = glm::vec4(float(SHADOWLAB_LIGHT_DIRECTIONAL),
+                               cascades.frusta.empty() ? 0.0f : float(cascades.frusta.size()), 0, 0);
         }
         l.params = glm::vec4(float(kMaxSlopeTan), float(int(settings.filter)), float(settings.normalOffset),
                              float(settings.pcfSize));
@@ -232,7 +282,8 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     attributes["backend"] = "raster";
     attributes["shadow_map_size"] = std::to_string(settings.shadowMapSize);
     attributes["filter"] = filterName(settings.filter);
-    if (settings.filter == scene::ShadowFilter::Pcf || settings.filter == scene::ShadowFilter::Poisson)
+    if (settings.filter == scene::ShadowFilter::Pcf || settings.filter == scene::ShadowFilter::Poisson ||
+        settings.filter == scene::ShadowFilter::Pcss)
         attributes["pcf_size"] = std::to_string(settings.pcfSize);
     attributes["normal_offset"] = formatNumber(settings.normalOffset);
     attributes["light_frustum_fit"] = settings.fitLightFrustum ? "receivers" : "bounding-sphere";
@@ -266,11 +317,20 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
         attributes["texel_world_size"] = texel;
         attributes["light_frustum"] = frustum;
     }
+    attributes["cascades"] = std::to_string(cascadesUsed);
+    if (!cascadeSplits.empty()) {
+        std::string splits, texels;
+        for (std::size_t k = 0; k < cascadeSplits.size(); ++k) splits += (k ? ";" : "") + formatNumber(cascadeSplits[k]);
+        for (std::size_t k = 0; k < cascadeTexels.size(); ++k) texels += (k ? ";" : "") + formatNumber(cascadeTexels[k]);
+        attributes["cascade_splits"] = splits;
+        attributes["cascade_texel_world_size"] = texels;
+    }
     setupMs = msSince(setupStart);
     pendingSetupMs = setupMs;
 }
 
-void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, const ValidationLog& log) {
+void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, const ValidationLog& log,
+                            RenderDebug* debug) {
     using namespace scene;
     const bool wantIds = (channels & kChannelBlockerId) != 0;
     const bool wantAovs = (channels & (kChannelObjectId | kChannelNdotL | kChannelDepth | kChannelBlockerId)) != 0;
@@ -292,7 +352,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                                                             .aovTarget = !beautyOnly,
                                                             .lightTargets = std::uint32_t(targets.lights.size()),
                                                             .lightCount = std::uint32_t(lightCount),
-                                                            .lightKinds = lightKinds});
+                                                            .lightKinds = lightKinds,
+                                                            .cascades = std::uint32_t(cascadesUsed)});
         if (bindings.set == VK_NULL_HANDLE) bindings = createLitBindings(ctx, litPipeline, uniforms, albedos, maps);
         setup += msSince(pipelineStart);
     }
@@ -312,6 +373,20 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     stamp(commands, 1);
     ctx.submitAndWait(commands);
     frame.timingsMs.emplace_back("shadow_pass", msSince(shadowStart));
+    if (debug) {
+        // What each layer holds (fixed by the constructor) and, when asked, its depths (read
+        // back outside the pass timings).
+        debug->frusta = frusta;
+        debug->layerLight = layerLight;
+        debug->layerLabels = layerLabels;
+        debug->mapSize = frusta.empty() ? 1u : std::uint32_t(settings.shadowMapSize);
+        debug->cascadeSplits = cascadeSplits;
+        debug->cascadeTexels = cascadeTexels;
+        debug->layerDepths.clear();
+        if (debug->captureShadowMaps)
+            for (std::uint32_t k = 0; k < std::uint32_t(lightMatrices.size()); ++k)
+                debug->layerDepths.push_back(readShadowMap(ctx, maps, k));
+    }
 
     // --- lit pass ---
     const auto litStart = Clock::now();
@@ -433,26 +508,33 @@ Renderer::~Renderer() = default;
 Renderer::Renderer(Renderer&&) noexcept = default;
 Renderer& Renderer::operator=(Renderer&&) noexcept = default;
 
-scene::Frame Renderer::render(scene::ChannelMask channels) {
+scene::Frame Renderer::render(scene::ChannelMask channels, RenderDebug* debug) {
     scene::Frame frame;
-    impl_->render(frame, channels, *log_);
+    impl_->render(frame, channels, *log_, debug);
     return frame;
 }
-void Renderer::render(scene::Frame& frame, scene::ChannelMask channels) { impl_->render(frame, channels, *log_); }
+void Renderer::render(scene::Frame& frame, scene::ChannelMask channels, RenderDebug* debug) {
+    impl_->render(frame, channels, *log_, debug);
+}
 double Renderer::setupMs() const { return impl_->setupMs; }
 int Renderer::validationMessages() const { return log_->count.load(); }
 
 scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settings,
-                    scene::ChannelMask channels) {
+                    scene::ChannelMask channels, RenderDebug* debug) {
     std::shared_ptr<const ValidationLog> log;
     scene::Frame frame;
     {
         Renderer renderer(scene, plan, settings);
         log = renderer.validationLog();
-        frame = renderer.render(channels);
+        frame = renderer.render(channels, debug);
     }  // the device is destroyed here; validation messages raised by that still count
     if (settings.validate) frame.attributes["validation_messages"] = std::to_string(log->count.load());
     return frame;
+}
+
+scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settings,
+                    RenderDebug* debug) {
+    return render(scene, plan, settings, scene::kAllChannels, debug);
 }
 
 }  // namespace shadowlab::raster

@@ -2,9 +2,13 @@
 // Frame, and list the Vulkan devices for `shadowlab info`.
 #pragma once
 
+#include <cstdint>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "raster/devices.h"
+#include "raster/light_frustum.h"
 #include "raster/vulkan_error.h"
 #include "scene/frame.h"
 #include "scene/render_plan.h"
@@ -14,6 +18,24 @@
 namespace shadowlab::raster {
 
 struct ValidationLog;
+
+// What a render used, for the debug views (raster/debug_views.h) and tests.
+struct RenderDebug {
+    bool captureShadowMaps = false;  // in: read every layer back after the shadow pass
+    // Out, one entry per shadow-map layer: its frustum, the light it belongs to, a short label
+    // ("L0", "L0 C2" for cascade 2, "L1 +X" for a point light's face) and, when captured, its
+    // depths (mapSize² floats, row 0 first; 1 = cleared, nothing there).
+    std::vector<LightFrustum> frusta;
+    std::vector<int> layerLight;
+    std::vector<std::string> layerLabels;
+    std::vector<std::vector<float>> layerDepths;
+    std::uint32_t mapSize = 0;
+    // Cascades (the same for every directional light: they depend on the camera only): the
+    // count + 1 split depths along the view, and each cascade's texel world size. Empty without
+    // cascades.
+    std::vector<double> cascadeSplits;
+    std::vector<double> cascadeTexels;
+};
 
 // A reusable raster renderer for one scene and its settings: the constructor does the setup
 // once (instance, device, tessellation, geometry upload into device-local buffers, shadow maps,
@@ -38,9 +60,12 @@ public:
 
     // The two passes and the readback of `channels` (scene/frame.h). Vectors of channels not
     // asked for are left empty; lightVisibility is filled only for scenes with > 1 light.
-    scene::Frame render(scene::ChannelMask channels = scene::kAllChannels);
+    // With `debug`, also fills it: what each shadow-map layer holds and, with
+    // debug->captureShadowMaps, every layer's depths (read back after the shadow pass, outside
+    // its timing).
+    scene::Frame render(scene::ChannelMask channels = scene::kAllChannels, RenderDebug* debug = nullptr);
     // The same into `frame`, reusing its vectors' memory (a loop over frames allocates nothing).
-    void render(scene::Frame& frame, scene::ChannelMask channels = scene::kAllChannels);
+    void render(scene::Frame& frame, scene::ChannelMask channels = scene::kAllChannels, RenderDebug* debug = nullptr);
     double setupMs() const;  // the constructor's time
     // Validation messages counted so far (settings.validate); messages raised when the Renderer
     // is destroyed are not in any frame: raster::render() adds them to its frame.
@@ -54,7 +79,8 @@ private:
 };
 
 // Renders on a headless Vulkan 1.3 device (lavapipe unless settings.device names another):
-// one depth pass per directional or spot light, six (a cube map) per point light, for each
+// one depth pass per directional (one per cascade with settings.cascades > 1) or spot light,
+// six (a cube map) per point light, for each
 // light whose plan says it needs a shadow test, then
 // the lit camera pass, then the readback. Fills every Frame AOV including blockerId, the
 // timings "setup", "shadow_pass", "lit_pass", "readback" and the attributes backend, device,
@@ -64,8 +90,13 @@ private:
 // validation_messages (the count; each is printed to stderr). Throws RasterError (no loader,
 // driver or device; bad settings) or VulkanError (a failed call). Call it from one thread at a time: the Vulkan
 // function pointers it loads are shared by the process.
-// One frame from a Renderer made for it (setup included in the "setup" timing).
+// One frame from a Renderer made for it (setup included in the "setup" timing); with `debug`,
+// as Renderer::render.
 scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan,
-                    const scene::RasterSettings& settings, scene::ChannelMask channels = scene::kAllChannels);
+                    const scene::RasterSettings& settings, scene::ChannelMask channels = scene::kAllChannels,
+                    RenderDebug* debug = nullptr);
+// All channels, with `debug` (the debug views).
+scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan,
+                    const scene::RasterSettings& settings, RenderDebug* debug);
 
 }  // namespace shadowlab::raster

@@ -13,6 +13,7 @@
 
 #include "scene/error.h"
 #include "scene/mesh_loader.h"
+#include "scene/settings.h"
 
 namespace shadowlab::scene {
 
@@ -296,7 +297,7 @@ Object readObject(const Reader& r, const Json& node, const JsonPath& path,
 
 ShadowDefaults readShadow(const Reader& r, const Json& node, const JsonPath& path) {
     r.checkKeys(node, path, {"shadow_map_size", "depth_bias", "slope_bias", "filter", "pcf_size", "normal_offset",
-                             "fit_light_frustum", "ray_bias", "precision", "samples"});
+                             "fit_light_frustum", "cascades", "ray_bias", "precision", "samples"});
     ShadowDefaults d;
     if (node.contains("shadow_map_size"))
         d.shadowMapSize = r.integer(node["shadow_map_size"], path / "shadow_map_size", 16, 16384);
@@ -310,8 +311,9 @@ ShadowDefaults readShadow(const Reader& r, const Json& node, const JsonPath& pat
     }
     if (node.contains("filter")) {
         d.filter = r.string(node["filter"], path / "filter");
-        if (*d.filter != "none" && *d.filter != "pcf2x2" && *d.filter != "pcf" && *d.filter != "poisson")
-            r.fail(path / "filter", "expected none, pcf2x2, pcf or poisson, got '" + *d.filter + "'");
+        if (*d.filter != "none" && *d.filter != "pcf2x2" && *d.filter != "pcf" && *d.filter != "poisson" &&
+            *d.filter != "pcss")
+            r.fail(path / "filter", "expected none, pcf2x2, pcf, poisson or pcss, got '" + *d.filter + "'");
     }
     if (node.contains("pcf_size")) d.pcfSize = r.integer(node["pcf_size"], path / "pcf_size", 1, 15);
     if (node.contains("normal_offset")) {
@@ -320,6 +322,7 @@ ShadowDefaults readShadow(const Reader& r, const Json& node, const JsonPath& pat
     }
     if (node.contains("fit_light_frustum"))
         d.fitLightFrustum = r.boolean(node["fit_light_frustum"], path / "fit_light_frustum");
+    if (node.contains("cascades")) d.cascades = r.integer(node["cascades"], path / "cascades", 1, kMaxCascades);
     if (node.contains("ray_bias")) {
         const Json& v = node["ray_bias"];
         if (v.is_string()) {

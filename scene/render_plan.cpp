@@ -15,7 +15,7 @@ bool isConvex(const Shape& shape) {
 
 }  // namespace
 
-RenderPlan makeRenderPlan(const Scene& scene, const RenderSettings& /*settings*/) {
+RenderPlan makeRenderPlan(const Scene& scene, const RenderSettings& settings) {
     RenderPlan plan;
     plan.anyHitShadowRays = scene.allOpaque();
     for (const Object& o : scene.objects)
@@ -39,6 +39,26 @@ RenderPlan makeRenderPlan(const Scene& scene, const RenderSettings& /*settings*/
         if (light.radius > 0.0 && light.type != LightType::Directional) plan.hasAreaLights = true;
         plan.lights.push_back(lp);
     }
+
+    // Cascades split a directional light's orthographic map along the view; spot and point maps
+    // are perspective from the light already and are not split.
+    bool shadowedDirectional = false;
+    for (const LightPlan& lp : plan.lights)
+        if (lp.needsShadowTest && scene.lights[std::size_t(lp.light)].type == LightType::Directional)
+            shadowedDirectional = true;
+    const int asked = settings.raster.cascades;
+    if (asked <= 1) {
+        plan.cascades = 1;
+        plan.cascadesReason = "one map per directional light (cascades = 1)";
+    } else if (!shadowedDirectional) {
+        plan.cascades = 1;
+        plan.cascadesReason = "cascades = " + std::to_string(asked) +
+                              " ignored: no shadowed directional light (only directional maps are split)";
+    } else {
+        plan.cascades = asked;
+        plan.cascadesReason = std::to_string(asked) +
+                              " per directional light, split along the view depth of the visible receivers";
+    }
     return plan;
 }
 
@@ -59,6 +79,7 @@ std::string RenderPlan::explain() const {
       << "\n";
     s << "area lights: " << (hasAreaLights ? "yes, soft shadows are sampled" : "none, shadows are hard")
       << "\n";
+    s << "cascades: " << cascades << " (" << cascadesReason << ")\n";
     for (const LightPlan& lp : lights)
         s << "light " << lp.light << ": shadow pass "
           << (lp.needsShadowTest ? "rendered" : "skipped") << " (" << lp.reason << ")\n";

@@ -24,6 +24,10 @@ struct RenderPlan {
     bool needsCubeMap = false;            // a point light is shadowed (raster)
     bool needsTransmittanceMap = false;   // semi-transparent casters (raster)
     bool hasAreaLights = false;
+    // Cascaded shadow maps per shadowed directional light (raster): settings.raster.cascades, or 1
+    // when more were asked for but no directional light is shadowed; cascadesReason says which.
+    int cascades = 1;
+    std::string cascadesReason;
     std::vector<LightPlan> lights;
 
     std::string explain() const;  // human-readable, one decision per line with its reason

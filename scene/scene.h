@@ -132,6 +132,7 @@ struct ShadowDefaults {
     std::optional<int> pcfSize;          // texels
     std::optional<double> normalOffset;  // texels
     std::optional<bool> fitLightFrustum;
+    std::optional<int> cascades;         // directional lights: cascaded shadow maps, 1..kMaxCascades
     std::optional<double> rayBias;       // world units; absent: scene-scaled
     std::optional<bool> robustRayOffset; // "ray_bias": "robust"
     std::optional<std::string> precision;

@@ -16,7 +16,8 @@ ShadowFilter parseFilter(const std::string& text, const std::string& where) {
     if (text == "pcf2x2") return ShadowFilter::Pcf2x2;
     if (text == "pcf") return ShadowFilter::Pcf;
     if (text == "poisson") return ShadowFilter::Poisson;
-    throw InputError(where + ": expected none|pcf2x2|pcf|poisson, got '" + text + "'");
+    if (text == "pcss") return ShadowFilter::Pcss;
+    throw InputError(where + ": expected none|pcf2x2|pcf|poisson|pcss, got '" + text + "'");
 }
 
 Precision parsePrecision(const std::string& text, const std::string& where) {
@@ -68,6 +69,10 @@ RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& o) {
     if (!std::isfinite(s.raster.normalOffset) || s.raster.normalOffset < 0.0)
         throw InputError("--normal-offset: must be a finite value >= 0 (texels)");
     s.raster.fitLightFrustum = o.fitLightFrustum.value_or(d.fitLightFrustum.value_or(false));
+    s.raster.cascades = o.cascades.value_or(d.cascades.value_or(1));
+    if (s.raster.cascades < 1 || s.raster.cascades > kMaxCascades)
+        throw InputError("--cascades: must be in 1.." + std::to_string(kMaxCascades) + ", got " +
+                         std::to_string(s.raster.cascades));
     s.raster.device = o.device.value_or("");
     s.raster.validate = o.validate;
 
@@ -121,6 +126,7 @@ const char* toString(ShadowFilter f) {
         case ShadowFilter::Pcf2x2: return "pcf2x2";
         case ShadowFilter::Pcf: return "pcf";
         case ShadowFilter::Poisson: return "poisson";
+        case ShadowFilter::Pcss: return "pcss";
     }
     return "?";
 }

@@ -14,8 +14,15 @@ enum class Backend { Raster, Raytrace, Reference };
 // none: nearest texel; pcf2x2: bilinear 2x2 compare filtering; pcf: mean of pcfSize x pcfSize
 // compare taps one texel apart; poisson: 16 compare taps on a per-pixel rotated Poisson disk of
 // diameter pcfSize texels (raster/ implements them; see docs/raster.md).
-enum class ShadowFilter { None, Pcf2x2, Pcf, Poisson };
+// pcss: percentage-closer soft shadows for spot and point lights with a radius (Fernando 2005): a
+// blocker search, then a Poisson filter as wide as the penumbra; elsewhere it is `poisson`.
+enum class ShadowFilter { None, Pcf2x2, Pcf, Poisson, Pcss };
 enum class Precision { Float, Double };
+
+// Cascaded shadow maps: at most this many cascades per directional light. Four is what engines
+// commonly ship (each cascade is one more depth pass; beyond four the near cascades gain little
+// texel density while every pass redraws the whole scene), see docs/raster.md.
+inline constexpr int kMaxCascades = 4;
 
 struct RasterSettings {
     int shadowMapSize = 2048;   // texels per side
@@ -28,6 +35,9 @@ struct RasterSettings {
     int pcfSize = 3;            // pcf: taps per side; poisson: kernel diameter in texels (1..15)
     double normalOffset = 0.0;  // texels: the receiver moves along its normal by this x texel world size
     bool fitLightFrustum = false;  // fit each light's map to the casters of visible receivers (else the scene's bounding sphere)
+    // Directional lights: split the view's depth range into this many slices, each with its own
+    // map (1 = one map for the whole view, as fitLightFrustum or the bounding sphere decide).
+    int cascades = 1;
     std::string device;         // "" = lavapipe if present, else the first device; index or name substring
     bool validate = false;      // enable VK_LAYER_KHRONOS_validation and count its messages
 };
@@ -55,6 +65,7 @@ struct SettingsOverrides {
     std::optional<int> pcfSize;          // --pcf-size
     std::optional<double> normalOffset;  // --normal-offset (texels)
     std::optional<bool> fitLightFrustum; // --fit-light-frustum
+    std::optional<int> cascades;         // --cascades (1..kMaxCascades)
     std::optional<std::string> rayBias;  // a number or "robust"
     std::optional<std::string> precision;
     std::optional<int> samples;

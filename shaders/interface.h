@@ -6,6 +6,8 @@
 // Shadowed lights one lit pass handles; a UBO array needs a fixed size, and eight directional
 // lights is far more than any scene we ship (the renderer throws above it).
 #define SHADOWLAB_MAX_LIGHTS 8
+// Cascaded shadow maps per directional light (scene::kMaxCascades; raster/ static_asserts that).
+#define SHADOWLAB_MAX_CASCADES 4
 
 // Filter codes in LightData.params.y (floats: the interface has vec4s only); the values
 // follow scene::ShadowFilter.
@@ -13,6 +15,7 @@
 #define SHADOWLAB_FILTER_PCF2X2 1
 #define SHADOWLAB_FILTER_PCF 2
 #define SHADOWLAB_FILTER_POISSON 3
+#define SHADOWLAB_FILTER_PCSS 4
 
 // Light kinds in LightData.kind.x.
 #define SHADOWLAB_LIGHT_DIRECTIONAL 0
@@ -45,9 +48,19 @@ struct LightData {
     vec4 params;     // x: max tan(theta) for the slope bias, y: filter code, z: normal offset
                      // (texels), w: pcf size (taps per side / Poisson diameter in texels)
     vec4 kind;       // x: SHADOWLAB_LIGHT_*, y: spot: cos(cone half-angle); point: tan of each
-                     // cube face's half field of view, z: spot, point: near, w: spot, point: far
+                     // cube face's half field of view; directional: number of cascades (0 or 1:
+                     // one map, described by this struct), z: spot, point: near, w: spot, point: far
                      // (distances along the map's axis)
-    vec4 axis;       // spot: xyz unit direction the light travels; w: unused
+    vec4 axis;       // spot: xyz unit direction the light travels; w: spot, point: light size
+                     // (diameter, world units; 0 = a point), for PCSS
+};
+
+// One cascade of a directional light's cascaded shadow map; its layer is the light's layer
+// (LightData.toLight.w) plus the cascade's index.
+struct CascadeData {
+    mat4 toShadow;  // as LightData.toShadow, for this cascade's map
+    vec4 params;    // x: far end of the cascade's slice (view depth); y: texel world size;
+                    // z: shadow-map depth per world unit; w: depth bias (world)
 };
 
 // The lit pass's uniform buffer.
@@ -57,12 +70,15 @@ struct LitUniforms {
     vec4 background;  // rgb: background color; w: unused
     vec4 counts;      // x: number of lights; yzw: unused
     LightData lights[SHADOWLAB_MAX_LIGHTS];
+    CascadeData cascades[SHADOWLAB_MAX_LIGHTS * SHADOWLAB_MAX_CASCADES];  // light i: i*MAX_CASCADES + c
 };
 
 #ifdef __cplusplus
 static_assert(sizeof(ShadowPush) == 64, "ShadowPush must match std430 push constants");
 static_assert(sizeof(LightData) == 64 + 6 * 16, "LightData must match std140");
-static_assert(sizeof(LitUniforms) == 64 + 3 * 16 + SHADOWLAB_MAX_LIGHTS * sizeof(LightData),
+static_assert(sizeof(CascadeData) == 64 + 16, "CascadeData must match std140");
+static_assert(sizeof(LitUniforms) == 64 + 3 * 16 + SHADOWLAB_MAX_LIGHTS * sizeof(LightData) +
+                                         SHADOWLAB_MAX_LIGHTS * SHADOWLAB_MAX_CASCADES * sizeof(CascadeData),
               "LitUniforms must match std140");
 }  // namespace shadowlab::shaders
 #endif

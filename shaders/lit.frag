@@ -12,6 +12,15 @@ layout(set = 0, binding = 1, std430) readonly buffer Albedos { vec4 albedo[]; };
 layout(set = 0, binding = 2) uniform sampler2DArrayShadow shadowMaps;
 // The object nearest the light in each texel (0 = none), same layout as shadowMaps.
 layout(set = 0, binding = 3) uniform usampler2DArray blockerIds;
+// The same maps' raw depths (NEAREST, no compare; 1 outside): the PCSS blocker search reads them.
+layout(set = 0, binding = 4) uniform sampler2DArray shadowDepths;
+
+// PCSS: the blocker search looks at most this fraction of the map's side from the point, and the
+// penumbra filter is at most this fraction wide (diameter). The tap count is fixed (16 each), so
+// these bound how sparse the taps get, not the cost; a fraction, not texels, so a finer map of the
+// same scene keeps the same world-size limits.
+const float kPcssMaxSearchFraction = 1.0 / 16.0;
+const float kPcssMaxFilterFraction = 1.0 / 8.0;
 
 layout(location = 0) in vec3 inPosition;  // camera-relative world position
 layout(location = 1) in vec3 inNormal;
@@ -33,7 +42,7 @@ layout(location = 3) out vec4 outLights1;
 
 // Specialization constants, set per pipeline by raster/lit_pass.cpp. lavapipe (llvmpipe) runs
 // every branch of a fragment shader for all lanes under an execution mask instead of jumping
-// over it, so a filter chosen at run time paid for the texture taps of all four filters and
+// over it, so a filter chosen at run time paid for the texture taps of every filter and
 // the blocker-id lookups on every pixel. Fixed at pipeline creation, the dead paths are gone.
 layout(constant_id = 0) const int kFilter = SHADOWLAB_FILTER_PCF2X2;  // the filter of every light
 layout(constant_id = 1) const bool kBlockerIds = true;  // look up and write the blocker ids
@@ -42,6 +51,10 @@ layout(constant_id = 1) const bool kBlockerIds = true;  // look up and write the
 // the spot and point-light paths are left out of scenes without such lights.
 layout(constant_id = 2) const int kLightCount = SHADOWLAB_MAX_LIGHTS;
 layout(constant_id = 3) const int kLightKinds = 7;
+// The cascades of the cascaded directional lights (1: none cascaded; every cascaded light has
+// the same count, as the cascades depend on the camera only), so scenes without cascades have
+// no cascade selection and the selection loop has a constant length.
+layout(constant_id = 4) const int kCascades = 1;
 const bool kAnyPerspective =
     (kLightKinds & ((1 << SHADOWLAB_LIGHT_SPOT) | (1 << SHADOWLAB_LIGHT_POINT))) != 0;
 
@@ -159,6 +172,40 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, inout uint blocke
     // Wide kernels: a tap d texels from the point compares against a surface that a plane
     // tilted by θ has moved d·texel·tan(θ) along the light, so each tap's slope term grows
     // with its distance (a per-tap receiver-plane bias; without it wide kernels make acne).
+    float kernelTexels = light.params.w;  // poisson: the diameter given
+    const float lightSize = light.axis.w;
+    if (filterCode == SHADOWLAB_FILTER_PCSS && perspective && lightSize > 0.0) {
+        // Percentage-closer soft shadows (Fernando, "Percentage-Closer Soft Shadows", SIGGRAPH 2005
+        // sketch). 1. Blocker search: a blocker at distance d along the axis, s to the side of the
+        // receiver's ray, shadows the receiver (distance dr) from some point of a light of size w
+        // when s <= (w/2)(dr − d)/dr; in the map that is s/(d·texelPerDistance) texels, largest at
+        // the near plane, so the search covers that, capped at kPcssMaxSearchFraction of the map.
+        const float near = light.kind.z, far = light.kind.w;
+        const float dr = r.axial;
+        const float reach = 0.5 * lightSize * (dr - near) / dr / (near * light.bias.z);
+        const float searchRadius = clamp(reach, 1.0, kPcssMaxSearchFraction * size);
+        const float angle = 2.0 * kPi * interleavedGradientNoise(gl_FragCoord.xy);
+        const mat2 rotation = mat2(cos(angle), sin(angle), -sin(angle), cos(angle));
+        float blockerSum = 0.0;
+        int blockers = 0;
+        for (int k = 0; k < 16; ++k) {
+            const vec2 o = rotation * kPoisson[k] * searchRadius;
+            const float z = texture(shadowDepths, vec3(r.uv + o / size, layer)).r;
+            if (z >= 1.0) continue;  // nothing drawn there
+            // Stored perspective depth back to distance: z = far/(far−near)(1 − near/d).
+            const float d = near / max(1.0 - z * (far - near) / far, 1e-7);
+            if (d < dr - (r.biasWorld + r.slopeStep * length(o))) {
+                blockerSum += d;
+                ++blockers;
+            }
+        }
+        if (blockers == 0) return 1.0;  // nothing between the point and the light
+        // 2. Penumbra width at the receiver: (dr − db)·w/db (similar triangles), in texels of the
+        // receiver's distance. 3. Poisson PCF over that diameter, below.
+        const float db = blockerSum / float(blockers);
+        const float penumbra = (dr - db) * lightSize / db;
+        kernelTexels = clamp(penumbra / texel, 1.0, kPcssMaxFilterFraction * size);
+    }
     const int taps = clamp(int(light.params.w), 1, 15);
     float sum = 0.0;
     if (filterCode == SHADOWLAB_FILTER_PCF) {
@@ -171,15 +218,36 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, inout uint blocke
             }
         return sum / float(taps * taps);
     }
-    // Poisson: 16 taps on a disk of diameter `taps` texels, rotated per pixel.
+    // Poisson (and PCSS, and pcss where it has no light size): 16 taps on a disk of diameter
+    // `taps` (PCSS: the penumbra's) texels, rotated per pixel.
     const float angle = 2.0 * kPi * interleavedGradientNoise(gl_FragCoord.xy);
     const mat2 rotation = mat2(cos(angle), sin(angle), -sin(angle), cos(angle));
-    const float radius = 0.5 * float(taps);
+    const float radius = 0.5 * (filterCode == SHADOWLAB_FILTER_PCSS ? kernelTexels : float(taps));
     for (int k = 0; k < 16; ++k) {
         const vec2 o = rotation * kPoisson[k] * radius;
         sum += tap(r.uv + o / size, layer, reference(light, r, r.biasWorld + r.slopeStep * length(o)), blocker);
     }
     return sum / 16.0;
+}
+
+// Cascaded shadow maps: a directional light with kind.y = kCascades > 1 cascades uses the cascade
+// whose slice holds p's view depth (the Frame's Z, same expression); that cascade's map, texel
+// size, depth scale and constant bias replace the light's, and its layer follows the light's
+// first one.
+LightData cascadeOf(LightData light, int lightIndex, vec3 p) {
+    const int first = lightIndex * SHADOWLAB_MAX_CASCADES;
+    const int count = min(kCascades, SHADOWLAB_MAX_CASCADES);  // = light.kind.y
+    const float z = dot(p, u.forward.xyz);
+    int c = 0;
+    [[unroll]] for (int k = 0; k + 1 < count; ++k)
+        if (z > u.cascades[first + k].params.x) c = k + 1;
+    const CascadeData cascade = u.cascades[first + c];
+    light.toShadow = cascade.toShadow;
+    light.toLight.w += float(c);
+    light.bias.x = cascade.params.w;
+    light.bias.z = cascade.params.y;
+    light.bias.w = cascade.params.z;
+    return light;
 }
 
 void main() {
@@ -198,7 +266,11 @@ void main() {
     vec4 lightVisibility[2] = vec4[](vec4(0.0), vec4(0.0));
 #endif
     [[unroll]] for (int i = 0; i < lightCount; ++i) {
-        const LightData light = u.lights[i];
+        LightData light = u.lights[i];
+        // A cascaded directional light (kind.y cascades; 0 without a shadow test) takes its
+        // cascade's map. The code exists only in pipelines made for cascades (kCascades > 1).
+        if (kCascades > 1 && isKind(light, SHADOWLAB_LIGHT_DIRECTIONAL) && light.kind.y > 1.5)
+            light = cascadeOf(light, i, inPosition);
         vec3 l;
         float irradiance;  // relative to radiance: 1 for directional lights
         if (isPerspective(light)) {

@@ -128,7 +128,7 @@ TEST(App, MemoryIsEstimatedBeforeRenderingAndBoundsThePeak) {
 
 struct BadRun {
     const char* name;
-    std::vector<std::string> args;  // "OUT" is replaced by an output path in a fresh folder
+    std::vector<std::string> args;  // "OUT" ("OUTPNG") is replaced by a .exr (.png) path in a fresh folder
     std::string mentions;
 };
 
@@ -142,6 +142,7 @@ TEST_P(BadInput, OneClearErrorNonZeroExitNothingWritten) {
     std::vector<std::string> args;
     for (const auto& a : GetParam().args)
         args.push_back(a == "OUT" ? (dir.path() / "out" / "x.exr").string()
+                       : a == "OUTPNG" ? (dir.path() / "out" / "x.png").string()
                        : a == "OUTDIR" ? (dir.path() / "out").string()
                        : a == "BAD" ? scene.string() : a);
     const std::size_t before = dir.fileCount();
@@ -164,8 +165,40 @@ INSTANTIATE_TEST_SUITE_P(
         BadRun{"bad_ray_bias", {"run", "seed", "--ray-bias", "lots", "-o", "OUTDIR"}, "--ray-bias"},
         BadRun{"bad_backend", {"render", "seed", "--backend", "magic", "-o", "OUT"}, "--backend"},
         BadRun{"bad_extension", {"render", "seed", "-o", "frame.tiff"}, "unknown output type"},
+        BadRun{"view_needs_raster", {"render", "seed", "--view", "cascades", "-o", "OUTPNG"},
+               "needs --backend raster and a .png output"},
+        BadRun{"view_needs_png", {"render", "seed", "--backend", "raster", "--view", "shadow-map", "-o", "OUT"},
+               "needs --backend raster and a .png output"},
+        BadRun{"unknown_view", {"render", "seed", "--backend", "raster", "--view", "normals", "-o", "OUTPNG"}, "--view"},
+        BadRun{"bad_cascades", {"render", "seed", "--backend", "raster", "--cascades", "9", "-o", "OUT"}, "--cascades"},
         BadRun{"missing_frames", {"compare", "a.exr", "b.exr", "-o", "OUT.png"}, "no such file"}),
     [](const ::testing::TestParamInfo<BadRun>& info) { return std::string(info.param.name); });
+
+// Width and height from a PNG's IHDR chunk (big-endian at bytes 16..23).
+std::pair<int, int> pngSize(const std::filesystem::path& file) {
+    const std::string bytes = slurp(file);
+    if (bytes.size() < 24 || bytes.compare(1, 3, "PNG") != 0) return {-1, -1};
+    auto be32 = [&](std::size_t at) {
+        return (int((unsigned char)bytes[at]) << 24) | (int((unsigned char)bytes[at + 1]) << 16) |
+               (int((unsigned char)bytes[at + 2]) << 8) | int((unsigned char)bytes[at + 3]);
+    };
+    return {be32(16), be32(20)};
+}
+
+TEST(App, RenderViewsWriteImagesOfTheDocumentedSizes) {
+    TempDir dir;
+    // 4 cascades at map 128: 2 x 2 tiles of 128 pixels, 4 apart; the other views: the image size.
+    const std::vector<std::pair<std::string, std::pair<int, int>>> views = {
+        {"shadow-map", {2 * 128 + 4, 2 * 128 + 4}}, {"cascades", {96, 54}}, {"texel-density", {96, 54}}};
+    for (const auto& [view, size] : views) {
+        const auto out = dir.path() / (view + ".png");
+        const Result r = shadowlab({"render", "seed", "--backend", "raster", "--view", view, "--cascades", "4",
+                                    "--shadow-map-size", "128", "--resolution", "96x54", "--validate", "-o",
+                                    out.string()});
+        ASSERT_EQ(r.exitCode, 0) << view << ": " << r.err;
+        EXPECT_EQ(pngSize(out), size) << view;
+    }
+}
 
 TEST(App, StabilityRunsTheNamedCasesAndWritesItsReport) {
     TempDir dir;

@@ -397,6 +397,44 @@ TEST_F(GridFile, ASingleValuedDepthAxisIsHeldFixedInASlopeSeries) {
     for (const auto& c : both.configs) EXPECT_EQ(c.biasKind, "depth") << c.label();
 }
 
+TEST_F(GridFile, CascadesAxisVariesTheRasterRowsAndIsRecorded) {
+    const SweepGrid g = loadGrid(write(R"({ "raster": { "shadow_map_size": [512], "cascades": [1, 3] } })"), scene);
+    ASSERT_EQ(g.configs.size(), 2u);
+    EXPECT_EQ(g.configs[0].overrides.cascades, std::optional<int>(1));
+    EXPECT_EQ(g.configs[1].overrides.cascades, std::optional<int>(3));
+    EXPECT_NE(g.configs[0].key(), g.configs[1].key());
+    EXPECT_NE(g.configs[1].label().find("3 cascades"), std::string::npos) << g.configs[1].label();
+    // The CSV has a cascades column, and the JSON rows carry the override.
+    std::vector<SweepRow> rows(2);
+    for (std::size_t i = 0; i < 2; ++i) {
+        rows[i].config = g.configs[i];
+        rows[i].key = g.configs[i].key();
+    }
+    const std::string csv = rowsToCsv(rows);
+    const std::string header = csv.substr(0, csv.find('\n'));
+    EXPECT_NE(header.find(",filter,cascades,depth_bias,"), std::string::npos) << header;
+    const std::string row3 = csv.substr(csv.rfind(rows[1].key));
+    EXPECT_NE(row3.find(",512,,3,"), std::string::npos) << row3;  // map, filter (none given), cascades
+    const nlohmann::json j = rowsToJson(rows);
+    EXPECT_EQ(j[1]["overrides"]["cascades"], 3);
+}
+
+TEST_F(GridFile, DefaultGridComparesCascadesOnlyWithADirectionalLight) {
+    auto cascaded = [](const SweepGrid& g) {
+        std::size_t n = 0;
+        for (const auto& c : g.configs) n += c.overrides.cascades.value_or(1) > 1 ? 1 : 0;
+        return n;
+    };
+    EXPECT_EQ(cascaded(defaultGrid(scene, true)), 1u);
+    EXPECT_EQ(cascaded(defaultGrid(scene, false)), 2u);
+    scene::Scene spotOnly = scene;
+    for (auto& l : spotOnly.lights) {
+        l.type = scene::LightType::Spot;
+        l.coneAngleDegrees = 30.0;
+    }
+    EXPECT_EQ(cascaded(defaultGrid(spotOnly, false)), 0u);
+}
+
 TEST_F(GridFile, BadValuesAreRejectedWithTheirJsonPath) {
     const std::vector<std::pair<std::string, std::string>> cases = {
         {R"({ "raster": { "depth_bias": [0, 0.1, -1] } })", "raster.depth_bias[2]"},
@@ -413,6 +451,11 @@ TEST_F(GridFile, BadValuesAreRejectedWithTheirJsonPath) {
         {R"({ "resolution": "0x10", "raster": { "filter": ["none"] } })", "resolution"},
         {R"({ "include_default": "yes" })", "include_default"},
         {R"({ "rasterr": {} })", "rasterr"},
+        {R"({ "raster": { "cascades": [1, 0] } })", "raster.cascades[1]"},
+        {R"({ "raster": { "cascades": [5] } })", "raster.cascades[0]"},
+        {R"({ "raster": { "cascades": [2.5] } })", "raster.cascades[0]"},
+        {R"({ "raster": { "cascades": ["3"] } })", "raster.cascades[0]"},
+        {R"({ "raytrace": { "cascades": [3] } })", "raytrace.cascades"},
     };
     for (const auto& [text, path] : cases) {
         const fs::path file = write(text);

@@ -70,6 +70,49 @@ inline scene::Scene makeScene(const SphereOverPlane& p) {
     return s;
 }
 
+// A large scene for cascades: a 200 x 200 plane (id 1; x in -100..100, z in -200..0) with spheres
+// of radius 0.6 resting above it along the view (ids 2...), seen from a low camera at the plane's
+// near edge looking down the length of it, so that the visible receivers span view depths from a
+// few units to ~200 and every cascade's slice holds some of the plane.
+inline scene::Scene makeLongPlane(int width = 160, int height = 90) {
+    scene::Scene s;
+    s.camera.position = Vec3(0, 2.5, 2);
+    s.camera.lookAt = Vec3(0, 0.5, -20);
+    s.camera.up = Vec3(0, 1, 0);
+    s.camera.fovYDegrees = 40.0;
+    s.camera.width = width;
+    s.camera.height = height;
+    s.camera.near = 0.1;
+    s.camera.far = 400.0;
+    s.ambient = 0.05;
+    scene::Material m;
+    m.name = "matte";
+    m.albedo = Vec3(0.8);
+    s.materials.push_back(m);
+    scene::Light l;
+    l.type = scene::LightType::Directional;
+    l.direction = glm::normalize(Vec3(-1.0, -1.5, -0.6));
+    l.intensity = 3.0;
+    s.lights.push_back(l);
+    scene::Quad q;
+    q.center = Vec3(0, 0, -100);
+    q.normal = Vec3(0, 1, 0);
+    q.size = scene::Vec2(200, 200);
+    scene::quadAxes(q.normal, q.uAxis, q.vAxis);
+    scene::Object plane;
+    plane.name = "objects[0]";
+    plane.shape = q;
+    s.objects.push_back(plane);
+    const double zs[] = {-3, -5, -8, -12, -18, -27, -40, -60, -90, -135};
+    for (std::size_t i = 0; i < std::size(zs); ++i) {
+        scene::Object o;
+        o.name = "objects[" + std::to_string(i + 1) + "]";
+        o.shape = scene::Sphere{Vec3((i % 2 ? 1.5 : -1.5) * (1.0 - zs[i] / 40.0), 0.8, zs[i]), 0.6};
+        s.objects.push_back(o);
+    }
+    return s;
+}
+
 // A direction for light arriving `elevationDegrees` above the horizon, travelling toward -x.
 inline Vec3 lightFromElevation(double elevationDegrees) {
     const double a = elevationDegrees * kPi / 180.0;

@@ -149,7 +149,11 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"spot_without_cone", withLights(R"("lights": [{"type": "spot", "position": [0,5,0], "direction": [0,-1,0]}])"),
                 "lights[0].cone_angle", "is required"},
         BadCase{"bad_shadow_filter", sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"filter": "blur"})"),
-                "shadow.filter", "expected none, pcf2x2, pcf or poisson"}),
+                "shadow.filter", "expected none, pcf2x2, pcf, poisson or pcss"},
+        BadCase{"too_many_cascades", sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"cascades": 5})"),
+                "shadow.cascades", "must be in 1..4"},
+        BadCase{"fractional_cascades", sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"cascades": 2.5})"),
+                "shadow.cascades", "expected an integer"}),
     [](const ::testing::TestParamInfo<BadCase>& info) { return std::string(info.param.name); });
 
 TEST(SceneLoader, AGltfFileIsASceneWithAFramedCameraAndADefaultSun) {

@@ -56,6 +56,22 @@ TEST(RenderPlan, CubeMapOnlyForAShadowedPointLight) {
     EXPECT_FALSE(makeRenderPlan(s, {}).needsCubeMap);
 }
 
+TEST(RenderPlan, CascadesApplyToADirectionalLightAndAreIgnoredWithoutOne) {
+    Scene s = sphereOnPlane();
+    RenderSettings settings;
+    settings.raster.cascades = 3;
+    EXPECT_EQ(makeRenderPlan(s, settings).cascades, 3);
+    EXPECT_NE(makeRenderPlan(s, settings).explain().find("cascades: 3"), std::string::npos);
+    for (Light& l : s.lights) {
+        l.type = LightType::Point;
+        l.position = {0, 5, 0};
+    }
+    const RenderPlan p = makeRenderPlan(s, settings);
+    EXPECT_EQ(p.cascades, 1);
+    EXPECT_NE(p.explain().find("cascades = 3 ignored: no shadowed directional light"), std::string::npos)
+        << p.explain();
+}
+
 TEST(RenderPlan, MeshesNeedTheTriangleBvh) {
     Scene s = sphereOnPlane();
     s.objects.push_back({"mesh", Mesh{}, 0});

@@ -47,6 +47,16 @@ TEST(Settings, CommandLineBeatsTheSceneWhichBeatsTheDefault) {
     EXPECT_TRUE(r.raytrace.robustOffset);
 }
 
+TEST(Settings, CascadesComeFromTheCommandLineThenTheSceneThenOne) {
+    Scene s = unitScene(1.0);
+    EXPECT_EQ(resolveSettings(s, {}).raster.cascades, 1);
+    s.shadow.cascades = 3;
+    EXPECT_EQ(resolveSettings(s, {}).raster.cascades, 3);
+    SettingsOverrides o;
+    o.cascades = 2;
+    EXPECT_EQ(resolveSettings(s, o).raster.cascades, 2);
+}
+
 TEST(Settings, BadValuesNameTheOption) {
     const Scene s = unitScene(1.0);
     auto expectError = [&](SettingsOverrides o, const std::string& option) {
@@ -67,7 +77,9 @@ TEST(Settings, BadValuesNameTheOption) {
     o.precision = "half"; expectError(o, "--precision"); o = {};
     o.depthBias = -1.0; expectError(o, "--depth-bias"); o = {};
     o.samples = 0; expectError(o, "--samples"); o = {};
-    o.threads = -2; expectError(o, "--threads");
+    o.threads = -2; expectError(o, "--threads"); o = {};
+    o.cascades = 0; expectError(o, "--cascades"); o = {};
+    o.cascades = kMaxCascades + 1; expectError(o, "--cascades");
 }
 
 TEST(Settings, ReferenceIsDoubleRobustAndUnbiased) {

@@ -1,0 +1,65 @@
+// raster/cascades.h: cascaded shadow maps for directional lights: the practical split scheme
+// over the view depth of the visible receivers, and one orthographic map per slice, sized by the
+// slice's bounding sphere (rotation-stable) and snapped to a world-fixed texel grid (no swimming).
+#pragma once
+
+#include <array>
+#include <optional>
+#include <vector>
+
+#include "raster/light_frustum.h"
+#include "scene/camera.h"
+#include "scene/scene.h"
+
+namespace shadowlab::raster {
+
+// Blend of the logarithmic and the uniform split (Zhang et al. 2006, "Parallel-split shadow
+// maps", the "practical" scheme): C_i = λ·n·(f/n)^(i/N) + (1 − λ)·(n + (f − n)·i/N). λ = 1 is
+// the logarithmic split (even texel density per unit of log depth, but a first slice of a few
+// near-plane widths); λ = 0 the uniform one (the near slice as long as the far one). 0.75 keeps
+// the near slices short where texels matter most and the far slice not absurdly long.
+inline constexpr double kCascadeSplitLambda = 0.75;
+
+// Each cascade map reaches this many texels past its slice's bounding sphere on every side, so
+// that filter taps and normal offsets at the sphere's rim stay on the map (the widest PCF kernel
+// is 15 taps: 7 texels from the center).
+inline constexpr double kCascadeMarginTexels = 8.0;
+
+// The view-depth range [near, far] (distance along the camera's forward axis) that the visible
+// receivers cover: each object's bounding box clipped to the camera frustum, clamped to the
+// camera's near and far planes. None when the camera sees none of the scene.
+std::optional<std::array<double, 2>> visibleDepthRange(const scene::Scene& scene);
+
+// count + 1 split depths from near to far (the first is near, the last far) by the practical
+// scheme with blend `lambda`. Requires 0 < near < far and count >= 1.
+std::vector<double> practicalSplits(double near, double far, int count, double lambda = kCascadeSplitLambda);
+
+// The eight corners of the camera frustum between view depths d0 and d1.
+std::array<scene::Vec3, 8> sliceCorners(const scene::CameraBasis& cam, double d0, double d1);
+
+struct BoundingSphere {
+    scene::Vec3 center;
+    double radius = 0.0;
+};
+// The smallest sphere through the slice's corners (its center on the view axis): it depends only on
+// d0, d1 and the field of view, not on where the camera looks, so its size does not change when the
+// camera turns.
+BoundingSphere sliceBoundingSphere(const scene::CameraBasis& cam, double d0, double d1);
+
+// The map of one cascade: an orthographic frustum along `direction` whose square covers the slice's
+// bounding sphere plus kCascadeMarginTexels (half-width quantized up to 1/16 of its power of two,
+// so that small changes of the slice do not change the texel size), centered on the sphere's center
+// snapped to the world-fixed texel grid of setBasis()'s axes; in depth it covers the sphere and
+// reaches toward the light to every caster over the square (nearestCasterDepth()).
+LightFrustum fitCascade(const scene::Scene& scene, const scene::CameraBasis& cam, double d0, double d1,
+                        const scene::Vec3& direction, int mapSize);
+
+struct CascadeSet {
+    std::vector<double> splits;        // count + 1 view depths, near to far
+    std::vector<LightFrustum> frusta;  // one per slice; empty when the camera sees none of the scene
+};
+// The splits over visibleDepthRange() and fitCascade() of each slice, except that a cascade whose
+// map would be wider than the scene's bounding-sphere map (fitDirectionalLight) uses that instead.
+CascadeSet fitCascades(const scene::Scene& scene, const scene::Vec3& direction, int count, int mapSize);
+
+}  // namespace shadowlab::raster
