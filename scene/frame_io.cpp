@@ -312,10 +312,12 @@ Frame readFrame(const fs::path& file) {
         throw InputError(file.string() + ": not a 2D image");
     // The same bound as a render's (kMaxPixels), and reading by bands of rows below, keep the
     // memory a Frame file can make us allocate to the Frame itself plus one band.
-    if (std::int64_t(spec.width) * spec.height > kMaxPixels || spec.nchannels > 64)
+    if (spec.width > kMaxResolution || spec.height > kMaxResolution ||
+        std::int64_t(spec.width) * spec.height > kMaxPixels || spec.nchannels > 64)
         throw InputError(file.string() + ": image too large for a Frame (" + std::to_string(spec.width) + "x" +
                          std::to_string(spec.height) + ", " + std::to_string(spec.nchannels) +
-                         " channels; at most " + std::to_string(kMaxPixels) + " pixels and 64 channels)");
+                         " channels; at most " + std::to_string(kMaxResolution) + " a side, " +
+                         std::to_string(kMaxPixels) + " pixels and 64 channels)");
 
     auto channelIndex = [&](const std::string& name, bool required) {
         const auto it = std::find(spec.channelnames.begin(), spec.channelnames.end(), name);
@@ -339,8 +341,9 @@ Frame readFrame(const fs::path& file) {
         iLights.push_back(idx);
     }
 
-    Frame f = Frame::allocate(spec.width, spec.height, iBl >= 0);
-    f.lightVisibility.assign(iLights.size(), std::vector<float>(f.pixelCount()));
+    // The Frame is allocated once the first band has been read: a small damaged file that
+    // declares a huge image fails there, before gigabytes are allocated (found by fuzzing).
+    Frame f;
     const int c = spec.nchannels;
     constexpr int kBandRows = 64;
     std::vector<float> band(std::size_t(spec.width) * std::min(kBandRows, spec.height) * c);
@@ -348,6 +351,10 @@ Frame readFrame(const fs::path& file) {
         const int y1 = std::min(spec.height, y0 + kBandRows);
         if (!in->read_scanlines(0, 0, spec.y + y0, spec.y + y1, 0, 0, c, TypeDesc::FLOAT, band.data()))
             throw InputError(file.string() + ": read failed: " + in->geterror());
+        if (y0 == 0) {
+            f = Frame::allocate(spec.width, spec.height, iBl >= 0);
+            f.lightVisibility.assign(iLights.size(), std::vector<float>(f.pixelCount()));
+        }
         const std::size_t first = std::size_t(y0) * spec.width;
         const std::size_t count = std::size_t(y1 - y0) * spec.width;
         for (std::size_t k = 0; k < count; ++k) {
