@@ -2,6 +2,7 @@
 // beside the depth map, against closed forms: each object a shadow ray passes through multiplies
 // the light by 1 − opacity once (DESIGN.md), on lavapipe with the validation layer.
 // Set SHADOWLAB_TEST_PNG_DIR to also write the beauty images there for a look.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -255,6 +256,40 @@ TEST(RasterTransmittance, ACasterOfOpacityZeroChangesNoPixel) {
         EXPECT_EQ(b.attributes.at("transmittance_map"), "made");
         EXPECT_EQ(a.visibility, b.visibility) << "filter " << int(filter);
         EXPECT_EQ(a.beauty, b.beauty) << "filter " << int(filter);
+    }
+}
+
+TEST(RasterTransmittance, APointLightsCubeFacesCarryTheTransmittanceToo) {
+    // A point light 4 above the floor and a 0.5 pane 2 x 2 at height 2: the pane's shadow is the
+    // pane scaled by 4 / (4 − 2) = 2, |x|, |z| < 2 on the floor (in the −Y face; the wider floor
+    // in the side faces, lit), 0.5 inside and 1 outside.
+    scene::Scene s = floorScene();
+    s.lights[0].type = scene::LightType::Point;
+    s.lights[0].position = Vec3(0, 4, 0);
+    s.lights[0].intensity = 200.0;
+    s.objects.push_back(quadObject("pane", Vec3(0, 2, 0), 2.0, 1));
+    s.camera.position = Vec3(0, 1.5, 7);
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    for (const scene::ShadowFilter filter : kFilters) {
+        const scene::Frame f = renderWith(s, filter, "transmittance_point_" + std::to_string(int(filter)));
+        EXPECT_EQ(f.attributes.at("transmittance_map"), "made");
+        int inside = 0, outside = 0, wrong = 0;
+        for (int y = 0; y < f.height; ++y)
+            for (int x = 0; x < f.width; ++x) {
+                const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
+                if (f.objectId[i] != 1.0f) continue;
+                const Vec3 q = floorPoint(cam, x, y);
+                const double m = std::max(std::abs(q.x), std::abs(q.z));
+                double expected;
+                if (m < 1.8) expected = 0.5;
+                else if (m > 2.2 && m < 6.0) expected = 1.0;
+                else continue;
+                ++(expected == 0.5 ? inside : outside);
+                if (std::abs(f.visibility[i] - expected) > 1e-5) ++wrong;
+            }
+        EXPECT_GT(inside, 200) << "filter " << int(filter);
+        EXPECT_GT(outside, 200) << "filter " << int(filter);
+        EXPECT_EQ(wrong, 0) << "filter " << int(filter);
     }
 }
 
