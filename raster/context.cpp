@@ -324,10 +324,16 @@ Context::Context(const ContextOptions& options) {
         .synchronization2 = VK_TRUE,
         .dynamicRendering = VK_TRUE,
     };
-    const VkPhysicalDeviceFeatures2 features{
+    // independentBlend (optional): the transmittance pass blends its two targets differently
+    // (raster/shadow_pass.h); without it scenes with semi-transparent casters are refused there.
+    VkPhysicalDeviceFeatures2 supported{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+    vkGetPhysicalDeviceFeatures2(physicalDevice, &supported);
+    independentBlend = supported.features.independentBlend == VK_TRUE;
+    VkPhysicalDeviceFeatures2 features{
         .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2,
         .pNext = &features13,
     };
+    features.features.independentBlend = independentBlend ? VK_TRUE : VK_FALSE;
     const VkDeviceCreateInfo deviceInfo{
         .sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO,
         .pNext = &features,

@@ -40,6 +40,7 @@ struct Context {
     DeviceReport deviceReport;
     VkPhysicalDeviceProperties properties{};
     VkPhysicalDeviceMemoryProperties memoryProperties{};
+    bool independentBlend = false;  // enabled when supported (the transmittance pass needs it)
     std::uint32_t queueFamily = 0;
     LogicalDeviceHandle device;
     VkQueue queue = VK_NULL_HANDLE;

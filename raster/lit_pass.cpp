@@ -26,10 +26,15 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant) {
         // The shadow maps' raw depths (no compare), for the PCSS blocker search.
         {.binding = 4, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
+        // The transmittance maps: the product of 1 − opacity, and the nearest transparent depth.
+        {.binding = 5, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
+         .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
+        {.binding = 6, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
+         .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
     };
     const VkDescriptorSetLayoutCreateInfo setInfo{
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
-        .bindingCount = 5,
+        .bindingCount = 7,
         .pBindings = bindings,
     };
     LitPipeline p;
@@ -45,13 +50,13 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant) {
     VK_CHECK(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &layout));
     p.layout = PipelineLayoutHandle(device, layout);
     // lit.frag's constant_id 0: the filter code, 1: blocker ids (a bool is 32 bits wide),
-    // 2: the light count, 3: the light kinds, 4: the cascade count.
-    const std::int32_t constants[5] = {std::int32_t(variant.filter), variant.blockerIds ? 1 : 0,
+    // 2: the light count, 3: the light kinds, 4: the cascade count, 5: transmittance (bool).
+    const std::int32_t constants[6] = {std::int32_t(variant.filter), variant.blockerIds ? 1 : 0,
                                        std::int32_t(variant.lightCount), std::int32_t(variant.lightKinds),
-                                       std::int32_t(variant.cascades)};
-    const VkSpecializationMapEntry entries[5] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}, {3, 12, 4}, {4, 16, 4}};
+                                       std::int32_t(variant.cascades), variant.transmittance ? 1 : 0};
+    const VkSpecializationMapEntry entries[6] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}, {3, 12, 4}, {4, 16, 4}, {5, 20, 4}};
     const VkSpecializationInfo specialization{
-        .mapEntryCount = 5, .pMapEntries = entries, .dataSize = sizeof constants, .pData = constants};
+        .mapEntryCount = 6, .pMapEntries = entries, .dataSize = sizeof constants, .pData = constants};
     std::vector<VkFormat> colorFormats{kLitColorFormat};
     if (variant.aovTarget) colorFormats.insert(colorFormats.end(), 1 + variant.lightTargets, kLitColorFormat);
     p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{
@@ -98,7 +103,8 @@ LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32
 }
 
 LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, const shaders::LitUniforms& uniforms,
-                              const std::vector<glm::vec4>& albedos, const ShadowMaps& maps) {
+                              const std::vector<glm::vec4>& albedos, const ShadowMaps& maps,
+                              const TransmittanceMaps& transmittance) {
     VkDevice device = ctx.device.get();
     LitBindings b;
     // A depth-compare sampler: result = (ref <= stored), i.e. "receiver depth - bias <= stored
@@ -144,7 +150,7 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
     const VkDescriptorPoolSize sizes[] = {
         {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
         {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
-        {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 3},
+        {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 5},
     };
     const VkDescriptorPoolCreateInfo poolInfo{
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
@@ -169,6 +175,11 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
     const VkDescriptorImageInfo imageInfo{sampler, maps.depth.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkDescriptorImageInfo idInfo{idSampler, maps.ids.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkDescriptorImageInfo depthInfo{depthSampler, maps.depth.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    // The transmittance maps use the raw-depth sampler: NEAREST, border 1 (all light, nothing near).
+    const VkDescriptorImageInfo transmittanceInfo{depthSampler, transmittance.transmittance.view.get(),
+                                                  VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    const VkDescriptorImageInfo nearInfo{depthSampler, transmittance.nearDepth.view.get(),
+                                         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkWriteDescriptorSet writes[] = {
         {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 0, .descriptorCount = 1,
          .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .pBufferInfo = &uniformInfo},
@@ -180,8 +191,12 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
          .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &idInfo},
         {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 4, .descriptorCount = 1,
          .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &depthInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 5, .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &transmittanceInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 6, .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &nearInfo},
     };
-    vkUpdateDescriptorSets(device, 5, writes, 0, nullptr);
+    vkUpdateDescriptorSets(device, 7, writes, 0, nullptr);
     return b;
 }
 

@@ -27,6 +27,7 @@ struct LitVariant {
     std::uint32_t lightCount = 1;    // = LitUniforms::counts.x
     std::uint32_t lightKinds = 7;    // bit (1 << SHADOWLAB_LIGHT_*) for each kind in the scene
     std::uint32_t cascades = 1;      // cascades of the cascaded directional lights (1: none cascaded)
+    bool transmittance = false;      // semi-transparent casters: read the transmittance maps
 };
 // Per-light visibility targets: four lights in each RGBA32F target, SHADOWLAB_MAX_LIGHTS in all.
 inline constexpr std::uint32_t kLightTargets = (SHADOWLAB_MAX_LIGHTS + 3) / 4;
@@ -55,7 +56,8 @@ LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32
                             std::uint32_t lightTargets = 0, bool readInPlace = true);
 
 // The lit pass's descriptor set: uniforms, per-object albedo, shadow maps behind a NEAREST
-// depth-compare sampler (lit.frag builds the filters from its taps), blocker ids.
+// depth-compare sampler (lit.frag builds the filters from its taps), blocker ids, and the
+// transmittance maps (placeholders in scenes without semi-transparent casters).
 struct LitBindings {
     SamplerHandle sampler;    // depth compare, for the shadow maps
     SamplerHandle idSampler;  // plain NEAREST, for the blocker ids
@@ -66,7 +68,8 @@ struct LitBindings {
     VkDescriptorSet set = VK_NULL_HANDLE;  // freed with the pool
 };
 LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, const shaders::LitUniforms& uniforms,
-                              const std::vector<glm::vec4>& albedos, const ShadowMaps& maps);
+                              const std::vector<glm::vec4>& albedos, const ShadowMaps& maps,
+                              const TransmittanceMaps& transmittance);
 
 // Records the pass; background pixels keep `background` (rgb, visibility 0) and zero AOVs.
 // Leaves every color target in TRANSFER_SRC_OPTIMAL for recordReadback(), or, for host-readable

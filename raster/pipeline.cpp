@@ -41,8 +41,10 @@ PipelineHandle createGraphicsPipeline(const Context& ctx, const PipelineDesc& de
         .binding = 0, .stride = sizeof(Vertex), .inputRate = VK_VERTEX_INPUT_RATE_VERTEX};
     std::vector<VkVertexInputAttributeDescription> attributes{
         {.location = 0, .binding = 0, .format = VK_FORMAT_R32G32B32_SFLOAT, .offset = offsetof(Vertex, position)},
-        {.location = 2, .binding = 0, .format = VK_FORMAT_R32_UINT, .offset = offsetof(Vertex, objectId)},
     };
+    if (desc.usesObjectId)
+        attributes.push_back(
+            {.location = 2, .binding = 0, .format = VK_FORMAT_R32_UINT, .offset = offsetof(Vertex, objectId)});
     if (desc.usesNormal)
         attributes.push_back(
             {.location = 1, .binding = 0, .format = VK_FORMAT_R32G32B32_SFLOAT, .offset = offsetof(Vertex, normal)});
@@ -77,7 +79,7 @@ PipelineHandle createGraphicsPipeline(const Context& ctx, const PipelineDesc& de
     const VkPipelineDepthStencilStateCreateInfo depthStencil{
         .sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
         .depthTestEnable = VK_TRUE,
-        .depthWriteEnable = VK_TRUE,
+        .depthWriteEnable = desc.depthWrite ? VK_TRUE : VK_FALSE,
         .depthCompareOp = desc.depthCompare,
         .maxDepthBounds = 1.0f,
     };
@@ -88,6 +90,24 @@ PipelineHandle createGraphicsPipeline(const Context& ctx, const PipelineDesc& de
             .colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
                               VK_COLOR_COMPONENT_A_BIT,
         });
+    if (desc.transmittanceBlend && blend.size() == 2) {
+        // dst · src: result = src·0 + dst·src.
+        blend[0].blendEnable = VK_TRUE;
+        blend[0].srcColorBlendFactor = VK_BLEND_FACTOR_ZERO;
+        blend[0].dstColorBlendFactor = VK_BLEND_FACTOR_SRC_COLOR;
+        blend[0].colorBlendOp = VK_BLEND_OP_ADD;
+        blend[0].srcAlphaBlendFactor = VK_BLEND_FACTOR_ZERO;
+        blend[0].dstAlphaBlendFactor = VK_BLEND_FACTOR_SRC_ALPHA;
+        blend[0].alphaBlendOp = VK_BLEND_OP_ADD;
+        // min(src, dst) (the factors are ignored by MIN).
+        blend[1].blendEnable = VK_TRUE;
+        blend[1].srcColorBlendFactor = VK_BLEND_FACTOR_ONE;
+        blend[1].dstColorBlendFactor = VK_BLEND_FACTOR_ONE;
+        blend[1].colorBlendOp = VK_BLEND_OP_MIN;
+        blend[1].srcAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+        blend[1].dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+        blend[1].alphaBlendOp = VK_BLEND_OP_MIN;
+    }
     const VkPipelineColorBlendStateCreateInfo colorBlend{
         .sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
         .attachmentCount = std::uint32_t(blend.size()),

@@ -18,13 +18,18 @@ struct PipelineDesc {
     const VkSpecializationInfo* fragmentSpecialization = nullptr;  // the fragment stage's constants
     VkPipelineLayout layout = VK_NULL_HANDLE;
     bool usesNormal = true;  // declare vertex location 1; the validation layer warns about unused inputs
+    bool usesObjectId = true;  // declare vertex location 2 (the same warning)
     std::vector<VkFormat> colorFormats;
     VkFormat depthFormat = VK_FORMAT_D32_SFLOAT;
     VkCompareOp depthCompare = VK_COMPARE_OP_LESS;
+    bool depthWrite = true;
+    // The transmittance pass's blending (raster/shadow_pass.h): color target 0 multiplied
+    // (dst · src), target 1 kept at the minimum.
+    bool transmittanceBlend = false;
 };
 
-// Triangle lists, no culling (quads are two-sided, and both faces must cast), depth test and
-// write on, no blending, viewport and scissor dynamic.
+// Triangle lists, no culling (quads are two-sided, and both faces must cast), depth test on,
+// depth write and blending as desc says, viewport and scissor dynamic.
 PipelineHandle createGraphicsPipeline(const Context& ctx, const PipelineDesc& desc);
 
 // Throws RasterError naming the device and the format when it lacks `features` (optimal tiling).

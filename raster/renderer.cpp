@@ -2,12 +2,15 @@
 // pass, readback into a Frame, timings and metadata.
 #include "raster/renderer.h"
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <map>
 #include <memory>
+#include <tuple>
+#include <variant>
 
 #include "raster/cascades.h"
 #include "raster/context.h"
@@ -35,6 +38,56 @@ std::string formatNumber(double v) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "%.9g", v);
     return buf;
+}
+
+// A closed surface: every edge (a pair of positions) is shared by exactly two of its triangles.
+// Meshes repeat positions at seams of normals or texture coordinates, so edges are compared by
+// position, not by vertex index.
+bool isClosed(const SceneGeometry& g, std::size_t first, std::size_t count) {
+    std::map<std::array<float, 6>, int> edges;
+    auto key = [&](std::uint32_t a, std::uint32_t b) {
+        glm::vec3 p = g.vertices[a].position, q = g.vertices[b].position;
+        if (std::tie(q.x, q.y, q.z) < std::tie(p.x, p.y, p.z)) std::swap(p, q);
+        return std::array<float, 6>{p.x, p.y, p.z, q.x, q.y, q.z};
+    };
+    for (std::size_t t = first; t < first + count; t += 3)
+        for (int e = 0; e < 3; ++e) ++edges[key(g.indices[t + std::size_t(e)], g.indices[t + std::size_t((e + 1) % 3)])];
+    for (const auto& [edge, uses] : edges)
+        if (uses != 2) return false;
+    return !edges.empty();
+}
+
+// Reorders the triangles: the opaque objects' first (in their order), then each semi-transparent
+// object's as one range (returned; `transmittance` = 1 − opacity). Only for a transmittance map.
+std::vector<TransparentDraw> separateTransparent(const scene::Scene& scene, SceneGeometry& g,
+                                                 std::uint32_t& opaqueIndexCount) {
+    std::vector<std::uint32_t> opaque, transparent;
+    std::vector<std::vector<std::uint32_t>> perObject(scene.objects.size());
+    for (std::size_t t = 0; t + 2 < g.indices.size(); t += 3) {
+        const std::uint32_t id = g.vertices[g.indices[t]].objectId;  // object index + 1
+        const bool isOpaque = id == 0 || scene.materialOf(scene.objects[id - 1]).opaque();
+        std::vector<std::uint32_t>& to = isOpaque ? opaque : perObject[id - 1];
+        to.insert(to.end(), g.indices.begin() + std::ptrdiff_t(t), g.indices.begin() + std::ptrdiff_t(t + 3));
+    }
+    opaqueIndexCount = std::uint32_t(opaque.size());
+    std::vector<TransparentDraw> draws;
+    g.indices = std::move(opaque);
+    for (std::size_t o = 0; o < perObject.size(); ++o) {
+        if (perObject[o].empty()) continue;
+        TransparentDraw d;
+        d.firstIndex = std::uint32_t(g.indices.size());
+        d.indexCount = std::uint32_t(perObject[o].size());
+        d.transmittance = float(1.0 - scene.materialOf(scene.objects[o]).opacity);
+        g.indices.insert(g.indices.end(), perObject[o].begin(), perObject[o].end());
+        // Quads are open (one surface: every crossing counts); spheres and boxes closed; a mesh
+        // by its edges.
+        const scene::Shape& shape = scene.objects[o].shape;
+        d.closed = std::holds_alternative<scene::Quad>(shape)  ? false
+                   : std::holds_alternative<scene::Mesh>(shape) ? isClosed(g, d.firstIndex, d.indexCount)
+                                                                : true;
+        draws.push_back(d);
+    }
+    return draws;
 }
 
 bool needsShadowTest(const scene::RenderPlan& plan, std::size_t light) {
@@ -114,6 +167,12 @@ struct Renderer::Impl {
     // Made on first use. Shadow: without and with blocker ids (index 0, 1). Lit: beauty target
     // only, all targets without blocker ids, all with (index 0, 1, 2).
     ShadowPipeline shadowPipelines[2];
+    // Semi-transparent casters (RenderPlan::needsTransmittanceMap): the transmittance pass, its
+    // maps (1x1x1 placeholders without), and per layer the light it is drawn from.
+    bool transmit = false;
+    ShadowPipeline transmitPipeline;
+    TransmittanceMaps transmittanceMaps;
+    std::vector<glm::vec4> layerLights;
     LitPipeline litPipelines[3];
     LitBindings bindings;  // allocated with the first lit pipeline's (identical) set layout
     shaders::LitUniforms uniforms{};
@@ -134,13 +193,17 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     background = glm::vec3(scene.background);
     attributes["device"] = ctx.deviceReport.name;
 
-    const SceneGeometry geometry = tessellateScene(scene, origin);
+    SceneGeometry geometry = tessellateScene(scene, origin);
+    std::vector<TransparentDraw> transparentDraws;
+    std::uint32_t opaqueIndexCount = ~0u;
+    if (plan.needsTransmittanceMap) transparentDraws = separateTransparent(scene, geometry, opaqueIndexCount);
     const std::size_t triangles = geometry.triangleCount();
     const int sphereSegmentsUsed = geometry.maxSphereSegments;
     // Device-local, uploaded once for every frame of this Renderer.
     vertexBuffer = uploadBuffer(ctx, geometry.vertices, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
     indexBuffer = uploadBuffer(ctx, geometry.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
-    draw = DrawGeometry{vertexBuffer.buffer.get(), indexBuffer.buffer.get(), std::uint32_t(geometry.indices.size())};
+    draw = DrawGeometry{vertexBuffer.buffer.get(), indexBuffer.buffer.get(), std::uint32_t(geometry.indices.size()),
+                        opaqueIndexCount, transparentDraws};
 
     std::vector<double> usedDepthBias;  // per shadow-mapped light (spot, directional)
     // One shadow-map layer per light that needs a shadow test.
@@ -255,12 +318,23 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
                              float(settings.pcfSize));
     }
     for (const scene::Object& o : scene.objects)
-        albedos.emplace_back(glm::vec3(scene.materialOf(o).albedo), 1.0f);
+        // a: 1 − opacity, divided out of a semi-transparent receiver's own transmittance (lit.frag).
+        albedos.emplace_back(glm::vec3(scene.materialOf(o).albedo),
+                             scene.materialOf(o).opaque() ? 1.0f : float(1.0 - scene.materialOf(o).opacity));
 
     // Without a shadowed light a 1x1 cleared layer keeps the descriptor valid.
     const auto mapSize = lightMatrices.empty() ? 1u : std::uint32_t(settings.shadowMapSize);
     const auto layers = std::max<std::uint32_t>(1, std::uint32_t(lightMatrices.size()));
     maps = createShadowMaps(ctx, mapSize, layers);
+    transmit = !draw.transparent.empty() && !lightMatrices.empty();
+    transmittanceMaps = createTransmittanceMaps(ctx, transmit ? mapSize : 1, transmit ? layers : 1);
+    for (const int i : layerLight) {
+        const scene::Light& light = scene.lights[std::size_t(i)];
+        layerLights.push_back(light.type == scene::LightType::Directional
+                                  ? glm::vec4(glm::vec3(-glm::normalize(light.direction)), 0.0f)
+                                  : glm::vec4(glm::vec3(light.position - origin), 1.0f));
+    }
+    attributes["transmittance_map"] = transmit ? "made" : "none";
     targets = createLitTargets(ctx, width, height, lightCount > 1 ? kLightTargets : 0, options.readTargetsInPlace);
     if (!targets.hostReadable) readback = createReadback(ctx, targets);
     // How the targets reach the Frame: read in place (lavapipe) or copied into buffers first.
@@ -346,6 +420,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     if (!shadowPipeline.pipeline || !litPipeline.pipeline) {
         const auto pipelineStart = Clock::now();
         if (!shadowPipeline.pipeline) shadowPipeline = createShadowPipeline(ctx, wantIds);
+        if (transmit && !transmitPipeline.pipeline) transmitPipeline = createTransmittancePipeline(ctx);
         if (!litPipeline.pipeline)
             litPipeline = createLitPipeline(ctx, LitVariant{.filter = settings.filter,
                                                             .blockerIds = wantIds,
@@ -353,8 +428,10 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                                                             .lightTargets = std::uint32_t(targets.lights.size()),
                                                             .lightCount = std::uint32_t(lightCount),
                                                             .lightKinds = lightKinds,
-                                                            .cascades = std::uint32_t(cascadesUsed)});
-        if (bindings.set == VK_NULL_HANDLE) bindings = createLitBindings(ctx, litPipeline, uniforms, albedos, maps);
+                                                            .cascades = std::uint32_t(cascadesUsed),
+                                                            .transmittance = transmit});
+        if (bindings.set == VK_NULL_HANDLE)
+            bindings = createLitBindings(ctx, litPipeline, uniforms, albedos, maps, transmittanceMaps);
         setup += msSince(pipelineStart);
     }
 
@@ -369,7 +446,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     VkCommandBuffer commands = ctx.beginCommands();
     if (timestamps) vkCmdResetQueryPool(commands, queries.get(), 0, 4);
     stamp(commands, 0);
-    recordShadowPass(commands, shadowPipeline, maps, draw, lightMatrices, wantIds);
+    const TransmittancePass transmittancePass{transmit ? &transmitPipeline : nullptr, &transmittanceMaps, layerLights};
+    recordShadowPass(commands, shadowPipeline, maps, draw, lightMatrices, wantIds, &transmittancePass);
     stamp(commands, 1);
     ctx.submitAndWait(commands);
     frame.timingsMs.emplace_back("shadow_pass", msSince(shadowStart));

@@ -68,9 +68,148 @@ ShadowMaps createShadowMaps(const Context& ctx, std::uint32_t size, std::uint32_
     return m;
 }
 
+TransmittanceMaps createTransmittanceMaps(const Context& ctx, std::uint32_t size, std::uint32_t layers) {
+    requireFormat(ctx, kTransmittanceFormat,
+                  VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT |
+                      VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT,
+                  "the transmittance map");
+    requireDeviceMemory(ctx, VkDeviceSize(size) * size * layers * 8,
+                        std::to_string(layers) + " transmittance map(s) of " + std::to_string(size) + "x" +
+                            std::to_string(size));
+    TransmittanceMaps m;
+    m.size = size;
+    m.layers = layers;
+    const VkImageUsageFlags usage =
+        VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    m.transmittance = createImage(ctx, kTransmittanceFormat, size, size, layers, usage, VK_IMAGE_ASPECT_COLOR_BIT,
+                                  VK_IMAGE_VIEW_TYPE_2D_ARRAY);
+    m.nearDepth = createImage(ctx, kTransmittanceFormat, size, size, layers, usage, VK_IMAGE_ASPECT_COLOR_BIT,
+                              VK_IMAGE_VIEW_TYPE_2D_ARRAY);
+    for (std::uint32_t i = 0; i < layers; ++i) {
+        m.transmittanceLayerViews.push_back(createView(ctx, m.transmittance.image.get(), kTransmittanceFormat,
+                                                       VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D, i, 1));
+        m.nearDepthLayerViews.push_back(createView(ctx, m.nearDepth.image.get(), kTransmittanceFormat,
+                                                   VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D, i, 1));
+    }
+    return m;
+}
+
+ShadowPipeline createTransmittancePipeline(const Context& ctx) {
+    if (!ctx.independentBlend)
+        throw RasterError("semi-transparent casters need the independentBlend feature, which " + ctx.deviceReport.name +
+                          " lacks (the transmittance map blends its two targets differently)");
+    const VkPushConstantRange push{.stageFlags = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+                                   .offset = 0,
+                                   .size = sizeof(shaders::TransmitPush)};
+    const VkPipelineLayoutCreateInfo layoutInfo{
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
+        .pushConstantRangeCount = 1,
+        .pPushConstantRanges = &push,
+    };
+    ShadowPipeline p;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    VK_CHECK(vkCreatePipelineLayout(ctx.device.get(), &layoutInfo, nullptr, &layout));
+    p.layout = PipelineLayoutHandle(ctx.device.get(), layout);
+    p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{
+                                                 .vertexShader = shaders::transmitVertSpirv(),
+                                                 .fragmentShader = shaders::transmitFragSpirv(),
+                                                 .layout = layout,
+                                                 .usesNormal = true,
+                                                 .usesObjectId = false,
+                                                 .colorFormats = {kTransmittanceFormat, kTransmittanceFormat},
+                                                 .depthFormat = kShadowMapFormat,
+                                                 .depthCompare = VK_COMPARE_OP_LESS,
+                                                 .depthWrite = false,
+                                                 .transmittanceBlend = true,
+                                             });
+    return p;
+}
+
+namespace {
+
+// The transmittance pass of every layer drawn (the depth pass has run; the depth array is in
+// DEPTH_ATTACHMENT_OPTIMAL), or, without a pipeline, only the layout change for the lit pass.
+void recordTransmittance(VkCommandBuffer commands, const TransmittancePass& pass, const ShadowMaps& shadow,
+                         const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices) {
+    const TransmittanceMaps& maps = *pass.maps;
+    const bool draw = pass.pipeline != nullptr;
+    std::vector<ImageTransition> before;
+    for (VkImage image : {maps.transmittance.image.get(), maps.nearDepth.image.get()})
+        before.push_back({image, VK_IMAGE_ASPECT_COLOR_BIT, maps.layers, VK_IMAGE_LAYOUT_UNDEFINED,
+                          draw ? VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                          VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_NONE,
+                          draw ? VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT : VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                          draw ? VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT
+                               : VK_ACCESS_2_NONE});
+    if (draw)  // the depth pass's writes before this pass's depth tests (same layout)
+        before.push_back({shadow.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, shadow.layers,
+                          VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                          VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                          VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                          VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                          VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT});
+    transition(commands, before);
+    if (!draw) return;
+    for (std::uint32_t layer = 0; layer < maps.layers; ++layer) {
+        VkRenderingAttachmentInfo colors[2];
+        for (int k = 0; k < 2; ++k)
+            colors[k] = VkRenderingAttachmentInfo{
+                .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+                .imageView = (k == 0 ? maps.transmittanceLayerViews : maps.nearDepthLayerViews)[layer].get(),
+                .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+                .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+                .clearValue = {.color = {.float32 = {1.0f, 1.0f, 1.0f, 1.0f}}},  // all light, nothing near
+            };
+        const VkRenderingAttachmentInfo depth{
+            .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+            .imageView = shadow.layerViews[layer].get(),
+            .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+            .loadOp = VK_ATTACHMENT_LOAD_OP_LOAD,
+            .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+        };
+        const VkRenderingInfo rendering{
+            .sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
+            .renderArea = {{0, 0}, {maps.size, maps.size}},
+            .layerCount = 1,
+            .colorAttachmentCount = 2,
+            .pColorAttachments = colors,
+            .pDepthAttachment = &depth,
+        };
+        vkCmdBeginRendering(commands, &rendering);
+        if (layer < lightMatrices.size() && layer < pass.layerLights.size() && !geometry.transparent.empty()) {
+            vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pass.pipeline->pipeline.get());
+            setViewport(commands, maps.size, maps.size);
+            const VkDeviceSize offset = 0;
+            vkCmdBindVertexBuffers(commands, 0, 1, &geometry.vertices, &offset);
+            vkCmdBindIndexBuffer(commands, geometry.indices, 0, VK_INDEX_TYPE_UINT32);
+            for (const TransparentDraw& object : geometry.transparent) {
+                const shaders::TransmitPush push{
+                    .lightMatrix = lightMatrices[layer],
+                    .light = pass.layerLights[layer],
+                    .params = glm::vec4(object.transmittance, object.closed ? 1.0f : 0.0f, 0.0f, 0.0f)};
+                vkCmdPushConstants(commands, pass.pipeline->layout.get(),
+                                   VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof push, &push);
+                vkCmdDrawIndexed(commands, object.indexCount, 1, object.firstIndex, 0, 0);
+            }
+        }
+        vkCmdEndRendering(commands);
+    }
+    std::vector<ImageTransition> after;
+    for (VkImage image : {maps.transmittance.image.get(), maps.nearDepth.image.get()})
+        after.push_back({image, VK_IMAGE_ASPECT_COLOR_BIT, maps.layers, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                         VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                         VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT,
+                         VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT});
+    transition(commands, after);
+}
+
+}  // namespace
+
 void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, const ShadowMaps& maps,
                       const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices,
-                      bool blockerIds) {
+                      bool blockerIds, const TransmittancePass* transmittance) {
     // Source stage: the previous frame's lit pass sampled both arrays (a reused Renderer).
     transition(commands, {{maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, maps.layers,
                            VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
@@ -109,7 +248,7 @@ void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, 
             .pDepthAttachment = &depth,
         };
         vkCmdBeginRendering(commands, &rendering);
-        if (layer < lightMatrices.size() && geometry.indexCount > 0) {
+        if (layer < lightMatrices.size() && geometry.depthPassIndexCount() > 0) {
             vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.pipeline.get());
             setViewport(commands, maps.size, maps.size);
             const shaders::ShadowPush push{.lightMatrix = lightMatrices[layer]};
@@ -117,10 +256,11 @@ void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, 
             const VkDeviceSize offset = 0;
             vkCmdBindVertexBuffers(commands, 0, 1, &geometry.vertices, &offset);
             vkCmdBindIndexBuffer(commands, geometry.indices, 0, VK_INDEX_TYPE_UINT32);
-            vkCmdDrawIndexed(commands, geometry.indexCount, 1, 0, 0, 0);
+            vkCmdDrawIndexed(commands, geometry.depthPassIndexCount(), 1, 0, 0, 0);
         }
         vkCmdEndRendering(commands);
     }
+    if (transmittance) recordTransmittance(commands, *transmittance, maps, geometry, lightMatrices);
     std::vector<ImageTransition> after{{maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, maps.layers,
                            VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                            VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
@@ -168,6 +308,15 @@ std::vector<float> readShadowMap(const Context& ctx, const ShadowMaps& maps, std
     std::vector<float> depths(std::size_t(maps.size) * maps.size);
     readLayer(ctx, maps, maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, layer, depths.data());
     return depths;
+}
+
+std::vector<float> readTransmittance(const Context& ctx, const TransmittanceMaps& maps, std::uint32_t layer) {
+    ShadowMaps shape;  // readLayer needs only the size and layer count
+    shape.size = maps.size;
+    shape.layers = maps.layers;
+    std::vector<float> values(std::size_t(maps.size) * maps.size);
+    readLayer(ctx, shape, maps.transmittance.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layer, values.data());
+    return values;
 }
 
 std::vector<std::uint32_t> readBlockerIds(const Context& ctx, const ShadowMaps& maps, std::uint32_t layer) {

@@ -32,21 +32,69 @@ struct ShadowMaps {
 };
 ShadowMaps createShadowMaps(const Context& ctx, std::uint32_t size, std::uint32_t layers);
 
+// One semi-transparent caster's triangles in the index buffer, for the transmittance pass.
+struct TransparentDraw {
+    std::uint32_t firstIndex = 0;
+    std::uint32_t indexCount = 0;
+    float transmittance = 1.0f;  // 1 − opacity
+    bool closed = true;          // count only its surfaces facing the light (transmit.frag)
+};
+
 // Index and vertex buffers of the whole scene (raster/geometry.h layout).
 struct DrawGeometry {
     VkBuffer vertices = VK_NULL_HANDLE;
     VkBuffer indices = VK_NULL_HANDLE;
     std::uint32_t indexCount = 0;
+    // The depth pass draws the first opaqueIndexCount indices (all by default). With a
+    // transmittance map the opaque casters' triangles come first and each semi-transparent
+    // caster's follow as one range (`transparent`), drawn by the transmittance pass only.
+    std::uint32_t opaqueIndexCount = ~0u;
+    std::vector<TransparentDraw> transparent;
+    std::uint32_t depthPassIndexCount() const { return opaqueIndexCount < indexCount ? opaqueIndexCount : indexCount; }
+};
+
+// The transmittance map beside the depth map (made only for scenes with semi-transparent
+// casters, RenderPlan::needsTransmittanceMap): per layer, the product of 1 − opacity of the
+// semi-transparent casters in front of the opaque depth (R32_SFLOAT, 1 = nothing), and the
+// depth of the nearest of them (R32_SFLOAT, 1 = none), in the depth map's depth space.
+inline constexpr VkFormat kTransmittanceFormat = VK_FORMAT_R32_SFLOAT;
+struct TransmittanceMaps {
+    Image transmittance;
+    std::vector<ImageViewHandle> transmittanceLayerViews;
+    Image nearDepth;
+    std::vector<ImageViewHandle> nearDepthLayerViews;
+    std::uint32_t size = 0;
+    std::uint32_t layers = 0;
+};
+// Without semi-transparent casters the renderer makes 1x1x1 placeholders that keep the lit
+// pass's descriptors valid.
+TransmittanceMaps createTransmittanceMaps(const Context& ctx, std::uint32_t size, std::uint32_t layers);
+
+// The transmittance pass: transmit.vert/.frag, depth test LESS against the depth map without
+// writing it, target 0 multiplied, target 1 MIN (needs the device's independentBlend).
+ShadowPipeline createTransmittancePipeline(const Context& ctx);
+
+// What recordShadowPass needs for the transmittance pass: the pipeline, the maps, and per layer
+// the light it is drawn from (TransmitPush::light).
+struct TransmittancePass {
+    const ShadowPipeline* pipeline = nullptr;
+    const TransmittanceMaps* maps = nullptr;
+    std::vector<glm::vec4> layerLights;
 };
 
 // Records: every layer cleared to depth 1 (far: lit) and id 0, and layer i drawn with
 // lightMatrices[i] (layers past the end of lightMatrices are only cleared), then both arrays
 // made readable by fragment shaders (SHADER_READ_ONLY_OPTIMAL). Without blockerIds (the
 // pipeline made so) the id array is not rendered, only moved to SHADER_READ_ONLY_OPTIMAL with
-// undefined contents, for a lit pass that does not read it.
+// undefined contents, for a lit pass that does not read it. The depth pass draws only
+// geometry.depthPassIndexCount() indices. With `transmittance`, each drawn layer then gets the
+// transmittance pass (its targets cleared to 1, the semi-transparent casters drawn, depth-tested
+// against the layer's opaque depths); its maps end in SHADER_READ_ONLY_OPTIMAL either way (with
+// `transmittance.pipeline` null: undefined contents, for a lit pass that does not read them).
 void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, const ShadowMaps& maps,
                       const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices,
-                      bool blockerIds = true);
+                      bool blockerIds = true, const TransmittancePass* transmittance = nullptr);
+std::vector<float> readTransmittance(const Context& ctx, const TransmittanceMaps& maps, std::uint32_t layer);
 
 // Diagnostics and tests: the depths of one layer after recordShadowPass() has run, row 0 first.
 std::vector<float> readShadowMap(const Context& ctx, const ShadowMaps& maps, std::uint32_t layer);

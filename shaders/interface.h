@@ -34,6 +34,15 @@ struct ShadowPush {
     mat4 lightMatrix;  // camera-relative world position -> light clip space (z 0..1, light side 0)
 };
 
+// Push constants of the transmittance pass (semi-transparent casters; raster/shadow_pass.h).
+struct TransmitPush {
+    mat4 lightMatrix;  // as ShadowPush
+    vec4 light;        // w = 0: xyz unit vector toward a directional light; w = 1: xyz the light's
+                       // camera-relative position
+    vec4 params;       // x: the object's transmittance 1 − opacity; y: 1 = closed (count only the
+                       // surfaces facing the light), 0 = open (count every fragment)
+};
+
 struct LightData {
     // Camera-relative world position -> homogeneous shadow-map coordinates: (u, v) = xy / w in
     // 0..1. Directional: orthographic, w = 1 and z = depth 0..1 (linear along the light).
@@ -75,6 +84,7 @@ struct LitUniforms {
 
 #ifdef __cplusplus
 static_assert(sizeof(ShadowPush) == 64, "ShadowPush must match std430 push constants");
+static_assert(sizeof(TransmitPush) == 64 + 2 * 16, "TransmitPush must match std430 push constants");
 static_assert(sizeof(LightData) == 64 + 6 * 16, "LightData must match std140");
 static_assert(sizeof(CascadeData) == 64 + 16, "CascadeData must match std140");
 static_assert(sizeof(LitUniforms) == 64 + 3 * 16 + SHADOWLAB_MAX_LIGHTS * sizeof(LightData) +

@@ -7,13 +7,18 @@
 #include "interface.h"
 
 layout(set = 0, binding = 0, std140) uniform Uniforms { LitUniforms u; };
-layout(set = 0, binding = 1, std430) readonly buffer Albedos { vec4 albedo[]; };  // per object
+layout(set = 0, binding = 1, std430) readonly buffer Albedos { vec4 albedo[]; };  // per object; a: 1 − opacity
 // NEAREST depth-compare sampler: each tap returns "ref <= stored" for one texel.
 layout(set = 0, binding = 2) uniform sampler2DArrayShadow shadowMaps;
 // The object nearest the light in each texel (0 = none), same layout as shadowMaps.
 layout(set = 0, binding = 3) uniform usampler2DArray blockerIds;
 // The same maps' raw depths (NEAREST, no compare; 1 outside): the PCSS blocker search reads them.
 layout(set = 0, binding = 4) uniform sampler2DArray shadowDepths;
+// Semi-transparent casters (raster/shadow_pass.h TransmittanceMaps, same layout; NEAREST, 1
+// outside): the product of 1 − opacity of those in front of the opaque depth, and the depth of
+// the nearest of them.
+layout(set = 0, binding = 5) uniform sampler2DArray transmittanceMaps;
+layout(set = 0, binding = 6) uniform sampler2DArray transparentDepths;
 
 // PCSS: the blocker search looks at most this fraction of the map's side from the point, and the
 // penumbra filter is at most this fraction wide (diameter). The tap count is fixed (16 each), so
@@ -55,6 +60,9 @@ layout(constant_id = 3) const int kLightKinds = 7;
 // the same count, as the cascades depend on the camera only), so scenes without cascades have
 // no cascade selection and the selection loop has a constant length.
 layout(constant_id = 4) const int kCascades = 1;
+// The scene has semi-transparent casters: every compare tap is multiplied by the transmittance
+// map's texel. Scenes without have none of that code.
+layout(constant_id = 5) const bool kTransmittance = false;
 const bool kAnyPerspective =
     (kLightKinds & ((1 << SHADOWLAB_LIGHT_SPOT) | (1 << SHADOWLAB_LIGHT_POINT))) != 0;
 
@@ -78,11 +86,25 @@ float interleavedGradientNoise(vec2 pixel) {
     return fract(52.9829189 * fract(dot(pixel, vec2(0.06711056, 0.00583715))));
 }
 
-// One compare tap; records the object stored there when it shadows and none was found yet.
+// The light left by the semi-transparent casters of one texel for a receiver at map depth ref:
+// their transmittance product when the receiver lies behind the nearest of them, else 1 (a
+// receiver in front of them, or on the nearest one itself, which the bias keeps in front).
+// A semi-transparent receiver lies in front of the opaque depth, so its own 1 − opacity is in
+// the product: it is divided out (the receiver's object, albedo[].a; 1 for opaque receivers).
+float receiverTransmittance = 1.0;
+float transmittanceTap(vec2 uv, float layer, float ref) {
+    const vec3 at = vec3(uv, layer);
+    return ref > texture(transparentDepths, at).r
+               ? min(texture(transmittanceMaps, at).r / receiverTransmittance, 1.0)
+               : 1.0;
+}
+
+// One compare tap; records the object stored there when it shadows and none was found yet
+// (opaque casters only: the blocker-id map holds no semi-transparent ones).
 float tap(vec2 uv, float layer, float ref, inout uint blocker) {
     const float lit = texture(shadowMaps, vec4(uv, layer, ref));
     if (kBlockerIds && lit < 0.5 && blocker == 0u) blocker = texture(blockerIds, vec3(uv, layer)).r;
-    return lit;
+    return kTransmittance ? lit * transmittanceTap(uv, layer, ref) : lit;
 }
 
 // Where the receiver is, in the light's map, and how its depth is compared.
@@ -104,24 +126,52 @@ float reference(LightData light, Receiver r, float bias) {
     return r.axial - bias * light.bias.w;  // orthographic depth is linear: bias / depth range
 }
 
+// A point light's cube face for the direction d from the light (its major axis: +X −X +Y −Y +Z
+// −Z, as raster/light_frustum.h cubeFaceDirection), and the face's basis as
+// LightFrustum::toTexture (setBasis()'s rule: right = axis × (world Y, or X for a vertical axis),
+// up = right × axis). Returns the face's layer offset 0..5.
+int cubeFace(vec3 d, out vec3 axis, out vec3 right, out vec3 up) {
+    const vec3 a = abs(d);
+    const int k = a.x >= a.y && a.x >= a.z ? 0 : a.y >= a.z ? 1 : 2;
+    const bool negative = d[k] < 0.0;
+    axis = vec3(0.0);
+    axis[k] = negative ? -1.0 : 1.0;
+    const vec3 ref = abs(axis.y) < 0.99 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
+    right = normalize(cross(axis, ref));
+    up = cross(right, axis);
+    return 2 * k + (negative ? 1 : 0);
+}
+
+// A PCSS tap of a point light at map coordinates uv of the receiver's face (basis axis, right,
+// up), which may lie past that face's edge: the tap's direction from the light is looked up in
+// the face it falls in (xy: map coordinates there, z: layer), and `axial` becomes the receiver's
+// (qd: the normal-offset point minus the light) distance along that face's axis, so its compare
+// reference and blocker test use the same face's depths. A face map holds only
+// kPointFaceMarginTexels past its 90° edge; PCSS kernels reach up to 1/8 of the map, and without
+// this the taps beyond the margin read nothing (border: lit), cutting the penumbra along the seam.
+vec3 cubeTap(LightData light, vec3 axis, vec3 right, vec3 up, vec3 qd, vec2 uv, out float axial) {
+    const vec2 s = (2.0 * uv - 1.0) * light.kind.y;  // tan of the tap's angles in the face
+    const vec3 d = axis + s.x * right + s.y * up;
+    vec3 fAxis, fRight, fUp;
+    const int face = cubeFace(d, fAxis, fRight, fUp);
+    const float along = dot(d, fAxis);
+    axial = dot(qd, fAxis);
+    return vec3(0.5 + 0.5 * vec2(dot(d, fRight), dot(d, fUp)) / (along * light.kind.y), light.toLight.w + float(face));
+}
+
 // Visibility 0..1 of `light` at camera-relative position p with unit normal n (facing the
 // viewer), N·L = ndotl > 0. `blocker` gets the id of the object that shadowed, if any.
 float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, inout uint blocker) {
     const bool perspective = isPerspective(light);
     const bool point = isKind(light, SHADOWLAB_LIGHT_POINT);
     vec3 axis = light.axis.xyz;
+    vec3 right = vec3(0.0), up = vec3(0.0);  // point: the face's basis
     float layer = light.toLight.w;
     if (point) {
-        // The cube face is the major axis of the direction from the light (+X −X +Y −Y +Z −Z,
-        // as raster/light_frustum.h cubeFaceDirection). Each face map reaches a few texels past
-        // its edge, so the normal offset and the filter taps below stay inside this one face.
-        const vec3 d = p - light.toLight.xyz;
-        const vec3 a = abs(d);
-        const int k = a.x >= a.y && a.x >= a.z ? 0 : a.y >= a.z ? 1 : 2;
-        const bool negative = d[k] < 0.0;
-        axis = vec3(0.0);
-        axis[k] = negative ? -1.0 : 1.0;
-        layer += float(2 * k + (negative ? 1 : 0));
+        // The cube face is the major axis of the direction from the light. Each face map
+        // reaches a few texels past its edge, so the normal offset and the pcf/poisson taps
+        // below stay inside this one face (PCSS taps may not: cubeTap).
+        layer += float(cubeFace(p - light.toLight.xyz, axis, right, up));
     }
     // World size of a texel at p: constant for an orthographic map, growing with distance
     // along the axis for a perspective one.
@@ -134,11 +184,7 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, inout uint blocke
     r.slopeStep = light.bias.y * texel * tanTheta;
     r.biasWorld = light.bias.x + r.slopeStep;
     if (point) {
-        // The face's perspective map, as LightFrustum::toTexture: the basis is setBasis()'s rule
-        // (right = direction × (world Y, or X for a vertical direction), up = right × direction).
-        const vec3 ref = abs(axis.y) < 0.99 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
-        const vec3 right = normalize(cross(axis, ref));
-        const vec3 up = cross(right, axis);
+        // The face's perspective map, as LightFrustum::toTexture.
         const vec3 d = q - light.toLight.xyz;
         r.axial = dot(d, axis);
         r.uv = 0.5 + 0.5 * vec2(dot(d, right), dot(d, up)) / (r.axial * light.kind.y);
@@ -162,10 +208,17 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, inout uint blocke
         const vec2 f = t - i0;
         const vec3 corner = vec3((i0 + 1.0) / size, layer);
         // Components: x = (i0, j0+1), y = (i0+1, j0+1), z = (i0+1, j0), w = (i0, j0).
-        const vec4 g = textureGather(shadowMaps, corner, reference(light, r, r.biasWorld + r.slopeStep));
+        const float ref = reference(light, r, r.biasWorld + r.slopeStep);
+        vec4 g = textureGather(shadowMaps, corner, ref);
         if (kBlockerIds && blocker == 0u && min(min(g.x, g.y), min(g.z, g.w)) < 0.5) {
             const uvec4 ids = textureGather(blockerIds, corner);
             blocker = g.w < 0.5 ? ids.w : g.z < 0.5 ? ids.z : g.x < 0.5 ? ids.x : ids.y;
+        }
+        if (kTransmittance) {
+            // The same four texels' transmittance, each where the receiver lies behind them.
+            const vec4 t = textureGather(transmittanceMaps, corner);
+            const vec4 near = textureGather(transparentDepths, corner);
+            g *= mix(vec4(1.0), min(t / receiverTransmittance, vec4(1.0)), greaterThan(vec4(ref), near));
         }
         return mix(mix(g.w, g.z, f.x), mix(g.x, g.y, f.x), f.y);
     }
@@ -174,7 +227,10 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, inout uint blocke
     // with its distance (a per-tap receiver-plane bias; without it wide kernels make acne).
     float kernelTexels = light.params.w;  // poisson: the diameter given
     const float lightSize = light.axis.w;
-    if (filterCode == SHADOWLAB_FILTER_PCSS && perspective && lightSize > 0.0) {
+    const bool pcss = filterCode == SHADOWLAB_FILTER_PCSS && perspective && lightSize > 0.0;
+    const bool wrap = pcss && point;  // PCSS taps of a point light go on into the neighbouring faces
+    const vec3 qd = q - light.toLight.xyz;
+    if (pcss) {
         // Percentage-closer soft shadows (Fernando, "Percentage-Closer Soft Shadows", SIGGRAPH 2005
         // sketch). 1. Blocker search: a blocker at distance d along the axis, s to the side of the
         // receiver's ray, shadows the receiver (distance dr) from some point of a light of size w
@@ -190,11 +246,14 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, inout uint blocke
         int blockers = 0;
         for (int k = 0; k < 16; ++k) {
             const vec2 o = rotation * kPoisson[k] * searchRadius;
-            const float z = texture(shadowDepths, vec3(r.uv + o / size, layer)).r;
+            vec3 at = vec3(r.uv + o / size, layer);
+            float drTap = dr;
+            if (wrap) at = cubeTap(light, axis, right, up, qd, at.xy, drTap);
+            const float z = texture(shadowDepths, at).r;
             if (z >= 1.0) continue;  // nothing drawn there
             // Stored perspective depth back to distance: z = far/(far−near)(1 − near/d).
             const float d = near / max(1.0 - z * (far - near) / far, 1e-7);
-            if (d < dr - (r.biasWorld + r.slopeStep * length(o))) {
+            if (d < drTap - (r.biasWorld + r.slopeStep * length(o))) {
                 blockerSum += d;
                 ++blockers;
             }
@@ -225,7 +284,13 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, inout uint blocke
     const float radius = 0.5 * (filterCode == SHADOWLAB_FILTER_PCSS ? kernelTexels : float(taps));
     for (int k = 0; k < 16; ++k) {
         const vec2 o = rotation * kPoisson[k] * radius;
-        sum += tap(r.uv + o / size, layer, reference(light, r, r.biasWorld + r.slopeStep * length(o)), blocker);
+        if (wrap) {
+            Receiver rt = r;
+            const vec3 at = cubeTap(light, axis, right, up, qd, r.uv + o / size, rt.axial);
+            sum += tap(at.xy, at.z, reference(light, rt, r.biasWorld + r.slopeStep * length(o)), blocker);
+        } else {
+            sum += tap(r.uv + o / size, layer, reference(light, r, r.biasWorld + r.slopeStep * length(o)), blocker);
+        }
     }
     return sum / 16.0;
 }
@@ -255,7 +320,9 @@ void main() {
     // Two-sided surfaces: the normal faces the viewer (the ray tracer's rule: flip when N·ray > 0).
     if (dot(n, inPosition) > 0.0) n = -n;
 
-    const vec3 albedoColor = albedo[inObjectId - 1u].rgb;
+    const vec4 objectAlbedo = albedo[inObjectId - 1u];
+    const vec3 albedoColor = objectAlbedo.rgb;
+    if (kTransmittance) receiverTransmittance = max(objectAlbedo.a, 1e-6);
     vec3 color = u.forward.w * albedoColor;
     float weightSum = 0.0;
     float weightedVisibility = 0.0;

@@ -9,11 +9,15 @@
 #include "lit_vert.spv.h"
 #include "shadow_frag.spv.h"
 #include "shadow_vert.spv.h"
+#include "transmit_frag.spv.h"
+#include "transmit_vert.spv.h"
 
 namespace shadowlab::shaders {
 
 std::span<const std::uint32_t> shadowVertSpirv() { return kShadowVertSpv; }
 std::span<const std::uint32_t> shadowFragSpirv() { return kShadowFragSpv; }
+std::span<const std::uint32_t> transmitVertSpirv() { return kTransmitVertSpv; }
+std::span<const std::uint32_t> transmitFragSpirv() { return kTransmitFragSpv; }
 std::span<const std::uint32_t> litVertSpirv() { return kLitVertSpv; }
 std::span<const std::uint32_t> litFragSpirv() { return kLitFragSpv; }
 std::span<const std::uint32_t> litFragLightsSpirv() { return kLitFragLightsSpv; }

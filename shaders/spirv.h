@@ -8,6 +8,9 @@ namespace shadowlab::shaders {
 
 std::span<const std::uint32_t> shadowVertSpirv();
 std::span<const std::uint32_t> shadowFragSpirv();
+// The transmittance pass (semi-transparent casters).
+std::span<const std::uint32_t> transmitVertSpirv();
+std::span<const std::uint32_t> transmitFragSpirv();
 std::span<const std::uint32_t> litVertSpirv();
 std::span<const std::uint32_t> litFragSpirv();
 // lit.frag compiled with SHADOWLAB_LIGHT_OUTPUTS: two more targets with per-light visibility.

@@ -4,11 +4,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <variant>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "raster/renderer.h"
+#include "scene/frame_io.h"
 #include "tests/raster/test_scenes.h"
 
 namespace shadowlab::raster {
@@ -129,6 +134,90 @@ TEST(RasterPcss, APointSizedLightKeepsTheHardShadowOfPoisson) {
     const scene::Frame b = render(s, test::planFor(s, poisson), poisson);
     EXPECT_EQ(a.visibility, b.visibility);
     EXPECT_EQ(a.attributes.at("validation_messages"), "0");
+}
+
+// A point light of diameter 1 at height 4 above the origin, a blocker quad at height 2 covering
+// x in [0, 8], z in [-6, 0]: its straight edge (z = 0) casts a penumbra 1 unit wide on the floor
+// along z = 0, which crosses the seam between the cube's -Y and +X faces at x = 4 (there the
+// direction from the light is 45° down). The PCSS search (up to 1/16 of the map) and filter (1/8)
+// reach far past a face's 12-texel margin there.
+constexpr double kSeamH = 4.0, kSeamHb = 2.0, kSeamDiameter = 1.0;
+
+scene::Scene seamScene() {
+    scene::Scene s = edgeScene(kSeamHb);
+    s.camera.position = Vec3(kSeamH, 2.5, 3.0);
+    s.camera.lookAt = Vec3(kSeamH, 0.0, 0.0);
+    s.lights[0].type = scene::LightType::Point;
+    s.lights[0].position = Vec3(0, kSeamH, 0);
+    s.lights[0].radius = 0.5 * kSeamDiameter;
+    s.lights[0].intensity = 500.0;
+    scene::Quad& blocker = std::get<scene::Quad>(s.objects[1].shape);
+    blocker.center = Vec3(kSeamH, kSeamHb, -3.0);
+    blocker.size = scene::Vec2(2.0 * kSeamH, 6.0);
+    scene::quadAxes(blocker.normal, blocker.uAxis, blocker.vAxis);
+    return s;
+}
+
+// The fraction of the light's disk (radius R, facing q) seen from the floor point q past the
+// blocker: a 64×64 grid over the disk, each segment to the light's point tested against the
+// blocker's rectangle at y = hb. Independent of the renderer.
+double diskVisibility(const Vec3& q) {
+    const Vec3 c(0, kSeamH, 0);
+    const Vec3 w = glm::normalize(c - q);
+    const Vec3 a = std::abs(w.y) < 0.9 ? Vec3(0, 1, 0) : Vec3(1, 0, 0);
+    const Vec3 u = glm::normalize(glm::cross(w, a));
+    const Vec3 v = glm::cross(w, u);
+    constexpr int n = 64;
+    const double r = 0.5 * kSeamDiameter;
+    int inside = 0, seen = 0;
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            const double x = (2.0 * (i + 0.5) / n - 1.0) * r, y = (2.0 * (j + 0.5) / n - 1.0) * r;
+            if (x * x + y * y > r * r) continue;
+            ++inside;
+            const Vec3 l = c + x * u + y * v;
+            const double t = (kSeamHb - q.y) / (l.y - q.y);
+            const Vec3 h = q + t * (l - q);
+            const bool blocked = h.x >= 0.0 && h.x <= 2.0 * kSeamH && h.z >= -6.0 && h.z <= 0.0;
+            if (!blocked) ++seen;
+        }
+    return double(seen) / inside;
+}
+
+TEST(RasterPcss, APointLightPenumbraCrossesACubeFaceSeamWithoutACut) {
+    const scene::Scene s = seamScene();
+    const scene::Frame f = renderPcss(s);
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    // Floor pixels within 0.3 of the seam (x = 4), from the lit side (z = 0.8) through the
+    // penumbra into the umbra (z = -2.5): each side's mean error of the visibility against the
+    // disk integral. PCSS is an estimate (a mean
+    // blocker depth, 16 rotated taps), so single pixels differ; a cut would leave a whole side
+    // wrong (before the fix: a streak of light along the seam in the umbra, and a narrower penumbra).
+    double err[2] = {0, 0};
+    int count[2] = {0, 0};
+    for (int y = 0; y < f.height; ++y)
+        for (int x = 0; x < f.width; ++x) {
+            const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
+            if (f.objectId[i] != 1.0f) continue;  // the floor
+            const Vec3 d = test::pixelRay(cam, x, y);
+            const Vec3 q = cam.position + (-cam.position.y / d.y) * d;
+            if (std::abs(q.x - kSeamH) > 0.3 || std::abs(q.x - kSeamH) < 0.02 || q.z < -2.5 || q.z > 0.8) continue;
+            const int side = q.x > kSeamH ? 1 : 0;
+            err[side] += std::abs(double(f.visibility[i]) - diskVisibility(q));
+            ++count[side];
+        }
+    ASSERT_GT(count[0], 500);
+    ASSERT_GT(count[1], 500);
+    for (int side = 0; side < 2; ++side) {
+        const double mean = err[side] / count[side];
+        std::printf("side %d (%s the seam): %d pixels, mean |V - V_disk| = %.4f\n", side, side ? "+X face," : "-Y face,",
+                    count[side], mean);
+        EXPECT_LT(mean, 0.04) << (side ? "+X" : "-Y") << " side of the seam";
+    }
+    EXPECT_LT(std::abs(err[0] / count[0] - err[1] / count[1]), 0.03);
+    if (const char* dir = std::getenv("SHADOWLAB_TEST_PNG_DIR")) {
+        scene::writePngLinear(std::filesystem::path(dir) / "pcss_point_seam.png", f.width, f.height, f.beauty);
+    }
 }
 
 }  // namespace

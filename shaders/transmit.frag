@@ -1,0 +1,30 @@
+// shaders/transmit.frag: one semi-transparent caster's fragment in the transmittance map
+// (raster/shadow_pass.h). Target 0 is blended multiplicatively (dst · src): it holds the product
+// of (1 − opacity) of every counted fragment in front of the opaque depth; target 1 is blended
+// with MIN: the nearest counted fragment's depth, so the lit pass applies the product only to
+// receivers behind it.
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#include "interface.h"
+
+layout(push_constant) uniform Push { TransmitPush push; };
+
+layout(location = 0) in vec3 inPosition;
+layout(location = 1) in vec3 inNormal;
+
+layout(location = 0) out float outTransmittance;
+layout(location = 1) out float outNearDepth;
+
+void main() {
+    // DESIGN.md: an object multiplies the light by 1 − opacity once, however many of its surfaces
+    // a ray crosses. A ray from the light enters a closed convex object through exactly one
+    // surface facing the light, so a closed object counts only those (decided by its normal, not
+    // by the winding, so it holds for every mesh's index order); an open surface (a quad) counts
+    // every fragment (a ray crosses it once).
+    if (push.params.y > 0.5) {
+        const vec3 toLight = push.light.w > 0.5 ? push.light.xyz - inPosition : push.light.xyz;
+        if (dot(inNormal, toLight) <= 0.0) discard;
+    }
+    outTransmittance = push.params.x;
+    outNearDepth = gl_FragCoord.z;
+}
