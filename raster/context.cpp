@@ -7,10 +7,14 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <iterator>
+#include <iomanip>
+#include <fstream>
 #include <iostream>
 #include <sstream>
 
 #include "raster/vulkan_error.h"
+#include "scene/frame_io.h"
 
 namespace shadowlab::raster {
 
@@ -20,16 +24,20 @@ constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
 
 // Lavapipe compiles shaders with LLVM on first use; its disk cache makes warm starts fast.
 // Point it into our own cache folder unless the user chose one.
+// The user's cache folder for shadowlab ($XDG_CACHE_HOME/shadowlab or ~/.cache/shadowlab), empty
+// when neither is set.
+std::filesystem::path cacheDirectory() {
+    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::filesystem::path(xdg) / "shadowlab";
+    if (const char* home = std::getenv("HOME"); home && *home)
+        return std::filesystem::path(home) / ".cache" / "shadowlab";
+    return {};
+}
+
 void setShaderCacheDir() {
     if (std::getenv("MESA_SHADER_CACHE_DIR")) return;
-    std::filesystem::path base;
-    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
-        base = xdg;
-    else if (const char* home = std::getenv("HOME"); home && *home)
-        base = std::filesystem::path(home) / ".cache";
-    else
-        return;  // no place to put it: Mesa's own default applies
-    const std::filesystem::path dir = base / "shadowlab" / "mesa";
+    const std::filesystem::path base = cacheDirectory();
+    if (base.empty()) return;  // no place to put it: Mesa's own default applies
+    const std::filesystem::path dir = base / "mesa";
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
     if (!ec) setenv("MESA_SHADER_CACHE_DIR", dir.c_str(), 0);
@@ -288,6 +296,41 @@ std::string describeDevices(bool validate) {
     return s.str();
 }
 
+// The pipeline cache file's data, when its header (Vulkan spec, vkGetPipelineCacheData: header
+// length, version 1, vendor id, device id, pipelineCacheUUID) names this device; else nothing,
+// so a cache from another driver or version is never handed to this one.
+static std::vector<char> readPipelineCache(const std::filesystem::path& file, const VkPhysicalDeviceProperties& props) {
+    std::ifstream in(file, std::ios::binary);
+    std::vector<char> data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (data.size() < 32) return {};
+    std::uint32_t header[4];
+    std::memcpy(header, data.data(), sizeof header);
+    if (header[0] < 32 || header[1] != VK_PIPELINE_CACHE_HEADER_VERSION_ONE || header[2] != props.vendorID ||
+        header[3] != props.deviceID || std::memcmp(data.data() + 16, props.pipelineCacheUUID, VK_UUID_SIZE) != 0)
+        return {};
+    return data;
+}
+
+static void createPipelineCache(Context& ctx) {
+    const std::filesystem::path dir = cacheDirectory();
+    if (!dir.empty()) {
+        std::ostringstream name;
+        name << "pipelines-" << std::hex << ctx.properties.vendorID << "-" << ctx.properties.deviceID << "-";
+        for (std::uint8_t b : ctx.properties.pipelineCacheUUID) name << std::setw(2) << std::setfill('0') << int(b);
+        ctx.pipelineCacheFile = dir / "vulkan" / (name.str() + ".bin");
+    }
+    const std::vector<char> initial =
+        ctx.pipelineCacheFile.empty() ? std::vector<char>() : readPipelineCache(ctx.pipelineCacheFile, ctx.properties);
+    const VkPipelineCacheCreateInfo info{
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO,
+        .initialDataSize = initial.size(),
+        .pInitialData = initial.empty() ? nullptr : initial.data(),
+    };
+    VkPipelineCache cache = VK_NULL_HANDLE;
+    VK_CHECK(vkCreatePipelineCache(ctx.device.get(), &info, nullptr, &cache));
+    ctx.pipelineCache = PipelineCacheHandle(ctx.device.get(), cache);
+}
+
 Context::Context(const ContextOptions& options) {
     if (options.validate && !options.log)
         throw std::invalid_argument("raster::Context: validation needs a ValidationLog");
@@ -353,6 +396,7 @@ Context::Context(const ContextOptions& options) {
     VkCommandPool pool = VK_NULL_HANDLE;
     VK_CHECK(vkCreateCommandPool(d, &poolInfo, nullptr, &pool));
     commandPool = CommandPoolHandle(d, pool);
+    createPipelineCache(*this);
 }
 
 std::uint32_t Context::memoryType(std::uint32_t typeBits, VkMemoryPropertyFlags required,
@@ -399,6 +443,21 @@ static std::uint64_t gpuTimeoutNanoseconds() {
             throw RasterError(std::string("SHADOWLAB_GPU_TIMEOUT_S: expected seconds > 0, got '") + text + "'");
     }
     return std::uint64_t(seconds * 1e9);
+}
+
+Context::~Context() {
+    // Best effort: a cache that cannot be saved only costs the next run its warm start.
+    if (pipelineCache.get() == VK_NULL_HANDLE || pipelineCacheFile.empty()) return;
+    std::size_t size = 0;
+    if (vkGetPipelineCacheData(device.get(), pipelineCache.get(), &size, nullptr) != VK_SUCCESS || size == 0) return;
+    std::string data(size, '\0');
+    if (vkGetPipelineCacheData(device.get(), pipelineCache.get(), &size, data.data()) != VK_SUCCESS) return;
+    data.resize(size);
+    try {
+        std::filesystem::create_directories(pipelineCacheFile.parent_path());
+        scene::writeTextAtomic(pipelineCacheFile, data);
+    } catch (const std::exception&) {
+    }
 }
 
 void Context::submitAndWait(VkCommandBuffer commands) const {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <atomic>
+#include <filesystem>
 #include <cstdint>
 #include <mutex>
 #include <string>
@@ -33,6 +34,9 @@ struct ContextOptions {
 // Members are declared in creation order; the destructor runs in reverse.
 struct Context {
     explicit Context(const ContextOptions& options);
+    ~Context();  // saves the pipeline cache
+    Context(const Context&) = delete;
+    Context& operator=(const Context&) = delete;
 
     InstanceHandle instance;
     MessengerHandle messenger;
@@ -45,6 +49,12 @@ struct Context {
     LogicalDeviceHandle device;
     VkQueue queue = VK_NULL_HANDLE;
     CommandPoolHandle commandPool;
+    // Every pipeline is created through it. Loaded from and saved to pipelineCacheFile (empty:
+    // no cache folder), named by the device's vendor, device id and pipelineCacheUUID.
+    // Lavapipe keeps no code in it (a 32-byte header; its warm start is Mesa's shader cache),
+    // real drivers keep their compiled pipelines.
+    PipelineCacheHandle pipelineCache;
+    std::filesystem::path pipelineCacheFile;
 
     // A memory type allowed by `typeBits` with all of `required`; among those, one with all of
     // `preferred` when there is one. Throws RasterError when none fits.

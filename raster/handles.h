@@ -86,6 +86,7 @@ using DescriptorPoolHandle = DeviceHandle<VkDescriptorPool, &vkDestroyDescriptor
 using PipelineLayoutHandle = DeviceHandle<VkPipelineLayout, &vkDestroyPipelineLayout>;
 using PipelineHandle = DeviceHandle<VkPipeline, &vkDestroyPipeline>;
 using CommandPoolHandle = DeviceHandle<VkCommandPool, &vkDestroyCommandPool>;
+using PipelineCacheHandle = DeviceHandle<VkPipelineCache, &vkDestroyPipelineCache>;
 using FenceHandle = DeviceHandle<VkFence, &vkDestroyFence>;
 using QueryPoolHandle = DeviceHandle<VkQueryPool, &vkDestroyQueryPool>;
 

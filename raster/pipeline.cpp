@@ -141,7 +141,7 @@ PipelineHandle createGraphicsPipeline(const Context& ctx, const PipelineDesc& de
         .layout = desc.layout,
     };
     VkPipeline pipeline = VK_NULL_HANDLE;
-    VK_CHECK(vkCreateGraphicsPipelines(ctx.device.get(), VK_NULL_HANDLE, 1, &info, nullptr, &pipeline));
+    VK_CHECK(vkCreateGraphicsPipelines(ctx.device.get(), ctx.pipelineCache.get(), 1, &info, nullptr, &pipeline));
     return PipelineHandle(ctx.device.get(), pipeline);
 }
 

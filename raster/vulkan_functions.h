@@ -69,6 +69,9 @@
     X(vkCreatePipelineLayout)                   \
     X(vkDestroyPipelineLayout)                  \
     X(vkCreateGraphicsPipelines)                \
+    X(vkCreatePipelineCache)                    \
+    X(vkDestroyPipelineCache)                   \
+    X(vkGetPipelineCacheData)                   \
     X(vkDestroyPipeline)                        \
     X(vkCreateQueryPool)                        \
     X(vkDestroyQueryPool)                       \

@@ -3,6 +3,9 @@
 #include "raster/context.h"
 
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
 #include <optional>
 
 #include <gtest/gtest.h>
@@ -139,6 +142,36 @@ TEST(Devices, ValidatedContextCreationAndDestructionIsClean) {
         EXPECT_NE(ctx.queue, VK_NULL_HANDLE);
     }
     EXPECT_EQ(log.count.load(), 0);
+}
+
+TEST(Devices, ThePipelineCacheIsSavedForThisDeviceAndLoadedAgain) {
+    const std::filesystem::path home =
+        std::filesystem::temp_directory_path() / ("shadowlab-cache-test-" + std::to_string(::getpid()));
+    ::setenv("XDG_CACHE_HOME", home.c_str(), 1);
+    ValidationLog log;
+    std::filesystem::path file;
+    VkPhysicalDeviceProperties props{};
+    {
+        const Context ctx(ContextOptions{.validate = true, .log = &log});
+        ASSERT_NE(ctx.pipelineCache.get(), VK_NULL_HANDLE);
+        file = ctx.pipelineCacheFile;
+        props = ctx.properties;
+        EXPECT_EQ(file.parent_path(), home / "shadowlab" / "vulkan");
+    }
+    // The saved file starts with the header the spec defines, naming this device.
+    std::ifstream in(file, std::ios::binary);
+    std::uint32_t header[4] = {};
+    ASSERT_TRUE(in.read(reinterpret_cast<char*>(header), sizeof header)) << file;
+    EXPECT_GE(header[0], 32u);
+    EXPECT_EQ(header[1], std::uint32_t(VK_PIPELINE_CACHE_HEADER_VERSION_ONE));
+    EXPECT_EQ(header[2], props.vendorID);
+    EXPECT_EQ(header[3], props.deviceID);
+    // A second context reads it back (and a damaged file is ignored, not handed to the driver).
+    { const Context again(ContextOptions{.validate = true, .log = &log}); }
+    std::ofstream(file, std::ios::binary | std::ios::trunc) << std::string(64, 'x');
+    { const Context damaged(ContextOptions{.validate = true, .log = &log}); }
+    EXPECT_EQ(log.count.load(), 0);
+    std::filesystem::remove_all(home);
 }
 
 TEST(Devices, AnUnvalidatedInstanceDoesNotBreakALivingValidatedOne) {
