@@ -303,6 +303,8 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     attributes["depth_bias"] = depthBias;
     attributes["depth_bias_default"] = settings.depthBiasIsDefault ? "true" : "false";
     attributes["slope_bias"] = formatNumber(settings.slopeBias);
+    // On, the receiver's plane replaces the slope term in every tap (lit.frag), so slope_bias is unused.
+    attributes["receiver_plane_bias"] = settings.receiverPlaneBias ? "true" : "false";
     attributes["max_slope_tan"] = formatNumber(kMaxSlopeTan);
     attributes["triangles"] = std::to_string(triangles);
     attributes["sphere_segments"] = std::to_string(sphereSegmentsUsed);
@@ -353,7 +355,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                                                             .lightTargets = std::uint32_t(targets.lights.size()),
                                                             .lightCount = std::uint32_t(lightCount),
                                                             .lightKinds = lightKinds,
-                                                            .cascades = std::uint32_t(cascadesUsed)});
+                                                            .cascades = std::uint32_t(cascadesUsed),
+                                                            .receiverPlane = settings.receiverPlaneBias});
         if (bindings.set == VK_NULL_HANDLE) bindings = createLitBindings(ctx, litPipeline, uniforms, albedos, maps);
         setup += msSince(pipelineStart);
     }

@@ -34,6 +34,9 @@ struct RasterSettings {
     ShadowFilter filter = ShadowFilter::Pcf2x2;
     int pcfSize = 3;            // pcf: taps per side; poisson: kernel diameter in texels (1..15)
     double normalOffset = 0.0;  // texels: the receiver moves along its normal by this x texel world size
+    // Receiver-plane depth bias (Isidoro 2006): each filter tap compares against the receiver's
+    // plane extrapolated to the texel it reads, instead of the slope bias (see docs/raster.md).
+    bool receiverPlaneBias = false;
     bool fitLightFrustum = false;  // fit each light's map to the casters of visible receivers (else the scene's bounding sphere)
     // Directional lights: split the view's depth range into this many slices, each with its own
     // map (1 = one map for the whole view, as fitLightFrustum or the bounding sphere decide).
@@ -64,6 +67,7 @@ struct SettingsOverrides {
     std::optional<std::string> filter;
     std::optional<int> pcfSize;          // --pcf-size
     std::optional<double> normalOffset;  // --normal-offset (texels)
+    std::optional<bool> receiverPlaneBias;  // --receiver-plane-bias
     std::optional<bool> fitLightFrustum; // --fit-light-frustum
     std::optional<int> cascades;         // --cascades (1..kMaxCascades)
     std::optional<std::string> rayBias;  // a number or "robust"
