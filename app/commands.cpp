@@ -61,7 +61,10 @@ Prepared prepare(const SceneOptions& o) {
     if (o.resolution) applyResolution(p.scene, *o.resolution);
     p.settings = scene::resolveSettings(p.scene, o.settings);
     p.plan = scene::makeRenderPlan(p.scene, p.settings);
-    if (o.explain) std::cerr << "render plan for " << p.scene.file.string() << ":\n" << p.plan.explain();
+    if (o.explain)
+        std::cerr << "render plan for " << p.scene.file.string() << ":\n"
+                  << p.plan.explain()
+                  << "raster shadow-map size: " << raster::chooseShadowMapSize(p.scene, p.settings.raster).reason << "\n";
     return p;
 }
 

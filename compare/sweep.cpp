@@ -333,7 +333,8 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
         if (!block.is_object()) throw SceneError(file, path, "expected an object of axes");
         const bool isRaster = std::string(backend) == "raster";
         const std::vector<const char*> names = isRaster
-            ? std::vector<const char*>{"shadow_map_size", "filter", "cascades", "depth_bias", "slope_bias"}
+            ? std::vector<const char*>{"shadow_map_size", "filter", "cascades", "receiver_plane_bias", "depth_bias",
+                                       "slope_bias"}
             : std::vector<const char*>{"ray_bias", "precision", "samples"};
         for (const auto& [key, value] : block.items())
             if (std::none_of(names.begin(), names.end(), [&](const char* n) { return key == n; }))
@@ -370,6 +371,9 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
                             throw SceneError(file, at, "expected an integer in 1.." + std::to_string(scene::kMaxCascades) +
                                                            " (cascaded shadow maps per directional light), got " + v.dump());
                         c.overrides.cascades = v.get<int>();
+                    } else if (n == "receiver_plane_bias") {
+                        if (!v.is_boolean()) throw SceneError(file, at, "expected true or false, got " + v.dump());
+                        c.overrides.receiverPlaneBias = v.get<bool>();
                     } else if (n == "depth_bias") {
                         c.overrides.depthBias = num(0.0);
                         c.biasKind = "depth";

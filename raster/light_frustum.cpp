@@ -296,4 +296,43 @@ std::string LightFrustum::describe() const {
     return buf;
 }
 
+ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::RasterSettings& settings) {
+    const int size = settings.shadowMapSize;
+    auto keep = [&](const std::string& why) { return ShadowMapSizeChoice{size, std::to_string(size) + " (" + why + ")"}; };
+    // A size set after resolveSettings() (a test, the sweep) is forced too.
+    if (!settings.shadowMapSizeIsDefault || size != scene::kDefaultShadowMapSize)
+        return keep("set by --shadow-map-size or the scene");
+    for (const scene::Light& l : scene.lights)
+        if (l.type != scene::LightType::Directional)
+            return keep("default: spot and point maps have texels that grow with distance");
+    if (settings.cascades > 1) return keep("default: cascades size their texels per slice");
+    // The nearest view depth of any visible receiver: over each object's bounds clipped to the
+    // camera frustum (the scene's box would reach up to the camera), at a vertex of the clipped box.
+    const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
+    double zMin = INFINITY;
+    for (const scene::Object& o : scene.objects)
+        for (const Vec3& p : visibleReceiverPoints(scene, scene::boundsOf(o.shape)))
+            zMin = std::min(zMin, glm::dot(p - cam.position, cam.forward));
+    if (!std::isfinite(zMin)) return keep("default: the camera sees no receiver");
+    zMin = std::max(zMin, scene.camera.near);
+    // A pixel's world size on a receiver facing the camera at view depth z; tilted receivers
+    // have larger footprints, so this is the finest detail the image can show.
+    const double pixel = 2.0 * cam.tanHalfFovY * zMin / std::max(scene.camera.height, 1);
+    double widest = 0.0;
+    for (const scene::Light& l : scene.lights) {
+        const LightFrustum f = settings.fitLightFrustum ? fitDirectionalLightToReceivers(scene, l.direction, size)
+                                                        : fitDirectionalLight(scene.bounds(), l.direction, size);
+        widest = std::max(widest, 2.0 * f.halfWidth);
+    }
+    const double needed = widest / pixel;
+    int chosen = kMinAutoShadowMapSize;
+    while (chosen < needed && chosen < size) chosen *= 2;
+    chosen = std::min(chosen, size);
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "%d (%s: map width %.4g / smallest pixel footprint %.4g at view depth %.4g = %.0f texels%s)",
+                  chosen, chosen < size ? "from receiver detail" : "default", widest, pixel, zMin, needed,
+                  chosen < size ? ", rounded up to a power of two" : ", capped at the default");
+    return ShadowMapSizeChoice{chosen, buf};
+}
+
 }  // namespace shadowlab::raster

@@ -142,6 +142,15 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     indexBuffer = uploadBuffer(ctx, geometry.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
     draw = DrawGeometry{vertexBuffer.buffer.get(), indexBuffer.buffer.get(), std::uint32_t(geometry.indices.size())};
 
+    // Map size from the receivers' detail when nobody chose one; a default constant bias (half a
+    // texel of the bounding-sphere map) follows the size.
+    const ShadowMapSizeChoice mapChoice = chooseShadowMapSize(scene, settings);
+    if (mapChoice.size != settings.shadowMapSize) {
+        settings.shadowMapSize = mapChoice.size;
+        if (settings.depthBiasIsDefault) settings.depthBias = scene::defaultDepthBias(scene, mapChoice.size);
+    }
+    attributes["shadow_map_size_reason"] = mapChoice.reason;
+
     std::vector<double> usedDepthBias;  // per shadow-mapped light (spot, directional)
     // One shadow-map layer per light that needs a shadow test.
     const scene::Bounds bounds = scene.bounds();

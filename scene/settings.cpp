@@ -47,7 +47,8 @@ RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& o) {
     RenderSettings s;
     const ShadowDefaults& d = scene.shadow;
 
-    s.raster.shadowMapSize = o.shadowMapSize.value_or(d.shadowMapSize.value_or(2048));
+    s.raster.shadowMapSize = o.shadowMapSize.value_or(d.shadowMapSize.value_or(kDefaultShadowMapSize));
+    s.raster.shadowMapSizeIsDefault = !o.shadowMapSize && !d.shadowMapSize;
     if (s.raster.shadowMapSize < 16 || s.raster.shadowMapSize > 16384)
         throw InputError("--shadow-map-size: must be in 16..16384, got " +
                          std::to_string(s.raster.shadowMapSize));

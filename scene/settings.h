@@ -24,8 +24,14 @@ enum class Precision { Float, Double };
 // texel density while every pass redraws the whole scene), see docs/raster.md.
 inline constexpr int kMaxCascades = 4;
 
+// The shadow-map size when neither the command line nor the scene sets one.
+inline constexpr int kDefaultShadowMapSize = 2048;
+
 struct RasterSettings {
-    int shadowMapSize = 2048;   // texels per side
+    int shadowMapSize = kDefaultShadowMapSize;  // texels per side
+    // True when shadowMapSize is the default (no option, no scene value): the raster backend may
+    // then lower it to what the receivers' detail on screen needs (raster::chooseShadowMapSize).
+    bool shadowMapSizeIsDefault = false;
     double depthBias = 0.0;     // world units along the light direction 
     // True when depthBias is defaultDepthBias() (no option, no scene value): the raster backend
     // then re-derives it as half a texel of each fitted map (fitLightFrustum), see docs/raster.md.
