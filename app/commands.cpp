@@ -65,6 +65,12 @@ Prepared prepare(const SceneOptions& o) {
         std::cerr << "render plan for " << p.scene.file.string() << ":\n"
                   << p.plan.explain()
                   << "raster shadow-map size: " << raster::chooseShadowMapSize(p.scene, p.settings.raster).reason << "\n";
+    if (o.explain) {
+        const std::vector<int> culled = raster::culledCasters(p.scene, p.settings.raster);
+        for (std::size_t i = 0; i < culled.size(); ++i)
+            std::cerr << "raster light " << i << ": " << culled[i] << " of " << p.scene.objects.size()
+                      << " objects left out of the depth pass (cannot cast onto the visible receivers)\n";
+    }
     return p;
 }
 

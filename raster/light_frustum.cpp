@@ -335,4 +335,51 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
     return ShadowMapSizeChoice{chosen, buf};
 }
 
+
+std::vector<bool> castsIntoView(const scene::Scene& scene, const LightFrustum& f, double marginTexels) {
+    std::vector<bool> casts(scene.objects.size(), true);
+    const std::vector<Vec3> receivers = visibleReceiverPoints(scene);
+    if (receivers.empty() || f.perspective) return casts;
+    double minU = INFINITY, maxU = -INFINITY, minV = INFINITY, maxV = -INFINITY, maxDepth = -INFINITY;
+    for (const Vec3& c : receivers) {
+        const Vec3 d = c - f.center;
+        minU = std::min(minU, glm::dot(d, f.right));
+        maxU = std::max(maxU, glm::dot(d, f.right));
+        minV = std::min(minV, glm::dot(d, f.up));
+        maxV = std::max(maxV, glm::dot(d, f.up));
+        maxDepth = std::max(maxDepth, glm::dot(d, f.direction));
+    }
+    const double margin = marginTexels * f.texelWorldSize();
+    for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+        const scene::Bounds b = scene::boundsOf(scene.objects[i].shape);
+        if (b.empty()) continue;
+        double oMinU = INFINITY, oMaxU = -INFINITY, oMinV = INFINITY, oMaxV = -INFINITY, oMinDepth = INFINITY;
+        for (const Vec3& c : corners(b)) {
+            const Vec3 d = c - f.center;
+            oMinU = std::min(oMinU, glm::dot(d, f.right));
+            oMaxU = std::max(oMaxU, glm::dot(d, f.right));
+            oMinV = std::min(oMinV, glm::dot(d, f.up));
+            oMaxV = std::max(oMaxV, glm::dot(d, f.up));
+            oMinDepth = std::min(oMinDepth, glm::dot(d, f.direction));
+        }
+        casts[i] = oMaxU >= minU - margin && oMinU <= maxU + margin && oMaxV >= minV - margin &&
+                   oMinV <= maxV + margin && oMinDepth <= maxDepth + margin;
+    }
+    return casts;
+}
+
+std::vector<int> culledCasters(const scene::Scene& scene, const scene::RasterSettings& settingsIn) {
+    scene::RasterSettings settings = settingsIn;
+    settings.shadowMapSize = chooseShadowMapSize(scene, settingsIn).size;
+    std::vector<int> culled(scene.lights.size(), 0);
+    for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+        const scene::Light& l = scene.lights[i];
+        if (l.type != scene::LightType::Directional || settings.cascades > 1) continue;
+        const LightFrustum f = settings.fitLightFrustum
+                                   ? fitDirectionalLightToReceivers(scene, l.direction, settings.shadowMapSize)
+                                   : fitDirectionalLight(scene.bounds(), l.direction, settings.shadowMapSize);
+        for (const bool c : castsIntoView(scene, f, kCullMarginTexels + settings.normalOffset)) culled[i] += c ? 0 : 1;
+    }
+    return culled;
+}
 }  // namespace shadowlab::raster

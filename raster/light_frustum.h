@@ -93,6 +93,18 @@ double cubeFaceTanHalfFov(int mapSize);
 LightFrustum fitPointLightFace(const scene::Bounds& bounds, const scene::Vec3& position, int face, int mapSize);
 
 
+// Caster culling (issue 5) for a directional light's map f: whether each object can cast onto
+// the visible receivers (visibleReceiverPoints, the scene's box clipped to the camera). Seen along
+// the light, the object's bounding box must overlap the receivers' extent across it, widened by
+// marginTexels texels (filter taps and normal offset look that far), and reach nearer the light
+// than the farthest receiver. All true when the camera sees none of the scene.
+// The widest filter reach in texels (a 15-tap kernel's half, pcf2x2's extra texel, rounding).
+inline constexpr double kCullMarginTexels = 10.0;
+std::vector<bool> castsIntoView(const scene::Scene& scene, const LightFrustum& f, double marginTexels);
+// Per light, how many objects castsIntoView leaves out of its depth pass (0 for spot and point
+// lights and cascades, which are not culled), with the frusta the renderer makes for `settings`.
+std::vector<int> culledCasters(const scene::Scene& scene, const scene::RasterSettings& settings);
+
 // Map size from the receivers' detail (issue 5): when nobody chose a size (settings
 // shadowMapSizeIsDefault and the size is kDefaultShadowMapSize), a map whose texel is smaller than the smallest world footprint of a
 // screen pixel on the visible receivers adds nothing the image can show. The size is then the

@@ -151,6 +151,10 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     }
     attributes["shadow_map_size_reason"] = mapChoice.reason;
 
+    // Caster culling: per culled layer, which objects are drawn into it; per light, how many not.
+    std::map<std::size_t, std::vector<bool>> layerCasters;
+    std::vector<int> culledPerLight(scene.lights.size(), 0);
+
     std::vector<double> usedDepthBias;  // per shadow-mapped light (spot, directional)
     // One shadow-map layer per light that needs a shadow test.
     const scene::Bounds bounds = scene.bounds();
@@ -229,6 +233,12 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
                 layerLight.push_back(int(i));
                 layerLabels.push_back("L" + std::to_string(i));
                 layer = float(lightMatrices.size());
+                if (!spot && settings.cullCasters) {
+                    // Objects that cannot cast onto the visible receivers stay out of this map.
+                    std::vector<bool> casts = castsIntoView(scene, f, kCullMarginTexels + settings.normalOffset);
+                    for (const bool c : casts) culledPerLight[i] += c ? 0 : 1;
+                    layerCasters[lightMatrices.size()] = std::move(casts);
+                }
                 lightMatrices.push_back(glm::mat4(f.toClip(origin)));
                 l.toShadow = glm::mat4(f.toTexture(origin));
                 // The default constant bias is half a texel of the bounding-sphere map
@@ -265,6 +275,23 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     }
     for (const scene::Object& o : scene.objects)
         albedos.emplace_back(glm::vec3(scene.materialOf(o).albedo), 1.0f);
+    // Each layer's index ranges: every object, or the culled layer's casters (runs of them merged).
+    for (std::size_t k = 0; k < lightMatrices.size(); ++k) {
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges;
+        const auto it = layerCasters.find(k);
+        for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+            if (it != layerCasters.end() && !it->second[o]) continue;
+            const std::uint32_t first = geometry.objectFirstIndex[o], end = geometry.objectFirstIndex[o + 1];
+            if (!ranges.empty() && ranges.back().first + ranges.back().second == first)
+                ranges.back().second += end - first;
+            else
+                ranges.emplace_back(first, end - first);
+        }
+        draw.layerRanges.push_back(std::move(ranges));
+    }
+    std::string culled;
+    for (std::size_t i = 0; i < culledPerLight.size(); ++i) culled += (i ? ";" : "") + std::to_string(culledPerLight[i]);
+    attributes["culled_casters"] = culled;
 
     // Without a shadowed light a 1x1 cleared layer keeps the descriptor valid.
     const auto mapSize = lightMatrices.empty() ? 1u : std::uint32_t(settings.shadowMapSize);

@@ -117,7 +117,12 @@ void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, 
             const VkDeviceSize offset = 0;
             vkCmdBindVertexBuffers(commands, 0, 1, &geometry.vertices, &offset);
             vkCmdBindIndexBuffer(commands, geometry.indices, 0, VK_INDEX_TYPE_UINT32);
-            vkCmdDrawIndexed(commands, geometry.indexCount, 1, 0, 0, 0);
+            if (layer < geometry.layerRanges.size()) {
+                for (const auto& [first, count] : geometry.layerRanges[layer])
+                    if (count > 0) vkCmdDrawIndexed(commands, count, 1, first, 0, 0);
+            } else {
+                vkCmdDrawIndexed(commands, geometry.indexCount, 1, 0, 0, 0);
+            }
         }
         vkCmdEndRendering(commands);
     }

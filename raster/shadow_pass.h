@@ -37,6 +37,9 @@ struct DrawGeometry {
     VkBuffer vertices = VK_NULL_HANDLE;
     VkBuffer indices = VK_NULL_HANDLE;
     std::uint32_t indexCount = 0;
+    // Shadow pass only: per layer, the index ranges (first, count) drawn into it (the casters
+    // left after culling); layers past the end of this list draw every index.
+    std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> layerRanges;
 };
 
 // Records: every layer cleared to depth 1 (far: lit) and id 0, and layer i drawn with
