@@ -61,7 +61,16 @@ Prepared prepare(const SceneOptions& o) {
     if (o.resolution) applyResolution(p.scene, *o.resolution);
     p.settings = scene::resolveSettings(p.scene, o.settings);
     p.plan = scene::makeRenderPlan(p.scene, p.settings);
-    if (o.explain) std::cerr << "render plan for " << p.scene.file.string() << ":\n" << p.plan.explain();
+    if (o.explain)
+        std::cerr << "render plan for " << p.scene.file.string() << ":\n"
+                  << p.plan.explain()
+                  << "raster shadow-map size: " << raster::chooseShadowMapSize(p.scene, p.settings.raster).reason << "\n";
+    if (o.explain) {
+        const std::vector<int> culled = raster::culledCasters(p.scene, p.settings.raster);
+        for (std::size_t i = 0; i < culled.size(); ++i)
+            std::cerr << "raster light " << i << ": " << culled[i] << " of " << p.scene.objects.size()
+                      << " objects left out of the depth pass (cannot cast onto the visible receivers)\n";
+    }
     return p;
 }
 

@@ -29,6 +29,9 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
     cmd.add_option("--pcf-size", s.pcfSize, "raster: pcf taps per side, or poisson kernel diameter in texels (default 3)");
     cmd.add_option("--normal-offset", s.normalOffset,
                    "raster: move receivers along their normal by this many texels (default 0)");
+    cmd.add_flag("--receiver-plane-bias", s.receiverPlaneBias,
+                 "raster: compare each filter tap against the receiver's plane (from screen-space derivatives) "
+                 "instead of the slope bias");
     cmd.add_flag("--fit-light-frustum", s.fitLightFrustum,
                  "raster: fit each light's map to the casters of visible receivers, not the scene's bounds");
     cmd.add_option("--cascades", s.cascades,

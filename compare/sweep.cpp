@@ -61,6 +61,7 @@ Json overridesToJson(const scene::SettingsOverrides& o) {
     if (o.samples) j["samples"] = *o.samples;
     if (o.pcfSize) j["pcf_size"] = *o.pcfSize;
     if (o.normalOffset) j["normal_offset"] = *o.normalOffset;
+    if (o.receiverPlaneBias) j["receiver_plane_bias"] = *o.receiverPlaneBias;
     if (o.fitLightFrustum) j["fit_light_frustum"] = *o.fitLightFrustum;
     if (o.cascades) j["cascades"] = *o.cascades;
     return j;
@@ -77,6 +78,7 @@ scene::SettingsOverrides overridesFromJson(const Json& j) {
     if (j.contains("samples")) o.samples = j["samples"].get<int>();
     if (j.contains("pcf_size")) o.pcfSize = j["pcf_size"].get<int>();
     if (j.contains("normal_offset")) o.normalOffset = j["normal_offset"].get<double>();
+    if (j.contains("receiver_plane_bias")) o.receiverPlaneBias = j["receiver_plane_bias"].get<bool>();
     if (j.contains("fit_light_frustum")) o.fitLightFrustum = j["fit_light_frustum"].get<bool>();
     if (j.contains("cascades")) o.cascades = j["cascades"].get<int>();
     return o;
@@ -162,6 +164,7 @@ std::string SweepConfig::key() const {
     if (o.samples) k += ";samples=" + std::to_string(*o.samples);
     if (o.pcfSize) k += ";pcf_size=" + std::to_string(*o.pcfSize);
     if (o.normalOffset) k += ";normal_offset=" + number(*o.normalOffset);
+    if (o.receiverPlaneBias) k += std::string(";receiver_plane_bias=") + (*o.receiverPlaneBias ? "1" : "0");
     if (o.fitLightFrustum) k += std::string(";fit_light_frustum=") + (*o.fitLightFrustum ? "1" : "0");
     if (o.cascades) k += ";cascades=" + std::to_string(*o.cascades);
     return k;
@@ -179,6 +182,7 @@ std::string SweepConfig::label() const {
     if (o.samples) parts.push_back(std::to_string(*o.samples) + " samples");
     if (o.pcfSize) parts.push_back("pcf size " + std::to_string(*o.pcfSize));
     if (o.normalOffset) parts.push_back("normal offset " + number(*o.normalOffset));
+    if (o.receiverPlaneBias) parts.push_back(*o.receiverPlaneBias ? "receiver-plane bias" : "no receiver-plane bias");
     if (o.fitLightFrustum) parts.push_back(*o.fitLightFrustum ? "fitted frustum" : "bounds frustum");
     if (o.cascades) parts.push_back(std::to_string(*o.cascades) + (*o.cascades == 1 ? " cascade" : " cascades"));
     std::string s = backend + ":";
@@ -329,7 +333,8 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
         if (!block.is_object()) throw SceneError(file, path, "expected an object of axes");
         const bool isRaster = std::string(backend) == "raster";
         const std::vector<const char*> names = isRaster
-            ? std::vector<const char*>{"shadow_map_size", "filter", "cascades", "depth_bias", "slope_bias"}
+            ? std::vector<const char*>{"shadow_map_size", "filter", "cascades", "receiver_plane_bias", "depth_bias",
+                                       "slope_bias"}
             : std::vector<const char*>{"ray_bias", "precision", "samples"};
         for (const auto& [key, value] : block.items())
             if (std::none_of(names.begin(), names.end(), [&](const char* n) { return key == n; }))
@@ -366,6 +371,9 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
                             throw SceneError(file, at, "expected an integer in 1.." + std::to_string(scene::kMaxCascades) +
                                                            " (cascaded shadow maps per directional light), got " + v.dump());
                         c.overrides.cascades = v.get<int>();
+                    } else if (n == "receiver_plane_bias") {
+                        if (!v.is_boolean()) throw SceneError(file, at, "expected true or false, got " + v.dump());
+                        c.overrides.receiverPlaneBias = v.get<bool>();
                     } else if (n == "depth_bias") {
                         c.overrides.depthBias = num(0.0);
                         c.biasKind = "depth";

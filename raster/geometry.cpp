@@ -130,6 +130,7 @@ SceneGeometry tessellateScene(const scene::Scene& scene, const scene::Vec3& orig
     const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
     for (std::size_t i = 0; i < scene.objects.size(); ++i) {
         const scene::Object& o = scene.objects[i];
+        out.objectFirstIndex.push_back(std::uint32_t(out.indices.size()));
         Builder b(out, origin, std::uint32_t(i + 1));
         if (const auto* s = std::get_if<scene::Sphere>(&o.shape)) {
             // Nearest distance from the camera to the sphere; inside it, the near plane.
@@ -145,6 +146,7 @@ SceneGeometry tessellateScene(const scene::Scene& scene, const scene::Vec3& orig
             addMesh(b, o, *m);
         }
     }
+    out.objectFirstIndex.push_back(std::uint32_t(out.indices.size()));
     return out;
 }
 

@@ -23,6 +23,8 @@ struct SceneGeometry {
     std::vector<Vertex> vertices;
     std::vector<std::uint32_t> indices;  // three per triangle
     int maxSphereSegments = 0;           // the finest sphere (0 when there is none)
+    // Object i's triangles are indices objectFirstIndex[i] .. objectFirstIndex[i + 1] − 1.
+    std::vector<std::uint32_t> objectFirstIndex;
     std::size_t triangleCount() const { return indices.size() / 3; }
 };
 

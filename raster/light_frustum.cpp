@@ -296,4 +296,90 @@ std::string LightFrustum::describe() const {
     return buf;
 }
 
+ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::RasterSettings& settings) {
+    const int size = settings.shadowMapSize;
+    auto keep = [&](const std::string& why) { return ShadowMapSizeChoice{size, std::to_string(size) + " (" + why + ")"}; };
+    // A size set after resolveSettings() (a test, the sweep) is forced too.
+    if (!settings.shadowMapSizeIsDefault || size != scene::kDefaultShadowMapSize)
+        return keep("set by --shadow-map-size or the scene");
+    for (const scene::Light& l : scene.lights)
+        if (l.type != scene::LightType::Directional)
+            return keep("default: spot and point maps have texels that grow with distance");
+    if (settings.cascades > 1) return keep("default: cascades size their texels per slice");
+    // The nearest view depth of any visible receiver: over each object's bounds clipped to the
+    // camera frustum (the scene's box would reach up to the camera), at a vertex of the clipped box.
+    const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
+    double zMin = INFINITY;
+    for (const scene::Object& o : scene.objects)
+        for (const Vec3& p : visibleReceiverPoints(scene, scene::boundsOf(o.shape)))
+            zMin = std::min(zMin, glm::dot(p - cam.position, cam.forward));
+    if (!std::isfinite(zMin)) return keep("default: the camera sees no receiver");
+    zMin = std::max(zMin, scene.camera.near);
+    // A pixel's world size on a receiver facing the camera at view depth z; tilted receivers
+    // have larger footprints, so this is the finest detail the image can show.
+    const double pixel = 2.0 * cam.tanHalfFovY * zMin / std::max(scene.camera.height, 1);
+    double widest = 0.0;
+    for (const scene::Light& l : scene.lights) {
+        const LightFrustum f = settings.fitLightFrustum ? fitDirectionalLightToReceivers(scene, l.direction, size)
+                                                        : fitDirectionalLight(scene.bounds(), l.direction, size);
+        widest = std::max(widest, 2.0 * f.halfWidth);
+    }
+    const double needed = widest / pixel;
+    int chosen = kMinAutoShadowMapSize;
+    while (chosen < needed && chosen < size) chosen *= 2;
+    chosen = std::min(chosen, size);
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "%d (%s: map width %.4g / smallest pixel footprint %.4g at view depth %.4g = %.0f texels%s)",
+                  chosen, chosen < size ? "from receiver detail" : "default", widest, pixel, zMin, needed,
+                  chosen < size ? ", rounded up to a power of two" : ", capped at the default");
+    return ShadowMapSizeChoice{chosen, buf};
+}
+
+
+std::vector<bool> castsIntoView(const scene::Scene& scene, const LightFrustum& f, double marginTexels) {
+    std::vector<bool> casts(scene.objects.size(), true);
+    const std::vector<Vec3> receivers = visibleReceiverPoints(scene);
+    if (receivers.empty() || f.perspective) return casts;
+    double minU = INFINITY, maxU = -INFINITY, minV = INFINITY, maxV = -INFINITY, maxDepth = -INFINITY;
+    for (const Vec3& c : receivers) {
+        const Vec3 d = c - f.center;
+        minU = std::min(minU, glm::dot(d, f.right));
+        maxU = std::max(maxU, glm::dot(d, f.right));
+        minV = std::min(minV, glm::dot(d, f.up));
+        maxV = std::max(maxV, glm::dot(d, f.up));
+        maxDepth = std::max(maxDepth, glm::dot(d, f.direction));
+    }
+    const double margin = marginTexels * f.texelWorldSize();
+    for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+        const scene::Bounds b = scene::boundsOf(scene.objects[i].shape);
+        if (b.empty()) continue;
+        double oMinU = INFINITY, oMaxU = -INFINITY, oMinV = INFINITY, oMaxV = -INFINITY, oMinDepth = INFINITY;
+        for (const Vec3& c : corners(b)) {
+            const Vec3 d = c - f.center;
+            oMinU = std::min(oMinU, glm::dot(d, f.right));
+            oMaxU = std::max(oMaxU, glm::dot(d, f.right));
+            oMinV = std::min(oMinV, glm::dot(d, f.up));
+            oMaxV = std::max(oMaxV, glm::dot(d, f.up));
+            oMinDepth = std::min(oMinDepth, glm::dot(d, f.direction));
+        }
+        casts[i] = oMaxU >= minU - margin && oMinU <= maxU + margin && oMaxV >= minV - margin &&
+                   oMinV <= maxV + margin && oMinDepth <= maxDepth + margin;
+    }
+    return casts;
+}
+
+std::vector<int> culledCasters(const scene::Scene& scene, const scene::RasterSettings& settingsIn) {
+    scene::RasterSettings settings = settingsIn;
+    settings.shadowMapSize = chooseShadowMapSize(scene, settingsIn).size;
+    std::vector<int> culled(scene.lights.size(), 0);
+    for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+        const scene::Light& l = scene.lights[i];
+        if (l.type != scene::LightType::Directional || settings.cascades > 1) continue;
+        const LightFrustum f = settings.fitLightFrustum
+                                   ? fitDirectionalLightToReceivers(scene, l.direction, settings.shadowMapSize)
+                                   : fitDirectionalLight(scene.bounds(), l.direction, settings.shadowMapSize);
+        for (const bool c : castsIntoView(scene, f, kCullMarginTexels + settings.normalOffset)) culled[i] += c ? 0 : 1;
+    }
+    return culled;
+}
 }  // namespace shadowlab::raster

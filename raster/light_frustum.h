@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "scene/scene.h"
+#include "scene/settings.h"
 
 namespace shadowlab::raster {
 
@@ -90,5 +91,33 @@ double cubeFaceTanHalfFov(int mapSize);
 // and far enclose the scene's bounding sphere (the same for all six faces, near no closer than
 // far · kSpotMinNearOverFar).
 LightFrustum fitPointLightFace(const scene::Bounds& bounds, const scene::Vec3& position, int face, int mapSize);
+
+
+// Caster culling (issue 5) for a directional light's map f: whether each object can cast onto
+// the visible receivers (visibleReceiverPoints, the scene's box clipped to the camera). Seen along
+// the light, the object's bounding box must overlap the receivers' extent across it, widened by
+// marginTexels texels (filter taps and normal offset look that far), and reach nearer the light
+// than the farthest receiver. All true when the camera sees none of the scene.
+// The widest filter reach in texels (a 15-tap kernel's half, pcf2x2's extra texel, rounding).
+inline constexpr double kCullMarginTexels = 10.0;
+std::vector<bool> castsIntoView(const scene::Scene& scene, const LightFrustum& f, double marginTexels);
+// Per light, how many objects castsIntoView leaves out of its depth pass (0 for spot and point
+// lights and cascades, which are not culled), with the frusta the renderer makes for `settings`.
+std::vector<int> culledCasters(const scene::Scene& scene, const scene::RasterSettings& settings);
+
+// Map size from the receivers' detail (issue 5): when nobody chose a size (settings
+// shadowMapSizeIsDefault and the size is kDefaultShadowMapSize), a map whose texel is smaller than the smallest world footprint of a
+// screen pixel on the visible receivers adds nothing the image can show. The size is then the
+// widest directional map's width divided by that footprint, rounded up to a power of two and
+// clamped to [kMinAutoShadowMapSize, the default]. Kept as set when forced, with spot or point
+// lights (their texels grow with distance; one array holds every map), with cascades (sized per
+// slice already) or when the camera sees nothing. `reason` says which, for --explain and the Frame.
+// The smallest size chosen that way: below it the bias defaults (half a texel) grow coarse.
+inline constexpr int kMinAutoShadowMapSize = 256;
+struct ShadowMapSizeChoice {
+    int size = 0;
+    std::string reason;
+};
+ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::RasterSettings& settings);
 
 }  // namespace shadowlab::raster

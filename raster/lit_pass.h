@@ -28,6 +28,7 @@ struct LitVariant {
     std::uint32_t lightKinds = 7;    // bit (1 << SHADOWLAB_LIGHT_*) for each kind in the scene
     std::uint32_t cascades = 1;      // cascades of the cascaded directional lights (1: none cascaded)
     bool transmittance = false;      // semi-transparent casters: read the transmittance maps
+    bool receiverPlane = false;      // receiver-plane depth bias in every filter tap
 };
 // Per-light visibility targets: four lights in each RGBA32F target, SHADOWLAB_MAX_LIGHTS in all.
 inline constexpr std::uint32_t kLightTargets = (SHADOWLAB_MAX_LIGHTS + 3) / 4;

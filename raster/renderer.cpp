@@ -205,6 +205,19 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     draw = DrawGeometry{vertexBuffer.buffer.get(), indexBuffer.buffer.get(), std::uint32_t(geometry.indices.size()),
                         opaqueIndexCount, transparentDraws};
 
+    // Map size from the receivers' detail when nobody chose one; a default constant bias (half a
+    // texel of the bounding-sphere map) follows the size.
+    const ShadowMapSizeChoice mapChoice = chooseShadowMapSize(scene, settings);
+    if (mapChoice.size != settings.shadowMapSize) {
+        settings.shadowMapSize = mapChoice.size;
+        if (settings.depthBiasIsDefault) settings.depthBias = scene::defaultDepthBias(scene, mapChoice.size);
+    }
+    attributes["shadow_map_size_reason"] = mapChoice.reason;
+
+    // Caster culling: per culled layer, which objects are drawn into it; per light, how many not.
+    std::map<std::size_t, std::vector<bool>> layerCasters;
+    std::vector<int> culledPerLight(scene.lights.size(), 0);
+
     std::vector<double> usedDepthBias;  // per shadow-mapped light (spot, directional)
     // One shadow-map layer per light that needs a shadow test.
     const scene::Bounds bounds = scene.bounds();
@@ -283,6 +296,12 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
                 layerLight.push_back(int(i));
                 layerLabels.push_back("L" + std::to_string(i));
                 layer = float(lightMatrices.size());
+                if (!spot && settings.cullCasters) {
+                    // Objects that cannot cast onto the visible receivers stay out of this map.
+                    std::vector<bool> casts = castsIntoView(scene, f, kCullMarginTexels + settings.normalOffset);
+                    for (const bool c : casts) culledPerLight[i] += c ? 0 : 1;
+                    layerCasters[lightMatrices.size()] = std::move(casts);
+                }
                 lightMatrices.push_back(glm::mat4(f.toClip(origin)));
                 l.toShadow = glm::mat4(f.toTexture(origin));
                 // The default constant bias is half a texel of the bounding-sphere map
@@ -321,6 +340,25 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
         // a: 1 − opacity, divided out of a semi-transparent receiver's own transmittance (lit.frag).
         albedos.emplace_back(glm::vec3(scene.materialOf(o).albedo),
                              scene.materialOf(o).opaque() ? 1.0f : float(1.0 - scene.materialOf(o).opacity));
+    // Each layer's index ranges: every object, or the culled layer's casters (runs of them merged).
+    // Not with a transmittance map: its index order (opaque casters first) is not per object, so
+    // the depth pass then draws every opaque caster (layerRanges empty).
+    for (std::size_t k = 0; k < lightMatrices.size() && !plan.needsTransmittanceMap; ++k) {
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges;
+        const auto it = layerCasters.find(k);
+        for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+            if (it != layerCasters.end() && !it->second[o]) continue;
+            const std::uint32_t first = geometry.objectFirstIndex[o], end = geometry.objectFirstIndex[o + 1];
+            if (!ranges.empty() && ranges.back().first + ranges.back().second == first)
+                ranges.back().second += end - first;
+            else
+                ranges.emplace_back(first, end - first);
+        }
+        draw.layerRanges.push_back(std::move(ranges));
+    }
+    std::string culled;
+    for (std::size_t i = 0; i < culledPerLight.size(); ++i) culled += (i ? ";" : "") + std::to_string(culledPerLight[i]);
+    attributes["culled_casters"] = culled;
 
     // Without a shadowed light a 1x1 cleared layer keeps the descriptor valid.
     const auto mapSize = lightMatrices.empty() ? 1u : std::uint32_t(settings.shadowMapSize);
@@ -377,6 +415,8 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     attributes["depth_bias"] = depthBias;
     attributes["depth_bias_default"] = settings.depthBiasIsDefault ? "true" : "false";
     attributes["slope_bias"] = formatNumber(settings.slopeBias);
+    // On, the receiver's plane replaces the slope term in every tap (lit.frag), so slope_bias is unused.
+    attributes["receiver_plane_bias"] = settings.receiverPlaneBias ? "true" : "false";
     attributes["max_slope_tan"] = formatNumber(kMaxSlopeTan);
     attributes["triangles"] = std::to_string(triangles);
     attributes["sphere_segments"] = std::to_string(sphereSegmentsUsed);
@@ -429,7 +469,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                                                             .lightCount = std::uint32_t(lightCount),
                                                             .lightKinds = lightKinds,
                                                             .cascades = std::uint32_t(cascadesUsed),
-                                                            .transmittance = transmit});
+                                                            .transmittance = transmit,
+                                                            .receiverPlane = settings.receiverPlaneBias});
         if (bindings.set == VK_NULL_HANDLE)
             bindings = createLitBindings(ctx, litPipeline, uniforms, albedos, maps, transmittanceMaps);
         setup += msSince(pipelineStart);

@@ -256,7 +256,12 @@ void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, 
             const VkDeviceSize offset = 0;
             vkCmdBindVertexBuffers(commands, 0, 1, &geometry.vertices, &offset);
             vkCmdBindIndexBuffer(commands, geometry.indices, 0, VK_INDEX_TYPE_UINT32);
-            vkCmdDrawIndexed(commands, geometry.depthPassIndexCount(), 1, 0, 0, 0);
+            if (layer < geometry.layerRanges.size()) {  // the casters left after culling
+                for (const auto& [first, count] : geometry.layerRanges[layer])
+                    if (count > 0) vkCmdDrawIndexed(commands, count, 1, first, 0, 0);
+            } else {
+                vkCmdDrawIndexed(commands, geometry.depthPassIndexCount(), 1, 0, 0, 0);
+            }
         }
         vkCmdEndRendering(commands);
     }

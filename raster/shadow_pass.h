@@ -51,6 +51,9 @@ struct DrawGeometry {
     std::uint32_t opaqueIndexCount = ~0u;
     std::vector<TransparentDraw> transparent;
     std::uint32_t depthPassIndexCount() const { return opaqueIndexCount < indexCount ? opaqueIndexCount : indexCount; }
+    // Shadow pass only: per layer, the index ranges (first, count) drawn into it (the casters
+    // left after culling); layers past the end of this list draw every index.
+    std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> layerRanges;
 };
 
 // The transmittance map beside the depth map (made only for scenes with semi-transparent

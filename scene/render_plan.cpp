@@ -1,6 +1,8 @@
 // scene/render_plan.cpp: decides what each render leaves out, with the reason for each choice.
 #include "scene/render_plan.h"
 
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 
 namespace shadowlab::scene {
@@ -12,6 +14,22 @@ bool isConvex(const Shape& shape) {
            std::holds_alternative<Quad>(shape);
 }
 
+// Whether a spot light's cone can reach any part of `b`: the box's bounding sphere (center c,
+// radius R) meets the infinite one-sided cone from the apex with half-angle α when c is within R
+// of the apex, or when the angle between the axis and the direction to c is at most α + asin(R/|c|)
+// (the sphere's angular radius seen from the apex). Conservative: a box's sphere is larger than
+// the box.
+bool coneReaches(const Light& spot, const Bounds& b) {
+    if (b.empty()) return false;
+    constexpr double kPi = 3.14159265358979323846;
+    const Vec3 v = b.center() - spot.position;
+    const double d = glm::length(v);
+    const double radius = 0.5 * b.diagonal();
+    if (d <= radius) return true;
+    const double cosAngle = std::clamp(glm::dot(v, glm::normalize(spot.direction)) / d, -1.0, 1.0);
+    const double reach = spot.coneAngleDegrees * kPi / 180.0 + std::asin(std::min(radius / d, 1.0));
+    return reach >= kPi || std::acos(cosAngle) <= reach;
+}
 
 }  // namespace
 
@@ -35,6 +53,21 @@ RenderPlan makeRenderPlan(const Scene& scene, const RenderSettings& settings) {
         lp.reason = canShadow ? "objects can cast shadows"
                               : (scene.objects.empty() ? "the scene has no objects"
                                                        : "a single convex object cannot shadow itself");
+        if (canShadow && light.type == LightType::Spot) {
+            // A spot lights only what its cone holds, and a blocker must lie on the segment from
+            // a lit point to the apex, which the (convex) cone also holds: with nothing in the
+            // cone, or one convex object alone, its map would shadow nothing.
+            std::vector<const Object*> inCone;
+            for (const Object& o : scene.objects)
+                if (coneReaches(light, boundsOf(o.shape))) inCone.push_back(&o);
+            if (inCone.empty()) {
+                lp.needsShadowTest = false;
+                lp.reason = "no object inside the spot's cone";
+            } else if (inCone.size() == 1 && isConvex(inCone[0]->shape)) {
+                lp.needsShadowTest = false;
+                lp.reason = "only one convex object inside the spot's cone, which cannot shadow itself";
+            }
+        }
         if (light.type == LightType::Point && lp.needsShadowTest) plan.needsCubeMap = true;
         if (light.radius > 0.0 && light.type != LightType::Directional) plan.hasAreaLights = true;
         plan.lights.push_back(lp);

@@ -131,6 +131,7 @@ struct ShadowDefaults {
     std::optional<std::string> filter;   // "none" | "pcf2x2" | "pcf" | "poisson"
     std::optional<int> pcfSize;          // texels
     std::optional<double> normalOffset;  // texels
+    std::optional<bool> receiverPlaneBias;
     std::optional<bool> fitLightFrustum;
     std::optional<int> cascades;         // directional lights: cascaded shadow maps, 1..kMaxCascades
     std::optional<double> rayBias;       // world units; absent: scene-scaled

@@ -47,7 +47,8 @@ RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& o) {
     RenderSettings s;
     const ShadowDefaults& d = scene.shadow;
 
-    s.raster.shadowMapSize = o.shadowMapSize.value_or(d.shadowMapSize.value_or(2048));
+    s.raster.shadowMapSize = o.shadowMapSize.value_or(d.shadowMapSize.value_or(kDefaultShadowMapSize));
+    s.raster.shadowMapSizeIsDefault = !o.shadowMapSize && !d.shadowMapSize;
     if (s.raster.shadowMapSize < 16 || s.raster.shadowMapSize > 16384)
         throw InputError("--shadow-map-size: must be in 16..16384, got " +
                          std::to_string(s.raster.shadowMapSize));
@@ -68,6 +69,7 @@ RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& o) {
     s.raster.normalOffset = o.normalOffset.value_or(d.normalOffset.value_or(0.0));
     if (!std::isfinite(s.raster.normalOffset) || s.raster.normalOffset < 0.0)
         throw InputError("--normal-offset: must be a finite value >= 0 (texels)");
+    s.raster.receiverPlaneBias = o.receiverPlaneBias.value_or(d.receiverPlaneBias.value_or(false));
     s.raster.fitLightFrustum = o.fitLightFrustum.value_or(d.fitLightFrustum.value_or(false));
     s.raster.cascades = o.cascades.value_or(d.cascades.value_or(1));
     if (s.raster.cascades < 1 || s.raster.cascades > kMaxCascades)

@@ -24,8 +24,14 @@ enum class Precision { Float, Double };
 // texel density while every pass redraws the whole scene), see docs/raster.md.
 inline constexpr int kMaxCascades = 4;
 
+// The shadow-map size when neither the command line nor the scene sets one.
+inline constexpr int kDefaultShadowMapSize = 2048;
+
 struct RasterSettings {
-    int shadowMapSize = 2048;   // texels per side
+    int shadowMapSize = kDefaultShadowMapSize;  // texels per side
+    // True when shadowMapSize is the default (no option, no scene value): the raster backend may
+    // then lower it to what the receivers' detail on screen needs (raster::chooseShadowMapSize).
+    bool shadowMapSizeIsDefault = false;
     double depthBias = 0.0;     // world units along the light direction 
     // True when depthBias is defaultDepthBias() (no option, no scene value): the raster backend
     // then re-derives it as half a texel of each fitted map (fitLightFrustum), see docs/raster.md.
@@ -34,10 +40,16 @@ struct RasterSettings {
     ShadowFilter filter = ShadowFilter::Pcf2x2;
     int pcfSize = 3;            // pcf: taps per side; poisson: kernel diameter in texels (1..15)
     double normalOffset = 0.0;  // texels: the receiver moves along its normal by this x texel world size
+    // Receiver-plane depth bias (Isidoro 2006): each filter tap compares against the receiver's
+    // plane extrapolated to the texel it reads, instead of the slope bias (see docs/raster.md).
+    bool receiverPlaneBias = false;
     bool fitLightFrustum = false;  // fit each light's map to the casters of visible receivers (else the scene's bounding sphere)
     // Directional lights: split the view's depth range into this many slices, each with its own
     // map (1 = one map for the whole view, as fitLightFrustum or the bounding sphere decide).
     int cascades = 1;
+    // Leave objects that cannot cast onto the visible receivers out of directional maps (raster
+    // castsIntoView); tests and benchmarks turn it off to compare.
+    bool cullCasters = true;
     std::string device;         // "" = lavapipe if present, else the first device; index or name substring
     bool validate = false;      // enable VK_LAYER_KHRONOS_validation and count its messages
 };
@@ -64,6 +76,7 @@ struct SettingsOverrides {
     std::optional<std::string> filter;
     std::optional<int> pcfSize;          // --pcf-size
     std::optional<double> normalOffset;  // --normal-offset (texels)
+    std::optional<bool> receiverPlaneBias;  // --receiver-plane-bias
     std::optional<bool> fitLightFrustum; // --fit-light-frustum
     std::optional<int> cascades;         // --cascades (1..kMaxCascades)
     std::optional<std::string> rayBias;  // a number or "robust"

@@ -63,6 +63,8 @@ layout(constant_id = 4) const int kCascades = 1;
 // The scene has semi-transparent casters: every compare tap is multiplied by the transmittance
 // map's texel. Scenes without have none of that code.
 layout(constant_id = 5) const bool kTransmittance = false;
+// Receiver-plane depth bias in every tap (see shadowTest); off, its code is compiled out.
+layout(constant_id = 6) const bool kReceiverPlane = false;
 const bool kAnyPerspective =
     (kLightKinds & ((1 << SHADOWLAB_LIGHT_SPOT) | (1 << SHADOWLAB_LIGHT_POINT))) != 0;
 
@@ -113,6 +115,10 @@ struct Receiver {
     float axial;      // spot: distance along the light's axis; directional: its linear depth 0..1
     float biasWorld;  // depthBias + slopeBias·texel·tan(θ): the bias of a tap at the point
     float slopeStep;  // what one texel of tap distance adds to the bias (slopeBias·texel·tan(θ))
+    // Receiver-plane bias (kReceiverPlane): the receiver's depth gradient, world units per texel
+    // of (u, v); plane = false where the derivatives cannot give one (then the slope bias is used).
+    vec2 grad;
+    bool plane;
 };
 
 // The compare reference for a receiver biased by `bias` world units toward the light.
@@ -159,9 +165,68 @@ vec3 cubeTap(LightData light, vec3 axis, vec3 right, vec3 up, vec3 qd, vec2 uv, 
     return vec3(0.5 + 0.5 * vec2(dot(d, fRight), dot(d, fUp)) / (along * light.kind.y), light.toLight.w + float(face));
 }
 
+// Map coordinates (u, v) and axial depth (as Receiver.uv, .axial) of camera-relative point q, for
+// the face whose axis is `axis` (point lights) or the light's own map.
+vec3 mapCoordinates(LightData light, vec3 axis, vec3 q) {
+    if (isKind(light, SHADOWLAB_LIGHT_POINT)) {
+        const vec3 ref = abs(axis.y) < 0.99 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
+        const vec3 right = normalize(cross(axis, ref));
+        const vec3 up = cross(right, axis);
+        const vec3 d = q - light.toLight.xyz;
+        const float axial = dot(d, axis);
+        return vec3(0.5 + 0.5 * vec2(dot(d, right), dot(d, up)) / (axial * light.kind.y), axial);
+    }
+    const vec4 s = light.toShadow * vec4(q, 1.0);
+    return vec3(s.xy / s.w, isPerspective(light) ? dot(q - light.toLight.xyz, axis) : s.z);
+}
+
+// Receiver-plane depth bias (Isidoro, "Shadow Mapping: GPU-based Tips and Techniques", GDC 2006).
+// The neighbouring pixels' positions (q + dFdx, q + dFdy of the position) mapped into the light's
+// map give the screen-space derivatives of (u, v, depth); solving
+//   [du/dx dv/dx; du/dy dv/dy] · (dz/du, dz/dv) = (dz/dx, dz/dy)
+// gives the receiver's depth gradient in the map. The derivatives come in from main(), taken in
+// uniform control flow (inside the per-light branch they would be undefined). Where the 2x2 matrix
+// is near singular (the surface seen edge-on by the camera, or its footprint in the map a line)
+// there is no plane, and the slope bias is used instead; the gradient is capped as the slope bias
+// is (kMaxSlopeTan texels of depth per texel), so a grazing plane cannot push taps far behind.
+void receiverPlane(LightData light, vec3 axis, vec3 q, vec3 dpdx, vec3 dpdy, float size, float texel,
+                   inout Receiver r) {
+    const vec3 c = mapCoordinates(light, axis, q);
+    const vec3 cx = mapCoordinates(light, axis, q + dpdx) - c;
+    const vec3 cy = mapCoordinates(light, axis, q + dpdy) - c;
+    const vec2 ux = cx.xy * size, uy = cy.xy * size;  // texels per pixel
+    // World units per unit of axial depth: orthographic depth is 0..1 over the depth range.
+    const float worldPerAxial = isPerspective(light) ? 1.0 : 1.0 / light.bias.w;
+    const float zx = cx.z * worldPerAxial, zy = cy.z * worldPerAxial;
+    const float det = ux.x * uy.y - ux.y * uy.x;
+    // Near singular: the two footprint vectors less than ~0.06° apart (|sin| < 1e-3).
+    r.plane = abs(det) > 1e-3 * length(ux) * length(uy) && det != 0.0;
+    if (!r.plane) return;
+    vec2 g = vec2(uy.y * zx - ux.y * zy, ux.x * zy - uy.x * zx) / det;
+    const float cap = light.params.x * texel;
+    const float len = length(g);
+    if (!(len <= cap)) g = len > 0.0 && !isinf(len) ? g * (cap / len) : vec2(0.0);  // also NaN -> 0
+    r.grad = g;
+}
+
+// The tap `o` texels from the point. Receiver plane: the tap reads the texel holding that
+// position at its center, and compares against the plane's depth there (where that texel's depth
+// was rasterized) minus the constant bias; sampling at the center makes sure the texel compared
+// is the one the plane was evaluated for. Else the constant bias plus the slope term grown with
+// the tap's distance.
+float biasedTap(LightData light, Receiver r, vec2 o, float size, float layer, inout uint blocker) {
+    if (kReceiverPlane && r.plane) {
+        const vec2 t = r.uv * size;
+        const vec2 center = floor(t + o) + 0.5;
+        return tap(center / size, layer, reference(light, r, r.biasWorld - dot(r.grad, center - t)), blocker);
+    }
+    return tap(r.uv + o / size, layer, reference(light, r, r.biasWorld + r.slopeStep * length(o)), blocker);
+}
+
 // Visibility 0..1 of `light` at camera-relative position p with unit normal n (facing the
-// viewer), N·L = ndotl > 0. `blocker` gets the id of the object that shadowed, if any.
-float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, inout uint blocker) {
+// viewer), N·L = ndotl > 0; dpdx, dpdy: p's screen-space derivatives (receiver plane only).
+// `blocker` gets the id of the object that shadowed, if any.
+float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, vec3 dpdx, vec3 dpdy, inout uint blocker) {
     const bool perspective = isPerspective(light);
     const bool point = isKind(light, SHADOWLAB_LIGHT_POINT);
     vec3 axis = light.axis.xyz;
@@ -195,7 +260,32 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, inout uint blocke
     }
     const int filterCode = kFilter;  // light.params.y holds the same code
     const float size = float(textureSize(shadowMaps, 0).x);
-    if (filterCode == SHADOWLAB_FILTER_NONE) return tap(r.uv, layer, reference(light, r, r.biasWorld), blocker);
+    r.plane = false;
+    r.grad = vec2(0.0);
+    if (kReceiverPlane) {
+        receiverPlane(light, axis, q, dpdx, dpdy, size, texel, r);
+        // The plane replaces the slope term; the constant bias stays.
+        if (r.plane) r.biasWorld = light.bias.x;
+    }
+    if (filterCode == SHADOWLAB_FILTER_NONE) {
+        if (kReceiverPlane && r.plane) return biasedTap(light, r, vec2(0.0), size, layer, blocker);
+        return tap(r.uv, layer, reference(light, r, r.biasWorld), blocker);
+    }
+    if (filterCode == SHADOWLAB_FILTER_PCF2X2 && kReceiverPlane && r.plane) {
+        // The same bilinear weights, but each of the four texels compared against the plane at
+        // its own center (a gather has one reference for all four).
+        const vec2 t = r.uv * size - 0.5;
+        const vec2 i0 = floor(t);
+        const vec2 f = t - i0;
+        const vec2 c00 = i0 + 0.5;  // texel-center coordinates of (i0, j0), in texels
+        const vec2 fromPoint = c00 - r.uv * size;
+        float v[4];
+        [[unroll]] for (int k = 0; k < 4; ++k) {
+            const vec2 ab = vec2(k & 1, k >> 1);
+            v[k] = tap((c00 + ab) / size, layer, reference(light, r, r.biasWorld - dot(r.grad, fromPoint + ab)), blocker);
+        }
+        return mix(mix(v[0], v[1], f.x), mix(v[2], v[3], f.x), f.y);
+    }
     if (filterCode == SHADOWLAB_FILTER_PCF2X2) {
         // The bilinear mix of the four comparisons around the point: what a LINEAR compare
         // sampler does in hardware, done here because lavapipe cannot filter D32_SFLOAT
@@ -273,7 +363,7 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, inout uint blocke
         for (int j = 0; j < taps; ++j)
             for (int i = 0; i < taps; ++i) {
                 const vec2 o = vec2(i, j) - c;
-                sum += tap(r.uv + o / size, layer, reference(light, r, r.biasWorld + r.slopeStep * length(o)), blocker);
+                sum += biasedTap(light, r, o, size, layer, blocker);
             }
         return sum / float(taps * taps);
     }
@@ -289,7 +379,7 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, inout uint blocke
             const vec3 at = cubeTap(light, axis, right, up, qd, r.uv + o / size, rt.axial);
             sum += tap(at.xy, at.z, reference(light, rt, r.biasWorld + r.slopeStep * length(o)), blocker);
         } else {
-            sum += tap(r.uv + o / size, layer, reference(light, r, r.biasWorld + r.slopeStep * length(o)), blocker);
+            sum += biasedTap(light, r, o, size, layer, blocker);
         }
     }
     return sum / 16.0;
@@ -316,6 +406,9 @@ LightData cascadeOf(LightData light, int lightIndex, vec3 p) {
 }
 
 void main() {
+    // Receiver plane: the position's screen-space derivatives, here in uniform control flow.
+    const vec3 dpdx = kReceiverPlane ? dFdx(inPosition) : vec3(0.0);
+    const vec3 dpdy = kReceiverPlane ? dFdy(inPosition) : vec3(0.0);
     vec3 n = normalize(inNormal);
     // Two-sided surfaces: the normal faces the viewer (the ray tracer's rule: flip when N·ray > 0).
     if (dot(n, inPosition) > 0.0) n = -n;
@@ -357,7 +450,7 @@ void main() {
         // continue, so that the loop unrolls.)
         if (ndotl > 0.0 && irradiance > 0.0) {
             uint lightBlocker = 0u;
-            const float v = light.toLight.w >= 0.0 ? shadowTest(light, inPosition, n, ndotl, lightBlocker) : 1.0;
+            const float v = light.toLight.w >= 0.0 ? shadowTest(light, inPosition, n, ndotl, dpdx, dpdy, lightBlocker) : 1.0;
             if (blocker == 0u) blocker = lightBlocker;  // the first light that found one, as raytrace/
 #ifdef SHADOWLAB_LIGHT_OUTPUTS
             lightVisibility[i / 4][i % 4] = v;

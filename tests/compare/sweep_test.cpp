@@ -419,6 +419,18 @@ TEST_F(GridFile, CascadesAxisVariesTheRasterRowsAndIsRecorded) {
     EXPECT_EQ(j[1]["overrides"]["cascades"], 3);
 }
 
+TEST_F(GridFile, ReceiverPlaneBiasAxisVariesTheRasterRowsAndIsRecorded) {
+    const SweepGrid g =
+        loadGrid(write(R"({ "raster": { "receiver_plane_bias": [false, true], "slope_bias": [0, 2] } })"), scene);
+    ASSERT_EQ(g.configs.size(), 4u);
+    EXPECT_EQ(g.configs[0].overrides.receiverPlaneBias, std::optional<bool>(false));
+    EXPECT_EQ(g.configs[2].overrides.receiverPlaneBias, std::optional<bool>(true));
+    EXPECT_NE(g.configs[0].key(), g.configs[2].key());
+    EXPECT_NE(g.configs[2].label().find("receiver-plane bias"), std::string::npos) << g.configs[2].label();
+    EXPECT_EQ(g.configs[2].biasKind, "slope");  // the series is still the slope bias
+    EXPECT_THROW(loadGrid(write(R"({ "raster": { "receiver_plane_bias": [1] } })"), scene), scene::SceneError);
+}
+
 TEST_F(GridFile, DefaultGridComparesCascadesOnlyWithADirectionalLight) {
     auto cascaded = [](const SweepGrid& g) {
         std::size_t n = 0;

@@ -152,6 +152,9 @@ INSTANTIATE_TEST_SUITE_P(
                 "shadow.filter", "expected none, pcf2x2, pcf, poisson or pcss"},
         BadCase{"too_many_cascades", sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"cascades": 5})"),
                 "shadow.cascades", "must be in 1..4"},
+        BadCase{"receiver_plane_bias_not_bool",
+                sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"receiver_plane_bias": 1})"),
+                "shadow.receiver_plane_bias", "expected"},
         BadCase{"fractional_cascades", sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"cascades": 2.5})"),
                 "shadow.cascades", "expected an integer"}),
     [](const ::testing::TestParamInfo<BadCase>& info) { return std::string(info.param.name); });

@@ -45,6 +45,36 @@ TEST(RenderPlan, ASingleConvexObjectNeedsNoShadowPass) {
     EXPECT_NE(p.explain().find("skipped"), std::string::npos);
 }
 
+TEST(RenderPlan, ASpotWhoseConeHoldsNoObjectOrOneConvexObjectNeedsNoShadowPass) {
+    Scene s = sphereOnPlane();  // sphere r=1 at (0,1,0); ground 20x20 at y=0
+    Quad ground;
+    ground.size = {20, 20};
+    quadAxes(ground.normal, ground.uAxis, ground.vAxis);  // so that its bounds span the 20x20
+    s.objects[1] = {"ground", ground, 0};
+    Light spot;
+    spot.type = LightType::Spot;
+    spot.position = {0, 30, 0};
+    spot.coneAngleDegrees = 20.0;
+    spot.direction = {0, 1, 0};  // up, away from everything below it
+    s.lights = {spot};
+    // Both objects lie straight below the apex (180° off the axis); the ground's bounding sphere
+    // (radius √(20²+20²)/2 ≈ 14.1, 30 away) spans asin(14.1/30) ≈ 28°, far from 180° − 20°.
+    EXPECT_FALSE(makeRenderPlan(s, {}).lights[0].needsShadowTest);
+    EXPECT_NE(makeRenderPlan(s, {}).explain().find("no object inside the spot's cone"), std::string::npos);
+    // Pointed down: the sphere over the ground, both in the cone.
+    s.lights[0].direction = {0, -1, 0};
+    EXPECT_TRUE(makeRenderPlan(s, {}).lights[0].needsShadowTest);
+    // The ground replaced by a ball at (50, 50, 50): from the apex (50, 20, 50), 106° off the
+    // down axis (cos = −20/73.5), its sphere spanning asin(√3/73.5) ≈ 1.4°: outside. The sphere
+    // alone in the cone cannot shadow itself.
+    s.objects[1] = {"far ball", Sphere{{50, 50, 50}, 1.0}, 0};
+    EXPECT_FALSE(makeRenderPlan(s, {}).lights[0].needsShadowTest);
+    EXPECT_NE(makeRenderPlan(s, {}).explain().find("only one convex object"), std::string::npos);
+    // A directional light in the same scene: two objects, tested.
+    s.lights[0].type = LightType::Directional;
+    EXPECT_TRUE(makeRenderPlan(s, {}).lights[0].needsShadowTest);
+}
+
 TEST(RenderPlan, CubeMapOnlyForAShadowedPointLight) {
     Scene s = sphereOnPlane();
     Light point;

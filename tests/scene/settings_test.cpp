@@ -57,6 +57,16 @@ TEST(Settings, CascadesComeFromTheCommandLineThenTheSceneThenOne) {
     EXPECT_EQ(resolveSettings(s, o).raster.cascades, 2);
 }
 
+TEST(Settings, ReceiverPlaneBiasComesFromTheCommandLineThenTheSceneThenOff) {
+    Scene s = unitScene(1.0);
+    EXPECT_FALSE(resolveSettings(s, {}).raster.receiverPlaneBias);
+    s.shadow.receiverPlaneBias = true;
+    EXPECT_TRUE(resolveSettings(s, {}).raster.receiverPlaneBias);
+    SettingsOverrides o;
+    o.receiverPlaneBias = false;
+    EXPECT_FALSE(resolveSettings(s, o).raster.receiverPlaneBias);
+}
+
 TEST(Settings, BadValuesNameTheOption) {
     const Scene s = unitScene(1.0);
     auto expectError = [&](SettingsOverrides o, const std::string& option) {

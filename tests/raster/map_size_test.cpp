@@ -1,0 +1,91 @@
+// tests/raster/map_size_test.cpp: the shadow-map size from the receivers' detail
+// (raster::chooseShadowMapSize): a small render of the seed scene gets a smaller map with the same
+// shadow classification against the double-precision reference; a forced size is kept.
+#include <cmath>
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "compare/compare.h"
+#include "raster/renderer.h"
+#include "raytrace/renderer.h"
+#include "scene/loader.h"
+#include "scene/render_plan.h"
+
+namespace shadowlab::raster {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+scene::Scene seed(int width, int height) {
+    scene::Scene s = scene::loadScene(std::filesystem::path(SHADOWLAB_SOURCE_DIR) / "scenes" / "seed.json");
+    s.camera.width = width;
+    s.camera.height = height;
+    return s;
+}
+
+scene::Frame rasterRender(const scene::Scene& s, const scene::SettingsOverrides& o) {
+    scene::RenderSettings settings = scene::resolveSettings(s, o);
+    settings.raster.validate = true;
+    scene::Frame f = render(s, scene::makeRenderPlan(s, settings), settings.raster);
+    EXPECT_EQ(f.attributes["validation_messages"], "0") << "validation messages were printed above";
+    return f;
+}
+
+// The size the seed scene's receivers need at `height` rows, worked out from its numbers: camera
+// at (0, 2, 6) looking at (0, 0.7, 0), fov 40°. The nearest visible receiver is where the image's
+// bottom edge meets the ground y = 0: that ray is 20° + atan(1.3/6) below the horizon, hits the
+// ground 2/sin(that) away, at view depth (distance)·cos 20°. A pixel there is 2·tan 20°·z/height
+// wide. The map (bounding sphere of the ±10 x 0..2 x ±10 box, 1.01 margin) is 1.01·√804 wide.
+int expectedSize(int height) {
+    const double below = (20.0 * kPi / 180.0) + std::atan(1.3 / 6.0);
+    const double z = 2.0 / std::sin(below) * std::cos(20.0 * kPi / 180.0);
+    const double pixel = 2.0 * std::tan(20.0 * kPi / 180.0) * z / height;
+    const double width = 1.01 * std::sqrt(804.0);
+    int size = 256;
+    while (size < width / pixel && size < 2048) size *= 2;
+    return size;
+}
+
+TEST(RasterMapSize, ASmallRenderGetsASmallerMapWithTheSameShadows) {
+    ASSERT_EQ(expectedSize(36), 512);  // 28.6 / 0.0713 ≈ 402 texels
+    const scene::Scene s = seed(64, 36);
+    scene::Frame automatic = rasterRender(s, {});
+    EXPECT_EQ(automatic.attributes["shadow_map_size"], "512");
+    EXPECT_NE(automatic.attributes["shadow_map_size_reason"].find("receiver detail"), std::string::npos);
+    scene::SettingsOverrides forced;
+    forced.shadowMapSize = 2048;
+    scene::Frame full = rasterRender(s, forced);
+    EXPECT_EQ(full.attributes["shadow_map_size"], "2048");
+    EXPECT_NE(full.attributes["shadow_map_size_reason"].find("set by"), std::string::npos);
+
+    const scene::RenderSettings settings = scene::resolveSettings(s, {});
+    const scene::Frame ref = raytrace::renderReference(s, scene::makeRenderPlan(s, settings),
+                                                       scene::referenceSettings(settings.raytrace));
+    const compare::Metrics a = compare::compareFrames(automatic, ref).metrics;
+    const compare::Metrics b = compare::compareFrames(full, ref).metrics;
+    std::printf("counted %zu, reference shadowed %zu; wrong: auto %zu, 2048 %zu\n", a.counted, a.shadowedReference,
+                a.falseShadow + a.missedShadow, b.falseShadow + b.missedShadow);
+    ASSERT_GT(a.shadowedReference, 25u);  // 38 at 64x36: the sphere's shadow is ~3% of the image
+    // The same classification within a small tolerance: at most 1% of the counted pixels more wrong.
+    EXPECT_LE(a.falseShadow + a.missedShadow, b.falseShadow + b.missedShadow + a.counted / 100);
+}
+
+TEST(RasterMapSize, AFullSizeRenderKeepsTheDefault) {
+    // At 720 rows the receivers need ≈ 8000 texels: capped at the default.
+    EXPECT_EQ(expectedSize(720), 2048);
+    const scene::Scene s = seed(1280, 720);
+    const ShadowMapSizeChoice c = chooseShadowMapSize(s, scene::resolveSettings(s, {}).raster);
+    EXPECT_EQ(c.size, 2048);
+}
+
+TEST(RasterMapSize, ASizeFromTheSceneIsKept) {
+    scene::Scene s = seed(64, 36);
+    s.shadow.shadowMapSize = 2048;
+    EXPECT_EQ(chooseShadowMapSize(s, scene::resolveSettings(s, {}).raster).size, 2048);
+    s.shadow.shadowMapSize.reset();
+    EXPECT_EQ(chooseShadowMapSize(s, scene::resolveSettings(s, {}).raster).size, 512);
+}
+
+}  // namespace
+}  // namespace shadowlab::raster
