@@ -38,6 +38,23 @@ std::array<Vec3, 8> corners(const scene::Bounds& b) {
     return c;
 }
 
+// A box's extent in a light frustum's basis: across (right, up) and its nearest depth along the light.
+struct Footprint {
+    double minU = INFINITY, maxU = -INFINITY, minV = INFINITY, maxV = -INFINITY, minDepth = INFINITY;
+};
+Footprint footprint(const scene::Bounds& b, const LightFrustum& f) {
+    Footprint o;
+    for (const Vec3& c : corners(b)) {
+        const Vec3 d = c - f.center;
+        o.minU = std::min(o.minU, glm::dot(d, f.right));
+        o.maxU = std::max(o.maxU, glm::dot(d, f.right));
+        o.minV = std::min(o.minV, glm::dot(d, f.up));
+        o.maxV = std::max(o.maxV, glm::dot(d, f.up));
+        o.minDepth = std::min(o.minDepth, glm::dot(d, f.direction));
+    }
+    return o;
+}
+
 struct Plane {
     Vec3 n;      // inward normal
     double d;    // inside: dot(n, p) + d >= 0
@@ -132,20 +149,12 @@ std::vector<Vec3> visibleReceiverPoints(const scene::Scene& scene, const scene::
 double nearestCasterDepth(const scene::Scene& scene, const LightFrustum& f, double minU, double maxU, double minV,
                           double maxV) {
     double minDepth = INFINITY;
-    for (const scene::Object& o : scene.objects) {
-        const scene::Bounds b = scene::boundsOf(o.shape);
+    for (const scene::Object& object : scene.objects) {
+        const scene::Bounds b = scene::boundsOf(object.shape);
         if (b.empty()) continue;
-        double oMinU = INFINITY, oMaxU = -INFINITY, oMinV = INFINITY, oMaxV = -INFINITY, oMinDepth = INFINITY;
-        for (const Vec3& c : corners(b)) {
-            const Vec3 d = c - f.center;
-            oMinU = std::min(oMinU, glm::dot(d, f.right));
-            oMaxU = std::max(oMaxU, glm::dot(d, f.right));
-            oMinV = std::min(oMinV, glm::dot(d, f.up));
-            oMaxV = std::max(oMaxV, glm::dot(d, f.up));
-            oMinDepth = std::min(oMinDepth, glm::dot(d, f.direction));
-        }
-        if (oMaxU < minU || oMinU > maxU || oMaxV < minV || oMinV > maxV) continue;
-        minDepth = std::min(minDepth, oMinDepth);
+        const Footprint o = footprint(b, f);
+        if (o.maxU < minU || o.minU > maxU || o.maxV < minV || o.minV > maxV) continue;
+        minDepth = std::min(minDepth, o.minDepth);
     }
     return minDepth;
 }
@@ -353,17 +362,9 @@ std::vector<bool> castsIntoView(const scene::Scene& scene, const LightFrustum& f
     for (std::size_t i = 0; i < scene.objects.size(); ++i) {
         const scene::Bounds b = scene::boundsOf(scene.objects[i].shape);
         if (b.empty()) continue;
-        double oMinU = INFINITY, oMaxU = -INFINITY, oMinV = INFINITY, oMaxV = -INFINITY, oMinDepth = INFINITY;
-        for (const Vec3& c : corners(b)) {
-            const Vec3 d = c - f.center;
-            oMinU = std::min(oMinU, glm::dot(d, f.right));
-            oMaxU = std::max(oMaxU, glm::dot(d, f.right));
-            oMinV = std::min(oMinV, glm::dot(d, f.up));
-            oMaxV = std::max(oMaxV, glm::dot(d, f.up));
-            oMinDepth = std::min(oMinDepth, glm::dot(d, f.direction));
-        }
-        casts[i] = oMaxU >= minU - margin && oMinU <= maxU + margin && oMaxV >= minV - margin &&
-                   oMinV <= maxV + margin && oMinDepth <= maxDepth + margin;
+        const Footprint o = footprint(b, f);
+        casts[i] = o.maxU >= minU - margin && o.minU <= maxU + margin && o.maxV >= minV - margin &&
+                   o.minV <= maxV + margin && o.minDepth <= maxDepth + margin;
     }
     return casts;
 }

@@ -72,6 +72,8 @@ void checkExrHeader(const fs::path& file) {
         for (char& ch : t) if (ch < 0x20 || ch > 0x7e) ch = '?';
         return t;
     };
+    constexpr int kMaxChannels = 32;
+    int channels = 0;
     for (int count = 0;; ++count) {
         std::string name, type;
         readName(name);
@@ -104,10 +106,24 @@ void checkExrHeader(const fs::path& file) {
             for (std::string channel;;) {
                 readName(channel);
                 if (channel.empty()) break;
+                if (++channels > kMaxChannels)
+                    throw bad("more than " + std::to_string(kMaxChannels) + " channels (a Frame has about ten)");
                 char fields[16];  // pixel type, pLinear + 3 reserved bytes, x and y sampling
                 if (!in.read(fields, 16) || std::int64_t(in.tellg()) > end) throw mismatch();
             }
             if (std::int64_t(in.tellg()) != end) throw mismatch();
+        } else if (name == "dataWindow" && type == "box2i") {
+            // The image size, bounded as a render's is before OpenEXR sizes its line buffers from
+            // it (a fuzzed 500-byte file made it allocate 1.2 GB for one chunk).
+            std::uint32_t box[4];
+            for (std::uint32_t& v : box)
+                if (!readU32(v)) throw mismatch();
+            const std::int64_t w = std::int64_t(std::int32_t(box[2])) - std::int32_t(box[0]) + 1;
+            const std::int64_t h = std::int64_t(std::int32_t(box[3])) - std::int32_t(box[1]) + 1;
+            if (w < 1 || h < 1 || w > kMaxResolution || h > kMaxResolution || w * h > kMaxPixels)
+                throw InputError(file.string() + ": image too large for a Frame (" + std::to_string(w) + "x" +
+                                 std::to_string(h) + "; at most " + std::to_string(kMaxResolution) + " a side and " +
+                                 std::to_string(kMaxPixels) + " pixels)");
         } else if (type == "preview") {  // width, height, then width * height RGBA bytes
             std::uint32_t w = 0, h = 0;
             if (size < 8 || !readU32(w) || !readU32(h) || std::uint64_t(w) * h * 4 + 8 != size) throw mismatch();
@@ -313,11 +329,11 @@ Frame readFrame(const fs::path& file) {
     // The same bound as a render's (kMaxPixels), and reading by bands of rows below, keep the
     // memory a Frame file can make us allocate to the Frame itself plus one band.
     if (spec.width > kMaxResolution || spec.height > kMaxResolution ||
-        std::int64_t(spec.width) * spec.height > kMaxPixels || spec.nchannels > 64)
+        std::int64_t(spec.width) * spec.height > kMaxPixels || spec.nchannels > 32)
         throw InputError(file.string() + ": image too large for a Frame (" + std::to_string(spec.width) + "x" +
                          std::to_string(spec.height) + ", " + std::to_string(spec.nchannels) +
                          " channels; at most " + std::to_string(kMaxResolution) + " a side, " +
-                         std::to_string(kMaxPixels) + " pixels and 64 channels)");
+                         std::to_string(kMaxPixels) + " pixels and 32 channels)");
 
     auto channelIndex = [&](const std::string& name, bool required) {
         const auto it = std::find(spec.channelnames.begin(), spec.channelnames.end(), name);
