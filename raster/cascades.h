@@ -38,7 +38,7 @@ std::vector<double> practicalSplits(double near, double far, int count, double l
 std::array<scene::Vec3, 8> sliceCorners(const scene::CameraBasis& cam, double d0, double d1);
 
 struct BoundingSphere {
-    scene::Vec3 center;
+    scene::Vec3 center{0, 0, 0};
     double radius = 0.0;
 };
 // The smallest sphere through the slice's corners (its center on the view axis): it depends only on

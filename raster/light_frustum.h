@@ -15,19 +15,19 @@ namespace shadowlab::raster {
 
 struct LightFrustum {
     bool perspective = false;  // spot light
-    scene::Vec3 direction;     // unit, the way the light travels (the map looks along it)
-    scene::Vec3 right;         // unit, the map's +u axis
-    scene::Vec3 up;            // unit, the map's +v axis (v grows with framebuffer rows)
+    scene::Vec3 direction{0, -1, 0};  // unit, the way the light travels (the map looks along it)
+    scene::Vec3 right{1, 0, 0};       // unit, the map's +u axis
+    scene::Vec3 up{0, 0, 1};          // unit, the map's +v axis (v grows with framebuffer rows)
     int mapSize = 1;           // texels per side
     // Orthographic: the map spans center ± halfWidth across, and depth 0..1 runs from
     // center − halfWidth·direction to center + halfWidth·direction... unless fitted, where
     // nearDepth/farDepth (along direction, relative to center) bound it.
-    scene::Vec3 center;
+    scene::Vec3 center{0, 0, 0};
     double halfWidth = 1;
     double nearDepth = -1, farDepth = 1;  // along direction from center; default ±halfWidth
     // Perspective: from `position`, half-angle atan(tanHalfFov), depth from near to far along
     // `direction`.
-    scene::Vec3 position;
+    scene::Vec3 position{0, 0, 0};
     double tanHalfFov = 1;
     double near = 0.1, far = 1;
 

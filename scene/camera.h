@@ -12,10 +12,10 @@ namespace shadowlab::scene {
 // the look-at is degenerate; world Z (or X) is used as up instead, so a camera looking
 // straight down still renders (see docs/decisions.md).
 struct CameraBasis {
-    Vec3 position;
-    Vec3 forward;  // unit, toward look_at
-    Vec3 right;    // unit
-    Vec3 up;       // unit, = right × forward
+    Vec3 position{0, 0, 0};
+    Vec3 forward{0, 0, -1};  // unit, toward look_at
+    Vec3 right{1, 0, 0};     // unit
+    Vec3 up{0, 1, 0};        // unit, = right × forward
     double tanHalfFovY = 0.0;
     double aspect = 1.0;  // width / height
     int width = 0;

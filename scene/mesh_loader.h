@@ -20,12 +20,12 @@ namespace shadowlab::scene {
 // What a glTF file holds besides triangles: its perspective cameras and KHR_lights_punctual
 // lights, in the file's world space (not moved by the object transform).
 struct GltfCamera {
-    Vec3 position, forward, up;
+    Vec3 position{0, 0, 0}, forward{0, 0, -1}, up{0, 1, 0};
     double yfovRadians = 0.0, znear = 0.0, zfar = 0.0, aspect = 0.0;  // zfar/aspect 0: unset
 };
 struct GltfLight {
     std::string type;  // "directional" | "point" | "spot"
-    Vec3 position, direction, color{1, 1, 1};
+    Vec3 position{0, 0, 0}, direction{0, 0, -1}, color{1, 1, 1};
     double intensity = 1.0;         // lux (directional) or candela (point, spot)
     double outerConeRadians = 0.0;  // spot
 };

@@ -53,7 +53,7 @@ struct Light {
 };
 
 struct Sphere {
-    Vec3 center;
+    Vec3 center{0, 0, 0};
     double radius = 1.0;
 };
 
@@ -61,7 +61,7 @@ struct Sphere {
 // (size.x) and `vAxis` (size.y); see quadAxes() for how they follow from the normal.
 // Quads are two-sided: they block light and are seen from both sides.
 struct Quad {
-    Vec3 center;
+    Vec3 center{0, 0, 0};
     Vec3 normal{0, 1, 0};
     Vec2 size{1, 1};
     Vec3 uAxis{1, 0, 0};
@@ -69,8 +69,8 @@ struct Quad {
 };
 
 struct Box {
-    Vec3 min;
-    Vec3 max;
+    Vec3 min{0, 0, 0};
+    Vec3 max{0, 0, 0};
 };
 
 // A triangle mesh in its own object space (double precision), shared (shared_ptr<const>) by

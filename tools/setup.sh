@@ -32,7 +32,10 @@ fi
 
 if [ ! -f "$build/build.ninja" ]; then
     say "configuring a Release build in $build"
-    cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release >&2
+    # ccache, where installed, makes rebuilds in fresh build folders (worktrees, CI caches) cheap.
+    launcher=()
+    command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+    cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" >&2
 fi
 # Ninja rebuilds only what changed; a no-op takes a fraction of a second.
 targets=()
