@@ -339,7 +339,10 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, vec3 dpdx, vec3 d
             vec3 at = vec3(r.uv + o / size, layer);
             float drTap = dr;
             if (wrap) at = cubeTap(light, axis, right, up, qd, at.xy, drTap);
-            const float z = texture(shadowDepths, at).r;
+            // The nearest caster of the texel: the opaque depth or, with semi-transparent casters,
+            // the nearest of those when it is nearer, so their shadows are softened too.
+            float z = texture(shadowDepths, at).r;
+            if (kTransmittance) z = min(z, texture(transparentDepths, at).r);
             if (z >= 1.0) continue;  // nothing drawn there
             // Stored perspective depth back to distance: z = far/(far−near)(1 − near/d).
             const float d = near / max(1.0 - z * (far - near) / far, 1e-7);

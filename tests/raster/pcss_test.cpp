@@ -62,8 +62,10 @@ scene::Scene edgeScene(double hb) {
 
 // The 10%–90% width of the visibility ramp across the edge, on the floor near z = 0: floor pixels
 // (found by the test's own ray–plane intersection) are binned by x, each bin's mean visibility
-// taken, and the 0.1 and 0.9 crossings interpolated.
-double rampWidth(const scene::Scene& s, const scene::Frame& f) {
+// taken, and the 0.1 and 0.9 crossings interpolated. `umbra`: the visibility in the full shadow
+// (0 behind an opaque blocker, 1 − opacity behind a semi-transparent one); the levels are taken
+// between it and 1.
+double rampWidth(const scene::Scene& s, const scene::Frame& f, double umbra = 0.0) {
     const scene::CameraBasis cam = scene::cameraBasis(s.camera);
     constexpr double lo = -1.2, hi = 1.2, bin = 0.02;
     const int bins = int((hi - lo) / bin);
@@ -91,7 +93,7 @@ double rampWidth(const scene::Scene& s, const scene::Frame& f) {
         }
         return std::nan("");
     };
-    return crossing(0.9) - crossing(0.1);
+    return crossing(umbra + 0.9 * (1.0 - umbra)) - crossing(umbra + 0.1 * (1.0 - umbra));
 }
 
 scene::Frame renderPcss(const scene::Scene& s) {
@@ -120,6 +122,50 @@ TEST(RasterPcss, PenumbraWidensWithTheReceiverBlockerDistanceAsTheFormulaSays) {
         EXPECT_NEAR(widths[i], 0.687 * formula[i], 0.3 * 0.687 * formula[i] + 0.04)
             << "blocker " << (i ? 4 : 2) << " above the floor";
     // The ratio does not depend on the kernel's shape: (4/6)/(2/8) = 2.67.
+    EXPECT_NEAR(widths[1] / widths[0], formula[1] / formula[0], 0.2 * formula[1] / formula[0]);
+}
+
+TEST(RasterPcss, ASemiTransparentBlockerGetsTheSamePenumbraAtItsOwnDepth) {
+    // The blocker of opacity 0.5: its umbra lets half the light through (visibility 0.5) and its
+    // penumbra ramps from 0.5 to 1 over the same width as an opaque blocker's at that height. The
+    // blocker search sees it through the transmittance map's nearest depths (before, it found no
+    // opaque blocker and returned "lit": no shadow at all).
+    std::vector<double> widths, formula;
+    for (const double hb : {2.0, 4.0}) {
+        scene::Scene s = edgeScene(hb);
+        scene::Material glass;
+        glass.name = "glass";
+        glass.opacity = 0.5;
+        s.materials.push_back(glass);
+        s.objects[1].material = 1;
+        const scene::Frame f = renderPcss(s);
+        EXPECT_EQ(f.attributes.at("transmittance_map"), "made");
+        // In the umbra (x in [-1.2, -0.6], z near 0) and in the light (x in [0.6, 1.2]): the
+        // penumbra is at most 1·4/6 = 0.67 wide, centered on x = 0.
+        const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+        double umbra = 0.0, lit = 0.0;
+        int nu = 0, nl = 0;
+        for (int y = 0; y < f.height; ++y)
+            for (int x = 0; x < f.width; ++x) {
+                const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
+                if (f.objectId[i] != 1.0f) continue;
+                const Vec3 d = test::pixelRay(cam, x, y);
+                const Vec3 q = cam.position + (-cam.position.y / d.y) * d;
+                if (std::abs(q.z) > 0.4) continue;
+                if (q.x > -1.2 && q.x < -0.6) umbra += f.visibility[i], ++nu;
+                if (q.x > 0.6 && q.x < 1.2) lit += f.visibility[i], ++nl;
+            }
+        ASSERT_GT(nu, 20);
+        ASSERT_GT(nl, 20);
+        EXPECT_NEAR(umbra / nu, 0.5, 0.01) << "blocker at " << hb;
+        EXPECT_NEAR(lit / nl, 1.0, 0.01) << "blocker at " << hb;
+        widths.push_back(rampWidth(s, f, 0.5));
+        formula.push_back(kSize * hb / (kH - hb));
+    }
+    ASSERT_TRUE(std::isfinite(widths[0]) && std::isfinite(widths[1])) << widths[0] << " " << widths[1];
+    for (std::size_t i = 0; i < 2; ++i)
+        EXPECT_NEAR(widths[i], 0.687 * formula[i], 0.3 * 0.687 * formula[i] + 0.04)
+            << "blocker " << (i ? 4 : 2) << " above the floor";
     EXPECT_NEAR(widths[1] / widths[0], formula[1] / formula[0], 0.2 * formula[1] / formula[0]);
 }
 
