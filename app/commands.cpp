@@ -179,7 +179,7 @@ int render(const RenderOptions& o) {
     // A view writes a display image, not the Frame; the shadow-map view holds every layer's depths.
     const std::uint64_t estimate =
         scene::kProgramBytes + backendMemory(p, o.backend) +
-        (o.view ? raster::debugViewBytes(p.scene, p.plan, p.settings.raster, *o.view == "shadow-map")
+        (o.view ? raster::debugViewBytes(p.scene, p.plan, p.settings.raster, *o.view)
                 : scene::frameWriteBytes(p.scene));
     scene::checkMemory(estimate, o.view ? "rendering the " + *o.view + " view of " +
                                               std::to_string(p.scene.camera.width) + "x" +
@@ -194,9 +194,10 @@ int render(const RenderOptions& o) {
         debug.captureShadowMaps = *o.view == "shadow-map";
         const scene::Frame frame = raster::render(p.scene, p.plan, p.settings.raster, &debug);
         checkValidation(frame, p.settings.raster);
-        const raster::DisplayImage img = *o.view == "shadow-map" ? raster::shadowMapView(debug)
-                                         : *o.view == "cascades" ? raster::cascadeView(frame, debug)
-                                                                 : raster::texelDensityView(frame, p.scene, debug);
+        const raster::DisplayImage img = *o.view == "shadow-map"      ? raster::shadowMapView(debug)
+                                         : *o.view == "cascades"      ? raster::cascadeView(frame, debug)
+                                         : *o.view == "light-frustum" ? raster::lightFrustumView(frame, p.scene, debug)
+                                                                      : raster::texelDensityView(frame, p.scene, debug);
         scene::writePngDisplay(o.output, img.width, img.height, img.rgb);
         stage.done(std::to_string(img.width) + "x" + std::to_string(img.height) + " -> " + o.output.string() +
                    ", " + memoryLine(estimate));

@@ -24,7 +24,7 @@ struct RenderOptions {
     SceneOptions common;
     std::string backend = "raytrace";
     std::filesystem::path output;
-    std::optional<std::string> view;  // raster debug view: shadow-map | cascades | texel-density
+    std::optional<std::string> view;  // raster debug view: shadow-map | cascades | texel-density | light-frustum
 };
 
 struct RunOptions {

@@ -76,8 +76,9 @@ int main(int argc, char** argv) {
     renderCmd->add_option("--view", renderOptions.view,
                           "raster debug view instead of the beauty image (.png only): shadow-map (every map "
                           "layer as depth), cascades (beauty tinted by cascade), texel-density (shadow texel vs "
-                          "screen pixel size)")
-        ->check(CLI::IsMember({"shadow-map", "cascades", "texel-density"}));
+                          "screen pixel size), light-frustum (each map's frustum drawn over the scene; what it "
+                          "covers tinted, lit points outside it striped magenta)")
+        ->check(CLI::IsMember({"shadow-map", "cascades", "texel-density", "light-frustum"}));
 
     shadowlab::app::SweepOptions sweepOptions;
     auto* sweepCmd = app.add_subcommand("sweep", "Render a grid of settings for both backends, time each and "

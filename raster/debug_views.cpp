@@ -1,10 +1,11 @@
-// raster/debug_views.cpp: the shadow-map, cascade and texel-density views.
+// raster/debug_views.cpp: the shadow-map, cascade, texel-density and light-frustum views.
 #include "raster/debug_views.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "raster/tolerances.h"
 #include "scene/camera.h"
 #include "scene/frame_io.h"
 
@@ -22,7 +23,7 @@ constexpr Glyph kGlyphs[] = {
     {'4', {5, 5, 7, 1, 1}}, {'5', {7, 4, 7, 1, 7}}, {'6', {7, 4, 7, 5, 7}}, {'7', {7, 1, 1, 2, 2}},
     {'8', {7, 5, 7, 5, 7}}, {'9', {7, 5, 7, 1, 7}}, {'L', {4, 4, 4, 4, 7}}, {'C', {7, 4, 4, 4, 7}},
     {'X', {5, 5, 2, 5, 5}}, {'Y', {5, 5, 2, 2, 2}}, {'Z', {7, 1, 2, 4, 7}}, {'+', {0, 2, 7, 2, 0}},
-    {'-', {0, 0, 7, 0, 0}},
+    {'-', {0, 0, 7, 0, 0}}, {'O', {2, 5, 5, 5, 2}}, {'U', {5, 5, 5, 5, 7}}, {'T', {7, 2, 2, 2, 2}},
 };
 
 void fill(DisplayImage& img, int x0, int y0, int w, int h, const std::array<float, 3>& color) {
@@ -189,6 +190,320 @@ DisplayImage texelDensityView(const scene::Frame& frame, const scene::Scene& sce
         const std::array<float, 3> c = densityColor(ratio[i]);
         for (int k = 0; k < 3; ++k) img.rgb[3 * i + std::size_t(k)] = c[std::size_t(k)];
     }
+    return img;
+}
+
+// --- The light-frustum view ---
+
+bool insideLightMap(const LightFrustum& f, const scene::Vec3& p) {
+    if (!f.perspective) {
+        const scene::Vec3 q = p - f.center;
+        const double along = glm::dot(q, f.direction);
+        return std::abs(glm::dot(q, f.right)) <= f.halfWidth && std::abs(glm::dot(q, f.up)) <= f.halfWidth &&
+               along >= f.nearDepth && along <= f.farDepth;
+    }
+    const scene::Vec3 q = p - f.position;
+    const double d = glm::dot(q, f.direction);
+    const double across = d * f.tanHalfFov;
+    return d >= f.near && d <= f.far && std::abs(glm::dot(q, f.right)) <= across &&
+           std::abs(glm::dot(q, f.up)) <= across;
+}
+
+std::array<scene::Vec3, 8> frustumCorners(const LightFrustum& f) {
+    std::array<scene::Vec3, 8> c;
+    for (int k = 0; k < 8; ++k) {
+        const double su = (k & 1) ? 1.0 : -1.0, sv = (k & 2) ? 1.0 : -1.0;
+        if (f.perspective) {
+            const double d = (k & 4) ? f.far : f.near;
+            c[std::size_t(k)] = f.position + d * (f.direction + su * f.tanHalfFov * f.right + sv * f.tanHalfFov * f.up);
+        } else {
+            const double d = (k & 4) ? f.farDepth : f.nearDepth;
+            c[std::size_t(k)] = f.center + su * f.halfWidth * f.right + sv * f.halfWidth * f.up + d * f.direction;
+        }
+    }
+    return c;
+}
+
+ScreenPoint projectPoint(const scene::CameraBasis& cam, const scene::Vec3& p) {
+    const scene::Vec3 d = p - cam.position;
+    const double z = glm::dot(d, cam.forward);
+    const double sx = glm::dot(d, cam.right) / (z * cam.tanHalfFovY * cam.aspect);
+    const double sy = glm::dot(d, cam.up) / (z * cam.tanHalfFovY);
+    return {(1.0 + sx) * 0.5 * cam.width, (1.0 - sy) * 0.5 * cam.height, z};
+}
+
+std::optional<ScreenSegment> projectSegment(const scene::CameraBasis& cam, double near, const scene::Vec3& a,
+                                            const scene::Vec3& b) {
+    const double za = glm::dot(a - cam.position, cam.forward), zb = glm::dot(b - cam.position, cam.forward);
+    if (!(za >= near) && !(zb >= near)) return std::nullopt;
+    // Clip in world space, where depth is linear along the segment.
+    scene::Vec3 p = a, q = b;
+    if (za < near) p = a + (b - a) * ((near - za) / (zb - za));
+    if (zb < near) q = b + (a - b) * ((near - zb) / (za - zb));
+    return ScreenSegment{projectPoint(cam, p), projectPoint(cam, q)};
+}
+
+std::array<float, 3> lightTint(const scene::Light& light) {
+    const double m = std::max({light.color.r, light.color.g, light.color.b});
+    if (!(m > 0.0)) return {1.0f, 1.0f, 1.0f};
+    return {float(light.color.r / m), float(light.color.g / m), float(light.color.b / m)};
+}
+
+namespace {
+
+// The layers of one shadowed light: debug.frusta[first .. first + count).
+struct LightLayers {
+    int light = 0;
+    int first = 0;
+    int count = 0;
+};
+std::vector<LightLayers> shadowedLights(const RenderDebug& debug) {
+    std::vector<LightLayers> out;
+    for (std::size_t k = 0; k < debug.layerLight.size() && k < debug.frusta.size(); ++k) {
+        if (out.empty() || out.back().light != debug.layerLight[k])
+            out.push_back({debug.layerLight[k], int(k), 0});
+        ++out.back().count;
+    }
+    return out;
+}
+
+// The layer lit.frag reads for light `ll` at p: a point light's cube face of p's major axis from
+// the light (ties as cubeFace: x before y before z), a cascaded light's cascade, else its one map.
+int layerAt(const LightLayers& ll, const scene::Light& light, const scene::Vec3& p, int cascade) {
+    if (light.type == scene::LightType::Point && ll.count == kCubeFaces) {
+        const scene::Vec3 d = p - light.position, a = glm::abs(d);
+        const int k = a.x >= a.y && a.x >= a.z ? 0 : a.y >= a.z ? 1 : 2;
+        return ll.first + 2 * k + (d[k] < 0.0 ? 1 : 0);
+    }
+    return ll.first + std::clamp(cascade, 0, ll.count - 1);
+}
+
+bool reaches(const scene::Light& light, const scene::Vec3& p) {
+    if (light.type != scene::LightType::Spot) return true;
+    constexpr double kPi = 3.14159265358979323846;
+    // lit.frag: outside when dot(−l, axis) < cos(cone), l the unit vector toward the light.
+    return glm::dot(glm::normalize(p - light.position), glm::normalize(light.direction)) >=
+           std::cos(light.coneAngleDegrees * kPi / 180.0);
+}
+
+struct PixelCoverage {
+    Coverage coverage = Coverage::Background;
+    std::array<float, 3> tint{0.0f, 0.0f, 0.0f};  // the mean tint of the lights whose maps hold it
+};
+
+// lightMapCoverage() and the tint for every pixel.
+std::vector<PixelCoverage> coverage(const scene::Frame& frame, const scene::Scene& scene, const RenderDebug& debug) {
+    std::vector<PixelCoverage> out(frame.pixelCount());
+    scene::Camera camera = scene.camera;
+    camera.width = frame.width;
+    camera.height = frame.height;
+    const scene::CameraBasis cam = scene::cameraBasis(camera);
+    const std::vector<LightLayers> lights = shadowedLights(debug);
+    const std::vector<int> cascade = cascadeIndices(frame, debug);
+    const bool hasNdotL = frame.ndotl.size() == frame.pixelCount();
+    for (int y = 0; y < frame.height; ++y)
+        for (int x = 0; x < frame.width; ++x) {
+            const std::size_t i = std::size_t(y) * std::size_t(frame.width) + std::size_t(x);
+            PixelCoverage& c = out[i];
+            if (!(frame.objectId[i] > 0.0f)) continue;
+            c.coverage = Coverage::Outside;
+            const bool facing = !hasNdotL || frame.ndotl[i] > 0.0f;
+            const scene::Vec3 p = cam.position + double(frame.depth[i]) * scene::pixelDirection(cam, x, y);
+            int inside = 0;
+            bool uncovered = false;
+            for (const LightLayers& ll : lights) {
+                const scene::Light& light = scene.lights[std::size_t(ll.light)];
+                const int layer = layerAt(ll, light, p, cascade[i]);
+                if (!insideLightMap(debug.frusta[std::size_t(layer)], p)) {
+                    uncovered = uncovered || (facing && reaches(light, p));
+                    continue;
+                }
+                const bool cascaded = light.type == scene::LightType::Directional && ll.count > 1;
+                const std::array<float, 3> t = cascaded ? cascadeTint(layer - ll.first) : lightTint(light);
+                for (int k = 0; k < 3; ++k) c.tint[std::size_t(k)] += t[std::size_t(k)];
+                ++inside;
+            }
+            if (uncovered)
+                c.coverage = Coverage::Uncovered;
+            else if (inside > 0) {
+                c.coverage = Coverage::Covered;
+                for (float& t : c.tint) t /= float(inside);
+            }
+        }
+    return out;
+}
+
+std::array<float, 3> pixel(const DisplayImage& img, int x, int y) {
+    const std::size_t o = 3 * (std::size_t(y) * std::size_t(img.width) + std::size_t(x));
+    return {img.rgb[o], img.rgb[o + 1], img.rgb[o + 2]};
+}
+
+// What the outline is drawn over: the frame's view depth per pixel (0 on the background).
+struct DepthBuffer {
+    const scene::Frame& frame;
+    // Whether a line point at view depth z over pixel (x, y) is hidden by the visible surface.
+    bool hides(int x, int y, double z) const {
+        const std::size_t i = std::size_t(y) * std::size_t(frame.width) + std::size_t(x);
+        return frame.objectId[i] > 0.0f && z > double(frame.depth[i]) * (1.0 + kFrustumEdgeDepthTolerance);
+    }
+};
+
+// How drawSegment() draws: the samples in front of the visible surface or those behind it, and
+// the dark halo around the line (one pixel each side, drawn for all edges before any line, so
+// that a line stays visible on a surface of its own colour) or the line itself.
+struct Stroke {
+    bool hidden = false;
+    bool halo = false;
+};
+
+// One stroke of the projected segment: in front of the surface solid, behind it dashed (3 px on,
+// 3 off) and mixed half way into what is under it.
+void drawSegment(DisplayImage& img, const DepthBuffer& depth, const ScreenSegment& s,
+                 const std::array<float, 3>& color, int width, Stroke stroke) {
+    // Liang–Barsky against the image rectangle, in the screen parameter t (0 at a, 1 at b).
+    const double dx = s.b.x - s.a.x, dy = s.b.y - s.a.y;
+    double t0 = 0.0, t1 = 1.0;
+    const double p[4] = {-dx, dx, -dy, dy};
+    const double q[4] = {s.a.x + 1.0, img.width + 1.0 - s.a.x, s.a.y + 1.0, img.height + 1.0 - s.a.y};
+    for (int k = 0; k < 4; ++k) {
+        if (p[k] == 0.0) {
+            if (q[k] < 0.0) return;
+            continue;
+        }
+        const double r = q[k] / p[k];
+        if (p[k] < 0.0) t0 = std::max(t0, r);
+        else t1 = std::min(t1, r);
+    }
+    if (!(t0 <= t1)) return;
+    const double length = std::hypot(dx, dy) * (t1 - t0);
+    const int steps = int(std::ceil(2.0 * length)) + 1;  // half-pixel steps: no gaps
+    const bool steep = std::abs(dy) > std::abs(dx);
+    const int from = stroke.halo ? -1 : 0, to = stroke.halo ? width : width - 1;
+    for (int k = 0; k <= steps; ++k) {
+        const double t = t0 + (t1 - t0) * double(k) / steps;
+        const int x = int(std::floor(s.a.x + t * dx)), y = int(std::floor(s.a.y + t * dy));
+        // Depth is not linear in screen space; its reciprocal is.
+        const double z = 1.0 / ((1.0 - t) / s.a.z + t / s.b.z);
+        if (stroke.hidden && (int(length * double(k) / steps) / 3) % 2) continue;
+        for (int w = from; w <= to; ++w) {
+            const int px = x + (steep ? w : 0), py = y + (steep ? 0 : w);
+            if (px < 0 || py < 0 || px >= img.width || py >= img.height) continue;
+            if (depth.hides(px, py, z) != stroke.hidden) continue;
+            const std::array<float, 3> c = stroke.halo     ? std::array<float, 3>{0.0f, 0.0f, 0.0f}
+                                           : stroke.hidden ? mix(pixel(img, px, py), color, 0.5)
+                                                           : color;
+            // A hidden line's halo only darkens, so the dashes stay faint.
+            fill(img, px, py, 1, 1, stroke.halo && stroke.hidden ? mix(pixel(img, px, py), c, 0.5) : c);
+        }
+    }
+}
+
+// A ring (radius r) and a cross through it at a positional light, solid or faint as its center.
+void drawMarker(DisplayImage& img, const DepthBuffer& depth, const scene::CameraBasis& cam, double near,
+                const scene::Vec3& position, const std::array<float, 3>& color, int width) {
+    const double z = glm::dot(position - cam.position, cam.forward);
+    if (!(z >= near)) return;
+    const ScreenPoint c = projectPoint(cam, position);
+    const int cx = int(std::floor(c.x)), cy = int(std::floor(c.y));
+    const bool onImage = cx >= 0 && cy >= 0 && cx < img.width && cy < img.height;
+    const bool hidden = onImage && depth.hides(cx, cy, z);
+    const int r = std::max(4, img.height / 60);
+    for (int dy = -r - 1; dy <= r + 1; ++dy)
+        for (int dx = -r - 1; dx <= r + 1; ++dx) {
+            const int x = cx + dx, y = cy + dy;
+            if (x < 0 || y < 0 || x >= img.width || y >= img.height) continue;
+            const double dist = std::hypot(double(dx), double(dy));
+            const bool ring = std::abs(dist - r) < 0.5 * width + 0.25;
+            const bool cross = (std::abs(dx) < width || std::abs(dy) < width) && dist <= r;
+            if (ring || cross) fill(img, x, y, 1, 1, hidden ? mix(pixel(img, x, y), color, 0.5) : color);
+        }
+}
+
+// A swatch (`stripes`: the Uncovered mark) and a label, one legend row at (x0, y0).
+void legendRow(DisplayImage& img, int x0, int y0, int scale, const std::array<float, 3>& color, bool stripes,
+               const std::string& label) {
+    const int side = 7 * scale;
+    fill(img, x0, y0, side, side, {0.0f, 0.0f, 0.0f});
+    for (int y = 0; y < side - 2 * scale; ++y)
+        for (int x = 0; x < side - 2 * scale; ++x)
+            if (!stripes || ((x + y) / kLeakStripeWidth) % 2 == 0) fill(img, x0 + scale + x, y0 + scale + y, 1, 1, color);
+    drawLabel(img, x0 + side, y0, label, scale);
+}
+
+}  // namespace
+
+std::vector<Coverage> lightMapCoverage(const scene::Frame& frame, const scene::Scene& scene, const RenderDebug& debug) {
+    std::vector<Coverage> out;
+    out.reserve(frame.pixelCount());
+    for (const PixelCoverage& c : coverage(frame, scene, debug)) out.push_back(c.coverage);
+    return out;
+}
+
+int frustumLineWidth(int imageHeight) { return imageHeight < 360 ? 1 : 2; }
+
+DisplayImage lightFrustumView(const scene::Frame& frame, const scene::Scene& scene, const RenderDebug& debug) {
+    DisplayImage img{frame.width, frame.height, std::vector<float>(frame.pixelCount() * 3)};
+    const std::vector<PixelCoverage> cover = coverage(frame, scene, debug);
+    for (int y = 0; y < frame.height; ++y)
+        for (int x = 0; x < frame.width; ++x) {
+            const std::size_t i = std::size_t(y) * std::size_t(frame.width) + std::size_t(x);
+            const float* b = &frame.beauty[3 * i];
+            std::array<float, 3> c;
+            for (int k = 0; k < 3; ++k)
+                c[std::size_t(k)] = kFrustumViewDim * scene::linearToSrgb(std::clamp(b[k], 0.0f, 1.0f));
+            if (cover[i].coverage == Coverage::Covered) {
+                const float shade = kCoveredShade[0] + kCoveredShade[1] * luminance(b);
+                for (int k = 0; k < 3; ++k) c[std::size_t(k)] = cover[i].tint[std::size_t(k)] * shade;
+            } else if (cover[i].coverage == Coverage::Uncovered && ((x + y) / kLeakStripeWidth) % 2 == 0) {
+                c = kLeakColor;
+            }
+            fill(img, x, y, 1, 1, c);
+        }
+
+    scene::Camera camera = scene.camera;
+    camera.width = frame.width;
+    camera.height = frame.height;
+    const scene::CameraBasis cam = scene::cameraBasis(camera);
+    const DepthBuffer depth{frame};
+    const int width = frustumLineWidth(frame.height);
+    const int scale = std::max(1, frame.height / 240);
+    // Every map's edges, stroke by stroke: hidden parts first, so that a solid edge crossing a
+    // dashed one stays solid; halos before lines.
+    for (const Stroke stroke : {Stroke{true, true}, Stroke{true, false}, Stroke{false, true}, Stroke{false, false}})
+        for (const LightLayers& ll : shadowedLights(debug)) {
+            const scene::Light& light = scene.lights[std::size_t(ll.light)];
+            if (light.type == scene::LightType::Point) continue;
+            const bool cascaded = light.type == scene::LightType::Directional && ll.count > 1;
+            for (int k = 0; k < ll.count; ++k) {
+                const std::array<float, 3> color = cascaded ? cascadeTint(k) : lightTint(light);
+                const std::array<scene::Vec3, 8> corners = frustumCorners(debug.frusta[std::size_t(ll.first + k)]);
+                for (const auto& e : kFrustumEdges)
+                    if (const auto s = projectSegment(cam, scene.camera.near, corners[std::size_t(e[0])],
+                                                      corners[std::size_t(e[1])]))
+                        drawSegment(img, depth, *s, color, width, stroke);
+            }
+        }
+    int legendY = 2;
+    for (const LightLayers& ll : shadowedLights(debug)) {
+        const scene::Light& light = scene.lights[std::size_t(ll.light)];
+        const bool point = light.type == scene::LightType::Point;
+        const bool cascaded = light.type == scene::LightType::Directional && ll.count > 1;
+        std::string name = "L";  // (not "L" + to_string: GCC 12 warns falsely, -Wrestrict)
+        name += std::to_string(ll.light);
+        if (!point)
+            for (int k = 0; k < ll.count; ++k) {
+                const std::array<float, 3> color = cascaded ? cascadeTint(k) : lightTint(light);
+                legendRow(img, 2, legendY, scale, color, false, cascaded ? name + " C" + std::to_string(k) : name);
+                legendY += 8 * scale;
+            }
+        if (point || light.type == scene::LightType::Spot)
+            drawMarker(img, depth, cam, scene.camera.near, light.position, lightTint(light), width);
+        if (point) {
+            legendRow(img, 2, legendY, scale, lightTint(light), false, name);
+            legendY += 8 * scale;
+        }
+    }
+    if (legendY > 2) legendRow(img, 2, legendY, scale, kLeakColor, true, "OUT");
     return img;
 }
 

@@ -57,13 +57,13 @@ std::uint64_t shadowMapLayers(const scene::Scene& scene, const scene::RenderPlan
 }
 
 std::uint64_t debugViewBytes(const scene::Scene& scene, const scene::RenderPlan& plan,
-                             const scene::RasterSettings& settings, bool captureShadowMaps) {
-    if (captureShadowMaps) {
+                             const scene::RasterSettings& settings, std::string_view view) {
+    if (view == "shadow-map") {
         const std::uint64_t texels = std::uint64_t(settings.shadowMapSize) * std::uint64_t(settings.shadowMapSize);
         return shadowMapLayers(scene, plan, settings) * texels * (4 + 12 + 3);
     }
     const std::uint64_t pixels = std::uint64_t(scene.camera.width) * std::uint64_t(scene.camera.height);
-    return pixels * (12 + 4);
+    return pixels * (view == "light-frustum" ? 12 + 4 + 16 : 12 + 4);
 }
 
 }  // namespace shadowlab::raster

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string_view>
 
 #include "scene/render_plan.h"
 #include "scene/scene.h"
@@ -22,11 +23,12 @@ std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::Render
 std::uint64_t shadowMapLayers(const scene::Scene& scene, const scene::RenderPlan& plan,
                               const scene::RasterSettings& settings);
 
-// What `render --view` holds on the host besides estimateMemoryBytes() (it writes no EXR): with
-// captureShadowMaps every layer's depths (4 bytes a texel) and the tiled display image (at most
-// 12 bytes a texel, gaps included as a quarter more); otherwise a display image and a cascade
-// index per camera pixel.
+// What `render --view VIEW` holds on the host besides estimateMemoryBytes() (it writes no EXR):
+// for "shadow-map" every layer's depths (4 bytes a texel) and the tiled display image (at most
+// 12 bytes a texel, gaps included as a quarter more); for "light-frustum" a display image (12
+// bytes), a cascade index (4) and a coverage record (16, raster/debug_views.cpp) per camera
+// pixel; otherwise a display image and a cascade index per camera pixel.
 std::uint64_t debugViewBytes(const scene::Scene& scene, const scene::RenderPlan& plan,
-                             const scene::RasterSettings& settings, bool captureShadowMaps);
+                             const scene::RasterSettings& settings, std::string_view view);
 
 }  // namespace shadowlab::raster

@@ -46,4 +46,12 @@ inline constexpr double kMaxSlopeTan = 10.0;
 // pixel and light is already slow on lavapipe, and wider penumbrae want a different filter.
 inline constexpr int kMaxPcfSize = 15;
 
+// The light-frustum view draws an edge point as hidden when it lies farther from the camera than
+// the pixel's visible surface by more than this fraction of the surface's view depth: the Frame's
+// depth is sampled at the pixel's center while the line point is anywhere in the pixel, so an edge
+// lying on a surface must not flicker between solid and dashed. Half a pixel's footprint at 720
+// rows and a 40° field of view is 5e-4·z; on a surface turned θ away from facing the camera the
+// depth changes by that times tan θ, which stays below 2e-3·z up to θ ≈ 75°.
+inline constexpr double kFrustumEdgeDepthTolerance = 2e-3;
+
 }  // namespace shadowlab::raster

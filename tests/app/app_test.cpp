@@ -169,7 +169,8 @@ INSTANTIATE_TEST_SUITE_P(
                "needs --backend raster and a .png output"},
         BadRun{"view_needs_png", {"render", "seed", "--backend", "raster", "--view", "shadow-map", "-o", "OUT"},
                "needs --backend raster and a .png output"},
-        BadRun{"unknown_view", {"render", "seed", "--backend", "raster", "--view", "normals", "-o", "OUTPNG"}, "--view"},
+        BadRun{"unknown_view", {"render", "seed", "--backend", "raster", "--view", "normals", "-o", "OUTPNG"},
+               "--view: normals not in {shadow-map,cascades,texel-density,light-frustum}"},
         BadRun{"bad_cascades", {"render", "seed", "--backend", "raster", "--cascades", "9", "-o", "OUT"}, "--cascades"},
         BadRun{"missing_frames", {"compare", "a.exr", "b.exr", "-o", "OUT.png"}, "no such file"}),
     [](const ::testing::TestParamInfo<BadRun>& info) { return std::string(info.param.name); });
@@ -189,7 +190,8 @@ TEST(App, RenderViewsWriteImagesOfTheDocumentedSizes) {
     TempDir dir;
     // 4 cascades at map 128: 2 x 2 tiles of 128 pixels, 4 apart; the other views: the image size.
     const std::vector<std::pair<std::string, std::pair<int, int>>> views = {
-        {"shadow-map", {2 * 128 + 4, 2 * 128 + 4}}, {"cascades", {96, 54}}, {"texel-density", {96, 54}}};
+        {"shadow-map", {2 * 128 + 4, 2 * 128 + 4}}, {"cascades", {96, 54}}, {"texel-density", {96, 54}},
+        {"light-frustum", {96, 54}}};
     for (const auto& [view, size] : views) {
         const auto out = dir.path() / (view + ".png");
         const Result r = shadowlab({"render", "seed", "--backend", "raster", "--view", view, "--cascades", "4",
