@@ -66,10 +66,29 @@ Prepared prepare(const SceneOptions& o) {
                   << p.plan.explain()
                   << "raster shadow-map size: " << raster::chooseShadowMapSize(p.scene, p.settings.raster).reason << "\n";
     if (o.explain) {
-        const std::vector<int> culled = raster::culledCasters(p.scene, p.settings.raster);
-        for (std::size_t i = 0; i < culled.size(); ++i)
-            std::cerr << "raster light " << i << ": " << culled[i] << " of " << p.scene.objects.size()
-                      << " objects left out of the depth pass (cannot cast onto the visible receivers)\n";
+        const std::vector<raster::LightCulling> culled = raster::culledCasters(p.scene, p.settings.raster, &p.plan);
+        const std::size_t objects = p.scene.objects.size();
+        for (std::size_t i = 0; i < culled.size(); ++i) {
+            const raster::LightCulling& c = culled[i];
+            std::cerr << "raster light " << i << ": ";
+            if (c.layers.empty()) {
+                std::cerr << "no caster culling ("
+                          << (!p.settings.raster.cullCasters ? "turned off"
+                              : p.plan.needsTransmittanceMap ? "the transmittance map draws every caster"
+                                                             : "no shadow map")
+                          << ")\n";
+            } else if (c.layers.size() == 1) {
+                std::cerr << c.culled[0] << " of " << objects
+                          << " objects left out of the depth pass (cannot cast onto the visible receivers)\n";
+            } else {
+                // Per cascade or cube face: each draws only what can cast onto its own receivers.
+                std::cerr << c.total() << " of " << c.layers.size() * objects << " object draws left out of "
+                          << c.layers.size() << " depth passes (";
+                for (std::size_t k = 0; k < c.layers.size(); ++k)
+                    std::cerr << (k ? ", " : "") << c.layers[k] << " " << c.culled[k] << " of " << objects;
+                std::cerr << "; cannot cast onto the receivers each map serves)\n";
+            }
+        }
     }
     return p;
 }

@@ -113,4 +113,10 @@ CascadeSet fitCascades(const scene::Scene& scene, const Vec3& direction, int cou
     return set;
 }
 
+std::vector<Vec3> cascadeReceivers(const scene::Scene& scene, const std::vector<double>& splits, std::size_t c) {
+    const double lo = c == 0 ? -INFINITY : splits[c] * (1.0 - kCascadeSplitSlack);
+    const double hi = c + 2 >= splits.size() ? INFINITY : splits[c + 1] * (1.0 + kCascadeSplitSlack);
+    return visibleReceiverPointsInSlice(scene, lo, hi);
+}
+
 }  // namespace shadowlab::raster

@@ -54,6 +54,13 @@ BoundingSphere sliceBoundingSphere(const scene::CameraBasis& cam, double d0, dou
 LightFrustum fitCascade(const scene::Scene& scene, const scene::CameraBasis& cam, double d0, double d1,
                         const scene::Vec3& direction, int mapSize);
 
+// The receivers of cascade `c` of a set with these splits: visibleReceiverPointsInSlice() over
+// [splits[c], splits[c + 1]], the first reaching down to the near plane and the last out to the
+// far one (lit.frag gives them everything nearer or farther), the inner ends widened by
+// kCascadeSplitSlack because lit.frag compares the view depth with the splits in float.
+inline constexpr double kCascadeSplitSlack = 1e-4;
+std::vector<scene::Vec3> cascadeReceivers(const scene::Scene& scene, const std::vector<double>& splits, std::size_t c);
+
 struct CascadeSet {
     std::vector<double> splits;        // count + 1 view depths, near to far
     std::vector<LightFrustum> frusta;  // one per slice; empty when the camera sees none of the scene

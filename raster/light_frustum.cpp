@@ -8,6 +8,7 @@
 #include <limits>
 #include <vector>
 
+#include "raster/cascades.h"
 #include "raster/tolerances.h"
 #include "scene/camera.h"
 
@@ -143,6 +144,18 @@ std::vector<Vec3> visibleReceiverPoints(const scene::Scene& scene, const scene::
     for (const Vec3& c : corners(sceneBounds)) farthest = std::max(farthest, glm::dot(c - cam.position, cam.forward));
     const double nearD = scene.camera.near, farD = std::min(scene.camera.far, farthest);
     if (!(farD > nearD)) return {};  // the scene is behind the camera
+    return clipBoxToFrustum(sceneBounds, cam, nearD, farD);
+}
+
+std::vector<Vec3> visibleReceiverPointsInSlice(const scene::Scene& scene, double minDepth, double maxDepth) {
+    const scene::Bounds sceneBounds = scene.bounds();
+    if (sceneBounds.empty()) return {};
+    const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
+    double farthest = 0.0;
+    for (const Vec3& c : corners(sceneBounds)) farthest = std::max(farthest, glm::dot(c - cam.position, cam.forward));
+    const double nearD = std::max(scene.camera.near, minDepth);
+    const double farD = std::min({scene.camera.far, farthest, maxDepth});
+    if (!(farD > nearD)) return {};
     return clipBoxToFrustum(sceneBounds, cam, nearD, farD);
 }
 
@@ -311,76 +324,276 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
     // A size set after resolveSettings() (a test, the sweep) is forced too.
     if (!settings.shadowMapSizeIsDefault || size != scene::kDefaultShadowMapSize)
         return keep("set by --shadow-map-size or the scene");
-    for (const scene::Light& l : scene.lights)
-        if (l.type != scene::LightType::Directional)
-            return keep("default: spot and point maps have texels that grow with distance");
-    if (settings.cascades > 1) return keep("default: cascades size their texels per slice");
-    // The nearest view depth of any visible receiver: over each object's bounds clipped to the
-    // camera frustum (the scene's box would reach up to the camera), at a vertex of the clipped box.
-    const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
-    double zMin = INFINITY;
-    for (const scene::Object& o : scene.objects)
-        for (const Vec3& p : visibleReceiverPoints(scene, scene::boundsOf(o.shape)))
-            zMin = std::min(zMin, glm::dot(p - cam.position, cam.forward));
-    if (!std::isfinite(zMin)) return keep("default: the camera sees no receiver");
-    zMin = std::max(zMin, scene.camera.near);
-    // A pixel's world size on a receiver facing the camera at view depth z; tilted receivers
-    // have larger footprints, so this is the finest detail the image can show.
-    const double pixel = 2.0 * cam.tanHalfFovY * zMin / std::max(scene.camera.height, 1);
-    double widest = 0.0;
+    bool directional = false;
     for (const scene::Light& l : scene.lights) {
-        const LightFrustum f = settings.fitLightFrustum ? fitDirectionalLightToReceivers(scene, l.direction, size)
-                                                        : fitDirectionalLight(scene.bounds(), l.direction, size);
-        widest = std::max(widest, 2.0 * f.halfWidth);
+        if (l.type == scene::LightType::Point)
+            return keep("default: a point light's cube faces are not sized from receiver detail");
+        directional = directional || l.type == scene::LightType::Directional;
     }
-    const double needed = widest / pixel;
+    if (settings.cascades > 1 && directional) return keep("default: cascades size their texels per slice");
+    // The visible receivers: each object's bounds clipped to the camera frustum (the scene's box
+    // would reach up to the camera), a convex polytope each, between the near and far planes.
+    const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
+    std::vector<std::vector<Vec3>> visible;
+    for (const scene::Object& o : scene.objects) {
+        std::vector<Vec3> v = visibleReceiverPoints(scene, scene::boundsOf(o.shape));
+        if (!v.empty()) visible.push_back(std::move(v));
+    }
+    if (visible.empty()) return keep("default: the camera sees no receiver");
+    // A pixel's world size on a receiver facing the camera at view depth zc (raster/debug_views.h
+    // pixelWorldSize); tilted receivers have larger footprints, so this is the finest detail the
+    // image can show.
+    auto pixelAt = [&](double zc) { return 2.0 * cam.tanHalfFovY * zc / std::max(scene.camera.height, 1); };
+    auto viewDepth = [&](const Vec3& p) { return std::max(glm::dot(p - cam.position, cam.forward), scene.camera.near); };
+    double needed = 0.0;
+    std::string why;
+    char buf[256];
+    if (directional) {
+        // The nearest view depth of any visible receiver, at a vertex (a linear function).
+        double zMin = INFINITY;
+        for (const std::vector<Vec3>& v : visible)
+            for (const Vec3& p : v) zMin = std::min(zMin, viewDepth(p));
+        const double pixel = pixelAt(zMin);
+        double widest = 0.0;
+        for (const scene::Light& l : scene.lights) {
+            if (l.type != scene::LightType::Directional) continue;
+            const LightFrustum f = settings.fitLightFrustum ? fitDirectionalLightToReceivers(scene, l.direction, size)
+                                                            : fitDirectionalLight(scene.bounds(), l.direction, size);
+            widest = std::max(widest, 2.0 * f.halfWidth);
+        }
+        needed = widest / pixel;
+        std::snprintf(buf, sizeof buf, "map width %.4g / smallest pixel footprint %.4g at view depth %.4g = %.0f texels",
+                      widest, pixel, zMin, needed);
+        why = buf;
+    }
+    for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+        const scene::Light& l = scene.lights[i];
+        if (l.type != scene::LightType::Spot) continue;
+        // A texel at distance z along the axis is z·2t/N wide, a pixel at view depth zc is
+        // pixelAt(zc): N ≥ 2t·z/pixelAt(zc) = 2t·(z/zc)/pixelAt(1). Both z and zc are affine in the
+        // point, and zc > 0 on each visible polytope K, so r = z/zc is quasi-linear there: if
+        // r(v) ≤ m at every vertex v, then z − m·zc ≤ 0 at the vertices, hence (affine) on all of
+        // K, i.e. r ≤ m on K. Its maximum over K is at a vertex.
+        const LightFrustum f = fitSpotLight(scene.bounds(), l.position, l.direction, l.coneAngleDegrees, size);
+        double ratio = 0.0;
+        for (const std::vector<Vec3>& v : visible)
+            for (const Vec3& p : v) {
+                const double r = glm::dot(p - f.position, f.direction) / viewDepth(p);
+                ratio = std::max(ratio, r);
+            }
+        const double spotNeeded = 2.0 * f.tanHalfFov * ratio / pixelAt(1.0);
+        std::snprintf(buf, sizeof buf, "%sspot %zu: 2·tan(half fov) %.4g x (distance / view depth) %.4g / pixel %.4g at view depth 1 = %.0f texels",
+                      why.empty() ? "" : "; ", i, 2.0 * f.tanHalfFov, ratio, pixelAt(1.0), spotNeeded);
+        why += buf;
+        needed = std::max(needed, spotNeeded);
+    }
+    if (why.empty()) return keep("default: no directional or spot light");
     int chosen = kMinAutoShadowMapSize;
     while (chosen < needed && chosen < size) chosen *= 2;
     chosen = std::min(chosen, size);
-    char buf[256];
-    std::snprintf(buf, sizeof buf, "%d (%s: map width %.4g / smallest pixel footprint %.4g at view depth %.4g = %.0f texels%s)",
-                  chosen, chosen < size ? "from receiver detail" : "default", widest, pixel, zMin, needed,
-                  chosen < size ? ", rounded up to a power of two" : ", capped at the default");
-    return ShadowMapSizeChoice{chosen, buf};
+    return ShadowMapSizeChoice{chosen, std::to_string(chosen) + " (" +
+                                           (chosen < size ? "from receiver detail: " : "default: ") + why +
+                                           (chosen < size ? ", rounded up to a power of two" : ", capped at the default") +
+                                           ")"};
 }
 
+namespace {
 
-std::vector<bool> castsIntoView(const scene::Scene& scene, const LightFrustum& f, double marginTexels) {
-    std::vector<bool> casts(scene.objects.size(), true);
-    const std::vector<Vec3> receivers = visibleReceiverPoints(scene);
-    if (receivers.empty() || f.perspective) return casts;
-    double minU = INFINITY, maxU = -INFINITY, minV = INFINITY, maxV = -INFINITY, maxDepth = -INFINITY;
-    for (const Vec3& c : receivers) {
-        const Vec3 d = c - f.center;
-        minU = std::min(minU, glm::dot(d, f.right));
-        maxU = std::max(maxU, glm::dot(d, f.right));
-        minV = std::min(minV, glm::dot(d, f.up));
-        maxV = std::max(maxV, glm::dot(d, f.up));
-        maxDepth = std::max(maxDepth, glm::dot(d, f.direction));
+// Both a box's and the receivers' extent in f's map and their depth along its axis. Orthographic:
+// u, v are world offsets across the light from f.center; perspective: tangents x/d, y/d of the
+// direction from f.position.
+struct MapExtent {
+    double minU = INFINITY, maxU = -INFINITY, minV = INFINITY, maxV = -INFINITY;
+    double minDepth = INFINITY, maxDepth = -INFINITY;
+    bool empty() const { return !(minU <= maxU && minV <= maxV); }
+};
+
+// The receivers' extent in a perspective map: of their hull's part in front of the light (d > 0).
+// The hull's vertices with d > 0 project to finite (u, v); the rest of that part lies near where
+// an edge from such a vertex a to one behind, b, crosses the plane d = 0, at c. Along that edge
+// u = x/d runs monotonically from u_a to +∞ when x_c > 0 (−∞ when x_c < 0; constant u_a when
+// x_c = 0), and the hull's vertex pairs include all its edges (the other pairs cross inside the
+// hull, which adds nothing false). Then clamped to the map's own extent: a receiver outside it
+// reads at most the border and the texels a filter reaches from there, which the margin covers.
+MapExtent perspectiveReceiverExtent(const std::vector<Vec3>& receivers, const LightFrustum& f) {
+    struct Local {
+        double x, y, d;
+    };
+    std::vector<Local> front, behind;
+    for (const Vec3& p : receivers) {
+        const Vec3 r = p - f.position;
+        const Local l{glm::dot(r, f.right), glm::dot(r, f.up), glm::dot(r, f.direction)};
+        (l.d > 0.0 ? front : behind).push_back(l);
     }
-    const double margin = marginTexels * f.texelWorldSize();
+    MapExtent e;
+    for (const Local& a : front) {
+        e.minU = std::min(e.minU, a.x / a.d);
+        e.maxU = std::max(e.maxU, a.x / a.d);
+        e.minV = std::min(e.minV, a.y / a.d);
+        e.maxV = std::max(e.maxV, a.y / a.d);
+        e.maxDepth = std::max(e.maxDepth, a.d);
+    }
+    for (const Local& a : front)
+        for (const Local& b : behind) {
+            const double s = a.d / (a.d - b.d);
+            const double xc = a.x + s * (b.x - a.x), yc = a.y + s * (b.y - a.y);
+            if (xc > 0.0) e.maxU = INFINITY;
+            if (xc < 0.0) e.minU = -INFINITY;
+            if (yc > 0.0) e.maxV = INFINITY;
+            if (yc < 0.0) e.minV = -INFINITY;
+        }
+    const double t = f.tanHalfFov;
+    e.minU = std::clamp(e.minU, -t, t);
+    e.maxU = std::clamp(e.maxU, -t, t);
+    e.minV = std::clamp(e.minV, -t, t);
+    e.maxV = std::clamp(e.maxV, -t, t);
+    return e;
+}
+
+MapExtent orthographicExtent(const std::vector<Vec3>& points, const LightFrustum& f) {
+    MapExtent e;
+    for (const Vec3& c : points) {
+        const Vec3 d = c - f.center;
+        e.minU = std::min(e.minU, glm::dot(d, f.right));
+        e.maxU = std::max(e.maxU, glm::dot(d, f.right));
+        e.minV = std::min(e.minV, glm::dot(d, f.up));
+        e.maxV = std::max(e.maxV, glm::dot(d, f.up));
+        e.minDepth = std::min(e.minDepth, glm::dot(d, f.direction));
+        e.maxDepth = std::max(e.maxDepth, glm::dot(d, f.direction));
+    }
+    return e;
+}
+
+}  // namespace
+
+std::vector<bool> castsOnto(const scene::Scene& scene, const LightFrustum& f, const std::vector<Vec3>& receivers,
+                            double reachTexels, double normalOffsetTexels) {
+    std::vector<bool> casts(scene.objects.size(), true);
+    if (receivers.empty()) return casts;
+    if (!f.perspective) {
+        const MapExtent r = orthographicExtent(receivers, f);
+        // The normal offset moves a receiver by that many texels in any direction.
+        const double margin = (reachTexels + normalOffsetTexels) * f.texelWorldSize();
+        for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+            const scene::Bounds b = scene::boundsOf(scene.objects[i].shape);
+            if (b.empty()) continue;
+            const std::array<Vec3, 8> c = corners(b);
+            const MapExtent o = orthographicExtent({c.begin(), c.end()}, f);
+            casts[i] = o.maxU >= r.minU - margin && o.minU <= r.maxU + margin && o.maxV >= r.minV - margin &&
+                       o.minV <= r.maxV + margin && o.minDepth <= r.maxDepth + margin;
+        }
+        return casts;
+    }
+    // Perspective. The normal offset moves a receiver at distance d by k·d, k = offset · texel
+    // angle: its direction turns by at most k·√(1 + u²)/(1 − k) in tangent units and its distance
+    // grows by at most k·d. For k < 0.1 and |u| ≤ ~1.13·t (beyond, the offset point stays off the
+    // map) that is under 2·k·√(1 + t²).
+    const double texelAngle = f.texelWorldSize();  // 2·t/N: tangent units per texel
+    const double k = normalOffsetTexels * texelAngle;
+    if (!(k < 0.1)) return casts;
+    const double t = f.tanHalfFov;
+    const double margin = (reachTexels + 2.0 * normalOffsetTexels * std::sqrt(1.0 + t * t)) * texelAngle;
+    const MapExtent r = perspectiveReceiverExtent(receivers, f);
+    if (r.empty()) return std::vector<bool>(scene.objects.size(), false);  // no receiver in front: none reads it
+    const double farthest = r.maxDepth * (1.0 + margin);
     for (std::size_t i = 0; i < scene.objects.size(); ++i) {
         const scene::Bounds b = scene::boundsOf(scene.objects[i].shape);
         if (b.empty()) continue;
-        const Footprint o = footprint(b, f);
-        casts[i] = o.maxU >= minU - margin && o.minU <= maxU + margin && o.maxV >= minV - margin &&
-                   o.minV <= maxV + margin && o.minDepth <= maxDepth + margin;
+        MapExtent o;
+        int behind = 0;
+        for (const Vec3& c : corners(b)) {
+            const Vec3 q = c - f.position;
+            const double d = glm::dot(q, f.direction);
+            if (!(d > 0.0)) {
+                ++behind;
+                continue;
+            }
+            const double u = glm::dot(q, f.right) / d, v = glm::dot(q, f.up) / d;
+            o.minU = std::min(o.minU, u);
+            o.maxU = std::max(o.maxU, u);
+            o.minV = std::min(o.minV, v);
+            o.maxV = std::max(o.maxV, v);
+            o.minDepth = std::min(o.minDepth, d);
+        }
+        if (behind == 8) {
+            casts[i] = false;  // wholly behind the light: clipped from this map
+        } else if (behind > 0) {
+            casts[i] = true;  // across the light's plane (or around the light): its projection is unbounded
+        } else {
+            // All corners in front: the box projects into the rectangle of its corners' projections.
+            casts[i] = o.maxU >= r.minU - margin && o.minU <= r.maxU + margin && o.maxV >= r.minV - margin &&
+                       o.minV <= r.maxV + margin && o.minDepth <= farthest;
+        }
     }
     return casts;
 }
 
-std::vector<int> culledCasters(const scene::Scene& scene, const scene::RasterSettings& settingsIn) {
+std::vector<bool> castsIntoView(const scene::Scene& scene, const LightFrustum& f, double reachTexels,
+                                double normalOffsetTexels) {
+    return castsOnto(scene, f, visibleReceiverPoints(scene), reachTexels, normalOffsetTexels);
+}
+
+double cullReachTexels(const scene::RasterSettings& settings, const scene::Light& light, int mapSize) {
+    double reach = kCullMarginTexels;
+    if (settings.filter == scene::ShadowFilter::Pcss && light.type != scene::LightType::Directional &&
+        light.radius > 0.0)
+        reach += (light.type == scene::LightType::Point ? kCubeWrapReachFactor : 1.0) * kPcssReachFraction * mapSize;
+    return reach;
+}
+
+std::vector<bool> layerCasters(const scene::Scene& scene, const scene::RasterSettings& settings,
+                               const scene::Light& light, const LightFrustum& f, const std::vector<Vec3>& receivers) {
+    return castsOnto(scene, f, receivers, cullReachTexels(settings, light, f.mapSize), settings.normalOffset);
+}
+
+int LightCulling::total() const {
+    int n = 0;
+    for (const int c : culled) n += c;
+    return n;
+}
+
+std::vector<LightCulling> culledCasters(const scene::Scene& scene, const scene::RasterSettings& settingsIn,
+                                        const scene::RenderPlan* plan) {
     scene::RasterSettings settings = settingsIn;
     settings.shadowMapSize = chooseShadowMapSize(scene, settingsIn).size;
-    std::vector<int> culled(scene.lights.size(), 0);
+    std::vector<LightCulling> out(scene.lights.size());
+    if (!settings.cullCasters || (plan && plan->needsTransmittanceMap)) return out;
+    const scene::Bounds bounds = scene.bounds();
+    const std::vector<Vec3> receivers = visibleReceiverPoints(scene);
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {
         const scene::Light& l = scene.lights[i];
-        if (l.type != scene::LightType::Directional || settings.cascades > 1) continue;
-        const LightFrustum f = settings.fitLightFrustum
-                                   ? fitDirectionalLightToReceivers(scene, l.direction, settings.shadowMapSize)
-                                   : fitDirectionalLight(scene.bounds(), l.direction, settings.shadowMapSize);
-        for (const bool c : castsIntoView(scene, f, kCullMarginTexels + settings.normalOffset)) culled[i] += c ? 0 : 1;
+        if (plan) {
+            bool shadowed = true;
+            for (const scene::LightPlan& lp : plan->lights)
+                if (lp.light == int(i)) shadowed = lp.needsShadowTest;
+            if (!shadowed) continue;
+        }
+        auto add = [&](const std::string& label, const LightFrustum& f, const std::vector<Vec3>& r) {
+            int n = 0;
+            for (const bool c : layerCasters(scene, settings, l, f, r)) n += c ? 0 : 1;
+            out[i].layers.push_back(label);
+            out[i].culled.push_back(n);
+        };
+        static const char* const kFaces[] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
+        if (l.type == scene::LightType::Point) {
+            for (int face = 0; face < kCubeFaces; ++face)
+                add(kFaces[face], fitPointLightFace(bounds, l.position, face, settings.shadowMapSize), receivers);
+        } else if (l.type == scene::LightType::Spot) {
+            add("", fitSpotLight(bounds, l.position, l.direction, l.coneAngleDegrees, settings.shadowMapSize), receivers);
+        } else if (const CascadeSet cs = settings.cascades > 1
+                                              ? fitCascades(scene, l.direction, settings.cascades, settings.shadowMapSize)
+                                              : CascadeSet{};
+                   !cs.frusta.empty()) {
+            for (std::size_t c = 0; c < cs.frusta.size(); ++c)
+                add(std::string(1, 'C').append(std::to_string(c)), cs.frusta[c], cascadeReceivers(scene, cs.splits, c));
+        } else {
+            add("",
+                settings.fitLightFrustum ? fitDirectionalLightToReceivers(scene, l.direction, settings.shadowMapSize)
+                                         : fitDirectionalLight(bounds, l.direction, settings.shadowMapSize),
+                receivers);
+        }
     }
-    return culled;
+    return out;
 }
+
 }  // namespace shadowlab::raster

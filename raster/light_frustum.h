@@ -8,6 +8,7 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/render_plan.h"
 #include "scene/scene.h"
 #include "scene/settings.h"
 
@@ -65,6 +66,9 @@ void setBasis(LightFrustum& f, const scene::Vec3& direction);
 std::vector<scene::Vec3> visibleReceiverPoints(const scene::Scene& scene);
 // The same for any box in the scene (an object's bounds): the part of it the camera frustum holds.
 std::vector<scene::Vec3> visibleReceiverPoints(const scene::Scene& scene, const scene::Bounds& box);
+// The same (for the scene's bounds) with the view depths further limited to [minDepth, maxDepth]:
+// the receivers of one cascade's slice.
+std::vector<scene::Vec3> visibleReceiverPointsInSlice(const scene::Scene& scene, double minDepth, double maxDepth);
 
 // The smallest depth along f.direction (relative to f.center) of any object whose bounding box's
 // extent across the light (f.right, f.up, relative to f.center) overlaps [minU, maxU] × [minV,
@@ -93,25 +97,76 @@ double cubeFaceTanHalfFov(int mapSize);
 LightFrustum fitPointLightFace(const scene::Bounds& bounds, const scene::Vec3& position, int face, int mapSize);
 
 
-// Caster culling (issue 5) for a directional light's map f: whether each object can cast onto
-// the visible receivers (visibleReceiverPoints, the scene's box clipped to the camera). Seen along
-// the light, the object's bounding box must overlap the receivers' extent across it, widened by
-// marginTexels texels (filter taps and normal offset look that far), and reach nearer the light
-// than the farthest receiver. All true when the camera sees none of the scene.
+// Caster culling (issue 5): which objects can shadow a receiver that reads map f. An object is
+// left out of f's depth pass when it cannot write a depth any visible receiver's shadow test reads
+// as nearer than itself; leaving it out then changes no comparison, so the image stays the same.
+// The receivers are given as the vertices of their convex hull (visibleReceiverPoints, or one
+// cascade's slice of it). With margin m (reachTexels + the normal offset, in f's texels):
+// - orthographic: seen along the light, the object's bounding box must overlap the receivers'
+//   extent across it widened by m texels, and reach nearer the light than the farthest receiver
+//   (+ m texels);
+// - perspective (spot, cube face): projected (u = x/d, v = y/d, d along the map's axis), the box's
+//   rectangle must overlap the receivers' rectangle widened by m texels of angle, and its nearest
+//   corner be nearer than the farthest receiver (d·(1 + m·texel angle)). The receivers' rectangle
+//   is that of their hull's part in front of the light, clamped to the map's extent [−t, t]; where
+//   the hull crosses the light's plane it is unbounded toward the side the crossing lies on. A box
+//   with corners on both sides of the light's plane (or holding the light) is always kept; one
+//   wholly behind it is left out (the map cannot hold it). The normal offset counts
+//   2·√(1 + t²) times: it moves a point across the light's rays by up to that many texels of
+//   angle while the offset is under a tenth of the point's distance (else nothing is culled).
+// All true when there are no receivers.
+std::vector<bool> castsOnto(const scene::Scene& scene, const LightFrustum& f, const std::vector<scene::Vec3>& receivers,
+                            double reachTexels, double normalOffsetTexels);
+// castsOnto() with every receiver the camera sees (visibleReceiverPoints(scene)).
+std::vector<bool> castsIntoView(const scene::Scene& scene, const LightFrustum& f, double reachTexels,
+                                double normalOffsetTexels = 0.0);
 // The widest filter reach in texels (a 15-tap kernel's half, pcf2x2's extra texel, rounding).
 inline constexpr double kCullMarginTexels = 10.0;
-std::vector<bool> castsIntoView(const scene::Scene& scene, const LightFrustum& f, double marginTexels);
-// Per light, how many objects castsIntoView leaves out of its depth pass (0 for spot and point
-// lights and cascades, which are not culled), with the frusta the renderer makes for `settings`.
-std::vector<int> culledCasters(const scene::Scene& scene, const scene::RasterSettings& settings);
+// PCSS of a spot or point light with a size looks up to this fraction of the map's side from the
+// point, in its blocker search and its widest kernel (shaders/lit.frag kPcssMaxSearchFraction,
+// half of kPcssMaxFilterFraction).
+inline constexpr double kPcssReachFraction = 1.0 / 16.0;
+// A point light's PCSS taps go on into the neighbouring face (lit.frag cubeTap); an offset of r
+// texels in one face is at most ~2.3·r texels in the next near their shared edge (the change of
+// face coordinates 1/a, b/a has derivatives up to 1/a² and (a + |b|)/a² with a ≥ 1 − r·texel
+// angle, |b| ≤ a), so the reach counts this many times there.
+inline constexpr double kCubeWrapReachFactor = 3.0;
+// How far from its own texel a receiver's shadow test of `light` reads, in texels of a map of
+// mapSize: kCullMarginTexels, plus the PCSS reach for a spot or point light with a radius.
+double cullReachTexels(const scene::RasterSettings& settings, const scene::Light& light, int mapSize);
+
+// Per light, what culling leaves out of its depth passes with the frusta the renderer makes for
+// `settings` (and `plan`, when given: lights it gives no shadow test have no maps): per layer (one
+// for a single map, one per cascade, six cube faces) its label ("" for a single map, "C0".., "+X"..)
+// and how many objects its depth pass leaves out. No layers where nothing is culled: a light
+// without a map, settings.cullCasters off, or a transmittance map (plan.needsTransmittanceMap),
+// whose draw order is not per object.
+struct LightCulling {
+    std::vector<std::string> layers;
+    std::vector<int> culled;
+    int total() const;  // object draws left out over all the light's layers
+};
+std::vector<LightCulling> culledCasters(const scene::Scene& scene, const scene::RasterSettings& settings,
+                                        const scene::RenderPlan* plan = nullptr);
+// The objects drawn into one layer of `light` (f its frustum, receivers those that read it).
+std::vector<bool> layerCasters(const scene::Scene& scene, const scene::RasterSettings& settings,
+                               const scene::Light& light, const LightFrustum& f,
+                               const std::vector<scene::Vec3>& receivers);
 
 // Map size from the receivers' detail (issue 5): when nobody chose a size (settings
-// shadowMapSizeIsDefault and the size is kDefaultShadowMapSize), a map whose texel is smaller than the smallest world footprint of a
-// screen pixel on the visible receivers adds nothing the image can show. The size is then the
-// widest directional map's width divided by that footprint, rounded up to a power of two and
-// clamped to [kMinAutoShadowMapSize, the default]. Kept as set when forced, with spot or point
-// lights (their texels grow with distance; one array holds every map), with cascades (sized per
-// slice already) or when the camera sees nothing. `reason` says which, for --explain and the Frame.
+// shadowMapSizeIsDefault and the size is kDefaultShadowMapSize), a map whose texel is smaller than
+// the world footprint of a screen pixel on the visible receivers adds nothing the image can show.
+// Each light with a map says how many texels it needs, and the size (one array holds every map)
+// is the most any needs, rounded up to a power of two and clamped to [kMinAutoShadowMapSize, the
+// default]:
+// - directional: the widest map's width divided by the smallest pixel footprint on the visible
+//   receivers;
+// - spot: max over the visible receivers of 2·tanHalfFov·z / pixelWorldSize(zc), z the distance
+//   along the spot's axis and zc the view depth (the texel there is z·2·tanHalfFov/N); z/zc is
+//   linear-fractional, so its maximum over each object's visible part (a convex polytope, zc > 0)
+//   is at a vertex.
+// Kept as set when forced, with point lights (see docs/raster.md), with cascades (sized per slice
+// already) or when the camera sees nothing. `reason` says which, for --explain and the Frame.
 // The smallest size chosen that way: below it the bias defaults (half a texel) grow coarse.
 inline constexpr int kMinAutoShadowMapSize = 256;
 struct ShadowMapSizeChoice {

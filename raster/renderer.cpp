@@ -9,6 +9,7 @@
 #include <cstring>
 #include <map>
 #include <memory>
+#include <set>
 #include <tuple>
 #include <variant>
 
@@ -214,9 +215,23 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     }
     attributes["shadow_map_size_reason"] = mapChoice.reason;
 
-    // Caster culling: per culled layer, which objects are drawn into it; per light, how many not.
-    std::map<std::size_t, std::vector<bool>> layerCasters;
+    // Caster culling: per culled layer, which objects are drawn into it, and how many are not.
+    // Not with a transmittance map: its index order (opaque casters first) is not per object.
+    const bool cull = settings.cullCasters && !plan.needsTransmittanceMap;
+    const std::vector<scene::Vec3> receivers = cull ? visibleReceiverPoints(scene) : std::vector<scene::Vec3>{};
+    std::map<std::size_t, std::vector<bool>> casters;
     std::vector<int> culledPerLight(scene.lights.size(), 0);
+    std::vector<int> culledPerLayer;
+    auto cullLayer = [&](std::size_t light, const LightFrustum& lf, const std::vector<scene::Vec3>& layerReceivers) {
+        int n = 0;
+        if (cull) {
+            std::vector<bool> c = layerCasters(scene, settings, scene.lights[light], lf, layerReceivers);
+            for (const bool k : c) n += k ? 0 : 1;
+            casters[lightMatrices.size()] = std::move(c);  // called before the layer's matrix is added
+        }
+        culledPerLight[light] += n;
+        culledPerLayer.push_back(n);
+    };
 
     std::vector<double> usedDepthBias;  // per shadow-mapped light (spot, directional)
     // One shadow-map layer per light that needs a shadow test.
@@ -247,6 +262,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
                 layer = float(lightMatrices.size());
                 for (int face = 0; face < kCubeFaces; ++face) {
                     f = fitPointLightFace(bounds, light.position, face, settings.shadowMapSize);
+                    cullLayer(i, f, receivers);  // each face draws only its own casters
                     lightMatrices.push_back(glm::mat4(f.toClip(origin)));
                     frusta.push_back(f);
                     static const char* const kFaces[] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
@@ -271,6 +287,8 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
                 for (std::size_t c = 0; c < cascades.frusta.size(); ++c) {
                     const LightFrustum& cf = cascades.frusta[c];
                     const double depthBias = settings.depthBiasIsDefault ? 0.5 * cf.texelWorldSize() : settings.depthBias;
+                    // Each cascade draws only the casters of the receivers of its own slice.
+                    cullLayer(i, cf, cull ? cascadeReceivers(scene, cascades.splits, c) : std::vector<scene::Vec3>{});
                     lightMatrices.push_back(glm::mat4(cf.toClip(origin)));
                     frusta.push_back(cf);
                     usedDepthBias.push_back(depthBias);
@@ -296,12 +314,8 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
                 layerLight.push_back(int(i));
                 layerLabels.push_back("L" + std::to_string(i));
                 layer = float(lightMatrices.size());
-                if (!spot && settings.cullCasters) {
-                    // Objects that cannot cast onto the visible receivers stay out of this map.
-                    std::vector<bool> casts = castsIntoView(scene, f, kCullMarginTexels + settings.normalOffset);
-                    for (const bool c : casts) culledPerLight[i] += c ? 0 : 1;
-                    layerCasters[lightMatrices.size()] = std::move(casts);
-                }
+                // Objects that cannot cast onto the visible receivers stay out of this map.
+                cullLayer(i, f, receivers);
                 lightMatrices.push_back(glm::mat4(f.toClip(origin)));
                 l.toShadow = glm::mat4(f.toTexture(origin));
                 // The default constant bias is half a texel of the bounding-sphere map
@@ -345,9 +359,9 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     // the depth pass then draws every opaque caster (layerRanges empty).
     for (std::size_t k = 0; k < lightMatrices.size() && !plan.needsTransmittanceMap; ++k) {
         std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges;
-        const auto it = layerCasters.find(k);
+        const auto it = casters.find(k);
         for (std::size_t o = 0; o < scene.objects.size(); ++o) {
-            if (it != layerCasters.end() && !it->second[o]) continue;
+            if (it != casters.end() && !it->second[o]) continue;
             const std::uint32_t first = geometry.objectFirstIndex[o], end = geometry.objectFirstIndex[o + 1];
             if (!ranges.empty() && ranges.back().first + ranges.back().second == first)
                 ranges.back().second += end - first;
@@ -359,6 +373,13 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     std::string culled;
     for (std::size_t i = 0; i < culledPerLight.size(); ++i) culled += (i ? ";" : "") + std::to_string(culledPerLight[i]);
     attributes["culled_casters"] = culled;
+    // Per layer (in layer order, as shadow_maps and light_frustum list them), when a light has more
+    // than one (cascades, cube faces).
+    if (layerLight.size() > std::set<int>(layerLight.begin(), layerLight.end()).size()) {
+        std::string perLayer;
+        for (std::size_t k = 0; k < culledPerLayer.size(); ++k) perLayer += (k ? ";" : "") + std::to_string(culledPerLayer[k]);
+        attributes["culled_casters_per_layer"] = perLayer;
+    }
 
     // Without a shadowed light a 1x1 cleared layer keeps the descriptor valid.
     const auto mapSize = lightMatrices.empty() ? 1u : std::uint32_t(settings.shadowMapSize);

@@ -47,8 +47,8 @@ struct RasterSettings {
     // Directional lights: split the view's depth range into this many slices, each with its own
     // map (1 = one map for the whole view, as fitLightFrustum or the bounding sphere decide).
     int cascades = 1;
-    // Leave objects that cannot cast onto the visible receivers out of directional maps (raster
-    // castsIntoView); tests and benchmarks turn it off to compare.
+    // Leave objects that cannot cast onto the receivers a map serves out of its depth pass (every
+    // map: raster castsOnto); tests and benchmarks turn it off to compare.
     bool cullCasters = true;
     std::string device;         // "" = lavapipe if present, else the first device; index or name substring
     bool validate = false;      // enable VK_LAYER_KHRONOS_validation and count its messages

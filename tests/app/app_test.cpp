@@ -202,6 +202,44 @@ TEST(App, RenderViewsWriteImagesOfTheDocumentedSizes) {
     }
 }
 
+// The seed scene under a spot or point light at (0, 8, 0), with a sphere behind the camera that can
+// shadow nothing the camera sees (tests/raster/caster_culling_test.cpp derives which maps leave it
+// out) and one above the view whose shadow falls into it.
+std::string culledScene(const std::string& light, const std::string& far, const std::string& kept) {
+    return R"({"camera": {"position": [0, 2, 6], "look_at": [0, 0.7, 0], "up": [0, 1, 0], "fov_y": 40,
+                          "resolution": [96, 54], "near": 0.1, "far": 100},
+               "materials": {"m": {"albedo": [0.8, 0.8, 0.8]}},
+               "lights": [)" + light + R"(],
+               "objects": [
+                 {"type": "sphere", "center": [0, 1, 0], "radius": 1, "material": "m"},
+                 {"type": "quad", "center": [0, 0, 0], "normal": [0, 1, 0], "size": [20, 20], "material": "m"},
+                 )" + far + ",\n" + kept + "]}";
+}
+
+TEST(App, ExplainSaysHowManyCastersEachMapLeavesOut) {
+    TempDir dir;
+    // Spot straight down, cone 60°: the sphere at (0, 1, 12) lies in its cone but can shadow no
+    // visible receiver: 1 of 4 objects left out.
+    const auto spot = dir.write(
+        "spot.json", culledScene(R"({"type": "spot", "position": [0, 8, 0], "direction": [0, -1, 0], "cone_angle": 60, "intensity": 800})",
+                                 R"({"type": "sphere", "center": [0, 1, 12], "radius": 1, "material": "m"})",
+                                 R"({"type": "sphere", "center": [2, 6, -2], "radius": 0.5, "material": "m"})"));
+    Result r = shadowlab({"render", spot.string(), "--backend", "raster", "--explain", "--validate", "-o",
+                          (dir.path() / "spot.png").string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("raster light 0: 1 of 4 objects left out of the depth pass"), std::string::npos) << r.err;
+    // Point light: per face; every receiver lies below the light, so +Y draws none of the 4.
+    const auto point = dir.write(
+        "point.json", culledScene(R"({"type": "point", "position": [0, 8, 0], "intensity": 800})",
+                                  R"({"type": "sphere", "center": [3, 1, 40], "radius": 1, "material": "m"})",
+                                  R"({"type": "sphere", "center": [1.5, 6, -1.5], "radius": 0.4, "material": "m"})"));
+    r = shadowlab({"render", point.string(), "--backend", "raster", "--explain", "--validate", "-o",
+                   (dir.path() / "point.png").string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("left out of 6 depth passes (+X "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("+Y 4 of 4"), std::string::npos) << r.err;
+}
+
 TEST(App, StabilityRunsTheNamedCasesAndWritesItsReport) {
     TempDir dir;
     const auto out = dir.path() / "stability";

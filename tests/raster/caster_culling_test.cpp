@@ -1,10 +1,15 @@
 // tests/raster/caster_culling_test.cpp: objects that cannot cast onto what the camera sees are
-// left out of a directional light's depth pass (raster::castsIntoView), on the seed scene, on
-// lavapipe with the validation layer.
+// left out of the depth passes (raster::castsOnto) of directional, spot and point-light maps and
+// of each cascade, on the seed scene, on lavapipe with the validation layer; culling never changes
+// the image. Also the spot map's size from receiver detail (raster::chooseShadowMapSize).
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <string>
 
 #include <gtest/gtest.h>
 
+#include "raster/cascades.h"
 #include "raster/renderer.h"
 #include "scene/loader.h"
 #include "scene/render_plan.h"
@@ -23,13 +28,19 @@ scene::Scene seedWith(const scene::Vec3& center, double radius) {
     return s;
 }
 
-scene::Frame rasterRender(const scene::Scene& s, bool cull) {
-    scene::RenderSettings settings = scene::resolveSettings(s, {});
+scene::Frame rasterRender(const scene::Scene& s, bool cull, int cascades = 1) {
+    scene::SettingsOverrides o;
+    o.cascades = cascades;
+    scene::RenderSettings settings = scene::resolveSettings(s, o);
     settings.raster.validate = true;
     settings.raster.cullCasters = cull;
     scene::Frame f = render(s, scene::makeRenderPlan(s, settings), settings.raster);
     EXPECT_EQ(f.attributes["validation_messages"], "0") << "validation messages were printed above";
     return f;
+}
+
+int countOf(const std::vector<float>& ids, int id) {
+    return int(std::count(ids.begin(), ids.end(), float(id)));
 }
 
 TEST(RasterCasterCulling, AFarObjectThatCannotShadowTheViewIsCulledAndTheImageIsUnchanged) {
@@ -57,6 +68,293 @@ TEST(RasterCasterCulling, AnObjectOutsideTheViewThatCastsIntoItIsKept) {
     int byExtra = 0;
     for (const float id : f.blockerId) byExtra += id == 3.0f ? 1 : 0;
     EXPECT_GT(byExtra, 0);
+}
+
+// The seed scene (camera at (0, 2, 6) looking at (0, 0.7, 0), fov 40°, ground ±10 at y = 0, sphere
+// r = 1 at (0, 1, 0)) lit by one spot or point light instead of the sun, and two more spheres:
+// object 2 `far` (never visible, its shadow neither) and object 3 `kept` (outside the view, its
+// shadow inside it).
+scene::Scene seedLitBy(const scene::Light& light, const scene::Vec3& far, double farRadius, const scene::Vec3& kept,
+                       double keptRadius) {
+    scene::Scene s = seedWith(far, farRadius);
+    scene::Object k = s.objects[0];
+    k.name = "kept";
+    k.shape = scene::Sphere{kept, keptRadius};
+    s.objects.push_back(k);
+    s.lights = {light};
+    return s;
+}
+
+scene::Light spotDown() {
+    // At (0, 8, 0) straight down, cone 60°: the map's half-angle is 61.2°, t = tan 61.2° ≈ 1.82.
+    // Its basis (setBasis: the axis is vertical, so right = dir × X) is right = +z, up = +x:
+    // u = z/d, v = x/d with d = 8 − y.
+    scene::Light l;
+    l.type = scene::LightType::Spot;
+    l.position = {0, 8, 0};
+    l.direction = {0, -1, 0};
+    l.coneAngleDegrees = 60;
+    l.intensity = 800;
+    return l;
+}
+
+scene::Light pointAbove() {
+    scene::Light l;
+    l.type = scene::LightType::Point;
+    l.position = {0, 8, 0};
+    l.intensity = 800;
+    return l;
+}
+
+// Spot: `far` at (0, 1, 12) r = 1, behind the camera but inside the cone (59.7° off the axis): its
+// box's directions have u = z/(8 − y) ≥ 11/8 = 1.375. The visible receivers (the scene's box in the
+// camera frustum, which reaches back only to the near plane at z ≈ 5.9, y ≈ 2.04) have u ≤ 5.9/5.96
+// < 1, and the margin (10 texels + 2·√(1 + t²)·normal offset: under 0.2 in u on any map of 256 or
+// more with the default offset) leaves them
+// short of 1.375: culled. `kept` at (2, 6, −2) r = 0.5 is 26° above the horizon seen from the
+// camera, whose view reaches 7.8° above it: outside the view; the light's ray through its center
+// meets the ground at (0, 8, 0) + 4·(2, −2, −2) = (8, 0, −8), 27° to the side and 8° below the
+// horizon: inside the view (half-angles 32.9° and 20° around a view 12.2° down), and clear of the
+// seed sphere.
+scene::Scene spotScene() { return seedLitBy(spotDown(), {0, 1, 12}, 1.0, {2, 6, -2}, 0.5); }
+
+TEST(RasterCasterCulling, ASpotMapLeavesOutWhatCannotShadowTheViewAndKeepsWhatDoes) {
+    const scene::Scene s = spotScene();
+    const scene::Frame culled = rasterRender(s, true);
+    const scene::Frame all = rasterRender(s, false);
+    EXPECT_EQ(culled.attributes.at("culled_casters"), "1");  // `far` only
+    EXPECT_EQ(all.attributes.at("culled_casters"), "0");
+    EXPECT_EQ(culled.visibility, all.visibility);
+    EXPECT_EQ(culled.beauty, all.beauty);
+    EXPECT_EQ(culled.blockerId, all.blockerId);
+    // `kept` (id 4) shadows visible ground in the culled render, and nothing shows `far` (id 3).
+    EXPECT_GT(countOf(culled.blockerId, 4), 0);
+    EXPECT_EQ(countOf(culled.objectId, 3) + countOf(culled.objectId, 4), 0);
+    const std::vector<LightCulling> c = culledCasters(s, scene::resolveSettings(s, {}).raster);
+    ASSERT_EQ(c.size(), 1u);
+    ASSERT_EQ(c[0].culled.size(), 1u);
+    EXPECT_EQ(c[0].culled[0], 1);
+}
+
+// Point light at (0, 8, 0). The visible receivers all lie below y ≈ 4.2 (the view's top edge rises
+// 7.8° over at most 16 units), so no receiver is in front of the +Y face: it draws nothing. `far`
+// at (3, 1, 40) r = 1 is behind the camera: wholly behind the light's planes of −X (x > 0), −Z
+// (z > 0) and +Y (y < 8); for +X its directions have z/x ≥ 39/4, for −Y z/(8 − y) ≥ 39/8, both far past the face's edge
+// (t ≈ 1.01) where the receivers' rectangle is clamped; for +Z its nearest depth 39 is beyond every
+// receiver's (z ≤ 5.91). Culled from all six faces. `kept` at (1.5, 6, −1.5)
+// r = 0.4 is 27.6° above the horizon from the camera (outside the view); the light's ray through
+// it meets the ground at (0, 8, 0) + 4·(1.5, −2, −1.5) = (6, 0, −6), inside the view, in the −Y
+// face, where its box (u = z/d in [−1.19, −0.46], v = x/d in [0.46, 1.19], d = 8 − y) overlaps
+// the ground's visible part.
+scene::Scene pointScene() { return seedLitBy(pointAbove(), {3, 1, 40}, 1.0, {1.5, 6, -1.5}, 0.4); }
+
+TEST(RasterCasterCulling, EachCubeFaceDrawsOnlyItsOwnCastersAndTheImageIsUnchanged) {
+    const scene::Scene s = pointScene();
+    const scene::RasterSettings settings = scene::resolveSettings(s, {}).raster;
+    const std::vector<LightCulling> c = culledCasters(s, settings);
+    ASSERT_EQ(c.size(), 1u);
+    ASSERT_EQ(c[0].layers, (std::vector<std::string>{"+X", "-X", "+Y", "-Y", "+Z", "-Z"}));
+    EXPECT_EQ(c[0].culled[2], 4);  // +Y: every object
+    const std::vector<scene::Vec3> receivers = visibleReceiverPoints(s);
+    for (int face = 0; face < kCubeFaces; ++face) {
+        SCOPED_TRACE(face);
+        const LightFrustum f = fitPointLightFace(s.bounds(), s.lights[0].position, face, settings.shadowMapSize);
+        const std::vector<bool> casts = layerCasters(s, settings, s.lights[0], f, receivers);
+        EXPECT_FALSE(casts[2]);                // `far`
+        if (face == 3) {
+            EXPECT_TRUE(casts[3]);  // `kept` in −Y
+        }
+        EXPECT_EQ(c[0].culled[std::size_t(face)], int(std::count(casts.begin(), casts.end(), false)));
+    }
+    const scene::Frame culled = rasterRender(s, true);
+    const scene::Frame all = rasterRender(s, false);
+    EXPECT_EQ(culled.attributes.at("culled_casters"), std::to_string(c[0].total()));
+    EXPECT_EQ(culled.attributes.at("culled_casters_per_layer"),
+              std::to_string(c[0].culled[0]) + ";" + std::to_string(c[0].culled[1]) + ";" +
+                  std::to_string(c[0].culled[2]) + ";" + std::to_string(c[0].culled[3]) + ";" +
+                  std::to_string(c[0].culled[4]) + ";" + std::to_string(c[0].culled[5]));
+    EXPECT_EQ(all.attributes.at("culled_casters"), "0");
+    EXPECT_EQ(culled.visibility, all.visibility);
+    EXPECT_EQ(culled.beauty, all.beauty);
+    EXPECT_EQ(culled.blockerId, all.blockerId);
+    EXPECT_GT(countOf(culled.blockerId, 4), 0);  // `kept` shadows the visible ground
+}
+
+TEST(RasterCasterCulling, PcssOfAnAreaPointLightReachesFartherAndStillLeavesTheImageUnchanged) {
+    // PCSS taps of a point light reach up to 1/16 of the map and wrap into the next face; with a
+    // light of radius 0.5 the soft shadows read far more texels than a pcf kernel.
+    scene::Scene s = pointScene();
+    s.lights[0].radius = 0.5;
+    s.shadow.filter = "pcss";
+    const scene::Frame culled = rasterRender(s, true);
+    const scene::Frame all = rasterRender(s, false);
+    EXPECT_NE(culled.attributes.at("culled_casters"), "0");
+    EXPECT_EQ(culled.visibility, all.visibility);
+    EXPECT_EQ(culled.blockerId, all.blockerId);
+}
+
+TEST(RasterCasterCulling, EachCascadeDrawsOnlyTheCastersOfItsOwnSlice) {
+    // Three cascades under the seed's sun (light along (−1, −2, −1)). An extra sphere r = 0.5 at
+    // (8, 1, −9) shadows the ground at (8, 1, −9) + 0.5·(−1, −2, −1) = (7.5, 0, −9.5), view depth
+    // ≈ 15.6: the last slice (the splits over the visible depths ≈ 3.5..16.9 are ≈ 6.4 and 10.6).
+    // Toward the light its shadow line (8 + s, 1 + 2s, −9 + s) reaches the first slice's z > −0.4
+    // (the slice ends ≈ 6.4 from the camera at z = 6) only for s > 8.6, at y > 18 and x > 16, where
+    // no receiver is: it cannot cast onto cascade 0's receivers, only onto the last one's.
+    const scene::Scene s = seedWith({8, 1, -9}, 0.5);
+    scene::SettingsOverrides o;
+    o.cascades = 3;
+    const scene::RasterSettings settings = scene::resolveSettings(s, o).raster;
+    const CascadeSet cs = fitCascades(s, s.lights[0].direction, 3, settings.shadowMapSize);
+    ASSERT_EQ(cs.frusta.size(), 3u);
+    const std::vector<bool> first = layerCasters(s, settings, s.lights[0], cs.frusta[0], cascadeReceivers(s, cs.splits, 0));
+    const std::vector<bool> last = layerCasters(s, settings, s.lights[0], cs.frusta[2], cascadeReceivers(s, cs.splits, 2));
+    EXPECT_FALSE(first[2]);
+    EXPECT_TRUE(last[2]);
+    const std::vector<LightCulling> c = culledCasters(s, settings);
+    ASSERT_EQ(c[0].layers, (std::vector<std::string>{"C0", "C1", "C2"}));
+    EXPECT_GE(c[0].culled[0], 1);
+
+    const scene::Frame culled = rasterRender(s, true, 3);
+    const scene::Frame all = rasterRender(s, false, 3);
+    EXPECT_EQ(culled.attributes.at("cascades"), "3");
+    EXPECT_EQ(culled.attributes.at("culled_casters"), std::to_string(c[0].total()));
+    EXPECT_EQ(all.attributes.at("culled_casters"), "0");
+    EXPECT_EQ(culled.visibility, all.visibility);
+    EXPECT_EQ(culled.beauty, all.beauty);
+    EXPECT_EQ(culled.blockerId, all.blockerId);
+    EXPECT_GT(countOf(culled.blockerId, 3), 0);  // the extra sphere's shadow is seen, from cascade 2
+}
+
+// castsOnto() for a perspective map at the origin looking down −z (basis right = +x, up = +y, so
+// u = x/d, v = y/d, d = −z), t = 1, 1000 texels (0.002 in u per texel; the 10-texel margin is
+// 0.02), without normal offset.
+LightFrustum lookingDownMinusZ() {
+    LightFrustum f;
+    f.perspective = true;
+    setBasis(f, {0, 0, -1});
+    f.position = {0, 0, 0};
+    f.tanHalfFov = 1.0;
+    f.mapSize = 1000;
+    f.near = 0.1;
+    f.far = 100;
+    return f;
+}
+
+scene::Scene boxes(const std::vector<scene::Box>& list) {
+    scene::Scene s;
+    for (const scene::Box& b : list) {
+        scene::Object o;
+        o.shape = b;
+        s.objects.push_back(o);
+    }
+    return s;
+}
+
+TEST(RasterCasterCulling, PerspectiveDecisionsIncludingBoxesAcrossTheLightsPlane) {
+    const LightFrustum f = lookingDownMinusZ();
+    ASSERT_DOUBLE_EQ(f.right.x, 1.0);
+    ASSERT_DOUBLE_EQ(f.up.y, 1.0);
+    // Receivers: the square x, y in ±1 at z = −5: u, v in ±0.2, depth 5.
+    std::vector<scene::Vec3> receivers;
+    for (const double x : {-1.0, 1.0})
+        for (const double y : {-1.0, 1.0}) receivers.push_back({x, y, -5});
+    const scene::Scene s = boxes({
+        {{-0.1, -0.1, -3}, {0.1, 0.1, -2}},  // between light and receivers: kept
+        {{2, -0.1, -3}, {3, 0.1, -2}},       // u ≥ 2/3 > 0.2 + 0.02: culled
+        {{-0.1, -0.1, -9}, {0.1, 0.1, -8}},  // behind the receivers (depth 8 > 5·1.02): culled
+        {{5, -0.1, -1}, {6, 0.1, 1}},        // across the light's plane: kept
+        {{-1, -1, -1}, {1, 1, 1}},           // holds the light: kept
+        {{-0.1, -0.1, 1}, {0.1, 0.1, 2}},    // wholly behind the light: culled
+        {{0.21, -0.1, -1}, {0.3, 0.1, -1}},  // u from 0.21: within the margin of 0.2: kept
+        {{0.23, -0.1, -1}, {0.3, 0.1, -1}},  // u from 0.23: past it: culled
+    });
+    EXPECT_EQ(castsOnto(s, f, receivers, kCullMarginTexels, 0.0),
+              (std::vector<bool>{true, false, false, true, true, false, true, false}));
+    // No receiver in front of the map: nothing reads it.
+    EXPECT_EQ(castsOnto(s, f, {{0, 0, 5}, {1, 1, 6}}, kCullMarginTexels, 0.0), std::vector<bool>(8, false));
+    // No receivers at all (the camera sees nothing): everything kept.
+    EXPECT_EQ(castsOnto(s, f, {}, kCullMarginTexels, 0.0), std::vector<bool>(8, true));
+}
+
+TEST(RasterCasterCulling, ReceiversPartlyBehindTheLightReachTheMapsEdgeOnlyOnTheirSide) {
+    const LightFrustum f = lookingDownMinusZ();
+    // Receivers x in [1, 2], y in ±1, z in ±5: the hull crosses the light's plane z = 0 at x in
+    // [1, 2] > 0, so in u it runs from 1/5 (the front corners' least x/d) out to +∞, clamped to the
+    // map's edge t = 1; in v the crossing has y of both signs: the whole map.
+    std::vector<scene::Vec3> receivers;
+    for (const double x : {1.0, 2.0})
+        for (const double y : {-1.0, 1.0})
+            for (const double z : {-5.0, 5.0}) receivers.push_back({x, y, z});
+    const scene::Scene s = boxes({
+        {{2, 3, -3}, {2.5, 4, -2}},    // u in [0.67, 1.25], v in [1, 2]: overlaps (v from 1 = t): kept
+        {{4, -0.1, -3}, {5, 0.1, -2}},  // u ≥ 4/3, past the clamped edge 1 + 0.02: culled
+        {{-3, -0.1, -3}, {-2, 0.1, -2}},  // u ≤ −2/3: on the side away from the crossing: culled
+        {{0.5, -0.1, -3}, {0.6, 0.1, -2}},  // u in [0.17, 0.3]: kept
+    });
+    EXPECT_EQ(castsOnto(s, f, receivers, kCullMarginTexels, 0.0), (std::vector<bool>{true, false, false, true}));
+}
+
+// The spot map's size from receiver detail, by hand: camera at (0, 10, 0) looking straight down
+// (fov 40°), spot at (0, 12, 0) straight down with a 30° cone (map half-angle 30.6°). Objects: the
+// ground (y = 0, view depth 10, distance along the spot's axis 12) and a box [−1, 1] x [0, 2] x
+// [−1, 1] whose top (view depth 8: the view there is ±2.9 high, ±5.2 wide, so all of it is seen) is
+// at distance 10. Both depths are 10 − y and 12 − y, so distance / view depth is largest where y is:
+// 10/8 on the box's top. N ≥ 2·tan 30.6°·(10/8) / (2·tan 20°/H) = 2.031·H texels: 365.6 at H = 180,
+// so 512; 731 at H = 360, so 1024; 4062 at H = 2000, capped at 2048.
+scene::Scene spotFromAbove(int height) {
+    scene::Scene s = seedWith({0, 1, 0}, 1.0);
+    s.objects.pop_back();
+    s.objects[0].shape = scene::Box{{-1, 0, -1}, {1, 2, 1}};
+    s.camera.position = {0, 10, 0};
+    s.camera.lookAt = {0, 0, 0};
+    s.camera.up = {0, 0, -1};
+    s.camera.width = height * 16 / 9;
+    s.camera.height = height;
+    scene::Light l = spotDown();
+    l.position = {0, 12, 0};
+    l.coneAngleDegrees = 30;
+    s.lights = {l};
+    return s;
+}
+
+int expectedSpotSize(int height) {
+    constexpr double kPi = 3.14159265358979323846;
+    const double needed = 2.0 * std::tan(30.6 * kPi / 180.0) * (10.0 / 8.0) / (2.0 * std::tan(20.0 * kPi / 180.0) / height);
+    int size = 256;
+    while (size < needed && size < 2048) size *= 2;
+    return size;
+}
+
+TEST(RasterMapSize, ASpotMapIsSizedByTheFinestReceiverDetailUnderIt) {
+    EXPECT_EQ(expectedSpotSize(180), 512);
+    EXPECT_EQ(expectedSpotSize(360), 1024);
+    EXPECT_EQ(expectedSpotSize(2000), 2048);
+    for (const int height : {180, 360, 2000}) {
+        SCOPED_TRACE(height);
+        const scene::Scene s = spotFromAbove(height);
+        const ShadowMapSizeChoice c = chooseShadowMapSize(s, scene::resolveSettings(s, {}).raster);
+        EXPECT_EQ(c.size, expectedSpotSize(height)) << c.reason;
+        EXPECT_NE(c.reason.find(height < 2000 ? "from receiver detail" : "capped at the default"), std::string::npos)
+            << c.reason;
+    }
+    // The render uses it.
+    scene::Scene s = spotFromAbove(180);
+    EXPECT_EQ(rasterRender(s, true).attributes.at("shadow_map_size"), "512");
+}
+
+TEST(RasterMapSize, ForcedSizesStayForcedWithSpotAndPointLights) {
+    scene::Scene s = spotFromAbove(180);
+    s.shadow.shadowMapSize = 2048;
+    EXPECT_EQ(chooseShadowMapSize(s, scene::resolveSettings(s, {}).raster).size, 2048);
+    s.shadow.shadowMapSize.reset();
+    scene::SettingsOverrides o;
+    o.shadowMapSize = 1024;
+    EXPECT_EQ(chooseShadowMapSize(s, scene::resolveSettings(s, o).raster).size, 1024);
+    // A point light keeps the default (docs/raster.md says why).
+    const scene::Scene p = pointScene();
+    const ShadowMapSizeChoice c = chooseShadowMapSize(p, scene::resolveSettings(p, {}).raster);
+    EXPECT_EQ(c.size, scene::kDefaultShadowMapSize);
+    EXPECT_NE(c.reason.find("point light"), std::string::npos) << c.reason;
 }
 
 }  // namespace
