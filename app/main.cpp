@@ -70,8 +70,10 @@ int main(int argc, char** argv) {
     auto* renderCmd = app.add_subcommand("render", "Render one backend into a Frame (.exr: every AOV and "
                                                    "metadata) or a beauty image (.png)");
     addSceneOptions(*renderCmd, renderOptions.common);
-    renderCmd->add_option("--backend", renderOptions.backend, "raster|raytrace|reference (default raytrace)")
-        ->check(CLI::IsMember({"raster", "raytrace", "reference"}));
+    auto* backendOption =
+        renderCmd->add_option("--backend", renderOptions.backend,
+                              "raster|raytrace|reference (default raytrace; raster with --view)")
+            ->check(CLI::IsMember({"raster", "raytrace", "reference"}));
     renderCmd->add_option("-o,--output", renderOptions.output, "Output file, .exr or .png")->required();
     renderCmd->add_option("--view", renderOptions.view,
                           "raster debug view instead of the beauty image (.png only): shadow-map (every map "
@@ -127,7 +129,11 @@ int main(int argc, char** argv) {
 
     try {
         if (*runCmd) return shadowlab::app::run(runOptions);
-        if (*renderCmd) return shadowlab::app::render(renderOptions);
+        if (*renderCmd) {
+            // The debug views are views of the shadow maps: --view alone means the raster backend.
+            if (renderOptions.view && backendOption->count() == 0) renderOptions.backend = "raster";
+            return shadowlab::app::render(renderOptions);
+        }
         if (*compareCmd) return shadowlab::app::compareFiles(compareOptions);
         if (*infoCmd) return shadowlab::app::info(infoValidate);
         if (*sweepCmd) return shadowlab::app::sweep(sweepOptions);

@@ -165,7 +165,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadRun{"bad_ray_bias", {"run", "seed", "--ray-bias", "lots", "-o", "OUTDIR"}, "--ray-bias"},
         BadRun{"bad_backend", {"render", "seed", "--backend", "magic", "-o", "OUT"}, "--backend"},
         BadRun{"bad_extension", {"render", "seed", "-o", "frame.tiff"}, "unknown output type"},
-        BadRun{"view_needs_raster", {"render", "seed", "--view", "cascades", "-o", "OUTPNG"},
+        BadRun{"view_needs_raster", {"render", "seed", "--backend", "raytrace", "--view", "cascades", "-o", "OUTPNG"},
                "needs --backend raster and a .png output"},
         BadRun{"view_needs_png", {"render", "seed", "--backend", "raster", "--view", "shadow-map", "-o", "OUT"},
                "needs --backend raster and a .png output"},
@@ -200,6 +200,12 @@ TEST(App, RenderViewsWriteImagesOfTheDocumentedSizes) {
         ASSERT_EQ(r.exitCode, 0) << view << ": " << r.err;
         EXPECT_EQ(pngSize(out), size) << view;
     }
+    // --view without --backend: the views are of the shadow maps, so it renders with raster.
+    const auto out = dir.path() / "implied.png";
+    const Result r = shadowlab({"render", "seed", "--view", "light-frustum", "--resolution", "96x54", "--validate",
+                                "-o", out.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(pngSize(out), std::make_pair(96, 54));
 }
 
 // The seed scene under a spot or point light at (0, 8, 0), with a sphere behind the camera that can
