@@ -60,28 +60,36 @@ scene::Scene edgeScene(double hb) {
     return s;
 }
 
+// Calls fn(q, visibility) for every floor pixel (object id 1) with q its point on the floor y = 0,
+// found by the test's own ray–plane intersection, not the renderer's.
+template <class Fn>
+void forEachFloorPixel(const scene::Scene& s, const scene::Frame& f, Fn fn) {
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    for (int y = 0; y < f.height; ++y)
+        for (int x = 0; x < f.width; ++x) {
+            const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
+            if (f.objectId[i] != 1.0f) continue;
+            const Vec3 d = test::pixelRay(cam, x, y);
+            fn(cam.position + (-cam.position.y / d.y) * d, double(f.visibility[i]));
+        }
+}
+
 // The 10%–90% width of the visibility ramp across the edge, on the floor near z = 0: floor pixels
 // (found by the test's own ray–plane intersection) are binned by x, each bin's mean visibility
 // taken, and the 0.1 and 0.9 crossings interpolated. `umbra`: the visibility in the full shadow
 // (0 behind an opaque blocker, 1 − opacity behind a semi-transparent one); the levels are taken
 // between it and 1.
 double rampWidth(const scene::Scene& s, const scene::Frame& f, double umbra = 0.0) {
-    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
     constexpr double lo = -1.2, hi = 1.2, bin = 0.02;
     const int bins = int((hi - lo) / bin);
     std::vector<double> sum(std::size_t(bins), 0.0);
     std::vector<int> count(std::size_t(bins), 0);
-    for (int y = 0; y < f.height; ++y)
-        for (int x = 0; x < f.width; ++x) {
-            const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
-            if (f.objectId[i] != 1.0f) continue;  // the floor
-            const Vec3 d = test::pixelRay(cam, x, y);
-            const Vec3 q = cam.position + (-cam.position.y / d.y) * d;
-            if (std::abs(q.z) > 0.4 || q.x < lo || q.x >= hi) continue;
-            const int b = int((q.x - lo) / bin);
-            sum[std::size_t(b)] += f.visibility[i];
-            ++count[std::size_t(b)];
-        }
+    forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
+        if (std::abs(q.z) > 0.4 || q.x < lo || q.x >= hi) return;
+        const int b = int((q.x - lo) / bin);
+        sum[std::size_t(b)] += v;
+        ++count[std::size_t(b)];
+    });
     auto crossing = [&](double level) {
         double prevV = -1.0, prevX = 0.0;
         for (int b = 0; b < bins; ++b) {
@@ -104,6 +112,18 @@ scene::Frame renderPcss(const scene::Scene& s) {
     return f;
 }
 
+// The measured 10–90 widths of blockers at heights 2 and 4 against Fernando's formula for them.
+void expectPenumbraWidths(const std::vector<double>& widths, const std::vector<double>& formula) {
+    ASSERT_TRUE(std::isfinite(widths[0]) && std::isfinite(widths[1])) << widths[0] << " " << widths[1];
+    // The visibility under a disk kernel of diameter W across a straight edge is the disk's area
+    // beyond a line; it passes 10% and 90% at ±0.687·W/2, so the 10–90 width is 0.687·W.
+    for (std::size_t i = 0; i < 2; ++i)
+        EXPECT_NEAR(widths[i], 0.687 * formula[i], 0.3 * 0.687 * formula[i] + 0.04)
+            << "blocker " << (i ? 4 : 2) << " above the floor";
+    // The ratio does not depend on the kernel's shape: (4/6)/(2/8) = 2.67.
+    EXPECT_NEAR(widths[1] / widths[0], formula[1] / formula[0], 0.2 * formula[1] / formula[0]);
+}
+
 TEST(RasterPcss, PenumbraWidensWithTheReceiverBlockerDistanceAsTheFormulaSays) {
     // Light points at x_L in [-w/2, w/2] at height H; the line through the edge (0, hb) meets the
     // floor at x = -x_L·hb/(H − hb): the penumbra is w·hb/(H − hb) wide, which is Fernando's
@@ -115,14 +135,7 @@ TEST(RasterPcss, PenumbraWidensWithTheReceiverBlockerDistanceAsTheFormulaSays) {
         widths.push_back(rampWidth(s, f));
         formula.push_back(kSize * hb / (kH - hb));
     }
-    ASSERT_TRUE(std::isfinite(widths[0]) && std::isfinite(widths[1])) << widths[0] << " " << widths[1];
-    // The visibility under a disk kernel of diameter W across a straight edge is the disk's area
-    // beyond a line; it passes 10% and 90% at ±0.687·W/2, so the 10–90 width is 0.687·W.
-    for (std::size_t i = 0; i < 2; ++i)
-        EXPECT_NEAR(widths[i], 0.687 * formula[i], 0.3 * 0.687 * formula[i] + 0.04)
-            << "blocker " << (i ? 4 : 2) << " above the floor";
-    // The ratio does not depend on the kernel's shape: (4/6)/(2/8) = 2.67.
-    EXPECT_NEAR(widths[1] / widths[0], formula[1] / formula[0], 0.2 * formula[1] / formula[0]);
+    expectPenumbraWidths(widths, formula);
 }
 
 TEST(RasterPcss, ASemiTransparentBlockerGetsTheSamePenumbraAtItsOwnDepth) {
@@ -142,19 +155,13 @@ TEST(RasterPcss, ASemiTransparentBlockerGetsTheSamePenumbraAtItsOwnDepth) {
         EXPECT_EQ(f.attributes.at("transmittance_map"), "made");
         // In the umbra (x in [-1.2, -0.6], z near 0) and in the light (x in [0.6, 1.2]): the
         // penumbra is at most 1·4/6 = 0.67 wide, centered on x = 0.
-        const scene::CameraBasis cam = scene::cameraBasis(s.camera);
         double umbra = 0.0, lit = 0.0;
         int nu = 0, nl = 0;
-        for (int y = 0; y < f.height; ++y)
-            for (int x = 0; x < f.width; ++x) {
-                const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
-                if (f.objectId[i] != 1.0f) continue;
-                const Vec3 d = test::pixelRay(cam, x, y);
-                const Vec3 q = cam.position + (-cam.position.y / d.y) * d;
-                if (std::abs(q.z) > 0.4) continue;
-                if (q.x > -1.2 && q.x < -0.6) umbra += f.visibility[i], ++nu;
-                if (q.x > 0.6 && q.x < 1.2) lit += f.visibility[i], ++nl;
-            }
+        forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
+            if (std::abs(q.z) > 0.4) return;
+            if (q.x > -1.2 && q.x < -0.6) umbra += v, ++nu;
+            if (q.x > 0.6 && q.x < 1.2) lit += v, ++nl;
+        });
         ASSERT_GT(nu, 20);
         ASSERT_GT(nl, 20);
         EXPECT_NEAR(umbra / nu, 0.5, 0.01) << "blocker at " << hb;
@@ -162,11 +169,7 @@ TEST(RasterPcss, ASemiTransparentBlockerGetsTheSamePenumbraAtItsOwnDepth) {
         widths.push_back(rampWidth(s, f, 0.5));
         formula.push_back(kSize * hb / (kH - hb));
     }
-    ASSERT_TRUE(std::isfinite(widths[0]) && std::isfinite(widths[1])) << widths[0] << " " << widths[1];
-    for (std::size_t i = 0; i < 2; ++i)
-        EXPECT_NEAR(widths[i], 0.687 * formula[i], 0.3 * 0.687 * formula[i] + 0.04)
-            << "blocker " << (i ? 4 : 2) << " above the floor";
-    EXPECT_NEAR(widths[1] / widths[0], formula[1] / formula[0], 0.2 * formula[1] / formula[0]);
+    expectPenumbraWidths(widths, formula);
 }
 
 TEST(RasterPcss, APointSizedLightKeepsTheHardShadowOfPoisson) {
@@ -233,7 +236,6 @@ double diskVisibility(const Vec3& q) {
 TEST(RasterPcss, APointLightPenumbraCrossesACubeFaceSeamWithoutACut) {
     const scene::Scene s = seamScene();
     const scene::Frame f = renderPcss(s);
-    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
     // Floor pixels within 0.3 of the seam (x = 4), from the lit side (z = 0.8) through the
     // penumbra into the umbra (z = -2.5): each side's mean error of the visibility against the
     // disk integral. PCSS is an estimate (a mean
@@ -241,17 +243,12 @@ TEST(RasterPcss, APointLightPenumbraCrossesACubeFaceSeamWithoutACut) {
     // wrong (before the fix: a streak of light along the seam in the umbra, and a narrower penumbra).
     double err[2] = {0, 0};
     int count[2] = {0, 0};
-    for (int y = 0; y < f.height; ++y)
-        for (int x = 0; x < f.width; ++x) {
-            const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
-            if (f.objectId[i] != 1.0f) continue;  // the floor
-            const Vec3 d = test::pixelRay(cam, x, y);
-            const Vec3 q = cam.position + (-cam.position.y / d.y) * d;
-            if (std::abs(q.x - kSeamH) > 0.3 || std::abs(q.x - kSeamH) < 0.02 || q.z < -2.5 || q.z > 0.8) continue;
-            const int side = q.x > kSeamH ? 1 : 0;
-            err[side] += std::abs(double(f.visibility[i]) - diskVisibility(q));
-            ++count[side];
-        }
+    forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
+        if (std::abs(q.x - kSeamH) > 0.3 || std::abs(q.x - kSeamH) < 0.02 || q.z < -2.5 || q.z > 0.8) return;
+        const int side = q.x > kSeamH ? 1 : 0;
+        err[side] += std::abs(v - diskVisibility(q));
+        ++count[side];
+    });
     ASSERT_GT(count[0], 500);
     ASSERT_GT(count[1], 500);
     for (int side = 0; side < 2; ++side) {
