@@ -246,11 +246,16 @@ LightFrustum fitPointLightFace(const scene::Bounds& bounds, const Vec3& position
     f.tanHalfFov = cubeFaceTanHalfFov(mapSize);
     const Vec3 c = bounds.empty() ? position : bounds.center();
     const double radius = bounds.empty() ? 1.0 : 0.5 * bounds.diagonal() * kLightFrustumMargin;
-    // Any direction may hold geometry, so the range is the distance band of the bounding sphere,
-    // not its extent along this face's axis: one near/far serves all six faces (the shader has one).
+    // Any direction may hold geometry, so the range comes from the distance band of the bounding
+    // sphere, not its extent along this face's axis: one near/far serves all six faces (the shader
+    // has one). Near and far are planes across the axis: a point at distance r in a direction θ off
+    // the axis has depth r·cos θ, as little as r/√(1 + 2t²) in the window's corners (tan θ = t√2),
+    // so the near plane is the nearest distance scaled by that (the radial distance itself clipped
+    // the corner of a box seen down its diagonal); a depth never exceeds the distance, so far is it.
     const double dist = glm::length(c - position);
+    const double t = f.tanHalfFov;
     f.far = std::max(dist + radius, 1e-6);
-    f.near = std::max(dist - radius, f.far * kSpotMinNearOverFar);
+    f.near = std::max((dist - radius) / std::sqrt(1.0 + 2.0 * t * t), f.far * kSpotMinNearOverFar);
     return f;
 }
 

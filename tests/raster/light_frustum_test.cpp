@@ -194,5 +194,42 @@ TEST(CubeFaces, EachFaceReachesTheMarginPastItsEdgeAndLooksAlongItsAxis) {
     }
 }
 
+TEST(CubeFaces, EveryPointOfTheBoundsInAFacesWindowLiesBetweenItsNearAndFar) {
+    // A face's near and far are planes across its axis, so a point at distance r from the light in
+    // a direction θ off the axis has depth r·cos θ, down to r/√(1 + 2t²) in the window's corners.
+    // Light outside the bounds along their diagonal: the nearest corner is straight down the
+    // cube's diagonal, 54.7° off every face's axis. Rays over each face's window (the test's own
+    // slab intersection with the box) must enter and leave the box between near and far.
+    const scene::Bounds bounds{Vec3(-1), Vec3(1)};
+    for (const double distance : {2.0, 3.0, 10.0, 100.0}) {
+        const Vec3 light = distance * glm::normalize(Vec3(1, 1, 1));
+        for (int face = 0; face < kCubeFaces; ++face) {
+            const LightFrustum f = fitPointLightFace(bounds, light, face, 512);
+            int hits = 0;
+            constexpr int n = 64;
+            for (int j = 0; j <= n; ++j)
+                for (int i = 0; i <= n; ++i) {
+                    const double u = f.tanHalfFov * (2.0 * i / n - 1.0), v = f.tanHalfFov * (2.0 * j / n - 1.0);
+                    const Vec3 d = f.direction + u * f.right + v * f.up;  // depth along the axis = λ
+                    double enter = 0.0, leave = INFINITY;
+                    for (int k = 0; k < 3; ++k) {
+                        if (d[k] == 0.0) {
+                            if (light[k] < -1.0 || light[k] > 1.0) leave = -1.0;
+                            continue;
+                        }
+                        const double a = (-1.0 - light[k]) / d[k], b = (1.0 - light[k]) / d[k];
+                        enter = std::max(enter, std::min(a, b));
+                        leave = std::min(leave, std::max(a, b));
+                    }
+                    if (enter > leave) continue;
+                    ++hits;
+                    EXPECT_GE(enter, f.near * (1.0 - 1e-12)) << "distance " << distance << " face " << face;
+                    EXPECT_LE(leave, f.far * (1.0 + 1e-12)) << "distance " << distance << " face " << face;
+                }
+            if (face % 2 == 1) EXPECT_GT(hits, 0) << "the −X, −Y, −Z faces look at the box";
+        }
+    }
+}
+
 }  // namespace
 }  // namespace shadowlab::raster
