@@ -123,11 +123,13 @@ void checkValidation(const scene::Frame& frame, const scene::RasterSettings& set
                                  " message(s) (printed above)");
 }
 
+// `debug`: raster only, what the debug views need (every channel is read back with it).
 scene::Frame renderBackend(const Prepared& p, const std::string& backend,
-                           scene::ChannelMask channels = scene::kAllChannels) {
+                           scene::ChannelMask channels = scene::kAllChannels, raster::RenderDebug* debug = nullptr) {
     scene::Frame f;
     if (backend == "raster") {
-        f = raster::render(p.scene, p.plan, p.settings.raster, channels);
+        f = debug ? raster::render(p.scene, p.plan, p.settings.raster, debug)
+                  : raster::render(p.scene, p.plan, p.settings.raster, channels);
         checkValidation(f, p.settings.raster);
     } else if (backend == "raytrace") {
         f = raytrace::render(p.scene, p.plan, p.settings.raytrace);
@@ -185,6 +187,34 @@ std::function<void(const compare::SweepProgress&)> sweepProgressPrinter() {
     };
 }
 
+// The display image of a `--view` (raster/debug_views.h), from a raster Frame and its RenderDebug
+// (the shadow-map view needs debug.captureShadowMaps).
+raster::DisplayImage debugView(const std::string& view, const scene::Frame& frame, const scene::Scene& scene,
+                               const raster::RenderDebug& debug) {
+    if (view == "shadow-map") return raster::shadowMapView(debug);
+    if (view == "cascades") return raster::cascadeView(frame, debug);
+    if (view == "light-frustum") return raster::lightFrustumView(frame, scene, debug);
+    return raster::texelDensityView(frame, scene, debug);
+}
+
+// What each view the run report shows is for, under its image.
+struct RunView {
+    const char* view;
+    const char* title;
+    const char* caption;
+};
+constexpr RunView kRunViews[] = {
+    {"shadow-map", "shadow maps",
+     "Every shadow-map layer as depth: near the light white, far dark gray, nothing drawn dark blue."},
+    {"light-frustum", "light frustum",
+     "What each map holds, tinted over the scene, and its frustum's edges (dashed where hidden); lit points no "
+     "map holds are striped magenta: no shadow can fall there."},
+    {"texel-density", "texel density",
+     "Shadow-map texel against screen pixel at every visible point: green 1:1, yellow to red texels larger "
+     "(blocky shadows), cyan to blue smaller (map resolution wasted)."},
+    {"cascades", "cascades", "The cascade each pixel's shadow test used: red, green, blue, yellow from near to far."},
+};
+
 }  // namespace
 
 int render(const RenderOptions& o) {
@@ -213,10 +243,7 @@ int render(const RenderOptions& o) {
         debug.captureShadowMaps = *o.view == "shadow-map";
         const scene::Frame frame = raster::render(p.scene, p.plan, p.settings.raster, &debug);
         checkValidation(frame, p.settings.raster);
-        const raster::DisplayImage img = *o.view == "shadow-map"      ? raster::shadowMapView(debug)
-                                         : *o.view == "cascades"      ? raster::cascadeView(frame, debug)
-                                         : *o.view == "light-frustum" ? raster::lightFrustumView(frame, p.scene, debug)
-                                                                      : raster::texelDensityView(frame, p.scene, debug);
+        const raster::DisplayImage img = debugView(*o.view, frame, p.scene, debug);
         scene::writePngDisplay(o.output, img.width, img.height, img.rgb);
         stage.done(std::to_string(img.width) + "x" + std::to_string(img.height) + " -> " + o.output.string() +
                    ", " + memoryLine(estimate));
@@ -274,9 +301,15 @@ int run(const RunOptions& o) {
     // The reference, the ray-traced and the raster Frames are all held until the report is
     // written, with a difference image for each method (the half-size sweep needs less).
     const std::uint64_t pixels = std::uint64_t(p.scene.camera.width) * std::uint64_t(p.scene.camera.height);
-    const std::uint64_t estimate = scene::kProgramBytes + backendMemory(p, "raytrace") + scene::frameBytes(p.scene) +
-                                   (o.skipRaster ? 0 : backendMemory(p, "raster")) + scene::frameWriteBytes(p.scene) +
-                                   2 * pixels * 3 * sizeof(float);
+    // The raster backend's debug views for the report: its shadow maps read back, and one display
+    // image at a time (a view's bytes hold the maps and the image being written).
+    const bool views = !o.skipRaster && std::any_of(p.plan.lights.begin(), p.plan.lights.end(),
+                                                     [](const scene::LightPlan& l) { return l.needsShadowTest; });
+    const std::uint64_t estimate =
+        scene::kProgramBytes + backendMemory(p, "raytrace") + scene::frameBytes(p.scene) +
+        (o.skipRaster ? 0 : backendMemory(p, "raster")) + scene::frameWriteBytes(p.scene) +
+        2 * pixels * 3 * sizeof(float) +
+        (views ? raster::debugViewBytes(p.scene, p.plan, p.settings.raster, "shadow-map") : 0);
     scene::checkMemory(estimate, "run at " + std::to_string(p.scene.camera.width) + "x" +
                                      std::to_string(p.scene.camera.height));
     fs::create_directories(o.outputDir);
@@ -305,8 +338,10 @@ int run(const RunOptions& o) {
         if (backend == "raster" && o.skipRaster) continue;
         Stage stage(backend == "raster" ? "raster (Vulkan shadow map)" : "raytrace (shadow rays)");
         scene::Frame frame;
+        raster::RenderDebug debug;
+        debug.captureShadowMaps = views;
         try {
-            frame = renderBackend(p, backend);
+            frame = renderBackend(p, backend, scene::kAllChannels, backend == "raster" && views ? &debug : nullptr);
         } catch (const std::exception& e) {
             // One backend failing (no Vulkan driver, say) must not lose the other's results.
             std::cerr << "\nshadowlab: error: " << backend << " backend failed: " << e.what() << "\n";
@@ -324,6 +359,15 @@ int run(const RunOptions& o) {
                                        {"timings_ms", timingsJson(frame)},
                                        {"attributes", frame.attributes}};
         report.methods.push_back({backend, backend + ".png", "diff-" + backend + ".png", frame, c.metrics});
+        if (backend == "raster" && views) {
+            for (const RunView& v : kRunViews) {
+                if (std::string_view(v.view) == "cascades" && debug.cascadeSplits.empty()) continue;
+                const raster::DisplayImage img = debugView(v.view, frame, p.scene, debug);
+                const std::string png = std::string("raster-") + v.view + ".png";
+                scene::writePngDisplay(dir / png, img.width, img.height, img.rgb);
+                report.shadowMapViews.push_back({v.title, png, img.width, img.height, v.caption});
+            }
+        }
     }
 
     if (!o.skipSweep) {

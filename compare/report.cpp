@@ -528,6 +528,19 @@ std::string renderReportHtml(const ReportInput& in) {
     }
     o << "</div>\n";
 
+    if (!in.shadowMapViews.empty()) {
+        o << "<h2>Inside the shadow maps (raster)</h2>\n<div class=\"grid\" style=\"grid-template-columns: repeat("
+          << std::min<std::size_t>(in.shadowMapViews.size(), 3) << ", minmax(0, 1fr))\">\n";
+        for (const ReportView& v : in.shadowMapViews) {
+            FrameInfo size;
+            size.width = v.width;
+            size.height = v.height;
+            o << "<div>" << figure(v.title, "", v.png, size, nullptr) << "<div class=\"small\">" << escapeHtml(v.caption)
+              << "</div></div>\n";
+        }
+        o << "</div>\n";
+    }
+
     if (!in.methods.empty()) {
         o << "<h2>Metrics</h2>\n" << metricsTable(in);
         o << "<p class=\"small\">Rates are over counted pixels unless noted. Aliasing counts wrong pixels within "

@@ -39,6 +39,14 @@ struct ReportMethod {
     Metrics metrics;
 };
 
+// A display image of the raster backend's shadow maps (`render --view`), with what it shows.
+struct ReportView {
+    std::string title;  // "light frustum"
+    std::string png;    // file name beside report.html
+    int width = 0, height = 0;
+    std::string caption;
+};
+
 struct ReportFailure {
     std::string label;    // backend that failed
     std::string message;  // its error
@@ -65,6 +73,8 @@ struct ReportInput {
     std::vector<ReportFailure> failures;
     // Scene object names by index (object id - 1), to say "acne on the plane"; optional.
     std::vector<std::string> objectNames;
+    // The raster backend's debug views; empty: no "Inside the shadow maps" section.
+    std::vector<ReportView> shadowMapViews;
     // The quick sweep `run` renders into DIR/sweep/; absent: no sweep section.
     std::optional<SweepSummary> sweep;
 };

@@ -55,6 +55,17 @@ Result shadowlab(const std::vector<std::string>& args) {
     return r;
 }
 
+// Width and height from a PNG's IHDR chunk (big-endian at bytes 16..23).
+std::pair<int, int> pngSize(const std::filesystem::path& file) {
+    const std::string bytes = slurp(file);
+    if (bytes.size() < 24 || bytes.compare(1, 3, "PNG") != 0) return {-1, -1};
+    auto be32 = [&](std::size_t at) {
+        return (int((unsigned char)bytes[at]) << 24) | (int((unsigned char)bytes[at + 1]) << 16) |
+               (int((unsigned char)bytes[at + 2]) << 8) | int((unsigned char)bytes[at + 3]);
+    };
+    return {be32(16), be32(20)};
+}
+
 TEST(App, RunOnTheSeedSceneWritesEveryOutputWithSaneMetrics) {
     TempDir dir;
     const auto out = dir.path() / "seed";
@@ -79,6 +90,17 @@ TEST(App, RunOnTheSeedSceneWritesEveryOutputWithSaneMetrics) {
     const std::string html = slurp(out / "report.html");
     for (const char* f : {"reference.png", "diff-raster.png", "diff-raytrace.png"})
         EXPECT_NE(html.find(f), std::string::npos) << f;
+    // The raster backend's debug views, in the report: one 1024² map shown as a 512² tile, the
+    // others at the image's size; no cascades view without cascades.
+    const std::vector<std::pair<std::string, std::pair<int, int>>> views = {
+        {"raster-shadow-map.png", {512, 512}}, {"raster-light-frustum.png", {192, 108}},
+        {"raster-texel-density.png", {192, 108}}};
+    for (const auto& [file, size] : views) {
+        EXPECT_EQ(pngSize(out / file), size) << file;
+        EXPECT_NE(html.find("src=\"" + file + "\""), std::string::npos) << file;
+    }
+    EXPECT_FALSE(std::filesystem::exists(out / "raster-cascades.png"));
+    EXPECT_NE(html.find("Inside the shadow maps"), std::string::npos);
 }
 
 TEST(App, RenderWritesTheRequestedFrame) {
@@ -174,17 +196,6 @@ INSTANTIATE_TEST_SUITE_P(
         BadRun{"bad_cascades", {"render", "seed", "--backend", "raster", "--cascades", "9", "-o", "OUT"}, "--cascades"},
         BadRun{"missing_frames", {"compare", "a.exr", "b.exr", "-o", "OUT.png"}, "no such file"}),
     [](const ::testing::TestParamInfo<BadRun>& info) { return std::string(info.param.name); });
-
-// Width and height from a PNG's IHDR chunk (big-endian at bytes 16..23).
-std::pair<int, int> pngSize(const std::filesystem::path& file) {
-    const std::string bytes = slurp(file);
-    if (bytes.size() < 24 || bytes.compare(1, 3, "PNG") != 0) return {-1, -1};
-    auto be32 = [&](std::size_t at) {
-        return (int((unsigned char)bytes[at]) << 24) | (int((unsigned char)bytes[at + 1]) << 16) |
-               (int((unsigned char)bytes[at + 2]) << 8) | int((unsigned char)bytes[at + 3]);
-    };
-    return {be32(16), be32(20)};
-}
 
 TEST(App, RenderViewsWriteImagesOfTheDocumentedSizes) {
     TempDir dir;
