@@ -205,8 +205,8 @@ bool insideLightMap(const LightFrustum& f, const scene::Vec3& p) {
     const scene::Vec3 q = p - f.position;
     const double d = glm::dot(q, f.direction);
     const double across = d * f.tanHalfFov;
-    return d >= f.near && d <= f.far && std::abs(glm::dot(q, f.right)) <= across &&
-           std::abs(glm::dot(q, f.up)) <= across;
+    return d >= f.near && d <= f.far && std::abs(glm::dot(q, f.right) - d * f.windowU) <= across &&
+           std::abs(glm::dot(q, f.up) - d * f.windowV) <= across;
 }
 
 std::array<scene::Vec3, 8> frustumCorners(const LightFrustum& f) {
@@ -215,7 +215,8 @@ std::array<scene::Vec3, 8> frustumCorners(const LightFrustum& f) {
         const double su = (k & 1) ? 1.0 : -1.0, sv = (k & 2) ? 1.0 : -1.0;
         if (f.perspective) {
             const double d = (k & 4) ? f.far : f.near;
-            c[std::size_t(k)] = f.position + d * (f.direction + su * f.tanHalfFov * f.right + sv * f.tanHalfFov * f.up);
+            c[std::size_t(k)] = f.position + d * (f.direction + (f.windowU + su * f.tanHalfFov) * f.right +
+                                                  (f.windowV + sv * f.tanHalfFov) * f.up);
         } else {
             const double d = (k & 4) ? f.farDepth : f.nearDepth;
             c[std::size_t(k)] = f.center + su * f.halfWidth * f.right + sv * f.halfWidth * f.up + d * f.direction;

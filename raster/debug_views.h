@@ -64,13 +64,15 @@ DisplayImage texelDensityView(const scene::Frame& frame, const scene::Scene& sce
 // Whether world point p lies in the volume a map of frustum f holds, boundaries included.
 // Orthographic: |(p − center)·right| and |(p − center)·up| <= halfWidth, and (p − center)·direction
 // in nearDepth..farDepth. Perspective: with d = (p − position)·direction, near <= d <= far and
-// |(p − position)·right|, |(p − position)·up| <= d·tanHalfFov (the pyramid between near and far).
+// |(p − position)·right − d·windowU|, |(p − position)·up − d·windowV| <= d·tanHalfFov (the
+// pyramid of the map's window between near and far).
 // Outside, the shader's lookup lands off the map (or past its far plane) and finds no caster.
 bool insideLightMap(const LightFrustum& f, const scene::Vec3& p);
 
 // The frustum's eight corners: bit 0 of the index picks −/+ right, bit 1 −/+ up, bit 2 the near
 // or far end (orthographic: center ± halfWidth·right ± halfWidth·up + nearDepth|farDepth·direction;
-// perspective: position + d·(direction ± tanHalfFov·right ± tanHalfFov·up), d = near|far).
+// perspective: position + d·(direction + (windowU ± tanHalfFov)·right + (windowV ± tanHalfFov)·up),
+// d = near|far).
 std::array<scene::Vec3, 8> frustumCorners(const LightFrustum& f);
 // Its 12 edges as pairs of corner indices: four around the near end, four around the far end,
 // four joining them.

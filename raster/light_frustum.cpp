@@ -74,6 +74,21 @@ std::vector<Vec3> clipPolygon(const std::vector<Vec3>& poly, const Plane& plane)
     return out;
 }
 
+// The vertices of box ∩ {the inner side of every plane} that lie on the box's faces: each face
+// clipped in turn. (The planes' own vertices inside the box, if any, are the caller's.)
+std::vector<Vec3> clipBoxFaces(const scene::Bounds& box, const Plane* planes, std::size_t count) {
+    const std::array<Vec3, 8> c = corners(box);
+    // Faces as corner indices (bit 0: x, bit 1: y, bit 2: z), each in order around the face.
+    const int faces[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
+    std::vector<Vec3> out;
+    for (const auto& face : faces) {
+        std::vector<Vec3> poly{c[face[0]], c[face[1]], c[face[2]], c[face[3]]};
+        for (std::size_t k = 0; k < count && !poly.empty(); ++k) poly = clipPolygon(poly, planes[k]);
+        out.insert(out.end(), poly.begin(), poly.end());
+    }
+    return out;
+}
+
 // The vertices of box ∩ camera frustum (between view depths nearD and farD); none when disjoint.
 std::vector<Vec3> clipBoxToFrustum(const scene::Bounds& box, const scene::CameraBasis& cam, double nearD, double farD) {
     const Vec3 e = cam.position;
@@ -86,18 +101,7 @@ std::vector<Vec3> clipBoxToFrustum(const scene::Bounds& box, const scene::Camera
         {ty * cam.forward - cam.up, -glm::dot(ty * cam.forward - cam.up, e)},
         {ty * cam.forward + cam.up, -glm::dot(ty * cam.forward + cam.up, e)},
     };
-    const std::array<Vec3, 8> c = corners(box);
-    // Faces as corner indices (bit 0: x, bit 1: y, bit 2: z), each in order around the face.
-    const int faces[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
-    std::vector<Vec3> out;
-    for (const auto& face : faces) {
-        std::vector<Vec3> poly{c[face[0]], c[face[1]], c[face[2]], c[face[3]]};
-        for (const Plane& p : planes) {
-            poly = clipPolygon(poly, p);
-            if (poly.empty()) break;
-        }
-        out.insert(out.end(), poly.begin(), poly.end());
-    }
+    std::vector<Vec3> out = clipBoxFaces(box, planes, std::size(planes));
     // The frustum's own corners inside the box are vertices too (a camera inside the box).
     for (const double z : {nearD, farD})
         for (const double sx : {-1.0, 1.0})
@@ -277,18 +281,20 @@ glm::dmat4 LightFrustum::toClip(const Vec3& origin) const {
         m[3][3] = 1.0;
         return m;
     }
-    // Perspective with d = (q − o')·dir: x = (q − o')·right / t, y = (q − o')·up / t, w = d,
+    // Perspective with d = (q − o')·dir: x = ((q − o')·right − windowU·d) / t, y likewise with up
+    // and windowV (x/w = (u − windowU)/t: the window's center at 0, its edges at ±1), w = d,
     // z = A·(d − near), A = far/(far − near), so z/w = far/(far − near)·(1 − near/d).
     const Vec3 o = position - origin;
     const double a = far / (far - near);
+    const Vec3 rightW = right - windowU * direction, upW = up - windowV * direction;
     for (int k = 0; k < 3; ++k) {
-        m[k][0] = right[k] / tanHalfFov;
-        m[k][1] = up[k] / tanHalfFov;
+        m[k][0] = rightW[k] / tanHalfFov;
+        m[k][1] = upW[k] / tanHalfFov;
         m[k][2] = a * direction[k];
         m[k][3] = direction[k];
     }
-    m[3][0] = -glm::dot(o, right) / tanHalfFov;
-    m[3][1] = -glm::dot(o, up) / tanHalfFov;
+    m[3][0] = -glm::dot(o, rightW) / tanHalfFov;
+    m[3][1] = -glm::dot(o, upW) / tanHalfFov;
     m[3][2] = -a * (glm::dot(o, direction) + near);
     m[3][3] = -glm::dot(o, direction);
     return m;
@@ -309,12 +315,19 @@ glm::dmat4 LightFrustum::toTexture(const Vec3& origin) const {
 }
 
 std::string LightFrustum::describe() const {
-    char buf[320];
-    if (perspective)
+    char buf[400];
+    if (perspective && windowU == 0.0 && windowV == 0.0)
         std::snprintf(buf, sizeof buf,
                       "perspective position=(%.9g,%.9g,%.9g) direction=(%.9g,%.9g,%.9g) half_fov_deg=%.9g near=%.9g far=%.9g",
                       position.x, position.y, position.z, direction.x, direction.y, direction.z,
                       std::atan(tanHalfFov) * 180.0 / kPi, near, far);
+    else if (perspective)  // an off-center window: its tangent ranges across the axis
+        std::snprintf(buf, sizeof buf,
+                      "perspective position=(%.9g,%.9g,%.9g) direction=(%.9g,%.9g,%.9g) half_fov_deg=%.9g "
+                      "window_u=%.9g..%.9g window_v=%.9g..%.9g near=%.9g far=%.9g",
+                      position.x, position.y, position.z, direction.x, direction.y, direction.z,
+                      std::atan(tanHalfFov) * 180.0 / kPi, windowU - tanHalfFov, windowU + tanHalfFov,
+                      windowV - tanHalfFov, windowV + tanHalfFov, near, far);
     else
         std::snprintf(buf, sizeof buf,
                       "orthographic center=(%.9g,%.9g,%.9g) half_width=%.9g direction=(%.9g,%.9g,%.9g) depth=%.9g..%.9g",
@@ -330,11 +343,7 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
     if (!settings.shadowMapSizeIsDefault || size != scene::kDefaultShadowMapSize)
         return keep("set by --shadow-map-size or the scene");
     bool directional = false;
-    for (const scene::Light& l : scene.lights) {
-        if (l.type == scene::LightType::Point)
-            return keep("default: a point light's cube faces are not sized from receiver detail");
-        directional = directional || l.type == scene::LightType::Directional;
-    }
+    for (const scene::Light& l : scene.lights) directional = directional || l.type == scene::LightType::Directional;
     if (settings.cascades > 1 && directional) return keep("default: cascades size their texels per slice");
     // The visible receivers: each object's bounds clipped to the camera frustum (the scene's box
     // would reach up to the camera), a convex polytope each, between the near and far planes.
@@ -350,9 +359,10 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
     // image can show.
     auto pixelAt = [&](double zc) { return 2.0 * cam.tanHalfFovY * zc / std::max(scene.camera.height, 1); };
     auto viewDepth = [&](const Vec3& p) { return std::max(glm::dot(p - cam.position, cam.forward), scene.camera.near); };
-    double needed = 0.0;
+    double needed = 0.0;  // texels, rounded up to a power of two below
+    int neededSize = 0;     // a size some light needs as it is (fitted spot windows)
     std::string why;
-    char buf[256];
+    char buf[320];
     if (directional) {
         // The nearest view depth of any visible receiver, at a vertex (a linear function).
         double zMin = INFINITY;
@@ -379,21 +389,52 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
         // point, and zc > 0 on each visible polytope K, so r = z/zc is quasi-linear there: if
         // r(v) ≤ m at every vertex v, then z − m·zc ≤ 0 at the vertices, hence (affine) on all of
         // K, i.e. r ≤ m on K. Its maximum over K is at a vertex.
-        const LightFrustum f = fitSpotLight(scene.bounds(), l.position, l.direction, l.coneAngleDegrees, size);
         double ratio = 0.0;
         for (const std::vector<Vec3>& v : visible)
             for (const Vec3& p : v) {
-                const double r = glm::dot(p - f.position, f.direction) / viewDepth(p);
+                const double r = glm::dot(p - l.position, glm::normalize(l.direction)) / viewDepth(p);
                 ratio = std::max(ratio, r);
             }
-        const double spotNeeded = 2.0 * f.tanHalfFov * ratio / pixelAt(1.0);
-        std::snprintf(buf, sizeof buf, "%sspot %zu: 2·tan(half fov) %.4g x (distance / view depth) %.4g / pixel %.4g at view depth 1 = %.0f texels",
-                      why.empty() ? "" : "; ", i, 2.0 * f.tanHalfFov, ratio, pixelAt(1.0), spotNeeded);
+        // A fitted window depends on N (margin in texels, snapped size): the smallest power of two
+        // whose own window is fine enough. The cone's does not, and this is then the rounding below.
+        int n = kMinAutoShadowMapSize;
+        double spotNeeded = 0.0, window = 0.0;
+        for (;; n *= 2) {
+            window = 2.0 * spotLightFrustum(scene, settings, l, n).tanHalfFov;
+            spotNeeded = window * ratio / pixelAt(1.0);
+            if (spotNeeded <= n || n >= size) break;
+        }
+        std::snprintf(buf, sizeof buf,
+                      "%sspot %zu: 2·tan(half %s) %.4g x (distance / view depth) %.4g / pixel %.4g at view depth 1 = %.0f texels",
+                      why.empty() ? "" : "; ", i, settings.fitLightFrustum ? "window" : "fov", window, ratio,
+                      pixelAt(1.0), spotNeeded);
         why += buf;
-        needed = std::max(needed, spotNeeded);
+        needed = std::max(needed, std::min(spotNeeded, double(n)));
+        neededSize = std::max(neededSize, n);
     }
-    if (why.empty()) return keep("default: no directional or spot light");
-    int chosen = kMinAutoShadowMapSize;
+    for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+        const scene::Light& l = scene.lights[i];
+        if (l.type != scene::LightType::Point) continue;
+        // A receiver uses the face of its major axis, at axial distance ‖p − light‖∞, where a texel
+        // is 2t/N = 2/(N − 2·margin) per unit (t = N/(N − 2·margin), cubeFaceTanHalfFov): N ≥
+        // 2·max(‖p − light‖∞ / pixelAt(zc)) + 2·margin. ‖p − light‖∞ is convex and zc affine and
+        // positive, so their ratio is quasi-convex: on each visible polytope, largest at a vertex.
+        double ratio = 0.0;
+        for (const std::vector<Vec3>& v : visible)
+            for (const Vec3& p : v) {
+                const Vec3 d = glm::abs(p - l.position);
+                ratio = std::max(ratio, std::max({d.x, d.y, d.z}) / viewDepth(p));
+            }
+        const double pointNeeded = 2.0 * ratio / pixelAt(1.0) + 2.0 * kPointFaceMarginTexels;
+        std::snprintf(buf, sizeof buf,
+                      "%spoint %zu: 2 x (axial distance / view depth) %.4g / pixel %.4g at view depth 1 + 2 x %.0f "
+                      "margin = %.0f texels",
+                      why.empty() ? "" : "; ", i, ratio, pixelAt(1.0), kPointFaceMarginTexels, pointNeeded);
+        why += buf;
+        needed = std::max(needed, pointNeeded);
+    }
+    if (why.empty()) return keep("default: no light with a map");
+    int chosen = std::max(kMinAutoShadowMapSize, neededSize);
     while (chosen < needed && chosen < size) chosen *= 2;
     chosen = std::min(chosen, size);
     return ShadowMapSizeChoice{chosen, std::to_string(chosen) + " (" +
@@ -418,7 +459,7 @@ struct MapExtent {
 // an edge from such a vertex a to one behind, b, crosses the plane d = 0, at c. Along that edge
 // u = x/d runs monotonically from u_a to +∞ when x_c > 0 (−∞ when x_c < 0; constant u_a when
 // x_c = 0), and the hull's vertex pairs include all its edges (the other pairs cross inside the
-// hull, which adds nothing false). Then clamped to the map's own extent: a receiver outside it
+// hull, which adds nothing false). Then clamped to the map's own window: a receiver outside it
 // reads at most the border and the texels a filter reaches from there, which the margin covers.
 MapExtent perspectiveReceiverExtent(const std::vector<Vec3>& receivers, const LightFrustum& f) {
     struct Local {
@@ -448,10 +489,10 @@ MapExtent perspectiveReceiverExtent(const std::vector<Vec3>& receivers, const Li
             if (yc < 0.0) e.minV = -INFINITY;
         }
     const double t = f.tanHalfFov;
-    e.minU = std::clamp(e.minU, -t, t);
-    e.maxU = std::clamp(e.maxU, -t, t);
-    e.minV = std::clamp(e.minV, -t, t);
-    e.maxV = std::clamp(e.maxV, -t, t);
+    e.minU = std::clamp(e.minU, f.windowU - t, f.windowU + t);
+    e.maxU = std::clamp(e.maxU, f.windowU - t, f.windowU + t);
+    e.minV = std::clamp(e.minV, f.windowV - t, f.windowV + t);
+    e.maxV = std::clamp(e.maxV, f.windowV - t, f.windowV + t);
     return e;
 }
 
@@ -496,7 +537,8 @@ std::vector<bool> castsOnto(const scene::Scene& scene, const LightFrustum& f, co
     const double texelAngle = f.texelWorldSize();  // 2·t/N: tangent units per texel
     const double k = normalOffsetTexels * texelAngle;
     if (!(k < 0.1)) return casts;
-    const double t = f.tanHalfFov;
+    // The widest tangent the map holds (an off-center fitted window reaches past its half-size).
+    const double t = std::max(std::abs(f.windowU), std::abs(f.windowV)) + f.tanHalfFov;
     const double margin = (reachTexels + 2.0 * normalOffsetTexels * std::sqrt(1.0 + t * t)) * texelAngle;
     const MapExtent r = perspectiveReceiverExtent(receivers, f);
     if (r.empty()) return std::vector<bool>(scene.objects.size(), false);  // no receiver in front: none reads it
@@ -546,6 +588,115 @@ double cullReachTexels(const scene::RasterSettings& settings, const scene::Light
     return reach;
 }
 
+double fitMarginTexels(const scene::RasterSettings& settings, const scene::Light& light, int mapSize, double t) {
+    return cullReachTexels(settings, light, mapSize) + 2.0 * settings.normalOffset * std::sqrt(1.0 + t * t);
+}
+
+double snapWindowHalfSize(double half) {
+    // 2^(k/4), k the smallest integer with 2^(k/4) ≥ half (the 1e-9 keeps an exact power itself).
+    return std::exp2(std::ceil(4.0 * std::log2(half) - 1e-9) / 4.0);
+}
+
+namespace {
+
+// The nearest distance along f's axis of any point of an object's box inside f's window pyramid
+// (the directions the map holds): the part of the box the map's depth pass can draw. A linear
+// function on box ∩ pyramid (a convex polytope) is least at a vertex: a clipped face's vertex, or
+// the pyramid's apex (the light) when the box holds it, which gives 0. +infinity when no box
+// reaches into the pyramid.
+double nearestDepthInWindow(const scene::Scene& scene, const LightFrustum& f) {
+    const double u0 = f.windowU - f.tanHalfFov, u1 = f.windowU + f.tanHalfFov;
+    const double v0 = f.windowV - f.tanHalfFov, v1 = f.windowV + f.tanHalfFov;
+    // u ≤ u1 ⇔ u1·d − x ≥ 0, u ≥ u0 ⇔ x − u0·d ≥ 0 (d > 0), likewise v; planes through the light.
+    const Vec3 normals[] = {u1 * f.direction - f.right, f.right - u0 * f.direction, v1 * f.direction - f.up,
+                            f.up - v0 * f.direction, f.direction};
+    Plane planes[5];
+    for (int k = 0; k < 5; ++k) planes[k] = {normals[k], -glm::dot(normals[k], f.position)};
+    double nearest = INFINITY;
+    for (const scene::Object& object : scene.objects) {
+        const scene::Bounds b = scene::boundsOf(object.shape);
+        if (b.empty()) continue;
+        if (glm::all(glm::greaterThanEqual(f.position, b.min)) && glm::all(glm::lessThanEqual(f.position, b.max)))
+            return 0.0;
+        for (const Vec3& p : clipBoxFaces(b, planes, 5))
+            nearest = std::min(nearest, glm::dot(p - f.position, f.direction));
+    }
+    return nearest;
+}
+
+// Near/far of perspective map f (its window already set) from the intersection of the casters'
+// and the receivers' depth ranges: far = the farthest receiver in front (maxDepth) grown by the
+// margin (the normal offset moves a point up to that fraction of its distance farther) and 1%;
+// near = the nearest caster in the window less 1%. Both stay inside f's own range (the bounding
+// sphere's) and near ≥ far · kSpotMinNearOverFar; f is unchanged when they would not make a range.
+void fitDepthRange(const scene::Scene& scene, LightFrustum& f, double maxDepth, double marginTexels) {
+    const double far = std::min(maxDepth * (1.0 + marginTexels * f.texelWorldSize()) * kLightFrustumMargin, f.far);
+    const double nearest = nearestDepthInWindow(scene, f);
+    const double near = std::max({std::isfinite(nearest) ? nearest / kLightFrustumMargin : f.near, f.near,
+                                  far * kSpotMinNearOverFar});
+    if (!(near < far)) return;
+    f.near = near;
+    f.far = far;
+}
+
+}  // namespace
+
+LightFrustum fitSpotLightToReceivers(const scene::Scene& scene, const scene::Light& light, int mapSize,
+                                     double marginTexels) {
+    LightFrustum f = fitSpotLight(scene.bounds(), light.position, light.direction, light.coneAngleDegrees, mapSize);
+    const std::vector<Vec3> receivers = visibleReceiverPoints(scene);
+    if (receivers.empty()) return f;
+    const MapExtent r = perspectiveReceiverExtent(receivers, f);  // clamped to the cone's square
+    if (r.empty()) return f;  // no receiver in front of the light
+    bool inFront = true;
+    for (const Vec3& p : receivers) inFront = inFront && glm::dot(p - f.position, f.direction) > 0.0;
+    // The window: half-size h with the receivers' half-extent e, margin m texels and half a texel
+    // for the center's snapping inside it: h − (m + ½)·2h/N ≥ e, i.e. h ≥ e / (1 − (2m + 1)/N),
+    // rounded up to a power of 2^(1/4); the center to a multiple of the texel 2h/N.
+    const double n = f.mapSize;
+    const double keep = 1.0 - (2.0 * marginTexels + 1.0) / n;
+    if (inFront && keep > 0.0) {
+        const double extent = 0.5 * std::max(r.maxU - r.minU, r.maxV - r.minV);
+        const double half = snapWindowHalfSize(std::max(extent / keep, 1e-9 * f.tanHalfFov));
+        if (half < f.tanHalfFov) {
+            const double texel = 2.0 * half / n;
+            f.windowU = std::round(0.5 * (r.minU + r.maxU) / texel) * texel;
+            f.windowV = std::round(0.5 * (r.minV + r.maxV) / texel) * texel;
+            f.tanHalfFov = half;
+        }
+    }
+    fitDepthRange(scene, f, r.maxDepth, marginTexels);
+    return f;
+}
+
+LightFrustum spotLightFrustum(const scene::Scene& scene, const scene::RasterSettings& settings,
+                              const scene::Light& light, int mapSize) {
+    const LightFrustum cone =
+        fitSpotLight(scene.bounds(), light.position, light.direction, light.coneAngleDegrees, mapSize);
+    if (!settings.fitLightFrustum) return cone;
+    // The fitted window's center lies in the cone's square and its half-size is below the cone's,
+    // so no direction it holds has a tangent beyond 2·t.
+    return fitSpotLightToReceivers(scene, light, mapSize, fitMarginTexels(settings, light, mapSize, 2.0 * cone.tanHalfFov));
+}
+
+LightFrustum fitPointLightFaceToReceivers(const scene::Scene& scene, const scene::Light& light, int face, int mapSize,
+                                          double marginTexels) {
+    LightFrustum f = fitPointLightFace(scene.bounds(), light.position, face, mapSize);
+    const std::vector<Vec3> receivers = visibleReceiverPoints(scene);
+    if (receivers.empty()) return f;
+    const MapExtent r = perspectiveReceiverExtent(receivers, f);
+    if (r.empty()) return f;  // no receiver in front of this face: nothing reads it
+    fitDepthRange(scene, f, r.maxDepth, marginTexels);
+    return f;
+}
+
+LightFrustum pointLightFaceFrustum(const scene::Scene& scene, const scene::RasterSettings& settings,
+                                   const scene::Light& light, int face, int mapSize) {
+    if (!settings.fitLightFrustum) return fitPointLightFace(scene.bounds(), light.position, face, mapSize);
+    const double t = cubeFaceTanHalfFov(mapSize);
+    return fitPointLightFaceToReceivers(scene, light, face, mapSize, fitMarginTexels(settings, light, mapSize, t));
+}
+
 std::vector<bool> layerCasters(const scene::Scene& scene, const scene::RasterSettings& settings,
                                const scene::Light& light, const LightFrustum& f, const std::vector<Vec3>& receivers) {
     return castsOnto(scene, f, receivers, cullReachTexels(settings, light, f.mapSize), settings.normalOffset);
@@ -582,9 +733,9 @@ std::vector<LightCulling> culledCasters(const scene::Scene& scene, const scene::
         static const char* const kFaces[] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
         if (l.type == scene::LightType::Point) {
             for (int face = 0; face < kCubeFaces; ++face)
-                add(kFaces[face], fitPointLightFace(bounds, l.position, face, settings.shadowMapSize), receivers);
+                add(kFaces[face], pointLightFaceFrustum(scene, settings, l, face, settings.shadowMapSize), receivers);
         } else if (l.type == scene::LightType::Spot) {
-            add("", fitSpotLight(bounds, l.position, l.direction, l.coneAngleDegrees, settings.shadowMapSize), receivers);
+            add("", spotLightFrustum(scene, settings, l, settings.shadowMapSize), receivers);
         } else if (const CascadeSet cs = settings.cascades > 1
                                               ? fitCascades(scene, l.direction, settings.cascades, settings.shadowMapSize)
                                               : CascadeSet{};

@@ -1,6 +1,7 @@
 // raster/light_frustum.h: the projection of each light's shadow map: orthographic for a
 // directional light (fitted to the scene's bounding sphere, or to the casters of what the
-// camera sees), perspective for a spot light; and the texel size the biases scale with.
+// camera sees), perspective for a spot light (its cone, or a window of it fitted to what the
+// camera sees) and a point light's cube faces; and the texel size the biases scale with.
 #pragma once
 
 #include <string>
@@ -26,13 +27,18 @@ struct LightFrustum {
     scene::Vec3 center{0, 0, 0};
     double halfWidth = 1;
     double nearDepth = -1, farDepth = 1;  // along direction from center; default ±halfWidth
-    // Perspective: from `position`, half-angle atan(tanHalfFov), depth from near to far along
-    // `direction`.
+    // Perspective: from `position`, depth from near to far along `direction`. The map holds the
+    // directions whose tangents u = x/d (along right), v = y/d (along up) lie in the square window
+    // windowU ± tanHalfFov, windowV ± tanHalfFov: symmetric about the axis (window 0, half-angle
+    // atan(tanHalfFov)) unless fitted to receivers off the axis (an off-center perspective that
+    // keeps the axis, so depth along it means the same).
     scene::Vec3 position{0, 0, 0};
     double tanHalfFov = 1;
+    double windowU = 0, windowV = 0;
     double near = 0.1, far = 1;
 
-    // Orthographic: world size of one texel. Perspective: per unit of distance along the axis.
+    // Orthographic: world size of one texel. Perspective: per unit of distance along the axis
+    // (tangent units per texel, 2·tanHalfFov/mapSize).
     double texelWorldSize() const;
     // World units per unit of orthographic depth (0..1).
     double depthRange() const { return farDepth - nearDepth; }
@@ -83,6 +89,31 @@ double nearestCasterDepth(const scene::Scene& scene, const LightFrustum& f, doub
 LightFrustum fitSpotLight(const scene::Bounds& bounds, const scene::Vec3& position, const scene::Vec3& direction,
                           double coneDegrees, int mapSize);
 
+// Spot light `light` (a spot) fitted to what the camera sees (issue 5, `fitLightFrustum`), from
+// fitSpotLight()'s cone map:
+// - window: the visible receivers (visibleReceiverPoints) projected into the map (u, v), their
+//   rectangle clamped to the cone's square, held by the smallest square window that leaves
+//   `marginTexels` texels of it (the filter's reach and the normal offset, as castsOnto) plus half
+//   a texel (the center's snapping) on every side; its half-size is rounded up to a power of 2^(1/4)
+//   and its center to a whole texel (a multiple of 2·tanHalfFov/mapSize), so a camera moving a
+//   little keeps the texel grid still (no swimming). Kept at the cone when that window would not
+//   be smaller, or when a receiver lies on or behind the light's plane;
+// - near/far: far is the farthest visible receiver in front of the light (+ the margin's fraction
+//   of its distance, + 1%), near the nearest point of any object's box inside the window's pyramid
+//   (− 1%), both within the cone map's and near ≥ far/1000.
+// The cone map when the camera sees none of the scene or no receiver lies in front of the light.
+LightFrustum fitSpotLightToReceivers(const scene::Scene& scene, const scene::Light& light, int mapSize,
+                                     double marginTexels);
+// The margin fitSpotLightToReceivers and fitPointLightFaceToReceivers keep around the receivers,
+// in texels of a map of mapSize: cullReachTexels plus the normal offset, counted 2·√(1 + t²)
+// times (t: tangent of the widest direction the map holds; castsOnto says why).
+double fitMarginTexels(const scene::RasterSettings& settings, const scene::Light& light, int mapSize, double t);
+// The fitted spot map when settings.fitLightFrustum, else the cone map.
+LightFrustum spotLightFrustum(const scene::Scene& scene, const scene::RasterSettings& settings,
+                              const scene::Light& light, int mapSize);
+// Rounds a window half-size up to the next power of 2^(1/4) (the fitted windows' sizes).
+double snapWindowHalfSize(double half);
+
 // The six faces of a point light's cube map, in this order: +X, −X, +Y, −Y, +Z, −Z (each
 // face's `direction`; its right and up axes come from the same rule as every other frustum, and
 // shaders/lit.frag rebuilds them the same way).
@@ -95,6 +126,15 @@ double cubeFaceTanHalfFov(int mapSize);
 // and far enclose the scene's bounding sphere (the same for all six faces, near no closer than
 // far · kSpotMinNearOverFar).
 LightFrustum fitPointLightFace(const scene::Bounds& bounds, const scene::Vec3& position, int face, int mapSize);
+// The same face with near/far fitted to what the camera sees (`fitLightFrustum`), as a fitted spot
+// map's: far from the visible receivers in front of the face, near from the objects' boxes inside
+// the face's pyramid (its whole window, 90° plus the seam margin, which stays: the seams depend on
+// it). fitPointLightFace() when no receiver lies in front of the face (nothing reads it).
+LightFrustum fitPointLightFaceToReceivers(const scene::Scene& scene, const scene::Light& light, int face, int mapSize,
+                                          double marginTexels);
+// Face `face` of `light`'s cube map: fitted when settings.fitLightFrustum.
+LightFrustum pointLightFaceFrustum(const scene::Scene& scene, const scene::RasterSettings& settings,
+                                   const scene::Light& light, int face, int mapSize);
 
 
 // Caster culling (issue 5): which objects can shadow a receiver that reads map f. An object is
@@ -164,9 +204,14 @@ std::vector<bool> layerCasters(const scene::Scene& scene, const scene::RasterSet
 // - spot: max over the visible receivers of 2·tanHalfFov·z / pixelWorldSize(zc), z the distance
 //   along the spot's axis and zc the view depth (the texel there is z·2·tanHalfFov/N); z/zc is
 //   linear-fractional, so its maximum over each object's visible part (a convex polytope, zc > 0)
-//   is at a vertex.
-// Kept as set when forced, with point lights (see docs/raster.md), with cascades (sized per slice
-// already) or when the camera sees nothing. `reason` says which, for --explain and the Frame.
+//   is at a vertex. A fitted window (fitLightFrustum) depends on N (its margin is in texels, its
+//   size snapped), so the size is the smallest power of two whose own window satisfies this;
+// - point: a face's texel is 2/(N − 2·kPointFaceMarginTexels) per unit of ‖p − light‖∞ (the axial
+//   distance in the face of p's major axis), so N ≥ 2·max(‖p − light‖∞ / pixelWorldSize(zc)) +
+//   2·kPointFaceMarginTexels; ‖p − light‖∞/zc is quasi-convex (convex over positive affine), so
+//   again largest at a vertex.
+// Kept as set when forced, with cascades (sized per slice already) or when the camera sees
+// nothing. `reason` says which, for --explain and the Frame.
 // The smallest size chosen that way: below it the bias defaults (half a texel) grow coarse.
 inline constexpr int kMinAutoShadowMapSize = 256;
 struct ShadowMapSizeChoice {

@@ -258,10 +258,15 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
         if (needsShadowTest(plan, i)) {
             if (point) {
                 // Six layers, +X −X +Y −Y +Z −Z; the shader picks the face and builds its
-                // projection itself, so toShadow stays unused.
+                // projection itself, so toShadow holds each face's near and far instead
+                // (shaders/interface.h: columns 0, 1 the nears, 2, 3 the fars, face k in row k % 4
+                // of column k / 4).
                 layer = float(lightMatrices.size());
+                l.toShadow = glm::mat4(0.0f);
                 for (int face = 0; face < kCubeFaces; ++face) {
-                    f = fitPointLightFace(bounds, light.position, face, settings.shadowMapSize);
+                    f = pointLightFaceFrustum(scene, settings, light, face, settings.shadowMapSize);
+                    l.toShadow[face / 4][face % 4] = float(f.near);
+                    l.toShadow[2 + face / 4][face % 4] = float(f.far);
                     cullLayer(i, f, receivers);  // each face draws only its own casters
                     lightMatrices.push_back(glm::mat4(f.toClip(origin)));
                     frusta.push_back(f);
@@ -271,8 +276,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
                 }
                 l.bias = glm::vec4(float(settings.depthBias), float(settings.slopeBias), float(f.texelWorldSize()), 0.0f);
             } else if (spot)
-                f = fitSpotLight(bounds, light.position, light.direction, light.coneAngleDegrees,
-                                 settings.shadowMapSize);
+                f = spotLightFrustum(scene, settings, light, settings.shadowMapSize);
             else if (settings.cascades > 1 &&
                      !(cascades = fitCascades(scene, light.direction, settings.cascades, settings.shadowMapSize))
                           .frusta.empty()) {
@@ -333,7 +337,8 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
         if (point) {
             l.axis = glm::vec4(0.0f, 0.0f, 0.0f, float(2.0 * light.radius));  // w: light size (PCSS)
             l.toLight = glm::vec4(glm::vec3(light.position - origin), layer);
-            // Without a shadow test f is default; near/far are then unused.
+            // Without a shadow test f is default; near/far are then unused. With one, each face's
+            // are in toShadow (lit.frag faceRange); these are the last face's.
             l.kind = glm::vec4(float(SHADOWLAB_LIGHT_POINT), float(cubeFaceTanHalfFov(settings.shadowMapSize)),
                                float(f.near), float(f.far));
         } else if (spot) {

@@ -45,7 +45,9 @@ struct TransmitPush {
 
 struct LightData {
     // Camera-relative world position -> homogeneous shadow-map coordinates: (u, v) = xy / w in
-    // 0..1. Directional: orthographic, w = 1 and z = depth 0..1 (linear along the light).
+    // 0..1. Directional: orthographic, w = 1 and z = depth 0..1 (linear along the light). Point:
+    // no matrix (lit.frag builds each face's projection) but each cube face's near and far (face
+    // k = 0..5, +X −X +Y −Y +Z −Z: near in column k / 4, far in column 2 + k / 4, row k % 4).
     mat4 toShadow;
     vec4 toLight;    // directional: xyz unit vector toward the light; spot, point: xyz
                      // camera-relative position. w: shadow-map layer (point: of its +X face,
@@ -58,8 +60,8 @@ struct LightData {
                      // (texels), w: pcf size (taps per side / Poisson diameter in texels)
     vec4 kind;       // x: SHADOWLAB_LIGHT_*, y: spot: cos(cone half-angle); point: tan of each
                      // cube face's half field of view; directional: number of cascades (0 or 1:
-                     // one map, described by this struct), z: spot, point: near, w: spot, point: far
-                     // (distances along the map's axis)
+                     // one map, described by this struct), z: spot: near, w: spot: far (distances
+                     // along the map's axis; a point light's faces have theirs in toShadow)
     vec4 axis;       // spot: xyz unit direction the light travels; w: spot, point: light size
                      // (diameter, world units; 0 = a point), for PCSS
 };

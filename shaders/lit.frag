@@ -148,20 +148,27 @@ int cubeFace(vec3 d, out vec3 axis, out vec3 right, out vec3 up) {
     return 2 * k + (negative ? 1 : 0);
 }
 
+// Near and far of a point light's cube face 0..5 (LightData.toShadow holds them; each face's
+// depth range is fitted on its own).
+vec2 faceRange(LightData light, int face) {
+    return vec2(light.toShadow[face / 4][face % 4], light.toShadow[2 + face / 4][face % 4]);
+}
+
 // A PCSS tap of a point light at map coordinates uv of the receiver's face (basis axis, right,
 // up), which may lie past that face's edge: the tap's direction from the light is looked up in
 // the face it falls in (xy: map coordinates there, z: layer), and `axial` becomes the receiver's
 // (qd: the normal-offset point minus the light) distance along that face's axis, so its compare
-// reference and blocker test use the same face's depths. A face map holds only
+// reference and blocker test use the same face's depths (and `range`, its near and far). A face map holds only
 // kPointFaceMarginTexels past its 90° edge; PCSS kernels reach up to 1/8 of the map, and without
 // this the taps beyond the margin read nothing (border: lit), cutting the penumbra along the seam.
-vec3 cubeTap(LightData light, vec3 axis, vec3 right, vec3 up, vec3 qd, vec2 uv, out float axial) {
+vec3 cubeTap(LightData light, vec3 axis, vec3 right, vec3 up, vec3 qd, vec2 uv, out float axial, out vec2 range) {
     const vec2 s = (2.0 * uv - 1.0) * light.kind.y;  // tan of the tap's angles in the face
     const vec3 d = axis + s.x * right + s.y * up;
     vec3 fAxis, fRight, fUp;
     const int face = cubeFace(d, fAxis, fRight, fUp);
     const float along = dot(d, fAxis);
     axial = dot(qd, fAxis);
+    range = faceRange(light, face);
     return vec3(0.5 + 0.5 * vec2(dot(d, fRight), dot(d, fUp)) / (along * light.kind.y), light.toLight.w + float(face));
 }
 
@@ -236,7 +243,9 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, vec3 dpdx, vec3 d
         // The cube face is the major axis of the direction from the light. Each face map
         // reaches a few texels past its edge, so the normal offset and the pcf/poisson taps
         // below stay inside this one face (PCSS taps may not: cubeTap).
-        layer += float(cubeFace(p - light.toLight.xyz, axis, right, up));
+        const int face = cubeFace(p - light.toLight.xyz, axis, right, up);
+        layer += float(face);
+        light.kind.zw = faceRange(light, face);  // reference() and PCSS read near, far there
     }
     // World size of a texel at p: constant for an orthographic map, growing with distance
     // along the axis for a perspective one.
@@ -338,14 +347,15 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, vec3 dpdx, vec3 d
             const vec2 o = rotation * kPoisson[k] * searchRadius;
             vec3 at = vec3(r.uv + o / size, layer);
             float drTap = dr;
-            if (wrap) at = cubeTap(light, axis, right, up, qd, at.xy, drTap);
+            vec2 range = vec2(near, far);
+            if (wrap) at = cubeTap(light, axis, right, up, qd, at.xy, drTap, range);
             // The nearest caster of the texel: the opaque depth or, with semi-transparent casters,
             // the nearest of those when it is nearer, so their shadows are softened too.
             float z = texture(shadowDepths, at).r;
             if (kTransmittance) z = min(z, texture(transparentDepths, at).r);
             if (z >= 1.0) continue;  // nothing drawn there
             // Stored perspective depth back to distance: z = far/(far−near)(1 − near/d).
-            const float d = near / max(1.0 - z * (far - near) / far, 1e-7);
+            const float d = range.x / max(1.0 - z * (range.y - range.x) / range.y, 1e-7);
             if (d < drTap - (r.biasWorld + r.slopeStep * length(o))) {
                 blockerSum += d;
                 ++blockers;
@@ -379,8 +389,11 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, vec3 dpdx, vec3 d
         const vec2 o = rotation * kPoisson[k] * radius;
         if (wrap) {
             Receiver rt = r;
-            const vec3 at = cubeTap(light, axis, right, up, qd, r.uv + o / size, rt.axial);
-            sum += tap(at.xy, at.z, reference(light, rt, r.biasWorld + r.slopeStep * length(o)), blocker);
+            LightData lt = light;
+            vec2 range;
+            const vec3 at = cubeTap(light, axis, right, up, qd, r.uv + o / size, rt.axial, range);
+            lt.kind.zw = range;
+            sum += tap(at.xy, at.z, reference(lt, rt, r.biasWorld + r.slopeStep * length(o)), blocker);
         } else {
             sum += biasedTap(light, r, o, size, layer, blocker);
         }

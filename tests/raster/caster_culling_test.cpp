@@ -350,11 +350,12 @@ TEST(RasterMapSize, ForcedSizesStayForcedWithSpotAndPointLights) {
     scene::SettingsOverrides o;
     o.shadowMapSize = 1024;
     EXPECT_EQ(chooseShadowMapSize(s, scene::resolveSettings(s, o).raster).size, 1024);
-    // A point light keeps the default (docs/raster.md says why).
-    const scene::Scene p = pointScene();
+    // And with a point light (its size from receiver detail: light_fit_test.cpp).
+    scene::Scene p = pointScene();
+    p.shadow.shadowMapSize = 1024;
     const ShadowMapSizeChoice c = chooseShadowMapSize(p, scene::resolveSettings(p, {}).raster);
-    EXPECT_EQ(c.size, scene::kDefaultShadowMapSize);
-    EXPECT_NE(c.reason.find("point light"), std::string::npos) << c.reason;
+    EXPECT_EQ(c.size, 1024);
+    EXPECT_NE(c.reason.find("set by"), std::string::npos) << c.reason;
 }
 
 }  // namespace

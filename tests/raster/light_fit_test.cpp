@@ -1,0 +1,352 @@
+// tests/raster/light_fit_test.cpp: spot maps and point-light cube faces fitted to what the camera
+// sees (issue 5, `fitLightFrustum`): the fitted spot window by hand, that it holds every visible
+// receiver, does not swim, ignores unrelated far objects and renders no worse against the
+// reference; a cube face's near/far by hand; the point light's map size from receiver detail by
+// hand. Renders are on lavapipe with the validation layer.
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "compare/compare.h"
+#include "raster/debug_views.h"
+#include "raster/light_frustum.h"
+#include "raster/renderer.h"
+#include "raytrace/renderer.h"
+#include "scene/camera.h"
+#include "scene/render_plan.h"
+#include "tests/raster/test_scenes.h"
+
+namespace shadowlab::raster {
+namespace {
+
+using test::kPi;
+using test::Vec3;
+
+double deg(double d) { return d * kPi / 180.0; }
+
+// Spot at (0, 8, 0) straight down, cone 60° (the cone map's half-angle 61.2°, t0 = tan 61.2°),
+// over a 20 x 20 ground at y = 0 with a sphere r = 0.5 at (2, 0.5, 0); the camera at (cameraX, 4, 0)
+// looks straight down (up −z, fov 40°, 160 x 90), so it sees the ground x = cameraX ± 4·tan 20°·16/9,
+// z = ±4·tan 20°. The map's basis (the axis is vertical, so right = dir × X): right = +z, up = +x,
+// u = z/d, v = x/d with d = 8 − y.
+scene::Scene spotScene(double cameraX = 2.0, int width = 160, int height = 90) {
+    test::SphereOverPlane p;
+    p.width = width;
+    p.height = height;
+    p.center = {2, 0.5, 0};
+    p.radius = 0.5;
+    p.planeSize = 20.0;
+    p.eye = {cameraX, 4, 0};
+    p.lookAt = {cameraX, 0, 0};
+    scene::Scene s = test::makeScene(p);
+    s.camera.up = {0, 0, -1};
+    scene::Light l;
+    l.type = scene::LightType::Spot;
+    l.position = {0, 8, 0};
+    l.direction = {0, -1, 0};
+    l.coneAngleDegrees = 60;
+    l.intensity = 800;
+    s.lights = {l};
+    return s;
+}
+
+scene::RasterSettings fitSettings(int size, bool fit) {
+    scene::RasterSettings r = test::validatedSettings(size, 0.01, 1.0, scene::ShadowFilter::Pcf2x2);
+    r.normalOffset = 0.0;
+    r.fitLightFrustum = fit;
+    return r;
+}
+
+scene::Frame renderValidated(const scene::Scene& s, const scene::RasterSettings& settings, RenderDebug* debug = nullptr) {
+    scene::Frame f = render(s, test::planFor(s, settings), settings, debug);
+    EXPECT_EQ(f.attributes["validation_messages"], "0") << "validation messages were printed above";
+    return f;
+}
+
+// The window's half-size by hand. The visible receivers are the scene box (y 0..1) in the view:
+// at y = 0 (d = 8) x = 2 ± 4·tan 20°·16/9, z = ±4·tan 20°; at y = 1 (d = 7) x = 2 ± 3·tan 20°·16/9.
+// Their widest extent is in v at y = 0: 2·4·tan 20°·(16/9)/8 = tan 20°·16/9, half of it e. With a
+// margin of m = 10 texels (pcf2x2, no normal offset) and half a texel for the snapped center,
+// h ≥ e/(1 − 21/N), rounded up to a power of 2^(1/4).
+double expectedHalf(int n) {
+    const double e = 0.5 * std::tan(deg(20)) * 16.0 / 9.0;
+    const double h = e / (1.0 - 21.0 / n);
+    return std::exp2(std::ceil(4.0 * std::log2(h)) / 4.0);
+}
+
+TEST(RasterSpotFit, TheWindowIsTheHandComputedFractionOfTheCone) {
+    // e = 0.3235; at N = 1024, h ≥ 0.3303 → 2^(−6/4) = 0.3536 (4·log2 0.3303 = −6.39, well clear
+    // of −6); the cone's t0 = tan 61.2° = 1.823, so the texel is 0.194 of the cone map's.
+    ASSERT_NEAR(expectedHalf(1024), std::exp2(-1.5), 1e-12);
+    const scene::Scene s = spotScene();
+    const LightFrustum f = spotLightFrustum(s, fitSettings(1024, true), s.lights[0], 1024);
+    const LightFrustum cone = spotLightFrustum(s, fitSettings(1024, false), s.lights[0], 1024);
+    EXPECT_NEAR(cone.tanHalfFov, std::tan(deg(61.2)), 1e-12);
+    EXPECT_NEAR(f.tanHalfFov, std::exp2(-1.5), 1e-12);
+    EXPECT_NEAR(f.texelWorldSize() / cone.texelWorldSize(), std::exp2(-1.5) / std::tan(deg(61.2)), 1e-12);
+    // Centered on the receivers: u (z) around 0, v (x) around the middle of [(2 − 2.588)/8,
+    // (2 + 2.588)/8] = 0.25, each to within half a texel, on whole texels.
+    const double texel = 2.0 * f.tanHalfFov / 1024;
+    EXPECT_NEAR(f.windowU, 0.0, 0.5 * texel);
+    EXPECT_NEAR(f.windowV, 0.25, 0.5 * texel);
+    EXPECT_NEAR(f.windowV / texel, std::round(f.windowV / texel), 1e-6);
+    // The depth range: the farthest receiver is the ground (d = 8), grown by the margin's fraction
+    // 10 texels · 2h/N and 1%; the nearest caster in the window is the sphere's box top (y = 1,
+    // d = 7), less 1%.
+    EXPECT_NEAR(f.far, 8.0 * (1.0 + 10.0 * texel) * 1.01, 1e-9);
+    EXPECT_NEAR(f.near, 7.0 / 1.01, 1e-9);
+    EXPECT_GT(cone.far, 1.5 * f.far);
+}
+
+TEST(RasterSpotFit, TheFittedWindowHoldsEveryVisibleReceiverWithTheMargin) {
+    // Rendered: every pixel the camera sees, rebuilt from the Frame's depth, lies in the fitted
+    // map (insideLightMap) and, through the matrix the shader uses (toTexture), at least the
+    // margin (10 texels) inside its edges. The render's texel_world_size is the fitted map's.
+    const scene::Scene s = spotScene();
+    RenderDebug debug;
+    const scene::Frame frame = renderValidated(s, fitSettings(1024, true), &debug);
+    ASSERT_EQ(debug.frusta.size(), 1u);
+    const LightFrustum& f = debug.frusta[0];
+    EXPECT_NEAR(f.tanHalfFov, std::exp2(-1.5), 1e-12);
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.9g*d", 2.0 * std::exp2(-1.5) / 1024);
+    EXPECT_EQ(frame.attributes.at("texel_world_size"), buf);
+    EXPECT_NE(frame.attributes.at("light_frustum").find("window_u="), std::string::npos);
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    const glm::dmat4 toTexture = f.toTexture(Vec3(0.0));
+    int seen = 0;
+    double closest = INFINITY;  // texels from the nearest edge
+    for (int y = 0; y < frame.height; ++y)
+        for (int x = 0; x < frame.width; ++x) {
+            const std::size_t i = std::size_t(y) * frame.width + x;
+            if (!(frame.objectId[i] > 0.0f)) continue;
+            const Vec3 p = cam.position + double(frame.depth[i]) * scene::pixelDirection(cam, x, y);
+            ++seen;
+            EXPECT_TRUE(insideLightMap(f, p)) << x << "," << y;
+            const glm::dvec4 t = toTexture * glm::dvec4(p, 1.0);
+            const double u = t.x / t.w * 1024, v = t.y / t.w * 1024;
+            closest = std::min({closest, u, v, 1024 - u, 1024 - v});
+        }
+    EXPECT_EQ(seen, frame.width * frame.height);
+    EXPECT_GE(closest, 10.0);
+}
+
+TEST(RasterSpotFit, MovingTheCameraByAFractionOfATexelKeepsTheSizeAndMovesTheCenterByWholeTexels) {
+    // A texel of the fitted map at the ground is 8·2h/N = 0.0055 units; the camera moves along x
+    // (the map's v) by 0.3 texel, then by 20.3 texels. The half-size stays 2^(−1.5) and the center
+    // moves by a whole number of texels (0 or 1 for the small move, about 20 for the larger).
+    const int n = 1024;
+    const double h = std::exp2(-1.5), texel = 2.0 * h / n, ground = 8.0 * texel;
+    const scene::RasterSettings settings = fitSettings(n, true);
+    const scene::Scene s0 = spotScene(2.0);
+    const LightFrustum f0 = spotLightFrustum(s0, settings, s0.lights[0], n);
+    ASSERT_NEAR(f0.tanHalfFov, h, 1e-12);
+    for (const double move : {0.3, 20.3}) {
+        SCOPED_TRACE(move);
+        const scene::Scene s1 = spotScene(2.0 + move * ground);
+        const LightFrustum f1 = spotLightFrustum(s1, settings, s1.lights[0], n);
+        EXPECT_EQ(f1.tanHalfFov, f0.tanHalfFov);
+        const double dv = (f1.windowV - f0.windowV) / texel;
+        EXPECT_NEAR(dv, std::round(dv), 1e-6);
+        EXPECT_NEAR(dv, move, 1.0);
+        EXPECT_EQ(f1.windowU, f0.windowU);
+    }
+}
+
+TEST(RasterSpotFit, AnUnrelatedFarObjectChangesNeitherTheTexelNorTheDepthRange) {
+    // A sphere r = 1 at (40, 1, 40): out of the view and of the window's pyramid (its direction from
+    // the light has v = 40/7 ≫ the window's 0.6), casting nothing into view. It stretches the scene's
+    // bounds, so the cone map's far plane moves out (the control), but the fitted map is the same.
+    const scene::Scene plain = spotScene();
+    scene::Scene withFar = plain;
+    scene::Object far = withFar.objects[0];
+    far.name = "far";
+    far.shape = scene::Sphere{Vec3(40, 1, 40), 1.0};
+    withFar.objects.push_back(far);
+    const scene::RasterSettings fit = fitSettings(1024, true), cone = fitSettings(1024, false);
+    const LightFrustum a = spotLightFrustum(plain, fit, plain.lights[0], 1024);
+    const LightFrustum b = spotLightFrustum(withFar, fit, withFar.lights[0], 1024);
+    EXPECT_EQ(a.texelWorldSize(), b.texelWorldSize());
+    EXPECT_EQ(a.windowU, b.windowU);
+    EXPECT_EQ(a.windowV, b.windowV);
+    EXPECT_EQ(a.near, b.near);
+    EXPECT_EQ(a.far, b.far);
+    // Cone map: far = 7.5 + 1.01·½·√(20² + 1 + 20²) = 21.8 without, 7 + 1.01·½·√(51² + 2² + 51²) =
+    // 43.4 with the far sphere.
+    EXPECT_GT(spotLightFrustum(withFar, cone, withFar.lights[0], 1024).far,
+              1.9 * spotLightFrustum(plain, cone, plain.lights[0], 1024).far);
+    // Rendered: the texel_world_size attribute is the same with and without the far sphere.
+    EXPECT_EQ(renderValidated(plain, fit).attributes.at("texel_world_size"),
+              renderValidated(withFar, fit).attributes.at("texel_world_size"));
+}
+
+TEST(RasterSpotFit, ReceiversBehindTheLightsPlaneKeepTheWholeCone) {
+    // With the spot at y = 0.5, inside the scene box's height 0..1, the visible receivers at y = 1
+    // lie behind the light's plane (its map could not hold them): the whole cone is kept.
+    scene::Scene s = spotScene();
+    s.lights[0].position = {0, 0.5, 0};
+    const LightFrustum f = spotLightFrustum(s, fitSettings(1024, true), s.lights[0], 1024);
+    EXPECT_NEAR(f.tanHalfFov, std::tan(deg(61.2)), 1e-12);
+    EXPECT_EQ(f.windowU, 0.0);
+    EXPECT_EQ(f.windowV, 0.0);
+}
+
+TEST(RasterSpotFit, TheFittedRenderIsNoWorseAgainstTheReference) {
+    // The same map size (256, coarse for the whole cone): the fitted map's texel is ~5x finer, so
+    // the sphere's shadow edge is closer to the reference's. Wrong pixels (false + missed) and the
+    // mean |V − V_ref| must not grow; in fact the fitted map has clearly fewer. 320 x 180: the
+    // camera looks down past the sphere onto its shadow, most of which the sphere hides.
+    const scene::Scene s = spotScene(2.0, 320, 180);
+    scene::RenderSettings settings;
+    settings.raster = fitSettings(256, false);
+    const scene::Frame ref =
+        raytrace::renderReference(s, scene::makeRenderPlan(s, settings), scene::referenceSettings(settings.raytrace));
+    const scene::Frame cone = renderValidated(s, fitSettings(256, false));
+    const scene::Frame fitted = renderValidated(s, fitSettings(256, true));
+    const compare::Metrics a = compare::compareFrames(fitted, ref).metrics;
+    const compare::Metrics b = compare::compareFrames(cone, ref).metrics;
+    std::printf("reference shadowed %zu of %zu; wrong: fitted %zu, cone %zu; mean |dV| fitted %.4f, cone %.4f\n",
+                a.shadowedReference, a.counted, a.falseShadow + a.missedShadow, b.falseShadow + b.missedShadow,
+                a.meanAbsVisibilityError, b.meanAbsVisibilityError);
+    ASSERT_GT(a.shadowedReference, 200u);  // the sphere's shadow is in view (~400 pixels)
+    EXPECT_LE(a.falseShadow + a.missedShadow, b.falseShadow + b.missedShadow);
+    EXPECT_LE(a.meanAbsVisibilityError, b.meanAbsVisibilityError);
+    EXPECT_LT(a.meanAbsVisibilityError, 0.75 * b.meanAbsVisibilityError);
+}
+
+// Point light at (0, 4, 0) over the same ground and sphere (at (0, 0.5, 0) here), the camera at
+// (0, 3, 6) looking at the origin.
+scene::Scene pointScene(int width = 160, int height = 90) {
+    test::SphereOverPlane p;
+    p.width = width;
+    p.height = height;
+    p.center = {0, 0.5, 0};
+    p.radius = 0.5;
+    p.planeSize = 20.0;
+    p.eye = {0, 3, 6};
+    p.lookAt = {0, 0, 0};
+    scene::Scene s = test::makeScene(p);
+    scene::Light l;
+    l.type = scene::LightType::Point;
+    l.position = {0, 4, 0};
+    l.intensity = 400;
+    s.lights = {l};
+    return s;
+}
+
+TEST(RasterPointFit, EachFaceTakesItsNearAndFarFromItsCastersAndReceivers) {
+    // N = 1024: t = N/(N − 24) = 1.0240, a texel 2t/N per unit of distance; margin 10 texels.
+    // −Y (down): the farthest receiver is the ground, d = 4, so far = 4·(1 + 10·2t/N)·1.01; the
+    // nearest caster in its pyramid is the sphere's box top (y = 1, d = 3), near = 3/1.01.
+    // +X: the ground enters its pyramid where 4/x ≤ t, i.e. at x = 4/t, the sphere's box (x ≤ 0.5)
+    // never does (it would need x ≥ 3/t): near = (4/t)/1.01. +Y: nothing visible lies above the
+    // light, so its range stays the bounding sphere's.
+    const int n = 1024;
+    const double t = double(n) / (n - 24);
+    const scene::Scene s = pointScene(320, 180);
+    const scene::RasterSettings fit = fitSettings(n, true), plain = fitSettings(n, false);
+    const LightFrustum down = pointLightFaceFrustum(s, fit, s.lights[0], 3, n);
+    EXPECT_NEAR(down.far, 4.0 * (1.0 + 10.0 * 2.0 * t / n) * 1.01, 1e-9);
+    EXPECT_NEAR(down.near, 3.0 / 1.01, 1e-9);
+    const LightFrustum plusX = pointLightFaceFrustum(s, fit, s.lights[0], 0, n);
+    EXPECT_NEAR(plusX.near, 4.0 / t / 1.01, 1e-9);
+    const LightFrustum up = pointLightFaceFrustum(s, fit, s.lights[0], 2, n);
+    const LightFrustum upPlain = pointLightFaceFrustum(s, plain, s.lights[0], 2, n);
+    EXPECT_EQ(up.near, upPlain.near);
+    EXPECT_EQ(up.far, upPlain.far);
+    // The bounding sphere's range (near = far/1000 with the light inside the scene's box) is much
+    // wider: the fitted near is over 100x farther.
+    EXPECT_GT(down.near, 100.0 * pointLightFaceFrustum(s, plain, s.lights[0], 3, n).near);
+
+    // Rendered (validated), with each face's range in the shader: the same shadows as the
+    // bounding-sphere range, up to a few pixels on the sphere's shadow edge.
+    RenderDebug debug;
+    const scene::Frame fitted = renderValidated(s, fit, &debug);
+    const scene::Frame wide = renderValidated(s, plain);
+    ASSERT_EQ(debug.frusta.size(), 6u);
+    EXPECT_NEAR(debug.frusta[3].near, down.near, 1e-12);
+    int differ = 0, shadowed = 0;
+    for (std::size_t i = 0; i < fitted.visibility.size(); ++i) {
+        differ += std::abs(fitted.visibility[i] - wide.visibility[i]) > 0.5f;
+        shadowed += wide.visibility[i] < 0.5f && wide.objectId[i] == 2.0f;
+    }
+    ASSERT_GT(shadowed, 100);
+    EXPECT_LE(differ, shadowed / 50) << differ << " pixels differ, " << shadowed << " shadowed";
+
+    // PCSS of a light of radius 0.3, whose taps go on into the neighbouring faces (each with its
+    // own range there, lit.frag cubeTap). The blocker search's reach follows the face's near plane
+    // (it is largest for blockers there), which the fit moves from far/1000 to the sphere, so the
+    // penumbrae are not the same as before: against the reference (256 samples of the sphere
+    // light) they must be no worse.
+    scene::Scene soft = pointScene(160, 90);
+    soft.lights[0].radius = 0.3;
+    scene::RasterSettings pcssFit = fit, pcssPlain = plain;
+    pcssFit.filter = pcssPlain.filter = scene::ShadowFilter::Pcss;
+    scene::RenderSettings rs;
+    rs.raster = pcssPlain;
+    const scene::Frame ref = raytrace::renderReference(soft, scene::makeRenderPlan(soft, rs),
+                                                       scene::referenceSettings(rs.raytrace));
+    const compare::Metrics a = compare::compareFrames(renderValidated(soft, pcssFit), ref).metrics;
+    const compare::Metrics b = compare::compareFrames(renderValidated(soft, pcssPlain), ref).metrics;
+    std::printf("pcss: mean |dV| fitted %.4f, bounding-sphere range %.4f; wrong %zu, %zu\n", a.meanAbsVisibilityError,
+                b.meanAbsVisibilityError, a.falseShadow + a.missedShadow, b.falseShadow + b.missedShadow);
+    EXPECT_LE(a.meanAbsVisibilityError, b.meanAbsVisibilityError * 1.05);
+    EXPECT_LE(a.falseShadow + a.missedShadow, b.falseShadow + b.missedShadow + a.counted / 200);
+}
+
+// The point light's map size by hand: camera at (0, 10, 0) looking straight down (fov 40°) at the
+// ground y = 0 (view depth 10) and a box [−1, 1] x [0, 2] x [−1, 1] (its top at view depth 8, all
+// in view), point light at (0, 12, 0). ‖p − light‖∞ is 12 − y wherever |x|, |z| < 12 − y (the view
+// reaches |x| ≤ 10·tan 20°·16/9 = 6.5 on the ground), so ‖p − light‖∞ / view depth = (12 − y)/(10 −
+// y), largest on the box's top: 10/8. N ≥ 2·(10/8)/(2·tan 20°/H) + 24 = 3.434·H + 24: 333 at
+// H = 90 → 512, 642 at H = 180 → 1024, 230 at H = 60 → 256, 1260 at H = 360 → 2048.
+scene::Scene pointFromAbove(int height) {
+    scene::Scene s = pointScene();
+    s.objects[0].shape = scene::Box{{-1, 0, -1}, {1, 2, 1}};
+    s.camera.position = {0, 10, 0};
+    s.camera.lookAt = {0, 0, 0};
+    s.camera.up = {0, 0, -1};
+    s.camera.width = height * 16 / 9;
+    s.camera.height = height;
+    s.lights[0].position = {0, 12, 0};
+    return s;
+}
+
+TEST(RasterMapSize, APointLightsMapIsSizedByTheFinestReceiverDetail) {
+    auto expected = [](int height) {
+        const double needed = 2.0 * (10.0 / 8.0) / (2.0 * std::tan(deg(20)) / height) + 24.0;
+        int size = 256;
+        while (size < needed && size < 2048) size *= 2;
+        return size;
+    };
+    EXPECT_EQ(expected(60), 256);
+    EXPECT_EQ(expected(90), 512);
+    EXPECT_EQ(expected(180), 1024);
+    EXPECT_EQ(expected(360), 2048);
+    for (const int height : {60, 90, 180, 360}) {
+        SCOPED_TRACE(height);
+        const scene::Scene s = pointFromAbove(height);
+        const ShadowMapSizeChoice c = chooseShadowMapSize(s, scene::resolveSettings(s, {}).raster);
+        EXPECT_EQ(c.size, expected(height)) << c.reason;
+        EXPECT_NE(c.reason.find("point 0"), std::string::npos) << c.reason;
+    }
+    // Forced sizes stay forced.
+    scene::Scene s = pointFromAbove(90);
+    scene::SettingsOverrides o;
+    o.shadowMapSize = 2048;
+    EXPECT_EQ(chooseShadowMapSize(s, scene::resolveSettings(s, o).raster).size, 2048);
+    s.shadow.shadowMapSize = 1024;
+    EXPECT_EQ(chooseShadowMapSize(s, scene::resolveSettings(s, {}).raster).size, 1024);
+    // The render uses it (validated).
+    scene::RenderSettings rs = scene::resolveSettings(pointFromAbove(90), {});
+    rs.raster.validate = true;
+    const scene::Scene p = pointFromAbove(90);
+    const scene::Frame f = render(p, scene::makeRenderPlan(p, rs), rs.raster);
+    EXPECT_EQ(f.attributes.at("validation_messages"), "0");
+    EXPECT_EQ(f.attributes.at("shadow_map_size"), "512");
+}
+
+}  // namespace
+}  // namespace shadowlab::raster
