@@ -227,6 +227,13 @@ SweepGrid defaultGrid(const scene::Scene& scene, bool quick) {
             c.overrides.cascades = 3;
             g.configs.push_back(c);
         }
+    // The map fitted to what the camera sees (--fit-light-frustum) against the bounding-sphere maps
+    // above, at each size: what an engine's fitted frustum gains on this view.
+    for (int size : sizes) {
+        SweepConfig c = raster(size, "pcf2x2");
+        c.overrides.fitLightFrustum = true;
+        g.configs.push_back(c);
+    }
 
     // Constant depth bias alone (slope 0), then slope bias alone (constant 0): each series shows
     // one parameter's acne-to-leak trade-off and its bias window.

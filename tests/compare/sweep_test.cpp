@@ -447,6 +447,24 @@ TEST_F(GridFile, DefaultGridComparesCascadesOnlyWithADirectionalLight) {
     EXPECT_EQ(cascaded(defaultGrid(spotOnly, false)), 0u);
 }
 
+TEST_F(GridFile, DefaultGridComparesAFittedMapAtEverySize) {
+    // One pcf2x2 row per map size with the fitted frustum, beside the bounding-sphere rows.
+    for (const bool quick : {true, false}) {
+        std::set<int> fittedSizes, sizes;
+        for (const auto& c : defaultGrid(scene, quick).configs) {
+            if (c.backend != "raster" || !c.overrides.shadowMapSize) continue;
+            sizes.insert(*c.overrides.shadowMapSize);
+            if (c.overrides.fitLightFrustum.value_or(false)) {
+                fittedSizes.insert(*c.overrides.shadowMapSize);
+                EXPECT_EQ(c.overrides.filter.value_or(""), "pcf2x2");
+                EXPECT_NE(c.label().find("fitted frustum"), std::string::npos) << c.label();
+            }
+        }
+        EXPECT_EQ(fittedSizes.size(), quick ? 2u : 4u);
+        for (int size : fittedSizes) EXPECT_TRUE(sizes.count(size)) << size;
+    }
+}
+
 TEST_F(GridFile, BadValuesAreRejectedWithTheirJsonPath) {
     const std::vector<std::pair<std::string, std::string>> cases = {
         {R"({ "raster": { "depth_bias": [0, 0.1, -1] } })", "raster.depth_bias[2]"},
