@@ -64,7 +64,7 @@ Prepared prepare(const SceneOptions& o) {
     if (o.explain)
         std::cerr << "render plan for " << p.scene.file.string() << ":\n"
                   << p.plan.explain()
-                  << "raster shadow-map size: " << raster::chooseShadowMapSize(p.scene, p.settings.raster).reason << "\n";
+                  << "raster shadow-map size: " << raster::chooseShadowMapSize(p.scene, p.settings.raster, &p.plan).reason << "\n";
     if (o.explain) {
         const std::vector<raster::LightCulling> culled = raster::culledCasters(p.scene, p.settings.raster, &p.plan);
         const std::size_t objects = p.scene.objects.size();

@@ -251,8 +251,8 @@ LightFrustum fitPointLightFace(const scene::Bounds& bounds, const Vec3& position
     const Vec3 c = bounds.empty() ? position : bounds.center();
     const double radius = bounds.empty() ? 1.0 : 0.5 * bounds.diagonal() * kLightFrustumMargin;
     // Any direction may hold geometry, so the range comes from the distance band of the bounding
-    // sphere, not its extent along this face's axis: one near/far serves all six faces (the shader
-    // has one). Near and far are planes across the axis: a point at distance r in a direction θ off
+    // sphere, not its extent along this face's axis: one near/far serves all six faces (unfitted;
+    // fitPointLightFaceToReceivers gives each face its own). Near and far are planes across the axis: a point at distance r in a direction θ off
     // the axis has depth r·cos θ, as little as r/√(1 + 2t²) in the window's corners (tan θ = t√2),
     // so the near plane is the nearest distance scaled by that (the radial distance itself clipped
     // the corner of a box seen down its diagonal); a depth never exceeds the distance, so far is it.
@@ -336,14 +336,23 @@ std::string LightFrustum::describe() const {
     return buf;
 }
 
-ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::RasterSettings& settings) {
+ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::RasterSettings& settings,
+                                        const scene::RenderPlan* plan) {
     const int size = settings.shadowMapSize;
+    // Only the lights that get a map ask for texels.
+    auto mapped = [&](std::size_t i) {
+        if (!plan) return true;
+        for (const scene::LightPlan& lp : plan->lights)
+            if (std::size_t(lp.light) == i) return lp.needsShadowTest;
+        return false;
+    };
     auto keep = [&](const std::string& why) { return ShadowMapSizeChoice{size, std::to_string(size) + " (" + why + ")"}; };
     // A size set after resolveSettings() (a test, the sweep) is forced too.
     if (!settings.shadowMapSizeIsDefault || size != scene::kDefaultShadowMapSize)
         return keep("set by --shadow-map-size or the scene");
     bool directional = false;
-    for (const scene::Light& l : scene.lights) directional = directional || l.type == scene::LightType::Directional;
+    for (std::size_t i = 0; i < scene.lights.size(); ++i)
+        directional = directional || (mapped(i) && scene.lights[i].type == scene::LightType::Directional);
     if (settings.cascades > 1 && directional) return keep("default: cascades size their texels per slice");
     // The visible receivers: each object's bounds clipped to the camera frustum (the scene's box
     // would reach up to the camera), a convex polytope each, between the near and far planes.
@@ -370,8 +379,9 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
             for (const Vec3& p : v) zMin = std::min(zMin, viewDepth(p));
         const double pixel = pixelAt(zMin);
         double widest = 0.0;
-        for (const scene::Light& l : scene.lights) {
-            if (l.type != scene::LightType::Directional) continue;
+        for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+            const scene::Light& l = scene.lights[i];
+            if (l.type != scene::LightType::Directional || !mapped(i)) continue;
             const LightFrustum f = settings.fitLightFrustum ? fitDirectionalLightToReceivers(scene, l.direction, size)
                                                             : fitDirectionalLight(scene.bounds(), l.direction, size);
             widest = std::max(widest, 2.0 * f.halfWidth);
@@ -383,7 +393,7 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
     }
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {
         const scene::Light& l = scene.lights[i];
-        if (l.type != scene::LightType::Spot) continue;
+        if (l.type != scene::LightType::Spot || !mapped(i)) continue;
         // A texel at distance z along the axis is z·2t/N wide, a pixel at view depth zc is
         // pixelAt(zc): N ≥ 2t·z/pixelAt(zc) = 2t·(z/zc)/pixelAt(1). Both z and zc are affine in the
         // point, and zc > 0 on each visible polytope K, so r = z/zc is quasi-linear there: if
@@ -414,7 +424,7 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
     }
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {
         const scene::Light& l = scene.lights[i];
-        if (l.type != scene::LightType::Point) continue;
+        if (l.type != scene::LightType::Point || !mapped(i)) continue;
         // A receiver uses the face of its major axis, at axial distance ‖p − light‖∞, where a texel
         // is 2t/N = 2/(N − 2·margin) per unit (t = N/(N − 2·margin), cubeFaceTanHalfFov): N ≥
         // 2·max(‖p − light‖∞ / pixelAt(zc)) + 2·margin. ‖p − light‖∞ is convex and zc affine and
@@ -711,7 +721,7 @@ int LightCulling::total() const {
 std::vector<LightCulling> culledCasters(const scene::Scene& scene, const scene::RasterSettings& settingsIn,
                                         const scene::RenderPlan* plan) {
     scene::RasterSettings settings = settingsIn;
-    settings.shadowMapSize = chooseShadowMapSize(scene, settingsIn).size;
+    settings.shadowMapSize = chooseShadowMapSize(scene, settingsIn, plan).size;
     std::vector<LightCulling> out(scene.lights.size());
     if (!settings.cullCasters || (plan && plan->needsTransmittanceMap)) return out;
     const scene::Bounds bounds = scene.bounds();

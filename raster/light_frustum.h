@@ -123,8 +123,9 @@ scene::Vec3 cubeFaceDirection(int face);
 // never more than 2 for tiny maps.
 double cubeFaceTanHalfFov(int mapSize);
 // Face `face` of the cube map of a point light at `position`: a perspective frustum whose near
-// and far enclose the scene's bounding sphere (the same for all six faces, near no closer than
-// far · kSpotMinNearOverFar).
+// and far planes enclose the scene's bounding sphere in every direction of the face's window (the
+// same for all six faces; near = nearest distance / √(1 + 2t²), no closer than far ·
+// kSpotMinNearOverFar).
 LightFrustum fitPointLightFace(const scene::Bounds& bounds, const scene::Vec3& position, int face, int mapSize);
 // The same face with near/far fitted to what the camera sees (`fitLightFrustum`), as a fitted spot
 // map's: far from the visible receivers in front of the face, near from the objects' boxes inside
@@ -218,6 +219,8 @@ struct ShadowMapSizeChoice {
     int size = 0;
     std::string reason;
 };
-ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::RasterSettings& settings);
+// With a plan, only the lights it gives a shadow pass count (without: every light).
+ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::RasterSettings& settings,
+                                        const scene::RenderPlan* plan = nullptr);
 
 }  // namespace shadowlab::raster

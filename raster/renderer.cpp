@@ -208,7 +208,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
 
     // Map size from the receivers' detail when nobody chose one; a default constant bias (half a
     // texel of the bounding-sphere map) follows the size.
-    const ShadowMapSizeChoice mapChoice = chooseShadowMapSize(scene, settings);
+    const ShadowMapSizeChoice mapChoice = chooseShadowMapSize(scene, settings, &plan);
     if (mapChoice.size != settings.shadowMapSize) {
         settings.shadowMapSize = mapChoice.size;
         if (settings.depthBiasIsDefault) settings.depthBias = scene::defaultDepthBias(scene, mapChoice.size);

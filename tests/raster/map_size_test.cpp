@@ -87,5 +87,25 @@ TEST(RasterMapSize, ASizeFromTheSceneIsKept) {
     EXPECT_EQ(chooseShadowMapSize(s, scene::resolveSettings(s, {}).raster).size, 512);
 }
 
+TEST(RasterMapSize, OnlyLightsWithAShadowPassAskForTexels) {
+    // The seed at 64x36 needs 512 for its directional light (above). A point light 500 above the
+    // scene asks for far more: its texels are 2/(N − 24) per unit of axial distance (~500) and a
+    // pixel at view depth ~6 is 6·2·tan 20°/36 = 0.12, so N ≈ 2·500/0.12 ≫ 2048, capped at the
+    // default. When the plan gives that light no shadow pass, it asks for nothing.
+    scene::Scene s = seed(64, 36);
+    scene::Light point;
+    point.type = scene::LightType::Point;
+    point.position = scene::Vec3(0, 500, 0);
+    s.lights.push_back(point);
+    const scene::RasterSettings settings = scene::resolveSettings(s, {}).raster;
+    scene::RenderPlan plan = scene::makeRenderPlan(s, scene::resolveSettings(s, {}));
+    ASSERT_TRUE(plan.lights[1].needsShadowTest);
+    const int withPoint = chooseShadowMapSize(s, settings, &plan).size;
+    EXPECT_EQ(withPoint, 2048);
+    EXPECT_EQ(chooseShadowMapSize(s, settings).size, withPoint);  // no plan: every light counts
+    plan.lights[1].needsShadowTest = false;
+    EXPECT_EQ(chooseShadowMapSize(s, settings, &plan).size, 512);
+}
+
 }  // namespace
 }  // namespace shadowlab::raster
