@@ -177,7 +177,8 @@ vec3 mapCoordinates(LightData light, vec3 axis, vec3 q) {
         return vec3(0.5 + 0.5 * vec2(dot(d, right), dot(d, up)) / (axial * light.kind.y), axial);
     }
     const vec4 s = light.toShadow * vec4(q, 1.0);
-    return vec3(s.xy / s.w, isPerspective(light) ? dot(q - light.toLight.xyz, axis) : s.z);
+    const bool perspective = isPerspective(light);
+    return vec3(perspective ? s.xy / s.w : s.xy, perspective ? dot(q - light.toLight.xyz, axis) : s.z);
 }
 
 // Receiver-plane depth bias (Isidoro, "Shadow Mapping: GPU-based Tips and Techniques", GDC 2006).
@@ -255,11 +256,13 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, vec3 dpdx, vec3 d
         r.uv = 0.5 + 0.5 * vec2(dot(d, right), dot(d, up)) / (r.axial * light.kind.y);
     } else {
         const vec4 s = light.toShadow * vec4(q, 1.0);
-        r.uv = s.xy / s.w;
+        // Orthographic (directional): toShadow's last row is exactly (0, 0, 0, 1), so w = 1 and
+        // the division would change nothing; without it the w row is not computed either.
+        r.uv = perspective ? s.xy / s.w : s.xy;
         r.axial = perspective ? dot(q - light.toLight.xyz, axis) : s.z;
     }
     const int filterCode = kFilter;  // light.params.y holds the same code
-    const float size = float(textureSize(shadowMaps, 0).x);
+    const float size = u.counts.y;  // = textureSize(shadowMaps, 0).x, without a query per fragment
     r.plane = false;
     r.grad = vec2(0.0);
     if (kReceiverPlane) {
