@@ -30,6 +30,8 @@ const float kPcssMaxFilterFraction = 1.0 / 8.0;
 layout(location = 0) in vec3 inPosition;  // camera-relative world position
 layout(location = 1) in vec3 inNormal;
 layout(location = 2) flat in uint inObjectId;
+layout(location = 3) in vec3 inLightCoordinates;  // lit.vert: light 0's (toShadow · (p, 1)).xyz
+layout(location = 4) in vec3 inLightNormal;       // lit.vert: toShadow's 3x3 · the unnormalized normal
 
 layout(location = 0) out vec4 outBeauty;  // rgb: linear color; a: visibility
 #ifndef SHADOWLAB_BEAUTY_ONLY
@@ -65,6 +67,10 @@ layout(constant_id = 4) const int kCascades = 1;
 layout(constant_id = 5) const bool kTransmittance = false;
 // Receiver-plane depth bias in every tap (see shadowTest); off, its code is compiled out.
 layout(constant_id = 6) const bool kReceiverPlane = false;
+// One directional light with one map and no receiver plane: its map coordinates are interpolated
+// from lit.vert (see shadowTest) instead of a matrix product per fragment.
+const bool kVertexLightCoordinates = kLightCount == 1 && kLightKinds == (1 << SHADOWLAB_LIGHT_DIRECTIONAL) &&
+                                     kCascades == 1 && !kReceiverPlane;
 const bool kAnyPerspective =
     (kLightKinds & ((1 << SHADOWLAB_LIGHT_SPOT) | (1 << SHADOWLAB_LIGHT_POINT))) != 0;
 
@@ -227,7 +233,9 @@ float biasedTap(LightData light, Receiver r, vec2 o, float size, float layer, in
 // Visibility 0..1 of `light` at camera-relative position p with unit normal n (facing the
 // viewer), N·L = ndotl > 0; dpdx, dpdy: p's screen-space derivatives (receiver plane only).
 // `blocker` gets the id of the object that shadowed, if any.
-float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, vec3 dpdx, vec3 dpdy, inout uint blocker) {
+// nScale: ±1/|inNormal| (the normalization and the flip that made n from inNormal), for
+// kVertexLightCoordinates.
+float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec3 dpdx, vec3 dpdy, inout uint blocker) {
     const bool perspective = isPerspective(light);
     const bool point = isKind(light, SHADOWLAB_LIGHT_POINT);
     vec3 axis = light.axis.xyz;
@@ -254,6 +262,15 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, vec3 dpdx, vec3 d
         const vec3 d = q - light.toLight.xyz;
         r.axial = dot(d, axis);
         r.uv = 0.5 + 0.5 * vec2(dot(d, right), dot(d, up)) / (r.axial * light.kind.y);
+    } else if (kVertexLightCoordinates) {
+        // toShadow · (p + n·offset, 1) = toShadow · (p, 1) + offset · toShadow₃ₓ₃ · n, and both
+        // terms are linear in the position and the normal, so they interpolate exactly: lit.vert
+        // computes them per vertex. In float the sum differs from the product of the interpolated
+        // position by rounding at the scale of the map's coordinates (≈1e-7 of its extent), not of
+        // the camera-relative position: far below a texel (2048 of them) and the depth bias.
+        const vec3 s = inLightCoordinates + (light.params.z * texel * nScale) * inLightNormal;
+        r.uv = s.xy;
+        r.axial = s.z;
     } else {
         const vec4 s = light.toShadow * vec4(q, 1.0);
         // Orthographic (directional): toShadow's last row is exactly (0, 0, 0, 1), so w = 1 and
@@ -416,8 +433,12 @@ void main() {
     const vec3 dpdx = kReceiverPlane ? dFdx(inPosition) : vec3(0.0);
     const vec3 dpdy = kReceiverPlane ? dFdy(inPosition) : vec3(0.0);
     vec3 n = normalize(inNormal);
+    float nScale = kVertexLightCoordinates ? inversesqrt(dot(inNormal, inNormal)) : 1.0;
     // Two-sided surfaces: the normal faces the viewer (the ray tracer's rule: flip when N·ray > 0).
-    if (dot(n, inPosition) > 0.0) n = -n;
+    if (dot(n, inPosition) > 0.0) {
+        n = -n;
+        nScale = -nScale;
+    }
 
     const vec4 objectAlbedo = albedo[inObjectId - 1u];
     const vec3 albedoColor = objectAlbedo.rgb;
@@ -456,7 +477,7 @@ void main() {
         // continue, so that the loop unrolls.)
         if (ndotl > 0.0 && irradiance > 0.0) {
             uint lightBlocker = 0u;
-            const float v = light.toLight.w >= 0.0 ? shadowTest(light, inPosition, n, ndotl, dpdx, dpdy, lightBlocker) : 1.0;
+            const float v = light.toLight.w >= 0.0 ? shadowTest(light, inPosition, n, nScale, ndotl, dpdx, dpdy, lightBlocker) : 1.0;
             if (blocker == 0u) blocker = lightBlocker;  // the first light that found one, as raytrace/
 #ifdef SHADOWLAB_LIGHT_OUTPUTS
             lightVisibility[i / 4][i % 4] = v;

@@ -13,10 +13,17 @@ layout(location = 2) in uint inObjectId;
 layout(location = 0) out vec3 outPosition;
 layout(location = 1) out vec3 outNormal;
 layout(location = 2) flat out uint outObjectId;
+// The first light's map coordinates of the position (toShadow · (p, 1)).xyz and of the normal
+// (toShadow's 3x3 · n), which lit.frag interpolates instead of a matrix product per fragment
+// where that light is the only one and directional (kVertexLightCoordinates); unused otherwise.
+layout(location = 3) out vec3 outLightCoordinates;
+layout(location = 4) out vec3 outLightNormal;
 
 void main() {
     outPosition = inPosition;
     outNormal = inNormal;
     outObjectId = inObjectId;
+    outLightCoordinates = (u.lights[0].toShadow * vec4(inPosition, 1.0)).xyz;
+    outLightNormal = mat3(u.lights[0].toShadow) * inNormal;
     gl_Position = u.viewProj * vec4(inPosition, 1.0);
 }
