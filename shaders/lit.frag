@@ -7,7 +7,6 @@
 #include "interface.h"
 
 layout(set = 0, binding = 0, std140) uniform Uniforms { LitUniforms u; };
-layout(set = 0, binding = 1, std430) readonly buffer Albedos { vec4 albedo[]; };  // per object; a: 1 − opacity
 // NEAREST depth-compare sampler: each tap returns "ref <= stored" for one texel.
 layout(set = 0, binding = 2) uniform sampler2DArrayShadow shadowMaps;
 // The object nearest the light in each texel (0 = none), same layout as shadowMaps.
@@ -32,6 +31,9 @@ layout(location = 1) in vec3 inNormal;
 layout(location = 2) flat in uint inObjectId;
 layout(location = 3) in vec3 inLightCoordinates;  // lit.vert: light 0's (toShadow · (p, 1)).xyz
 layout(location = 4) in vec3 inLightNormal;       // lit.vert: toShadow's 3x3 · the unnormalized normal
+// The object's albedo (rgb) and 1 − opacity (a), which lit.vert reads from the per-object buffer
+// (binding 1): flat, so the same value as a read here, without a buffer lookup per fragment.
+layout(location = 5) flat in vec4 inAlbedo;
 
 layout(location = 0) out vec4 outBeauty;  // rgb: linear color; a: visibility
 #ifndef SHADOWLAB_BEAUTY_ONLY
@@ -98,7 +100,7 @@ float interleavedGradientNoise(vec2 pixel) {
 // their transmittance product when the receiver lies behind the nearest of them, else 1 (a
 // receiver in front of them, or on the nearest one itself, which the bias keeps in front).
 // A semi-transparent receiver lies in front of the opaque depth, so its own 1 − opacity is in
-// the product: it is divided out (the receiver's object, albedo[].a; 1 for opaque receivers).
+// the product: it is divided out (the receiver's object, inAlbedo.a; 1 for opaque receivers).
 float receiverTransmittance = 1.0;
 float transmittanceTap(vec2 uv, float layer, float ref) {
     const vec3 at = vec3(uv, layer);
@@ -440,7 +442,7 @@ void main() {
         nScale = -nScale;
     }
 
-    const vec4 objectAlbedo = albedo[inObjectId - 1u];
+    const vec4 objectAlbedo = inAlbedo;
     const vec3 albedoColor = objectAlbedo.rgb;
     if (kTransmittance) receiverTransmittance = max(objectAlbedo.a, 1e-6);
     vec3 color = u.forward.w * albedoColor;
