@@ -85,7 +85,16 @@ void freshShaderCache(std::vector<fs::path>& made) {
     }
 }
 
+// SHADOWLAB_BENCH_SCENE=seed or Sponza: only that scene (while iterating on one);
+// SHADOWLAB_BENCH_NO_FRESH=1: leave out the "into a new Frame" series (a quarter of the run).
+bool wantScene(const char* label) {
+    const char* only = std::getenv("SHADOWLAB_BENCH_SCENE");
+    return !only || !*only || std::string(only) == label;
+}
+
 void benchScene(const std::string& label, const fs::path& file, int repeats, std::vector<fs::path>& caches) {
+    const char* noFresh = std::getenv("SHADOWLAB_BENCH_NO_FRESH");
+    const bool skipFresh = noFresh && std::string(noFresh) == "1";
     scene::Scene s = scene::loadScene(file);
     s.camera.width = kWidth;
     s.camera.height = kHeight;
@@ -132,7 +141,7 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
         ours.render(beautyFrame, scene::kChannelBeauty);
         beauty.add("cpu_per_frame", cpuMs() - c);
         addOurs(beauty, beautyFrame);
-        addOurs(fresh, ours.render(scene::kAllChannels));  // a new Frame every time
+        if (!skipFresh) addOurs(fresh, ours.render(scene::kAllChannels));  // a new Frame every time
         c = cpuMs();
         const bench::BareTimings t = bare.render(rgba);
         base.add("cpu_per_frame", cpuMs() - c);
@@ -203,13 +212,14 @@ int main(int argc, char** argv) {
     std::printf("raster_bench: LP_NUM_THREADS=%s repeats=%d\n", std::getenv("LP_NUM_THREADS"), repeats);
     std::vector<fs::path> caches;
     int rc = 0;
-    try {
+    if (wantScene("seed")) try {
         benchScene("seed", scene::findScene("seed"), repeats, caches);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "seed scene failed: %s\n", e.what());
         rc = 1;
     }
-    if (!fs::exists(kSponzaPath)) {
+    if (!wantScene("Sponza")) {
+    } else if (!fs::exists(kSponzaPath)) {
         std::printf("\n=== Sponza: SKIPPED, file absent: %s ===\n", kSponzaPath);
     } else {
         try {

@@ -390,6 +390,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     const auto mapSize = lightMatrices.empty() ? 1u : std::uint32_t(settings.shadowMapSize);
     const auto layers = std::max<std::uint32_t>(1, std::uint32_t(lightMatrices.size()));
     maps = createShadowMaps(ctx, mapSize, layers);
+    uniforms.counts.y = float(mapSize);  // lit.frag's map size, instead of a textureSize() per fragment
     transmit = !draw.transparent.empty() && !lightMatrices.empty();
     transmittanceMaps = createTransmittanceMaps(ctx, transmit ? mapSize : 1, transmit ? layers : 1);
     for (const int i : layerLight) {

@@ -7,7 +7,6 @@
 #include "interface.h"
 
 layout(set = 0, binding = 0, std140) uniform Uniforms { LitUniforms u; };
-layout(set = 0, binding = 1, std430) readonly buffer Albedos { vec4 albedo[]; };  // per object; a: 1 − opacity
 // NEAREST depth-compare sampler: each tap returns "ref <= stored" for one texel.
 layout(set = 0, binding = 2) uniform sampler2DArrayShadow shadowMaps;
 // The object nearest the light in each texel (0 = none), same layout as shadowMaps.
@@ -30,6 +29,11 @@ const float kPcssMaxFilterFraction = 1.0 / 8.0;
 layout(location = 0) in vec3 inPosition;  // camera-relative world position
 layout(location = 1) in vec3 inNormal;
 layout(location = 2) flat in uint inObjectId;
+layout(location = 3) in vec3 inLightCoordinates;  // lit.vert: light 0's (toShadow · (p, 1)).xyz
+layout(location = 4) in vec3 inLightNormal;       // lit.vert: toShadow's 3x3 · the unnormalized normal
+// The object's albedo (rgb) and 1 − opacity (a), which lit.vert reads from the per-object buffer
+// (binding 1): flat, so the same value as a read here, without a buffer lookup per fragment.
+layout(location = 5) flat in vec4 inAlbedo;
 
 layout(location = 0) out vec4 outBeauty;  // rgb: linear color; a: visibility
 #ifndef SHADOWLAB_BEAUTY_ONLY
@@ -65,6 +69,10 @@ layout(constant_id = 4) const int kCascades = 1;
 layout(constant_id = 5) const bool kTransmittance = false;
 // Receiver-plane depth bias in every tap (see shadowTest); off, its code is compiled out.
 layout(constant_id = 6) const bool kReceiverPlane = false;
+// One directional light with one map and no receiver plane: its map coordinates are interpolated
+// from lit.vert (see shadowTest) instead of a matrix product per fragment.
+const bool kVertexLightCoordinates = kLightCount == 1 && kLightKinds == (1 << SHADOWLAB_LIGHT_DIRECTIONAL) &&
+                                     kCascades == 1 && !kReceiverPlane;
 const bool kAnyPerspective =
     (kLightKinds & ((1 << SHADOWLAB_LIGHT_SPOT) | (1 << SHADOWLAB_LIGHT_POINT))) != 0;
 
@@ -92,7 +100,7 @@ float interleavedGradientNoise(vec2 pixel) {
 // their transmittance product when the receiver lies behind the nearest of them, else 1 (a
 // receiver in front of them, or on the nearest one itself, which the bias keeps in front).
 // A semi-transparent receiver lies in front of the opaque depth, so its own 1 − opacity is in
-// the product: it is divided out (the receiver's object, albedo[].a; 1 for opaque receivers).
+// the product: it is divided out (the receiver's object, inAlbedo.a; 1 for opaque receivers).
 float receiverTransmittance = 1.0;
 float transmittanceTap(vec2 uv, float layer, float ref) {
     const vec3 at = vec3(uv, layer);
@@ -184,7 +192,8 @@ vec3 mapCoordinates(LightData light, vec3 axis, vec3 q) {
         return vec3(0.5 + 0.5 * vec2(dot(d, right), dot(d, up)) / (axial * light.kind.y), axial);
     }
     const vec4 s = light.toShadow * vec4(q, 1.0);
-    return vec3(s.xy / s.w, isPerspective(light) ? dot(q - light.toLight.xyz, axis) : s.z);
+    const bool perspective = isPerspective(light);
+    return vec3(perspective ? s.xy / s.w : s.xy, perspective ? dot(q - light.toLight.xyz, axis) : s.z);
 }
 
 // Receiver-plane depth bias (Isidoro, "Shadow Mapping: GPU-based Tips and Techniques", GDC 2006).
@@ -233,7 +242,9 @@ float biasedTap(LightData light, Receiver r, vec2 o, float size, float layer, in
 // Visibility 0..1 of `light` at camera-relative position p with unit normal n (facing the
 // viewer), N·L = ndotl > 0; dpdx, dpdy: p's screen-space derivatives (receiver plane only).
 // `blocker` gets the id of the object that shadowed, if any.
-float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, vec3 dpdx, vec3 dpdy, inout uint blocker) {
+// nScale: ±1/|inNormal| (the normalization and the flip that made n from inNormal), for
+// kVertexLightCoordinates.
+float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec3 dpdx, vec3 dpdy, inout uint blocker) {
     const bool perspective = isPerspective(light);
     const bool point = isKind(light, SHADOWLAB_LIGHT_POINT);
     vec3 axis = light.axis.xyz;
@@ -262,13 +273,24 @@ float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, vec3 dpdx, vec3 d
         const vec3 d = q - light.toLight.xyz;
         r.axial = dot(d, axis);
         r.uv = 0.5 + 0.5 * vec2(dot(d, right), dot(d, up)) / (r.axial * light.kind.y);
+    } else if (kVertexLightCoordinates) {
+        // toShadow · (p + n·offset, 1) = toShadow · (p, 1) + offset · toShadow₃ₓ₃ · n, and both
+        // terms are linear in the position and the normal, so they interpolate exactly: lit.vert
+        // computes them per vertex. In float the sum differs from the product of the interpolated
+        // position by rounding at the scale of the map's coordinates (≈1e-7 of its extent), not of
+        // the camera-relative position: far below a texel (2048 of them) and the depth bias.
+        const vec3 s = inLightCoordinates + (light.params.z * texel * nScale) * inLightNormal;
+        r.uv = s.xy;
+        r.axial = s.z;
     } else {
         const vec4 s = light.toShadow * vec4(q, 1.0);
-        r.uv = s.xy / s.w;
+        // Orthographic (directional): toShadow's last row is exactly (0, 0, 0, 1), so w = 1 and
+        // the division would change nothing; without it the w row is not computed either.
+        r.uv = perspective ? s.xy / s.w : s.xy;
         r.axial = perspective ? dot(q - light.toLight.xyz, axis) : s.z;
     }
     const int filterCode = kFilter;  // light.params.y holds the same code
-    const float size = float(textureSize(shadowMaps, 0).x);
+    const float size = u.counts.y;  // = textureSize(shadowMaps, 0).x, without a query per fragment
     r.plane = false;
     r.grad = vec2(0.0);
     if (kReceiverPlane) {
@@ -426,10 +448,14 @@ void main() {
     const vec3 dpdx = kReceiverPlane ? dFdx(inPosition) : vec3(0.0);
     const vec3 dpdy = kReceiverPlane ? dFdy(inPosition) : vec3(0.0);
     vec3 n = normalize(inNormal);
+    float nScale = kVertexLightCoordinates ? inversesqrt(dot(inNormal, inNormal)) : 1.0;
     // Two-sided surfaces: the normal faces the viewer (the ray tracer's rule: flip when N·ray > 0).
-    if (dot(n, inPosition) > 0.0) n = -n;
+    if (dot(n, inPosition) > 0.0) {
+        n = -n;
+        nScale = -nScale;
+    }
 
-    const vec4 objectAlbedo = albedo[inObjectId - 1u];
+    const vec4 objectAlbedo = inAlbedo;
     const vec3 albedoColor = objectAlbedo.rgb;
     if (kTransmittance) receiverTransmittance = max(objectAlbedo.a, 1e-6);
     vec3 color = u.forward.w * albedoColor;
@@ -466,7 +492,7 @@ void main() {
         // continue, so that the loop unrolls.)
         if (ndotl > 0.0 && irradiance > 0.0) {
             uint lightBlocker = 0u;
-            const float v = light.toLight.w >= 0.0 ? shadowTest(light, inPosition, n, ndotl, dpdx, dpdy, lightBlocker) : 1.0;
+            const float v = light.toLight.w >= 0.0 ? shadowTest(light, inPosition, n, nScale, ndotl, dpdx, dpdy, lightBlocker) : 1.0;
             if (blocker == 0u) blocker = lightBlocker;  // the first light that found one, as raytrace/
 #ifdef SHADOWLAB_LIGHT_OUTPUTS
             lightVisibility[i / 4][i % 4] = v;

@@ -5,6 +5,7 @@
 #include "interface.h"
 
 layout(set = 0, binding = 0, std140) uniform Uniforms { LitUniforms u; };
+layout(set = 0, binding = 1, std430) readonly buffer Albedos { vec4 albedo[]; };  // per object; a: 1 − opacity
 
 layout(location = 0) in vec3 inPosition;  // camera-relative world position
 layout(location = 1) in vec3 inNormal;
@@ -13,10 +14,20 @@ layout(location = 2) in uint inObjectId;
 layout(location = 0) out vec3 outPosition;
 layout(location = 1) out vec3 outNormal;
 layout(location = 2) flat out uint outObjectId;
+// The first light's map coordinates of the position (toShadow · (p, 1)).xyz and of the normal
+// (toShadow's 3x3 · n), which lit.frag interpolates instead of a matrix product per fragment
+// where that light is the only one and directional (kVertexLightCoordinates); unused otherwise.
+layout(location = 3) out vec3 outLightCoordinates;
+layout(location = 4) out vec3 outLightNormal;
+// The object's albedo (lit.frag's), read here once per vertex instead of once per fragment.
+layout(location = 5) flat out vec4 outAlbedo;
 
 void main() {
     outPosition = inPosition;
     outNormal = inNormal;
     outObjectId = inObjectId;
+    outAlbedo = albedo[inObjectId - 1u];
+    outLightCoordinates = (u.lights[0].toShadow * vec4(inPosition, 1.0)).xyz;
+    outLightNormal = mat3(u.lights[0].toShadow) * inNormal;
     gl_Position = u.viewProj * vec4(inPosition, 1.0);
 }

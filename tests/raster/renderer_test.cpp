@@ -710,6 +710,55 @@ TEST(RasterRender, TwoLightsKeepEachLightsVisibilityAndCombineThem) {
     }
 }
 
+TEST(RasterRender, InterpolatedLightCoordinatesMatchThePerFragmentProduct) {
+    // With one directional light lit.frag takes the map coordinates interpolated from lit.vert
+    // (toShadow·(p, 1) and toShadow₃ₓ₃·n); with a second light it multiplies the interpolated
+    // position by toShadow per fragment. Light 0's visibility must agree between the two (the
+    // second light is a dim copy from elsewhere, so light 0's map is the same), near the origin
+    // and 10^7 units from it (camera-relative floats), with the normal offset on and a slope bias
+    // small enough that the offset decides the shadow's edge. The two sums round differently at
+    // the map coordinates' own scale (≈1e-7 of the map, 2e-4 of a texel here): pcf2x2's bilinear
+    // weights move by that much, and at most a few edge texels may flip.
+    for (const double offset : {0.0, 1.0e7})
+        for (ShadowFilter filter : {ShadowFilter::None, ShadowFilter::Pcf2x2, ShadowFilter::Poisson}) {
+            SphereOverPlane p;
+            p.width = 320;
+            p.height = 180;
+            p.lightDirection = lightFromElevation(50.0);
+            const Vec3 shift(offset, 0.0, -offset);
+            p.eye += shift;
+            p.lookAt += shift;
+            scene::Scene one = makeScene(p);
+            std::get<scene::Sphere>(one.objects[0].shape).center += shift;
+            std::get<scene::Quad>(one.objects[1].shape).center += shift;
+            scene::Scene two = one;
+            scene::Light dim = one.lights[0];
+            dim.direction = lightFromElevation(70.0);
+            dim.intensity = 0.1;
+            two.lights.push_back(dim);
+            scene::RasterSettings settings = validatedSettings(512, 0.002, 0.1, filter);
+            settings.normalOffset = 1.5;
+            const scene::Frame a = renderValidated(one, settings, "one light");
+            const scene::Frame b = renderValidated(two, settings, "two lights");
+            ASSERT_EQ(b.lightVisibility.size(), 2u);
+            std::size_t lit = 0, shadowed = 0, differ = 0;
+            double worst = 0.0;
+            for (std::size_t i = 0; i < a.pixelCount(); ++i) {
+                if (a.objectId[i] == 0.0f) continue;
+                ASSERT_EQ(a.objectId[i], b.objectId[i]);
+                const double d = std::abs(double(a.visibility[i]) - double(b.lightVisibility[0][i]));
+                if (d <= 1e-3) worst = std::max(worst, d);
+                differ += d > 1e-3;
+                lit += a.visibility[i] > 0.99f;
+                shadowed += a.visibility[i] < 0.01f;
+            }
+            EXPECT_GT(shadowed, 500u) << "the sphere shadows the plane";
+            EXPECT_GT(lit, 10000u);
+            EXPECT_LE(differ, 3u) << "offset " << offset << ", filter " << int(filter);
+            EXPECT_LE(worst, 2e-4) << "offset " << offset << ", filter " << int(filter);
+        }
+}
+
 TEST(RasterRender, OneLightKeepsNoPerLightVisibility) {
     const scene::Scene s = makeScene(SphereOverPlane{});
     const scene::Frame f = renderValidated(s, validatedSettings(256, 0.01, 1.0, ShadowFilter::None), "one-light");
