@@ -135,6 +135,23 @@ TEST(MethodRender, FloatWithZeroBiasShowsAcneOnTheLitPlaneAndReferenceDoesNot) {
     EXPECT_EQ(falseShadowsOnPlane(s, at, render(s, plan, robust), lit), 0);
 }
 
+TEST(MethodRender, ATinyBiasIsEnoughInDoubleButNotInFloat) {
+    // The lesson's two fixes for acne: double precision, or a bias along the normal. The same
+    // scene ~1300 from the origin, a bias of 1e-8: a float hit point there is off the plane by up
+    // to a few ulps of 1000 (2⁻¹³ ≈ 1.2e-4), far more than the bias, so acne stays; a double one
+    // by ~1e-13, far less, so the bias alone clears it.
+    test::Placement at;
+    at.offset = Vec3(1000.3, 200.7, -800.1);
+    at.rotation = test::rotation(Vec3(1, 0.5, 0.2), 25);
+    const scene::Scene s = test::sphereOverPlane(at);
+    const scene::RenderPlan plan = test::planFor(s);
+    int lit = 0;
+    const int floatAcne = falseShadowsOnPlane(s, at, render(s, plan, test::biasSettings(1e-8, scene::Precision::Float)), lit);
+    ASSERT_GT(lit, 5000);
+    EXPECT_GT(floatAcne, lit / 10) << floatAcne << " of " << lit;
+    EXPECT_EQ(falseShadowsOnPlane(s, at, render(s, plan, test::biasSettings(1e-8, scene::Precision::Double)), lit), 0);
+}
+
 TEST(MethodRender, HugeBiasLiftsTheContactShadowExactlyAsTheShiftedOriginPredicts) {
     // Bias 1.5·r moves the plane's shadow-ray origins to y = 1.5: points within 0.87 of the
     // contact start inside the sphere (still blocked), the rest of the shadow's far end sees
