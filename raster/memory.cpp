@@ -28,7 +28,7 @@ std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::Render
                                   const scene::RasterSettings& settings) {
     const std::uint64_t pixels = std::uint64_t(scene.camera.width) * std::uint64_t(scene.camera.height);
     // Per shadow-map texel: depth and blocker id, and with semi-transparent casters the
-    // transmittance map's two R32F values.
+    // transmittance map's four R32F values (T_all, D1, and behind the nearest layer T_rest, D2).
     const std::uint64_t layers = shadowMapLayers(scene, plan, settings);
     const std::uint64_t texels = std::uint64_t(settings.shadowMapSize) * std::uint64_t(settings.shadowMapSize);
     std::uint64_t triangles = 0;
@@ -38,7 +38,7 @@ std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::Render
         else triangles += 12;
     }
     return kDriverAllowance + scene::frameBytes(scene) + pixels * litBytesPerPixel(scene.lights.size()) +
-           layers * texels * (plan.needsTransmittanceMap ? 4 + 4 + 8 : 4 + 4) + triangles * kBytesPerTriangle;
+           layers * texels * (plan.needsTransmittanceMap ? 4 + 4 + 16 : 4 + 4) + triangles * kBytesPerTriangle;
 }
 
 std::uint64_t shadowMapLayers(const scene::Scene& scene, const scene::RenderPlan& plan,

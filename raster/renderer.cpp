@@ -173,6 +173,7 @@ struct Renderer::Impl {
     bool transmit = false;
     ShadowPipeline transmitPipeline;
     TransmittanceMaps transmittanceMaps;
+    TransmittanceRestPipeline transmitRestPipeline;  // the second pass, bound to transmittanceMaps
     std::vector<glm::vec4> layerLights;
     LitPipeline litPipelines[3];
     LitBindings bindings;  // allocated with the first lit pipeline's (identical) set layout
@@ -488,6 +489,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
         const auto pipelineStart = Clock::now();
         if (!shadowPipeline.pipeline) shadowPipeline = createShadowPipeline(ctx, wantIds);
         if (transmit && !transmitPipeline.pipeline) transmitPipeline = createTransmittancePipeline(ctx);
+        if (transmit && !transmitRestPipeline.pipeline)
+            transmitRestPipeline = createTransmittanceRestPipeline(ctx, transmittanceMaps);
         if (!litPipeline.pipeline)
             litPipeline = createLitPipeline(ctx, LitVariant{.filter = settings.filter,
                                                             .blockerIds = wantIds,
@@ -514,7 +517,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     VkCommandBuffer commands = ctx.beginCommands();
     if (timestamps) vkCmdResetQueryPool(commands, queries.get(), 0, 4);
     stamp(commands, 0);
-    const TransmittancePass transmittancePass{transmit ? &transmitPipeline : nullptr, &transmittanceMaps, layerLights};
+    const TransmittancePass transmittancePass{transmit ? &transmitPipeline : nullptr, &transmittanceMaps, layerLights,
+                                              transmit ? &transmitRestPipeline : nullptr};
     recordShadowPass(commands, shadowPipeline, maps, draw, lightMatrices, wantIds, &transmittancePass);
     stamp(commands, 1);
     ctx.submitAndWait(commands);

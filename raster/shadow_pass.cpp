@@ -1,9 +1,11 @@
-// raster/shadow_pass.cpp: the depth-only pass from the lights.
+// raster/shadow_pass.cpp: the depth-only pass from the lights, and with semi-transparent casters
+// the two transmittance passes after it.
 #include "raster/shadow_pass.h"
 
 #include <cstring>
 
 #include "raster/pipeline.h"
+#include "raster/tolerances.h"
 #include "raster/vulkan_error.h"
 #include "shaders/interface.h"
 #include "shaders/spirv.h"
@@ -73,7 +75,8 @@ TransmittanceMaps createTransmittanceMaps(const Context& ctx, std::uint32_t size
                   VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT |
                       VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT,
                   "the transmittance map");
-    requireDeviceMemory(ctx, VkDeviceSize(size) * size * layers * 8,
+    // Four R32F arrays: T_all, D1, T_rest, D2.
+    requireDeviceMemory(ctx, VkDeviceSize(size) * size * layers * 16,
                         std::to_string(layers) + " transmittance map(s) of " + std::to_string(size) + "x" +
                             std::to_string(size));
     TransmittanceMaps m;
@@ -85,11 +88,19 @@ TransmittanceMaps createTransmittanceMaps(const Context& ctx, std::uint32_t size
                                   VK_IMAGE_VIEW_TYPE_2D_ARRAY);
     m.nearDepth = createImage(ctx, kTransmittanceFormat, size, size, layers, usage, VK_IMAGE_ASPECT_COLOR_BIT,
                               VK_IMAGE_VIEW_TYPE_2D_ARRAY);
+    m.restTransmittance = createImage(ctx, kTransmittanceFormat, size, size, layers, usage,
+                                      VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D_ARRAY);
+    m.secondDepth = createImage(ctx, kTransmittanceFormat, size, size, layers, usage, VK_IMAGE_ASPECT_COLOR_BIT,
+                                VK_IMAGE_VIEW_TYPE_2D_ARRAY);
     for (std::uint32_t i = 0; i < layers; ++i) {
-        m.transmittanceLayerViews.push_back(createView(ctx, m.transmittance.image.get(), kTransmittanceFormat,
-                                                       VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D, i, 1));
-        m.nearDepthLayerViews.push_back(createView(ctx, m.nearDepth.image.get(), kTransmittanceFormat,
-                                                   VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D, i, 1));
+        auto layerView = [&](const Image& image) {
+            return createView(ctx, image.image.get(), kTransmittanceFormat, VK_IMAGE_ASPECT_COLOR_BIT,
+                              VK_IMAGE_VIEW_TYPE_2D, i, 1);
+        };
+        m.transmittanceLayerViews.push_back(layerView(m.transmittance));
+        m.nearDepthLayerViews.push_back(layerView(m.nearDepth));
+        m.restTransmittanceLayerViews.push_back(layerView(m.restTransmittance));
+        m.secondDepthLayerViews.push_back(layerView(m.secondDepth));
     }
     return m;
 }
@@ -125,37 +136,99 @@ ShadowPipeline createTransmittancePipeline(const Context& ctx) {
     return p;
 }
 
+TransmittanceRestPipeline createTransmittanceRestPipeline(const Context& ctx, const TransmittanceMaps& maps) {
+    if (!ctx.independentBlend)
+        throw RasterError("semi-transparent casters need the independentBlend feature, which " + ctx.deviceReport.name +
+                          " lacks (the transmittance map blends its two targets differently)");
+    VkDevice device = ctx.device.get();
+    TransmittanceRestPipeline p;
+    // transmit.frag reads D1 with texelFetch at its own texel: no filtering, no addressing.
+    const VkSamplerCreateInfo samplerInfo{
+        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
+        .magFilter = VK_FILTER_NEAREST,
+        .minFilter = VK_FILTER_NEAREST,
+        .mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
+        .addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .maxLod = 0.0f,
+    };
+    VkSampler sampler = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateSampler(device, &samplerInfo, nullptr, &sampler));
+    p.sampler = SamplerHandle(device, sampler);
+    const VkDescriptorSetLayoutBinding binding{.binding = 0,
+                                               .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                                               .descriptorCount = 1,
+                                               .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT};
+    const VkDescriptorSetLayoutCreateInfo setInfo{
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 1, .pBindings = &binding};
+    VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &setLayout));
+    p.setLayout = DescriptorSetLayoutHandle(device, setLayout);
+    const VkDescriptorPoolSize poolSize{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1};
+    const VkDescriptorPoolCreateInfo poolInfo{
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1, .poolSizeCount = 1, .pPoolSizes = &poolSize};
+    VkDescriptorPool pool = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateDescriptorPool(device, &poolInfo, nullptr, &pool));
+    p.pool = DescriptorPoolHandle(device, pool);
+    const VkDescriptorSetAllocateInfo allocInfo{.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
+                                                .descriptorPool = pool,
+                                                .descriptorSetCount = 1,
+                                                .pSetLayouts = &setLayout};
+    VK_CHECK(vkAllocateDescriptorSets(device, &allocInfo, &p.set));
+    const VkDescriptorImageInfo nearInfo{sampler, maps.nearDepth.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    const VkWriteDescriptorSet write{.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+                                     .dstSet = p.set,
+                                     .dstBinding = 0,
+                                     .descriptorCount = 1,
+                                     .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                                     .pImageInfo = &nearInfo};
+    vkUpdateDescriptorSets(device, 1, &write, 0, nullptr);
+    const VkPushConstantRange push{.stageFlags = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+                                   .offset = 0,
+                                   .size = sizeof(shaders::TransmitPush)};
+    const VkPipelineLayoutCreateInfo layoutInfo{
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
+        .setLayoutCount = 1,
+        .pSetLayouts = &setLayout,
+        .pushConstantRangeCount = 1,
+        .pPushConstantRanges = &push,
+    };
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    VK_CHECK(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &layout));
+    p.layout = PipelineLayoutHandle(device, layout);
+    p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{
+                                                 .vertexShader = shaders::transmitVertSpirv(),
+                                                 .fragmentShader = shaders::transmitFragRestSpirv(),
+                                                 .layout = layout,
+                                                 .usesNormal = true,
+                                                 .usesObjectId = false,
+                                                 .colorFormats = {kTransmittanceFormat, kTransmittanceFormat},
+                                                 .depthFormat = kShadowMapFormat,
+                                                 .depthCompare = VK_COMPARE_OP_LESS,
+                                                 .depthWrite = false,
+                                                 .transmittanceBlend = true,
+                                             });
+    return p;
+}
+
 namespace {
 
-// The transmittance pass of every layer drawn (the depth pass has run; the depth array is in
-// DEPTH_ATTACHMENT_OPTIMAL), or, without a pipeline, only the layout change for the lit pass.
-void recordTransmittance(VkCommandBuffer commands, const TransmittancePass& pass, const ShadowMaps& shadow,
-                         const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices) {
+// One transmittance pass over every layer: the product and nearest-depth targets (per layer
+// views) cleared to 1 and the semi-transparent casters drawn with `pipeline`, depth-tested against
+// the layer's opaque depths; with `rest`, the second pass (its descriptor set bound).
+void drawTransmittanceLayers(VkCommandBuffer commands, const TransmittancePass& pass, VkPipeline pipeline,
+                             VkPipelineLayout layout, const TransmittanceRestPipeline* rest,
+                             const std::vector<ImageViewHandle>& productViews,
+                             const std::vector<ImageViewHandle>& depthViews, const ShadowMaps& shadow,
+                             const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices) {
     const TransmittanceMaps& maps = *pass.maps;
-    const bool draw = pass.pipeline != nullptr;
-    std::vector<ImageTransition> before;
-    for (VkImage image : {maps.transmittance.image.get(), maps.nearDepth.image.get()})
-        before.push_back({image, VK_IMAGE_ASPECT_COLOR_BIT, maps.layers, VK_IMAGE_LAYOUT_UNDEFINED,
-                          draw ? VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                          VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_NONE,
-                          draw ? VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT : VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                          draw ? VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT
-                               : VK_ACCESS_2_NONE});
-    if (draw)  // the depth pass's writes before this pass's depth tests (same layout)
-        before.push_back({shadow.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, shadow.layers,
-                          VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                          VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                          VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                          VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                          VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT});
-    transition(commands, before);
-    if (!draw) return;
     for (std::uint32_t layer = 0; layer < maps.layers; ++layer) {
         VkRenderingAttachmentInfo colors[2];
         for (int k = 0; k < 2; ++k)
             colors[k] = VkRenderingAttachmentInfo{
                 .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
-                .imageView = (k == 0 ? maps.transmittanceLayerViews : maps.nearDepthLayerViews)[layer].get(),
+                .imageView = (k == 0 ? productViews : depthViews)[layer].get(),
                 .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                 .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
                 .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
@@ -178,7 +251,10 @@ void recordTransmittance(VkCommandBuffer commands, const TransmittancePass& pass
         };
         vkCmdBeginRendering(commands, &rendering);
         if (layer < lightMatrices.size() && layer < pass.layerLights.size() && !geometry.transparent.empty()) {
-            vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pass.pipeline->pipeline.get());
+            vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
+            if (rest)
+                vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, layout, 0, 1, &rest->set, 0,
+                                        nullptr);
             setViewport(commands, maps.size, maps.size);
             const VkDeviceSize offset = 0;
             vkCmdBindVertexBuffers(commands, 0, 1, &geometry.vertices, &offset);
@@ -187,21 +263,61 @@ void recordTransmittance(VkCommandBuffer commands, const TransmittancePass& pass
                 const shaders::TransmitPush push{
                     .lightMatrix = lightMatrices[layer],
                     .light = pass.layerLights[layer],
-                    .params = glm::vec4(object.transmittance, object.closed ? 1.0f : 0.0f, 0.0f, 0.0f)};
-                vkCmdPushConstants(commands, pass.pipeline->layout.get(),
-                                   VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof push, &push);
+                    .params = glm::vec4(object.transmittance, object.closed ? 1.0f : 0.0f, float(layer),
+                                        kTransmittanceLayerSeparation)};
+                vkCmdPushConstants(commands, layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                                   sizeof push, &push);
                 vkCmdDrawIndexed(commands, object.indexCount, 1, object.firstIndex, 0, 0);
             }
         }
         vkCmdEndRendering(commands);
     }
+}
+
+// The transmittance pass of every layer drawn (the depth pass has run; the depth array is in
+// DEPTH_ATTACHMENT_OPTIMAL), or, without a pipeline, only the layout change for the lit pass.
+void recordTransmittance(VkCommandBuffer commands, const TransmittancePass& pass, const ShadowMaps& shadow,
+                         const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices) {
+    const TransmittanceMaps& maps = *pass.maps;
+    const bool draw = pass.pipeline != nullptr && pass.rest != nullptr;
+    // Source stage: the previous frame's lit pass (and second pass) sampled them.
+    std::vector<ImageTransition> before;
+    for (VkImage image : {maps.transmittance.image.get(), maps.nearDepth.image.get(),
+                          maps.restTransmittance.image.get(), maps.secondDepth.image.get()})
+        before.push_back({image, VK_IMAGE_ASPECT_COLOR_BIT, maps.layers, VK_IMAGE_LAYOUT_UNDEFINED,
+                          draw ? VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                          VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_NONE,
+                          draw ? VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT : VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                          draw ? VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT
+                               : VK_ACCESS_2_NONE});
+    if (draw)  // the depth pass's writes before this pass's depth tests (same layout)
+        before.push_back({shadow.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, shadow.layers,
+                          VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                          VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                          VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                          VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                          VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT});
+    transition(commands, before);
+    if (!draw) return;
+    // 1. T_all and D1.
+    drawTransmittanceLayers(commands, pass, pass.pipeline->pipeline.get(), pass.pipeline->layout.get(), nullptr,
+                            maps.transmittanceLayerViews, maps.nearDepthLayerViews, shadow, geometry, lightMatrices);
+    // 2. T_rest and D2, behind D1: the first pass's writes of D1 before the second's reads of it.
+    const VkPipelineStageFlags2 readers = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT;
+    const VkAccessFlags2 reads = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT;
+    transition(commands, {{maps.nearDepth.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, maps.layers,
+                           VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                           VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                           readers, reads}});
+    drawTransmittanceLayers(commands, pass, pass.rest->pipeline.get(), pass.rest->layout.get(), pass.rest,
+                            maps.restTransmittanceLayerViews, maps.secondDepthLayerViews, shadow, geometry,
+                            lightMatrices);
     std::vector<ImageTransition> after;
-    for (VkImage image : {maps.transmittance.image.get(), maps.nearDepth.image.get()})
+    for (VkImage image :
+         {maps.transmittance.image.get(), maps.restTransmittance.image.get(), maps.secondDepth.image.get()})
         after.push_back({image, VK_IMAGE_ASPECT_COLOR_BIT, maps.layers, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                          VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                         VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-                         VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT,
-                         VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT});
+                         VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, readers, reads});
     transition(commands, after);
 }
 
@@ -315,12 +431,17 @@ std::vector<float> readShadowMap(const Context& ctx, const ShadowMaps& maps, std
     return depths;
 }
 
-std::vector<float> readTransmittance(const Context& ctx, const TransmittanceMaps& maps, std::uint32_t layer) {
+std::vector<float> readTransmittance(const Context& ctx, const TransmittanceMaps& maps, std::uint32_t layer,
+                                     TransmittanceArray array) {
     ShadowMaps shape;  // readLayer needs only the size and layer count
     shape.size = maps.size;
     shape.layers = maps.layers;
+    const Image& image = array == TransmittanceArray::All         ? maps.transmittance
+                         : array == TransmittanceArray::NearDepth ? maps.nearDepth
+                         : array == TransmittanceArray::Rest      ? maps.restTransmittance
+                                                                  : maps.secondDepth;
     std::vector<float> values(std::size_t(maps.size) * maps.size);
-    readLayer(ctx, shape, maps.transmittance.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layer, values.data());
+    readLayer(ctx, shape, image.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layer, values.data());
     return values;
 }
 

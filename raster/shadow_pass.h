@@ -57,15 +57,21 @@ struct DrawGeometry {
 };
 
 // The transmittance map beside the depth map (made only for scenes with semi-transparent
-// casters, RenderPlan::needsTransmittanceMap): per layer, the product of 1 − opacity of the
+// casters, RenderPlan::needsTransmittanceMap): per layer, the product T_all of 1 − opacity of the
 // semi-transparent casters in front of the opaque depth (R32_SFLOAT, 1 = nothing), and the
-// depth of the nearest of them (R32_SFLOAT, 1 = none), in the depth map's depth space.
+// depth D1 of the nearest of them (R32_SFLOAT, 1 = none), in the depth map's depth space; and
+// the same two for the fragments behind that nearest layer only (T_rest, D2), so that a receiver
+// on the second layer gets the nearest layer's factor T_all / T_rest (lit.frag transmittanceTap).
 inline constexpr VkFormat kTransmittanceFormat = VK_FORMAT_R32_SFLOAT;
 struct TransmittanceMaps {
-    Image transmittance;
+    Image transmittance;  // T_all
     std::vector<ImageViewHandle> transmittanceLayerViews;
-    Image nearDepth;
+    Image nearDepth;  // D1
     std::vector<ImageViewHandle> nearDepthLayerViews;
+    Image restTransmittance;  // T_rest
+    std::vector<ImageViewHandle> restTransmittanceLayerViews;
+    Image secondDepth;  // D2
+    std::vector<ImageViewHandle> secondDepthLayerViews;
     std::uint32_t size = 0;
     std::uint32_t layers = 0;
 };
@@ -77,12 +83,26 @@ TransmittanceMaps createTransmittanceMaps(const Context& ctx, std::uint32_t size
 // writing it, target 0 multiplied, target 1 MIN (needs the device's independentBlend).
 ShadowPipeline createTransmittancePipeline(const Context& ctx);
 
-// What recordShadowPass needs for the transmittance pass: the pipeline, the maps, and per layer
-// the light it is drawn from (TransmitPush::light).
+// The second transmittance pass (behind the nearest layer): the same draws and blending, with
+// transmit.frag's SHADOWLAB_REST_LAYER variant, which reads the first pass's nearest depths
+// (`maps.nearDepth`, bound here once: the set belongs to these maps).
+struct TransmittanceRestPipeline {
+    SamplerHandle sampler;
+    DescriptorSetLayoutHandle setLayout;
+    DescriptorPoolHandle pool;
+    VkDescriptorSet set = VK_NULL_HANDLE;  // freed with the pool
+    PipelineLayoutHandle layout;
+    PipelineHandle pipeline;
+};
+TransmittanceRestPipeline createTransmittanceRestPipeline(const Context& ctx, const TransmittanceMaps& maps);
+
+// What recordShadowPass needs for the transmittance passes: the pipelines (both or neither), the
+// maps, and per layer the light it is drawn from (TransmitPush::light).
 struct TransmittancePass {
     const ShadowPipeline* pipeline = nullptr;
     const TransmittanceMaps* maps = nullptr;
     std::vector<glm::vec4> layerLights;
+    const TransmittanceRestPipeline* rest = nullptr;
 };
 
 // Records: every layer cleared to depth 1 (far: lit) and id 0, and layer i drawn with
@@ -92,12 +112,16 @@ struct TransmittancePass {
 // undefined contents, for a lit pass that does not read it. The depth pass draws only
 // geometry.depthPassIndexCount() indices. With `transmittance`, each drawn layer then gets the
 // transmittance pass (its targets cleared to 1, the semi-transparent casters drawn, depth-tested
-// against the layer's opaque depths); its maps end in SHADER_READ_ONLY_OPTIMAL either way (with
-// `transmittance.pipeline` null: undefined contents, for a lit pass that does not read them).
+// against the layer's opaque depths), and after all layers' the second pass behind the nearest
+// layer (reading the first's nearest depths); its maps end in SHADER_READ_ONLY_OPTIMAL either way
+// (with `transmittance.pipeline` null: undefined contents, for a lit pass that does not read them).
 void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, const ShadowMaps& maps,
                       const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices,
                       bool blockerIds = true, const TransmittancePass* transmittance = nullptr);
-std::vector<float> readTransmittance(const Context& ctx, const TransmittanceMaps& maps, std::uint32_t layer);
+// One layer of one of the four transmittance arrays (tests and diagnostics), row 0 first.
+enum class TransmittanceArray { All, NearDepth, Rest, SecondDepth };
+std::vector<float> readTransmittance(const Context& ctx, const TransmittanceMaps& maps, std::uint32_t layer,
+                                     TransmittanceArray array = TransmittanceArray::All);
 
 // Diagnostics and tests: the depths of one layer after recordShadowPass() has run, row 0 first.
 std::vector<float> readShadowMap(const Context& ctx, const ShadowMaps& maps, std::uint32_t layer);

@@ -36,6 +36,18 @@ inline constexpr double kSpotMinNearOverFar = 1e-3;
 // half-width (kMaxPcfSize / 2 = 7.5 texels) plus 4 texels of normal offset.
 inline constexpr double kPointFaceMarginTexels = 12.0;
 
+// The transmittance map's second pass counts a semi-transparent fragment as behind the nearest
+// layer when its depth exceeds that layer's depth D1 by more than this (map depth units, 0..1).
+// The nearest layer's own fragment is drawn by the same vertex shader, matrix and triangles in
+// both passes, so it has D1 exactly on lavapipe; this only absorbs rounding that an implementation
+// may add between two pipelines (without `invariant`, which glslang puts on a gl_PerVertex member
+// and the validation layer then flags): 4 ulps of a float depth in [0.5, 1) (ulp 6e-8),
+// more below 0.5. In world units it is 4 ulps of the depth resolution: 2.5e-7 of the depth range
+// for an orthographic map (5e-6 units for a 20-unit scene), and for a perspective map
+// 2.5e-7·d²/near at distance d, at most 2.5e-4·far with kSpotMinNearOverFar. Layers closer than
+// that are one layer, which changes only the factor a receiver between them gets.
+inline constexpr float kTransmittanceLayerSeparation = 2.5e-7f;
+
 // The slope bias grows with tan(theta), which is infinite at grazing light; clamping it at
 // 10 (theta ~ 84°) keeps the bias finite where a receiver is nearly edge-on to the light and
 // its N·L shading is close to zero anyway (a common clamp: Microsoft's "Common Techniques to

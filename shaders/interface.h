@@ -40,7 +40,8 @@ struct TransmitPush {
     vec4 light;        // w = 0: xyz unit vector toward a directional light; w = 1: xyz the light's
                        // camera-relative position
     vec4 params;       // x: the object's transmittance 1 − opacity; y: 1 = closed (count only the
-                       // surfaces facing the light), 0 = open (count every fragment)
+                       // surfaces facing the light), 0 = open (count every fragment); second pass
+                       // only (behind the nearest layer): z: the layer, w: the depth separation
 };
 
 struct LightData {

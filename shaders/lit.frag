@@ -18,6 +18,10 @@ layout(set = 0, binding = 4) uniform sampler2DArray shadowDepths;
 // the nearest of them.
 layout(set = 0, binding = 5) uniform sampler2DArray transmittanceMaps;
 layout(set = 0, binding = 6) uniform sampler2DArray transparentDepths;
+// The same two for the semi-transparent fragments behind the nearest one only (its layer
+// excluded): T_rest and D2, so that a receiver on the second layer gets the first layer's factor.
+layout(set = 0, binding = 7) uniform sampler2DArray restTransmittanceMaps;
+layout(set = 0, binding = 8) uniform sampler2DArray secondTransparentDepths;
 
 // PCSS: the blocker search looks at most this fraction of the map's side from the point, and the
 // penumbra filter is at most this fraction wide (diameter). The tap count is fixed (16 each), so
@@ -96,17 +100,31 @@ float interleavedGradientNoise(vec2 pixel) {
     return fract(52.9829189 * fract(dot(pixel, vec2(0.06711056, 0.00583715))));
 }
 
-// The light left by the semi-transparent casters of one texel for a receiver at map depth ref:
-// their transmittance product when the receiver lies behind the nearest of them, else 1 (a
-// receiver in front of them, or on the nearest one itself, which the bias keeps in front).
-// A semi-transparent receiver lies in front of the opaque depth, so its own 1 − opacity is in
-// the product: it is divided out (the receiver's object, inAlbedo.a; 1 for opaque receivers).
+// The light left by the semi-transparent casters of (up to four) texels for a receiver at map
+// depth ref, from each texel's product T_all and nearest depth D1, and the product T_rest and
+// nearest depth D2 of what lies behind that nearest layer:
+// - ref <= D1: 1 (a receiver in front of them, or on the nearest one itself, which the bias keeps
+//   in front);
+// - D1 < ref <= D2: T_all / T_rest, the nearest layer's factor alone. Exact for a receiver on the
+//   second layer (its own surface is D2, the bias keeps it in front of that), whose own
+//   1 − opacity and everything below it are in T_rest;
+// - ref > D2: T_all divided by the receiver's own 1 − opacity (a semi-transparent receiver lies
+//   in front of the opaque depth, so it is in the product; inAlbedo.a, 1 for opaque receivers),
+//   clamped to 1 (taps past the receiver's outline). Exact for opaque receivers and for the
+//   deepest semi-transparent one; a third layer of four also gets the fourth's factor.
 float receiverTransmittance = 1.0;
+vec4 layeredTransmittance(vec4 all, vec4 near, vec4 rest, vec4 second, float ref) {
+    const vec4 behindAll = min(all / receiverTransmittance, vec4(1.0));
+    const vec4 nearestOnly = min(all / max(rest, vec4(1e-30)), vec4(1.0));  // (rest 0 only by underflow)
+    const vec4 behindNearest = mix(nearestOnly, behindAll, greaterThan(vec4(ref), second));
+    return mix(vec4(1.0), behindNearest, greaterThan(vec4(ref), near));
+}
 float transmittanceTap(vec2 uv, float layer, float ref) {
     const vec3 at = vec3(uv, layer);
-    return ref > texture(transparentDepths, at).r
-               ? min(texture(transmittanceMaps, at).r / receiverTransmittance, 1.0)
-               : 1.0;
+    return layeredTransmittance(vec4(texture(transmittanceMaps, at).r), vec4(texture(transparentDepths, at).r),
+                                vec4(texture(restTransmittanceMaps, at).r),
+                                vec4(texture(secondTransparentDepths, at).r), ref)
+        .x;
 }
 
 // One compare tap; records the object stored there when it shadows and none was found yet
@@ -336,10 +354,10 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
             blocker = g.w < 0.5 ? ids.w : g.z < 0.5 ? ids.z : g.x < 0.5 ? ids.x : ids.y;
         }
         if (kTransmittance) {
-            // The same four texels' transmittance, each where the receiver lies behind them.
-            const vec4 t = textureGather(transmittanceMaps, corner);
-            const vec4 near = textureGather(transparentDepths, corner);
-            g *= mix(vec4(1.0), min(t / receiverTransmittance, vec4(1.0)), greaterThan(vec4(ref), near));
+            // The same four texels' transmittance, each by where the receiver lies among their layers.
+            g *= layeredTransmittance(textureGather(transmittanceMaps, corner), textureGather(transparentDepths, corner),
+                                      textureGather(restTransmittanceMaps, corner),
+                                      textureGather(secondTransparentDepths, corner), ref);
         }
         return mix(mix(g.w, g.z, f.x), mix(g.x, g.y, f.x), f.y);
     }

@@ -10,6 +10,7 @@
 #include "shadow_frag.spv.h"
 #include "shadow_vert.spv.h"
 #include "transmit_frag.spv.h"
+#include "transmit_frag_rest.spv.h"
 #include "transmit_vert.spv.h"
 
 namespace shadowlab::shaders {
@@ -18,6 +19,7 @@ std::span<const std::uint32_t> shadowVertSpirv() { return kShadowVertSpv; }
 std::span<const std::uint32_t> shadowFragSpirv() { return kShadowFragSpv; }
 std::span<const std::uint32_t> transmitVertSpirv() { return kTransmitVertSpv; }
 std::span<const std::uint32_t> transmitFragSpirv() { return kTransmitFragSpv; }
+std::span<const std::uint32_t> transmitFragRestSpirv() { return kTransmitFragRestSpv; }
 std::span<const std::uint32_t> litVertSpirv() { return kLitVertSpv; }
 std::span<const std::uint32_t> litFragSpirv() { return kLitFragSpv; }
 std::span<const std::uint32_t> litFragLightsSpirv() { return kLitFragLightsSpv; }

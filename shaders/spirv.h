@@ -11,6 +11,8 @@ std::span<const std::uint32_t> shadowFragSpirv();
 // The transmittance pass (semi-transparent casters).
 std::span<const std::uint32_t> transmitVertSpirv();
 std::span<const std::uint32_t> transmitFragSpirv();
+// transmit.frag compiled with SHADOWLAB_REST_LAYER: the second pass, behind the nearest layer.
+std::span<const std::uint32_t> transmitFragRestSpirv();
 std::span<const std::uint32_t> litVertSpirv();
 std::span<const std::uint32_t> litFragSpirv();
 // lit.frag compiled with SHADOWLAB_LIGHT_OUTPUTS: two more targets with per-light visibility.

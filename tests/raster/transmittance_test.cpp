@@ -293,6 +293,139 @@ TEST(RasterTransmittance, APointLightsCubeFacesCarryTheTransmittanceToo) {
     }
 }
 
+// The repro of the transmittance map's first limit (issue 5), light straight down: a 3 x 3 pane
+// of opacity 0.5 at height 5, a glass sphere (opacity 0.5, radius 1) at height 2.5, another 3 x 3
+// pane of 0.5 at height 0.8, over the floor. Objects: floor 1, top pane 2, sphere 3, low pane 4.
+scene::Scene paneSpherePane() {
+    scene::Scene s = floorScene();
+    s.objects.push_back(quadObject("top pane", Vec3(0, 5, 0), 3.0, 1));
+    scene::Object sphere;
+    sphere.name = "middle glass";
+    sphere.shape = scene::Sphere{Vec3(0, 2.5, 0), 1.0};
+    sphere.material = 1;
+    s.objects.push_back(sphere);
+    s.objects.push_back(quadObject("low pane", Vec3(0, 0.8, 0), 3.0, 1));
+    return s;
+}
+
+TEST(RasterTransmittance, AGlassSphereBetweenTwoPanesGetsOnlyTheUpperPanesFactor) {
+    // The sphere's lit top lies behind the top pane only: 0.5. Its texels hold T_all = 0.125
+    // (pane, sphere, pane), D1 the top pane, and behind that T_rest = 0.25 with D2 the sphere's
+    // top itself, so T_all / T_rest = 0.5 (the first version divided T_all by the sphere's own 0.5
+    // and gave 0.25). Seen from (0, 4, 9), below the top pane, as the repro's camera.
+    scene::Scene s = paneSpherePane();
+    s.camera.position = Vec3(0, 4, 9);
+    s.camera.lookAt = Vec3(0, 2, 0);
+    // Counted: the pixels that the same scene with an opaque sphere gives exactly the top pane's
+    // 0.5 (its lit side away from the few tessellation-shadowed pixels near its outline).
+    scene::Scene opaque = s;
+    scene::Material solid = s.materials[1];
+    solid.name = "solid glass";
+    solid.opacity = 1.0;
+    opaque.materials.push_back(solid);
+    opaque.objects[2].material = 2;
+    for (const scene::ShadowFilter filter : kFilters) {
+        const scene::Frame f = renderWith(s, filter, "transmittance_between_" + std::to_string(int(filter)));
+        const scene::Frame o = renderWith(opaque, filter, "transmittance_between_opaque");
+        EXPECT_EQ(f.attributes.at("transmittance_map"), "made");
+        int top = 0, wrong = 0;
+        for (std::size_t i = 0; i < f.visibility.size(); ++i) {
+            if (f.objectId[i] != 3.0f || f.ndotl[i] <= 0.2f || o.visibility[i] != 0.5f) continue;
+            ++top;
+            if (std::abs(f.visibility[i] - 0.5) > 1e-5) ++wrong;
+        }
+        EXPECT_GT(top, 300) << "filter " << int(filter);
+        EXPECT_EQ(wrong, 0) << "filter " << int(filter);
+    }
+}
+
+TEST(RasterTransmittance, TheFloorUnderPaneSpherePaneGetsEveryFactorOnce) {
+    // The floor (seen from below the low pane): under all three 0.5³ = 0.125 (the sphere's shadow
+    // is the unit disk: its tessellated outline lies inside, so ρ < 0.8), under the two panes only
+    // 0.25 (|x|, |z| < 1.5, outside the disk), 1 beyond the panes.
+    const scene::Scene s = paneSpherePane();
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    for (const scene::ShadowFilter filter : kFilters) {
+        const scene::Frame f = renderWith(s, filter, "transmittance_between_floor_" + std::to_string(int(filter)));
+        // Away from outlines by the widest kernel's reach: Poisson's 2.4 texels plus half a texel
+        // (nearest), 3 texels of 29.0 / 512 (the scene's bounding sphere, radius 14.36, × 1.01) = 0.17.
+        constexpr double m = 0.2;
+        int counted[3] = {0, 0, 0}, wrong = 0;
+        for (int y = 0; y < f.height; ++y)
+            for (int x = 0; x < f.width; ++x) {
+                const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
+                if (f.objectId[i] != 1.0f) continue;
+                const Vec3 q = floorPoint(cam, x, y);
+                const double rho = std::hypot(q.x, q.z);
+                const double box = std::max(std::abs(q.x), std::abs(q.z));
+                double expected;
+                if (rho < 0.8) expected = 0.125;
+                else if (rho > 1.0 + m && box < 1.5 - m) expected = 0.25;
+                else if (box > 1.5 + m) expected = 1.0;
+                else continue;
+                ++counted[expected == 0.125 ? 0 : expected == 0.25 ? 1 : 2];
+                if (std::abs(f.visibility[i] - expected) > 1e-5) ++wrong;
+            }
+        EXPECT_GT(counted[0], 100) << "filter " << int(filter);
+        EXPECT_GT(counted[1], 100) << "filter " << int(filter);
+        EXPECT_GT(counted[2], 200) << "filter " << int(filter);
+        EXPECT_EQ(wrong, 0) << "filter " << int(filter);
+    }
+}
+
+// Four stacked 3 x 3 panes, light straight down: A at height 4 (opacity 0.2, 1 − opacity 0.8),
+// B at 3 (0.5), C at 2 (0.4, 1 − opacity 0.6), D at 1 (0.5). Objects: floor 1, A 2, B 3, C 4, D 5.
+scene::Scene fourPanes() {
+    scene::Scene s = floorScene();
+    const double opacities[] = {0.2, 0.5, 0.4, 0.5};
+    for (int k = 0; k < 4; ++k) {
+        scene::Material m;
+        m.name = std::string("glass ") + char('A' + k);
+        m.opacity = opacities[k];
+        s.materials.push_back(m);
+        s.objects.push_back(quadObject(std::string(1, char('A' + k)), Vec3(0, 4 - k, 0), 3.0, int(s.materials.size()) - 1));
+    }
+    return s;
+}
+
+// Every lit pixel of the top of the horizontal quad `object` at `height`, |x|, |z| < 1.35 (away
+// from its outline), seen from just above it, has visibility `expected` (to 1e-5).
+void expectPaneTop(const scene::Scene& base, float object, double height, scene::ShadowFilter filter, double expected,
+                   const std::string& name) {
+    scene::Scene s = base;
+    s.camera.position = Vec3(0, height + 0.5, 6);
+    s.camera.lookAt = Vec3(0, height, 0);
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    const scene::Frame f = renderWith(s, filter, name + "_" + std::to_string(int(filter)));
+    int counted = 0, wrong = 0;
+    for (int y = 0; y < f.height; ++y)
+        for (int x = 0; x < f.width; ++x) {
+            const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
+            if (f.objectId[i] != object || f.ndotl[i] <= 0.0f) continue;
+            const Vec3 d = test::pixelRay(cam, x, y);
+            const Vec3 q = cam.position + ((height - cam.position.y) / d.y) * d;
+            if (std::max(std::abs(q.x), std::abs(q.z)) > 1.35) continue;
+            ++counted;
+            if (std::abs(f.visibility[i] - expected) > 1e-5) ++wrong;
+        }
+    EXPECT_GT(counted, 150) << name << " filter " << int(filter);
+    EXPECT_EQ(wrong, 0) << name << " filter " << int(filter);
+}
+
+TEST(RasterTransmittance, FourLayersTheThirdAlsoGetsTheFourthsFactorTheKnownLimit) {
+    // Per texel: T_all = 0.8·0.5·0.6·0.5 = 0.12, D1 = A; behind A, T_rest = 0.5·0.6·0.5 = 0.15,
+    // D2 = B. Two layers are kept, so:
+    // - B (second layer, ref <= D2): T_all / T_rest = 0.8, exact;
+    // - C (third, ref > D2): T_all / (1 − opacity of C) = 0.12 / 0.6 = 0.2, where the ray tracer
+    //   gives 0.8·0.5 = 0.4: it also gets D's 0.5, the factor of the layer behind it (the limit);
+    // - D (fourth, the deepest): 0.12 / 0.5 = 0.24 = 0.8·0.5·0.6, exact; the floor 0.12.
+    const scene::Scene s = fourPanes();
+    for (const scene::ShadowFilter filter : kFilters) expectPaneTop(s, 4.0f, 2.0, filter, 0.2, "transmittance_four_C");
+    expectPaneTop(s, 3.0f, 3.0, scene::ShadowFilter::Pcf2x2, 0.8, "transmittance_four_B");
+    expectPaneTop(s, 5.0f, 1.0, scene::ShadowFilter::Pcf2x2, 0.24, "transmittance_four_D");
+    expectPaneTop(s, 1.0f, 0.0, scene::ShadowFilter::Pcf2x2, 0.12, "transmittance_four_floor");
+}
+
 TEST(RasterTransmittance, ExplainSaysWhetherTheMapIsMade) {
     const scene::RasterSettings r = test::validatedSettings(256, 0.02, 1.0, scene::ShadowFilter::Pcf2x2);
     const std::string withPanes = test::planFor(twoPanes(), r).explain();
