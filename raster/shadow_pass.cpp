@@ -105,6 +105,28 @@ TransmittanceMaps createTransmittanceMaps(const Context& ctx, std::uint32_t size
     return m;
 }
 
+namespace {
+
+// Both transmittance passes: the semi-transparent casters' triangles depth-tested against the
+// opaque map (not written), into the two R32F targets, blended as transmit.frag says.
+PipelineHandle createTransmitPipeline(const Context& ctx, VkPipelineLayout layout,
+                                      std::span<const std::uint32_t> fragmentShader) {
+    return createGraphicsPipeline(ctx, PipelineDesc{
+                                           .vertexShader = shaders::transmitVertSpirv(),
+                                           .fragmentShader = fragmentShader,
+                                           .layout = layout,
+                                           .usesNormal = true,
+                                           .usesObjectId = false,
+                                           .colorFormats = {kTransmittanceFormat, kTransmittanceFormat},
+                                           .depthFormat = kShadowMapFormat,
+                                           .depthCompare = VK_COMPARE_OP_LESS,
+                                           .depthWrite = false,
+                                           .transmittanceBlend = true,
+                                       });
+}
+
+}  // namespace
+
 ShadowPipeline createTransmittancePipeline(const Context& ctx) {
     if (!ctx.independentBlend)
         throw RasterError("semi-transparent casters need the independentBlend feature, which " + ctx.deviceReport.name +
@@ -121,18 +143,7 @@ ShadowPipeline createTransmittancePipeline(const Context& ctx) {
     VkPipelineLayout layout = VK_NULL_HANDLE;
     VK_CHECK(vkCreatePipelineLayout(ctx.device.get(), &layoutInfo, nullptr, &layout));
     p.layout = PipelineLayoutHandle(ctx.device.get(), layout);
-    p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{
-                                                 .vertexShader = shaders::transmitVertSpirv(),
-                                                 .fragmentShader = shaders::transmitFragSpirv(),
-                                                 .layout = layout,
-                                                 .usesNormal = true,
-                                                 .usesObjectId = false,
-                                                 .colorFormats = {kTransmittanceFormat, kTransmittanceFormat},
-                                                 .depthFormat = kShadowMapFormat,
-                                                 .depthCompare = VK_COMPARE_OP_LESS,
-                                                 .depthWrite = false,
-                                                 .transmittanceBlend = true,
-                                             });
+    p.pipeline = createTransmitPipeline(ctx, layout, shaders::transmitFragSpirv());
     return p;
 }
 
@@ -197,18 +208,7 @@ TransmittanceRestPipeline createTransmittanceRestPipeline(const Context& ctx, co
     VkPipelineLayout layout = VK_NULL_HANDLE;
     VK_CHECK(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &layout));
     p.layout = PipelineLayoutHandle(device, layout);
-    p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{
-                                                 .vertexShader = shaders::transmitVertSpirv(),
-                                                 .fragmentShader = shaders::transmitFragRestSpirv(),
-                                                 .layout = layout,
-                                                 .usesNormal = true,
-                                                 .usesObjectId = false,
-                                                 .colorFormats = {kTransmittanceFormat, kTransmittanceFormat},
-                                                 .depthFormat = kShadowMapFormat,
-                                                 .depthCompare = VK_COMPARE_OP_LESS,
-                                                 .depthWrite = false,
-                                                 .transmittanceBlend = true,
-                                             });
+    p.pipeline = createTransmitPipeline(ctx, layout, shaders::transmitFragRestSpirv());
     return p;
 }
 
