@@ -368,6 +368,13 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
     // image can show.
     auto pixelAt = [&](double zc) { return 2.0 * cam.tanHalfFovY * zc / std::max(scene.camera.height, 1); };
     auto viewDepth = [&](const Vec3& p) { return std::max(glm::dot(p - cam.position, cam.forward), scene.camera.near); };
+    // The largest distance(p) / view depth over the visible polytopes' vertices (and 0).
+    auto maxOverViewDepth = [&](auto distance) {
+        double ratio = 0.0;
+        for (const std::vector<Vec3>& v : visible)
+            for (const Vec3& p : v) ratio = std::max(ratio, distance(p) / viewDepth(p));
+        return ratio;
+    };
     double needed = 0.0;  // texels, rounded up to a power of two below
     int neededSize = 0;     // a size some light needs as it is (fitted spot windows)
     std::string why;
@@ -399,12 +406,8 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
         // point, and zc > 0 on each visible polytope K, so r = z/zc is quasi-linear there: if
         // r(v) ≤ m at every vertex v, then z − m·zc ≤ 0 at the vertices, hence (affine) on all of
         // K, i.e. r ≤ m on K. Its maximum over K is at a vertex.
-        double ratio = 0.0;
-        for (const std::vector<Vec3>& v : visible)
-            for (const Vec3& p : v) {
-                const double r = glm::dot(p - l.position, glm::normalize(l.direction)) / viewDepth(p);
-                ratio = std::max(ratio, r);
-            }
+        const Vec3 axis = glm::normalize(l.direction);
+        const double ratio = maxOverViewDepth([&](const Vec3& p) { return glm::dot(p - l.position, axis); });
         // A fitted window depends on N (margin in texels, snapped size): the smallest power of two
         // whose own window is fine enough. The cone's does not, and this is then the rounding below.
         int n = kMinAutoShadowMapSize;
@@ -429,12 +432,10 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
         // is 2t/N = 2/(N − 2·margin) per unit (t = N/(N − 2·margin), cubeFaceTanHalfFov): N ≥
         // 2·max(‖p − light‖∞ / pixelAt(zc)) + 2·margin. ‖p − light‖∞ is convex and zc affine and
         // positive, so their ratio is quasi-convex: on each visible polytope, largest at a vertex.
-        double ratio = 0.0;
-        for (const std::vector<Vec3>& v : visible)
-            for (const Vec3& p : v) {
-                const Vec3 d = glm::abs(p - l.position);
-                ratio = std::max(ratio, std::max({d.x, d.y, d.z}) / viewDepth(p));
-            }
+        const double ratio = maxOverViewDepth([&](const Vec3& p) {
+            const Vec3 d = glm::abs(p - l.position);
+            return std::max({d.x, d.y, d.z});
+        });
         const double pointNeeded = 2.0 * ratio / pixelAt(1.0) + 2.0 * kPointFaceMarginTexels;
         std::snprintf(buf, sizeof buf,
                       "%spoint %zu: 2 x (axial distance / view depth) %.4g / pixel %.4g at view depth 1 + 2 x %.0f "
