@@ -105,14 +105,18 @@ int falseShadowsOnPlane(const scene::Scene& s, const test::Placement& at, const 
     return acne;
 }
 
-TEST(MethodRender, FloatWithZeroBiasShowsAcneOnTheLitPlaneAndReferenceDoesNot) {
-    // The seed scene tilted 25° and moved ~1000 from the origin: the plane is no longer a
-    // float grid plane, so the rounded o + t·d lands below it about half the time and its
-    // shadow ray hits the plane itself. (An axis-aligned plane hides acne: o.y + t·d.y rounds
-    // to the plane's own float y.)
+// The seed scene tilted 25° and moved ~1000 from the origin: the plane is no longer a float grid
+// plane, so a rounded o + t·d lands below it about half the time and its shadow ray hits the
+// plane itself. (An axis-aligned plane hides acne: o.y + t·d.y rounds to the plane's own float y.)
+test::Placement tiltedFarAway() {
     test::Placement at;
     at.offset = Vec3(1000.3, 200.7, -800.1);
     at.rotation = test::rotation(Vec3(1, 0.5, 0.2), 25);
+    return at;
+}
+
+TEST(MethodRender, FloatWithZeroBiasShowsAcneOnTheLitPlaneAndReferenceDoesNot) {
+    const test::Placement at = tiltedFarAway();
     const scene::Scene s = test::sphereOverPlane(at);
     const scene::RenderPlan plan = test::planFor(s);
     const scene::Frame method = render(s, plan, test::biasSettings(0.0, scene::Precision::Float));
@@ -136,13 +140,11 @@ TEST(MethodRender, FloatWithZeroBiasShowsAcneOnTheLitPlaneAndReferenceDoesNot) {
 }
 
 TEST(MethodRender, ATinyBiasIsEnoughInDoubleButNotInFloat) {
-    // The lesson's two fixes for acne: double precision, or a bias along the normal. The same
-    // scene ~1300 from the origin, a bias of 1e-8: a float hit point there is off the plane by up
+    // The lesson's two fixes for acne: double precision, or a bias along the normal. The scene
+    // above, ~1300 from the origin, a bias of 1e-8: a float hit point there is off the plane by up
     // to a few ulps of 1000 (2⁻¹³ ≈ 1.2e-4), far more than the bias, so acne stays; a double one
     // by ~1e-13, far less, so the bias alone clears it.
-    test::Placement at;
-    at.offset = Vec3(1000.3, 200.7, -800.1);
-    at.rotation = test::rotation(Vec3(1, 0.5, 0.2), 25);
+    const test::Placement at = tiltedFarAway();
     const scene::Scene s = test::sphereOverPlane(at);
     const scene::RenderPlan plan = test::planFor(s);
     int lit = 0;
