@@ -13,6 +13,7 @@
 #include "raster/renderer.h"
 #include "scene/loader.h"
 #include "scene/render_plan.h"
+#include "tests/raster/test_scenes.h"
 
 namespace shadowlab::raster {
 namespace {
@@ -85,19 +86,6 @@ scene::Scene seedLitBy(const scene::Light& light, const scene::Vec3& far, double
     return s;
 }
 
-scene::Light spotDown() {
-    // At (0, 8, 0) straight down, cone 60°: the map's half-angle is 61.2°, t = tan 61.2° ≈ 1.82.
-    // Its basis (setBasis: the axis is vertical, so right = dir × X) is right = +z, up = +x:
-    // u = z/d, v = x/d with d = 8 − y.
-    scene::Light l;
-    l.type = scene::LightType::Spot;
-    l.position = {0, 8, 0};
-    l.direction = {0, -1, 0};
-    l.coneAngleDegrees = 60;
-    l.intensity = 800;
-    return l;
-}
-
 scene::Light pointAbove() {
     scene::Light l;
     l.type = scene::LightType::Point;
@@ -116,7 +104,7 @@ scene::Light pointAbove() {
 // meets the ground at (0, 8, 0) + 4·(2, −2, −2) = (8, 0, −8), 27° to the side and 8° below the
 // horizon: inside the view (half-angles 32.9° and 20° around a view 12.2° down), and clear of the
 // seed sphere.
-scene::Scene spotScene() { return seedLitBy(spotDown(), {0, 1, 12}, 1.0, {2, 6, -2}, 0.5); }
+scene::Scene spotScene() { return seedLitBy(test::spotDown(), {0, 1, 12}, 1.0, {2, 6, -2}, 0.5); }
 
 TEST(RasterCasterCulling, ASpotMapLeavesOutWhatCannotShadowTheViewAndKeepsWhatDoes) {
     const scene::Scene s = spotScene();
@@ -310,7 +298,7 @@ scene::Scene spotFromAbove(int height) {
     s.camera.up = {0, 0, -1};
     s.camera.width = height * 16 / 9;
     s.camera.height = height;
-    scene::Light l = spotDown();
+    scene::Light l = test::spotDown();
     l.position = {0, 12, 0};
     l.coneAngleDegrees = 30;
     s.lights = {l};

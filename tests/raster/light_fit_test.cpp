@@ -42,13 +42,7 @@ scene::Scene spotScene(double cameraX = 2.0, int width = 160, int height = 90) {
     p.lookAt = {cameraX, 0, 0};
     scene::Scene s = test::makeScene(p);
     s.camera.up = {0, 0, -1};
-    scene::Light l;
-    l.type = scene::LightType::Spot;
-    l.position = {0, 8, 0};
-    l.direction = {0, -1, 0};
-    l.coneAngleDegrees = 60;
-    l.intensity = 800;
-    s.lights = {l};
+    s.lights = {test::spotDown()};
     return s;
 }
 

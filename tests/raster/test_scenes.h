@@ -215,4 +215,17 @@ inline scene::RasterSettings validatedSettings(int shadowMapSize, double depthBi
     return r;
 }
 
+// A spot at (0, 8, 0) straight down, cone 60° (the map's half-angle 61.2°, tan ≈ 1.82), intensity
+// 800. Its map's basis (setBasis: the axis is vertical, so right = dir × X) is right = +z, up = +x:
+// u = z/d, v = x/d with d = 8 − y.
+inline scene::Light spotDown() {
+    scene::Light l;
+    l.type = scene::LightType::Spot;
+    l.position = {0, 8, 0};
+    l.direction = {0, -1, 0};
+    l.coneAngleDegrees = 60;
+    l.intensity = 800;
+    return l;
+}
+
 }  // namespace shadowlab::raster::test
