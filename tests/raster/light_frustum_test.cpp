@@ -226,7 +226,9 @@ TEST(CubeFaces, EveryPointOfTheBoundsInAFacesWindowLiesBetweenItsNearAndFar) {
                     EXPECT_GE(enter, f.near * (1.0 - 1e-12)) << "distance " << distance << " face " << face;
                     EXPECT_LE(leave, f.far * (1.0 + 1e-12)) << "distance " << distance << " face " << face;
                 }
-            if (face % 2 == 1) EXPECT_GT(hits, 0) << "the −X, −Y, −Z faces look at the box";
+            if (face % 2 == 1) {
+                EXPECT_GT(hits, 0) << "the −X, −Y, −Z faces look at the box";
+            }
         }
     }
 }
