@@ -36,6 +36,9 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
                  "raster: fit each light's map to the casters of visible receivers, not the scene's bounds");
     cmd.add_option("--cascades", s.cascades,
                    "raster: cascaded shadow maps per directional light, 1..4 (default 1: one map)");
+    cmd.add_option("--cascade-blend", s.cascadeBlend,
+                   "raster: blend each cascade into the next over this fraction of its slice before the split, "
+                   "0..0.5 (default 0: switch abruptly)");
     cmd.add_option("--device", s.device, "raster: Vulkan device index or name part (default: lavapipe)");
     cmd.add_option("--ray-bias", s.rayBias,
                    "raytrace: shadow-ray offset along the normal in world units, or 'robust' "

@@ -57,15 +57,15 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant) {
     p.layout = PipelineLayoutHandle(device, layout);
     // lit.frag's constant_id 0: the filter code, 1: blocker ids (a bool is 32 bits wide),
     // 2: the light count, 3: the light kinds, 4: the cascade count, 5: transmittance (bool),
-    // 6: receiver-plane bias (bool).
-    const std::int32_t constants[7] = {std::int32_t(variant.filter),     variant.blockerIds ? 1 : 0,
+    // 6: receiver-plane bias (bool), 7: cascade blend bands (bool).
+    const std::int32_t constants[8] = {std::int32_t(variant.filter),     variant.blockerIds ? 1 : 0,
                                        std::int32_t(variant.lightCount), std::int32_t(variant.lightKinds),
                                        std::int32_t(variant.cascades),   variant.transmittance ? 1 : 0,
-                                       variant.receiverPlane ? 1 : 0};
-    const VkSpecializationMapEntry entries[7] = {{0, 0, 4},   {1, 4, 4},   {2, 8, 4}, {3, 12, 4},
-                                                 {4, 16, 4}, {5, 20, 4}, {6, 24, 4}};
+                                       variant.receiverPlane ? 1 : 0,    variant.cascadeBlend ? 1 : 0};
+    const VkSpecializationMapEntry entries[8] = {{0, 0, 4},   {1, 4, 4},   {2, 8, 4},   {3, 12, 4},
+                                                 {4, 16, 4}, {5, 20, 4}, {6, 24, 4}, {7, 28, 4}};
     const VkSpecializationInfo specialization{
-        .mapEntryCount = 7, .pMapEntries = entries, .dataSize = sizeof constants, .pData = constants};
+        .mapEntryCount = 8, .pMapEntries = entries, .dataSize = sizeof constants, .pData = constants};
     std::vector<VkFormat> colorFormats{kLitColorFormat};
     if (variant.aovTarget) colorFormats.insert(colorFormats.end(), 1 + variant.lightTargets, kLitColorFormat);
     p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{

@@ -29,6 +29,7 @@ struct LitVariant {
     std::uint32_t cascades = 1;      // cascades of the cascaded directional lights (1: none cascaded)
     bool transmittance = false;      // semi-transparent casters: read the transmittance maps
     bool receiverPlane = false;      // receiver-plane depth bias in every filter tap
+    bool cascadeBlend = false;       // blend bands before the cascade splits (LitUniforms::counts.z)
 };
 // Per-light visibility targets: four lights in each RGBA32F target, SHADOWLAB_MAX_LIGHTS in all.
 inline constexpr std::uint32_t kLightTargets = (SHADOWLAB_MAX_LIGHTS + 3) / 4;

@@ -152,6 +152,9 @@ struct Renderer::Impl {
     // the split depths and each cascade's texel world size; empty without cascades.
     std::vector<double> cascadeSplits, cascadeTexels;
     int cascadesUsed = 1;  // lit.frag's cascade count (specialization constant)
+    // The blend band before each split (settings.cascadeBlend), 0 without cascades: when > 0,
+    // lit.frag's blend code is compiled in (specialization constant) and reads it from counts.z.
+    double cascadeBlendUsed = 0.0;
     double setupMs = 0.0;
     double pendingSetupMs = 0.0;  // setup not yet reported in a frame (the constructor's)
 
@@ -392,6 +395,11 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     const auto layers = std::max<std::uint32_t>(1, std::uint32_t(lightMatrices.size()));
     maps = createShadowMaps(ctx, mapSize, layers);
     uniforms.counts.y = float(mapSize);  // lit.frag's map size, instead of a textureSize() per fragment
+    if (cascadesUsed > 1 && settings.cascadeBlend > 0.0) {
+        cascadeBlendUsed = settings.cascadeBlend;
+        uniforms.counts.z = float(cascadeBlendUsed);
+        uniforms.counts.w = float(cascadeSplits[0]);  // cascade 0's slice starts here (the band's width)
+    }
     transmit = !draw.transparent.empty() && !lightMatrices.empty();
     transmittanceMaps = createTransmittanceMaps(ctx, transmit ? mapSize : 1, transmit ? layers : 1);
     for (const int i : layerLight) {
@@ -466,6 +474,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
         for (std::size_t k = 0; k < cascadeTexels.size(); ++k) texels += (k ? ";" : "") + formatNumber(cascadeTexels[k]);
         attributes["cascade_splits"] = splits;
         attributes["cascade_texel_world_size"] = texels;
+        attributes["cascade_blend"] = formatNumber(cascadeBlendUsed);
     }
     setupMs = msSince(setupStart);
     pendingSetupMs = setupMs;
@@ -500,7 +509,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                                                             .lightKinds = lightKinds,
                                                             .cascades = std::uint32_t(cascadesUsed),
                                                             .transmittance = transmit,
-                                                            .receiverPlane = settings.receiverPlaneBias});
+                                                            .receiverPlane = settings.receiverPlaneBias,
+                                                            .cascadeBlend = cascadeBlendUsed > 0.0});
         if (bindings.set == VK_NULL_HANDLE)
             bindings = createLitBindings(ctx, litPipeline, uniforms, albedos, maps, transmittanceMaps);
         setup += msSince(pipelineStart);

@@ -297,7 +297,7 @@ Object readObject(const Reader& r, const Json& node, const JsonPath& path,
 
 ShadowDefaults readShadow(const Reader& r, const Json& node, const JsonPath& path) {
     r.checkKeys(node, path, {"shadow_map_size", "depth_bias", "slope_bias", "filter", "pcf_size", "normal_offset",
-                             "receiver_plane_bias", "fit_light_frustum", "cascades", "ray_bias", "precision", "samples"});
+                             "receiver_plane_bias", "fit_light_frustum", "cascades", "cascade_blend", "ray_bias", "precision", "samples"});
     ShadowDefaults d;
     if (node.contains("shadow_map_size"))
         d.shadowMapSize = r.integer(node["shadow_map_size"], path / "shadow_map_size", 16, 16384);
@@ -325,6 +325,11 @@ ShadowDefaults readShadow(const Reader& r, const Json& node, const JsonPath& pat
     if (node.contains("fit_light_frustum"))
         d.fitLightFrustum = r.boolean(node["fit_light_frustum"], path / "fit_light_frustum");
     if (node.contains("cascades")) d.cascades = r.integer(node["cascades"], path / "cascades", 1, kMaxCascades);
+    if (node.contains("cascade_blend")) {
+        d.cascadeBlend = r.number(node["cascade_blend"], path / "cascade_blend");
+        if (!(*d.cascadeBlend >= 0 && *d.cascadeBlend <= kMaxCascadeBlend))
+            r.fail(path / "cascade_blend", "must be in 0..0.5 (a fraction of each cascade's slice)");
+    }
     if (node.contains("ray_bias")) {
         const Json& v = node["ray_bias"];
         if (v.is_string()) {

@@ -92,6 +92,18 @@ RenderPlan makeRenderPlan(const Scene& scene, const RenderSettings& settings) {
         plan.cascadesReason = std::to_string(asked) +
                               " per directional light, split along the view depth of the visible receivers";
     }
+    const double blend = settings.raster.cascadeBlend;
+    std::ostringstream band;
+    band << blend;
+    if (blend <= 0.0) {
+        plan.cascadeBlendReason = "off: each split switches cascades abruptly (cascade_blend = 0)";
+    } else if (plan.cascades <= 1) {
+        plan.cascadeBlendReason = "cascade_blend = " + band.str() + " ignored: no cascades";
+    } else {
+        plan.cascadeBlend = blend;
+        plan.cascadeBlendReason = "the last " + band.str() +
+                                  " of each slice but the last mixes its cascade's visibility with the next's";
+    }
     return plan;
 }
 
@@ -113,6 +125,7 @@ std::string RenderPlan::explain() const {
     s << "area lights: " << (hasAreaLights ? "yes, soft shadows are sampled" : "none, shadows are hard")
       << "\n";
     s << "cascades: " << cascades << " (" << cascadesReason << ")\n";
+    s << "cascade blend: " << cascadeBlend << " (" << cascadeBlendReason << ")\n";
     for (const LightPlan& lp : lights)
         s << "light " << lp.light << ": shadow pass "
           << (lp.needsShadowTest ? "rendered" : "skipped") << " (" << lp.reason << ")\n";

@@ -28,6 +28,10 @@ struct RenderPlan {
     // when more were asked for but no directional light is shadowed; cascadesReason says which.
     int cascades = 1;
     std::string cascadesReason;
+    // The blend band before each split (settings.raster.cascadeBlend), 0 when off or without
+    // cascades; cascadeBlendReason says which.
+    double cascadeBlend = 0.0;
+    std::string cascadeBlendReason;
     std::vector<LightPlan> lights;
 
     std::string explain() const;  // human-readable, one decision per line with its reason

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <string>
 
 #include "scene/error.h"
@@ -24,6 +25,14 @@ Precision parsePrecision(const std::string& text, const std::string& where) {
     if (text == "float") return Precision::Float;
     if (text == "double") return Precision::Double;
     throw InputError(where + ": expected float|double, got '" + text + "'");
+}
+
+// The value as given (shortest round-trip form), for an error message.
+std::string formatBlend(double v) {
+    std::ostringstream s;
+    s.precision(17);
+    s << v;
+    return s.str();
 }
 
 }  // namespace
@@ -75,6 +84,10 @@ RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& o) {
     if (s.raster.cascades < 1 || s.raster.cascades > kMaxCascades)
         throw InputError("--cascades: must be in 1.." + std::to_string(kMaxCascades) + ", got " +
                          std::to_string(s.raster.cascades));
+    s.raster.cascadeBlend = o.cascadeBlend.value_or(d.cascadeBlend.value_or(0.0));
+    if (!(s.raster.cascadeBlend >= 0.0 && s.raster.cascadeBlend <= kMaxCascadeBlend))  // also rejects NaN
+        throw InputError("--cascade-blend: must be in 0..0.5 (a fraction of each cascade's slice), got " +
+                         formatBlend(s.raster.cascadeBlend));
     s.raster.device = o.device.value_or("");
     s.raster.validate = o.validate;
 

@@ -23,6 +23,9 @@ enum class Precision { Float, Double };
 // commonly ship (each cascade is one more depth pass; beyond four the near cascades gain little
 // texel density while every pass redraws the whole scene), see docs/raster.md.
 inline constexpr int kMaxCascades = 4;
+// The widest cascade blend band, as a fraction of a slice: at most half, so the band before a
+// split never reaches the band before the previous one (a pixel mixes at most two cascades).
+inline constexpr double kMaxCascadeBlend = 0.5;
 
 // The shadow-map size when neither the command line nor the scene sets one.
 inline constexpr int kDefaultShadowMapSize = 2048;
@@ -47,6 +50,9 @@ struct RasterSettings {
     // Directional lights: split the view's depth range into this many slices, each with its own
     // map (1 = one map for the whole view, as fitLightFrustum or the bounding sphere decide).
     int cascades = 1;
+    // Blend band before each cascade split: the last cascadeBlend of each slice (0..0.5, 0 = off:
+    // the cascade switches abruptly at the split) mixes its cascade's visibility with the next's.
+    double cascadeBlend = 0.0;
     // Leave objects that cannot cast onto the receivers a map serves out of its depth pass (every
     // map: raster castsOnto); tests and benchmarks turn it off to compare.
     bool cullCasters = true;
@@ -79,6 +85,7 @@ struct SettingsOverrides {
     std::optional<bool> receiverPlaneBias;  // --receiver-plane-bias
     std::optional<bool> fitLightFrustum; // --fit-light-frustum
     std::optional<int> cascades;         // --cascades (1..kMaxCascades)
+    std::optional<double> cascadeBlend;  // --cascade-blend (0..kMaxCascadeBlend)
     std::optional<std::string> rayBias;  // a number or "robust"
     std::optional<std::string> precision;
     std::optional<int> samples;

@@ -80,7 +80,8 @@ struct LitUniforms {
     mat4 viewProj;    // camera-relative world position -> clip (reversed Z)
     vec4 forward;     // xyz: camera forward (view depth = dot(position, forward)); w: ambient
     vec4 background;  // rgb: background color; w: unused
-    vec4 counts;      // x: number of lights; y: the shadow maps' side in texels (every layer); zw: unused
+    vec4 counts;      // x: number of lights; y: the shadow maps' side in texels (every layer); z: cascade
+                      // blend band (fraction of a slice, 0 = off); w: near end of cascade 0's slice
     LightData lights[SHADOWLAB_MAX_LIGHTS];
     CascadeData cascades[SHADOWLAB_MAX_LIGHTS * SHADOWLAB_MAX_CASCADES];  // light i: i*MAX_CASCADES + c
 };

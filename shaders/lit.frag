@@ -73,6 +73,9 @@ layout(constant_id = 4) const int kCascades = 1;
 layout(constant_id = 5) const bool kTransmittance = false;
 // Receiver-plane depth bias in every tap (see shadowTest); off, its code is compiled out.
 layout(constant_id = 6) const bool kReceiverPlane = false;
+// Cascaded lights blend each cascade into the next over a band before the split (u.counts.z, the
+// band's fraction of the slice; see cascadeOf); off, the second shadow test is compiled out.
+layout(constant_id = 7) const bool kCascadeBlend = false;
 // One directional light with one map and no receiver plane: its map coordinates are interpolated
 // from lit.vert (see shadowTest) instead of a matrix product per fragment.
 const bool kVertexLightCoordinates = kLightCount == 1 && kLightKinds == (1 << SHADOWLAB_LIGHT_DIRECTIONAL) &&
@@ -441,17 +444,9 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
     return sum / 16.0;
 }
 
-// Cascaded shadow maps: a directional light with kind.y = kCascades > 1 cascades uses the cascade
-// whose slice holds p's view depth (the Frame's Z, same expression); that cascade's map, texel
-// size, depth scale and constant bias replace the light's, and its layer follows the light's
-// first one.
-LightData cascadeOf(LightData light, int lightIndex, vec3 p) {
-    const int first = lightIndex * SHADOWLAB_MAX_CASCADES;
-    const int count = min(kCascades, SHADOWLAB_MAX_CASCADES);  // = light.kind.y
-    const float z = dot(p, u.forward.xyz);
-    int c = 0;
-    [[unroll]] for (int k = 0; k + 1 < count; ++k)
-        if (z > u.cascades[first + k].params.x) c = k + 1;
+// Cascade c's map, texel size, depth scale and constant bias in place of the light's; its layer
+// follows the light's first one.
+LightData withCascade(LightData light, int first, int c) {
     const CascadeData cascade = u.cascades[first + c];
     light.toShadow = cascade.toShadow;
     light.toLight.w += float(c);
@@ -459,6 +454,33 @@ LightData cascadeOf(LightData light, int lightIndex, vec3 p) {
     light.bias.z = cascade.params.y;
     light.bias.w = cascade.params.z;
     return light;
+}
+
+// Cascaded shadow maps: a directional light with kind.y = kCascades > 1 cascades uses the cascade
+// c whose slice holds p's view depth z (the Frame's Z, same expression).
+// Blend bands (kCascadeBlend, F = u.counts.z): where z lies in the last F of slice c (split[c] to
+// split[c+1]) and c is not the last cascade, `next` gets cascade c + 1 and `blend` the position in
+// the band, 0 at its start to 1 at the split, so the visibility goes over linearly to the next
+// cascade's and is continuous across the split; elsewhere blend = 0.
+LightData cascadeOf(LightData light, int lightIndex, vec3 p, out LightData next, out float blend) {
+    const int first = lightIndex * SHADOWLAB_MAX_CASCADES;
+    const int count = min(kCascades, SHADOWLAB_MAX_CASCADES);  // = light.kind.y
+    const float z = dot(p, u.forward.xyz);
+    int c = 0;
+    [[unroll]] for (int k = 0; k + 1 < count; ++k)
+        if (z > u.cascades[first + k].params.x) c = k + 1;
+    blend = 0.0;
+    next = light;
+    if (kCascadeBlend && c + 1 < count) {
+        const float start = c == 0 ? u.counts.w : u.cascades[first + c - 1].params.x;  // split[c]
+        const float end = u.cascades[first + c].params.x;                              // split[c+1]
+        const float bandStart = end - u.counts.z * (end - start);
+        if (z > bandStart) {
+            blend = clamp((z - bandStart) / (end - bandStart), 0.0, 1.0);
+            next = withCascade(light, first, c + 1);
+        }
+    }
+    return withCascade(light, first, c);
 }
 
 void main() {
@@ -489,8 +511,10 @@ void main() {
         LightData light = u.lights[i];
         // A cascaded directional light (kind.y cascades; 0 without a shadow test) takes its
         // cascade's map. The code exists only in pipelines made for cascades (kCascades > 1).
+        LightData nextCascade;
+        float cascadeBlend = 0.0;  // > 0: in a blend band, mix with nextCascade's visibility
         if (kCascades > 1 && isKind(light, SHADOWLAB_LIGHT_DIRECTIONAL) && light.kind.y > 1.5)
-            light = cascadeOf(light, i, inPosition);
+            light = cascadeOf(light, i, inPosition, nextCascade, cascadeBlend);
         vec3 l;
         float irradiance;  // relative to radiance: 1 for directional lights
         if (isPerspective(light)) {
@@ -510,7 +534,15 @@ void main() {
         // continue, so that the loop unrolls.)
         if (ndotl > 0.0 && irradiance > 0.0) {
             uint lightBlocker = 0u;
-            const float v = light.toLight.w >= 0.0 ? shadowTest(light, inPosition, n, nScale, ndotl, dpdx, dpdy, lightBlocker) : 1.0;
+            float v = light.toLight.w >= 0.0 ? shadowTest(light, inPosition, n, nScale, ndotl, dpdx, dpdy, lightBlocker) : 1.0;
+            if (kCascadeBlend && cascadeBlend > 0.0) {
+                // (A cascaded light always has a shadow test: kind.y > 1 only then.) The blocker
+                // id stays the first cascade's when it found one.
+                uint nextBlocker = 0u;
+                const float vNext = shadowTest(nextCascade, inPosition, n, nScale, ndotl, dpdx, dpdy, nextBlocker);
+                v = mix(v, vNext, cascadeBlend);
+                if (lightBlocker == 0u) lightBlocker = nextBlocker;
+            }
             if (blocker == 0u) blocker = lightBlocker;  // the first light that found one, as raytrace/
 #ifdef SHADOWLAB_LIGHT_OUTPUTS
             lightVisibility[i / 4][i % 4] = v;

@@ -194,6 +194,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadRun{"unknown_view", {"render", "seed", "--backend", "raster", "--view", "normals", "-o", "OUTPNG"},
                "--view: normals not in {shadow-map,cascades,texel-density,light-frustum}"},
         BadRun{"bad_cascades", {"render", "seed", "--backend", "raster", "--cascades", "9", "-o", "OUT"}, "--cascades"},
+        BadRun{"bad_cascade_blend", {"render", "seed", "--backend", "raster", "--cascades", "3", "--cascade-blend", "0.7",
+                                     "-o", "OUT"},
+               "--cascade-blend: must be in 0..0.5"},
         BadRun{"missing_frames", {"compare", "a.exr", "b.exr", "-o", "OUT.png"}, "no such file"}),
     [](const ::testing::TestParamInfo<BadRun>& info) { return std::string(info.param.name); });
 

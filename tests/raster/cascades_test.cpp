@@ -3,9 +3,11 @@
 // snapping under camera motion, the texel gain on a large scene (closed-form bound), and, on
 // lavapipe with validation, that one cascade is the single map, that cascades are ignored without
 // a directional light, the debug views (sizes, exactly N tints, the density ramp), and cascades
-// through the reusable Renderer (channel masks, later frames, two lights).
+// through the reusable Renderer (channel masks, later frames, two lights); and the blend bands
+// before the splits (--cascade-blend): off is bit for bit the unblended frame, on is the linear mix.
 #include "raster/cascades.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <set>
@@ -424,6 +426,160 @@ TEST(RasterCascades, EachOfTwoLightsUsesItsOwnCascades) {
         EXPECT_GT(shadowed, 20u) << "light " << light << " casts no shadow: the comparison proves nothing";
     }
     EXPECT_NE(f.lightVisibility[0], f.lightVisibility[1]);
+}
+
+// --- blend bands before the splits (--cascade-blend) ---
+
+// Where pixel i lies with respect to the blend band F of its cascade's slice, from its view depth
+// (the Frame's Z, the expression lit.frag selects by) and the splits, in float as lit.frag: the band
+// is z > end − F·(end − start) of slice [start, end] for every cascade but the last; t is the
+// position in it, 0 at its start to 1 at the split. Pixels within a relative 1e-4 of the band's
+// start are "unsure" (float rounding of the two computations may differ there).
+struct BandPosition {
+    enum Kind { Outside, Inside, Unsure } kind = Outside;
+    int cascade = 0;
+    double t = 0.0;
+};
+BandPosition bandPosition(const scene::Frame& f, const std::vector<double>& splits, double blend, std::size_t i) {
+    BandPosition b;
+    const float z = f.depth[i];
+    const std::size_t count = splits.size() - 1;
+    for (std::size_t k = 0; k + 1 < count; ++k)
+        if (z > float(splits[k + 1])) b.cascade = int(k) + 1;
+    if (std::size_t(b.cascade) + 1 >= count) return b;  // the last cascade has no band
+    const double start = float(splits[std::size_t(b.cascade)]), end = float(splits[std::size_t(b.cascade) + 1]);
+    const double bandStart = end - blend * (end - start);
+    const double margin = 1e-4 * end;
+    if (z < bandStart - margin) return b;
+    b.kind = z > bandStart + margin ? BandPosition::Inside : BandPosition::Unsure;
+    b.t = std::clamp((z - bandStart) / (end - bandStart), 0.0, 1.0);
+    return b;
+}
+
+// The long plane with two larger spheres whose shadows lie in the blend bands of both inner splits
+// (view depths ~24 and ~68; the splits are near 29 and 76), seen at 480x270 so that the far band
+// is more than a few rows tall, so that their edges, where the two
+// cascades' texels give different filtered visibilities, cross the bands.
+scene::Scene blendScene() {
+    scene::Scene s = test::makeLongPlane(480, 270);
+    const std::pair<Vec3, double> extra[] = {{Vec3(4.0, 1.6, -22.0), 1.5}, {Vec3(-5.0, 3.2, -66.0), 3.0}};
+    for (const auto& [center, radius] : extra) {
+        scene::Object o;
+        o.name = "objects[" + std::to_string(s.objects.size()) + "]";
+        o.shape = scene::Sphere{center, radius};
+        s.objects.push_back(o);
+    }
+    return s;
+}
+
+scene::RasterSettings blendSettings(double blend) {
+    scene::RasterSettings r = cascadeSettings(3);
+    r.cascadeBlend = blend;
+    return r;
+}
+
+TEST(RasterCascadeBlend, ZeroIsTheFrameWithoutTheSettingBitForBit) {
+    scene::Scene s = test::makeLongPlane();
+    s.shadow.cascades = 3;
+    scene::SettingsOverrides absent, zero;
+    zero.cascadeBlend = 0.0;
+    const scene::RenderSettings withoutSetting = scene::resolveSettings(s, absent);
+    const scene::RenderSettings withZero = scene::resolveSettings(s, zero);
+    ASSERT_EQ(withoutSetting.raster.cascades, 3);
+    EXPECT_EQ(withZero.raster.cascadeBlend, 0.0);
+    scene::RasterSettings a = blendSettings(0.0), b = blendSettings(0.0);
+    a.cascadeBlend = withoutSetting.raster.cascadeBlend;
+    b.cascadeBlend = withZero.raster.cascadeBlend;
+    const scene::Frame fa = renderChecked(s, a), fb = renderChecked(s, b);
+    EXPECT_EQ(fa.beauty, fb.beauty);
+    EXPECT_EQ(fa.visibility, fb.visibility);
+    EXPECT_EQ(fa.blockerId, fb.blockerId);
+    EXPECT_EQ(fb.attributes.at("cascade_blend"), "0");
+    // And a band changes the picture (the comparisons here and below can fail).
+    EXPECT_NE(renderChecked(s, blendSettings(0.5)).visibility, fb.visibility);
+}
+
+// On the long plane (3 cascades, with blendScene()'s shadows crossing both inner bands): with F = 0.25 and
+// 0.5, every pixel outside the bands is the unblended frame's, bit for bit; inside, the visibility
+// is the linear mix v = v_c + t·(v_{c+1} − v_c) of cascade c's own value v_c (the unblended frame's
+// there, as the band lies inside slice c) and cascade c + 1's. v_{c+1} is unknown, so it is solved
+// from the F = 0.5 frame, where t is largest; it must be a visibility (0..1), and it must predict
+// the F = 0.25 frame at the same pixel with that band's t (the mix is linear in t, and both
+// frames use the same two cascades' taps). Where v_c is 0 or 1 and both frames agree with it (fully
+// shadowed or lit by both cascades) the mix is exactly that value.
+TEST(RasterCascadeBlend, OutsideTheBandsUnchangedInsideTheLinearMixOfTheTwoCascades) {
+    const scene::Scene s = blendScene();
+    RenderDebug debug;
+    const scene::Frame plain = renderChecked(s, blendSettings(0.0), &debug);
+    const scene::Frame half = renderChecked(s, blendSettings(0.5));
+    const scene::Frame quarter = renderChecked(s, blendSettings(0.25));
+    ASSERT_EQ(debug.cascadeSplits.size(), 4u);
+    EXPECT_EQ(half.attributes.at("cascade_blend"), "0.5");
+    EXPECT_EQ(quarter.attributes.at("cascade_blend"), "0.25");
+    std::size_t outside = 0, checked = 0, mixed[2] = {0, 0}, exact = 0, notHeld = 0;
+    const CascadeSet set = fitCascades(s, s.lights[0].direction, 3, 512);
+    ASSERT_EQ(set.splits, debug.cascadeSplits);
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    for (std::size_t i = 0; i < plain.pixelCount(); ++i) {
+        if (!(plain.objectId[i] > 0.0f)) continue;
+        const BandPosition bh = bandPosition(plain, debug.cascadeSplits, 0.5, i);
+        const BandPosition bq = bandPosition(plain, debug.cascadeSplits, 0.25, i);
+        const float vc = plain.visibility[i];
+        if (bq.kind == BandPosition::Outside) {
+            ASSERT_EQ(quarter.visibility[i], vc) << "pixel " << i;
+            ASSERT_EQ(quarter.beauty[3 * i], plain.beauty[3 * i]) << "pixel " << i;
+        }
+        if (bh.kind == BandPosition::Outside) {
+            ++outside;
+            ASSERT_EQ(half.visibility[i], vc) << "pixel " << i;
+            for (std::size_t k = 0; k < 3; ++k) ASSERT_EQ(half.beauty[3 * i + k], plain.beauty[3 * i + k]) << "pixel " << i;
+            continue;
+        }
+        const int x = int(i % std::size_t(plain.width)), y = int(i / std::size_t(plain.width));
+        const Vec3 point = cam.position + double(plain.depth[i]) * test::pixelRay(cam, x, y);
+        if (!insideFrustum(set.frusta[std::size_t(bh.cascade) + 1], point, 1e-6)) ++notHeld;
+        if (bh.kind != BandPosition::Inside || bh.t < 0.2) continue;
+        const double next = vc + (double(half.visibility[i]) - vc) / bh.t;  // v_{c+1}
+        EXPECT_GE(next, -1e-4) << "pixel " << i;
+        EXPECT_LE(next, 1.0 + 1e-4) << "pixel " << i;
+        if (std::abs(half.visibility[i] - vc) > 0.02f) ++mixed[bh.cascade];
+        if (bq.kind == BandPosition::Inside) {
+            ++checked;
+            EXPECT_NEAR(quarter.visibility[i], vc + bq.t * (next - vc), 2e-4) << "pixel " << i << " t " << bq.t;
+            if ((vc == 0.0f || vc == 1.0f) && half.visibility[i] == vc) {
+                EXPECT_EQ(quarter.visibility[i], vc) << "pixel " << i;
+                ++exact;
+            }
+        } else if (bq.kind == BandPosition::Outside) {
+            EXPECT_EQ(quarter.visibility[i], vc) << "pixel " << i;
+        }
+    }
+    // The band lies in the nearer slice: the next cascade's map must hold it, or its taps read the
+    // border (lit). Every band pixel's point (the camera ray to its view depth) is inside that map.
+    // Enough of each kind that the checks mean something: most of the image outside the bands,
+    // band pixels of both inner splits where the two cascades disagree (a shadow edge crosses).
+    EXPECT_EQ(notHeld, 0u);
+    EXPECT_GT(outside, plain.pixelCount() / 4);
+    EXPECT_GT(checked, 200u);
+    EXPECT_GT(exact, 100u);
+    EXPECT_GE(mixed[0], 20u);
+    EXPECT_GE(mixed[1], 3u);
+}
+
+TEST(RasterCascadeBlend, IgnoredWithoutCascadesWithTheReasonInThePlan) {
+    const scene::Scene s = test::makeLongPlane();
+    scene::RasterSettings one = cascadeSettings(1);
+    one.cascadeBlend = 0.5;
+    scene::RenderSettings settings;
+    settings.raster = one;
+    const scene::RenderPlan plan = scene::makeRenderPlan(s, settings);
+    EXPECT_EQ(plan.cascadeBlend, 0.0);
+    EXPECT_NE(plan.explain().find("cascade blend: 0 (cascade_blend = 0.5 ignored: no cascades)"), std::string::npos)
+        << plan.explain();
+    EXPECT_EQ(renderChecked(s, one).visibility, renderChecked(s, cascadeSettings(1)).visibility);
+    settings.raster = blendSettings(0.25);
+    EXPECT_NE(scene::makeRenderPlan(s, settings).explain().find("cascade blend: 0.25 (the last 0.25 of each slice"),
+              std::string::npos);
 }
 
 TEST(DebugViews, DensityRampIsGreenAtOneToOneRedWhenUndersampledBlueWhenOversampled) {

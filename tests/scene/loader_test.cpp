@@ -81,6 +81,15 @@ struct BadCase {
 
 class BadScene : public ::testing::TestWithParam<BadCase> {};
 
+TEST(SceneLoader, ShadowBlockReadsTheCascadeBlend) {
+    TempDir dir;
+    const auto file = dir.write("blend.json", sceneText(kCamera, kMaterials, kLights, kObjects,
+                                                          R"(, "shadow": {"cascades": 3, "cascade_blend": 0.2})"));
+    const Scene s = loadScene(file);
+    ASSERT_TRUE(s.shadow.cascadeBlend.has_value());
+    EXPECT_EQ(*s.shadow.cascadeBlend, 0.2);
+}
+
 TEST_P(BadScene, GivesOneErrorNamingFileAndPath) {
     const BadCase& c = GetParam();
     TempDir dir;
@@ -152,6 +161,12 @@ INSTANTIATE_TEST_SUITE_P(
                 "shadow.filter", "expected none, pcf2x2, pcf, poisson or pcss"},
         BadCase{"too_many_cascades", sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"cascades": 5})"),
                 "shadow.cascades", "must be in 1..4"},
+        BadCase{"cascade_blend_too_wide",
+                sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"cascade_blend": 0.6})"),
+                "shadow.cascade_blend", "must be in 0..0.5"},
+        BadCase{"cascade_blend_negative",
+                sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"cascade_blend": -0.1})"),
+                "shadow.cascade_blend", "must be in 0..0.5"},
         BadCase{"receiver_plane_bias_not_bool",
                 sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"receiver_plane_bias": 1})"),
                 "shadow.receiver_plane_bias", "expected"},

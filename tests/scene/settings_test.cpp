@@ -2,6 +2,8 @@
 // scene-scaled defaults, and clear errors for bad values.
 #include "scene/settings.h"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "scene/error.h"
@@ -57,6 +59,18 @@ TEST(Settings, CascadesComeFromTheCommandLineThenTheSceneThenOne) {
     EXPECT_EQ(resolveSettings(s, o).raster.cascades, 2);
 }
 
+TEST(Settings, CascadeBlendComesFromTheCommandLineThenTheSceneThenOff) {
+    Scene s = unitScene(1.0);
+    EXPECT_EQ(resolveSettings(s, {}).raster.cascadeBlend, 0.0);
+    s.shadow.cascadeBlend = 0.25;
+    EXPECT_EQ(resolveSettings(s, {}).raster.cascadeBlend, 0.25);
+    SettingsOverrides o;
+    o.cascadeBlend = 0.5;  // the upper end is allowed
+    EXPECT_EQ(resolveSettings(s, o).raster.cascadeBlend, 0.5);
+    o.cascadeBlend = 0.0;  // and 0 on the command line turns the scene's band off
+    EXPECT_EQ(resolveSettings(s, o).raster.cascadeBlend, 0.0);
+}
+
 TEST(Settings, ReceiverPlaneBiasComesFromTheCommandLineThenTheSceneThenOff) {
     Scene s = unitScene(1.0);
     EXPECT_FALSE(resolveSettings(s, {}).raster.receiverPlaneBias);
@@ -89,7 +103,10 @@ TEST(Settings, BadValuesNameTheOption) {
     o.samples = 0; expectError(o, "--samples"); o = {};
     o.threads = -2; expectError(o, "--threads"); o = {};
     o.cascades = 0; expectError(o, "--cascades"); o = {};
-    o.cascades = kMaxCascades + 1; expectError(o, "--cascades");
+    o.cascades = kMaxCascades + 1; expectError(o, "--cascades"); o = {};
+    o.cascadeBlend = -0.01; expectError(o, "--cascade-blend"); o = {};
+    o.cascadeBlend = 0.51; expectError(o, "--cascade-blend"); o = {};
+    o.cascadeBlend = std::nan(""); expectError(o, "--cascade-blend");
 }
 
 TEST(Settings, ReferenceIsDoubleRobustAndUnbiased) {
