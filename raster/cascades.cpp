@@ -96,7 +96,7 @@ LightFrustum fitCascade(const scene::Scene& scene, const scene::CameraBasis& cam
     return f;
 }
 
-CascadeSet fitCascades(const scene::Scene& scene, const Vec3& direction, int count, int mapSize) {
+CascadeSet fitCascades(const scene::Scene& scene, const Vec3& direction, int count, int mapSize, double blend) {
     CascadeSet set;
     const auto range = visibleDepthRange(scene);
     if (!range || count < 1) return set;
@@ -106,15 +106,19 @@ CascadeSet fitCascades(const scene::Scene& scene, const Vec3& direction, int cou
     // bounding-sphere map, which is finer, and (fixed in the world) cannot swim either.
     const LightFrustum whole = fitDirectionalLight(scene.bounds(), direction, mapSize);
     for (int i = 0; i < count; ++i) {
-        const LightFrustum f =
-            fitCascade(scene, cam, set.splits[std::size_t(i)], set.splits[std::size_t(i) + 1], direction, mapSize);
+        // With blending, the pixels in the band before split i read this map too: it starts there.
+        const double d0 = set.splits[std::size_t(i)] -
+                          (i > 0 ? blend * (set.splits[std::size_t(i)] - set.splits[std::size_t(i) - 1]) : 0.0);
+        const LightFrustum f = fitCascade(scene, cam, d0, set.splits[std::size_t(i) + 1], direction, mapSize);
         set.frusta.push_back(f.halfWidth < whole.halfWidth ? f : whole);
     }
     return set;
 }
 
-std::vector<Vec3> cascadeReceivers(const scene::Scene& scene, const std::vector<double>& splits, std::size_t c) {
-    const double lo = c == 0 ? -INFINITY : splits[c] * (1.0 - kCascadeSplitSlack);
+std::vector<Vec3> cascadeReceivers(const scene::Scene& scene, const std::vector<double>& splits, std::size_t c,
+                                   double blend) {
+    const double lo =
+        c == 0 ? -INFINITY : (splits[c] - blend * (splits[c] - splits[c - 1])) * (1.0 - kCascadeSplitSlack);
     const double hi = c + 2 >= splits.size() ? INFINITY : splits[c + 1] * (1.0 + kCascadeSplitSlack);
     return visibleReceiverPointsInSlice(scene, lo, hi);
 }

@@ -59,7 +59,10 @@ LightFrustum fitCascade(const scene::Scene& scene, const scene::CameraBasis& cam
 // far one (lit.frag gives them everything nearer or farther), the inner ends widened by
 // kCascadeSplitSlack because lit.frag compares the view depth with the splits in float.
 inline constexpr double kCascadeSplitSlack = 1e-4;
-std::vector<scene::Vec3> cascadeReceivers(const scene::Scene& scene, const std::vector<double>& splits, std::size_t c);
+// With a blend band (RasterSettings::cascadeBlend), cascade c > 0 also serves the last `blend` of
+// slice c − 1, where lit.frag mixes it in: its receivers start there.
+std::vector<scene::Vec3> cascadeReceivers(const scene::Scene& scene, const std::vector<double>& splits, std::size_t c,
+                                          double blend = 0.0);
 
 struct CascadeSet {
     std::vector<double> splits;        // count + 1 view depths, near to far
@@ -67,6 +70,15 @@ struct CascadeSet {
 };
 // The splits over visibleDepthRange() and fitCascade() of each slice, except that a cascade whose
 // map would be wider than the scene's bounding-sphere map (fitDirectionalLight) uses that instead.
-CascadeSet fitCascades(const scene::Scene& scene, const scene::Vec3& direction, int count, int mapSize);
+// With a blend band (`blend` of each slice before its far split, lit.frag mixes the next cascade
+// in there), each cascade c > 0 covers the band of slice c − 1 too: its slice starts there.
+CascadeSet fitCascades(const scene::Scene& scene, const scene::Vec3& direction, int count, int mapSize,
+                       double blend = 0.0);
+// The band the maps cover for these settings: the widest one (kMaxCascadeBlend) whenever blending
+// is on, so that the maps, and every pixel outside the bands, do not change with the band's width;
+// 0 when it is off (the maps of the plain slices).
+inline double cascadeBandCover(const scene::RasterSettings& settings) {
+    return settings.cascadeBlend > 0.0 ? scene::kMaxCascadeBlend : 0.0;
+}
 
 }  // namespace shadowlab::raster

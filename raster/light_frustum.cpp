@@ -748,11 +748,11 @@ std::vector<LightCulling> culledCasters(const scene::Scene& scene, const scene::
         } else if (l.type == scene::LightType::Spot) {
             add("", spotLightFrustum(scene, settings, l, settings.shadowMapSize), receivers);
         } else if (const CascadeSet cs = settings.cascades > 1
-                                              ? fitCascades(scene, l.direction, settings.cascades, settings.shadowMapSize)
+                                              ? fitCascades(scene, l.direction, settings.cascades, settings.shadowMapSize, cascadeBandCover(settings))
                                               : CascadeSet{};
                    !cs.frusta.empty()) {
             for (std::size_t c = 0; c < cs.frusta.size(); ++c)
-                add(std::string(1, 'C').append(std::to_string(c)), cs.frusta[c], cascadeReceivers(scene, cs.splits, c));
+                add(std::string(1, 'C').append(std::to_string(c)), cs.frusta[c], cascadeReceivers(scene, cs.splits, c, cascadeBandCover(settings)));
         } else {
             add("",
                 settings.fitLightFrustum ? fitDirectionalLightToReceivers(scene, l.direction, settings.shadowMapSize)

@@ -282,7 +282,8 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
             } else if (spot)
                 f = spotLightFrustum(scene, settings, light, settings.shadowMapSize);
             else if (settings.cascades > 1 &&
-                     !(cascades = fitCascades(scene, light.direction, settings.cascades, settings.shadowMapSize))
+                     !(cascades = fitCascades(scene, light.direction, settings.cascades, settings.shadowMapSize,
+                                                              cascadeBandCover(settings)))
                           .frusta.empty()) {
                 // Cascaded: one layer per slice; the shader picks the cascade by view depth
                 // (lit.frag cascadeOf). Cascades are fitted to their slices, so
@@ -296,7 +297,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
                     const LightFrustum& cf = cascades.frusta[c];
                     const double depthBias = settings.depthBiasIsDefault ? 0.5 * cf.texelWorldSize() : settings.depthBias;
                     // Each cascade draws only the casters of the receivers of its own slice.
-                    cullLayer(i, cf, cull ? cascadeReceivers(scene, cascades.splits, c) : std::vector<scene::Vec3>{});
+                    cullLayer(i, cf, cull ? cascadeReceivers(scene, cascades.splits, c, cascadeBandCover(settings)) : std::vector<scene::Vec3>{});
                     lightMatrices.push_back(glm::mat4(cf.toClip(origin)));
                     frusta.push_back(cf);
                     usedDepthBias.push_back(depthBias);

@@ -137,6 +137,36 @@ TEST(Cascades, EveryCascadeFrustumContainsItsSliceCornersAndTheCastersTowardTheL
     }
 }
 
+TEST(Cascades, WithABlendBandEachCascadeAlsoHoldsTheBandOfTheSliceBeforeIt) {
+    // lit.frag mixes cascade i into the last `blend` of slice i − 1, so cascade i's map must hold
+    // that band's corners too. A narrow view (fov 20°, 16:9: the slice's sphere is centered between
+    // its ends, (d0 + d1)(1 + k²)/2, k² = tan²(10°)(1 + (16/9)²) ≈ 0.13) and the widest band (0.5):
+    // the band's near corners lie well outside the sphere of slice i alone.
+    scene::Scene s = test::makeLongPlane();
+    s.camera.fovYDegrees = 20.0;
+    const Vec3 dir = s.lights[0].direction;
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    const double blend = 0.5;
+    const CascadeSet plain = fitCascades(s, dir, 3, 1024);
+    const CascadeSet blended = fitCascades(s, dir, 3, 1024, blend);
+    ASSERT_EQ(blended.frusta.size(), 3u);
+    ASSERT_EQ(blended.splits, plain.splits);  // the splits stay; only the maps grow
+    const LightFrustum whole = fitDirectionalLight(s.bounds(), dir, 1024);
+    int outsideWithoutBand = 0;
+    for (std::size_t i = 1; i < 3; ++i) {
+        const double bandStart = blended.splits[i] - blend * (blended.splits[i] - blended.splits[i - 1]);
+        for (const double sx : {-1.0, 1.0})
+            for (const double sy : {-1.0, 1.0}) {
+                const Vec3 corner = frustumCorner(cam, bandStart, sx, sy);
+                if (blended.frusta[i].halfWidth == whole.halfWidth && blended.frusta[i].center == whole.center)
+                    continue;  // the scene's own map: it holds every receiver (previous test)
+                EXPECT_TRUE(insideFrustum(blended.frusta[i], corner)) << "cascade " << i << ", band corner";
+                if (!insideFrustum(plain.frusta[i], corner)) ++outsideWithoutBand;
+            }
+    }
+    EXPECT_GT(outsideWithoutBand, 0) << "the scene does not tell a band-aware fit from a plain one";
+}
+
 TEST(Cascades, SnappedCenterStaysOnTheTexelGridWhenTheCameraMovesByAFractionOfATexel) {
     scene::Scene s = test::makeLongPlane();
     const Vec3 dir = s.lights[0].direction;
@@ -500,7 +530,7 @@ TEST(RasterCascadeBlend, ZeroIsTheFrameWithoutTheSettingBitForBit) {
 }
 
 // On the long plane (3 cascades, with blendScene()'s shadows crossing both inner bands): with F = 0.25 and
-// 0.5, every pixel outside the bands is the unblended frame's, bit for bit; inside, the visibility
+// 0.5, every pixel outside the bands is the unblended frame's (same maps), bit for bit; inside, the visibility
 // is the linear mix v = v_c + t·(v_{c+1} − v_c) of cascade c's own value v_c (the unblended frame's
 // there, as the band lies inside slice c) and cascade c + 1's. v_{c+1} is unknown, so it is solved
 // from the F = 0.5 frame, where t is largest; it must be a visibility (0..1), and it must predict
@@ -510,14 +540,17 @@ TEST(RasterCascadeBlend, ZeroIsTheFrameWithoutTheSettingBitForBit) {
 TEST(RasterCascadeBlend, OutsideTheBandsUnchangedInsideTheLinearMixOfTheTwoCascades) {
     const scene::Scene s = blendScene();
     RenderDebug debug;
-    const scene::Frame plain = renderChecked(s, blendSettings(0.0), &debug);
+    // With blending on, every cascade's map covers the widest band (cascadeBandCover), whatever F:
+    // the unblended reference is a frame with a vanishing band (1e-9 of a slice: no pixel in it)
+    // and the same maps as F = 0.25 and 0.5.
+    const scene::Frame plain = renderChecked(s, blendSettings(1e-9), &debug);
     const scene::Frame half = renderChecked(s, blendSettings(0.5));
     const scene::Frame quarter = renderChecked(s, blendSettings(0.25));
     ASSERT_EQ(debug.cascadeSplits.size(), 4u);
     EXPECT_EQ(half.attributes.at("cascade_blend"), "0.5");
     EXPECT_EQ(quarter.attributes.at("cascade_blend"), "0.25");
     std::size_t outside = 0, checked = 0, mixed[2] = {0, 0}, exact = 0, notHeld = 0;
-    const CascadeSet set = fitCascades(s, s.lights[0].direction, 3, 512);
+    const CascadeSet set = fitCascades(s, s.lights[0].direction, 3, 512, scene::kMaxCascadeBlend);
     ASSERT_EQ(set.splits, debug.cascadeSplits);
     const scene::CameraBasis cam = scene::cameraBasis(s.camera);
     for (std::size_t i = 0; i < plain.pixelCount(); ++i) {
