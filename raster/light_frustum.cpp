@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "raster/cascades.h"
@@ -39,21 +40,27 @@ std::array<Vec3, 8> corners(const scene::Bounds& b) {
     return c;
 }
 
-// A box's extent in a light frustum's basis: across (right, up) and its nearest depth along the light.
-struct Footprint {
-    double minU = INFINITY, maxU = -INFINITY, minV = INFINITY, maxV = -INFINITY, minDepth = INFINITY;
+// Both a box's and the receivers' extent in f's map and their depth along its axis. Orthographic:
+// u, v are world offsets across the light from f.center; perspective: tangents x/d, y/d of the
+// direction from f.position.
+struct MapExtent {
+    double minU = INFINITY, maxU = -INFINITY, minV = INFINITY, maxV = -INFINITY;
+    double minDepth = INFINITY, maxDepth = -INFINITY;
+    bool empty() const { return !(minU <= maxU && minV <= maxV); }
 };
-Footprint footprint(const scene::Bounds& b, const LightFrustum& f) {
-    Footprint o;
-    for (const Vec3& c : corners(b)) {
+
+MapExtent orthographicExtent(std::span<const Vec3> points, const LightFrustum& f) {
+    MapExtent e;
+    for (const Vec3& c : points) {
         const Vec3 d = c - f.center;
-        o.minU = std::min(o.minU, glm::dot(d, f.right));
-        o.maxU = std::max(o.maxU, glm::dot(d, f.right));
-        o.minV = std::min(o.minV, glm::dot(d, f.up));
-        o.maxV = std::max(o.maxV, glm::dot(d, f.up));
-        o.minDepth = std::min(o.minDepth, glm::dot(d, f.direction));
+        e.minU = std::min(e.minU, glm::dot(d, f.right));
+        e.maxU = std::max(e.maxU, glm::dot(d, f.right));
+        e.minV = std::min(e.minV, glm::dot(d, f.up));
+        e.maxV = std::max(e.maxV, glm::dot(d, f.up));
+        e.minDepth = std::min(e.minDepth, glm::dot(d, f.direction));
+        e.maxDepth = std::max(e.maxDepth, glm::dot(d, f.direction));
     }
-    return o;
+    return e;
 }
 
 struct Plane {
@@ -169,7 +176,7 @@ double nearestCasterDepth(const scene::Scene& scene, const LightFrustum& f, doub
     for (const scene::Object& object : scene.objects) {
         const scene::Bounds b = scene::boundsOf(object.shape);
         if (b.empty()) continue;
-        const Footprint o = footprint(b, f);
+        const MapExtent o = orthographicExtent(corners(b), f);
         if (o.maxU < minU || o.minU > maxU || o.maxV < minV || o.minV > maxV) continue;
         minDepth = std::min(minDepth, o.minDepth);
     }
@@ -456,14 +463,6 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
 
 namespace {
 
-// Both a box's and the receivers' extent in f's map and their depth along its axis. Orthographic:
-// u, v are world offsets across the light from f.center; perspective: tangents x/d, y/d of the
-// direction from f.position.
-struct MapExtent {
-    double minU = INFINITY, maxU = -INFINITY, minV = INFINITY, maxV = -INFINITY;
-    double minDepth = INFINITY, maxDepth = -INFINITY;
-    bool empty() const { return !(minU <= maxU && minV <= maxV); }
-};
 
 // The receivers' extent in a perspective map: of their hull's part in front of the light (d > 0).
 // The hull's vertices with d > 0 project to finite (u, v); the rest of that part lies near where
@@ -507,19 +506,6 @@ MapExtent perspectiveReceiverExtent(const std::vector<Vec3>& receivers, const Li
     return e;
 }
 
-MapExtent orthographicExtent(const std::vector<Vec3>& points, const LightFrustum& f) {
-    MapExtent e;
-    for (const Vec3& c : points) {
-        const Vec3 d = c - f.center;
-        e.minU = std::min(e.minU, glm::dot(d, f.right));
-        e.maxU = std::max(e.maxU, glm::dot(d, f.right));
-        e.minV = std::min(e.minV, glm::dot(d, f.up));
-        e.maxV = std::max(e.maxV, glm::dot(d, f.up));
-        e.minDepth = std::min(e.minDepth, glm::dot(d, f.direction));
-        e.maxDepth = std::max(e.maxDepth, glm::dot(d, f.direction));
-    }
-    return e;
-}
 
 }  // namespace
 
@@ -534,8 +520,7 @@ std::vector<bool> castsOnto(const scene::Scene& scene, const LightFrustum& f, co
         for (std::size_t i = 0; i < scene.objects.size(); ++i) {
             const scene::Bounds b = scene::boundsOf(scene.objects[i].shape);
             if (b.empty()) continue;
-            const std::array<Vec3, 8> c = corners(b);
-            const MapExtent o = orthographicExtent({c.begin(), c.end()}, f);
+            const MapExtent o = orthographicExtent(corners(b), f);
             casts[i] = o.maxU >= r.minU - margin && o.minU <= r.maxU + margin && o.maxV >= r.minV - margin &&
                        o.minV <= r.maxV + margin && o.minDepth <= r.maxDepth + margin;
         }
