@@ -125,9 +125,8 @@ PipelineHandle createTransmitPipeline(const Context& ctx, VkPipelineLayout layou
                                        });
 }
 
-}  // namespace
-
-ShadowPipeline createTransmittancePipeline(const Context& ctx) {
+// Both passes' layout: the transmit push constants, and the set that holds D1 (the second pass).
+PipelineLayoutHandle createTransmitLayout(const Context& ctx, VkDescriptorSetLayout set) {
     if (!ctx.independentBlend)
         throw RasterError("semi-transparent casters need the independentBlend feature, which " + ctx.deviceReport.name +
                           " lacks (the transmittance map blends its two targets differently)");
@@ -136,21 +135,26 @@ ShadowPipeline createTransmittancePipeline(const Context& ctx) {
                                    .size = sizeof(shaders::TransmitPush)};
     const VkPipelineLayoutCreateInfo layoutInfo{
         .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
+        .setLayoutCount = set != VK_NULL_HANDLE ? 1u : 0u,
+        .pSetLayouts = set != VK_NULL_HANDLE ? &set : nullptr,
         .pushConstantRangeCount = 1,
         .pPushConstantRanges = &push,
     };
-    ShadowPipeline p;
     VkPipelineLayout layout = VK_NULL_HANDLE;
     VK_CHECK(vkCreatePipelineLayout(ctx.device.get(), &layoutInfo, nullptr, &layout));
-    p.layout = PipelineLayoutHandle(ctx.device.get(), layout);
-    p.pipeline = createTransmitPipeline(ctx, layout, shaders::transmitFragSpirv());
+    return PipelineLayoutHandle(ctx.device.get(), layout);
+}
+
+}  // namespace
+
+ShadowPipeline createTransmittancePipeline(const Context& ctx) {
+    ShadowPipeline p;
+    p.layout = createTransmitLayout(ctx, VK_NULL_HANDLE);
+    p.pipeline = createTransmitPipeline(ctx, p.layout.get(), shaders::transmitFragSpirv());
     return p;
 }
 
 TransmittanceRestPipeline createTransmittanceRestPipeline(const Context& ctx, const TransmittanceMaps& maps) {
-    if (!ctx.independentBlend)
-        throw RasterError("semi-transparent casters need the independentBlend feature, which " + ctx.deviceReport.name +
-                          " lacks (the transmittance map blends its two targets differently)");
     VkDevice device = ctx.device.get();
     TransmittanceRestPipeline p;
     // transmit.frag reads D1 with texelFetch at its own texel: no filtering, no addressing.
@@ -195,20 +199,8 @@ TransmittanceRestPipeline createTransmittanceRestPipeline(const Context& ctx, co
                                      .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                                      .pImageInfo = &nearInfo};
     vkUpdateDescriptorSets(device, 1, &write, 0, nullptr);
-    const VkPushConstantRange push{.stageFlags = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
-                                   .offset = 0,
-                                   .size = sizeof(shaders::TransmitPush)};
-    const VkPipelineLayoutCreateInfo layoutInfo{
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
-        .setLayoutCount = 1,
-        .pSetLayouts = &setLayout,
-        .pushConstantRangeCount = 1,
-        .pPushConstantRanges = &push,
-    };
-    VkPipelineLayout layout = VK_NULL_HANDLE;
-    VK_CHECK(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &layout));
-    p.layout = PipelineLayoutHandle(device, layout);
-    p.pipeline = createTransmitPipeline(ctx, layout, shaders::transmitFragRestSpirv());
+    p.layout = createTransmitLayout(ctx, setLayout);
+    p.pipeline = createTransmitPipeline(ctx, p.layout.get(), shaders::transmitFragRestSpirv());
     return p;
 }
 

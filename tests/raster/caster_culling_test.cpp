@@ -292,12 +292,7 @@ TEST(RasterCasterCulling, ReceiversPartlyBehindTheLightReachTheMapsEdgeOnlyOnThe
 scene::Scene spotFromAbove(int height) {
     scene::Scene s = seedWith({0, 1, 0}, 1.0);
     s.objects.pop_back();
-    s.objects[0].shape = scene::Box{{-1, 0, -1}, {1, 2, 1}};
-    s.camera.position = {0, 10, 0};
-    s.camera.lookAt = {0, 0, 0};
-    s.camera.up = {0, 0, -1};
-    s.camera.width = height * 16 / 9;
-    s.camera.height = height;
+    test::boxUnderADownwardCamera(s, height);
     scene::Light l = test::spotDown();
     l.position = {0, 12, 0};
     l.coneAngleDegrees = 30;

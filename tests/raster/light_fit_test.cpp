@@ -298,12 +298,7 @@ TEST(RasterPointFit, EachFaceTakesItsNearAndFarFromItsCastersAndReceivers) {
 // H = 90 → 512, 642 at H = 180 → 1024, 230 at H = 60 → 256, 1260 at H = 360 → 2048.
 scene::Scene pointFromAbove(int height) {
     scene::Scene s = pointScene();
-    s.objects[0].shape = scene::Box{{-1, 0, -1}, {1, 2, 1}};
-    s.camera.position = {0, 10, 0};
-    s.camera.lookAt = {0, 0, 0};
-    s.camera.up = {0, 0, -1};
-    s.camera.width = height * 16 / 9;
-    s.camera.height = height;
+    test::boxUnderADownwardCamera(s, height);
     s.lights[0].position = {0, 12, 0};
     return s;
 }

@@ -215,6 +215,18 @@ inline scene::RasterSettings validatedSettings(int shadowMapSize, double depthBi
     return r;
 }
 
+// The map-size scenes: the first object becomes the box [−1, 1] x [0, 2] x [−1, 1] on the ground
+// y = 0, and the camera at (0, 10, 0) looks straight down at it (up −z, the scene's fov), `height`
+// rows at 16:9. The box's top lies at view depth 8, the ground at 10.
+inline void boxUnderADownwardCamera(scene::Scene& s, int height) {
+    s.objects[0].shape = scene::Box{{-1, 0, -1}, {1, 2, 1}};
+    s.camera.position = {0, 10, 0};
+    s.camera.lookAt = {0, 0, 0};
+    s.camera.up = {0, 0, -1};
+    s.camera.width = height * 16 / 9;
+    s.camera.height = height;
+}
+
 // A spot at (0, 8, 0) straight down, cone 60° (the map's half-angle 61.2°, tan ≈ 1.82), intensity
 // 800. Its map's basis (setBasis: the axis is vertical, so right = dir × X) is right = +z, up = +x:
 // u = z/d, v = x/d with d = 8 − y.
