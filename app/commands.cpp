@@ -256,9 +256,10 @@ int render(const RenderOptions& o) {
         return 0;
     }
     Stage stage("rendering " + p.scene.file.filename().string() + " with " + o.backend);
-    // A PNG holds the beauty only: the raster backend then reads back nothing else.
-    const scene::Frame frame =
-        renderBackend(p, o.backend, ext == ".png" ? scene::kChannelBeauty : scene::kAllChannels);
+    // A PNG holds the beauty only, in 8-bit sRGB: the raster backend then renders nothing else,
+    // into an 8-bit sRGB target.
+    const scene::Frame frame = renderBackend(
+        p, o.backend, ext == ".png" ? scene::kChannelBeauty | scene::kBeautyForDisplay : scene::kAllChannels);
     scene::writeFrame(frame, o.output);
     stage.done(std::to_string(frame.width) + "x" + std::to_string(frame.height) + " -> " + o.output.string() +
                ", " + memoryLine(estimate));

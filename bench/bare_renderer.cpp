@@ -51,7 +51,7 @@ struct BareRenderer::Impl {
     VkDescriptorSet set = VK_NULL_HANDLE;
 };
 
-BareRenderer::BareRenderer(const scene::Scene& scene, const scene::RasterSettings& settings)
+BareRenderer::BareRenderer(const scene::Scene& scene, const scene::RasterSettings& settings, bool srgbTarget)
     : impl_(std::make_unique<Impl>()) {
     const auto start = Clock::now();
     Impl& m = *impl_;
@@ -61,6 +61,7 @@ BareRenderer::BareRenderer(const scene::Scene& scene, const scene::RasterSetting
     m.width = std::uint32_t(scene.camera.width);
     m.height = std::uint32_t(scene.camera.height);
     m.mapSize = std::uint32_t(settings.shadowMapSize);
+    const VkFormat colorFormat = srgbTarget ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
 
     const SceneGeometry geometry = tessellateScene(scene, cam.position);
     m.vertices = uploadBuffer(ctx, geometry.vertices, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
@@ -94,7 +95,7 @@ BareRenderer::BareRenderer(const scene::Scene& scene, const scene::RasterSetting
     m.map = createImage(ctx, VK_FORMAT_D32_SFLOAT, m.mapSize, m.mapSize, 1,
                         VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
                         VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_VIEW_TYPE_2D);
-    m.color = createImage(ctx, VK_FORMAT_R8G8B8A8_UNORM, m.width, m.height, 1,
+    m.color = createImage(ctx, colorFormat, m.width, m.height, 1,
                           VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
                           VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D);
     m.depth = createImage(ctx, VK_FORMAT_D32_SFLOAT, m.width, m.height, 1, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
@@ -153,7 +154,7 @@ BareRenderer::BareRenderer(const scene::Scene& scene, const scene::RasterSetting
                                                              .fragmentShader = kBareLitFragSpv,
                                                              .fragmentSpecialization = &specialization,
                                                              .layout = m.litLayout.get(),
-                                                             .colorFormats = {VK_FORMAT_R8G8B8A8_UNORM},
+                                                             .colorFormats = {colorFormat},
                                                              .depthFormat = VK_FORMAT_D32_SFLOAT,
                                                              // scene::projectionMatrix is reversed Z
                                                              .depthCompare = VK_COMPARE_OP_GREATER});

@@ -27,7 +27,9 @@ struct BareTimings {
 class BareRenderer {
 public:
     // The first directional light of `scene` (else straight down) casts; others are ignored.
-    BareRenderer(const scene::Scene& scene, const scene::RasterSettings& settings);
+    // srgbTarget: an R8G8B8A8_SRGB target (the device encodes on store, as ours does for a PNG)
+    // instead of R8G8B8A8_UNORM.
+    BareRenderer(const scene::Scene& scene, const scene::RasterSettings& settings, bool srgbTarget = false);
     ~BareRenderer();
     // One frame: both passes and the readback into an RGBA8 image (row 0 on top).
     BareTimings render(std::vector<std::uint8_t>& rgba);

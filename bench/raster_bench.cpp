@@ -115,6 +115,10 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
     bench::BareRenderer bare(s, settings.raster);
     bare.render(rgba);
     const double bareCold = msSince(t0);
+    // The same bare passes writing an sRGB target, as ours does for a PNG: what the device's
+    // sRGB encoding on store costs (the headline ratios are against the UNORM one above).
+    bench::BareRenderer bareSrgb(s, settings.raster, true);
+    bareSrgb.render(rgba);
 
     std::printf("\n=== %s: %s triangles, %dx%d, shadow map %d, filter %s, bare PCF: %s ===\n", label.c_str(),
                 frame.attributes["triangles"].c_str(), kWidth, kHeight, kShadowMapSize,
@@ -128,10 +132,11 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
     }
 
     // Warm frames, interleaved so that both see the same machine: ours with every channel
-    // (what compare reads), ours with the beauty only (`render -o x.png`), the bare renderer.
-    // Each keeps its frame between repetitions, as the bare renderer keeps its image.
-    Series all, beauty, fresh, base;
-    scene::Frame allFrame, beautyFrame;
+    // (what compare reads), ours with the float beauty only, ours for a PNG (`render -o x.png`:
+    // the beauty into the 8-bit sRGB target), the bare renderer. Each keeps its frame between
+    // repetitions, as the bare renderer keeps its image.
+    Series all, beauty, png, fresh, base, baseSrgb;
+    scene::Frame allFrame, beautyFrame, pngFrame;
     for (int i = 0; i < repeats; ++i) {
         double c = cpuMs();
         ours.render(allFrame, scene::kAllChannels);
@@ -141,11 +146,19 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
         ours.render(beautyFrame, scene::kChannelBeauty);
         beauty.add("cpu_per_frame", cpuMs() - c);
         addOurs(beauty, beautyFrame);
+        c = cpuMs();
+        ours.render(pngFrame, scene::kChannelBeauty | scene::kBeautyForDisplay);
+        png.add("cpu_per_frame", cpuMs() - c);
+        addOurs(png, pngFrame);
         if (!skipFresh) addOurs(fresh, ours.render(scene::kAllChannels));  // a new Frame every time
         c = cpuMs();
         const bench::BareTimings t = bare.render(rgba);
         base.add("cpu_per_frame", cpuMs() - c);
         addBare(base, t);
+        c = cpuMs();
+        const bench::BareTimings ts = bareSrgb.render(rgba);
+        baseSrgb.add("cpu_per_frame", cpuMs() - c);
+        addBare(baseSrgb, ts);
     }
 
     // Warm first frames: a new renderer (new device) whose shaders are now in the cache.
@@ -163,8 +176,8 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
     const double bareWarmFirst = msSince(t0);
 
     std::printf("median of %d warm frames, ms (min-max)\n", repeats);
-    std::printf("  %-12s %22s %22s %22s %9s %9s\n", "stage", "ours (all channels)", "ours (beauty only)",
-                "bare baseline", "all/bare", "bty/bare");
+    std::printf("  %-12s %22s %22s %22s %22s %9s %9s %9s\n", "stage", "ours (all channels)", "ours (float beauty)",
+                "ours (png)", "bare baseline", "all/bare", "bty/bare", "png/bare");
     for (const char* stage : {"shadow_pass", "lit_pass", "readback", "per_frame", "cpu_per_frame"}) {
         auto cell = [&](const Series& x) {
             char buf[64];
@@ -172,9 +185,14 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
             std::snprintf(buf, sizeof buf, "%.1f (%.1f-%.1f)", x.med(stage), lo, hi);
             return std::string(buf);
         };
-        std::printf("  %-12s %22s %22s %22s %9.2f %9.2f\n", stage, cell(all).c_str(), cell(beauty).c_str(),
-                    cell(base).c_str(), all.med(stage) / base.med(stage), beauty.med(stage) / base.med(stage));
+        std::printf("  %-12s %22s %22s %22s %22s %9.2f %9.2f %9.2f\n", stage, cell(all).c_str(), cell(beauty).c_str(),
+                    cell(png).c_str(), cell(base).c_str(), all.med(stage) / base.med(stage),
+                    beauty.med(stage) / base.med(stage), png.med(stage) / base.med(stage));
     }
+    std::printf("  bare with an sRGB target: per_frame %.1f, lit_pass %.1f, cpu_per_frame %.1f; png / bare sRGB: "
+                "per_frame %.2f, cpu %.2f\n",
+                baseSrgb.med("per_frame"), baseSrgb.med("lit_pass"), baseSrgb.med("cpu_per_frame"),
+                png.med("per_frame") / baseSrgb.med("per_frame"), png.med("cpu_per_frame") / baseSrgb.med("cpu_per_frame"));
     std::printf("  ours (all channels) into a new Frame each time: per_frame %.1f, readback %.1f\n",
                 fresh.med("per_frame"), fresh.med("readback"));
     std::printf("  setup (construction): ours %.1f, bare %.1f\n", ours.setupMs(), bare.setupMs());
@@ -184,11 +202,12 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
                 frame.attributes["gpu_shadow_pass_ms"].c_str(), frame.attributes["gpu_lit_pass_ms"].c_str(),
                 allFrame.attributes["gpu_shadow_pass_ms"].c_str(), allFrame.attributes["gpu_lit_pass_ms"].c_str());
     const char* threads = std::getenv("LP_NUM_THREADS");
-    std::printf("ROW | %s | %s | %.1f | %.1f | %.1f | %.2f | %.2f | %.2f | %.1f | %.1f | %.1f / %.1f | %.1f / %.1f |\n",
+    std::printf("ROW | %s | %s | %.1f | %.1f | %.1f | %.1f | %.2f | %.2f | %.2f | %.2f | %.2f | %.1f | %.1f | %.1f / %.1f | %.1f / %.1f |\n",
                 label.c_str(), threads ? threads : "?", all.med("per_frame"), beauty.med("per_frame"),
-                base.med("per_frame"), all.med("per_frame") / base.med("per_frame"),
-                beauty.med("per_frame") / base.med("per_frame"),
-                all.med("cpu_per_frame") / base.med("cpu_per_frame"), all.med("lit_pass"), base.med("lit_pass"),
+                png.med("per_frame"), base.med("per_frame"), all.med("per_frame") / base.med("per_frame"),
+                beauty.med("per_frame") / base.med("per_frame"), png.med("per_frame") / base.med("per_frame"),
+                all.med("cpu_per_frame") / base.med("cpu_per_frame"), png.med("cpu_per_frame") / base.med("cpu_per_frame"),
+                all.med("lit_pass"), base.med("lit_pass"),
                 oursCold, bareCold, oursWarmFirst, bareWarmFirst);
 }
 

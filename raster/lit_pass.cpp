@@ -57,16 +57,18 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant) {
     p.layout = PipelineLayoutHandle(device, layout);
     // lit.frag's constant_id 0: the filter code, 1: blocker ids (a bool is 32 bits wide),
     // 2: the light count, 3: the light kinds, 4: the cascade count, 5: transmittance (bool),
-    // 6: receiver-plane bias (bool), 7: cascade blend bands (bool).
-    const std::int32_t constants[8] = {std::int32_t(variant.filter),     variant.blockerIds ? 1 : 0,
+    // 6: receiver-plane bias (bool), 7: cascade blend bands (bool), 8: visibility in the beauty's
+    // alpha (bool; not for the display target).
+    const std::int32_t constants[9] = {std::int32_t(variant.filter),     variant.blockerIds ? 1 : 0,
                                        std::int32_t(variant.lightCount), std::int32_t(variant.lightKinds),
                                        std::int32_t(variant.cascades),   variant.transmittance ? 1 : 0,
-                                       variant.receiverPlane ? 1 : 0,    variant.cascadeBlend ? 1 : 0};
-    const VkSpecializationMapEntry entries[8] = {{0, 0, 4},   {1, 4, 4},   {2, 8, 4},   {3, 12, 4},
-                                                 {4, 16, 4}, {5, 20, 4}, {6, 24, 4}, {7, 28, 4}};
+                                       variant.receiverPlane ? 1 : 0,    variant.cascadeBlend ? 1 : 0,
+                                       variant.displayTarget ? 0 : 1};
+    const VkSpecializationMapEntry entries[9] = {{0, 0, 4},   {1, 4, 4},   {2, 8, 4},   {3, 12, 4}, {4, 16, 4},
+                                                 {5, 20, 4}, {6, 24, 4}, {7, 28, 4}, {8, 32, 4}};
     const VkSpecializationInfo specialization{
-        .mapEntryCount = 8, .pMapEntries = entries, .dataSize = sizeof constants, .pData = constants};
-    std::vector<VkFormat> colorFormats{kLitColorFormat};
+        .mapEntryCount = 9, .pMapEntries = entries, .dataSize = sizeof constants, .pData = constants};
+    std::vector<VkFormat> colorFormats{variant.displayTarget ? kLitDisplayFormat : kLitColorFormat};
     if (variant.aovTarget) colorFormats.insert(colorFormats.end(), 1 + variant.lightTargets, kLitColorFormat);
     p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{
                                                  .vertexShader = shaders::litVertSpirv(),
@@ -91,8 +93,9 @@ LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32
         throw RasterError("image " + std::to_string(width) + "x" + std::to_string(height) +
                           " exceeds the device's limit of " + std::to_string(limit) + " per side (" +
                           ctx.deviceReport.name + ")");
-    // Two (plus lightTargets) RGBA32F targets, D32 depth, and as many RGBA32F readback buffers.
-    requireDeviceMemory(ctx, VkDeviceSize(width) * height * ((2 + lightTargets) * 16 * 2 + 4),
+    // Two (plus lightTargets) RGBA32F targets, D32 depth, as many RGBA32F readback buffers, and
+    // the RGBA8 display target.
+    requireDeviceMemory(ctx, VkDeviceSize(width) * height * ((2 + lightTargets) * 16 * 2 + 4 + 4),
                         "a " + std::to_string(width) + "x" + std::to_string(height) + " image");
     LitTargets t;
     t.width = width;
@@ -108,6 +111,11 @@ LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32
     for (std::uint32_t i = 0; i < lightTargets; ++i)
         t.lights.push_back(createImage(ctx, kLitColorFormat, width, height, 1, colorUsage, VK_IMAGE_ASPECT_COLOR_BIT,
                                        VK_IMAGE_VIEW_TYPE_2D, t.hostReadable));
+    // (lavapipe allocates host memory on first touch, so a display target never rendered costs
+    // address space only.)
+    if (t.hostReadable && canReadImagesOnHost(ctx, kLitDisplayFormat, colorUsage))
+        t.display = createImage(ctx, kLitDisplayFormat, width, height, 1, colorUsage, VK_IMAGE_ASPECT_COLOR_BIT,
+                                VK_IMAGE_VIEW_TYPE_2D, true);
     return t;
 }
 
@@ -219,12 +227,13 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
 
 void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const LitBindings& bindings,
                    const LitTargets& targets, const DrawGeometry& geometry, const glm::vec3& background,
-                   bool beautyOnly) {
+                   LitOutputs outputs) {
     const VkPipelineStageFlags2 colorStage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
     const VkPipelineStageFlags2 depthStages =
         VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
-    std::vector<const Image*> colorImages{&targets.beauty};
-    if (!beautyOnly) {
+    const Image* beautyImage = outputs == LitOutputs::kDisplay ? &targets.display : &targets.beauty;
+    std::vector<const Image*> colorImages{beautyImage};
+    if (outputs == LitOutputs::kAll) {
         colorImages.push_back(&targets.aovs);
         for (const Image& l : targets.lights) colorImages.push_back(&l);
     }
@@ -236,7 +245,7 @@ void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const 
                           VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                           targets.hostReadable ? VK_PIPELINE_STAGE_2_HOST_BIT : VK_PIPELINE_STAGE_2_COPY_BIT,
                           VK_ACCESS_2_NONE, colorStage, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT});
-        const bool isBeauty = image == &targets.beauty;
+        const bool isBeauty = image == beautyImage;  // (the sRGB target encodes the linear clear color)
         colors.push_back({.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
                           .imageView = image->view.get(),
                           .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
@@ -281,7 +290,9 @@ void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const 
     vkCmdEndRendering(commands);
     std::vector<ImageTransition> after;
     for (const Image* image : colorImages)
-        if (targets.hostReadable)  // host access to a linear image needs GENERAL (Vulkan spec)
+        // Host access to a linear image needs GENERAL (Vulkan spec); the display target is
+        // host-readable whenever it exists.
+        if (targets.hostReadable)
             after.push_back({image->image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1,
                              VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL, colorStage,
                              VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,

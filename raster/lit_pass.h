@@ -15,6 +15,9 @@ namespace shadowlab::raster {
 
 inline constexpr VkFormat kLitColorFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 inline constexpr VkFormat kLitDepthFormat = VK_FORMAT_D32_SFLOAT;
+// The beauty of frames that are only written as an 8-bit PNG (scene::kBeautyForDisplay): the
+// device encodes sRGB on store, 4 bytes a pixel instead of 16 (docs/raster.md "Display target").
+inline constexpr VkFormat kLitDisplayFormat = VK_FORMAT_R8G8B8A8_SRGB;
 
 // What is fixed when the lit pipeline is created (lit.frag's specialization constants and
 // variant): lavapipe executes every branch of a shader, so run-time switches cost as much as
@@ -23,6 +26,7 @@ struct LitVariant {
     scene::ShadowFilter filter = scene::ShadowFilter::Pcf2x2;  // of every light
     bool blockerIds = true;         // look up blocker ids (the blocker-id maps must be rendered)
     bool aovTarget = true;          // false: the beauty target only (no AOVs, no per-light targets)
+    bool displayTarget = false;     // the beauty target is kLitDisplayFormat (implies !aovTarget)
     std::uint32_t lightTargets = 0;  // 0, or kLightTargets: per-light visibility targets
     std::uint32_t lightCount = 1;    // = LitUniforms::counts.x
     std::uint32_t lightKinds = 7;    // bit (1 << SHADOWLAB_LIGHT_*) for each kind in the scene
@@ -47,6 +51,10 @@ struct LitTargets {
     Image depth;   // reversed Z (cleared to 0 = far)
     // With lightTargets: light i's visibility in component i % 4 of lights[i / 4].
     std::vector<Image> lights;
+    // The 8-bit sRGB beauty (kLitDisplayFormat), host-readable; only where the float targets are
+    // read in place and the device can render to a linear image of that format (else null, and
+    // display frames use the float beauty target).
+    Image display;
     // Color targets are linear images in host-visible memory, read in place after the pass
     // (lavapipe); otherwise they are copied into readback buffers.
     bool hostReadable = false;
@@ -76,10 +84,12 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
 // Records the pass; background pixels keep `background` (rgb, visibility 0) and zero AOVs.
 // Leaves every color target in TRANSFER_SRC_OPTIMAL for recordReadback(), or, for host-readable
 // targets, in GENERAL and visible to host reads once the submission has finished.
-// With beautyOnly (a pipeline made without aovTarget) only the beauty target is attached.
+// Which targets a frame renders into, as its pipeline was made: every target, the float beauty
+// only (a pipeline without aovTarget), or the 8-bit display beauty only (displayTarget).
+enum class LitOutputs { kAll, kBeauty, kDisplay };
 void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const LitBindings& bindings,
                    const LitTargets& targets, const DrawGeometry& geometry, const glm::vec3& background,
-                   bool beautyOnly = false);
+                   LitOutputs outputs = LitOutputs::kAll);
 
 struct Readback {
     Buffer beauty;

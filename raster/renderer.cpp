@@ -21,6 +21,7 @@
 #include "raster/shadow_pass.h"
 #include "raster/tolerances.h"
 #include "scene/camera.h"
+#include "scene/frame_io.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -131,6 +132,7 @@ struct Renderer::Impl {
          const RendererOptions& options, ValidationLog& log);
     void render(scene::Frame& frame, scene::ChannelMask channels, const ValidationLog& log, RenderDebug* debug);
     void readPixels(scene::Frame& frame, scene::ChannelMask channels) const;
+    void readDisplayPixels(scene::Frame& frame) const;
     void invalidateMemory(VkDeviceMemory memory) const {
         const VkMappedMemoryRange range{.sType = VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE, .memory = memory, .size = VK_WHOLE_SIZE};
         VK_CHECK(vkInvalidateMappedMemoryRanges(ctx.device.get(), 1, &range));
@@ -169,7 +171,7 @@ struct Renderer::Impl {
     bool timestamps = false;
     QueryPoolHandle queries;
     // Made on first use. Shadow: without and with blocker ids (index 0, 1). Lit: beauty target
-    // only, all targets without blocker ids, all with (index 0, 1, 2).
+    // only, all targets without blocker ids, all with, the display target only (index 0..3).
     ShadowPipeline shadowPipelines[2];
     // Semi-transparent casters (RenderPlan::needsTransmittanceMap): the transmittance pass, its
     // maps (1x1x1 placeholders without), and per layer the light it is drawn from.
@@ -178,7 +180,7 @@ struct Renderer::Impl {
     TransmittanceMaps transmittanceMaps;
     TransmittanceRestPipeline transmitRestPipeline;  // the second pass, bound to transmittanceMaps
     std::vector<glm::vec4> layerLights;
-    LitPipeline litPipelines[3];
+    LitPipeline litPipelines[4];
     LitBindings bindings;  // allocated with the first lit pipeline's (identical) set layout
     shaders::LitUniforms uniforms{};
     std::vector<glm::vec4> albedos;
@@ -492,7 +494,11 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     // --- setup still owed: the pipelines this frame needs (shader compilation) ---
     ShadowPipeline& shadowPipeline = shadowPipelines[wantIds ? 1 : 0];
     const bool beautyOnly = !wantAovs && !wantLights;  // the beauty target holds visibility too
-    LitPipeline& litPipeline = litPipelines[beautyOnly ? 0 : wantIds ? 2 : 1];
+    // Only the beauty, only for an 8-bit sRGB image: the display target, where there is one.
+    const bool display = beautyOnly && (channels & kBeautyForDisplay) && !(channels & kChannelVisibility) &&
+                         targets.display.image;
+    const LitOutputs outputs = display ? LitOutputs::kDisplay : beautyOnly ? LitOutputs::kBeauty : LitOutputs::kAll;
+    LitPipeline& litPipeline = litPipelines[display ? 3 : beautyOnly ? 0 : wantIds ? 2 : 1];
     double setup = pendingSetupMs;  // 0 for a frame that creates nothing
     pendingSetupMs = 0.0;
     if (!shadowPipeline.pipeline || !litPipeline.pipeline) {
@@ -505,6 +511,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
             litPipeline = createLitPipeline(ctx, LitVariant{.filter = settings.filter,
                                                             .blockerIds = wantIds,
                                                             .aovTarget = !beautyOnly,
+                                                            .displayTarget = display,
                                                             .lightTargets = std::uint32_t(targets.lights.size()),
                                                             .lightCount = std::uint32_t(lightCount),
                                                             .lightKinds = lightKinds,
@@ -553,7 +560,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     const auto litStart = Clock::now();
     commands = ctx.beginCommands();
     stamp(commands, 2);
-    recordLitPass(commands, litPipeline, bindings, targets, draw, background, beautyOnly);
+    recordLitPass(commands, litPipeline, bindings, targets, draw, background, outputs);
     stamp(commands, 3);
     ctx.submitAndWait(commands);
     frame.timingsMs.emplace_back("lit_pass", msSince(litStart));
@@ -564,6 +571,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
         // The lit pass's barrier made the writes visible to the host; coherent memory needs no
         // invalidation, the rest does.
         for (const Image* image : {&targets.beauty, &targets.aovs}) invalidateMemory(image->memory.get());
+        if (display) invalidateMemory(targets.display.memory.get());
         for (const Image& image : targets.lights) invalidateMemory(image.memory.get());
     } else {
         commands = ctx.beginCommands();
@@ -575,7 +583,12 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
         if (wantLights)
             for (const Buffer& b : readback.lights) invalidate(ctx, b);
     }
-    readPixels(frame, channels);
+    if (display) {
+        readDisplayPixels(frame);
+        frame.attributes["beauty_precision"] = "srgb8";
+    } else {
+        readPixels(frame, channels);
+    }
     frame.timingsMs.emplace_back("readback", msSince(readStart));
     if (timestamps) {
         std::uint64_t ticks[4] = {};
@@ -658,6 +671,32 @@ void Renderer::Impl::readPixels(scene::Frame& frame, scene::ChannelMask channels
                 const float* p = lightRows[l / 4].row(y) + l % 4;
                 for (std::size_t x = 0; x < w; ++x) lights[l][o + x] = p[4 * x];
             }
+        }
+    });
+}
+
+// The display target's sRGB codes, decoded to the linear values that encode to the same codes
+// (the Frame's beauty is linear); every other channel is left empty.
+void Renderer::Impl::readDisplayPixels(scene::Frame& frame) const {
+    using namespace scene;
+    frame.width = int(width);
+    frame.height = int(height);
+    const std::size_t n = frame.pixelCount();
+    frame.beauty.resize(3 * n);
+    for (std::vector<float>* v : {&frame.visibility, &frame.objectId, &frame.ndotl, &frame.depth, &frame.blockerId})
+        v->clear();
+    frame.lightVisibility.clear();
+    std::array<float, 256> decode{};
+    for (int k = 0; k < 256; ++k) decode[std::size_t(k)] = srgbCodeToLinear(std::uint8_t(k));
+    const auto* base = static_cast<const std::uint8_t*>(targets.display.mapped);
+    const std::size_t pitch = std::size_t(targets.display.rowPitch), w = width;
+    float* const rgb = frame.beauty.data();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, height, 16), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t y = r.begin(); y < r.end(); ++y) {
+            const std::uint8_t* p = base + y * pitch;
+            float* out = rgb + 3 * y * w;
+            for (std::size_t x = 0; x < w; ++x)
+                for (std::size_t c = 0; c < 3; ++c) out[3 * x + c] = decode[p[4 * x + c]];
         }
     });
 }

@@ -22,6 +22,11 @@ inline constexpr ChannelMask kChannelDepth = 1u << 4;
 inline constexpr ChannelMask kChannelBlockerId = 1u << 5;
 inline constexpr ChannelMask kChannelLightVisibility = 1u << 6;  // per light, > 1 light only
 inline constexpr ChannelMask kAllChannels = (1u << 7) - 1;
+// Not a channel but a promise about kChannelBeauty: it will only be written as an 8-bit sRGB
+// image (`render -o x.png`). A backend may then deliver the beauty already quantized to the sRGB
+// codes (decoded back to linear with srgbCodeToLinear, so that writing the PNG gives those codes
+// again) and skip its float precision; the raster backend renders into an 8-bit sRGB target.
+inline constexpr ChannelMask kBeautyForDisplay = 1u << 7;
 
 struct Frame {
     int width = 0;

@@ -3,6 +3,7 @@
 #include "scene/frame_io.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -197,8 +198,7 @@ void writePng8(const fs::path& file, int width, int height, const std::vector<fl
     for (std::size_t i = 0; i < rgb.size(); ++i) {
         float v = rgb[i];
         if (!std::isfinite(v)) v = 0.0f;
-        if (encodeSrgb) v = linearToSrgb(v);
-        bytes[i] = static_cast<unsigned char>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
+        bytes[i] = encodeSrgb ? linearToSrgbCode(v) : static_cast<unsigned char>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
     }
     ImageSpec spec(width, height, 3, TypeDesc::UINT8);
     writeAtomically(file, [&](const fs::path& tmp) {
@@ -250,6 +250,28 @@ std::string lightVisibilityChannel(std::size_t light) { return "visibility." + s
 float linearToSrgb(float c) {
     c = std::clamp(c, 0.0f, 1.0f);
     return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+}
+
+std::uint8_t linearToSrgbCode(float linear) {
+    if (!std::isfinite(linear)) linear = 0.0f;
+    return static_cast<std::uint8_t>(std::lround(std::clamp(linearToSrgb(linear), 0.0f, 1.0f) * 255.0f));
+}
+
+float srgbCodeToLinear(std::uint8_t code) {
+    static const std::array<float, 256> table = [] {
+        std::array<float, 256> t{};
+        for (int k = 0; k < 256; ++k) {
+            const double e = k / 255.0;  // IEC 61966-2-1 decoding, in double
+            float v = float(e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4));
+            // The float encoder rounds differently from the exact curve by a few ulps at most:
+            // step toward the code until it is the one encoded (a handful of steps, once).
+            for (int guard = 0; guard < 1 << 16 && linearToSrgbCode(v) != k; ++guard)
+                v = std::nextafter(v, linearToSrgbCode(v) < k ? 2.0f : -1.0f);
+            t[std::size_t(k)] = v;
+        }
+        return t;
+    }();
+    return table[code];
 }
 
 void writePngLinear(const fs::path& file, int width, int height, const std::vector<float>& rgb) {

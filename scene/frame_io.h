@@ -3,6 +3,7 @@
 // same folder and are renamed into place, so a reader never sees a torn file.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -43,5 +44,11 @@ void removeStaleTemporaries(const std::filesystem::path& dir);
 void replaceDirectory(const std::filesystem::path& fresh, const std::filesystem::path& target);
 
 float linearToSrgb(float linear);
+// The 8-bit code the PNG writers give a linear value (NaN and infinities as 0).
+std::uint8_t linearToSrgbCode(float linear);
+// A linear value whose sRGB code (linearToSrgbCode) is `code`: the exact inverse of the sRGB curve
+// at code/255, moved by the fewest float steps needed when rounding would give a neighbouring code.
+// For frames whose beauty comes from an 8-bit sRGB target (kBeautyForDisplay).
+float srgbCodeToLinear(std::uint8_t code);
 
 }  // namespace shadowlab::scene

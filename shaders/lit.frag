@@ -76,6 +76,9 @@ layout(constant_id = 6) const bool kReceiverPlane = false;
 // Cascaded lights blend each cascade into the next over a band before the split (u.counts.z, the
 // band's fraction of the slice; see cascadeOf); off, the second shadow test is compiled out.
 layout(constant_id = 7) const bool kCascadeBlend = false;
+// The beauty target's alpha holds the visibility AOV; off for the 8-bit display target (a PNG has
+// no alpha), which leaves out the weighting and the division per pixel.
+layout(constant_id = 8) const bool kVisibility = true;
 // One directional light with one map and no receiver plane: its map coordinates are interpolated
 // from lit.vert (see shadowTest) instead of a matrix product per fragment.
 const bool kVertexLightCoordinates = kLightCount == 1 && kLightKinds == (1 << SHADOWLAB_LIGHT_DIRECTIONAL) &&
@@ -554,7 +557,7 @@ void main() {
             color += albedoColor * light.radiance.rgb * (irradiance * ndotl * v);
         }
     }
-    const float visibility = weightSum > 0.0 ? weightedVisibility / weightSum : 0.0;
+    const float visibility = !kVisibility ? 1.0 : weightSum > 0.0 ? weightedVisibility / weightSum : 0.0;
     outBeauty = vec4(color, visibility);
 #ifndef SHADOWLAB_BEAUTY_ONLY
     outAovs = vec4(float(inObjectId), maxNdotL, dot(inPosition, u.forward.xyz), float(blocker));

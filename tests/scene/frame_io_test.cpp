@@ -3,6 +3,7 @@
 #include "scene/frame_io.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include <OpenImageIO/imageio.h>
@@ -103,6 +104,24 @@ TEST(FrameIo, PngIsSrgbEncodedBeauty) {
     EXPECT_EQ(px[3], 188);
     EXPECT_EQ(px[4], 255);
     EXPECT_NEAR(px[5], 128, 1);
+}
+
+TEST(FrameIo, EverySrgbCodeDecodesToALinearValueThatEncodesBackToIt) {
+    // What a frame from an 8-bit sRGB target holds (kBeautyForDisplay): code k -> linear -> the
+    // PNG writer's code must be k again, and the linear value must be the sRGB curve's inverse
+    // (IEC 61966-2-1, written out here in double) up to float rounding.
+    float previous = -1.0f;
+    for (int k = 0; k < 256; ++k) {
+        const float v = srgbCodeToLinear(std::uint8_t(k));
+        EXPECT_EQ(int(linearToSrgbCode(v)), k) << "code " << k << " decodes to " << v;
+        const double e = k / 255.0;
+        const double exact = e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4);
+        EXPECT_NEAR(v, exact, 1e-6 * exact + 1e-12) << "code " << k;
+        EXPECT_GT(v, previous) << "not increasing at code " << k;
+        previous = v;
+    }
+    EXPECT_EQ(srgbCodeToLinear(0), 0.0f);
+    EXPECT_EQ(srgbCodeToLinear(255), 1.0f);
 }
 
 TEST(FrameIo, WritesLeaveNoTemporaryFilesBehind) {
