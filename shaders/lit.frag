@@ -33,8 +33,8 @@ const float kPcssMaxFilterFraction = 1.0 / 8.0;
 layout(location = 0) in vec3 inPosition;  // camera-relative world position
 layout(location = 1) in vec3 inNormal;
 layout(location = 2) flat in uint inObjectId;
-layout(location = 3) in vec3 inLightCoordinates;  // lit.vert: light 0's (toShadow · (p, 1)).xyz
-layout(location = 4) in vec3 inLightNormal;       // lit.vert: toShadow's 3x3 · the unnormalized normal
+layout(location = 3) in vec4 inLightCoordinates;  // lit.vert: light 0's toShadow · (p, 1)
+layout(location = 4) in vec4 inLightNormal;       // lit.vert: toShadow · (the unnormalized normal, 0)
 // The object's albedo (rgb) and 1 − opacity (a), which lit.vert reads from the per-object buffer
 // (binding 1): flat, so the same value as a read here, without a buffer lookup per fragment.
 layout(location = 5) flat in vec4 inAlbedo;
@@ -79,10 +79,15 @@ layout(constant_id = 7) const bool kCascadeBlend = false;
 // The beauty target's alpha holds the visibility AOV; off for the 8-bit display target (a PNG has
 // no alpha), which leaves out the weighting and the division per pixel.
 layout(constant_id = 8) const bool kVisibility = true;
-// One directional light with one map and no receiver plane: its map coordinates are interpolated
-// from lit.vert (see shadowTest) instead of a matrix product per fragment.
-const bool kVertexLightCoordinates = kLightCount == 1 && kLightKinds == (1 << SHADOWLAB_LIGHT_DIRECTIONAL) &&
-                                     kCascades == 1 && !kReceiverPlane;
+// One directional light with one map, or one spot light, and no receiver plane: its map
+// coordinates are interpolated from lit.vert (see shadowTest) instead of a matrix product per
+// fragment.
+// (Written without ||: glslang turns || of specialization constants into a branch and an OpPhi
+// inside a function, which the constant's uses elsewhere cannot see.)
+const bool kVertexSpot = kLightCount == 1 && kLightKinds == (1 << SHADOWLAB_LIGHT_SPOT) && !kReceiverPlane;
+const bool kVertexDirectional = kLightCount == 1 && kLightKinds == (1 << SHADOWLAB_LIGHT_DIRECTIONAL) &&
+                                kCascades == 1 && !kReceiverPlane;
+const bool kVertexLightCoordinates = !(!kVertexSpot && !kVertexDirectional);
 const bool kAnyPerspective =
     (kLightKinds & ((1 << SHADOWLAB_LIGHT_SPOT) | (1 << SHADOWLAB_LIGHT_POINT))) != 0;
 
@@ -283,8 +288,10 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         light.kind.zw = faceRange(light, face);  // reference() and PCSS read near, far there
     }
     // World size of a texel at p: constant for an orthographic map, growing with distance
-    // along the axis for a perspective one.
-    const float texel = light.bias.z * (perspective ? dot(p - light.toLight.xyz, axis) : 1.0);
+    // along the axis for a perspective one. (kVertexSpot: toShadow's w row is that distance,
+    // (axis, −axis·L), so lit.vert's interpolated w is it.)
+    const float axialP = kVertexSpot ? inLightCoordinates.w : dot(p - light.toLight.xyz, axis);
+    const float texel = light.bias.z * (perspective ? axialP : 1.0);
     // Normal offset: look the map up from a point moved off the surface along its normal.
     const vec3 q = p + n * (light.params.z * texel);
     // bias_world = depthBias + slopeBias * texel * min(tan(theta), maxTan), cos(theta) = N·L.
@@ -298,14 +305,21 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         r.axial = dot(d, axis);
         r.uv = 0.5 + 0.5 * vec2(dot(d, right), dot(d, up)) / (r.axial * light.kind.y);
     } else if (kVertexLightCoordinates) {
-        // toShadow · (p + n·offset, 1) = toShadow · (p, 1) + offset · toShadow₃ₓ₃ · n, and both
-        // terms are linear in the position and the normal, so they interpolate exactly: lit.vert
+        // toShadow · (p + n·offset, 1) = toShadow · (p, 1) + offset · toShadow · (n, 0), and both
+        // factors are linear in the position and the normal, so they interpolate exactly: lit.vert
         // computes them per vertex. In float the sum differs from the product of the interpolated
         // position by rounding at the scale of the map's coordinates (≈1e-7 of its extent), not of
         // the camera-relative position: far below a texel (2048 of them) and the depth bias.
-        const vec3 s = inLightCoordinates + (light.params.z * texel * nScale) * inLightNormal;
-        r.uv = s.xy;
-        r.axial = s.z;
+        // A spot: offset = k·texel(p) is not constant, but texel(p) = bias.z·w(p) with w the
+        // interpolated (linear) distance along the axis, so offset · toShadow · (n, 0) is a
+        // product of two interpolated factors, formed here; the clip coordinates are linear before
+        // the divide, which is done per fragment, and w = (q − L)·axis is the axial distance of the
+        // offset point. Each component rounds at its own scale (x, y ≈ w·(u, v): ≈1e-7 of w, so
+        // ≈1e-7 of the map after the divide; w ≈1e-7 of max(|p|, |L|) camera-relative, against a
+        // bias of half a texel ≈ 1e-3·w at 2048²), as the per-fragment product does.
+        const vec4 s = inLightCoordinates + (light.params.z * texel * nScale) * inLightNormal;
+        r.uv = kVertexSpot ? s.xy / s.w : s.xy;
+        r.axial = kVertexSpot ? s.w : s.z;
     } else {
         const vec4 s = light.toShadow * vec4(q, 1.0);
         // Orthographic (directional): toShadow's last row is exactly (0, 0, 0, 1), so w = 1 and

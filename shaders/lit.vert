@@ -14,11 +14,12 @@ layout(location = 2) in uint inObjectId;
 layout(location = 0) out vec3 outPosition;
 layout(location = 1) out vec3 outNormal;
 layout(location = 2) flat out uint outObjectId;
-// The first light's map coordinates of the position (toShadow · (p, 1)).xyz and of the normal
-// (toShadow's 3x3 · n), which lit.frag interpolates instead of a matrix product per fragment
-// where that light is the only one and directional (kVertexLightCoordinates); unused otherwise.
-layout(location = 3) out vec3 outLightCoordinates;
-layout(location = 4) out vec3 outLightNormal;
+// The first light's homogeneous map coordinates of the position (toShadow · (p, 1)) and of the
+// normal (toShadow · (n, 0)), which lit.frag interpolates instead of a matrix product per fragment
+// where that light is the only one and directional or a spot (kVertexLightCoordinates); unused
+// otherwise. The w row matters for a spot (its perspective divide and its distance along the axis).
+layout(location = 3) out vec4 outLightCoordinates;
+layout(location = 4) out vec4 outLightNormal;
 // The object's albedo (lit.frag's), read here once per vertex instead of once per fragment.
 layout(location = 5) flat out vec4 outAlbedo;
 
@@ -27,7 +28,7 @@ void main() {
     outNormal = inNormal;
     outObjectId = inObjectId;
     outAlbedo = albedo[inObjectId - 1u];
-    outLightCoordinates = (u.lights[0].toShadow * vec4(inPosition, 1.0)).xyz;
-    outLightNormal = mat3(u.lights[0].toShadow) * inNormal;
+    outLightCoordinates = u.lights[0].toShadow * vec4(inPosition, 1.0);
+    outLightNormal = u.lights[0].toShadow * vec4(inNormal, 0.0);
     gl_Position = u.viewProj * vec4(inPosition, 1.0);
 }

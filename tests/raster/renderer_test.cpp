@@ -759,6 +759,79 @@ TEST(RasterRender, InterpolatedLightCoordinatesMatchThePerFragmentProduct) {
         }
 }
 
+TEST(RasterRender, InterpolatedSpotLightCoordinatesMatchThePerFragmentProduct) {
+    // The same comparison for one spot light: lit.vert interpolates toShadow·(p, 1) and
+    // toShadow·(N, 0) (all four rows), lit.frag scales the second by k·texel(p) with texel(p) =
+    // bias.z·w(p), adds, and divides by w; with a second (dim) spot it multiplies the normal-offset
+    // point by toShadow per fragment. Algebraically the same (clip coordinates are linear in the
+    // point, and the offset's two factors each in the position and the normal), so light 0's
+    // visibility must agree up to rounding at the map's scale: the divided (u, v) ≈1e-7 of the map,
+    // < 1e-4 of a 512² texel, so pcf2x2's weights move by ≲ 1e-4 and at most a few edge texels may
+    // flip. The spot shines at ≈40° to the plane, so the offset (along the plane's normal) moves
+    // u, v as well as the axial distance; PCSS (a light of radius 0.1) also takes the axial
+    // distance and the texel size into its blocker search and kernel width. Near the origin and
+    // 10^7 units away. (An offset 10% too long in the interpolated path flips 8 (none) to 195
+    // (pcss) pixels here.)
+    // The closed form (the unshifted scene: the pixels see the same) counts the plane pixels well
+    // inside the cone whose segment to the light meets the sphere, so the comparison covers a shadow.
+    const SphereOverPlane base{.width = 320, .height = 180};
+    const scene::CameraBasis cam = scene::cameraBasis(makeScene(base).camera);
+    const Vec3 spotPosition(2.5, 3.0, 1.5), spotDirection = glm::normalize(Vec3(-2.5, -2.2, -1.5));
+    const double cone = 45.0;
+    for (const double offset : {0.0, 1.0e7})
+        for (const ShadowFilter filter :
+             {ShadowFilter::None, ShadowFilter::Pcf2x2, ShadowFilter::Poisson, ShadowFilter::Pcss}) {
+            SphereOverPlane p = base;
+            const Vec3 shift(offset, 0.0, -offset);
+            p.eye += shift;
+            p.lookAt += shift;
+            scene::Scene one = makeScene(p);
+            std::get<scene::Sphere>(one.objects[0].shape).center += shift;
+            std::get<scene::Quad>(one.objects[1].shape).center += shift;
+            scene::Light& spot = one.lights[0];
+            spot.type = scene::LightType::Spot;
+            spot.position = spotPosition + shift;
+            spot.direction = spotDirection;
+            spot.coneAngleDegrees = cone;
+            spot.radius = 0.1;
+            spot.intensity = 300.0;
+            scene::Scene two = one;
+            scene::Light dim = one.lights[0];
+            dim.position = Vec3(-2.0, 5.0, 1.0) + shift;
+            dim.direction = glm::normalize(Vec3(0.4, -1.0, -0.2));
+            dim.intensity = 30.0;
+            two.lights.push_back(dim);
+            scene::RasterSettings settings = validatedSettings(512, 0.004, 0.1, filter);
+            settings.normalOffset = 1.5;
+            const scene::Frame a = renderValidated(one, settings, "one spot");
+            const scene::Frame b = renderValidated(two, settings, "two spots");
+            ASSERT_EQ(b.lightVisibility.size(), 2u);
+            std::size_t lit = 0, shadowedInCone = 0, differ = 0;
+            double worst = 0.0;
+            for (int y = 0; y < a.height; ++y)
+                for (int x = 0; x < a.width; ++x) {
+                    const std::size_t i = at(a, x, y);
+                    if (a.objectId[i] == 0.0f) continue;
+                    ASSERT_EQ(a.objectId[i], b.objectId[i]);
+                    const double d = std::abs(double(a.visibility[i]) - double(b.lightVisibility[0][i]));
+                    if (d <= 1e-3) worst = std::max(worst, d);
+                    differ += d > 1e-3;
+                    lit += a.visibility[i] > 0.99f;
+                    const PrimaryHit h = primaryHit(base, cam, x, y);
+                    const Vec3 toLight = spotPosition - h.p;
+                    if (h.id == 2 && glm::dot(-glm::normalize(toLight), spotDirection) >
+                                         std::cos(cone * kPi / 180.0) + 0.01) {
+                        const auto t = raySphere(h.p, toLight, base.center, base.radius);
+                        shadowedInCone += t && *t < 1.0;
+                    }
+                }
+            EXPECT_GT(shadowedInCone, 500u) << "the sphere shadows the plane inside the cone";
+            EXPECT_GT(lit, 10000u);
+            EXPECT_LE(differ, 3u) << "offset " << offset << ", filter " << int(filter);
+            EXPECT_LE(worst, 2e-4) << "offset " << offset << ", filter " << int(filter);
+        }
+}
+
 TEST(RasterRender, OneLightKeepsNoPerLightVisibility) {
     const scene::Scene s = makeScene(SphereOverPlane{});
     const scene::Frame f = renderValidated(s, validatedSettings(256, 0.01, 1.0, ShadowFilter::None), "one-light");
