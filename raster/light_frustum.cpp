@@ -593,6 +593,29 @@ double snapWindowHalfSize(double half) {
     return std::exp2(std::ceil(4.0 * std::log2(half) - 1e-9) / 4.0);
 }
 
+// The fitted near and far planes lie on a geometric grid, the powers of 2^(1/4) (near rounded
+// down, far up: the range only grows, so whatever it held it still holds). Why this grid:
+// - distances from the light have no natural unit and no origin but the light, so the grid must be
+//   scale-invariant: the same scene scaled by 2 gets the same planes scaled by 2, and moving the
+//   whole scene (light included) away from the origin changes nothing;
+// - perspective depth resolution is set by near (a depth step δz is δd ≈ δz·d²·(1/near − 1/far)
+//   at distance d), so near must move by a bounded factor, not a bounded amount: a step that is a
+//   fraction of the range would round a near much smaller than the range down to 0 (then to
+//   far/1000, a ~1000-fold loss);
+// - 2^(1/4) is the window's step (snapWindowHalfSize): near/far change about as rarely as the
+//   texel size, only when what the camera sees changes depth by 19%.
+// The cost: 1/near − 1/far grows from (1 − r)/near to at most (s − r/s)/near (s = 2^(1/4), r =
+// near/far unsnapped), so depth steps get at most 1.19× coarser when near ≪ far, 1.54× at r = 0.5
+// and 2.6× at r = 0.8 (a range a quarter of near wide); never coarser than a map
+// with far at infinity and near/1.19, nor than the unfitted map (the range stays inside its range).
+// With D32 float that is under 1e-7·d²/near world units, far below any bias.
+double snapDepthDown(double d) {
+    return std::exp2(std::floor(kDepthGridStepsPerOctave * std::log2(d)) / kDepthGridStepsPerOctave);
+}
+double snapDepthUp(double d) {
+    return std::exp2(std::ceil(kDepthGridStepsPerOctave * std::log2(d)) / kDepthGridStepsPerOctave);
+}
+
 namespace {
 
 // The nearest distance along f's axis of any point of an object's box inside f's window pyramid
@@ -623,13 +646,17 @@ double nearestDepthInWindow(const scene::Scene& scene, const LightFrustum& f) {
 // Near/far of perspective map f (its window already set) from the intersection of the casters'
 // and the receivers' depth ranges: far = the farthest receiver in front (maxDepth) grown by the
 // margin (the normal offset moves a point up to that fraction of its distance farther) and 1%;
-// near = the nearest caster in the window less 1%. Both stay inside f's own range (the bounding
-// sphere's) and near ≥ far · kSpotMinNearOverFar; f is unchanged when they would not make a range.
+// near = the nearest caster in the window less 1%. Both are then snapped outward to the depth grid
+// (snapDepthDown/Up) so that a moving camera leaves them, and so every stored depth, unchanged until
+// they cross a step of it. Both stay inside f's own range (the bounding sphere's, fixed for the
+// scene) and near ≥ far · kSpotMinNearOverFar (of the snapped far); f is unchanged when they would
+// not make a range.
 void fitDepthRange(const scene::Scene& scene, LightFrustum& f, double maxDepth, double marginTexels) {
-    const double far = std::min(maxDepth * (1.0 + marginTexels * f.texelWorldSize()) * kLightFrustumMargin, f.far);
+    const double fitFar = maxDepth * (1.0 + marginTexels * f.texelWorldSize()) * kLightFrustumMargin;
+    const double far = std::min(snapDepthUp(fitFar), f.far);
     const double nearest = nearestDepthInWindow(scene, f);
-    const double near = std::max({std::isfinite(nearest) ? nearest / kLightFrustumMargin : f.near, f.near,
-                                  far * kSpotMinNearOverFar});
+    const double near = std::max({std::isfinite(nearest) ? snapDepthDown(nearest / kLightFrustumMargin) : f.near,
+                                  f.near, far * kSpotMinNearOverFar});
     if (!(near < far)) return;
     f.near = near;
     f.far = far;

@@ -100,7 +100,8 @@ LightFrustum fitSpotLight(const scene::Bounds& bounds, const scene::Vec3& positi
 //   be smaller, or when a receiver lies on or behind the light's plane;
 // - near/far: far is the farthest visible receiver in front of the light (+ the margin's fraction
 //   of its distance, + 1%), near the nearest point of any object's box inside the window's pyramid
-//   (− 1%), both within the cone map's and near ≥ far/1000.
+//   (− 1%), snapped outward to powers of 2^(1/4) (snapDepthDown/Up: still while the camera
+//   moves a little), both within the cone map's and near ≥ far/1000.
 // The cone map when the camera sees none of the scene or no receiver lies in front of the light.
 LightFrustum fitSpotLightToReceivers(const scene::Scene& scene, const scene::Light& light, int mapSize,
                                      double marginTexels);
@@ -113,6 +114,13 @@ LightFrustum spotLightFrustum(const scene::Scene& scene, const scene::RasterSett
                               const scene::Light& light, int mapSize);
 // Rounds a window half-size up to the next power of 2^(1/4) (the fitted windows' sizes).
 double snapWindowHalfSize(double half);
+// The fitted near/far planes' grid (spot maps and cube faces): distances from the light rounded
+// down (near) or up (far) to a power of 2^(1/kDepthGridStepsPerOctave), so that a moving camera
+// changes them, and with them every stored depth, only when what it sees crosses a step (issue 5:
+// no swimming). light_frustum.cpp says why this grid and what depth precision it costs.
+inline constexpr double kDepthGridStepsPerOctave = 4.0;
+double snapDepthDown(double d);
+double snapDepthUp(double d);
 
 // The six faces of a point light's cube map, in this order: +X, −X, +Y, −Y, +Z, −Z (each
 // face's `direction`; its right and up axes come from the same rule as every other frustum, and

@@ -408,7 +408,26 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
             vec3 at = vec3(r.uv + o / size, layer);
             float drTap = dr;
             vec2 range = vec2(near, far);
-            if (wrap) at = cubeTap(light, axis, right, up, qd, at.xy, drTap, range);
+            // How much nearer than the receiver (dr) a stored depth must be to count as a blocker.
+            // With the receiver plane, as biasedTap: the tap reads the texel at its center, where the
+            // receiver lies at the plane's depth, so its own texels are not blockers (the slope term,
+            // which the plane makes unnecessary elsewhere so that it may be 0, and which is capped at
+            // tan θ = 10, need not cover them across a wide search); the threshold is the nearer of
+            // that and dr (a surface behind the point cannot shadow it, even where the plane lies
+            // deeper), less the constant bias (r.biasWorld is that alone with a plane). A tap that
+            // wraps into another face (point lights) keeps the slope term: the plane and its texel
+            // grid are the receiver's face's.
+            float nearerBy = r.biasWorld + r.slopeStep * length(o);
+            if (kReceiverPlane && r.plane) {
+                const vec2 t = r.uv * size;
+                const vec2 center = floor(t + o) + 0.5;
+                at.xy = center / size;
+                nearerBy = r.biasWorld - min(dot(r.grad, center - t), 0.0);
+            }
+            if (wrap) {
+                at = cubeTap(light, axis, right, up, qd, at.xy, drTap, range);
+                if (kReceiverPlane && r.plane && at.z != layer) nearerBy = r.biasWorld + r.slopeStep * length(o);
+            }
             // The nearest caster of the texel: the opaque depth or, with semi-transparent casters,
             // the nearest of those when it is nearer, so their shadows are softened too.
             float z = texture(shadowDepths, at).r;
@@ -416,7 +435,7 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
             if (z >= 1.0) continue;  // nothing drawn there
             // Stored perspective depth back to distance: z = far/(far−near)(1 − near/d).
             const float d = range.x / max(1.0 - z * (range.y - range.x) / range.y, 1e-7);
-            if (d < drTap - (r.biasWorld + r.slopeStep * length(o))) {
+            if (d < drTap - nearerBy) {
                 blockerSum += d;
                 ++blockers;
             }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <variant>
 
 #include <gtest/gtest.h>
 
@@ -87,11 +88,16 @@ TEST(RasterSpotFit, TheWindowIsTheHandComputedFractionOfTheCone) {
     EXPECT_NEAR(f.windowV, 0.25, 0.5 * texel);
     EXPECT_NEAR(f.windowV / texel, std::round(f.windowV / texel), 1e-6);
     // The depth range: the farthest receiver is the ground (d = 8), grown by the margin's fraction
-    // 10 texels · 2h/N and 1%; the nearest caster in the window is the sphere's box top (y = 1,
-    // d = 7), less 1%.
-    EXPECT_NEAR(f.far, 8.0 * (1.0 + 10.0 * texel) * 1.01, 1e-9);
-    EXPECT_NEAR(f.near, 7.0 / 1.01, 1e-9);
+    // 10 texels · 2h/N and 1%: 8·(1 + 10·0.000691)·1.01 = 8.136; the nearest caster in the window
+    // is the sphere's box top (y = 1, d = 7), less 1%: 6.931. Snapped outward to powers of 2^(1/4):
+    // 4·log2 8.136 = 12.10, so far = 2^(13/4) = 9.51; 4·log2 6.931 = 11.17, so near = 2^(11/4) = 6.73.
+    const double fitFar = 8.0 * (1.0 + 10.0 * texel) * 1.01, fitNear = 7.0 / 1.01;
+    ASSERT_NEAR(4.0 * std::log2(fitFar), 12.10, 0.01);
+    ASSERT_NEAR(4.0 * std::log2(fitNear), 11.17, 0.01);
+    EXPECT_NEAR(f.far, std::exp2(13.0 / 4.0), 1e-12);
+    EXPECT_NEAR(f.near, std::exp2(11.0 / 4.0), 1e-12);
     EXPECT_GT(cone.far, 1.5 * f.far);
+    EXPECT_LT(cone.near, f.near);
 }
 
 TEST(RasterSpotFit, TheFittedWindowHoldsEveryVisibleReceiverWithTheMargin) {
@@ -126,6 +132,118 @@ TEST(RasterSpotFit, TheFittedWindowHoldsEveryVisibleReceiverWithTheMargin) {
     EXPECT_EQ(seen, frame.width * frame.height);
     EXPECT_GE(closest, 10.0);
 }
+
+// spotScene's spot tilted toward +x, direction (1, −2, 0)/√5 (cone map 61.2°, its axis 26.6° off
+// the vertical), and everything (camera, light, objects) moved by `offset`. A ground point
+// (x, 0, z) lies at d = (x + 16)/√5 along the axis (relative to the offset), so the farthest
+// visible receiver is the ground's visible edge x = cameraX + 4·tan 20°·16/9, and the fitted far
+// plane before snapping moves with the camera.
+scene::Scene tiltedSpotScene(double cameraX, const Vec3& offset = Vec3(0.0)) {
+    scene::Scene s = spotScene(cameraX);
+    s.lights[0].direction = glm::normalize(Vec3(1, -2, 0));
+    s.lights[0].position += offset;
+    s.camera.position += offset;
+    s.camera.lookAt += offset;
+    std::get<scene::Sphere>(s.objects[0].shape).center += offset;
+    std::get<scene::Quad>(s.objects[1].shape).center += offset;
+    return s;
+}
+
+// tiltedSpotScene's far plane before snapping: the farthest receiver's d, grown by the margin
+// (10 texels of the window's 2h/N) and 1%.
+double tiltedFitFar(double cameraX, double h, int n) {
+    return (cameraX + 4.0 * std::tan(deg(20)) * 16.0 / 9.0 + 16.0) / std::sqrt(5.0) * (1.0 + 10.0 * 2.0 * h / n) * 1.01;
+}
+
+TEST(RasterSpotFit, SmallCameraMovesLeaveNearAndFarBitIdenticalAndLargeOnesStepAlongTheGrid) {
+    // Issue 5: the fitted map must not swim. The window moves by whole texels (above); near and far
+    // lie on powers of 2^(1/4), so stored depths do not change either while the camera moves a
+    // little, though the unsnapped far moves with it (1/√5 · 1.01 per unit of camera x).
+    const int n = 1024;
+    const scene::RasterSettings settings = fitSettings(n, true);
+    const double x0 = 0.6;
+    const scene::Scene s0 = tiltedSpotScene(x0);
+    const LightFrustum f0 = spotLightFrustum(s0, settings, s0.lights[0], n);
+    const LightFrustum cone = spotLightFrustum(s0, fitSettings(n, false), s0.lights[0], n);
+    ASSERT_LT(f0.tanHalfFov, 0.5 * cone.tanHalfFov);  // a fitted window
+    // Far: (0.6 + 2.588 + 16)/√5 · (1 + 20h/N) · 1.01 = 8.72 (h = 2^(−1.5): 8.73), halfway between
+    // the steps 2^(12/4) = 8 and 2^(13/4) = 9.51 (4·log2 = 12.5), so it snaps up to 2^(13/4).
+    const double fitFar = tiltedFitFar(x0, f0.tanHalfFov, n);
+    ASSERT_NEAR(4.0 * std::log2(fitFar), 12.5, 0.1);
+    EXPECT_NEAR(f0.far, std::exp2(13.0 / 4.0), 1e-12);
+    // Near: a power of 2^(1/4) (the nearest caster in the window less 1%, rounded down), above the
+    // cone map's near and far/1000.
+    EXPECT_NEAR(4.0 * std::log2(f0.near), std::round(4.0 * std::log2(f0.near)), 1e-9);
+    EXPECT_GT(f0.near, cone.near);
+    EXPECT_GT(f0.near, f0.far / 1000.0);
+    // A texel of the window is 2h/N·d ≈ 0.0061 units at the ground; moves of 0.3 texel, a thousandth
+    // of a unit and 0.25 units (the unsnapped far changes by up to 0.11, which 8.73 → 9.51 has room
+    // for) keep near and far bit for bit.
+    for (const double move : {0.3 * 0.0061, 1e-3, -0.25, 0.25}) {
+        SCOPED_TRACE(move);
+        const scene::Scene s1 = tiltedSpotScene(x0 + move);
+        const LightFrustum f1 = spotLightFrustum(s1, settings, s1.lights[0], n);
+        EXPECT_NE(tiltedFitFar(x0 + move, f1.tanHalfFov, n), fitFar);
+        EXPECT_EQ(f1.near, f0.near);
+        EXPECT_EQ(f1.far, f0.far);
+    }
+    // A move of 3 units: the unsnapped far grows by 3/√5·1.01 = 1.36 to 10.1, past 2^(13/4), so
+    // far steps to 2^(14/4) = 11.3.
+    const scene::Scene s2 = tiltedSpotScene(x0 + 3.0);
+    const LightFrustum f2 = spotLightFrustum(s2, settings, s2.lights[0], n);
+    ASSERT_NEAR(4.0 * std::log2(tiltedFitFar(x0 + 3.0, f2.tanHalfFov, n)), 13.3, 0.1);
+    EXPECT_NEAR(f2.far, std::exp2(14.0 / 4.0), 1e-12);
+}
+
+TEST(RasterSpotFit, TheSnappedDepthRangeStillHoldsEveryVisibleReceiverAndCaster) {
+    // Rendered (validated) from the tilted spot: every visible point, rebuilt from the Frame's depth,
+    // lies between near and far along the light's axis, and the sphere (the only caster above the
+    // ground in the window) lies beyond near: its nearest point to the light along the axis is
+    // (center − light)·axis − r = (2 + 15)/√5 − 0.5 = 7.10.
+    const scene::Scene s = tiltedSpotScene(0.6);
+    RenderDebug debug;
+    const scene::Frame frame = renderValidated(s, fitSettings(1024, true), &debug);
+    ASSERT_EQ(debug.frusta.size(), 1u);
+    const LightFrustum& f = debug.frusta[0];
+    const Vec3 axis = glm::normalize(Vec3(1, -2, 0));
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    double nearest = INFINITY, farthest = 0.0;
+    for (int y = 0; y < frame.height; ++y)
+        for (int x = 0; x < frame.width; ++x) {
+            const std::size_t i = std::size_t(y) * frame.width + x;
+            if (!(frame.objectId[i] > 0.0f)) continue;
+            const Vec3 p = cam.position + double(frame.depth[i]) * scene::pixelDirection(cam, x, y);
+            const double d = glm::dot(p - s.lights[0].position, axis);
+            nearest = std::min(nearest, d);
+            farthest = std::max(farthest, d);
+        }
+    EXPECT_GE(nearest, f.near);
+    EXPECT_LE(farthest, f.far);
+    EXPECT_LE(f.near, 17.0 / std::sqrt(5.0) - 0.5);
+}
+
+TEST(RasterSpotFit, FarFromTheOriginTheFittedMapIsTheSame) {
+    // The whole tilted scene moved 10⁶ units away: distances from the light are the same up to
+    // rounding of the positions (~1e-10), far from any step of the grid or texel of the window, so
+    // the window and the depth range are bit for bit the origin's; a small camera move there keeps
+    // them too. The same for every face of a point light.
+    const int n = 1024;
+    const scene::RasterSettings settings = fitSettings(n, true);
+    const Vec3 offset(1e6, 1e6, -1e6);
+    const scene::Scene a = tiltedSpotScene(0.6), b = tiltedSpotScene(0.6, offset);
+    const LightFrustum fa = spotLightFrustum(a, settings, a.lights[0], n);
+    const LightFrustum fb = spotLightFrustum(b, settings, b.lights[0], n);
+    EXPECT_EQ(fb.tanHalfFov, fa.tanHalfFov);
+    EXPECT_EQ(fb.windowU, fa.windowU);
+    EXPECT_EQ(fb.windowV, fa.windowV);
+    EXPECT_EQ(fb.near, fa.near);
+    EXPECT_EQ(fb.far, fa.far);
+    const scene::Scene moved = tiltedSpotScene(0.6 + 1e-3, offset);
+    const LightFrustum fm = spotLightFrustum(moved, settings, moved.lights[0], n);
+    EXPECT_EQ(fm.near, fa.near);
+    EXPECT_EQ(fm.far, fa.far);
+}
+
 
 TEST(RasterSpotFit, MovingTheCameraByAFractionOfATexelKeepsTheSizeAndMovesTheCenterByWholeTexels) {
     // A texel of the fitted map at the ground is 8·2h/N = 0.0055 units; the camera moves along x
@@ -241,11 +359,16 @@ TEST(RasterPointFit, EachFaceTakesItsNearAndFarFromItsCastersAndReceivers) {
     const double t = double(n) / (n - 24);
     const scene::Scene s = pointScene(320, 180);
     const scene::RasterSettings fit = fitSettings(n, true), plain = fitSettings(n, false);
+    // Each snapped outward to a power of 2^(1/4): far 4·1.02·1.01 = 4.121 (4·log2 = 8.17) → 2^(9/4);
+    // near 2.970 (6.28) → 2^(6/4); +X near 3.867 (7.81) → 2^(7/4).
+    ASSERT_NEAR(4.0 * std::log2(4.0 * (1.0 + 10.0 * 2.0 * t / n) * 1.01), 8.17, 0.01);
+    ASSERT_NEAR(4.0 * std::log2(3.0 / 1.01), 6.28, 0.01);
+    ASSERT_NEAR(4.0 * std::log2(4.0 / t / 1.01), 7.81, 0.01);
     const LightFrustum down = pointLightFaceFrustum(s, fit, s.lights[0], 3, n);
-    EXPECT_NEAR(down.far, 4.0 * (1.0 + 10.0 * 2.0 * t / n) * 1.01, 1e-9);
-    EXPECT_NEAR(down.near, 3.0 / 1.01, 1e-9);
+    EXPECT_NEAR(down.far, std::exp2(9.0 / 4.0), 1e-12);
+    EXPECT_NEAR(down.near, std::exp2(6.0 / 4.0), 1e-12);
     const LightFrustum plusX = pointLightFaceFrustum(s, fit, s.lights[0], 0, n);
-    EXPECT_NEAR(plusX.near, 4.0 / t / 1.01, 1e-9);
+    EXPECT_NEAR(plusX.near, std::exp2(7.0 / 4.0), 1e-12);
     const LightFrustum up = pointLightFaceFrustum(s, fit, s.lights[0], 2, n);
     const LightFrustum upPlain = pointLightFaceFrustum(s, plain, s.lights[0], 2, n);
     EXPECT_EQ(up.near, upPlain.near);
@@ -288,6 +411,37 @@ TEST(RasterPointFit, EachFaceTakesItsNearAndFarFromItsCastersAndReceivers) {
                 b.meanAbsVisibilityError, a.falseShadow + a.missedShadow, b.falseShadow + b.missedShadow);
     EXPECT_LE(a.meanAbsVisibilityError, b.meanAbsVisibilityError * 1.05);
     EXPECT_LE(a.falseShadow + a.missedShadow, b.falseShadow + b.missedShadow + a.counted / 200);
+}
+
+TEST(RasterPointFit, SmallCameraMovesLeaveEveryFacesNearAndFarBitIdentical) {
+    // The point scene's camera moved sideways by a thousandth and a hundredth of a unit: the visible
+    // ground's edge, and with it the unsnapped far of the side faces, moves; the snapped ranges of
+    // all six faces stay bit for bit. Moved 10⁶ units away (light and all), the same ranges.
+    const int n = 1024;
+    const scene::RasterSettings settings = fitSettings(n, true);
+    const scene::Scene s0 = pointScene(320, 180);
+    for (const double move : {1e-3, 1e-2}) {
+        SCOPED_TRACE(move);
+        scene::Scene s1 = s0;
+        s1.camera.position.x += move;
+        s1.camera.lookAt.x += move;
+        scene::Scene far = s0;
+        const Vec3 offset(-1e6, 1e6, 1e6);
+        far.camera.position += offset + Vec3(move, 0, 0);
+        far.camera.lookAt += offset + Vec3(move, 0, 0);
+        far.lights[0].position += offset;
+        std::get<scene::Sphere>(far.objects[0].shape).center += offset;
+        std::get<scene::Quad>(far.objects[1].shape).center += offset;
+        for (int face = 0; face < kCubeFaces; ++face) {
+            SCOPED_TRACE(face);
+            const LightFrustum f0 = pointLightFaceFrustum(s0, settings, s0.lights[0], face, n);
+            for (const scene::Scene* s : {&s1, &far}) {
+                const LightFrustum f1 = pointLightFaceFrustum(*s, settings, s->lights[0], face, n);
+                EXPECT_EQ(f1.near, f0.near);
+                EXPECT_EQ(f1.far, f0.far);
+            }
+        }
+    }
 }
 
 // The point light's map size by hand: camera at (0, 10, 0) looking straight down (fov 40°) at the

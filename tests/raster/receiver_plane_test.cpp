@@ -13,6 +13,7 @@
 #include "raytrace/renderer.h"
 #include "scene/frame_io.h"
 #include "scene/loader.h"
+#include "scene/camera.h"
 #include "scene/render_plan.h"
 
 namespace shadowlab::raster {
@@ -97,6 +98,102 @@ TEST(RasterReceiverPlane, IsRecordedAndTheSameFrameTwice) {
     EXPECT_EQ(a.visibility, b.visibility);
     settings.receiverPlaneBias = false;
     EXPECT_EQ(rasterRender(s, settings, "rpb-2x2-off").attributes["receiver_plane_bias"], "false");
+}
+
+// A spot of diameter 1.5 at (−8, 2, 0) shining along (11, −2, 0), so light meets the floor y = 0
+// about 10° above it (tan θ ≈ 5.6 from the normal), and a 1.5 x 1.5 quad 0.02 above the floor
+// centered at (2, 0.02, 0): a contact shadow on a large, steeply tilted receiver. The camera looks
+// down at the quad from the side.
+scene::Scene grazingSpot() {
+    scene::Scene s;
+    s.camera.position = {1.5, 3, 4};
+    s.camera.lookAt = {1.5, 0, 0};
+    s.camera.up = {0, 1, 0};
+    s.camera.fovYDegrees = 40.0;
+    s.camera.width = 320;
+    s.camera.height = 180;
+    s.camera.near = 0.1;
+    s.camera.far = 100.0;
+    scene::Material m;
+    m.name = "matte";
+    s.materials.push_back(m);
+    scene::Light l;
+    l.type = scene::LightType::Spot;
+    l.position = {-8, 2, 0};
+    l.direction = glm::normalize(scene::Vec3(11, -2, 0));
+    l.coneAngleDegrees = 30.0;
+    l.radius = 0.75;
+    l.intensity = 800.0;
+    s.lights.push_back(l);
+    auto quad = [](const scene::Vec3& c, double side) {
+        scene::Quad q;
+        q.center = c;
+        q.normal = {0, 1, 0};
+        q.size = scene::Vec2(side, side);
+        scene::quadAxes(q.normal, q.uAxis, q.vAxis);
+        return q;
+    };
+    s.objects.push_back({"floor", quad({0, 0, 0}, 20.0), 0});
+    s.objects.push_back({"caster", quad({2, 0.02, 0}, 1.5), 0});
+    return s;
+}
+
+TEST(RasterReceiverPlane, PcssBlockerSearchDoesNotCountTheReceiverItself) {
+    // PCSS with the receiver plane and no slope bias (the plane replaces it). The blocker search
+    // reaches up to 64 texels (1/16 of 1024) from the point; there the floor is up to 64 texels ·
+    // 0.0104 · 5.6 ≈ 3.7 units nearer the light than the point, so a search that compares its taps
+    // against the point's own depth counts the floor as its blocker, sizes a wide penumbra from it,
+    // and the filter then reaches the quad's shadow from lit floor around it. Compared against the
+    // plane at each tap's texel (and the point's depth), the floor is never a blocker.
+    // Judged where nothing can block: floor points nearer the light along its axis than any corner
+    // of the quad, (q − L)·dir < (corner − L)·dir = ((1.25 + 8)·11 + 1.98·2)/√125 = 9.455, i.e.
+    // x < 1.245 on the floor; with 0.25 to spare, x < 1 (and inside the cone). No blocker can be
+    // nearer than such a point, so the reference is 1 there and the search must find nothing:
+    // visibility exactly 1.
+    const scene::Scene s = grazingSpot();
+    scene::RasterSettings settings = scene::resolveSettings(s, {}).raster;
+    settings.shadowMapSize = 1024;
+    settings.depthBias = 0.005;  // about half a texel at the floor (2·tan 30.6°/1024 · 9 = 0.0104)
+    settings.depthBiasIsDefault = false;
+    settings.slopeBias = 0.0;
+    settings.filter = scene::ShadowFilter::Pcss;
+    settings.receiverPlaneBias = true;
+    const scene::Frame f = rasterRender(s, settings, "rpb-pcss");
+    scene::RenderSettings rs;
+    rs.raster = settings;
+    const scene::Frame ref = raytrace::renderReference(s, scene::makeRenderPlan(s, rs),
+                                                       scene::referenceSettings(rs.raytrace));
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    int front = 0, refLit = 0, darkened = 0, umbra = 0, umbraDark = 0;
+    double worst = 1.0;
+    for (int y = 0; y < f.height; ++y)
+        for (int x = 0; x < f.width; ++x) {
+            const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
+            if (f.objectId[i] != 1.0f || ref.objectId[i] != 1.0f) continue;  // the floor in both
+            const scene::Vec3 d = scene::pixelDirection(cam, x, y);
+            const scene::Vec3 q = cam.position + (-cam.position.y / d.y) * d;  // the test's own hit
+            // Inside the cone (visibility 0 outside it), 1° to spare.
+            const double cosAxis = glm::dot(glm::normalize(q - s.lights[0].position), s.lights[0].direction);
+            if (q.x < 1.0 && cosAxis > std::cos(29.0 * 3.14159265358979323846 / 180.0)) {
+                ++front;
+                refLit += ref.visibility[i] >= 0.999f;
+                darkened += f.visibility[i] < 1.0f;
+                worst = std::min(worst, double(f.visibility[i]));
+            }
+            // The shadow stays: the reference's umbra (under and just past the quad).
+            if (ref.visibility[i] <= 0.001f) {
+                ++umbra;
+                umbraDark += f.visibility[i] < 0.5f;
+            }
+        }
+    std::printf("floor in front of the quad: %d pixels, reference lit %d, pcss darkened %d (worst %.3f); "
+                "umbra %d, dark there %d\n",
+                front, refLit, darkened, worst, umbra, umbraDark);
+    ASSERT_GT(front, 10000);
+    EXPECT_EQ(refLit, front);
+    EXPECT_EQ(darkened, 0);
+    ASSERT_GT(umbra, 100);
+    EXPECT_GT(umbraDark, umbra * 9 / 10);
 }
 
 }  // namespace
