@@ -471,6 +471,13 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
             LightData lt = light;
             vec2 range;
             const vec3 at = cubeTap(light, axis, right, up, qd, r.uv + o / size, rt.axial, range);
+            if (kReceiverPlane && r.plane && at.z == layer) {
+                // Still in the receiver's face: the same texel grid and depths as a spot's map, so
+                // the tap compares against the receiver plane as biasedTap does (with the slope
+                // bias 0 the slope term would take the tilted receiver's own texels for blockers).
+                sum += biasedTap(light, r, o, size, layer, blocker);
+                continue;
+            }
             lt.kind.zw = range;
             sum += tap(at.xy, at.z, reference(lt, rt, r.biasWorld + r.slopeStep * length(o)), blocker);
         } else {
