@@ -207,13 +207,31 @@ LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const Vec
 
     // Square texels: the larger extent sets the half-width; the map is centered on the
     // receivers across the light. Same margin as the bounding-sphere fit.
-    const double half = 0.5 * std::max(maxU - minU, maxV - minV) * kLightFrustumMargin;
+    // Snapped so that the map does not swim as the camera moves (as each cascade's, fitCascade):
+    // - the half-width is rounded up to 1/16 of its power of two, so a small move keeps the
+    //   texel size; the center then moves by up to half a texel on each axis, so the window
+    //   needed grows by that: h·(1 − 1/N) ≥ the receivers' half extent, h ≥ half·N/(N − 1);
+    // - the center lies on the world-fixed texel grid (multiples of the texel along right and
+    //   up from the world origin), so the map moves by whole texels only;
+    // - near and far are rounded outward to 1/16 of the power of two of their range, from the
+    //   bounding sphere's center (fixed for the scene), so stored depths keep their values.
+    const double size = f.mapSize;
+    double half = 0.5 * std::max(maxU - minU, maxV - minV) * kLightFrustumMargin * size / std::max(size - 1.0, 1.0);
+    if (!(half > 0.0)) return f;
+    const double quantum = std::exp2(std::floor(std::log2(half)) - 4.0);
+    half = std::ceil(half / quantum) * quantum;
+    if (half >= f.halfWidth) return f;  // no gain over the bounding sphere
     const double pad = (kLightFrustumMargin - 1.0) * (maxDepth - minDepth);
-    if (!(half > 0.0) || half >= f.halfWidth) return f;  // no gain over the bounding sphere
-    f.center = f.center + 0.5 * (minU + maxU) * f.right + 0.5 * (minV + maxV) * f.up;
+    const Vec3 receiversCenter = f.center + 0.5 * (minU + maxU) * f.right + 0.5 * (minV + maxV) * f.up;
     f.halfWidth = half;
-    f.nearDepth = minDepth - pad;
-    f.farDepth = maxDepth + pad;
+    const double texel = f.texelWorldSize();
+    const double u = glm::dot(receiversCenter, f.right), v = glm::dot(receiversCenter, f.up);
+    f.center = receiversCenter + (std::round(u / texel) * texel - u) * f.right +
+               (std::round(v / texel) * texel - v) * f.up;
+    const double nearDepth = minDepth - pad, farDepth = maxDepth + pad;
+    const double depthQuantum = std::exp2(std::floor(std::log2(farDepth - nearDepth)) - 4.0);
+    f.nearDepth = std::floor(nearDepth / depthQuantum) * depthQuantum;
+    f.farDepth = std::ceil(farDepth / depthQuantum) * depthQuantum;
     return f;
 }
 

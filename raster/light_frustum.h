@@ -58,8 +58,10 @@ LightFrustum fitDirectionalLight(const scene::Bounds& bounds, const scene::Vec3&
 // A map covering only what can shadow what the camera sees: the receivers are the scene's
 // bounds clipped to the camera frustum (its far plane pulled in to the scene); across the light
 // the map covers their extent, and in depth it reaches back toward the light to the nearest
-// object whose extent across the light overlaps theirs. Falls back to fitDirectionalLight()
-// when the camera sees none of the scene.
+// object whose extent across the light overlaps theirs. Snapped so that it does not swim: the
+// half-width rounded up to 1/16 of its power of two, the center on the world-fixed texel grid,
+// near and far rounded outward to 1/16 of their range's power of two. Falls back to
+// fitDirectionalLight() when the camera sees none of the scene.
 LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const scene::Vec3& direction, int mapSize);
 
 // The map's basis for light travelling along `direction`: right = direction × (world Y, or X for

@@ -158,6 +158,52 @@ TEST(LightFrustum, FittedToReceiversIsSmallerAndStillCoversEveryVisiblePoint) {
     EXPECT_GE(top.z, 0.0);
 }
 
+TEST(LightFrustum, FittedMapMovesByWholeTexelsAndKeepsItsSizeAndDepthsAsTheCameraMoves) {
+    // Issue 5: "texel-snapped so the map does not swim". A camera move of a fraction of a texel
+    // keeps the texel size and the depth range bit for bit, and the map's center stays on the
+    // world-fixed grid (whole texels along right and up from the world origin), so every texel
+    // that still covers the scene covers the same world square.
+    const Vec3 dir = glm::normalize(Vec3(-1, -2, -1));
+    for (const double far : {0.0, 1e6}) {
+        scene::Scene s = bigPlaneScene();
+        const Vec3 shift(far, 0, far);
+        std::get<scene::Sphere>(s.objects[0].shape).center += shift;
+        std::get<scene::Quad>(s.objects[1].shape).center += shift;
+        s.camera.position += shift;
+        s.camera.lookAt += shift;
+        const LightFrustum a = fitDirectionalLightToReceivers(s, dir, 1024);
+        const double texel = a.texelWorldSize();
+        ASSERT_LT(a.halfWidth, 0.5 * fitDirectionalLight(s.bounds(), dir, 1024).halfWidth) << "fitted at all";
+        // On the grid: the center's coordinates across the light are whole texels.
+        for (const Vec3& axis : {a.right, a.up}) {
+            const double k = glm::dot(a.center, axis) / texel;
+            EXPECT_NEAR(k, std::round(k), 1e-6 * std::max(1.0, std::abs(k))) << far;
+        }
+        // Moves of 0.3 texel and of 10⁻³ units along x.
+        for (const double move : {0.3 * texel, 1e-3}) {
+            scene::Scene moved = s;
+            moved.camera.position.x += move;
+            moved.camera.lookAt.x += move;
+            const LightFrustum b = fitDirectionalLightToReceivers(moved, dir, 1024);
+            EXPECT_EQ(b.halfWidth, a.halfWidth) << move;
+            EXPECT_EQ(b.nearDepth, a.nearDepth) << move;
+            EXPECT_EQ(b.farDepth, a.farDepth) << move;
+            for (const Vec3& axis : {a.right, a.up}) {
+                const double steps = glm::dot(b.center - a.center, axis) / texel;
+                EXPECT_NEAR(steps, std::round(steps), 1e-6) << move;
+                EXPECT_LE(std::abs(steps), 1.0 + 1e-6) << move;
+            }
+            EXPECT_NEAR(glm::dot(b.center - a.center, a.direction), 0.0, 1e-9 * std::max(1.0, far));
+        }
+        // A move of many texels moves the map by about as many whole texels.
+        scene::Scene moved = s;
+        moved.camera.position.x += 40.0 * texel;
+        moved.camera.lookAt.x += 40.0 * texel;
+        const LightFrustum c = fitDirectionalLightToReceivers(moved, dir, 1024);
+        EXPECT_GT(glm::length(c.center - a.center), 10.0 * texel);
+    }
+}
+
 TEST(LightFrustum, FittedFallsBackToTheBoundingSphereWhenTheCameraSeesNothing) {
     scene::Scene s = bigPlaneScene();
     s.camera.lookAt = Vec3(0, 10, 6);  // straight up, away from everything
