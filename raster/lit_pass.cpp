@@ -58,16 +58,16 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant) {
     // lit.frag's constant_id 0: the filter code, 1: blocker ids (a bool is 32 bits wide),
     // 2: the light count, 3: the light kinds, 4: the cascade count, 5: transmittance (bool),
     // 6: receiver-plane bias (bool), 7: cascade blend bands (bool), 8: visibility in the beauty's
-    // alpha (bool; not for the display target).
-    const std::int32_t constants[9] = {std::int32_t(variant.filter),     variant.blockerIds ? 1 : 0,
-                                       std::int32_t(variant.lightCount), std::int32_t(variant.lightKinds),
-                                       std::int32_t(variant.cascades),   variant.transmittance ? 1 : 0,
-                                       variant.receiverPlane ? 1 : 0,    variant.cascadeBlend ? 1 : 0,
-                                       variant.displayTarget ? 0 : 1};
-    const VkSpecializationMapEntry entries[9] = {{0, 0, 4},   {1, 4, 4},   {2, 8, 4},   {3, 12, 4}, {4, 16, 4},
-                                                 {5, 20, 4}, {6, 24, 4}, {7, 28, 4}, {8, 32, 4}};
+    // alpha (bool; not for the display target), 9: normal offset (bool).
+    const std::int32_t constants[10] = {std::int32_t(variant.filter),     variant.blockerIds ? 1 : 0,
+                                        std::int32_t(variant.lightCount), std::int32_t(variant.lightKinds),
+                                        std::int32_t(variant.cascades),   variant.transmittance ? 1 : 0,
+                                        variant.receiverPlane ? 1 : 0,    variant.cascadeBlend ? 1 : 0,
+                                        variant.displayTarget ? 0 : 1,    variant.normalOffset ? 1 : 0};
+    VkSpecializationMapEntry entries[10];
+    for (std::uint32_t i = 0; i < 10; ++i) entries[i] = {i, 4 * i, 4};
     const VkSpecializationInfo specialization{
-        .mapEntryCount = 9, .pMapEntries = entries, .dataSize = sizeof constants, .pData = constants};
+        .mapEntryCount = 10, .pMapEntries = entries, .dataSize = sizeof constants, .pData = constants};
     std::vector<VkFormat> colorFormats{variant.displayTarget ? kLitDisplayFormat : kLitColorFormat};
     if (variant.aovTarget) colorFormats.insert(colorFormats.end(), 1 + variant.lightTargets, kLitColorFormat);
     p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{

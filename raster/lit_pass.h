@@ -27,6 +27,7 @@ struct LitVariant {
     bool blockerIds = true;         // look up blocker ids (the blocker-id maps must be rendered)
     bool aovTarget = true;          // false: the beauty target only (no AOVs, no per-light targets)
     bool displayTarget = false;     // the beauty target is kLitDisplayFormat (implies !aovTarget)
+    bool normalOffset = true;       // a normal offset is set (false: its code is left out)
     std::uint32_t lightTargets = 0;  // 0, or kLightTargets: per-light visibility targets
     std::uint32_t lightCount = 1;    // = LitUniforms::counts.x
     std::uint32_t lightKinds = 7;    // bit (1 << SHADOWLAB_LIGHT_*) for each kind in the scene

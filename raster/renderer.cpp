@@ -512,6 +512,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                                                             .blockerIds = wantIds,
                                                             .aovTarget = !beautyOnly,
                                                             .displayTarget = display,
+                                                            .normalOffset = settings.normalOffset != 0.0,
                                                             .lightTargets = std::uint32_t(targets.lights.size()),
                                                             .lightCount = std::uint32_t(lightCount),
                                                             .lightKinds = lightKinds,

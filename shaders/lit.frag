@@ -79,6 +79,10 @@ layout(constant_id = 7) const bool kCascadeBlend = false;
 // The beauty target's alpha holds the visibility AOV; off for the 8-bit display target (a PNG has
 // no alpha), which leaves out the weighting and the division per pixel.
 layout(constant_id = 8) const bool kVisibility = true;
+// A normal offset is set (LightData.params.z, the same for every light): off (the default), the
+// lookup point is the surface point itself, and the vertex path's map-space normal is not read
+// (one varying and its arithmetic less per pixel).
+layout(constant_id = 9) const bool kNormalOffset = true;
 // One directional light with one map, or one spot light, and no receiver plane: its map
 // coordinates are interpolated from lit.vert (see shadowTest) instead of a matrix product per
 // fragment.
@@ -293,7 +297,7 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
     const float axialP = kVertexSpot ? inLightCoordinates.w : dot(p - light.toLight.xyz, axis);
     const float texel = light.bias.z * (perspective ? axialP : 1.0);
     // Normal offset: look the map up from a point moved off the surface along its normal.
-    const vec3 q = p + n * (light.params.z * texel);
+    const vec3 q = kNormalOffset ? p + n * (light.params.z * texel) : p;
     // bias_world = depthBias + slopeBias * texel * min(tan(theta), maxTan), cos(theta) = N·L.
     const float tanTheta = min(sqrt(max(1.0 - ndotl * ndotl, 0.0)) / ndotl, light.params.x);
     Receiver r;
@@ -317,7 +321,8 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         // offset point. Each component rounds at its own scale (x, y ≈ w·(u, v): ≈1e-7 of w, so
         // ≈1e-7 of the map after the divide; w ≈1e-7 of max(|p|, |L|) camera-relative, against a
         // bias of half a texel ≈ 1e-3·w at 2048²), as the per-fragment product does.
-        const vec4 s = inLightCoordinates + (light.params.z * texel * nScale) * inLightNormal;
+        const vec4 s =
+            kNormalOffset ? inLightCoordinates + (light.params.z * texel * nScale) * inLightNormal : inLightCoordinates;
         r.uv = kVertexSpot ? s.xy / s.w : s.xy;
         r.axial = kVertexSpot ? s.w : s.z;
     } else {
