@@ -118,13 +118,14 @@ TEST(LightFrustum, SpotNearPlaneStaysAFractionOfFarWhenTheLightIsInsideTheScene)
     EXPECT_NEAR(f.near, f.far * kSpotMinNearOverFar, 1e-12);
 }
 
-// A camera at (0, 2, 6) looking at the origin over a 200 x 200 plane with a small sphere.
-scene::Scene bigPlaneScene() {
+// A camera at (0, 2, 6) looking at the origin over a 200 x 200 plane with a small sphere (all of
+// it moved by `shift`).
+scene::Scene bigPlaneScene(const Vec3& shift = Vec3(0)) {
     test::SphereOverPlane p;
     p.planeSize = 200.0;
     p.eye = Vec3(0, 2, 6);
     p.lookAt = Vec3(0, 0, 0);
-    scene::Scene s = test::makeScene(p);
+    scene::Scene s = test::makeScene(p, shift);
     s.camera.far = 30.0;  // the visible part of the plane ends 30 units away
     return s;
 }
@@ -165,12 +166,7 @@ TEST(LightFrustum, FittedMapMovesByWholeTexelsAndKeepsItsSizeAndDepthsAsTheCamer
     // that still covers the scene covers the same world square.
     const Vec3 dir = glm::normalize(Vec3(-1, -2, -1));
     for (const double far : {0.0, 1e6}) {
-        scene::Scene s = bigPlaneScene();
-        const Vec3 shift(far, 0, far);
-        std::get<scene::Sphere>(s.objects[0].shape).center += shift;
-        std::get<scene::Quad>(s.objects[1].shape).center += shift;
-        s.camera.position += shift;
-        s.camera.lookAt += shift;
+        const scene::Scene s = bigPlaneScene(Vec3(far, 0, far));
         const LightFrustum a = fitDirectionalLightToReceivers(s, dir, 1024);
         const double texel = a.texelWorldSize();
         ASSERT_LT(a.halfWidth, 0.5 * fitDirectionalLight(s.bounds(), dir, 1024).halfWidth) << "fitted at all";

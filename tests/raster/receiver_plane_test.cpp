@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -138,6 +139,30 @@ scene::Scene grazingSpot() {
     return s;
 }
 
+// A PCSS render of `s` with the receiver plane, slope bias 0 and a constant bias of about half a
+// texel at the floor (2·tan 30.6°/1024 · 9 = 0.0104), map 1024, with its double-precision
+// reference and the camera basis (the tests below rebuild each pixel's floor point).
+struct PcssPlaneRun {
+    scene::Frame f, ref;
+    scene::CameraBasis cam;
+};
+PcssPlaneRun pcssWithThePlane(const scene::Scene& s, const std::string& name) {
+    scene::RasterSettings settings = scene::resolveSettings(s, {}).raster;
+    settings.shadowMapSize = 1024;
+    settings.depthBias = 0.005;
+    settings.depthBiasIsDefault = false;
+    settings.slopeBias = 0.0;
+    settings.filter = scene::ShadowFilter::Pcss;
+    settings.receiverPlaneBias = true;
+    PcssPlaneRun run;
+    run.f = rasterRender(s, settings, name);
+    scene::RenderSettings rs;
+    rs.raster = settings;
+    run.ref = raytrace::renderReference(s, scene::makeRenderPlan(s, rs), scene::referenceSettings(rs.raytrace));
+    run.cam = scene::cameraBasis(s.camera);
+    return run;
+}
+
 TEST(RasterReceiverPlane, PcssBlockerSearchDoesNotCountTheReceiverItself) {
     // PCSS with the receiver plane and no slope bias (the plane replaces it). The blocker search
     // reaches up to 64 texels (1/16 of 1024) from the point; there the floor is up to 64 texels ·
@@ -151,19 +176,7 @@ TEST(RasterReceiverPlane, PcssBlockerSearchDoesNotCountTheReceiverItself) {
     // nearer than such a point, so the reference is 1 there and the search must find nothing:
     // visibility exactly 1.
     const scene::Scene s = grazingSpot();
-    scene::RasterSettings settings = scene::resolveSettings(s, {}).raster;
-    settings.shadowMapSize = 1024;
-    settings.depthBias = 0.005;  // about half a texel at the floor (2·tan 30.6°/1024 · 9 = 0.0104)
-    settings.depthBiasIsDefault = false;
-    settings.slopeBias = 0.0;
-    settings.filter = scene::ShadowFilter::Pcss;
-    settings.receiverPlaneBias = true;
-    const scene::Frame f = rasterRender(s, settings, "rpb-pcss");
-    scene::RenderSettings rs;
-    rs.raster = settings;
-    const scene::Frame ref = raytrace::renderReference(s, scene::makeRenderPlan(s, rs),
-                                                       scene::referenceSettings(rs.raytrace));
-    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    const auto [f, ref, cam] = pcssWithThePlane(s, "rpb-pcss");
     int front = 0, refLit = 0, darkened = 0, umbra = 0, umbraDark = 0;
     double worst = 1.0;
     for (int y = 0; y < f.height; ++y)
@@ -208,19 +221,7 @@ TEST(RasterReceiverPlane, PcssOfAPointLightKeepsTheReceiverPlaneInItsOwnFace) {
     // d ≈ 10, texel 2·10·tan 45.3°/1024 ≈ 0.02) is lit in the reference: the render must be lit too.
     scene::Scene s = grazingSpot();
     s.lights[0].type = scene::LightType::Point;
-    scene::RasterSettings settings = scene::resolveSettings(s, {}).raster;
-    settings.shadowMapSize = 1024;
-    settings.depthBias = 0.005;
-    settings.depthBiasIsDefault = false;
-    settings.slopeBias = 0.0;
-    settings.filter = scene::ShadowFilter::Pcss;
-    settings.receiverPlaneBias = true;
-    const scene::Frame f = rasterRender(s, settings, "rpb-pcss-point");
-    scene::RenderSettings rs;
-    rs.raster = settings;
-    const scene::Frame ref = raytrace::renderReference(s, scene::makeRenderPlan(s, rs),
-                                                       scene::referenceSettings(rs.raytrace));
-    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    const auto [f, ref, cam] = pcssWithThePlane(s, "rpb-pcss-point");
     int beside = 0, refLit = 0, darkened = 0, umbra = 0;
     double worst = 1.0, umbraSum = 0.0;
     for (int y = 0; y < f.height; ++y)

@@ -726,11 +726,7 @@ TEST(RasterRender, InterpolatedLightCoordinatesMatchThePerFragmentProduct) {
             p.height = 180;
             p.lightDirection = lightFromElevation(50.0);
             const Vec3 shift(offset, 0.0, -offset);
-            p.eye += shift;
-            p.lookAt += shift;
-            scene::Scene one = makeScene(p);
-            std::get<scene::Sphere>(one.objects[0].shape).center += shift;
-            std::get<scene::Quad>(one.objects[1].shape).center += shift;
+            scene::Scene one = makeScene(p, shift);
             scene::Scene two = one;
             scene::Light dim = one.lights[0];
             dim.direction = lightFromElevation(70.0);
@@ -783,11 +779,7 @@ TEST(RasterRender, InterpolatedSpotLightCoordinatesMatchThePerFragmentProduct) {
              {ShadowFilter::None, ShadowFilter::Pcf2x2, ShadowFilter::Poisson, ShadowFilter::Pcss}) {
             SphereOverPlane p = base;
             const Vec3 shift(offset, 0.0, -offset);
-            p.eye += shift;
-            p.lookAt += shift;
-            scene::Scene one = makeScene(p);
-            std::get<scene::Sphere>(one.objects[0].shape).center += shift;
-            std::get<scene::Quad>(one.objects[1].shape).center += shift;
+            scene::Scene one = makeScene(p, shift);
             scene::Light& spot = one.lights[0];
             spot.type = scene::LightType::Spot;
             spot.position = spotPosition + shift;

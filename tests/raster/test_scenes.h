@@ -34,10 +34,11 @@ struct SphereOverPlane {
     int height = 90;
 };
 
-inline scene::Scene makeScene(const SphereOverPlane& p) {
+// `shift` moves the whole scene (camera, sphere, plane), for tests far from the origin.
+inline scene::Scene makeScene(const SphereOverPlane& p, const Vec3& shift = Vec3(0)) {
     scene::Scene s;
-    s.camera.position = p.eye;
-    s.camera.lookAt = p.lookAt;
+    s.camera.position = p.eye + shift;
+    s.camera.lookAt = p.lookAt + shift;
     s.camera.up = Vec3(0, 1, 0);
     s.camera.fovYDegrees = 40.0;
     s.camera.width = p.width;
@@ -56,10 +57,10 @@ inline scene::Scene makeScene(const SphereOverPlane& p) {
     s.lights.push_back(l);
     scene::Object sphere;
     sphere.name = "objects[0]";
-    sphere.shape = scene::Sphere{p.center, p.radius};
+    sphere.shape = scene::Sphere{p.center + shift, p.radius};
     s.objects.push_back(sphere);
     scene::Quad q;
-    q.center = Vec3(0);
+    q.center = shift;
     q.normal = Vec3(0, 1, 0);
     q.size = scene::Vec2(p.planeSize, p.planeSize);
     scene::quadAxes(q.normal, q.uAxis, q.vAxis);
