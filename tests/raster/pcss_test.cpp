@@ -28,14 +28,7 @@ constexpr double kH = 10.0, kSize = 1.0;
 
 scene::Scene edgeScene(double hb) {
     scene::Scene s;
-    s.camera.position = Vec3(2.5, 3.0, 0.0);
-    s.camera.lookAt = Vec3(0.0, 0.0, 0.0);
-    s.camera.up = Vec3(0, 1, 0);
-    s.camera.fovYDegrees = 40.0;
-    s.camera.width = 320;
-    s.camera.height = 180;
-    s.camera.near = 0.1;
-    s.camera.far = 100.0;
+    s.camera = {.position = Vec3(2.5, 3.0, 0.0), .lookAt = Vec3(0.0), .width = 320, .height = 180};  // fov 40°, near 0.1
     scene::Material m;
     m.name = "matte";
     s.materials.push_back(m);

@@ -107,14 +107,7 @@ TEST(RasterReceiverPlane, IsRecordedAndTheSameFrameTwice) {
 // down at the quad from the side.
 scene::Scene grazingSpot() {
     scene::Scene s;
-    s.camera.position = {1.5, 3, 4};
-    s.camera.lookAt = {1.5, 0, 0};
-    s.camera.up = {0, 1, 0};
-    s.camera.fovYDegrees = 40.0;
-    s.camera.width = 320;
-    s.camera.height = 180;
-    s.camera.near = 0.1;
-    s.camera.far = 100.0;
+    s.camera = {.position = {1.5, 3, 4}, .lookAt = {1.5, 0, 0}, .width = 320, .height = 180};  // fov 40°, near 0.1
     scene::Material m;
     m.name = "matte";
     s.materials.push_back(m);
