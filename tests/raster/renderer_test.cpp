@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <cstdio>
 #include <filesystem>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -710,6 +711,18 @@ TEST(RasterRender, TwoLightsKeepEachLightsVisibilityAndCombineThem) {
     }
 }
 
+// The scene `one` rendered alone and with `dim` added (a second light takes lit.frag off the
+// interpolated map-coordinate path, onto the per-fragment product), normal offset 1.5 texels.
+std::pair<scene::Frame, scene::Frame> aloneAndWithADimLight(const scene::Scene& one, const scene::Light& dim,
+                                                           scene::RasterSettings settings) {
+    settings.normalOffset = 1.5;
+    scene::Scene two = one;
+    two.lights.push_back(dim);
+    std::pair<scene::Frame, scene::Frame> frames{renderValidated(one, settings, "one light"),
+                                                 renderValidated(two, settings, "two lights")};
+    return frames;
+}
+
 TEST(RasterRender, InterpolatedLightCoordinatesMatchThePerFragmentProduct) {
     // With one directional light lit.frag takes the map coordinates interpolated from lit.vert
     // (toShadow·(p, 1) and toShadow₃ₓ₃·n); with a second light it multiplies the interpolated
@@ -727,15 +740,10 @@ TEST(RasterRender, InterpolatedLightCoordinatesMatchThePerFragmentProduct) {
             p.lightDirection = lightFromElevation(50.0);
             const Vec3 shift(offset, 0.0, -offset);
             scene::Scene one = makeScene(p, shift);
-            scene::Scene two = one;
             scene::Light dim = one.lights[0];
             dim.direction = lightFromElevation(70.0);
             dim.intensity = 0.1;
-            two.lights.push_back(dim);
-            scene::RasterSettings settings = validatedSettings(512, 0.002, 0.1, filter);
-            settings.normalOffset = 1.5;
-            const scene::Frame a = renderValidated(one, settings, "one light");
-            const scene::Frame b = renderValidated(two, settings, "two lights");
+            const auto [a, b] = aloneAndWithADimLight(one, dim, validatedSettings(512, 0.002, 0.1, filter));
             ASSERT_EQ(b.lightVisibility.size(), 2u);
             std::size_t lit = 0, shadowed = 0, differ = 0;
             double worst = 0.0;
@@ -787,16 +795,11 @@ TEST(RasterRender, InterpolatedSpotLightCoordinatesMatchThePerFragmentProduct) {
             spot.coneAngleDegrees = cone;
             spot.radius = 0.1;
             spot.intensity = 300.0;
-            scene::Scene two = one;
             scene::Light dim = one.lights[0];
             dim.position = Vec3(-2.0, 5.0, 1.0) + shift;
             dim.direction = glm::normalize(Vec3(0.4, -1.0, -0.2));
             dim.intensity = 30.0;
-            two.lights.push_back(dim);
-            scene::RasterSettings settings = validatedSettings(512, 0.004, 0.1, filter);
-            settings.normalOffset = 1.5;
-            const scene::Frame a = renderValidated(one, settings, "one spot");
-            const scene::Frame b = renderValidated(two, settings, "two spots");
+            const auto [a, b] = aloneAndWithADimLight(one, dim, validatedSettings(512, 0.004, 0.1, filter));
             ASSERT_EQ(b.lightVisibility.size(), 2u);
             std::size_t lit = 0, shadowedInCone = 0, differ = 0;
             double worst = 0.0;
