@@ -414,8 +414,12 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
         for (std::size_t i = 0; i < scene.lights.size(); ++i) {
             const scene::Light& l = scene.lights[i];
             if (l.type != scene::LightType::Directional || !mapped(i)) continue;
-            const LightFrustum f = settings.fitLightFrustum ? fitDirectionalLightToReceivers(scene, l.direction, size)
-                                                            : fitDirectionalLight(scene.bounds(), l.direction, size);
+            // A fitted map's snapped width shrinks (weakly) as N grows (its N/(N − 1) factor, then
+            // rounding up), so its width at the smallest candidate size bounds the width at the size
+            // chosen below.
+            const LightFrustum f = settings.fitLightFrustum
+                                       ? fitDirectionalLightToReceivers(scene, l.direction, kMinAutoShadowMapSize)
+                                       : fitDirectionalLight(scene.bounds(), l.direction, size);
             widest = std::max(widest, 2.0 * f.halfWidth);
         }
         needed = widest / pixel;
@@ -665,7 +669,7 @@ double nearestDepthInWindow(const scene::Scene& scene, const LightFrustum& f) {
 // and the receivers' depth ranges: far = the farthest receiver in front (maxDepth) grown by the
 // margin (the normal offset moves a point up to that fraction of its distance farther) and 1%;
 // near = the nearest caster in the window less 1%. Both are then snapped outward to the depth grid
-// (snapDepthDown/Up) so that a moving camera leaves them, and so every stored depth, unchanged until
+// (snapDepthDown/Up) so that a moving camera leaves them, and so the depth scale, unchanged until
 // they cross a step of it. Both stay inside f's own range (the bounding sphere's, fixed for the
 // scene) and near ≥ far · kSpotMinNearOverFar (of the snapped far); f is unchanged when they would
 // not make a range.
@@ -673,8 +677,10 @@ void fitDepthRange(const scene::Scene& scene, LightFrustum& f, double maxDepth, 
     const double fitFar = maxDepth * (1.0 + marginTexels * f.texelWorldSize()) * kLightFrustumMargin;
     const double far = std::min(snapDepthUp(fitFar), f.far);
     const double nearest = nearestDepthInWindow(scene, f);
-    const double near = std::max({std::isfinite(nearest) ? snapDepthDown(nearest / kLightFrustumMargin) : f.near,
-                                  f.near, far * kSpotMinNearOverFar});
+    // (nearest may be a rounding below 0 at the apex: the snap takes a logarithm, so only of > 0.)
+    const double near =
+        std::max({std::isfinite(nearest) && nearest > 0.0 ? snapDepthDown(nearest / kLightFrustumMargin) : f.near,
+                  f.near, far * kSpotMinNearOverFar});
     if (!(near < far)) return;
     f.near = near;
     f.far = far;

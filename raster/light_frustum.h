@@ -118,7 +118,7 @@ LightFrustum spotLightFrustum(const scene::Scene& scene, const scene::RasterSett
 double snapWindowHalfSize(double half);
 // The fitted near/far planes' grid (spot maps and cube faces): distances from the light rounded
 // down (near) or up (far) to a power of 2^(1/kDepthGridStepsPerOctave), so that a moving camera
-// changes them, and with them every stored depth, only when what it sees crosses a step (issue 5:
+// changes them, and with them the depth scale, only when what it sees crosses a step (issue 5:
 // no swimming). light_frustum.cpp says why this grid and what depth precision it costs.
 inline constexpr double kDepthGridStepsPerOctave = 4.0;
 double snapDepthDown(double d);

@@ -200,6 +200,23 @@ TEST(LightFrustum, FittedMapMovesByWholeTexelsAndKeepsItsSizeAndDepthsAsTheCamer
     }
 }
 
+TEST(LightFrustum, FittedMapIsNoWiderAtALargerMapSize) {
+    // chooseShadowMapSize sizes a fitted directional map from its width at the smallest candidate
+    // size, which must bound its width at every larger size (the N/(N − 1) growth shrinks with N,
+    // and rounding up keeps the order), or the map chosen could be coarser than the receivers need.
+    const Vec3 dir = glm::normalize(Vec3(-1, -2, -1));
+    for (const double far : {6.0, 12.0, 30.0, 60.0}) {
+        scene::Scene s = bigPlaneScene();
+        s.camera.far = far;
+        double previous = INFINITY;
+        for (int n = kMinAutoShadowMapSize; n <= 4096; n *= 2) {
+            const double half = fitDirectionalLightToReceivers(s, dir, n).halfWidth;
+            EXPECT_LE(half, previous) << "far " << far << ", size " << n;
+            previous = half;
+        }
+    }
+}
+
 TEST(LightFrustum, FittedFallsBackToTheBoundingSphereWhenTheCameraSeesNothing) {
     scene::Scene s = bigPlaneScene();
     s.camera.lookAt = Vec3(0, 10, 6);  // straight up, away from everything
