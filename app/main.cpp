@@ -32,6 +32,10 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
     cmd.add_flag("--receiver-plane-bias", s.receiverPlaneBias,
                  "raster: compare each filter tap against the receiver's plane (from screen-space derivatives) "
                  "instead of the slope bias");
+    cmd.add_flag("--hardware-bias", s.hardwareBias,
+                 "raster: apply the constant and slope bias with the rasterizer's depth-bias state in the depth "
+                 "pass of directional maps (converted from world units and texels; recorded in the Frame) "
+                 "instead of in the lit shader");
     cmd.add_flag("--fit-light-frustum", s.fitLightFrustum,
                  "raster: fit each light's map to the casters of visible receivers, not the scene's bounds");
     cmd.add_option("--cascades", s.cascades,

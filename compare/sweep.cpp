@@ -62,6 +62,7 @@ Json overridesToJson(const scene::SettingsOverrides& o) {
     if (o.pcfSize) j["pcf_size"] = *o.pcfSize;
     if (o.normalOffset) j["normal_offset"] = *o.normalOffset;
     if (o.receiverPlaneBias) j["receiver_plane_bias"] = *o.receiverPlaneBias;
+    if (o.hardwareBias) j["hardware_bias"] = *o.hardwareBias;
     if (o.fitLightFrustum) j["fit_light_frustum"] = *o.fitLightFrustum;
     if (o.cascades) j["cascades"] = *o.cascades;
     return j;
@@ -79,6 +80,7 @@ scene::SettingsOverrides overridesFromJson(const Json& j) {
     if (j.contains("pcf_size")) o.pcfSize = j["pcf_size"].get<int>();
     if (j.contains("normal_offset")) o.normalOffset = j["normal_offset"].get<double>();
     if (j.contains("receiver_plane_bias")) o.receiverPlaneBias = j["receiver_plane_bias"].get<bool>();
+    if (j.contains("hardware_bias")) o.hardwareBias = j["hardware_bias"].get<bool>();
     if (j.contains("fit_light_frustum")) o.fitLightFrustum = j["fit_light_frustum"].get<bool>();
     if (j.contains("cascades")) o.cascades = j["cascades"].get<int>();
     return o;
@@ -165,6 +167,7 @@ std::string SweepConfig::key() const {
     if (o.pcfSize) k += ";pcf_size=" + std::to_string(*o.pcfSize);
     if (o.normalOffset) k += ";normal_offset=" + number(*o.normalOffset);
     if (o.receiverPlaneBias) k += std::string(";receiver_plane_bias=") + (*o.receiverPlaneBias ? "1" : "0");
+    if (o.hardwareBias) k += std::string(";hardware_bias=") + (*o.hardwareBias ? "1" : "0");
     if (o.fitLightFrustum) k += std::string(";fit_light_frustum=") + (*o.fitLightFrustum ? "1" : "0");
     if (o.cascades) k += ";cascades=" + std::to_string(*o.cascades);
     return k;
@@ -183,6 +186,7 @@ std::string SweepConfig::label() const {
     if (o.pcfSize) parts.push_back("pcf size " + std::to_string(*o.pcfSize));
     if (o.normalOffset) parts.push_back("normal offset " + number(*o.normalOffset));
     if (o.receiverPlaneBias) parts.push_back(*o.receiverPlaneBias ? "receiver-plane bias" : "no receiver-plane bias");
+    if (o.hardwareBias) parts.push_back(*o.hardwareBias ? "hardware bias" : "shader bias");
     if (o.fitLightFrustum) parts.push_back(*o.fitLightFrustum ? "fitted frustum" : "bounds frustum");
     if (o.cascades) parts.push_back(std::to_string(*o.cascades) + (*o.cascades == 1 ? " cascade" : " cascades"));
     std::string s = backend + ":";
@@ -340,8 +344,8 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
         if (!block.is_object()) throw SceneError(file, path, "expected an object of axes");
         const bool isRaster = std::string(backend) == "raster";
         const std::vector<const char*> names = isRaster
-            ? std::vector<const char*>{"shadow_map_size", "filter", "cascades", "receiver_plane_bias", "depth_bias",
-                                       "slope_bias"}
+            ? std::vector<const char*>{"shadow_map_size", "filter", "cascades", "receiver_plane_bias", "hardware_bias",
+                                       "depth_bias", "slope_bias"}
             : std::vector<const char*>{"ray_bias", "precision", "samples"};
         for (const auto& [key, value] : block.items())
             if (std::none_of(names.begin(), names.end(), [&](const char* n) { return key == n; }))
@@ -381,6 +385,9 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
                     } else if (n == "receiver_plane_bias") {
                         if (!v.is_boolean()) throw SceneError(file, at, "expected true or false, got " + v.dump());
                         c.overrides.receiverPlaneBias = v.get<bool>();
+                    } else if (n == "hardware_bias") {
+                        if (!v.is_boolean()) throw SceneError(file, at, "expected true or false, got " + v.dump());
+                        c.overrides.hardwareBias = v.get<bool>();
                     } else if (n == "depth_bias") {
                         c.overrides.depthBias = num(0.0);
                         c.biasKind = "depth";

@@ -69,7 +69,8 @@ PipelineHandle createGraphicsPipeline(const Context& ctx, const PipelineDesc& de
         .polygonMode = VK_POLYGON_MODE_FILL,
         .cullMode = VK_CULL_MODE_NONE,
         .frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE,
-        .depthBiasEnable = VK_FALSE,  // biases are applied in the shader, in world units
+        // Off unless the hardware bias is asked for: biases are applied in the lit shader, in world units.
+        .depthBiasEnable = desc.dynamicDepthBias ? VK_TRUE : VK_FALSE,
         .lineWidth = 1.0f,
     };
     const VkPipelineMultisampleStateCreateInfo multisample{
@@ -113,10 +114,11 @@ PipelineHandle createGraphicsPipeline(const Context& ctx, const PipelineDesc& de
         .attachmentCount = std::uint32_t(blend.size()),
         .pAttachments = blend.data(),
     };
-    const VkDynamicState dynamicStates[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    const VkDynamicState dynamicStates[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR,
+                                            VK_DYNAMIC_STATE_DEPTH_BIAS};
     const VkPipelineDynamicStateCreateInfo dynamic{
         .sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO,
-        .dynamicStateCount = 2,
+        .dynamicStateCount = desc.dynamicDepthBias ? 3u : 2u,
         .pDynamicStates = dynamicStates,
     };
     const VkPipelineRenderingCreateInfo rendering{

@@ -26,6 +26,8 @@ struct PipelineDesc {
     // The transmittance pass's blending (raster/shadow_pass.h): color target 0 multiplied
     // (dst · src), target 1 kept at the minimum.
     bool transmittanceBlend = false;
+    // Depth bias on, its factors dynamic (vkCmdSetDepthBias before each draw): the hardware bias.
+    bool dynamicDepthBias = false;
 };
 
 // Triangle lists, no culling (quads are two-sided, and both faces must cast), depth test on,

@@ -180,6 +180,7 @@ struct Renderer::Impl {
     TransmittanceMaps transmittanceMaps;
     TransmittanceRestPipeline transmitRestPipeline;  // the second pass, bound to transmittanceMaps
     std::vector<glm::vec4> layerLights;
+    std::vector<DepthBiasFactors> layerBias;  // per shadow-map layer (settings.hardwareBias)
     LitPipeline litPipelines[4];
     LitBindings bindings;  // allocated with the first lit pipeline's (identical) set layout
     shaders::LitUniforms uniforms{};
@@ -240,6 +241,12 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     };
 
     std::vector<double> usedDepthBias;  // per shadow-mapped light (spot, directional)
+    // The hardware bias of an orthographic map (settings.hardwareBias): the world constant bias
+    // in units of r (its depth is linear: bias / depth range), the slope bias in texels as it is
+    // (the rasterizer's slope is depth per texel, as the shader's slope term is per texel).
+    auto hardwareDepthBias = [&](double depthBias, const LightFrustum& map) {
+        return DepthBiasFactors{float(depthBias / map.depthRange() / kShadowDepthUnitR), float(settings.slopeBias)};
+    };
     // One shadow-map layer per light that needs a shadow test.
     const scene::Bounds bounds = scene.bounds();
     const glm::dmat4 viewProj = scene::projectionMatrix(cam, scene.camera.near, scene.camera.far) *
@@ -275,6 +282,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
                     l.toShadow[2 + face / 4][face % 4] = float(f.far);
                     cullLayer(i, f, receivers);  // each face draws only its own casters
                     lightMatrices.push_back(glm::mat4(f.toClip(origin)));
+                    layerBias.push_back({});  // a point light keeps the shader's bias
                     frusta.push_back(f);
                     static const char* const kFaces[] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
                     layerLight.push_back(int(i));
@@ -301,6 +309,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
                     // Each cascade draws only the casters of the receivers of its own slice.
                     cullLayer(i, cf, cull ? cascadeReceivers(scene, cascades.splits, c, cascadeBandCover(settings)) : std::vector<scene::Vec3>{});
                     lightMatrices.push_back(glm::mat4(cf.toClip(origin)));
+                    layerBias.push_back(settings.hardwareBias ? hardwareDepthBias(depthBias, cf) : DepthBiasFactors{});
                     frusta.push_back(cf);
                     usedDepthBias.push_back(depthBias);
                     cascadeTexels.push_back(cf.texelWorldSize());
@@ -309,13 +318,15 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
                     shaders::CascadeData& cd = uniforms.cascades[i * SHADOWLAB_MAX_CASCADES + c];
                     cd.toShadow = glm::mat4(cf.toTexture(origin));
                     cd.params = glm::vec4(float(cascades.splits[c + 1]), float(cf.texelWorldSize()),
-                                          float(1.0 / cf.depthRange()), float(depthBias));
+                                          float(1.0 / cf.depthRange()),
+                                          settings.hardwareBias ? 0.0f : float(depthBias));
                 }
                 // Cascade 0 also fills the light's own map fields (what count <= 1 would use).
                 f = cascades.frusta[0];
                 l.toShadow = uniforms.cascades[i * SHADOWLAB_MAX_CASCADES].toShadow;
-                l.bias = glm::vec4(float(usedDepthBias[usedDepthBias.size() - cascades.frusta.size()]),
-                                   float(settings.slopeBias), float(f.texelWorldSize()),
+                l.bias = glm::vec4(settings.hardwareBias ? 0.0f
+                                                         : float(usedDepthBias[usedDepthBias.size() - cascades.frusta.size()]),
+                                   settings.hardwareBias ? 0.0f : float(settings.slopeBias), float(f.texelWorldSize()),
                                    float(1.0 / f.depthRange()));
             } else if (settings.fitLightFrustum)
                 f = fitDirectionalLightToReceivers(scene, light.direction, settings.shadowMapSize);
@@ -336,8 +347,12 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
                                              ? 0.5 * f.texelWorldSize()
                                              : settings.depthBias;
                 usedDepthBias.push_back(depthBias);
-                l.bias = glm::vec4(float(depthBias), float(settings.slopeBias), float(f.texelWorldSize()),
-                                   spot ? 0.0f : float(1.0 / f.depthRange()));
+                // With the hardware bias a directional map's depth pass applies both terms, and
+                // the lit shader none; a spot map keeps the shader's (docs/raster.md).
+                const bool hardware = settings.hardwareBias && !spot;
+                layerBias.push_back(hardware ? hardwareDepthBias(depthBias, f) : DepthBiasFactors{});
+                l.bias = glm::vec4(hardware ? 0.0f : float(depthBias), hardware ? 0.0f : float(settings.slopeBias),
+                                   float(f.texelWorldSize()), spot ? 0.0f : float(1.0 / f.depthRange()));
                 frusta.push_back(f);
             }
         }
@@ -456,6 +471,20 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     attributes["slope_bias"] = formatNumber(settings.slopeBias);
     // On, the receiver's plane replaces the slope term in every tap (lit.frag), so slope_bias is unused.
     attributes["receiver_plane_bias"] = settings.receiverPlaneBias ? "true" : "false";
+    // Where the constant and slope bias are applied, and with the hardware bias the factors each
+    // directional layer's depth pass was given (docs/raster.md "Hardware depth bias").
+    attributes["bias_mode"] = settings.hardwareBias ? "hardware" : "shader";
+    if (settings.hardwareBias) {
+        std::string constant, slope;
+        for (std::size_t k = 0; k < layerBias.size(); ++k) {
+            constant += (k ? ";" : "") + formatNumber(layerBias[k].constant);
+            slope += (k ? ";" : "") + formatNumber(layerBias[k].slope);
+        }
+        attributes["hardware_depth_bias_constant_factor"] = constant;
+        attributes["hardware_depth_bias_slope_factor"] = slope;
+        attributes["hardware_depth_bias_unit"] =
+            "r = 2^-24 (D32_SFLOAT, depths in [0.5, 1)); spot and point layers 0: they keep the shader bias";
+    }
     attributes["max_slope_tan"] = formatNumber(kMaxSlopeTan);
     attributes["triangles"] = std::to_string(triangles);
     attributes["sphere_segments"] = std::to_string(sphereSegmentsUsed);
@@ -503,7 +532,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     pendingSetupMs = 0.0;
     if (!shadowPipeline.pipeline || !litPipeline.pipeline) {
         const auto pipelineStart = Clock::now();
-        if (!shadowPipeline.pipeline) shadowPipeline = createShadowPipeline(ctx, wantIds);
+        if (!shadowPipeline.pipeline) shadowPipeline = createShadowPipeline(ctx, wantIds, settings.hardwareBias);
         if (transmit && !transmitPipeline.pipeline) transmitPipeline = createTransmittancePipeline(ctx);
         if (transmit && !transmitRestPipeline.pipeline)
             transmitRestPipeline = createTransmittanceRestPipeline(ctx, transmittanceMaps);
@@ -538,7 +567,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     stamp(commands, 0);
     const TransmittancePass transmittancePass{transmit ? &transmitPipeline : nullptr, &transmittanceMaps, layerLights,
                                               transmit ? &transmitRestPipeline : nullptr};
-    recordShadowPass(commands, shadowPipeline, maps, draw, lightMatrices, wantIds, &transmittancePass);
+    recordShadowPass(commands, shadowPipeline, maps, draw, lightMatrices, wantIds, &transmittancePass, &layerBias);
     stamp(commands, 1);
     ctx.submitAndWait(commands);
     frame.timingsMs.emplace_back("shadow_pass", msSince(shadowStart));

@@ -12,7 +12,7 @@
 
 namespace shadowlab::raster {
 
-ShadowPipeline createShadowPipeline(const Context& ctx, bool blockerIds) {
+ShadowPipeline createShadowPipeline(const Context& ctx, bool blockerIds, bool hardwareBias) {
     requireFormat(ctx, kShadowMapFormat,
                   VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT,
                   "the shadow map");
@@ -39,7 +39,9 @@ ShadowPipeline createShadowPipeline(const Context& ctx, bool blockerIds) {
                                                                             : std::vector<VkFormat>{},
                                                  .depthFormat = kShadowMapFormat,
                                                  .depthCompare = VK_COMPARE_OP_LESS,
+                                                 .dynamicDepthBias = hardwareBias,
                                              });
+    p.hardwareBias = hardwareBias;
     return p;
 }
 
@@ -317,7 +319,8 @@ void recordTransmittance(VkCommandBuffer commands, const TransmittancePass& pass
 
 void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, const ShadowMaps& maps,
                       const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices,
-                      bool blockerIds, const TransmittancePass* transmittance) {
+                      bool blockerIds, const TransmittancePass* transmittance,
+                      const std::vector<DepthBiasFactors>* layerBias) {
     // Source stage: the previous frame's lit pass sampled both arrays (a reused Renderer).
     transition(commands, {{maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, maps.layers,
                            VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
@@ -359,6 +362,11 @@ void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, 
         if (layer < lightMatrices.size() && geometry.depthPassIndexCount() > 0) {
             vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.pipeline.get());
             setViewport(commands, maps.size, maps.size);
+            if (pipeline.hardwareBias) {
+                const DepthBiasFactors b =
+                    layerBias && layer < layerBias->size() ? (*layerBias)[layer] : DepthBiasFactors{};
+                vkCmdSetDepthBias(commands, b.constant, 0.0f, b.slope);
+            }
             const shaders::ShadowPush push{.lightMatrix = lightMatrices[layer]};
             vkCmdPushConstants(commands, pipeline.layout.get(), VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof push, &push);
             const VkDeviceSize offset = 0;

@@ -18,9 +18,22 @@ inline constexpr VkFormat kBlockerIdFormat = VK_FORMAT_R32_UINT;
 struct ShadowPipeline {
     PipelineLayoutHandle layout;
     PipelineHandle pipeline;
+    bool hardwareBias = false;  // depth bias dynamic: set per layer before drawing
 };
-// Without blockerIds: depth only, no fragment shader (much cheaper on lavapipe).
-ShadowPipeline createShadowPipeline(const Context& ctx, bool blockerIds = true);
+// Without blockerIds: depth only, no fragment shader (much cheaper on lavapipe). hardwareBias:
+// depth bias on with dynamic factors (recordShadowPass sets each layer's).
+ShadowPipeline createShadowPipeline(const Context& ctx, bool blockerIds = true, bool hardwareBias = false);
+
+// The rasterizer's depth-bias factors of one layer (vkCmdSetDepthBias): the stored depth of a
+// primitive grows by constant·r + slope·max(|∂z/∂x|, |∂z/∂y|), r the depth format's minimum
+// resolvable difference at the primitive's depths (D32_SFLOAT: 2^(e − 23), e the exponent of
+// its largest depth), the slopes in depth per texel.
+struct DepthBiasFactors {
+    float constant = 0.0f;
+    float slope = 0.0f;
+};
+// D32_SFLOAT's r for depths in [0.5, 1): the unit the constant factor is converted in.
+inline constexpr double kShadowDepthUnitR = 1.0 / 16777216.0;  // 2^-24
 
 struct ShadowMaps {
     Image depth;                             // size x size x layers; view: 2D array for sampling
@@ -115,9 +128,11 @@ struct TransmittancePass {
 // against the layer's opaque depths), and after all layers' the second pass behind the nearest
 // layer (reading the first's nearest depths); its maps end in SHADER_READ_ONLY_OPTIMAL either way
 // (with `transmittance.pipeline` null: undefined contents, for a lit pass that does not read them).
+// layerBias: a pipeline made with hardwareBias needs each drawn layer's factors (missing ones: 0).
 void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, const ShadowMaps& maps,
                       const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices,
-                      bool blockerIds = true, const TransmittancePass* transmittance = nullptr);
+                      bool blockerIds = true, const TransmittancePass* transmittance = nullptr,
+                      const std::vector<DepthBiasFactors>* layerBias = nullptr);
 // One layer of one of the four transmittance arrays (tests and diagnostics), row 0 first.
 enum class TransmittanceArray { All, NearDepth, Rest, SecondDepth };
 std::vector<float> readTransmittance(const Context& ctx, const TransmittanceMaps& maps, std::uint32_t layer,

@@ -88,6 +88,7 @@
     X(vkCmdPushConstants)                       \
     X(vkCmdSetViewport)                         \
     X(vkCmdSetScissor)                          \
+    X(vkCmdSetDepthBias)                        \
     X(vkCmdDrawIndexed)                         \
     X(vkCmdCopyBuffer)                          \
     X(vkCmdCopyImageToBuffer)

@@ -297,7 +297,7 @@ Object readObject(const Reader& r, const Json& node, const JsonPath& path,
 
 ShadowDefaults readShadow(const Reader& r, const Json& node, const JsonPath& path) {
     r.checkKeys(node, path, {"shadow_map_size", "depth_bias", "slope_bias", "filter", "pcf_size", "normal_offset",
-                             "receiver_plane_bias", "fit_light_frustum", "cascades", "cascade_blend", "ray_bias", "precision", "samples"});
+                             "receiver_plane_bias", "hardware_bias", "fit_light_frustum", "cascades", "cascade_blend", "ray_bias", "precision", "samples"});
     ShadowDefaults d;
     if (node.contains("shadow_map_size"))
         d.shadowMapSize = r.integer(node["shadow_map_size"], path / "shadow_map_size", 16, 16384);
@@ -322,6 +322,7 @@ ShadowDefaults readShadow(const Reader& r, const Json& node, const JsonPath& pat
     }
     if (node.contains("receiver_plane_bias"))
         d.receiverPlaneBias = r.boolean(node["receiver_plane_bias"], path / "receiver_plane_bias");
+    if (node.contains("hardware_bias")) d.hardwareBias = r.boolean(node["hardware_bias"], path / "hardware_bias");
     if (node.contains("fit_light_frustum"))
         d.fitLightFrustum = r.boolean(node["fit_light_frustum"], path / "fit_light_frustum");
     if (node.contains("cascades")) d.cascades = r.integer(node["cascades"], path / "cascades", 1, kMaxCascades);

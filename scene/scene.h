@@ -132,6 +132,7 @@ struct ShadowDefaults {
     std::optional<int> pcfSize;          // texels
     std::optional<double> normalOffset;  // texels
     std::optional<bool> receiverPlaneBias;
+    std::optional<bool> hardwareBias;
     std::optional<bool> fitLightFrustum;
     std::optional<int> cascades;         // directional lights: cascaded shadow maps, 1..kMaxCascades
     std::optional<double> cascadeBlend;  // fraction of each slice blended into the next, 0..0.5

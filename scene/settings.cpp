@@ -79,6 +79,7 @@ RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& o) {
     if (!std::isfinite(s.raster.normalOffset) || s.raster.normalOffset < 0.0)
         throw InputError("--normal-offset: must be a finite value >= 0 (texels)");
     s.raster.receiverPlaneBias = o.receiverPlaneBias.value_or(d.receiverPlaneBias.value_or(false));
+    s.raster.hardwareBias = o.hardwareBias.value_or(d.hardwareBias.value_or(false));
     s.raster.fitLightFrustum = o.fitLightFrustum.value_or(d.fitLightFrustum.value_or(false));
     s.raster.cascades = o.cascades.value_or(d.cascades.value_or(1));
     if (s.raster.cascades < 1 || s.raster.cascades > kMaxCascades)

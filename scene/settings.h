@@ -46,6 +46,10 @@ struct RasterSettings {
     // Receiver-plane depth bias (Isidoro 2006): each filter tap compares against the receiver's
     // plane extrapolated to the texel it reads, instead of the slope bias (see docs/raster.md).
     bool receiverPlaneBias = false;
+    // Constant and slope bias through the rasterizer's depth-bias state (vkCmdSetDepthBias) in the
+    // depth pass of directional maps, converted from the world and texel units above, instead of
+    // in the lit shader (spot and point maps keep the shader's; see docs/raster.md).
+    bool hardwareBias = false;
     bool fitLightFrustum = false;  // fit each light's map to the casters of visible receivers (else the scene's bounding sphere)
     // Directional lights: split the view's depth range into this many slices, each with its own
     // map (1 = one map for the whole view, as fitLightFrustum or the bounding sphere decide).
@@ -83,6 +87,7 @@ struct SettingsOverrides {
     std::optional<int> pcfSize;          // --pcf-size
     std::optional<double> normalOffset;  // --normal-offset (texels)
     std::optional<bool> receiverPlaneBias;  // --receiver-plane-bias
+    std::optional<bool> hardwareBias;       // --hardware-bias
     std::optional<bool> fitLightFrustum; // --fit-light-frustum
     std::optional<int> cascades;         // --cascades (1..kMaxCascades)
     std::optional<double> cascadeBlend;  // --cascade-blend (0..kMaxCascadeBlend)

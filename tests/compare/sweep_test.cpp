@@ -431,6 +431,21 @@ TEST_F(GridFile, ReceiverPlaneBiasAxisVariesTheRasterRowsAndIsRecorded) {
     EXPECT_THROW(loadGrid(write(R"({ "raster": { "receiver_plane_bias": [1] } })"), scene), scene::SceneError);
 }
 
+TEST_F(GridFile, HardwareBiasAxisVariesTheRasterRowsAndRoundTrips) {
+    const SweepGrid g = loadGrid(write(R"({ "raster": { "hardware_bias": [false, true], "depth_bias": [0, 0.01] } })"), scene);
+    ASSERT_EQ(g.configs.size(), 4u);
+    EXPECT_EQ(g.configs[0].overrides.hardwareBias, std::optional<bool>(false));
+    EXPECT_EQ(g.configs[2].overrides.hardwareBias, std::optional<bool>(true));
+    EXPECT_NE(g.configs[0].key(), g.configs[2].key());
+    EXPECT_NE(g.configs[2].label().find("hardware bias"), std::string::npos) << g.configs[2].label();
+    EXPECT_EQ(g.configs[2].biasKind, "depth");
+    SweepRow row;
+    row.key = g.configs[2].key();
+    row.config = g.configs[2];
+    EXPECT_EQ(rowsToJson({row})[0]["overrides"]["hardware_bias"], true);
+    EXPECT_THROW(loadGrid(write(R"({ "raster": { "hardware_bias": ["on"] } })"), scene), scene::SceneError);
+}
+
 TEST_F(GridFile, DefaultGridComparesCascadesOnlyWithADirectionalLight) {
     auto cascaded = [](const SweepGrid& g) {
         std::size_t n = 0;

@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "raster/cascades.h"
 #include "scene/frame_io.h"
 #include "tests/raster/test_scenes.h"
 
@@ -219,19 +220,27 @@ TEST(RasterBias, BiasSeriesAtGrazingLightTradeAcneForMissedOrDisplacedShadow) {
     const int size = 512;
     // The bounding-sphere map's texel: 2 · 1.01 · half the diagonal / size.
     const double texel = 1.01 * s.bounds().diagonal() / size;
-    enum Kind { Depth, Slope, NormalOffset };
+    // HardwareDepth, HardwareSlope: the same two biases through the rasterizer's depth-bias state
+    // (--hardware-bias): the stored depths grow instead of the references shrinking, so the counts
+    // are monotone pixel by pixel too (the stored depth of a texel is the least over the primitives
+    // drawn there, each raised by more as the factor grows).
+    enum Kind { Depth, Slope, NormalOffset, HardwareDepth, HardwareSlope };
     auto series = [&](Kind kind, const std::vector<double>& steps) {
         std::vector<ShadowErrors> out;
         for (const double k : steps) {
             scene::RasterSettings settings = validatedSettings(size, 0.0, 0.0, ShadowFilter::None);
-            if (kind == Depth) settings.depthBias = k * texel;
-            if (kind == Slope) settings.slopeBias = k;
+            settings.hardwareBias = kind == HardwareDepth || kind == HardwareSlope;
+            if (kind == Depth || kind == HardwareDepth) settings.depthBias = k * texel;
+            if (kind == Slope || kind == HardwareSlope) settings.slopeBias = k;
             if (kind == NormalOffset) settings.normalOffset = k;
-            out.push_back(shadowErrors(p, s, renderValidated(s, settings, "bias-series")));
+            const scene::Frame f = renderValidated(s, settings, "bias-series");
+            EXPECT_EQ(f.attributes.at("bias_mode"), settings.hardwareBias ? "hardware" : "shader");
+            out.push_back(shadowErrors(p, s, f));
         }
         return out;
     };
-    for (const Kind kind : {Depth, Slope}) {
+    std::vector<ShadowErrors> depthSeries;
+    for (const Kind kind : {Depth, Slope, HardwareDepth, HardwareSlope}) {
         const std::vector<ShadowErrors> e = series(kind, {0.0, 1.0, 4.0, 16.0, 64.0});
         for (std::size_t i = 1; i < e.size(); ++i) {
             EXPECT_LE(e[i].falseShadow, e[i - 1].falseShadow) << "kind " << kind << " step " << i;
@@ -240,7 +249,20 @@ TEST(RasterBias, BiasSeriesAtGrazingLightTradeAcneForMissedOrDisplacedShadow) {
         ASSERT_GT(e[0].analyticShadowed, 500);
         EXPECT_GT(e[0].falseShadow, e[0].counted / 5) << "kind " << kind << ": no acne at zero bias";
         EXPECT_LT(e.back().falseShadow, e[0].counted / 1000) << "kind " << kind;
-        EXPECT_GT(e.back().missedShadow, e[0].missedShadow + e[0].analyticShadowed / 10) << "kind " << kind;
+        if (kind == Depth) depthSeries = e;
+        if (kind != HardwareDepth) {
+            EXPECT_GT(e.back().missedShadow, e[0].missedShadow + e[0].analyticShadowed / 10) << "kind " << kind;
+            continue;
+        }
+        // The hardware constant bias is converted in units of r = 2^-24, D32_SFLOAT's step for
+        // depths in [0.5, 1); the sphere's light-facing triangles lie in [0.46, 0.5) (its radius
+        // 0.5 against the map's depth range of 1.01 · 11.4), where r is 2^-25: they are raised by
+        // half the bias, and the leak (their shadow's contact region) is that of a shader bias
+        // between b/2 and b: at b = 64 texels, at least the shader's at 16 and at most its at 64.
+        // (Measured: 99 missed; the shader's 50 at 16 texels and 303 at 64; 10 without bias.)
+        EXPECT_GE(e.back().missedShadow, depthSeries[3].missedShadow);
+        EXPECT_LE(e.back().missedShadow, depthSeries[4].missedShadow);
+        EXPECT_GT(e.back().missedShadow, e[0].missedShadow);
     }
     // The normal offset at grazing light moves the lookup point mostly *across* the light
     // (the normal is 85° from it), so past the offset that removes acne ((√2/2)·sin 85° ≈ 0.7
@@ -255,6 +277,104 @@ TEST(RasterBias, BiasSeriesAtGrazingLightTradeAcneForMissedOrDisplacedShadow) {
         EXPECT_GT(e[i].falseShadow, e[i - 1].falseShadow) << "displacement grows, step " << i;
         EXPECT_LE(e[i].missedShadow, e[0].missedShadow) << "no leak, step " << i;
     }
+}
+
+TEST(RasterHardwareBias, FactorsAreTheWorldAndTexelBiasesInTheRasterizersUnits) {
+    // The bounding-sphere map of a directional light spans 1.01 · the bounds' diagonal in depth
+    // (orthographic, depth 0..1 linear), so a world bias b is b / (1.01·diagonal) in depth, which
+    // in units of r = 2^-24 (D32_SFLOAT at depths in [0.5, 1)) is that times 2^24; the slope factor
+    // is the slope bias in texels as given (the rasterizer's slope is depth per texel).
+    SphereOverPlane p;
+    p.lightDirection = lightFromElevation(40.0);
+    const scene::Scene s = makeScene(p);
+    scene::RasterSettings settings = validatedSettings(512, 0.01, 1.5, ShadowFilter::Pcf2x2);
+    settings.hardwareBias = true;
+    const scene::Frame f = renderValidated(s, settings, "hardware-factors");
+    const double range = 1.01 * s.bounds().diagonal();
+    EXPECT_EQ(f.attributes.at("bias_mode"), "hardware");
+    EXPECT_NEAR(std::stod(f.attributes.at("hardware_depth_bias_constant_factor")), 0.01 / range * 16777216.0,
+                1e-6 * 0.01 / range * 16777216.0);
+    EXPECT_EQ(f.attributes.at("hardware_depth_bias_slope_factor"), "1.5");
+    // The world values stay recorded beside them.
+    EXPECT_EQ(f.attributes.at("depth_bias"), "0.01");
+    EXPECT_EQ(f.attributes.at("slope_bias"), "1.5");
+    settings.hardwareBias = false;
+    const scene::Frame shader = renderValidated(s, settings, "shader-factors");
+    EXPECT_EQ(shader.attributes.at("bias_mode"), "shader");
+    EXPECT_EQ(shader.attributes.count("hardware_depth_bias_constant_factor"), 0u);
+}
+
+TEST(RasterHardwareBias, AConstantBiasInTheDepthPassComparesAsTheSameBiasInTheShader) {
+    // Nearest filter, no slope bias, a constant bias of 2 texels: lit when ref − b ≤ stored
+    // (shader) or ref ≤ stored + b (hardware) is the same test up to rounding, wherever the
+    // stored primitive's depths reach [0.5, 1), where r = 2^-24 is the unit the factor was
+    // converted in. The seed sphere's map puts the plane's visible part and the sphere's
+    // light-facing side around the middle of the depth range; a primitive wholly below 0.5 gets
+    // half the bias (or less) and may differ. So: the two agree on nearly every counted pixel,
+    // and both match the closed form's shadow as well.
+    SphereOverPlane p;
+    p.center = Vec3(0, 0.5, 0);
+    p.width = 320;
+    p.height = 180;
+    p.lightDirection = lightFromElevation(40.0);
+    const scene::Scene s = makeScene(p);
+    const int size = 1024;
+    const double texel = 1.01 * s.bounds().diagonal() / size;
+    scene::RasterSettings settings = validatedSettings(size, 2.0 * texel, 0.0, ShadowFilter::None);
+    const scene::Frame shader = renderValidated(s, settings, "constant-shader");
+    settings.hardwareBias = true;
+    const scene::Frame hardware = renderValidated(s, settings, "constant-hardware");
+    std::size_t counted = 0, differ = 0;
+    for (std::size_t i = 0; i < shader.pixelCount(); ++i) {
+        if (shader.objectId[i] == 0.0f || shader.ndotl[i] <= 0.0f) continue;
+        ++counted;
+        differ += shader.visibility[i] != hardware.visibility[i];
+    }
+    ASSERT_GT(counted, 20000u);
+    EXPECT_LT(differ, counted / 200) << differ << " of " << counted;
+    const ShadowErrors a = shadowErrors(p, s, shader), b = shadowErrors(p, s, hardware);
+    EXPECT_LT(std::abs(a.falseShadow - b.falseShadow), a.counted / 200);
+    EXPECT_LT(std::abs(a.missedShadow - b.missedShadow), a.analyticShadowed / 20 + 1);
+}
+
+TEST(RasterHardwareBias, SpotAndPointMapsKeepTheShaderBiasAndCascadesTakeTheirOwnFactors) {
+    // Perspective depth is not linear in distance, so one constant factor cannot be one world bias:
+    // spot and point layers keep the shader's bias (factors 0, the same pixels as without the
+    // option). Cascades: each layer's factor is its own world bias over its own depth range.
+    scene::Scene s = makeScene(SphereOverPlane{});
+    s.lights[0].type = scene::LightType::Spot;
+    s.lights[0].position = Vec3(2, 5, 2);
+    s.lights[0].direction = glm::normalize(Vec3(-2, -5, -2));
+    s.lights[0].coneAngleDegrees = 45;
+    s.lights[0].intensity = 300;
+    scene::RasterSettings settings = validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2);
+    const scene::Frame shader = renderValidated(s, settings, "spot-shader");
+    settings.hardwareBias = true;
+    const scene::Frame hardware = renderValidated(s, settings, "spot-hardware");
+    EXPECT_EQ(hardware.attributes.at("hardware_depth_bias_constant_factor"), "0");
+    EXPECT_EQ(hardware.visibility, shader.visibility);
+    EXPECT_EQ(hardware.blockerId, shader.blockerId);
+    s.lights[0].type = scene::LightType::Point;
+    const scene::Frame point = renderValidated(s, settings, "point-hardware");
+    EXPECT_EQ(point.attributes.at("hardware_depth_bias_constant_factor"), "0;0;0;0;0;0");
+    settings.hardwareBias = false;
+    EXPECT_EQ(point.visibility, renderValidated(s, settings, "point-shader").visibility);
+
+    const scene::Scene sun = makeScene(SphereOverPlane{});
+    scene::RasterSettings cascaded = validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2);
+    cascaded.cascades = 3;
+    cascaded.hardwareBias = true;
+    const scene::Frame c = renderValidated(sun, cascaded, "cascades-hardware");
+    ASSERT_EQ(c.attributes.at("cascades"), "3");
+    // Each factor is 0.01 over that cascade's depth range in units of 2^-24; the ranges come from
+    // the same cascade fit the renderer uses.
+    const CascadeSet set = fitCascades(sun, sun.lights[0].direction, 3, 512, 0.0);
+    std::string expected;
+    for (std::size_t k = 0; k < set.frusta.size(); ++k) {
+        if (k) expected += ';';
+        expected += formatForTest(float(0.01 / set.frusta[k].depthRange() * 16777216.0));
+    }
+    EXPECT_EQ(c.attributes.at("hardware_depth_bias_constant_factor"), expected);
 }
 
 TEST(RasterFittedFrustum, DefaultDepthBiasBecomesHalfTheFittedTexel) {

@@ -81,13 +81,14 @@ struct BadCase {
 
 class BadScene : public ::testing::TestWithParam<BadCase> {};
 
-TEST(SceneLoader, ShadowBlockReadsTheCascadeBlend) {
+TEST(SceneLoader, ShadowBlockReadsTheCascadeBlendAndTheHardwareBias) {
     TempDir dir;
     const auto file = dir.write("blend.json", sceneText(kCamera, kMaterials, kLights, kObjects,
-                                                          R"(, "shadow": {"cascades": 3, "cascade_blend": 0.2})"));
+                                                          R"(, "shadow": {"cascades": 3, "cascade_blend": 0.2, "hardware_bias": true})"));
     const Scene s = loadScene(file);
     ASSERT_TRUE(s.shadow.cascadeBlend.has_value());
     EXPECT_EQ(*s.shadow.cascadeBlend, 0.2);
+    EXPECT_EQ(s.shadow.hardwareBias, std::optional<bool>(true));
 }
 
 TEST_P(BadScene, GivesOneErrorNamingFileAndPath) {
@@ -167,6 +168,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"cascade_blend_negative",
                 sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"cascade_blend": -0.1})"),
                 "shadow.cascade_blend", "must be in 0..0.5"},
+        BadCase{"hardware_bias_not_bool",
+                sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"hardware_bias": "yes"})"),
+                "shadow.hardware_bias", "expected"},
         BadCase{"receiver_plane_bias_not_bool",
                 sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"receiver_plane_bias": 1})"),
                 "shadow.receiver_plane_bias", "expected"},

@@ -81,6 +81,16 @@ TEST(Settings, ReceiverPlaneBiasComesFromTheCommandLineThenTheSceneThenOff) {
     EXPECT_FALSE(resolveSettings(s, o).raster.receiverPlaneBias);
 }
 
+TEST(Settings, HardwareBiasComesFromTheCommandLineThenTheSceneThenOff) {
+    Scene s = unitScene(1.0);
+    EXPECT_FALSE(resolveSettings(s, {}).raster.hardwareBias);
+    s.shadow.hardwareBias = true;
+    EXPECT_TRUE(resolveSettings(s, {}).raster.hardwareBias);
+    SettingsOverrides o;
+    o.hardwareBias = false;
+    EXPECT_FALSE(resolveSettings(s, o).raster.hardwareBias);
+}
+
 TEST(Settings, BadValuesNameTheOption) {
     const Scene s = unitScene(1.0);
     auto expectError = [&](SettingsOverrides o, const std::string& option) {
