@@ -145,6 +145,17 @@ ShadowErrors shadowErrors(const SphereOverPlane& p, const scene::Scene& s, const
     return e;
 }
 
+// The sphere resting on the plane (center at its radius, 0.5), 320x180, light `elevation`° above
+// the plane.
+SphereOverPlane restingSphere(double elevation) {
+    SphereOverPlane p;
+    p.center = Vec3(0, 0.5, 0);
+    p.width = 320;
+    p.height = 180;
+    p.lightDirection = lightFromElevation(elevation);
+    return p;
+}
+
 TEST(RasterRender, ZeroBiasAtGrazingLightGivesAcneOnTheLitPlane) {
     // Light 10° above the horizon: across one texel the plane's light depth changes by
     // texel·tan(80°) ≈ 5.7 texels' worth, so without bias about half the plane compares
@@ -211,11 +222,7 @@ TEST(RasterBias, BiasSeriesAtGrazingLightTradeAcneForMissedOrDisplacedShadow) {
     // answer is a compare of one stored depth against the receiver depth minus the bias, so
     // for depth and slope bias the counts are monotone pixel by pixel; the normal offset moves
     // the lookup point, so its counts get a small slack.
-    SphereOverPlane p;
-    p.center = Vec3(0, 0.5, 0);
-    p.width = 320;
-    p.height = 180;
-    p.lightDirection = lightFromElevation(5.0);
+    const SphereOverPlane p = restingSphere(5.0);
     const scene::Scene s = makeScene(p);
     const int size = 512;
     // The bounding-sphere map's texel: 2 · 1.01 · half the diagonal / size.
@@ -312,11 +319,7 @@ TEST(RasterHardwareBias, AConstantBiasInTheDepthPassComparesAsTheSameBiasInTheSh
     // light-facing side around the middle of the depth range; a primitive wholly below 0.5 gets
     // half the bias (or less) and may differ. So: the two agree on nearly every counted pixel,
     // and both match the closed form's shadow as well.
-    SphereOverPlane p;
-    p.center = Vec3(0, 0.5, 0);
-    p.width = 320;
-    p.height = 180;
-    p.lightDirection = lightFromElevation(40.0);
+    const SphereOverPlane p = restingSphere(40.0);
     const scene::Scene s = makeScene(p);
     const int size = 1024;
     const double texel = 1.01 * s.bounds().diagonal() / size;
