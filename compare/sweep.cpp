@@ -231,6 +231,14 @@ SweepGrid defaultGrid(const scene::Scene& scene, bool quick) {
             c.overrides.cascades = 3;
             g.configs.push_back(c);
         }
+    // The same default biases through the rasterizer's depth-bias state (--hardware-bias), beside
+    // the pcf2x2 row of the largest size: what moving them into the depth pass changes. Only with a
+    // directional light (spot and point maps keep the shader's bias).
+    if (directional) {
+        SweepConfig c = raster(sizes.back(), "pcf2x2");
+        c.overrides.hardwareBias = true;
+        g.configs.push_back(c);
+    }
     // The map fitted to what the camera sees (--fit-light-frustum) against the bounding-sphere maps
     // above, at each size: what an engine's fitted frustum gains on this view.
     for (int size : sizes) {

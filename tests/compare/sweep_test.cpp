@@ -462,6 +462,28 @@ TEST_F(GridFile, DefaultGridComparesCascadesOnlyWithADirectionalLight) {
     EXPECT_EQ(cascaded(defaultGrid(spotOnly, false)), 0u);
 }
 
+TEST_F(GridFile, DefaultGridComparesTheHardwareBiasOnceWithADirectionalLight) {
+    auto hardware = [](const SweepGrid& g) {
+        std::vector<SweepConfig> rows;
+        for (const auto& c : g.configs)
+            if (c.overrides.hardwareBias.value_or(false)) rows.push_back(c);
+        return rows;
+    };
+    for (const bool quick : {true, false}) {
+        const std::vector<SweepConfig> rows = hardware(defaultGrid(scene, quick));
+        ASSERT_EQ(rows.size(), 1u);
+        EXPECT_EQ(rows[0].overrides.shadowMapSize, std::optional<int>(quick ? 2048 : 4096));
+        EXPECT_EQ(rows[0].overrides.filter, std::optional<std::string>("pcf2x2"));
+        EXPECT_NE(rows[0].label().find("hardware bias"), std::string::npos) << rows[0].label();
+    }
+    scene::Scene spotOnly = scene;
+    for (auto& l : spotOnly.lights) {
+        l.type = scene::LightType::Spot;
+        l.coneAngleDegrees = 30.0;
+    }
+    EXPECT_TRUE(hardware(defaultGrid(spotOnly, false)).empty());
+}
+
 TEST_F(GridFile, DefaultGridComparesAFittedMapAtEverySize) {
     // One pcf2x2 row per map size with the fitted frustum, beside the bounding-sphere rows.
     for (const bool quick : {true, false}) {
