@@ -64,7 +64,17 @@ Prepared prepare(const SceneOptions& o) {
     if (o.explain)
         std::cerr << "render plan for " << p.scene.file.string() << ":\n"
                   << p.plan.explain()
-                  << "raster shadow-map size: " << raster::chooseShadowMapSize(p.scene, p.settings.raster, &p.plan).reason << "\n";
+                  << "raster shadow-map size: " << raster::chooseShadowMapSize(p.scene, p.settings.raster, &p.plan).reason << "\n"
+                  << "raster bias: constant " << p.settings.raster.depthBias << " world units"
+                  << (p.settings.raster.depthBiasIsDefault ? " (default: half a texel of the bounding-sphere map)" : "")
+                  << ", slope " << p.settings.raster.slopeBias << " texels x tan(angle to light), "
+                  << (p.settings.raster.hardwareBias
+                          ? "through the rasterizer's depth-bias state in directional maps' depth pass (converted per "
+                            "layer, recorded in the Frame; spot and point maps in the lit shader)"
+                          : "in the lit shader")
+                  << (p.settings.raster.receiverPlaneBias ? "; the receiver plane replaces the slope term in the shader"
+                                                          : "")
+                  << "\n";
     if (o.explain) {
         const std::vector<raster::LightCulling> culled = raster::culledCasters(p.scene, p.settings.raster, &p.plan);
         const std::size_t objects = p.scene.objects.size();

@@ -260,6 +260,23 @@ TEST(App, ExplainSaysHowManyCastersEachMapLeavesOut) {
     EXPECT_NE(r.err.find("+Y 4 of 4"), std::string::npos) << r.err;
 }
 
+TEST(App, ExplainSaysWhereTheBiasIsApplied) {
+    TempDir dir;
+    const std::string out = (dir.path() / "seed.png").string();
+    Result r = shadowlab({"render", "seed", "--backend", "raster", "--explain", "--resolution", "96x54",
+                          "--depth-bias", "0.02", "--slope-bias", "1.5", "-o", out});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("raster bias: constant 0.02 world units, slope 1.5 texels x tan(angle to light), in the "
+                         "lit shader\n"),
+              std::string::npos)
+        << r.err;
+    r = shadowlab({"render", "seed", "--backend", "raster", "--explain", "--resolution", "96x54", "--hardware-bias",
+                   "-o", out});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("(default: half a texel of the bounding-sphere map)"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("through the rasterizer's depth-bias state"), std::string::npos) << r.err;
+}
+
 TEST(App, StabilityRunsTheNamedCasesAndWritesItsReport) {
     TempDir dir;
     const auto out = dir.path() / "stability";
