@@ -2,6 +2,7 @@
 // pass, readback into a Frame, timings and metadata.
 #include "raster/renderer.h"
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -40,6 +41,20 @@ std::string formatNumber(double v) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "%.9g", v);
     return buf;
+}
+
+// An attribute listing one value per light, layer or cascade: text(item) for each, joined by sep.
+template <class T, class Text>
+std::string joined(const std::vector<T>& items, Text text, const char* sep = ";") {
+    std::string out;
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        if (i) out += sep;
+        out += text(items[i]);
+    }
+    return out;
+}
+std::string joinedNumbers(const std::vector<double>& values) {
+    return joined(values, [](double v) { return formatNumber(v); });
 }
 
 // A closed surface: every edge (a pair of positions) is shared by exactly two of its triangles.
@@ -397,16 +412,12 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
         }
         draw.layerRanges.push_back(std::move(ranges));
     }
-    std::string culled;
-    for (std::size_t i = 0; i < culledPerLight.size(); ++i) culled += (i ? ";" : "") + std::to_string(culledPerLight[i]);
-    attributes["culled_casters"] = culled;
+    const auto count = [](int n) { return std::to_string(n); };
+    attributes["culled_casters"] = joined(culledPerLight, count);
     // Per layer (in layer order, as shadow_maps and light_frustum list them), when a light has more
     // than one (cascades, cube faces).
-    if (layerLight.size() > std::set<int>(layerLight.begin(), layerLight.end()).size()) {
-        std::string perLayer;
-        for (std::size_t k = 0; k < culledPerLayer.size(); ++k) perLayer += (k ? ";" : "") + std::to_string(culledPerLayer[k]);
-        attributes["culled_casters_per_layer"] = perLayer;
-    }
+    if (layerLight.size() > std::set<int>(layerLight.begin(), layerLight.end()).size())
+        attributes["culled_casters_per_layer"] = joined(culledPerLayer, count);
 
     // Without a shadowed light a 1x1 cleared layer keeps the descriptor valid.
     const auto mapSize = lightMatrices.empty() ? 1u : std::uint32_t(settings.shadowMapSize);
@@ -455,18 +466,11 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     attributes["light_frustum_fit"] = settings.fitLightFrustum ? "receivers" : "bounding-sphere";
     // The constant bias actually used: one value, or one per light (';') when a default was
     // re-derived per fitted map and the maps differ.
-    std::string depthBias = formatNumber(settings.depthBias);
-    if (!usedDepthBias.empty()) {
-        depthBias = formatNumber(usedDepthBias[0]);
-        for (std::size_t i = 1; i < usedDepthBias.size(); ++i)
-            if (usedDepthBias[i] != usedDepthBias[0]) {
-                depthBias.clear();
-                for (std::size_t k = 0; k < usedDepthBias.size(); ++k)
-                    depthBias += (k ? ";" : "") + formatNumber(usedDepthBias[k]);
-                break;
-            }
-    }
-    attributes["depth_bias"] = depthBias;
+    const bool oneBias = std::all_of(usedDepthBias.begin(), usedDepthBias.end(),
+                                     [&](double b) { return b == usedDepthBias[0]; });
+    attributes["depth_bias"] = usedDepthBias.empty() ? formatNumber(settings.depthBias)
+                               : oneBias            ? formatNumber(usedDepthBias[0])
+                                                    : joinedNumbers(usedDepthBias);
     attributes["depth_bias_default"] = settings.depthBiasIsDefault ? "true" : "false";
     attributes["slope_bias"] = formatNumber(settings.slopeBias);
     // On, the receiver's plane replaces the slope term in every tap (lit.frag), so slope_bias is unused.
@@ -475,13 +479,10 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     // directional layer's depth pass was given (docs/raster.md "Hardware depth bias").
     attributes["bias_mode"] = settings.hardwareBias ? "hardware" : "shader";
     if (settings.hardwareBias) {
-        std::string constant, slope;
-        for (std::size_t k = 0; k < layerBias.size(); ++k) {
-            constant += (k ? ";" : "") + formatNumber(layerBias[k].constant);
-            slope += (k ? ";" : "") + formatNumber(layerBias[k].slope);
-        }
-        attributes["hardware_depth_bias_constant_factor"] = constant;
-        attributes["hardware_depth_bias_slope_factor"] = slope;
+        attributes["hardware_depth_bias_constant_factor"] =
+            joined(layerBias, [](const DepthBiasFactors& b) { return formatNumber(b.constant); });
+        attributes["hardware_depth_bias_slope_factor"] =
+            joined(layerBias, [](const DepthBiasFactors& b) { return formatNumber(b.slope); });
         attributes["hardware_depth_bias_unit"] =
             "r = 2^-24 (D32_SFLOAT, depths in [0.5, 1)); spot and point layers 0: they keep the shader bias";
     }
@@ -490,22 +491,16 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     attributes["sphere_segments"] = std::to_string(sphereSegmentsUsed);
     attributes["shadow_maps"] = std::to_string(frusta.size());
     if (!frusta.empty()) {
-        std::string texel, frustum;
-        for (std::size_t i = 0; i < frusta.size(); ++i) {
-            // A spot map's texel grows with distance: "<size per unit distance>*d".
-            texel += (i ? ";" : "") + formatNumber(frusta[i].texelWorldSize()) + (frusta[i].perspective ? "*d" : "");
-            frustum += (i ? "; " : "") + frusta[i].describe();
-        }
-        attributes["texel_world_size"] = texel;
-        attributes["light_frustum"] = frustum;
+        // A spot map's texel grows with distance: "<size per unit distance>*d".
+        attributes["texel_world_size"] = joined(frusta, [](const LightFrustum& f) {
+            return formatNumber(f.texelWorldSize()) + (f.perspective ? "*d" : "");
+        });
+        attributes["light_frustum"] = joined(frusta, [](const LightFrustum& f) { return f.describe(); }, "; ");
     }
     attributes["cascades"] = std::to_string(cascadesUsed);
     if (!cascadeSplits.empty()) {
-        std::string splits, texels;
-        for (std::size_t k = 0; k < cascadeSplits.size(); ++k) splits += (k ? ";" : "") + formatNumber(cascadeSplits[k]);
-        for (std::size_t k = 0; k < cascadeTexels.size(); ++k) texels += (k ? ";" : "") + formatNumber(cascadeTexels[k]);
-        attributes["cascade_splits"] = splits;
-        attributes["cascade_texel_world_size"] = texels;
+        attributes["cascade_splits"] = joinedNumbers(cascadeSplits);
+        attributes["cascade_texel_world_size"] = joinedNumbers(cascadeTexels);
         attributes["cascade_blend"] = formatNumber(cascadeBlendUsed);
     }
     setupMs = msSince(setupStart);

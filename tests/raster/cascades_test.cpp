@@ -259,11 +259,7 @@ scene::RasterSettings cascadeSettings(int cascades, int mapSize = 512) {
     return r;
 }
 
-scene::Frame renderChecked(const scene::Scene& s, const scene::RasterSettings& settings, RenderDebug* debug = nullptr) {
-    scene::Frame f = render(s, test::planFor(s, settings), settings, debug);
-    EXPECT_EQ(f.attributes["validation_messages"], "0") << "validation messages were printed above";
-    return f;
-}
+using test::renderChecked;
 
 std::vector<double> parseList(const std::string& text) {
     std::vector<double> v;

@@ -205,11 +205,7 @@ TEST(FrustumView, InsideLightMapOnEachFaceOfASpotPyramidAndAPointFace) {
 
 // --- On lavapipe, with validation ---
 
-scene::Frame renderChecked(const scene::Scene& s, const scene::RasterSettings& settings, RenderDebug* debug) {
-    scene::Frame f = render(s, test::planFor(s, settings), settings, debug);
-    EXPECT_EQ(f.attributes["validation_messages"], "0") << "validation messages were printed above";
-    return f;
-}
+using test::renderChecked;
 
 void maybeWritePng(const DisplayImage& img, const std::string& name) {
     if (const char* dir = std::getenv("SHADOWLAB_TEST_PNG_DIR"))

@@ -54,11 +54,7 @@ scene::RasterSettings fitSettings(int size, bool fit) {
     return r;
 }
 
-scene::Frame renderValidated(const scene::Scene& s, const scene::RasterSettings& settings, RenderDebug* debug = nullptr) {
-    scene::Frame f = render(s, test::planFor(s, settings), settings, debug);
-    EXPECT_EQ(f.attributes["validation_messages"], "0") << "validation messages were printed above";
-    return f;
-}
+using test::renderChecked;
 
 // The window's half-size by hand. The visible receivers are the scene box (y 0..1) in the view:
 // at y = 0 (d = 8) x = 2 ± 4·tan 20°·16/9, z = ±4·tan 20°; at y = 1 (d = 7) x = 2 ± 3·tan 20°·16/9.
@@ -106,7 +102,7 @@ TEST(RasterSpotFit, TheFittedWindowHoldsEveryVisibleReceiverWithTheMargin) {
     // margin (10 texels) inside its edges. The render's texel_world_size is the fitted map's.
     const scene::Scene s = spotScene();
     RenderDebug debug;
-    const scene::Frame frame = renderValidated(s, fitSettings(1024, true), &debug);
+    const scene::Frame frame = renderChecked(s, fitSettings(1024, true), &debug);
     ASSERT_EQ(debug.frusta.size(), 1u);
     const LightFrustum& f = debug.frusta[0];
     EXPECT_NEAR(f.tanHalfFov, std::exp2(-1.5), 1e-12);
@@ -204,7 +200,7 @@ TEST(RasterSpotFit, TheSnappedDepthRangeStillHoldsEveryVisibleReceiverAndCaster)
     // (center − light)·axis − r = (2 + 15)/√5 − 0.5 = 7.10.
     const scene::Scene s = tiltedSpotScene(0.6);
     RenderDebug debug;
-    const scene::Frame frame = renderValidated(s, fitSettings(1024, true), &debug);
+    const scene::Frame frame = renderChecked(s, fitSettings(1024, true), &debug);
     ASSERT_EQ(debug.frusta.size(), 1u);
     const LightFrustum& f = debug.frusta[0];
     const Vec3 axis = glm::normalize(Vec3(1, -2, 0));
@@ -292,8 +288,8 @@ TEST(RasterSpotFit, AnUnrelatedFarObjectChangesNeitherTheTexelNorTheDepthRange) 
     EXPECT_GT(spotLightFrustum(withFar, cone, withFar.lights[0], 1024).far,
               1.9 * spotLightFrustum(plain, cone, plain.lights[0], 1024).far);
     // Rendered: the texel_world_size attribute is the same with and without the far sphere.
-    EXPECT_EQ(renderValidated(plain, fit).attributes.at("texel_world_size"),
-              renderValidated(withFar, fit).attributes.at("texel_world_size"));
+    EXPECT_EQ(renderChecked(plain, fit).attributes.at("texel_world_size"),
+              renderChecked(withFar, fit).attributes.at("texel_world_size"));
 }
 
 TEST(RasterSpotFit, ReceiversBehindTheLightsPlaneKeepTheWholeCone) {
@@ -317,8 +313,8 @@ TEST(RasterSpotFit, TheFittedRenderIsNoWorseAgainstTheReference) {
     settings.raster = fitSettings(256, false);
     const scene::Frame ref =
         raytrace::renderReference(s, scene::makeRenderPlan(s, settings), scene::referenceSettings(settings.raytrace));
-    const scene::Frame cone = renderValidated(s, fitSettings(256, false));
-    const scene::Frame fitted = renderValidated(s, fitSettings(256, true));
+    const scene::Frame cone = renderChecked(s, fitSettings(256, false));
+    const scene::Frame fitted = renderChecked(s, fitSettings(256, true));
     const compare::Metrics a = compare::compareFrames(fitted, ref).metrics;
     const compare::Metrics b = compare::compareFrames(cone, ref).metrics;
     std::printf("reference shadowed %zu of %zu; wrong: fitted %zu, cone %zu; mean |dV| fitted %.4f, cone %.4f\n",
@@ -382,8 +378,8 @@ TEST(RasterPointFit, EachFaceTakesItsNearAndFarFromItsCastersAndReceivers) {
     // Rendered (validated), with each face's range in the shader: the same shadows as the
     // bounding-sphere range, up to a few pixels on the sphere's shadow edge.
     RenderDebug debug;
-    const scene::Frame fitted = renderValidated(s, fit, &debug);
-    const scene::Frame wide = renderValidated(s, plain);
+    const scene::Frame fitted = renderChecked(s, fit, &debug);
+    const scene::Frame wide = renderChecked(s, plain);
     ASSERT_EQ(debug.frusta.size(), 6u);
     EXPECT_NEAR(debug.frusta[3].near, down.near, 1e-12);
     int differ = 0, shadowed = 0;
@@ -407,8 +403,8 @@ TEST(RasterPointFit, EachFaceTakesItsNearAndFarFromItsCastersAndReceivers) {
     rs.raster = pcssPlain;
     const scene::Frame ref = raytrace::renderReference(soft, scene::makeRenderPlan(soft, rs),
                                                        scene::referenceSettings(rs.raytrace));
-    const compare::Metrics a = compare::compareFrames(renderValidated(soft, pcssFit), ref).metrics;
-    const compare::Metrics b = compare::compareFrames(renderValidated(soft, pcssPlain), ref).metrics;
+    const compare::Metrics a = compare::compareFrames(renderChecked(soft, pcssFit), ref).metrics;
+    const compare::Metrics b = compare::compareFrames(renderChecked(soft, pcssPlain), ref).metrics;
     std::printf("pcss: mean |dV| fitted %.4f, bounding-sphere range %.4f; wrong %zu, %zu\n", a.meanAbsVisibilityError,
                 b.meanAbsVisibilityError, a.falseShadow + a.missedShadow, b.falseShadow + b.missedShadow);
     EXPECT_LE(a.meanAbsVisibilityError, b.meanAbsVisibilityError * 1.05);

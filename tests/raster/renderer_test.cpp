@@ -834,6 +834,18 @@ TEST(RasterRender, TwoLightsKeepEachLightsVisibilityAndCombineThem) {
     }
 }
 
+// Light 0's visibility at pixel i in `a` (one light) against `b` (light 0 and a dim one):
+// `differ` counts pixels more than 1e-3 apart, `worst` is the largest difference among the rest.
+struct LightZeroAgreement {
+    std::size_t differ = 0;
+    double worst = 0.0;
+    void add(const scene::Frame& a, const scene::Frame& b, std::size_t i) {
+        const double d = std::abs(double(a.visibility[i]) - double(b.lightVisibility[0][i]));
+        if (d <= 1e-3) worst = std::max(worst, d);
+        differ += d > 1e-3;
+    }
+};
+
 // The scene `one` rendered alone and with `dim` added (a second light takes lit.frag off the
 // interpolated map-coordinate path, onto the per-fragment product), normal offset 1.5 texels.
 std::pair<scene::Frame, scene::Frame> aloneAndWithADimLight(const scene::Scene& one, const scene::Light& dim,
@@ -868,21 +880,19 @@ TEST(RasterRender, InterpolatedLightCoordinatesMatchThePerFragmentProduct) {
             dim.intensity = 0.1;
             const auto [a, b] = aloneAndWithADimLight(one, dim, validatedSettings(512, 0.002, 0.1, filter));
             ASSERT_EQ(b.lightVisibility.size(), 2u);
-            std::size_t lit = 0, shadowed = 0, differ = 0;
-            double worst = 0.0;
+            std::size_t lit = 0, shadowed = 0;
+            LightZeroAgreement agree;
             for (std::size_t i = 0; i < a.pixelCount(); ++i) {
                 if (a.objectId[i] == 0.0f) continue;
                 ASSERT_EQ(a.objectId[i], b.objectId[i]);
-                const double d = std::abs(double(a.visibility[i]) - double(b.lightVisibility[0][i]));
-                if (d <= 1e-3) worst = std::max(worst, d);
-                differ += d > 1e-3;
+                agree.add(a, b, i);
                 lit += a.visibility[i] > 0.99f;
                 shadowed += a.visibility[i] < 0.01f;
             }
             EXPECT_GT(shadowed, 500u) << "the sphere shadows the plane";
             EXPECT_GT(lit, 10000u);
-            EXPECT_LE(differ, 3u) << "offset " << offset << ", filter " << int(filter);
-            EXPECT_LE(worst, 2e-4) << "offset " << offset << ", filter " << int(filter);
+            EXPECT_LE(agree.differ, 3u) << "offset " << offset << ", filter " << int(filter);
+            EXPECT_LE(agree.worst, 2e-4) << "offset " << offset << ", filter " << int(filter);
         }
 }
 
@@ -924,16 +934,14 @@ TEST(RasterRender, InterpolatedSpotLightCoordinatesMatchThePerFragmentProduct) {
             dim.intensity = 30.0;
             const auto [a, b] = aloneAndWithADimLight(one, dim, validatedSettings(512, 0.004, 0.1, filter));
             ASSERT_EQ(b.lightVisibility.size(), 2u);
-            std::size_t lit = 0, shadowedInCone = 0, differ = 0;
-            double worst = 0.0;
+            std::size_t lit = 0, shadowedInCone = 0;
+            LightZeroAgreement agree;
             for (int y = 0; y < a.height; ++y)
                 for (int x = 0; x < a.width; ++x) {
                     const std::size_t i = at(a, x, y);
                     if (a.objectId[i] == 0.0f) continue;
                     ASSERT_EQ(a.objectId[i], b.objectId[i]);
-                    const double d = std::abs(double(a.visibility[i]) - double(b.lightVisibility[0][i]));
-                    if (d <= 1e-3) worst = std::max(worst, d);
-                    differ += d > 1e-3;
+                    agree.add(a, b, i);
                     lit += a.visibility[i] > 0.99f;
                     const PrimaryHit h = primaryHit(base, cam, x, y);
                     const Vec3 toLight = spotPosition - h.p;
@@ -945,8 +953,8 @@ TEST(RasterRender, InterpolatedSpotLightCoordinatesMatchThePerFragmentProduct) {
                 }
             EXPECT_GT(shadowedInCone, 500u) << "the sphere shadows the plane inside the cone";
             EXPECT_GT(lit, 10000u);
-            EXPECT_LE(differ, 3u) << "offset " << offset << ", filter " << int(filter);
-            EXPECT_LE(worst, 2e-4) << "offset " << offset << ", filter " << int(filter);
+            EXPECT_LE(agree.differ, 3u) << "offset " << offset << ", filter " << int(filter);
+            EXPECT_LE(agree.worst, 2e-4) << "offset " << offset << ", filter " << int(filter);
         }
 }
 

@@ -9,6 +9,9 @@
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
+
+#include "raster/renderer.h"
 #include "scene/camera.h"
 #include "scene/frame.h"
 #include "scene/render_plan.h"
@@ -202,6 +205,14 @@ inline scene::RenderPlan planFor(const scene::Scene& s, const scene::RasterSetti
     scene::RenderSettings settings;
     settings.raster = raster;
     return scene::makeRenderPlan(s, settings);
+}
+
+// A raster render of `s` (settings.validate should be on), failing the test on any validation message.
+inline scene::Frame renderChecked(const scene::Scene& s, const scene::RasterSettings& settings,
+                                  RenderDebug* debug = nullptr) {
+    scene::Frame f = render(s, planFor(s, settings), settings, debug);
+    EXPECT_EQ(f.attributes["validation_messages"], "0") << "validation messages were printed above";
+    return f;
 }
 
 // Every Vulkan test renders with the validation layer on.
