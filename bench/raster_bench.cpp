@@ -11,6 +11,7 @@
 #include <exception>
 #include <filesystem>
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -27,8 +28,14 @@ using namespace shadowlab;
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-constexpr int kWidth = 1920;
-constexpr int kHeight = 1080;
+// The image: 1920x1080 (the issue's), or SHADOWLAB_BENCH_RESOLUTION=WxH.
+std::pair<int, int> benchResolution() {
+    int w = 1920, h = 1080;
+    if (const char* v = std::getenv("SHADOWLAB_BENCH_RESOLUTION"); v && *v)
+        if (std::sscanf(v, "%dx%d", &w, &h) != 2 || w <= 0 || h <= 0)
+            throw std::runtime_error(std::string("SHADOWLAB_BENCH_RESOLUTION: expected WxH, got ") + v);
+    return {w, h};
+}
 constexpr int kShadowMapSize = 2048;
 constexpr const char* kSponzaPath = "/work/shared/scenes/Sponza/Sponza.gltf";
 
@@ -92,10 +99,24 @@ bool wantScene(const char* label) {
     return !only || !*only || std::string(only) == label;
 }
 
+// SHADOWLAB_BENCH_LIGHT_CONSTANTS=uniform|vertex: force where our lit pass reads the light's
+// constants (raster::RendererOptions::lightConstants; default: the renderer's own choice).
+raster::RendererOptions rendererOptions() {
+    raster::RendererOptions o;
+    if (const char* v = std::getenv("SHADOWLAB_BENCH_LIGHT_CONSTANTS"); v && *v) {
+        const std::string which = v;
+        if (which == "uniform") o.lightConstants = raster::LightConstants::kUniformBuffer;
+        else if (which == "vertex") o.lightConstants = raster::LightConstants::kVertexOutputs;
+        else throw std::runtime_error("SHADOWLAB_BENCH_LIGHT_CONSTANTS: expected uniform or vertex, got " + which);
+    }
+    return o;
+}
+
 void benchScene(const std::string& label, const fs::path& file, int repeats, std::vector<fs::path>& caches) {
     const char* noFresh = std::getenv("SHADOWLAB_BENCH_NO_FRESH");
     const bool skipFresh = noFresh && std::string(noFresh) == "1";
     scene::Scene s = scene::loadScene(file);
+    const auto [kWidth, kHeight] = benchResolution();
     s.camera.width = kWidth;
     s.camera.height = kHeight;
     scene::SettingsOverrides overrides;
@@ -107,7 +128,7 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
     // bare renderer compile different shaders, so both are cold in the same cache.
     freshShaderCache(caches);
     auto t0 = Clock::now();
-    raster::Renderer ours(s, plan, settings.raster);
+    raster::Renderer ours(s, plan, settings.raster, rendererOptions());
     scene::Frame frame = ours.render();
     const double oursCold = msSince(t0);
     std::vector<std::uint8_t> rgba;
@@ -120,15 +141,33 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
     bench::BareRenderer bareSrgb(s, settings.raster, true);
     bareSrgb.render(rgba);
 
-    std::printf("\n=== %s: %s triangles, %dx%d, shadow map %d, filter %s, bare PCF: %s ===\n", label.c_str(),
-                frame.attributes["triangles"].c_str(), kWidth, kHeight, kShadowMapSize,
-                frame.attributes["filter"].c_str(), bare.pcfKind().c_str());
+    std::printf("\n=== %s: %s triangles, %dx%d, shadow map %d, filter %s, light constants: %s, bare PCF: "
+                "%s ===\n",
+                label.c_str(), frame.attributes["triangles"].c_str(), kWidth, kHeight, kShadowMapSize,
+                frame.attributes["filter"].c_str(), frame.attributes["light_constants"].c_str(),
+                bare.pcfKind().c_str());
     if (const char* dir = std::getenv("SHADOWLAB_BENCH_PNG_DIR")) {
         scene::writePngLinear(fs::path(dir) / (label + "-ours.png"), frame.width, frame.height, frame.beauty);
         std::vector<float> rgb(std::size_t(kWidth) * kHeight * 3);
         for (std::size_t i = 0; i < rgb.size() / 3; ++i)
             for (int c = 0; c < 3; ++c) rgb[3 * i + c] = float(rgba[4 * i + c]) / 255.0f;
         scene::writePngDisplay(fs::path(dir) / (label + "-bare.png"), kWidth, kHeight, rgb);
+    }
+
+    // SHADOWLAB_BENCH_PROFILE=all|beauty|png|bare|bare-srgb: only that series, `repeats` frames,
+    // nothing printed: a process to run under `perf record` (docs/performance.md).
+    if (const char* profile = std::getenv("SHADOWLAB_BENCH_PROFILE"); profile && *profile) {
+        const std::string which = profile;
+        scene::Frame into;
+        for (int i = 0; i < repeats; ++i) {
+            if (which == "all") ours.render(into, scene::kAllChannels);
+            else if (which == "beauty") ours.render(into, scene::kChannelBeauty);
+            else if (which == "png") ours.render(into, scene::kChannelBeauty | scene::kBeautyForDisplay);
+            else if (which == "bare") bare.render(rgba);
+            else if (which == "bare-srgb") bareSrgb.render(rgba);
+            else throw std::runtime_error("SHADOWLAB_BENCH_PROFILE: expected all, beauty, png, bare or bare-srgb, got " + which);
+        }
+        return;
     }
 
     // Warm frames, interleaved so that both see the same machine: ours with every channel
@@ -164,7 +203,7 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
     // Warm first frames: a new renderer (new device) whose shaders are now in the cache.
     t0 = Clock::now();
     {
-        raster::Renderer again(s, plan, settings.raster);
+        raster::Renderer again(s, plan, settings.raster, rendererOptions());
         again.render();
     }
     const double oursWarmFirst = msSince(t0);

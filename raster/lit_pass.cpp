@@ -9,6 +9,12 @@
 
 namespace shadowlab::raster {
 
+bool usesVertexLightCoordinates(const LitVariant& variant) {
+    if (variant.lightCount != 1 || variant.receiverPlane) return false;
+    return (variant.lightKinds == (1u << SHADOWLAB_LIGHT_DIRECTIONAL) && variant.cascades == 1) ||
+           variant.lightKinds == (1u << SHADOWLAB_LIGHT_SPOT);
+}
+
 LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant) {
     requireFormat(ctx, kLitColorFormat,
                   VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_TRANSFER_SRC_BIT, "the lit pass targets");
@@ -55,19 +61,21 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant) {
     VkPipelineLayout layout = VK_NULL_HANDLE;
     VK_CHECK(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &layout));
     p.layout = PipelineLayoutHandle(device, layout);
-    // lit.frag's constant_id 0: the filter code, 1: blocker ids (a bool is 32 bits wide),
-    // 2: the light count, 3: the light kinds, 4: the cascade count, 5: transmittance (bool),
-    // 6: receiver-plane bias (bool), 7: cascade blend bands (bool), 8: visibility in the beauty's
-    // alpha (bool; not for the display target), 9: normal offset (bool).
-    const std::int32_t constants[10] = {std::int32_t(variant.filter),     variant.blockerIds ? 1 : 0,
-                                        std::int32_t(variant.lightCount), std::int32_t(variant.lightKinds),
-                                        std::int32_t(variant.cascades),   variant.transmittance ? 1 : 0,
-                                        variant.receiverPlane ? 1 : 0,    variant.cascadeBlend ? 1 : 0,
-                                        variant.displayTarget ? 0 : 1,    variant.normalOffset ? 1 : 0};
-    VkSpecializationMapEntry entries[10];
-    for (std::uint32_t i = 0; i < 10; ++i) entries[i] = {i, 4 * i, 4};
+    // shaders/lit_constants.glsl's constant_id 0: the filter code, 1: blocker ids (a bool is 32
+    // bits wide), 2: the light count, 3: the light kinds, 4: the cascade count, 5: transmittance
+    // (bool), 6: receiver-plane bias (bool), 7: cascade blend bands (bool), 8: visibility in the
+    // beauty's alpha (bool; not for the display target), 9: normal offset (bool), 10: the light's
+    // constants as flat vertex outputs (bool). Both stages get them all.
+    constexpr std::uint32_t kConstants = 11;
+    const std::int32_t constants[kConstants] = {
+        std::int32_t(variant.filter),     variant.blockerIds ? 1 : 0,       std::int32_t(variant.lightCount),
+        std::int32_t(variant.lightKinds), std::int32_t(variant.cascades),   variant.transmittance ? 1 : 0,
+        variant.receiverPlane ? 1 : 0,    variant.cascadeBlend ? 1 : 0,     variant.displayTarget ? 0 : 1,
+        variant.normalOffset ? 1 : 0,     variant.vertexLightConstants ? 1 : 0};
+    VkSpecializationMapEntry entries[kConstants];
+    for (std::uint32_t i = 0; i < kConstants; ++i) entries[i] = {i, 4 * i, 4};
     const VkSpecializationInfo specialization{
-        .mapEntryCount = 10, .pMapEntries = entries, .dataSize = sizeof constants, .pData = constants};
+        .mapEntryCount = kConstants, .pMapEntries = entries, .dataSize = sizeof constants, .pData = constants};
     std::vector<VkFormat> colorFormats{variant.displayTarget ? kLitDisplayFormat : kLitColorFormat};
     if (variant.aovTarget) colorFormats.insert(colorFormats.end(), 1 + variant.lightTargets, kLitColorFormat);
     p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{
@@ -77,6 +85,7 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant) {
                                                                        ? shaders::litFragLightsSpirv()
                                                                        : shaders::litFragSpirv(),
                                                  .fragmentSpecialization = &specialization,
+                                                 .vertexSpecialization = &specialization,
                                                  .layout = layout,
                                                  .colorFormats = colorFormats,
                                                  .depthFormat = kLitDepthFormat,

@@ -35,7 +35,15 @@ struct LitVariant {
     bool transmittance = false;      // semi-transparent casters: read the transmittance maps
     bool receiverPlane = false;      // receiver-plane depth bias in every filter tap
     bool cascadeBlend = false;       // blend bands before the cascade splits (LitUniforms::counts.z)
+    // Light 0's constants reach lit.frag as flat outputs of lit.vert instead of uniform reads
+    // (shaders/lit_constants.glsl kVertexLightConstants); takes effect only where
+    // usesVertexLightCoordinates().
+    bool vertexLightConstants = false;
 };
+// Whether lit.frag takes light 0's map coordinates from lit.vert (lit_constants.glsl
+// kVertexLightCoordinates, the same condition): one light, directional with one map or a spot, and
+// no receiver-plane bias.
+bool usesVertexLightCoordinates(const LitVariant& variant);
 // Per-light visibility targets: four lights in each RGBA32F target, SHADOWLAB_MAX_LIGHTS in all.
 inline constexpr std::uint32_t kLightTargets = (SHADOWLAB_MAX_LIGHTS + 3) / 4;
 

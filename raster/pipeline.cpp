@@ -25,6 +25,7 @@ PipelineHandle createGraphicsPipeline(const Context& ctx, const PipelineDesc& de
         .stage = VK_SHADER_STAGE_VERTEX_BIT,
         .module = vertex.get(),
         .pName = "main",
+        .pSpecializationInfo = desc.vertexSpecialization,
     }};
     if (!desc.fragmentShader.empty()) {
         fragment = createShaderModule(ctx, desc.fragmentShader);

@@ -172,6 +172,7 @@ struct Renderer::Impl {
     // The blend band before each split (settings.cascadeBlend), 0 without cascades: when > 0,
     // lit.frag's blend code is compiled in (specialization constant) and reads it from counts.z.
     double cascadeBlendUsed = 0.0;
+    bool vertexLightConstants = false;  // LitVariant::vertexLightConstants of every lit pipeline
     double setupMs = 0.0;
     double pendingSetupMs = 0.0;  // setup not yet reported in a frame (the constructor's)
 
@@ -503,6 +504,13 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
         attributes["cascade_texel_world_size"] = joinedNumbers(cascadeTexels);
         attributes["cascade_blend"] = formatNumber(cascadeBlendUsed);
     }
+    // Where lit.frag reads the light's constants (RendererOptions::lightConstants).
+    const bool vertexCoordinates = usesVertexLightCoordinates(LitVariant{.lightCount = std::uint32_t(lightCount),
+                                                                         .lightKinds = lightKinds,
+                                                                         .cascades = std::uint32_t(cascadesUsed),
+                                                                         .receiverPlane = settings.receiverPlaneBias});
+    vertexLightConstants = vertexCoordinates && options.lightConstants == LightConstants::kVertexOutputs;
+    attributes["light_constants"] = vertexLightConstants ? "vertex-outputs" : "uniform-buffer";
     setupMs = msSince(setupStart);
     pendingSetupMs = setupMs;
 }
@@ -543,7 +551,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                                                             .cascades = std::uint32_t(cascadesUsed),
                                                             .transmittance = transmit,
                                                             .receiverPlane = settings.receiverPlaneBias,
-                                                            .cascadeBlend = cascadeBlendUsed > 0.0});
+                                                            .cascadeBlend = cascadeBlendUsed > 0.0,
+                                                            .vertexLightConstants = vertexLightConstants});
         if (bindings.set == VK_NULL_HANDLE)
             bindings = createLitBindings(ctx, litPipeline, uniforms, albedos, maps, transmittanceMaps);
         setup += msSince(pipelineStart);

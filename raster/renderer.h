@@ -44,10 +44,19 @@ struct RenderDebug {
 // first render() that needs them (the blocker-id variant only when blocker ids are asked for).
 // The first frame's "setup" timing is the constructor's time plus any pipeline creation; later
 // frames have "setup" 0 unless they had to create a pipeline. Call from one thread at a time.
+// Where the lit pass's fragment shader reads the one light's constants, where it takes that
+// light's map coordinates from the vertex shader (one directional light with one map, or one
+// spot; shaders/lit_constants.glsl): as flat outputs of the vertex shader (the default: lavapipe
+// reads a uniform lane by lane for every eight pixels, a flat input once per triangle;
+// docs/performance.md), or from the uniform buffer. The frames are the same bit for bit (tests
+// render both).
+enum class LightConstants { kVertexOutputs, kUniformBuffer };
+
 struct RendererOptions {
     // Read the targets in place where the device's memory is the host's (lavapipe); false
     // copies them into readback buffers first, as on other devices (tests compare the two).
     bool readTargetsInPlace = true;
+    LightConstants lightConstants = LightConstants::kVertexOutputs;
 };
 
 class Renderer {

@@ -38,6 +38,10 @@ layout(location = 4) in vec4 inLightNormal;       // lit.vert: toShadow · (the 
 // The object's albedo (rgb) and 1 − opacity (a), which lit.vert reads from the per-object buffer
 // (binding 1): flat, so the same value as a read here, without a buffer lookup per fragment.
 layout(location = 5) flat in vec4 inAlbedo;
+// kVertexLightConstants: light 0's constants, and LitUniforms' forward and counts, from lit.vert
+// (lightAt(), forward(), counts()).
+layout(location = 6) flat in vec4 inLight[6];
+layout(location = 12) flat in vec4 inFrame[2];
 
 layout(location = 0) out vec4 outBeauty;  // rgb: linear color; a: visibility
 #ifndef SHADOWLAB_BEAUTY_ONLY
@@ -53,47 +57,25 @@ layout(location = 2) out vec4 outLights0;
 layout(location = 3) out vec4 outLights1;
 #endif
 
-// Specialization constants, set per pipeline by raster/lit_pass.cpp. lavapipe (llvmpipe) runs
-// every branch of a fragment shader for all lanes under an execution mask instead of jumping
-// over it, so a filter chosen at run time paid for the texture taps of every filter and
-// the blocker-id lookups on every pixel. Fixed at pipeline creation, the dead paths are gone.
-layout(constant_id = 0) const int kFilter = SHADOWLAB_FILTER_PCF2X2;  // the filter of every light
-layout(constant_id = 1) const bool kBlockerIds = true;  // look up and write the blocker ids
-// The number of lights (u.counts.x holds the same), so the light loop unrolls and each light's
-// uniforms are loaded from a constant index; and the light kinds present (bit 1 << kind), so
-// the spot and point-light paths are left out of scenes without such lights.
-layout(constant_id = 2) const int kLightCount = SHADOWLAB_MAX_LIGHTS;
-layout(constant_id = 3) const int kLightKinds = 7;
-// The cascades of the cascaded directional lights (1: none cascaded; every cascaded light has
-// the same count, as the cascades depend on the camera only), so scenes without cascades have
-// no cascade selection and the selection loop has a constant length.
-layout(constant_id = 4) const int kCascades = 1;
-// The scene has semi-transparent casters: every compare tap is multiplied by the transmittance
-// map's texel. Scenes without have none of that code.
-layout(constant_id = 5) const bool kTransmittance = false;
-// Receiver-plane depth bias in every tap (see shadowTest); off, its code is compiled out.
-layout(constant_id = 6) const bool kReceiverPlane = false;
-// Cascaded lights blend each cascade into the next over a band before the split (u.counts.z, the
-// band's fraction of the slice; see cascadeOf); off, the second shadow test is compiled out.
-layout(constant_id = 7) const bool kCascadeBlend = false;
-// The beauty target's alpha holds the visibility AOV; off for the 8-bit display target (a PNG has
-// no alpha), which leaves out the weighting and the division per pixel.
-layout(constant_id = 8) const bool kVisibility = true;
-// A normal offset is set (LightData.params.z, the same for every light): off (the default), the
-// lookup point is the surface point itself, and the vertex path's map-space normal is not read
-// (one varying and its arithmetic less per pixel).
-layout(constant_id = 9) const bool kNormalOffset = true;
-// One directional light with one map, or one spot light, and no receiver plane: its map
-// coordinates are interpolated from lit.vert (see shadowTest) instead of a matrix product per
-// fragment.
-// (Written without ||: glslang turns || of specialization constants into a branch and an OpPhi
-// inside a function, which the constant's uses elsewhere cannot see.)
-const bool kVertexSpot = kLightCount == 1 && kLightKinds == (1 << SHADOWLAB_LIGHT_SPOT) && !kReceiverPlane;
-const bool kVertexDirectional = kLightCount == 1 && kLightKinds == (1 << SHADOWLAB_LIGHT_DIRECTIONAL) &&
-                                kCascades == 1 && !kReceiverPlane;
-const bool kVertexLightCoordinates = !(!kVertexSpot && !kVertexDirectional);
-const bool kAnyPerspective =
-    (kLightKinds & ((1 << SHADOWLAB_LIGHT_SPOT) | (1 << SHADOWLAB_LIGHT_POINT))) != 0;
+#include "lit_constants.glsl"
+
+// Light i's constants and LitUniforms' forward and counts: the uniform buffer's, or the same values
+// as flat inputs from lit.vert (kVertexLightConstants, light 0 only). Fields lit.vert does not
+// pass are read from the buffer (where no code uses them, not at all).
+LightData lightAt(int i) {
+    if (!kVertexLightConstants) return u.lights[i];
+    LightData light;
+    light.toShadow = u.lights[0].toShadow;
+    light.toLight = inLight[0];
+    light.radiance = inLight[1];
+    light.bias = inLight[2];
+    light.params = inLight[3];
+    light.kind = kVertexSpot ? inLight[4] : u.lights[0].kind;
+    light.axis = kVertexSpot ? inLight[5] : u.lights[0].axis;
+    return light;
+}
+vec4 forward() { return kVertexLightConstants ? inFrame[0] : u.forward; }
+vec4 counts() { return kVertexLightConstants ? inFrame[1] : u.counts; }
 
 // Constant false for a kind the scene lacks, which removes its code.
 bool isKind(LightData light, int kind) { return (kLightKinds & (1 << kind)) != 0 && int(light.kind.x) == kind; }
@@ -333,7 +315,7 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         r.axial = perspective ? dot(q - light.toLight.xyz, axis) : s.z;
     }
     const int filterCode = kFilter;  // light.params.y holds the same code
-    const float size = u.counts.y;  // = textureSize(shadowMaps, 0).x, without a query per fragment
+    const float size = counts().y;  // = textureSize(shadowMaps, 0).x, without a query per fragment
     r.plane = false;
     r.grad = vec2(0.0);
     if (kReceiverPlane) {
@@ -546,7 +528,7 @@ void main() {
     const vec4 objectAlbedo = inAlbedo;
     const vec3 albedoColor = objectAlbedo.rgb;
     if (kTransmittance) receiverTransmittance = max(objectAlbedo.a, 1e-6);
-    vec3 color = u.forward.w * albedoColor;
+    vec3 color = forward().w * albedoColor;
     float weightSum = 0.0;
     float weightedVisibility = 0.0;
     uint blocker = 0u;
@@ -556,7 +538,7 @@ void main() {
     vec4 lightVisibility[2] = vec4[](vec4(0.0), vec4(0.0));
 #endif
     [[unroll]] for (int i = 0; i < lightCount; ++i) {
-        LightData light = u.lights[i];
+        LightData light = lightAt(i);
         // A cascaded directional light (kind.y cascades; 0 without a shadow test) takes its
         // cascade's map. The code exists only in pipelines made for cascades (kCascades > 1).
         LightData nextCascade;
@@ -605,7 +587,7 @@ void main() {
     const float visibility = !kVisibility ? 1.0 : weightSum > 0.0 ? weightedVisibility / weightSum : 0.0;
     outBeauty = vec4(color, visibility);
 #ifndef SHADOWLAB_BEAUTY_ONLY
-    outAovs = vec4(float(inObjectId), maxNdotL, dot(inPosition, u.forward.xyz), float(blocker));
+    outAovs = vec4(float(inObjectId), maxNdotL, dot(inPosition, forward().xyz), float(blocker));
 #endif
 #ifdef SHADOWLAB_LIGHT_OUTPUTS
     outLights0 = lightVisibility[0];

@@ -1,8 +1,10 @@
 // shaders/lit.vert: the camera pass; passes the camera-relative position on so that the
-// fragment shader can find its place in every shadow map.
+// fragment shader can find its place in every shadow map, and where lit.frag asks for them
+// (kVertexLightConstants) the one light's constants, which it then need not read per pixel.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "interface.h"
+#include "lit_constants.glsl"
 
 layout(set = 0, binding = 0, std140) uniform Uniforms { LitUniforms u; };
 layout(set = 0, binding = 1, std430) readonly buffer Albedos { vec4 albedo[]; };  // per object; a: 1 − opacity
@@ -22,6 +24,11 @@ layout(location = 3) out vec4 outLightCoordinates;
 layout(location = 4) out vec4 outLightNormal;
 // The object's albedo (lit.frag's), read here once per vertex instead of once per fragment.
 layout(location = 5) flat out vec4 outAlbedo;
+// kVertexLightConstants (lit_constants.glsl): light 0's LightData after toShadow (toLight,
+// radiance, bias, params, kind, axis; kind and axis only for a spot, which alone reads them), and
+// LitUniforms' forward and counts; written only then.
+layout(location = 6) flat out vec4 outLight[6];
+layout(location = 12) flat out vec4 outFrame[2];
 
 void main() {
     outPosition = inPosition;
@@ -30,5 +37,17 @@ void main() {
     outAlbedo = albedo[inObjectId - 1u];
     outLightCoordinates = u.lights[0].toShadow * vec4(inPosition, 1.0);
     outLightNormal = u.lights[0].toShadow * vec4(inNormal, 0.0);
+    if (kVertexLightConstants) {
+        outLight[0] = u.lights[0].toLight;
+        outLight[1] = u.lights[0].radiance;
+        outLight[2] = u.lights[0].bias;
+        outLight[3] = u.lights[0].params;
+        if (kVertexSpot) {
+            outLight[4] = u.lights[0].kind;
+            outLight[5] = u.lights[0].axis;
+        }
+        outFrame[0] = u.forward;
+        outFrame[1] = u.counts;
+    }
     gl_Position = u.viewProj * vec4(inPosition, 1.0);
 }

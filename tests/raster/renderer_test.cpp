@@ -4,6 +4,7 @@
 #include "raster/renderer.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstdio>
 #include <filesystem>
@@ -1102,6 +1103,104 @@ TEST(RasterRenderer, ReadingTheTargetsInPlaceAndCopyingThemGiveTheSameFrame) {
     }
     EXPECT_EQ(inPlace.validationMessages(), 0);
     EXPECT_EQ(copied.validationMessages(), 0);
+}
+
+// The frames of two renderers, one reading light 0's constants from the uniform buffer and one
+// taking them as flat outputs of the vertex shader, for the same channels.
+std::pair<scene::Frame, scene::Frame> withBothLightConstantSources(const scene::Scene& s,
+                                                                   const scene::RasterSettings& settings,
+                                                                   scene::ChannelMask channels) {
+    Renderer buffer(s, planFor(s, settings), settings, RendererOptions{.lightConstants = LightConstants::kUniformBuffer});
+    Renderer vertex(s, planFor(s, settings), settings, RendererOptions{.lightConstants = LightConstants::kVertexOutputs});
+    std::pair<scene::Frame, scene::Frame> frames{buffer.render(channels), vertex.render(channels)};
+    EXPECT_EQ(buffer.validationMessages(), 0);
+    EXPECT_EQ(vertex.validationMessages(), 0);
+    return frames;
+}
+
+TEST(RasterRenderer, LightConstantsFromTheVertexShaderGiveTheSameFrameBitForBit) {
+    // lit.frag can read the one light's constants (direction or position, radiance, biases,
+    // filter parameters, a spot's cone and size), the ambient and the map side from the uniform
+    // buffer or as flat inputs from lit.vert (shaders/lit_constants.glsl). Flat inputs carry the
+    // same floats into the same arithmetic, so every channel must be the same bit for bit: a
+    // field passed wrongly or not at all (a zero) changes shadows, shading or both. One
+    // directional light and one spot, the normal offset on (its code reads the most fields),
+    // every filter the light kind has, near the origin and 10^7 units away; the PNG's display
+    // target too.
+    for (const double offset : {0.0, 1.0e7})
+        for (const bool spot : {false, true})
+            for (const ShadowFilter filter : {ShadowFilter::None, ShadowFilter::Pcf2x2, ShadowFilter::Pcf,
+                                              ShadowFilter::Poisson, ShadowFilter::Pcss}) {
+                if (filter == ShadowFilter::Pcss && !spot) continue;  // PCSS needs a light with a size
+                SphereOverPlane p;
+                p.width = 320;
+                p.height = 180;
+                p.lightDirection = lightFromElevation(50.0);
+                const Vec3 shift(offset, 0.0, -offset);
+                scene::Scene s = makeScene(p, shift);
+                if (spot) {
+                    scene::Light& l = s.lights[0];
+                    l.type = scene::LightType::Spot;
+                    l.position = Vec3(2.5, 3.0, 1.5) + shift;
+                    l.direction = glm::normalize(Vec3(-2.5, -2.2, -1.5));
+                    l.coneAngleDegrees = 45.0;
+                    l.radius = 0.1;
+                    l.intensity = 300.0;
+                }
+                scene::RasterSettings settings = validatedSettings(512, 0.004, 0.5, filter);
+                settings.normalOffset = 0.5;
+                const std::string what = std::string(spot ? "spot" : "directional") + ", filter " +
+                                         std::to_string(int(filter)) + ", offset " + std::to_string(offset);
+                const auto [a, b] = withBothLightConstantSources(s, settings, scene::kAllChannels);
+                EXPECT_EQ(a.attributes.at("light_constants"), "uniform-buffer");
+                EXPECT_EQ(b.attributes.at("light_constants"), "vertex-outputs");
+                std::size_t shadowed = 0;
+                for (std::size_t i = 0; i < a.pixelCount(); ++i) shadowed += a.visibility[i] < 0.5f;
+                EXPECT_GT(shadowed, 500u) << what << ": the sphere shadows the plane";
+                EXPECT_TRUE(a.beauty == b.beauty) << what;
+                EXPECT_TRUE(a.visibility == b.visibility) << what;
+                EXPECT_TRUE(a.ndotl == b.ndotl) << what;
+                EXPECT_TRUE(a.depth == b.depth) << what;
+                EXPECT_TRUE(a.objectId == b.objectId) << what;
+                EXPECT_TRUE(a.blockerId == b.blockerId) << what;
+                if (offset == 0.0 && filter == ShadowFilter::Pcf2x2) {
+                    const auto [c, d] =
+                        withBothLightConstantSources(s, settings, scene::kChannelBeauty | scene::kBeautyForDisplay);
+                    ASSERT_EQ(c.attributes.count("beauty_precision"), 1u);
+                    EXPECT_TRUE(c.beauty == d.beauty) << what << ", display target";
+                }
+            }
+}
+
+TEST(RasterRenderer, LightConstantsComeFromTheVertexShaderWhereItGivesTheLightsMapCoordinates) {
+    // By default lit.frag takes the one light's constants from lit.vert wherever it takes that
+    // light's map coordinates from there (one directional light with one map, or one spot; no
+    // receiver plane); a second light, cascades or the receiver-plane bias keep the uniform buffer.
+    const scene::RasterSettings settings = validatedSettings(256, 0.01, 1.0, ShadowFilter::Pcf2x2);
+    const scene::Scene one = makeScene(SphereOverPlane{});
+    auto source = [](const scene::Scene& s, const scene::RasterSettings& r) {
+        Renderer renderer(s, planFor(s, r), r);
+        const scene::Frame f = renderer.render(scene::kChannelBeauty);
+        EXPECT_EQ(renderer.validationMessages(), 0);
+        return f.attributes.at("light_constants");
+    };
+    EXPECT_EQ(source(one, settings), "vertex-outputs");
+    scene::Scene spot = one;
+    spot.lights[0].type = scene::LightType::Spot;
+    spot.lights[0].position = Vec3(2.5, 3.0, 1.5);
+    spot.lights[0].direction = glm::normalize(Vec3(-2.5, -2.2, -1.5));
+    spot.lights[0].coneAngleDegrees = 45.0;
+    EXPECT_EQ(source(spot, settings), "vertex-outputs");
+    scene::Scene two = one;
+    two.lights.push_back(two.lights[0]);
+    two.lights[1].direction = lightFromElevation(40.0);
+    EXPECT_EQ(source(two, settings), "uniform-buffer");
+    scene::RasterSettings plane = settings;
+    plane.receiverPlaneBias = true;
+    EXPECT_EQ(source(one, plane), "uniform-buffer");
+    scene::RasterSettings cascades = settings;
+    cascades.cascades = 3;
+    EXPECT_EQ(source(one, cascades), "uniform-buffer");
 }
 
 TEST(RasterRender, BadPcfSizeIsRejected) {

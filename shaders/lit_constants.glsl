@@ -1,0 +1,53 @@
+// shaders/lit_constants.glsl: the lit pass's specialization constants, shared by lit.vert and
+// lit.frag (raster/lit_pass.cpp gives both stages the same VkSpecializationInfo; each uses the
+// constants it needs). lavapipe (llvmpipe) runs every branch of a fragment shader for all lanes
+// under an execution mask instead of jumping over it, so a filter chosen at run time paid for the
+// texture taps of every filter and the blocker-id lookups on every pixel. Fixed at pipeline
+// creation, the dead paths are gone.
+layout(constant_id = 0) const int kFilter = SHADOWLAB_FILTER_PCF2X2;  // the filter of every light
+layout(constant_id = 1) const bool kBlockerIds = true;  // look up and write the blocker ids
+// The number of lights (u.counts.x holds the same), so the light loop unrolls and each light's
+// uniforms are loaded from a constant index; and the light kinds present (bit 1 << kind), so
+// the spot and point-light paths are left out of scenes without such lights.
+layout(constant_id = 2) const int kLightCount = SHADOWLAB_MAX_LIGHTS;
+layout(constant_id = 3) const int kLightKinds = 7;
+// The cascades of the cascaded directional lights (1: none cascaded; every cascaded light has
+// the same count, as the cascades depend on the camera only), so scenes without cascades have
+// no cascade selection and the selection loop has a constant length.
+layout(constant_id = 4) const int kCascades = 1;
+// The scene has semi-transparent casters: every compare tap is multiplied by the transmittance
+// map's texel. Scenes without have none of that code.
+layout(constant_id = 5) const bool kTransmittance = false;
+// Receiver-plane depth bias in every tap (see shadowTest); off, its code is compiled out.
+layout(constant_id = 6) const bool kReceiverPlane = false;
+// Cascaded lights blend each cascade into the next over a band before the split (u.counts.z, the
+// band's fraction of the slice; see cascadeOf); off, the second shadow test is compiled out.
+layout(constant_id = 7) const bool kCascadeBlend = false;
+// The beauty target's alpha holds the visibility AOV; off for the 8-bit display target (a PNG has
+// no alpha), which leaves out the weighting and the division per pixel.
+layout(constant_id = 8) const bool kVisibility = true;
+// A normal offset is set (LightData.params.z, the same for every light): off (the default), the
+// lookup point is the surface point itself, and the vertex path's map-space normal is not read
+// (one varying and its arithmetic less per pixel).
+layout(constant_id = 9) const bool kNormalOffset = true;
+// One directional light with one map, or one spot light, and no receiver plane: its map
+// coordinates are interpolated from lit.vert (see shadowTest) instead of a matrix product per
+// fragment.
+// (Written without ||: glslang turns || of specialization constants into a branch and an OpPhi
+// inside a function, which the constant's uses elsewhere cannot see.)
+const bool kVertexSpot = kLightCount == 1 && kLightKinds == (1 << SHADOWLAB_LIGHT_SPOT) && !kReceiverPlane;
+const bool kVertexDirectional = kLightCount == 1 && kLightKinds == (1 << SHADOWLAB_LIGHT_DIRECTIONAL) &&
+                                kCascades == 1 && !kReceiverPlane;
+const bool kVertexLightCoordinates = !(!kVertexSpot && !kVertexDirectional);
+const bool kAnyPerspective =
+    (kLightKinds & ((1 << SHADOWLAB_LIGHT_SPOT) | (1 << SHADOWLAB_LIGHT_POINT))) != 0;
+// The one light's constants (LightData after toShadow), the ambient and the map size reach
+// lit.frag as flat outputs of lit.vert instead of uniform-buffer reads, where lit.frag takes that
+// light's map coordinates from lit.vert too (kVertexLightCoordinates). lavapipe (Mesa 22.3's
+// llvmpipe) reads a uniform in a fragment shader lane by lane, with a bounds check, for every
+// eight pixels; a flat input is set up once per triangle and then read as a constant
+// (docs/performance.md: less CPU per frame on the seed scene and on Sponza, down to half a pixel
+// per triangle). The values are the same floats either way (raster::LightConstants).
+layout(constant_id = 10) const bool kVertexLightConstantsAsked = false;
+const bool kVertexLightConstants = kVertexLightConstantsAsked && kVertexLightCoordinates;
+
