@@ -859,6 +859,16 @@ std::pair<scene::Frame, scene::Frame> aloneAndWithADimLight(const scene::Scene& 
     return frames;
 }
 
+// The sphere over the plane at 320x180 under a directional light 50° above the plane, the whole
+// scene moved by (offset, 0, −offset).
+scene::Scene sunAt50Degrees(double offset) {
+    SphereOverPlane p;
+    p.width = 320;
+    p.height = 180;
+    p.lightDirection = lightFromElevation(50.0);
+    return makeScene(p, Vec3(offset, 0.0, -offset));
+}
+
 TEST(RasterRender, InterpolatedLightCoordinatesMatchThePerFragmentProduct) {
     // With one directional light lit.frag takes the map coordinates interpolated from lit.vert
     // (toShadow·(p, 1) and toShadow₃ₓ₃·n); with a second light it multiplies the interpolated
@@ -870,12 +880,7 @@ TEST(RasterRender, InterpolatedLightCoordinatesMatchThePerFragmentProduct) {
     // weights move by that much, and at most a few edge texels may flip.
     for (const double offset : {0.0, 1.0e7})
         for (ShadowFilter filter : {ShadowFilter::None, ShadowFilter::Pcf2x2, ShadowFilter::Poisson}) {
-            SphereOverPlane p;
-            p.width = 320;
-            p.height = 180;
-            p.lightDirection = lightFromElevation(50.0);
-            const Vec3 shift(offset, 0.0, -offset);
-            scene::Scene one = makeScene(p, shift);
+            scene::Scene one = sunAt50Degrees(offset);
             scene::Light dim = one.lights[0];
             dim.direction = lightFromElevation(70.0);
             dim.intensity = 0.1;
@@ -1132,12 +1137,8 @@ TEST(RasterRenderer, LightConstantsFromTheVertexShaderGiveTheSameFrameBitForBit)
             for (const ShadowFilter filter : {ShadowFilter::None, ShadowFilter::Pcf2x2, ShadowFilter::Pcf,
                                               ShadowFilter::Poisson, ShadowFilter::Pcss}) {
                 if (filter == ShadowFilter::Pcss && !spot) continue;  // PCSS needs a light with a size
-                SphereOverPlane p;
-                p.width = 320;
-                p.height = 180;
-                p.lightDirection = lightFromElevation(50.0);
                 const Vec3 shift(offset, 0.0, -offset);
-                scene::Scene s = makeScene(p, shift);
+                scene::Scene s = sunAt50Degrees(offset);
                 if (spot) {
                     scene::Light& l = s.lights[0];
                     l.type = scene::LightType::Spot;
