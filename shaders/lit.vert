@@ -26,7 +26,8 @@ layout(location = 4) out vec4 outLightNormal;
 layout(location = 5) flat out vec4 outAlbedo;
 // kVertexLightConstants (lit_constants.glsl): light 0's LightData after toShadow (toLight,
 // radiance, bias, params, kind, axis; kind and axis only for a spot, which alone reads them), and
-// LitUniforms' forward and counts; written only then.
+// LitUniforms' forward and counts; written only then. (Locations 0..13, 56 components: within the
+// 64 every Vulkan device must take, maxVertexOutputComponents and maxFragmentInputComponents.)
 layout(location = 6) flat out vec4 outLight[6];
 layout(location = 12) flat out vec4 outFrame[2];
 
