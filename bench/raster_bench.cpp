@@ -116,9 +116,9 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
     const char* noFresh = std::getenv("SHADOWLAB_BENCH_NO_FRESH");
     const bool skipFresh = noFresh && std::string(noFresh) == "1";
     scene::Scene s = scene::loadScene(file);
-    const auto [kWidth, kHeight] = benchResolution();
-    s.camera.width = kWidth;
-    s.camera.height = kHeight;
+    const auto [width, height] = benchResolution();
+    s.camera.width = width;
+    s.camera.height = height;
     scene::SettingsOverrides overrides;
     overrides.shadowMapSize = kShadowMapSize;
     const scene::RenderSettings settings = scene::resolveSettings(s, overrides);
@@ -143,15 +143,15 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
 
     std::printf("\n=== %s: %s triangles, %dx%d, shadow map %d, filter %s, light constants: %s, bare PCF: "
                 "%s ===\n",
-                label.c_str(), frame.attributes["triangles"].c_str(), kWidth, kHeight, kShadowMapSize,
+                label.c_str(), frame.attributes["triangles"].c_str(), width, height, kShadowMapSize,
                 frame.attributes["filter"].c_str(), frame.attributes["light_constants"].c_str(),
                 bare.pcfKind().c_str());
     if (const char* dir = std::getenv("SHADOWLAB_BENCH_PNG_DIR")) {
         scene::writePngLinear(fs::path(dir) / (label + "-ours.png"), frame.width, frame.height, frame.beauty);
-        std::vector<float> rgb(std::size_t(kWidth) * kHeight * 3);
+        std::vector<float> rgb(std::size_t(width) * height * 3);
         for (std::size_t i = 0; i < rgb.size() / 3; ++i)
             for (int c = 0; c < 3; ++c) rgb[3 * i + c] = float(rgba[4 * i + c]) / 255.0f;
-        scene::writePngDisplay(fs::path(dir) / (label + "-bare.png"), kWidth, kHeight, rgb);
+        scene::writePngDisplay(fs::path(dir) / (label + "-bare.png"), width, height, rgb);
     }
 
     // SHADOWLAB_BENCH_PROFILE=all|beauty|png|bare|bare-srgb: only that series, `repeats` frames,

@@ -37,13 +37,6 @@ struct RenderDebug {
     std::vector<double> cascadeTexels;
 };
 
-// A reusable raster renderer for one scene and its settings: the constructor does the setup
-// once (instance, device, tessellation, geometry upload into device-local buffers, shadow maps,
-// targets, readback buffers, uniforms); render() then runs the two passes and the readback of
-// the channels asked for, and can be called any number of times. Pipelines are made on the
-// first render() that needs them (the blocker-id variant only when blocker ids are asked for).
-// The first frame's "setup" timing is the constructor's time plus any pipeline creation; later
-// frames have "setup" 0 unless they had to create a pipeline. Call from one thread at a time.
 // Where the lit pass's fragment shader reads the one light's constants, where it takes that
 // light's map coordinates from the vertex shader (one directional light with one map, or one
 // spot; shaders/lit_constants.glsl): as flat outputs of the vertex shader (the default: lavapipe
@@ -59,6 +52,13 @@ struct RendererOptions {
     LightConstants lightConstants = LightConstants::kVertexOutputs;
 };
 
+// A reusable raster renderer for one scene and its settings: the constructor does the setup
+// once (instance, device, tessellation, geometry upload into device-local buffers, shadow maps,
+// targets, readback buffers, uniforms); render() then runs the two passes and the readback of
+// the channels asked for, and can be called any number of times. Pipelines are made on the
+// first render() that needs them (the blocker-id variant only when blocker ids are asked for).
+// The first frame's "setup" timing is the constructor's time plus any pipeline creation; later
+// frames have "setup" 0 unless they had to create a pipeline. Call from one thread at a time.
 class Renderer {
 public:
     Renderer(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settings,

@@ -41,13 +41,14 @@ const bool kVertexDirectional = kLightCount == 1 && kLightKinds == (1 << SHADOWL
 const bool kVertexLightCoordinates = !(!kVertexSpot && !kVertexDirectional);
 const bool kAnyPerspective =
     (kLightKinds & ((1 << SHADOWLAB_LIGHT_SPOT) | (1 << SHADOWLAB_LIGHT_POINT))) != 0;
-// The one light's constants (LightData after toShadow), the ambient and the map size reach
-// lit.frag as flat outputs of lit.vert instead of uniform-buffer reads, where lit.frag takes that
-// light's map coordinates from lit.vert too (kVertexLightCoordinates). lavapipe (Mesa 22.3's
-// llvmpipe) reads a uniform in a fragment shader lane by lane, with a bounds check, for every
-// eight pixels; a flat input is set up once per triangle and then read as a constant
-// (docs/performance.md: less CPU per frame on the seed scene and on Sponza, down to half a pixel
-// per triangle). The values are the same floats either way (raster::LightConstants).
+// The one light's constants (LightData after toShadow) and LitUniforms' forward (with the
+// ambient) and counts (with the map side) reach lit.frag as flat outputs of lit.vert instead of
+// uniform-buffer reads, where lit.frag takes that light's map coordinates from lit.vert too
+// (kVertexLightCoordinates). lavapipe (Mesa 22.3's llvmpipe) reads a uniform in a fragment shader
+// lane by lane, with a bounds check, for every eight pixels; a flat input is set up once per
+// triangle and then read as a constant (docs/performance.md: less CPU per frame on the seed scene
+// and on Sponza, down to half a pixel per triangle). The values are the same floats either way
+// (raster::LightConstants).
 layout(constant_id = 10) const bool kVertexLightConstantsAsked = false;
 const bool kVertexLightConstants = kVertexLightConstantsAsked && kVertexLightCoordinates;
 
