@@ -4,7 +4,8 @@
 # and munge when missing (without starting their system services), writes a munge key and a
 # slurm.conf into a temporary folder, starts munged, slurmctld and slurmd on localhost (free
 # ports, nothing under /etc or /run), submits an N-task job array plus its dependent merge job,
-# waits for it, compares rows, metrics and verdicts (not run times) with tests' sweep_equal, and
+# waits for it, compares rows, metrics and verdicts (not run times) with tests' sweep_equal, does
+# the same after deleting one shard and rerunning it alone (--only), and
 # stops the daemons and removes the folder whatever happens. Needs root (slurmd runs jobs as
 # their user and munged guards its key). Usage: tools/slurm-local-check.sh [N]   (default 3);
 # SLURM_CHECK_KEEP=1 keeps the folder (logs, both sweeps) for a look.
@@ -129,4 +130,9 @@ for k in $(seq 0 $((n - 1))); do
     [ -f "$tmp/out/shard-$k-of-$n/shard.json" ] || { say "error: shard $k/$n left no folder"; exit 1; }
 done
 "$build/tests/app/sweep_equal" "$tmp/whole" "$tmp/out"
-say "ok: the merged Slurm sweep equals the unsharded one"
+# A lost shard rerun alone (--only) and merged again.
+rm -rf "$tmp/out/shard-1-of-$n" "$tmp/out/results.json"
+SHADOWLAB="$build/app/shadowlab" timeout 600 "$root/tools/slurm-sweep.sh" -n "$n" -o "$tmp/out" --only 1 --wait \
+    --sbatch "-c 1" -- "${args[@]}"
+"$build/tests/app/sweep_equal" "$tmp/whole" "$tmp/out"
+say "ok: the merged Slurm sweep equals the unsharded one, also after a shard rerun alone"

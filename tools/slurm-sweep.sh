@@ -5,8 +5,9 @@
 # shard started), all into DIR on a file system every node sees; the merge job runs
 # `shadowlab merge DIR`. See docs/sweep.md, "Sharded sweeps on Slurm".
 #
-# Usage: tools/slurm-sweep.sh -n N -o DIR [--wait] [--sbatch "ARGS"] [--merge-sbatch "ARGS"] -- SCENE [sweep options]
+# Usage: tools/slurm-sweep.sh -n N -o DIR [--only LIST] [--wait] [--sbatch "ARGS"] [--merge-sbatch "ARGS"] -- SCENE [sweep options]
 #   -n N            shards (array tasks 0..N-1)
+#   --only LIST     submit only these shards (a Slurm array list, e.g. "2,5" or "4-7"): reruns
 #   -o DIR          the sweep's folder (shared file system); logs go to DIR/slurm/
 #   --wait          return when the merge job has ended, with its exit status
 #   --sbatch ARGS   extra sbatch options for the shard tasks (e.g. "-p batch -c 4 --time=2:00:00")
@@ -17,13 +18,14 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 self="$root/tools/slurm-sweep.sh"
 shadowlab="${SHADOWLAB:-$root/build/app/shadowlab}"
 
-# Inside the array: one shard. SLURM_ARRAY_TASK_COUNT is N (older Slurm: MAX - MIN + 1).
+# Inside the array: one shard. SLURM_ARRAY_TASK_COUNT is N for the whole array (older Slurm:
+# MAX - MIN + 1); a rerun of some shards (--only) passes N, since its array is not all of them.
 if [ "${1:-}" = "--task" ]; then
-    shift
-    dir="$1"
-    shift
+    dir="$2"
+    n="$3"
+    shift 3
     k="$SLURM_ARRAY_TASK_ID"
-    n="${SLURM_ARRAY_TASK_COUNT:-$((SLURM_ARRAY_TASK_MAX - SLURM_ARRAY_TASK_MIN + 1))}"
+    [ "$n" = all ] && n="${SLURM_ARRAY_TASK_COUNT:-$((SLURM_ARRAY_TASK_MAX - SLURM_ARRAY_TASK_MIN + 1))}"
     resume=()
     [ -f "$dir/shard-$k-of-$n/results.jsonl" ] && resume=(--resume)
     echo "shadowlab shard $k/$n on $(hostname) (job $SLURM_JOB_ID, ${SLURM_CPUS_ON_NODE:-?} CPUs)"
@@ -35,11 +37,12 @@ if [ "${1:-}" = "--merge" ]; then
 fi
 
 usage() { sed -n '/^# Usage/,/^# Environment/p' "$self" | sed 's/^# \{0,1\}//' >&2; exit 2; }
-n="" dir="" wait=0 extra="" mergeExtra=""
+n="" dir="" only="" wait=0 extra="" mergeExtra=""
 while [ $# -gt 0 ]; do
     case "$1" in
         -n) n="$2"; shift 2 ;;
         -o) dir="$2"; shift 2 ;;
+        --only) only="$2"; shift 2 ;;
         --wait) wait=1; shift ;;
         --sbatch) extra="$2"; shift 2 ;;
         --merge-sbatch) mergeExtra="$2"; shift 2 ;;
@@ -53,11 +56,13 @@ done
 mkdir -p "$dir/slurm"
 dir="$(cd "$dir" && pwd)"
 
+tasks="0-$((n - 1))" count=all
+[ -n "$only" ] && { tasks="$only"; count="$n"; }
 # shellcheck disable=SC2086  # ARGS are sbatch options, split on purpose
-array=$(sbatch --parsable --array="0-$((n - 1))" --job-name=shadowlab-sweep --chdir="$PWD" \
-    --output="$dir/slurm/shard-%a.out" $extra "$self" --task "$dir" "$@")
+array=$(sbatch --parsable --array="$tasks" --job-name=shadowlab-sweep --chdir="$PWD" \
+    --output="$dir/slurm/shard-%a.out" $extra "$self" --task "$dir" "$count" "$@")
 array="${array%%;*}"
-echo "slurm-sweep: shards: job array $array (tasks 0-$((n - 1))), logs in $dir/slurm/"
+echo "slurm-sweep: shards: job array $array (tasks $tasks of $n), logs in $dir/slurm/"
 waitArg=()
 [ "$wait" = 1 ] && waitArg=(--wait)
 # A shard that fails makes the dependency impossible: the merge job is cancelled, not left pending.
