@@ -206,6 +206,23 @@ TEST(ShardMerge, EqualsTheUnshardedRunAndRendersTheReferenceOnce) {
     EXPECT_TRUE(fs::exists(f.path / "sharded" / "reference.png"));
 }
 
+TEST(ShardMerge, MoreShardsThanRowsGivesEmptyShardsThatNeedNoReferenceAndMergeCleanly) {
+    Folder f;
+    const scene::Scene scene = scene::loadScene(writeScene(f.path / "scene"));
+    const SweepGrid g = grid(1);  // 3 rows
+    FakeRenderer whole, parts;
+    const SweepResult unsharded = runSweep(scene, g, options(f.path / "whole", whole));
+    // Shards 3..7 of 8 are empty: they finish without a reference.
+    for (int k = 7; k >= 3; --k) runShard(scene, g, {k, 8}, options(f.path / "s", parts));
+    EXPECT_EQ(parts.referenceCalls, 0);
+    EXPECT_FALSE(fs::exists(f.path / "s" / "reference.exr"));
+    for (int k = 2; k >= 0; --k) runShard(scene, g, {k, 8}, options(f.path / "s", parts));
+    EXPECT_EQ(parts.referenceCalls, 1);
+    const MergedSweep m = readShards({f.path / "s"});
+    EXPECT_EQ(m.shardDirs.size(), 8u);
+    EXPECT_EQ(rowDifferences(unsharded.rows, m.rows), std::vector<std::string>{});
+}
+
 TEST(ShardMerge, TheComparisonSeesAChangedMetric) {
     // The check above must be able to fail: one metric changed is one difference.
     Folder f;
