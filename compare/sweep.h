@@ -103,7 +103,7 @@ SweepResult runSweep(const scene::Scene& scene, const SweepGrid& grid, const Swe
 // scene::InputError on a bad resolution.
 scene::Scene sweepScene(const scene::Scene& scene, const SweepGrid& grid);
 
-// One journal line's JSON and back (merge reads journals strictly with these). journalRow
+// One journal line's JSON and back (merge reads journals strictly with these). rowFromJournal
 // throws nlohmann::json::exception on a line that is JSON but not a row.
 nlohmann::json journalRow(const SweepRow& row);
 SweepRow rowFromJournal(const nlohmann::json& line);
