@@ -124,7 +124,8 @@ say "single-node Slurm up on $host ($cpus CPUs), $n shards"
 args=(seed --quick --resolution 48x27 --repetitions 1 --shadow-map-size 256)
 "$build/app/shadowlab" sweep "${args[@]}" -o "$tmp/whole" 2>"$tmp/whole.log"
 # A job that never starts (a node that went down) must not hang CI: ten minutes at most.
-SHADOWLAB="$build/app/shadowlab" timeout 600 "$root/tools/slurm-sweep.sh" -n "$n" -o "$tmp/out" --wait --sbatch "-c 1" \
+# The program found from the checkout, as a user runs it: not passed in SHADOWLAB.
+env -u SHADOWLAB SHADOWLAB_BUILD_DIR="$build" timeout 600 "$root/tools/slurm-sweep.sh" -n "$n" -o "$tmp/out" --wait --sbatch "-c 1" \
     -- "${args[@]}"
 for k in $(seq 0 $((n - 1))); do
     [ -f "$tmp/out/shard-$k-of-$n/shard.json" ] || { say "error: shard $k/$n left no folder"; exit 1; }
@@ -132,7 +133,7 @@ done
 "$build/tests/app/sweep_equal" "$tmp/whole" "$tmp/out"
 # A lost shard rerun alone (--only) and merged again.
 rm -rf "$tmp/out/shard-1-of-$n" "$tmp/out/results.json"
-SHADOWLAB="$build/app/shadowlab" timeout 600 "$root/tools/slurm-sweep.sh" -n "$n" -o "$tmp/out" --only 1 --wait \
+env -u SHADOWLAB SHADOWLAB_BUILD_DIR="$build" timeout 600 "$root/tools/slurm-sweep.sh" -n "$n" -o "$tmp/out" --only 1 --wait \
     --sbatch "-c 1" -- "${args[@]}"
 "$build/tests/app/sweep_equal" "$tmp/whole" "$tmp/out"
 say "ok: the merged Slurm sweep equals the unsharded one, also after a shard rerun alone"

@@ -12,11 +12,12 @@
 #   --wait          return when the merge job has ended, with its exit status
 #   --sbatch ARGS   extra sbatch options for the shard tasks (e.g. "-p batch -c 4 --time=2:00:00")
 #   --merge-sbatch ARGS   extra sbatch options for the merge job
-# Environment: SHADOWLAB, the program (default: build/app/shadowlab of this checkout).
+# Environment: SHADOWLAB, the program (default: app/shadowlab in SHADOWLAB_BUILD_DIR or build/ of
+# this checkout).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 self="$root/tools/slurm-sweep.sh"
-shadowlab="${SHADOWLAB:-$root/build/app/shadowlab}"
+shadowlab="${SHADOWLAB:-${SHADOWLAB_BUILD_DIR:-$root/build}/app/shadowlab}"
 
 # Inside the array: one shard. SLURM_ARRAY_TASK_COUNT is N for the whole array (older Slurm:
 # MAX - MIN + 1); a rerun of some shards (--only) passes N, since its array is not all of them.
@@ -55,11 +56,15 @@ done
 [ -x "$shadowlab" ] || { echo "slurm-sweep: $shadowlab is not built (tools/setup.sh) or set SHADOWLAB" >&2; exit 2; }
 mkdir -p "$dir/slurm"
 dir="$(cd "$dir" && pwd)"
+# A job runs a copy of this script from Slurm's spool folder, where the checkout cannot be found
+# from its path: the program's absolute path goes along in the environment.
+shadowlab="$(cd "$(dirname "$shadowlab")" && pwd)/$(basename "$shadowlab")"
+export SHADOWLAB="$shadowlab"
 
 tasks="0-$((n - 1))" count=all
 [ -n "$only" ] && { tasks="$only"; count="$n"; }
 # shellcheck disable=SC2086  # ARGS are sbatch options, split on purpose
-array=$(sbatch --parsable --array="$tasks" --job-name=shadowlab-sweep --chdir="$PWD" \
+array=$(sbatch --parsable --export=ALL --array="$tasks" --job-name=shadowlab-sweep --chdir="$PWD" \
     --output="$dir/slurm/shard-%a.out" $extra "$self" --task "$dir" "$count" "$@")
 array="${array%%;*}"
 echo "slurm-sweep: shards: job array $array (tasks $tasks of $n), logs in $dir/slurm/"
@@ -67,7 +72,7 @@ waitArg=()
 [ "$wait" = 1 ] && waitArg=(--wait)
 # A shard that fails makes the dependency impossible: the merge job is cancelled, not left pending.
 # shellcheck disable=SC2086
-merge=$(sbatch --parsable --dependency="afterok:$array" --kill-on-invalid-dep=yes --job-name=shadowlab-merge \
+merge=$(sbatch --parsable --export=ALL --dependency="afterok:$array" --kill-on-invalid-dep=yes --job-name=shadowlab-merge \
     --chdir="$PWD" --output="$dir/slurm/merge.out" "${waitArg[@]}" $mergeExtra "$self" --merge "$dir") &&
     status=0 || status=$?
 echo "slurm-sweep: merge: job ${merge%%;*}, after every shard succeeded$([ "$wait" = 1 ] && echo ", ended with status $status")"
