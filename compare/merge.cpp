@@ -244,6 +244,9 @@ MergedSweep readShards(const std::vector<fs::path>& inputs) {
 
 void writeMerged(const MergedSweep& m, const fs::path& out) {
     std::error_code ec;
+    if (fs::exists(out / "shard.json", ec))
+        throw scene::InputError(out.string() + ": is a shard folder (shard.json), whose journal the merge would "
+                                "overwrite; merge into the folder above it or another one");
     if (fs::exists(out / "sweep.json", ec) && !fs::exists(out / "merge.json", ec))
         throw scene::InputError(out.string() + ": holds an unsharded sweep (sweep.json); merge into another folder");
     fs::create_directories(out / "images");

@@ -34,7 +34,8 @@ struct MergedSweep {
 // renders its rows (`sweep --shard K/N`, with `--resume` when it started).
 MergedSweep readShards(const std::vector<std::filesystem::path>& inputs);
 
-// Writes the merged folder `out` (see above). Refuses a folder that holds an unsharded sweep.
+// Writes the merged folder `out` (see above). Refuses a shard folder and a folder that holds an
+// unsharded sweep (scene::InputError), before writing anything.
 void writeMerged(const MergedSweep& merged, const std::filesystem::path& out);
 
 // The report input of a merged folder written by writeMerged.

@@ -329,6 +329,22 @@ TEST(ShardMerge, ADamagedJournalLineIsOneErrorNamingTheFileAndLine) {
     EXPECT_NE(torn.find("shard 0/2 is unfinished"), std::string::npos) << torn;
 }
 
+TEST(ShardMerge, WillNotWriteIntoAShardFolderOrAnUnshardedSweep) {
+    Folder f;
+    const scene::Scene scene = scene::loadScene(writeScene(f.path / "scene"));
+    FakeRenderer fake;
+    runAllShards(scene, grid(4), 2, f.path / "s", fake);
+    runSweep(scene, grid(4), options(f.path / "whole", fake));
+    const MergedSweep m = readShards({f.path / "s"});
+    const fs::path shard = f.path / "s" / "shard-0-of-2";
+    const std::string journal = readText(shard / "results.jsonl");
+    EXPECT_NE(errorOf([&] { writeMerged(m, shard); }).find("is a shard folder"), std::string::npos);
+    EXPECT_EQ(readText(shard / "results.jsonl"), journal);
+    const std::string csv = readText(f.path / "whole" / "results.csv");
+    EXPECT_NE(errorOf([&] { writeMerged(m, f.path / "whole"); }).find("holds an unsharded sweep"), std::string::npos);
+    EXPECT_EQ(readText(f.path / "whole" / "results.csv"), csv);
+}
+
 TEST(ShardMerge, AMissingFolderOrAFolderWithoutShardsIsRefused) {
     Folder f;
     EXPECT_NE(errorOf([&] { readShards({f.path / "nowhere"}); }).find("nowhere: no such folder"), std::string::npos);
