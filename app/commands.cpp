@@ -7,13 +7,17 @@
 #include <functional>
 #include <cstdio>
 #include <iostream>
+#include <set>
 #include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
 #include "compare/compare.h"
+#include "compare/machine.h"
 #include "compare/report.h"
 #include "compare/stability.h"
+#include "compare/merge.h"
+#include "compare/shard.h"
 #include "compare/sweep.h"
 #include "compare/sweep_report.h"
 #include "raster/debug_views.h"
@@ -419,6 +423,59 @@ int run(const RunOptions& o) {
     return status;
 }
 
+namespace {
+
+// One shard of a sweep: its rows only, into DIR/shard-K-of-N; the report comes from `merge`.
+int sweepShard(const SweepOptions& o, const scene::Scene& scene, const compare::SweepGrid& grid,
+               const compare::SweepOptions& options) {
+    const compare::Shard shard = compare::parseShard(*o.shard);
+    const std::size_t mine = compare::shardGrid(grid, shard).configs.size();
+    const fs::path dir = o.outputDir / compare::shardFolderName(shard);
+    std::cerr << "shadowlab: sweep shard " << shard.index << "/" << shard.count << ": " << mine << " of "
+              << compare::gridKeys(grid).size() << " configurations, " << grid.repetitions
+              << " timed frames each, into " << dir.string() << "\n";
+    compare::SharedReferenceOptions ref;
+    ref.log = [](const std::string& line) { std::cerr << "shadowlab: " << line << "\n"; };
+    const compare::SweepResult result = compare::runShard(scene, grid, shard, options, ref);
+    std::size_t failed = 0;
+    for (const auto& r : result.rows) failed += r.error.empty() ? 0 : 1;
+    std::cerr << "shadowlab: wrote " << dir.string() << " (" << result.rows.size() << " rows"
+              << (failed ? ", " + std::to_string(failed) + " failed" : "") << "); when every shard is done: shadowlab merge "
+              << o.outputDir.string() << "\n";
+    if (o.common.json) std::cout << compare::rowsToJson(result.rows).dump(2) << "\n";
+    return failed ? 1 : 0;
+}
+
+}  // namespace
+
+int merge(const MergeOptions& o) {
+    const compare::MergedSweep merged = compare::readShards(o.inputs);
+    fs::path out;
+    if (o.outputDir) {
+        out = *o.outputDir;
+    } else if (o.inputs.size() == 1 && !fs::exists(o.inputs.front() / "shard.json")) {
+        out = o.inputs.front();
+    } else {
+        throw scene::InputError("merge: give the merged folder with -o (the inputs are " +
+                                std::string(o.inputs.size() == 1 ? "a shard folder" : "several folders") + ")");
+    }
+    compare::writeMerged(merged, out);
+    compare::writeSweepReport(out, compare::mergedReportInput(merged, out));
+    std::size_t failed = 0;
+    std::set<std::string> machines;
+    for (const auto& r : merged.rows) {
+        failed += r.error.empty() ? 0 : 1;
+        machines.insert(compare::machineFromJson(r.machine).id());
+    }
+    std::cerr << "shadowlab: merged " << merged.shardCount << " shards (" << merged.shardDirs.size() << " folders, "
+              << merged.rows.size() << " rows" << (failed ? ", " + std::to_string(failed) + " failed" : "")
+              << (merged.duplicates ? ", " + std::to_string(merged.duplicates) + " duplicate rows merged once" : "")
+              << (machines.size() > 1 ? ", timed on " + std::to_string(machines.size()) + " machines" : "")
+              << "): wrote " << (out / "report.html").string() << ", results.csv and results.json\n";
+    if (o.json) std::cout << compare::rowsToJson(merged.rows).dump(2) << "\n";
+    return failed ? 1 : 0;
+}
+
 int sweep(const SweepOptions& o) {
     const Prepared p = prepare(o.common);
     compare::SweepGrid grid = o.grid ? compare::loadGrid(*o.grid, p.scene) : compare::defaultGrid(p.scene, o.quick);
@@ -445,6 +502,7 @@ int sweep(const SweepOptions& o) {
     options.outputDir = o.outputDir;
     options.resume = o.resume;
     options.progress = sweepProgressPrinter();
+    if (o.shard) return sweepShard(o, p.scene, grid, options);
     std::cerr << "shadowlab: sweep of " << grid.configs.size() << " configurations, " << grid.repetitions
               << " timed frames each, into " << o.outputDir.string() << "\n";
     const compare::SweepResult result = compare::runSweep(p.scene, grid, options);

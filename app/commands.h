@@ -41,6 +41,13 @@ struct SweepOptions {
     bool resume = false;
     bool quick = false;
     std::optional<int> repetitions;
+    std::optional<std::string> shard;  // "K/N": render only shard K of N (compare/shard.h)
+};
+
+struct MergeOptions {
+    std::vector<std::filesystem::path> inputs;  // shard folders, or folders holding shard-K-of-N folders
+    std::optional<std::filesystem::path> outputDir;  // default: the one input folder
+    bool json = false;
 };
 
 struct StabilityCommandOptions {
@@ -66,6 +73,7 @@ int run(const RunOptions& options);
 int compareFiles(const CompareOptions& options);
 int info(bool validate);
 int sweep(const SweepOptions& options);
+int merge(const MergeOptions& options);
 int stability(const StabilityCommandOptions& options);
 
 }  // namespace shadowlab::app

@@ -100,6 +100,18 @@ int main(int argc, char** argv) {
     sweepCmd->add_flag("--quick", sweepOptions.quick, "The small built-in grid (what `run` includes)");
     sweepCmd->add_option("--repetitions", sweepOptions.repetitions, "Timed frames per configuration (default 3)")
         ->check(CLI::Range(1, 100));
+    sweepCmd->add_option("--shard", sweepOptions.shard,
+                         "K/N: render only shard K (from 0) of N into OUTPUT/shard-K-of-N, sharing OUTPUT/reference.exr; "
+                         "join the shards with `shadowlab merge` (docs/sweep.md)");
+
+    shadowlab::app::MergeOptions mergeOptions;
+    auto* mergeCmd = app.add_subcommand("merge", "Join the shards of a sweep (`sweep --shard K/N`) into the results.csv, "
+                                                 "results.json, plots and report.html of the whole sweep");
+    mergeCmd->add_option("DIRS", mergeOptions.inputs,
+                         "Shard folders, or folders holding shard-K-of-N folders (the -o of `sweep --shard`)")
+        ->required();
+    mergeCmd->add_option("-o,--output", mergeOptions.outputDir, "Merged folder (default: the one input folder)");
+    mergeCmd->add_flag("--json", mergeOptions.json, "Print the merged rows as JSON on stdout");
 
     shadowlab::app::StabilityCommandOptions stabilityOptions;
     auto* stabilityCmd = app.add_subcommand(
@@ -144,6 +156,7 @@ int main(int argc, char** argv) {
         if (*compareCmd) return shadowlab::app::compareFiles(compareOptions);
         if (*infoCmd) return shadowlab::app::info(infoValidate);
         if (*sweepCmd) return shadowlab::app::sweep(sweepOptions);
+        if (*mergeCmd) return shadowlab::app::merge(mergeOptions);
         if (*stabilityCmd) return shadowlab::app::stability(stabilityOptions);
     } catch (const shadowlab::scene::SceneError& e) {
         std::cerr << "shadowlab: error: " << e.what() << "\n";

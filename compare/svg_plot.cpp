@@ -91,6 +91,39 @@ Range fitRange(const PlotAxis& axis, const std::vector<double>& values) {
     return r;
 }
 
+
+// The opening tag of a marker of `shape` centred on (x, y), without its ">" or "/>" (a tooltip
+// may go inside). Shapes other than the circle are paths of equal area, so none looks heavier.
+std::string markerShape(int shape, double x, double y, double r, const std::string& color, double stroke) {
+    std::ostringstream o;
+    const std::string paint = "\" fill=\"" + color + "\" stroke=\"#fff\" stroke-width=\"" + num(stroke) + "\"";
+    const int k = ((shape % 5) + 5) % 5;
+    if (k == 0) {
+        o << "<circle cx=\"" << num(x) << "\" cy=\"" << num(y) << "\" r=\"" << num(r) << paint;
+        return o.str();
+    }
+    std::vector<std::pair<double, double>> pts;
+    if (k == 1) {  // square
+        const double a = r * 0.886;
+        pts = {{-a, -a}, {a, -a}, {a, a}, {-a, a}};
+    } else if (k == 2) {  // diamond
+        const double a = r * 1.25;
+        pts = {{0, -a}, {a, 0}, {0, a}, {-a, 0}};
+    } else if (k == 3) {  // plus
+        const double a = r * 1.15, b = r * 0.42;
+        pts = {{-b, -a}, {b, -a}, {b, -b}, {a, -b}, {a, b}, {b, b}, {b, a}, {-b, a}, {-b, b}, {-a, b}, {-a, -b}, {-b, -b}};
+    } else {  // hexagon
+        for (int i = 0; i < 6; ++i)
+            pts.push_back({r * 1.1 * std::cos(i * 1.0471975512), r * 1.1 * std::sin(i * 1.0471975512)});
+    }
+    o << "<path d=\"";
+    for (std::size_t i = 0; i < pts.size(); ++i) o << (i ? " L" : "M") << num(x + pts[i].first) << "," << num(y + pts[i].second);
+    o << " Z" << paint;
+    return o.str();
+}
+
+std::string markerEnd(int shape) { return ((shape % 5) + 5) % 5 == 0 ? "</circle>" : "</path>"; }
+
 }  // namespace
 
 std::vector<double> axisTicks(double lo, double hi, bool log) {
@@ -165,8 +198,7 @@ std::string renderSvg(const ScatterPlot& plot) {
               << "\" y2=\"40\" stroke=\"" << escapeHtml(s.color) << "\" stroke-width=\"2\""
               << (s.dashed ? " stroke-dasharray=\"5 3\"" : "") << "/>";
         if (s.markers)
-            o << "<circle cx=\"" << num(lx + 9) << "\" cy=\"40\" r=\"4.5\" fill=\""
-              << escapeHtml(s.color) << "\" stroke=\"#fff\" stroke-width=\"1\"/>";
+            o << markerShape(s.shape, lx + 9, 40, 4.5, escapeHtml(s.color), 1.0) << "/>";
         o << "<text x=\"" << num(lx + 24) << "\" y=\"44\" fill=\"#3e4c59\">" << escapeHtml(s.name)
           << "</text></g>\n";
         lx += 24 + 7.0 * static_cast<double>(s.name.size()) + 18;
@@ -244,12 +276,11 @@ std::string renderSvg(const ScatterPlot& plot) {
                       << num(y - 7) << " L" << num(x) << "," << num(y) << " Z\" fill=\"" << color
                       << "\" stroke=\"#fff\" stroke-width=\"1\">";
                 } else {
-                    o << "<circle cx=\"" << num(x) << "\" cy=\"" << num(y) << "\" r=\"5\" fill=\""
-                      << color << "\" stroke=\"#fff\" stroke-width=\"1.2\">";
+                    o << markerShape(s.shape, x, y, 5, color, 1.2) << ">";
                 }
                 const std::string tip = p.title.empty() ? p.label : p.title;
                 if (!tip.empty()) o << "<title>" << escapeHtml(tip) << "</title>";
-                o << (offLow(rx, p.x) || offLow(ry, p.y) ? "</path>" : "</circle>") << "</g>\n";
+                o << (offLow(rx, p.x) || offLow(ry, p.y) ? "</path>" : markerEnd(s.shape)) << "</g>\n";
             }
             if (s.showLabels && !p.label.empty()) {
                 const bool right = x < x1 - 120;
@@ -284,20 +315,39 @@ ScatterPlot errorTimePlot(const std::vector<SweepPoint>& points, double referenc
     for (const auto& pt : points)
         if (std::find(backends.begin(), backends.end(), pt.backend) == backends.end())
             backends.push_back(pt.backend);
+    std::vector<std::string> machines;
+    for (const auto& pt : points)
+        if (std::find(machines.begin(), machines.end(), pt.machine) == machines.end()) machines.push_back(pt.machine);
+    const bool perMachine = machines.size() > 1;
     for (std::size_t b = 0; b < backends.size(); ++b) {
         PlotSeries s;
         s.name = backends[b];
         s.color = backendColor(backends[b], b);
         s.showLabels = options.labels;
         std::vector<TimeErrorPoint> te;
+        std::vector<PlotSeries> byMachine(perMachine ? machines.size() : 0, s);
         for (const auto& pt : points) {
             if (pt.backend != backends[b]) continue;
             const std::string tip = pt.backend + (pt.label.empty() || pt.label == pt.backend ? "" : " " + pt.label) + ": " +
-                                    formatDuration(pt.timeMs) + ", " + formatPercent(pt.error);
+                                    formatDuration(pt.timeMs) + ", " + formatPercent(pt.error) +
+                                    (perMachine ? " (timed on " + pt.machine + ")" : "");
             s.points.push_back({pt.timeMs, pt.error, pt.label, tip});
             te.push_back({pt.timeMs, pt.error});
+            if (perMachine) {
+                const std::size_t m = std::size_t(std::find(machines.begin(), machines.end(), pt.machine) - machines.begin());
+                byMachine[m].points.push_back(s.points.back());
+            }
         }
-        p.series.push_back(s);
+        if (perMachine) {
+            for (std::size_t m = 0; m < machines.size(); ++m) {
+                if (byMachine[m].points.empty()) continue;
+                byMachine[m].name = backends[b] + " · " + (machines[m].empty() ? "unknown machine" : machines[m]);
+                byMachine[m].shape = int(m);
+                p.series.push_back(byMachine[m]);
+            }
+        } else {
+            p.series.push_back(s);
+        }
         if (options.fronts && s.points.size() > 1) {
             PlotSeries front;
             front.color = s.color;

@@ -26,6 +26,10 @@ struct PlotSeries {
     bool connect = false;     // join the points in increasing x with a line (fronts, curves)
     bool showLabels = false;  // write each point's label next to it
     bool dashed = false;
+    // Marker shape: 0 circle, 1 square, 2 diamond, 3 plus, 4 hexagon; more wrap around (the
+    // triangle is taken: it marks a value below a log axis). Sweeps
+    // timed on several machines give each machine its own shape.
+    int shape = 0;
 };
 
 struct PlotAxis {
@@ -77,6 +81,7 @@ struct SweepPoint {
     double timeMs = 0.0;
     double error = 0.0;   // a rate in 0..1, e.g. mismatch rate
     std::string label;    // settings of the row, shown on hover (and beside the point if asked)
+    std::string machine;  // where it was timed; with more than one, each machine gets a marker shape
 };
 
 struct ErrorTimeOptions {
@@ -88,7 +93,8 @@ struct ErrorTimeOptions {
 };
 
 // Error against time, one series per backend (in first-seen order), each backend's Pareto
-// front as a line, the reference's run time as a dashed marker (skipped when ≤ 0).
+// front as a line, the reference's run time as a dashed marker (skipped when ≤ 0). Points of
+// more than one machine: one series per backend and machine, the machine's marker shape.
 ScatterPlot errorTimePlot(const std::vector<SweepPoint>& points, double referenceTimeMs,
                           const ErrorTimeOptions& options = {});
 // False- (red) and missed- (blue) shadow rates (log axis) against bias, the threshold as a dashed line and

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "compare/compare.h"
+#include "compare/machine.h"
 #include "raster/renderer.h"
 #include "raytrace/renderer.h"
 #include "scene/error.h"
@@ -103,6 +104,7 @@ Json rowToJson(const SweepRow& r) {
               {"error", r.error},
               {"image", r.image},
               {"diff_image", r.diffImage}};
+    if (!r.machine.is_null()) j["machine"] = r.machine;
     return j;
 }
 
@@ -125,6 +127,7 @@ SweepRow rowFromJson(const Json& j) {
     r.error = j.value("error", "");
     r.image = j.value("image", "");
     r.diffImage = j.value("diff_image", "");
+    r.machine = j.value("machine", Json(nullptr));
     return r;
 }
 
@@ -495,7 +498,7 @@ std::string rowsToCsv(const std::vector<SweepRow>& rows) {
     s << "key,backend,label,shadow_map_size,filter,cascades,depth_bias,slope_bias,ray_bias,precision,samples,"
          "bias_kind,bias_value,repetitions,setup_ms,frame_ms,frame_ms_min,frame_ms_max";
     for (const char* m : kMetrics) s << "," << m;
-    s << ",error\n";
+    s << ",error,machine\n";
     for (const SweepRow& r : rows) {
         const auto& o = r.config.overrides;
         s << csvField(r.key) << "," << r.config.backend << "," << csvField(r.config.label()) << ","
@@ -508,7 +511,7 @@ std::string rowsToCsv(const std::vector<SweepRow>& rows) {
           << number(r.setupMs) << "," << number(r.frameMs) << "," << number(r.frameMsMin) << ","
           << number(r.frameMsMax);
         for (const char* m : kMetrics) s << "," << jsonNumber(r.metrics, m);
-        s << "," << csvField(r.error) << "\n";
+        s << "," << csvField(r.error) << "," << csvField(machineFromJson(r.machine).host) << "\n";
     }
     return s.str();
 }
@@ -519,13 +522,7 @@ Json rowsToJson(const std::vector<SweepRow>& rows) {
     return a;
 }
 
-SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const SweepOptions& options) {
-    using Clock = std::chrono::steady_clock;
-    const auto start = Clock::now();
-    const fs::path dir = options.outputDir;
-    const fs::path journal = dir / "results.jsonl";
-    const fs::path manifest = dir / "sweep.json";
-
+scene::Scene sweepScene(const scene::Scene& baseScene, const SweepGrid& grid) {
     scene::Scene scene = baseScene;
     if (grid.resolution) {
         int w = 0, h = 0;
@@ -537,6 +534,20 @@ SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const
         scene.camera.width = w;
         scene.camera.height = h;
     }
+    return scene;
+}
+
+Json journalRow(const SweepRow& row) { return rowToJson(row); }
+SweepRow rowFromJournal(const Json& line) { return rowFromJson(line); }
+
+SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const SweepOptions& options) {
+    using Clock = std::chrono::steady_clock;
+    const auto start = Clock::now();
+    const fs::path dir = options.outputDir;
+    const fs::path journal = dir / "results.jsonl";
+    const fs::path manifest = dir / "sweep.json";
+
+    const scene::Scene scene = sweepScene(baseScene, grid);
     const Json identity = {{"scene", scene.file.string()},
                            {"resolution", {scene.camera.width, scene.camera.height}}};
 
@@ -582,7 +593,9 @@ SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const
             haveReference = false;
         }
     }
-    if (!haveReference) {
+    if (!haveReference && options.reference) {
+        result.reference = options.reference(scene);
+    } else if (!haveReference) {
         const scene::RenderSettings settings = scene::resolveSettings(scene, {});
         result.reference = options.render(scene, settings, "reference");
         result.reference.attributes["scene"] = scene.file.string();
@@ -650,6 +663,7 @@ SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const
             row.error = e.what();
             row.metrics = nullptr;
         }
+        row.machine = toJson(currentMachine());
         appendLine(journal, rowToJson(row).dump());
         rows.push_back(row);
         ++renderedHere;

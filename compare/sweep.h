@@ -59,6 +59,7 @@ struct SweepRow {
     nlohmann::json settings;               // the settings applied (Frame attributes)
     std::string error;                     // non-empty when the configuration failed
     std::string image, diffImage;          // file names under DIR/images/
+    nlohmann::json machine;                // compare::toJson(MachineInfo) it was timed on; null in old journals
 
     double rate(const char* name) const;   // a metrics rate, NaN when absent
 };
@@ -81,6 +82,9 @@ struct SweepOptions {
     bool writeImages = true;
     RenderFn render = renderWithBackend;
     std::function<void(const SweepProgress&)> progress;
+    // Where the reference comes from, given the scene at the sweep's resolution; unset: rendered
+    // once and cached as DIR/reference.exr. Shards share one (compare/shard.h).
+    std::function<scene::Frame(const scene::Scene&)> reference;
 };
 
 struct SweepResult {
@@ -94,6 +98,15 @@ struct SweepResult {
 // DIR/results.csv and DIR/results.json after every row. Throws scene::InputError when DIR
 // already holds a sweep and `resume` is false, or holds one of another scene.
 SweepResult runSweep(const scene::Scene& scene, const SweepGrid& grid, const SweepOptions& options);
+
+// The scene a sweep renders: `scene` at the grid's resolution, when it sets one. Throws
+// scene::InputError on a bad resolution.
+scene::Scene sweepScene(const scene::Scene& scene, const SweepGrid& grid);
+
+// One journal line's JSON and back (merge reads journals strictly with these). rowFromJournal
+// throws nlohmann::json::exception on a line that is JSON but not a row.
+nlohmann::json journalRow(const SweepRow& row);
+SweepRow rowFromJournal(const nlohmann::json& line);
 
 // Reads the rows of a journal; a torn last line (a kill in the middle of a write) is ignored.
 std::vector<SweepRow> readJournal(const std::filesystem::path& file);

@@ -8,6 +8,7 @@
 #include <map>
 #include <sstream>
 
+#include "compare/machine.h"
 #include "compare/pareto.h"
 #include "compare/svg_plot.h"
 #include "compare/text.h"
@@ -69,6 +70,40 @@ std::vector<std::string> backendsOf(const std::vector<SweepRow>& rows) {
     for (const auto& r : rows)
         if (std::find(b.begin(), b.end(), r.config.backend) == b.end()) b.push_back(r.config.backend);
     return b;
+}
+
+// The machines the rows were timed on, in first-seen order, and each row's index into them.
+// Rows of journals that predate machine records are one "unknown machine".
+struct Machines {
+    std::vector<MachineInfo> list;
+    std::vector<std::size_t> ofRow;
+    std::vector<std::size_t> rowCount;
+    // The host name when hosts tell the machines apart, else the full description.
+    std::string label(std::size_t m) const {
+        bool hostsUnique = true;
+        for (std::size_t i = 0; i < list.size(); ++i)
+            for (std::size_t j = i + 1; j < list.size(); ++j) hostsUnique = hostsUnique && list[i].host != list[j].host;
+        if (list[m].host.empty()) return "unknown machine";
+        return hostsUnique ? list[m].host : list[m].describe();
+    }
+};
+
+Machines machinesOf(const std::vector<SweepRow>& rows) {
+    Machines m;
+    std::vector<std::string> ids;
+    for (const SweepRow& r : rows) {
+        const MachineInfo mi = machineFromJson(r.machine);
+        const auto it = std::find(ids.begin(), ids.end(), mi.id());
+        if (it == ids.end()) {
+            ids.push_back(mi.id());
+            m.list.push_back(mi);
+            m.rowCount.push_back(0);
+        }
+        const std::size_t k = std::size_t(std::find(ids.begin(), ids.end(), mi.id()) - ids.begin());
+        m.ofRow.push_back(k);
+        ++m.rowCount[k];
+    }
+    return m;
 }
 
 FrameInfo frameOf(const SweepRow& r, const SweepReportInput& in) {
@@ -184,10 +219,13 @@ std::string configCard(const SweepRow& r, const std::string& tag, const SweepRep
 std::string rowsTable(const SweepReportInput& in, const std::vector<bool>& front) {
     std::map<std::string, Extremes> ext;
     for (const auto& b : backendsOf(in.rows)) ext[b] = extremesOf(in.rows, b);
+    const Machines machines = machinesOf(in.rows);
+    const bool perMachine = machines.list.size() > 1;
     std::ostringstream o;
     o << "<table class=\"rows\"><thead><tr><th>#</th><th>backend</th><th>settings</th><th>setup ms</th>"
-         "<th>frame ms, median [min–max]</th><th>false shadow</th><th>missed shadow</th><th>mismatch</th>"
-         "<th>IoU</th><th>images</th></tr></thead><tbody>\n";
+         "<th>frame ms, median [min–max]</th>"
+      << (perMachine ? "<th>timed on</th>" : "")
+      << "<th>false shadow</th><th>missed shadow</th><th>mismatch</th><th>IoU</th><th>images</th></tr></thead><tbody>\n";
     for (std::size_t i = 0; i < in.rows.size(); ++i) {
         const SweepRow& r = in.rows[i];
         if (!usable(r)) continue;
@@ -198,7 +236,12 @@ std::string rowsTable(const SweepReportInput& in, const std::vector<bool>& front
         if (std::ptrdiff_t(i) == e.best) o << " <span class=\"tag best\">best</span>";
         if (std::ptrdiff_t(i) == e.worst && e.worst != e.best) o << " <span class=\"tag worst\">worst</span>";
         o << "</td><td>" << ms(r.setupMs) << "</td><td>" << ms(r.frameMs) << " <span class=\"small\">[" << ms(r.frameMsMin)
-          << "–" << ms(r.frameMsMax) << "]</span></td><td>" << formatPercent(r.rate("false_shadow_rate")) << "</td><td>"
+          << "–" << ms(r.frameMsMax) << "]</span></td><td>";
+        if (perMachine) {
+            o << escapeHtml(machines.label(machines.ofRow[i])) << " <span class=\"small\">load " << formatFixed(machineFromJson(r.machine).load, 1)
+              << "</span></td><td>";
+        }
+        o << formatPercent(r.rate("false_shadow_rate")) << "</td><td>"
           << formatPercent(r.rate("missed_shadow_rate")) << "</td><td><b>" << formatPercent(r.rate("mismatch_rate"))
           << "</b></td><td>" << formatFixed(r.rate("shadow_iou"), 3) << "</td><td>";
         if (!r.image.empty()) o << "<a href=\"" << escapeHtml(r.image) << "\">image</a>";
@@ -239,6 +282,7 @@ tr.front td { background: #f8f5ff; }
 
 std::string svgName(const std::string& kind) { return "bias-" + kind + ".svg"; }
 
+
 }  // namespace
 
 SweepReportInput makeSweepReportInput(const std::string& sceneName, const std::string& scenePath,
@@ -256,8 +300,13 @@ SweepReportInput makeSweepReportInput(const std::string& sceneName, const std::s
 
 std::string sweepErrorTimeSvg(const SweepReportInput& in) {
     std::vector<SweepPoint> points;
-    for (const SweepRow& r : in.rows)
-        if (usable(r)) points.push_back({r.config.backend, r.frameMs, r.rate("mismatch_rate"), rowTitle(r)});
+    const Machines machines = machinesOf(in.rows);
+    for (std::size_t i = 0; i < in.rows.size(); ++i) {
+        const SweepRow& r = in.rows[i];
+        if (usable(r))
+            points.push_back({r.config.backend, r.frameMs, r.rate("mismatch_rate"), rowTitle(r),
+                              machines.label(machines.ofRow[i])});
+    }
     ErrorTimeOptions o;
     o.title = "Shadow error against per-frame time";
     o.errorName = "mismatch rate (false + missed)";
@@ -293,6 +342,14 @@ std::vector<std::string> describeSweep(const SweepReportInput& in, const AutoBia
         lines.push_back(s);
     }
     for (const std::string& note : bias.notes) lines.push_back(note);
+    if (const Machines machines = machinesOf(in.rows); machines.list.size() > 1) {
+        std::string s = "The rows were timed on " + std::to_string(machines.list.size()) + " different machines (";
+        for (std::size_t m = 0; m < machines.list.size(); ++m)
+            s += (m ? "; " : "") + machines.list[m].describe() + ": " + std::to_string(machines.rowCount[m]) + " rows";
+        s += "), so run times of rows from different machines are not comparable; the error-time plot gives each "
+             "machine its own marker.";
+        lines.push_back(s);
+    }
     std::size_t failed = 0;
     for (const SweepRow& r : in.rows) failed += usable(r) ? 0 : 1;
     if (failed > 0)

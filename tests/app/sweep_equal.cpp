@@ -1,0 +1,28 @@
+// tests/app/sweep_equal.cpp: `sweep_equal A B` exits 0 when the sweep folders A and B hold the
+// same rows (keys, settings, metrics, errors, in order) and verdicts (bias windows, robust
+// offsets), ignoring run times and machines; 1 and one line per difference otherwise; 2 on bad
+// input. tools/slurm-local-check.sh uses it to check a merged sweep against the unsharded one.
+#include <iostream>
+
+#include "compare/merge.h"
+#include "scene/error.h"
+
+int main(int argc, char** argv) {
+    if (argc != 3) {
+        std::cerr << "usage: sweep_equal SWEEP_DIR_A SWEEP_DIR_B\n";
+        return 2;
+    }
+    try {
+        using namespace shadowlab::compare;
+        const auto a = readResults(argv[1]), b = readResults(argv[2]);
+        auto diffs = rowDifferences(a, b);
+        for (const std::string& d : verdictDifferences(a, b)) diffs.push_back(d);
+        for (const std::string& d : diffs) std::cout << d << "\n";
+        if (!diffs.empty()) return 1;
+        std::cout << "sweep_equal: " << a.size() << " rows, metrics and verdicts equal\n";
+        return 0;
+    } catch (const shadowlab::scene::InputError& e) {
+        std::cerr << "sweep_equal: error: " << e.what() << "\n";
+        return 2;
+    }
+}
