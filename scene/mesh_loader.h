@@ -20,6 +20,7 @@ namespace shadowlab::scene {
 // What a glTF file holds besides triangles: its perspective cameras and KHR_lights_punctual
 // lights, in the file's world space (not moved by the object transform).
 struct GltfCamera {
+    std::string name, nodeName;  // the camera's and its node's "name" ("" when unnamed)
     Vec3 position{0, 0, 0}, forward{0, 0, -1}, up{0, 1, 0};
     double yfovRadians = 0.0, znear = 0.0, zfar = 0.0, aspect = 0.0;  // zfar/aspect 0: unset
 };
