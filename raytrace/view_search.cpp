@@ -37,6 +37,7 @@ constexpr double kSunElevations[] = {35.0, 55.0, 75.0};
 // elevations, −20°..+20°) meets a front face; the model encloses its space when a quarter of the
 // probe points outside solids are enclosed.
 constexpr double kEnclosedShare = 0.9;
+constexpr double kInteriorAmbient = 0.15;
 constexpr double kInteriorShare = 0.25;
 
 std::string fmt(double v, const char* f = "%.3g") {
@@ -136,7 +137,7 @@ ViewScore score(const Thumbnail& t, const std::vector<std::int8_t>& cls, const V
     s.sunSide = light.type == scene::LightType::Directional ? glm::dot(forward, light.direction) : 0.0;
     // Shadows a quarter to a third of the lit-facing surface read best; more is a dark picture.
     const double fShare = s.shadowedShare <= 0.35 ? s.shadowedShare / 0.35
-                                                  : std::max(0.2, 1.0 - (s.shadowedShare - 0.35) / 0.65);
+                                                  : std::max(0.2, 1.0 - (s.shadowedShare - 0.35) / 0.4);
     const double fEdge = std::min(1.0, 0.5 * s.edgeLength);  // two image sides of edge: a pattern, not one line
     const double fCover = std::min(1.0, s.coverage / 0.5);
     // Most of what is seen should face the light, the model itself included: a model seen from
@@ -145,7 +146,7 @@ ViewScore score(const Thumbnail& t, const std::vector<std::int8_t>& cls, const V
     const double fFacing = std::min(1.0, s.facing / 0.6) * std::min(1.0, 0.2 + s.modelFacing / 0.6);
     // From the sun's side every shadow hides behind its caster.
     const double fSide = 1.0 - 0.6 * std::max(0.0, s.sunSide);
-    const double fNear = hit && near > hit / 2 ? 0.3 : 1.0;  // half the view is a wall in the face
+    const double fNear = hit && near > hit / 2 ? 0.3 : 1.0;  // half the view is a wall in the face (4% of the size)
     s.score = fCover * fFacing * (0.5 * fShare + 0.5 * fEdge) * fSide * fNear;
     return s;
 }
@@ -365,6 +366,12 @@ void chooseViewAndSun(scene::Scene& scene, int threads) {
     if (o.chooseSun) {
         scene.lights.front().direction = r.sunDirection;
         scene::recordChoice(scene, "sun", r.sunText + " (with the view above)");
+    }
+    // Most of an interior is in shadow, lit by the ambient term alone: at the default 0.05 its
+    // shape is lost in the dark. The shipped JSON interiors use 0.15 too.
+    if (r.interior && o.chooseView && scene.origin.modelScene && scene.ambient < kInteriorAmbient) {
+        scene.ambient = kInteriorAmbient;
+        scene::recordChoice(scene, "ambient", fmt(kInteriorAmbient) + " (an interior seen from inside)");
     }
     scene.origin.chooseView = scene.origin.chooseSun = false;
 }
