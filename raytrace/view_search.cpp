@@ -220,6 +220,15 @@ struct Candidate {
     std::string text;
 };
 
+// With --camera auto the file's own cameras compete too (a city model's first camera may face a
+// wall in shadow while another looks down a sunlit street).
+void addFileCameras(const scene::Scene& scene, std::vector<Candidate>& out) {
+    for (std::size_t i = 0; i < scene.origin.cameras.size(); ++i) {
+        const scene::FileCamera& c = scene.origin.cameras[i];
+        out.push_back({c.camera, "file camera " + std::to_string(i) + (c.name.empty() ? "" : " '" + c.name + "'")});
+    }
+}
+
 std::vector<Candidate> viewCandidates(const scene::Scene& scene, const scene::Bounds& b, bool interior,
                                       const std::vector<Vec3>& enclosed) {
     std::vector<Candidate> out;
@@ -232,6 +241,7 @@ std::vector<Candidate> viewCandidates(const scene::Scene& scene, const scene::Bo
                 out.push_back({scene::framedCamera(b, from, 40.0, scene.camera),
                                "from outside, azimuth " + fmt(az) + ", elevation " + fmt(el) + " degrees"});
             }
+        addFileCameras(scene, out);
         return out;
     }
     // Inside: the enclosed probe points that see the most sky (probeInterior's order).
@@ -253,6 +263,7 @@ std::vector<Candidate> viewCandidates(const scene::Scene& scene, const scene::Bo
             out.push_back({c, "from inside at (" + fmt(eye.x) + ", " + fmt(eye.y) + ", " + fmt(eye.z) +
                                   "), heading " + fmt(az) + " degrees, 10 degrees down"});
         }
+    addFileCameras(scene, out);
     return out;
 }
 

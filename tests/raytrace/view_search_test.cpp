@@ -13,6 +13,7 @@
 #include "scene/model_view.h"
 #include "scene/render_plan.h"
 #include "scene/settings.h"
+#include "tests/scene/camera_gltf.h"
 #include "tests/scene/gltf_files.h"
 #include "tests/scene/test_files.h"
 
@@ -73,6 +74,19 @@ TEST(ViewSearch, AModelOutsideIsSeenFromOutsideUnderASunAboveTheHorizonWithItsSh
     bool recorded = false;
     for (const auto& [key, text] : s.origin.choices) recorded = recorded || (key == "view" && text.find("searched") == 0);
     EXPECT_TRUE(recorded);
+}
+
+TEST(ViewSearch, CameraAutoLetsTheFilesCamerasCompeteWithTheSearchedViews) {
+    test::TempDir dir;
+    scene::Scene s = scene::loadScene(dir.write("box.gltf", test::cameraBoxGltf()));
+    EXPECT_FALSE(s.origin.chooseView);  // the file's first camera, by default
+    scene::applyCameraOption(s, "auto");
+    scene::applyGround(s, std::nullopt);
+    ViewSearchOptions o;
+    o.chooseSun = false;
+    const ViewSearchResult r = searchViewAndSun(s, o);
+    EXPECT_EQ(r.views, 24 + 2);
+    EXPECT_EQ(r.suns, 1);
 }
 
 TEST(ViewSearch, TheSearchIsBetterThanTheFramedPlaceholder) {
