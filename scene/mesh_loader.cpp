@@ -404,11 +404,18 @@ std::vector<MeshInstance> loadMeshInstances(const fs::path& meshFile, const glm:
         std::error_code ec;
         const fs::path canonical = fs::weakly_canonical(meshFile, ec);
         key = (ec ? meshFile : canonical).string();
-        if (const auto it = cache->files.find(key); it != cache->files.end()) instances = it->second;
+        if (const auto it = cache->files.find(key); it != cache->files.end()) {
+            instances = it->second;
+            if (extras) *extras = cache->extras[key];  // the same cameras for every object naming the file
+        }
     }
     if (instances.empty()) {
-        instances = readMeshFile(meshFile, sceneFile, path, extras);
-        if (cache) cache->files.emplace(key, instances);
+        GltfExtras own;
+        instances = readMeshFile(meshFile, sceneFile, path, extras ? extras : (cache ? &own : nullptr));
+        if (cache) {
+            cache->files.emplace(key, instances);
+            cache->extras[key] = extras ? *extras : own;
+        }
     }
     std::vector<MeshInstance> out;
     for (MeshInstance& inst : instances) {

@@ -95,6 +95,20 @@ TEST(ModelView, AMeshObjectsCameraKeyTakesTheViewFromItsFileMovedWithTheObject) 
     expectNear(t.camera.position, {0.5, 0.25, 3});
 }
 
+TEST(ModelView, TwoObjectsNamingOneFileEachListItsCamerasAndEitherMayNameTheView) {
+    // The file is read once (the mesh cache), but each object places its cameras by its own transform.
+    test::TempDir dir;
+    dir.write("box.gltf", test::cameraBoxGltf());
+    const Scene s = loadScene(dir.write("two.json", R"({"camera": {}, "materials": {"m": {}},
+        "lights": [{"type": "directional", "direction": [0, -1, 0]}],
+        "objects": [{"type": "mesh", "file": "box.gltf", "material": "m"},
+                    {"type": "mesh", "file": "box.gltf", "translate": [0, 0, -20], "material": "m", "camera": "Front"}]})"));
+    ASSERT_EQ(s.origin.cameras.size(), 4u);
+    expectNear(s.origin.cameras[0].camera.position, {0.5, 0.25, 3});
+    expectNear(s.origin.cameras[2].camera.position, {0.5, 0.25, -17});
+    expectNear(s.camera.position, {0.5, 0.25, -17});
+}
+
 TEST(ModelView, AMeshObjectsCameraKeyRefusesAViewGivenTwiceOrACameraTheFileLacks) {
     test::TempDir dir;
     dir.write("box.gltf", test::cameraBoxGltf());
