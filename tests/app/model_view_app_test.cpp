@@ -69,6 +69,15 @@ TEST(ModelViewApp, SunAndNoGroundOverrideTheDefaults) {
     }
 }
 
+TEST(ModelViewApp, HelpNamesTheViewOptions) {
+    for (const char* cmd : {"render", "run", "sweep"}) {
+        const auto r = runShadowlab({cmd, "--help"});
+        EXPECT_EQ(r.exitCode, 0);
+        for (const char* option : {"--camera", "--sun", "--ground", "--no-ground"})
+            EXPECT_NE(r.out.find(option), std::string::npos) << cmd << " " << option;
+    }
+}
+
 TEST(ModelViewApp, GroundOnAJsonSceneAddsOne) {
     TempDir dir;
     const auto s = runShadowlab({"render", "seed", "--ground", "--explain", "--resolution", "32x18", "-o",
