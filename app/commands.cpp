@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <fstream>
 #include <functional>
 #include <cstdio>
 #include <iostream>
@@ -25,10 +26,12 @@
 #include "raster/renderer.h"
 #include "raytrace/memory.h"
 #include "raytrace/renderer.h"
+#include "raytrace/view_search.h"
 #include "scene/error.h"
 #include "scene/frame_io.h"
 #include "scene/loader.h"
 #include "scene/memory.h"
+#include "scene/model_view.h"
 #include "scene/render_plan.h"
 
 namespace shadowlab::app {
@@ -60,9 +63,20 @@ void applyResolution(scene::Scene& s, const std::string& text) {
     s.camera.height = h;
 }
 
+// The choices a scene file leaves open (scene/model_view.h): a file camera, a ground, the sun,
+// then a search for a view and a sun that show shadows where the file has no camera or light.
+void chooseView(scene::Scene& s, const SceneOptions* o) {
+    if (o && o->camera) scene::applyCameraOption(s, *o->camera);
+    scene::applyGround(s, o ? o->ground : std::nullopt);
+    if (o && o->sun) scene::applySunOption(s, *o->sun);
+    raytrace::chooseViewAndSun(s, o && o->settings.threads ? *o->settings.threads : 0);
+}
+
 Prepared prepare(const SceneOptions& o) {
     Prepared p{scene::loadScene(scene::findScene(o.scene)), {}, {}};
     if (o.resolution) applyResolution(p.scene, *o.resolution);
+    chooseView(p.scene, &o);
+    if (o.explain) std::cerr << scene::explainOrigin(p.scene);
     p.settings = scene::resolveSettings(p.scene, o.settings);
     p.plan = scene::makeRenderPlan(p.scene, p.settings);
     if (o.explain)
@@ -151,6 +165,7 @@ scene::Frame renderBackend(const Prepared& p, const std::string& backend,
         f = raytrace::renderReference(p.scene, p.plan, p.settings.raytrace);
     }
     f.attributes["scene"] = p.scene.file.string();
+    for (const auto& [key, text] : p.scene.origin.choices) f.attributes["choice." + key] = text;
     f.attributes["version"] = SHADOWLAB_VERSION;
     return f;
 }
@@ -229,6 +244,91 @@ constexpr RunView kRunViews[] = {
     {"cascades", "cascades", "The cascade each pixel's shadow test used: red, green, blue, yellow from near to far."},
 };
 
+
+// Where `render -o` writes: an existing folder in the way, or a file where the folder should be,
+// is bad input (exit 2) found before rendering; a missing folder is created once the input is
+// known to be good, and the user is told (docs/decisions.md, "Output paths").
+void checkOutputFile(const fs::path& output) {
+    std::error_code ec;
+    if (fs::is_directory(output, ec))
+        throw scene::InputError(output.string() + ": is a folder; -o names the file to write (e.g. " +
+                                (output / "render.png").string() + ")");
+    for (fs::path dir = output.parent_path(); !dir.empty(); dir = dir.parent_path()) {
+        if (fs::exists(dir, ec)) {
+            if (!fs::is_directory(dir, ec))
+                throw scene::InputError(output.string() + ": " + dir.string() +
+                                        " is a file, not a folder, so nothing can be written under it");
+            break;
+        }
+        if (dir == dir.parent_path()) break;
+    }
+}
+void createOutputFolder(const fs::path& output) {
+    if (!output.has_parent_path()) return;
+    std::error_code ec;
+    if (fs::is_directory(output.parent_path(), ec)) return;
+    fs::create_directories(output.parent_path());
+    std::cerr << "shadowlab: created the folder " << output.parent_path().string() << " for " << output.filename().string()
+              << "\n";
+}
+
+// `run -o DIR`: DIR must be a folder or not exist yet; a file there is bad input (exit 2),
+// found before anything renders.
+void checkOutputFolder(const fs::path& dir) {
+    std::error_code ec;
+    if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+        throw scene::InputError(dir.string() + ": is a file, not a folder; run writes a folder of outputs (frames, "
+                                "images, metrics.json, report.html), so -o must name a folder");
+    for (fs::path p = dir.parent_path(); !p.empty(); p = p.parent_path()) {
+        if (fs::exists(p, ec)) {
+            if (!fs::is_directory(p, ec))
+                throw scene::InputError(dir.string() + ": " + p.string() + " is a file, not a folder");
+            break;
+        }
+        if (p == p.parent_path()) break;
+    }
+}
+
+// The run folder's manifest: every file and folder a run wrote, relative to the folder. The next
+// run into the same folder removes what the manifest lists and it did not write again (an earlier
+// run's raster-cascades.png, or raster.exr before --no-raster), so the folder holds only what its
+// report owns; nothing else in the folder is touched (docs/decisions.md, "Run folders").
+constexpr const char* kRunManifest = ".shadowlab-run.json";
+
+std::vector<std::string> readRunManifest(const fs::path& dir) {
+    std::vector<std::string> names;
+    std::ifstream in(dir / kRunManifest);
+    if (!in) return names;
+    try {
+        const Json j = Json::parse(in);
+        for (const Json& n : j.at("files"))
+            if (n.is_string()) names.push_back(n.get<std::string>());
+    } catch (const std::exception&) {
+        return {};  // not ours, or damaged: remove nothing
+    }
+    return names;
+}
+
+// Removes what the earlier manifest lists and this run did not write, then records this run's
+// own. A name is used only when it is a plain name in the folder (no '/' but a trailing one for
+// sweep/, no "..", no dot file), so a hand-edited manifest cannot reach outside the folder.
+void updateRunManifest(const fs::path& dir, const std::vector<std::string>& earlier,
+                       const std::vector<std::string>& written) {
+    for (const std::string& name : earlier) {
+        if (std::find(written.begin(), written.end(), name) != written.end()) continue;
+        std::string plain = name;
+        if (!plain.empty() && plain.back() == '/') plain.pop_back();
+        if (plain.empty() || plain.find('/') != std::string::npos || plain.front() == '.') continue;
+        std::error_code ec;
+        const fs::path p = dir / plain;
+        if (name.back() == '/' ? fs::is_directory(p, ec) : fs::is_regular_file(p, ec)) {
+            fs::remove_all(p, ec);
+            if (!ec) std::cerr << "shadowlab: removed " << p.string() << " (an earlier run's, not part of this report)\n";
+        }
+    }
+    scene::writeTextAtomic(dir / kRunManifest, Json{{"files", written}}.dump(2) + "\n");
+}
+
 }  // namespace
 
 int render(const RenderOptions& o) {
@@ -238,6 +338,7 @@ int render(const RenderOptions& o) {
     if (o.view && (o.backend != "raster" || ext != ".png"))
         throw scene::InputError("--view " + *o.view + ": needs --backend raster and a .png output (a view is a "
                                 "display image of the shadow maps), got --backend " + o.backend + " and '" + ext + "'");
+    checkOutputFile(o.output);
     const Prepared p = prepare(o.common);
     // A view writes a display image, not the Frame; the shadow-map view holds every layer's depths.
     const std::uint64_t estimate =
@@ -250,7 +351,7 @@ int render(const RenderOptions& o) {
                                         : "rendering " + std::to_string(p.scene.camera.width) + "x" +
                                               std::to_string(p.scene.camera.height) + " with " + o.backend);
     // Only once the input is known to be good may the output's folder be created.
-    if (o.output.has_parent_path()) fs::create_directories(o.output.parent_path());
+    createOutputFolder(o.output);
     if (o.view) {
         Stage stage("rendering the " + *o.view + " view of " + p.scene.file.filename().string());
         raster::RenderDebug debug;
@@ -312,6 +413,7 @@ int info(bool validate) {
 }
 
 int run(const RunOptions& o) {
+    checkOutputFolder(o.outputDir);
     const Prepared p = prepare(o.common);
     // The reference, the ray-traced and the raster Frames are all held until the report is
     // written, with a difference image for each method (the half-size sweep needs less).
@@ -330,6 +432,8 @@ int run(const RunOptions& o) {
     fs::create_directories(o.outputDir);
     const fs::path dir = o.outputDir;
     scene::removeStaleTemporaries(dir);  // what an earlier run that was killed left behind
+    const std::vector<std::string> earlierFiles = readRunManifest(dir);
+    std::vector<std::string> written;  // for the manifest
     int status = 0;
 
     Json metrics = {{"scene", p.scene.file.string()},
@@ -345,6 +449,7 @@ int run(const RunOptions& o) {
     const scene::Frame reference = renderBackend(p, "reference");
     scene::writeFrame(reference, dir / "reference.exr");
     scene::writePngLinear(dir / "reference.png", reference.width, reference.height, reference.beauty);
+    written.insert(written.end(), {"reference.exr", "reference.png"});
     refStage.done();
     metrics["reference"] = {{"timings_ms", timingsJson(reference)}, {"attributes", reference.attributes}};
     report.reference = {"reference", "reference.png", reference};
@@ -369,6 +474,7 @@ int run(const RunOptions& o) {
         scene::writePngLinear(dir / (backend + ".png"), frame.width, frame.height, frame.beauty);
         const compare::Comparison c = compare::compareFrames(frame, reference);
         scene::writePngDisplay(dir / ("diff-" + backend + ".png"), c.width, c.height, c.diffRgb);
+        written.insert(written.end(), {backend + ".exr", backend + ".png", "diff-" + backend + ".png"});
         stage.done(compare::summaryLine(c.metrics));
         metrics["methods"][backend] = {{"metrics", compare::toJson(c.metrics)},
                                        {"timings_ms", timingsJson(frame)},
@@ -380,6 +486,7 @@ int run(const RunOptions& o) {
                 const raster::DisplayImage img = debugView(v.view, frame, p.scene, debug);
                 const std::string png = std::string("raster-") + v.view + ".png";
                 scene::writePngDisplay(dir / png, img.width, img.height, img.rgb);
+                written.push_back(png);
                 report.shadowMapViews.push_back({v.title, png, img.width, img.height, v.caption});
             }
         }
@@ -409,6 +516,7 @@ int run(const RunOptions& o) {
             compare::makeSweepReportInput(report.sceneName, report.scenePath, result);
         compare::writeSweepReport(options.outputDir, input);
         scene::replaceDirectory(options.outputDir, dir / "sweep");
+        written.push_back("sweep/");
         report.sweep = compare::summarizeSweep(input, "sweep/report.html");
         stage.done("sweep/report.html");
         metrics["sweep"] = {{"configurations", result.rows.size()}, {"report", "sweep/report.html"},
@@ -418,6 +526,8 @@ int run(const RunOptions& o) {
     metrics["memory"] = memoryJson(estimate);
     scene::writeTextAtomic(dir / "metrics.json", metrics.dump(2) + "\n");
     compare::writeReport(dir, report);
+    written.insert(written.end(), {"metrics.json", "report.html"});
+    updateRunManifest(dir, earlierFiles, written);
     std::cerr << "shadowlab: wrote " << (dir / "report.html").string() << "; " << memoryLine(estimate) << "\n";
     if (o.common.json) std::cout << metrics.dump(2) << "\n";
     return status;
@@ -527,7 +637,10 @@ int stability(const StabilityCommandOptions& o) {
         for (const std::string& name : o.scenes) files.push_back(scene::findScene(name));
     }
     std::vector<scene::Scene> scenes;
-    for (const fs::path& f : files) scenes.push_back(scene::loadScene(f));
+    for (const fs::path& f : files) {
+        scenes.push_back(scene::loadScene(f));
+        chooseView(scenes.back(), nullptr);
+    }
     scene::Scene probe;
     applyResolution(probe, o.resolution);
 

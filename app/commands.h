@@ -16,6 +16,9 @@ struct SceneOptions {
     std::string scene;                    // path or shipped name
     std::optional<std::string> resolution;  // "WxH" overrides the scene's camera
     scene::SettingsOverrides settings;
+    std::optional<std::string> camera;    // --camera N|NAME|auto: a file camera, or search a view
+    std::optional<bool> ground;           // --ground / --no-ground
+    std::optional<std::string> sun;       // --sun AZIMUTH,ELEVATION (degrees)
     bool explain = false;                 // print the RenderPlan before rendering
     bool json = false;                    // machine-readable results on stdout
 };

@@ -52,6 +52,16 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
     cmd.add_option("--threads", s.threads, "raytrace: worker threads, 0 = all cores (default 0)");
     cmd.add_flag("--validate", s.validate,
                  "raster: enable VK_LAYER_KHRONOS_validation; any message makes the command fail");
+    cmd.add_option("--camera", o.camera,
+                   "View: a camera of the scene's glTF file by index (0, 1, ...) or name, or 'auto' to search a view "
+                   "that shows shadows (default: the file's first camera; a search where it has none)");
+    cmd.add_flag_function(
+           "--ground", [&o](std::int64_t) { o.ground = true; },
+           "Put a ground under the model, sized from its bounds (default for a glTF scene without a floor of its own)");
+    cmd.add_flag_function("--no-ground", [&o](std::int64_t) { o.ground = false; }, "No added ground");
+    cmd.add_option("--sun", o.sun,
+                   "AZIMUTH,ELEVATION in degrees: the directional light's direction (azimuth in the ground plane from "
+                   "+Z toward +X, elevation above the horizon; default: the scene's, or a search)");
     cmd.add_flag("--explain", o.explain, "Print what this scene needs (the render plan) before rendering");
     cmd.add_flag("--json", o.json, "Print machine-readable results on stdout");
 }

@@ -570,6 +570,7 @@ SurfacePoint<Real> Tracer<Real>::surfacePoint(const Ray<Real>& ray, const Hit<Re
     if (glm::dot(sp.ng, ray.d) > 0) {
         sp.ng = -sp.ng;
         sp.ns = -sp.ns;
+        sp.backFacing = true;
     }
     return sp;
 }

@@ -37,6 +37,9 @@ struct SurfacePoint {
     Vec ng;  // unit geometric normal, facing the side the ray came from
     Vec ns;  // unit shading normal, flipped together with ng
     int object = -1;
+    // The ray met the surface from behind: against a triangle's winding, from inside a sphere or
+    // a box, from a quad's back (the view search tells rooms from solids by it).
+    bool backFacing = false;
 };
 
 enum class ShapeKind : std::uint8_t { Sphere, Quad, Box, Mesh };

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -13,6 +14,7 @@
 
 #include "scene/error.h"
 #include "scene/mesh_loader.h"
+#include "scene/model_view.h"
 #include "scene/settings.h"
 
 namespace shadowlab::scene {
@@ -229,8 +231,18 @@ Light readLight(const Reader& r, const Json& node, const JsonPath& path) {
     return l;
 }
 
+// A mesh object's glTF cameras, before the scene's bounds (which their near/far default to) are known.
+struct PendingCameras {
+    std::vector<GltfCamera> cameras;
+    glm::dmat4 transform{1.0};
+    std::string source;
+    std::optional<std::string> pick;  // the object's "camera" key, as text
+    JsonPath pickPath;
+};
+
 Object readObject(const Reader& r, const Json& node, const JsonPath& path,
-                  const std::map<std::string, int>& materials, MeshCache& meshCache) {
+                  const std::map<std::string, int>& materials, MeshCache& meshCache,
+                  PendingCameras* pending = nullptr) {
     r.expectObject(node, path);
     Object o;
     const std::string type = r.string(r.require(node, path, "type"), path / "type");
@@ -261,7 +273,7 @@ Object readObject(const Reader& r, const Json& node, const JsonPath& path,
                 r.fail(path / "max", "must be greater than min on every axis (axis " + std::to_string(i) + ")");
         o.shape = b;
     } else if (type == "mesh") {
-        r.checkKeys(node, path, {"type", "name", "material", "file", "translate", "rotate", "scale"});
+        r.checkKeys(node, path, {"type", "name", "material", "file", "translate", "rotate", "scale", "camera"});
         const std::string file = r.string(r.require(node, path, "file"), path / "file");
         if (file.empty()) r.fail(path / "file", "must name a mesh file");
         const Vec3 translate = r.vec3(node, path, "translate", Vec3(0.0));
@@ -276,8 +288,20 @@ Object readObject(const Reader& r, const Json& node, const JsonPath& path,
         Mesh m;
         const fs::path base = r.file().has_parent_path() ? r.file().parent_path() : fs::path(".");
         m.file = fs::path(file).is_absolute() ? fs::path(file) : base / file;
+        GltfExtras extras;
         m.instances = loadMeshInstances(m.file, objectTransform(translate, rotate, scale), r.file(),
-                                        path / "file", nullptr, &meshCache);
+                                        path / "file", pending ? &extras : nullptr, &meshCache);
+        if (pending) {
+            pending->cameras = extras.cameras;
+            pending->transform = objectTransform(translate, rotate, scale);
+            pending->source = path.str() + " (" + fs::path(file).filename().string() + ")";
+            if (node.contains("camera")) {
+                const Json& c = node["camera"];
+                pending->pickPath = path / "camera";
+                if (c.is_string()) pending->pick = c.get<std::string>();
+                else pending->pick = std::to_string(r.integer(c, path / "camera", 0, 1 << 20));
+            }
+        }
         o.shape = m;
     } else {
         r.fail(path / "type", "unknown object type '" + type + "' (expected sphere, quad, box or mesh)");
@@ -350,6 +374,37 @@ ShadowDefaults readShadow(const Reader& r, const Json& node, const JsonPath& pat
     return d;
 }
 
+// The JSON scene's glTF cameras in world space (origin.cameras), and the one a mesh object's
+// "camera" key names as the view.
+void addFileCameras(const Reader& r, Scene& scene, const std::vector<PendingCameras>& pending, bool nearFarGiven) {
+    const Bounds bounds = scene.bounds();
+    for (const PendingCameras& p : pending) {
+        std::vector<FileCamera> own;
+        for (const GltfCamera& c : p.cameras) {
+            const glm::dmat3 linear(p.transform);
+            const Vec3 position(p.transform * glm::dvec4(c.position, 1.0));
+            own.push_back({c.name.empty() ? c.nodeName : c.name, p.source,
+                           cameraFromGltf(position, glm::normalize(linear * c.forward), glm::normalize(linear * c.up),
+                                          c.yfovRadians, c.znear, c.zfar, 0.0, bounds, scene.camera)});
+        }
+        if (p.pick) {
+            std::string why;
+            const int i = findFileCamera(own, *p.pick, why);
+            if (i < 0) r.fail(p.pickPath, why);
+            const Camera keep = scene.camera;
+            scene.camera = own[std::size_t(i)].camera;
+            if (nearFarGiven) {
+                scene.camera.near = keep.near;
+                scene.camera.far = keep.far;
+            }
+            scene.origin.choices.emplace_back(
+                "view", "file camera " + std::to_string(scene.origin.cameras.size() + std::size_t(i)) + " (" +
+                            p.pickPath.str() + ")");
+        }
+        scene.origin.cameras.insert(scene.origin.cameras.end(), own.begin(), own.end());
+    }
+}
+
 // "line L, column C" for a byte offset, so a syntax error points at the place in an editor.
 std::string lineColumn(const std::string& text, std::size_t byte) {
     std::size_t line = 1, column = 1;
@@ -376,11 +431,37 @@ Scene parseScene(const fs::path& file, const std::string& text) {
         if (const auto pos = what.find("] "); pos != std::string::npos) what = what.substr(pos + 2);
         throw SceneError(file, root, "invalid JSON: " + what + " (numbers must be finite)");
     }
-    r.checkKeys(doc, root, {"camera", "background", "ambient", "materials", "lights", "objects", "shadow", "description"});
+    r.checkKeys(doc, root, {"camera", "background", "ambient", "materials", "lights", "objects", "shadow", "description",
+                            "ground", "$schema"});
 
     Scene scene;
     scene.file = file;
-    scene.camera = readCamera(r, r.require(doc, root, "camera"), root / "camera");
+    // A mesh object's "camera" key takes the view from its glTF file: the "camera" block may then
+    // hold only the image size and near/far (docs/scene-format.md).
+    bool viewFromModel = false;
+    if (const auto it = doc.find("objects"); it != doc.end() && it->is_array())
+        for (const Json& o : *it)
+            viewFromModel = viewFromModel || (o.is_object() && o.contains("camera") && o.value("type", Json()) == "mesh");
+    bool nearFarGiven = false;
+    if (viewFromModel) {
+        if (doc.contains("camera")) {
+            const Json& node = doc["camera"];
+            for (const char* key : {"position", "look_at", "up", "fov_y"})
+                if (node.is_object() && node.contains(key))
+                    r.fail(root / "camera" / key, "a mesh object's \"camera\" key sets the view; give only "
+                                                  "resolution, near and far here");
+            r.checkKeys(node, root / "camera", {"resolution", "near", "far"});
+            Json full = node;
+            full["position"] = Json::array({0, 0, 1});
+            full["look_at"] = Json::array({0, 0, 0});
+            scene.camera = readCamera(r, full, root / "camera");
+            nearFarGiven = node.contains("near") || node.contains("far");
+        }
+    } else {
+        scene.camera = readCamera(r, r.require(doc, root, "camera"), root / "camera");
+    }
+    if (doc.contains("ground")) scene.origin.ground = r.boolean(doc["ground"], root / "ground");
+    if (doc.contains("$schema")) r.string(doc["$schema"], root / "$schema");
     scene.background = r.color(doc, root, "background", scene.background);
     if (doc.contains("ambient")) scene.ambient = r.unitInterval(doc["ambient"], root / "ambient");
     if (doc.contains("description")) r.string(doc["description"], root / "description");
@@ -413,8 +494,16 @@ Scene parseScene(const fs::path& file, const std::string& text) {
     if (objects.empty()) r.fail(root / "objects", "must hold at least one object");
     if (objects.size() > 1000000) r.fail(root / "objects", "has more than 1,000,000 objects");
     MeshCache meshCache;  // objects naming the same file share its geometry
-    for (std::size_t i = 0; i < objects.size(); ++i)
-        scene.objects.push_back(readObject(r, objects[i], root / "objects" / i, materialIndex, meshCache));
+    std::vector<PendingCameras> pending;
+    bool picked = false;
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+        PendingCameras p;
+        scene.objects.push_back(readObject(r, objects[i], root / "objects" / i, materialIndex, meshCache, &p));
+        if (p.pick && picked) r.fail(p.pickPath, "only one mesh object may name the scene's camera");
+        picked = picked || p.pick.has_value();
+        if (!p.cameras.empty() || p.pick) pending.push_back(std::move(p));
+    }
+    addFileCameras(r, scene, pending, nearFarGiven);
 
     if (doc.contains("shadow")) scene.shadow = readShadow(r, doc["shadow"], root / "shadow");
     return scene;
@@ -434,26 +523,21 @@ Scene loadModelScene(const fs::path& file) {
     mesh.instances = loadMeshInstances(file, glm::dmat4(1.0), file, JsonPath(), &extras);
     scene.objects.push_back({file.stem().string(), mesh, 0});
     const Bounds b = scene.bounds();
-    const double radius = std::max(0.5 * b.diagonal(), 1e-9);
-
-    Camera& cam = scene.camera;
-    if (!extras.cameras.empty()) {
-        const GltfCamera& c = extras.cameras.front();
-        cam.position = c.position;
-        cam.lookAt = c.position + c.forward;
-        cam.up = c.up;
-        cam.fovYDegrees = std::clamp(c.yfovRadians * 180.0 / kPi, 1.0, 170.0);
-        cam.near = c.znear > 0 ? c.znear : radius * 1e-3;
-        cam.far = c.zfar > cam.near ? c.zfar : glm::length(c.position - b.center()) + 4.0 * radius;
-        if (c.aspect > 0) cam.height = std::clamp(int(std::lround(cam.width / c.aspect)), 1, kMaxResolution);
+    scene.origin.modelScene = true;
+    scene.origin.modelBounds = b;
+    for (const GltfCamera& c : extras.cameras)
+        scene.origin.cameras.push_back({c.name.empty() ? c.nodeName : c.name, file.filename().string(),
+                                        cameraFromGltf(c.position, c.forward, c.up, c.yfovRadians, c.znear, c.zfar,
+                                                       c.aspect, b, scene.camera)});
+    if (!scene.origin.cameras.empty()) {
+        scene.camera = scene.origin.cameras.front().camera;
+        scene.origin.choices.emplace_back("view", "file camera 0 of " + std::to_string(scene.origin.cameras.size()) +
+                                                      " (the first; --camera picks another)");
     } else {
-        // Framed: the bounding sphere fills the vertical field of view from above and in front.
-        cam.fovYDegrees = 40.0;
-        const double distance = 1.15 * radius / std::sin(0.5 * cam.fovYDegrees * kPi / 180.0);
-        cam.lookAt = b.center();
-        cam.position = b.center() + distance * glm::normalize(Vec3(0.55, 0.45, 1.0));
-        cam.near = std::max(distance - 2.0 * radius, distance * 1e-3);
-        cam.far = distance + 2.0 * radius;
+        // Framed from above and in front: a placeholder the view search replaces (scene/model_view.h).
+        scene.camera = framedCamera(b, Vec3(0.55, 0.45, 1.0), 40.0, scene.camera);
+        scene.origin.chooseView = true;
+        scene.origin.choices.emplace_back("view", "framed from above and in front (the file has no camera)");
     }
     for (const GltfLight& l : extras.lights) {
         Light light;
@@ -474,12 +558,25 @@ Scene loadModelScene(const fs::path& file) {
         scene.lights.push_back(light);
     }
     if (scene.lights.empty()) {
-        Light sun;  // from above, left and in front of the default framing
+        Light sun;  // from above, left and in front of the default framing; a view search may turn it
         sun.direction = glm::normalize(Vec3(-0.4, -1.0, -0.6));
         sun.intensity = 1.4;
         scene.lights.push_back(sun);
+        scene.origin.chooseSun = true;
+        scene.origin.choices.emplace_back("sun", "a default sun (the file has no light)");
+    } else {
+        scene.origin.choices.emplace_back("sun", std::to_string(scene.lights.size()) + " light(s) from the file");
     }
     return scene;
+}
+
+// Model formats people try first that shadowlab does not read: named as such rather than
+// parsed as JSON (which would report a syntax error at byte 1).
+bool isOtherModelFormat(const std::string& ext) {
+    for (const char* e : {".ply", ".stl", ".fbx", ".dae", ".3ds", ".blend", ".usd", ".usda", ".usdc", ".usdz",
+                          ".off", ".x3d", ".wrl", ".abc"})
+        if (ext == e) return true;
+    return false;
 }
 
 }  // namespace
@@ -494,6 +591,9 @@ Scene loadScene(const fs::path& file) {
     if (ext == ".obj")
         throw SceneError(file, {}, "an OBJ file has no camera or light: reference it from a JSON scene "
                                    "as {\"type\": \"mesh\", \"file\": \"" + file.filename().string() + "\"}");
+    if (isOtherModelFormat(ext))
+        throw SceneError(file, {}, "unsupported format '" + ext + "': a scene is a .json file or a .gltf/.glb model, "
+                                   "and a mesh is .obj, .gltf or .glb (convert the model, e.g. to .obj or .glb)");
     const auto size = fs::file_size(file, ec);
     if (ec) throw SceneError(file, {}, "cannot read: " + ec.message());
     if (size > 256u * 1024 * 1024) throw SceneError(file, {}, "is larger than 256 MiB; not a scene file");
@@ -518,7 +618,7 @@ fs::path findScene(const std::string& nameOrPath) {
         if (fs::is_regular_file(candidate, ec)) return candidate;
     std::set<std::string> names;
     for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
-        if (it->path().extension() == ".json")
+        if (it->path().extension() == ".json" && !it->path().stem().string().ends_with(".schema"))  // not scene.schema.json
             names.insert(fs::relative(it->path(), dir, ec).replace_extension().string());
     std::string list;
     for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;

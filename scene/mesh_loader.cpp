@@ -206,6 +206,8 @@ void collectCameraAndLight(const tinygltf::Model& model, const tinygltf::Node& n
         model.cameras[node.camera].type == "perspective" && finite(forward) && finite(up)) {
         const auto& pc = model.cameras[node.camera].perspective;
         GltfCamera c;
+        c.name = model.cameras[node.camera].name;
+        c.nodeName = node.name;
         c.position = origin;
         c.forward = forward;
         c.up = up;
@@ -315,7 +317,7 @@ std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path&
     } else if (ext == ".gltf" || ext == ".glb") {
         loadGltf(meshFile, raw, sceneFile, path, extras);
     } else {
-        fail(sceneFile, path, meshFile, "unknown mesh type '" + ext + "' (use .obj, .gltf or .glb)");
+        fail(sceneFile, path, meshFile, "unsupported format '" + ext + "': a mesh is .obj, .gltf or .glb (convert the model, e.g. to .obj or .glb)");
     }
     // Degenerate triangles are judged in object space: an invertible affine map keeps a
     // triangle's area zero or non-zero.
@@ -402,11 +404,18 @@ std::vector<MeshInstance> loadMeshInstances(const fs::path& meshFile, const glm:
         std::error_code ec;
         const fs::path canonical = fs::weakly_canonical(meshFile, ec);
         key = (ec ? meshFile : canonical).string();
-        if (const auto it = cache->files.find(key); it != cache->files.end()) instances = it->second;
+        if (const auto it = cache->files.find(key); it != cache->files.end()) {
+            instances = it->second;
+            if (extras) *extras = cache->extras[key];  // the same cameras for every object naming the file
+        }
     }
     if (instances.empty()) {
-        instances = readMeshFile(meshFile, sceneFile, path, extras);
-        if (cache) cache->files.emplace(key, instances);
+        GltfExtras own;
+        instances = readMeshFile(meshFile, sceneFile, path, extras ? extras : (cache ? &own : nullptr));
+        if (cache) {
+            cache->files.emplace(key, instances);
+            cache->extras[key] = extras ? *extras : own;
+        }
     }
     std::vector<MeshInstance> out;
     for (MeshInstance& inst : instances) {

@@ -20,6 +20,7 @@ namespace shadowlab::scene {
 // What a glTF file holds besides triangles: its perspective cameras and KHR_lights_punctual
 // lights, in the file's world space (not moved by the object transform).
 struct GltfCamera {
+    std::string name, nodeName;  // the camera's and its node's "name" ("" when unnamed)
     Vec3 position{0, 0, 0}, forward{0, 0, -1}, up{0, 1, 0};
     double yfovRadians = 0.0, znear = 0.0, zfar = 0.0, aspect = 0.0;  // zfar/aspect 0: unset
 };
@@ -38,13 +39,14 @@ struct GltfExtras {
 // (the key is the file's canonical path).
 struct MeshCache {
     std::map<std::string, std::vector<MeshInstance>> files;
+    std::map<std::string, GltfExtras> extras;  // each glTF file's cameras and lights
 };
 
 // Reads `meshFile`: one instance for an OBJ file, one per node that uses a mesh for glTF (the
 // node hierarchy applied; a glTF mesh used by several nodes is one shared geometry), each then
 // placed by `transform` (object to world). Errors name `sceneFile` and `path` (the JSON path of
-// the object's "file" key) as well as the mesh file. For glTF files, `extras` (when given and
-// the file is not already in `cache`) receives the file's cameras and lights.
+// the object's "file" key) as well as the mesh file. For glTF files, `extras` (when given)
+// receives the file's cameras and lights, also when the file was read earlier into `cache`.
 std::vector<MeshInstance> loadMeshInstances(const std::filesystem::path& meshFile,
                                             const glm::dmat4& transform,
                                             const std::filesystem::path& sceneFile,

@@ -155,6 +155,29 @@ struct Bounds {
     double maxAbsCoordinate() const;
 };
 
+// A camera held by one of the scene's glTF files (the model given as the scene, or a mesh
+// object's file), placed in world space; --camera and a mesh object's "camera" key pick one.
+struct FileCamera {
+    std::string name;    // the glTF camera's name, else its node's ("" when both are unnamed)
+    std::string source;  // the file, or "objects[2] (truck.gltf)" in a JSON scene
+    Camera camera;       // the scene's image size; near/far from the file or the scene's size
+};
+
+// Where a scene's view, sun and ground came from: what its files hold, what is left to choose
+// (a glTF given as the scene without a camera or a light; see scene/model_view.h and
+// raytrace/view_search.h), and each choice in words for --explain and the Frame's attributes.
+struct SceneOrigin {
+    std::vector<FileCamera> cameras;
+    bool modelScene = false;   // a .gltf/.glb given directly as the scene
+    bool chooseView = false;   // the camera is a placeholder: a view search replaces it
+    bool chooseSun = false;    // lights[0] is a placeholder sun: a view search replaces its direction
+    std::optional<bool> ground;  // the scene file's "ground" key
+    Bounds modelBounds;        // the objects without an added ground (what a view frames)
+    // ("view", "searched: ..."), ("sun", ...), ("ground", ...): printed by --explain, recorded
+    // in every Frame as attributes "choice.view", "choice.sun", ...
+    std::vector<std::pair<std::string, std::string>> choices;
+};
+
 struct Scene {
     std::filesystem::path file;  // where it was loaded from (for messages and metadata)
     Camera camera;
@@ -164,6 +187,7 @@ struct Scene {
     std::vector<Light> lights;
     std::vector<Object> objects;
     ShadowDefaults shadow;
+    SceneOrigin origin;
 
     const Material& materialOf(const Object& o) const { return materials[o.material]; }
     bool allOpaque() const;

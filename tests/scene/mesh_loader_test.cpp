@@ -74,7 +74,7 @@ TEST(MeshLoader, BadMeshesGiveClearErrors) {
     expectError(dir.write("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), "out of range");
     expectError(dir.write("nan.obj", "v 0 nan 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), "not a finite number");
     expectError(dir.write("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"), "degenerate");
-    expectError(dir.write("mesh.stl", "solid"), "unknown mesh type");
+    expectError(dir.write("mesh.stl", "solid"), "unsupported format");
     expectError(dir.write("garbage.gltf", "\x01\x02 not json"), "not a readable glTF");
 }
 

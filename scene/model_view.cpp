@@ -1,0 +1,222 @@
+// scene/model_view.cpp: picking a file's camera, the ground under a model, the sun's direction.
+#include "scene/model_view.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "scene/error.h"
+#include "scene/loader.h"
+
+namespace shadowlab::scene {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDegrees = kPi / 180.0;
+
+std::string describeCamera(const std::vector<FileCamera>& cameras, std::size_t i) {
+    const FileCamera& c = cameras[i];
+    return std::to_string(i) + (c.name.empty() ? " (unnamed)" : " '" + c.name + "'") + " in " + c.source;
+}
+
+std::string listCameras(const std::vector<FileCamera>& cameras) {
+    if (cameras.empty()) return "the scene's files hold no camera";
+    std::string list;
+    for (std::size_t i = 0; i < cameras.size(); ++i) list += (i ? ", " : "") + describeCamera(cameras, i);
+    return "cameras: " + list;
+}
+
+std::string fmt(double v, const char* f = "%.3g") {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, f, v);
+    return buf;
+}
+
+}  // namespace
+
+int findFileCamera(const std::vector<FileCamera>& cameras, const std::string& spec, std::string& why) {
+    char* end = nullptr;
+    const long index = std::strtol(spec.c_str(), &end, 10);
+    if (!spec.empty() && end && *end == '\0') {
+        if (index >= 0 && std::size_t(index) < cameras.size()) return int(index);
+        why = "no camera " + spec + " (" + listCameras(cameras) + ")";
+        return -1;
+    }
+    for (std::size_t i = 0; i < cameras.size(); ++i)
+        if (cameras[i].name == spec) return int(i);
+    why = "no camera named '" + spec + "' (" + listCameras(cameras) + ")";
+    return -1;
+}
+
+Camera cameraFromGltf(const Vec3& position, const Vec3& forward, const Vec3& up, double yfovRadians, double znear,
+                      double zfar, double aspect, const Bounds& bounds, const Camera& base) {
+    const double radius = std::max(0.5 * bounds.diagonal(), 1e-9);
+    Camera cam = base;
+    cam.position = position;
+    cam.lookAt = position + forward;
+    cam.up = up;
+    cam.fovYDegrees = std::clamp(yfovRadians / kDegrees, 1.0, 170.0);
+    cam.near = znear > 0 ? znear : radius * 1e-3;
+    cam.far = zfar > cam.near ? zfar : glm::length(position - bounds.center()) + 4.0 * radius;
+    if (aspect > 0) cam.height = std::clamp(int(std::lround(cam.width / aspect)), 1, kMaxResolution);
+    return cam;
+}
+
+Camera framedCamera(const Bounds& bounds, const Vec3& fromDirection, double fovYDegrees, const Camera& base) {
+    const double radius = std::max(0.5 * bounds.diagonal(), 1e-9);
+    Camera cam = base;
+    cam.fovYDegrees = fovYDegrees;
+    const double distance = 1.15 * radius / std::sin(0.5 * fovYDegrees * kDegrees);
+    cam.lookAt = bounds.center();
+    cam.position = bounds.center() + distance * glm::normalize(fromDirection);
+    cam.up = {0, 1, 0};
+    cam.near = std::max(distance - 2.0 * radius, distance * 1e-3);
+    cam.far = distance + 2.0 * radius;
+    return cam;
+}
+
+void recordChoice(Scene& scene, const std::string& key, const std::string& text) {
+    for (auto& [k, v] : scene.origin.choices)
+        if (k == key) {
+            v = text;
+            return;
+        }
+    scene.origin.choices.emplace_back(key, text);
+}
+
+void applyCameraOption(Scene& scene, const std::string& spec) {
+    if (spec == "auto") {
+        scene.origin.chooseView = true;
+        recordChoice(scene, "view", "to be searched (--camera auto)");
+        return;
+    }
+    std::string why;
+    const int i = findFileCamera(scene.origin.cameras, spec, why);
+    if (i < 0) throw InputError("--camera " + spec + ": " + why);
+    const Camera& c = scene.origin.cameras[std::size_t(i)].camera;
+    const int width = scene.camera.width, height = scene.camera.height;
+    scene.camera = c;
+    scene.camera.width = width;  // the image size stays the scene's (or --resolution's)
+    scene.camera.height = height;
+    scene.origin.chooseView = false;
+    recordChoice(scene, "view", "file camera " + describeCamera(scene.origin.cameras, std::size_t(i)) + " (--camera)");
+}
+
+bool hasOwnGround(const Scene& scene) {
+    const Bounds b = scene.origin.modelBounds.empty() ? scene.bounds() : scene.origin.modelBounds;
+    if (b.empty()) return false;
+    const Vec3 e = b.extent();
+    const double footprint = e.x * e.z;
+    if (!(footprint > 0)) return false;
+    const double top = b.min.y + 0.05 * e.y;
+    double area = 0;  // projected onto the ground plane
+    for (const Object& o : scene.objects) {
+        if (const Quad* q = std::get_if<Quad>(&o.shape)) {
+            if (std::abs(q->normal.y) > 0.7 && q->center.y <= top) area += q->size.x * q->size.y * std::abs(q->normal.y);
+        } else if (const Mesh* m = std::get_if<Mesh>(&o.shape)) {
+            for (const MeshInstance& in : m->instances) {
+                if (!in.geometry) continue;
+                const TriangleMesh& g = *in.geometry;
+                for (std::size_t t = 0; t + 2 < g.indices.size(); t += 3) {
+                    const Vec3 p0 = transformPoint(in.transform, g.positions[g.indices[t]]);
+                    const Vec3 p1 = transformPoint(in.transform, g.positions[g.indices[t + 1]]);
+                    const Vec3 p2 = transformPoint(in.transform, g.positions[g.indices[t + 2]]);
+                    if (std::max({p0.y, p1.y, p2.y}) > top) continue;
+                    const Vec3 n = glm::cross(p1 - p0, p2 - p0);  // |n| = twice the area
+                    const double len = glm::length(n);
+                    if (len > 0 && n.y > 0.7 * len) area += 0.5 * n.y;
+                }
+            }
+        }
+    }
+    return area >= 0.5 * footprint;
+}
+
+void addGround(Scene& scene) {
+    const Bounds b = scene.origin.modelBounds.empty() ? scene.bounds() : scene.origin.modelBounds;
+    const Vec3 e = b.extent();
+    const double side = std::max(e.x, e.z) + 3.0 * e.y;
+    Quad q;
+    q.center = {b.center().x, b.min.y - 1e-4 * b.diagonal(), b.center().z};
+    q.normal = {0, 1, 0};
+    q.size = {side, side};
+    quadAxes(q.normal, q.uAxis, q.vAxis);
+    scene.materials.push_back({"ground", {0.75, 0.75, 0.75}, 1.0});
+    scene.objects.push_back({"ground", q, int(scene.materials.size()) - 1});
+}
+
+void applyGround(Scene& scene, std::optional<bool> option) {
+    if (scene.origin.modelBounds.empty()) scene.origin.modelBounds = scene.bounds();
+    bool on = false;
+    std::string why;
+    if (option) {
+        on = *option;
+        why = on ? "--ground" : "--no-ground";
+    } else if (scene.origin.ground) {
+        on = *scene.origin.ground;
+        why = std::string("the scene's \"ground\": ") + (on ? "true" : "false");
+    } else if (scene.origin.modelScene) {
+        on = !hasOwnGround(scene);
+        why = on ? "default for a model without a floor of its own: a model with nothing under it casts its "
+                   "shadow into the void"
+                 : "none: the model has a floor of its own (upward faces over half its footprint at its base)";
+    } else {
+        return;  // a JSON scene without the key: as its author wrote it
+    }
+    if (on) {
+        addGround(scene);
+        const Quad& q = std::get<Quad>(scene.objects.back().shape);
+        why = "a " + fmt(q.size.x) + " x " + fmt(q.size.y) + " quad at y = " + fmt(q.center.y, "%.4g") + " (" + why + ")";
+    } else if (option || scene.origin.ground) {
+        why = "none (" + why + ")";
+    }
+    recordChoice(scene, "ground", why);
+}
+
+Vec3 sunDirection(double azimuthDegrees, double elevationDegrees) {
+    const double a = azimuthDegrees * kDegrees, e = elevationDegrees * kDegrees;
+    return -Vec3(std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a));
+}
+
+glm::dvec2 sunAngles(const Vec3& direction) {
+    const Vec3 toSun = -glm::normalize(direction);
+    double az = std::atan2(toSun.x, toSun.z) / kDegrees;
+    if (az < 0) az += 360.0;
+    const double el = std::asin(std::clamp(toSun.y, -1.0, 1.0)) / kDegrees;
+    return {az, el};
+}
+
+void applySunOption(Scene& scene, const std::string& text) {
+    double az = 0, el = 0;
+    char comma = 0, extra = 0;
+    if (std::sscanf(text.c_str(), "%lf%c%lf%c", &az, &comma, &el, &extra) != 3 || comma != ',' ||
+        !std::isfinite(az) || !std::isfinite(el))
+        throw InputError("--sun: expected AZIMUTH,ELEVATION in degrees (e.g. 135,40), got '" + text + "'");
+    if (el < -90.0 || el > 90.0)
+        throw InputError("--sun " + text + ": the elevation must be in -90..90 degrees, got " + fmt(el));
+    for (Light& l : scene.lights) {
+        if (l.type != LightType::Directional) continue;
+        l.direction = sunDirection(az, el);
+        scene.origin.chooseSun = false;
+        recordChoice(scene, "sun", "azimuth " + fmt(az) + ", elevation " + fmt(el) + " degrees (--sun)");
+        return;
+    }
+    throw InputError("--sun " + text + ": the scene has no directional light to point");
+}
+
+std::string explainOrigin(const Scene& scene) {
+    std::string out;
+    if (!scene.origin.cameras.empty()) {
+        out += "file cameras (--camera N|NAME):";
+        for (std::size_t i = 0; i < scene.origin.cameras.size(); ++i)
+            out += "\n  " + describeCamera(scene.origin.cameras, i);
+        out += "\n";
+    } else if (scene.origin.modelScene) {
+        out += "file cameras: none\n";
+    }
+    for (const auto& [key, text] : scene.origin.choices) out += key + ": " + text + "\n";
+    return out;
+}
+
+}  // namespace shadowlab::scene

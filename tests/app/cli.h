@@ -1,0 +1,54 @@
+// tests/app/cli.h: runs the `shadowlab` program with arguments and captures its exit code,
+// stdout and stderr (for test files other than app_test.cpp, which keeps its own copy).
+#pragma once
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+#include <vector>
+
+#include "tests/scene/test_files.h"
+
+namespace shadowlab::test {
+
+struct CliResult {
+    int exitCode = -1;
+    std::string out;
+    std::string err;
+};
+
+inline std::string slurpFile(const std::filesystem::path& p) {
+    std::ifstream in(p);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+inline CliResult runShadowlab(const std::vector<std::string>& args) {
+    auto quote = [](const std::string& s) {
+        std::string q = "'";
+        for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+        return q + "'";
+    };
+    TempDir io;
+    std::string cmd = quote(SHADOWLAB_EXE);
+    for (const auto& a : args) {
+        cmd += ' ';
+        cmd += quote(a);
+    }
+    cmd += " >";
+    cmd += quote((io.path() / "out").string());
+    cmd += " 2>";
+    cmd += quote((io.path() / "err").string());
+    const int status = std::system(cmd.c_str());
+    CliResult r;
+    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurpFile(io.path() / "out");
+    r.err = slurpFile(io.path() / "err");
+    return r;
+}
+
+}  // namespace shadowlab::test

@@ -1,0 +1,95 @@
+// tests/app/outputs_test.cpp: where outputs go: `run -o` naming a file, `render -o` into a missing
+// folder, a model format shadowlab does not read, and a run folder left from an earlier run.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "tests/app/cli.h"
+
+namespace shadowlab {
+namespace {
+
+namespace fs = std::filesystem;
+using test::runShadowlab;
+using test::TempDir;
+
+TEST(Outputs, RunIntoAFileExitsTwoWithAClearMessageAndLeavesTheFile) {
+    TempDir dir;
+    const auto file = dir.write("report.txt", "mine");
+    const auto r = runShadowlab({"run", "seed", "-o", file.string(), "--no-raster", "--no-sweep"});
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("is a file, not a folder"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("filesystem error"), std::string::npos) << r.err;
+    EXPECT_EQ(test::slurpFile(file), "mine");
+    EXPECT_EQ(dir.fileCount(), 1u);
+}
+
+TEST(Outputs, RenderIntoAMissingFolderCreatesItAndSaysSo) {
+    TempDir dir;
+    const auto out = dir.path() / "new" / "deeper" / "x.png";
+    const auto r = runShadowlab({"render", "seed", "--resolution", "32x18", "-o", out.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_TRUE(fs::is_regular_file(out));
+    EXPECT_NE(r.err.find("created the folder " + out.parent_path().string()), std::string::npos) << r.err;
+}
+
+TEST(Outputs, RenderUnderAFileOrOntoAFolderIsBadInput) {
+    TempDir dir;
+    const auto file = dir.write("plain", "x");
+    const auto under = runShadowlab({"render", "seed", "--resolution", "32x18", "-o", (file / "x.png").string()});
+    EXPECT_EQ(under.exitCode, 2);
+    EXPECT_NE(under.err.find("is a file, not a folder"), std::string::npos) << under.err;
+    fs::create_directories(dir.path() / "folder.png");
+    const auto onto = runShadowlab({"render", "seed", "--resolution", "32x18", "-o", (dir.path() / "folder.png").string()});
+    EXPECT_EQ(onto.exitCode, 2);
+    EXPECT_NE(onto.err.find("is a folder"), std::string::npos) << onto.err;
+}
+
+TEST(Outputs, APlyModelIsAnUnsupportedFormatNotAJsonError) {
+    TempDir dir;
+    const auto ply = dir.write("bunny.ply", "ply\nformat ascii 1.0\nelement vertex 0\nend_header\n");
+    const auto r = runShadowlab({"render", ply.string(), "-o", (dir.path() / "x.png").string()});
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("unsupported format '.ply'"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("JSON"), std::string::npos) << r.err;
+    // Named as a mesh in a JSON scene, the same words, with the scene's JSON path.
+    const auto scene = dir.write("s.json", R"({"camera": {"position": [0, 1, 5], "look_at": [0, 0, 0]},
+        "materials": {"m": {}}, "lights": [{"type": "directional", "direction": [0, -1, 0]}],
+        "objects": [{"type": "mesh", "file": "bunny.ply", "material": "m"}]})");
+    const auto m = runShadowlab({"render", scene.string(), "-o", (dir.path() / "x.png").string()});
+    EXPECT_EQ(m.exitCode, 2);
+    EXPECT_NE(m.err.find("unsupported format '.ply'"), std::string::npos) << m.err;
+    EXPECT_NE(m.err.find("objects[0].file"), std::string::npos) << m.err;
+    EXPECT_FALSE(fs::exists(dir.path() / "x.png"));
+}
+
+TEST(Outputs, ARunRemovesWhatTheEarlierRunWroteAndThisOneDoesNotButNothingElse) {
+    TempDir dir;
+    const auto out = dir.path() / "run";
+    // An earlier run's folder: its manifest lists raster outputs and a sweep this run will not
+    // write; notes.txt is the user's, and raster-cascades.png is not in the manifest.
+    dir.write("run/raster.exr", "old");
+    dir.write("run/diff-raster.png", "old");
+    dir.write("run/sweep/results.csv", "old");
+    dir.write("run/notes.txt", "mine");
+    dir.write("run/raster-cascades.png", "not listed");
+    dir.write("run/.shadowlab-run.json",
+              R"({"files": ["raster.exr", "diff-raster.png", "sweep/", "reference.exr", "../outside.txt"]})");
+    dir.write("outside.txt", "mine too");
+    const auto r = runShadowlab({"run", "seed", "-o", out.string(), "--no-raster", "--no-sweep", "--resolution", "32x18"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_FALSE(fs::exists(out / "raster.exr"));
+    EXPECT_FALSE(fs::exists(out / "diff-raster.png"));
+    EXPECT_FALSE(fs::exists(out / "sweep"));
+    EXPECT_TRUE(fs::is_regular_file(out / "reference.exr"));  // written again
+    EXPECT_EQ(test::slurpFile(out / "notes.txt"), "mine");
+    EXPECT_EQ(test::slurpFile(out / "raster-cascades.png"), "not listed");
+    EXPECT_EQ(test::slurpFile(dir.path() / "outside.txt"), "mine too");
+    const auto manifest = nlohmann::json::parse(test::slurpFile(out / ".shadowlab-run.json"));
+    std::vector<std::string> files = manifest.at("files");
+    std::sort(files.begin(), files.end());
+    EXPECT_EQ(files, (std::vector<std::string>{"diff-raytrace.png", "metrics.json", "raytrace.exr", "raytrace.png",
+                                               "reference.exr", "reference.png", "report.html"}));
+}
+
+}  // namespace
+}  // namespace shadowlab

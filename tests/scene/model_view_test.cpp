@@ -1,0 +1,204 @@
+// tests/scene/model_view_test.cpp: picking a glTF file's camera (--camera, a mesh object's
+// "camera" key), the ground under a model, the sun's direction from azimuth and elevation.
+#include "scene/model_view.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "scene/error.h"
+#include "scene/loader.h"
+#include "tests/scene/camera_gltf.h"
+#include "tests/scene/test_files.h"
+
+namespace shadowlab::scene {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+void expectNear(const Vec3& a, const Vec3& b, double tol = 1e-9) {
+    EXPECT_NEAR(a.x, b.x, tol);
+    EXPECT_NEAR(a.y, b.y, tol);
+    EXPECT_NEAR(a.z, b.z, tol);
+}
+
+TEST(ModelView, AModelSceneListsItsCamerasAndUsesTheFirst) {
+    test::TempDir dir;
+    const Scene s = loadScene(dir.write("box.gltf", test::cameraBoxGltf()));
+    ASSERT_EQ(s.origin.cameras.size(), 2u);
+    EXPECT_EQ(s.origin.cameras[0].name, "Front");
+    EXPECT_EQ(s.origin.cameras[1].name, "Side");
+    EXPECT_FALSE(s.origin.chooseView);
+    expectNear(s.camera.position, {0.5, 0.25, 3});
+    EXPECT_NEAR(s.camera.fovYDegrees, 0.7 * 180 / kPi, 1e-9);
+}
+
+TEST(ModelView, ANamedCameraIsPlacedWhereItsGltfNodeIs) {
+    test::TempDir dir;
+    for (const char* spec : {"Side", "1"}) {
+        Scene s = loadScene(dir.write("box.gltf", test::cameraBoxGltf()));
+        applyCameraOption(s, spec);
+        // The node's translation, and its 90° turn about Y takes the camera's −Z to −X.
+        expectNear(s.camera.position, {4, 0.25, 0.125});
+        expectNear(glm::normalize(s.camera.lookAt - s.camera.position), {-1, 0, 0}, 1e-9);
+        EXPECT_NEAR(s.camera.fovYDegrees, 0.5 * 180 / kPi, 1e-9);
+        EXPECT_DOUBLE_EQ(s.camera.near, 0.02);
+        EXPECT_DOUBLE_EQ(s.camera.far, 40);
+        EXPECT_EQ(s.camera.width, 1280);  // the image size stays the scene's
+    }
+}
+
+TEST(ModelView, AnUnknownCameraIsBadInputThatListsTheCameras) {
+    test::TempDir dir;
+    Scene s = loadScene(dir.write("box.gltf", test::cameraBoxGltf()));
+    for (const char* spec : {"Top", "2", "-1"}) {
+        try {
+            applyCameraOption(s, spec);
+            ADD_FAILURE() << spec << " was accepted";
+        } catch (const InputError& e) {
+            const std::string what = e.what();
+            EXPECT_NE(what.find("'Front'"), std::string::npos) << what;
+            EXPECT_NE(what.find("'Side'"), std::string::npos) << what;
+        }
+    }
+    applyCameraOption(s, "auto");
+    EXPECT_TRUE(s.origin.chooseView);
+}
+
+TEST(ModelView, AModelWithoutCameraOrLightAsksForASearch) {
+    test::TempDir dir;
+    const Scene s = loadScene(dir.write("box.gltf", test::cameraBoxGltf(false)));
+    EXPECT_TRUE(s.origin.cameras.empty());
+    EXPECT_TRUE(s.origin.chooseView);
+    EXPECT_TRUE(s.origin.chooseSun);
+    EXPECT_TRUE(s.origin.modelScene);
+}
+
+std::string jsonWithModel(const std::string& objectExtra, const std::string& camera) {
+    return R"({"camera": )" + camera + R"(, "materials": {"m": {}},
+        "lights": [{"type": "directional", "direction": [0, -1, 0]}],
+        "objects": [{"type": "mesh", "file": "box.gltf", "translate": [10, 0, 0], "material": "m")" + objectExtra + "}]}";
+}
+
+TEST(ModelView, AMeshObjectsCameraKeyTakesTheViewFromItsFileMovedWithTheObject) {
+    test::TempDir dir;
+    dir.write("box.gltf", test::cameraBoxGltf());
+    const Scene s = loadScene(dir.write("a.json", jsonWithModel(R"(, "camera": "Side")", R"({"resolution": [320, 180]})")));
+    expectNear(s.camera.position, {14, 0.25, 0.125});  // the node's position, translated with the object
+    expectNear(glm::normalize(s.camera.lookAt - s.camera.position), {-1, 0, 0}, 1e-9);
+    EXPECT_EQ(s.camera.width, 320);
+    ASSERT_EQ(s.origin.cameras.size(), 2u);
+    // Without a "camera" block at all, by index.
+    const Scene t = loadScene(dir.write("b.json", R"({"materials": {"m": {}},
+        "lights": [{"type": "directional", "direction": [0, -1, 0]}],
+        "objects": [{"type": "mesh", "file": "box.gltf", "material": "m", "camera": 0}]})"));
+    expectNear(t.camera.position, {0.5, 0.25, 3});
+}
+
+TEST(ModelView, TwoObjectsNamingOneFileEachListItsCamerasAndEitherMayNameTheView) {
+    // The file is read once (the mesh cache), but each object places its cameras by its own transform.
+    test::TempDir dir;
+    dir.write("box.gltf", test::cameraBoxGltf());
+    const Scene s = loadScene(dir.write("two.json", R"({"camera": {}, "materials": {"m": {}},
+        "lights": [{"type": "directional", "direction": [0, -1, 0]}],
+        "objects": [{"type": "mesh", "file": "box.gltf", "material": "m"},
+                    {"type": "mesh", "file": "box.gltf", "translate": [0, 0, -20], "material": "m", "camera": "Front"}]})"));
+    ASSERT_EQ(s.origin.cameras.size(), 4u);
+    expectNear(s.origin.cameras[0].camera.position, {0.5, 0.25, 3});
+    expectNear(s.origin.cameras[2].camera.position, {0.5, 0.25, -17});
+    expectNear(s.camera.position, {0.5, 0.25, -17});
+}
+
+TEST(ModelView, AMeshObjectsCameraKeyRefusesAViewGivenTwiceOrACameraTheFileLacks) {
+    test::TempDir dir;
+    dir.write("box.gltf", test::cameraBoxGltf());
+    const auto expectError = [&](const std::string& text, const std::string& part) {
+        try {
+            loadScene(dir.write("bad.json", text));
+            ADD_FAILURE() << "accepted: " << text;
+        } catch (const SceneError& e) {
+            EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+        }
+    };
+    expectError(jsonWithModel(R"(, "camera": "Side")", R"({"position": [0, 1, 5], "look_at": [0, 0, 0]})"),
+                "camera.position");
+    expectError(jsonWithModel(R"(, "camera": 7)", "{}"), "objects[0].camera");
+    expectError(jsonWithModel(R"(, "camera": "Top")", "{}"), "'Side'");
+}
+
+TEST(ModelView, AModelWithoutAFloorGetsAGroundJustBelowIt) {
+    test::TempDir dir;
+    Scene s = loadScene(dir.write("box.gltf", test::cameraBoxGltf(false)));
+    EXPECT_FALSE(hasOwnGround(s));
+    applyGround(s, std::nullopt);
+    ASSERT_EQ(s.objects.size(), 2u);
+    const Quad& q = std::get<Quad>(s.objects.back().shape);
+    // The box spans [0,1] x [0,0.5] x [0,0.25]: side max(1, 0.25) + 3 x 0.5, centered under it.
+    EXPECT_DOUBLE_EQ(q.size.x, 2.5);
+    EXPECT_DOUBLE_EQ(q.size.y, 2.5);
+    EXPECT_NEAR(q.center.x, 0.5, 1e-12);
+    EXPECT_NEAR(q.center.z, 0.125, 1e-12);
+    EXPECT_LT(q.center.y, 0.0);
+    EXPECT_GT(q.center.y, -1e-3);
+    expectNear(q.normal, {0, 1, 0});
+    EXPECT_EQ(s.materials[std::size_t(s.objects.back().material)].name, "ground");
+}
+
+TEST(ModelView, NoGroundWhenAskedOrWhenTheModelHasAFloor) {
+    test::TempDir dir;
+    Scene s = loadScene(dir.write("box.gltf", test::cameraBoxGltf(false)));
+    applyGround(s, false);
+    EXPECT_EQ(s.objects.size(), 1u);
+    // A wide floor at the bottom of the bounds: a floor of its own.
+    Scene withFloor = s;
+    Quad floor;
+    floor.center = {0.5, 0, 0.125};
+    floor.size = {4, 4};
+    quadAxes(floor.normal, floor.uAxis, floor.vAxis);
+    withFloor.objects.push_back({"floor", floor, 0});
+    withFloor.origin.modelBounds = {};
+    EXPECT_TRUE(hasOwnGround(withFloor));
+    applyGround(withFloor, std::nullopt);
+    EXPECT_EQ(withFloor.objects.size(), 2u);
+}
+
+TEST(ModelView, AJsonScenesGroundKeyAddsOne) {
+    test::TempDir dir;
+    const std::string scene = R"({"camera": {"position": [0, 2, 6], "look_at": [0, 0, 0]}, "ground": true,
+        "materials": {"m": {}}, "lights": [{"type": "directional", "direction": [0, -1, 0]}],
+        "objects": [{"type": "sphere", "center": [0, 1, 0], "radius": 1, "material": "m"}]})";
+    Scene s = loadScene(dir.write("g.json", scene));
+    applyGround(s, std::nullopt);
+    ASSERT_EQ(s.objects.size(), 2u);
+    EXPECT_NEAR(std::get<Quad>(s.objects.back().shape).center.y, -1e-4 * std::sqrt(12.0), 1e-12);
+    Scene off = loadScene(dir.write("g.json", scene));
+    applyGround(off, false);  // --no-ground wins over the key
+    EXPECT_EQ(off.objects.size(), 1u);
+}
+
+TEST(ModelView, SunAzimuthRunsFromZTowardXAndElevationUpFromTheHorizon) {
+    // Azimuth 0: the sun toward +Z, its light travelling toward −Z; azimuth 90: toward +X.
+    expectNear(sunDirection(0, 0), {0, 0, -1});
+    expectNear(sunDirection(90, 0), {-1, 0, 0});
+    expectNear(sunDirection(0, 90), {0, -1, 0});
+    expectNear(sunDirection(90, 30), {-std::sqrt(3.0) / 2, -0.5, 0});
+    const glm::dvec2 a = sunAngles(sunDirection(225, 40));
+    EXPECT_NEAR(a.x, 225, 1e-9);
+    EXPECT_NEAR(a.y, 40, 1e-9);
+}
+
+TEST(ModelView, SunOptionPointsTheDirectionalLightAndRefusesBadText) {
+    test::TempDir dir;
+    Scene s = loadScene(dir.write("box.gltf", test::cameraBoxGltf(false)));
+    applySunOption(s, "90,30");
+    expectNear(s.lights[0].direction, {-std::sqrt(3.0) / 2, -0.5, 0});
+    EXPECT_FALSE(s.origin.chooseSun);
+    for (const char* bad : {"90", "90;30", "a,b", "0,95", "0,-91", "1,2,3"})
+        EXPECT_THROW(applySunOption(s, bad), InputError) << bad;
+    Scene point = s;
+    point.lights[0].type = LightType::Point;
+    EXPECT_THROW(applySunOption(point, "0,45"), InputError);
+}
+
+}  // namespace
+}  // namespace shadowlab::scene
