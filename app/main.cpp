@@ -36,10 +36,15 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
                  "raster: apply the constant and slope bias with the rasterizer's depth-bias state in the depth "
                  "pass of directional maps (converted from world units and texels; recorded in the Frame) "
                  "instead of in the lit shader");
-    cmd.add_flag("--fit-light-frustum", s.fitLightFrustum,
-                 "raster: fit each light's map to the casters of visible receivers, not the scene's bounds");
+    // A callback, so the option stays unset (the default: fitted) unless given; the count is
+    // positive for --fit-light-frustum[=on] and negative for =off or --no-fit-light-frustum.
+    cmd.add_flag_function("--fit-light-frustum,!--no-fit-light-frustum",
+                 [&s](std::int64_t count) { s.fitLightFrustum = count > 0; },
+                 "raster: fit each light's map to the casters of visible receivers (default on; "
+                 "--no-fit-light-frustum or --fit-light-frustum=off: the scene's bounding sphere)");
     cmd.add_option("--cascades", s.cascades,
-                   "raster: cascaded shadow maps per directional light, 1..4 (default 1: one map)");
+                   "raster: cascaded shadow maps per directional light, 1..4 (default: chosen per view, 1 unless "
+                   "one map's texel exceeds 2 pixels at the nearest receiver; --explain says why)");
     cmd.add_option("--cascade-blend", s.cascadeBlend,
                    "raster: blend each cascade into the next over this fraction of its slice before the split, "
                    "0..0.5 (default 0: switch abruptly)");

@@ -80,7 +80,10 @@ RenderPlan makeRenderPlan(const Scene& scene, const RenderSettings& settings) {
         if (lp.needsShadowTest && scene.lights[std::size_t(lp.light)].type == LightType::Directional)
             shadowedDirectional = true;
     const int asked = settings.raster.cascades;
-    if (asked <= 1) {
+    if (asked <= 1 && settings.raster.cascadesIsDefault && shadowedDirectional) {
+        plan.cascades = 1;
+        plan.cascadesReason = "by default chosen per view by the raster backend: see 'raster cascades'";
+    } else if (asked <= 1) {
         plan.cascades = 1;
         plan.cascadesReason = "one map per directional light (cascades = 1)";
     } else if (!shadowedDirectional) {
