@@ -564,7 +564,7 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
     while (chosen < needed && chosen < size) chosen *= 2;
     chosen = std::min(chosen, size);
     return ShadowMapSizeChoice{chosen, std::to_string(chosen) + " (" +
-                                           (chosen < size ? "from receiver and caster detail: " : "default: ") + why +
+                                           (chosen < size ? "from receiver detail and caster features: " : "default: ") + why +
                                            (chosen < size ? ", rounded up to a power of two" : ", capped at the default") +
                                            ")"};
 }
