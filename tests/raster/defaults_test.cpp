@@ -282,6 +282,38 @@ TEST(RasterDefaults, TheAutomaticMapSizeResolvesTheThinnestCaster) {
     EXPECT_EQ(chooseShadowMapSize(s, scene::resolveSettings(s, o).raster).size, 256);
 }
 
+// The same rule for a spot: a texel at distance d along the axis is d·2t/N, so a caster of width w
+// whose farthest point lies d along the axis needs N ≥ 4·2t·d/w. A spot 8 above the ground pointing
+// down, cone 60° (the unfitted map's half-angle 1.02·60° = 61.2°, t = tan 61.2° = 1.8190), over a
+// bar 0.2 wide standing on the ground (d = 8): 4·2·1.8190·8/0.2 = 582 texels → 1024. The camera, 10
+// above the ground looking down at 32 x 18, needs far fewer for the receivers.
+TEST(RasterDefaults, TheAutomaticSpotMapSizeResolvesTheThinnestCasterAtItsDistance) {
+    scene::Scene s = largeGround(90.0, Vec3(0, 10, 0.001), Vec3(0, 0, 0));
+    std::get<scene::Quad>(s.objects[0].shape).size = scene::Vec2(10, 10);
+    scene::Light spot;
+    spot.type = scene::LightType::Spot;
+    spot.position = {0, 8, 0};
+    spot.direction = {0, -1, 0};
+    spot.coneAngleDegrees = 60;
+    spot.intensity = 800;
+    s.lights = {spot};
+    s.camera.width = 32;
+    s.camera.height = 18;
+    scene::Object bar;
+    bar.name = "bar";
+    bar.shape = scene::Box{{-0.1, 0, -1}, {0.1, 1, 1}};
+    s.objects.push_back(bar);
+    scene::SettingsOverrides o;
+    o.fitLightFrustum = false;
+    const double t = std::tan(61.2 * kPi / 180.0);
+    ASSERT_NEAR(4.0 * 2.0 * t * 8.0 / 0.2, 582.1, 0.5);
+    const ShadowMapSizeChoice c = chooseShadowMapSize(s, scene::resolveSettings(s, o).raster);
+    EXPECT_EQ(c.size, 1024) << c.reason;
+    EXPECT_NE(c.reason.find("'bar'"), std::string::npos) << c.reason;
+    s.objects.pop_back();
+    EXPECT_EQ(chooseShadowMapSize(s, scene::resolveSettings(s, o).raster).size, 256);
+}
+
 // A sphere's feature is its diameter, a quad's its shorter side; a mesh's the median width (twice
 // the area over the longest edge) of its triangles: a strip of right triangles with legs 0.01 and
 // 1 (width 0.01/√(1 + 0.0001)) and one larger triangle (legs 1, 1: width 1/√2) has the strip's.
