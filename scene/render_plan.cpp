@@ -100,6 +100,9 @@ RenderPlan makeRenderPlan(const Scene& scene, const RenderSettings& settings) {
     band << blend;
     if (blend <= 0.0) {
         plan.cascadeBlendReason = "off: each split switches cascades abruptly (cascade_blend = 0)";
+    } else if (plan.cascades <= 1 && settings.raster.cascadesIsDefault && shadowedDirectional) {
+        plan.cascadeBlendReason = "cascade_blend = " + band.str() +
+                                  " applies if the raster backend splits the view (see 'raster cascades')";
     } else if (plan.cascades <= 1) {
         plan.cascadeBlendReason = "cascade_blend = " + band.str() + " ignored: no cascades";
     } else {

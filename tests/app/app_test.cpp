@@ -296,6 +296,9 @@ TEST(App, ExplainGivesEveryAutomaticRasterChoiceAndEachCanBeForced) {
         EXPECT_NE(r.err.find("raster cascades: 2 (set by --cascades or the scene)"), std::string::npos) << r.err;
         EXPECT_NE(r.err.find("raster shadow-map size: 1024 (set by"), std::string::npos) << r.err;
     }
+    r = shadowlab({"render", "seed", "--backend", "raster", "--fit-light-frustum=maybe", "-o", out});
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    EXPECT_NE(r.err.find("--fit-light-frustum: expected on or off, got 'maybe'"), std::string::npos) << r.err;
 }
 
 TEST(App, StabilityRunsTheNamedCasesAndWritesItsReport) {
