@@ -358,7 +358,7 @@ int run(const RunOptions& o) {
     compare::ReportInput report;
     report.sceneName = p.scene.file.stem().string();
     report.scenePath = p.scene.file.string();
-    report.planText = p.plan.explain();
+    report.planText = p.plan.explain() + explainAutomaticChoices(p);  // and the raster backend's choices
     for (const scene::Object& object : p.scene.objects) report.objectNames.push_back(object.name);
 
     Stage refStage("reference (double precision, robust offsets)");
