@@ -127,7 +127,8 @@ std::vector<Vec3> cascadeReceivers(const scene::Scene& scene, const std::vector<
 CascadeChoice chooseCascades(const scene::Scene& scene, const scene::RasterSettings& settings,
                              const scene::RenderPlan* plan) {
     const int asked = settings.cascades;
-    if (!settings.cascadesIsDefault)
+    // A count other than 1 set after resolveSettings() (a test, the sweep) is forced too.
+    if (!settings.cascadesIsDefault || asked != 1)
         return {asked, std::to_string(asked) + " (set by --cascades or the scene)"};
     std::vector<std::size_t> lights;
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {
@@ -141,9 +142,9 @@ CascadeChoice chooseCascades(const scene::Scene& scene, const scene::RasterSetti
     if (lights.empty()) return {asked, std::to_string(asked) + " (default: no shadowed directional light)"};
     const auto range = visibleDepthRange(scene);
     if (!range) return {asked, std::to_string(asked) + " (default: the camera sees no receiver)"};
-    // A default size is at most the default (chooseShadowMapSize only lowers it); cascades keep it.
-    const int size = settings.shadowMapSizeIsDefault ? std::max(settings.shadowMapSize, scene::kDefaultShadowMapSize)
-                                                     : settings.shadowMapSize;
+    // The size as set: a default one is kDefaultShadowMapSize, the most chooseShadowMapSize keeps
+    // (cascades keep it whole).
+    const int size = settings.shadowMapSize;
     const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
     // World size of a pixel on a receiver facing the camera at view depth z (debug_views.h).
     auto pixelAt = [&](double z) { return 2.0 * cam.tanHalfFovY * z / std::max(scene.camera.height, 1); };

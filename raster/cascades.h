@@ -96,9 +96,10 @@ struct CascadeChoice {
     int count = 1;
     std::string reason;
 };
-// The texels per pixel a count gives (its worst slice), for the map size the raster backend would
-// use (a default size counts as kDefaultShadowMapSize: the size chosen later never exceeds it).
-// With a plan, only lights it gives a shadow test count. A forced count is kept.
+// The texels per pixel a count gives (its worst slice) are measured at settings.shadowMapSize (a
+// default size is kDefaultShadowMapSize, which chooseShadowMapSize then keeps for cascades). With a
+// plan, only lights it gives a shadow test count. A forced count (or one other than 1 set in code
+// after resolveSettings) is kept.
 CascadeChoice chooseCascades(const scene::Scene& scene, const scene::RasterSettings& settings,
                              const scene::RenderPlan* plan = nullptr);
 // settings with the automatic choices the raster backend makes before drawing resolved: the
