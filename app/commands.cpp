@@ -21,6 +21,7 @@
 #include "compare/shard.h"
 #include "compare/sweep.h"
 #include "compare/sweep_report.h"
+#include "raster/cascades.h"
 #include "raster/debug_views.h"
 #include "raster/memory.h"
 #include "raster/renderer.h"
@@ -72,6 +73,24 @@ void chooseView(scene::Scene& s, const SceneOptions* o) {
     raytrace::chooseViewAndSun(s, o && o->settings.threads ? *o->settings.threads : 0);
 }
 
+// The raster backend's automatic choices, each with its reason (--explain; the Frame records the
+// same reasons): light-frustum fitting, the cascade count, the map size.
+std::string explainAutomaticChoices(const Prepared& p) {
+    const scene::RasterSettings& s = p.settings.raster;
+    raster::CascadeChoice cascades;
+    raster::ShadowMapSizeChoice size;
+    raster::resolveAutomaticChoices(p.scene, s, &p.plan, &cascades, &size);
+    std::string out = "raster light frustum: ";
+    out += s.fitLightFrustum ? "fitted to what the camera sees (visible receivers and the casters that can shade "
+                               "them), snapped so it holds still"
+                             : "the scene's bounding sphere";
+    out += s.fitLightFrustumIsDefault ? " (default; --no-fit-light-frustum for the bounding sphere)\n"
+                                      : " (set by --fit-light-frustum or the scene)\n";
+    out += "raster cascades: " + cascades.reason + "\n";
+    out += "raster shadow-map size: " + size.reason + "\n";
+    return out;
+}
+
 Prepared prepare(const SceneOptions& o) {
     Prepared p{scene::loadScene(scene::findScene(o.scene)), {}, {}};
     if (o.resolution) applyResolution(p.scene, *o.resolution);
@@ -82,9 +101,14 @@ Prepared prepare(const SceneOptions& o) {
     if (o.explain)
         std::cerr << "render plan for " << p.scene.file.string() << ":\n"
                   << p.plan.explain()
-                  << "raster shadow-map size: " << raster::chooseShadowMapSize(p.scene, p.settings.raster, &p.plan).reason << "\n"
+                  << explainAutomaticChoices(p)
                   << "raster bias: constant " << p.settings.raster.depthBias << " world units"
-                  << (p.settings.raster.depthBiasIsDefault ? " (default: half a texel of the bounding-sphere map)" : "")
+                  << (p.settings.raster.depthBiasIsDefault
+                          ? (p.settings.raster.fitLightFrustum
+                                 ? " (default: half a texel of each map as fitted or cascaded; this value for a "
+                                   "bounding-sphere map and spot and point maps)"
+                                 : " (default: half a texel of the bounding-sphere map; of each cascade's with cascades)")
+                          : "")
                   << ", slope " << p.settings.raster.slopeBias << " texels x tan(angle to light), "
                   << (p.settings.raster.hardwareBias
                           ? "through the rasterizer's depth-bias state in directional maps' depth pass (converted per "
@@ -442,7 +466,7 @@ int run(const RunOptions& o) {
     compare::ReportInput report;
     report.sceneName = p.scene.file.stem().string();
     report.scenePath = p.scene.file.string();
-    report.planText = p.plan.explain();
+    report.planText = p.plan.explain() + explainAutomaticChoices(p);  // and the raster backend's choices
     for (const scene::Object& object : p.scene.objects) report.objectNames.push_back(object.name);
 
     Stage refStage("reference (double precision, robust offsets)");

@@ -3,6 +3,7 @@
 //   1  a render or device failure, 2  bad input (scene, frame, command line).
 #include <cstdio>
 #include <iostream>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
@@ -36,10 +37,22 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
                  "raster: apply the constant and slope bias with the rasterizer's depth-bias state in the depth "
                  "pass of directional maps (converted from world units and texels; recorded in the Frame) "
                  "instead of in the lit shader");
-    cmd.add_flag("--fit-light-frustum", s.fitLightFrustum,
-                 "raster: fit each light's map to the casters of visible receivers, not the scene's bounds");
+    // Unset (the default: fitted) unless given. --fit-light-frustum[=on|off] goes through a string
+    // so a bad value is a parse error (exit 2), and --no-fit-light-frustum is its short form of off.
+    static std::string fitText;
+    cmd.add_flag("--fit-light-frustum{on}", fitText,
+                 "raster: fit each light's map to the casters of visible receivers (default on; "
+                 "--fit-light-frustum=off or --no-fit-light-frustum: the scene's bounding sphere)")
+        ->each([&s](const std::string& v) {
+            if (v == "on" || v == "true" || v == "1") s.fitLightFrustum = true;
+            else if (v == "off" || v == "false" || v == "0") s.fitLightFrustum = false;
+            else throw CLI::ValidationError("--fit-light-frustum: expected on or off, got '" + v + "'");
+        });
+    cmd.add_flag_callback("--no-fit-light-frustum", [&s] { s.fitLightFrustum = false; },
+                          "raster: the scene's bounding-sphere map (and the whole spot cone and cube), not fitted");
     cmd.add_option("--cascades", s.cascades,
-                   "raster: cascaded shadow maps per directional light, 1..4 (default 1: one map)");
+                   "raster: cascaded shadow maps per directional light, 1..4 (default: chosen per view, 1 unless "
+                   "one map's texel exceeds 2 pixels at the nearest receiver; --explain says why)");
     cmd.add_option("--cascade-blend", s.cascadeBlend,
                    "raster: blend each cascade into the next over this fraction of its slice before the split, "
                    "0..0.5 (default 0: switch abruptly)");

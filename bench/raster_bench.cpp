@@ -121,6 +121,9 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
     s.camera.height = height;
     scene::SettingsOverrides overrides;
     overrides.shadowMapSize = kShadowMapSize;
+    // One map, as the bare two-pass baseline draws (the defaults would fit it and may cascade it).
+    overrides.fitLightFrustum = false;
+    overrides.cascades = 1;
     const scene::RenderSettings settings = scene::resolveSettings(s, overrides);
     const scene::RenderPlan plan = scene::makeRenderPlan(s, settings);
 

@@ -34,6 +34,9 @@ Json contextOf(const SweepConfig& c, const std::string& skipKey) {
         if (o.filter) j["filter"] = *o.filter;
         if (o.depthBias) j["depth_bias"] = *o.depthBias;
         if (o.slopeBias) j["slope_bias"] = *o.slopeBias;
+        // The map a bias was found on: a recommended block carries it, so the bias is used on it.
+        if (o.fitLightFrustum) j["fit_light_frustum"] = *o.fitLightFrustum;
+        if (o.cascades) j["cascades"] = *o.cascades;
     } else {
         if (o.rayBias) {
             // Scene files take a number or "robust"; the overrides keep the command-line text.

@@ -52,6 +52,8 @@ scene::SettingsOverrides overridesFromBlock(const Json& block) {
         o.rayBias = r.is_string() ? r.get<std::string>() : Json(r.get<double>()).dump();
     }
     if (block.contains("precision")) o.precision = block["precision"].get<std::string>();
+    if (block.contains("fit_light_frustum")) o.fitLightFrustum = block["fit_light_frustum"].get<bool>();
+    if (block.contains("cascades")) o.cascades = block["cascades"].get<int>();
     return o;
 }
 

@@ -212,11 +212,16 @@ SweepGrid defaultGrid(const scene::Scene& scene, bool quick) {
     const double texel = 2.0 * scene::defaultDepthBias(scene, biasMapSize);
     const double extent = std::max(scene.bounds().diagonal(), 1e-30);
 
+    // Every raster row names its map explicitly (the defaults fit it to the view and choose the
+    // cascades per view): the bounding-sphere map with one cascade unless a row says otherwise, so
+    // each row, and the texel unit of the bias series below, means the same on every view.
     auto raster = [&](int size, const std::string& filter) {
         SweepConfig c;
         c.backend = "raster";
         c.overrides.shadowMapSize = size;
         c.overrides.filter = filter;
+        c.overrides.fitLightFrustum = false;
+        c.overrides.cascades = 1;
         return c;
     };
     const std::vector<int> sizes = quick ? std::vector<int>{512, 2048} : std::vector<int>{512, 1024, 2048, 4096};
@@ -242,8 +247,8 @@ SweepGrid defaultGrid(const scene::Scene& scene, bool quick) {
         c.overrides.hardwareBias = true;
         g.configs.push_back(c);
     }
-    // The map fitted to what the camera sees (--fit-light-frustum) against the bounding-sphere maps
-    // above, at each size: what an engine's fitted frustum gains on this view.
+    // The map fitted to what the camera sees (the default fitting, one cascade) against the
+    // bounding-sphere maps above, at each size: what the fitted frustum gains on this view.
     for (int size : sizes) {
         SweepConfig c = raster(size, "pcf2x2");
         c.overrides.fitLightFrustum = true;

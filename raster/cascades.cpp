@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "raster/tolerances.h"
 
@@ -121,6 +122,87 @@ std::vector<Vec3> cascadeReceivers(const scene::Scene& scene, const std::vector<
         c == 0 ? -INFINITY : (splits[c] - blend * (splits[c] - splits[c - 1])) * (1.0 - kCascadeSplitSlack);
     const double hi = c + 2 >= splits.size() ? INFINITY : splits[c + 1] * (1.0 + kCascadeSplitSlack);
     return visibleReceiverPointsInSlice(scene, lo, hi);
+}
+
+CascadeChoice chooseCascades(const scene::Scene& scene, const scene::RasterSettings& settings,
+                             const scene::RenderPlan* plan) {
+    const int asked = settings.cascades;
+    // A count other than 1 set after resolveSettings() (a test, the sweep) is forced too.
+    if (!settings.cascadesIsDefault || asked != 1)
+        return {asked, std::to_string(asked) + " (set by --cascades or the scene)"};
+    std::vector<std::size_t> lights;
+    for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+        if (scene.lights[i].type != scene::LightType::Directional) continue;
+        bool shadowed = true;
+        if (plan)
+            for (const scene::LightPlan& lp : plan->lights)
+                if (std::size_t(lp.light) == i) shadowed = lp.needsShadowTest;
+        if (shadowed) lights.push_back(i);
+    }
+    if (lights.empty()) return {asked, std::to_string(asked) + " (default: no shadowed directional light)"};
+    const auto range = visibleDepthRange(scene);
+    if (!range) return {asked, std::to_string(asked) + " (default: the camera sees no receiver)"};
+    // The size as set: a default one is kDefaultShadowMapSize, the most chooseShadowMapSize keeps
+    // (cascades keep it whole).
+    const int size = settings.shadowMapSize;
+    const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
+    // World size of a pixel on a receiver facing the camera at view depth z (debug_views.h).
+    auto pixelAt = [&](double z) { return 2.0 * cam.tanHalfFovY * z / std::max(scene.camera.height, 1); };
+    const double zMin = (*range)[0];
+    // Worst texels per pixel of `count` maps over every shadowed directional light.
+    auto worst = [&](int count) {
+        double ratio = 0.0;
+        for (const std::size_t i : lights) {
+            const scene::Vec3 dir = scene.lights[i].direction;
+            if (count == 1) {
+                const LightFrustum f = settings.fitLightFrustum ? fitDirectionalLightToReceivers(scene, dir, size)
+                                                                : fitDirectionalLight(scene.bounds(), dir, size);
+                ratio = std::max(ratio, f.texelWorldSize() / pixelAt(zMin));
+                continue;
+            }
+            const CascadeSet cs = fitCascades(scene, dir, count, size, cascadeBandCover(settings));
+            for (std::size_t c = 0; c < cs.frusta.size(); ++c)
+                ratio = std::max(ratio, cs.frusta[c].texelWorldSize() / pixelAt(std::max(cs.splits[c], zMin)));
+        }
+        return ratio;
+    };
+    double ratios[scene::kMaxCascades + 1] = {};
+    std::string table;
+    char buf[96];
+    for (int n = 1; n <= scene::kMaxCascades; ++n) {
+        ratios[n] = worst(n);
+        std::snprintf(buf, sizeof buf, "%s%d: %.3g", n == 1 ? "" : ", ", n, ratios[n]);
+        table += buf;
+    }
+    std::snprintf(buf, sizeof buf, "; map %d, visible view depths %.4g..%.4g)", size, zMin, (*range)[1]);
+    const std::string what = "worst shadow texel / pixel footprint by cascade count (" + table + buf;
+    if (ratios[1] <= kCascadeTexelsPerPixel)
+        return {1, "1 (default: one map keeps its texel within 2 pixels; " + what + ")"};
+    for (int n = 2; n <= scene::kMaxCascades; ++n)
+        if (ratios[n] <= kCascadeTexelsPerPixel)
+            return {n, std::to_string(n) + " (default: the fewest cascades that keep every slice's texel within 2 "
+                                           "pixels; " + what + ")"};
+    int best = 1;
+    for (int n = 2; n <= scene::kMaxCascades; ++n)
+        if (ratios[n] * kCascadeGainTolerance < ratios[best]) best = n;
+    return {best, std::to_string(best) + " (default: no count keeps the texel within 2 pixels; the finest worst "
+                                         "slice" + (best == 1 ? ", cascades gain nothing" : "") + "; " + what + ")"};
+}
+
+scene::RasterSettings resolveAutomaticChoices(const scene::Scene& scene, const scene::RasterSettings& settingsIn,
+                                              const scene::RenderPlan* plan, CascadeChoice* cascades,
+                                              ShadowMapSizeChoice* mapSize) {
+    scene::RasterSettings settings = settingsIn;
+    const CascadeChoice cc = chooseCascades(scene, settings, plan);
+    settings.cascades = cc.count;
+    const ShadowMapSizeChoice mc = chooseShadowMapSize(scene, settings, plan);
+    if (mc.size != settings.shadowMapSize) {
+        settings.shadowMapSize = mc.size;
+        if (settings.depthBiasIsDefault) settings.depthBias = scene::defaultDepthBias(scene, mc.size);
+    }
+    if (cascades) *cascades = cc;
+    if (mapSize) *mapSize = mc;
+    return settings;
 }
 
 }  // namespace shadowlab::raster

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "raster/light_frustum.h"
@@ -80,5 +81,32 @@ CascadeSet fitCascades(const scene::Scene& scene, const scene::Vec3& direction, 
 inline double cascadeBandCover(const scene::RasterSettings& settings) {
     return settings.cascadeBlend > 0.0 ? scene::kMaxCascadeBlend : 0.0;
 }
+
+// Automatic cascade count (settings.cascadesIsDefault): one map is kept while its texel is at most
+// kCascadeTexelsPerPixel screen pixels wide at the nearest visible receiver (where a pixel's
+// footprint is smallest); past that, the fewest cascades (2..kMaxCascades) whose every slice keeps
+// its texel within that many pixels at the slice's near end, or, when no count does, the count
+// whose worst slice is finest (fewer on a tie within kCascadeGainTolerance). Each cascade is one
+// more depth pass over the scene, so a count is taken only when it is that much finer.
+// Two pixels a texel: bilinear PCF's edge then moves by at most about a pixel, and a small
+// caster still spans several texels wherever it spans a few pixels.
+inline constexpr double kCascadeTexelsPerPixel = 2.0;
+inline constexpr double kCascadeGainTolerance = 1.1;
+struct CascadeChoice {
+    int count = 1;
+    std::string reason;
+};
+// The texels per pixel a count gives (its worst slice) are measured at settings.shadowMapSize (a
+// default size is kDefaultShadowMapSize, which chooseShadowMapSize then keeps for cascades). With a
+// plan, only lights it gives a shadow test count. A forced count (or one other than 1 set in code
+// after resolveSettings) is kept.
+CascadeChoice chooseCascades(const scene::Scene& scene, const scene::RasterSettings& settings,
+                             const scene::RenderPlan* plan = nullptr);
+// settings with the automatic choices the raster backend makes before drawing resolved: the
+// cascade count (chooseCascades), then the map size (chooseShadowMapSize), and a default constant
+// bias re-derived for that size. `reasons` (cascades, map size) when given.
+scene::RasterSettings resolveAutomaticChoices(const scene::Scene& scene, const scene::RasterSettings& settings,
+                                              const scene::RenderPlan* plan, CascadeChoice* cascades = nullptr,
+                                              ShadowMapSizeChoice* mapSize = nullptr);
 
 }  // namespace shadowlab::raster

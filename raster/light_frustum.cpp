@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <limits>
 #include <span>
+#include <variant>
 #include <vector>
 
 #include "raster/cascades.h"
@@ -361,6 +362,43 @@ std::string LightFrustum::describe() const {
     return buf;
 }
 
+double casterFeatureSize(const scene::Object& object) {
+    struct Feature {
+        double operator()(const scene::Sphere& s) const { return 2.0 * s.radius; }
+        double operator()(const scene::Quad& q) const { return std::min(q.size.x, q.size.y); }
+        double operator()(const scene::Box& b) const {
+            const Vec3 e = b.max - b.min;
+            return std::min({e.x, e.y, e.z});
+        }
+        double operator()(const scene::Mesh& m) const {
+            // At most ~64k triangles are looked at (evenly strided): the median of a sample that
+            // size is within a fraction of a percentile of the whole mesh's, and it stays cheap.
+            std::size_t total = 0;
+            for (const scene::MeshInstance& inst : m.instances) total += inst.geometry->triangleCount();
+            const std::size_t stride = std::max<std::size_t>(1, total / 65536);
+            std::vector<double> widths;
+            std::size_t k = 0;
+            for (const scene::MeshInstance& inst : m.instances) {
+                const scene::TriangleMesh& g = *inst.geometry;
+                for (std::size_t t = 0; t < g.triangleCount(); ++t, ++k) {
+                    if (k % stride) continue;
+                    const Vec3 a = scene::transformPoint(inst.transform, g.positions[g.indices[3 * t]]);
+                    const Vec3 b = scene::transformPoint(inst.transform, g.positions[g.indices[3 * t + 1]]);
+                    const Vec3 c = scene::transformPoint(inst.transform, g.positions[g.indices[3 * t + 2]]);
+                    const double area2 = glm::length(glm::cross(b - a, c - a));
+                    const double longest = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
+                    if (longest > 0.0) widths.push_back(area2 / longest);
+                }
+            }
+            if (widths.empty()) return INFINITY;
+            auto mid = widths.begin() + std::ptrdiff_t(widths.size() / 2);
+            std::nth_element(widths.begin(), mid, widths.end());
+            return *mid;
+        }
+    };
+    return std::visit(Feature{}, object.shape);
+}
+
 ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::RasterSettings& settings,
                                         const scene::RenderPlan* plan) {
     const int size = settings.shadowMapSize;
@@ -400,6 +438,14 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
             for (const Vec3& p : v) ratio = std::max(ratio, distance(p) / viewDepth(p));
         return ratio;
     };
+    // Each object's smallest feature as a caster, and the most texels any caster asks for.
+    std::vector<double> features;
+    for (const scene::Object& o : scene.objects) features.push_back(std::max(casterFeatureSize(o), 1e-300));
+    double casterNeeded = 0.0;
+    std::size_t casterObject = scene.objects.size();
+    auto noteCaster = [&](std::size_t o, double texels) {
+        if (texels > casterNeeded) casterNeeded = texels, casterObject = o;
+    };
     double needed = 0.0;  // texels, rounded up to a power of two below
     int neededSize = 0;     // a size some light needs as it is (fitted spot windows)
     std::string why;
@@ -426,6 +472,18 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
         std::snprintf(buf, sizeof buf, "map width %.4g / smallest pixel footprint %.4g at view depth %.4g = %.0f texels",
                       widest, pixel, zMin, needed);
         why = buf;
+        // The casters' detail: k texels across the smallest feature of any object that can shade a
+        // visible receiver, in the widest map.
+        for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+            const scene::Light& l = scene.lights[i];
+            if (l.type != scene::LightType::Directional || !mapped(i)) continue;
+            const LightFrustum f = settings.fitLightFrustum
+                                       ? fitDirectionalLightToReceivers(scene, l.direction, kMinAutoShadowMapSize)
+                                       : fitDirectionalLight(scene.bounds(), l.direction, size);
+            const std::vector<bool> casts = castsIntoView(scene, f, kCullMarginTexels);
+            for (std::size_t o = 0; o < scene.objects.size(); ++o)
+                if (casts[o]) noteCaster(o, kTexelsPerCasterFeature * 2.0 * f.halfWidth / features[o]);
+        }
     }
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {
         const scene::Light& l = scene.lights[i];
@@ -453,6 +511,17 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
         why += buf;
         needed = std::max(needed, std::min(spotNeeded, double(n)));
         neededSize = std::max(neededSize, n);
+        // Casters: a texel at distance d is d·window/N, so N ≥ k·window·d/feature at the object's
+        // farthest distance along the axis (its box's farthest corner, where its texels are widest).
+        const LightFrustum f = spotLightFrustum(scene, settings, l, size);
+        const std::vector<bool> casts = castsIntoView(scene, f, kCullMarginTexels);
+        for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+            if (!casts[o]) continue;
+            double far = 0.0;
+            for (const Vec3& c : corners(scene::boundsOf(scene.objects[o].shape)))
+                far = std::max(far, glm::dot(c - l.position, axis));
+            noteCaster(o, kTexelsPerCasterFeature * window * std::max(far, f.near) / features[o]);
+        }
     }
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {
         const scene::Light& l = scene.lights[i];
@@ -472,13 +541,30 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
                       why.empty() ? "" : "; ", i, ratio, pixelAt(1.0), kPointFaceMarginTexels, pointNeeded);
         why += buf;
         needed = std::max(needed, pointNeeded);
+        // Casters: a face's texel is 2/(N − 24) per unit of axial distance, widest at the object's
+        // farthest ‖corner − light‖∞ (a convex function on its box is largest at a corner).
+        for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+            double far = 0.0;
+            for (const Vec3& c : corners(scene::boundsOf(scene.objects[o].shape))) {
+                const Vec3 d = glm::abs(c - l.position);
+                far = std::max({far, d.x, d.y, d.z});
+            }
+            noteCaster(o, 2.0 * kTexelsPerCasterFeature * far / features[o] + 2.0 * kPointFaceMarginTexels);
+        }
     }
     if (why.empty()) return keep("default: no light with a map");
+    if (casterObject < scene.objects.size()) {
+        std::snprintf(buf, sizeof buf, "; casters: %.0f texels across the smallest feature, %.4g of '%s' (%.0f texels)",
+                      kTexelsPerCasterFeature, features[casterObject], scene.objects[casterObject].name.c_str(),
+                      casterNeeded);
+        why += buf;
+        needed = std::max(needed, casterNeeded);
+    }
     int chosen = std::max(kMinAutoShadowMapSize, neededSize);
     while (chosen < needed && chosen < size) chosen *= 2;
     chosen = std::min(chosen, size);
     return ShadowMapSizeChoice{chosen, std::to_string(chosen) + " (" +
-                                           (chosen < size ? "from receiver detail: " : "default: ") + why +
+                                           (chosen < size ? "from receiver detail and caster features: " : "default: ") + why +
                                            (chosen < size ? ", rounded up to a power of two" : ", capped at the default") +
                                            ")"};
 }
@@ -757,8 +843,7 @@ int LightCulling::total() const {
 
 std::vector<LightCulling> culledCasters(const scene::Scene& scene, const scene::RasterSettings& settingsIn,
                                         const scene::RenderPlan* plan) {
-    scene::RasterSettings settings = settingsIn;
-    settings.shadowMapSize = chooseShadowMapSize(scene, settingsIn, plan).size;
+    const scene::RasterSettings settings = resolveAutomaticChoices(scene, settingsIn, plan);
     std::vector<LightCulling> out(scene.lights.size());
     if (!settings.cullCasters || (plan && plan->needsTransmittanceMap)) return out;
     const scene::Bounds bounds = scene.bounds();

@@ -223,8 +223,22 @@ std::vector<bool> layerCasters(const scene::Scene& scene, const scene::RasterSet
 //   again largest at a vertex.
 // Kept as set when forced, with cascades (sized per slice already) or when the camera sees
 // nothing. `reason` says which, for --explain and the Frame.
+// The casters count too: a caster narrower than a few texels is lost in the map (bilinear PCF
+// blurs its shadow's edges over a texel each, and the slope bias eats a thin one), so each light
+// also needs kTexelsPerCasterFeature texels across the smallest feature of every object that can
+// shade a visible receiver (casterFeatureSize): N ≥ k·(map width)/feature for a directional map,
+// k·2t·d/feature for a spot (d the object's farthest distance along the axis), 2k·d∞/feature + 24
+// for a point light's faces.
 // The smallest size chosen that way: below it the bias defaults (half a texel) grow coarse.
 inline constexpr int kMinAutoShadowMapSize = 256;
+// Texels a caster's smallest feature spans in the map: four leaves at least two texels of its
+// shadow's interior past the one-texel PCF ramps at its edges (docs/raster.md).
+inline constexpr double kTexelsPerCasterFeature = 4.0;
+// The world size of an object's smallest feature, as a caster: a sphere's diameter, a box's
+// shortest side, a quad's shorter side, and for a mesh the median over its placed triangles of
+// their width (twice the area over the longest edge): a mesh holds no detail finer than its
+// triangles, and the median ignores the few slivers every mesh has.
+double casterFeatureSize(const scene::Object& object);
 struct ShadowMapSizeChoice {
     int size = 0;
     std::string reason;

@@ -229,14 +229,13 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     draw = DrawGeometry{vertexBuffer.buffer.get(), indexBuffer.buffer.get(), std::uint32_t(geometry.indices.size()),
                         opaqueIndexCount, transparentDraws};
 
-    // Map size from the receivers' detail when nobody chose one; a default constant bias (half a
-    // texel of the bounding-sphere map) follows the size.
-    const ShadowMapSizeChoice mapChoice = chooseShadowMapSize(scene, settings, &plan);
-    if (mapChoice.size != settings.shadowMapSize) {
-        settings.shadowMapSize = mapChoice.size;
-        if (settings.depthBiasIsDefault) settings.depthBias = scene::defaultDepthBias(scene, mapChoice.size);
-    }
+    // The automatic choices: a default cascade count follows the view, then a default size follows
+    // the receivers' and casters' detail, and a default constant bias follows the size.
+    CascadeChoice cascadeChoice;
+    ShadowMapSizeChoice mapChoice;
+    settings = resolveAutomaticChoices(scene, settings, &plan, &cascadeChoice, &mapChoice);
     attributes["shadow_map_size_reason"] = mapChoice.reason;
+    attributes["cascades_reason"] = cascadeChoice.reason;
 
     // Caster culling: per culled layer, which objects are drawn into it, and how many are not.
     // Not with a transmittance map: its index order (opaque casters first) is not per object.
@@ -465,6 +464,8 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
         attributes["pcf_size"] = std::to_string(settings.pcfSize);
     attributes["normal_offset"] = formatNumber(settings.normalOffset);
     attributes["light_frustum_fit"] = settings.fitLightFrustum ? "receivers" : "bounding-sphere";
+    attributes["light_frustum_fit_reason"] =
+        settings.fitLightFrustumIsDefault ? "default" : "set by --fit-light-frustum, the scene or code";
     // The constant bias actually used: one value, or one per light (';') when a default was
     // re-derived per fitted map and the maps differ.
     const bool oneBias = std::all_of(usedDepthBias.begin(), usedDepthBias.end(),

@@ -80,7 +80,10 @@ RenderPlan makeRenderPlan(const Scene& scene, const RenderSettings& settings) {
         if (lp.needsShadowTest && scene.lights[std::size_t(lp.light)].type == LightType::Directional)
             shadowedDirectional = true;
     const int asked = settings.raster.cascades;
-    if (asked <= 1) {
+    if (asked <= 1 && settings.raster.cascadesIsDefault && shadowedDirectional) {
+        plan.cascades = 1;
+        plan.cascadesReason = "by default chosen per view by the raster backend: see 'raster cascades'";
+    } else if (asked <= 1) {
         plan.cascades = 1;
         plan.cascadesReason = "one map per directional light (cascades = 1)";
     } else if (!shadowedDirectional) {
@@ -97,6 +100,9 @@ RenderPlan makeRenderPlan(const Scene& scene, const RenderSettings& settings) {
     band << blend;
     if (blend <= 0.0) {
         plan.cascadeBlendReason = "off: each split switches cascades abruptly (cascade_blend = 0)";
+    } else if (plan.cascades <= 1 && settings.raster.cascadesIsDefault && shadowedDirectional) {
+        plan.cascadeBlendReason = "cascade_blend = " + band.str() +
+                                  " applies if the raster backend splits the view (see 'raster cascades')";
     } else if (plan.cascades <= 1) {
         plan.cascadeBlendReason = "cascade_blend = " + band.str() + " ignored: no cascades";
     } else {

@@ -80,8 +80,12 @@ RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& o) {
         throw InputError("--normal-offset: must be a finite value >= 0 (texels)");
     s.raster.receiverPlaneBias = o.receiverPlaneBias.value_or(d.receiverPlaneBias.value_or(false));
     s.raster.hardwareBias = o.hardwareBias.value_or(d.hardwareBias.value_or(false));
-    s.raster.fitLightFrustum = o.fitLightFrustum.value_or(d.fitLightFrustum.value_or(false));
+    // Fitted by default: a map around the scene's bounding sphere loses every shadow of small
+    // casters on a large ground (docs/decisions.md, "Defaults that keep the shadow").
+    s.raster.fitLightFrustum = o.fitLightFrustum.value_or(d.fitLightFrustum.value_or(true));
+    s.raster.fitLightFrustumIsDefault = !o.fitLightFrustum && !d.fitLightFrustum;
     s.raster.cascades = o.cascades.value_or(d.cascades.value_or(1));
+    s.raster.cascadesIsDefault = !o.cascades && !d.cascades;
     if (s.raster.cascades < 1 || s.raster.cascades > kMaxCascades)
         throw InputError("--cascades: must be in 1.." + std::to_string(kMaxCascades) + ", got " +
                          std::to_string(s.raster.cascades));

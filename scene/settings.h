@@ -50,10 +50,19 @@ struct RasterSettings {
     // depth pass of directional maps, converted from the world and texel units above, instead of
     // in the lit shader (spot and point maps keep the shader's; see docs/raster.md).
     bool hardwareBias = false;
-    bool fitLightFrustum = false;  // fit each light's map to the casters of visible receivers (else the scene's bounding sphere)
+    // Fit each light's map to the casters of visible receivers (else the scene's bounding sphere).
+    // resolveSettings() turns it on unless the command line or the scene says otherwise; a
+    // RasterSettings made in code starts from the unfitted map.
+    bool fitLightFrustum = false;
+    // True when fitLightFrustum is resolveSettings()'s default (no option, no scene value): only
+    // --explain and the Frame's reasons read it.
+    bool fitLightFrustumIsDefault = false;
     // Directional lights: split the view's depth range into this many slices, each with its own
     // map (1 = one map for the whole view, as fitLightFrustum or the bounding sphere decide).
     int cascades = 1;
+    // True when cascades is the default (no option, no scene value): the raster backend may then
+    // raise it to what keeps the shadow texel near the pixel size (raster::chooseCascades).
+    bool cascadesIsDefault = false;
     // Blend band before each cascade split: the last cascadeBlend of each slice (0..0.5, 0 = off:
     // the cascade switches abruptly at the split) mixes its cascade's visibility with the next's.
     double cascadeBlend = 0.0;
@@ -88,7 +97,7 @@ struct SettingsOverrides {
     std::optional<double> normalOffset;  // --normal-offset (texels)
     std::optional<bool> receiverPlaneBias;  // --receiver-plane-bias
     std::optional<bool> hardwareBias;       // --hardware-bias
-    std::optional<bool> fitLightFrustum; // --fit-light-frustum
+    std::optional<bool> fitLightFrustum; // --fit-light-frustum on|off (--no-fit-light-frustum)
     std::optional<int> cascades;         // --cascades (1..kMaxCascades)
     std::optional<double> cascadeBlend;  // --cascade-blend (0..kMaxCascadeBlend)
     std::optional<std::string> rayBias;  // a number or "robust"

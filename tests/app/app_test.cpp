@@ -273,8 +273,32 @@ TEST(App, ExplainSaysWhereTheBiasIsApplied) {
     r = shadowlab({"render", "seed", "--backend", "raster", "--explain", "--resolution", "96x54", "--hardware-bias",
                    "-o", out});
     ASSERT_EQ(r.exitCode, 0) << r.err;
-    EXPECT_NE(r.err.find("(default: half a texel of the bounding-sphere map)"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("(default: half a texel of each map as fitted or cascaded"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("through the rasterizer's depth-bias state"), std::string::npos) << r.err;
+}
+
+TEST(App, ExplainGivesEveryAutomaticRasterChoiceAndEachCanBeForced) {
+    TempDir dir;
+    const std::string out = (dir.path() / "seed.png").string();
+    Result r = shadowlab({"render", "seed", "--backend", "raster", "--explain", "--resolution", "96x54", "-o", out});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("raster light frustum: fitted to what the camera sees"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("(default; --no-fit-light-frustum for the bounding sphere)"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("raster cascades: 1 (default: one map keeps its texel within 2 pixels"), std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("raster shadow-map size: "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("casters: 4 texels across the smallest feature"), std::string::npos) << r.err;
+    for (const char* off : {"--no-fit-light-frustum", "--fit-light-frustum=off"}) {
+        r = shadowlab({"render", "seed", "--backend", "raster", "--explain", "--resolution", "96x54", off,
+                       "--cascades", "2", "--shadow-map-size", "1024", "-o", out});
+        ASSERT_EQ(r.exitCode, 0) << r.err;
+        EXPECT_NE(r.err.find("raster light frustum: the scene's bounding sphere (set by"), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("raster cascades: 2 (set by --cascades or the scene)"), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("raster shadow-map size: 1024 (set by"), std::string::npos) << r.err;
+    }
+    r = shadowlab({"render", "seed", "--backend", "raster", "--fit-light-frustum=maybe", "-o", out});
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    EXPECT_NE(r.err.find("--fit-light-frustum: expected on or off, got 'maybe'"), std::string::npos) << r.err;
 }
 
 TEST(App, StabilityRunsTheNamedCasesAndWritesItsReport) {

@@ -19,6 +19,9 @@ scene::Frame rasterWith(const scene::Scene& s, int cascades) {
     settings.raster.shadowMapSize = 512;
     settings.raster.depthBias = scene::defaultDepthBias(s, 512);
     settings.raster.cascades = cascades;
+    settings.raster.cascadesIsDefault = false;  // as given, not chosen per view
+    // One map over the whole scene: the bounding-sphere map, named (the default fits it to the view).
+    settings.raster.fitLightFrustum = false;
     settings.raster.validate = true;
     scene::Frame f = raster::render(s, scene::makeRenderPlan(s, settings), settings.raster);
     EXPECT_EQ(f.attributes["validation_messages"], "0") << "validation messages were printed above";

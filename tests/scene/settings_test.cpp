@@ -59,6 +59,35 @@ TEST(Settings, CascadesComeFromTheCommandLineThenTheSceneThenOne) {
     EXPECT_EQ(resolveSettings(s, o).raster.cascades, 2);
 }
 
+TEST(Settings, LightFrustumFittingIsOnUnlessTheCommandLineOrTheSceneTurnItOff) {
+    Scene s = unitScene(1.0);
+    RenderSettings r = resolveSettings(s, {});
+    EXPECT_TRUE(r.raster.fitLightFrustum);
+    EXPECT_TRUE(r.raster.fitLightFrustumIsDefault);
+    s.shadow.fitLightFrustum = false;
+    r = resolveSettings(s, {});
+    EXPECT_FALSE(r.raster.fitLightFrustum);
+    EXPECT_FALSE(r.raster.fitLightFrustumIsDefault);
+    SettingsOverrides o;
+    o.fitLightFrustum = true;
+    EXPECT_TRUE(resolveSettings(s, o).raster.fitLightFrustum);
+    s.shadow.fitLightFrustum.reset();
+    o.fitLightFrustum = false;
+    r = resolveSettings(s, o);
+    EXPECT_FALSE(r.raster.fitLightFrustum);
+    EXPECT_FALSE(r.raster.fitLightFrustumIsDefault);
+}
+
+TEST(Settings, ACascadeCountIsTheRasterBackendsToChooseOnlyWhenNobodySetIt) {
+    Scene s = unitScene(1.0);
+    EXPECT_TRUE(resolveSettings(s, {}).raster.cascadesIsDefault);
+    SettingsOverrides o;
+    o.cascades = 1;  // forcing one map is a choice too
+    EXPECT_FALSE(resolveSettings(s, o).raster.cascadesIsDefault);
+    s.shadow.cascades = 1;
+    EXPECT_FALSE(resolveSettings(s, {}).raster.cascadesIsDefault);
+}
+
 TEST(Settings, CascadeBlendComesFromTheCommandLineThenTheSceneThenOff) {
     Scene s = unitScene(1.0);
     EXPECT_EQ(resolveSettings(s, {}).raster.cascadeBlend, 0.0);
