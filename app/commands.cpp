@@ -16,6 +16,7 @@
 #include "compare/stability.h"
 #include "compare/sweep.h"
 #include "compare/sweep_report.h"
+#include "compare/text.h"
 #include "raster/debug_views.h"
 #include "raster/memory.h"
 #include "raster/renderer.h"
@@ -101,6 +102,19 @@ Prepared prepare(const SceneOptions& o) {
         }
     }
     return p;
+}
+
+// A light with a radius casts soft shadows; in the raster backend only pcss estimates them, every
+// other filter gives a hard (or PCF-blurred) edge whose penumbra error the classes barely see.
+std::vector<std::string> hardFilterWarnings(const scene::Scene& s, const scene::RasterSettings& r) {
+    std::vector<std::string> out;
+    if (r.filter == scene::ShadowFilter::Pcss) return out;
+    for (std::size_t i = 0; i < s.lights.size(); ++i)
+        if (s.lights[i].radius > 0.0 && s.lights[i].type != scene::LightType::Directional)
+            out.push_back("light " + std::to_string(i) + " has a radius (" + compare::formatShort(s.lights[i].radius) +
+                          ") and casts soft shadows, but the raster backend renders it with the hard filter '" +
+                          scene::toString(r.filter) + "': its penumbra is wrong (see the continuous error); use --filter pcss.");
+    return out;
 }
 
 // Progress on stderr: long work says what it is doing and how long it took.
@@ -265,6 +279,9 @@ int render(const RenderOptions& o) {
         }
         return 0;
     }
+    if (o.backend == "raster")
+        for (const std::string& w : hardFilterWarnings(p.scene, p.settings.raster))
+            std::cerr << "shadowlab: warning: " << w << "\n";
     Stage stage("rendering " + p.scene.file.filename().string() + " with " + o.backend);
     // A PNG holds the beauty only, in 8-bit sRGB: the raster backend then renders nothing else,
     // into an 8-bit sRGB target.
@@ -284,6 +301,8 @@ int render(const RenderOptions& o) {
 int compareFiles(const CompareOptions& o) {
     if (o.output.extension() != ".png")
         throw scene::InputError(o.output.string() + ": the difference image must be a .png");
+    if (o.heat && o.heat->extension() != ".png")
+        throw scene::InputError(o.heat->string() + ": the heat map must be a .png");
     const scene::Frame method = scene::readFrame(o.method);
     const scene::Frame reference = scene::readFrame(o.reference);
     compare::Comparison c;
@@ -293,6 +312,7 @@ int compareFiles(const CompareOptions& o) {
         throw scene::InputError(o.method.string() + " vs " + o.reference.string() + ": " + e.what());
     }
     scene::writePngDisplay(o.output, c.width, c.height, c.diffRgb);
+    if (o.heat) scene::writePngDisplay(*o.heat, c.width, c.height, c.heatRgb);
     if (o.json)
         std::cout << compare::toJson(c.metrics).dump(2) << "\n";
     else
@@ -337,6 +357,11 @@ int run(const RunOptions& o) {
     report.planText = p.plan.explain();
     for (const scene::Object& object : p.scene.objects) report.objectNames.push_back(object.name);
 
+    if (!o.skipRaster) {
+        report.warnings = hardFilterWarnings(p.scene, p.settings.raster);
+        for (const std::string& w : report.warnings) std::cerr << "shadowlab: warning: " << w << "\n";
+        if (!report.warnings.empty()) metrics["warnings"] = report.warnings;
+    }
     Stage refStage("reference (double precision, robust offsets)");
     const scene::Frame reference = renderBackend(p, "reference");
     scene::writeFrame(reference, dir / "reference.exr");
@@ -369,7 +394,14 @@ int run(const RunOptions& o) {
         metrics["methods"][backend] = {{"metrics", compare::toJson(c.metrics)},
                                        {"timings_ms", timingsJson(frame)},
                                        {"attributes", frame.attributes}};
-        report.methods.push_back({backend, backend + ".png", "diff-" + backend + ".png", frame, c.metrics});
+        compare::ReportMethod method{backend, backend + ".png", "diff-" + backend + ".png", frame, c.metrics};
+        method.heatPng = "heat-" + backend + ".png";
+        scene::writePngDisplay(dir / method.heatPng, c.width, c.height, c.heatRgb);
+        for (std::size_t l = 0; l < c.lightHeatRgb.size(); ++l) {
+            method.lightHeatPngs.push_back("heat-" + backend + "-light" + std::to_string(l) + ".png");
+            scene::writePngDisplay(dir / method.lightHeatPngs.back(), c.width, c.height, c.lightHeatRgb[l]);
+        }
+        report.methods.push_back(std::move(method));
         if (backend == "raster" && views) {
             for (const RunView& v : kRunViews) {
                 if (std::string_view(v.view) == "cascades" && debug.cascadeSplits.empty()) continue;
