@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <functional>
+#include <optional>
 #include <cstdio>
 #include <iostream>
 #include <unistd.h>
@@ -370,6 +371,8 @@ int run(const RunOptions& o) {
     metrics["reference"] = {{"timings_ms", timingsJson(reference)}, {"attributes", reference.attributes}};
     report.reference = {"reference", "reference.png", reference};
 
+    // The user's configuration at the requested resolution, kept for the recommendation's check.
+    std::optional<scene::Frame> defaultsFrame[2];  // raytrace, raster
     for (const std::string backend : {"raytrace", "raster"}) {
         if (backend == "raster" && o.skipRaster) continue;
         Stage stage(backend == "raster" ? "raster (Vulkan shadow map)" : "raytrace (shadow rays)");
@@ -386,6 +389,7 @@ int run(const RunOptions& o) {
             status = 1;
             continue;
         }
+        defaultsFrame[backend == "raster"] = frame;
         scene::writeFrame(frame, dir / (backend + ".exr"));
         scene::writePngLinear(dir / (backend + ".png"), frame.width, frame.height, frame.beauty);
         const compare::Comparison c = compare::compareFrames(frame, reference);
@@ -433,14 +437,30 @@ int run(const RunOptions& o) {
         options.progress = sweepProgressPrinter();
         Stage stage("quick sweep of " + std::to_string(grid.configs.size()) + " configurations at " + *grid.resolution);
         const compare::SweepResult result = compare::runSweep(p.scene, grid, options);
-        const compare::SweepReportInput input =
-            compare::makeSweepReportInput(report.sceneName, report.scenePath, result);
+        compare::SweepReportInput input = compare::makeSweepReportInput(report.sceneName, report.scenePath, result);
+        {
+            Stage rec("recommended shadow block: biases searched in this configuration, checked at " +
+                      std::to_string(p.scene.camera.width) + "x" + std::to_string(p.scene.camera.height));
+            scene::Scene half = p.scene;
+            half.camera.width = result.reference.width;
+            half.camera.height = result.reference.height;
+            compare::RecommendOptions ro;
+            ro.user = o.common.settings;
+            ro.raster = !o.skipRaster;
+            input.recommendation = compare::recommendShadow(
+                half, result.reference, p.scene, reference, defaultsFrame[1] ? &*defaultsFrame[1] : nullptr,
+                defaultsFrame[0] ? &*defaultsFrame[0] : nullptr,
+                compare::rayCandidateOf(compare::recommendBias(result.rows)), ro);
+            rec.done(std::to_string(input.recommendation->points.size()) + " raster points");
+            for (const std::string& note : input.recommendation->notes) std::cerr << "shadowlab: " << note << "\n";
+        }
         compare::writeSweepReport(options.outputDir, input);
         scene::replaceDirectory(options.outputDir, dir / "sweep");
         report.sweep = compare::summarizeSweep(input, "sweep/report.html");
         stage.done("sweep/report.html");
         metrics["sweep"] = {{"configurations", result.rows.size()}, {"report", "sweep/report.html"},
-                            {"results", "sweep/results.csv"}};
+                            {"results", "sweep/results.csv"},
+                            {"recommended", input.recommendation->toJson()}};
     }
 
     metrics["memory"] = memoryJson(estimate);
@@ -480,8 +500,27 @@ int sweep(const SweepOptions& o) {
     std::cerr << "shadowlab: sweep of " << grid.configs.size() << " configurations, " << grid.repetitions
               << " timed frames each, into " << o.outputDir.string() << "\n";
     const compare::SweepResult result = compare::runSweep(p.scene, grid, options);
-    compare::writeSweepReport(o.outputDir, compare::makeSweepReportInput(p.scene.file.stem().string(),
-                                                                         p.scene.file.string(), result));
+    compare::SweepReportInput input =
+        compare::makeSweepReportInput(p.scene.file.stem().string(), p.scene.file.string(), result);
+    {
+        // The recommendation is searched and checked at the sweep's resolution, in the settings
+        // given on the command line (the grid's own rows vary them; the user runs these).
+        scene::Scene at = p.scene;
+        at.camera.width = result.reference.width;
+        at.camera.height = result.reference.height;
+        compare::RecommendOptions ro;
+        ro.user = o.common.settings;
+        ro.raster = std::any_of(grid.configs.begin(), grid.configs.end(),
+                                [](const compare::SweepConfig& c) { return c.backend == "raster"; });
+        ro.raytrace = std::any_of(grid.configs.begin(), grid.configs.end(),
+                                  [](const compare::SweepConfig& c) { return c.backend == "raytrace"; });
+        Stage rec("recommended shadow block: biases searched in this configuration");
+        input.recommendation = compare::recommendShadow(at, result.reference, at, result.reference, nullptr, nullptr,
+                                                        compare::rayCandidateOf(compare::recommendBias(result.rows)), ro);
+        rec.done();
+        for (const std::string& note : input.recommendation->notes) std::cerr << "shadowlab: " << note << "\n";
+    }
+    compare::writeSweepReport(o.outputDir, input);
     std::size_t failed = 0;
     for (const auto& r : result.rows) failed += r.error.empty() ? 0 : 1;
     std::cerr << "shadowlab: wrote " << (o.outputDir / "report.html").string() << ", results.csv and results.json ("
