@@ -557,7 +557,15 @@ int stability(const StabilityCommandOptions& o) {
         const std::string name = files[i].stem().string();
         Stage stage("stability case " + std::to_string(i + 1) + "/" + std::to_string(scenes.size()) + " " + name);
         cases.push_back(compare::runStabilityCase(scenes[i], options, name, compare::readDescription(files[i])));
-        stage.done(compare::suitePassed({cases.back()}) ? "ok" : "FAILED");
+        // The reference's verdict and each backend's state, not one PASS that hides acne.
+        const compare::StabilityCase& c = cases.back();
+        std::string note = std::string(c.failed() ? "FAILED to run cleanly; " : "") + "reference " + c.referenceVerdict();
+        for (const char* backend : {"raster", "raytrace"})
+            for (const char* variant : {"defaults", "best"})
+                if (const compare::BackendRun* r = c.run(backend, variant))
+                    note += std::string("; ") + backend + " at " + variant + ": " +
+                            compare::stateOf(r, std::string(variant) == "best").text;
+        stage.done(note);
     }
     compare::writeStabilityReport(o.outputDir, cases);
     std::cerr << "shadowlab: wrote " << (o.outputDir / "stability.html").string() << "\n";
