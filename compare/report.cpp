@@ -85,8 +85,9 @@ std::string describeContinuous(const Metrics& m) {
     if (m.softErrorPixels > 0) {
         s += " " + formatCount(m.softErrorPixels) + " px (" + formatPercent(m.softErrorRate) + ") are off by more than " +
              formatShort(kSoftErrorTolerance) + " without crossing τ";
-        s += m.softErrorPixels > wrong ? ": soft-shadow error dominates, and the mismatch rate does not show it."
-                                       : ": soft-shadow error beside the wrong pixels.";
+        if (m.softErrorRate <= kNotableSoftErrorRate) s += ".";
+        else s += m.softErrorPixels > wrong ? ": soft-shadow error dominates, and the mismatch rate does not show it."
+                                            : ": soft-shadow error beside the wrong pixels.";
     }
     for (const LightError& l : m.perLight)
         if (l.softErrorPixels > 0 || l.meanAbsVisibilityErrorPenumbra > kSoftErrorTolerance)
@@ -103,7 +104,7 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
     if (m.counted == 0) {
         s = who + " has no pixel to compare: no visible point faces the light in both frames "
                   "on the same object.";
-    } else if (m.falseShadow + m.missedShadow == 0 && m.softErrorPixels == 0) {
+    } else if (m.falseShadow + m.missedShadow == 0 && m.softErrorRate <= kNotableSoftErrorRate) {
         s = who + " matches the reference on all " + formatCount(m.counted) +
             " counted pixels (mean |ΔV| " + formatFixed(m.meanAbsVisibilityError, 4) + ").";
     } else if (m.falseShadow + m.missedShadow == 0) {
@@ -316,11 +317,11 @@ std::string legendHtml() {
 }
 
 std::string heatLegendHtml() {
-    std::string stops;
+    std::ostringstream stops;
     for (std::size_t k = 0; k < HeatScale::kStops.size(); ++k)
-        stops += "," + swatch(HeatScale::kStops[k]) + " " + formatShort(100.0 * double(k) / 4.0) + "%";
+        stops << ',' << swatch(HeatScale::kStops[k]) << ' ' << formatShort(100.0 * double(k) / 4.0) << '%';
     std::ostringstream o;
-    o << "<div class=\"heatbar\" style=\"background:linear-gradient(90deg" << stops << ")\"></div>"
+    o << "<div class=\"heatbar\" style=\"background:linear-gradient(90deg" << stops.str() << ")\"></div>"
       << "<div class=\"heatticks\"><span>0</span><span>0.25</span><span>0.5 (τ)</span><span>0.75</span><span>1</span></div>"
       << "<p class=\"small\">|V<sub>method</sub> − V<sub>reference</sub>| per counted pixel: dark where the two agree, "
          "brighter the further apart. Between 0.25 and 0.5 (purple to red) a pixel is wrong but still agrees in class; "

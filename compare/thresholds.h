@@ -43,6 +43,11 @@ inline constexpr double kSweepGoodMismatchRate = 0.01;
 // light or too dark is visible, while PCF's half-texel edge blur stays well under it).
 inline constexpr float kSoftErrorTolerance = 0.25f;
 
+// Soft-shadow error is named in the findings ("dominates", "does not match") when it holds more
+// than this share of the counted pixels: the bias window's 0.1%, below which scattered pixels are
+// not visible at 1:1 (a 16-sample ray tracer's noise leaves a few such pixels in a penumbra).
+inline constexpr double kNotableSoftErrorRate = 0.001;
+
 // The reference's penumbra: counted pixels with kPenumbraMargin < V_R < 1 − kPenumbraMargin.
 // Not exactly 0 and 1: the reference stores float, and a weighted mean of exact 0/1 answers of
 // several lights can round a hair inside the range (float epsilon is 1.2e-7).

@@ -94,7 +94,9 @@ TEST_P(ExtremeCase, MeetsItsExpectedOutcome) {
     for (const char* backend : {"raster", "raytrace"}) {
         const BackendRun* d = c.run(backend, "defaults");
         const BackendRun* b = c.run(backend, "best");
-        if (d && b) EXPECT_LE(b->mismatchRate, d->mismatchRate) << backend << " " << c.bestShadowBlock.dump();
+        if (d && b) {
+            EXPECT_LE(b->mismatchRate, d->mismatchRate) << backend << " " << c.bestShadowBlock.dump();
+        }
     }
     const MethodBias* raster = c.biasOf("raster");
     ASSERT_NE(raster, nullptr);
