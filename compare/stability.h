@@ -1,6 +1,8 @@
-// compare/stability.h: the stability suite (issue 7): runs one extreme case through the
+// compare/stability.h: the stability suite: runs one extreme case through the
 // reference, the analytic oracle and both backends at default and at searched-best settings,
-// and judges it: FAIL on a wrong reference, NaN/Inf, a backend failure or a black frame.
+// and gives separate verdicts: the reference's (exact / wrong / unchecked), each backend's state
+// (clean, acne, leaks, stiff) and whether it ran cleanly (no wrong reference, NaN/Inf, failure or
+// black frame).
 // See docs/stability.md.
 #pragma once
 

@@ -144,7 +144,12 @@ TEST(StabilityTest, DISABLED_WriteReport) {
     for (const std::string& name : extremeCases()) {
         const fs::path file = scene::scenesDirectory() / "extreme" / (name + ".json");
         cases.push_back(runStabilityCase(scene::loadScene(file), o, name, readDescription(file)));
-        std::cout << name << (cases.back().failed() ? " FAIL" : " PASS") << std::endl;
+        const StabilityCase& c = cases.back();
+        std::cout << name << ": reference " << c.referenceVerdict() << "; raster "
+                  << stateOf(c.run("raster", "defaults"), false).text << " / " << stateOf(c.run("raster", "best"), true).text
+                  << "; raytrace " << stateOf(c.run("raytrace", "defaults"), false).text << " / "
+                  << stateOf(c.run("raytrace", "best"), true).text << (c.failed() ? "; FAILED to run cleanly" : "")
+                  << std::endl;
     }
     writeStabilityReport(out, cases);
 }
