@@ -82,7 +82,7 @@ Json measuredJson(const Measured& m) {
     if (!m.ok) return {{"error", m.error}};
     return {{"mismatch_rate", m.mismatchRate},         {"false_shadow_rate", m.falseShadowRate},
             {"missed_shadow_rate", m.missedShadowRate}, {"shadow_iou", m.shadowIoU},
-            {"mean_abs_visibility_error", m.meanAbsVisibilityError}};
+            {"mean_abs_visibility_error", m.meanAbsVisibilityError}, {"soft_error_rate", m.softErrorRate}};
 }
 
 // The scene-file keys of the user's own settings (everything but the biases this file chooses),
@@ -152,6 +152,7 @@ Measured measure(const scene::Frame& method, const scene::Frame& reference) {
     m.missedShadowRate = k.missedShadowRate;
     m.shadowIoU = k.shadowIoU;
     m.meanAbsVisibilityError = k.meanAbsVisibilityError;
+    m.softErrorRate = k.softErrorRate;
     return m;
 }
 
@@ -160,6 +161,11 @@ bool better(const Measured& a, const Measured& b) {
     if (!b.ok) return true;
     if (a.mismatchRate != b.mismatchRate) return a.mismatchRate < b.mismatchRate;
     return a.meanAbsVisibilityError < b.meanAbsVisibilityError;
+}
+
+bool beats(const Measured& c, const Measured& d) {
+    return c.ok && d.ok && better(c, d) && c.mismatchRate <= d.mismatchRate &&
+           c.meanAbsVisibilityError <= d.meanAbsVisibilityError;
 }
 
 Json rayCandidateOf(const AutoBias& bias) {
@@ -242,10 +248,11 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
             for (double k : o.slopeSteps) slopeAxis.push_back(tidy(k * s0));
             for (double depth : depthAxis)
                 for (double slope : slopeAxis) tryPoint(depth, slope, false);
+            // Only points that could replace the defaults compete (beats(): no larger mean |ΔV|).
             auto bestIndex = [&] {
                 int best = 0;
                 for (int i = 1; i < int(r.points.size()); ++i)
-                    if (better(r.points[i].at, r.points[best].at)) best = i;
+                    if (beats(r.points[i].at, r.points[0].at) && better(r.points[i].at, r.points[best].at)) best = i;
                 return best;
             };
             if (o.refine) {
@@ -275,7 +282,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
             ov.depthBias = best.depthBias;
             ov.slopeBias = best.slopeBias;
             v.tried = measureRender(o, scene, ov, "raster", reference);
-            v.beatsDefaults = v.defaults.ok && better(v.tried, v.defaults);
+            v.beatsDefaults = beats(v.tried, v.defaults);
         }
         v.recommended = v.beatsDefaults ? v.tried : v.defaults;
         const std::string config = "filter " + attribute(defaultsFrame, "filter") + ", map " +
@@ -308,7 +315,9 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
                       v.tried.error + "): the block keeps the defaults.";
             else
                 why = "the best searched point (" + v.candidate + ") gives " + percentPair(v.tried, v.defaults) +
-                      " at " + r.resolution + ", no better: the block keeps the defaults.";
+                      " and mean |dV| " + formatFixed(v.tried.meanAbsVisibilityError, 4) + " against " +
+                      formatFixed(v.defaults.meanAbsVisibilityError, 4) + " at " + r.resolution +
+                      ", not better in every respect: the block keeps the defaults.";
             r.notes.push_back("For the shadow map, " + why);
         }
     }
@@ -330,7 +339,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
         v.searched = true;
         v.candidate = "ray bias " + *ov.rayBias + (ov.precision ? " (" + *ov.precision + ")" : "");
         v.tried = measureRender(o, scene, ov, "raytrace", reference);
-        v.beatsDefaults = v.defaults.ok && better(v.tried, v.defaults);
+        v.beatsDefaults = beats(v.tried, v.defaults);
         v.recommended = v.beatsDefaults ? v.tried : v.defaults;
         if (v.beatsDefaults) {
             setRayBias(block, *ov.rayBias);

@@ -25,10 +25,16 @@ struct Measured {
     std::string error;  // when !ok
     double mismatchRate = 0.0, falseShadowRate = 0.0, missedShadowRate = 0.0;
     double shadowIoU = 1.0, meanAbsVisibilityError = 0.0;
+    double softErrorRate = 0.0;  // off by more than 0.25 without crossing τ (compare.h)
 };
 Measured measure(const scene::Frame& method, const scene::Frame& reference);
-// True when a is strictly better than b: less mismatch, or equal mismatch and less mean |ΔV|.
+// The search's order: a is strictly better than b with less mismatch, or as much and less mean
+// |ΔV|. A failed measurement is never better.
 bool better(const Measured& a, const Measured& b);
+// A candidate replaces the defaults only when it is better AND its mean |ΔV| is no larger: with a
+// filter, a bias can trade a few wrong pixels for a wide band of partial acne the classes do not
+// see (mean |ΔV| many times the defaults'), which must not count as a gain.
+bool beats(const Measured& candidate, const Measured& defaults);
 
 // One searched raster point. `defaults` is the user's configuration untouched: its biases are
 // whatever resolveSettings gives (a default depth bias is re-derived per fitted map and cascade).

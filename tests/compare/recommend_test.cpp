@@ -209,6 +209,7 @@ void checkNeverLoses(const std::string& name) {
                 r.points.size(), 100 * defaults.mismatchRate, defaults.shadowIoU, 100 * block.mismatchRate,
                 block.shadowIoU, r.shadowBlock.dump().c_str());
     EXPECT_LE(block.mismatchRate, defaults.mismatchRate) << r.shadowBlock.dump();
+    EXPECT_LE(block.meanAbsVisibilityError, defaults.meanAbsVisibilityError) << r.shadowBlock.dump();
     EXPECT_DOUBLE_EQ(r.raster.recommended.mismatchRate, block.mismatchRate);
 }
 
