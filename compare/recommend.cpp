@@ -209,12 +209,27 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
     Json block = userBlock(user);
 
     if (o.raster) {
+        // The user's defaults at the requested resolution, first: the automatic map size follows
+        // the image size, so the search holds the size this resolution resolves to (a bias in world
+        // units found with another map size would be another configuration).
+        Verified& v = r.raster;
+        scene::Frame fullDefaults;
+        v.defaults = rasterDefaults ? measure(*rasterDefaults, reference)
+                                    : measureRender(o, scene, user, "raster", reference, &fullDefaults);
+        scene::SettingsOverrides searchUser = user;
+        const std::string fullMap = attribute(rasterDefaults ? *rasterDefaults : fullDefaults, "shadow_map_size");
+        if (!user.shadowMapSize && !fullMap.empty()) {
+            char* end = nullptr;
+            const long size = std::strtol(fullMap.c_str(), &end, 10);
+            if (end && *end == '\0' && size >= 16 && size <= 16384) searchUser.shadowMapSize = int(size);
+        }
+
         // The user's configuration as it is: the first point, and the scale of the search.
         BiasPoint d;
         d.defaults = true;
         scene::Frame defaultsFrame;
-        d.at = measureRender(o, searchScene, user, "raster", searchReference, &defaultsFrame);
-        const scene::RenderSettings resolved = scene::resolveSettings(searchScene, user);
+        d.at = measureRender(o, searchScene, searchUser, "raster", searchReference, &defaultsFrame);
+        const scene::RenderSettings resolved = scene::resolveSettings(searchScene, searchUser);
         const std::string applied = attribute(defaultsFrame, "depth_bias");
         double b0 = smallestPositive(applied);
         if (!(b0 > 0.0)) b0 = resolved.raster.depthBias;
@@ -236,7 +251,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
             p.depthBias = depth;
             p.slopeBias = slope;
             p.refined = refined;
-            scene::SettingsOverrides ov = user;
+            scene::SettingsOverrides ov = searchUser;
             ov.depthBias = depth;
             ov.slopeBias = slope;
             p.at = measureRender(o, searchScene, ov, "raster", searchReference);
@@ -270,9 +285,6 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
         }
 
         // At the requested resolution: the user's defaults against the best point.
-        Verified& v = r.raster;
-        v.defaults = rasterDefaults ? measure(*rasterDefaults, reference)
-                                    : measureRender(o, scene, user, "raster", reference);
         const BiasPoint& best = r.points[r.best];
         if (!best.defaults && best.at.ok) {
             v.searched = true;
