@@ -6,6 +6,7 @@
 #include <chrono>
 #include <fstream>
 #include <functional>
+#include <optional>
 #include <cstdio>
 #include <iostream>
 #include <set>
@@ -22,6 +23,7 @@
 #include "compare/sweep.h"
 #include "compare/sweep_report.h"
 #include "raster/cascades.h"
+#include "compare/text.h"
 #include "raster/debug_views.h"
 #include "raster/memory.h"
 #include "raster/renderer.h"
@@ -143,6 +145,19 @@ Prepared prepare(const SceneOptions& o) {
         }
     }
     return p;
+}
+
+// A light with a radius casts soft shadows; in the raster backend only pcss estimates them, every
+// other filter gives a hard (or PCF-blurred) edge whose penumbra error the classes barely see.
+std::vector<std::string> hardFilterWarnings(const scene::Scene& s, const scene::RasterSettings& r) {
+    std::vector<std::string> out;
+    if (r.filter == scene::ShadowFilter::Pcss) return out;
+    for (std::size_t i = 0; i < s.lights.size(); ++i)
+        if (s.lights[i].radius > 0.0 && s.lights[i].type != scene::LightType::Directional)
+            out.push_back("light " + std::to_string(i) + " has a radius (" + compare::formatShort(s.lights[i].radius) +
+                          ") and casts soft shadows, but the raster backend renders it with the hard filter '" +
+                          scene::toString(r.filter) + "': its penumbra is wrong (see the continuous error); use --filter pcss.");
+    return out;
 }
 
 // Progress on stderr: long work says what it is doing and how long it took.
@@ -394,6 +409,9 @@ int render(const RenderOptions& o) {
         }
         return 0;
     }
+    if (o.backend == "raster")
+        for (const std::string& w : hardFilterWarnings(p.scene, p.settings.raster))
+            std::cerr << "shadowlab: warning: " << w << "\n";
     Stage stage("rendering " + p.scene.file.filename().string() + " with " + o.backend);
     // A PNG holds the beauty only, in 8-bit sRGB: the raster backend then renders nothing else,
     // into an 8-bit sRGB target.
@@ -413,6 +431,8 @@ int render(const RenderOptions& o) {
 int compareFiles(const CompareOptions& o) {
     if (o.output.extension() != ".png")
         throw scene::InputError(o.output.string() + ": the difference image must be a .png");
+    if (o.heat && o.heat->extension() != ".png")
+        throw scene::InputError(o.heat->string() + ": the heat map must be a .png");
     const scene::Frame method = scene::readFrame(o.method);
     const scene::Frame reference = scene::readFrame(o.reference);
     compare::Comparison c;
@@ -422,6 +442,7 @@ int compareFiles(const CompareOptions& o) {
         throw scene::InputError(o.method.string() + " vs " + o.reference.string() + ": " + e.what());
     }
     scene::writePngDisplay(o.output, c.width, c.height, c.diffRgb);
+    if (o.heat) scene::writePngDisplay(*o.heat, c.width, c.height, c.heatRgb);
     if (o.json)
         std::cout << compare::toJson(c.metrics).dump(2) << "\n";
     else
@@ -469,6 +490,11 @@ int run(const RunOptions& o) {
     report.planText = p.plan.explain() + explainAutomaticChoices(p);  // and the raster backend's choices
     for (const scene::Object& object : p.scene.objects) report.objectNames.push_back(object.name);
 
+    if (!o.skipRaster) {
+        report.warnings = hardFilterWarnings(p.scene, p.settings.raster);
+        for (const std::string& w : report.warnings) std::cerr << "shadowlab: warning: " << w << "\n";
+        if (!report.warnings.empty()) metrics["warnings"] = report.warnings;
+    }
     Stage refStage("reference (double precision, robust offsets)");
     const scene::Frame reference = renderBackend(p, "reference");
     scene::writeFrame(reference, dir / "reference.exr");
@@ -478,6 +504,8 @@ int run(const RunOptions& o) {
     metrics["reference"] = {{"timings_ms", timingsJson(reference)}, {"attributes", reference.attributes}};
     report.reference = {"reference", "reference.png", reference};
 
+    // The user's configuration at the requested resolution, kept for the recommendation's check.
+    std::optional<scene::Frame> defaultsFrame[2];  // raytrace, raster
     for (const std::string backend : {"raytrace", "raster"}) {
         if (backend == "raster" && o.skipRaster) continue;
         Stage stage(backend == "raster" ? "raster (Vulkan shadow map)" : "raytrace (shadow rays)");
@@ -494,6 +522,7 @@ int run(const RunOptions& o) {
             status = 1;
             continue;
         }
+        defaultsFrame[backend == "raster"] = frame;
         scene::writeFrame(frame, dir / (backend + ".exr"));
         scene::writePngLinear(dir / (backend + ".png"), frame.width, frame.height, frame.beauty);
         const compare::Comparison c = compare::compareFrames(frame, reference);
@@ -503,7 +532,14 @@ int run(const RunOptions& o) {
         metrics["methods"][backend] = {{"metrics", compare::toJson(c.metrics)},
                                        {"timings_ms", timingsJson(frame)},
                                        {"attributes", frame.attributes}};
-        report.methods.push_back({backend, backend + ".png", "diff-" + backend + ".png", frame, c.metrics});
+        compare::ReportMethod method{backend, backend + ".png", "diff-" + backend + ".png", frame, c.metrics};
+        method.heatPng = "heat-" + backend + ".png";
+        scene::writePngDisplay(dir / method.heatPng, c.width, c.height, c.heatRgb);
+        for (std::size_t l = 0; l < c.lightHeatRgb.size(); ++l) {
+            method.lightHeatPngs.push_back("heat-" + backend + "-light" + std::to_string(l) + ".png");
+            scene::writePngDisplay(dir / method.lightHeatPngs.back(), c.width, c.height, c.lightHeatRgb[l]);
+        }
+        report.methods.push_back(std::move(method));
         if (backend == "raster" && views) {
             for (const RunView& v : kRunViews) {
                 if (std::string_view(v.view) == "cascades" && debug.cascadeSplits.empty()) continue;
@@ -536,15 +572,31 @@ int run(const RunOptions& o) {
         options.progress = sweepProgressPrinter();
         Stage stage("quick sweep of " + std::to_string(grid.configs.size()) + " configurations at " + *grid.resolution);
         const compare::SweepResult result = compare::runSweep(p.scene, grid, options);
-        const compare::SweepReportInput input =
-            compare::makeSweepReportInput(report.sceneName, report.scenePath, result);
+        compare::SweepReportInput input = compare::makeSweepReportInput(report.sceneName, report.scenePath, result);
+        {
+            Stage rec("recommended shadow block: biases searched in this configuration, checked at " +
+                      std::to_string(p.scene.camera.width) + "x" + std::to_string(p.scene.camera.height));
+            scene::Scene half = p.scene;
+            half.camera.width = result.reference.width;
+            half.camera.height = result.reference.height;
+            compare::RecommendOptions ro;
+            ro.user = o.common.settings;
+            ro.raster = !o.skipRaster;
+            input.recommendation = compare::recommendShadow(
+                half, result.reference, p.scene, reference, defaultsFrame[1] ? &*defaultsFrame[1] : nullptr,
+                defaultsFrame[0] ? &*defaultsFrame[0] : nullptr,
+                compare::rayCandidateOf(compare::recommendBias(result.rows)), ro);
+            rec.done(std::to_string(input.recommendation->points.size()) + " raster points");
+            for (const std::string& note : input.recommendation->notes) std::cerr << "shadowlab: " << note << "\n";
+        }
         compare::writeSweepReport(options.outputDir, input);
         scene::replaceDirectory(options.outputDir, dir / "sweep");
         written.push_back("sweep/");
         report.sweep = compare::summarizeSweep(input, "sweep/report.html");
         stage.done("sweep/report.html");
         metrics["sweep"] = {{"configurations", result.rows.size()}, {"report", "sweep/report.html"},
-                            {"results", "sweep/results.csv"}};
+                            {"results", "sweep/results.csv"},
+                            {"recommended", input.recommendation->toJson()}};
     }
 
     metrics["memory"] = memoryJson(estimate);
@@ -640,8 +692,27 @@ int sweep(const SweepOptions& o) {
     std::cerr << "shadowlab: sweep of " << grid.configs.size() << " configurations, " << grid.repetitions
               << " timed frames each, into " << o.outputDir.string() << "\n";
     const compare::SweepResult result = compare::runSweep(p.scene, grid, options);
-    compare::writeSweepReport(o.outputDir, compare::makeSweepReportInput(p.scene.file.stem().string(),
-                                                                         p.scene.file.string(), result));
+    compare::SweepReportInput input =
+        compare::makeSweepReportInput(p.scene.file.stem().string(), p.scene.file.string(), result);
+    {
+        // The recommendation is searched and checked at the sweep's resolution, in the settings
+        // given on the command line (the grid's own rows vary them; the user runs these).
+        scene::Scene at = p.scene;
+        at.camera.width = result.reference.width;
+        at.camera.height = result.reference.height;
+        compare::RecommendOptions ro;
+        ro.user = o.common.settings;
+        ro.raster = std::any_of(grid.configs.begin(), grid.configs.end(),
+                                [](const compare::SweepConfig& c) { return c.backend == "raster"; });
+        ro.raytrace = std::any_of(grid.configs.begin(), grid.configs.end(),
+                                  [](const compare::SweepConfig& c) { return c.backend == "raytrace"; });
+        Stage rec("recommended shadow block: biases searched in this configuration");
+        input.recommendation = compare::recommendShadow(at, result.reference, at, result.reference, nullptr, nullptr,
+                                                        compare::rayCandidateOf(compare::recommendBias(result.rows)), ro);
+        rec.done();
+        for (const std::string& note : input.recommendation->notes) std::cerr << "shadowlab: " << note << "\n";
+    }
+    compare::writeSweepReport(o.outputDir, input);
     std::size_t failed = 0;
     for (const auto& r : result.rows) failed += r.error.empty() ? 0 : 1;
     std::cerr << "shadowlab: wrote " << (o.outputDir / "report.html").string() << ", results.csv and results.json ("
@@ -681,7 +752,15 @@ int stability(const StabilityCommandOptions& o) {
         const std::string name = files[i].stem().string();
         Stage stage("stability case " + std::to_string(i + 1) + "/" + std::to_string(scenes.size()) + " " + name);
         cases.push_back(compare::runStabilityCase(scenes[i], options, name, compare::readDescription(files[i])));
-        stage.done(compare::suitePassed({cases.back()}) ? "ok" : "FAILED");
+        // The reference's verdict and each backend's state, not one PASS that hides acne.
+        const compare::StabilityCase& c = cases.back();
+        std::string note = std::string(c.failed() ? "FAILED to run cleanly; " : "") + "reference " + c.referenceVerdict();
+        for (const char* backend : {"raster", "raytrace"})
+            for (const char* variant : {"defaults", "best"})
+                if (const compare::BackendRun* r = c.run(backend, variant))
+                    note += std::string("; ") + backend + " at " + variant + ": " +
+                            compare::stateOf(r, std::string(variant) == "best").text;
+        stage.done(note);
     }
     compare::writeStabilityReport(o.outputDir, cases);
     std::cerr << "shadowlab: wrote " << (o.outputDir / "stability.html").string() << "\n";

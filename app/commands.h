@@ -68,6 +68,7 @@ struct CompareOptions {
     std::filesystem::path method;
     std::filesystem::path reference;
     std::filesystem::path output;
+    std::optional<std::filesystem::path> heat;  // the |ΔV| heat map (.png)
     bool json = false;
 };
 

@@ -158,6 +158,8 @@ int main(int argc, char** argv) {
     compareCmd->add_option("REFERENCE", compareOptions.reference, "Reference Frame (.exr)")->required();
     compareCmd->add_option("-o,--output", compareOptions.output, "Difference image (.png)")->required();
     compareCmd->add_flag("--json", compareOptions.json, "Print the metrics as JSON on stdout");
+    compareCmd->add_option("--heat", compareOptions.heat,
+                           "Also write the |V_method - V_reference| heat map (.png; docs/compare.md has its color scale)");
 
     bool infoValidate = false;
     auto* infoCmd = app.add_subcommand("info", "Vulkan devices, driver and API versions, lavapipe or not");

@@ -282,20 +282,21 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
         const BiasSeries* other = raster == depth ? slope : depth;
         std::string why;
         if (raster->window.stiff) {
-            why = "The shadow map is stiff for this scene: no " + std::string(other ? "depth or slope bias" : raster->name()) +
-                  " keeps both rates <= " + formatPercent(threshold) + ". The block uses the best compromise, " +
+            why = "On the probe slice the shadow map is stiff for this scene: no " +
+                  std::string(other ? "depth or slope bias" : raster->name()) + " keeps both rates <= " +
+                  formatPercent(threshold) + ". Its best compromise is " +
                   raster->name() + " " + formatShort(raster->recommended) + ", where " +
                   artifactName(raster->dominant, raster->kind) + " dominates.";
         } else if (other) {
-            why = "For the shadow map the " + raster->name() + " is recommended (" + formatShort(raster->recommended) +
+            why = "On the probe slice the " + raster->name() + " is the pick (" + formatShort(raster->recommended) +
                   " " + raster->unit() + "): ";
             why += other->window.stiff ? "the " + other->name() + " has no window."
                                        : "its window holds " + std::to_string(raster->window.acceptableSamples) +
                                              " sampled values against " + std::to_string(other->window.acceptableSamples) +
                                              " for the " + other->name() + ".";
-            why += " Each was measured with the other held fixed, so the block keeps it that way.";
+            why += " Each was measured with the other held fixed.";
         } else {
-            why = "For the shadow map: " + raster->name() + " " + formatShort(raster->recommended) + " " + raster->unit() + ".";
+            why = "On the probe slice: " + raster->name() + " " + formatShort(raster->recommended) + " " + raster->unit() + ".";
         }
         out.notes.push_back(why);
     }

@@ -213,6 +213,16 @@ PixelClass classifyCounted(float vMethod, float vReference) {
     return vReference > kVisibilityTolerance ? PixelClass::AgreeLit : PixelClass::AgreeShadow;
 }
 
+std::array<float, 3> heatColor(float e) {
+    if (std::isnan(e)) return DiffColors::kInvalid;
+    const float t = std::clamp(e, 0.0f, 1.0f) * 4.0f;
+    const int k = std::min(3, int(t));
+    const float f = t - float(k);
+    const auto& a = HeatScale::kStops[k];
+    const auto& b = HeatScale::kStops[k + 1];
+    return {a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1]), a[2] + f * (b[2] - a[2])};
+}
+
 std::array<float, 3> diffColor(PixelClass c, float refR, float refG, float refB) {
     using C = DiffColors;
     switch (c) {
@@ -263,7 +273,20 @@ Comparison compareFrames(const Frame& method, const Frame& reference,
     const auto nearEdge = dilate(edges, w, h, options.edgeRadius);
 
     std::map<long long, ObjectErrors> perObject;
-    double sumAbs = 0.0;
+    double sumAbs = 0.0, sumAbsPenumbra = 0.0;
+    out.heatRgb.assign(3 * n, 0.0f);
+    auto isPenumbra = [](float v) { return v > kPenumbraMargin && v < 1.0f - kPenumbraMargin; };
+    // Per light only when both frames hold the same lights' channels at full size.
+    const std::size_t lights = method.lightVisibility.size();
+    bool perLight = lights > 0 && reference.lightVisibility.size() == lights;
+    for (std::size_t l = 0; perLight && l < lights; ++l)
+        perLight = method.lightVisibility[l].size() == n && reference.lightVisibility[l].size() == n;
+    std::vector<double> lightSum(perLight ? lights : 0, 0.0), lightPenumbraSum(lightSum);
+    if (perLight) {
+        m.perLight.resize(lights);
+        out.lightHeatRgb.assign(lights, std::vector<float>(3 * n, 0.0f));
+        for (std::size_t l = 0; l < lights; ++l) m.perLight[l].light = int(l);
+    }
     for (std::size_t i = 0; i < n; ++i) {
         const float vm = method.visibility[i], vr = reference.visibility[i];
         const float idm = method.objectId[i], idr = reference.objectId[i];
@@ -283,7 +306,29 @@ Comparison compareFrames(const Frame& method, const Frame& reference,
         } else {
             c = classifyCounted(vm, vr);
             ++m.counted;
-            sumAbs += std::fabs(double(vm) - double(vr));
+            const double e = std::fabs(double(vm) - double(vr));
+            sumAbs += e;
+            m.maxAbsVisibilityError = std::max(m.maxAbsVisibilityError, e);
+            if (isPenumbra(vr)) {
+                ++m.penumbraPixels;
+                sumAbsPenumbra += e;
+            }
+            if (e > kSoftErrorTolerance && e <= kVisibilityTolerance) ++m.softErrorPixels;
+            const auto heat = heatColor(float(e));
+            std::copy(heat.begin(), heat.end(), out.heatRgb.begin() + 3 * std::ptrdiff_t(i));
+            for (std::size_t l = 0; l < lightSum.size(); ++l) {
+                const float lm = method.lightVisibility[l][i], lr = reference.lightVisibility[l][i];
+                const double el = std::isfinite(lm) && std::isfinite(lr) ? std::fabs(double(lm) - double(lr)) : 1.0;
+                LightError& le = m.perLight[l];
+                lightSum[l] += el;
+                if (isPenumbra(lr)) {
+                    ++le.penumbraPixels;
+                    lightPenumbraSum[l] += el;
+                }
+                if (el > kSoftErrorTolerance && el <= kVisibilityTolerance) ++le.softErrorPixels;
+                const auto lh = heatColor(float(el));
+                std::copy(lh.begin(), lh.end(), out.lightHeatRgb[l].begin() + 3 * std::ptrdiff_t(i));
+            }
             const bool shM = vm <= kVisibilityTolerance, shR = vr <= kVisibilityTolerance;
             m.shadowedMethod += shM;
             m.shadowedReference += shR;
@@ -310,6 +355,11 @@ Comparison compareFrames(const Frame& method, const Frame& reference,
                 ++m.agreeShadow;
             }
         }
+        if (c == PixelClass::NotCounted || c == PixelClass::Invalid) {
+            const auto& flat = c == PixelClass::NotCounted ? DiffColors::kNotCounted : DiffColors::kInvalid;
+            std::copy(flat.begin(), flat.end(), out.heatRgb.begin() + 3 * std::ptrdiff_t(i));
+            for (auto& lh : out.lightHeatRgb) std::copy(flat.begin(), flat.end(), lh.begin() + 3 * std::ptrdiff_t(i));
+        }
         if (c == PixelClass::NotCounted) ++m.notCounted;
         if (c == PixelClass::Invalid) ++m.invalid;
         out.classes[i] = c;
@@ -323,6 +373,13 @@ Comparison compareFrames(const Frame& method, const Frame& reference,
     m.missedShadowRate = rate(m.missedShadow, m.counted);
     m.mismatchRate = rate(wrong, m.counted);
     m.meanAbsVisibilityError = m.counted ? sumAbs / double(m.counted) : 0.0;
+    m.meanAbsVisibilityErrorPenumbra = m.penumbraPixels ? sumAbsPenumbra / double(m.penumbraPixels) : 0.0;
+    m.softErrorRate = rate(m.softErrorPixels, m.counted);
+    for (std::size_t l = 0; l < lightSum.size(); ++l) {
+        LightError& le = m.perLight[l];
+        le.meanAbsVisibilityError = m.counted ? lightSum[l] / double(m.counted) : 0.0;
+        le.meanAbsVisibilityErrorPenumbra = le.penumbraPixels ? lightPenumbraSum[l] / double(le.penumbraPixels) : 0.0;
+    }
     m.shadowIoU = m.shadowedUnion ? double(m.shadowedIntersection) / double(m.shadowedUnion) : 1.0;
     m.silhouetteMismatchRate = rate(m.silhouetteMismatch, m.totalPixels);
     m.selfShadowAcneRate = rate(m.selfShadowAcne, m.counted);
@@ -367,6 +424,12 @@ nlohmann::json toJson(const Metrics& m) {
         {"missed_shadow_rate", m.missedShadowRate},
         {"mismatch_rate", m.mismatchRate},
         {"mean_abs_visibility_error", m.meanAbsVisibilityError},
+        {"max_abs_visibility_error", m.maxAbsVisibilityError},
+        {"penumbra_pixels", m.penumbraPixels},
+        {"mean_abs_visibility_error_penumbra", m.meanAbsVisibilityErrorPenumbra},
+        {"soft_error_pixels", m.softErrorPixels},
+        {"soft_error_rate", m.softErrorRate},
+        {"soft_error_tolerance", kSoftErrorTolerance},
         {"shadowed_method", m.shadowedMethod},
         {"shadowed_reference", m.shadowedReference},
         {"shadowed_intersection", m.shadowedIntersection},
@@ -394,6 +457,14 @@ nlohmann::json toJson(const Metrics& m) {
         {"method_non_finite", toJson(m.methodHealth)},
         {"reference_non_finite", toJson(m.referenceHealth)},
     };
+    nlohmann::json lights = nlohmann::json::array();
+    for (const LightError& l : m.perLight)
+        lights.push_back({{"light", l.light},
+                          {"mean_abs_visibility_error", l.meanAbsVisibilityError},
+                          {"penumbra_pixels", l.penumbraPixels},
+                          {"mean_abs_visibility_error_penumbra", l.meanAbsVisibilityErrorPenumbra},
+                          {"soft_error_pixels", l.softErrorPixels}});
+    j["per_light"] = lights;
     // Without blocker ids self-shadow acne is unknown, not zero.
     if (m.hasBlockerIds) {
         j["self_shadow_acne"] = m.selfShadowAcne;
@@ -410,7 +481,10 @@ std::string summaryLine(const Metrics& m) {
                     formatPercent(m.falseShadowRate);
     if (m.hasBlockerIds) s += " (self acne " + formatPercent(m.selfShadowAcneRate) + ")";
     s += ", missed " + formatPercent(m.missedShadowRate) + ", mismatch " +
-         formatPercent(m.mismatchRate) + ", IoU " + formatFixed(m.shadowIoU, 3) + ", silhouette " +
+         formatPercent(m.mismatchRate) + ", IoU " + formatFixed(m.shadowIoU, 3) + ", mean |dV| " +
+         formatFixed(m.meanAbsVisibilityError, 4) + " (penumbra " + formatFixed(m.meanAbsVisibilityErrorPenumbra, 3) +
+         " over " + formatCount(m.penumbraPixels) + " px), off by > " + formatFixed(kSoftErrorTolerance, 2) +
+         " within tau " + formatCount(m.softErrorPixels) + " px, silhouette " +
          formatPercent(m.silhouetteMismatchRate) + ", " + formatDuration(m.methodTiming.totalMs) +
          " (reference " + formatDuration(m.referenceTiming.totalMs) + ")";
     const std::size_t bad = m.methodHealth.total() + m.referenceHealth.total();

@@ -85,6 +85,16 @@ struct ErrorHotspot {
     std::size_t wrongPixels = 0;
 };
 
+// The continuous error of one light's own visibility channel (Frame::lightVisibility), over the
+// frame's counted pixels. Where light i does not reach a point both frames hold 0 there.
+struct LightError {
+    int light = 0;  // index in scene order
+    double meanAbsVisibilityError = 0.0;
+    std::size_t penumbraPixels = 0;
+    double meanAbsVisibilityErrorPenumbra = 0.0;
+    std::size_t softErrorPixels = 0;
+};
+
 struct Metrics {
     int width = 0, height = 0;
     std::size_t totalPixels = 0;
@@ -129,6 +139,16 @@ struct Metrics {
     std::vector<ObjectErrors> perObject;  // objects with any counted pixel, by id
     ErrorHotspot hotspot;
 
+    // Continuous error |V_M − V_R| beside the classes, which τ = 0.5 makes blind to a penumbra
+    // that is wrong by less than half the range (docs/compare.md "Continuous error").
+    double maxAbsVisibilityError = 0.0;      // over counted pixels
+    std::size_t penumbraPixels = 0;          // counted with 0 < V_R < 1 (kPenumbraMargin)
+    double meanAbsVisibilityErrorPenumbra = 0.0;  // mean |V_M − V_R| over them; 0 when none
+    // Counted pixels with kSoftErrorTolerance < |V_M − V_R| ≤ τ: wrong, but agreeing in class.
+    std::size_t softErrorPixels = 0;
+    double softErrorRate = 0.0;  // over counted
+    std::vector<LightError> perLight;  // one per light when both frames have per-light channels
+
     std::string methodBackend, referenceBackend;  // Frame attribute "backend", if any
     Timing methodTiming, referenceTiming;
     FrameHealth methodHealth, referenceHealth;
@@ -144,7 +164,25 @@ struct Comparison {
     int width = 0, height = 0;
     std::vector<float> diffRgb;               // display-encoded 0..1, 3 per pixel, row 0 on top
     std::vector<PixelClass> classes;          // one per pixel
+    std::vector<float> heatRgb;               // the error heat map (heatColor), 3 per pixel
+    std::vector<std::vector<float>> lightHeatRgb;  // one heat map per light, with perLight
 };
+
+// The heat map's color scale, display-encoded: |ΔV| in 0..1 through five stops at 0, 0.25,
+// 0.5, 0.75 and 1, linear in between (an inferno-like ramp: dark for no error, bright for large
+// error, monotonic in luminance so it reads in gray too). 0.25 is kSoftErrorTolerance, 0.5 is τ.
+struct HeatScale {
+    static constexpr std::array<std::array<float, 3>, 5> kStops{{
+        {0.00f, 0.00f, 0.02f},  // 0: no error
+        {0.34f, 0.06f, 0.43f},  // 0.25: purple
+        {0.74f, 0.22f, 0.33f},  // 0.5: red-magenta
+        {0.98f, 0.56f, 0.04f},  // 0.75: orange
+        {0.99f, 1.00f, 0.64f},  // 1: pale yellow
+    }};
+};
+// The heat-map color of a counted pixel's |ΔV| (clamped to 0..1; NaN gives the invalid color).
+// Not-counted pixels use DiffColors::kNotCounted, invalid ones DiffColors::kInvalid.
+std::array<float, 3> heatColor(float absError);
 
 // Throws scene::InputError when the sizes differ or a channel has the wrong length (naming
 // which frame and which channel).

@@ -73,6 +73,30 @@ std::string healthText(const FrameHealth& h) {
     return out;
 }
 
+// The continuous error in words: the mean, the penumbra's mean, and the soft-shadow error the
+// classes hide, named as what dominates when it outnumbers the wrong pixels.
+std::string describeContinuous(const Metrics& m) {
+    std::string s = "Its visibility is off by " + formatFixed(m.meanAbsVisibilityError, 4) + " on average";
+    if (m.penumbraPixels > 0)
+        s += " and by " + formatFixed(m.meanAbsVisibilityErrorPenumbra, 3) + " over the reference's penumbra (" +
+             formatCount(m.penumbraPixels) + " px where 0 < V < 1)";
+    s += ".";
+    const std::size_t wrong = m.falseShadow + m.missedShadow;
+    if (m.softErrorPixels > 0) {
+        s += " " + formatCount(m.softErrorPixels) + " px (" + formatPercent(m.softErrorRate) + ") are off by more than " +
+             formatShort(kSoftErrorTolerance) + " without crossing τ";
+        if (m.softErrorRate <= kNotableSoftErrorRate) s += ".";
+        else s += m.softErrorPixels > wrong ? ": soft-shadow error dominates, and the mismatch rate does not show it."
+                                            : ": soft-shadow error beside the wrong pixels.";
+    }
+    for (const LightError& l : m.perLight)
+        if (l.softErrorPixels > 0 || l.meanAbsVisibilityErrorPenumbra > kSoftErrorTolerance)
+            s += " Light " + std::to_string(l.light) + ": mean |ΔV| " + formatFixed(l.meanAbsVisibilityError, 4) +
+                 (l.penumbraPixels ? ", " + formatFixed(l.meanAbsVisibilityErrorPenumbra, 3) + " over its penumbra" : "") +
+                 ", " + formatCount(l.softErrorPixels) + " px off by more than " + formatShort(kSoftErrorTolerance) + ".";
+    return s;
+}
+
 std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
     const Metrics& m = rm.metrics;
     const std::string who = methodTitle(rm.label);
@@ -80,9 +104,12 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
     if (m.counted == 0) {
         s = who + " has no pixel to compare: no visible point faces the light in both frames "
                   "on the same object.";
-    } else if (m.falseShadow + m.missedShadow == 0) {
+    } else if (m.falseShadow + m.missedShadow == 0 && m.softErrorRate <= kNotableSoftErrorRate) {
         s = who + " matches the reference on all " + formatCount(m.counted) +
             " counted pixels (mean |ΔV| " + formatFixed(m.meanAbsVisibilityError, 4) + ").";
+    } else if (m.falseShadow + m.missedShadow == 0) {
+        s = who + " has no pixel wrong by more than τ = " + formatShort(kVisibilityTolerance) + " among the " +
+            formatCount(m.counted) + " counted pixels, so the classes call it agreement, but it does not match.";
     } else {
         s = who + " disagrees with the reference on " + formatPercent(m.mismatchRate) + " of the " +
             formatCount(m.counted) + " counted pixels: ";
@@ -126,6 +153,7 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
                  std::to_string(m.edgeRadius) + " px of one (aliasing).";
         s += " Its shadowed area overlaps the reference's with IoU " + formatFixed(m.shadowIoU, 3) + ".";
     }
+    if (m.counted > 0) s += " " + describeContinuous(m);
     if (m.silhouetteMismatchRate > kNotableSilhouetteRate)
         s += " Silhouettes differ on " + formatPercent(m.silhouetteMismatchRate) +
              " of the image (not counted).";
@@ -190,6 +218,10 @@ ul.sweeplines { margin: 0 0 8px; padding-left: 18px; }
 ul.sweeplines li { margin-bottom: 6px; }
 pre { background: #f0f4f8; padding: 10px 12px; border-radius: 6px; overflow-x: auto; font-size: 12px; }
 a { color: #1864ab; }
+.heatbar { height: 14px; border-radius: 3px; border: 1px solid #0003; }
+.heatticks { display: flex; justify-content: space-between; font-size: 12px; color: var(--muted); }
+.warning { background: #fff9db; border: 1px solid #ffe066; color: #5c3c00; border-radius: 8px;
+       padding: 10px 14px; margin-top: 12px; }
 )CSS";
 
 std::string swatch(const std::array<float, 3>& c) {
@@ -284,6 +316,21 @@ std::string legendHtml() {
     return o.str();
 }
 
+std::string heatLegendHtml() {
+    std::ostringstream stops;
+    for (std::size_t k = 0; k < HeatScale::kStops.size(); ++k)
+        stops << ',' << swatch(HeatScale::kStops[k]) << ' ' << formatShort(100.0 * double(k) / 4.0) << '%';
+    std::ostringstream o;
+    o << "<div class=\"heatbar\" style=\"background:linear-gradient(90deg" << stops.str() << ")\"></div>"
+      << "<div class=\"heatticks\"><span>0</span><span>0.25</span><span>0.5 (τ)</span><span>0.75</span><span>1</span></div>"
+      << "<p class=\"small\">|V<sub>method</sub> − V<sub>reference</sub>| per counted pixel: dark where the two agree, "
+         "brighter the further apart. Between 0.25 and 0.5 (purple to red) a pixel is wrong but still agrees in class; "
+         "above 0.5 it is a false or missed shadow. <span class=\"sw\" style=\"display:inline-block;vertical-align:middle;background:"
+      << swatch(DiffColors::kNotCounted) << "\"></span> not counted, <span class=\"sw\" style=\"display:inline-block;"
+         "vertical-align:middle;background:" << swatch(DiffColors::kInvalid) << "\"></span> invalid.</p>";
+    return o.str();
+}
+
 std::string metricsTable(const ReportInput& in) {
     std::ostringstream o;
     o << "<table class=\"metrics\"><thead><tr><th>metric</th>";
@@ -305,6 +352,22 @@ std::string metricsTable(const ReportInput& in) {
     row("agree, lit", [&](const Metrics& m) { return countCell(m.agreeLit, double(m.agreeLit) / std::max<double>(1, m.counted)); });
     row("agree, shadow", [&](const Metrics& m) { return countCell(m.agreeShadow, double(m.agreeShadow) / std::max<double>(1, m.counted)); });
     row("mean |V<sub>M</sub> − V<sub>R</sub>|", [&](const Metrics& m) { return plain(formatFixed(m.meanAbsVisibilityError, 4)); });
+    row("mean |V<sub>M</sub> − V<sub>R</sub>| over the reference's penumbra", [&](const Metrics& m) {
+        return m.penumbraPixels ? "<td>" + formatFixed(m.meanAbsVisibilityErrorPenumbra, 4) + "<span class=\"rate\">" +
+                                      formatCount(m.penumbraPixels) + " px</span></td>"
+                                : plain("no penumbra");
+    }, "key");
+    row("off by &gt; " + formatShort(kSoftErrorTolerance) + ", ≤ τ (soft error)", [&](const Metrics& m) { return countCell(m.softErrorPixels, m.softErrorRate); });
+    row("max |V<sub>M</sub> − V<sub>R</sub>|", [&](const Metrics& m) { return plain(formatFixed(m.maxAbsVisibilityError, 3)); });
+    std::size_t lights = 0;
+    for (const auto& rm : in.methods) lights = std::max(lights, rm.metrics.perLight.size());
+    for (std::size_t l = 0; l < lights; ++l)
+        row("light " + std::to_string(l) + ": mean |ΔV| / over its penumbra", [&](const Metrics& m) {
+            if (l >= m.perLight.size()) return plain("–");
+            const LightError& e = m.perLight[l];
+            return plain(formatFixed(e.meanAbsVisibilityError, 4) + " / " +
+                         (e.penumbraPixels ? formatFixed(e.meanAbsVisibilityErrorPenumbra, 4) : std::string("–")));
+        });
     row("IoU of shadowed areas", [&](const Metrics& m) { return plain(formatFixed(m.shadowIoU, 4)); }, "key");
     row("wrong near a shadow edge (aliasing)", [&](const Metrics& m) { return countCell(m.aliasingPixels, m.aliasingRate); });
     row("wrong away from edges (bias)", [&](const Metrics& m) { return countCell(m.biasErrorPixels, m.biasErrorRate); });
@@ -454,6 +517,7 @@ std::string describeFindings(const ReportInput& in) {
     }
     for (const auto& f : in.failures)
         lines.push_back("The " + f.label + " backend failed: " + f.message);
+    for (const auto& w : in.warnings) lines.push_back("Warning: " + w);
     if (in.reference.frame.width > 0) {
         // Reference health is checked once here rather than per method.
         for (const auto& rm : in.methods)
@@ -495,6 +559,7 @@ std::string renderReportHtml(const ReportInput& in) {
     o << "</div>\n";
     for (const auto& f : in.failures)
         o << "<div class=\"failure\"><b>" << escapeHtml(f.label) << " failed:</b> " << escapeHtml(f.message) << "</div>\n";
+    for (const auto& w : in.warnings) o << "<div class=\"warning\"><b>Warning:</b> " << escapeHtml(w) << "</div>\n";
 
     // Images over difference images, one column per frame.
     const std::size_t cols = 1 + in.methods.size();
@@ -527,6 +592,30 @@ std::string renderReportHtml(const ReportInput& in) {
         o << "</div>\n";
     }
     o << "</div>\n";
+
+    const bool anyHeat = std::any_of(in.methods.begin(), in.methods.end(), [](const ReportMethod& rm) { return !rm.heatPng.empty(); });
+    if (anyHeat) {
+        o << "<h2>Continuous error |V<sub>method</sub> − V<sub>reference</sub>|</h2>\n<div class=\"grid\" style=\""
+          << gridStyle << "\">\n<div>" << heatLegendHtml() << "</div>\n";
+        for (const auto& rm : in.methods) {
+            const Metrics& m = rm.metrics;
+            o << "<div>";
+            if (!rm.heatPng.empty()) {
+                std::string note = "mean " + formatFixed(m.meanAbsVisibilityError, 4);
+                if (m.penumbraPixels) note += ", penumbra " + formatFixed(m.meanAbsVisibilityErrorPenumbra, 3);
+                note += ", " + formatCount(m.softErrorPixels) + " px soft error";
+                o << figure(rm.label + " |ΔV|", note, rm.heatPng, rm.frame, nullptr);
+            }
+            for (std::size_t l = 0; l < rm.lightHeatPngs.size() && l < m.perLight.size(); ++l) {
+                const LightError& e = m.perLight[l];
+                std::string note = "mean " + formatFixed(e.meanAbsVisibilityError, 4);
+                if (e.penumbraPixels) note += ", penumbra " + formatFixed(e.meanAbsVisibilityErrorPenumbra, 3);
+                o << figure(rm.label + ", light " + std::to_string(l), note, rm.lightHeatPngs[l], rm.frame, nullptr);
+            }
+            o << "</div>\n";
+        }
+        o << "</div>\n";
+    }
 
     if (!in.shadowMapViews.empty()) {
         o << "<h2>Inside the shadow maps (raster)</h2>\n<div class=\"grid\" style=\"grid-template-columns: repeat("
@@ -587,6 +676,8 @@ std::string zoomCrop(const std::string& png, const FrameInfo& frame, const Error
 }
 
 std::string diffLegend() { return legendHtml(); }
+
+std::string heatLegend() { return heatLegendHtml(); }
 
 }  // namespace html
 

@@ -37,6 +37,8 @@ struct ReportMethod {
     std::string diffPng;  // its difference image
     FrameInfo frame;
     Metrics metrics;
+    std::string heatPng;                     // its |V_M − V_R| heat map; "" = none
+    std::vector<std::string> lightHeatPngs;  // one per light (Metrics::perLight), may be empty
 };
 
 // A display image of the raster backend's shadow maps (`render --view`), with what it shows.
@@ -75,6 +77,9 @@ struct ReportInput {
     std::vector<std::string> objectNames;
     // The raster backend's debug views; empty: no "Inside the shadow maps" section.
     std::vector<ReportView> shadowMapViews;
+    // Warnings about the configuration (a light with a radius under a hard filter), shown in the
+    // findings; `run` also prints them on stderr.
+    std::vector<std::string> warnings;
     // The quick sweep `run` renders into DIR/sweep/; absent: no sweep section.
     std::optional<SweepSummary> sweep;
 };
@@ -99,6 +104,8 @@ std::string zoomCrop(const std::string& png, const FrameInfo& frame, const Error
                      const std::string& alt);
 // The color legend of the difference images.
 std::string diffLegend();
+// The color scale of the error heat maps (HeatScale), as a bar with its ticks.
+std::string heatLegend();
 }  // namespace html
 
 }  // namespace shadowlab::compare

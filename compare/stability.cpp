@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "compare/auto_bias.h"
@@ -70,7 +71,8 @@ std::string describeOverrides(const Json& block, const std::string& backend) {
 
 BackendRun renderRun(const scene::Scene& scene, const scene::Frame& reference,
                      const scene::SettingsOverrides& overrides, const StabilityOptions& options,
-                     const std::string& backend, const std::string& variant, const std::string& label) {
+                     const std::string& backend, const std::string& variant, const std::string& label,
+                     scene::Frame* keep = nullptr) {
     BackendRun run;
     run.backend = backend;
     run.variant = variant;
@@ -94,6 +96,7 @@ BackendRun renderRun(const scene::Scene& scene, const scene::Frame& reference,
         run.missedShadowRate = cmp.metrics.missedShadowRate;
         run.mismatchRate = cmp.metrics.mismatchRate;
         run.diffRgb = cmp.diffRgb;
+        if (keep && !run.failed()) *keep = frame;
     } catch (const std::exception& e) {
         run.ok = false;
         run.error = e.what();
@@ -209,14 +212,36 @@ StabilityCase runStabilityCase(const scene::Scene& sceneIn, const StabilityOptio
         }
     }
 
-    // Backends at their defaults.
+    // Backends at their defaults (kept: the recommendation is checked against them).
+    std::map<std::string, scene::Frame> defaultsFrames;
     for (const std::string& backend : options.backends)
-        c.runs.push_back(renderRun(scene, c.reference, {}, options, backend, "defaults", "defaults"));
+        c.runs.push_back(renderRun(scene, c.reference, {}, options, backend, "defaults", "defaults",
+                                   &defaultsFrames[backend]));
+    auto defaultsOf = [&](const std::string& backend) -> const scene::Frame* {
+        const auto it = defaultsFrames.find(backend);
+        return it == defaultsFrames.end() || it->second.pixelCount() == 0 ? nullptr : &it->second;
+    };
+    auto hasBackend = [&](const char* b) {
+        return std::find(options.backends.begin(), options.backends.end(), b) != options.backends.end();
+    };
 
     // Bias search, then each backend at its best settings.
     if (options.search) {
         const AutoBias ab = searchBias(scene, c.reference, options);
-        c.bestShadowBlock = ab.shadowBlock;
+        // The best settings: searched in the case's own configuration and never worse than its
+        // defaults, at the case's resolution.
+        RecommendOptions ro;
+        ro.render = options.render;
+        ro.user.shadowMapSize = options.shadowMapSize;
+        ro.user.validate = options.validate;
+        ro.raster = hasBackend("raster");
+        ro.raytrace = hasBackend("raytrace");
+        ro.depthSteps = options.bestDepthSteps;
+        ro.slopeSteps = options.bestSlopeSteps;
+        const Recommendation rec = recommendShadow(scene, c.reference, scene, c.reference, defaultsOf("raster"),
+                                                   defaultsOf("raytrace"), rayCandidateOf(ab), ro);
+        c.bestShadowBlock = rec.shadowBlock;
+        c.bestNotes = rec.notes;
         for (const std::string& backend : options.backends) {
             MethodBias mb;
             mb.backend = backend;
@@ -244,12 +269,8 @@ StabilityCase runStabilityCase(const scene::Scene& sceneIn, const StabilityOptio
                                "): false " + fmt(100 * r.falseShadowRate, 3) + "%, missed " +
                                fmt(100 * r.missedShadowRate, 3) + "%" + (r.passes ? " (pass)." : " (fail).");
             c.bias.push_back(mb);
-            if (!ab.shadowBlock.empty()) {
-                Json block = ab.shadowBlock;
-                if (options.searchMapSize > 0 && backend == "raster") block["shadow_map_size"] = options.searchMapSize;
-                c.runs.push_back(renderRun(scene, c.reference, overridesFromBlock(block), options, backend,
-                                           "best", describeOverrides(block, backend)));
-            }
+            c.runs.push_back(renderRun(scene, c.reference, overridesFromBlock(rec.shadowBlock), options, backend,
+                                       "best", describeOverrides(rec.shadowBlock, backend)));
         }
     }
 
@@ -297,6 +318,30 @@ std::vector<StabilityCase> runStabilitySuite(const std::vector<fs::path>& files,
     return cases;
 }
 
+std::string StabilityCase::referenceVerdict() const {
+    if (!referenceOk || referenceHealth.total() > 0 || referenceBlack) return "wrong";
+    if (analytic) return analytic->passed() ? "exact" : "wrong";
+    return "unchecked";
+}
+
+BackendState stateOf(const BackendRun* r, bool atBest) {
+    if (!r) return {"not run", "not run"};
+    if (r->failed()) {
+        std::string why = !r->ok ? r->error
+                          : r->blackFrame ? "black frame"
+                          : r->health.total() > 0 ? std::to_string(r->health.total()) + " NaN/Inf"
+                                                  : std::to_string(r->validationMessages) + " validation messages";
+        return {"failed", "failed: " + why};
+    }
+    const bool acne = r->falseShadowRate > kBiasWindowMaxRate, leaks = r->missedShadowRate > kBiasWindowMaxRate;
+    if (!acne && !leaks) return {"clean", "clean"};
+    std::string text;
+    if (acne) text = "acne " + formatPercent(r->falseShadowRate);
+    if (leaks) text += std::string(acne ? ", " : "") + "leaks " + formatPercent(r->missedShadowRate);
+    if (atBest) return {"stiff", "stiff: " + text};
+    return {acne && leaks ? "acne+leaks" : acne ? "acne" : "leaks", text};
+}
+
 bool suitePassed(const std::vector<StabilityCase>& cases) {
     return std::none_of(cases.begin(), cases.end(), [](const StabilityCase& c) { return c.failed(); });
 }
@@ -305,7 +350,18 @@ Json toJson(const StabilityCase& c) {
     Json j;
     j["name"] = c.name;
     j["description"] = c.description;
-    j["verdict"] = c.failed() ? "FAIL" : "PASS";
+    // Separate verdicts: whether the case ran cleanly, whether the reference is right, and what
+    // each backend's shadows look like at its defaults and at its best bias.
+    j["health"] = c.failed() ? "failed" : "ok";
+    j["reference_verdict"] = c.referenceVerdict();
+    j["states"] = Json::object();
+    for (const BackendRun& r : c.runs) {
+        const BackendState st = stateOf(&r, r.variant == "best");
+        j["states"][r.backend][r.variant] = {{"state", st.state}, {"text", st.text},
+                                             {"false_shadow_rate", r.falseShadowRate},
+                                             {"missed_shadow_rate", r.missedShadowRate}};
+    }
+    j["best_notes"] = c.bestNotes;
     j["failures"] = c.failures;
     j["resolution"] = std::to_string(c.width) + "x" + std::to_string(c.height);
     j["reference"] = {{"ok", c.referenceOk}, {"error", c.referenceError}, {"time_ms", c.referenceMs},
@@ -356,59 +412,104 @@ std::string csvField(std::string s) {
 
 std::string stabilityCsv(const std::vector<StabilityCase>& cases) {
     std::ostringstream s;
-    s << "case,verdict,analytic,reference_ms,backend,variant,settings,ok,black,non_finite,"
+    s << "case,health,reference,analytic,reference_ms,backend,variant,state,settings,ok,black,non_finite,"
          "false_shadow_rate,missed_shadow_rate,time_ms,bias_window\n";
     for (const StabilityCase& c : cases) {
         const std::string analytic = c.analytic ? (c.analytic->passed() ? "exact" : "MISSED") : "n/a";
         for (const BackendRun& r : c.runs)
-            s << c.name << ',' << (c.failed() ? "FAIL" : "PASS") << ',' << analytic << ',' << c.referenceMs << ','
-              << r.backend << ',' << r.variant << ',' << csvField(r.settings) << ',' << r.ok << ',' << r.blackFrame
+            s << c.name << ',' << (c.failed() ? "failed" : "ok") << ',' << c.referenceVerdict() << ',' << analytic << ','
+              << c.referenceMs << ',' << r.backend << ',' << r.variant << ',' << csvField(stateOf(&r, r.variant == "best").text)
+              << ',' << csvField(r.settings) << ',' << r.ok << ',' << r.blackFrame
               << ',' << r.health.total() << ',' << r.falseShadowRate << ',' << r.missedShadowRate << ','
               << r.timeMs << ',' << csvField(windowText(c.biasOf(r.backend))) << '\n';
         if (c.runs.empty())
-            s << c.name << ',' << (c.failed() ? "FAIL" : "PASS") << ',' << analytic << ',' << c.referenceMs
-              << ",,,,,,,,,,\n";
+            s << c.name << ',' << (c.failed() ? "failed" : "ok") << ',' << c.referenceVerdict() << ',' << analytic << ','
+              << c.referenceMs << ",,,,,,,,,,,\n";
     }
     return s.str();
 }
 
+namespace {
+
+// A cell of the summary table: the state's text on its own color (the page's CSS, st-*).
+std::string stateCell(const BackendState& st) {
+    std::string cls = st.state;
+    std::replace(cls.begin(), cls.end(), '+', '-');
+    std::replace(cls.begin(), cls.end(), ' ', '-');
+    return "<td class=\"st-" + cls + "\">" + escapeHtml(st.text) + "</td>";
+}
+
+std::string referenceCell(const std::string& verdict) {
+    return "<td class=\"ref-" + verdict + "\">" + verdict + "</td>";
+}
+
+}  // namespace
+
 void writeStabilityReport(const fs::path& dir, const std::vector<StabilityCase>& cases) {
     fs::create_directories(dir / "stability");
     std::ostringstream h;
+    std::size_t failedCases = 0, exact = 0, wrong = 0;
+    for (const StabilityCase& c : cases) {
+        failedCases += c.failed() ? 1 : 0;
+        exact += c.referenceVerdict() == "exact" ? 1 : 0;
+        wrong += c.referenceVerdict() == "wrong" ? 1 : 0;
+    }
     h << "<!doctype html><html><head><meta charset=\"utf-8\"><title>shadowlab stability</title><style>"
       << html::css()
-      << " table.st td,table.st th{padding:2px 8px;border-bottom:1px solid #ddd;text-align:left}"
-         " .fail{color:#b00;font-weight:bold} .pass{color:#070;font-weight:bold}</style></head><body>"
-      << "<h1>Stability suite: " << (suitePassed(cases) ? "<span class=pass>PASS</span>" : "<span class=fail>FAIL</span>")
-      << "</h1><p>Each case runs through the double reference, the analytic oracle (where the scene is"
+      << " table.st td,table.st th{padding:3px 8px;border-bottom:1px solid #ddd;text-align:left}"
+         " .fail{color:#b00;font-weight:bold} .pass{color:#070;font-weight:bold}"
+         " .st-clean,.ref-exact{background:#d3f9d8;color:#1b5e20} .st-acne{background:#ffe3e3;color:#a51111}"
+         " .st-leaks{background:#dbe4ff;color:#1c3faa} .st-acne-leaks{background:#f3d9fa;color:#6b1e80}"
+         " .st-stiff{background:#fff0d4;color:#8a4b00;font-weight:600} .st-failed,.ref-wrong{background:#c92a2a;color:#fff;font-weight:600}"
+         " .st-not-run,.ref-unchecked{background:#f1f3f5;color:#495057} .figs{display:flex;flex-wrap:wrap;gap:10px}</style></head><body><main>"
+      << "<h1>Stability suite</h1><p>" << cases.size() << " cases. Reference: <span class=pass>" << exact
+      << " exact</span> against the analytic answer, " << (cases.size() - exact - wrong) << " unchecked (no analytic answer), "
+      << (wrong ? "<span class=fail>" : "") << wrong << " wrong" << (wrong ? "</span>" : "") << ". Runs: "
+      << (failedCases ? "<span class=fail>" + std::to_string(failedCases) + " with a crash, NaN/Inf, black frame or validation message</span>"
+                      : std::string("<span class=pass>none crashed, produced NaN/Inf, a black frame or a validation message</span>"))
+      << ".</p><p>Each case runs through the double reference, the analytic oracle (where the scene is"
          " spheres, quads and boxes under directional lights), and each backend at its defaults and at"
-         " the best settings of a bias search. Acne = false shadow rate, leak = missed shadow rate over"
-         " counted pixels.</p><table class=st><tr><th>case</th><th>verdict</th><th>analytic</th>"
-         "<th>raster window</th><th>raytrace window</th></tr>";
-    for (const StabilityCase& c : cases)
-        h << "<tr><td><a href=\"#" << escapeHtml(c.name) << "\">" << escapeHtml(c.name) << "</a></td><td class="
-          << (c.failed() ? "fail>FAIL" : "pass>PASS") << "</td><td>"
-          << (c.analytic ? (c.analytic->passed() ? "exact" : "MISSED") : "n/a") << "</td><td>"
-          << escapeHtml(windowText(c.biasOf("raster"))) << "</td><td>" << escapeHtml(windowText(c.biasOf("raytrace")))
-          << "</td></tr>";
+         " its best bias (searched in its own configuration over depth × slope, never worse than the defaults)."
+         " A backend's state: <span class=st-clean>clean</span> (false and missed shadow both ≤ "
+      << formatPercent(kBiasWindowMaxRate) << " of the counted pixels), <span class=st-acne>acne x%</span> (false shadow),"
+         " <span class=st-leaks>leaks y%</span> (missed shadow: light leaking, peter-panning),"
+         " <span class=st-acne-leaks>both</span>, and at the best bias <span class=st-stiff>stiff</span>: no searched"
+         " bias makes it clean. <span class=st-failed>failed</span>: crash, NaN/Inf, black frame or validation messages."
+         "</p><table class=st><tr><th>case</th><th>reference</th><th>raster at defaults</th><th>raster at best</th>"
+         "<th>raytrace at defaults</th><th>raytrace at best</th><th>raster window</th><th>raytrace window</th></tr>";
+    for (const StabilityCase& c : cases) {
+        h << "<tr><td><a href=\"#" << escapeHtml(c.name) << "\">" << escapeHtml(c.name) << "</a></td>"
+          << referenceCell(c.referenceVerdict());
+        for (const char* backend : {"raster", "raytrace"})
+            for (const char* variant : {"defaults", "best"})
+                h << stateCell(stateOf(c.run(backend, variant), std::string(variant) == "best"));
+        h << "<td>" << escapeHtml(windowText(c.biasOf("raster"))) << "</td><td>"
+          << escapeHtml(windowText(c.biasOf("raytrace"))) << "</td></tr>";
+    }
     h << "</table>" << html::diffLegend();
     for (const StabilityCase& c : cases) {
-        h << "<section id=\"" << escapeHtml(c.name) << "\"><h2>" << escapeHtml(c.name) << " — "
-          << (c.failed() ? "<span class=fail>FAIL</span>" : "<span class=pass>PASS</span>") << "</h2>";
+        h << "<section id=\"" << escapeHtml(c.name) << "\"><h2>" << escapeHtml(c.name) << "</h2><table class=st><tr>"
+          << "<th>reference</th><th>raster at defaults</th><th>raster at best</th><th>raytrace at defaults</th>"
+             "<th>raytrace at best</th></tr><tr>" << referenceCell(c.referenceVerdict());
+        for (const char* backend : {"raster", "raytrace"})
+            for (const char* variant : {"defaults", "best"})
+                h << stateCell(stateOf(c.run(backend, variant), std::string(variant) == "best"));
+        h << "</tr></table>";
         if (!c.description.empty()) h << "<p>" << escapeHtml(c.description) << "</p>";
         for (const std::string& f : c.failures) h << "<p class=fail>" << escapeHtml(f) << "</p>";
         h << "<p>Reference: " << fmt(c.referenceMs) << " ms, " << c.referenceHealth.total() << " NaN/Inf. Analytic: "
           << escapeHtml(c.analytic ? c.analytic->summary() : "not analytic (" + c.notAnalytic + ")") << ".</p>";
-        h << "<table class=st><tr><th>backend</th><th>settings</th><th>status</th><th>NaN/Inf</th><th>acne</th>"
+        h << "<table class=st><tr><th>backend</th><th>settings</th><th>state</th><th>NaN/Inf</th><th>acne</th>"
              "<th>leak</th><th>time ms</th></tr>";
         for (const BackendRun& r : c.runs)
-            h << "<tr><td>" << r.backend << "</td><td>" << escapeHtml(r.variant + ": " + r.settings) << "</td><td>"
-              << escapeHtml(!r.ok ? "failed: " + r.error : (r.blackFrame ? "black frame" : "ok")) << "</td><td>"
+            h << "<tr><td>" << r.backend << "</td><td>" << escapeHtml(r.variant + ": " + r.settings) << "</td>"
+              << stateCell(stateOf(&r, r.variant == "best")) << "<td>"
               << r.health.total() << "</td><td>" << fmt(100 * r.falseShadowRate, 3) << "%</td><td>"
               << fmt(100 * r.missedShadowRate, 3) << "%</td><td>" << fmt(r.timeMs) << "</td></tr>";
         h << "</table>";
         for (const MethodBias& b : c.bias)
-            h << "<p><b>" << b.backend << "</b>: " << escapeHtml(windowText(&b)) << ". " << escapeHtml(b.text) << "</p>";
+            h << "<p><b>" << b.backend << "</b> (probe slice): " << escapeHtml(windowText(&b)) << ". " << escapeHtml(b.text) << "</p>";
+        for (const std::string& note : c.bestNotes) h << "<p>" << escapeHtml(note) << "</p>";
         h << "<div class=figs>";
         if (c.referenceOk && !c.reference.beauty.empty()) {
             const std::string png = "stability/" + c.name + "-reference.png";
@@ -416,15 +517,16 @@ void writeStabilityReport(const fs::path& dir, const std::vector<StabilityCase>&
             h << "<figure><img src=\"" << png << "\" width=320><figcaption>reference</figcaption></figure>";
         }
         for (const BackendRun& r : c.runs) {
-            if (r.variant != "defaults" || r.diffRgb.empty()) continue;
-            const std::string png = "stability/" + c.name + "-" + r.backend + "-diff.png";
+            if (r.diffRgb.empty()) continue;
+            const std::string png =
+                "stability/" + c.name + "-" + r.backend + (r.variant == "defaults" ? "" : "-" + r.variant) + "-diff.png";
             scene::writePngDisplay(dir / png, c.width, c.height, r.diffRgb);
             h << "<figure><img src=\"" << png << "\" width=320 style=\"image-rendering:pixelated\"><figcaption>"
-              << r.backend << " at defaults vs reference</figcaption></figure>";
+              << r.backend << " at " << r.variant << " vs reference</figcaption></figure>";
         }
         h << "</div></section>";
     }
-    h << "</body></html>\n";
+    h << "</main></body></html>\n";
     scene::writeTextAtomic(dir / "stability.html", h.str());
     scene::writeTextAtomic(dir / "stability.csv", stabilityCsv(cases));
     Json all = Json::array();

@@ -1,6 +1,8 @@
-// compare/stability.h: the stability suite (issue 7): runs one extreme case through the
+// compare/stability.h: the stability suite: runs one extreme case through the
 // reference, the analytic oracle and both backends at default and at searched-best settings,
-// and judges it: FAIL on a wrong reference, NaN/Inf, a backend failure or a black frame.
+// and gives separate verdicts: the reference's (exact / wrong / unchecked), each backend's state
+// (clean, acne, leaks, stiff) and whether it ran cleanly (no wrong reference, NaN/Inf, failure or
+// black frame).
 // See docs/stability.md.
 #pragma once
 
@@ -14,6 +16,7 @@
 
 #include "compare/analytic.h"
 #include "compare/compare.h"
+#include "compare/recommend.h"
 #include "compare/sweep.h"
 #include "scene/frame.h"
 #include "scene/scene.h"
@@ -34,6 +37,10 @@ struct StabilityOptions {
     bool biasSeriesOnly = false;
     int searchMapSize = 0;
     bool validate = false;                 // Vulkan validation on every raster render
+    // The "best" renders use the recommendation searched in the case's own configuration
+    // (compare/recommend.h: depth × slope, never worse than the defaults); these are its grids.
+    std::vector<double> bestDepthSteps = RecommendOptions{}.depthSteps;
+    std::vector<double> bestSlopeSteps = RecommendOptions{}.slopeSteps;
     std::vector<std::string> backends{"raster", "raytrace"};
     RenderFn render = renderWithBackend;   // tests may pass a fake
 };
@@ -65,6 +72,16 @@ struct MethodBias {
     std::string text;        // BiasSeries::describe() of each series, joined
 };
 
+// What a backend's shadows look like in one run, for the page's colored columns: "clean" (both
+// rates ≤ kBiasWindowMaxRate), "acne" (false shadow above it), "leaks" (missed shadow above it),
+// "acne+leaks", at the best bias "stiff" (still not clean: no searched bias is), "failed"
+// (crash, NaN/Inf, black frame, validation messages) or "not run".
+struct BackendState {
+    std::string state;
+    std::string text;  // "clean", "acne 13.1%", "leaks 0.24%", "stiff: acne 0.48%", "failed: device lost"
+};
+BackendState stateOf(const BackendRun* run, bool atBest);
+
 struct StabilityCase {
     std::string name;         // file stem
     std::string description;  // from the scene file, when it has one
@@ -80,9 +97,13 @@ struct StabilityCase {
     std::vector<BackendRun> runs;       // defaults first, then best
     std::vector<MethodBias> bias;       // one per backend when searched
     nlohmann::json bestShadowBlock = nlohmann::json::object();
+    std::vector<std::string> bestNotes;  // the recommendation's sentences (what it searched and measured)
     std::vector<std::string> failures;  // why the case FAILs; empty: PASS
 
     bool failed() const { return !failures.empty(); }
+    // The reference's verdict: "exact" (matches the analytic answer), "wrong" (misses it, failed,
+    // NaN/Inf or black), "unchecked" (no analytic answer for this scene, healthy).
+    std::string referenceVerdict() const;
     const BackendRun* run(const std::string& backend, const std::string& variant) const;
     const MethodBias* biasOf(const std::string& backend) const;
 };

@@ -497,7 +497,7 @@ std::vector<SweepRow> readJournal(const fs::path& file) {
 std::string rowsToCsv(const std::vector<SweepRow>& rows) {
     static const char* kMetrics[] = {"counted", "false_shadow", "missed_shadow", "false_shadow_rate",
                                      "missed_shadow_rate", "mismatch_rate", "mean_abs_visibility_error",
-                                     "shadow_iou", "self_shadow_acne_rate", "aliasing_rate", "bias_error_rate",
+                                     "mean_abs_visibility_error_penumbra", "soft_error_rate", "shadow_iou", "self_shadow_acne_rate", "aliasing_rate", "bias_error_rate",
                                      "silhouette_mismatch_rate", "invalid"};
     std::ostringstream s;
     s << "key,backend,label,shadow_map_size,filter,cascades,depth_bias,slope_bias,ray_bias,precision,samples,"

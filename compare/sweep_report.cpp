@@ -350,6 +350,10 @@ std::vector<std::string> describeSweep(const SweepReportInput& in, const AutoBia
              "machine its own marker.";
         lines.push_back(s);
     }
+    if (in.recommendation)
+        for (const std::string& note : in.recommendation->notes) lines.push_back(note);
+    else
+        lines.push_back("The block below is the probe slice's and was not measured against your defaults.");
     std::size_t failed = 0;
     for (const SweepRow& r : in.rows) failed += usable(r) ? 0 : 1;
     if (failed > 0)
@@ -357,6 +361,11 @@ std::vector<std::string> describeSweep(const SweepReportInput& in, const AutoBia
                         " failed and " + (failed == 1 ? "is" : "are") + " listed at the end, not plotted.");
     if (in.rows.empty()) lines.push_back("The sweep holds no configuration yet.");
     return lines;
+}
+
+// The block the page shows and recommended-shadow.json holds under "shadow".
+static nlohmann::json recommendedBlock(const SweepReportInput& in, const AutoBias& bias) {
+    return in.recommendation ? in.recommendation->shadowBlock : bias.shadowBlock;
 }
 
 std::string renderSweepReportHtml(const SweepReportInput& in) {
@@ -390,7 +399,7 @@ std::string renderSweepReportHtml(const SweepReportInput& in) {
     for (const std::string& line : describeSweep(in, bias)) o << "<li>" << escapeHtml(line) << "</li>";
     o << "</ul><p style=\"margin-top:10px\">Recommended <code>\"shadow\"</code> block for the scene file "
          "(also in <code>recommended-shadow.json</code>):</p><pre>"
-      << escapeHtml(bias.shadowBlock.dump(2)) << "</pre></div>\n<div>";
+      << escapeHtml(recommendedBlock(in, bias).dump(2)) << "</pre></div>\n<div>";
     if (!in.referencePng.empty()) {
         FrameInfo ref;
         ref.width = width;
@@ -467,7 +476,9 @@ void writeSweepReport(const fs::path& dir, const SweepReportInput& input) {
             fs::remove(dir / svgName(kind), ec);
         }
     }
-    scene::writeTextAtomic(dir / "recommended-shadow.json", bias.shadowBlock.dump(2) + "\n");
+    const Json file = input.recommendation ? input.recommendation->toJson()
+                                           : Json{{"shadow", bias.shadowBlock}, {"measured", nullptr}};
+    scene::writeTextAtomic(dir / "recommended-shadow.json", file.dump(2) + "\n");
     scene::writeTextAtomic(dir / "report.html", renderSweepReportHtml(input));
 }
 
@@ -477,7 +488,7 @@ SweepSummary summarizeSweep(const SweepReportInput& input, const std::string& hr
     s.href = href;
     s.errorTimeSvg = sweepErrorTimeSvg(input);
     s.lines = describeSweep(input, bias);
-    s.shadowBlockJson = bias.shadowBlock.dump(2);
+    s.shadowBlockJson = recommendedBlock(input, bias).dump(2);
     s.configurations = input.rows.size();
     for (const SweepRow& r : input.rows) s.failed += usable(r) ? 0 : 1;
     int w = input.width, h = input.height;

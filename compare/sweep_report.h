@@ -10,7 +10,10 @@
 #include <string>
 #include <vector>
 
+#include <optional>
+
 #include "compare/auto_bias.h"
+#include "compare/recommend.h"
 #include "compare/report.h"
 #include "compare/sweep.h"
 #include "compare/thresholds.h"
@@ -25,6 +28,10 @@ struct SweepReportInput {
     double referenceMs = 0.0;                // the reference's render time (a marker on the plot)
     int width = 0, height = 0;               // render size; 0 = read from the rows' metrics
     double threshold = kBiasWindowMaxRate;   // bias-window threshold
+    // The block searched in the user's configuration and verified against their defaults
+    // (compare/recommend.h). Without it the page and recommended-shadow.json show the probe
+    // slice's block, marked as not measured against the defaults.
+    std::optional<Recommendation> recommendation;
 };
 
 // The input for a finished runSweep(): its rows, reference.png and the reference's time and size.
@@ -40,8 +47,8 @@ std::vector<std::string> describeSweep(const SweepReportInput& input, const Auto
 // The error-against-per-frame-time plot of the sweep (log-log, Pareto front per backend).
 std::string sweepErrorTimeSvg(const SweepReportInput& input);
 
-// Writes dir/report.html, dir/recommended-shadow.json (the AutoBias shadow block, a JSON object
-// to paste as the scene's "shadow") and beside them error-time.svg and bias-depth.svg,
+// Writes dir/report.html, dir/recommended-shadow.json ({"shadow": the block to merge into the
+// scene's "shadow", "measured": what it gained against the defaults, or null}) and beside them error-time.svg and bias-depth.svg,
 // bias-slope.svg, bias-ray.svg for the kinds that have data (a stale one of a kind without data
 // is removed). Every file is written atomically.
 void writeSweepReport(const std::filesystem::path& dir, const SweepReportInput& input);

@@ -38,6 +38,21 @@ inline constexpr double kBiasWindowMaxRate = 0.001;
 // a long edge, stays below it; a visible acne pattern or a detached shadow does not.
 inline constexpr double kSweepGoodMismatchRate = 0.01;
 
+// Continuous error: a counted pixel whose visibility is off by more than this, yet not by more
+// than τ, is a soft-shadow error the classes cannot see (a penumbra a quarter of the range too
+// light or too dark is visible, while PCF's half-texel edge blur stays well under it).
+inline constexpr float kSoftErrorTolerance = 0.25f;
+
+// Soft-shadow error is named in the findings ("dominates", "does not match") when it holds more
+// than this share of the counted pixels: the bias window's 0.1%, below which scattered pixels are
+// not visible at 1:1 (a 16-sample ray tracer's noise leaves a few such pixels in a penumbra).
+inline constexpr double kNotableSoftErrorRate = 0.001;
+
+// The reference's penumbra: counted pixels with kPenumbraMargin < V_R < 1 − kPenumbraMargin.
+// Not exactly 0 and 1: the reference stores float, and a weighted mean of exact 0/1 answers of
+// several lights can round a hair inside the range (float epsilon is 1.2e-7).
+inline constexpr float kPenumbraMargin = 1e-6f;
+
 // Findings paragraph: an object or cause is named as "mostly" responsible when it holds more
 // than half of a class, i.e. when it is the majority, not merely the largest share.
 inline constexpr double kMostlyShare = 0.5;

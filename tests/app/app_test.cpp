@@ -101,6 +101,37 @@ TEST(App, RunOnTheSeedSceneWritesEveryOutputWithSaneMetrics) {
     }
     EXPECT_FALSE(std::filesystem::exists(out / "raster-cascades.png"));
     EXPECT_NE(html.find("Inside the shadow maps"), std::string::npos);
+    // The continuous error: a heat map per method, and its numbers in metrics.json.
+    for (const char* method : {"raster", "raytrace"}) {
+        EXPECT_EQ(pngSize(out / (std::string("heat-") + method + ".png")), std::make_pair(192, 108)) << method;
+        EXPECT_NE(html.find(std::string("src=\"heat-") + method + ".png\""), std::string::npos) << method;
+        const auto& m = metrics.at("methods").at(method).at("metrics");
+        for (const char* key : {"mean_abs_visibility_error_penumbra", "penumbra_pixels", "soft_error_pixels"})
+            EXPECT_TRUE(m.contains(key)) << key;
+    }
+    // The recommendation was checked against this run's own defaults and never loses to them.
+    const auto rec = nlohmann::json::parse(slurp(out / "sweep" / "recommended-shadow.json"));
+    ASSERT_TRUE(rec.at("shadow").is_object());
+    const auto& measured = rec.at("measured").at("raster");
+    const double defaults = metrics.at("methods").at("raster").at("metrics").at("mismatch_rate").get<double>();
+    EXPECT_DOUBLE_EQ(measured.at("defaults").at("mismatch_rate").get<double>(), defaults);
+    EXPECT_LE(measured.at("recommended").at("mismatch_rate").get<double>(), defaults);
+    EXPECT_EQ(rec.at("shadow").at("shadow_map_size"), 1024);  // the user's own setting is kept
+    EXPECT_EQ(metrics.at("sweep").at("recommended"), rec);
+}
+
+TEST(App, RunWarnsWhenALightWithARadiusGetsAHardFilter) {
+    TempDir dir;
+    const auto out = dir.path() / "soft";
+    const Result r = shadowlab({"run", "lesson/spherical-light", "-o", out.string(), "--resolution", "64x36",
+                                "--no-sweep", "--filter", "pcf2x2"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("warning: light 0 has a radius"), std::string::npos) << r.err;
+    EXPECT_NE(slurp(out / "report.html").find("light 0 has a radius"), std::string::npos);
+    const Result pcss = shadowlab({"run", "lesson/spherical-light", "-o", (dir.path() / "pcss").string(),
+                                   "--resolution", "64x36", "--no-sweep", "--filter", "pcss"});
+    ASSERT_EQ(pcss.exitCode, 0) << pcss.err;
+    EXPECT_EQ(pcss.err.find("warning: light"), std::string::npos) << pcss.err;
 }
 
 TEST(App, RenderWritesTheRequestedFrame) {
@@ -114,6 +145,11 @@ TEST(App, RenderWritesTheRequestedFrame) {
     const auto j = nlohmann::json::parse(c.out);
     EXPECT_EQ(j.at("false_shadow").get<double>(), 0.0);  // a frame agrees with itself
     EXPECT_EQ(j.at("missed_shadow").get<double>(), 0.0);
+    EXPECT_EQ(j.at("mean_abs_visibility_error_penumbra").get<double>(), 0.0);
+    const Result h = shadowlab({"compare", exr.string(), exr.string(), "-o", (dir.path() / "d.png").string(), "--heat",
+                                (dir.path() / "h.png").string()});
+    ASSERT_EQ(h.exitCode, 0) << h.err;
+    EXPECT_EQ(pngSize(dir.path() / "h.png"), std::make_pair(32, 18));
 }
 
 TEST(App, MemoryIsEstimatedBeforeRenderingAndBoundsThePeak) {

@@ -90,6 +90,14 @@ TEST_P(ExtremeCase, MeetsItsExpectedOutcome) {
                 EXPECT_EQ(r->validationMessages, 0) << variant;
             }
         }
+    // The best settings never lose to the defaults (they are searched and then checked against them).
+    for (const char* backend : {"raster", "raytrace"}) {
+        const BackendRun* d = c.run(backend, "defaults");
+        const BackendRun* b = c.run(backend, "best");
+        if (d && b) {
+            EXPECT_LE(b->mismatchRate, d->mismatchRate) << backend << " " << c.bestShadowBlock.dump();
+        }
+    }
     const MethodBias* raster = c.biasOf("raster");
     ASSERT_NE(raster, nullptr);
     if (kRasterStiff.count(GetParam())) {
@@ -136,7 +144,12 @@ TEST(StabilityTest, DISABLED_WriteReport) {
     for (const std::string& name : extremeCases()) {
         const fs::path file = scene::scenesDirectory() / "extreme" / (name + ".json");
         cases.push_back(runStabilityCase(scene::loadScene(file), o, name, readDescription(file)));
-        std::cout << name << (cases.back().failed() ? " FAIL" : " PASS") << std::endl;
+        const StabilityCase& c = cases.back();
+        std::cout << name << ": reference " << c.referenceVerdict() << "; raster "
+                  << stateOf(c.run("raster", "defaults"), false).text << " / " << stateOf(c.run("raster", "best"), true).text
+                  << "; raytrace " << stateOf(c.run("raytrace", "defaults"), false).text << " / "
+                  << stateOf(c.run("raytrace", "best"), true).text << (c.failed() ? "; FAILED to run cleanly" : "")
+                  << std::endl;
     }
     writeStabilityReport(out, cases);
 }
@@ -238,8 +251,68 @@ TEST(StabilityTest, ReportFilesAreWritten) {
     std::ifstream in(dir / "stability.json");
     const nlohmann::json j = nlohmann::json::parse(in);
     EXPECT_TRUE(j["passed"].get<bool>());
-    EXPECT_EQ(j["cases"][0]["verdict"], "PASS");
+    EXPECT_EQ(j["cases"][0]["health"], "ok");
+    EXPECT_EQ(j["cases"][0]["reference_verdict"], "unchecked");
     fs::remove_all(dir);
+}
+
+// A fake raster whose defaults darken the first 26 of 200 lit pixels (13% acne) while a constant
+// bias of at least `cleanFrom` is clean; the reference and the ray tracer are exact.
+StabilityOptions acneOptions(double cleanFrom) {
+    StabilityOptions o;
+    o.width = 20;
+    o.height = 10;
+    o.render = [cleanFrom](const scene::Scene& s, const scene::RenderSettings& settings, const std::string& backend) {
+        scene::Frame f = fakeFrame(s.camera.width, s.camera.height, 0.5f);
+        if (backend == "raster" && settings.raster.depthBias < cleanFrom)
+            for (int i = 0; i < 26; ++i) f.visibility[i] = 0.0f;
+        f.attributes["validation_messages"] = "0";
+        return f;
+    };
+    return o;
+}
+
+TEST(StabilityVerdicts, InjectedAcneAtDefaultsShowsTheAcneStateNotAPass) {
+    StabilityOptions o = acneOptions(1e30);  // never clean
+    o.search = false;
+    const StabilityCase c = runStabilityCase(tinyScene(), o, "acne");
+    EXPECT_FALSE(c.failed());  // nothing crashed: the run is healthy, the shadows are not
+    EXPECT_EQ(c.referenceVerdict(), "unchecked");  // a point light: no analytic answer
+    const BackendState raster = stateOf(c.run("raster", "defaults"), false);
+    EXPECT_EQ(raster.state, "acne");
+    EXPECT_EQ(raster.text, "acne 13.0%");  // 26 / 200
+    EXPECT_EQ(stateOf(c.run("raytrace", "defaults"), false).state, "clean");
+    const nlohmann::json j = toJson(c);
+    EXPECT_EQ(j["states"]["raster"]["defaults"]["state"], "acne");
+    EXPECT_EQ(j["states"]["raytrace"]["defaults"]["state"], "clean");
+    EXPECT_FALSE(j.contains("verdict"));
+    const fs::path dir = fs::temp_directory_path() / "shadowlab_stability_acne";
+    fs::remove_all(dir);
+    writeStabilityReport(dir, {c});
+    std::ifstream in(dir / "stability.html");
+    const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(html.find("<td class=\"st-acne\">acne 13.0%</td>"), std::string::npos);
+    EXPECT_NE(html.find("<td class=\"ref-unchecked\">unchecked</td>"), std::string::npos);
+    EXPECT_EQ(html.find("PASS"), std::string::npos);
+    fs::remove_all(dir);
+}
+
+TEST(StabilityVerdicts, TheBestBiasIsCleanWhenTheSearchFindsOneAndStiffWhenNot) {
+    // Clean from 3 default half-texels: the search's 4 × b0 points are clean.
+    scene::Scene s = tinyScene();
+    s.camera.width = 20;
+    s.camera.height = 10;
+    const double b0 = scene::resolveSettings(s, {}).raster.depthBias;
+    StabilityCase c = runStabilityCase(tinyScene(), acneOptions(3.0 * b0), "fixable");
+    EXPECT_EQ(stateOf(c.run("raster", "defaults"), false).state, "acne");
+    EXPECT_EQ(stateOf(c.run("raster", "best"), true).state, "clean") << c.bestShadowBlock.dump();
+    EXPECT_GE(c.bestShadowBlock.at("depth_bias").get<double>(), 3.0 * b0);
+    // Never clean: the best bias is stiff, and says what remains.
+    c = runStabilityCase(tinyScene(), acneOptions(1e30), "stiff");
+    const BackendState best = stateOf(c.run("raster", "best"), true);
+    EXPECT_EQ(best.state, "stiff");
+    EXPECT_EQ(best.text, "stiff: acne 13.0%");
+    EXPECT_FALSE(c.bestShadowBlock.contains("depth_bias"));  // nothing beat the defaults
 }
 
 }  // namespace

@@ -77,7 +77,10 @@ TEST(SweepReport, WritesThePagePlotsAndTheShadowBlock) {
     EXPECT_FALSE(fs::exists(dir / "bias-slope.svg"));
     for (const auto& e : fs::directory_iterator(dir))
         EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
-    const Json block = Json::parse(readText(dir / "recommended-shadow.json"));
+    // Without a verified recommendation the file holds the probe slice's block, measured: null.
+    const Json file = Json::parse(readText(dir / "recommended-shadow.json"));
+    EXPECT_TRUE(file.at("measured").is_null());
+    const Json block = file.at("shadow");
     EXPECT_EQ(block, recommendBias(in.rows).shadowBlock);
     // The window 0.002 .. 0.008 of a log-spaced series: sqrt(0.002 · 0.008) = 0.004.
     EXPECT_DOUBLE_EQ(block.at("depth_bias").get<double>(), 0.004);
@@ -193,6 +196,31 @@ TEST(SweepReport, AnEmptySweepStillWritesAPage) {
     const std::string html = renderSweepReportHtml(in);
     EXPECT_NE(html.find("no configuration yet"), std::string::npos);
     EXPECT_NE(html.find("</html>"), std::string::npos);
+}
+
+TEST(SweepReport, AVerifiedRecommendationIsWhatTheFileAndThePageHold) {
+    const fs::path dir = fs::path(::testing::TempDir()) / "sweep_report_recommendation";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    SweepReportInput in = syntheticSweep();
+    Recommendation r;
+    r.resolution = "320x180";
+    r.shadowBlock = {{"depth_bias", 0.5}, {"slope_bias", 2.0}};
+    r.raster.searched = r.raster.beatsDefaults = true;
+    r.raster.defaults.ok = r.raster.tried.ok = true;
+    r.raster.defaults.mismatchRate = 0.004;
+    r.raster.tried.mismatchRate = 0.001;
+    r.raster.recommended = r.raster.tried;
+    r.notes.push_back("At 320x180 the searched point gains 0.3%.");
+    in.recommendation = r;
+    writeSweepReport(dir, in);
+    const Json file = Json::parse(readText(dir / "recommended-shadow.json"));
+    EXPECT_EQ(file.at("shadow"), r.shadowBlock);
+    EXPECT_DOUBLE_EQ(file.at("measured").at("raster").at("mismatch_rate_gain").get<double>(), 0.004 - 0.001);
+    const std::string html = readText(dir / "report.html");
+    EXPECT_NE(html.find("At 320x180 the searched point gains 0.3%."), std::string::npos);
+    EXPECT_NE(html.find(escapeHtml(r.shadowBlock.dump(2))), std::string::npos);
+    EXPECT_EQ(summarizeSweep(in, "sweep/report.html").shadowBlockJson, r.shadowBlock.dump(2));
 }
 
 }  // namespace
