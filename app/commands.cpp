@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "compare/compare.h"
+#include "compare/gates.h"
 #include "compare/report.h"
 #include "compare/stability.h"
 #include "compare/sweep.h"
@@ -22,7 +23,9 @@
 #include "raytrace/memory.h"
 #include "raytrace/renderer.h"
 #include "scene/error.h"
+#include "scene/frame_identity.h"
 #include "scene/frame_io.h"
+#include "scene/mask_io.h"
 #include "scene/loader.h"
 #include "scene/memory.h"
 #include "scene/render_plan.h"
@@ -148,6 +151,7 @@ scene::Frame renderBackend(const Prepared& p, const std::string& backend,
     }
     f.attributes["scene"] = p.scene.file.string();
     f.attributes["version"] = SHADOWLAB_VERSION;
+    scene::recordIdentity(f, p.scene);
     return f;
 }
 
@@ -225,6 +229,23 @@ constexpr RunView kRunViews[] = {
     {"cascades", "cascades", "The cascade each pixel's shadow test used: red, green, blue, yellow from near to far."},
 };
 
+scene::Budgets parseBudgets(const BudgetOptions& o) {
+    scene::Budgets b;
+    for (int k = 0; k < scene::kBudgetKindCount; ++k) {
+        const auto kind = scene::BudgetKind(k);
+        if (o.text[k]) b[kind] = scene::parseBudgetLimit(*o.text[k], kind, scene::budgetInfo(kind).option);
+    }
+    return b;
+}
+
+// Prints every budget checked for `method` on stderr (broken ones say so); true when one broke.
+bool reportBudgets(const std::string& method, const std::vector<compare::BudgetCheck>& checks) {
+    for (const compare::BudgetCheck& c : checks)
+        std::cerr << "shadowlab: budget: " << method << ": "
+                  << compare::describe(c) << "\n";
+    return compare::anyBroken(checks);
+}
+
 }  // namespace
 
 int render(const RenderOptions& o) {
@@ -284,20 +305,37 @@ int render(const RenderOptions& o) {
 int compareFiles(const CompareOptions& o) {
     if (o.output.extension() != ".png")
         throw scene::InputError(o.output.string() + ": the difference image must be a .png");
-    const scene::Frame method = scene::readFrame(o.method);
+    const scene::Budgets budgets = parseBudgets(o.budgets);
+    const bool maskOnly = o.maskChannel || o.maskInvert || o.maskSrgb || o.method.extension() == ".png";
     const scene::Frame reference = scene::readFrame(o.reference);
+    const scene::Frame method =
+        maskOnly ? scene::frameFromMask(scene::readShadowMask(o.method, {o.maskChannel, o.maskInvert, o.maskSrgb}),
+                                        reference, o.method)
+                 : scene::readFrame(o.method);
+    if (const std::string d = scene::describeIdentityDifference(method, reference); !d.empty()) {
+        if (!o.allowDifferentScene)
+            throw scene::InputError(o.method.string() + " vs " + o.reference.string() + ": " + d +
+                                    "; compare frames of one scene, camera and size (--allow-different-scene "
+                                    "compares them anyway)");
+        std::cerr << "shadowlab: warning: " << d << " (--allow-different-scene)\n";
+    }
     compare::Comparison c;
+    std::vector<compare::BudgetCheck> checks;
     try {
         c = compare::compareFrames(method, reference);
+        checks = compare::checkBudgets(c.metrics, budgets);
     } catch (const scene::InputError& e) {
         throw scene::InputError(o.method.string() + " vs " + o.reference.string() + ": " + e.what());
     }
     scene::writePngDisplay(o.output, c.width, c.height, c.diffRgb);
-    if (o.json)
-        std::cout << compare::toJson(c.metrics).dump(2) << "\n";
-    else
+    if (o.json) {
+        Json j = compare::toJson(c.metrics);
+        if (!checks.empty()) j["budgets"] = compare::toJson(checks);
+        std::cout << j.dump(2) << "\n";
+    } else {
         std::cout << compare::summaryLine(c.metrics) << "\n";
-    return 0;
+    }
+    return reportBudgets(o.method.filename().string(), checks) ? kExitBudgetBroken : 0;
 }
 
 int info(bool validate) {
@@ -308,7 +346,10 @@ int info(bool validate) {
 }
 
 int run(const RunOptions& o) {
+    const scene::Budgets cliBudgets = parseBudgets(o.budgets);
     const Prepared p = prepare(o.common);
+    const scene::Budgets budgets = p.scene.budgets.overriddenBy(cliBudgets);
+    bool budgetBroken = false;
     // The reference, the ray-traced and the raster Frames are all held until the report is
     // written, with a difference image for each method (the half-size sweep needs less).
     const std::uint64_t pixels = std::uint64_t(p.scene.camera.width) * std::uint64_t(p.scene.camera.height);
@@ -369,6 +410,9 @@ int run(const RunOptions& o) {
         metrics["methods"][backend] = {{"metrics", compare::toJson(c.metrics)},
                                        {"timings_ms", timingsJson(frame)},
                                        {"attributes", frame.attributes}};
+        const std::vector<compare::BudgetCheck> checks = compare::checkBudgets(c.metrics, budgets);
+        if (!checks.empty()) metrics["methods"][backend]["budgets"] = compare::toJson(checks);
+        budgetBroken = reportBudgets(backend, checks) || budgetBroken;
         report.methods.push_back({backend, backend + ".png", "diff-" + backend + ".png", frame, c.metrics});
         if (backend == "raster" && views) {
             for (const RunView& v : kRunViews) {
@@ -416,7 +460,8 @@ int run(const RunOptions& o) {
     compare::writeReport(dir, report);
     std::cerr << "shadowlab: wrote " << (dir / "report.html").string() << "; " << memoryLine(estimate) << "\n";
     if (o.common.json) std::cout << metrics.dump(2) << "\n";
-    return status;
+    // A failure (1) says more than a broken budget: a method that did not render measured nothing.
+    return status != 0 ? status : budgetBroken ? kExitBudgetBroken : 0;
 }
 
 int sweep(const SweepOptions& o) {

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "scene/budgets.h"
 #include "scene/error.h"
 #include "scene/mesh_loader.h"
 #include "scene/settings.h"
@@ -350,6 +351,14 @@ ShadowDefaults readShadow(const Reader& r, const Json& node, const JsonPath& pat
     return d;
 }
 
+}  // namespace
+
+ShadowDefaults readShadowBlock(const fs::path& file, const Json& node, const JsonPath& path) {
+    return readShadow(Reader(file), node, path);
+}
+
+namespace {
+
 // "line L, column C" for a byte offset, so a syntax error points at the place in an editor.
 std::string lineColumn(const std::string& text, std::size_t byte) {
     std::size_t line = 1, column = 1;
@@ -376,7 +385,8 @@ Scene parseScene(const fs::path& file, const std::string& text) {
         if (const auto pos = what.find("] "); pos != std::string::npos) what = what.substr(pos + 2);
         throw SceneError(file, root, "invalid JSON: " + what + " (numbers must be finite)");
     }
-    r.checkKeys(doc, root, {"camera", "background", "ambient", "materials", "lights", "objects", "shadow", "description"});
+    r.checkKeys(doc, root, {"camera", "background", "ambient", "materials", "lights", "objects", "shadow", "budgets",
+                            "description"});
 
     Scene scene;
     scene.file = file;
@@ -417,6 +427,7 @@ Scene parseScene(const fs::path& file, const std::string& text) {
         scene.objects.push_back(readObject(r, objects[i], root / "objects" / i, materialIndex, meshCache));
 
     if (doc.contains("shadow")) scene.shadow = readShadow(r, doc["shadow"], root / "shadow");
+    if (doc.contains("budgets")) scene.budgets = readBudgets(file, doc["budgets"], root / "budgets");
     return scene;
 }
 
