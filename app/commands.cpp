@@ -11,6 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "compare/check.h"
+#include "compare/check_report.h"
 #include "compare/compare.h"
 #include "compare/gates.h"
 #include "compare/report.h"
@@ -501,6 +503,69 @@ int sweep(const SweepOptions& o) {
               << result.rows.size() << " rows" << (failed ? ", " + std::to_string(failed) + " failed" : "") << ")\n";
     if (o.common.json) std::cout << compare::rowsToJson(result.rows).dump(2) << "\n";
     return failed ? 1 : 0;
+}
+
+int check(const CheckOptions& o) {
+    // The suite, every scene it names and the baseline are read and checked before anything runs.
+    const compare::CheckSuite suite = compare::loadSuite(o.suite);
+    const std::optional<fs::path> baselineFile = o.baseline ? o.baseline : suite.baseline;
+    if (o.updateBaseline && !baselineFile)
+        throw scene::InputError(o.suite.string() + ": --update-baseline: the suite names no \"baseline\" file and "
+                                "--baseline gives none");
+    std::optional<compare::Baseline> baseline;
+    if (baselineFile && !o.updateBaseline) {
+        if (!fs::exists(*baselineFile))
+            throw scene::InputError(baselineFile->string() + ": no such baseline (write one with --update-baseline)");
+        baseline = compare::loadBaseline(*baselineFile);
+    }
+    std::cerr << "shadowlab: check " << suite.name << ": " << suite.cases.size() << " cases"
+              << (baseline ? " against " + baselineFile->string() : std::string(" without a baseline")) << "\n";
+    const auto results = compare::runSuite(
+        suite, baseline ? &*baseline : nullptr, [&](std::size_t done, const compare::CaseResult& r) {
+            std::string what = r.verdict == compare::CaseVerdict::Error ? "ERROR: " + r.error
+                               : r.metrics ? compare::summaryLine(*r.metrics) : "";
+            if (r.verdict == compare::CaseVerdict::Failed) what = "FAILED: " + r.failures.front() + "; " + what;
+            std::cerr << "shadowlab: check [" << done << "/" << suite.cases.size() << "] " << r.name << ": " << what
+                      << "\n";
+        });
+
+    // Everything goes to a fresh folder that replaces DIR in one step: no file of an earlier run
+    // (a difference image of a case that failed then) survives next to this run's.
+    const fs::path dir = o.outputDir;
+    if (dir.has_parent_path()) fs::create_directories(dir.parent_path());
+    scene::removeStaleTemporaries(dir.has_parent_path() ? dir.parent_path() : fs::path("."));
+    const fs::path tmp = scene::temporarySibling(dir);
+    fs::create_directories(tmp / "cases");
+    std::size_t failed = 0, errors = 0;
+    for (std::size_t i = 0; i < results.size(); ++i) {
+        const compare::CaseResult& r = results[i];
+        failed += r.verdict == compare::CaseVerdict::Failed ? 1 : 0;
+        errors += r.verdict == compare::CaseVerdict::Error ? 1 : 0;
+        scene::writeTextAtomic(tmp / "cases" / (r.name + ".json"), compare::caseJson(suite.cases[i], r).dump(2) + "\n");
+        if (!r.diffRgb.empty())
+            scene::writePngDisplay(tmp / "cases" / (r.name + "-diff.png"), r.width, r.height, r.diffRgb);
+    }
+    scene::writeTextAtomic(tmp / "junit.xml", compare::junitXml(suite, results));
+    scene::writeTextAtomic(tmp / "summary.md", compare::markdownSummary(suite, results, o.updateBaseline));
+    scene::replaceDirectory(tmp, dir);
+    if (o.updateBaseline) {
+        // Cases that could not render keep their old entry; cases no longer in the suite go.
+        compare::Baseline old, next;
+        try {
+            if (fs::exists(*baselineFile)) old = compare::loadBaseline(*baselineFile);
+        } catch (const scene::SceneError&) {
+            // A damaged baseline is being replaced.
+        }
+        for (const compare::CaseResult& r : results) {
+            if (r.metrics) next[r.name] = compare::baselineEntry(*r.metrics);
+            else if (old.count(r.name)) next[r.name] = old[r.name];
+        }
+        scene::writeTextAtomic(*baselineFile, compare::baselineJson(suite.name, next).dump(2) + "\n");
+        std::cerr << "shadowlab: wrote the baseline " << baselineFile->string() << "\n";
+    }
+    std::cerr << "shadowlab: check " << suite.name << ": " << results.size() - failed - errors << " passed, " << failed
+              << " failed, " << errors << " errors; wrote " << (dir / "junit.xml").string() << ", summary.md, cases/\n";
+    return errors ? 1 : failed ? kExitBudgetBroken : 0;
 }
 
 int stability(const StabilityCommandOptions& o) {

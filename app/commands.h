@@ -79,7 +79,15 @@ struct CompareOptions {
     bool maskSrgb = false;
 };
 
+struct CheckOptions {
+    std::filesystem::path suite;
+    std::filesystem::path outputDir;
+    std::optional<std::filesystem::path> baseline;  // instead of the suite's "baseline"
+    bool updateBaseline = false;
+};
+
 int render(const RenderOptions& options);
+int check(const CheckOptions& options);
 int run(const RunOptions& options);
 int compareFiles(const CompareOptions& options);
 int info(bool validate);

@@ -153,6 +153,17 @@ int main(int argc, char** argv) {
     compareCmd->add_flag("--mask-srgb", compareOptions.maskSrgb,
                          "METHOD is a shadow mask with sRGB-encoded values (default: linear)");
 
+    shadowlab::app::CheckOptions checkOptions;
+    auto* checkCmd = app.add_subcommand(
+        "check", "CI gate: run a suite of cases (scene, backend, settings, budgets) against the reference, their "
+                 "budgets and a stored baseline; writes junit.xml, summary.md and one JSON per case; exits 3 "
+                 "when a case fails, 1 when one cannot render");
+    checkCmd->add_option("SUITE", checkOptions.suite, "Suite file (JSON, see docs/ci.md)")->required();
+    checkCmd->add_option("-o,--output", checkOptions.outputDir, "Output folder (replaced as a whole)")->required();
+    checkCmd->add_option("--baseline", checkOptions.baseline, "Baseline file instead of the suite's \"baseline\"");
+    checkCmd->add_flag("--update-baseline", checkOptions.updateBaseline,
+                       "Write this run's metrics as the baseline (budgets still apply; no regression check)");
+
     bool infoValidate = false;
     auto* infoCmd = app.add_subcommand("info", "Vulkan devices, driver and API versions, lavapipe or not");
     infoCmd->add_flag("--validate", infoValidate, "Also check that the validation layer loads");
@@ -174,6 +185,7 @@ int main(int argc, char** argv) {
         if (*infoCmd) return shadowlab::app::info(infoValidate);
         if (*sweepCmd) return shadowlab::app::sweep(sweepOptions);
         if (*stabilityCmd) return shadowlab::app::stability(stabilityOptions);
+        if (*checkCmd) return shadowlab::app::check(checkOptions);
     } catch (const shadowlab::scene::SceneError& e) {
         std::cerr << "shadowlab: error: " << e.what() << "\n";
         return 2;
