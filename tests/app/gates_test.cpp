@@ -162,6 +162,30 @@ TEST(AppGates, RunHoldsEveryMethodToTheBudgetsAndRecordsThem) {
     EXPECT_TRUE(fs::exists(out / "report.html"));  // a broken budget still writes everything
 }
 
+TEST(AppGates, ASceneCarriesItsBudgetsAndTheCommandLineOverridesThem) {
+    TempDir dir;
+    const std::string seed = readText(fs::path(SHADOWLAB_SOURCE_DIR) / "scenes" / "seed.json");
+    const auto withBudgets = [&](const std::string& block) {
+        const auto at = seed.rfind('}');
+        return dir.write("s.json", seed.substr(0, at) + ", \"budgets\": " + block + "}");
+    };
+    const auto scene = withBudgets(R"({"max_false_shadow": "1%"})");
+    const auto out = dir.path() / "run";
+    auto r = runShadowlab({"run", scene.string(), "-o", out.string(), "--resolution", "96x54", "--no-sweep",
+                           "--no-raster", "--ray-bias", "0"});
+    EXPECT_EQ(r.exitCode, 3) << r.err;
+    EXPECT_NE(r.err.find("--max-false-shadow: "), std::string::npos) << r.err;
+    r = runShadowlab({"run", scene.string(), "-o", out.string(), "--resolution", "96x54", "--no-sweep", "--no-raster",
+                      "--ray-bias", "0", "--max-false-shadow", "50%"});
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    const auto bad = withBudgets(R"({"max_mismatch": "lots"})");
+    const auto badOut = dir.path() / "bad";
+    r = runShadowlab({"run", bad.string(), "-o", badOut.string(), "--no-sweep"});
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find("s.json: budgets.max_mismatch: expected a rate in 0..1"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(badOut));
+}
+
 // ---- check ----
 
 struct Suite {
