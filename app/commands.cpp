@@ -308,7 +308,7 @@ int compareFiles(const CompareOptions& o) {
     if (o.output.extension() != ".png")
         throw scene::InputError(o.output.string() + ": the difference image must be a .png");
     const scene::Budgets budgets = parseBudgets(o.budgets);
-    const bool maskOnly = o.maskChannel || o.maskInvert || o.maskSrgb || o.method.extension() == ".png";
+    const bool maskOnly = o.maskChannel || o.maskInvert || o.maskSrgb || scene::looksLikeMask(o.method);
     const scene::Frame reference = scene::readFrame(o.reference);
     const scene::Frame method =
         maskOnly ? scene::frameFromMask(scene::readShadowMask(o.method, {o.maskChannel, o.maskInvert, o.maskSrgb}),

@@ -2,6 +2,7 @@
 #include "scene/mask_io.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 
@@ -20,6 +21,19 @@ float srgbToLinear(float e) {  // IEC 61966-2-1
 }
 
 }  // namespace
+
+bool looksLikeMask(const std::filesystem::path& file) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(file, ec)) return false;
+    std::string ext = file.extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (ext == ".png") return true;
+    if (ext != ".exr") return false;
+    auto in = OIIO::ImageInput::open(file.string());
+    if (!in) return false;
+    const auto& names = in->spec().channelnames;
+    return std::find(names.begin(), names.end(), "visibility") == names.end();
+}
 
 ShadowMask readShadowMask(const std::filesystem::path& file, const MaskOptions& o) {
     if (!std::filesystem::exists(file)) throw InputError(file.string() + ": no such file");

@@ -24,6 +24,10 @@ struct ShadowMask {
     std::string channel;            // the channel read
 };
 
+// True when `file` is an image without a "visibility" channel: not a Frame, so a mask (a PNG, a
+// single-channel EXR). False for a file that cannot be opened (readFrame then says why).
+bool looksLikeMask(const std::filesystem::path& file);
+
 // Throws InputError naming the file and what is wrong: unreadable, no such channel (listing the
 // channels), several channels and none chosen, a value outside 0..1 or not finite (its pixel).
 ShadowMask readShadowMask(const std::filesystem::path& file, const MaskOptions& options);

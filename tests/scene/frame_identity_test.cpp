@@ -232,5 +232,28 @@ TEST(ShadowMask, PngLinearSrgbAndInvertedDecodeToVisibility) {
     EXPECT_THROW(frameFromMask(lin, Frame::allocate(3, 1, false), png), InputError);
 }
 
+TEST(ShadowMask, ASingleChannelExrIsAMaskAndAFrameIsNot) {
+    TempDir dir;
+    const auto exr = dir.path() / "mask.exr";
+    {
+        auto out = OIIO::ImageOutput::create(exr.string());
+        ASSERT_TRUE(out);
+        OIIO::ImageSpec spec(2, 1, 1, OIIO::TypeDesc::FLOAT);
+        spec.channelnames = {"shadow"};
+        ASSERT_TRUE(out->open(exr.string(), spec));
+        const float v[2] = {0.25f, 1.0f};
+        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, v));
+        out->close();
+    }
+    EXPECT_TRUE(looksLikeMask(exr));
+    const ShadowMask m = readShadowMask(exr, {});
+    EXPECT_EQ(m.channel, "shadow");
+    EXPECT_EQ(m.visibility, (std::vector<float>{0.25f, 1.0f}));
+    const auto frame = dir.path() / "frame.exr";
+    writeFrame(Frame::allocate(2, 1, false), frame);
+    EXPECT_FALSE(looksLikeMask(frame));
+    EXPECT_FALSE(looksLikeMask(dir.path() / "missing.exr"));
+}
+
 }  // namespace
 }  // namespace shadowlab::scene
