@@ -285,6 +285,23 @@ TEST(Check, BaselineUpdateThenSameVerdictsThenARegressionFails) {
     EXPECT_FALSE(fs::exists(s.out() / "cases" / "raster-diff.png"));
 }
 
+TEST(Check, ABaselineGivenOnTheCommandLineAndAnImprovementPasses) {
+    Suite s;
+    const auto file = s.write(R"({"resolution": "96x54", "cases": [
+        {"name": "robust", "scene": "seed", "backend": "raytrace", "settings": {"ray_bias": "robust"}}]})");
+    // Robust offsets have no acne on the seed; a baseline that recorded 30% mismatch and an IoU
+    // of 0.5 is far worse: better beyond the tolerance, which passes and says so.
+    const auto base = s.dir.write("elsewhere.json", R"({"shadowlab_check_baseline": 1, "cases": {"robust":
+        {"mismatch_rate": 0.3, "shadow_iou": 0.5}}})");
+    const auto r = runShadowlab({"check", file.string(), "-o", s.out().string(), "--baseline", base.string()});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto j = nlohmann::json::parse(readText(s.out() / "cases" / "robust.json"));
+    EXPECT_EQ(j["has_baseline"], true);
+    ASSERT_EQ(j["baseline_drift"].size(), 2u);  // only the metrics the baseline holds
+    for (const auto& d : j["baseline_drift"]) EXPECT_EQ(d["improved"], true) << d;
+    EXPECT_NE(readText(s.out() / "summary.md").find("mismatch_rate better, shadow_iou better"), std::string::npos);
+}
+
 struct BadSuite {
     const char* name;
     std::string suite;     // written as suite.json
