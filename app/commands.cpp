@@ -14,8 +14,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "compare/check.h"
+#include "compare/check_report.h"
 #include "compare/compare.h"
 #include "compare/machine.h"
+#include "compare/gates.h"
 #include "compare/report.h"
 #include "compare/stability.h"
 #include "compare/merge.h"
@@ -31,7 +34,9 @@
 #include "raytrace/renderer.h"
 #include "raytrace/view_search.h"
 #include "scene/error.h"
+#include "scene/frame_identity.h"
 #include "scene/frame_io.h"
+#include "scene/mask_io.h"
 #include "scene/loader.h"
 #include "scene/memory.h"
 #include "scene/model_view.h"
@@ -206,6 +211,7 @@ scene::Frame renderBackend(const Prepared& p, const std::string& backend,
     f.attributes["scene"] = p.scene.file.string();
     for (const auto& [key, text] : p.scene.origin.choices) f.attributes["choice." + key] = text;
     f.attributes["version"] = SHADOWLAB_VERSION;
+    scene::recordIdentity(f, p.scene);
     return f;
 }
 
@@ -368,6 +374,23 @@ void updateRunManifest(const fs::path& dir, const std::vector<std::string>& earl
     scene::writeTextAtomic(dir / kRunManifest, Json{{"files", written}}.dump(2) + "\n");
 }
 
+scene::Budgets parseBudgets(const BudgetOptions& o) {
+    scene::Budgets b;
+    for (int k = 0; k < scene::kBudgetKindCount; ++k) {
+        const auto kind = scene::BudgetKind(k);
+        if (o.text[k]) b[kind] = scene::parseBudgetLimit(*o.text[k], kind, scene::budgetInfo(kind).option);
+    }
+    return b;
+}
+
+// Prints every budget checked for `method` on stderr (broken ones say so); true when one broke.
+bool reportBudgets(const std::string& method, const std::vector<compare::BudgetCheck>& checks) {
+    for (const compare::BudgetCheck& c : checks)
+        std::cerr << "shadowlab: budget: " << method << ": "
+                  << compare::describe(c) << "\n";
+    return compare::anyBroken(checks);
+}
+
 }  // namespace
 
 int render(const RenderOptions& o) {
@@ -433,21 +456,38 @@ int compareFiles(const CompareOptions& o) {
         throw scene::InputError(o.output.string() + ": the difference image must be a .png");
     if (o.heat && o.heat->extension() != ".png")
         throw scene::InputError(o.heat->string() + ": the heat map must be a .png");
-    const scene::Frame method = scene::readFrame(o.method);
+    const scene::Budgets budgets = parseBudgets(o.budgets);
+    const bool maskOnly = o.maskChannel || o.maskInvert || o.maskSrgb || scene::looksLikeMask(o.method);
     const scene::Frame reference = scene::readFrame(o.reference);
+    const scene::Frame method =
+        maskOnly ? scene::frameFromMask(scene::readShadowMask(o.method, {o.maskChannel, o.maskInvert, o.maskSrgb}),
+                                        reference, o.method)
+                 : scene::readFrame(o.method);
+    if (const std::string d = scene::describeIdentityDifference(method, reference); !d.empty()) {
+        if (!o.allowDifferentScene)
+            throw scene::InputError(o.method.string() + " vs " + o.reference.string() + ": " + d +
+                                    "; compare frames of one scene, camera and size (--allow-different-scene "
+                                    "compares them anyway)");
+        std::cerr << "shadowlab: warning: " << d << " (--allow-different-scene)\n";
+    }
     compare::Comparison c;
+    std::vector<compare::BudgetCheck> checks;
     try {
         c = compare::compareFrames(method, reference);
+        checks = compare::checkBudgets(c.metrics, budgets);
     } catch (const scene::InputError& e) {
         throw scene::InputError(o.method.string() + " vs " + o.reference.string() + ": " + e.what());
     }
     scene::writePngDisplay(o.output, c.width, c.height, c.diffRgb);
     if (o.heat) scene::writePngDisplay(*o.heat, c.width, c.height, c.heatRgb);
-    if (o.json)
-        std::cout << compare::toJson(c.metrics).dump(2) << "\n";
-    else
+    if (o.json) {
+        Json j = compare::toJson(c.metrics);
+        if (!checks.empty()) j["budgets"] = compare::toJson(checks);
+        std::cout << j.dump(2) << "\n";
+    } else {
         std::cout << compare::summaryLine(c.metrics) << "\n";
-    return 0;
+    }
+    return reportBudgets(o.method.filename().string(), checks) ? kExitBudgetBroken : 0;
 }
 
 int info(bool validate) {
@@ -459,7 +499,10 @@ int info(bool validate) {
 
 int run(const RunOptions& o) {
     checkOutputFolder(o.outputDir);
+    const scene::Budgets cliBudgets = parseBudgets(o.budgets);
     const Prepared p = prepare(o.common);
+    const scene::Budgets budgets = p.scene.budgets.overriddenBy(cliBudgets);
+    bool budgetBroken = false;
     // The reference, the ray-traced and the raster Frames are all held until the report is
     // written, with a difference image for each method (the half-size sweep needs less).
     const std::uint64_t pixels = std::uint64_t(p.scene.camera.width) * std::uint64_t(p.scene.camera.height);
@@ -532,12 +575,17 @@ int run(const RunOptions& o) {
         metrics["methods"][backend] = {{"metrics", compare::toJson(c.metrics)},
                                        {"timings_ms", timingsJson(frame)},
                                        {"attributes", frame.attributes}};
+        const std::vector<compare::BudgetCheck> checks = compare::checkBudgets(c.metrics, budgets);
+        if (!checks.empty()) metrics["methods"][backend]["budgets"] = compare::toJson(checks);
+        budgetBroken = reportBudgets(backend, checks) || budgetBroken;
         compare::ReportMethod method{backend, backend + ".png", "diff-" + backend + ".png", frame, c.metrics};
         method.heatPng = "heat-" + backend + ".png";
         scene::writePngDisplay(dir / method.heatPng, c.width, c.height, c.heatRgb);
+        written.push_back(method.heatPng);
         for (std::size_t l = 0; l < c.lightHeatRgb.size(); ++l) {
             method.lightHeatPngs.push_back("heat-" + backend + "-light" + std::to_string(l) + ".png");
             scene::writePngDisplay(dir / method.lightHeatPngs.back(), c.width, c.height, c.lightHeatRgb[l]);
+            written.push_back(method.lightHeatPngs.back());
         }
         report.methods.push_back(std::move(method));
         if (backend == "raster" && views) {
@@ -606,7 +654,8 @@ int run(const RunOptions& o) {
     updateRunManifest(dir, earlierFiles, written);
     std::cerr << "shadowlab: wrote " << (dir / "report.html").string() << "; " << memoryLine(estimate) << "\n";
     if (o.common.json) std::cout << metrics.dump(2) << "\n";
-    return status;
+    // A failure (1) says more than a broken budget: a method that did not render measured nothing.
+    return status != 0 ? status : budgetBroken ? kExitBudgetBroken : 0;
 }
 
 namespace {
@@ -719,6 +768,69 @@ int sweep(const SweepOptions& o) {
               << result.rows.size() << " rows" << (failed ? ", " + std::to_string(failed) + " failed" : "") << ")\n";
     if (o.common.json) std::cout << compare::rowsToJson(result.rows).dump(2) << "\n";
     return failed ? 1 : 0;
+}
+
+int check(const CheckOptions& o) {
+    // The suite, every scene it names and the baseline are read and checked before anything runs.
+    const compare::CheckSuite suite = compare::loadSuite(o.suite);
+    const std::optional<fs::path> baselineFile = o.baseline ? o.baseline : suite.baseline;
+    if (o.updateBaseline && !baselineFile)
+        throw scene::InputError(o.suite.string() + ": --update-baseline: the suite names no \"baseline\" file and "
+                                "--baseline gives none");
+    std::optional<compare::Baseline> baseline;
+    if (baselineFile && !o.updateBaseline) {
+        if (!fs::exists(*baselineFile))
+            throw scene::InputError(baselineFile->string() + ": no such baseline (write one with --update-baseline)");
+        baseline = compare::loadBaseline(*baselineFile);
+    }
+    std::cerr << "shadowlab: check " << suite.name << ": " << suite.cases.size() << " cases"
+              << (baseline ? " against " + baselineFile->string() : std::string(" without a baseline")) << "\n";
+    const auto results = compare::runSuite(
+        suite, baseline ? &*baseline : nullptr, [&](std::size_t done, const compare::CaseResult& r) {
+            std::string what = r.verdict == compare::CaseVerdict::Error ? "ERROR: " + r.error
+                               : r.metrics ? compare::summaryLine(*r.metrics) : "";
+            if (r.verdict == compare::CaseVerdict::Failed) what = "FAILED: " + r.failures.front() + "; " + what;
+            std::cerr << "shadowlab: check [" << done << "/" << suite.cases.size() << "] " << r.name << ": " << what
+                      << "\n";
+        });
+
+    // Everything goes to a fresh folder that replaces DIR in one step: no file of an earlier run
+    // (a difference image of a case that failed then) survives next to this run's.
+    const fs::path dir = o.outputDir;
+    if (dir.has_parent_path()) fs::create_directories(dir.parent_path());
+    scene::removeStaleTemporaries(dir.has_parent_path() ? dir.parent_path() : fs::path("."));
+    const fs::path tmp = scene::temporarySibling(dir);
+    fs::create_directories(tmp / "cases");
+    std::size_t failed = 0, errors = 0;
+    for (std::size_t i = 0; i < results.size(); ++i) {
+        const compare::CaseResult& r = results[i];
+        failed += r.verdict == compare::CaseVerdict::Failed ? 1 : 0;
+        errors += r.verdict == compare::CaseVerdict::Error ? 1 : 0;
+        scene::writeTextAtomic(tmp / "cases" / (r.name + ".json"), compare::caseJson(suite.cases[i], r).dump(2) + "\n");
+        if (!r.diffRgb.empty())
+            scene::writePngDisplay(tmp / "cases" / (r.name + "-diff.png"), r.width, r.height, r.diffRgb);
+    }
+    scene::writeTextAtomic(tmp / "junit.xml", compare::junitXml(suite, results));
+    scene::writeTextAtomic(tmp / "summary.md", compare::markdownSummary(suite, results, o.updateBaseline));
+    scene::replaceDirectory(tmp, dir);
+    if (o.updateBaseline) {
+        // Cases that could not render keep their old entry; cases no longer in the suite go.
+        compare::Baseline old, next;
+        try {
+            if (fs::exists(*baselineFile)) old = compare::loadBaseline(*baselineFile);
+        } catch (const scene::SceneError&) {
+            // A damaged baseline is being replaced.
+        }
+        for (const compare::CaseResult& r : results) {
+            if (r.metrics) next[r.name] = compare::baselineEntry(*r.metrics);
+            else if (old.count(r.name)) next[r.name] = old[r.name];
+        }
+        scene::writeTextAtomic(*baselineFile, compare::baselineJson(suite.name, next).dump(2) + "\n");
+        std::cerr << "shadowlab: wrote the baseline " << baselineFile->string() << "\n";
+    }
+    std::cerr << "shadowlab: check " << suite.name << ": " << results.size() - failed - errors << " passed, " << failed
+              << " failed, " << errors << " errors; wrote " << (dir / "junit.xml").string() << ", summary.md, cases/\n";
+    return errors ? 1 : failed ? kExitBudgetBroken : 0;
 }
 
 int stability(const StabilityCommandOptions& o) {

@@ -7,9 +7,19 @@
 #include <string>
 #include <vector>
 
+#include "scene/budgets.h"
 #include "scene/settings.h"
 
 namespace shadowlab::app {
+
+// Exit codes besides 0 (success), 1 (a render or device failure) and 2 (bad input): a method's
+// shadows broke at least one error budget (docs/ci.md).
+inline constexpr int kExitBudgetBroken = 3;
+
+// --max-mismatch and the other budgets as given, by scene::BudgetKind; parsed by the command.
+struct BudgetOptions {
+    std::optional<std::string> text[scene::kBudgetKindCount];
+};
 
 // Options every rendering command shares.
 struct SceneOptions {
@@ -35,6 +45,7 @@ struct RunOptions {
     std::filesystem::path outputDir;
     bool skipRaster = false;
     bool skipSweep = false;
+    BudgetOptions budgets;  // over the scene's "budgets" block, for every method
 };
 
 struct SweepOptions {
@@ -70,9 +81,24 @@ struct CompareOptions {
     std::filesystem::path output;
     std::optional<std::filesystem::path> heat;  // the |ΔV| heat map (.png)
     bool json = false;
+    BudgetOptions budgets;
+    bool allowDifferentScene = false;
+    // The method is another engine's shadow mask (docs/external-masks.md): with any of these, or
+    // when it is a .png.
+    std::optional<std::string> maskChannel;
+    bool maskInvert = false;
+    bool maskSrgb = false;
+};
+
+struct CheckOptions {
+    std::filesystem::path suite;
+    std::filesystem::path outputDir;
+    std::optional<std::filesystem::path> baseline;  // instead of the suite's "baseline"
+    bool updateBaseline = false;
 };
 
 int render(const RenderOptions& options);
+int check(const CheckOptions& options);
 int run(const RunOptions& options);
 int compareFiles(const CompareOptions& options);
 int info(bool validate);

@@ -1,6 +1,7 @@
 // app/main.cpp: the `shadowlab` program: parses the command line (CLI11), calls the
 // subcommand, and turns every failure into one message and a non-zero exit code:
-//   1  a render or device failure, 2  bad input (scene, frame, command line).
+//   1  a render or device failure, 2  bad input (scene, frame, command line),
+//   3  a method broke an error budget (compare, run, check).
 #include <cstdio>
 #include <iostream>
 #include <string>
@@ -79,6 +80,22 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
     cmd.add_flag("--json", o.json, "Print machine-readable results on stdout");
 }
 
+void addBudgetOptions(CLI::App& cmd, shadowlab::app::BudgetOptions& o) {
+    using shadowlab::scene::BudgetKind;
+    using shadowlab::scene::budgetInfo;
+    const char* help[shadowlab::scene::kBudgetKindCount] = {
+        "Budget: false + missed shadow pixels, as a rate of the counted pixels (0.005 or 0.5%) or a count (120px)",
+        "Budget: false-shadow (acne) pixels, a rate (0.5%) or a count (120px)",
+        "Budget: missed-shadow (leak) pixels, a rate (0.5%) or a count (120px)",
+        "Budget: self-shadow acne pixels (needs the method's blocker ids), a rate (0.5%) or a count (120px)",
+        "Budget: mean |V_method - V_reference| over the counted pixels, 0..1 or a percentage",
+        "Budget: least IoU of the shadowed sets, 0..1 or a percentage",
+    };
+    for (int k = 0; k < shadowlab::scene::kBudgetKindCount; ++k)
+        cmd.add_option(budgetInfo(BudgetKind(k)).option, o.text[k],
+                       std::string(help[k]) + "; a broken budget exits 3");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -95,6 +112,7 @@ int main(int argc, char** argv) {
     runCmd->add_option("-o,--output", runOptions.outputDir, "Output folder (created)")->required();
     runCmd->add_flag("--no-raster", runOptions.skipRaster, "Skip the Vulkan backend (no Vulkan on this machine)");
     runCmd->add_flag("--no-sweep", runOptions.skipSweep, "Skip the small settings sweep (error against run time, bias windows)");
+    addBudgetOptions(*runCmd, runOptions.budgets);
 
     shadowlab::app::RenderOptions renderOptions;
     auto* renderCmd = app.add_subcommand("render", "Render one backend into a Frame (.exr: every AOV and "
@@ -154,12 +172,34 @@ int main(int argc, char** argv) {
     shadowlab::app::CompareOptions compareOptions;
     auto* compareCmd = app.add_subcommand("compare", "Classify a method's shadows against a reference Frame "
                                                      "and write the difference image");
-    compareCmd->add_option("METHOD", compareOptions.method, "Method Frame (.exr from `render`)")->required();
+    compareCmd->add_option("METHOD", compareOptions.method,
+                           "Method Frame (.exr from `render`), or a shadow mask (.png, or with --mask-*)")
+        ->required();
     compareCmd->add_option("REFERENCE", compareOptions.reference, "Reference Frame (.exr)")->required();
     compareCmd->add_option("-o,--output", compareOptions.output, "Difference image (.png)")->required();
     compareCmd->add_flag("--json", compareOptions.json, "Print the metrics as JSON on stdout");
     compareCmd->add_option("--heat", compareOptions.heat,
                            "Also write the |V_method - V_reference| heat map (.png; docs/compare.md has its color scale)");
+    addBudgetOptions(*compareCmd, compareOptions.budgets);
+    compareCmd->add_flag("--allow-different-scene", compareOptions.allowDifferentScene,
+                         "Compare frames that record different scenes, cameras (a warning instead of exit 2)");
+    compareCmd->add_option("--mask-channel", compareOptions.maskChannel,
+                           "METHOD is a shadow mask: read this channel of it (1 = lit); ids, N.L and which pixels "
+                           "count come from REFERENCE");
+    compareCmd->add_flag("--mask-invert", compareOptions.maskInvert, "METHOD is a shadow mask storing 1 = shadowed");
+    compareCmd->add_flag("--mask-srgb", compareOptions.maskSrgb,
+                         "METHOD is a shadow mask with sRGB-encoded values (default: linear)");
+
+    shadowlab::app::CheckOptions checkOptions;
+    auto* checkCmd = app.add_subcommand(
+        "check", "CI gate: run a suite of cases (scene, backend, settings, budgets) against the reference, their "
+                 "budgets and a stored baseline; writes junit.xml, summary.md and one JSON per case; exits 3 "
+                 "when a case fails, 1 when one cannot render");
+    checkCmd->add_option("SUITE", checkOptions.suite, "Suite file (JSON, see docs/ci.md)")->required();
+    checkCmd->add_option("-o,--output", checkOptions.outputDir, "Output folder (replaced as a whole)")->required();
+    checkCmd->add_option("--baseline", checkOptions.baseline, "Baseline file instead of the suite's \"baseline\"");
+    checkCmd->add_flag("--update-baseline", checkOptions.updateBaseline,
+                       "Write this run's metrics as the baseline (budgets still apply; no regression check)");
 
     bool infoValidate = false;
     auto* infoCmd = app.add_subcommand("info", "Vulkan devices, driver and API versions, lavapipe or not");
@@ -183,6 +223,7 @@ int main(int argc, char** argv) {
         if (*sweepCmd) return shadowlab::app::sweep(sweepOptions);
         if (*mergeCmd) return shadowlab::app::merge(mergeOptions);
         if (*stabilityCmd) return shadowlab::app::stability(stabilityOptions);
+        if (*checkCmd) return shadowlab::app::check(checkOptions);
     } catch (const shadowlab::scene::SceneError& e) {
         std::cerr << "shadowlab: error: " << e.what() << "\n";
         return 2;

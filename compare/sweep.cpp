@@ -19,6 +19,7 @@
 #include "raster/renderer.h"
 #include "raytrace/renderer.h"
 #include "scene/error.h"
+#include "scene/frame_identity.h"
 #include "scene/frame_io.h"
 #include "scene/render_plan.h"
 
@@ -453,10 +454,13 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
 scene::Frame renderWithBackend(const scene::Scene& scene, const scene::RenderSettings& settings,
                                const std::string& backend) {
     const scene::RenderPlan plan = scene::makeRenderPlan(scene, settings);
-    if (backend == "raster") return raster::render(scene, plan, settings.raster);
-    if (backend == "raytrace") return raytrace::render(scene, plan, settings.raytrace);
-    if (backend == "reference") return raytrace::renderReference(scene, plan, settings.raytrace);
-    throw scene::InputError("unknown backend '" + backend + "'");
+    scene::Frame f;
+    if (backend == "raster") f = raster::render(scene, plan, settings.raster);
+    else if (backend == "raytrace") f = raytrace::render(scene, plan, settings.raytrace);
+    else if (backend == "reference") f = raytrace::renderReference(scene, plan, settings.raytrace);
+    else throw scene::InputError("unknown backend '" + backend + "'");
+    scene::recordIdentity(f, scene);
+    return f;
 }
 
 namespace {
@@ -472,7 +476,11 @@ std::function<scene::Frame()> frameSource(const SweepOptions& options, const sce
     if (backend == "raster" && fn && *fn == &renderWithBackend) {
         auto renderer =
             std::make_shared<raster::Renderer>(scene, scene::makeRenderPlan(scene, settings), settings.raster);
-        return [renderer] { return renderer->render(); };
+        return [renderer, &scene] {
+            scene::Frame f = renderer->render();
+            scene::recordIdentity(f, scene);
+            return f;
+        };
     }
     return [&options, &scene, &settings, backend] { return options.render(scene, settings, backend); };
 }

@@ -6,7 +6,11 @@
 #include <map>
 #include <string>
 #include <utility>
+#include <variant>
 #include <vector>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
 
 namespace shadowlab::scene {
 
@@ -28,6 +32,11 @@ inline constexpr ChannelMask kAllChannels = (1u << 7) - 1;
 // again) and skip its float precision; the raster backend renders into an 8-bit sRGB target.
 inline constexpr ChannelMask kBeautyForDisplay = 1u << 7;
 
+// A typed metadata value, written as the EXR attribute type of its own: int, float, v3f, m44f.
+// A matrix is held as GLM holds it (column vectors: p' = M·p); written to EXR, where matrices
+// act on row vectors (p' = p·M), it is the transpose, which is GLM's memory order as it is.
+using AttributeValue = std::variant<int, float, glm::vec3, glm::mat4>;
+
 struct Frame {
     int width = 0;
     int height = 0;
@@ -46,6 +55,9 @@ struct Frame {
     std::vector<std::vector<float>> lightVisibility;
     // Metadata written as EXR header attributes: "backend", "scene", "version", settings...
     std::map<std::string, std::string> attributes;
+    // Numbers as typed EXR attributes: the camera as OpenEXR's standard "worldToCamera" and
+    // "worldToNDC", each light's parameters ("light.0.intensity", ...); see frame_identity.h.
+    std::map<std::string, AttributeValue> typedAttributes;
     // Stage timings in milliseconds, in the order they ran ("setup", "shadow_pass", ...).
     std::vector<std::pair<std::string, double>> timingsMs;
 

@@ -8,7 +8,9 @@
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <cstring>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <cerrno>
 #include <csignal>
@@ -138,6 +140,19 @@ void checkExrHeader(const fs::path& file) {
         }
         in.seekg(end);
     }
+}
+
+// OpenEXR's standard camera attributes go by other names inside OpenImageIO, which renames them
+// on reading and writing ("worldToCamera" is OIIO's "worldtocamera").
+std::optional<std::string> exrStandardToOiio(const std::string& exrName) {
+    if (exrName == "worldToCamera") return "worldtocamera";
+    if (exrName == "worldToNDC") return "worldtoNDC";
+    return std::nullopt;
+}
+std::optional<std::string> exrStandardFromOiio(const std::string& oiioName) {
+    if (oiioName == "worldtocamera" || oiioName == "worldToCamera") return "worldToCamera";
+    if (oiioName == "worldtoNDC" || oiioName == "worldToNDC") return "worldToNDC";
+    return std::nullopt;
 }
 
 // Runs `write(tmp)` and renames tmp onto `file`; removes tmp if anything fails.
@@ -320,6 +335,14 @@ void writeFrame(const Frame& frame, const fs::path& file) {
     spec.attribute("compression", "zip");
     for (const auto& [key, value] : frame.attributes) spec.attribute(kAttrPrefix + key, value);
     spec.attribute(kTimingsAttr, encodeTimings(frame.timingsMs));
+    for (const auto& [key, value] : frame.typedAttributes) {
+        const std::string name = exrStandardToOiio(key).value_or(kAttrPrefix + key);
+        if (const int* i = std::get_if<int>(&value)) spec.attribute(name, TypeDesc::INT, i);
+        else if (const float* f = std::get_if<float>(&value)) spec.attribute(name, TypeDesc::FLOAT, f);
+        else if (const glm::vec3* v = std::get_if<glm::vec3>(&value)) spec.attribute(name, OIIO::TypeVector, v);
+        // GLM's memory order is the transpose of the matrix it means: the row-vector m44f EXR wants.
+        else spec.attribute(name, OIIO::TypeMatrix44, &std::get<glm::mat4>(value));
+    }
 
     const int firstLight = withBlocker ? 8 : 7;
     std::vector<float> pixels(n * channels);
@@ -412,10 +435,27 @@ Frame readFrame(const fs::path& file) {
     const std::string prefix = kAttrPrefix;
     for (const auto& attr : spec.extra_attribs) {
         const std::string name = attr.name().string();
-        if (name == kTimingsAttr)
+        const TypeDesc t = attr.type();
+        const std::optional<std::string> standard = exrStandardFromOiio(name);
+        const bool ours = name.rfind(prefix, 0) == 0;
+        if (name == kTimingsAttr) {
             f.timingsMs = decodeTimings(attr.get_string());
-        else if (name.rfind(prefix, 0) == 0)
+        } else if ((ours || standard) && t == TypeDesc::INT) {
+            f.typedAttributes[standard.value_or(name.substr(prefix.size()))] = attr.get_int();
+        } else if ((ours || standard) && t == TypeDesc::FLOAT) {
+            f.typedAttributes[standard.value_or(name.substr(prefix.size()))] = attr.get_float();
+        } else if ((ours || standard) && t.basetype == TypeDesc::FLOAT && t.aggregate == TypeDesc::VEC3 && !t.arraylen) {
+            glm::vec3 v;
+            std::memcpy(&v, attr.data(), sizeof v);
+            f.typedAttributes[standard.value_or(name.substr(prefix.size()))] = v;
+        } else if ((ours || standard) && t.basetype == TypeDesc::FLOAT && t.aggregate == TypeDesc::MATRIX44 &&
+                   !t.arraylen) {
+            glm::mat4 m;
+            std::memcpy(&m, attr.data(), sizeof m);
+            f.typedAttributes[standard.value_or(name.substr(prefix.size()))] = m;
+        } else if (ours) {
             f.attributes[name.substr(prefix.size())] = attr.get_string();
+        }
     }
     return f;
 }

@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "scene/budgets.h"
 #include "scene/error.h"
 #include "scene/mesh_loader.h"
 #include "scene/model_view.h"
@@ -405,6 +406,15 @@ void addFileCameras(const Reader& r, Scene& scene, const std::vector<PendingCame
     }
 }
 
+
+}  // namespace
+
+ShadowDefaults readShadowBlock(const fs::path& file, const Json& node, const JsonPath& path) {
+    return readShadow(Reader(file), node, path);
+}
+
+namespace {
+
 // "line L, column C" for a byte offset, so a syntax error points at the place in an editor.
 std::string lineColumn(const std::string& text, std::size_t byte) {
     std::size_t line = 1, column = 1;
@@ -431,8 +441,8 @@ Scene parseScene(const fs::path& file, const std::string& text) {
         if (const auto pos = what.find("] "); pos != std::string::npos) what = what.substr(pos + 2);
         throw SceneError(file, root, "invalid JSON: " + what + " (numbers must be finite)");
     }
-    r.checkKeys(doc, root, {"camera", "background", "ambient", "materials", "lights", "objects", "shadow", "description",
-                            "ground", "$schema"});
+    r.checkKeys(doc, root, {"camera", "background", "ambient", "materials", "lights", "objects", "shadow", "budgets",
+                            "description", "ground", "$schema"});
 
     Scene scene;
     scene.file = file;
@@ -506,6 +516,7 @@ Scene parseScene(const fs::path& file, const std::string& text) {
     addFileCameras(r, scene, pending, nearFarGiven);
 
     if (doc.contains("shadow")) scene.shadow = readShadow(r, doc["shadow"], root / "shadow");
+    if (doc.contains("budgets")) scene.budgets = readBudgets(file, doc["budgets"], root / "budgets");
     return scene;
 }
 

@@ -5,6 +5,9 @@
 #include <filesystem>
 #include <string>
 
+#include <nlohmann/json_fwd.hpp>
+
+#include "scene/error.h"
 #include "scene/scene.h"
 
 namespace shadowlab::scene {
@@ -15,6 +18,10 @@ Scene loadScene(const std::filesystem::path& file);
 // in the scenes folder. Throws InputError listing the shipped names when nothing matches.
 std::filesystem::path findScene(const std::string& nameOrPath);
 std::filesystem::path scenesDirectory();
+
+// A "shadow" block (the settings keys of a scene file) found in another file, e.g. a case of a
+// `check` suite; throws SceneError naming `file` and the JSON path of a bad value.
+ShadowDefaults readShadowBlock(const std::filesystem::path& file, const nlohmann::json& node, const JsonPath& path);
 
 // Largest image the loaders accept on either side, and in total pixels. Above this a render
 // would need more memory than the machines we target have (see docs/decisions.md).

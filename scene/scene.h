@@ -13,6 +13,8 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/budgets.h"
+
 namespace shadowlab::scene {
 
 using Vec2 = glm::dvec2;
@@ -188,6 +190,8 @@ struct Scene {
     std::vector<Object> objects;
     ShadowDefaults shadow;
     SceneOrigin origin;
+    // The optional "budgets" block: limits `run` and `check` hold each method to (docs/ci.md).
+    Budgets budgets;
 
     const Material& materialOf(const Object& o) const { return materials[o.material]; }
     bool allOpaque() const;

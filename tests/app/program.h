@@ -1,0 +1,53 @@
+// tests/app/program.h: runs the `shadowlab` program with arguments and collects its exit code,
+// stdout and stderr (for test files that need no process control; see subprocess.h for that).
+#pragma once
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+#include <vector>
+
+#include "tests/scene/test_files.h"
+
+namespace shadowlab::test {
+
+struct ProgramResult {
+    int exitCode = -1;
+    std::string out;
+    std::string err;
+};
+
+inline std::string readText(const std::filesystem::path& p) {
+    std::ifstream in(p);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+inline ProgramResult runShadowlab(const std::vector<std::string>& args) {
+    auto quote = [](const std::string& s) {
+        std::string q = "'";
+        for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+        return q + "'";
+    };
+    TempDir io;
+    std::string cmd = quote(SHADOWLAB_EXE);
+    for (const auto& a : args) {
+        cmd += ' ';
+        cmd += quote(a);
+    }
+    cmd += " >";
+    cmd += quote((io.path() / "out").string());
+    cmd += " 2>";
+    cmd += quote((io.path() / "err").string());
+    const int status = std::system(cmd.c_str());
+    ProgramResult r;
+    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = readText(io.path() / "out");
+    r.err = readText(io.path() / "err");
+    return r;
+}
+
+}  // namespace shadowlab::test
