@@ -87,8 +87,8 @@ TEST(Outputs, ARunRemovesWhatTheEarlierRunWroteAndThisOneDoesNotButNothingElse) 
     const auto manifest = nlohmann::json::parse(test::slurpFile(out / ".shadowlab-run.json"));
     std::vector<std::string> files = manifest.at("files");
     std::sort(files.begin(), files.end());
-    EXPECT_EQ(files, (std::vector<std::string>{"diff-raytrace.png", "metrics.json", "raytrace.exr", "raytrace.png",
-                                               "reference.exr", "reference.png", "report.html"}));
+    EXPECT_EQ(files, (std::vector<std::string>{"diff-raytrace.png", "heat-raytrace.png", "metrics.json", "raytrace.exr",
+                                               "raytrace.png", "reference.exr", "reference.png", "report.html"}));
 }
 
 }  // namespace
