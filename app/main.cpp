@@ -38,6 +38,10 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
                  "instead of in the lit shader");
     cmd.add_flag("--fit-light-frustum", s.fitLightFrustum,
                  "raster: fit each light's map to the casters of visible receivers, not the scene's bounds");
+    cmd.add_flag_callback(
+        "--no-snap", [&s] { s.snapLightFrustum = false; },
+        "raster: leave fitted directional maps and cascades unsnapped (they then swim as the camera moves; for "
+        "measuring what snapping buys, docs/temporal.md)");
     cmd.add_option("--cascades", s.cascades,
                    "raster: cascaded shadow maps per directional light, 1..4 (default 1: one map)");
     cmd.add_option("--cascade-blend", s.cascadeBlend,
@@ -101,6 +105,25 @@ int main(int argc, char** argv) {
     sweepCmd->add_option("--repetitions", sweepOptions.repetitions, "Timed frames per configuration (default 3)")
         ->check(CLI::Range(1, 100));
 
+    shadowlab::app::PathCommandOptions pathOptions;
+    auto* pathCmd = app.add_subcommand("path", "Render frames along a camera or light path with the reference and "
+                                               "both backends and measure flicker and swimming (docs/temporal.md)");
+    addSceneOptions(*pathCmd, pathOptions.common);
+    pathCmd->add_option("-o,--output", pathOptions.outputDir, "Output folder (created)")->required();
+    pathCmd->add_option("--kind", pathOptions.kind,
+                        "orbit|dolly|pan|subtexel|sun-azimuth|sun-elevation|light-move (default orbit)");
+    pathCmd->add_option("--frames", pathOptions.frames, "Frames along the path (default 12)");
+    pathCmd->add_option("--amount", pathOptions.amount,
+                        "The path's extent: degrees (orbit 20, sun-azimuth 20, sun-elevation 10), fraction of the "
+                        "distance to the look-at point (dolly 0.3, pan 0.1), per-frame step in min(texel, pixel) "
+                        "(subtexel 0.1), fraction of the scene's size (light-move 0.1)");
+    pathCmd->add_option("--light", pathOptions.light, "The light a light path moves (default 0)");
+    pathCmd->add_flag("--resume", pathOptions.resume, "Continue a stopped path in the same folder");
+    pathCmd->add_flag("--no-raster", pathOptions.skipRaster, "Skip the Vulkan backend");
+    pathCmd->add_flag("--no-raytrace", pathOptions.skipRaytrace, "Skip the ray-traced method");
+    pathCmd->add_flag("--no-held-view", pathOptions.noHeldView,
+                      "Camera paths: skip the raster frames drawn from frame 0's camera");
+
     shadowlab::app::StabilityCommandOptions stabilityOptions;
     auto* stabilityCmd = app.add_subcommand(
         "stability", "Run stiff and extreme cases through the reference and both backends (defaults and best "
@@ -145,6 +168,7 @@ int main(int argc, char** argv) {
         if (*infoCmd) return shadowlab::app::info(infoValidate);
         if (*sweepCmd) return shadowlab::app::sweep(sweepOptions);
         if (*stabilityCmd) return shadowlab::app::stability(stabilityOptions);
+        if (*pathCmd) return shadowlab::app::path(pathOptions);
     } catch (const shadowlab::scene::SceneError& e) {
         std::cerr << "shadowlab: error: " << e.what() << "\n";
         return 2;

@@ -81,6 +81,7 @@ RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& o) {
     s.raster.receiverPlaneBias = o.receiverPlaneBias.value_or(d.receiverPlaneBias.value_or(false));
     s.raster.hardwareBias = o.hardwareBias.value_or(d.hardwareBias.value_or(false));
     s.raster.fitLightFrustum = o.fitLightFrustum.value_or(d.fitLightFrustum.value_or(false));
+    s.raster.snapLightFrustum = o.snapLightFrustum.value_or(true);
     s.raster.cascades = o.cascades.value_or(d.cascades.value_or(1));
     if (s.raster.cascades < 1 || s.raster.cascades > kMaxCascades)
         throw InputError("--cascades: must be in 1.." + std::to_string(kMaxCascades) + ", got " +
