@@ -378,7 +378,8 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
         if (done.count(t)) {
             const Json& j = done[t];
             for (const auto& [name, ms] : j.at("frame_ms").items()) times[name].push_back(ms.get<double>());
-            for (const auto& [name, ms] : j.value("setup_ms", Json::object()).items()) setupMs[name] = ms.get<double>();
+            const Json setups = j.value("setup_ms", Json::object());  // kept: items() refers to it
+            for (const auto& [name, ms] : setups.items()) setupMs[name] = ms.get<double>();
             ++result.resumedFrames;
             continue;
         }
@@ -485,20 +486,11 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
             const scene::Frame& f1 = frames[std::size_t(t) + 1];
             const scene::Frame& r0 = *heldRefs[std::size_t(t)];
             const scene::Frame& r1 = *heldRefs[std::size_t(t) + 1];
-            std::vector<unsigned char> mask(std::size_t(w) * h, 0);
+            const std::vector<unsigned char> mask = flickerMask(f0, f1, r0, r1, comparisons[std::size_t(t)].classes,
+                                                                comparisons[std::size_t(t) + 1].classes);
             std::vector<float> map = displayBeauty(f0);
-            const float tau = kVisibilityTolerance;
-            for (std::size_t i = 0; i < mask.size(); ++i) {
-                const auto counted = [&](PixelClass c) { return c != PixelClass::NotCounted && c != PixelClass::Invalid; };
-                if (!counted(comparisons[std::size_t(t)].classes[i]) || !counted(comparisons[std::size_t(t) + 1].classes[i]))
-                    continue;
-                const bool mc = (f0.visibility[i] > tau) != (f1.visibility[i] > tau);
-                const bool rc = (r0.visibility[i] > tau) != (r1.visibility[i] > tau);
-                if (mc && !rc) {
-                    mask[i] = 1;
-                    map[3 * i] = 1.0f, map[3 * i + 1] = 0.08f, map[3 * i + 2] = 0.05f;
-                }
-            }
+            for (std::size_t i = 0; i < mask.size(); ++i)
+                if (mask[i]) map[3 * i] = 1.0f, map[3 * i + 1] = 0.08f, map[3 * i + 2] = 0.05f;
             const ErrorHotspot win = densestWindow(mask, w, h, std::max(16, std::min(w, h) / 5));
             // Zoom: frame t, frame t + 1 and the flicker map of the window, magnified 6x.
             const int z = 6, side = win.size * z;

@@ -197,6 +197,20 @@ TemporalSummary measureTemporal(const std::vector<const scene::Frame*>& method,
     return measureTemporal(method, reference, pointers);
 }
 
+std::vector<unsigned char> flickerMask(const scene::Frame& m0, const scene::Frame& m1, const scene::Frame& r0,
+                                       const scene::Frame& r1, const std::vector<PixelClass>& c0,
+                                       const std::vector<PixelClass>& c1) {
+    const std::size_t n = c0.size();
+    std::vector<unsigned char> mask(n, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+        if (!counts(c0[i]) || !counts(c1[i])) continue;
+        const bool m = (m0.visibility[i] > kTau) != (m1.visibility[i] > kTau);
+        const bool r = (r0.visibility[i] > kTau) != (r1.visibility[i] > kTau);
+        mask[i] = m && !r;
+    }
+    return mask;
+}
+
 nlohmann::json toJson(const PairStability& p) {
     return {{"first", p.first},
             {"comparable", p.comparable},

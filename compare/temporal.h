@@ -74,6 +74,12 @@ TemporalSummary measureTemporal(const std::vector<const scene::Frame*>& method,
 TemporalSummary measureTemporal(const std::vector<const scene::Frame*>& method,
                                 const std::vector<const scene::Frame*>& reference);
 
+// Per pixel, 1 where pair (t, t + 1) flickers (counted in both, the method's state changes, the
+// reference's does not), else 0: what PairStability::flicker counts.
+std::vector<unsigned char> flickerMask(const scene::Frame& method0, const scene::Frame& method1,
+                                       const scene::Frame& reference0, const scene::Frame& reference1,
+                                       const std::vector<PixelClass>& classes0, const std::vector<PixelClass>& classes1);
+
 nlohmann::json toJson(const TemporalSummary& summary);
 nlohmann::json toJson(const PairStability& pair);
 

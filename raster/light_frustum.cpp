@@ -232,8 +232,11 @@ LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const Vec
     }
     const double texel = f.texelWorldSize();
     const double u = glm::dot(receiversCenter, f.right), v = glm::dot(receiversCenter, f.up);
-    f.center = receiversCenter + (std::round(u / texel) * texel - u) * f.right +
-               (std::round(v / texel) * texel - v) * f.up;
+    // From the grid indices alone (and the bounding sphere's depth, fixed for the scene): a map
+    // whose indices did not change is the same to the last bit, not carrying the rounding of the
+    // receivers' extent (docs/temporal.md tests this).
+    f.center = (std::round(u / texel) * texel) * f.right + (std::round(v / texel) * texel) * f.up +
+               glm::dot(f.center, f.direction) * f.direction;
     const double nearDepth = minDepth - pad, farDepth = maxDepth + pad;
     const double depthQuantum = std::exp2(std::floor(std::log2(farDepth - nearDepth)) - 4.0);
     f.nearDepth = std::floor(nearDepth / depthQuantum) * depthQuantum;

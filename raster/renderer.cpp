@@ -279,7 +279,11 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
     lightKinds = 0;
     std::fill(std::begin(uniforms.lights), std::end(uniforms.lights), shaders::LightData{});
     std::fill(std::begin(uniforms.cascades), std::end(uniforms.cascades), shaders::CascadeData{});
-    viewDepthOffset = glm::dot(origin - cam.position, cam.forward);
+    // Cascades are chosen by the view depth of the camera the maps are fitted for (scene.camera):
+    // which cascade a point reads is part of that camera's shadow setup, also when the image is
+    // drawn from another view (a held view); the Frame's Z is that depth too.
+    const scene::CameraBasis fitCam = scene::cameraBasis(scene.camera);
+    viewDepthOffset = glm::dot(origin - fitCam.position, fitCam.forward);
 
     // Caster culling: per culled layer, which objects are drawn into it, and how many are not.
     // Not with a transmittance map: its index order (opaque casters first) is not per object.
@@ -310,7 +314,7 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
     const glm::dmat4 viewProj = scene::projectionMatrix(cam, view.near, view.far) *
                                 scene::viewMatrix(cam, origin);
     uniforms.viewProj = glm::mat4(viewProj);
-    uniforms.forward = glm::vec4(glm::vec3(cam.forward), float(scene.ambient));
+    uniforms.forward = glm::vec4(glm::vec3(fitCam.forward), float(scene.ambient));
     uniforms.background = glm::vec4(glm::vec3(scene.background), 0.0f);
     uniforms.counts = glm::vec4(float(scene.lights.size()), 0, 0, 0);
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {

@@ -84,8 +84,8 @@ public:
     // device but one staging buffer for the uniforms.
     void update(const scene::Scene& scene);
     // The same with the maps fitted for scene.camera but the image drawn from `view` (same
-    // resolution): the held-view frames of a camera path (docs/temporal.md). Cascades are chosen
-    // by the view depth of `view`.
+    // resolution): the held-view frames of a camera path (docs/temporal.md). Cascades are chosen,
+    // and the Frame's Z measured, along scene.camera's view axis: the shadow setup is that camera's.
     void update(const scene::Scene& scene, const scene::Camera& view);
     double setupMs() const;  // the constructor's time
     // Validation messages counted so far (settings.validate); messages raised when the Renderer

@@ -74,7 +74,7 @@ scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan,
     std::optional<Tracer<Real>> own;
     if (!prebuilt) own.emplace(scene);
     const Tracer<Real>& tracer = prebuilt ? *prebuilt : *own;
-    frame.timingsMs.emplace_back("setup", msSince(setupStart));
+    frame.timingsMs.emplace_back("setup", prebuilt ? 0.0 : msSince(setupStart));
 
     const int tilesX = (width + kTileSize - 1) / kTileSize;
     const int tilesY = (height + kTileSize - 1) / kTileSize;
