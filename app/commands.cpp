@@ -19,6 +19,8 @@
 #include "compare/compare.h"
 #include "compare/machine.h"
 #include "compare/gates.h"
+#include "compare/path.h"
+#include "compare/text.h"
 #include "compare/report.h"
 #include "compare/stability.h"
 #include "compare/merge.h"
@@ -831,6 +833,33 @@ int check(const CheckOptions& o) {
     std::cerr << "shadowlab: check " << suite.name << ": " << results.size() - failed - errors << " passed, " << failed
               << " failed, " << errors << " errors; wrote " << (dir / "junit.xml").string() << ", summary.md, cases/\n";
     return errors ? 1 : failed ? kExitBudgetBroken : 0;
+}
+
+int path(const PathCommandOptions& o) {
+    const Prepared p = prepare(o.common);
+    compare::PathSpec spec;
+    spec.kind = compare::parsePathKind(o.kind);
+    spec.frames = o.frames;
+    spec.amount = o.amount;
+    spec.light = o.light;
+    compare::pathScenes(p.scene, p.settings, spec);  // bad paths fail before anything is written
+    compare::PathRunOptions options;
+    options.outputDir = o.outputDir;
+    options.resume = o.resume;
+    options.raster = !o.skipRaster;
+    options.raytrace = !o.skipRaytrace;
+    options.heldView = !o.noHeldView;
+    options.progress = [](const std::string& line) { std::cerr << "shadowlab: path " << line << "\n"; };
+    std::cerr << "shadowlab: " << o.kind << " path of " << o.frames << " frames into " << o.outputDir.string() << "\n";
+    const compare::PathResult result = compare::runPath(p.scene, p.settings, spec, options);
+    for (const compare::PathMethod& m : result.methods)
+        std::cerr << "shadowlab: " << m.name << ": mean flicker " << compare::formatPercent(m.temporal.meanFlickerRate)
+                  << " (" << m.temporal.totalFlicker << " px over " << m.temporal.pairs.size() << " pairs), swim "
+                  << compare::formatFixed(m.temporal.meanSwimPixels, 3) << " px, edge offset "
+                  << compare::formatFixed(m.temporal.meanEdgeOffset, 3) << " px\n";
+    std::cerr << "shadowlab: wrote " << (o.outputDir / "report.html").string() << " and metrics.json\n";
+    if (o.common.json) std::cout << compare::toJson(result).dump(2) << "\n";
+    return 0;
 }
 
 int stability(const StabilityCommandOptions& o) {

@@ -97,8 +97,22 @@ struct CheckOptions {
     bool updateBaseline = false;
 };
 
+struct PathCommandOptions {
+    SceneOptions common;
+    std::filesystem::path outputDir;
+    std::string kind = "orbit";  // compare::PathKind
+    int frames = 12;
+    std::optional<double> amount;
+    int light = 0;
+    bool resume = false;
+    bool skipRaster = false;
+    bool skipRaytrace = false;
+    bool noHeldView = false;
+};
+
 int render(const RenderOptions& options);
 int check(const CheckOptions& options);
+int path(const PathCommandOptions& options);
 int run(const RunOptions& options);
 int compareFiles(const CompareOptions& options);
 int info(bool validate);

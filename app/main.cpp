@@ -51,6 +51,10 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
         });
     cmd.add_flag_callback("--no-fit-light-frustum", [&s] { s.fitLightFrustum = false; },
                           "raster: the scene's bounding-sphere map (and the whole spot cone and cube), not fitted");
+    cmd.add_flag_callback(
+        "--no-snap", [&s] { s.snapLightFrustum = false; },
+        "raster: leave fitted directional maps and cascades unsnapped (they then swim as the camera moves; for "
+        "measuring what snapping buys, docs/temporal.md)");
     cmd.add_option("--cascades", s.cascades,
                    "raster: cascaded shadow maps per directional light, 1..4 (default: chosen per view, 1 unless "
                    "one map's texel exceeds 2 pixels at the nearest receiver; --explain says why)");
@@ -154,6 +158,25 @@ int main(int argc, char** argv) {
     mergeCmd->add_option("-o,--output", mergeOptions.outputDir, "Merged folder (default: the one input folder)");
     mergeCmd->add_flag("--json", mergeOptions.json, "Print the merged rows as JSON on stdout");
 
+    shadowlab::app::PathCommandOptions pathOptions;
+    auto* pathCmd = app.add_subcommand("path", "Render frames along a camera or light path with the reference and "
+                                               "both backends and measure flicker and swimming (docs/temporal.md)");
+    addSceneOptions(*pathCmd, pathOptions.common);
+    pathCmd->add_option("-o,--output", pathOptions.outputDir, "Output folder (created)")->required();
+    pathCmd->add_option("--kind", pathOptions.kind,
+                        "orbit|dolly|pan|subtexel|sun-azimuth|sun-elevation|light-move (default orbit)");
+    pathCmd->add_option("--frames", pathOptions.frames, "Frames along the path (default 12)");
+    pathCmd->add_option("--amount", pathOptions.amount,
+                        "The path's extent: degrees (orbit 20, sun-azimuth 20, sun-elevation 10), fraction of the "
+                        "distance to the look-at point (dolly 0.3, pan 0.1), per-frame step in min(texel, pixel) "
+                        "(subtexel 0.1), fraction of the scene's size (light-move 0.1)");
+    pathCmd->add_option("--light", pathOptions.light, "The light a light path moves (default 0)");
+    pathCmd->add_flag("--resume", pathOptions.resume, "Continue a stopped path in the same folder");
+    pathCmd->add_flag("--no-raster", pathOptions.skipRaster, "Skip the Vulkan backend");
+    pathCmd->add_flag("--no-raytrace", pathOptions.skipRaytrace, "Skip the ray-traced method");
+    pathCmd->add_flag("--no-held-view", pathOptions.noHeldView,
+                      "Camera paths: skip the raster frames drawn from frame 0's camera");
+
     shadowlab::app::StabilityCommandOptions stabilityOptions;
     auto* stabilityCmd = app.add_subcommand(
         "stability", "Run stiff and extreme cases through the reference and both backends (defaults and best "
@@ -224,6 +247,7 @@ int main(int argc, char** argv) {
         if (*mergeCmd) return shadowlab::app::merge(mergeOptions);
         if (*stabilityCmd) return shadowlab::app::stability(stabilityOptions);
         if (*checkCmd) return shadowlab::app::check(checkOptions);
+        if (*pathCmd) return shadowlab::app::path(pathOptions);
     } catch (const shadowlab::scene::SceneError& e) {
         std::cerr << "shadowlab: error: " << e.what() << "\n";
         return 2;

@@ -66,7 +66,7 @@ BoundingSphere sliceBoundingSphere(const scene::CameraBasis& cam, double d0, dou
 }
 
 LightFrustum fitCascade(const scene::Scene& scene, const scene::CameraBasis& cam, double d0, double d1,
-                        const Vec3& direction, int mapSize) {
+                        const Vec3& direction, int mapSize, bool snap) {
     LightFrustum f;
     setBasis(f, direction);
     f.mapSize = std::max(mapSize, 1);
@@ -78,7 +78,7 @@ LightFrustum fitCascade(const scene::Scene& scene, const scene::CameraBasis& cam
     // Quantized up to 1/16 of its power of two: the texel size stays the same while the slice
     // changes a little (a moving camera changes the visible depth range, hence the slices).
     const double quantum = std::exp2(std::floor(std::log2(half)) - 4.0);
-    half = std::ceil(half / quantum) * quantum;
+    if (snap) half = std::ceil(half / quantum) * quantum;
     f.halfWidth = half;
     // Snap the center across the light to the world-fixed grid of texels (multiples of the texel
     // along right and up, from the world origin): the map then moves by whole texels only, and a
@@ -86,7 +86,8 @@ LightFrustum fitCascade(const scene::Scene& scene, const scene::CameraBasis& cam
     // ±size/2 texels from the center, on the grid too.
     const double texel = f.texelWorldSize();
     const double u = glm::dot(s.center, f.right), v = glm::dot(s.center, f.up);
-    const double du = std::round(u / texel) * texel - u, dv = std::round(v / texel) * texel - v;
+    const double du = snap ? std::round(u / texel) * texel - u : 0.0;
+    const double dv = snap ? std::round(v / texel) * texel - v : 0.0;
     f.center = s.center + du * f.right + dv * f.up;
     // Depth: the sphere, and back toward the light to every caster over the map's square.
     const double reach = s.radius * kLightFrustumMargin;
@@ -97,7 +98,8 @@ LightFrustum fitCascade(const scene::Scene& scene, const scene::CameraBasis& cam
     return f;
 }
 
-CascadeSet fitCascades(const scene::Scene& scene, const Vec3& direction, int count, int mapSize, double blend) {
+CascadeSet fitCascades(const scene::Scene& scene, const Vec3& direction, int count, int mapSize, double blend,
+                       bool snap) {
     CascadeSet set;
     const auto range = visibleDepthRange(scene);
     if (!range || count < 1) return set;
@@ -110,7 +112,7 @@ CascadeSet fitCascades(const scene::Scene& scene, const Vec3& direction, int cou
         // With blending, the pixels in the band before split i read this map too: it starts there.
         const double d0 = set.splits[std::size_t(i)] -
                           (i > 0 ? blend * (set.splits[std::size_t(i)] - set.splits[std::size_t(i) - 1]) : 0.0);
-        const LightFrustum f = fitCascade(scene, cam, d0, set.splits[std::size_t(i) + 1], direction, mapSize);
+        const LightFrustum f = fitCascade(scene, cam, d0, set.splits[std::size_t(i) + 1], direction, mapSize, snap);
         set.frusta.push_back(f.halfWidth < whole.halfWidth ? f : whole);
     }
     return set;

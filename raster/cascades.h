@@ -52,8 +52,9 @@ BoundingSphere sliceBoundingSphere(const scene::CameraBasis& cam, double d0, dou
 // so that small changes of the slice do not change the texel size), centered on the sphere's center
 // snapped to the world-fixed texel grid of setBasis()'s axes; in depth it covers the sphere and
 // reaches toward the light to every caster over the square (nearestCasterDepth()).
+// snap = false: neither quantized nor on the grid (RasterSettings::snapLightFrustum).
 LightFrustum fitCascade(const scene::Scene& scene, const scene::CameraBasis& cam, double d0, double d1,
-                        const scene::Vec3& direction, int mapSize);
+                        const scene::Vec3& direction, int mapSize, bool snap = true);
 
 // The receivers of cascade `c` of a set with these splits: visibleReceiverPointsInSlice() over
 // [splits[c], splits[c + 1]], the first reaching down to the near plane and the last out to the
@@ -74,7 +75,7 @@ struct CascadeSet {
 // With a blend band (`blend` of each slice before its far split, lit.frag mixes the next cascade
 // in there), each cascade c > 0 covers the band of slice c − 1 too: its slice starts there.
 CascadeSet fitCascades(const scene::Scene& scene, const scene::Vec3& direction, int count, int mapSize,
-                       double blend = 0.0);
+                       double blend = 0.0, bool snap = true);
 // The band the maps cover for these settings: the widest one (kMaxCascadeBlend) whenever blending
 // is on, so that the maps, and every pixel outside the bands, do not change with the band's width;
 // 0 when it is off (the maps of the plain slices).

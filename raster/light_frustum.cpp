@@ -184,7 +184,7 @@ double nearestCasterDepth(const scene::Scene& scene, const LightFrustum& f, doub
     return minDepth;
 }
 
-LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const Vec3& direction, int mapSize) {
+LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const Vec3& direction, int mapSize, bool snap) {
     const scene::Bounds sceneBounds = scene.bounds();
     LightFrustum f = fitDirectionalLight(sceneBounds, direction, mapSize);
     if (sceneBounds.empty()) return f;
@@ -220,15 +220,24 @@ LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const Vec
     double half = 0.5 * std::max(maxU - minU, maxV - minV) * kLightFrustumMargin * size / std::max(size - 1.0, 1.0);
     if (!(half > 0.0)) return f;
     const double quantum = std::exp2(std::floor(std::log2(half)) - 4.0);
-    half = std::ceil(half / quantum) * quantum;
+    if (snap) half = std::ceil(half / quantum) * quantum;
     if (half >= f.halfWidth) return f;  // no gain over the bounding sphere
     const double pad = (kLightFrustumMargin - 1.0) * (maxDepth - minDepth);
     const Vec3 receiversCenter = f.center + 0.5 * (minU + maxU) * f.right + 0.5 * (minV + maxV) * f.up;
     f.halfWidth = half;
+    if (!snap) {
+        f.center = receiversCenter;
+        f.nearDepth = minDepth - pad;
+        f.farDepth = maxDepth + pad;
+        return f;
+    }
     const double texel = f.texelWorldSize();
     const double u = glm::dot(receiversCenter, f.right), v = glm::dot(receiversCenter, f.up);
-    f.center = receiversCenter + (std::round(u / texel) * texel - u) * f.right +
-               (std::round(v / texel) * texel - v) * f.up;
+    // From the grid indices alone (and the bounding sphere's depth, fixed for the scene): a map
+    // whose indices did not change is the same to the last bit, not carrying the rounding of the
+    // receivers' extent (docs/temporal.md tests this).
+    f.center = (std::round(u / texel) * texel) * f.right + (std::round(v / texel) * texel) * f.up +
+               glm::dot(f.center, f.direction) * f.direction;
     const double nearDepth = minDepth - pad, farDepth = maxDepth + pad;
     const double depthQuantum = std::exp2(std::floor(std::log2(farDepth - nearDepth)) - 4.0);
     f.nearDepth = std::floor(nearDepth / depthQuantum) * depthQuantum;
@@ -869,14 +878,15 @@ std::vector<LightCulling> culledCasters(const scene::Scene& scene, const scene::
         } else if (l.type == scene::LightType::Spot) {
             add("", spotLightFrustum(scene, settings, l, settings.shadowMapSize), receivers);
         } else if (const CascadeSet cs = settings.cascades > 1
-                                              ? fitCascades(scene, l.direction, settings.cascades, settings.shadowMapSize, cascadeBandCover(settings))
+                                              ? fitCascades(scene, l.direction, settings.cascades, settings.shadowMapSize, cascadeBandCover(settings), settings.snapLightFrustum)
                                               : CascadeSet{};
                    !cs.frusta.empty()) {
             for (std::size_t c = 0; c < cs.frusta.size(); ++c)
                 add(std::string(1, 'C').append(std::to_string(c)), cs.frusta[c], cascadeReceivers(scene, cs.splits, c, cascadeBandCover(settings)));
         } else {
             add("",
-                settings.fitLightFrustum ? fitDirectionalLightToReceivers(scene, l.direction, settings.shadowMapSize)
+                settings.fitLightFrustum ? fitDirectionalLightToReceivers(scene, l.direction, settings.shadowMapSize,
+                                                                          settings.snapLightFrustum)
                                          : fitDirectionalLight(bounds, l.direction, settings.shadowMapSize),
                 receivers);
         }

@@ -62,7 +62,9 @@ LightFrustum fitDirectionalLight(const scene::Bounds& bounds, const scene::Vec3&
 // half-width rounded up to 1/16 of its power of two, the center on the world-fixed texel grid,
 // near and far rounded outward to 1/16 of their range's power of two. Falls back to
 // fitDirectionalLight() when the camera sees none of the scene.
-LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const scene::Vec3& direction, int mapSize);
+// snap = false leaves all three unsnapped (RasterSettings::snapLightFrustum, the temporal study).
+LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const scene::Vec3& direction, int mapSize,
+                                            bool snap = true);
 
 // The map's basis for light travelling along `direction`: right = direction × (world Y, or X for
 // a vertical light), up = right × direction. Fixed in the world, so texel grids are too.

@@ -201,6 +201,26 @@ struct Renderer::Impl {
     LitBindings bindings;  // allocated with the first lit pipeline's (identical) set layout
     shaders::LitUniforms uniforms{};
     std::vector<glm::vec4> albedos;
+
+    // What update() needs to redo the per-camera, per-light part of the setup (placeLights).
+    scene::Vec3 origin{0.0};  // the first camera's position: the vertex buffer is relative to it
+    scene::RenderPlan plan;
+    std::vector<std::uint32_t> objectFirstIndex;
+    std::vector<double> usedDepthBias;  // per shadow-mapped light (spot, directional)
+    std::size_t triangles = 0;
+    int sphereSegmentsUsed = 0;
+    // The view depth of the camera the image is drawn from minus the depth the shaders compute
+    // relative to `origin` (0 for the first camera): added to Z on readback, taken off the
+    // cascade splits (update()).
+    double viewDepthOffset = 0.0;
+    double pendingUpdateMs = 0.0;  // the last update()'s time, reported by the next frame as "update"
+    // Light frusta, cascades, caster culling and the lit pass's uniforms for `scene` (its camera
+    // fits the maps) drawn from `view`.
+    void placeLights(const scene::Scene& scene, const scene::Camera& view);
+    // The rest of the constructor: shadow maps, targets, readback, queries, attributes.
+    void createTargets(const scene::Scene& scene, const RendererOptions& options);
+    void describeLayers();  // the attributes that follow the frusta
+    void update(const scene::Scene& scene, const scene::Camera& view);
 };
 
 Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settingsIn,
@@ -209,8 +229,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
       ctx((checkSupported(scene, settingsIn),
            ContextOptions{.device = settingsIn.device, .validate = settingsIn.validate, .log = &log})) {
     const auto setupStart = Clock::now();
-    const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
-    const scene::Vec3 origin = cam.position;  // camera-relative rendering
+    origin = scene::cameraBasis(scene.camera).position;  // camera-relative rendering
     width = std::uint32_t(scene.camera.width);
     height = std::uint32_t(scene.camera.height);
     lightCount = scene.lights.size();
@@ -221,8 +240,10 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     std::vector<TransparentDraw> transparentDraws;
     std::uint32_t opaqueIndexCount = ~0u;
     if (plan.needsTransmittanceMap) transparentDraws = separateTransparent(scene, geometry, opaqueIndexCount);
-    const std::size_t triangles = geometry.triangleCount();
-    const int sphereSegmentsUsed = geometry.maxSphereSegments;
+    triangles = geometry.triangleCount();
+    sphereSegmentsUsed = geometry.maxSphereSegments;
+    objectFirstIndex = geometry.objectFirstIndex;
+    this->plan = plan;
     // Device-local, uploaded once for every frame of this Renderer.
     vertexBuffer = uploadBuffer(ctx, geometry.vertices, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
     indexBuffer = uploadBuffer(ctx, geometry.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
@@ -236,6 +257,32 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     settings = resolveAutomaticChoices(scene, settings, &plan, &cascadeChoice, &mapChoice);
     attributes["shadow_map_size_reason"] = mapChoice.reason;
     attributes["cascades_reason"] = cascadeChoice.reason;
+    placeLights(scene, scene.camera);
+    createTargets(scene, options);
+    setupMs = msSince(setupStart);
+    pendingSetupMs = setupMs;
+}
+
+void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera& view) {
+    const scene::CameraBasis cam = scene::cameraBasis(view);
+    lightMatrices.clear();
+    frusta.clear();
+    layerLight.clear();
+    layerLabels.clear();
+    layerBias.clear();
+    cascadeSplits.clear();
+    cascadeTexels.clear();
+    usedDepthBias.clear();
+    draw.layerRanges.clear();
+    cascadesUsed = 1;
+    lightKinds = 0;
+    std::fill(std::begin(uniforms.lights), std::end(uniforms.lights), shaders::LightData{});
+    std::fill(std::begin(uniforms.cascades), std::end(uniforms.cascades), shaders::CascadeData{});
+    // Cascades are chosen by the view depth of the camera the maps are fitted for (scene.camera):
+    // which cascade a point reads is part of that camera's shadow setup, also when the image is
+    // drawn from another view (a held view); the Frame's Z is that depth too.
+    const scene::CameraBasis fitCam = scene::cameraBasis(scene.camera);
+    viewDepthOffset = glm::dot(origin - fitCam.position, fitCam.forward);
 
     // Caster culling: per culled layer, which objects are drawn into it, and how many are not.
     // Not with a transmittance map: its index order (opaque casters first) is not per object.
@@ -255,7 +302,6 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
         culledPerLayer.push_back(n);
     };
 
-    std::vector<double> usedDepthBias;  // per shadow-mapped light (spot, directional)
     // The hardware bias of an orthographic map (settings.hardwareBias): the world constant bias
     // in units of r (its depth is linear: bias / depth range), the slope bias in texels as it is
     // (the rasterizer's slope is depth per texel, as the shader's slope term is per texel).
@@ -264,10 +310,10 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     };
     // One shadow-map layer per light that needs a shadow test.
     const scene::Bounds bounds = scene.bounds();
-    const glm::dmat4 viewProj = scene::projectionMatrix(cam, scene.camera.near, scene.camera.far) *
+    const glm::dmat4 viewProj = scene::projectionMatrix(cam, view.near, view.far) *
                                 scene::viewMatrix(cam, origin);
     uniforms.viewProj = glm::mat4(viewProj);
-    uniforms.forward = glm::vec4(glm::vec3(cam.forward), float(scene.ambient));
+    uniforms.forward = glm::vec4(glm::vec3(fitCam.forward), float(scene.ambient));
     uniforms.background = glm::vec4(glm::vec3(scene.background), 0.0f);
     uniforms.counts = glm::vec4(float(scene.lights.size()), 0, 0, 0);
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {
@@ -308,7 +354,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
                 f = spotLightFrustum(scene, settings, light, settings.shadowMapSize);
             else if (settings.cascades > 1 &&
                      !(cascades = fitCascades(scene, light.direction, settings.cascades, settings.shadowMapSize,
-                                                              cascadeBandCover(settings)))
+                                                              cascadeBandCover(settings), settings.snapLightFrustum))
                           .frusta.empty()) {
                 // Cascaded: one layer per slice; the shader picks the cascade by view depth
                 // (lit.frag cascadeOf). Cascades are fitted to their slices, so
@@ -332,7 +378,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
                     layerLabels.push_back("L" + std::to_string(i) + " C" + std::to_string(c));
                     shaders::CascadeData& cd = uniforms.cascades[i * SHADOWLAB_MAX_CASCADES + c];
                     cd.toShadow = glm::mat4(cf.toTexture(origin));
-                    cd.params = glm::vec4(float(cascades.splits[c + 1]), float(cf.texelWorldSize()),
+                    cd.params = glm::vec4(float(cascades.splits[c + 1] - viewDepthOffset), float(cf.texelWorldSize()),
                                           float(1.0 / cf.depthRange()),
                                           settings.hardwareBias ? 0.0f : float(depthBias));
                 }
@@ -344,7 +390,8 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
                                    settings.hardwareBias ? 0.0f : float(settings.slopeBias), float(f.texelWorldSize()),
                                    float(1.0 / f.depthRange()));
             } else if (settings.fitLightFrustum)
-                f = fitDirectionalLightToReceivers(scene, light.direction, settings.shadowMapSize);
+                f = fitDirectionalLightToReceivers(scene, light.direction, settings.shadowMapSize,
+                                                   settings.snapLightFrustum);
             else
                 f = fitDirectionalLight(bounds, light.direction, settings.shadowMapSize);
             if (!point && cascades.frusta.empty()) {
@@ -392,6 +439,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
         l.params = glm::vec4(float(kMaxSlopeTan), float(int(settings.filter)), float(settings.normalOffset),
                              float(settings.pcfSize));
     }
+    albedos.clear();
     for (const scene::Object& o : scene.objects)
         // a: 1 − opacity, divided out of a semi-transparent receiver's own transmittance (lit.frag).
         albedos.emplace_back(glm::vec3(scene.materialOf(o).albedo),
@@ -404,7 +452,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
         const auto it = casters.find(k);
         for (std::size_t o = 0; o < scene.objects.size(); ++o) {
             if (it != casters.end() && !it->second[o]) continue;
-            const std::uint32_t first = geometry.objectFirstIndex[o], end = geometry.objectFirstIndex[o + 1];
+            const std::uint32_t first = objectFirstIndex[o], end = objectFirstIndex[o + 1];
             if (!ranges.empty() && ranges.back().first + ranges.back().second == first)
                 ranges.back().second += end - first;
             else
@@ -418,7 +466,9 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     // than one (cascades, cube faces).
     if (layerLight.size() > std::set<int>(layerLight.begin(), layerLight.end()).size())
         attributes["culled_casters_per_layer"] = joined(culledPerLayer, count);
+}
 
+void Renderer::Impl::createTargets(const scene::Scene& scene, const RendererOptions& options) {
     // Without a shadowed light a 1x1 cleared layer keeps the descriptor valid.
     const auto mapSize = lightMatrices.empty() ? 1u : std::uint32_t(settings.shadowMapSize);
     const auto layers = std::max<std::uint32_t>(1, std::uint32_t(lightMatrices.size()));
@@ -427,7 +477,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     if (cascadesUsed > 1 && settings.cascadeBlend > 0.0) {
         cascadeBlendUsed = settings.cascadeBlend;
         uniforms.counts.z = float(cascadeBlendUsed);
-        uniforms.counts.w = float(cascadeSplits[0]);  // cascade 0's slice starts here (the band's width)
+        uniforms.counts.w = float(cascadeSplits[0] - viewDepthOffset);  // cascade 0's slice starts here (the band's width)
     }
     transmit = !draw.transparent.empty() && !lightMatrices.empty();
     transmittanceMaps = createTransmittanceMaps(ctx, transmit ? mapSize : 1, transmit ? layers : 1);
@@ -456,6 +506,17 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
         queries = QueryPoolHandle(ctx.device.get(), pool);
     }
 
+    // Where lit.frag reads the light's constants (RendererOptions::lightConstants).
+    const bool vertexCoordinates = usesVertexLightCoordinates(LitVariant{.lightCount = std::uint32_t(lightCount),
+                                                                         .lightKinds = lightKinds,
+                                                                         .cascades = std::uint32_t(cascadesUsed),
+                                                                         .receiverPlane = settings.receiverPlaneBias});
+    vertexLightConstants = vertexCoordinates && options.lightConstants == LightConstants::kVertexOutputs;
+    attributes["light_constants"] = vertexLightConstants ? "vertex-outputs" : "uniform-buffer";
+    describeLayers();
+}
+
+void Renderer::Impl::describeLayers() {
     attributes["backend"] = "raster";
     attributes["shadow_map_size"] = std::to_string(settings.shadowMapSize);
     attributes["filter"] = filterName(settings.filter);
@@ -466,6 +527,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     attributes["light_frustum_fit"] = settings.fitLightFrustum ? "receivers" : "bounding-sphere";
     attributes["light_frustum_fit_reason"] =
         settings.fitLightFrustumIsDefault ? "default" : "set by --fit-light-frustum, the scene or code";
+    if (!settings.snapLightFrustum) attributes["light_frustum_snap"] = "off";
     // The constant bias actually used: one value, or one per light (';') when a default was
     // re-derived per fitted map and the maps differ.
     const bool oneBias = std::all_of(usedDepthBias.begin(), usedDepthBias.end(),
@@ -505,15 +567,48 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
         attributes["cascade_texel_world_size"] = joinedNumbers(cascadeTexels);
         attributes["cascade_blend"] = formatNumber(cascadeBlendUsed);
     }
-    // Where lit.frag reads the light's constants (RendererOptions::lightConstants).
-    const bool vertexCoordinates = usesVertexLightCoordinates(LitVariant{.lightCount = std::uint32_t(lightCount),
-                                                                         .lightKinds = lightKinds,
-                                                                         .cascades = std::uint32_t(cascadesUsed),
-                                                                         .receiverPlane = settings.receiverPlaneBias});
-    vertexLightConstants = vertexCoordinates && options.lightConstants == LightConstants::kVertexOutputs;
-    attributes["light_constants"] = vertexLightConstants ? "vertex-outputs" : "uniform-buffer";
-    setupMs = msSince(setupStart);
-    pendingSetupMs = setupMs;
+}
+
+void Renderer::Impl::update(const scene::Scene& scene, const scene::Camera& view) {
+    if (scene.lights.size() != lightCount || scene.objects.size() + 1 != objectFirstIndex.size() ||
+        std::uint32_t(view.width) != width || std::uint32_t(view.height) != height)
+        throw RasterError("Renderer::update: the scene must keep the objects, the number of lights and the "
+                          "resolution the Renderer was made for");
+    const auto updateStart = Clock::now();
+    const std::size_t layers = lightMatrices.size();
+    const int cascadeCount = cascadesUsed;
+    const std::uint32_t kinds = lightKinds;
+    const glm::vec4 counts = uniforms.counts;
+    placeLights(scene, view);
+    // The maps, pipelines and descriptor set were made for this many layers of these kinds.
+    if (lightMatrices.size() != layers || cascadesUsed != cascadeCount || lightKinds != kinds)
+        throw RasterError("Renderer::update: the new camera or lights change the number of shadow-map layers (" +
+                          std::to_string(layers) + " -> " + std::to_string(lightMatrices.size()) +
+                          ") or cascades; make a new Renderer");
+    uniforms.counts.y = counts.y;
+    if (cascadeBlendUsed > 0.0) {
+        uniforms.counts.z = counts.z;
+        uniforms.counts.w = float(cascadeSplits[0] - viewDepthOffset);
+    }
+    layerLights.clear();
+    for (const int i : layerLight) {
+        const scene::Light& light = scene.lights[std::size_t(i)];
+        layerLights.push_back(light.type == scene::LightType::Directional
+                                  ? glm::vec4(glm::vec3(-glm::normalize(light.direction)), 0.0f)
+                                  : glm::vec4(glm::vec3(light.position - origin), 1.0f));
+    }
+    describeLayers();
+    // The descriptor set's uniform buffer is device-local: refill it through a staging buffer.
+    if (bindings.uniforms.buffer) {
+        Buffer staging = createBuffer(ctx, sizeof uniforms, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                                      VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+        std::memcpy(staging.mapped, &uniforms, sizeof uniforms);
+        VkCommandBuffer commands = ctx.beginCommands();
+        const VkBufferCopy region{.size = sizeof uniforms};
+        vkCmdCopyBuffer(commands, staging.buffer.get(), bindings.uniforms.buffer.get(), 1, &region);
+        ctx.submitAndWait(commands);  // the fence makes the copy visible to the next submission
+    }
+    pendingUpdateMs = msSince(updateStart);
 }
 
 void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, const ValidationLog& log,
@@ -561,6 +656,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
 
     frame.attributes = attributes;
     frame.timingsMs.assign(1, {"setup", setup});
+    if (pendingUpdateMs > 0.0) frame.timingsMs.emplace_back("update", pendingUpdateMs);
+    pendingUpdateMs = 0.0;
     auto stamp = [&](VkCommandBuffer cb, std::uint32_t query) {
         if (timestamps) vkCmdWriteTimestamp2(cb, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, queries.get(), query);
     };
@@ -679,6 +776,7 @@ void Renderer::Impl::readPixels(scene::Frame& frame, scene::ChannelMask channels
     for (std::size_t t = 0; t < targets.lights.size(); ++t)
         lightRows.push_back(rows(targets.lights[t], targets.hostReadable ? nullptr : &readback.lights[t]));
     const std::size_t w = width;
+    const float depthOffset = float(viewDepthOffset);  // 0 for the camera the Renderer was made for
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, height, 16), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t y = r.begin(); y < r.end(); ++y) {
             const std::size_t o = y * w;  // first pixel of the row in the Frame
@@ -698,7 +796,7 @@ void Renderer::Impl::readPixels(scene::Frame& frame, scene::ChannelMask channels
                 for (std::size_t x = 0; x < w; ++x) {
                     if (objectId) objectId[o + x] = p[4 * x + 0];
                     if (ndotl) ndotl[o + x] = p[4 * x + 1];
-                    if (depth) depth[o + x] = p[4 * x + 2];
+                    if (depth) depth[o + x] = p[4 * x + 0] != 0.0f ? p[4 * x + 2] + depthOffset : p[4 * x + 2];
                     if (blockerId) blockerId[o + x] = p[4 * x + 3];
                 }
             }
@@ -751,6 +849,8 @@ scene::Frame Renderer::render(scene::ChannelMask channels, RenderDebug* debug) {
 void Renderer::render(scene::Frame& frame, scene::ChannelMask channels, RenderDebug* debug) {
     impl_->render(frame, channels, *log_, debug);
 }
+void Renderer::update(const scene::Scene& scene) { impl_->update(scene, scene.camera); }
+void Renderer::update(const scene::Scene& scene, const scene::Camera& view) { impl_->update(scene, view); }
 double Renderer::setupMs() const { return impl_->setupMs; }
 int Renderer::validationMessages() const { return log_->count.load(); }
 

@@ -75,6 +75,18 @@ public:
     scene::Frame render(scene::ChannelMask channels = scene::kAllChannels, RenderDebug* debug = nullptr);
     // The same into `frame`, reusing its vectors' memory (a loop over frames allocates nothing).
     void render(scene::Frame& frame, scene::ChannelMask channels = scene::kAllChannels, RenderDebug* debug = nullptr);
+    // Per-frame change along a path (a moving camera or light): `scene` must have the objects, the
+    // number of lights and the resolution the Renderer was made for; its camera and lights may
+    // differ. Redoes what depends on them (light frusta, cascades, caster culling, the lit pass's
+    // uniforms) and keeps the rest: geometry stays in the buffer made relative to the first
+    // camera, the map size is the first frame's. Throws RasterError when the change needs other
+    // maps (another number of layers or cascades). Cheap next to a frame: no allocation on the
+    // device but one staging buffer for the uniforms.
+    void update(const scene::Scene& scene);
+    // The same with the maps fitted for scene.camera but the image drawn from `view` (same
+    // resolution): the held-view frames of a camera path (docs/temporal.md). Cascades are chosen,
+    // and the Frame's Z measured, along scene.camera's view axis: the shadow setup is that camera's.
+    void update(const scene::Scene& scene, const scene::Camera& view);
     double setupMs() const;  // the constructor's time
     // Validation messages counted so far (settings.validate); messages raised when the Renderer
     // is destroyed are not in any frame: raster::render() adds them to its frame.

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <iomanip>
 #include <limits>
+#include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -47,9 +49,11 @@ std::uint64_t sampleSeed(std::size_t pixel, int light) {
            (std::uint64_t(light + 1) << 48);
 }
 
+// With `prebuilt`, its acceleration structures are used and "setup" is 0 (Renderer).
 template <typename Real>
 scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan,
-                     const scene::RaytraceSettings& settings, const char* backend) {
+                     const scene::RaytraceSettings& settings, const char* backend,
+                     const Tracer<Real>* prebuilt = nullptr) {
     const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
     const int width = cam.width, height = cam.height;
     scene::Frame frame = scene::Frame::allocate(width, height, true);
@@ -67,8 +71,10 @@ scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan,
             needsShadowTest[lp.light] = lp.needsShadowTest;
 
     const auto setupStart = Clock::now();
-    const Tracer<Real> tracer(scene);
-    frame.timingsMs.emplace_back("setup", msSince(setupStart));
+    std::optional<Tracer<Real>> own;
+    if (!prebuilt) own.emplace(scene);
+    const Tracer<Real>& tracer = prebuilt ? *prebuilt : *own;
+    frame.timingsMs.emplace_back("setup", prebuilt ? 0.0 : msSince(setupStart));
 
     const int tilesX = (width + kTileSize - 1) / kTileSize;
     const int tilesY = (height + kTileSize - 1) / kTileSize;
@@ -176,6 +182,35 @@ scene::Frame renderReference(const scene::Scene& scene, const scene::RenderPlan&
                              const scene::RaytraceSettings& base) {
     return renderWith(scene, plan, scene::referenceSettings(base), "reference");
 }
+
+struct Renderer::Impl {
+    scene::RaytraceSettings settings;
+    const char* backend;
+    std::unique_ptr<Tracer<float>> single;
+    std::unique_ptr<Tracer<double>> twice;
+    double setupMs = 0.0;
+};
+
+Renderer::Renderer(const scene::Scene& scene, const scene::RaytraceSettings& settings, bool reference)
+    : impl_(std::make_unique<Impl>()) {
+    impl_->settings = reference ? scene::referenceSettings(settings) : settings;
+    impl_->backend = reference ? "reference" : "raytrace";
+    const auto start = Clock::now();
+    if (impl_->settings.precision == scene::Precision::Double)
+        impl_->twice = std::make_unique<Tracer<double>>(scene);
+    else
+        impl_->single = std::make_unique<Tracer<float>>(scene);
+    impl_->setupMs = msSince(start);
+}
+Renderer::~Renderer() = default;
+Renderer::Renderer(Renderer&&) noexcept = default;
+Renderer& Renderer::operator=(Renderer&&) noexcept = default;
+
+scene::Frame Renderer::render(const scene::Scene& scene, const scene::RenderPlan& plan) const {
+    if (impl_->twice) return renderT<double>(scene, plan, impl_->settings, impl_->backend, impl_->twice.get());
+    return renderT<float>(scene, plan, impl_->settings, impl_->backend, impl_->single.get());
+}
+double Renderer::setupMs() const { return impl_->setupMs; }
 
 template <typename Real>
 double visibilityAt(const scene::Scene& scene, const scene::Vec3& p, const scene::Vec3& n,

@@ -2,6 +2,8 @@
 // lesson's bias or robust offsets) and the double-precision reference the method is judged by.
 #pragma once
 
+#include <memory>
+
 #include "scene/frame.h"
 #include "scene/render_plan.h"
 #include "scene/scene.h"
@@ -21,6 +23,25 @@ scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan,
 // offsets, no tunable bias, many area-light samples); backend attribute "reference".
 scene::Frame renderReference(const scene::Scene& scene, const scene::RenderPlan& plan,
                              const scene::RaytraceSettings& base);
+
+// The ray tracer with its acceleration structures built once (the constructor: the "setup"),
+// for many frames of one scene's objects: render() takes the scene again, whose camera and lights
+// may differ from frame to frame but whose objects must be the constructor's (the trees hold
+// them). Frames from render() have "setup" 0; setupMs() is the build. With `reference`, the
+// settings are scene::referenceSettings(settings) and frames say backend "reference".
+class Renderer {
+public:
+    Renderer(const scene::Scene& scene, const scene::RaytraceSettings& settings, bool reference = false);
+    ~Renderer();
+    Renderer(Renderer&&) noexcept;
+    Renderer& operator=(Renderer&&) noexcept;
+    scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan) const;
+    double setupMs() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
 
 // Diagnostic/test entry: the shadow test at world point p with normal n (unit, the side the
 // light should be on) for scene.lights[light], in precision Real, with the given offsets.

@@ -84,6 +84,7 @@ RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& o) {
     // casters on a large ground (docs/decisions.md, "Defaults that keep the shadow").
     s.raster.fitLightFrustum = o.fitLightFrustum.value_or(d.fitLightFrustum.value_or(true));
     s.raster.fitLightFrustumIsDefault = !o.fitLightFrustum && !d.fitLightFrustum;
+    s.raster.snapLightFrustum = o.snapLightFrustum.value_or(true);
     s.raster.cascades = o.cascades.value_or(d.cascades.value_or(1));
     s.raster.cascadesIsDefault = !o.cascades && !d.cascades;
     if (s.raster.cascades < 1 || s.raster.cascades > kMaxCascades)

@@ -57,6 +57,10 @@ struct RasterSettings {
     // True when fitLightFrustum is resolveSettings()'s default (no option, no scene value): only
     // --explain and the Frame's reasons read it.
     bool fitLightFrustumIsDefault = false;
+    // Snap fitted directional maps and cascades to the world-fixed texel grid and their sizes to
+    // coarse steps, so a moving camera does not make them swim. Off only for the temporal study
+    // (docs/temporal.md), which measures what snapping buys; spot and point maps always snap.
+    bool snapLightFrustum = true;
     // Directional lights: split the view's depth range into this many slices, each with its own
     // map (1 = one map for the whole view, as fitLightFrustum or the bounding sphere decide).
     int cascades = 1;
@@ -98,6 +102,7 @@ struct SettingsOverrides {
     std::optional<bool> receiverPlaneBias;  // --receiver-plane-bias
     std::optional<bool> hardwareBias;       // --hardware-bias
     std::optional<bool> fitLightFrustum; // --fit-light-frustum on|off (--no-fit-light-frustum)
+    std::optional<bool> snapLightFrustum;  // --no-snap sets false (the temporal study)
     std::optional<int> cascades;         // --cascades (1..kMaxCascades)
     std::optional<double> cascadeBlend;  // --cascade-blend (0..kMaxCascadeBlend)
     std::optional<std::string> rayBias;  // a number or "robust"

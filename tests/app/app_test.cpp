@@ -233,7 +233,12 @@ INSTANTIATE_TEST_SUITE_P(
         BadRun{"bad_cascade_blend", {"render", "seed", "--backend", "raster", "--cascades", "3", "--cascade-blend", "0.7",
                                      "-o", "OUT"},
                "--cascade-blend: must be in 0..0.5"},
-        BadRun{"missing_frames", {"compare", "a.exr", "b.exr", "-o", "OUT.png"}, "no such file"}),
+        BadRun{"missing_frames", {"compare", "a.exr", "b.exr", "-o", "OUT.png"}, "no such file"},
+        BadRun{"bad_path_kind", {"path", "seed", "--kind", "spiral", "-o", "OUTDIR"}, "--kind: expected orbit|"},
+        BadRun{"path_one_frame", {"path", "seed", "--frames", "1", "-o", "OUTDIR"}, "--frames: must be in 2.."},
+        BadRun{"path_no_such_light", {"path", "seed", "--kind", "sun-azimuth", "--light", "2", "-o", "OUTDIR"},
+               "--light: the scene has 1 light(s)"},
+        BadRun{"path_bad_scene", {"path", "BAD", "-o", "OUTDIR"}, "lights[0].direction"}),
     [](const ::testing::TestParamInfo<BadRun>& info) { return std::string(info.param.name); });
 
 TEST(App, RenderViewsWriteImagesOfTheDocumentedSizes) {
