@@ -12,7 +12,10 @@
 #include <nlohmann/json.hpp>
 
 #include "scene/error.h"
+#include "scene/input_file.h"
+#include "scene/json_input.h"
 #include "scene/mesh_loader.h"
+#include "scene/scene_checks.h"
 #include "scene/settings.h"
 
 namespace shadowlab::scene {
@@ -38,11 +41,7 @@ std::size_t editDistance(const std::string& a, const std::string& b) {
     return row[b.size()];
 }
 
-std::string describe(const Json& v) {
-    std::string s = v.dump();
-    if (s.size() > 60) s = s.substr(0, 57) + "...";
-    return s;
-}
+std::string describe(const Json& v) { return describeJson(v); }
 
 const char* typeName(const Json& v) {
     switch (v.type()) {
@@ -80,6 +79,9 @@ public:
             std::string list;
             for (const char* a : allowed) {
                 list += (list.empty() ? "" : ", ") + std::string(a);
+                // (a key much longer than any allowed one is no typo; its distance would cost
+                // its length times theirs)
+                if (key.size() > 64) continue;
                 if (const std::size_t d = editDistance(key, a); d < bestDistance) {
                     bestDistance = d;
                     best = a;
@@ -226,6 +228,7 @@ Light readLight(const Reader& r, const Json& node, const JsonPath& path) {
         l.intensity = r.number(node["intensity"], path / "intensity");
         if (l.intensity < 0.0) r.fail(path / "intensity", "must be >= 0, got " + describe(node["intensity"]));
     }
+    if (const ValueProblem problem = lightProblem(l)) r.fail(path / problem.key, problem.what);
     return l;
 }
 
@@ -363,6 +366,7 @@ Scene parseScene(const fs::path& file, const std::string& text) {
     const Reader r(file);
     const JsonPath root;
     Json doc;
+    checkJsonNesting(file, text);
     try {
         doc = Json::parse(text);
     } catch (const Json::parse_error& e) {
@@ -417,6 +421,7 @@ Scene parseScene(const fs::path& file, const std::string& text) {
         scene.objects.push_back(readObject(r, objects[i], root / "objects" / i, materialIndex, meshCache));
 
     if (doc.contains("shadow")) scene.shadow = readShadow(r, doc["shadow"], root / "shadow");
+    checkSceneExtent(scene, true);
     return scene;
 }
 
@@ -433,6 +438,7 @@ Scene loadModelScene(const fs::path& file) {
     mesh.file = file;
     mesh.instances = loadMeshInstances(file, glm::dmat4(1.0), file, JsonPath(), &extras);
     scene.objects.push_back({file.stem().string(), mesh, 0});
+    checkSceneExtent(scene, false);  // before the framing is computed from the bounds
     const Bounds b = scene.bounds();
     const double radius = std::max(0.5 * b.diagonal(), 1e-9);
 
@@ -445,7 +451,8 @@ Scene loadModelScene(const fs::path& file) {
         cam.fovYDegrees = std::clamp(c.yfovRadians * 180.0 / kPi, 1.0, 170.0);
         cam.near = c.znear > 0 ? c.znear : radius * 1e-3;
         cam.far = c.zfar > cam.near ? c.zfar : glm::length(c.position - b.center()) + 4.0 * radius;
-        if (c.aspect > 0) cam.height = std::clamp(int(std::lround(cam.width / c.aspect)), 1, kMaxResolution);
+        if (c.aspect > 0)
+            cam.height = int(std::lround(std::clamp(cam.width / c.aspect, 1.0, double(kMaxResolution))));
     } else {
         // Framed: the bounding sphere fills the vertical field of view from above and in front.
         cam.fovYDegrees = 40.0;
@@ -471,6 +478,14 @@ Scene loadModelScene(const fs::path& file) {
             if (light.type == LightType::Spot)
                 light.coneAngleDegrees = std::clamp(l.outerConeRadians * 180.0 / kPi, 0.1, 89.9);
         }
+        // The checks a JSON light gets, at the glTF light's path (its position and direction
+        // come from its node).
+        if (const ValueProblem problem = lightProblem(light))
+            throw SceneError(file, JsonPath() / "extensions" / "KHR_lights_punctual" / "lights" / std::size_t(l.index) /
+                                       (problem.key == "cone_angle" ? std::string("spot.outerConeAngle") : problem.key),
+                             problem.what + (problem.key == "position" || problem.key == "direction"
+                                                 ? " (from the transform of the node that holds the light)"
+                                                 : ""));
         scene.lights.push_back(light);
     }
     if (scene.lights.empty()) {
@@ -479,29 +494,27 @@ Scene loadModelScene(const fs::path& file) {
         sun.intensity = 1.4;
         scene.lights.push_back(sun);
     }
+    checkSceneExtent(scene, false);
     return scene;
 }
 
 }  // namespace
 
 Scene loadScene(const fs::path& file) {
-    std::error_code ec;
-    if (!fs::exists(file, ec)) throw SceneError(file, {}, "no such file");
-    if (fs::is_directory(file, ec)) throw SceneError(file, {}, "is a folder, not a scene file");
     std::string ext = file.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+    std::string text;
+    try {
+        if (ext == ".gltf" || ext == ".glb" || ext == ".obj") checkInputFile(file, kMaxMeshFileBytes);
+        else text = readInputFile(file, kMaxJsonFileBytes);
+    } catch (const InputFileError& e) {
+        throw SceneError(file, {}, e.problem());
+    }
     if (ext == ".gltf" || ext == ".glb") return loadModelScene(file);
     if (ext == ".obj")
         throw SceneError(file, {}, "an OBJ file has no camera or light: reference it from a JSON scene "
-                                   "as {\"type\": \"mesh\", \"file\": \"" + file.filename().string() + "\"}");
-    const auto size = fs::file_size(file, ec);
-    if (ec) throw SceneError(file, {}, "cannot read: " + ec.message());
-    if (size > 256u * 1024 * 1024) throw SceneError(file, {}, "is larger than 256 MiB; not a scene file");
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw SceneError(file, {}, "cannot open for reading");
-    std::ostringstream text;
-    text << in.rdbuf();
-    return parseScene(file, text.str());
+                                   "as {\"type\": \"mesh\", \"file\": \"" + excerpt(file.filename().string()) + "\"}");
+    return parseScene(file, text);
 }
 
 fs::path scenesDirectory() {

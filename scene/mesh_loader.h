@@ -24,6 +24,7 @@ struct GltfCamera {
     double yfovRadians = 0.0, znear = 0.0, zfar = 0.0, aspect = 0.0;  // zfar/aspect 0: unset
 };
 struct GltfLight {
+    int index = -1;    // in KHR_lights_punctual.lights
     std::string type;  // "directional" | "point" | "spot"
     Vec3 position{0, 0, 0}, direction{0, 0, -1}, color{1, 1, 1};
     double intensity = 1.0;         // lux (directional) or candela (point, spot)
