@@ -2,6 +2,9 @@
 // validated completely before anything is written, so bad input leaves no file behind.
 #include "app/commands.h"
 
+#include "app/guards.h"
+#include "scene/folder_lock.h"
+
 #include <algorithm>
 #include <chrono>
 #include <functional>
@@ -57,7 +60,7 @@ void applyResolution(scene::Scene& s, const std::string& text) {
 }
 
 Prepared prepare(const SceneOptions& o) {
-    Prepared p{scene::loadScene(scene::findScene(o.scene)), {}, {}};
+    Prepared p{readingInput(o.scene, [&] { return scene::loadScene(scene::findScene(o.scene)); }), {}, {}};
     if (o.resolution) applyResolution(p.scene, *o.resolution);
     p.settings = scene::resolveSettings(p.scene, o.settings);
     p.plan = scene::makeRenderPlan(p.scene, p.settings);
@@ -225,6 +228,16 @@ constexpr RunView kRunViews[] = {
     {"cascades", "cascades", "The cascade each pixel's shadow test used: red, green, blue, yellow from near to far."},
 };
 
+// A run's staging folder: removed when the run ends without committing it.
+struct StagingFolder {
+    fs::path dir;
+    bool committed = false;
+    ~StagingFolder() {
+        std::error_code ignored;
+        if (!committed) fs::remove_all(dir, ignored);
+    }
+};
+
 }  // namespace
 
 int render(const RenderOptions& o) {
@@ -234,6 +247,7 @@ int render(const RenderOptions& o) {
     if (o.view && (o.backend != "raster" || ext != ".png"))
         throw scene::InputError("--view " + *o.view + ": needs --backend raster and a .png output (a view is a "
                                 "display image of the shadow maps), got --backend " + o.backend + " and '" + ext + "'");
+    checkOutputFile(o.output);  // before any work: an output that cannot be written fails now
     const Prepared p = prepare(o.common);
     // A view writes a display image, not the Frame; the shadow-map view holds every layer's depths.
     const std::uint64_t estimate =
@@ -284,8 +298,9 @@ int render(const RenderOptions& o) {
 int compareFiles(const CompareOptions& o) {
     if (o.output.extension() != ".png")
         throw scene::InputError(o.output.string() + ": the difference image must be a .png");
-    const scene::Frame method = scene::readFrame(o.method);
-    const scene::Frame reference = scene::readFrame(o.reference);
+    checkOutputFile(o.output);
+    const scene::Frame method = readingInput(o.method.string(), [&] { return scene::readFrame(o.method); });
+    const scene::Frame reference = readingInput(o.reference.string(), [&] { return scene::readFrame(o.reference); });
     compare::Comparison c;
     try {
         c = compare::compareFrames(method, reference);
@@ -308,6 +323,7 @@ int info(bool validate) {
 }
 
 int run(const RunOptions& o) {
+    checkOutputFolder(o.outputDir);
     const Prepared p = prepare(o.common);
     // The reference, the ray-traced and the raster Frames are all held until the report is
     // written, with a difference image for each method (the half-size sweep needs less).
@@ -324,8 +340,16 @@ int run(const RunOptions& o) {
     scene::checkMemory(estimate, "run at " + std::to_string(p.scene.camera.width) + "x" +
                                      std::to_string(p.scene.camera.height));
     fs::create_directories(o.outputDir);
-    const fs::path dir = o.outputDir;
-    scene::removeStaleTemporaries(dir);  // what an earlier run that was killed left behind
+    const scene::FolderLock lock(o.outputDir, "run");
+    // The run's files are made in a fresh folder beside the output folder, which they replace as
+    // a set once all are written (commitRun): a folder never mixes two runs, and a run that
+    // fails half-way (a full disk) leaves the previous one whole.
+    const fs::path target = fs::canonical(o.outputDir);
+    scene::removeStaleTemporaries(target.parent_path());  // what an earlier run that was killed left behind
+    scene::removeStaleTemporaries(target);
+    const fs::path dir = scene::temporarySibling(target);
+    fs::create_directory(dir);
+    StagingFolder staging{dir};
     int status = 0;
 
     Json metrics = {{"scene", p.scene.file.string()},
@@ -414,14 +438,20 @@ int run(const RunOptions& o) {
     metrics["memory"] = memoryJson(estimate);
     scene::writeTextAtomic(dir / "metrics.json", metrics.dump(2) + "\n");
     compare::writeReport(dir, report);
-    std::cerr << "shadowlab: wrote " << (dir / "report.html").string() << "; " << memoryLine(estimate) << "\n";
+    // The commit: this run's files replace the previous run's as a set; the user's own files
+    // (and the lock) stay.
+    scene::replaceFolderContents(dir, target, [](const std::string& name) { return !isRunOutput(name); });
+    staging.committed = true;
+    std::cerr << "shadowlab: wrote " << (o.outputDir / "report.html").string() << "; " << memoryLine(estimate) << "\n";
     if (o.common.json) std::cout << metrics.dump(2) << "\n";
     return status;
 }
 
 int sweep(const SweepOptions& o) {
+    checkOutputFolder(o.outputDir);
     const Prepared p = prepare(o.common);
-    compare::SweepGrid grid = o.grid ? compare::loadGrid(*o.grid, p.scene) : compare::defaultGrid(p.scene, o.quick);
+    compare::SweepGrid grid = o.grid ? readingInput(o.grid->string(), [&] { return compare::loadGrid(*o.grid, p.scene); })
+                                     : compare::defaultGrid(p.scene, o.quick);
     if (o.repetitions) grid.repetitions = *o.repetitions;
     if (o.common.resolution) grid.resolution = o.common.resolution;
     // Settings given on the command line apply to every configuration that does not vary them.
@@ -445,6 +475,9 @@ int sweep(const SweepOptions& o) {
     options.outputDir = o.outputDir;
     options.resume = o.resume;
     options.progress = sweepProgressPrinter();
+    // One writer per folder: two sweeps appending to one journal would duplicate its keys.
+    fs::create_directories(o.outputDir);
+    const scene::FolderLock lock(o.outputDir, "sweep");
     std::cerr << "shadowlab: sweep of " << grid.configs.size() << " configurations, " << grid.repetitions
               << " timed frames each, into " << o.outputDir.string() << "\n";
     const compare::SweepResult result = compare::runSweep(p.scene, grid, options);
@@ -460,6 +493,7 @@ int sweep(const SweepOptions& o) {
 
 int stability(const StabilityCommandOptions& o) {
     // Every case is loaded and checked before anything renders or is written.
+    checkOutputFolder(o.outputDir);
     std::vector<fs::path> files;
     if (o.scenes.empty()) {
         for (const auto& e : fs::directory_iterator(scene::scenesDirectory() / "extreme"))
@@ -469,9 +503,12 @@ int stability(const StabilityCommandOptions& o) {
         for (const std::string& name : o.scenes) files.push_back(scene::findScene(name));
     }
     std::vector<scene::Scene> scenes;
-    for (const fs::path& f : files) scenes.push_back(scene::loadScene(f));
+    for (const fs::path& f : files)
+        scenes.push_back(readingInput(f.string(), [&] { return scene::loadScene(f); }));
     scene::Scene probe;
     applyResolution(probe, o.resolution);
+    fs::create_directories(o.outputDir);
+    const scene::FolderLock lock(o.outputDir, "stability");
 
     compare::StabilityOptions options;
     options.width = probe.camera.width;
