@@ -251,7 +251,7 @@ int render(const RenderOptions& o) {
     const Prepared p = prepare(o.common);
     // A view writes a display image, not the Frame; the shadow-map view holds every layer's depths.
     const std::uint64_t estimate =
-        scene::kProgramBytes + backendMemory(p, o.backend) +
+        scene::kProgramBytes + scene::sceneBytes(p.scene) + backendMemory(p, o.backend) +
         (o.view ? raster::debugViewBytes(p.scene, p.plan, p.settings.raster, *o.view)
                 : scene::frameWriteBytes(p.scene));
     scene::checkMemory(estimate, o.view ? "rendering the " + *o.view + " view of " +
@@ -333,7 +333,7 @@ int run(const RunOptions& o) {
     const bool views = !o.skipRaster && std::any_of(p.plan.lights.begin(), p.plan.lights.end(),
                                                      [](const scene::LightPlan& l) { return l.needsShadowTest; });
     const std::uint64_t estimate =
-        scene::kProgramBytes + backendMemory(p, "raytrace") + scene::frameBytes(p.scene) +
+        scene::kProgramBytes + scene::sceneBytes(p.scene) + backendMemory(p, "raytrace") + scene::frameBytes(p.scene) +
         (o.skipRaster ? 0 : backendMemory(p, "raster")) + scene::frameWriteBytes(p.scene) +
         2 * pixels * 3 * sizeof(float) +
         (views ? raster::debugViewBytes(p.scene, p.plan, p.settings.raster, "shadow-map") : 0);

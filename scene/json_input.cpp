@@ -2,6 +2,7 @@
 #include "scene/json_input.h"
 
 #include "scene/error.h"
+#include "scene/memory.h"
 
 namespace shadowlab::scene {
 
@@ -75,8 +76,40 @@ void checkJsonNesting(const std::filesystem::path& file, std::string_view text) 
     if (const std::string problem = jsonNestingProblem(text); !problem.empty()) throw SceneError(file, {}, problem);
 }
 
+std::uint64_t jsonTreeBytes(std::string_view text) {
+    std::uint64_t values = 0, containers = 0, members = 0, strings = 0, stringBytes = 0;
+    bool inString = false, inScalar = false;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (inString) {
+            ++stringBytes;
+            if (c == '\\') ++i;
+            else if (c == '"') inString = false;
+            continue;
+        }
+        const bool scalarChar = (c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') || c == '-' || c == '+' || c == '.' ||
+                                (c >= 'A' && c <= 'Z');
+        if (scalarChar && !inScalar) ++values;
+        inScalar = scalarChar;
+        if (c == '"') {
+            inString = true;
+            ++strings;
+            ++values;
+        } else if (c == '[' || c == '{') {
+            ++containers;
+            ++values;
+        } else if (c == ':') {
+            ++members;
+        }
+    }
+    return 32 * values + 64 * containers + 96 * members + 48 * strings + stringBytes;
+}
+
 nlohmann::json parseJsonText(const std::filesystem::path& file, std::string_view text) {
     checkJsonNesting(file, text);
+    if (const std::uint64_t tree = jsonTreeBytes(text), available = availableMemoryBytes(); available != 0 && tree > available)
+        throw SceneError(file, {}, "parsing it needs about " + std::to_string(tree >> 20) + " MiB, more than the " +
+                                       std::to_string(available >> 20) + " MiB available");
     try {
         return nlohmann::json::parse(text.begin(), text.end());
     } catch (const nlohmann::json::parse_error& e) {

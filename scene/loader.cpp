@@ -14,6 +14,7 @@
 #include "scene/error.h"
 #include "scene/input_file.h"
 #include "scene/json_input.h"
+#include "scene/memory.h"
 #include "scene/mesh_loader.h"
 #include "scene/scene_checks.h"
 #include "scene/settings.h"
@@ -367,6 +368,11 @@ Scene parseScene(const fs::path& file, const std::string& text) {
     const JsonPath root;
     Json doc;
     checkJsonNesting(file, text);
+    // The parsed tree takes several times the text: refused before it is built when it cannot fit.
+    const std::uint64_t treeBytes = std::uint64_t(text.size()) + jsonTreeBytes(text);
+    if (const std::uint64_t available = availableMemoryBytes(); available != 0 && treeBytes > available)
+        throw SceneError(file, root, "parsing it needs about " + std::to_string(treeBytes / kMiB) + " MiB, more than the " +
+                                         std::to_string(available / kMiB) + " MiB available");
     try {
         doc = Json::parse(text);
     } catch (const Json::parse_error& e) {
@@ -422,6 +428,7 @@ Scene parseScene(const fs::path& file, const std::string& text) {
 
     if (doc.contains("shadow")) scene.shadow = readShadow(r, doc["shadow"], root / "shadow");
     checkSceneExtent(scene, true);
+    scene.loadBytes = treeBytes + meshCache.peakLoadBytes;
     return scene;
 }
 
@@ -495,6 +502,7 @@ Scene loadModelScene(const fs::path& file) {
         scene.lights.push_back(sun);
     }
     checkSceneExtent(scene, false);
+    scene.loadBytes = extras.loadBytes;
     return scene;
 }
 

@@ -477,8 +477,11 @@ bool invertible(const glm::dmat4& m) {
 }
 
 // The file's instances with `transform` not yet applied (what the cache keeps).
+// `loadBytes`: an upper estimate of what reading the file held at its peak beside the result:
+// its bytes, tinyobjloader's arrays (about three times an OBJ's text), or tinygltf's JSON tree
+// (twice: its parse tree and the model's copies), buffers and the accessors read as doubles.
 std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path& sceneFile,
-                                       const JsonPath& path, GltfExtras* extras) {
+                                       const JsonPath& path, GltfExtras* extras, std::uint64_t& loadBytes) {
     std::string bytes;
     try {
         bytes = readInputFile(meshFile, kMaxMeshFileBytes);
@@ -489,6 +492,11 @@ std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path&
     std::vector<RawInstance> raw;
     std::string ext = meshFile.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+    loadBytes = ext == ".obj" ? 4 * std::uint64_t(bytes.size())
+                              : 5 * std::uint64_t(bytes.size()) + 2 * jsonTreeBytes(gltfJson(bytes, ext == ".glb"));
+    if (const std::uint64_t available = availableMemoryBytes(); available != 0 && loadBytes > available)
+        fail(sceneFile, path, meshFile, "reading it needs about " + std::to_string(loadBytes / kMiB) + " MiB, more than the " +
+                                            std::to_string(available / kMiB) + " MiB available");
     if (ext == ".obj") {
         raw.push_back({std::make_shared<TriangleMesh>(), glm::dmat4(1.0)});
         loadObj(meshFile, bytes, *raw.back().geometry, sceneFile, path);
@@ -585,8 +593,13 @@ std::vector<MeshInstance> loadMeshInstances(const fs::path& meshFile, const glm:
         if (const auto it = cache->files.find(key); it != cache->files.end()) instances = it->second;
     }
     if (instances.empty()) {
-        instances = readMeshFile(meshFile, sceneFile, path, extras);
-        if (cache) cache->files.emplace(key, instances);
+        std::uint64_t loadBytes = 0;
+        instances = readMeshFile(meshFile, sceneFile, path, extras, loadBytes);
+        if (cache) {
+            cache->files.emplace(key, instances);
+            cache->peakLoadBytes = std::max(cache->peakLoadBytes, loadBytes);
+        }
+        if (extras) extras->loadBytes = std::max(extras->loadBytes, loadBytes);
     }
     std::vector<MeshInstance> out;
     bool overflowed = false;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <filesystem>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
@@ -33,12 +34,14 @@ struct GltfLight {
 struct GltfExtras {
     std::vector<GltfCamera> cameras;
     std::vector<GltfLight> lights;
+    std::uint64_t loadBytes = 0;  // the file's temporaries while it was read (text, trees, buffers)
 };
 
 // Each mesh file read once per scene: objects that name the same file share its geometries
 // (the key is the file's canonical path).
 struct MeshCache {
     std::map<std::string, std::vector<MeshInstance>> files;
+    std::uint64_t peakLoadBytes = 0;  // the largest file's temporaries while it was read
 };
 
 // Reads `meshFile`: one instance for an OBJ file, one per node that uses a mesh for glTF (the

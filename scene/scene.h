@@ -164,6 +164,9 @@ struct Scene {
     std::vector<Light> lights;
     std::vector<Object> objects;
     ShadowDefaults shadow;
+    // What loading took at its peak beyond the scene itself (the file's text, its parsed JSON
+    // tree, the largest mesh file's temporaries): part of the memory estimate (scene/memory.h).
+    std::uint64_t loadBytes = 0;
 
     const Material& materialOf(const Object& o) const { return materials[o.material]; }
     bool allOpaque() const;

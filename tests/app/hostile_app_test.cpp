@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "app/guards.h"
 #include "scene/folder_lock.h"
@@ -106,6 +107,47 @@ TEST(HostileApp, ARunReplacesThePreviousRunsFilesAsASetAndKeepsTheUsers) {
     EXPECT_FALSE(fs::exists(out / scene::kLockFileName));
     for (const auto& e : fs::directory_iterator(dir.path()))  // no staging folder left beside it
         EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
+}
+
+TEST(HostileApp, TheMemoryEstimateCountsTheSceneItself) {
+    // 200000 glTF nodes placing one triangle each: the file's parsed tree, the nodes and their
+    // placements cost far more than their triangles, which were all the estimate counted.
+    TempDir dir;
+    std::string nodes, roots;
+    for (int i = 0; i < 200000; ++i) {
+        if (i) {
+            nodes += ',';
+            roots += ',';
+        }
+        nodes += R"({"mesh":0,"translation":[)" + std::to_string(i % 500) + ",0," + std::to_string(i / 500) + "]}";
+        roots += std::to_string(i);
+    }
+    // One triangle (0,0,0), (1,0,0), (0,1,0) as 9 little-endian floats, base64.
+    const std::string gltf = R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[)" + roots + R"(]}],"nodes":[)" + nodes +
+                             R"(],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],
+        "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}],
+        "bufferViews":[{"buffer":0,"byteLength":36}],
+        "buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]})";
+    const fs::path file = dir.path() / "nodes.gltf";
+    std::ofstream(file) << gltf;
+    const std::string frame = (dir.path() / "n.exr").string();
+    TempDir io;
+    const Outcome r = run("render " + file.string() + " --resolution 16x9 --json -o " + frame,
+                          (io.path() / "out.json").string());
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    std::ifstream out(io.path() / "out.json");
+    const auto memory = nlohmann::json::parse(out).at("memory");
+#ifndef __SANITIZE_ADDRESS__  // AddressSanitizer's shadow memory and quarantine are not in the estimate
+    EXPECT_LE(memory.at("peak_mib").get<double>(), memory.at("estimate_mib").get<double>()) << memory.dump();
+#endif
+    // Under a limit below the estimate it is refused before rendering.
+    const std::string limit = std::to_string(memory.at("estimate_mib").get<int>() - 10);
+    ::setenv("SHADOWLAB_MEMORY_LIMIT_MB", limit.c_str(), 1);
+    const Outcome small = run("render " + file.string() + " --resolution 16x9 -o " + frame + ".2.exr");
+    ::unsetenv("SHADOWLAB_MEMORY_LIMIT_MB");
+    EXPECT_EQ(small.exitCode, 2) << small.err;
+    EXPECT_NE(small.err.find("needs about"), std::string::npos) << small.err;
+    EXPECT_FALSE(fs::exists(frame + ".2.exr"));
 }
 
 TEST(HostileApp, StandardExceptionsWhileReadingAnInputBecomeBadInputNamingIt) {
