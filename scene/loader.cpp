@@ -470,6 +470,9 @@ Scene loadModelScene(const fs::path& file) {
         cam.far = distance + 2.0 * radius;
     }
     for (const GltfLight& l : extras.lights) {
+        const JsonPath lightPath = JsonPath() / "extensions" / "KHR_lights_punctual" / "lights" / std::size_t(l.index);
+        if (!(l.intensity >= 0))  // in the file's units, before the conversion below
+            throw SceneError(file, lightPath / "intensity", "must be finite and >= 0, got " + describeJson(l.intensity));
         Light light;
         light.color = l.color;
         if (l.type == "directional") {
@@ -488,8 +491,7 @@ Scene loadModelScene(const fs::path& file) {
         // The checks a JSON light gets, at the glTF light's path (its position and direction
         // come from its node).
         if (const ValueProblem problem = lightProblem(light))
-            throw SceneError(file, JsonPath() / "extensions" / "KHR_lights_punctual" / "lights" / std::size_t(l.index) /
-                                       (problem.key == "cone_angle" ? std::string("spot.outerConeAngle") : problem.key),
+            throw SceneError(file, lightPath / (problem.key == "cone_angle" ? std::string("spot.outerConeAngle") : problem.key),
                              problem.what + (problem.key == "position" || problem.key == "direction"
                                                  ? " (from the transform of the node that holds the light)"
                                                  : ""));

@@ -29,7 +29,8 @@ namespace fs = std::filesystem;
 
 [[noreturn]] void fail(const fs::path& sceneFile, const JsonPath& path, const fs::path& mesh,
                        const std::string& what) {
-    throw SceneError(sceneFile, path, mesh.string() + ": " + what);
+    // (a glTF given as the scene is both: named once)
+    throw SceneError(sceneFile, path, mesh == sceneFile ? what : mesh.string() + ": " + what);
 }
 
 bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
