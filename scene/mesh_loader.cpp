@@ -313,8 +313,9 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
 
 // A node's camera and KHR_lights_punctual light, placed by the node's world transform (glTF
 // cameras and lights look down their local −Z with +Y up).
-void collectCameraAndLight(const tinygltf::Model& model, const tinygltf::Node& node,
-                           const glm::dmat4& world, GltfExtras& out) {
+void collectCameraAndLight(const tinygltf::Model& model, const tinygltf::Node& node, int nodeIndex,
+                           const glm::dmat4& world, GltfExtras& out, const fs::path& file, const fs::path& sceneFile,
+                           const JsonPath& path) {
     const Vec3 origin(world * glm::dvec4(0, 0, 0, 1));
     const Vec3 forward = glm::normalize(Vec3(world * glm::dvec4(0, 0, -1, 0)));
     const Vec3 up = glm::normalize(Vec3(world * glm::dvec4(0, 1, 0, 0)));
@@ -333,9 +334,20 @@ void collectCameraAndLight(const tinygltf::Model& model, const tinygltf::Node& n
     }
     const auto ext = node.extensions.find("KHR_lights_punctual");
     if (ext == node.extensions.end() || !ext->second.Has("light")) return;
-    const int index = ext->second.Get("light").GetNumberAsInt();
-    if (index < 0 || std::size_t(index) >= model.lights.size()) return;
-    const tinygltf::Light& l = model.lights[index];
+    // The index is the file's: any number (GetNumberAsInt of 1e15 is undefined behaviour, found
+    // by fuzzing), so it is checked as a double first.
+    const tinygltf::Value& v = ext->second.Get("light");
+    const double number = v.IsNumber() || v.IsInt() ? v.GetNumberAsDouble() : -1.0;
+    if (!(number >= 0 && number < double(model.lights.size()) && number == std::floor(number)))
+        fail(sceneFile, path, file, "nodes[" + std::to_string(nodeIndex) +
+                                        "].extensions.KHR_lights_punctual.light: names no light (" +
+                                        std::to_string(model.lights.size()) + " lights)");
+    const int index = int(number);
+    const tinygltf::Light& l = model.lights[std::size_t(index)];
+    if (l.type != "directional" && l.type != "point" && l.type != "spot")
+        fail(sceneFile, path, file, "extensions.KHR_lights_punctual.lights[" + std::to_string(index) +
+                                        "].type: unknown light type '" + excerpt(l.type) +
+                                        "' (expected directional, point or spot)");
     GltfLight light;
     light.index = index;
     light.type = l.type;
@@ -461,7 +473,7 @@ void loadGltf(const fs::path& file, const std::string& bytes, std::vector<RawIns
             }
             out.push_back({geometry, world});
         }
-        if (extras) collectCameraAndLight(model, node, world, *extras);
+        if (extras) collectCameraAndLight(model, node, nodeIndex, world, *extras, file, sceneFile, path);
         for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.emplace_back(*c, world);
     }
 }
