@@ -342,7 +342,7 @@ int run(const RunOptions& o) {
     fs::create_directories(o.outputDir);
     const scene::FolderLock lock(o.outputDir, "run");
     // The run's files are made in a fresh folder beside the output folder, which they replace as
-    // a set once all are written (commitRun): a folder never mixes two runs, and a run that
+    // a set once all are written (the commit at the end): a folder never mixes two runs, and a run that
     // fails half-way (a full disk) leaves the previous one whole.
     const fs::path target = fs::canonical(o.outputDir);
     scene::removeStaleTemporaries(target.parent_path());  // what an earlier run that was killed left behind
