@@ -171,10 +171,71 @@ void loadObj(const fs::path& file, const std::string& text, TriangleMesh& mesh, 
 bool addChecked(std::uint64_t a, std::uint64_t b, std::uint64_t& out) { return !__builtin_add_overflow(a, b, &out); }
 bool mulChecked(std::uint64_t a, std::uint64_t b, std::uint64_t& out) { return !__builtin_mul_overflow(a, b, &out); }
 
-// Reads one accessor as doubles (`components` per element). Every offset, count and stride is
-// the file's, so each sum and product is checked for overflow and against the lengths of the
-// buffer view and the buffer (glTF 2.0, 3.6.2.4: byteOffset + (count - 1) * stride + element
-// size must fit the view); errors name the glTF JSON path of the field at fault.
+// `count` elements of `nComp` components of `componentType` from buffer view `viewIndex`,
+// starting `byteOffset` into it, `stride` bytes apart (0: the view's stride, or packed), as
+// doubles. Every offset, count and stride is the file's, so each sum and product is checked for
+// overflow and against the lengths of the view and its buffer (glTF 2.0, 3.6.2.4: byteOffset +
+// (count - 1) * stride + element size must fit the view); `where` names the field at fault.
+std::vector<double> readElements(const tinygltf::Model& model, int viewIndex, std::uint64_t byteOffset,
+                                 std::uint64_t count, int componentType, int nComp, bool packed,
+                                 const std::string& where, const fs::path& file, const fs::path& sceneFile,
+                                 const JsonPath& path) {
+    auto bad = [&](const std::string& at, const std::string& what) { fail(sceneFile, path, file, at + ": " + what); };
+    if (viewIndex < 0 || std::size_t(viewIndex) >= model.bufferViews.size())
+        bad(where + ".bufferView", "names buffer view " + std::to_string(viewIndex) + ", which does not exist (" +
+                                       std::to_string(model.bufferViews.size()) + " buffer views)");
+    const std::string viewAt = "bufferViews[" + std::to_string(viewIndex) + "]";
+    const auto& view = model.bufferViews[std::size_t(viewIndex)];
+    if (view.buffer < 0 || std::size_t(view.buffer) >= model.buffers.size())
+        bad(viewAt + ".buffer", "names buffer " + std::to_string(view.buffer) + ", which does not exist");
+    const auto& buffer = model.buffers[std::size_t(view.buffer)];
+    const int compSize = tinygltf::GetComponentSizeInBytes(componentType);
+    if (compSize <= 0) bad(where + ".componentType", "unsupported component type " + std::to_string(componentType));
+    const std::uint64_t element = std::uint64_t(compSize) * std::uint64_t(nComp);
+    const std::uint64_t stride = !packed && view.byteStride ? std::uint64_t(view.byteStride) : element;
+    if (stride < element)
+        bad(viewAt + ".byteStride", std::to_string(stride) + " is smaller than one element (" + std::to_string(element) +
+                                        " bytes)");
+    std::uint64_t viewEnd = 0;
+    if (!addChecked(view.byteOffset, view.byteLength, viewEnd) || viewEnd > buffer.data.size())
+        bad(viewAt, "byteOffset " + std::to_string(view.byteOffset) + " + byteLength " + std::to_string(view.byteLength) +
+                        " reaches past the end of buffer " + std::to_string(view.buffer) + " (" +
+                        std::to_string(buffer.data.size()) + " bytes)");
+    std::uint64_t span = 0, last = 0, end = 0;
+    if (count > 0 && (!mulChecked(stride, count - 1, span) || !addChecked(span, element, last) ||
+                      !addChecked(last, byteOffset, end) || end > view.byteLength))
+        bad(where, "byteOffset " + std::to_string(byteOffset) + " + " + std::to_string(count) + " elements of stride " +
+                       std::to_string(stride) + " reach past the end of " + viewAt + " (" +
+                       std::to_string(view.byteLength) + " bytes)");
+    // The doubles read: at most 8 a byte of the buffer, but that may still be more than the
+    // machine has.
+    const std::uint64_t values = count * std::uint64_t(nComp);
+    if (const std::uint64_t available = availableMemoryBytes(); available != 0 && values * sizeof(double) > available)
+        bad(where, "reading its " + std::to_string(count) + " elements needs " +
+                       std::to_string(values * sizeof(double) / kMiB) + " MiB, more than the " +
+                       std::to_string(available / kMiB) + " MiB available");
+    std::vector<double> out(values);
+    const unsigned char* base = buffer.data.data() + view.byteOffset + byteOffset;
+    for (std::size_t i = 0; i < count; ++i) {
+        for (int c = 0; c < nComp; ++c) {
+            const unsigned char* p = base + i * stride + std::size_t(c) * compSize;
+            double v = 0;
+            switch (componentType) {
+                case TINYGLTF_COMPONENT_TYPE_FLOAT: { float f; std::memcpy(&f, p, 4); v = f; break; }
+                case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { std::uint32_t u; std::memcpy(&u, p, 4); v = u; break; }
+                case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { std::uint16_t u; std::memcpy(&u, p, 2); v = u; break; }
+                case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: v = *p; break;
+                default: bad(where + ".componentType", "unsupported component type " + std::to_string(componentType));
+            }
+            out[i * std::size_t(nComp) + std::size_t(c)] = v;
+        }
+    }
+    return out;
+}
+
+// Reads one accessor as doubles (`components` per element): its buffer view's elements, or
+// zeros where it has none, with a sparse accessor's replacements applied (glTF 2.0, 3.6.2.3:
+// `count` strictly increasing indices into the accessor, and as many packed values).
 std::vector<double> readAccessor(const tinygltf::Model& model, int accessorIndex, int components,
                                  const fs::path& file, const fs::path& sceneFile, const JsonPath& path) {
     const std::string at = "accessors[" + std::to_string(accessorIndex) + "]";
@@ -184,61 +245,47 @@ std::vector<double> readAccessor(const tinygltf::Model& model, int accessorIndex
     if (accessorIndex < 0 || std::size_t(accessorIndex) >= model.accessors.size())
         fail(sceneFile, path, file, "accessor " + std::to_string(accessorIndex) + " does not exist (" +
                                         std::to_string(model.accessors.size()) + " accessors)");
-    const auto& acc = model.accessors[accessorIndex];
-    // Sparse accessors (3.6.2.3) replace some elements by others; reading only the dense part
-    // would silently give the wrong geometry.
-    if (acc.sparse.isSparse) bad(at + ".sparse", "sparse accessors are not supported (export the values densely)");
-    if (acc.bufferView < 0 || std::size_t(acc.bufferView) >= model.bufferViews.size())
-        bad(at + ".bufferView", "names buffer view " + std::to_string(acc.bufferView) + ", which does not exist (" +
-                                    std::to_string(model.bufferViews.size()) + " buffer views)");
-    const std::string viewAt = "bufferViews[" + std::to_string(acc.bufferView) + "]";
-    const auto& view = model.bufferViews[acc.bufferView];
-    if (view.buffer < 0 || std::size_t(view.buffer) >= model.buffers.size())
-        bad(viewAt + ".buffer", "names buffer " + std::to_string(view.buffer) + ", which does not exist");
-    const auto& buffer = model.buffers[view.buffer];
-    const int compSize = tinygltf::GetComponentSizeInBytes(acc.componentType);
+    const auto& acc = model.accessors[std::size_t(accessorIndex)];
     const int nComp = tinygltf::GetNumComponentsInType(acc.type);
-    if (compSize <= 0 || nComp != components)
+    if (tinygltf::GetComponentSizeInBytes(acc.componentType) <= 0 || nComp != components)
         bad(at, "has an unexpected type (expected " + std::to_string(components) + " component(s) per element)");
-    const std::uint64_t element = std::uint64_t(compSize) * std::uint64_t(nComp);
-    const std::uint64_t stride = view.byteStride ? std::uint64_t(view.byteStride) : element;
-    if (stride < element)
-        bad(viewAt + ".byteStride", std::to_string(stride) + " is smaller than one element (" + std::to_string(element) +
-                                        " bytes)");
-    std::uint64_t viewEnd = 0;
-    if (!addChecked(view.byteOffset, view.byteLength, viewEnd) || viewEnd > buffer.data.size())
-        bad(viewAt, "byteOffset " + std::to_string(view.byteOffset) + " + byteLength " + std::to_string(view.byteLength) +
-                        " reaches past the end of buffer " + std::to_string(view.buffer) + " (" +
-                        std::to_string(buffer.data.size()) + " bytes)");
-    std::uint64_t span = 0, last = 0, accEnd = 0;
-    if (acc.count > 0 &&
-        (!mulChecked(stride, acc.count - 1, span) || !addChecked(span, element, last) ||
-         !addChecked(last, acc.byteOffset, accEnd) || accEnd > view.byteLength))
-        bad(at, "byteOffset " + std::to_string(acc.byteOffset) + " + " + std::to_string(acc.count) +
-                    " elements of stride " + std::to_string(stride) + " reach past the end of " + viewAt + " (" +
-                    std::to_string(view.byteLength) + " bytes)");
-    // The doubles read: at most 8 a byte of the buffer, but that may still be more than the
-    // machine has.
-    const std::uint64_t values = std::uint64_t(acc.count) * std::uint64_t(nComp);
-    if (const std::uint64_t available = availableMemoryBytes(); available != 0 && values * sizeof(double) > available)
-        bad(at, "reading its " + std::to_string(acc.count) + " elements needs " +
-                    std::to_string(values * sizeof(double) / kMiB) + " MiB, more than the " +
-                    std::to_string(available / kMiB) + " MiB available");
-    std::vector<double> out(values);
-    const unsigned char* base = buffer.data.data() + view.byteOffset + acc.byteOffset;
-    for (std::size_t i = 0; i < acc.count; ++i) {
-        for (int c = 0; c < nComp; ++c) {
-            const unsigned char* p = base + i * stride + std::size_t(c) * compSize;
-            double v = 0;
-            switch (acc.componentType) {
-                case TINYGLTF_COMPONENT_TYPE_FLOAT: { float f; std::memcpy(&f, p, 4); v = f; break; }
-                case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { std::uint32_t u; std::memcpy(&u, p, 4); v = u; break; }
-                case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { std::uint16_t u; std::memcpy(&u, p, 2); v = u; break; }
-                case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: v = *p; break;
-                default: bad(at + ".componentType", "unsupported component type " + std::to_string(acc.componentType));
-            }
-            out[i * nComp + c] = v;
-        }
+    std::vector<double> out;
+    if (acc.bufferView >= 0 || !acc.sparse.isSparse) {
+        out = readElements(model, acc.bufferView, acc.byteOffset, acc.count, acc.componentType, nComp, false, at, file,
+                           sceneFile, path);
+    } else {
+        // No buffer view: zeros (bounded like any read: by the memory there is).
+        const std::uint64_t values = std::uint64_t(acc.count) * std::uint64_t(nComp);
+        if (const std::uint64_t available = availableMemoryBytes(); available != 0 && values * sizeof(double) > available)
+            bad(at + ".count", std::to_string(acc.count) + " elements need more than the " +
+                                   std::to_string(available / kMiB) + " MiB available");
+        out.assign(values, 0.0);
+    }
+    if (!acc.sparse.isSparse) return out;
+    const auto& sparse = acc.sparse;
+    const std::string sparseAt = at + ".sparse";
+    if (sparse.count < 1 || std::uint64_t(sparse.count) > acc.count)
+        bad(sparseAt + ".count", "must be in 1.." + std::to_string(acc.count) + ", got " + std::to_string(sparse.count));
+    const int indexType = sparse.indices.componentType;
+    if (indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+        bad(sparseAt + ".indices.componentType", "must be an unsigned byte, short or int, got " + std::to_string(indexType));
+    if (sparse.indices.byteOffset < 0 || sparse.values.byteOffset < 0)
+        bad(sparseAt, "a byteOffset is negative");
+    const std::vector<double> indices =
+        readElements(model, sparse.indices.bufferView, std::uint64_t(sparse.indices.byteOffset), std::uint64_t(sparse.count),
+                     indexType, 1, true, sparseAt + ".indices", file, sceneFile, path);
+    const std::vector<double> values =
+        readElements(model, sparse.values.bufferView, std::uint64_t(sparse.values.byteOffset), std::uint64_t(sparse.count),
+                     acc.componentType, nComp, true, sparseAt + ".values", file, sceneFile, path);
+    for (std::size_t k = 0; k < indices.size(); ++k) {
+        const double index = indices[k];
+        if (index >= double(acc.count) || (k > 0 && !(index > indices[k - 1])))
+            bad(sparseAt + ".indices", "index " + std::to_string(std::uint64_t(index)) + " (element " + std::to_string(k) +
+                                           ") is out of range or not increasing (" + std::to_string(acc.count) +
+                                           " elements)");
+        for (int c = 0; c < nComp; ++c)
+            out[std::size_t(index) * std::size_t(nComp) + std::size_t(c)] = values[k * std::size_t(nComp) + std::size_t(c)];
     }
     return out;
 }

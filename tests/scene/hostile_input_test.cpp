@@ -240,13 +240,45 @@ TEST(GltfAccessor, OffsetsCountsAndStridesThatWrapOrOverrunAreErrorsWithTheirPat
     EXPECT_FALSE(e.empty());
 }
 
-TEST(GltfAccessor, SparseAccessorsAreRefusedNotIgnored) {
-    const std::string e = gltfError([](Json& g) {
-        g["accessors"][0]["sparse"] = {{"count", 1},
-                                       {"indices", {{"bufferView", 0}, {"componentType", 5125}}},
-                                       {"values", {{"bufferView", 0}}}};
-    });
-    EXPECT_NE(e.find("accessors[0].sparse: sparse accessors are not supported"), std::string::npos) << e;
+// The triangle with a sparse accessor moving vertex 2 from (0, 1, 0) to `moved` (buffer: the
+// 36 bytes of positions, one uint32 index at 36, 12 bytes of value at 40).
+Json sparseTriangle(std::uint32_t index, const float moved[3]) {
+    Json g = triangleGltf("", 52);
+    std::string bytes = triangleBytes();
+    bytes.append(reinterpret_cast<const char*>(&index), 4);
+    bytes.append(reinterpret_cast<const char*>(moved), 12);
+    g["buffers"][0]["uri"] = "data:application/octet-stream;base64," +
+                             test::base64(std::vector<unsigned char>(bytes.begin(), bytes.end()));
+    g["bufferViews"] = {{{"buffer", 0}, {"byteLength", 36}},
+                        {{"buffer", 0}, {"byteOffset", 36}, {"byteLength", 4}},
+                        {{"buffer", 0}, {"byteOffset", 40}, {"byteLength", 12}}};
+    g["accessors"][0]["sparse"] = {{"count", 1},
+                                   {"indices", {{"bufferView", 1}, {"componentType", 5125}}},
+                                   {"values", {{"bufferView", 2}}}};
+    return g;
+}
+
+TEST(GltfAccessor, SparseAccessorsReplaceTheElementsTheyName) {
+    TempDir dir;
+    const float moved[3] = {0, 0, 1};
+    const scene::Scene s = scene::loadScene(dir.write("sparse.gltf", sparseTriangle(2, moved).dump()));
+    // (0,0,0), (1,0,0) and the moved (0,0,1): the triangle lies in y = 0 and reaches z = 1.
+    const scene::Bounds b = s.bounds();
+    EXPECT_EQ(b.max.y, 0.0);
+    EXPECT_EQ(b.max.z, 1.0);
+    EXPECT_EQ(b.max.x, 1.0);
+    // An index past the accessor's 3 elements is an error at its path, not a write past the end.
+    const fs::path bad = dir.write("bad.gltf", sparseTriangle(5, moved).dump());
+    const std::string e = errorOf([&] { scene::loadScene(bad); });
+    EXPECT_NE(e.find("accessors[0].sparse.indices: index 5 (element 0) is out of range"), std::string::npos) << e;
+    // Values past the end of their view.
+    Json over = sparseTriangle(2, moved);
+    over["accessors"][0]["sparse"]["values"]["byteOffset"] = 4;
+    const std::string o = errorOf([&] { scene::loadScene(dir.write("over.gltf", over.dump())); });
+    EXPECT_NE(o.find("accessors[0].sparse.values: byteOffset 4 + 1 elements of stride 12 reach past the end of "
+                     "bufferViews[2]"),
+              std::string::npos)
+        << o;
 }
 
 TEST(ObjIndex, IndicesBeyondThe32BitRangeAreErrorsNamingTheLine) {
