@@ -2,6 +2,9 @@
 // validated completely before anything is written, so bad input leaves no file behind.
 #include "app/commands.h"
 
+#include "app/guards.h"
+#include "scene/folder_lock.h"
+
 #include <algorithm>
 #include <chrono>
 #include <fstream>
@@ -17,18 +20,17 @@
 #include "compare/check.h"
 #include "compare/check_report.h"
 #include "compare/compare.h"
-#include "compare/machine.h"
 #include "compare/gates.h"
-#include "compare/path.h"
-#include "compare/text.h"
-#include "compare/report.h"
-#include "compare/stability.h"
+#include "compare/machine.h"
 #include "compare/merge.h"
+#include "compare/path.h"
+#include "compare/report.h"
 #include "compare/shard.h"
+#include "compare/stability.h"
 #include "compare/sweep.h"
 #include "compare/sweep_report.h"
-#include "raster/cascades.h"
 #include "compare/text.h"
+#include "raster/cascades.h"
 #include "raster/debug_views.h"
 #include "raster/memory.h"
 #include "raster/renderer.h"
@@ -38,8 +40,9 @@
 #include "scene/error.h"
 #include "scene/frame_identity.h"
 #include "scene/frame_io.h"
-#include "scene/mask_io.h"
+#include "scene/input_file.h"
 #include "scene/loader.h"
+#include "scene/mask_io.h"
 #include "scene/memory.h"
 #include "scene/model_view.h"
 #include "scene/render_plan.h"
@@ -101,7 +104,7 @@ std::string explainAutomaticChoices(const Prepared& p) {
 }
 
 Prepared prepare(const SceneOptions& o) {
-    Prepared p{scene::loadScene(scene::findScene(o.scene)), {}, {}};
+    Prepared p{readingInput(o.scene, [&] { return scene::loadScene(scene::findScene(o.scene)); }), {}, {}};
     if (o.resolution) applyResolution(p.scene, *o.resolution);
     chooseView(p.scene, &o);
     if (o.explain) std::cerr << scene::explainOrigin(p.scene);
@@ -344,36 +347,17 @@ constexpr const char* kRunManifest = ".shadowlab-run.json";
 
 std::vector<std::string> readRunManifest(const fs::path& dir) {
     std::vector<std::string> names;
-    std::ifstream in(dir / kRunManifest);
-    if (!in) return names;
+    std::error_code ec;
+    if (!fs::exists(dir / kRunManifest, ec)) return names;
     try {
-        const Json j = Json::parse(in);
+        // Through the input opener: a FIFO or a huge file in its place is refused, not waited on.
+        const Json j = Json::parse(scene::readInputFile(dir / kRunManifest, scene::kMaxJsonFileBytes));
         for (const Json& n : j.at("files"))
             if (n.is_string()) names.push_back(n.get<std::string>());
     } catch (const std::exception&) {
-        return {};  // not ours, or damaged: remove nothing
+        return {};  // not ours, or damaged: the names run writes are still replaced
     }
     return names;
-}
-
-// Removes what the earlier manifest lists and this run did not write, then records this run's
-// own. A name is used only when it is a plain name in the folder (no '/' but a trailing one for
-// sweep/, no "..", no dot file), so a hand-edited manifest cannot reach outside the folder.
-void updateRunManifest(const fs::path& dir, const std::vector<std::string>& earlier,
-                       const std::vector<std::string>& written) {
-    for (const std::string& name : earlier) {
-        if (std::find(written.begin(), written.end(), name) != written.end()) continue;
-        std::string plain = name;
-        if (!plain.empty() && plain.back() == '/') plain.pop_back();
-        if (plain.empty() || plain.find('/') != std::string::npos || plain.front() == '.') continue;
-        std::error_code ec;
-        const fs::path p = dir / plain;
-        if (name.back() == '/' ? fs::is_directory(p, ec) : fs::is_regular_file(p, ec)) {
-            fs::remove_all(p, ec);
-            if (!ec) std::cerr << "shadowlab: removed " << p.string() << " (an earlier run's, not part of this report)\n";
-        }
-    }
-    scene::writeTextAtomic(dir / kRunManifest, Json{{"files", written}}.dump(2) + "\n");
 }
 
 scene::Budgets parseBudgets(const BudgetOptions& o) {
@@ -393,6 +377,16 @@ bool reportBudgets(const std::string& method, const std::vector<compare::BudgetC
     return compare::anyBroken(checks);
 }
 
+// A run's staging folder: removed when the run ends without committing it.
+struct StagingFolder {
+    fs::path dir;
+    bool committed = false;
+    ~StagingFolder() {
+        std::error_code ignored;
+        if (!committed) fs::remove_all(dir, ignored);
+    }
+};
+
 }  // namespace
 
 int render(const RenderOptions& o) {
@@ -402,11 +396,11 @@ int render(const RenderOptions& o) {
     if (o.view && (o.backend != "raster" || ext != ".png"))
         throw scene::InputError("--view " + *o.view + ": needs --backend raster and a .png output (a view is a "
                                 "display image of the shadow maps), got --backend " + o.backend + " and '" + ext + "'");
-    checkOutputFile(o.output);
+    checkOutputFile(o.output);  // before any work: an output that cannot be written fails now
     const Prepared p = prepare(o.common);
     // A view writes a display image, not the Frame; the shadow-map view holds every layer's depths.
     const std::uint64_t estimate =
-        scene::kProgramBytes + backendMemory(p, o.backend) +
+        scene::kProgramBytes + scene::sceneBytes(p.scene) + backendMemory(p, o.backend) +
         (o.view ? raster::debugViewBytes(p.scene, p.plan, p.settings.raster, *o.view)
                 : scene::frameWriteBytes(p.scene));
     scene::checkMemory(estimate, o.view ? "rendering the " + *o.view + " view of " +
@@ -460,11 +454,11 @@ int compareFiles(const CompareOptions& o) {
         throw scene::InputError(o.heat->string() + ": the heat map must be a .png");
     const scene::Budgets budgets = parseBudgets(o.budgets);
     const bool maskOnly = o.maskChannel || o.maskInvert || o.maskSrgb || scene::looksLikeMask(o.method);
-    const scene::Frame reference = scene::readFrame(o.reference);
+    const scene::Frame reference = readingInput(o.reference.string(), [&] { return scene::readFrame(o.reference); });
     const scene::Frame method =
         maskOnly ? scene::frameFromMask(scene::readShadowMask(o.method, {o.maskChannel, o.maskInvert, o.maskSrgb}),
                                         reference, o.method)
-                 : scene::readFrame(o.method);
+                 : readingInput(o.method.string(), [&] { return scene::readFrame(o.method); });
     if (const std::string d = scene::describeIdentityDifference(method, reference); !d.empty()) {
         if (!o.allowDifferentScene)
             throw scene::InputError(o.method.string() + " vs " + o.reference.string() + ": " + d +
@@ -513,16 +507,24 @@ int run(const RunOptions& o) {
     const bool views = !o.skipRaster && std::any_of(p.plan.lights.begin(), p.plan.lights.end(),
                                                      [](const scene::LightPlan& l) { return l.needsShadowTest; });
     const std::uint64_t estimate =
-        scene::kProgramBytes + backendMemory(p, "raytrace") + scene::frameBytes(p.scene) +
+        scene::kProgramBytes + scene::sceneBytes(p.scene) + backendMemory(p, "raytrace") + scene::frameBytes(p.scene) +
         (o.skipRaster ? 0 : backendMemory(p, "raster")) + scene::frameWriteBytes(p.scene) +
         2 * pixels * 3 * sizeof(float) +
         (views ? raster::debugViewBytes(p.scene, p.plan, p.settings.raster, "shadow-map") : 0);
     scene::checkMemory(estimate, "run at " + std::to_string(p.scene.camera.width) + "x" +
                                      std::to_string(p.scene.camera.height));
     fs::create_directories(o.outputDir);
-    const fs::path dir = o.outputDir;
-    scene::removeStaleTemporaries(dir);  // what an earlier run that was killed left behind
-    const std::vector<std::string> earlierFiles = readRunManifest(dir);
+    const scene::FolderLock lock(o.outputDir, "run");
+    // The run's files are made in a fresh folder beside the output folder, which they replace as
+    // a set once all are written (the commit at the end): a folder never mixes two runs, and a run that
+    // fails half-way (a full disk) leaves the previous one whole.
+    const fs::path target = fs::canonical(o.outputDir);
+    scene::removeStaleTemporaries(target.parent_path());  // what an earlier run that was killed left behind
+    scene::removeStaleTemporaries(target);
+    const fs::path dir = scene::temporarySibling(target);
+    fs::create_directory(dir);
+    StagingFolder staging{dir};
+    const std::vector<std::string> earlierFiles = readRunManifest(target);
     std::vector<std::string> written;  // for the manifest
     int status = 0;
 
@@ -653,8 +655,17 @@ int run(const RunOptions& o) {
     scene::writeTextAtomic(dir / "metrics.json", metrics.dump(2) + "\n");
     compare::writeReport(dir, report);
     written.insert(written.end(), {"metrics.json", "report.html"});
-    updateRunManifest(dir, earlierFiles, written);
-    std::cerr << "shadowlab: wrote " << (dir / "report.html").string() << "; " << memoryLine(estimate) << "\n";
+    scene::writeTextAtomic(dir / kRunManifest, Json{{"files", written}}.dump(2) + "\n");
+    // The commit: this run's files replace the previous run's as a set. What stays is the user's
+    // own: neither a name run writes nor one the earlier run's manifest lists (and the lock).
+    auto earlierRun = [&](const std::string& name) {
+        return std::find(earlierFiles.begin(), earlierFiles.end(), name) != earlierFiles.end() ||
+               std::find(earlierFiles.begin(), earlierFiles.end(), name + "/") != earlierFiles.end();
+    };
+    scene::replaceFolderContents(dir, target,
+                                 [&](const std::string& name) { return !isRunOutput(name) && !earlierRun(name); });
+    staging.committed = true;
+    std::cerr << "shadowlab: wrote " << (o.outputDir / "report.html").string() << "; " << memoryLine(estimate) << "\n";
     if (o.common.json) std::cout << metrics.dump(2) << "\n";
     // A failure (1) says more than a broken budget: a method that did not render measured nothing.
     return status != 0 ? status : budgetBroken ? kExitBudgetBroken : 0;
@@ -714,8 +725,10 @@ int merge(const MergeOptions& o) {
 }
 
 int sweep(const SweepOptions& o) {
+    checkOutputFolder(o.outputDir);
     const Prepared p = prepare(o.common);
-    compare::SweepGrid grid = o.grid ? compare::loadGrid(*o.grid, p.scene) : compare::defaultGrid(p.scene, o.quick);
+    compare::SweepGrid grid = o.grid ? readingInput(o.grid->string(), [&] { return compare::loadGrid(*o.grid, p.scene); })
+                                     : compare::defaultGrid(p.scene, o.quick);
     if (o.repetitions) grid.repetitions = *o.repetitions;
     if (o.common.resolution) grid.resolution = o.common.resolution;
     // Settings given on the command line apply to every configuration that does not vary them.
@@ -739,6 +752,9 @@ int sweep(const SweepOptions& o) {
     options.outputDir = o.outputDir;
     options.resume = o.resume;
     options.progress = sweepProgressPrinter();
+    // One writer per folder: two sweeps appending to one journal would duplicate its keys.
+    fs::create_directories(o.outputDir);
+    const scene::FolderLock lock(o.outputDir, "sweep");
     if (o.shard) return sweepShard(o, p.scene, grid, options);
     std::cerr << "shadowlab: sweep of " << grid.configs.size() << " configurations, " << grid.repetitions
               << " timed frames each, into " << o.outputDir.string() << "\n";
@@ -864,6 +880,7 @@ int path(const PathCommandOptions& o) {
 
 int stability(const StabilityCommandOptions& o) {
     // Every case is loaded and checked before anything renders or is written.
+    checkOutputFolder(o.outputDir);
     std::vector<fs::path> files;
     if (o.scenes.empty()) {
         for (const auto& e : fs::directory_iterator(scene::scenesDirectory() / "extreme"))
@@ -874,11 +891,13 @@ int stability(const StabilityCommandOptions& o) {
     }
     std::vector<scene::Scene> scenes;
     for (const fs::path& f : files) {
-        scenes.push_back(scene::loadScene(f));
+        scenes.push_back(readingInput(f.string(), [&] { return scene::loadScene(f); }));
         chooseView(scenes.back(), nullptr);
     }
     scene::Scene probe;
     applyResolution(probe, o.resolution);
+    fs::create_directories(o.outputDir);
+    const scene::FolderLock lock(o.outputDir, "stability");
 
     compare::StabilityOptions options;
     options.width = probe.camera.width;

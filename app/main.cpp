@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "app/commands.h"
+#include "app/guards.h"
 #include "raster/vulkan_error.h"
 #include "scene/error.h"
 
@@ -235,19 +236,21 @@ int main(int argc, char** argv) {
     }
 
     try {
-        if (*runCmd) return shadowlab::app::run(runOptions);
+        // Every command's results on stdout (--json) must reach it: a failed write is an error.
+        using shadowlab::app::finishStandardOutput;
+        if (*runCmd) return finishStandardOutput(shadowlab::app::run(runOptions));
         if (*renderCmd) {
             // The debug views are views of the shadow maps: --view alone means the raster backend.
             if (renderOptions.view && backendOption->count() == 0) renderOptions.backend = "raster";
-            return shadowlab::app::render(renderOptions);
+            return finishStandardOutput(shadowlab::app::render(renderOptions));
         }
-        if (*compareCmd) return shadowlab::app::compareFiles(compareOptions);
-        if (*infoCmd) return shadowlab::app::info(infoValidate);
-        if (*sweepCmd) return shadowlab::app::sweep(sweepOptions);
-        if (*mergeCmd) return shadowlab::app::merge(mergeOptions);
-        if (*stabilityCmd) return shadowlab::app::stability(stabilityOptions);
-        if (*checkCmd) return shadowlab::app::check(checkOptions);
-        if (*pathCmd) return shadowlab::app::path(pathOptions);
+        if (*compareCmd) return finishStandardOutput(shadowlab::app::compareFiles(compareOptions));
+        if (*infoCmd) return finishStandardOutput(shadowlab::app::info(infoValidate));
+        if (*sweepCmd) return finishStandardOutput(shadowlab::app::sweep(sweepOptions));
+        if (*mergeCmd) return finishStandardOutput(shadowlab::app::merge(mergeOptions));
+        if (*stabilityCmd) return finishStandardOutput(shadowlab::app::stability(stabilityOptions));
+        if (*checkCmd) return finishStandardOutput(shadowlab::app::check(checkOptions));
+        if (*pathCmd) return finishStandardOutput(shadowlab::app::path(pathOptions));
     } catch (const shadowlab::scene::SceneError& e) {
         std::cerr << "shadowlab: error: " << e.what() << "\n";
         return 2;

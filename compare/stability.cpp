@@ -14,6 +14,8 @@
 #include "compare/text.h"
 #include "scene/error.h"
 #include "scene/frame_io.h"
+#include "scene/input_file.h"
+#include "scene/json_input.h"
 #include "scene/loader.h"
 #include "scene/settings.h"
 
@@ -159,8 +161,7 @@ const MethodBias* StabilityCase::biasOf(const std::string& backend) const {
 
 std::string readDescription(const fs::path& sceneFile) {
     try {
-        std::ifstream in(sceneFile);
-        const Json doc = Json::parse(in);
+        const Json doc = scene::parseJsonText(sceneFile, scene::readInputFile(sceneFile, scene::kMaxJsonFileBytes));
         return doc.value("description", std::string());
     } catch (const std::exception&) {
         return {};

@@ -21,6 +21,8 @@
 #include "scene/error.h"
 #include "scene/frame_identity.h"
 #include "scene/frame_io.h"
+#include "scene/input_file.h"
+#include "scene/json_input.h"
 #include "scene/render_plan.h"
 
 namespace shadowlab::compare {
@@ -306,16 +308,13 @@ SweepGrid defaultGrid(const scene::Scene& scene, bool quick) {
 SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
     using scene::JsonPath;
     using scene::SceneError;
-    std::ifstream in(file);
-    if (!in) throw SceneError(file, {}, "no such file or not readable");
-    Json doc;
+    std::string text;
     try {
-        doc = Json::parse(in);
-    } catch (const Json::exception& e) {
-        std::string what = e.what();
-        if (const auto p = what.find("] "); p != std::string::npos) what = what.substr(p + 2);
-        throw SceneError(file, {}, "invalid JSON: " + what);
+        text = scene::readInputFile(file, scene::kMaxJsonFileBytes);
+    } catch (const scene::InputFileError& e) {
+        throw SceneError(file, {}, e.problem());
     }
+    const Json doc = scene::parseJsonText(file, text);
     const JsonPath root;
     if (!doc.is_object()) throw SceneError(file, root, "expected an object");
     SweepGrid g;
@@ -337,11 +336,11 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
         const Json& res = doc["resolution"];
         if (!res.is_string() || std::sscanf(res.get<std::string>().c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 ||
             x != 'x' || w < 1 || h < 1 || w > 16384 || h > 16384)
-            throw SceneError(file, root / "resolution", "expected \"WxH\" with sides in 1..16384, got " + res.dump());
+            throw SceneError(file, root / "resolution", "expected \"WxH\" with sides in 1..16384, got " + scene::describeJson(res));
         g.resolution = res.get<std::string>();
     }
     if (doc.contains("include_default") && !doc["include_default"].is_boolean())
-        throw SceneError(file, root / "include_default", "expected true or false, got " + doc["include_default"].dump());
+        throw SceneError(file, root / "include_default", "expected true or false, got " + scene::describeJson(doc["include_default"]));
     if (doc.value("include_default", false)) g.configs = defaultGrid(scene, false).configs;
 
     // Each backend block holds axes (arrays); the grid is their cartesian product.
@@ -374,7 +373,14 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
             const std::vector<Json> values = axis(block, path, name);
             if (values.empty()) continue;
             if (std::string(name) == "depth_bias") depthValues = values.size();
+            // The product is bounded before it is built: axes of 1000 values each multiply to
+            // more configurations than memory holds.
+            if (configs.size() * values.size() > kMaxGridConfigurations)
+                throw SceneError(file, path / name,
+                                 "the grid would have at least " + std::to_string(configs.size() * values.size()) +
+                                     " configurations, more than " + std::to_string(kMaxGridConfigurations));
             std::vector<SweepConfig> next;
+            next.reserve(configs.size() * values.size());
             for (const SweepConfig& base : configs)
                 for (std::size_t i = 0; i < values.size(); ++i) {
                     const Json& v = values[i];
@@ -383,27 +389,27 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
                     const std::string n = name;
                     auto num = [&](double lo) {
                         if (!v.is_number() || !std::isfinite(v.get<double>()) || v.get<double>() < lo)
-                            throw SceneError(file, at, "expected a number >= " + number(lo) + ", got " + v.dump());
+                            throw SceneError(file, at, "expected a number >= " + number(lo) + ", got " + scene::describeJson(v));
                         return v.get<double>();
                     };
                     if (n == "shadow_map_size") {
                         if (!v.is_number_integer() || v.get<long long>() < 16 || v.get<long long>() > 16384)
-                            throw SceneError(file, at, "expected an integer in 16..16384, got " + v.dump());
+                            throw SceneError(file, at, "expected an integer in 16..16384, got " + scene::describeJson(v));
                         c.overrides.shadowMapSize = v.get<int>();
                     } else if (n == "filter") {
                         if (!v.is_string() || (v.get<std::string>() != "none" && v.get<std::string>() != "pcf2x2"))
-                            throw SceneError(file, at, "expected \"none\" or \"pcf2x2\", got " + v.dump());
+                            throw SceneError(file, at, "expected \"none\" or \"pcf2x2\", got " + scene::describeJson(v));
                         c.overrides.filter = v.get<std::string>();
                     } else if (n == "cascades") {
                         if (!v.is_number_integer() || v.get<long long>() < 1 || v.get<long long>() > scene::kMaxCascades)
                             throw SceneError(file, at, "expected an integer in 1.." + std::to_string(scene::kMaxCascades) +
-                                                           " (cascaded shadow maps per directional light), got " + v.dump());
+                                                           " (cascaded shadow maps per directional light), got " + scene::describeJson(v));
                         c.overrides.cascades = v.get<int>();
                     } else if (n == "receiver_plane_bias") {
-                        if (!v.is_boolean()) throw SceneError(file, at, "expected true or false, got " + v.dump());
+                        if (!v.is_boolean()) throw SceneError(file, at, "expected true or false, got " + scene::describeJson(v));
                         c.overrides.receiverPlaneBias = v.get<bool>();
                     } else if (n == "hardware_bias") {
-                        if (!v.is_boolean()) throw SceneError(file, at, "expected true or false, got " + v.dump());
+                        if (!v.is_boolean()) throw SceneError(file, at, "expected true or false, got " + scene::describeJson(v));
                         c.overrides.hardwareBias = v.get<bool>();
                     } else if (n == "depth_bias") {
                         c.overrides.depthBias = num(0.0);
@@ -425,18 +431,20 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
                         }
                     } else if (n == "precision") {
                         if (!v.is_string() || (v.get<std::string>() != "float" && v.get<std::string>() != "double"))
-                            throw SceneError(file, at, "expected \"float\" or \"double\", got " + v.dump());
+                            throw SceneError(file, at, "expected \"float\" or \"double\", got " + scene::describeJson(v));
                         c.overrides.precision = v.get<std::string>();
                     } else if (n == "samples") {
                         if (!v.is_number_integer() || v.get<long long>() < 1 || v.get<long long>() > 65536)
-                            throw SceneError(file, at, "expected an integer in 1..65536, got " + v.dump());
+                            throw SceneError(file, at, "expected an integer in 1..65536, got " + scene::describeJson(v));
                         c.overrides.samples = v.get<int>();
                     }
                     next.push_back(c);
                 }
             configs = std::move(next);
-            if (configs.size() > 100000) throw SceneError(file, path, "the grid has more than 100000 configurations");
         }
+        if (g.configs.size() + configs.size() > kMaxGridConfigurations)
+            throw SceneError(file, path, "the grid would have more than " + std::to_string(kMaxGridConfigurations) +
+                                             " configurations");
         g.configs.insert(g.configs.end(), configs.begin(), configs.end());
     }
     if (g.configs.empty()) throw SceneError(file, root, "the grid is empty: give a \"raster\" or \"raytrace\" block");
@@ -489,10 +497,12 @@ std::function<scene::Frame()> frameSource(const SweepOptions& options, const sce
 
 std::vector<SweepRow> readJournal(const fs::path& file) {
     std::vector<SweepRow> rows;
-    std::ifstream in(file);
+    std::error_code ec;
+    if (!fs::exists(file, ec)) return rows;
+    std::istringstream in(scene::readInputFile(file, scene::kMaxJournalFileBytes));
     std::string line;
     while (std::getline(in, line)) {
-        if (line.empty()) continue;
+        if (line.empty() || !scene::jsonNestingProblem(line).empty()) continue;
         try {
             rows.push_back(rowFromJson(Json::parse(line)));
         } catch (const std::exception&) {
@@ -573,12 +583,12 @@ SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const
         throw scene::InputError(dir.string() + ": has results.jsonl but no sweep.json, so the scene it belongs "
                                 "to is unknown; choose another folder");
     if (options.resume && fs::exists(manifest, ec)) {
-        std::ifstream in(manifest);
+        const std::string manifestText = scene::readInputFile(manifest, scene::kMaxJsonFileBytes);
         Json old;
-        try { old = Json::parse(in); } catch (const std::exception&) { old = nullptr; }
+        try { old = scene::parseJsonText(manifest, manifestText); } catch (const std::exception&) { old = nullptr; }
         if (old != identity)
             throw scene::InputError(dir.string() + ": holds a sweep of another scene or resolution (" +
-                                    (old.is_null() ? std::string("unreadable sweep.json") : old.dump()) + ")");
+                                    (old.is_null() ? std::string("unreadable sweep.json") : scene::describeJson(old, 200)) + ")");
         scene::removeStaleTemporaries(dir);
         scene::removeStaleTemporaries(dir / "images");
         done = readJournal(journal);

@@ -34,6 +34,11 @@ struct SweepConfig {
     std::string label() const;
 };
 
+// The most configurations a grid file may multiply to, checked before they are built: far
+// beyond a sweep anyone would wait for (a configuration is at least one render), and small
+// enough that the grid and its rows fit in memory.
+inline constexpr std::size_t kMaxGridConfigurations = 100000;
+
 struct SweepGrid {
     std::vector<SweepConfig> configs;
     int repetitions = 3;                    // timed frames per configuration (after one warm-up)

@@ -15,6 +15,7 @@
 
 #include <unistd.h>
 
+#include "fuzz/targets.h"
 #include "scene/error.h"
 
 namespace shadowlab::fuzz {
@@ -31,6 +32,7 @@ inline const std::filesystem::path& caseDirectory() {
         std::error_code ignored;
         fs::create_directory_symlink(scenes / "models", root / "models", ignored);
         fs::create_directory_symlink(scenes / "extreme" / "models", root / "case" / "models", ignored);
+        makeIndirectFiles(root / "case");
         // Leave nothing behind in /dev/shm when the fuzzer exits normally. The handler runs after
         // static destructors, so it owns a copy of the path that is never destroyed.
         static const fs::path* const leftover = new fs::path(root);

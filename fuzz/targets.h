@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <sys/stat.h>
 #include <string>
 #include <string_view>
 
@@ -26,6 +28,25 @@ inline std::string inputName(std::string_view target, const std::uint8_t* data, 
     if (target == "gltf")  // GLB when it starts with the binary container's magic
         return size >= 4 && std::memcmp(data, "glTF", 4) == 0 ? "model.glb" : "model.gltf";
     return "frame.exr";
+}
+
+// Files an input may name indirectly (a mesh, an OBJ's mtllib, a glTF buffer or image URI),
+// laid out beside the input in `dir` so seeds and mutations reach every kind the one input
+// opener must refuse: FIFOs (which would block), links to /dev/zero (which never ends),
+// folders, and a good one of each ("tri.*"). The seeds in fuzz/corpus name them.
+inline void makeIndirectFiles(const std::filesystem::path& dir) {
+    namespace fs = std::filesystem;
+    std::error_code ignored;
+    for (const char* ext : {"bin", "mtl", "obj", "png", "gltf", "json"}) {
+        const std::string e = ext;
+        ::mkfifo((dir / ("pipe." + e)).c_str(), 0600);
+        fs::create_symlink("/dev/zero", dir / ("zero." + e), ignored);
+        fs::create_directory(dir / ("dir." + e), ignored);
+    }
+    const float triangle[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    std::ofstream(dir / "tri.bin", std::ios::binary).write(reinterpret_cast<const char*>(triangle), sizeof triangle);
+    std::ofstream(dir / "tri.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    std::ofstream(dir / "tri.mtl") << "newmtl m\nKd 1 1 1\n";
 }
 
 // Reads `file` the way the program reads input of `target`. Bad input throws SceneError or

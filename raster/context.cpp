@@ -15,6 +15,7 @@
 
 #include "raster/vulkan_error.h"
 #include "scene/frame_io.h"
+#include "scene/input_file.h"
 
 namespace shadowlab::raster {
 
@@ -300,8 +301,14 @@ std::string describeDevices(bool validate) {
 // length, version 1, vendor id, device id, pipelineCacheUUID) names this device; else nothing,
 // so a cache from another driver or version is never handed to this one.
 static std::vector<char> readPipelineCache(const std::filesystem::path& file, const VkPhysicalDeviceProperties& props) {
-    std::ifstream in(file, std::ios::binary);
-    std::vector<char> data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // Through the one input opener: a cache that is a FIFO or /dev/zero is no cache, not a hang.
+    std::string bytes;
+    try {
+        bytes = scene::readInputFile(file, scene::kMaxJsonFileBytes);
+    } catch (const scene::InputError&) {
+        return {};
+    }
+    std::vector<char> data(bytes.begin(), bytes.end());
     if (data.size() < 32) return {};
     std::uint32_t header[4];
     std::memcpy(header, data.data(), sizeof header);

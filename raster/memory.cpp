@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <variant>
 
+#include "raster/geometry.h"
+#include "scene/camera.h"
 #include "scene/memory.h"
 
 namespace shadowlab::raster {
@@ -31,14 +33,24 @@ std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::Render
     // transmittance map's four R32F values (T_all, D1, and behind the nearest layer T_rest, D2).
     const std::uint64_t layers = shadowMapLayers(scene, plan, settings);
     const std::uint64_t texels = std::uint64_t(settings.shadowMapSize) * std::uint64_t(settings.shadowMapSize);
+    // Spheres as tessellated (raster/geometry.cpp): segments by their size on screen, about
+    // segments² triangles; many small spheres are cheap, not kSphereTriangles each.
+    const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
     std::uint64_t triangles = 0;
     for (const scene::Object& o : scene.objects) {
-        if (const auto* m = std::get_if<scene::Mesh>(&o.shape)) triangles += m->triangleCount();
-        else if (std::holds_alternative<scene::Sphere>(o.shape)) triangles += kSphereTriangles;
-        else triangles += 12;
+        if (const auto* m = std::get_if<scene::Mesh>(&o.shape)) {
+            triangles += m->triangleCount();
+        } else if (const auto* s = std::get_if<scene::Sphere>(&o.shape)) {
+            const double d = std::max(glm::length(s->center - cam.position) - s->radius, scene.camera.near);
+            const std::uint64_t n = std::uint64_t(sphereSegments(s->radius, d, cam.tanHalfFovY, scene.camera.height));
+            triangles += std::min<std::uint64_t>(n * n + 2 * n, kSphereTriangles);
+        } else {
+            triangles += 12;
+        }
     }
     return kDriverAllowance + scene::frameBytes(scene) + pixels * litBytesPerPixel(scene.lights.size()) +
-           layers * texels * (plan.needsTransmittanceMap ? 4 + 4 + 16 : 4 + 4) + triangles * kBytesPerTriangle;
+           layers * texels * (plan.needsTransmittanceMap ? 4 + 4 + 16 : 4 + 4) + triangles * kBytesPerTriangle +
+           scene.objects.size() * scene::kBackendBytesPerObject;
 }
 
 std::uint64_t shadowMapLayers(const scene::Scene& scene, const scene::RenderPlan& plan,

@@ -13,7 +13,11 @@ std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::Render
         for (const scene::Object& o : scene.objects)
             if (const auto* m = std::get_if<scene::Mesh>(&o.shape)) triangles += m->triangleCount();
     constexpr std::uint64_t kAllowance = 64 * scene::kMiB;  // threads' stacks, tiles, the program
-    return kAllowance + scene::frameBytes(scene) + triangles * 100;
+    std::uint64_t placements = 0;  // one BVH entry per object, and per mesh instance
+    for (const scene::Object& o : scene.objects)
+        if (const auto* m = std::get_if<scene::Mesh>(&o.shape)) placements += m->instances.size();
+    return kAllowance + scene::frameBytes(scene) + triangles * 100 +
+           (scene.objects.size() + placements) * scene::kBackendBytesPerObject;
 }
 
 }  // namespace shadowlab::raytrace

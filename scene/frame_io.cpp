@@ -23,6 +23,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "scene/error.h"
+#include "scene/input_file.h"
 #include "scene/loader.h"
 
 namespace shadowlab::scene {
@@ -41,11 +42,12 @@ constexpr const char* kTimingsAttr = "shadowlab:timings_ms";
 // Checks an OpenEXR header's structure before OpenEXR reads it: OpenEXR 3.1 believes the size an
 // attribute declares and allocates it (a 1.6 GB "opaque attribute" in a 2 kB file, found by
 // fuzzing). Layout from "The OpenEXR File Layout" (openexr.com): magic 20000630, a version word
-// (bit 11: deep data, bit 12: multi-part), then attributes (name\0 type\0 int32 size, value)
-// until an empty name. A Frame is a single-part scanline or tiled image.
+// (bit 9: single-part tiled, bit 11: deep data, bit 12: multi-part), then attributes (name\0
+// type\0 int32 size, value) until an empty name. A Frame is a single-part scanline or tiled
+// (possibly mip-mapped: level 0 is read) image; deep and multi-part files are refused.
 void checkExrHeader(const fs::path& file) {
+    const auto fileSize = static_cast<std::int64_t>(checkInputFile(file, kMaxFrameFileBytes));
     std::ifstream in(file, std::ios::binary);
-    const auto fileSize = static_cast<std::int64_t>(fs::file_size(file));
     auto readU32 = [&](std::uint32_t& v) {
         unsigned char b[4];
         if (!in.read(reinterpret_cast<char*>(b), 4)) return false;
@@ -60,7 +62,9 @@ void checkExrHeader(const fs::path& file) {
     auto bad = [&](const std::string& what) { return InputError(file.string() + ": damaged OpenEXR header: " + what); };
     if (!readU32(version)) throw bad("truncated");
     if (version & 0x1800u)
-        throw InputError(file.string() + ": a deep or multi-part OpenEXR file is not a Frame written by shadowlab");
+        throw InputError(file.string() + ": a " + ((version & 0x1000u) ? "multi-part" : "deep") +
+                         " OpenEXR file is not a Frame (a Frame is one part of flat scanline or tiled pixels, as "
+                         "`shadowlab render -o X.exr` writes it)");
     const std::size_t maxName = (version & 0x400u) ? 255 : 31;
     auto readName = [&](std::string& name) {
         name.clear();
@@ -127,6 +131,14 @@ void checkExrHeader(const fs::path& file) {
                 throw InputError(file.string() + ": image too large for a Frame (" + std::to_string(w) + "x" +
                                  std::to_string(h) + "; at most " + std::to_string(kMaxResolution) + " a side and " +
                                  std::to_string(kMaxPixels) + " pixels)");
+        } else if (type == "tiledesc") {
+            // Tile sizes bound the buffers OpenEXR and OpenImageIO allocate for one tile, as the data
+            // window bounds a line's (a 0 size would divide by zero when tiles are counted).
+            std::uint32_t tw = 0, th = 0;
+            if (!readU32(tw) || !readU32(th)) throw mismatch();
+            if (tw < 1 || th < 1 || tw > std::uint32_t(kMaxResolution) || th > std::uint32_t(kMaxResolution))
+                throw bad("tiles of " + std::to_string(tw) + "x" + std::to_string(th) + " pixels (at most " +
+                          std::to_string(kMaxResolution) + " a side)");
         } else if (type == "preview") {  // width, height, then width * height RGBA bytes
             std::uint32_t w = 0, h = 0;
             if (size < 8 || !readU32(w) || !readU32(h) || std::uint64_t(w) * h * 4 + 8 != size) throw mismatch();
@@ -364,8 +376,7 @@ void writeFrame(const Frame& frame, const fs::path& file) {
 }
 
 Frame readFrame(const fs::path& file) {
-    if (!fs::exists(file)) throw InputError(file.string() + ": no such file");
-    checkExrHeader(file);
+    checkExrHeader(file);  // first of all: a regular file of a bounded size (checkInputFile)
     auto in = ImageInput::open(file.string());
     if (!in) throw InputError(file.string() + ": not a readable image: " + OIIO::geterror());
     const ImageSpec spec = in->spec();
@@ -407,11 +418,18 @@ Frame readFrame(const fs::path& file) {
     Frame f;
     const int c = spec.nchannels;
     constexpr int kBandRows = 64;
-    std::vector<float> band(std::size_t(spec.width) * std::min(kBandRows, spec.height) * c);
-    for (int y0 = 0; y0 < spec.height; y0 += kBandRows) {
-        const int y1 = std::min(spec.height, y0 + kBandRows);
-        if (!in->read_scanlines(0, 0, spec.y + y0, spec.y + y1, 0, 0, c, TypeDesc::FLOAT, band.data()))
-            throw InputError(file.string() + ": read failed: " + in->geterror());
+    // A tiled file is read a row of tiles at a time (read_tiles needs whole tiles; a band of a
+    // tiled file's scanlines crashed OpenImageIO), level 0 of a mip-mapped one.
+    const bool tiled = spec.tile_width > 0;
+    const int bandRows = tiled ? std::max(1, spec.tile_height) : kBandRows;
+    std::vector<float> band(std::size_t(spec.width) * std::min(bandRows, spec.height) * c);
+    for (int y0 = 0; y0 < spec.height; y0 += bandRows) {
+        const int y1 = std::min(spec.height, y0 + bandRows);
+        const bool read =
+            tiled ? in->read_tiles(0, 0, spec.x, spec.x + spec.width, spec.y + y0, spec.y + y1, spec.z, spec.z + 1, 0, c,
+                                   TypeDesc::FLOAT, band.data())
+                  : in->read_scanlines(0, 0, spec.y + y0, spec.y + y1, 0, 0, c, TypeDesc::FLOAT, band.data());
+        if (!read) throw InputError(file.string() + ": read failed: " + excerpt(in->geterror(), 300));
         if (y0 == 0) {
             f = Frame::allocate(spec.width, spec.height, iBl >= 0);
             f.lightVisibility.assign(iLights.size(), std::vector<float>(f.pixelCount()));

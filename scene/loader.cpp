@@ -14,8 +14,12 @@
 
 #include "scene/budgets.h"
 #include "scene/error.h"
+#include "scene/input_file.h"
+#include "scene/json_input.h"
+#include "scene/memory.h"
 #include "scene/mesh_loader.h"
 #include "scene/model_view.h"
+#include "scene/scene_checks.h"
 #include "scene/settings.h"
 
 namespace shadowlab::scene {
@@ -41,11 +45,7 @@ std::size_t editDistance(const std::string& a, const std::string& b) {
     return row[b.size()];
 }
 
-std::string describe(const Json& v) {
-    std::string s = v.dump();
-    if (s.size() > 60) s = s.substr(0, 57) + "...";
-    return s;
-}
+std::string describe(const Json& v) { return describeJson(v); }
 
 const char* typeName(const Json& v) {
     switch (v.type()) {
@@ -83,6 +83,9 @@ public:
             std::string list;
             for (const char* a : allowed) {
                 list += (list.empty() ? "" : ", ") + std::string(a);
+                // (a key much longer than any allowed one is no typo; its distance would cost
+                // its length times theirs)
+                if (key.size() > 64) continue;
                 if (const std::size_t d = editDistance(key, a); d < bestDistance) {
                     bestDistance = d;
                     best = a;
@@ -229,6 +232,7 @@ Light readLight(const Reader& r, const Json& node, const JsonPath& path) {
         l.intensity = r.number(node["intensity"], path / "intensity");
         if (l.intensity < 0.0) r.fail(path / "intensity", "must be >= 0, got " + describe(node["intensity"]));
     }
+    if (const ValueProblem problem = lightProblem(l)) r.fail(path / problem.key, problem.what);
     return l;
 }
 
@@ -428,6 +432,12 @@ Scene parseScene(const fs::path& file, const std::string& text) {
     const Reader r(file);
     const JsonPath root;
     Json doc;
+    checkJsonNesting(file, text);
+    // The parsed tree takes several times the text: refused before it is built when it cannot fit.
+    const std::uint64_t treeBytes = std::uint64_t(text.size()) + jsonTreeBytes(text);
+    if (const std::uint64_t available = availableMemoryBytes(); available != 0 && treeBytes > available)
+        throw SceneError(file, root, "parsing it needs about " + std::to_string(treeBytes / kMiB) + " MiB, more than the " +
+                                         std::to_string(available / kMiB) + " MiB available");
     try {
         doc = Json::parse(text);
     } catch (const Json::parse_error& e) {
@@ -517,6 +527,8 @@ Scene parseScene(const fs::path& file, const std::string& text) {
 
     if (doc.contains("shadow")) scene.shadow = readShadow(r, doc["shadow"], root / "shadow");
     if (doc.contains("budgets")) scene.budgets = readBudgets(file, doc["budgets"], root / "budgets");
+    checkSceneExtent(scene, true);
+    scene.loadBytes = treeBytes + meshCache.peakLoadBytes;
     return scene;
 }
 
@@ -533,6 +545,7 @@ Scene loadModelScene(const fs::path& file) {
     mesh.file = file;
     mesh.instances = loadMeshInstances(file, glm::dmat4(1.0), file, JsonPath(), &extras);
     scene.objects.push_back({file.stem().string(), mesh, 0});
+    checkSceneExtent(scene, false);  // before the framing is computed from the bounds
     const Bounds b = scene.bounds();
     scene.origin.modelScene = true;
     scene.origin.modelBounds = b;
@@ -551,6 +564,9 @@ Scene loadModelScene(const fs::path& file) {
         scene.origin.choices.emplace_back("view", "framed from above and in front (the file has no camera)");
     }
     for (const GltfLight& l : extras.lights) {
+        const JsonPath lightPath = JsonPath() / "extensions" / "KHR_lights_punctual" / "lights" / std::size_t(l.index);
+        if (!(l.intensity >= 0))  // in the file's units, before the conversion below
+            throw SceneError(file, lightPath / "intensity", "must be finite and >= 0, got " + describeJson(l.intensity));
         Light light;
         light.color = l.color;
         if (l.type == "directional") {
@@ -566,6 +582,13 @@ Scene loadModelScene(const fs::path& file) {
             if (light.type == LightType::Spot)
                 light.coneAngleDegrees = std::clamp(l.outerConeRadians * 180.0 / kPi, 0.1, 89.9);
         }
+        // The checks a JSON light gets, at the glTF light's path (its position and direction
+        // come from its node).
+        if (const ValueProblem problem = lightProblem(light))
+            throw SceneError(file, lightPath / (problem.key == "cone_angle" ? std::string("spot.outerConeAngle") : problem.key),
+                             problem.what + (problem.key == "position" || problem.key == "direction"
+                                                 ? " (from the transform of the node that holds the light)"
+                                                 : ""));
         scene.lights.push_back(light);
     }
     if (scene.lights.empty()) {
@@ -578,6 +601,8 @@ Scene loadModelScene(const fs::path& file) {
     } else {
         scene.origin.choices.emplace_back("sun", std::to_string(scene.lights.size()) + " light(s) from the file");
     }
+    checkSceneExtent(scene, false);
+    scene.loadBytes = extras.loadBytes;
     return scene;
 }
 
@@ -593,26 +618,24 @@ bool isOtherModelFormat(const std::string& ext) {
 }  // namespace
 
 Scene loadScene(const fs::path& file) {
-    std::error_code ec;
-    if (!fs::exists(file, ec)) throw SceneError(file, {}, "no such file");
-    if (fs::is_directory(file, ec)) throw SceneError(file, {}, "is a folder, not a scene file");
     std::string ext = file.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+    // Told by its name before any byte is read: a .ply read as JSON would be a parse error.
+    if (isOtherModelFormat(ext))
+        throw SceneError(file, {}, "unsupported format '" + excerpt(ext) + "': a scene is a .json file or a .gltf/.glb "
+                                   "model, and a mesh is .obj, .gltf or .glb (convert the model, e.g. to .obj or .glb)");
+    std::string text;
+    try {
+        if (ext == ".gltf" || ext == ".glb" || ext == ".obj") checkInputFile(file, kMaxMeshFileBytes);
+        else text = readInputFile(file, kMaxJsonFileBytes);
+    } catch (const InputFileError& e) {
+        throw SceneError(file, {}, e.problem());
+    }
     if (ext == ".gltf" || ext == ".glb") return loadModelScene(file);
     if (ext == ".obj")
         throw SceneError(file, {}, "an OBJ file has no camera or light: reference it from a JSON scene "
-                                   "as {\"type\": \"mesh\", \"file\": \"" + file.filename().string() + "\"}");
-    if (isOtherModelFormat(ext))
-        throw SceneError(file, {}, "unsupported format '" + ext + "': a scene is a .json file or a .gltf/.glb model, "
-                                   "and a mesh is .obj, .gltf or .glb (convert the model, e.g. to .obj or .glb)");
-    const auto size = fs::file_size(file, ec);
-    if (ec) throw SceneError(file, {}, "cannot read: " + ec.message());
-    if (size > 256u * 1024 * 1024) throw SceneError(file, {}, "is larger than 256 MiB; not a scene file");
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw SceneError(file, {}, "cannot open for reading");
-    std::ostringstream text;
-    text << in.rdbuf();
-    return parseScene(file, text.str());
+                                   "as {\"type\": \"mesh\", \"file\": \"" + excerpt(file.filename().string()) + "\"}");
+    return parseScene(file, text);
 }
 
 fs::path scenesDirectory() {

@@ -2,6 +2,8 @@
 #include "scene/memory.h"
 
 #include <cstdlib>
+#include <set>
+#include <variant>
 #include <fstream>
 #include <sstream>
 #include <sys/resource.h>
@@ -19,6 +21,25 @@ std::uint64_t frameBytes(const Scene& scene) {
 }
 
 std::uint64_t frameWriteBytes(const Scene& scene) { return 2 * frameBytes(scene); }
+
+std::uint64_t sceneBytes(const Scene& scene) {
+    std::uint64_t bytes = scene.loadBytes + sizeof(Scene);
+    std::set<const TriangleMesh*> geometries;
+    for (const Object& o : scene.objects) {
+        bytes += sizeof(Object) + (o.name.size() > 15 ? o.name.capacity() + 1 : 0);
+        if (const auto* m = std::get_if<Mesh>(&o.shape)) {
+            bytes += m->file.native().capacity() + m->instances.capacity() * sizeof(MeshInstance);
+            for (const MeshInstance& inst : m->instances) {
+                const TriangleMesh* g = inst.geometry.get();
+                if (!g || !geometries.insert(g).second) continue;
+                bytes += sizeof(TriangleMesh) + 32 /* shared_ptr control block */ +
+                         (g->positions.capacity() + g->normals.capacity()) * sizeof(Vec3) +
+                         g->indices.capacity() * sizeof(std::uint32_t);
+            }
+        }
+    }
+    return bytes;
+}
 
 std::uint64_t peakResidentBytes() {
     rusage usage{};

@@ -20,6 +20,16 @@ std::uint64_t frameBytes(const Scene& scene);
 // OpenEXR's own line buffers, measured at about 1.75 Frames (docs/reliability.md); counted as 2.
 std::uint64_t frameWriteBytes(const Scene& scene);
 
+// The scene itself: its objects, their names, mesh placements and geometry (each shared
+// geometry once), and what loading it took at its peak (Scene::loadBytes: the file's text and
+// parsed tree, which the process keeps as resident memory once freed).
+std::uint64_t sceneBytes(const Scene& scene);
+
+// What each backend holds per object besides its geometry (its entries in the object and
+// instance lists, bounds and acceleration-structure nodes): an allowance, measured at about
+// 100 bytes an object for a million spheres and rounded up.
+inline constexpr std::uint64_t kBackendBytesPerObject = 256;
+
 // The program and its libraries before any render (measured: 126 MiB resident), rounded up.
 inline constexpr std::uint64_t kProgramBytes = 160 * kMiB;
 

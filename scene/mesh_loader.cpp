@@ -2,7 +2,10 @@
 #include "scene/mesh_loader.h"
 
 #include <algorithm>
+#include <cerrno>
+#include <climits>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <map>
@@ -13,6 +16,11 @@
 #include <tiny_gltf.h>
 #include <tiny_obj_loader.h>
 
+#include "scene/input_file.h"
+#include "scene/json_input.h"
+#include "scene/memory.h"
+#include "scene/scene_checks.h"
+
 namespace shadowlab::scene {
 
 namespace {
@@ -21,50 +29,116 @@ namespace fs = std::filesystem;
 
 [[noreturn]] void fail(const fs::path& sceneFile, const JsonPath& path, const fs::path& mesh,
                        const std::string& what) {
-    throw SceneError(sceneFile, path, mesh.string() + ": " + what);
+    // (a glTF given as the scene is both: named once)
+    throw SceneError(sceneFile, path, mesh == sceneFile ? what : mesh.string() + ": " + what);
 }
 
 bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-// tinyobjloader reads "nan" or "inf" coordinates as 0 without a word; find them first so a
-// broken export is reported rather than silently reshaped.
-void checkObjVertices(const fs::path& file, const fs::path& sceneFile, const JsonPath& path) {
-    std::ifstream in(file);
-    std::string line;
-    for (std::size_t lineNo = 1; std::getline(in, line); ++lineNo) {
-        if (line.size() < 2 || line[0] != 'v' || (line[1] != ' ' && line[1] != '\t')) continue;
-        std::istringstream fields(line.substr(2));
+// What tinyobjloader does not check, found first so a broken export is reported with its line
+// rather than silently reshaped: "nan" or "inf" numbers (read as 0), and face indices beyond
+// the 32-bit range (wrapped to other, possibly valid, vertices). Lines are read as tinyobjloader
+// reads them, after leading spaces and tabs.
+void checkObjText(const std::string& text, const fs::path& file, const fs::path& sceneFile, const JsonPath& path) {
+    std::size_t vertices = 0, texcoords = 0, normals = 0;
+    std::size_t lineNo = 0;
+    for (std::size_t begin = 0; begin < text.size();) {
+        std::size_t end = text.find('\n', begin);
+        if (end == std::string::npos) end = text.size();
+        std::string_view line(text.data() + begin, end - begin);
+        begin = end + 1;
+        ++lineNo;
+        while (!line.empty() && (line.front() == ' ' || line.front() == '\t')) line.remove_prefix(1);
+        if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+        auto at = [&] { return "line " + std::to_string(lineNo) + ": "; };
+        const std::size_t space = line.find_first_of(" \t");
+        const std::string_view keyword = line.substr(0, space);
+        if (space == std::string_view::npos) continue;
+        std::istringstream fields{std::string(line.substr(space + 1))};
         std::string token;
-        for (int i = 0; i < 3 && fields >> token; ++i) {
-            char* end = nullptr;
-            const double v = std::strtod(token.c_str(), &end);
-            if (end == token.c_str() || *end != '\0' || !std::isfinite(v))
-                fail(sceneFile, path, file, "line " + std::to_string(lineNo) + ": vertex coordinate '" +
-                                                token + "' is not a finite number");
+        if (keyword == "v" || keyword == "vn" || keyword == "vt") {
+            (keyword == "v" ? vertices : keyword == "vn" ? normals : texcoords) += 1;
+            for (int i = 0; i < 3 && fields >> token; ++i) {
+                char* stop = nullptr;
+                const double v = std::strtod(token.c_str(), &stop);
+                if (stop == token.c_str() || *stop != '\0' || !std::isfinite(v))
+                    fail(sceneFile, path, file, at() + (keyword == "v" ? "vertex" : keyword == "vn" ? "normal" : "texture") +
+                                                    " coordinate '" + excerpt(token) + "' is not a finite number");
+            }
+        } else if (keyword == "f" || keyword == "l" || keyword == "p") {
+            while (fields >> token) {
+                // v, v/vt, v//vn or v/vt/vn; each counted from 1, or back from the latest when negative.
+                std::size_t part = 0;
+                for (std::size_t from = 0; from <= token.size(); ++part) {
+                    std::size_t slash = token.find('/', from);
+                    if (slash == std::string::npos) slash = token.size();
+                    const std::string number = token.substr(from, slash - from);
+                    from = slash + 1;
+                    if (number.empty()) continue;
+                    errno = 0;
+                    char* stop = nullptr;
+                    const long long index = std::strtoll(number.c_str(), &stop, 10);
+                    const std::size_t defined = part == 0 ? vertices : part == 1 ? texcoords : normals;
+                    const char* what = part == 0 ? "vertices" : part == 1 ? "texture coordinates" : "normals";
+                    if (stop == number.c_str() || *stop != '\0')
+                        fail(sceneFile, path, file, at() + "face index '" + excerpt(number) + "' is not a whole number");
+                    if (index == 0 || errno == ERANGE || index > std::int64_t(INT32_MAX) ||
+                        (index < 0 && std::uint64_t(-(index + 1)) >= defined))
+                        fail(sceneFile, path, file, at() + "face index " + excerpt(number) + " is out of range (" +
+                                                        std::to_string(defined) + " " + what + " defined so far)");
+                }
+            }
         }
     }
 }
 
-void loadObj(const fs::path& file, TriangleMesh& mesh, const fs::path& sceneFile,
+// OBJ material libraries name other files, which tinyobjloader would open itself (a FIFO hung
+// it, /dev/zero grew without bound). Shadows need no material, so a library is only checked
+// through the one input opener, never parsed: a missing one is ignored as before, one that is
+// not a regular file of a sane size is an error.
+class MaterialCheck : public tinyobj::MaterialReader {
+public:
+    explicit MaterialCheck(fs::path dir) : dir_(std::move(dir)) {}
+    bool operator()(const std::string& name, std::vector<tinyobj::material_t>*, std::map<std::string, int>*,
+                    std::string*, std::string*) override {
+        const fs::path lib = dir_ / name;
+        if (!problem_.empty() || !inputFileExists(lib)) return false;
+        try {
+            checkInputFile(lib, kMaxJsonFileBytes);
+        } catch (const InputFileError& e) {
+            problem_ = "mtllib " + excerpt(name) + ": " + e.what();
+        }
+        return false;
+    }
+    const std::string& problem() const { return problem_; }
+
+private:
+    fs::path dir_;
+    std::string problem_;
+};
+
+void loadObj(const fs::path& file, const std::string& text, TriangleMesh& mesh, const fs::path& sceneFile,
              const JsonPath& path) {
-    checkObjVertices(file, sceneFile, path);
-    tinyobj::ObjReaderConfig config;
-    config.triangulate = true;
-    config.vertex_color = false;
-    config.mtl_search_path = file.parent_path().string();
-    tinyobj::ObjReader reader;
-    if (!reader.ParseFromFile(file.string(), config))
-        fail(sceneFile, path, file, "not a readable OBJ file: " + reader.Error());
-    const auto& attrib = reader.GetAttrib();
+    checkObjText(text, file, sceneFile, path);
+    tinyobj::attrib_t attribStorage;
+    std::vector<tinyobj::shape_t> shapes;
+    std::vector<tinyobj::material_t> materials;
+    std::string warn, err;
+    std::istringstream stream(text);
+    MaterialCheck materialCheck(file.has_parent_path() ? file.parent_path() : fs::path("."));
+    const bool ok = tinyobj::LoadObj(&attribStorage, &shapes, &materials, &warn, &err, &stream, &materialCheck, true, false);
+    if (!materialCheck.problem().empty()) fail(sceneFile, path, file, materialCheck.problem());
+    if (!ok) fail(sceneFile, path, file, "not a readable OBJ file: " + excerpt(err, 200));
+    const auto& attrib = attribStorage;
     const std::size_t vertexCount = attrib.vertices.size() / 3;
     const std::size_t normalCount = attrib.normals.size() / 3;
     bool allHaveNormals = normalCount > 0;
     std::size_t faces = 0;
-    for (const auto& shape : reader.GetShapes()) {
+    for (const auto& shape : shapes) {
         for (const auto& idx : shape.mesh.indices) {
             if (idx.vertex_index < 0 || std::size_t(idx.vertex_index) >= vertexCount)
                 fail(sceneFile, path, file,
-                     "face index " + std::to_string(idx.vertex_index + 1) + " is out of range (" +
+                     "face index " + std::to_string(std::int64_t(idx.vertex_index) + 1) + " is out of range (" +
                          std::to_string(vertexCount) + " vertices)");
             if (idx.normal_index < 0 || std::size_t(idx.normal_index) >= normalCount)
                 allHaveNormals = false;
@@ -73,58 +147,145 @@ void loadObj(const fs::path& file, TriangleMesh& mesh, const fs::path& sceneFile
     }
     if (faces == 0) fail(sceneFile, path, file, "has no faces");
     // One output vertex per OBJ corner keeps per-corner normals; fine for the sizes we load.
-    for (const auto& shape : reader.GetShapes()) {
+    std::size_t corners = 0;
+    for (const auto& shape : shapes) corners += shape.mesh.indices.size();
+    if (corners > std::size_t(UINT32_MAX))
+        fail(sceneFile, path, file, "has " + std::to_string(corners) + " face corners, more than 32-bit indices hold");
+    for (const auto& shape : shapes) {
         for (const auto& idx : shape.mesh.indices) {
-            const Vec3 p(attrib.vertices[3 * idx.vertex_index], attrib.vertices[3 * idx.vertex_index + 1],
-                         attrib.vertices[3 * idx.vertex_index + 2]);
+            const Vec3 p(attrib.vertices[3 * std::size_t(idx.vertex_index)], attrib.vertices[3 * std::size_t(idx.vertex_index) + 1],
+                         attrib.vertices[3 * std::size_t(idx.vertex_index) + 2]);
             if (!finite(p)) fail(sceneFile, path, file, "vertex " + std::to_string(idx.vertex_index + 1) + " is not finite");
             mesh.indices.push_back(std::uint32_t(mesh.positions.size()));
             mesh.positions.push_back(p);
             if (allHaveNormals)
-                mesh.normals.emplace_back(attrib.normals[3 * idx.normal_index],
-                                          attrib.normals[3 * idx.normal_index + 1],
-                                          attrib.normals[3 * idx.normal_index + 2]);
+                mesh.normals.emplace_back(attrib.normals[3 * std::size_t(idx.normal_index)],
+                                          attrib.normals[3 * std::size_t(idx.normal_index) + 1],
+                                          attrib.normals[3 * std::size_t(idx.normal_index) + 2]);
         }
     }
     if (!allHaveNormals) mesh.normals.clear();
 }
 
-// Reads one accessor as doubles (`components` per element); validates every bound.
-std::vector<double> readAccessor(const tinygltf::Model& model, int accessorIndex, int components,
-                                 const fs::path& file, const fs::path& sceneFile, const JsonPath& path) {
-    if (accessorIndex < 0 || std::size_t(accessorIndex) >= model.accessors.size())
-        fail(sceneFile, path, file, "accessor " + std::to_string(accessorIndex) + " does not exist");
-    const auto& acc = model.accessors[accessorIndex];
-    if (acc.bufferView < 0 || std::size_t(acc.bufferView) >= model.bufferViews.size())
-        fail(sceneFile, path, file, "accessor " + std::to_string(accessorIndex) + " has no buffer view");
-    const auto& view = model.bufferViews[acc.bufferView];
+// a + b and a * b on sizes taken from a file, or nothing when they overflow.
+bool addChecked(std::uint64_t a, std::uint64_t b, std::uint64_t& out) { return !__builtin_add_overflow(a, b, &out); }
+bool mulChecked(std::uint64_t a, std::uint64_t b, std::uint64_t& out) { return !__builtin_mul_overflow(a, b, &out); }
+
+// `count` elements of `nComp` components of `componentType` from buffer view `viewIndex`,
+// starting `byteOffset` into it, `stride` bytes apart (0: the view's stride, or packed), as
+// doubles. Every offset, count and stride is the file's, so each sum and product is checked for
+// overflow and against the lengths of the view and its buffer (glTF 2.0, 3.6.2.4: byteOffset +
+// (count - 1) * stride + element size must fit the view); `where` names the field at fault.
+std::vector<double> readElements(const tinygltf::Model& model, int viewIndex, std::uint64_t byteOffset,
+                                 std::uint64_t count, int componentType, int nComp, bool packed,
+                                 const std::string& where, const fs::path& file, const fs::path& sceneFile,
+                                 const JsonPath& path) {
+    auto bad = [&](const std::string& at, const std::string& what) { fail(sceneFile, path, file, at + ": " + what); };
+    if (viewIndex < 0 || std::size_t(viewIndex) >= model.bufferViews.size())
+        bad(where + ".bufferView", "names buffer view " + std::to_string(viewIndex) + ", which does not exist (" +
+                                       std::to_string(model.bufferViews.size()) + " buffer views)");
+    const std::string viewAt = "bufferViews[" + std::to_string(viewIndex) + "]";
+    const auto& view = model.bufferViews[std::size_t(viewIndex)];
     if (view.buffer < 0 || std::size_t(view.buffer) >= model.buffers.size())
-        fail(sceneFile, path, file, "buffer view " + std::to_string(acc.bufferView) + " names a missing buffer");
-    const auto& buffer = model.buffers[view.buffer];
-    const int compSize = tinygltf::GetComponentSizeInBytes(acc.componentType);
-    const int nComp = tinygltf::GetNumComponentsInType(acc.type);
-    if (compSize <= 0 || nComp != components)
-        fail(sceneFile, path, file, "accessor " + std::to_string(accessorIndex) + " has an unexpected type");
-    const std::size_t stride = view.byteStride ? view.byteStride : std::size_t(compSize) * nComp;
-    const std::size_t begin = view.byteOffset + acc.byteOffset;
-    const std::size_t needed = acc.count == 0 ? 0 : begin + stride * (acc.count - 1) + std::size_t(compSize) * nComp;
-    if (needed > buffer.data.size() || view.byteOffset + view.byteLength > buffer.data.size())
-        fail(sceneFile, path, file, "accessor " + std::to_string(accessorIndex) + " reads past the end of its buffer");
-    std::vector<double> out(acc.count * nComp);
-    const unsigned char* base = buffer.data.data() + begin;
-    for (std::size_t i = 0; i < acc.count; ++i) {
+        bad(viewAt + ".buffer", "names buffer " + std::to_string(view.buffer) + ", which does not exist");
+    const auto& buffer = model.buffers[std::size_t(view.buffer)];
+    const int compSize = tinygltf::GetComponentSizeInBytes(componentType);
+    if (compSize <= 0) bad(where + ".componentType", "unsupported component type " + std::to_string(componentType));
+    const std::uint64_t element = std::uint64_t(compSize) * std::uint64_t(nComp);
+    const std::uint64_t stride = !packed && view.byteStride ? std::uint64_t(view.byteStride) : element;
+    if (stride < element)
+        bad(viewAt + ".byteStride", std::to_string(stride) + " is smaller than one element (" + std::to_string(element) +
+                                        " bytes)");
+    std::uint64_t viewEnd = 0;
+    if (!addChecked(view.byteOffset, view.byteLength, viewEnd) || viewEnd > buffer.data.size())
+        bad(viewAt, "byteOffset " + std::to_string(view.byteOffset) + " + byteLength " + std::to_string(view.byteLength) +
+                        " reaches past the end of buffer " + std::to_string(view.buffer) + " (" +
+                        std::to_string(buffer.data.size()) + " bytes)");
+    std::uint64_t span = 0, last = 0, end = 0;
+    if (count > 0 && (!mulChecked(stride, count - 1, span) || !addChecked(span, element, last) ||
+                      !addChecked(last, byteOffset, end) || end > view.byteLength))
+        bad(where, "byteOffset " + std::to_string(byteOffset) + " + " + std::to_string(count) + " elements of stride " +
+                       std::to_string(stride) + " reach past the end of " + viewAt + " (" +
+                       std::to_string(view.byteLength) + " bytes)");
+    // The doubles read: at most 8 a byte of the buffer, but that may still be more than the
+    // machine has.
+    const std::uint64_t values = count * std::uint64_t(nComp);
+    if (const std::uint64_t available = availableMemoryBytes(); available != 0 && values * sizeof(double) > available)
+        bad(where, "reading its " + std::to_string(count) + " elements needs " +
+                       std::to_string(values * sizeof(double) / kMiB) + " MiB, more than the " +
+                       std::to_string(available / kMiB) + " MiB available");
+    std::vector<double> out(values);
+    const unsigned char* base = buffer.data.data() + view.byteOffset + byteOffset;
+    for (std::size_t i = 0; i < count; ++i) {
         for (int c = 0; c < nComp; ++c) {
             const unsigned char* p = base + i * stride + std::size_t(c) * compSize;
             double v = 0;
-            switch (acc.componentType) {
+            switch (componentType) {
                 case TINYGLTF_COMPONENT_TYPE_FLOAT: { float f; std::memcpy(&f, p, 4); v = f; break; }
                 case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { std::uint32_t u; std::memcpy(&u, p, 4); v = u; break; }
                 case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { std::uint16_t u; std::memcpy(&u, p, 2); v = u; break; }
                 case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: v = *p; break;
-                default: fail(sceneFile, path, file, "accessor " + std::to_string(accessorIndex) + " has an unsupported component type");
+                default: bad(where + ".componentType", "unsupported component type " + std::to_string(componentType));
             }
-            out[i * nComp + c] = v;
+            out[i * std::size_t(nComp) + std::size_t(c)] = v;
         }
+    }
+    return out;
+}
+
+// Reads one accessor as doubles (`components` per element): its buffer view's elements, or
+// zeros where it has none, with a sparse accessor's replacements applied (glTF 2.0, 3.6.2.3:
+// `count` strictly increasing indices into the accessor, and as many packed values).
+std::vector<double> readAccessor(const tinygltf::Model& model, int accessorIndex, int components,
+                                 const fs::path& file, const fs::path& sceneFile, const JsonPath& path) {
+    const std::string at = "accessors[" + std::to_string(accessorIndex) + "]";
+    auto bad = [&](const std::string& where, const std::string& what) {
+        fail(sceneFile, path, file, where + ": " + what);
+    };
+    if (accessorIndex < 0 || std::size_t(accessorIndex) >= model.accessors.size())
+        fail(sceneFile, path, file, "accessor " + std::to_string(accessorIndex) + " does not exist (" +
+                                        std::to_string(model.accessors.size()) + " accessors)");
+    const auto& acc = model.accessors[std::size_t(accessorIndex)];
+    const int nComp = tinygltf::GetNumComponentsInType(acc.type);
+    if (tinygltf::GetComponentSizeInBytes(acc.componentType) <= 0 || nComp != components)
+        bad(at, "has an unexpected type (expected " + std::to_string(components) + " component(s) per element)");
+    std::vector<double> out;
+    if (acc.bufferView >= 0 || !acc.sparse.isSparse) {
+        out = readElements(model, acc.bufferView, acc.byteOffset, acc.count, acc.componentType, nComp, false, at, file,
+                           sceneFile, path);
+    } else {
+        // No buffer view: zeros (bounded like any read: by the memory there is).
+        const std::uint64_t values = std::uint64_t(acc.count) * std::uint64_t(nComp);
+        if (const std::uint64_t available = availableMemoryBytes(); available != 0 && values * sizeof(double) > available)
+            bad(at + ".count", std::to_string(acc.count) + " elements need more than the " +
+                                   std::to_string(available / kMiB) + " MiB available");
+        out.assign(values, 0.0);
+    }
+    if (!acc.sparse.isSparse) return out;
+    const auto& sparse = acc.sparse;
+    const std::string sparseAt = at + ".sparse";
+    if (sparse.count < 1 || std::uint64_t(sparse.count) > acc.count)
+        bad(sparseAt + ".count", "must be in 1.." + std::to_string(acc.count) + ", got " + std::to_string(sparse.count));
+    const int indexType = sparse.indices.componentType;
+    if (indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+        bad(sparseAt + ".indices.componentType", "must be an unsigned byte, short or int, got " + std::to_string(indexType));
+    if (sparse.indices.byteOffset < 0 || sparse.values.byteOffset < 0)
+        bad(sparseAt, "a byteOffset is negative");
+    const std::vector<double> indices =
+        readElements(model, sparse.indices.bufferView, std::uint64_t(sparse.indices.byteOffset), std::uint64_t(sparse.count),
+                     indexType, 1, true, sparseAt + ".indices", file, sceneFile, path);
+    const std::vector<double> values =
+        readElements(model, sparse.values.bufferView, std::uint64_t(sparse.values.byteOffset), std::uint64_t(sparse.count),
+                     acc.componentType, nComp, true, sparseAt + ".values", file, sceneFile, path);
+    for (std::size_t k = 0; k < indices.size(); ++k) {
+        const double index = indices[k];
+        if (index >= double(acc.count) || (k > 0 && !(index > indices[k - 1])))
+            bad(sparseAt + ".indices", "index " + std::to_string(std::uint64_t(index)) + " (element " + std::to_string(k) +
+                                           ") is out of range or not increasing (" + std::to_string(acc.count) +
+                                           " elements)");
+        for (int c = 0; c < nComp; ++c)
+            out[std::size_t(index) * std::size_t(nComp) + std::size_t(c)] = values[k * std::size_t(nComp) + std::size_t(c)];
     }
     return out;
 }
@@ -175,6 +336,8 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
             idx.resize(count);
             for (std::size_t i = 0; i < count; ++i) idx[i] = double(i);
         }
+        if (out.positions.size() + count > std::size_t(UINT32_MAX))
+            fail(sceneFile, path, file, "mesh " + std::to_string(meshIndex) + " has more vertices than 32-bit indices hold");
         const std::uint32_t base = std::uint32_t(out.positions.size());
         const bool keepNormals = !n.empty() && (out.positions.empty() || !out.normals.empty());
         if (!keepNormals) out.normals.clear();
@@ -197,8 +360,9 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
 
 // A node's camera and KHR_lights_punctual light, placed by the node's world transform (glTF
 // cameras and lights look down their local −Z with +Y up).
-void collectCameraAndLight(const tinygltf::Model& model, const tinygltf::Node& node,
-                           const glm::dmat4& world, GltfExtras& out) {
+void collectCameraAndLight(const tinygltf::Model& model, const tinygltf::Node& node, int nodeIndex,
+                           const glm::dmat4& world, GltfExtras& out, const fs::path& file, const fs::path& sceneFile,
+                           const JsonPath& path) {
     const Vec3 origin(world * glm::dvec4(0, 0, 0, 1));
     const Vec3 forward = glm::normalize(Vec3(world * glm::dvec4(0, 0, -1, 0)));
     const Vec3 up = glm::normalize(Vec3(world * glm::dvec4(0, 1, 0, 0)));
@@ -219,10 +383,22 @@ void collectCameraAndLight(const tinygltf::Model& model, const tinygltf::Node& n
     }
     const auto ext = node.extensions.find("KHR_lights_punctual");
     if (ext == node.extensions.end() || !ext->second.Has("light")) return;
-    const int index = ext->second.Get("light").GetNumberAsInt();
-    if (index < 0 || std::size_t(index) >= model.lights.size()) return;
-    const tinygltf::Light& l = model.lights[index];
+    // The index is the file's: any number (GetNumberAsInt of 1e15 is undefined behaviour, found
+    // by fuzzing), so it is checked as a double first.
+    const tinygltf::Value& v = ext->second.Get("light");
+    const double number = v.IsNumber() || v.IsInt() ? v.GetNumberAsDouble() : -1.0;
+    if (!(number >= 0 && number < double(model.lights.size()) && number == std::floor(number)))
+        fail(sceneFile, path, file, "nodes[" + std::to_string(nodeIndex) +
+                                        "].extensions.KHR_lights_punctual.light: names no light (" +
+                                        std::to_string(model.lights.size()) + " lights)");
+    const int index = int(number);
+    const tinygltf::Light& l = model.lights[std::size_t(index)];
+    if (l.type != "directional" && l.type != "point" && l.type != "spot")
+        fail(sceneFile, path, file, "extensions.KHR_lights_punctual.lights[" + std::to_string(index) +
+                                        "].type: unknown light type '" + excerpt(l.type) +
+                                        "' (expected directional, point or spot)");
     GltfLight light;
+    light.index = index;
     light.type = l.type;
     light.position = origin;
     light.direction = forward;
@@ -238,17 +414,70 @@ struct RawInstance {
     glm::dmat4 transform;
 };
 
-void loadGltf(const fs::path& file, std::vector<RawInstance>& out, const fs::path& sceneFile,
+// Every file a glTF names (buffers, images) is read through the one input opener, relative to
+// the glTF's own folder only.
+struct GltfFiles {
+    std::string baseDir;
+};
+
+bool gltfFileExists(const std::string& name, void* user) {
+    const auto* files = static_cast<const GltfFiles*>(user);
+    // tinygltf also tries the current folder; a URI is relative to the glTF file alone.
+    const std::string prefix = files->baseDir.empty() ? "" : files->baseDir + "/";
+    if (name.compare(0, prefix.size(), prefix) != 0) return false;
+    return inputFileExists(name);
+}
+
+std::string gltfExpandPath(const std::string& name, void*) { return name; }  // no ~ or $VAR expansion
+
+bool gltfReadFile(std::vector<unsigned char>* out, std::string* err, const std::string& name, void*) {
+    try {
+        const std::string bytes = readInputFile(name, kMaxMeshFileBytes);
+        out->assign(bytes.begin(), bytes.end());
+        return true;
+    } catch (const InputFileError& e) {
+        if (err) *err += e.problem();
+        return false;
+    }
+}
+
+bool gltfWriteFile(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+    if (err) *err += "shadowlab writes no glTF files";
+    return false;
+}
+
+// The JSON of a .gltf file, or of a GLB's first chunk (GLB header: magic, version, length; then
+// chunk length and type "JSON"), for the nesting check; empty when the header is not a GLB's
+// (tinygltf then says what is wrong).
+std::string_view gltfJson(const std::string& bytes, bool binary) {
+    if (!binary) return bytes;
+    if (bytes.size() < 20 || bytes.compare(0, 4, "glTF") != 0) return {};
+    std::uint32_t chunkLength = 0;
+    std::memcpy(&chunkLength, bytes.data() + 12, 4);
+    if (bytes.compare(16, 4, "JSON") != 0 || chunkLength > bytes.size() - 20) return {};
+    return std::string_view(bytes.data() + 20, chunkLength);
+}
+
+void loadGltf(const fs::path& file, const std::string& bytes, std::vector<RawInstance>& out, const fs::path& sceneFile,
               const JsonPath& path, GltfExtras* extras) {
-    tinygltf::TinyGLTF loader;
-    loader.SetImageLoader(ignoreImage, nullptr);
-    tinygltf::Model model;
-    std::string err, warn;
     std::string ext = file.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-    const bool ok = ext == ".glb" ? loader.LoadBinaryFromFile(&model, &err, &warn, file.string())
-                                  : loader.LoadASCIIFromFile(&model, &err, &warn, file.string());
-    if (!ok) fail(sceneFile, path, file, "not a readable glTF file: " + (err.empty() ? warn : err));
+    const bool binary = ext == ".glb";
+    // tinygltf parses extras and extensions recursively: nesting is bounded before it sees them.
+    if (const std::string problem = jsonNestingProblem(gltfJson(bytes, binary)); !problem.empty())
+        fail(sceneFile, path, file, problem);
+    tinygltf::TinyGLTF loader;
+    loader.SetImageLoader(ignoreImage, nullptr);
+    GltfFiles files{file.has_parent_path() ? file.parent_path().string() : std::string()};
+    loader.SetFsCallbacks({gltfFileExists, gltfExpandPath, gltfReadFile, gltfWriteFile, &files});
+    tinygltf::Model model;
+    std::string err, warn;
+    const bool ok =
+        binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()),
+                                             unsigned(std::min<std::size_t>(bytes.size(), UINT_MAX)), files.baseDir)
+               : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(),
+                                            unsigned(std::min<std::size_t>(bytes.size(), UINT_MAX)), files.baseDir);
+    if (!ok) fail(sceneFile, path, file, "not a readable glTF file: " + excerpt(err.empty() ? warn : err, 400));
 
     // Walk the default scene's node tree (depth first, in document order) so each node that
     // uses a mesh places it once; a mesh used by several nodes is read once and shared.
@@ -276,6 +505,13 @@ void loadGltf(const fs::path& file, std::vector<RawInstance>& out, const fs::pat
                                             "with two parents); glTF nodes must form trees");
         const auto& node = model.nodes[nodeIndex];
         const glm::dmat4 world = parent * nodeMatrix(node);
+        // A scale of 0 hides a mesh (dropped below), but one that overflows is not a placement.
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r)
+                if (!std::isfinite(world[c][r]))
+                    fail(sceneFile, path, file, "nodes[" + std::to_string(nodeIndex) +
+                                                    "]: its transform, applied after its parents', is not finite "
+                                                    "(a scale or translation overflows)");
         if (node.mesh >= 0) {
             if (std::size_t(node.mesh) >= model.meshes.size())
                 fail(sceneFile, path, file, "node names mesh " + std::to_string(node.mesh) + ", which does not exist");
@@ -286,7 +522,7 @@ void loadGltf(const fs::path& file, std::vector<RawInstance>& out, const fs::pat
             }
             out.push_back({geometry, world});
         }
-        if (extras) collectCameraAndLight(model, node, world, *extras);
+        if (extras) collectCameraAndLight(model, node, nodeIndex, world, *extras, file, sceneFile, path);
         for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.emplace_back(*c, world);
     }
 }
@@ -303,21 +539,33 @@ bool invertible(const glm::dmat4& m) {
 }
 
 // The file's instances with `transform` not yet applied (what the cache keeps).
+// `loadBytes`: an upper estimate of what reading the file held at its peak beside the result:
+// its bytes, tinyobjloader's arrays (about three times an OBJ's text), or tinygltf's JSON tree
+// (twice: its parse tree and the model's copies), buffers and the accessors read as doubles.
 std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path& sceneFile,
-                                       const JsonPath& path, GltfExtras* extras) {
-    std::error_code ec;
-    if (!fs::is_regular_file(meshFile, ec)) fail(sceneFile, path, meshFile, "no such file");
-    if (fs::file_size(meshFile, ec) == 0) fail(sceneFile, path, meshFile, "is empty (0 bytes)");
+                                       const JsonPath& path, GltfExtras* extras, std::uint64_t& loadBytes) {
+    std::string bytes;
+    try {
+        bytes = readInputFile(meshFile, kMaxMeshFileBytes);
+    } catch (const InputFileError& e) {
+        fail(sceneFile, path, meshFile, e.problem());
+    }
+    if (bytes.empty()) fail(sceneFile, path, meshFile, "is empty (0 bytes)");
     std::vector<RawInstance> raw;
     std::string ext = meshFile.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+    loadBytes = ext == ".obj" ? 4 * std::uint64_t(bytes.size())
+                              : 5 * std::uint64_t(bytes.size()) + 2 * jsonTreeBytes(gltfJson(bytes, ext == ".glb"));
+    if (const std::uint64_t available = availableMemoryBytes(); available != 0 && loadBytes > available)
+        fail(sceneFile, path, meshFile, "reading it needs about " + std::to_string(loadBytes / kMiB) + " MiB, more than the " +
+                                            std::to_string(available / kMiB) + " MiB available");
     if (ext == ".obj") {
         raw.push_back({std::make_shared<TriangleMesh>(), glm::dmat4(1.0)});
-        loadObj(meshFile, *raw.back().geometry, sceneFile, path);
+        loadObj(meshFile, bytes, *raw.back().geometry, sceneFile, path);
     } else if (ext == ".gltf" || ext == ".glb") {
-        loadGltf(meshFile, raw, sceneFile, path, extras);
+        loadGltf(meshFile, bytes, raw, sceneFile, path, extras);
     } else {
-        fail(sceneFile, path, meshFile, "unsupported format '" + ext + "': a mesh is .obj, .gltf or .glb (convert the model, e.g. to .obj or .glb)");
+        fail(sceneFile, path, meshFile, "unsupported format '" + excerpt(ext) + "': a mesh is .obj, .gltf or .glb (convert the model, e.g. to .obj or .glb)");
     }
     // Degenerate triangles are judged in object space: an invertible affine map keeps a
     // triangle's area zero or non-zero.
@@ -411,16 +659,24 @@ std::vector<MeshInstance> loadMeshInstances(const fs::path& meshFile, const glm:
     }
     if (instances.empty()) {
         GltfExtras own;
-        instances = readMeshFile(meshFile, sceneFile, path, extras ? extras : (cache ? &own : nullptr));
+        std::uint64_t loadBytes = 0;
+        instances = readMeshFile(meshFile, sceneFile, path, extras ? extras : (cache ? &own : nullptr), loadBytes);
         if (cache) {
             cache->files.emplace(key, instances);
             cache->extras[key] = extras ? *extras : own;
+            cache->peakLoadBytes = std::max(cache->peakLoadBytes, loadBytes);
         }
+        if (extras) extras->loadBytes = std::max(extras->loadBytes, loadBytes);
     }
     std::vector<MeshInstance> out;
+    bool overflowed = false;
     for (MeshInstance& inst : instances) {
         const glm::dmat4 m = transform * glm::dmat4(inst.transform);
-        if (!invertible(m)) continue;
+        if (!invertible(m)) {
+            // Zero scale hides a mesh; a determinant that overflows is a transform too large.
+            overflowed = overflowed || !std::isfinite(glm::determinant(glm::dmat3(m)));
+            continue;
+        }
         // The placed mesh must stay finite: its box's corners bound every placed vertex.
         Bounds b;
         for (const Vec3& p : inst.geometry->positions) b.extend(p);
@@ -432,7 +688,10 @@ std::vector<MeshInstance> loadMeshInstances(const fs::path& meshFile, const glm:
         }
         out.push_back({inst.geometry, affineOf(m)});
     }
-    if (out.empty()) fail(sceneFile, path, meshFile, "the object's transform is not invertible");
+    if (out.empty())
+        fail(sceneFile, path, meshFile, overflowed ? "the object's transform overflows (its scale is too large for "
+                                                     "double precision)"
+                                                   : "the object's transform is not invertible");
     return out;
 }
 

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <filesystem>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
@@ -25,6 +26,7 @@ struct GltfCamera {
     double yfovRadians = 0.0, znear = 0.0, zfar = 0.0, aspect = 0.0;  // zfar/aspect 0: unset
 };
 struct GltfLight {
+    int index = -1;    // in KHR_lights_punctual.lights
     std::string type;  // "directional" | "point" | "spot"
     Vec3 position{0, 0, 0}, direction{0, 0, -1}, color{1, 1, 1};
     double intensity = 1.0;         // lux (directional) or candela (point, spot)
@@ -33,6 +35,7 @@ struct GltfLight {
 struct GltfExtras {
     std::vector<GltfCamera> cameras;
     std::vector<GltfLight> lights;
+    std::uint64_t loadBytes = 0;  // the file's temporaries while it was read (text, trees, buffers)
 };
 
 // Each mesh file read once per scene: objects that name the same file share its geometries
@@ -40,6 +43,7 @@ struct GltfExtras {
 struct MeshCache {
     std::map<std::string, std::vector<MeshInstance>> files;
     std::map<std::string, GltfExtras> extras;  // each glTF file's cameras and lights
+    std::uint64_t peakLoadBytes = 0;  // the largest file's temporaries while it was read
 };
 
 // Reads `meshFile`: one instance for an OBJ file, one per node that uses a mesh for glTF (the

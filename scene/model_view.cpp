@@ -59,7 +59,8 @@ Camera cameraFromGltf(const Vec3& position, const Vec3& forward, const Vec3& up,
     cam.fovYDegrees = std::clamp(yfovRadians / kDegrees, 1.0, 170.0);
     cam.near = znear > 0 ? znear : radius * 1e-3;
     cam.far = zfar > cam.near ? zfar : glm::length(position - bounds.center()) + 4.0 * radius;
-    if (aspect > 0) cam.height = std::clamp(int(std::lround(cam.width / aspect)), 1, kMaxResolution);
+    // Clamped before the conversion: a tiny aspect would overflow int.
+    if (aspect > 0) cam.height = int(std::lround(std::clamp(cam.width / aspect, 1.0, double(kMaxResolution))));
     return cam;
 }
 

@@ -192,6 +192,9 @@ struct Scene {
     SceneOrigin origin;
     // The optional "budgets" block: limits `run` and `check` hold each method to (docs/ci.md).
     Budgets budgets;
+    // What loading took at its peak beyond the scene itself (the file's text, its parsed JSON
+    // tree, the largest mesh file's temporaries): part of the memory estimate (scene/memory.h).
+    std::uint64_t loadBytes = 0;
 
     const Material& materialOf(const Object& o) const { return materials[o.material]; }
     bool allOpaque() const;

@@ -4,7 +4,8 @@
 #
 #   tools/fuzz.sh [SECONDS] [TARGET...]     default: 60 s each, all of scene_json obj gltf exr
 #
-# Each target starts from the committed seed corpus fuzz/corpus/TARGET and keeps what it learns in
+# Each target starts from the committed seed corpus fuzz/corpus/TARGET (with fuzz/dict/TARGET.dict,
+# the tokens of its format and values that break size arithmetic) and keeps what it learns in
 # build-fuzz/corpus/TARGET (reused by later runs). Crashing inputs land in
 # build-fuzz/findings/TARGET/; copy each into tests/scene/fuzz_regressions/TARGET/ once fixed, where
 # FuzzRegression.* replays it in the normal suite. A summary line per target (executions, new
@@ -46,7 +47,9 @@ for t in "${targets[@]}"; do
     # -rss_limit_mb / -malloc_limit_mb: a loader that believes a "2 GB buffer" declared in a file
     # and allocates it is a finding, not an out-of-memory on the machine.
     set +e
-    "$build/fuzz/${t}_fuzz" "$build/corpus/$t" "$root/fuzz/corpus/$t" \
+    dict=()
+    [ -f "$root/fuzz/dict/$t.dict" ] && dict=(-dict="$root/fuzz/dict/$t.dict")
+    "$build/fuzz/${t}_fuzz" "$build/corpus/$t" "$root/fuzz/corpus/$t" "${dict[@]}" \
         -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=1024 \
         -max_len=262144 -print_final_stats=1 -artifact_prefix="$build/findings/$t/" >"$log" 2>&1
     rc=$?

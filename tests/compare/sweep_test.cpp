@@ -4,12 +4,14 @@
 #include "compare/sweep.h"
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <sys/stat.h>
 
 #include <gtest/gtest.h>
 
@@ -536,6 +538,47 @@ TEST_F(GridFile, BadValuesAreRejectedWithTheirJsonPath) {
             ADD_FAILURE() << "not a SceneError for " << text << ": " << e.what();
         }
     }
+}
+
+TEST_F(GridFile, HostileFilesAreRefusedBeforeTheyAreReadOrExpanded) {
+    fs::create_directories(root);
+    // A FIFO would block a reader forever, a folder or /dev/zero never end.
+    ASSERT_EQ(::mkfifo((root / "pipe.json").c_str(), 0600), 0);
+    fs::create_symlink("/dev/zero", root / "zero.json");
+    for (const char* name : {"pipe.json", "zero.json"}) {
+        try {
+            loadGrid(root / name, scene);
+            ADD_FAILURE() << name << " was read";
+        } catch (const scene::SceneError& e) {
+            EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
+        }
+    }
+    // Deep nesting is refused before the parser or a message printer recurses on it.
+    const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+    try {
+        loadGrid(write(R"({ "raster": { "depth_bias": )" + deep + " } }"), scene);
+        ADD_FAILURE() << "a deep grid was read";
+    } catch (const scene::SceneError& e) {
+        EXPECT_NE(std::string(e.what()).find("nested deeper than 64 levels"), std::string::npos) << e.what();
+    }
+    // Axes of 1000 values multiply to 10^9 configurations: refused before they are built (the
+    // loop that built them first exhausted memory).
+    std::string values = "[";
+    for (int i = 0; i < 1000; ++i) {
+        if (i) values += ',';
+        values += std::to_string(i);
+    }
+    values += "]";
+    const auto start = std::chrono::steady_clock::now();
+    try {
+        loadGrid(write(R"({ "raster": { "shadow_map_size": [16, 32, 64], "depth_bias": )" + values +
+                       R"(, "slope_bias": )" + values + R"(, "cascades": [1, 2, 3, 4] } })"),
+                 scene);
+        ADD_FAILURE() << "a grid of 10^9 configurations was built";
+    } catch (const scene::SceneError& e) {
+        EXPECT_NE(std::string(e.what()).find("configurations, more than 100000"), std::string::npos) << e.what();
+    }
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
 }
 
 }  // namespace

@@ -53,6 +53,7 @@ TEST(FuzzRegression, EveryKeptInputLoadsOrGetsAClearError) {
         fs::create_directories(dir.path() / "case");
         fs::create_directory_symlink(scenes / "models", dir.path() / "models");
         fs::create_directory_symlink(scenes / "extreme" / "models", dir.path() / "case" / "models");
+        fuzz::makeIndirectFiles(dir.path() / "case");
         const std::string bytes = bytesOf(r.input);
         const auto* data = reinterpret_cast<const std::uint8_t*>(bytes.data());
         const fs::path file = dir.write("case/" + fuzz::inputName(r.target, data, bytes.size()), bytes);

@@ -1,0 +1,75 @@
+// app/guards.cpp: input, output and standard-output checks (see guards.h).
+#include "app/guards.h"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <iostream>
+#include <unistd.h>
+
+namespace shadowlab::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// The nearest ancestor of `p` that exists must be a folder we may create entries in.
+void checkParent(const fs::path& p, const std::string& option) {
+    fs::path parent = fs::absolute(p).parent_path();
+    std::error_code ec;
+    while (!parent.empty() && !fs::exists(parent, ec) && parent != parent.root_path()) parent = parent.parent_path();
+    if (!fs::is_directory(parent, ec))
+        throw scene::InputError(option + " " + p.string() + ": " + parent.string() + " is not a folder");
+    if (::access(parent.c_str(), W_OK | X_OK) != 0)
+        throw scene::InputError(option + " " + p.string() + ": cannot write in " + parent.string() + " (" +
+                                std::strerror(errno) + ")");
+}
+
+}  // namespace
+
+void checkOutputFile(const fs::path& file, const std::string& option) {
+    std::error_code ec;
+    if (fs::is_directory(file, ec))
+        throw scene::InputError(option + " " + file.string() + ": is a folder; name the file to write");
+    if (fs::exists(file, ec) && !fs::is_regular_file(file, ec))
+        throw scene::InputError(option + " " + file.string() + ": exists and is not a regular file");
+    checkParent(file, option);
+}
+
+void checkOutputFolder(const fs::path& dir, const std::string& option) {
+    std::error_code ec;
+    if (fs::exists(dir, ec)) {
+        if (!fs::is_directory(dir, ec))
+            throw scene::InputError(option + " " + dir.string() + ": exists and is not a folder; name a folder");
+        if (::access(dir.c_str(), W_OK | X_OK) != 0)
+            throw scene::InputError(option + " " + dir.string() + ": cannot write in it (" + std::strerror(errno) + ")");
+        return;
+    }
+    checkParent(dir, option);
+}
+
+bool isRunOutput(const std::string& name) {
+    static const char* const kExact[] = {"reference.exr", "reference.png", "raytrace.exr", "raytrace.png",
+                                         "raster.exr",    "raster.png",    "metrics.json", "report.html",
+                                         "sweep",         ".shadowlab-run.json"};
+    for (const char* n : kExact)
+        if (name == n) return true;
+    auto startsEnds = [&](const char* prefix, const char* suffix) {
+        const std::string p = prefix, s = suffix;
+        return name.size() > p.size() + s.size() && name.compare(0, p.size(), p) == 0 &&
+               name.compare(name.size() - s.size(), s.size(), s) == 0;
+    };
+    return startsEnds("diff-", ".png") || startsEnds("raster-", ".png") || startsEnds("heat-", ".png");
+}
+
+int finishStandardOutput(int status) {
+    errno = 0;
+    std::cout.flush();
+    if (std::cout.good() && std::fflush(stdout) == 0) return status;
+    const int error = errno;
+    std::cerr << "shadowlab: error: writing to standard output failed"
+              << (error ? std::string(": ") + std::strerror(error) : std::string()) << "\n";
+    return status == 0 ? 1 : status;
+}
+
+}  // namespace shadowlab::app

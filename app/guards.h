@@ -1,0 +1,53 @@
+// app/guards.h: the checks every command makes at its edges: inputs read under one catch that
+// turns any standard exception into bad input naming the file, outputs checked before any work.
+#pragma once
+
+#include <filesystem>
+#include <new>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+
+#include "scene/error.h"
+
+namespace shadowlab::app {
+
+// Runs `read` (loading the input `name`). The project's own errors pass through; any other
+// standard exception thrown while reading (bad_alloc, length_error, filesystem_error...) is an
+// input the readers did not foresee, so it becomes InputError("NAME: cannot read: ...") and
+// exit 2, rather than a bare message and exit 1.
+template <typename Read>
+auto readingInput(const std::string& name, Read&& read) -> decltype(read()) {
+    try {
+        return read();
+    } catch (const scene::SceneError&) {
+        throw;
+    } catch (const scene::InputError&) {
+        throw;
+    } catch (const std::bad_alloc&) {
+        throw scene::InputError(name + ": cannot read: it needs more memory than there is (std::bad_alloc)");
+    } catch (const std::filesystem::filesystem_error& e) {
+        throw scene::InputError(name + ": cannot read: " + e.code().message() +
+                                (e.path1().empty() ? "" : " (" + e.path1().string() + ")"));
+    } catch (const std::exception& e) {
+        throw scene::InputError(name + ": cannot read: " + e.what());
+    }
+}
+
+// An output file (`-o FILE`): not an existing folder, and its nearest existing parent a folder
+// this process may write in. Throws InputError naming `option` and the path.
+void checkOutputFile(const std::filesystem::path& file, const std::string& option = "-o");
+
+// An output folder (`-o DIR`): a folder or nothing yet, and its nearest existing parent a
+// writable folder.
+void checkOutputFolder(const std::filesystem::path& dir, const std::string& option = "-o");
+
+// The names `run` writes into its folder (at the top level): what a new run replaces as a set.
+// Anything else in the folder is the user's and is kept.
+bool isRunOutput(const std::string& name);
+
+// Flushes standard output and returns `status`, or prints why the write failed (a full disk,
+// a closed pipe) and returns 1: results that did not reach their reader are a failure.
+int finishStandardOutput(int status);
+
+}  // namespace shadowlab::app
