@@ -295,24 +295,8 @@ constexpr RunView kRunViews[] = {
 };
 
 
-// Where `render -o` writes: an existing folder in the way, or a file where the folder should be,
-// is bad input (exit 2) found before rendering; a missing folder is created once the input is
-// known to be good, and the user is told (docs/decisions.md, "Output paths").
-void checkOutputFile(const fs::path& output) {
-    std::error_code ec;
-    if (fs::is_directory(output, ec))
-        throw scene::InputError(output.string() + ": is a folder; -o names the file to write (e.g. " +
-                                (output / "render.png").string() + ")");
-    for (fs::path dir = output.parent_path(); !dir.empty(); dir = dir.parent_path()) {
-        if (fs::exists(dir, ec)) {
-            if (!fs::is_directory(dir, ec))
-                throw scene::InputError(output.string() + ": " + dir.string() +
-                                        " is a file, not a folder, so nothing can be written under it");
-            break;
-        }
-        if (dir == dir.parent_path()) break;
-    }
-}
+// `render -o` into a missing folder: created once the input is known to be good, and the user is
+// told (docs/decisions.md, "Output paths"); app::checkOutputFile has refused what cannot be used.
 void createOutputFolder(const fs::path& output) {
     if (!output.has_parent_path()) return;
     std::error_code ec;
@@ -320,23 +304,6 @@ void createOutputFolder(const fs::path& output) {
     fs::create_directories(output.parent_path());
     std::cerr << "shadowlab: created the folder " << output.parent_path().string() << " for " << output.filename().string()
               << "\n";
-}
-
-// `run -o DIR`: DIR must be a folder or not exist yet; a file there is bad input (exit 2),
-// found before anything renders.
-void checkOutputFolder(const fs::path& dir) {
-    std::error_code ec;
-    if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
-        throw scene::InputError(dir.string() + ": is a file, not a folder; run writes a folder of outputs (frames, "
-                                "images, metrics.json, report.html), so -o must name a folder");
-    for (fs::path p = dir.parent_path(); !p.empty(); p = p.parent_path()) {
-        if (fs::exists(p, ec)) {
-            if (!fs::is_directory(p, ec))
-                throw scene::InputError(dir.string() + ": " + p.string() + " is a file, not a folder");
-            break;
-        }
-        if (p == p.parent_path()) break;
-    }
 }
 
 // The run folder's manifest: every file and folder a run wrote, relative to the folder. The next
@@ -679,6 +646,9 @@ int sweepShard(const SweepOptions& o, const scene::Scene& scene, const compare::
     const compare::Shard shard = compare::parseShard(*o.shard);
     const std::size_t mine = compare::shardGrid(grid, shard).configs.size();
     const fs::path dir = o.outputDir / compare::shardFolderName(shard);
+    // One writer per shard folder: the same shard started twice would duplicate its journal's keys.
+    fs::create_directories(dir);
+    const scene::FolderLock lock(dir, "sweep --shard");
     std::cerr << "shadowlab: sweep shard " << shard.index << "/" << shard.count << ": " << mine << " of "
               << compare::gridKeys(grid).size() << " configurations, " << grid.repetitions
               << " timed frames each, into " << dir.string() << "\n";
@@ -752,10 +722,11 @@ int sweep(const SweepOptions& o) {
     options.outputDir = o.outputDir;
     options.resume = o.resume;
     options.progress = sweepProgressPrinter();
+    // Shards share the output folder; each holds the lock of its own shard folder.
+    if (o.shard) return sweepShard(o, p.scene, grid, options);
     // One writer per folder: two sweeps appending to one journal would duplicate its keys.
     fs::create_directories(o.outputDir);
     const scene::FolderLock lock(o.outputDir, "sweep");
-    if (o.shard) return sweepShard(o, p.scene, grid, options);
     std::cerr << "shadowlab: sweep of " << grid.configs.size() << " configurations, " << grid.repetitions
               << " timed frames each, into " << o.outputDir.string() << "\n";
     const compare::SweepResult result = compare::runSweep(p.scene, grid, options);

@@ -19,7 +19,8 @@ void checkParent(const fs::path& p, const std::string& option) {
     std::error_code ec;
     while (!parent.empty() && !fs::exists(parent, ec) && parent != parent.root_path()) parent = parent.parent_path();
     if (!fs::is_directory(parent, ec))
-        throw scene::InputError(option + " " + p.string() + ": " + parent.string() + " is not a folder");
+        throw scene::InputError(option + " " + p.string() + ": " + parent.string() +
+                                " is a file, not a folder, so nothing can be written under it");
     if (::access(parent.c_str(), W_OK | X_OK) != 0)
         throw scene::InputError(option + " " + p.string() + ": cannot write in " + parent.string() + " (" +
                                 std::strerror(errno) + ")");
@@ -40,7 +41,8 @@ void checkOutputFolder(const fs::path& dir, const std::string& option) {
     std::error_code ec;
     if (fs::exists(dir, ec)) {
         if (!fs::is_directory(dir, ec))
-            throw scene::InputError(option + " " + dir.string() + ": exists and is not a folder; name a folder");
+            throw scene::InputError(option + " " + dir.string() + ": is a file, not a folder; this command writes a "
+                                    "folder of outputs, so " + option + " must name a folder");
         if (::access(dir.c_str(), W_OK | X_OK) != 0)
             throw scene::InputError(option + " " + dir.string() + ": cannot write in it (" + std::strerror(errno) + ")");
         return;

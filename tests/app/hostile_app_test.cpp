@@ -51,7 +51,7 @@ TEST(HostileApp, AnOutputThatIsAFolderFailsBeforeAnyRendering) {
     std::ofstream(dir.path() / "file") << "x";
     const Outcome f = run("run seed --no-raster -o " + (dir.path() / "file").string());
     EXPECT_EQ(f.exitCode, 2) << f.err;
-    EXPECT_NE(f.err.find("exists and is not a folder"), std::string::npos) << f.err;
+    EXPECT_NE(f.err.find("is a file, not a folder"), std::string::npos) << f.err;
 }
 
 TEST(HostileApp, JsonResultsThatCannotBeWrittenAreAnError) {
