@@ -93,7 +93,7 @@ double nearestCasterDepth(const scene::Scene& scene, const LightFrustum& f, doub
 LightFrustum fitSpotLight(const scene::Bounds& bounds, const scene::Vec3& position, const scene::Vec3& direction,
                           double coneDegrees, int mapSize);
 
-// Spot light `light` (a spot) fitted to what the camera sees (issue 5, `fitLightFrustum`), from
+// Spot light `light` (a spot) fitted to what the camera sees (`fitLightFrustum`), from
 // fitSpotLight()'s cone map:
 // - window: the visible receivers (visibleReceiverPoints) projected into the map (u, v), their
 //   rectangle clamped to the cone's square, held by the smallest square window that leaves
@@ -120,8 +120,8 @@ LightFrustum spotLightFrustum(const scene::Scene& scene, const scene::RasterSett
 double snapWindowHalfSize(double half);
 // The fitted near/far planes' grid (spot maps and cube faces): distances from the light rounded
 // down (near) or up (far) to a power of 2^(1/kDepthGridStepsPerOctave), so that a moving camera
-// changes them, and with them the depth scale, only when what it sees crosses a step (issue 5:
-// no swimming). light_frustum.cpp says why this grid and what depth precision it costs.
+// changes them, and with them the depth scale, only when what it sees crosses a step (so the
+// map does not swim). light_frustum.cpp says why this grid and what depth precision it costs.
 inline constexpr double kDepthGridStepsPerOctave = 4.0;
 double snapDepthDown(double d);
 double snapDepthUp(double d);
@@ -150,7 +150,7 @@ LightFrustum pointLightFaceFrustum(const scene::Scene& scene, const scene::Raste
                                    const scene::Light& light, int face, int mapSize);
 
 
-// Caster culling (issue 5): which objects can shadow a receiver that reads map f. An object is
+// Caster culling: which objects can shadow a receiver that reads map f. An object is
 // left out of f's depth pass when it cannot write a depth any visible receiver's shadow test reads
 // as nearer than itself; leaving it out then changes no comparison, so the image stays the same.
 // The receivers are given as the vertices of their convex hull (visibleReceiverPoints, or one
@@ -206,7 +206,7 @@ std::vector<bool> layerCasters(const scene::Scene& scene, const scene::RasterSet
                                const scene::Light& light, const LightFrustum& f,
                                const std::vector<scene::Vec3>& receivers);
 
-// Map size from the receivers' detail (issue 5): when nobody chose a size (settings
+// Map size from the receivers' detail: when nobody chose a size (settings
 // shadowMapSizeIsDefault and the size is kDefaultShadowMapSize), a map whose texel is smaller than
 // the world footprint of a screen pixel on the visible receivers adds nothing the image can show.
 // Each light with a map says how many texels it needs, and the size (one array holds every map)

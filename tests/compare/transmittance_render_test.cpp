@@ -1,4 +1,4 @@
-// tests/compare/transmittance_render_test.cpp: semi-transparent casters (issue 5): the raster
+// tests/compare/transmittance_render_test.cpp: semi-transparent casters: the raster
 // backend's transmittance map against the double-precision ray-traced reference, which multiplies
 // 1 − opacity once per object a shadow ray passes through, on lavapipe with the validation layer.
 #include <cmath>

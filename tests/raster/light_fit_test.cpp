@@ -1,5 +1,5 @@
 // tests/raster/light_fit_test.cpp: spot maps and point-light cube faces fitted to what the camera
-// sees (issue 5, `fitLightFrustum`): the fitted spot window by hand, that it holds every visible
+// sees (`fitLightFrustum`): the fitted spot window by hand, that it holds every visible
 // receiver, does not swim, ignores unrelated far objects and renders no worse against the
 // reference; a cube face's near/far by hand; the point light's map size from receiver detail by
 // hand. Renders are on lavapipe with the validation layer.
@@ -152,7 +152,7 @@ double tiltedFitFar(double cameraX, double h, int n) {
 }
 
 TEST(RasterSpotFit, SmallCameraMovesLeaveNearAndFarBitIdenticalAndLargeOnesStepAlongTheGrid) {
-    // Issue 5: the fitted map must not swim. The window moves by whole texels (above); near and far
+    // the fitted map must not swim. The window moves by whole texels (above); near and far
     // lie on powers of 2^(1/4), so stored depths do not change either while the camera moves a
     // little, though the unsnapped far moves with it (1/√5 · 1.01 per unit of camera x).
     const int n = 1024;

@@ -160,7 +160,7 @@ TEST(LightFrustum, FittedToReceiversIsSmallerAndStillCoversEveryVisiblePoint) {
 }
 
 TEST(LightFrustum, FittedMapMovesByWholeTexelsAndKeepsItsSizeAndDepthsAsTheCameraMoves) {
-    // Issue 5: "texel-snapped so the map does not swim". A camera move of a fraction of a texel
+    // "texel-snapped so the map does not swim". A camera move of a fraction of a texel
     // keeps the texel size and the depth range bit for bit, and the map's center stays on the
     // world-fixed grid (whole texels along right and up from the world origin), so every texel
     // that still covers the scene covers the same world square.

@@ -1,4 +1,4 @@
-// tests/raster/transmittance_test.cpp: semi-transparent casters (issue 5): the transmittance map
+// tests/raster/transmittance_test.cpp: semi-transparent casters: the transmittance map
 // beside the depth map, against closed forms: each object a shadow ray passes through multiplies
 // the light by 1 − opacity once (DESIGN.md), on lavapipe with the validation layer.
 // Set SHADOWLAB_TEST_PNG_DIR to also write the beauty images there for a look.
@@ -293,7 +293,7 @@ TEST(RasterTransmittance, APointLightsCubeFacesCarryTheTransmittanceToo) {
     }
 }
 
-// The repro of the transmittance map's first limit (issue 5), light straight down: a 3 x 3 pane
+// The repro of the transmittance map's first limit, light straight down: a 3 x 3 pane
 // of opacity 0.5 at height 5, a glass sphere (opacity 0.5, radius 1) at height 2.5, another 3 x 3
 // pane of 0.5 at height 0.8, over the floor. Objects: floor 1, top pane 2, sphere 3, low pane 4.
 scene::Scene paneSpherePane() {
