@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "tests/app/cli.h"
 #include "tests/scene/test_files.h"
 
 namespace shadowlab {
@@ -16,44 +17,11 @@ namespace {
 
 using test::TempDir;
 
-struct Result {
-    int exitCode = -1;
-    std::string out;
-    std::string err;
-};
+using Result = test::CliResult;
+using test::slurpFile;
 
-std::string quote(const std::string& s) {
-    std::string q = "'";
-    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-}
-
-std::string slurp(const std::filesystem::path& p) {
-    std::ifstream in(p);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
-Result shadowlab(const std::vector<std::string>& args) {
-    TempDir io;
-    std::string cmd = quote(SHADOWLAB_EXE);
-    // (appended piece by piece: GCC 12 warns falsely, -Wrestrict, on " " + std::string)
-    for (const auto& a : args) {
-        cmd += ' ';
-        cmd += quote(a);
-    }
-    cmd += " >";
-    cmd += quote((io.path() / "out").string());
-    cmd += " 2>";
-    cmd += quote((io.path() / "err").string());
-    const int status = std::system(cmd.c_str());
-    Result r;
-    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(io.path() / "out");
-    r.err = slurp(io.path() / "err");
-    return r;
-}
+std::string slurp(const std::filesystem::path& p) { return slurpFile(p); }
+Result shadowlab(const std::vector<std::string>& args) { return test::runShadowlab(args); }
 
 // Width and height from a PNG's IHDR chunk (big-endian at bytes 16..23).
 std::pair<int, int> pngSize(const std::filesystem::path& file) {

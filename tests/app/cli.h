@@ -1,5 +1,5 @@
 // tests/app/cli.h: runs the `shadowlab` program with arguments and captures its exit code,
-// stdout and stderr (for test files other than app_test.cpp, which keeps its own copy).
+// stdout and stderr (for test files that need no process control; see subprocess.h for that).
 #pragma once
 
 #include <cstdlib>
@@ -35,6 +35,7 @@ inline CliResult runShadowlab(const std::vector<std::string>& args) {
     };
     TempDir io;
     std::string cmd = quote(SHADOWLAB_EXE);
+    // (appended piece by piece: GCC 12 warns falsely, -Wrestrict, on " " + std::string)
     for (const auto& a : args) {
         cmd += ' ';
         cmd += quote(a);

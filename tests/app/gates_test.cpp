@@ -9,14 +9,14 @@
 
 #include "scene/frame.h"
 #include "scene/frame_io.h"
-#include "tests/app/program.h"
+#include "tests/app/cli.h"
 #include "tests/scene/test_files.h"
 
 namespace shadowlab {
 namespace {
 
 namespace fs = std::filesystem;
-using test::readText;
+using test::slurpFile;
 using test::runShadowlab;
 using test::TempDir;
 
@@ -90,7 +90,7 @@ TEST(AppGates, CompareRefusesFramesOfAnotherSceneCameraOrSize) {
     EXPECT_NE(r.err.find("warning: different scenes"), std::string::npos) << r.err;
 
     // The seed from another camera position: same scene hash, different worldToCamera.
-    const std::string seed = readText(fs::path(SHADOWLAB_SOURCE_DIR) / "scenes" / "seed.json");
+    const std::string seed = slurpFile(fs::path(SHADOWLAB_SOURCE_DIR) / "scenes" / "seed.json");
     const auto moved = std::regex_replace(seed, std::regex("\"position\": \\[[^\\]]*\\]"), "\"position\": [0.5, 2, 6]", std::regex_constants::format_first_only);
     ASSERT_NE(moved, seed);
     const auto movedScene = dir.write("moved.json", moved);
@@ -157,14 +157,14 @@ TEST(AppGates, RunHoldsEveryMethodToTheBudgetsAndRecordsThem) {
                                  "--ray-bias", "0", "--max-false-shadow", "1%"});
     EXPECT_EQ(r.exitCode, 3) << r.err;
     EXPECT_NE(r.err.find("budget: raytrace: --max-false-shadow: "), std::string::npos) << r.err;
-    const auto metrics = nlohmann::json::parse(readText(out / "metrics.json"));
+    const auto metrics = nlohmann::json::parse(slurpFile(out / "metrics.json"));
     EXPECT_EQ(metrics["methods"]["raytrace"]["budgets"][0]["broken"], true);
     EXPECT_TRUE(fs::exists(out / "report.html"));  // a broken budget still writes everything
 }
 
 TEST(AppGates, ASceneCarriesItsBudgetsAndTheCommandLineOverridesThem) {
     TempDir dir;
-    const std::string seed = readText(fs::path(SHADOWLAB_SOURCE_DIR) / "scenes" / "seed.json");
+    const std::string seed = slurpFile(fs::path(SHADOWLAB_SOURCE_DIR) / "scenes" / "seed.json");
     const auto withBudgets = [&](const std::string& block) {
         const auto at = seed.rfind('}');
         return dir.write("s.json", seed.substr(0, at) + ", \"budgets\": " + block + "}");
@@ -197,24 +197,24 @@ struct Suite {
 TEST(Check, TheShippedSuitePassesAgainstItsBaselineAndWritesJUnitAndMarkdown) {
     TempDir dir;
     const fs::path suite = fs::path(SHADOWLAB_SOURCE_DIR) / "suites" / "shipped.json";
-    const auto cases = nlohmann::json::parse(readText(suite))["cases"];
+    const auto cases = nlohmann::json::parse(slurpFile(suite))["cases"];
     const auto r = runShadowlab({"check", suite.string(), "-o", (dir.path() / "out").string()});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.err.find("[1/" + std::to_string(cases.size()) + "]"), std::string::npos);  // progress
-    const std::string xml = readText(dir.path() / "out" / "junit.xml");
+    const std::string xml = slurpFile(dir.path() / "out" / "junit.xml");
     EXPECT_EQ(xml.rfind("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuites ", 0), 0u) << xml.substr(0, 200);
     EXPECT_EQ(occurrences(xml, "<testsuite "), 1u);
     EXPECT_EQ(occurrences(xml, "<testcase "), cases.size());
     EXPECT_EQ(occurrences(xml, "<failure"), 0u);
     EXPECT_EQ(occurrences(xml, "<error"), 0u);
-    const std::string md = readText(dir.path() / "out" / "summary.md");
+    const std::string md = slurpFile(dir.path() / "out" / "summary.md");
     EXPECT_NE(md.find("All " + std::to_string(cases.size()) + " cases passed."), std::string::npos) << md;
     for (const auto& c : cases) {
         const std::string name = c["name"];
         EXPECT_TRUE(fs::exists(dir.path() / "out" / "cases" / (name + ".json"))) << name;
         EXPECT_FALSE(fs::exists(dir.path() / "out" / "cases" / (name + "-diff.png"))) << name;  // passing
         EXPECT_NE(md.find("| " + name + " |"), std::string::npos) << name;
-        const auto j = nlohmann::json::parse(readText(dir.path() / "out" / "cases" / (name + ".json")));
+        const auto j = nlohmann::json::parse(slurpFile(dir.path() / "out" / "cases" / (name + ".json")));
         EXPECT_EQ(j["has_baseline"], true) << name;
     }
 }
@@ -231,16 +231,16 @@ TEST(Check, FailingCasesFailErroringCasesAreErrorsAndTheOthersGoOn) {
          "budgets": {"max_mismatch": "0px"}}]})");
     const auto r = runShadowlab({"check", file.string(), "-o", s.out().string()});
     EXPECT_EQ(r.exitCode, 1) << r.err;  // an error outranks a failure
-    const std::string xml = readText(s.out() / "junit.xml");
+    const std::string xml = slurpFile(s.out() / "junit.xml");
     EXPECT_NE(xml.find("tests=\"3\" failures=\"1\" errors=\"1\""), std::string::npos) << xml;
     EXPECT_NE(xml.find("<failure message=\"budget --max-false-shadow: "), std::string::npos) << xml;
     EXPECT_EQ(occurrences(xml, "<error message="), 1u);
     EXPECT_TRUE(fs::exists(s.out() / "cases" / "acne-diff.png"));
     EXPECT_FALSE(fs::exists(s.out() / "cases" / "robust-diff.png"));
     EXPECT_FALSE(fs::exists(s.out() / "cases" / "no-device-diff.png"));
-    EXPECT_EQ(nlohmann::json::parse(readText(s.out() / "cases" / "robust.json"))["verdict"], "passed");
-    EXPECT_EQ(nlohmann::json::parse(readText(s.out() / "cases" / "no-device.json"))["verdict"], "error");
-    const std::string md = readText(s.out() / "summary.md");
+    EXPECT_EQ(nlohmann::json::parse(slurpFile(s.out() / "cases" / "robust.json"))["verdict"], "passed");
+    EXPECT_EQ(nlohmann::json::parse(slurpFile(s.out() / "cases" / "no-device.json"))["verdict"], "error");
+    const std::string md = slurpFile(s.out() / "summary.md");
     EXPECT_NE(md.find("1 passed, 1 failed, 1 errors."), std::string::npos) << md;
 
     // Without the error: a failure alone exits 3.
@@ -260,7 +260,7 @@ TEST(Check, BaselineUpdateThenSameVerdictsThenARegressionFails) {
     ASSERT_EQ(runShadowlab({"check", file.string(), "-o", s.out().string()}).exitCode, 2);  // no baseline yet
     const auto up = runShadowlab({"check", file.string(), "-o", s.out().string(), "--update-baseline"});
     ASSERT_EQ(up.exitCode, 0) << up.err;
-    const auto base = nlohmann::json::parse(readText(s.dir.path() / "base.json"));
+    const auto base = nlohmann::json::parse(slurpFile(s.dir.path() / "base.json"));
     EXPECT_EQ(base["shadowlab_check_baseline"], 1);
     const double acneRate = base["cases"]["acne"]["false_shadow_rate"];
     EXPECT_GT(acneRate, 0.01);
@@ -268,7 +268,7 @@ TEST(Check, BaselineUpdateThenSameVerdictsThenARegressionFails) {
     for (int run = 0; run < 2; ++run) {
         const auto again = runShadowlab({"check", file.string(), "-o", s.out().string()});
         ASSERT_EQ(again.exitCode, 0) << again.err;
-        const auto j = nlohmann::json::parse(readText(s.out() / "cases" / "acne.json"));
+        const auto j = nlohmann::json::parse(slurpFile(s.out() / "cases" / "acne.json"));
         EXPECT_EQ(j["metrics"]["false_shadow_rate"], acneRate);
     }
     // A baseline that says the acne case had no false shadows: its rate is a regression.
@@ -278,7 +278,7 @@ TEST(Check, BaselineUpdateThenSameVerdictsThenARegressionFails) {
     s.dir.write("base.json", edited.dump());
     const auto reg = runShadowlab({"check", file.string(), "-o", s.out().string()});
     EXPECT_EQ(reg.exitCode, 3) << reg.err;
-    const std::string xml = readText(s.out() / "junit.xml");
+    const std::string xml = slurpFile(s.out() / "junit.xml");
     EXPECT_NE(xml.find("type=\"regression\""), std::string::npos) << xml;
     EXPECT_NE(xml.find("regression: false_shadow_rate "), std::string::npos) << xml;
     EXPECT_TRUE(fs::exists(s.out() / "cases" / "acne-diff.png"));
@@ -295,11 +295,11 @@ TEST(Check, ABaselineGivenOnTheCommandLineAndAnImprovementPasses) {
         {"mismatch_rate": 0.3, "shadow_iou": 0.5}}})");
     const auto r = runShadowlab({"check", file.string(), "-o", s.out().string(), "--baseline", base.string()});
     ASSERT_EQ(r.exitCode, 0) << r.err;
-    const auto j = nlohmann::json::parse(readText(s.out() / "cases" / "robust.json"));
+    const auto j = nlohmann::json::parse(slurpFile(s.out() / "cases" / "robust.json"));
     EXPECT_EQ(j["has_baseline"], true);
     ASSERT_EQ(j["baseline_drift"].size(), 2u);  // only the metrics the baseline holds
     for (const auto& d : j["baseline_drift"]) EXPECT_EQ(d["improved"], true) << d;
-    EXPECT_NE(readText(s.out() / "summary.md").find("mismatch_rate better, shadow_iou better"), std::string::npos);
+    EXPECT_NE(slurpFile(s.out() / "summary.md").find("mismatch_rate better, shadow_iou better"), std::string::npos);
 }
 
 struct BadSuite {
