@@ -593,7 +593,24 @@ TEST(RasterFilters, NoneHasNoFractionalVisibility) {
     p.lightDirection = lightFromElevation(60.0);
     const scene::Scene s = makeScene(p);
     const scene::Frame f = renderValidated(s, filterSettings(ShadowFilter::None, 3), "filter-none-only");
-    for (float v : f.visibility) ASSERT_TRUE(v == 0.0f || v == 1.0f) << v;
+    // Over the objects, the frame must hold both answers (an all-lit frame would pass the binary
+    // check vacuously) and nothing between them.
+    std::size_t lit = 0, shadowed = 0, objects = 0;
+    for (std::size_t i = 0; i < f.visibility.size(); ++i) {
+        if (f.objectId[i] == 0.0f) continue;
+        ++objects;
+        const float v = f.visibility[i];
+        ASSERT_TRUE(v == 0.0f || v == 1.0f) << v << " at pixel " << i;
+        (v == 0.0f ? shadowed : lit) += 1;
+    }
+    EXPECT_GT(shadowed, objects / 100) << "no shadow to test the filter on";
+    EXPECT_GT(lit, objects / 10);
+    // The same scene through a filtering kernel has fractional values at the shadow's edge, so the
+    // scene can tell a nearest-texel lookup from a filter.
+    const scene::Frame pcf = renderValidated(s, filterSettings(ShadowFilter::Pcf2x2, 3), "filter-pcf2x2-contrast");
+    const auto fractional = std::count_if(pcf.visibility.begin(), pcf.visibility.end(),
+                                          [](float v) { return v > 0.0f && v < 1.0f; });
+    EXPECT_GT(fractional, 0);
 }
 
 TEST(RasterNormalOffset, NormalOffsetRemovesAcneWithoutDepthBias) {
