@@ -441,8 +441,10 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
     const int fps = 8;
     std::string gifs, zooms;
     ScatterPlot plot;
-    plot.title = "Flicker per frame pair (counted pixels whose state changes while the reference's does not)";
+    plot.title = "Flicker per frame pair";  // the definition is in the text above the plot
     plot.x.title = "frame pair (t, t+1)";
+    plot.x.min = 0.0;  // pairs 0 .. frames - 2, not a fitted margin past the last one
+    plot.x.max = double(std::max<std::size_t>(refs.size(), 3) - 2);
     plot.y.title = "flicker rate";
     plot.y.percent = true;
     plot.y.min = 0.0;
