@@ -151,7 +151,7 @@ int main(int argc, char** argv) {
                          "join the shards with `shadowlab merge` (docs/sweep.md)");
 
     shadowlab::app::MergeOptions mergeOptions;
-    auto* mergeCmd = app.add_subcommand("merge", "Join the shards of a sweep (`sweep --shard K/N`) into the results.csv, "
+    auto* mergeCmd = app.add_subcommand("merge", "Join the shards of a sweep (`sweep --shard K/N`) or a check (`check --shard K/N`, into junit.xml, summary.md and cases/) into the results.csv, "
                                                  "results.json, plots and report.html of the whole sweep");
     mergeCmd->add_option("DIRS", mergeOptions.inputs,
                          "Shard folders, or folders holding shard-K-of-N folders (the -o of `sweep --shard`)")
@@ -224,6 +224,9 @@ int main(int argc, char** argv) {
     checkCmd->add_option("--baseline", checkOptions.baseline, "Baseline file instead of the suite's \"baseline\"");
     checkCmd->add_flag("--update-baseline", checkOptions.updateBaseline,
                        "Write this run's metrics as the baseline (budgets still apply; no regression check)");
+    checkCmd->add_option("--shard", checkOptions.shard,
+                         "K/N: run only shard K (from 0) of N of the cases into OUTPUT/shard-K-of-N; join the shards "
+                         "with `shadowlab merge OUTPUT` (docs/ci.md)");
 
     bool infoValidate = false;
     auto* infoCmd = app.add_subcommand("info", "Vulkan devices, driver and API versions, lavapipe or not");
