@@ -154,5 +154,20 @@ TEST(CheckShardApp, AMissingShardIsNamedWithTheCommandThatWritesIt) {
     EXPECT_TRUE(fs::exists(out / "junit.xml"));
 }
 
+TEST(CheckShardApp, ShardsInFoldersOfTheirOwnAsACIMatrixDownloadsThemMergeIntoTheGivenFolder) {
+    TempDir dir;
+    const fs::path suite = dir.write("suite.json", kSuite);
+    const fs::path a = dir.path() / "shards" / "job-0", b = dir.path() / "shards" / "job-1";
+    ASSERT_NE(runShadowlab({"check", suite.string(), "--shard", "0/2", "-o", a.string()}).exitCode, 2);
+    ASSERT_NE(runShadowlab({"check", suite.string(), "--shard", "1/2", "-o", b.string()}).exitCode, 2);
+    EXPECT_EQ(runShadowlab({"merge", a.string(), b.string()}).exitCode, 2);  // two inputs: -o is needed
+    const fs::path merged = dir.path() / "merged";
+    const auto m = runShadowlab({"merge", a.string(), b.string(), "-o", merged.string()});
+    EXPECT_EQ(m.exitCode, 1) << m.err;
+    EXPECT_EQ(filesIn(merged / "cases"),
+              (std::set<std::string>{"acne.json", "acne-diff.png", "no-device.json", "robust.json"}));
+    EXPECT_NE(slurpFile(merged / "junit.xml").find("tests=\"3\" failures=\"1\" errors=\"1\""), std::string::npos);
+}
+
 }  // namespace
 }  // namespace shadowlab
