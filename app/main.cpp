@@ -151,10 +151,11 @@ int main(int argc, char** argv) {
                          "join the shards with `shadowlab merge` (docs/sweep.md)");
 
     shadowlab::app::MergeOptions mergeOptions;
-    auto* mergeCmd = app.add_subcommand("merge", "Join the shards of a sweep (`sweep --shard K/N`) or a check (`check --shard K/N`, into junit.xml, summary.md and cases/) into the results.csv, "
-                                                 "results.json, plots and report.html of the whole sweep");
+    auto* mergeCmd = app.add_subcommand("merge", "Join the shards of a sweep (`sweep --shard K/N`) into the results.csv, "
+                                                 "results.json, plots and report.html of the whole sweep, or those of a "
+                                                 "check (`check --shard K/N`) into its junit.xml, summary.md and cases/");
     mergeCmd->add_option("DIRS", mergeOptions.inputs,
-                         "Shard folders, or folders holding shard-K-of-N folders (the -o of `sweep --shard`)")
+                         "Shard folders, or folders holding shard-K-of-N folders (the -o of `sweep --shard` or `check --shard`)")
         ->required();
     mergeCmd->add_option("-o,--output", mergeOptions.outputDir, "Merged folder (default: the one input folder)");
     mergeCmd->add_flag("--json", mergeOptions.json, "Print the merged rows as JSON on stdout");
