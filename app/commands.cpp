@@ -666,7 +666,33 @@ int sweepShard(const SweepOptions& o, const scene::Scene& scene, const compare::
 
 }  // namespace
 
+namespace {
+
+// `merge` of check shards: the junit.xml, summary.md and cases/ of the unsharded check, and its exit code.
+int mergeCheck(const MergeOptions& o) {
+    const compare::MergedCheck merged = compare::readCheckShards(o.inputs);
+    fs::path out;
+    if (o.outputDir) out = *o.outputDir;
+    else if (o.inputs.size() == 1 && !fs::exists(o.inputs.front() / "shard.json")) out = o.inputs.front();
+    else
+        throw scene::InputError("merge: give the merged folder with -o (the inputs are " +
+                                std::string(o.inputs.size() == 1 ? "a shard folder" : "several folders") + ")");
+    compare::writeMergedCheck(merged, out);
+    std::size_t failed = 0, errors = 0;
+    for (const compare::CasePart& p : merged.parts) {
+        failed += p.verdict == compare::CaseVerdict::Failed ? 1 : 0;
+        errors += p.verdict == compare::CaseVerdict::Error ? 1 : 0;
+    }
+    std::cerr << "shadowlab: merged " << merged.shardDirs.size() << " check shards of " << merged.identity.suiteName
+              << ": " << merged.parts.size() - failed - errors << " passed, " << failed << " failed, " << errors
+              << " errors; wrote " << (out / "junit.xml").string() << ", summary.md, cases/\n";
+    return errors ? 1 : failed ? kExitBudgetBroken : 0;
+}
+
+}  // namespace
+
 int merge(const MergeOptions& o) {
+    if (compare::holdsCheckShards(o.inputs)) return mergeCheck(o);
     const compare::MergedSweep merged = compare::readShards(o.inputs);
     fs::path out;
     if (o.outputDir) {
@@ -761,7 +787,8 @@ int sweep(const SweepOptions& o) {
 
 int check(const CheckOptions& o) {
     // The suite, every scene it names and the baseline are read and checked before anything runs.
-    const compare::CheckSuite suite = compare::loadSuite(o.suite);
+    const compare::CheckSuite fullSuite = compare::loadSuite(o.suite);
+    compare::CheckSuite suite = fullSuite;
     const std::optional<fs::path> baselineFile = o.baseline ? o.baseline : suite.baseline;
     if (o.updateBaseline && !baselineFile)
         throw scene::InputError(o.suite.string() + ": --update-baseline: the suite names no \"baseline\" file and "
@@ -771,6 +798,26 @@ int check(const CheckOptions& o) {
         if (!fs::exists(*baselineFile))
             throw scene::InputError(baselineFile->string() + ": no such baseline (write one with --update-baseline)");
         baseline = compare::loadBaseline(*baselineFile);
+    }
+    std::optional<compare::Shard> shard;
+    compare::CheckShardManifest manifest;
+    if (o.shard) {
+        shard = compare::parseShard(*o.shard);
+        // N shards writing one baseline would race; a baseline comes from an unsharded run.
+        if (o.updateBaseline)
+            throw scene::InputError("check --shard: --update-baseline is not sharded; update the baseline with an "
+                                    "unsharded `check`");
+        manifest.version = SHADOWLAB_VERSION;
+        manifest.suite = o.suite.string();
+        manifest.suiteName = suite.name;
+        manifest.suiteHash = compare::fileHash(o.suite);
+        manifest.baselineHash = baseline ? compare::fileHash(*baselineFile) : "none";
+        manifest.shard = *shard;
+        for (const auto& c : fullSuite.cases) manifest.suiteCases.push_back(c.name);
+        suite = compare::shardSuite(fullSuite, *shard);
+        for (const auto& c : suite.cases) manifest.cases.push_back(c.name);
+        std::cerr << "shadowlab: check shard " << shard->index << "/" << shard->count << ": " << suite.cases.size()
+                  << " of " << fullSuite.cases.size() << " cases\n";
     }
     std::cerr << "shadowlab: check " << suite.name << ": " << suite.cases.size() << " cases"
               << (baseline ? " against " + baselineFile->string() : std::string(" without a baseline")) << "\n";
@@ -785,9 +832,11 @@ int check(const CheckOptions& o) {
 
     // Everything goes to a fresh folder that replaces DIR in one step: no file of an earlier run
     // (a difference image of a case that failed then) survives next to this run's.
-    const fs::path dir = o.outputDir;
+    const fs::path dir = shard ? o.outputDir / compare::shardFolderName(*shard) : o.outputDir;
     if (dir.has_parent_path()) fs::create_directories(dir.parent_path());
-    scene::removeStaleTemporaries(dir.has_parent_path() ? dir.parent_path() : fs::path("."));
+    // Not beside a shard: the shared folder may hold other machines' live temporaries, whose
+    // writers this host cannot see.
+    if (!shard) scene::removeStaleTemporaries(dir.has_parent_path() ? dir.parent_path() : fs::path("."));
     const fs::path tmp = scene::temporarySibling(dir);
     fs::create_directories(tmp / "cases");
     std::size_t failed = 0, errors = 0;
@@ -801,6 +850,12 @@ int check(const CheckOptions& o) {
     }
     scene::writeTextAtomic(tmp / "junit.xml", compare::junitXml(suite, results));
     scene::writeTextAtomic(tmp / "summary.md", compare::markdownSummary(suite, results, o.updateBaseline));
+    if (shard) {
+        nlohmann::json parts = nlohmann::json::array();
+        for (const compare::CasePart& part : compare::caseParts(suite, results)) parts.push_back(compare::toJson(part));
+        scene::writeTextAtomic(tmp / "shard-parts.json", parts.dump(1) + "\n");
+        scene::writeTextAtomic(tmp / "shard.json", compare::toJson(manifest).dump(1) + "\n");
+    }
     scene::replaceDirectory(tmp, dir);
     if (o.updateBaseline) {
         // Cases that could not render keep their old entry; cases no longer in the suite go.

@@ -95,6 +95,7 @@ struct CheckOptions {
     std::filesystem::path outputDir;
     std::optional<std::filesystem::path> baseline;  // instead of the suite's "baseline"
     bool updateBaseline = false;
+    std::optional<std::string> shard;  // "K/N": run only shard K of N into OUTPUT/shard-K-of-N
 };
 
 struct PathCommandOptions {

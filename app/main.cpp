@@ -152,9 +152,10 @@ int main(int argc, char** argv) {
 
     shadowlab::app::MergeOptions mergeOptions;
     auto* mergeCmd = app.add_subcommand("merge", "Join the shards of a sweep (`sweep --shard K/N`) into the results.csv, "
-                                                 "results.json, plots and report.html of the whole sweep");
+                                                 "results.json, plots and report.html of the whole sweep, or those of a "
+                                                 "check (`check --shard K/N`) into its junit.xml, summary.md and cases/");
     mergeCmd->add_option("DIRS", mergeOptions.inputs,
-                         "Shard folders, or folders holding shard-K-of-N folders (the -o of `sweep --shard`)")
+                         "Shard folders, or folders holding shard-K-of-N folders (the -o of `sweep --shard` or `check --shard`)")
         ->required();
     mergeCmd->add_option("-o,--output", mergeOptions.outputDir, "Merged folder (default: the one input folder)");
     mergeCmd->add_flag("--json", mergeOptions.json, "Print the merged rows as JSON on stdout");
@@ -224,6 +225,9 @@ int main(int argc, char** argv) {
     checkCmd->add_option("--baseline", checkOptions.baseline, "Baseline file instead of the suite's \"baseline\"");
     checkCmd->add_flag("--update-baseline", checkOptions.updateBaseline,
                        "Write this run's metrics as the baseline (budgets still apply; no regression check)");
+    checkCmd->add_option("--shard", checkOptions.shard,
+                         "K/N: run only shard K (from 0) of N of the cases into OUTPUT/shard-K-of-N; join the shards "
+                         "with `shadowlab merge OUTPUT` (docs/ci.md)");
 
     bool infoValidate = false;
     auto* infoCmd = app.add_subcommand("info", "Vulkan devices, driver and API versions, lavapipe or not");

@@ -242,6 +242,17 @@ Json baselineJson(const std::string& suiteName, const Baseline& baseline) {
     return {{"shadowlab_check_baseline", 1}, {"suite", suiteName}, {"cases", cases}};
 }
 
+CheckSuite shardSuite(const CheckSuite& suite, const Shard& shard) {
+    std::vector<std::string> names;
+    for (const CheckCase& c : suite.cases) names.push_back(c.name);
+    const std::vector<int> of = assignShards(names, shard.count);
+    CheckSuite s = suite;
+    s.cases.clear();
+    for (std::size_t i = 0; i < suite.cases.size(); ++i)
+        if (of[i] == shard.index) s.cases.push_back(suite.cases[i]);
+    return s;
+}
+
 std::vector<MetricDrift> compareWithBaseline(const Metrics& m, const BaselineEntry& entry, const CheckTolerance& t) {
     const BaselineEntry now = baselineEntry(m);
     std::vector<MetricDrift> out;

@@ -15,6 +15,7 @@
 
 #include "compare/compare.h"
 #include "compare/gates.h"
+#include "compare/shard.h"
 #include "scene/budgets.h"
 #include "scene/scene.h"
 
@@ -99,6 +100,11 @@ struct CaseResult {
 // `baseline` may be null (no regression check).
 std::vector<CaseResult> runSuite(const CheckSuite& suite, const Baseline* baseline,
                                  const std::function<void(std::size_t done, const CaseResult&)>& progress);
+
+// The cases of `shard` (`check --shard K/N`), in file order: case names are sorted and dealt
+// round-robin (compare::assignShards, the rule of sweep shards), so the split depends only on
+// the set of names.
+CheckSuite shardSuite(const CheckSuite& suite, const Shard& shard);
 
 // The drift of `metrics` from `entry`.
 std::vector<MetricDrift> compareWithBaseline(const Metrics& metrics, const BaselineEntry& entry,

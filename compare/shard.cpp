@@ -116,6 +116,12 @@ std::string sceneHash(const scene::Scene& scene) {
     return f.hex();
 }
 
+std::string fileHash(const fs::path& file) {
+    Fnv f;
+    if (!addFile(f, file)) throw scene::InputError(file.string() + ": cannot read");
+    return f.hex();
+}
+
 SweepIdentity sweepIdentity(const scene::Scene& scene, const SweepGrid& grid) {
     SweepIdentity id;
     id.version = SHADOWLAB_VERSION;

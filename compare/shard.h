@@ -51,6 +51,9 @@ struct SweepIdentity {
 // `scene` as the sweep renders it (sweepScene: the grid's resolution applied).
 SweepIdentity sweepIdentity(const scene::Scene& scene, const SweepGrid& grid);
 std::string sceneHash(const scene::Scene& scene);
+// The same 64-bit FNV-1a hash over one file's bytes (16 hex digits); throws scene::InputError
+// when it cannot be read.
+std::string fileHash(const std::filesystem::path& file);
 // The first field in which two identities differ, in words ("scene_hash 0123… vs 4567… (another
 // scene file or mesh)"); empty when they are of one sweep.
 std::string identityDifference(const SweepIdentity& a, const SweepIdentity& b);
