@@ -146,22 +146,31 @@ TEST(BrowserCheck, EveryPageShadowlabWritesLoadsRendersAndFits) {
          "--resolution", "48x27", "--no-search"});
     run({"path", "seed", "-o", (pages / "path").string(), "--frames", "3", "--resolution", "64x36",
          "--shadow-map-size", "512"});
-    // `check` writes Markdown and JUnit, no HTML of its own today; any it writes is checked too.
+    // `check`: summary.html, with the difference image of the case that fails (no ray bias: acne).
     const fs::path suite = pages / "suite.json";
     {
         std::ofstream(suite) << R"({"description": "browser check", "resolution": "64x36",
-            "cases": [{"name": "seed.raster", "scene": "seed", "backend": "raster",
-                       "budgets": {"max_mismatch": "0px"}},
-                      {"name": "seed.raytrace", "scene": "seed", "backend": "raytrace"}]})";
+            "cases": [{"name": "seed.raster", "scene": "seed", "backend": "raster"},
+                      {"name": "seed.raytrace.acne", "scene": "seed", "backend": "raytrace",
+                       "settings": {"ray_bias": 0}, "budgets": {"max_false_shadow": "0px"}}]})";
     }
     const test::CliResult check = test::runShadowlab({"check", suite.string(), "-o", (pages / "check").string()});
-    EXPECT_TRUE(check.exitCode == 0 || check.exitCode == 3) << check.err;
+    EXPECT_EQ(check.exitCode, 3) << check.err;
+    EXPECT_TRUE(fs::is_regular_file(pages / "check" / "cases" / "seed.raytrace.acne-diff.png"));
+
+    // The demos' synthetic reports reach what small real runs may not: a hotspot zoom on every
+    // method, the default sweep grid, configurations that failed.
+    for (const auto& [exe, folder] : {std::pair{REPORT_DEMO, "demo-run"}, std::pair{SWEEP_REPORT_DEMO, "demo-sweep"}}) {
+        const std::string cmd = quote(exe) + " " + quote((pages / folder).string()) + " >/dev/null 2>&1";
+        EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    }
 
     std::set<std::string> html;
     for (const auto& e : fs::recursive_directory_iterator(pages))
         if (e.path().extension() == ".html") html.insert(fs::relative(e.path(), pages).string());
     for (const char* p : {"run/report.html", "run/sweep/report.html", "sweep/report.html",
-                          "stability/stability.html", "path/report.html"})
+                          "stability/stability.html", "path/report.html", "check/summary.html", "demo-run/report.html",
+                          "demo-sweep/report.html", "demo-sweep/sweep/report.html"})
         EXPECT_TRUE(html.count(p)) << p << " was not written";
 
     const char* env = std::getenv("SHADOWLAB_BROWSER_SCREENSHOTS");
