@@ -204,14 +204,15 @@ std::string htmlSummary(const std::string& suiteName, const std::vector<CasePart
       << escapeHtml(suiteName) << "</title>\n<style>" << html::css()
       << " td.passed{color:#1b5e20} td.failed,td.error{color:#a51111;font-weight:600}"
          " .diffs{grid-template-columns:repeat(auto-fill,minmax(300px,1fr))} .why li{margin-bottom:4px}"
-         " .scroll{overflow-x:auto}</style>\n</head>\n<body>\n<main>\n";
+         " .scroll{overflow-x:auto} table.cases td{white-space:nowrap} table.cases :is(td,th){padding:6px 8px}"
+         " table.cases :is(td,th):is(:nth-child(-n+4),:nth-child(11)){text-align:left}</style>\n</head>\n<body>\n<main>\n";
     h << "<header><h1>shadowlab check: " << escapeHtml(suiteName) << "</h1><div class=\"sub\">"
       << (failed + errors == 0 ? "All " + std::to_string(parts.size()) + " cases passed."
                                : std::to_string(parts.size() - failed - errors) + " passed, " +
                                      std::to_string(failed) + " failed, " + std::to_string(errors) + " errors.")
       << (baselineUpdated ? " The baseline was written from this run." : "")
       << " JUnit: <a href=\"junit.xml\">junit.xml</a>; Markdown: <a href=\"summary.md\">summary.md</a>.</div></header>\n";
-    h << "<h2>Cases</h2>\n<div class=\"scroll\"><table><thead><tr><th>case</th><th>scene</th><th>backend</th>"
+    h << "<h2>Cases</h2>\n<div class=\"scroll\"><table class=\"cases\"><thead><tr><th>case</th><th>scene</th><th>backend</th>"
          "<th>verdict</th><th>mismatch</th><th>false shadow</th><th>missed</th><th>self acne</th><th>IoU</th>"
          "<th>mean |ΔV|</th><th>vs baseline</th><th>time</th></tr></thead><tbody>\n";
     for (const CasePart& p : parts) {

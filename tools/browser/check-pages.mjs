@@ -76,8 +76,10 @@ function localPath(url) {
   }
 }
 
-// Screenshot names: the page's path below the pages' common folder, '/' turned into '__'.
-const common = pages.length === 1 ? path.dirname(pages[0])
+// Screenshot names: the page's path below the folder given (or the pages' common folder), '/'
+// turned into '__'.
+const single = inputs.length === 1 && fs.statSync(inputs[0]).isDirectory() ? path.resolve(inputs[0]) : null;
+const common = single ? single : pages.length === 1 ? path.dirname(pages[0])
   : pages.reduce((a, p) => { while (!(p + path.sep).startsWith(a + path.sep)) a = path.dirname(a); return a; }, path.dirname(pages[0]));
 if (shotDir) fs.mkdirSync(shotDir, { recursive: true });
 
