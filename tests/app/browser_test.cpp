@@ -91,6 +91,8 @@ TEST(BrowserCheck, EachKindOfBadPageFailsWithItsOwnProblem) {
         {"overflowing-cell.html", {": overflow: table > tbody > tr > td", "text \"a_name_far_too_long", "sticks out"}},
         {"overflowing-table.html", {": overflow: div.box", "div > table", "sticks out by"}},
         {"overflowing-text.html", {": overflow: div.label", "text \"a caption that does not fit", "sticks out"}},
+        {"overflowing-height.html", {": overflow: div.note", "div > p \"Second line, below the box.\" sticks out by"}},
+        {"clipped-text.html", {": overflow: div.cap", "text \"a caption cut off", "is clipped by"}},
         {"svg-text-outside.html", {": overflow: svg > text \"a label running off the plot\"", "sticks out of its plot"}},
         {"console-error.html", {": console: error: plot data missing"}},
         {"page-error.html", {": console: page error: undefinedFunctionOfThePlot is not defined"}},

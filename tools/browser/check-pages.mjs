@@ -179,7 +179,7 @@ function inPageChecks(slack) {
     const clips = /hidden|clip/.test(cs.overflowX + cs.overflowY);
     if (/auto|scroll/.test(cs.overflowX + cs.overflowY)) continue;
     const wide = el.scrollWidth > el.clientWidth + slack;
-    const tall = el.scrollHeight > el.clientHeight + slack && cs.height !== 'auto' && el.clientHeight > 0;
+    const tall = el.scrollHeight > el.clientHeight + slack && el.clientHeight > 0;
     if (!wide && !tall) continue;
     if (el.tagName === 'IMG' || el.clientWidth === 0) continue;
     const r = el.getBoundingClientRect();
