@@ -185,6 +185,19 @@ TEST(BrowserCheck, EveryPageShadowlabWritesLoadsRendersAndFits) {
         for (std::size_t i; (i = name.find('/')) != std::string::npos;) name.replace(i, 1, "__");
         EXPECT_TRUE(fs::is_regular_file(shots / fs::path(name).replace_extension(".png"))) << name;
     }
+
+    // The same check fails on a copy of a real report that lost an image (the pages above stay
+    // whole: they are CI's artifacts): the page and the file are named.
+    test::TempDir copy;
+    fs::copy(pages / "run", copy.path() / "run", fs::copy_options::recursive);
+    fs::remove(copy.path() / "run" / "diff-raster.png");
+    const CheckResult broken = browserCheck({copy.path() / "run" / "report.html"}, copy.path() / "shots");
+    EXPECT_EQ(broken.exitCode, 1) << broken.err;
+    bool named = false;
+    for (const auto& l : broken.lines)
+        named = named || (l.find("run/report.html: image: ") != std::string::npos &&
+                          l.find("diff-raster.png: no such file") != std::string::npos);
+    EXPECT_TRUE(named) << joined(broken.lines);
 }
 
 }  // namespace
