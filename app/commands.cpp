@@ -685,7 +685,7 @@ int mergeCheck(const MergeOptions& o) {
     }
     std::cerr << "shadowlab: merged " << merged.shardDirs.size() << " check shards of " << merged.identity.suiteName
               << ": " << merged.parts.size() - failed - errors << " passed, " << failed << " failed, " << errors
-              << " errors; wrote " << (out / "junit.xml").string() << ", summary.md, cases/\n";
+              << " errors; wrote " << (out / "junit.xml").string() << ", summary.md, summary.html, cases/\n";
     return errors ? 1 : failed ? kExitBudgetBroken : 0;
 }
 
@@ -850,6 +850,11 @@ int check(const CheckOptions& o) {
     }
     scene::writeTextAtomic(tmp / "junit.xml", compare::junitXml(suite, results));
     scene::writeTextAtomic(tmp / "summary.md", compare::markdownSummary(suite, results, o.updateBaseline));
+    std::set<std::string> withDiff;
+    for (const compare::CaseResult& r : results)
+        if (!r.diffRgb.empty()) withDiff.insert(r.name);
+    scene::writeTextAtomic(tmp / "summary.html",
+                           compare::htmlSummary(suite.name, compare::caseParts(suite, results), o.updateBaseline, withDiff));
     if (shard) {
         nlohmann::json parts = nlohmann::json::array();
         for (const compare::CasePart& part : compare::caseParts(suite, results)) parts.push_back(compare::toJson(part));
@@ -873,7 +878,7 @@ int check(const CheckOptions& o) {
         std::cerr << "shadowlab: wrote the baseline " << baselineFile->string() << "\n";
     }
     std::cerr << "shadowlab: check " << suite.name << ": " << results.size() - failed - errors << " passed, " << failed
-              << " failed, " << errors << " errors; wrote " << (dir / "junit.xml").string() << ", summary.md, cases/\n";
+              << " failed, " << errors << " errors; wrote " << (dir / "junit.xml").string() << ", summary.md, summary.html, cases/\n";
     return errors ? 1 : failed ? kExitBudgetBroken : 0;
 }
 

@@ -153,7 +153,7 @@ int main(int argc, char** argv) {
     shadowlab::app::MergeOptions mergeOptions;
     auto* mergeCmd = app.add_subcommand("merge", "Join the shards of a sweep (`sweep --shard K/N`) into the results.csv, "
                                                  "results.json, plots and report.html of the whole sweep, or those of a "
-                                                 "check (`check --shard K/N`) into its junit.xml, summary.md and cases/");
+                                                 "check (`check --shard K/N`) into its junit.xml, summary.md, summary.html and cases/");
     mergeCmd->add_option("DIRS", mergeOptions.inputs,
                          "Shard folders, or folders holding shard-K-of-N folders (the -o of `sweep --shard` or `check --shard`)")
         ->required();
@@ -218,7 +218,7 @@ int main(int argc, char** argv) {
     shadowlab::app::CheckOptions checkOptions;
     auto* checkCmd = app.add_subcommand(
         "check", "CI gate: run a suite of cases (scene, backend, settings, budgets) against the reference, their "
-                 "budgets and a stored baseline; writes junit.xml, summary.md and one JSON per case; exits 3 "
+                 "budgets and a stored baseline; writes junit.xml, summary.md, summary.html and one JSON per case; exits 3 "
                  "when a case fails, 1 when one cannot render");
     checkCmd->add_option("SUITE", checkOptions.suite, "Suite file (JSON, see docs/ci.md)")->required();
     checkCmd->add_option("-o,--output", checkOptions.outputDir, "Output folder (replaced as a whole)")->required();

@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "compare/report.h"
 #include "compare/text.h"
 #include "scene/error.h"
 #include "scene/frame_io.h"
@@ -154,6 +155,105 @@ std::string markdownSummary(const std::string& suiteName, const std::vector<Case
         m << p.why;
     }
     return m.str();
+}
+
+namespace {
+
+// The Markdown the parts hold (`code`, **bold**), as HTML; everything else escaped.
+std::string inlineHtml(const std::string& md) {
+    std::string out;
+    bool code = false, bold = false;
+    for (std::size_t i = 0; i < md.size(); ++i) {
+        if (md[i] == '`') {
+            out += code ? "</code>" : "<code>";
+            code = !code;
+        } else if (!code && md.compare(i, 2, "**") == 0) {
+            out += bold ? "</b>" : "<b>";
+            bold = !bold;
+            ++i;
+        } else {
+            out += escapeHtml(std::string(1, md[i]));
+        }
+    }
+    if (code) out += "</code>";
+    if (bold) out += "</b>";
+    return out;
+}
+
+// The cells of a Markdown table row "| a | b |" (the parts' cells hold no pipe: cell() drops them).
+std::vector<std::string> rowCells(const std::string& row) {
+    std::vector<std::string> cells;
+    std::string r = row;
+    while (!r.empty() && (r.back() == '\n' || r.back() == ' ')) r.pop_back();
+    if (r.size() < 2 || r.front() != '|' || r.back() != '|') return cells;
+    std::istringstream in(r.substr(1, r.size() - 2));
+    for (std::string c; std::getline(in, c, '|');) {
+        const auto a = c.find_first_not_of(' '), b = c.find_last_not_of(' ');
+        cells.push_back(a == std::string::npos ? "" : c.substr(a, b - a + 1));
+    }
+    return cells;
+}
+
+}  // namespace
+
+std::string htmlSummary(const std::string& suiteName, const std::vector<CasePart>& parts, bool baselineUpdated,
+                        const std::set<std::string>& withDiff) {
+    const std::size_t failed = count(parts, CaseVerdict::Failed), errors = count(parts, CaseVerdict::Error);
+    std::ostringstream h;
+    h << "<!doctype html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>shadowlab check: "
+      << escapeHtml(suiteName) << "</title>\n<style>" << html::css()
+      << " td.passed{color:#1b5e20} td.failed,td.error{color:#a51111;font-weight:600}"
+         " .diffs{grid-template-columns:repeat(auto-fill,minmax(300px,1fr))} .why li{margin-bottom:4px}"
+         " .scroll{overflow-x:auto} table.cases td{white-space:nowrap} table.cases :is(td,th){padding:6px 8px}"
+         " table.cases :is(td,th):is(:nth-child(-n+4),:nth-child(11)){text-align:left}</style>\n</head>\n<body>\n<main>\n";
+    h << "<header><h1>shadowlab check: " << escapeHtml(suiteName) << "</h1><div class=\"sub\">"
+      << (failed + errors == 0 ? "All " + std::to_string(parts.size()) + " cases passed."
+                               : std::to_string(parts.size() - failed - errors) + " passed, " +
+                                     std::to_string(failed) + " failed, " + std::to_string(errors) + " errors.")
+      << (baselineUpdated ? " The baseline was written from this run." : "")
+      << " JUnit: <a href=\"junit.xml\">junit.xml</a>; Markdown: <a href=\"summary.md\">summary.md</a>.</div></header>\n";
+    h << "<h2>Cases</h2>\n<div class=\"scroll\"><table class=\"cases\"><thead><tr><th>case</th><th>scene</th><th>backend</th>"
+         "<th>verdict</th><th>mismatch</th><th>false shadow</th><th>missed</th><th>self acne</th><th>IoU</th>"
+         "<th>mean |ΔV|</th><th>vs baseline</th><th>time</th></tr></thead><tbody>\n";
+    for (const CasePart& p : parts) {
+        const std::vector<std::string> cells = rowCells(p.row);
+        const char* verdict = p.verdict == CaseVerdict::Passed ? "passed" : p.verdict == CaseVerdict::Failed ? "failed" : "error";
+        h << "<tr>";
+        for (std::size_t i = 0; i < cells.size(); ++i) {
+            if (i == 0) h << "<td><a href=\"cases/" << escapeHtml(p.name) << ".json\">" << escapeHtml(p.name) << "</a></td>";
+            else if (i == 3) h << "<td class=\"" << verdict << "\">" << verdict << "</td>";
+            else h << "<td>" << inlineHtml(cells[i]) << "</td>";
+        }
+        h << "</tr>\n";
+    }
+    h << "</tbody></table></div>\n";
+    if (failed + errors) {
+        h << "<h2>Why</h2>\n<ul class=\"why\">\n";
+        for (const CasePart& p : parts) {
+            std::istringstream lines(p.why);
+            for (std::string l; std::getline(lines, l);)
+                if (l.rfind("- ", 0) == 0) h << "<li>" << inlineHtml(l.substr(2)) << "</li>\n";
+        }
+        h << "</ul>\n";
+    }
+    bool any = false;
+    for (const CasePart& p : parts) {
+        if (!withDiff.count(p.name)) continue;
+        if (!any) {
+            // No hotspot zooms here: the legend's sentence about them goes.
+            std::string legend = html::diffLegend();
+            const auto a = legend.find(" The yellow square"), b = legend.find("</p>", a);
+            if (a != std::string::npos && b != std::string::npos) legend.erase(a, b - a);
+            h << "<h2>Difference images of the failing cases</h2>\n" << legend << "\n<div class=\"grid diffs\">\n";
+        }
+        any = true;
+        const std::string png = "cases/" + p.name + "-diff.png";
+        h << "<figure><figcaption>" << escapeHtml(p.name) << "</figcaption><a href=\"" << escapeHtml(png)
+          << "\"><img src=\"" << escapeHtml(png) << "\" alt=\"" << escapeHtml(p.name) << " difference\" class=\"upscale\"></a></figure>\n";
+    }
+    if (any) h << "</div>\n";
+    h << "</main>\n</body>\n</html>\n";
+    return h.str();
 }
 
 std::string markdownSummary(const CheckSuite& suite, const std::vector<CaseResult>& results, bool baselineUpdated) {
@@ -402,6 +502,10 @@ void writeMergedCheck(const MergedCheck& merged, const fs::path& out) {
     scene::replaceDirectory(tmp, out / "cases");
     scene::writeTextAtomic(out / "junit.xml", junitXml(merged.identity.suiteName, merged.parts));
     scene::writeTextAtomic(out / "summary.md", markdownSummary(merged.identity.suiteName, merged.parts, false));
+    std::set<std::string> withDiff;
+    for (const CasePart& p : merged.parts)
+        if (fs::exists(out / "cases" / (p.name + "-diff.png"), ec)) withDiff.insert(p.name);
+    scene::writeTextAtomic(out / "summary.html", htmlSummary(merged.identity.suiteName, merged.parts, false, withDiff));
 }
 
 }  // namespace shadowlab::compare

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,11 @@ CasePart casePart(const CheckSuite& suite, const CheckCase& c, const CaseResult&
 std::vector<CasePart> caseParts(const CheckSuite& suite, const std::vector<CaseResult>& results);
 std::string junitXml(const std::string& suiteName, const std::vector<CasePart>& parts);
 std::string markdownSummary(const std::string& suiteName, const std::vector<CasePart>& parts, bool baselineUpdated);
+// summary.html: the same table and reasons as summary.md, as a page for a CI artifact, with the
+// difference image of each case named in `withDiff` (cases/NAME-diff.png) and links to the
+// cases' JSON.
+std::string htmlSummary(const std::string& suiteName, const std::vector<CasePart>& parts, bool baselineUpdated,
+                        const std::set<std::string>& withDiff);
 nlohmann::json toJson(const CasePart& part);
 // Throws std::exception on a missing field or an unknown verdict.
 CasePart casePartFromJson(const nlohmann::json& j);

@@ -445,6 +445,7 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
     plot.x.title = "frame pair (t, t+1)";
     plot.x.min = 0.0;  // pairs 0 .. frames - 2, not a fitted margin past the last one
     plot.x.max = double(std::max<std::size_t>(refs.size(), 3) - 2);
+    plot.x.integer = true;
     plot.y.title = "flicker rate";
     plot.y.percent = true;
     plot.y.min = 0.0;
@@ -477,7 +478,9 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
             gifFrames.push_back(sideBySide({&a, &b, &comparisons[std::size_t(t)].diffRgb}, w, h, gw));
         }
         writeGif(dir / (name + ".gif"), gw, h, gifFrames, fps);
-        gifs += "<figure><img src=\"" + name + ".gif\" alt=\"" + name + "\" style=\"width:" + std::to_string(std::min(gw, 1200)) +
+        // Small frames are magnified by a whole factor (crisp pixels) so their shadows can be seen.
+        const int shown = gw > 1200 ? 1200 : gw * std::max(1, 960 / gw);
+        gifs += "<figure><img src=\"" + name + ".gif\" alt=\"" + name + "\" style=\"width:" + std::to_string(shown) +
                 "px;image-rendering:pixelated\"><figcaption><b>" + escapeHtml(name) +
                 "</b>: method | reference | difference, " + std::to_string(fps) + " frames/s</figcaption></figure>\n";
 
@@ -539,7 +542,8 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
     std::ostringstream html;
     html << "<!doctype html><html><head><meta charset=\"utf-8\"><title>shadowlab path: " << escapeHtml(toString(spec.kind))
          << "</title><style>body{font-family:sans-serif;margin:1.5em;max-width:1300px}table{border-collapse:collapse}"
-            "td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}th{background:#eee}figure{margin:1em 0}"
+            "td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}th{background:#eee}"
+            "td,tr th:first-child{white-space:nowrap}figure{margin:1em 0}"
             "</style></head><body>\n";
     html << "<h1>Temporal stability: " << escapeHtml(toString(spec.kind)) << " path</h1>\n<p>Scene <code>"
          << escapeHtml(base.file.string()) << "</code>, " << result.frames << " frames at " << w << "x" << h

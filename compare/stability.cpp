@@ -462,7 +462,7 @@ void writeStabilityReport(const fs::path& dir, const std::vector<StabilityCase>&
          " .st-clean,.ref-exact{background:#d3f9d8;color:#1b5e20} .st-acne{background:#ffe3e3;color:#a51111}"
          " .st-leaks{background:#dbe4ff;color:#1c3faa} .st-acne-leaks{background:#f3d9fa;color:#6b1e80}"
          " .st-stiff{background:#fff0d4;color:#8a4b00;font-weight:600} .st-failed,.ref-wrong{background:#c92a2a;color:#fff;font-weight:600}"
-         " .st-not-run,.ref-unchecked{background:#f1f3f5;color:#495057} .figs{display:flex;flex-wrap:wrap;gap:10px}</style></head><body><main>"
+         " .st-not-run,.ref-unchecked{background:#f1f3f5;color:#495057} .figs{display:flex;flex-wrap:wrap;gap:10px;margin:12px 0} .figs figure{width:320px}</style></head><body><main>"
       << "<h1>Stability suite</h1><p>" << cases.size() << " cases. Reference: <span class=pass>" << exact
       << " exact</span> against the analytic answer, " << (cases.size() - exact - wrong) << " unchecked (no analytic answer), "
       << (wrong ? "<span class=fail>" : "") << wrong << " wrong" << (wrong ? "</span>" : "") << ". Runs: "
@@ -512,17 +512,21 @@ void writeStabilityReport(const fs::path& dir, const std::vector<StabilityCase>&
             h << "<p><b>" << b.backend << "</b> (probe slice): " << escapeHtml(windowText(&b)) << ". " << escapeHtml(b.text) << "</p>";
         for (const std::string& note : c.bestNotes) h << "<p>" << escapeHtml(note) << "</p>";
         h << "<div class=figs>";
+        // Every image at one width (figures in a flex row would shrink to their captions), small
+        // renders magnified with crisp pixels so their shadows can be seen.
+        const std::string size = "width=320 height=" + std::to_string(std::max(1, 320 * c.height / std::max(1, c.width)));
         if (c.referenceOk && !c.reference.beauty.empty()) {
             const std::string png = "stability/" + c.name + "-reference.png";
             scene::writePngLinear(dir / png, c.width, c.height, c.reference.beauty);
-            h << "<figure><img src=\"" << png << "\" width=320><figcaption>reference</figcaption></figure>";
+            h << "<figure><img src=\"" << png << "\" " << size
+              << " class=upscale alt=reference><figcaption>reference</figcaption></figure>";
         }
         for (const BackendRun& r : c.runs) {
             if (r.diffRgb.empty()) continue;
             const std::string png =
                 "stability/" + c.name + "-" + r.backend + (r.variant == "defaults" ? "" : "-" + r.variant) + "-diff.png";
             scene::writePngDisplay(dir / png, c.width, c.height, r.diffRgb);
-            h << "<figure><img src=\"" << png << "\" width=320 style=\"image-rendering:pixelated\"><figcaption>"
+            h << "<figure><img src=\"" << png << "\" " << size << " class=upscale alt=\"" << r.backend << " difference\"><figcaption>"
               << r.backend << " at " << r.variant << " vs reference</figcaption></figure>";
         }
         h << "</div></section>";

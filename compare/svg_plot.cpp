@@ -219,14 +219,26 @@ std::string renderSvg(const ScatterPlot& plot) {
 
     // Grid, ticks and tick labels.
     o << "<g class=\"axes\" fill=\"#52606d\">\n";
-    for (const double t : axisTicks(rx.lo, rx.hi, rx.log)) {
+    // A whole-number axis keeps the whole ticks; with fewer than two left, every whole number.
+    auto ticksOf = [](double lo, double hi, bool log, bool integer) {
+        std::vector<double> all = axisTicks(lo, hi, log), whole;
+        if (!integer) return all;
+        for (const double t : all)
+            if (t == std::round(t)) whole.push_back(t);
+        if (whole.size() < 2) {
+            whole.clear();
+            for (double t = std::ceil(lo); t <= hi; t += 1.0) whole.push_back(t);
+        }
+        return whole;
+    };
+    for (const double t : ticksOf(rx.lo, rx.hi, rx.log, plot.x.integer)) {
         const double x = px(t);
         o << "<line x1=\"" << num(x) << "\" y1=\"" << num(y1) << "\" x2=\"" << num(x) << "\" y2=\""
           << num(y0) << "\" stroke=\"#e4e7eb\"/>";
         o << "<text x=\"" << num(x) << "\" y=\"" << num(y0 + 17) << "\" text-anchor=\"middle\">"
           << tickLabel(t, plot.x.percent) << "</text>\n";
     }
-    for (const double t : axisTicks(ry.lo, ry.hi, ry.log)) {
+    for (const double t : ticksOf(ry.lo, ry.hi, ry.log, plot.y.integer)) {
         const double y = py(t);
         o << "<line x1=\"" << num(x0) << "\" y1=\"" << num(y) << "\" x2=\"" << num(x1) << "\" y2=\""
           << num(y) << "\" stroke=\"#e4e7eb\"/>";

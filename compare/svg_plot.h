@@ -36,6 +36,7 @@ struct PlotAxis {
     std::string title;
     bool log = false;
     bool percent = false;  // values are 0..1 rates, ticks read "1%"
+    bool integer = false;  // values are counts or indices (frame pairs): ticks only at whole numbers
     std::optional<double> min, max;  // fixed range; otherwise fitted to the data with a margin
 };
 

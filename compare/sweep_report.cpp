@@ -60,6 +60,14 @@ std::string settingsOf(const SweepRow& r) {
     }
     if (o.precision) parts.push_back(*o.precision);
     if (o.samples) parts.push_back(std::to_string(*o.samples) + " samples");
+    // Every setting a row may override, as label() lists them: rows that differ only here
+    // (cascades, frustum fit, hardware bias) would otherwise read the same.
+    if (o.pcfSize) parts.push_back("pcf size " + std::to_string(*o.pcfSize));
+    if (o.normalOffset) parts.push_back("normal offset " + num(*o.normalOffset));
+    if (o.receiverPlaneBias) parts.push_back(*o.receiverPlaneBias ? "receiver-plane bias" : "no receiver-plane bias");
+    if (o.hardwareBias) parts.push_back(*o.hardwareBias ? "hardware bias" : "shader bias");
+    if (o.fitLightFrustum) parts.push_back(*o.fitLightFrustum ? "fitted frustum" : "bounds frustum");
+    if (o.cascades) parts.push_back(std::to_string(*o.cascades) + (*o.cascades == 1 ? " cascade" : " cascades"));
     std::string s;
     for (std::size_t i = 0; i < parts.size(); ++i) s += (i ? ", " : "") + parts[i];
     return s;

@@ -1,5 +1,5 @@
 // tests/app/check_shard_app_test.cpp: `check --shard K/N` and `merge` of check shards end to end:
-// the merged junit.xml, summary.md and cases/ equal the unsharded run's (run times aside) with
+// the merged junit.xml, summary.md, summary.html and cases/ equal the unsharded run's (run times aside) with
 // its exit code; shards of another suite or split refused; missing shards named; nothing written
 // by a refused merge.
 #include <filesystem>
@@ -75,6 +75,9 @@ void expectMergedEqualsUnsharded(const std::string& suiteJson, int expectedExit,
         EXPECT_FALSE(b.empty());
         EXPECT_EQ(withoutTimes(a), withoutTimes(b)) << "N=" << n;
         EXPECT_EQ(withoutTimes(slurpFile(dir.path() / "full" / "summary.md")), withoutTimes(slurpFile(out / "summary.md")))
+            << "N=" << n;
+        EXPECT_EQ(withoutTimes(slurpFile(dir.path() / "full" / "summary.html")),
+                  withoutTimes(slurpFile(out / "summary.html")))
             << "N=" << n;
         // Every case once, with its difference image when it failed.
         ASSERT_EQ(filesIn(dir.path() / "full" / "cases"), filesIn(out / "cases")) << "N=" << n;

@@ -1,5 +1,6 @@
 // tests/compare/check_shard_test.cpp: the split of `check --shard K/N`: every case in exactly one
-// shard, round-robin over the sorted case names, whatever order the suite file lists them in.
+// shard, round-robin over the sorted case names, whatever order the suite file lists them in;
+// and summary.html, the page of the parts every shard keeps.
 #include <algorithm>
 #include <map>
 #include <string>
@@ -8,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "compare/check.h"
+#include "compare/check_report.h"
 
 namespace shadowlab::compare {
 namespace {
@@ -71,6 +73,41 @@ TEST(CheckShard, TheSplitDoesNotDependOnTheFileOrder) {
     std::vector<std::string> zero;
     for (const CheckCase& c : shardSuite(a, {0, 3}).cases) zero.push_back(c.name);
     EXPECT_EQ(zero, (std::vector<std::string>{"a", "d"}));
+}
+
+TEST(CheckSummaryHtml, OneRowPerCaseWithItsVerdictReasonsAndOnlyTheNamedDifferenceImages) {
+    CasePart pass{"a.pass", CaseVerdict::Passed, 0.1, "", "| a.pass | seed | raster | passed | 0% | 0% | 0% | 0% | 1.000 | 0.0000 | within tolerance | 100 ms |\n", ""};
+    CasePart fail{"b<fail>", CaseVerdict::Failed, 0.2, "",
+                  "| b<fail> | seed | raytrace | **FAILED** | 6.7% | 6.7% | 0% | 6.7% | 0.279 | 0.0673 | no baseline | 0.3 ms |\n",
+                  "- `b<fail>`: budget --max-false-shadow: 6.7% > limit 0px: BROKEN (cases/b<fail>-diff.png)\n"};
+    CasePart error{"c.error", CaseVerdict::Error, 0.0, "", "| c.error | seed | raster | **ERROR** | | | | | | | no device | |\n",
+                   "- `c.error`: error: no device\n"};
+    const std::string h = htmlSummary("t", {pass, fail, error}, false, {"b<fail>"});
+    auto count = [&](const std::string& what) {
+        std::size_t n = 0;
+        for (auto p = h.find(what); p != std::string::npos; p = h.find(what, p + 1)) ++n;
+        return n;
+    };
+    EXPECT_EQ(h.rfind("<!doctype html>", 0), 0u);
+    EXPECT_NE(h.find("1 passed, 1 failed, 1 errors."), std::string::npos) << h;
+    EXPECT_EQ(count("<tr>"), 4u);  // header + 3
+    EXPECT_EQ(count("<td"), 36u);  // 12 cells each, the error row too
+    EXPECT_NE(h.find("<td class=\"passed\">passed</td>"), std::string::npos);
+    EXPECT_NE(h.find("<td class=\"failed\">failed</td>"), std::string::npos);
+    EXPECT_NE(h.find("<td class=\"error\">error</td>"), std::string::npos);
+    EXPECT_NE(h.find("<a href=\"cases/a.pass.json\">a.pass</a>"), std::string::npos);
+    // Names are escaped everywhere, Markdown code becomes <code>.
+    EXPECT_EQ(h.find("b<fail>"), std::string::npos);
+    EXPECT_NE(h.find("<li><code>b&lt;fail&gt;</code>: budget --max-false-shadow"), std::string::npos) << h;
+    EXPECT_NE(h.find("<li><code>c.error</code>: error: no device</li>"), std::string::npos) << h;
+    // The one named difference image, nothing for the error.
+    EXPECT_EQ(count("<img "), 1u);
+    EXPECT_NE(h.find("<img src=\"cases/b&lt;fail&gt;-diff.png\""), std::string::npos);
+    // All passed: no reasons, no images.
+    const std::string ok = htmlSummary("t", {pass}, true, {});
+    EXPECT_NE(ok.find("All 1 cases passed. The baseline was written from this run."), std::string::npos);
+    EXPECT_EQ(ok.find("<h2>Why</h2>"), std::string::npos);
+    EXPECT_EQ(ok.find("<img "), std::string::npos);
 }
 
 }  // namespace

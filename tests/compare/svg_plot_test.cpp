@@ -76,6 +76,26 @@ TEST(RenderSvg, ZeroOnALogAxisIsDrawnAsAnEdgeTriangleNotDropped) {
     EXPECT_EQ(count(svg, "<circle"), 2u);  // legend + the positive point
 }
 
+TEST(RenderSvg, AWholeNumberAxisTicksOnlyWholeNumbers) {
+    // Frame pairs 0..1 (a 3-frame path): a linear axis would tick 0, 0.2 .. 1; pair 0.4 is no pair.
+    ScatterPlot p;
+    p.x.min = 0.0;
+    p.x.max = 1.0;
+    p.x.integer = true;
+    p.y.min = 0.0;
+    p.y.max = 10.0;
+    p.series.push_back({"a", "#123456", {{0.0, 1.0, "", ""}, {1.0, 2.0, "", ""}}});
+    const std::string svg = renderSvg(p);
+    EXPECT_EQ(count(svg, "text-anchor=\"middle\">0<"), 1u) << svg;
+    EXPECT_EQ(count(svg, "text-anchor=\"middle\">1<"), 1u) << svg;
+    EXPECT_EQ(count(svg, ">0.2<") + count(svg, ">0.4<") + count(svg, ">0.5<"), 0u) << svg;
+    // A long range keeps its nice steps (all whole): 0, 20 .. 100.
+    p.x.max = 100.0;
+    const std::string wide = renderSvg(p);
+    EXPECT_EQ(count(wide, "text-anchor=\"middle\">20<"), 1u) << wide;
+    EXPECT_EQ(count(wide, "text-anchor=\"middle\">1<"), 0u) << wide;
+}
+
 TEST(RenderSvg, IsSelfContainedEscapedAndBalanced) {
     ScatterPlot p;
     p.title = "A < B & \"C\"";

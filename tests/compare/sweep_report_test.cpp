@@ -162,6 +162,23 @@ TEST(SweepReport, SummarySaysTheFastestUnderOnePercentAndTheBiasVerdicts) {
     EXPECT_NE(text.find("1 configuration failed"), std::string::npos) << text;
 }
 
+TEST(SweepReport, RowsThatDifferOnlyInCascadesFitOrHardwareBiasReadDifferently) {
+    // The quick grid's 2048/pcf2x2 rows differ only in these settings: each must show.
+    SweepReportInput in;
+    in.rows = {test::mapRow(2048, "pcf2x2", 0.0, 0.001, 40.0), test::mapRow(2048, "pcf2x2", 0.001, 0.001, 300.0),
+               test::mapRow(2048, "pcf2x2", 0.002, 0.001, 70.0)};
+    for (auto& r : in.rows) r.config.overrides.fitLightFrustum = false;
+    in.rows[0].config.overrides.cascades = 1;
+    in.rows[1].config.overrides.cascades = 3;
+    in.rows[2].config.overrides.cascades = 1;
+    in.rows[2].config.overrides.hardwareBias = true;
+    in.rows[2].config.overrides.pcfSize = 5;
+    const std::string html = renderSweepReportHtml(in);
+    for (const char* s : {">map 2048, pcf2x2, bounds frustum, 1 cascade", ">map 2048, pcf2x2, bounds frustum, 3 cascades",
+                          ">map 2048, pcf2x2, pcf size 5, hardware bias, bounds frustum, 1 cascade"})
+        EXPECT_NE(html.find(s), std::string::npos) << s;
+}
+
 TEST(SweepReport, SaysWhenNoConfigurationOfABackendIsUnderOnePercent) {
     SweepReportInput in;
     in.rows = {test::mapRow(512, "none", 0.03, 0.01, 2.0), test::mapRow(2048, "none", 0.02, 0.0, 6.0)};
