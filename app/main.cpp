@@ -155,6 +155,8 @@ int main(int argc, char** argv) {
         ->expected(0, 1);
     sweepCmd->add_option("--flicker-frames", sweepOptions.flickerFrames, "Frames of the flicker path (default 4)")
         ->check(CLI::Range(2, 64));
+
+    shadowlab::app::MergeOptions mergeOptions;
     auto* mergeCmd = app.add_subcommand("merge", "Join the shards of a sweep (`sweep --shard K/N`) into the results.csv, "
                                                  "results.json, plots and report.html of the whole sweep, those of a "
                                                  "check (`check --shard K/N`) into its junit.xml, summary.md and cases/, "
