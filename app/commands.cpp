@@ -691,8 +691,40 @@ int mergeCheck(const MergeOptions& o) {
 
 }  // namespace
 
+namespace {
+
+void printPathSummary(const compare::PathResult& result) {
+    for (const compare::PathMethod& m : result.methods)
+        std::cerr << "shadowlab: " << m.name << ": mean flicker " << compare::formatPercent(m.temporal.meanFlickerRate)
+                  << " (" << m.temporal.totalFlicker << " px over " << m.temporal.pairs.size() << " pairs), swim "
+                  << compare::formatFixed(m.temporal.meanSwimPixels, 3) << " px, edge offset "
+                  << compare::formatFixed(m.temporal.meanEdgeOffset, 3) << " px\n";
+}
+
+// `merge` of path shards: the frames, metrics.json and report of the unsharded path.
+int mergePath(const MergeOptions& o) {
+    fs::path out;
+    if (o.outputDir) out = *o.outputDir;
+    else if (o.inputs.size() == 1 && !fs::exists(o.inputs.front() / "shard.json")) out = o.inputs.front();
+    else
+        throw scene::InputError("merge: give the merged folder with -o (the inputs are " +
+                                std::string(o.inputs.size() == 1 ? "a shard folder" : "several folders") + ")");
+    const compare::MergedPath merged = compare::mergePathShards(o.inputs, out);
+    std::cerr << "shadowlab: merged " << merged.shardCount << " path shards (" << merged.shardDirs.size() << " folders, "
+              << merged.result.frames << " frames"
+              << (merged.duplicates ? ", " + std::to_string(merged.duplicates) + " duplicate frames merged once" : "")
+              << ")\n";
+    printPathSummary(merged.result);
+    std::cerr << "shadowlab: wrote " << (out / "report.html").string() << " and metrics.json\n";
+    if (o.json) std::cout << compare::toJson(merged.result).dump(2) << "\n";
+    return 0;
+}
+
+}  // namespace
+
 int merge(const MergeOptions& o) {
     if (compare::holdsCheckShards(o.inputs)) return mergeCheck(o);
+    if (compare::holdsPathShards(o.inputs)) return mergePath(o);
     const compare::MergedSweep merged = compare::readShards(o.inputs);
     fs::path out;
     if (o.outputDir) {
@@ -727,6 +759,14 @@ int sweep(const SweepOptions& o) {
                                      : compare::defaultGrid(p.scene, o.quick);
     if (o.repetitions) grid.repetitions = *o.repetitions;
     if (o.common.resolution) grid.resolution = o.common.resolution;
+    if (o.flicker || o.flickerFrames) {
+        compare::PathSpec path = grid.flicker.value_or(compare::defaultFlickerPath());
+        // Given without a value, CLI11 reports the flag as "true": the default kind.
+        if (o.flicker && !o.flicker->empty() && *o.flicker != "true") path.kind = compare::parsePathKind(*o.flicker);
+        if (o.flickerFrames) path.frames = *o.flickerFrames;
+        compare::flickerScenes(compare::sweepScene(p.scene, grid), path);  // a bad path fails before anything is written
+        grid.flicker = path;
+    }
     // Settings given on the command line apply to every configuration that does not vary them.
     const scene::SettingsOverrides& base = o.common.settings;
     for (compare::SweepConfig& c : grid.configs) {
@@ -736,6 +776,8 @@ int sweep(const SweepOptions& o) {
         if (!v.slopeBias) v.slopeBias = base.slopeBias;
         if (!v.filter) v.filter = base.filter;
         if (!v.cascades) v.cascades = base.cascades;
+        if (!v.cascadeBlend) v.cascadeBlend = base.cascadeBlend;
+        if (!v.snapLightFrustum) v.snapLightFrustum = base.snapLightFrustum;
         if (!v.rayBias) v.rayBias = base.rayBias;
         if (!v.precision) v.precision = base.precision;
         if (!v.samples) v.samples = base.samples;
@@ -884,11 +926,22 @@ int check(const CheckOptions& o) {
 
 int path(const PathCommandOptions& o) {
     const Prepared p = prepare(o.common);
+    // The command line's path replaces the scene's "path" block when it names a kind; otherwise the
+    // block is used, with --frames, --amount and --light over its values.
     compare::PathSpec spec;
-    spec.kind = compare::parsePathKind(o.kind);
-    spec.frames = o.frames;
-    spec.amount = o.amount;
-    spec.light = o.light;
+    const bool cliKind = o.kind || o.cameraAnimation;
+    if (!cliKind && p.scene.path) spec = compare::pathSpecOf(*p.scene.path);
+    if (o.kind) spec.kind = compare::parsePathKind(*o.kind);
+    if (o.cameraAnimation) {
+        if (o.kind && spec.kind != compare::PathKind::GltfAnimation)
+            throw scene::InputError("--camera-animation: follows a glTF animation; it cannot go with --kind " + *o.kind);
+        spec.kind = compare::PathKind::GltfAnimation;
+        // Given without a value, CLI11 reports the flag as "true": the first animation.
+        spec.animation = *o.cameraAnimation == "true" ? std::string() : *o.cameraAnimation;
+    }
+    if (o.frames) spec.frames = *o.frames;
+    if (o.amount) spec.amount = o.amount;
+    if (o.light) spec.light = *o.light;
     compare::pathScenes(p.scene, p.settings, spec);  // bad paths fail before anything is written
     compare::PathRunOptions options;
     options.outputDir = o.outputDir;
@@ -897,13 +950,25 @@ int path(const PathCommandOptions& o) {
     options.raytrace = !o.skipRaytrace;
     options.heldView = !o.noHeldView;
     options.progress = [](const std::string& line) { std::cerr << "shadowlab: path " << line << "\n"; };
-    std::cerr << "shadowlab: " << o.kind << " path of " << o.frames << " frames into " << o.outputDir.string() << "\n";
+    const std::string kind = compare::toString(spec.kind);
+    if (o.shard) {
+        const compare::Shard shard = compare::parseShard(*o.shard);
+        options.shardIndex = shard.index;
+        options.shardCount = shard.count;
+        const fs::path dir = o.outputDir / compare::shardFolderName(shard);
+        fs::create_directories(dir);
+        const scene::FolderLock lock(dir, "path --shard");
+        std::cerr << "shadowlab: " << kind << " path shard " << shard.index << "/" << shard.count << ": "
+                  << compare::pathShardFrames(spec.frames, shard.index, shard.count).size() << " of " << spec.frames
+                  << " frames into " << dir.string() << "\n";
+        const compare::PathResult result = compare::runPath(p.scene, p.settings, spec, options);
+        std::cerr << "shadowlab: wrote " << dir.string() << " (" << result.resumedFrames << " frames resumed); when every "
+                  << "shard is done: shadowlab merge " << o.outputDir.string() << "\n";
+        return 0;
+    }
+    std::cerr << "shadowlab: " << kind << " path of " << spec.frames << " frames into " << o.outputDir.string() << "\n";
     const compare::PathResult result = compare::runPath(p.scene, p.settings, spec, options);
-    for (const compare::PathMethod& m : result.methods)
-        std::cerr << "shadowlab: " << m.name << ": mean flicker " << compare::formatPercent(m.temporal.meanFlickerRate)
-                  << " (" << m.temporal.totalFlicker << " px over " << m.temporal.pairs.size() << " pairs), swim "
-                  << compare::formatFixed(m.temporal.meanSwimPixels, 3) << " px, edge offset "
-                  << compare::formatFixed(m.temporal.meanEdgeOffset, 3) << " px\n";
+    printPathSummary(result);
     std::cerr << "shadowlab: wrote " << (o.outputDir / "report.html").string() << " and metrics.json\n";
     if (o.common.json) std::cout << compare::toJson(result).dump(2) << "\n";
     return 0;

@@ -56,6 +56,9 @@ struct SweepOptions {
     bool quick = false;
     std::optional<int> repetitions;
     std::optional<std::string> shard;  // "K/N": render only shard K of N (compare/shard.h)
+    // The flicker axis: every row also along this path kind (--flicker [KIND], default subtexel).
+    std::optional<std::string> flicker;
+    std::optional<int> flickerFrames;
 };
 
 struct MergeOptions {
@@ -101,10 +104,13 @@ struct CheckOptions {
 struct PathCommandOptions {
     SceneOptions common;
     std::filesystem::path outputDir;
-    std::string kind = "orbit";  // compare::PathKind
-    int frames = 12;
+    // Unset kind, frames, amount, light: the scene's "path" block, else orbit, 12, the kind's default, 0.
+    std::optional<std::string> kind;  // compare::PathKind
+    std::optional<int> frames;
     std::optional<double> amount;
-    int light = 0;
+    std::optional<int> light;
+    std::optional<std::string> cameraAnimation;  // --camera-animation [NAME|INDEX]: kind gltf-animation
+    std::optional<std::string> shard;            // "K/N": render only shard K of N (merge measures)
     bool resume = false;
     bool skipRaster = false;
     bool skipRaytrace = false;

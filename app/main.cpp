@@ -149,13 +149,20 @@ int main(int argc, char** argv) {
     sweepCmd->add_option("--shard", sweepOptions.shard,
                          "K/N: render only shard K (from 0) of N into OUTPUT/shard-K-of-N, sharing OUTPUT/reference.exr; "
                          "join the shards with `shadowlab merge` (docs/sweep.md)");
+    sweepCmd->add_option("--flicker", sweepOptions.flicker,
+                         "The flicker axis: also render every row along a short path (KIND, default subtexel: "
+                         "sub-texel camera steps) and record flicker, error variation and swim (docs/sweep.md)")
+        ->expected(0, 1);
+    sweepCmd->add_option("--flicker-frames", sweepOptions.flickerFrames, "Frames of the flicker path (default 4)")
+        ->check(CLI::Range(2, 64));
 
     shadowlab::app::MergeOptions mergeOptions;
     auto* mergeCmd = app.add_subcommand("merge", "Join the shards of a sweep (`sweep --shard K/N`) into the results.csv, "
-                                                 "results.json, plots and report.html of the whole sweep, or those of a "
-                                                 "check (`check --shard K/N`) into its junit.xml, summary.md, summary.html and cases/");
+                                                 "results.json, plots and report.html of the whole sweep, those of a "
+                                                 "check (`check --shard K/N`) into its junit.xml, summary.md, summary.html and cases/, "
+                                                 "or those of a path (`path --shard K/N`) into its metrics and report");
     mergeCmd->add_option("DIRS", mergeOptions.inputs,
-                         "Shard folders, or folders holding shard-K-of-N folders (the -o of `sweep --shard` or `check --shard`)")
+                         "Shard folders, or folders holding shard-K-of-N folders (the -o of `sweep`, `check` or `path --shard`)")
         ->required();
     mergeCmd->add_option("-o,--output", mergeOptions.outputDir, "Merged folder (default: the one input folder)");
     mergeCmd->add_flag("--json", mergeOptions.json, "Print the merged rows as JSON on stdout");
@@ -166,7 +173,12 @@ int main(int argc, char** argv) {
     addSceneOptions(*pathCmd, pathOptions.common);
     pathCmd->add_option("-o,--output", pathOptions.outputDir, "Output folder (created)")->required();
     pathCmd->add_option("--kind", pathOptions.kind,
-                        "orbit|dolly|pan|subtexel|sun-azimuth|sun-elevation|light-move (default orbit)");
+                        "orbit|dolly|pan|subtexel|sun-azimuth|sun-elevation|light-move|gltf-animation (default: the "
+                        "scene's \"path\" block, else orbit)");
+    pathCmd->add_option("--camera-animation", pathOptions.cameraAnimation,
+                        "Follow a glTF camera animation of a .gltf/.glb scene (NAME or INDEX; empty: the first); "
+                        "the same as --kind gltf-animation")
+        ->expected(0, 1);
     pathCmd->add_option("--frames", pathOptions.frames, "Frames along the path (default 12)");
     pathCmd->add_option("--amount", pathOptions.amount,
                         "The path's extent: degrees (orbit 20, sun-azimuth 20, sun-elevation 10), fraction of the "
@@ -174,6 +186,9 @@ int main(int argc, char** argv) {
                         "(subtexel 0.1), fraction of the scene's size (light-move 0.1)");
     pathCmd->add_option("--light", pathOptions.light, "The light a light path moves (default 0)");
     pathCmd->add_flag("--resume", pathOptions.resume, "Continue a stopped path in the same folder");
+    pathCmd->add_option("--shard", pathOptions.shard,
+                        "K/N: render only the frames t with t mod N = K into OUTPUT/shard-K-of-N; `shadowlab merge "
+                        "OUTPUT` measures the merged frames (docs/temporal.md)");
     pathCmd->add_flag("--no-raster", pathOptions.skipRaster, "Skip the Vulkan backend");
     pathCmd->add_flag("--no-raytrace", pathOptions.skipRaytrace, "Skip the ray-traced method");
     pathCmd->add_flag("--no-held-view", pathOptions.noHeldView,

@@ -16,12 +16,14 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include "compare/shard.h"
 #include "compare/svg_plot.h"
 #include "compare/text.h"
 #include "raster/light_frustum.h"
 #include "raster/renderer.h"
 #include "raytrace/renderer.h"
 #include "scene/camera.h"
+#include "scene/camera_animation.h"
 #include "scene/error.h"
 #include "scene/frame_io.h"
 #include "scene/render_plan.h"
@@ -126,6 +128,7 @@ Json manifestOf(const scene::Scene& base, const PathSpec& spec, double amount, c
             {"frames", spec.frames},
             {"amount", amount},
             {"light", spec.light},
+            {"animation", spec.kind == PathKind::GltfAnimation ? Json(spec.animation) : Json(nullptr)},
             {"raster", o.raster},
             {"raytrace", o.raytrace},
             {"held_view", o.heldView},
@@ -192,20 +195,32 @@ const char* toString(PathKind kind) {
         case PathKind::SunAzimuth: return "sun-azimuth";
         case PathKind::SunElevation: return "sun-elevation";
         case PathKind::LightMove: return "light-move";
+        case PathKind::GltfAnimation: return "gltf-animation";
     }
     return "?";
 }
 
 PathKind parsePathKind(const std::string& text) {
     for (PathKind k : {PathKind::Orbit, PathKind::Dolly, PathKind::Pan, PathKind::SubTexel, PathKind::SunAzimuth,
-                       PathKind::SunElevation, PathKind::LightMove})
+                       PathKind::SunElevation, PathKind::LightMove, PathKind::GltfAnimation})
         if (text == toString(k)) return k;
-    throw scene::InputError("--kind: expected orbit|dolly|pan|subtexel|sun-azimuth|sun-elevation|light-move, got '" +
-                            text + "'");
+    throw scene::InputError(
+        "--kind: expected orbit|dolly|pan|subtexel|sun-azimuth|sun-elevation|light-move|gltf-animation, got '" + text + "'");
 }
 
 bool isCameraPath(PathKind kind) {
-    return kind == PathKind::Orbit || kind == PathKind::Dolly || kind == PathKind::Pan || kind == PathKind::SubTexel;
+    return kind == PathKind::Orbit || kind == PathKind::Dolly || kind == PathKind::Pan || kind == PathKind::SubTexel ||
+           kind == PathKind::GltfAnimation;
+}
+
+PathSpec pathSpecOf(const scene::PathBlock& block) {
+    PathSpec spec;
+    spec.kind = parsePathKind(block.kind);
+    if (block.frames) spec.frames = *block.frames;
+    spec.amount = block.amount;
+    spec.light = block.light.value_or(0);
+    spec.animation = block.animation.value_or("");
+    return spec;
 }
 
 double defaultAmount(PathKind kind) {
@@ -217,6 +232,7 @@ double defaultAmount(PathKind kind) {
         case PathKind::SunAzimuth: return 20.0;
         case PathKind::SunElevation: return 10.0;
         case PathKind::LightMove: return 0.1;
+        case PathKind::GltfAnimation: return 0.0;  // the keys set the motion
     }
     return 0.0;
 }
@@ -259,6 +275,13 @@ std::vector<scene::Scene> pathScenes(const scene::Scene& base, const scene::Rend
     if (spec.kind == PathKind::LightMove && base.lights[std::size_t(spec.light)].type == scene::LightType::Directional)
         throw scene::InputError("--kind light-move: light " + std::to_string(spec.light) +
                                 " is directional (use sun-azimuth or sun-elevation)");
+    if (spec.kind == PathKind::GltfAnimation && spec.amount)
+        throw scene::InputError("--amount: a glTF camera animation has no amount (its keys set the motion)");
+    const scene::CameraAnimation* animation =
+        spec.kind == PathKind::GltfAnimation ? &scene::findCameraAnimation(base, spec.animation) : nullptr;
+    if (animation && !(animation->end > animation->start))
+        throw scene::InputError("--camera-animation: animation " + std::to_string(animation->index) +
+                                " has one key time: nothing moves");
     if (spec.kind == PathKind::Dolly && !(amount < 1.0))
         throw scene::InputError("--amount: a dolly covers a fraction < 1 of the distance, got " + std::to_string(amount));
 
@@ -306,124 +329,55 @@ std::vector<scene::Scene> pathScenes(const scene::Scene& base, const scene::Rend
             case PathKind::LightMove:
                 s.lights[std::size_t(spec.light)].position.x += amount * u * diagonal;
                 break;
+            case PathKind::GltfAnimation:
+                c = scene::animatedCamera(base, *animation, animation->start + u * (animation->end - animation->start));
+                break;
         }
         out.push_back(std::move(s));
     }
     return out;
 }
 
-PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settings, const PathSpec& spec,
-                   const PathRunOptions& options) {
-    PathResult result;
-    result.spec = spec;
-    result.amount = spec.amount.value_or(defaultAmount(spec.kind));
-    const std::vector<scene::Scene> scenes = pathScenes(base, settings, spec);
-    result.frames = int(scenes.size());
-    const bool held = options.raster && options.heldView && isCameraPath(spec.kind);
+namespace {
 
-    // The folder: a manifest says which path it holds; the journal which frames are done.
-    const fs::path dir = options.outputDir, framesDir = dir / "frames";
-    const fs::path journal = dir / "frames.jsonl", manifestFile = dir / "path.json";
-    const Json manifest = manifestOf(base, spec, result.amount, options, settings);
-    std::error_code ec;
-    if (fs::exists(journal, ec) && !options.resume)
-        throw scene::InputError(dir.string() + ": already holds a path (frames.jsonl); use --resume to continue it");
-    if (options.resume && fs::exists(manifestFile, ec)) {
-        std::ifstream in(manifestFile);
-        Json old;
-        try {
-            in >> old;
-        } catch (const std::exception&) {
-            throw scene::InputError(manifestFile.string() + ": unreadable; remove the folder to start again");
-        }
-        if (old != manifest)
-            throw scene::InputError(manifestFile.string() +
-                                    ": the folder holds another path (scene, kind, frames, amount or settings differ)");
-    }
-    fs::create_directories(framesDir);
-    scene::removeStaleTemporaries(framesDir);
-    scene::writeTextAtomic(manifestFile, manifest.dump(2) + "\n");
-
-    // Finished frames: the journal's lines (a torn last line is dropped and the journal rewritten).
-    std::map<int, Json> done;
-    if (options.resume && fs::exists(journal, ec)) {
-        std::ifstream in(journal);
-        std::string line, kept;
-        while (std::getline(in, line)) {
-            try {
-                const Json j = Json::parse(line);
-                done[j.at("frame").get<int>()] = j;
-                kept += line + "\n";
-            } catch (const std::exception&) {
-                break;  // a kill in the middle of the last write
-            }
-        }
-        scene::writeTextAtomic(journal, kept);
-    }
-
-    // Method names in report order.
+// Method names in report order, from a folder's manifest (path.json).
+std::vector<std::string> methodNames(const Json& manifest) {
     std::vector<std::string> names;
-    if (options.raster) names.push_back("raster");
+    const bool raster = manifest.at("raster").get<bool>();
+    const bool held = raster && manifest.at("held_view").get<bool>() &&
+                      isCameraPath(parsePathKind(manifest.at("kind").get<std::string>()));
+    if (raster) names.push_back("raster");
     if (held) names.push_back("raster-held");
-    if (options.raytrace) names.push_back("raytrace");
+    if (manifest.at("raytrace").get<bool>()) names.push_back("raytrace");
+    return names;
+}
 
-    // One renderer per backend for the whole path, made for frame 0 (the raster vertex buffer is
-    // relative to frame 0's camera: a resumed path renders exactly what an unbroken one does).
-    const scene::RenderPlan plan = scene::makeRenderPlan(scenes[0], settings);
-    std::optional<raster::Renderer> rasterRenderer;
-    std::optional<raytrace::Renderer> tracer, reference;
-    std::map<std::string, double> setupMs;
-    std::map<std::string, std::vector<double>> times;
-    for (int t = 0; t < result.frames; ++t) {
-        if (done.count(t)) {
-            const Json& j = done[t];
-            for (const auto& [name, ms] : j.at("frame_ms").items()) times[name].push_back(ms.get<double>());
-            const Json setups = j.value("setup_ms", Json::object());  // kept: items() refers to it
-            for (const auto& [name, ms] : setups.items()) setupMs[name] = ms.get<double>();
-            ++result.resumedFrames;
-            continue;
-        }
-        const scene::Scene& s = scenes[std::size_t(t)];
-        const scene::RenderPlan framePlan = scene::makeRenderPlan(s, settings);
-        Json line = {{"frame", t}, {"frame_ms", Json::object()}, {"setup_ms", Json::object()}};
-        auto record = [&](const std::string& name, const scene::Frame& f, double setup) {
-            scene::writeFrame(f, framesDir / frameName(t, name));
-            line["frame_ms"][name] = frameMs(f);
-            line["setup_ms"][name] = setup;
-        };
-        if (!reference) reference.emplace(scenes[0], settings.raytrace, true);
-        record("reference", reference->render(s, framePlan), reference->setupMs());
-        if (options.raytrace) {
-            if (!tracer) tracer.emplace(scenes[0], settings.raytrace, false);
-            record("raytrace", tracer->render(s, framePlan), tracer->setupMs());
-        }
-        if (options.raster) {
-            double setup = 0.0;
-            if (!rasterRenderer) {
-                rasterRenderer.emplace(scenes[0], plan, settings.raster);
-                setup = rasterRenderer->setupMs();
-            }
-            rasterRenderer->update(s);
-            scene::Frame f = rasterRenderer->render();
-            setup += f.timing("setup");  // pipelines made by the first frame
-            record("raster", f, setup);
-            if (held) {
-                rasterRenderer->update(s, scenes[0].camera);
-                record("raster-held", rasterRenderer->render(), 0.0);
-            }
-            if (settings.raster.validate && rasterRenderer->validationMessages() > 0)
-                throw std::runtime_error("the Vulkan validation layer reported " +
-                                         std::to_string(rasterRenderer->validationMessages()) +
-                                         " message(s) (printed above)");
-        }
-        for (const auto& [name, ms] : line["frame_ms"].items()) times[name].push_back(ms.get<double>());
-        for (const auto& [name, ms] : line["setup_ms"].items())
-            if (ms.get<double>() > 0.0 || !setupMs.count(name)) setupMs[name] = ms.get<double>();
-        appendLine(journal, line.dump());
-        if (options.progress)
-            options.progress("frame " + std::to_string(t + 1) + "/" + std::to_string(result.frames));
-    }
+// What shards of one path share: the manifest without the scene's path (a shared file system may
+// be mounted at different places), the scene's hash and the program version.
+Json pathIdentity(const scene::Scene& base, const Json& manifest) {
+    Json id = manifest;
+    id.erase("scene");
+    id["scene_hash"] = sceneHash(base);
+    id["version"] = SHADOWLAB_VERSION;
+    return id;
+}
 
+Json pathShardManifest(const scene::Scene& base, const Json& manifest, const Shard& shard, int frames) {
+    return {{"program", "shadowlab"},
+            {"study", "path"},
+            {"scene", base.file.string()},
+            {"identity", pathIdentity(base, manifest)},
+            {"shard", {{"index", shard.index}, {"count", shard.count}}},
+            {"frames", frames}};
+}
+
+// Measures every method's frames in `dir` (all of them on disk) against the same frame's reference
+// and writes metrics.json, flicker.svg, the animations, the worst pairs' zooms and report.html.
+void measurePath(PathResult& result, const fs::path& dir, const std::string& sceneFile,
+                 const std::vector<std::string>& names, std::map<std::string, double>& setupMs,
+                 std::map<std::string, std::vector<double>>& times) {
+    const fs::path framesDir = dir / "frames";
+    const PathSpec& spec = result.spec;
     // Measure: every frame of every method against the same frame's reference.
     auto load = [&](const std::string& name) {
         std::vector<scene::Frame> frames;
@@ -546,7 +500,7 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
             "td,tr th:first-child{white-space:nowrap}figure{margin:1em 0}"
             "</style></head><body>\n";
     html << "<h1>Temporal stability: " << escapeHtml(toString(spec.kind)) << " path</h1>\n<p>Scene <code>"
-         << escapeHtml(base.file.string()) << "</code>, " << result.frames << " frames at " << w << "x" << h
+         << escapeHtml(sceneFile) << "</code>, " << result.frames << " frames at " << w << "x" << h
          << ", amount " << formatShort(result.amount) << ". Pixels are compared between frames at the same image "
          << "position; flicker counts the counted pixels whose lit/shadow state changes while the reference's does "
          << "not (docs/temporal.md).</p>\n";
@@ -576,6 +530,131 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
     html << "<p>Every figure: <a href=\"metrics.json\">metrics.json</a>; the frames: <code>frames/</code>.</p>"
             "</body></html>\n";
     scene::writeTextAtomic(dir / "report.html", html.str());
+}
+
+
+}  // namespace
+
+PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settings, const PathSpec& spec,
+                   const PathRunOptions& options) {
+    PathResult result;
+    result.spec = spec;
+    result.amount = spec.amount.value_or(defaultAmount(spec.kind));
+    const std::vector<scene::Scene> scenes = pathScenes(base, settings, spec);
+    result.frames = int(scenes.size());
+    const bool held = options.raster && options.heldView && isCameraPath(spec.kind);
+
+    const bool sharded = options.shardCount > 0;
+    if (sharded && !(options.shardIndex >= 0 && options.shardIndex < options.shardCount))
+        throw scene::InputError("--shard: expected K/N with 0 <= K < N");
+    const Shard shard{options.shardIndex, std::max(1, options.shardCount)};
+    std::set<int> mine;  // the frames this process renders
+    for (int t : pathShardFrames(result.frames, shard.index, shard.count)) mine.insert(t);
+
+    // The folder: a manifest says which path it holds; the journal which frames are done.
+    const fs::path dir = sharded ? options.outputDir / shardFolderName(shard) : options.outputDir;
+    const fs::path framesDir = dir / "frames";
+    const fs::path journal = dir / "frames.jsonl", manifestFile = dir / "path.json";
+    const Json manifest = manifestOf(base, spec, result.amount, options, settings);
+    std::error_code ec;
+    if (fs::exists(journal, ec) && !options.resume)
+        throw scene::InputError(dir.string() + ": already holds a path (frames.jsonl); use --resume to continue it");
+    if (options.resume && fs::exists(manifestFile, ec)) {
+        std::ifstream in(manifestFile);
+        Json old;
+        try {
+            in >> old;
+        } catch (const std::exception&) {
+            throw scene::InputError(manifestFile.string() + ": unreadable; remove the folder to start again");
+        }
+        if (old != manifest)
+            throw scene::InputError(manifestFile.string() +
+                                    ": the folder holds another path (scene, kind, frames, amount or settings differ)");
+    }
+    fs::create_directories(framesDir);
+    scene::removeStaleTemporaries(framesDir);
+    scene::writeTextAtomic(manifestFile, manifest.dump(2) + "\n");
+    if (sharded)
+        scene::writeTextAtomic(dir / "shard.json", pathShardManifest(base, manifest, shard, result.frames).dump(2) + "\n");
+
+    // Finished frames: the journal's lines (a torn last line is dropped and the journal rewritten).
+    std::map<int, Json> done;
+    if (options.resume && fs::exists(journal, ec)) {
+        std::ifstream in(journal);
+        std::string line, kept;
+        while (std::getline(in, line)) {
+            try {
+                const Json j = Json::parse(line);
+                done[j.at("frame").get<int>()] = j;
+                kept += line + "\n";
+            } catch (const std::exception&) {
+                break;  // a kill in the middle of the last write
+            }
+        }
+        scene::writeTextAtomic(journal, kept);
+    }
+
+    const std::vector<std::string> names = methodNames(manifest);
+
+    // One renderer per backend for the whole path, made for frame 0 (the raster vertex buffer is
+    // relative to frame 0's camera: a resumed path renders exactly what an unbroken one does).
+    const scene::RenderPlan plan = scene::makeRenderPlan(scenes[0], settings);
+    std::optional<raster::Renderer> rasterRenderer;
+    std::optional<raytrace::Renderer> tracer, reference;
+    std::map<std::string, double> setupMs;
+    std::map<std::string, std::vector<double>> times;
+    for (int t = 0; t < result.frames; ++t) {
+        if (!mine.count(t)) continue;
+        if (done.count(t)) {
+            const Json& j = done[t];
+            for (const auto& [name, ms] : j.at("frame_ms").items()) times[name].push_back(ms.get<double>());
+            const Json setups = j.value("setup_ms", Json::object());  // kept: items() refers to it
+            for (const auto& [name, ms] : setups.items()) setupMs[name] = ms.get<double>();
+            ++result.resumedFrames;
+            continue;
+        }
+        const scene::Scene& s = scenes[std::size_t(t)];
+        const scene::RenderPlan framePlan = scene::makeRenderPlan(s, settings);
+        Json line = {{"frame", t}, {"frame_ms", Json::object()}, {"setup_ms", Json::object()}};
+        auto record = [&](const std::string& name, const scene::Frame& f, double setup) {
+            scene::writeFrame(f, framesDir / frameName(t, name));
+            line["frame_ms"][name] = frameMs(f);
+            line["setup_ms"][name] = setup;
+        };
+        if (!reference) reference.emplace(scenes[0], settings.raytrace, true);
+        record("reference", reference->render(s, framePlan), reference->setupMs());
+        if (options.raytrace) {
+            if (!tracer) tracer.emplace(scenes[0], settings.raytrace, false);
+            record("raytrace", tracer->render(s, framePlan), tracer->setupMs());
+        }
+        if (options.raster) {
+            double setup = 0.0;
+            if (!rasterRenderer) {
+                rasterRenderer.emplace(scenes[0], plan, settings.raster);
+                setup = rasterRenderer->setupMs();
+            }
+            rasterRenderer->update(s);
+            scene::Frame f = rasterRenderer->render();
+            setup += f.timing("setup");  // pipelines made by the first frame
+            record("raster", f, setup);
+            if (held) {
+                rasterRenderer->update(s, scenes[0].camera);
+                record("raster-held", rasterRenderer->render(), 0.0);
+            }
+            if (settings.raster.validate && rasterRenderer->validationMessages() > 0)
+                throw std::runtime_error("the Vulkan validation layer reported " +
+                                         std::to_string(rasterRenderer->validationMessages()) +
+                                         " message(s) (printed above)");
+        }
+        for (const auto& [name, ms] : line["frame_ms"].items()) times[name].push_back(ms.get<double>());
+        for (const auto& [name, ms] : line["setup_ms"].items())
+            if (ms.get<double>() > 0.0 || !setupMs.count(name)) setupMs[name] = ms.get<double>();
+        appendLine(journal, line.dump());
+        if (options.progress)
+            options.progress("frame " + std::to_string(t + 1) + "/" + std::to_string(result.frames));
+    }
+    if (sharded) return result;  // measured by mergePathShards, from every shard's frames
+    measurePath(result, dir, base.file.string(), names, setupMs, times);
     return result;
 }
 
@@ -605,6 +684,256 @@ Json toJson(const PathResult& r) {
                            {"frame_ms", r.referenceFrameMs},
                            {"temporal", toJson(r.referenceTemporal)}}},
             {"methods", methods}};
+}
+
+std::vector<int> pathShardFrames(int frames, int index, int count) {
+    std::vector<int> out;
+    for (int t = index; count > 0 && t < frames; t += count) out.push_back(t);
+    return out;
+}
+
+namespace {
+
+// The shard folders under `input`: itself when it holds shard.json, else its shard-* folders.
+std::vector<fs::path> pathShardFolders(const fs::path& input) {
+    std::error_code ec;
+    std::vector<fs::path> dirs;
+    if (fs::exists(input / "shard.json", ec)) return {input};
+    for (const auto& e : fs::directory_iterator(input, ec))
+        if (e.is_directory() && e.path().filename().string().rfind("shard-", 0) == 0 && fs::exists(e.path() / "shard.json"))
+            dirs.push_back(e.path());
+    std::sort(dirs.begin(), dirs.end());
+    return dirs;
+}
+
+Json readJsonFile(const fs::path& file) {
+    std::ifstream in(file);
+    if (!in) throw scene::InputError(file.string() + ": cannot read");
+    try {
+        return Json::parse(in);
+    } catch (const Json::exception& e) {
+        throw scene::InputError(file.string() + ": not JSON (" + std::string(e.what()) + ")");
+    }
+}
+
+// The first field in which two path identities differ, in words; empty when they are one path's.
+std::string identityDifference(const Json& a, const Json& b) {
+    for (const auto& [key, value] : a.items())
+        if (!b.contains(key) || b[key] != value)
+            return key + " " + value.dump() + " vs " + (b.contains(key) ? b[key].dump() : std::string("(none)"));
+    for (const auto& [key, value] : b.items())
+        if (!a.contains(key)) return key + " (none) vs " + value.dump();
+    return "";
+}
+
+// Links src to dst (same file system) or copies it, through a temporary name.
+void placeFile(const fs::path& src, const fs::path& dst) {
+    std::error_code ec;
+    if (fs::exists(dst, ec) && fs::equivalent(src, dst, ec)) return;
+    const fs::path tmp = scene::temporarySibling(dst);
+    fs::create_hard_link(src, tmp, ec);
+    if (ec) {
+        ec.clear();
+        fs::copy_file(src, tmp, fs::copy_options::overwrite_existing, ec);
+        if (ec) {
+            fs::remove(tmp, ec);
+            throw scene::InputError(dst.string() + ": cannot copy " + src.string() + " here");
+        }
+    }
+    fs::rename(tmp, dst);
+}
+
+std::string quoted(const std::string& s) {
+    if (s.find_first_of(" \t'\"$\\") == std::string::npos) return s;
+    std::string q = "'";
+    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+}  // namespace
+
+bool holdsPathShards(const std::vector<fs::path>& inputs) {
+    for (const fs::path& input : inputs) {
+        std::error_code ec;
+        if (!fs::is_directory(input, ec)) continue;
+        for (const fs::path& d : pathShardFolders(input)) {
+            std::ifstream in(d / "shard.json");
+            const Json j = Json::parse(in, nullptr, false);
+            return j.is_object() && j.value("study", "") == "path";
+        }
+    }
+    return false;
+}
+
+MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& out) {
+    if (inputs.empty()) throw scene::InputError("merge: no input folder");
+    MergedPath merged;
+    Json identity, manifest;
+    std::string sceneFile;
+    fs::path firstDir, base;
+    int frames = 0;
+    std::map<int, fs::path> shardOf;                          // shard index → its first folder
+    std::map<int, std::pair<fs::path, Json>> lines;           // frame → (folder, journal line)
+    std::error_code ec;
+    for (const fs::path& input : inputs) {
+        if (!fs::is_directory(input, ec)) throw scene::InputError(input.string() + ": no such folder");
+        const std::vector<fs::path> dirs = pathShardFolders(input);
+        if (dirs.empty()) throw scene::InputError(input.string() + ": holds no path shard (shard-K-of-N/shard.json)");
+        if (base.empty()) base = dirs.size() == 1 && dirs.front() == input ? input.parent_path() : input;
+        for (const fs::path& d : dirs) {
+            const fs::path file = d / "shard.json";
+            const Json j = readJsonFile(file);
+            if (!j.is_object() || j.value("study", "") != "path" || !j.contains("identity") || !j.contains("shard") ||
+                !j.contains("frames"))
+                throw scene::InputError(file.string() + ": not the manifest of a path shard (a sweep's or a check's "
+                                        "shards are merged on their own)");
+            const int index = j["shard"].value("index", -1), count = j["shard"].value("count", 0);
+            if (identity.is_null()) {
+                identity = j["identity"];
+                sceneFile = j.value("scene", "");
+                frames = j["frames"].get<int>();
+                merged.shardCount = count;
+                firstDir = d;
+                manifest = readJsonFile(d / "path.json");
+            } else if (const std::string diff = identityDifference(identity, j["identity"]); !diff.empty()) {
+                throw scene::InputError(d.string() + ": a shard of another path than " + firstDir.string() + " (" +
+                                        diff + ")");
+            } else if (count != merged.shardCount) {
+                throw scene::InputError(d.string() + ": a shard of a split into " + std::to_string(count) +
+                                        ", not " + std::to_string(merged.shardCount) + " as " + firstDir.string());
+            }
+            if (!(index >= 0 && index < count)) throw scene::InputError(file.string() + ": shard index out of range");
+            merged.shardDirs.push_back(d);
+            shardOf.emplace(index, d);
+            // The journal, strictly: a damaged line is an error, a torn last line a frame not finished.
+            const fs::path journal = d / "frames.jsonl";
+            if (!fs::exists(journal, ec)) continue;
+            std::ifstream in(journal, std::ios::binary);
+            std::ostringstream all;
+            all << in.rdbuf();
+            const std::string text = all.str();
+            std::size_t begin = 0;
+            for (int line = 1; begin < text.size(); ++line) {
+                const std::size_t end = text.find('\n', begin);
+                const bool torn = end == std::string::npos;
+                const std::string l = text.substr(begin, torn ? std::string::npos : end - begin);
+                begin = torn ? text.size() : end + 1;
+                if (l.empty()) continue;
+                Json row;
+                int t = -1;
+                try {
+                    row = Json::parse(l);
+                    t = row.at("frame").get<int>();
+                    row.at("frame_ms").items();
+                } catch (const std::exception&) {
+                    if (torn) break;
+                    throw scene::InputError(journal.string() + ":" + std::to_string(line) +
+                                            ": damaged journal line (not a finished frame)");
+                }
+                if (t < 0 || t >= frames || t % count != index)
+                    throw scene::InputError(journal.string() + ":" + std::to_string(line) + ": frame " +
+                                            std::to_string(t) + " does not belong to shard " + std::to_string(index) +
+                                            "/" + std::to_string(count));
+                if (lines.count(t)) {
+                    ++merged.duplicates;
+                    continue;
+                }
+                lines[t] = {d, row};
+            }
+        }
+    }
+    // Every missing or unfinished shard, in one message, with the command that completes it.
+    std::vector<std::string> problems;
+    const std::string scene = quoted(sceneFile.empty() ? std::string("SCENE") : sceneFile);
+    for (int k = 0; k < merged.shardCount; ++k) {
+        const std::vector<int> want = pathShardFrames(frames, k, merged.shardCount);
+        std::size_t missing = 0;
+        for (int t : want) missing += lines.count(t) ? 0 : 1;
+        if (missing == 0) continue;
+        const std::string name = std::to_string(k) + "/" + std::to_string(merged.shardCount);
+        if (!shardOf.count(k))
+            problems.push_back("shard " + name + " is missing (no " + shardFolderName({k, merged.shardCount}) +
+                               "): render it with `shadowlab path " + scene + " -o " + quoted(base.string()) +
+                               " --shard " + name + "` and the same path options");
+        else
+            problems.push_back("shard " + name + " is unfinished (" + std::to_string(missing) + " of " +
+                               std::to_string(want.size()) + " frames missing): finish it with `shadowlab path " + scene +
+                               " -o " + quoted(base.string()) + " --shard " + name + " --resume` and the same path options");
+    }
+    if (!problems.empty()) {
+        std::string what = "merge: the path is incomplete:";
+        for (const std::string& p : problems) what += "\n  " + p;
+        throw scene::InputError(what);
+    }
+    const std::vector<std::string> names = methodNames(manifest);
+    std::vector<std::string> all = names;
+    all.push_back("reference");
+    for (const auto& [t, entry] : lines)
+        for (const std::string& name : all)
+            if (!fs::exists(entry.first / "frames" / frameName(t, name), ec))
+                throw scene::InputError((entry.first / "frames" / frameName(t, name)).string() +
+                                        ": missing, though the journal lists frame " + std::to_string(t));
+    if (fs::exists(out / "shard.json", ec)) throw scene::InputError(out.string() + ": is a shard folder; merge into another");
+    if (fs::exists(out / "frames.jsonl", ec) && !fs::exists(out / "merge.json", ec))
+        throw scene::InputError(out.string() + ": holds an unsharded path; merge into another folder");
+
+    // The merged folder: the frames linked (or copied), the journal in frame order, the manifest.
+    fs::create_directories(out / "frames");
+    std::map<std::string, double> setupMs;
+    std::map<std::string, std::vector<double>> times;
+    std::string journal;
+    for (const auto& [t, entry] : lines) {
+        for (const std::string& name : all) placeFile(entry.first / "frames" / frameName(t, name), out / "frames" / frameName(t, name));
+        journal += entry.second.dump() + "\n";
+        for (const auto& [name, ms] : entry.second.at("frame_ms").items()) times[name].push_back(ms.get<double>());
+        const Json setups = entry.second.value("setup_ms", Json::object());
+        for (const auto& [name, ms] : setups.items())
+            if (ms.get<double>() > 0.0 || !setupMs.count(name)) setupMs[name] = ms.get<double>();
+    }
+    scene::writeTextAtomic(out / "frames.jsonl", journal);
+    scene::writeTextAtomic(out / "path.json", manifest.dump(2) + "\n");
+    Json dirs = Json::array();
+    for (const fs::path& d : merged.shardDirs) dirs.push_back(d.string());
+    scene::writeTextAtomic(out / "merge.json",
+                           Json{{"shards", merged.shardCount}, {"folders", dirs}, {"duplicates", merged.duplicates}}.dump(2) + "\n");
+
+    PathResult& result = merged.result;
+    result.spec.kind = parsePathKind(manifest.at("kind").get<std::string>());
+    result.spec.frames = frames;
+    result.spec.light = manifest.value("light", 0);
+    if (manifest.contains("animation") && manifest["animation"].is_string())
+        result.spec.animation = manifest["animation"].get<std::string>();
+    result.amount = manifest.at("amount").get<double>();
+    result.spec.amount = result.amount;
+    result.frames = frames;
+    result.resumedFrames = frames;
+    measurePath(result, out, sceneFile, names, setupMs, times);
+    return merged;
+}
+
+std::vector<std::string> pathDifferences(const fs::path& a, const fs::path& b) {
+    const std::function<void(Json&)> strip = [&](Json& j) {
+        if (j.is_object()) {
+            for (const char* k : {"setup_ms", "median_frame_ms", "frame_ms", "method_timing", "reference_timing",
+                                  "resumed_frames"})
+                j.erase(k);
+            for (auto& [key, value] : j.items()) strip(value);
+        } else if (j.is_array()) {
+            for (Json& v : j) strip(v);
+        }
+    };
+    Json ja = readJsonFile(a / "metrics.json"), jb = readJsonFile(b / "metrics.json");
+    strip(ja);
+    strip(jb);
+    std::vector<std::string> out;
+    for (const Json& op : Json::diff(ja, jb)) {
+        const std::string at = op.value("path", "");
+        const Json::json_pointer p(at);
+        out.push_back(at + ": " + (ja.contains(p) ? ja[p].dump() : std::string("(none)")) + " vs " +
+                      (jb.contains(p) ? jb[p].dump() : std::string("(none)")));
+        if (out.size() >= 20) break;
+    }
+    return out;
 }
 
 }  // namespace shadowlab::compare

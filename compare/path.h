@@ -22,8 +22,10 @@ namespace shadowlab::compare {
 // toward the look-at point; pan: camera and look-at move along the view's right axis; subtexel:
 // camera and look-at move diagonally (right + up) by a fraction of the smaller of a shadow texel
 // and a pixel's footprint per frame; sun-azimuth / sun-elevation: a directional light turns about
-// world Y / about its horizontal axis; light-move: a spot or point light moves along world X.
-enum class PathKind { Orbit, Dolly, Pan, SubTexel, SunAzimuth, SunElevation, LightMove };
+// world Y / about its horizontal axis; light-move: a spot or point light moves along world X;
+// gltf-animation: the camera follows a glTF animation of a camera's node (scene/camera_animation.h),
+// sampled at N evenly spaced times from its first key to its last.
+enum class PathKind { Orbit, Dolly, Pan, SubTexel, SunAzimuth, SunElevation, LightMove, GltfAnimation };
 const char* toString(PathKind kind);
 // Throws scene::InputError naming the option and the kinds.
 PathKind parsePathKind(const std::string& text);
@@ -38,7 +40,10 @@ struct PathSpec {
     // min(texel, pixel footprint) (0.1); light-move: the fraction of the scene's diagonal (0.1).
     std::optional<double> amount;
     int light = 0;  // the light a light path moves
+    std::string animation;  // gltf-animation: its name or index; empty: the first camera animation
 };
+// The scene's "path" block as a PathSpec (the loader has checked its values).
+PathSpec pathSpecOf(const scene::PathBlock& block);
 double defaultAmount(PathKind kind);
 
 // The per-frame step of a subtexel path in world units (amount × min(texel, pixel footprint at
@@ -48,8 +53,9 @@ struct SubTexelStep {
 };
 SubTexelStep subTexelStep(const scene::Scene& scene, const scene::RasterSettings& settings, double amount);
 
-// The scene of every frame (frame 0 is `base` itself). Throws scene::InputError for a path the
-// scene cannot have (a light path without that light, a sun path on a point light, < 2 frames).
+// The scene of every frame (frame 0 is `base` itself, except for gltf-animation, whose frame 0 is
+// the animation's first key). Throws scene::InputError for a path the scene cannot have (a light
+// path without that light, a sun path on a point light, < 2 frames, no such camera animation).
 std::vector<scene::Scene> pathScenes(const scene::Scene& base, const scene::RenderSettings& settings,
                                      const PathSpec& spec);
 
@@ -62,6 +68,10 @@ struct PathRunOptions {
     // which removes the image's own motion (docs/temporal.md).
     bool heldView = true;
     std::function<void(const std::string&)> progress;  // one line per finished frame
+    // Sharded (`path --shard K/N`, shardCount > 0): render only the frames t with t mod N = K into
+    // outputDir/shard-K-of-N, with its shard.json, and measure nothing; mergePathShards measures
+    // the merged frames (docs/temporal.md).
+    int shardIndex = 0, shardCount = 0;
 };
 
 // One method along the path.
@@ -92,5 +102,31 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
                    const PathRunOptions& options);
 
 nlohmann::json toJson(const PathResult& result);
+
+// The frames shard K of N renders: t with t mod N = K, in order (none when K ≥ frames).
+std::vector<int> pathShardFrames(int frames, int index, int count);
+
+// True when the inputs hold shards of a path (a shard.json naming a path study).
+bool holdsPathShards(const std::vector<std::filesystem::path>& inputs);
+
+struct MergedPath {
+    PathResult result;
+    int shardCount = 0;
+    std::vector<std::filesystem::path> shardDirs;
+    std::size_t duplicates = 0;  // frames found in more than one shard folder (a rerun), merged once
+};
+// Reads the path shards under `inputs` (shard folders, or folders holding shard-K-of-N folders),
+// checks that they are of one path (program version, scene hash, kind, frames, amount, settings,
+// methods) and one split, and that every frame is there, then writes `out` as the unsharded path
+// writes its folder (frames/, frames.jsonl, path.json, metrics.json, the report; plus merge.json)
+// and measures it from the merged frames. Throws scene::InputError naming the folder when a shard
+// is of another path, a frame is in the wrong shard or a journal line is damaged, and, with the
+// command that renders them, every missing or unfinished shard; nothing is written then.
+MergedPath mergePathShards(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& out);
+
+// What differs between two path folders' metrics.json, leaving out what timing measures (setup and
+// frame times, compare's stage timings) and how many frames were resumed: one line per difference
+// (a JSON pointer and both values), empty when they hold the same figures. Throws scene::InputError.
+std::vector<std::string> pathDifferences(const std::filesystem::path& a, const std::filesystem::path& b);
 
 }  // namespace shadowlab::compare

@@ -134,6 +134,7 @@ SweepIdentity sweepIdentity(const scene::Scene& scene, const SweepGrid& grid) {
     Fnv f;
     for (const std::string& k : id.keys) f.add(k);
     f.add("repetitions=" + std::to_string(grid.repetitions));
+    if (grid.flicker) f.add("flicker=" + flickerKey(*grid.flicker));  // only with the axis: other hashes stay
     id.gridHash = f.hex();
     return id;
 }

@@ -69,6 +69,8 @@ Json overridesToJson(const scene::SettingsOverrides& o) {
     if (o.hardwareBias) j["hardware_bias"] = *o.hardwareBias;
     if (o.fitLightFrustum) j["fit_light_frustum"] = *o.fitLightFrustum;
     if (o.cascades) j["cascades"] = *o.cascades;
+    if (o.snapLightFrustum) j["snap_light_frustum"] = *o.snapLightFrustum;
+    if (o.cascadeBlend) j["cascade_blend"] = *o.cascadeBlend;
     return j;
 }
 
@@ -87,6 +89,8 @@ scene::SettingsOverrides overridesFromJson(const Json& j) {
     if (j.contains("hardware_bias")) o.hardwareBias = j["hardware_bias"].get<bool>();
     if (j.contains("fit_light_frustum")) o.fitLightFrustum = j["fit_light_frustum"].get<bool>();
     if (j.contains("cascades")) o.cascades = j["cascades"].get<int>();
+    if (j.contains("snap_light_frustum")) o.snapLightFrustum = j["snap_light_frustum"].get<bool>();
+    if (j.contains("cascade_blend")) o.cascadeBlend = j["cascade_blend"].get<double>();
     return o;
 }
 
@@ -108,6 +112,7 @@ Json rowToJson(const SweepRow& r) {
               {"image", r.image},
               {"diff_image", r.diffImage}};
     if (!r.machine.is_null()) j["machine"] = r.machine;
+    if (!r.temporal.is_null()) j["temporal"] = r.temporal;
     return j;
 }
 
@@ -131,6 +136,7 @@ SweepRow rowFromJson(const Json& j) {
     r.image = j.value("image", "");
     r.diffImage = j.value("diff_image", "");
     r.machine = j.value("machine", Json(nullptr));
+    r.temporal = j.value("temporal", Json(nullptr));
     return r;
 }
 
@@ -176,6 +182,9 @@ std::string SweepConfig::key() const {
     if (o.hardwareBias) k += std::string(";hardware_bias=") + (*o.hardwareBias ? "1" : "0");
     if (o.fitLightFrustum) k += std::string(";fit_light_frustum=") + (*o.fitLightFrustum ? "1" : "0");
     if (o.cascades) k += ";cascades=" + std::to_string(*o.cascades);
+    // Appended only when set, so the keys of rows without them stay as they were.
+    if (o.snapLightFrustum) k += std::string(";snap=") + (*o.snapLightFrustum ? "1" : "0");
+    if (o.cascadeBlend) k += ";cascade_blend=" + number(*o.cascadeBlend);
     return k;
 }
 
@@ -195,10 +204,38 @@ std::string SweepConfig::label() const {
     if (o.hardwareBias) parts.push_back(*o.hardwareBias ? "hardware bias" : "shader bias");
     if (o.fitLightFrustum) parts.push_back(*o.fitLightFrustum ? "fitted frustum" : "bounds frustum");
     if (o.cascades) parts.push_back(std::to_string(*o.cascades) + (*o.cascades == 1 ? " cascade" : " cascades"));
+    if (o.snapLightFrustum) parts.push_back(*o.snapLightFrustum ? "snapped" : "unsnapped");
+    if (o.cascadeBlend) parts.push_back("blend " + number(*o.cascadeBlend));
     std::string s = backend + ":";
     for (std::size_t i = 0; i < parts.size(); ++i) s += (i ? ", " : " ") + parts[i];
     if (parts.empty()) s += " defaults";
     return s;
+}
+
+double SweepRow::temporalValue(const char* name, bool held) const {
+    const Json* t = &temporal;
+    if (held) t = temporal.is_object() && temporal.contains("held") ? &temporal["held"] : nullptr;
+    if (!t || !t->is_object() || !t->contains(name) || !(*t)[name].is_number())
+        return std::numeric_limits<double>::quiet_NaN();
+    return (*t)[name].get<double>();
+}
+
+PathSpec defaultFlickerPath() {
+    PathSpec p;
+    p.kind = PathKind::SubTexel;
+    p.frames = 4;
+    return p;
+}
+
+std::vector<scene::Scene> flickerScenes(const scene::Scene& scene, const PathSpec& path) {
+    return pathScenes(scene, scene::resolveSettings(scene, {}), path);
+}
+
+std::string flickerKey(const PathSpec& p) {
+    std::string k = std::string("kind=") + toString(p.kind) + ";frames=" + std::to_string(p.frames) +
+                    ";amount=" + number(p.amount.value_or(defaultAmount(p.kind))) + ";light=" + std::to_string(p.light);
+    if (p.kind == PathKind::GltfAnimation) k += ";animation=" + p.animation;
+    return k;
 }
 
 double SweepRow::rate(const char* name) const {
@@ -320,8 +357,10 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
     SweepGrid g;
     g.configs.clear();
     for (const auto& [key, value] : doc.items()) {
-        if (key != "repetitions" && key != "resolution" && key != "raster" && key != "raytrace" && key != "include_default")
-            throw SceneError(file, root / key, "unknown key; allowed: repetitions, resolution, raster, raytrace, include_default");
+        if (key != "repetitions" && key != "resolution" && key != "raster" && key != "raytrace" && key != "include_default" &&
+            key != "flicker")
+            throw SceneError(file, root / key,
+                             "unknown key; allowed: repetitions, resolution, raster, raytrace, include_default, flicker");
     }
     if (doc.contains("repetitions")) {
         const Json& r = doc["repetitions"];
@@ -338,6 +377,55 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
             x != 'x' || w < 1 || h < 1 || w > 16384 || h > 16384)
             throw SceneError(file, root / "resolution", "expected \"WxH\" with sides in 1..16384, got " + scene::describeJson(res));
         g.resolution = res.get<std::string>();
+    }
+    if (doc.contains("flicker")) {
+        // true: the default path; an object: its kind, frames, amount and light (docs/sweep.md).
+        const Json& f = doc["flicker"];
+        const JsonPath at = root / "flicker";
+        if (f.is_boolean()) {
+            if (f.get<bool>()) g.flicker = defaultFlickerPath();
+        } else if (f.is_object()) {
+            PathSpec p = defaultFlickerPath();
+            for (const auto& [k, v] : f.items()) {
+                if (k == "kind") {
+                    if (!v.is_string()) throw SceneError(file, at / k, "expected a path kind, got " + scene::describeJson(v));
+                    try {
+                        p.kind = parsePathKind(v.get<std::string>());
+                    } catch (const scene::InputError& e) {
+                        throw SceneError(file, at / k, std::string(e.what()).substr(std::string("--kind: ").size()));
+                    }
+                } else if (k == "frames") {
+                    if (!v.is_number_integer() || v.get<long long>() < 2 || v.get<long long>() > 64)
+                        throw SceneError(file, at / k, "expected an integer in 2..64 (every row renders them), got " +
+                                                           scene::describeJson(v));
+                    p.frames = v.get<int>();
+                } else if (k == "amount") {
+                    if (!v.is_number() || !std::isfinite(v.get<double>()))
+                        throw SceneError(file, at / k, "expected a finite number, got " + scene::describeJson(v));
+                    p.amount = v.get<double>();
+                } else if (k == "light") {
+                    if (!v.is_number_integer() || v.get<long long>() < 0 || v.get<long long>() > 1000)
+                        throw SceneError(file, at / k, "expected a light index, got " + scene::describeJson(v));
+                    p.light = v.get<int>();
+                } else if (k == "animation") {
+                    if (!v.is_string()) throw SceneError(file, at / k, "expected a name or index as a string");
+                    p.animation = v.get<std::string>();
+                } else {
+                    throw SceneError(file, at / k, "unknown key; allowed: kind, frames, amount, light, animation");
+                }
+            }
+            g.flicker = p;
+        } else {
+            throw SceneError(file, at, "expected true, false or an object {kind, frames, amount, light}, got " +
+                                           scene::describeJson(f));
+        }
+        if (g.flicker) {
+            try {
+                flickerScenes(scene, *g.flicker);
+            } catch (const scene::InputError& e) {
+                throw SceneError(file, at, e.what());
+            }
+        }
     }
     if (doc.contains("include_default") && !doc["include_default"].is_boolean())
         throw SceneError(file, root / "include_default", "expected true or false, got " + scene::describeJson(doc["include_default"]));
@@ -360,8 +448,9 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
         if (!block.is_object()) throw SceneError(file, path, "expected an object of axes");
         const bool isRaster = std::string(backend) == "raster";
         const std::vector<const char*> names = isRaster
-            ? std::vector<const char*>{"shadow_map_size", "filter", "cascades", "receiver_plane_bias", "hardware_bias",
-                                       "depth_bias", "slope_bias"}
+            ? std::vector<const char*>{"shadow_map_size", "filter", "cascades", "cascade_blend", "fit_light_frustum",
+                                       "snap_light_frustum", "receiver_plane_bias", "hardware_bias", "depth_bias",
+                                       "slope_bias"}
             : std::vector<const char*>{"ray_bias", "precision", "samples"};
         for (const auto& [key, value] : block.items())
             if (std::none_of(names.begin(), names.end(), [&](const char* n) { return key == n; }))
@@ -397,9 +486,23 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
                             throw SceneError(file, at, "expected an integer in 16..16384, got " + scene::describeJson(v));
                         c.overrides.shadowMapSize = v.get<int>();
                     } else if (n == "filter") {
-                        if (!v.is_string() || (v.get<std::string>() != "none" && v.get<std::string>() != "pcf2x2"))
-                            throw SceneError(file, at, "expected \"none\" or \"pcf2x2\", got " + scene::describeJson(v));
-                        c.overrides.filter = v.get<std::string>();
+                        const std::string f = v.is_string() ? v.get<std::string>() : std::string();
+                        if (f != "none" && f != "pcf2x2" && f != "pcf" && f != "poisson" && f != "pcss")
+                            throw SceneError(file, at, "expected \"none\", \"pcf2x2\", \"pcf\", \"poisson\" or \"pcss\", got " +
+                                                           scene::describeJson(v));
+                        c.overrides.filter = f;
+                    } else if (n == "cascade_blend") {
+                        const double b = num(0.0);
+                        if (b > scene::kMaxCascadeBlend)
+                            throw SceneError(file, at, "expected a number in 0..0.5 (a fraction of a slice), got " +
+                                                           scene::describeJson(v));
+                        c.overrides.cascadeBlend = b;
+                    } else if (n == "fit_light_frustum") {
+                        if (!v.is_boolean()) throw SceneError(file, at, "expected true or false, got " + scene::describeJson(v));
+                        c.overrides.fitLightFrustum = v.get<bool>();
+                    } else if (n == "snap_light_frustum") {
+                        if (!v.is_boolean()) throw SceneError(file, at, "expected true or false, got " + scene::describeJson(v));
+                        c.overrides.snapLightFrustum = v.get<bool>();
                     } else if (n == "cascades") {
                         if (!v.is_number_integer() || v.get<long long>() < 1 || v.get<long long>() > scene::kMaxCascades)
                             throw SceneError(file, at, "expected an integer in 1.." + std::to_string(scene::kMaxCascades) +
@@ -493,6 +596,61 @@ std::function<scene::Frame()> frameSource(const SweepOptions& options, const sce
     return [&options, &scene, &settings, backend] { return options.render(scene, settings, backend); };
 }
 
+std::vector<const scene::Frame*> pointersTo(const std::vector<scene::Frame>& frames) {
+    std::vector<const scene::Frame*> p;
+    for (const scene::Frame& f : frames) p.push_back(&f);
+    return p;
+}
+
+Json temporalFigures(const TemporalSummary& t) {
+    Json pairs = Json::array();
+    for (const PairStability& p : t.pairs) pairs.push_back(p.flicker);
+    return {{"flicker_rate", t.meanFlickerRate},     {"max_flicker_rate", t.maxFlickerRate},
+            {"flicker_px", t.totalFlicker},          {"error_variation", t.meanErrorVariation},
+            {"swim_px", t.meanSwimPixels},           {"edge_offset_px", t.meanEdgeOffset},
+            {"pairs", pairs}};
+}
+
+// One configuration along the flicker axis's path, measured against the path's references. With
+// the default render function one Renderer (raster) or acceleration structure (ray tracer) serves
+// every frame, as `path` renders them, and a camera path adds the raster held view (each frame's
+// shadow setup drawn from frame 0's camera, docs/temporal.md); other render functions render each
+// frame anew and have no held view.
+Json rowTemporal(const SweepOptions& options, const PathSpec& spec, const std::vector<scene::Scene>& scenes,
+                 const std::vector<scene::Frame>& refs, const scene::RenderSettings& settings, const std::string& backend) {
+    using Fn = scene::Frame (*)(const scene::Scene&, const scene::RenderSettings&, const std::string&);
+    const Fn* fn = options.render.target<Fn>();
+    const bool real = fn && *fn == &renderWithBackend;
+    std::vector<scene::Frame> frames, held;
+    if (real && backend == "raster") {
+        raster::Renderer r(scenes[0], scene::makeRenderPlan(scenes[0], settings), settings.raster);
+        for (const scene::Scene& s : scenes) {
+            r.update(s);
+            frames.push_back(r.render());
+            if (isCameraPath(spec.kind)) {
+                r.update(s, scenes[0].camera);
+                held.push_back(r.render());
+            }
+        }
+        if (settings.raster.validate && r.validationMessages() > 0)
+            throw std::runtime_error("the Vulkan validation layer reported " + std::to_string(r.validationMessages()) +
+                                     " message(s) along the flicker path (printed above)");
+    } else if (real && backend == "raytrace") {
+        const raytrace::Renderer tracer(scenes[0], settings.raytrace, false);
+        for (const scene::Scene& s : scenes) frames.push_back(tracer.render(s, scene::makeRenderPlan(s, settings)));
+    } else {
+        for (const scene::Scene& s : scenes) frames.push_back(options.render(s, settings, backend));
+    }
+    Json j = temporalFigures(measureTemporal(pointersTo(frames), pointersTo(refs)));
+    j["path"] = toString(spec.kind);
+    j["frames"] = int(scenes.size());
+    if (!held.empty()) {
+        const std::vector<const scene::Frame*> still(held.size(), &refs[0]);
+        j["held"] = temporalFigures(measureTemporal(pointersTo(held), still));
+    }
+    return j;
+}
+
 }  // namespace
 
 std::vector<SweepRow> readJournal(const fs::path& file) {
@@ -521,7 +679,16 @@ std::string rowsToCsv(const std::vector<SweepRow>& rows) {
     s << "key,backend,label,shadow_map_size,filter,cascades,depth_bias,slope_bias,ray_bias,precision,samples,"
          "bias_kind,bias_value,repetitions,setup_ms,frame_ms,frame_ms_min,frame_ms_max";
     for (const char* m : kMetrics) s << "," << m;
-    s << ",error,machine\n";
+    s << ",error,machine";
+    // The flicker axis's columns, only when a row has them: a sweep without it writes what it did.
+    static const char* kTemporal[] = {"flicker_rate", "flicker_px", "error_variation", "swim_px", "edge_offset_px"};
+    const bool temporal = std::any_of(rows.begin(), rows.end(), [](const SweepRow& r) { return !r.temporal.is_null(); });
+    if (temporal) {
+        s << ",flicker_path";
+        for (const char* t : kTemporal) s << "," << t;
+        for (const char* t : kTemporal) s << ",held_" << t;
+    }
+    s << "\n";
     for (const SweepRow& r : rows) {
         const auto& o = r.config.overrides;
         s << csvField(r.key) << "," << r.config.backend << "," << csvField(r.config.label()) << ","
@@ -534,7 +701,16 @@ std::string rowsToCsv(const std::vector<SweepRow>& rows) {
           << number(r.setupMs) << "," << number(r.frameMs) << "," << number(r.frameMsMin) << ","
           << number(r.frameMsMax);
         for (const char* m : kMetrics) s << "," << jsonNumber(r.metrics, m);
-        s << "," << csvField(r.error) << "," << csvField(machineFromJson(r.machine).host) << "\n";
+        s << "," << csvField(r.error) << "," << csvField(machineFromJson(r.machine).host);
+        if (temporal) {
+            s << "," << csvField(r.temporal.is_object() ? r.temporal.value("path", "") : "");
+            for (bool held : {false, true})
+                for (const char* t : kTemporal) {
+                    const double v = r.temporalValue(t, held);
+                    s << "," << (std::isfinite(v) ? number(v) : "");
+                }
+        }
+        s << "\n";
     }
     return s.str();
 }
@@ -571,8 +747,8 @@ SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const
     const fs::path manifest = dir / "sweep.json";
 
     const scene::Scene scene = sweepScene(baseScene, grid);
-    const Json identity = {{"scene", scene.file.string()},
-                           {"resolution", {scene.camera.width, scene.camera.height}}};
+    Json identity = {{"scene", scene.file.string()}, {"resolution", {scene.camera.width, scene.camera.height}}};
+    if (grid.flicker) identity["flicker"] = flickerKey(*grid.flicker);  // absent without the axis
 
     std::error_code ec;
     if (fs::exists(journal, ec) && !options.resume)
@@ -631,6 +807,38 @@ SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const
     std::map<std::string, SweepRow> byKey;
     for (SweepRow& r : done) byKey[r.key] = std::move(r);
 
+    // The flicker axis: the path's frames, and their references (rendered when a row first needs
+    // them, cached as DIR/flicker/reference-NNNN.exr; frame 0 is the sweep's reference).
+    std::vector<scene::Scene> pathFrames;
+    std::vector<scene::Frame> pathReferences;
+    if (grid.flicker) pathFrames = flickerScenes(scene, *grid.flicker);
+    auto pathReferencesReady = [&]() -> const std::vector<scene::Frame>& {
+        if (!pathReferences.empty() || pathFrames.empty()) return pathReferences;
+        fs::create_directories(dir / "flicker");
+        pathReferences.push_back(result.reference);
+        for (std::size_t t = 1; t < pathFrames.size(); ++t) {
+            char name[40];
+            std::snprintf(name, sizeof name, "reference-%04zu.exr", t);
+            const fs::path file = dir / "flicker" / name;
+            scene::Frame f;
+            bool cached = false;
+            if (fs::exists(file, ec)) {
+                try {
+                    f = scene::readFrame(file);
+                    cached = f.width == scene.camera.width && f.height == scene.camera.height;
+                } catch (const std::exception&) {
+                    cached = false;
+                }
+            }
+            if (!cached) {
+                f = options.render(pathFrames[t], scene::resolveSettings(pathFrames[t], {}), "reference");
+                scene::writeFrame(f, file);
+            }
+            pathReferences.push_back(std::move(f));
+        }
+        return pathReferences;
+    };
+
     SweepProgress progress;
     progress.total = grid.configs.size();
     std::vector<SweepRow> rows;
@@ -672,6 +880,8 @@ SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const
             row.frameMsMax = *std::max_element(frames.begin(), frames.end());
             const Comparison c = compareFrames(frame, result.reference);
             row.metrics = toJson(c.metrics);
+            if (grid.flicker)
+                row.temporal = rowTemporal(options, *grid.flicker, pathFrames, pathReferencesReady(), settings, config.backend);
             row.settings = frame.attributes;
             if (options.writeImages) {
                 const std::string name = config.backend + "-" + shortHash(key);

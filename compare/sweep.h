@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "compare/path.h"
 #include "scene/frame.h"
 #include "scene/scene.h"
 #include "scene/settings.h"
@@ -43,7 +44,20 @@ struct SweepGrid {
     std::vector<SweepConfig> configs;
     int repetitions = 3;                    // timed frames per configuration (after one warm-up)
     std::optional<std::string> resolution;  // "WxH" for every render of the sweep
+    // The flicker axis (docs/sweep.md): every row is also rendered along this path (one path for
+    // the whole sweep, made with the scene's own settings) and measured with compare/temporal.h;
+    // unset, a sweep renders and writes exactly what it does without it.
+    std::optional<PathSpec> flicker;
 };
+
+// The flicker axis's path when a grid or the command line names none: four frames of sub-texel
+// camera steps of a tenth of min(texel, pixel), where a snapped map must hold still.
+PathSpec defaultFlickerPath();
+// The path's frames as the sweep renders them: pathScenes of `scene` (at the sweep's resolution)
+// with the scene's own settings, so every row moves along the same path. Throws scene::InputError.
+std::vector<scene::Scene> flickerScenes(const scene::Scene& scene, const PathSpec& path);
+// Canonical text of the path, in the sweep's identity (sweep.json, a shard's grid hash).
+std::string flickerKey(const PathSpec& path);
 
 // The grid `sweep` runs without --grid: shadow-map size × filter at default bias, a constant
 // and a slope depth-bias series, and a ray-bias series in float plus robust offsets in float and
@@ -65,8 +79,14 @@ struct SweepRow {
     std::string error;                     // non-empty when the configuration failed
     std::string image, diffImage;          // file names under DIR/images/
     nlohmann::json machine;                // compare::toJson(MachineInfo) it was timed on; null in old journals
+    // With a flicker axis: the row along the path (flicker_rate, flicker_px, error_variation,
+    // swim_px, edge_offset_px, pairs; "held": the same for the raster held view on camera paths).
+    // Null without one.
+    nlohmann::json temporal;
 
     double rate(const char* name) const;   // a metrics rate, NaN when absent
+    // A temporal figure (`held`: of the raster held view), NaN when absent.
+    double temporalValue(const char* name, bool held = false) const;
 };
 
 // Renders one configuration; the default calls the raster or raytrace backend.

@@ -224,16 +224,23 @@ std::string configCard(const SweepRow& r, const std::string& tag, const SweepRep
     return o.str();
 }
 
+bool hasFlicker(const SweepReportInput& in) {
+    return std::any_of(in.rows.begin(), in.rows.end(), [](const SweepRow& r) { return usable(r) && r.temporal.is_object(); });
+}
+
 std::string rowsTable(const SweepReportInput& in, const std::vector<bool>& front) {
     std::map<std::string, Extremes> ext;
     for (const auto& b : backendsOf(in.rows)) ext[b] = extremesOf(in.rows, b);
     const Machines machines = machinesOf(in.rows);
     const bool perMachine = machines.list.size() > 1;
+    const bool temporal = hasFlicker(in);
     std::ostringstream o;
     o << "<table class=\"rows\"><thead><tr><th>#</th><th>backend</th><th>settings</th><th>setup ms</th>"
          "<th>frame ms, median [min–max]</th>"
       << (perMachine ? "<th>timed on</th>" : "")
-      << "<th>false shadow</th><th>missed shadow</th><th>mismatch</th><th>IoU</th><th>images</th></tr></thead><tbody>\n";
+      << "<th>false shadow</th><th>missed shadow</th><th>mismatch</th><th>IoU</th>"
+      << (temporal ? "<th>flicker</th><th>held-view flicker</th><th>swim px</th>" : "")
+      << "<th>images</th></tr></thead><tbody>\n";
     for (std::size_t i = 0; i < in.rows.size(); ++i) {
         const SweepRow& r = in.rows[i];
         if (!usable(r)) continue;
@@ -252,6 +259,13 @@ std::string rowsTable(const SweepReportInput& in, const std::vector<bool>& front
         o << formatPercent(r.rate("false_shadow_rate")) << "</td><td>"
           << formatPercent(r.rate("missed_shadow_rate")) << "</td><td><b>" << formatPercent(r.rate("mismatch_rate"))
           << "</b></td><td>" << formatFixed(r.rate("shadow_iou"), 3) << "</td><td>";
+        if (temporal) {
+            auto cell = [&](double v, bool percent) {
+                return std::isfinite(v) ? (percent ? formatPercent(v) : formatFixed(v, 3)) : std::string("–");
+            };
+            o << cell(r.temporalValue("flicker_rate"), true) << "</td><td>" << cell(r.temporalValue("flicker_rate", true), true)
+              << "</td><td>" << cell(r.temporalValue("swim_px"), false) << "</td><td>";
+        }
         if (!r.image.empty()) o << "<a href=\"" << escapeHtml(r.image) << "\">image</a>";
         if (!r.image.empty() && !r.diffImage.empty()) o << " · ";
         if (!r.diffImage.empty()) o << "<a href=\"" << escapeHtml(r.diffImage) << "\">diff</a>";
@@ -319,6 +333,45 @@ std::string sweepErrorTimeSvg(const SweepReportInput& in) {
     o.title = "Shadow error against per-frame time";
     o.errorName = "mismatch rate (false + missed)";
     return renderSvg(errorTimePlot(points, in.referenceMs, o));
+}
+
+std::string sweepFlickerSvg(const SweepReportInput& in) {
+    ScatterPlot plot;
+    std::string path;
+    for (const SweepRow& r : in.rows)
+        if (usable(r) && r.temporal.is_object()) path = r.temporal.value("path", "") + " path, " +
+                                                        std::to_string(r.temporal.value("frames", 0)) + " frames";
+    plot.title = "Flicker against error (" + path + ")";
+    plot.x.title = "mismatch rate (false + missed)";
+    plot.x.log = true;
+    plot.x.percent = true;
+    plot.y.title = "mean flicker rate per frame pair";
+    plot.y.percent = true;
+    plot.y.min = 0.0;
+    // One series per backend (the moving view), and the raster held view where the path has one.
+    std::vector<std::string> names;
+    std::map<std::string, PlotSeries> series;
+    for (const SweepRow& r : in.rows) {
+        if (!usable(r) || !r.temporal.is_object()) continue;
+        for (bool held : {false, true}) {
+            const double f = r.temporalValue("flicker_rate", held);
+            if (!std::isfinite(f)) continue;
+            const std::string name = r.config.backend + (held ? " held view" : "");
+            if (!series.count(name)) {
+                names.push_back(name);
+                series[name].name = name;
+                series[name].color = backendColor(held ? "raster held view" : r.config.backend, names.size() - 1);
+                series[name].shape = held ? 1 : 0;
+            }
+            series[name].points.push_back(
+                {r.rate("mismatch_rate"), f, "",
+                 rowTitle(r) + ": " + formatPercent(f) + " flicker, " + formatFixed(r.temporalValue("swim_px", held), 3) +
+                     " px swim, " + formatPercent(r.rate("mismatch_rate")) + " wrong, " + formatDuration(r.frameMs) +
+                     " per frame"});
+        }
+    }
+    for (const std::string& n : names) plot.series.push_back(series[n]);
+    return renderSvg(plot);
 }
 
 std::vector<std::string> describeSweep(const SweepReportInput& in, const AutoBias& bias) {
@@ -438,6 +491,14 @@ std::string renderSweepReportHtml(const SweepReportInput& in) {
          "axis). The dashed line is the reference's render time.</p>"
          "<p class=\"small\">Hover a point for its settings. Times come from a shared machine: compare rows "
          "of this sweep with each other, not with other machines.</p></div></div>\n";
+    if (hasFlicker(in))
+        o << "<h2>Flicker against error</h2>\n<div class=\"plots\"><div>" << sweepFlickerSvg(in)
+          << "</div><div><p>Every configuration was also rendered along one short path (the same for all rows) and "
+             "measured against the reference at each frame: the flicker rate is the share of pixels, counted in both "
+             "frames of a pair, whose lit/shadow state changes while the reference's does not (docs/temporal.md). "
+             "Squares are the raster held view: each frame's shadow setup drawn from frame 0's camera, so every "
+             "change is the shadow maps' own (zero for a map that holds still). Error is that of the still frame; "
+             "hover a point for its run time.</p></div></div>\n";
     bool anyBias = false;
     for (const char* kind : kKinds) anyBias = anyBias || bias.primary(kind);
     if (anyBias) {
@@ -475,6 +536,7 @@ std::string renderSweepReportHtml(const SweepReportInput& in) {
 void writeSweepReport(const fs::path& dir, const SweepReportInput& input) {
     const AutoBias bias = recommendBias(input.rows, input.threshold);
     scene::writeTextAtomic(dir / "error-time.svg", sweepErrorTimeSvg(input));
+    if (hasFlicker(input)) scene::writeTextAtomic(dir / "flicker-error.svg", sweepFlickerSvg(input));
     for (const char* kind : kKinds) {
         const BiasSeries* s = bias.primary(kind);
         if (s) {

@@ -47,9 +47,13 @@ std::vector<std::string> describeSweep(const SweepReportInput& input, const Auto
 // The error-against-per-frame-time plot of the sweep (log-log, Pareto front per backend).
 std::string sweepErrorTimeSvg(const SweepReportInput& input);
 
+// With a flicker axis: mean flicker rate against mismatch rate, one series per backend and one for
+// the raster held view (docs/sweep.md).
+std::string sweepFlickerSvg(const SweepReportInput& input);
+
 // Writes dir/report.html, dir/recommended-shadow.json ({"shadow": the block to merge into the
 // scene's "shadow", "measured": what it gained against the defaults, or null}) and beside them error-time.svg and bias-depth.svg,
-// bias-slope.svg, bias-ray.svg for the kinds that have data (a stale one of a kind without data
+// bias-slope.svg, bias-ray.svg for the kinds that have data, flicker-error.svg with a flicker axis (a stale one of a kind without data
 // is removed). Every file is written atomically.
 void writeSweepReport(const std::filesystem::path& dir, const SweepReportInput& input);
 

@@ -413,6 +413,54 @@ void addFileCameras(const Reader& r, Scene& scene, const std::vector<PendingCame
 
 }  // namespace
 
+namespace {
+
+// The "path" block: the kinds and limits of `shadowlab path` (compare/path.h), checked here so a
+// bad value names the file and its JSON path.
+PathBlock readPath(const Reader& r, const Json& node, const JsonPath& path, const Scene& scene) {
+    r.checkKeys(node, path, {"kind", "frames", "amount", "light", "animation"});
+    PathBlock b;
+    b.kind = r.string(r.require(node, path, "kind"), path / "kind");
+    static const char* kKinds[] = {"orbit", "dolly", "pan", "subtexel", "sun-azimuth", "sun-elevation", "light-move",
+                                   "gltf-animation"};
+    if (std::none_of(std::begin(kKinds), std::end(kKinds), [&](const char* k) { return b.kind == k; }))
+        r.fail(path / "kind", "expected orbit, dolly, pan, subtexel, sun-azimuth, sun-elevation, light-move or "
+                              "gltf-animation, got " + describe(node["kind"]));
+    if (node.contains("frames")) b.frames = r.integer(node["frames"], path / "frames", 2, 10000);
+    if (node.contains("amount")) {
+        if (b.kind == "gltf-animation") r.fail(path / "amount", "a glTF animation has no amount (its keys set the motion)");
+        b.amount = r.number(node["amount"], path / "amount");
+        if (b.kind == "dolly" && !(*b.amount < 1.0))
+            r.fail(path / "amount", "a dolly covers a fraction < 1 of the distance, got " + describe(node["amount"]));
+    }
+    const bool lightPath = b.kind == "sun-azimuth" || b.kind == "sun-elevation" || b.kind == "light-move";
+    if (node.contains("light")) {
+        if (!lightPath) r.fail(path / "light", "only a light path (sun-azimuth, sun-elevation, light-move) moves a light");
+        b.light = r.integer(node["light"], path / "light", 0, (long long)(scene.lights.size()) - 1);
+    }
+    if (lightPath) {
+        const Light& l = scene.lights[std::size_t(b.light.value_or(0))];
+        const JsonPath at = node.contains("light") ? path / "light" : path / "kind";
+        if (b.kind != "light-move" && l.type != LightType::Directional)
+            r.fail(at, b.kind + " turns a directional light; light " + std::to_string(b.light.value_or(0)) + " is not one");
+        if (b.kind == "light-move" && l.type == LightType::Directional)
+            r.fail(at, "light-move moves a spot or point light; light " + std::to_string(b.light.value_or(0)) +
+                           " is directional (use sun-azimuth or sun-elevation)");
+    }
+    if (node.contains("animation")) {
+        if (b.kind != "gltf-animation") r.fail(path / "animation", "only a gltf-animation path names an animation");
+        const Json& a = node["animation"];
+        if (a.is_string()) b.animation = a.get<std::string>();
+        else b.animation = std::to_string(r.integer(a, path / "animation", 0, 1000000));
+    }
+    if (b.kind == "gltf-animation")
+        r.fail(path / "kind", "camera animations are read from a .gltf/.glb given as the scene "
+                              "(`shadowlab path MODEL.gltf --camera-animation`); a JSON scene has none");
+    return b;
+}
+
+}  // namespace
+
 ShadowDefaults readShadowBlock(const fs::path& file, const Json& node, const JsonPath& path) {
     return readShadow(Reader(file), node, path);
 }
@@ -452,7 +500,7 @@ Scene parseScene(const fs::path& file, const std::string& text) {
         throw SceneError(file, root, "invalid JSON: " + what + " (numbers must be finite)");
     }
     r.checkKeys(doc, root, {"camera", "background", "ambient", "materials", "lights", "objects", "shadow", "budgets",
-                            "description", "ground", "$schema"});
+                            "description", "ground", "$schema", "path"});
 
     Scene scene;
     scene.file = file;
@@ -527,6 +575,7 @@ Scene parseScene(const fs::path& file, const std::string& text) {
 
     if (doc.contains("shadow")) scene.shadow = readShadow(r, doc["shadow"], root / "shadow");
     if (doc.contains("budgets")) scene.budgets = readBudgets(file, doc["budgets"], root / "budgets");
+    if (doc.contains("path")) scene.path = readPath(r, doc["path"], root / "path", scene);
     checkSceneExtent(scene, true);
     scene.loadBytes = treeBytes + meshCache.peakLoadBytes;
     return scene;
@@ -553,6 +602,7 @@ Scene loadModelScene(const fs::path& file) {
         scene.origin.cameras.push_back({c.name.empty() ? c.nodeName : c.name, file.filename().string(),
                                         cameraFromGltf(c.position, c.forward, c.up, c.yfovRadians, c.znear, c.zfar,
                                                        c.aspect, b, scene.camera)});
+    scene.origin.cameraAnimations = extras.cameraAnimations;
     if (!scene.origin.cameras.empty()) {
         scene.camera = scene.origin.cameras.front().camera;
         scene.origin.choices.emplace_back("view", "file camera 0 of " + std::to_string(scene.origin.cameras.size()) +

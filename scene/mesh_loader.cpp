@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -307,6 +308,79 @@ glm::dmat4 nodeMatrix(const tinygltf::Node& node) {
     return m;
 }
 
+// The animations that move a camera's node (`cameraNodes`: node → its index in out.cameras and its
+// parents' transform): translation and rotation channels, read as curves; scale and weights are left
+// out (they do not move a camera). A channel on a camera node that cannot be sampled is an error.
+void collectCameraAnimations(const tinygltf::Model& model, const std::map<int, std::pair<int, glm::dmat4>>& cameraNodes,
+                             GltfExtras& out, const fs::path& file, const fs::path& sceneFile, const JsonPath& path) {
+    for (std::size_t a = 0; a < model.animations.size(); ++a) {
+        const tinygltf::Animation& anim = model.animations[a];
+        std::map<int, CameraAnimation> byNode;
+        for (std::size_t c = 0; c < anim.channels.size(); ++c) {
+            const tinygltf::AnimationChannel& ch = anim.channels[c];
+            const auto node = cameraNodes.find(ch.target_node);
+            if (node == cameraNodes.end() || (ch.target_path != "translation" && ch.target_path != "rotation")) continue;
+            const std::string at = "animations[" + std::to_string(a) + "].channels[" + std::to_string(c) + "]";
+            if (ch.sampler < 0 || std::size_t(ch.sampler) >= anim.samplers.size())
+                fail(sceneFile, path, file, at + ".sampler: names no sampler (" + std::to_string(anim.samplers.size()) + ")");
+            const tinygltf::AnimationSampler& sampler = anim.samplers[std::size_t(ch.sampler)];
+            const std::string sat = "animations[" + std::to_string(a) + "].samplers[" + std::to_string(ch.sampler) + "]";
+            AnimationCurve curve;
+            if (sampler.interpolation == "LINEAR" || sampler.interpolation.empty())
+                curve.interpolation = AnimationCurve::Interpolation::Linear;
+            else if (sampler.interpolation == "STEP") curve.interpolation = AnimationCurve::Interpolation::Step;
+            else if (sampler.interpolation == "CUBICSPLINE") curve.interpolation = AnimationCurve::Interpolation::CubicSpline;
+            else
+                fail(sceneFile, path, file, sat + ".interpolation: expected LINEAR, STEP or CUBICSPLINE, got '" +
+                                                excerpt(sampler.interpolation) + "'");
+            curve.times = readAccessor(model, sampler.input, 1, file, sceneFile, path);
+            if (curve.times.empty()) fail(sceneFile, path, file, sat + ".input: has no keys");
+            for (std::size_t k = 0; k < curve.times.size(); ++k)
+                if (!std::isfinite(curve.times[k]) || (k > 0 && !(curve.times[k] > curve.times[k - 1])))
+                    fail(sceneFile, path, file, sat + ".input: key times must be finite and increasing (key " +
+                                                    std::to_string(k) + ")");
+            const bool rotation = ch.target_path == "rotation";
+            const int components = rotation ? 4 : 3;
+            const std::vector<double> v = readAccessor(model, sampler.output, components, file, sceneFile, path);
+            const std::size_t perKey = curve.interpolation == AnimationCurve::Interpolation::CubicSpline ? 3 : 1;
+            if (v.size() != curve.times.size() * perKey * std::size_t(components))
+                fail(sceneFile, path, file, sat + ".output: holds " + std::to_string(v.size() / std::size_t(components)) +
+                                                " values for " + std::to_string(curve.times.size()) + " keys (expected " +
+                                                std::to_string(curve.times.size() * perKey) + ")");
+            for (std::size_t i = 0; i < v.size(); i += std::size_t(components)) {
+                glm::dvec4 value(v[i], v[i + 1], v[i + 2], rotation ? v[i + 3] : 0.0);
+                for (int k = 0; k < 4; ++k)
+                    if (!std::isfinite(value[k])) fail(sceneFile, path, file, sat + ".output: a value is not finite");
+                curve.values.push_back(value);
+            }
+            CameraAnimation& ca = byNode[ch.target_node];
+            (rotation ? ca.rotationCurve : ca.translationCurve) = std::move(curve);
+        }
+        for (auto& [nodeIndex, ca] : byNode) {
+            const tinygltf::Node& node = model.nodes[std::size_t(nodeIndex)];
+            if (node.matrix.size() == 16)
+                fail(sceneFile, path, file, "nodes[" + std::to_string(nodeIndex) +
+                                                "]: an animated node must have translation/rotation/scale, not a matrix");
+            ca.name = anim.name;
+            ca.index = int(a);
+            ca.camera = cameraNodes.at(nodeIndex).first;
+            ca.parent = cameraNodes.at(nodeIndex).second;
+            if (node.translation.size() == 3) ca.translation = Vec3(node.translation[0], node.translation[1], node.translation[2]);
+            if (node.rotation.size() == 4)
+                ca.rotation = glm::dvec4(node.rotation[0], node.rotation[1], node.rotation[2], node.rotation[3]);
+            if (node.scale.size() == 3) ca.scale = Vec3(node.scale[0], node.scale[1], node.scale[2]);
+            ca.start = std::numeric_limits<double>::infinity();
+            ca.end = -ca.start;
+            for (const auto* curve : {&ca.translationCurve, &ca.rotationCurve})
+                if (*curve) {
+                    ca.start = std::min(ca.start, (*curve)->times.front());
+                    ca.end = std::max(ca.end, (*curve)->times.back());
+                }
+            out.cameraAnimations.push_back(std::move(ca));
+        }
+    }
+}
+
 // glTF textures are not needed for shadows: accept any image, even a missing one.
 bool ignoreImage(tinygltf::Image*, const int, std::string*, std::string*, int, int,
                  const unsigned char*, int, void*) {
@@ -492,6 +566,7 @@ void loadGltf(const fs::path& file, const std::string& bytes, std::vector<RawIns
     // cycles), so a walk reaches each node once; a second visit means a cycle or a shared child,
     // which would otherwise loop forever or grow exponentially (found by fuzzing).
     std::vector<char> visited(model.nodes.size(), 0);
+    std::map<int, std::pair<int, glm::dmat4>> cameraNodes;  // node → camera index, parents' transform
     while (!stack.empty()) {
         auto [nodeIndex, parent] = stack.back();
         stack.pop_back();
@@ -522,9 +597,14 @@ void loadGltf(const fs::path& file, const std::string& bytes, std::vector<RawIns
             }
             out.push_back({geometry, world});
         }
-        if (extras) collectCameraAndLight(model, node, nodeIndex, world, *extras, file, sceneFile, path);
+        if (extras) {
+            const std::size_t before = extras->cameras.size();
+            collectCameraAndLight(model, node, nodeIndex, world, *extras, file, sceneFile, path);
+            if (extras->cameras.size() > before) cameraNodes[nodeIndex] = {int(before), parent};
+        }
         for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.emplace_back(*c, world);
     }
+    if (extras && !cameraNodes.empty()) collectCameraAnimations(model, cameraNodes, *extras, file, sceneFile, path);
 }
 
 // A transform that can place a mesh: finite, invertible linear part (a glTF node may scale by

@@ -35,6 +35,9 @@ struct GltfLight {
 struct GltfExtras {
     std::vector<GltfCamera> cameras;
     std::vector<GltfLight> lights;
+    // Animations whose translation or rotation channels move a camera's node; `camera` indexes
+    // `cameras` (scene/camera_animation.h samples them).
+    std::vector<CameraAnimation> cameraAnimations;
     std::uint64_t loadBytes = 0;  // the file's temporaries while it was read (text, trees, buffers)
 };
 

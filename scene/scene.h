@@ -165,11 +165,37 @@ struct FileCamera {
     Camera camera;       // the scene's image size; near/far from the file or the scene's size
 };
 
+// One animated property of a glTF node (glTF 2.0, 3.11): key times in seconds and values, xyz for
+// a translation, a quaternion xyzw for a rotation; CUBICSPLINE keys hold three values each (in-tangent,
+// value, out-tangent).
+struct AnimationCurve {
+    enum class Interpolation { Linear, Step, CubicSpline };
+    Interpolation interpolation = Interpolation::Linear;
+    std::vector<double> times;
+    std::vector<glm::dvec4> values;
+};
+
+// A glTF animation's channels that move the node of one of the file's cameras, kept so a path study
+// can sample the camera along it (scene/camera_animation.h). The node's parents are not animated.
+struct CameraAnimation {
+    std::string name;  // the animation's "name" ("" when unnamed)
+    int index = -1;    // in the file's animations
+    int camera = -1;   // into SceneOrigin::cameras
+    glm::dmat4 parent{1.0};  // the node's parents' transform
+    Vec3 translation{0, 0, 0};
+    glm::dvec4 rotation{0, 0, 0, 1};  // xyzw
+    Vec3 scale{1, 1, 1};
+    std::optional<AnimationCurve> translationCurve, rotationCurve;
+    double start = 0.0, end = 0.0;  // the keys' time range, seconds
+};
+
 // Where a scene's view, sun and ground came from: what its files hold, what is left to choose
 // (a glTF given as the scene without a camera or a light; see scene/model_view.h and
 // raytrace/view_search.h), and each choice in words for --explain and the Frame's attributes.
 struct SceneOrigin {
     std::vector<FileCamera> cameras;
+    // Animations of those cameras' nodes (a .gltf/.glb given as the scene; `path --camera-animation`).
+    std::vector<CameraAnimation> cameraAnimations;
     bool modelScene = false;   // a .gltf/.glb given directly as the scene
     bool chooseView = false;   // the camera is a placeholder: a view search replaces it
     bool chooseSun = false;    // lights[0] is a placeholder sun: a view search replaces its direction
@@ -178,6 +204,16 @@ struct SceneOrigin {
     // ("view", "searched: ..."), ("sun", ...), ("ground", ...): printed by --explain, recorded
     // in every Frame as attributes "choice.view", "choice.sun", ...
     std::vector<std::pair<std::string, std::string>> choices;
+};
+
+// The optional "path" block: the camera or light path `shadowlab path` renders when the command
+// line names none (compare/path.h holds the kinds and what `amount` means for each).
+struct PathBlock {
+    std::string kind;  // orbit | dolly | pan | subtexel | sun-azimuth | sun-elevation | light-move | gltf-animation
+    std::optional<int> frames;
+    std::optional<double> amount;
+    std::optional<int> light;
+    std::optional<std::string> animation;  // gltf-animation: a name or an index
 };
 
 struct Scene {
@@ -189,6 +225,7 @@ struct Scene {
     std::vector<Light> lights;
     std::vector<Object> objects;
     ShadowDefaults shadow;
+    std::optional<PathBlock> path;
     SceneOrigin origin;
     // The optional "budgets" block: limits `run` and `check` hold each method to (docs/ci.md).
     Budgets budgets;

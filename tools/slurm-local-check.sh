@@ -5,7 +5,8 @@
 # slurm.conf into a temporary folder, starts munged, slurmctld and slurmd on localhost (free
 # ports, nothing under /etc or /run), submits an N-task job array plus its dependent merge job,
 # waits for it, compares rows, metrics and verdicts (not run times) with tests' sweep_equal, does
-# the same after deleting one shard and rerunning it alone (--only), and
+# the same after deleting one shard and rerunning it alone (--only), runs a four-frame path as a
+# two-task array (`path --shard`) and checks its merge against the unsharded path, and
 # stops the daemons and removes the folder whatever happens. Needs root (slurmd runs jobs as
 # their user and munged guards its key). Usage: tools/slurm-local-check.sh [N]   (default 3);
 # SLURM_CHECK_KEEP=1 keeps the folder (logs, both sweeps) for a look.
@@ -137,3 +138,12 @@ env -u SHADOWLAB SHADOWLAB_BUILD_DIR="$build" timeout 600 "$root/tools/slurm-swe
     --sbatch "-c 1" -- "${args[@]}"
 "$build/tests/app/sweep_equal" "$tmp/whole" "$tmp/out"
 say "ok: the merged Slurm sweep equals the unsharded one, also after a shard rerun alone"
+
+# A path sharded by frame (docs/temporal.md): two array tasks and the merge, against the unsharded path.
+pargs=(seed --resolution 48x27 --shadow-map-size 256 --kind sun-azimuth --frames 4)
+"$build/app/shadowlab" path "${pargs[@]}" -o "$tmp/path-whole" 2>"$tmp/path-whole.log"
+timeout 300 sbatch --wait --array=0-1 -c 1 -o "$tmp/slurm-path-%a.out" \
+    --wrap "'$build/app/shadowlab' path ${pargs[*]} -o '$tmp/path-out' --shard \$SLURM_ARRAY_TASK_ID/\$SLURM_ARRAY_TASK_COUNT" >/dev/null
+"$build/app/shadowlab" merge "$tmp/path-out" 2>"$tmp/path-merge.log"
+"$build/tests/app/sweep_equal" "$tmp/path-whole" "$tmp/path-out"
+say "ok: the merged Slurm path equals the unsharded one"

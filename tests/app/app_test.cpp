@@ -206,7 +206,12 @@ INSTANTIATE_TEST_SUITE_P(
         BadRun{"path_one_frame", {"path", "seed", "--frames", "1", "-o", "OUTDIR"}, "--frames: must be in 2.."},
         BadRun{"path_no_such_light", {"path", "seed", "--kind", "sun-azimuth", "--light", "2", "-o", "OUTDIR"},
                "--light: the scene has 1 light(s)"},
-        BadRun{"path_bad_scene", {"path", "BAD", "-o", "OUTDIR"}, "lights[0].direction"}),
+        BadRun{"path_bad_scene", {"path", "BAD", "-o", "OUTDIR"}, "lights[0].direction"},
+        BadRun{"path_no_camera_animation", {"path", "seed", "--camera-animation", "-o", "OUTDIR"},
+               "has no animation that moves a camera"},
+        BadRun{"path_bad_shard", {"path", "seed", "--shard", "2/2", "-o", "OUTDIR"}, "--shard"},
+        BadRun{"sweep_bad_flicker_kind", {"sweep", "seed", "--quick", "--flicker", "spiral", "-o", "OUTDIR"},
+               "--kind: expected orbit|"}),
     [](const ::testing::TestParamInfo<BadRun>& info) { return std::string(info.param.name); });
 
 TEST(App, RenderViewsWriteImagesOfTheDocumentedSizes) {
