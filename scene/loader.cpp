@@ -292,8 +292,7 @@ Object readObject(const Reader& r, const Json& node, const JsonPath& path,
     r.expectObject(node, path);
     Object o;
     const std::string type = r.string(r.require(node, path, "type"), path / "type");
-    // The material first: a textured one decides whether a mesh is read with texture coordinates.
-    {
+    auto lookupMaterial = [&] {
         const std::string material = r.string(r.require(node, path, "material"), path / "material");
         const auto it = materials.find(material);
         if (it == materials.end()) {
@@ -302,9 +301,8 @@ Object readObject(const Reader& r, const Json& node, const JsonPath& path,
             r.fail(path / "material", "no material named '" + material + "' (defined: " +
                                           (known.empty() ? "none" : known) + ")");
         }
-        o.material = it->second;
-    }
-    const Material& mat = sceneMaterials[std::size_t(o.material)];
+        return it->second;
+    };
     if (type == "sphere") {
         r.checkKeys(node, path, {"type", "name", "material", "center", "radius"});
         Sphere s;
@@ -350,6 +348,8 @@ Object readObject(const Reader& r, const Json& node, const JsonPath& path,
         const fs::path base = r.file().has_parent_path() ? r.file().parent_path() : fs::path(".");
         m.file = fs::path(file).is_absolute() ? fs::path(file) : base / file;
         GltfExtras extras;
+        // A textured material decides whether the file is read with texture coordinates.
+        const Material& mat = sceneMaterials[std::size_t(lookupMaterial())];
         MeshRequest request;
         if (mat.alphaTextured()) request.uvSet = mat.texCoord;
         m.instances = loadMeshInstances(m.file, objectTransform(translate, rotate, scale), r.file(),
@@ -370,6 +370,7 @@ Object readObject(const Reader& r, const Json& node, const JsonPath& path,
         r.fail(path / "type", "unknown object type '" + type + "' (expected sphere, quad, box or mesh)");
     }
     o.name = node.contains("name") ? r.string(node["name"], path / "name") : path.str();
+    o.material = lookupMaterial();
     if ((std::holds_alternative<Sphere>(o.shape) || std::holds_alternative<Box>(o.shape)) &&
         sceneMaterials[std::size_t(o.material)].alphaTextured())
         r.fail(path / "material", "material '" + sceneMaterials[std::size_t(o.material)].name +

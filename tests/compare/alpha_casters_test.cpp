@@ -233,9 +233,8 @@ bool hitTriangle(const Vec3& o, const Vec3& d, const Vec3& a, const Vec3& b, con
 }
 
 TEST(AlphaCasters, AlphaBlendModeTestCastsWhatTheGltfAlphaRulesSay) {
-    // The glTF sample model: five test cards (OPAQUE, BLEND, MASK at cutoffs 0.25, 0.5, 0.75) in
-    // front of a bed whose back board catches their shadows under a light travelling into the
-    // board (−z) and down. For each bed pixel the test traces, in double and on its own, the shadow
+    // The glTF sample model: five test cards (OPAQUE, BLEND, MASK at cutoffs 0.25, 0.5, 0.75)
+    // standing in front of a bed whose back board catches their shadows. For each bed pixel the test traces, in double and on its own, the shadow
     // ray from the pixel's surface point against the cards' triangles, interpolates their UVs and
     // applies glTF §3.9.4 (OPAQUE casts, MASK casts where alpha ≥ cutoff, BLEND lets 1 − alpha through);
     // every backend must give that, except within a band of texel and pixel edges.
@@ -243,15 +242,18 @@ TEST(AlphaCasters, AlphaBlendModeTestCastsWhatTheGltfAlphaRulesSay) {
         std::filesystem::path(SHADOWLAB_SHARED_SCENES) / "AlphaBlendModeTest" / "AlphaBlendModeTest.gltf";
     if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " is not here";
     scene::Scene s = scene::loadScene(file);
-    s.camera.position = Vec3(0, 1.1, 9);
+    // The cards stand 0.47 in front of the bed's back board (z = −0.47), facing +z; a light from
+    // the front left casts them onto the board shifted by +0.47 in x, and a camera in front to the
+    // right sees each card shifted the other way, so the shadows show beside the cards.
+    s.camera.position = Vec3(6, 1.2, 5);
     s.camera.lookAt = Vec3(0, 1.0, -0.5);
     s.camera.up = Vec3(0, 1, 0);
-    s.camera.fovYDegrees = 30;
-    s.camera.width = 320;
-    s.camera.height = 180;
+    s.camera.fovYDegrees = 40;
+    s.camera.width = 480;
+    s.camera.height = 270;
     s.camera.near = 0.5;
     s.camera.far = 30;
-    const Vec3 toward = glm::normalize(Vec3(0.1, -0.25, -1));
+    const Vec3 toward = glm::normalize(Vec3(1.0, -0.3, -1));
     s.lights.assign(1, scene::Light{});
     s.lights[0].direction = toward;
     int bed = -1;

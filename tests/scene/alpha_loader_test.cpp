@@ -43,7 +43,7 @@ template <typename F>
 std::string errorOf(F&& f) {
     try {
         f();
-    } catch (const InputError& e) {
+    } catch (const std::exception& e) {  // SceneError and InputError
         return e.what();
     }
     return "";
@@ -133,9 +133,9 @@ TEST(AlphaLoader, AGltfModelSceneKeepsEachMaterialAsItsOwnObject) {
         const auto& mesh = std::get<Mesh>(o.shape);
         for (const MeshInstance& inst : mesh.instances)
             EXPECT_EQ(inst.geometry->uvs.empty(), !m.alphaTextured()) << m.name << ": UVs only where alpha is read";
-        if (m.name == "MatCutoff25") EXPECT_DOUBLE_EQ(m.alphaCutoff, 0.25);
-        if (m.name == "MatCutoff75") EXPECT_DOUBLE_EQ(m.alphaCutoff, 0.75);
-        if (m.name == "MatCutoffDefault") EXPECT_DOUBLE_EQ(m.alphaCutoff, 0.5);
+        if (m.name == "MatCutoff25") { EXPECT_DOUBLE_EQ(m.alphaCutoff, 0.25); }
+        if (m.name == "MatCutoff75") { EXPECT_DOUBLE_EQ(m.alphaCutoff, 0.75); }
+        if (m.name == "MatCutoffDefault") { EXPECT_DOUBLE_EQ(m.alphaCutoff, 0.5); }
         if (m.name.rfind("MatCutoff", 0) == 0) {
             EXPECT_EQ(m.alphaMode, AlphaMode::Mask);
             ASSERT_TRUE(m.alphaTexture);
@@ -144,7 +144,7 @@ TEST(AlphaLoader, AGltfModelSceneKeepsEachMaterialAsItsOwnObject) {
             EXPECT_EQ(m.alphaTexture.get(), labels);
             EXPECT_EQ(m.alphaTexture->width, 1024);
         }
-        if (m.name == "MatBlend") EXPECT_EQ(m.alphaMode, AlphaMode::Blend);
+        if (m.name == "MatBlend") { EXPECT_EQ(m.alphaMode, AlphaMode::Blend); }
         if (m.name == "MatOpaque" || m.name == "MatBed") {
             EXPECT_EQ(m.alphaMode, AlphaMode::Opaque);
             EXPECT_FALSE(m.alphaTexture) << "OPAQUE reads no texture";
