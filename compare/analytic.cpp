@@ -143,6 +143,7 @@ std::string whyNotAnalytic(const scene::Scene& scene) {
     for (const scene::Object& o : scene.objects) {
         if (std::holds_alternative<scene::Mesh>(o.shape)) return "mesh '" + o.name + "'";
         if (!scene.materialOf(o).opaque()) return "semi-transparent '" + o.name + "'";
+        if (scene.materialOf(o).alphaMode == scene::AlphaMode::Mask) return "alpha-tested '" + o.name + "'";
     }
     return {};
 }

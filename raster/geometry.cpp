@@ -17,12 +17,13 @@ using scene::Vec3;
 
 class Builder {
 public:
-    Builder(SceneGeometry& out, const Vec3& origin, std::uint32_t objectId)
-        : out_(out), origin_(origin), id_(objectId) {}
+    Builder(SceneGeometry& out, const Vec3& origin, std::uint32_t objectId, bool withUvs)
+        : out_(out), origin_(origin), id_(objectId), withUvs_(withUvs) {}
 
-    std::uint32_t vertex(const Vec3& p, const Vec3& n) {
+    std::uint32_t vertex(const Vec3& p, const Vec3& n, const scene::Vec2& uv = scene::Vec2(0.0)) {
         // Subtract in double, then round once: the float keeps the precision of the offset.
         out_.vertices.push_back(Vertex{glm::vec3(p - origin_), glm::vec3(n), id_});
+        if (withUvs_) out_.uvs.emplace_back(uv);
         return std::uint32_t(out_.vertices.size() - 1);
     }
     void triangle(std::uint32_t a, std::uint32_t b, std::uint32_t c) {
@@ -37,6 +38,7 @@ private:
     SceneGeometry& out_;
     Vec3 origin_;
     std::uint32_t id_;
+    bool withUvs_;
 };
 
 void addSphere(Builder& b, const scene::Sphere& s, int segments) {
@@ -64,8 +66,8 @@ void addSphere(Builder& b, const scene::Sphere& s, int segments) {
 void addQuad(Builder& b, const scene::Quad& q) {
     const Vec3 du = 0.5 * q.size.x * q.uAxis;
     const Vec3 dv = 0.5 * q.size.y * q.vAxis;
-    b.quad(b.vertex(q.center - du - dv, q.normal), b.vertex(q.center + du - dv, q.normal),
-           b.vertex(q.center + du + dv, q.normal), b.vertex(q.center - du + dv, q.normal));
+    b.quad(b.vertex(q.center - du - dv, q.normal, q.uvMin), b.vertex(q.center + du - dv, q.normal, {q.uvMax.x, q.uvMin.y}),
+           b.vertex(q.center + du + dv, q.normal, q.uvMax), b.vertex(q.center - du + dv, q.normal, {q.uvMin.x, q.uvMax.y}));
 }
 
 void addBox(Builder& b, const scene::Box& box) {
@@ -98,7 +100,8 @@ void addMesh(Builder& b, const scene::Object& o, const scene::Mesh& m) {
         std::uint32_t base = 0;
         for (std::size_t i = 0; i < g.positions.size(); ++i) {
             const Vec3 n = i < g.normals.size() ? glm::normalize(nm * g.normals[i]) : Vec3(0, 1, 0);
-            const std::uint32_t v = b.vertex(scene::transformPoint(inst.transform, g.positions[i]), n);
+            const std::uint32_t v = b.vertex(scene::transformPoint(inst.transform, g.positions[i]), n,
+                                             i < g.uvs.size() ? g.uvs[i] : scene::Vec2(0.0));
             if (i == 0) base = v;
         }
         for (std::size_t t = 0; t + 2 < g.indices.size(); t += 3)
@@ -125,13 +128,13 @@ int sphereSegments(double radius, double distance, double tanHalfFovY, int image
     return n + (n % 2);  // even, so rings = n / 2 spans the poles exactly
 }
 
-SceneGeometry tessellateScene(const scene::Scene& scene, const scene::Vec3& origin) {
+SceneGeometry tessellateScene(const scene::Scene& scene, const scene::Vec3& origin, bool withUvs) {
     SceneGeometry out;
     const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
     for (std::size_t i = 0; i < scene.objects.size(); ++i) {
         const scene::Object& o = scene.objects[i];
         out.objectFirstIndex.push_back(std::uint32_t(out.indices.size()));
-        Builder b(out, origin, std::uint32_t(i + 1));
+        Builder b(out, origin, std::uint32_t(i + 1), withUvs);
         if (const auto* s = std::get_if<scene::Sphere>(&o.shape)) {
             // Nearest distance from the camera to the sphere; inside it, the near plane.
             const double d = std::max(glm::length(s->center - cam.position) - s->radius, scene.camera.near);

@@ -21,6 +21,10 @@ static_assert(sizeof(Vertex) == 28, "vertex layout is declared to the pipelines 
 
 struct SceneGeometry {
     std::vector<Vertex> vertices;
+    // Per vertex, only with alpha-tested casters (tessellateScene's withUvs): quads' own
+    // coordinates, meshes' TEXCOORD_n / vt, 0 elsewhere. A second vertex buffer, so that the
+    // Vertex layout and scenes without alpha stay as they are.
+    std::vector<glm::vec2> uvs;
     std::vector<std::uint32_t> indices;  // three per triangle
     int maxSphereSegments = 0;           // the finest sphere (0 when there is none)
     // Object i's triangles are indices objectFirstIndex[i] .. objectFirstIndex[i + 1] − 1.
@@ -36,6 +40,6 @@ int sphereSegments(double radius, double distance, double tanHalfFovY, int image
 
 // Every object of `scene` as triangles, positions relative to `origin`. Throws RasterError for
 // a mesh whose geometry was not loaded.
-SceneGeometry tessellateScene(const scene::Scene& scene, const scene::Vec3& origin);
+SceneGeometry tessellateScene(const scene::Scene& scene, const scene::Vec3& origin, bool withUvs = false);
 
 }  // namespace shadowlab::raster

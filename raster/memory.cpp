@@ -50,6 +50,11 @@ std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::Render
     }
     return kDriverAllowance + scene::frameBytes(scene) + pixels * litBytesPerPixel(scene.lights.size()) +
            layers * texels * (plan.needsTransmittanceMap ? 4 + 4 + 16 : 4 + 4) + triangles * kBytesPerTriangle +
+           // Alpha-tested casters: a UV per vertex (every vertex of the scene gets a slot in the
+           // UV buffer, 3 · 8 bytes a triangle), the texels and one record per object.
+           (scene.hasAlphaCasters()
+                ? triangles * 24 + scene::alphaTextureBytes(scene) + scene.objects.size() * 32
+                : 0) +
            scene.objects.size() * scene::kBackendBytesPerObject;
 }
 

@@ -38,8 +38,9 @@ PipelineHandle createGraphicsPipeline(const Context& ctx, const PipelineDesc& de
         });
     }
 
-    const VkVertexInputBindingDescription binding{
-        .binding = 0, .stride = sizeof(Vertex), .inputRate = VK_VERTEX_INPUT_RATE_VERTEX};
+    const VkVertexInputBindingDescription bindings[2] = {
+        {.binding = 0, .stride = sizeof(Vertex), .inputRate = VK_VERTEX_INPUT_RATE_VERTEX},
+        {.binding = 1, .stride = sizeof(glm::vec2), .inputRate = VK_VERTEX_INPUT_RATE_VERTEX}};
     std::vector<VkVertexInputAttributeDescription> attributes{
         {.location = 0, .binding = 0, .format = VK_FORMAT_R32G32B32_SFLOAT, .offset = offsetof(Vertex, position)},
     };
@@ -49,10 +50,12 @@ PipelineHandle createGraphicsPipeline(const Context& ctx, const PipelineDesc& de
     if (desc.usesNormal)
         attributes.push_back(
             {.location = 1, .binding = 0, .format = VK_FORMAT_R32G32B32_SFLOAT, .offset = offsetof(Vertex, normal)});
+    if (desc.usesUv)
+        attributes.push_back({.location = 3, .binding = 1, .format = VK_FORMAT_R32G32_SFLOAT, .offset = 0});
     const VkPipelineVertexInputStateCreateInfo vertexInput{
         .sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
-        .vertexBindingDescriptionCount = 1,
-        .pVertexBindingDescriptions = &binding,
+        .vertexBindingDescriptionCount = desc.usesUv ? 2u : 1u,
+        .pVertexBindingDescriptions = bindings,
         .vertexAttributeDescriptionCount = std::uint32_t(attributes.size()),
         .pVertexAttributeDescriptions = attributes.data(),
     };

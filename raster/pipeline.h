@@ -20,6 +20,9 @@ struct PipelineDesc {
     VkPipelineLayout layout = VK_NULL_HANDLE;
     bool usesNormal = true;  // declare vertex location 1; the validation layer warns about unused inputs
     bool usesObjectId = true;  // declare vertex location 2 (the same warning)
+    // Declare vertex location 3, the texture coordinates (vec2) of vertex binding 1 (alpha-tested
+    // casters, raster/alpha_casters.h).
+    bool usesUv = false;
     std::vector<VkFormat> colorFormats;
     VkFormat depthFormat = VK_FORMAT_D32_SFLOAT;
     VkCompareOp depthCompare = VK_COMPARE_OP_LESS;

@@ -16,6 +16,7 @@
 
 #include "raster/cascades.h"
 #include "raster/context.h"
+#include "raster/alpha_casters.h"
 #include "raster/geometry.h"
 #include "raster/light_frustum.h"
 #include "raster/lit_pass.h"
@@ -94,7 +95,8 @@ std::vector<TransparentDraw> separateTransparent(const scene::Scene& scene, Scen
         TransparentDraw d;
         d.firstIndex = std::uint32_t(g.indices.size());
         d.indexCount = std::uint32_t(perObject[o].size());
-        d.transmittance = float(1.0 - scene.materialOf(scene.objects[o]).opacity);
+        // 1 − opacity (BLEND: 1 − opacity·factor; a textured BLEND's fragments take their own).
+        d.transmittance = float(scene.materialOf(scene.objects[o]).transmittance(1.0));
         g.indices.insert(g.indices.end(), perObject[o].begin(), perObject[o].end());
         // Quads are open (one surface: every crossing counts); spheres and boxes closed; a mesh
         // by its edges.
@@ -180,6 +182,7 @@ struct Renderer::Impl {
     Context ctx;
     Buffer vertexBuffer;
     Buffer indexBuffer;
+    AlphaCasters alpha;  // alpha-tested casters only (set == VK_NULL_HANDLE otherwise)
     DrawGeometry draw;
     ShadowMaps maps;
     LitTargets targets;
@@ -236,7 +239,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     background = glm::vec3(scene.background);
     attributes["device"] = ctx.deviceReport.name;
 
-    SceneGeometry geometry = tessellateScene(scene, origin);
+    SceneGeometry geometry = tessellateScene(scene, origin, scene.hasAlphaCasters());
     std::vector<TransparentDraw> transparentDraws;
     std::uint32_t opaqueIndexCount = ~0u;
     if (plan.needsTransmittanceMap) transparentDraws = separateTransparent(scene, geometry, opaqueIndexCount);
@@ -249,6 +252,12 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     indexBuffer = uploadBuffer(ctx, geometry.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
     draw = DrawGeometry{vertexBuffer.buffer.get(), indexBuffer.buffer.get(), std::uint32_t(geometry.indices.size()),
                         opaqueIndexCount, transparentDraws};
+    if (scene.hasAlphaCasters()) {
+        alpha = createAlphaCasters(ctx, scene, geometry);
+        draw.uvs = alpha.uvs.buffer.get();
+        draw.alphaSet = alpha.set;
+        attributes["alpha_casters"] = "alpha-tested in the depth pass";  // only where there are some
+    }
 
     // The automatic choices: a default cascade count follows the view, then a default size follows
     // the receivers' and casters' detail, and a default constant bias follows the size.
@@ -443,7 +452,7 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
     for (const scene::Object& o : scene.objects)
         // a: 1 − opacity, divided out of a semi-transparent receiver's own transmittance (lit.frag).
         albedos.emplace_back(glm::vec3(scene.materialOf(o).albedo),
-                             scene.materialOf(o).opaque() ? 1.0f : float(1.0 - scene.materialOf(o).opacity));
+                             scene.materialOf(o).opaque() ? 1.0f : float(scene.materialOf(o).transmittance(1.0)));
     // Each layer's index ranges: every object, or the culled layer's casters (runs of them merged).
     // Not with a transmittance map: its index order (opaque casters first) is not per object, so
     // the depth pass then draws every opaque caster (layerRanges empty).
@@ -631,10 +640,12 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     pendingSetupMs = 0.0;
     if (!shadowPipeline.pipeline || !litPipeline.pipeline) {
         const auto pipelineStart = Clock::now();
-        if (!shadowPipeline.pipeline) shadowPipeline = createShadowPipeline(ctx, wantIds, settings.hardwareBias);
-        if (transmit && !transmitPipeline.pipeline) transmitPipeline = createTransmittancePipeline(ctx);
+        const VkDescriptorSetLayout alphaLayout = alpha.setLayout.get();  // VK_NULL_HANDLE without
+        if (!shadowPipeline.pipeline)
+            shadowPipeline = createShadowPipeline(ctx, wantIds, settings.hardwareBias, alphaLayout);
+        if (transmit && !transmitPipeline.pipeline) transmitPipeline = createTransmittancePipeline(ctx, alphaLayout);
         if (transmit && !transmitRestPipeline.pipeline)
-            transmitRestPipeline = createTransmittanceRestPipeline(ctx, transmittanceMaps);
+            transmitRestPipeline = createTransmittanceRestPipeline(ctx, transmittanceMaps, alphaLayout);
         if (!litPipeline.pipeline)
             litPipeline = createLitPipeline(ctx, LitVariant{.filter = settings.filter,
                                                             .blockerIds = wantIds,

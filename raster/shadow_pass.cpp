@@ -12,7 +12,9 @@
 
 namespace shadowlab::raster {
 
-ShadowPipeline createShadowPipeline(const Context& ctx, bool blockerIds, bool hardwareBias) {
+ShadowPipeline createShadowPipeline(const Context& ctx, bool blockerIds, bool hardwareBias,
+                                    VkDescriptorSetLayout alphaSetLayout) {
+    const bool alpha = alphaSetLayout != VK_NULL_HANDLE;
     requireFormat(ctx, kShadowMapFormat,
                   VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT,
                   "the shadow map");
@@ -22,19 +24,26 @@ ShadowPipeline createShadowPipeline(const Context& ctx, bool blockerIds, bool ha
         .stageFlags = VK_SHADER_STAGE_VERTEX_BIT, .offset = 0, .size = sizeof(shaders::ShadowPush)};
     const VkPipelineLayoutCreateInfo layoutInfo{
         .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
+        .setLayoutCount = alpha ? 1u : 0u,
+        .pSetLayouts = alpha ? &alphaSetLayout : nullptr,
         .pushConstantRangeCount = 1,
         .pPushConstantRanges = &push,
     };
     ShadowPipeline p;
+    p.alpha = alpha;
     VkPipelineLayout layout = VK_NULL_HANDLE;
     VK_CHECK(vkCreatePipelineLayout(ctx.device.get(), &layoutInfo, nullptr, &layout));
     p.layout = PipelineLayoutHandle(ctx.device.get(), layout);
     p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{
-                                                 .vertexShader = shaders::shadowVertSpirv(),
-                                                 .fragmentShader = blockerIds ? shaders::shadowFragSpirv()
-                                                                              : std::span<const std::uint32_t>(),
+                                                 .vertexShader = alpha ? shaders::shadowVertAlphaSpirv()
+                                                                       : shaders::shadowVertSpirv(),
+                                                 .fragmentShader = alpha ? (blockerIds ? shaders::shadowFragAlphaSpirv()
+                                                                                       : shaders::shadowFragAlphaDepthSpirv())
+                                                                   : blockerIds ? shaders::shadowFragSpirv()
+                                                                                : std::span<const std::uint32_t>(),
                                                  .layout = layout,
                                                  .usesNormal = false,
+                                                 .usesUv = alpha,
                                                  .colorFormats = blockerIds ? std::vector<VkFormat>{kBlockerIdFormat}
                                                                             : std::vector<VkFormat>{},
                                                  .depthFormat = kShadowMapFormat,
@@ -112,13 +121,15 @@ namespace {
 // Both transmittance passes: the semi-transparent casters' triangles depth-tested against the
 // opaque map (not written), into the two R32F targets, blended as transmit.frag says.
 PipelineHandle createTransmitPipeline(const Context& ctx, VkPipelineLayout layout,
-                                      std::span<const std::uint32_t> fragmentShader) {
+                                      std::span<const std::uint32_t> fragmentShader, bool alpha) {
     return createGraphicsPipeline(ctx, PipelineDesc{
-                                           .vertexShader = shaders::transmitVertSpirv(),
+                                           .vertexShader = alpha ? shaders::transmitVertAlphaSpirv()
+                                                                 : shaders::transmitVertSpirv(),
                                            .fragmentShader = fragmentShader,
                                            .layout = layout,
                                            .usesNormal = true,
-                                           .usesObjectId = false,
+                                           .usesObjectId = alpha,
+                                           .usesUv = alpha,
                                            .colorFormats = {kTransmittanceFormat, kTransmittanceFormat},
                                            .depthFormat = kShadowMapFormat,
                                            .depthCompare = VK_COMPARE_OP_LESS,
@@ -128,17 +139,22 @@ PipelineHandle createTransmitPipeline(const Context& ctx, VkPipelineLayout layou
 }
 
 // Both passes' layout: the transmit push constants, and the set that holds D1 (the second pass).
-PipelineLayoutHandle createTransmitLayout(const Context& ctx, VkDescriptorSetLayout set) {
+PipelineLayoutHandle createTransmitLayout(const Context& ctx, VkDescriptorSetLayout set,
+                                          VkDescriptorSetLayout alphaSet = VK_NULL_HANDLE) {
     if (!ctx.independentBlend)
         throw RasterError("semi-transparent casters need the independentBlend feature, which " + ctx.deviceReport.name +
                           " lacks (the transmittance map blends its two targets differently)");
     const VkPushConstantRange push{.stageFlags = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
                                    .offset = 0,
                                    .size = sizeof(shaders::TransmitPush)};
+    // The second pass's D1 set first, the alpha records' after it (shaders/alpha.glsl's set).
+    std::vector<VkDescriptorSetLayout> sets;
+    if (set != VK_NULL_HANDLE) sets.push_back(set);
+    if (alphaSet != VK_NULL_HANDLE) sets.push_back(alphaSet);
     const VkPipelineLayoutCreateInfo layoutInfo{
         .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
-        .setLayoutCount = set != VK_NULL_HANDLE ? 1u : 0u,
-        .pSetLayouts = set != VK_NULL_HANDLE ? &set : nullptr,
+        .setLayoutCount = std::uint32_t(sets.size()),
+        .pSetLayouts = sets.empty() ? nullptr : sets.data(),
         .pushConstantRangeCount = 1,
         .pPushConstantRanges = &push,
     };
@@ -149,14 +165,17 @@ PipelineLayoutHandle createTransmitLayout(const Context& ctx, VkDescriptorSetLay
 
 }  // namespace
 
-ShadowPipeline createTransmittancePipeline(const Context& ctx) {
+ShadowPipeline createTransmittancePipeline(const Context& ctx, VkDescriptorSetLayout alphaSetLayout) {
     ShadowPipeline p;
-    p.layout = createTransmitLayout(ctx, VK_NULL_HANDLE);
-    p.pipeline = createTransmitPipeline(ctx, p.layout.get(), shaders::transmitFragSpirv());
+    p.alpha = alphaSetLayout != VK_NULL_HANDLE;
+    p.layout = createTransmitLayout(ctx, VK_NULL_HANDLE, alphaSetLayout);
+    p.pipeline = createTransmitPipeline(ctx, p.layout.get(),
+                                        p.alpha ? shaders::transmitFragAlphaSpirv() : shaders::transmitFragSpirv(), p.alpha);
     return p;
 }
 
-TransmittanceRestPipeline createTransmittanceRestPipeline(const Context& ctx, const TransmittanceMaps& maps) {
+TransmittanceRestPipeline createTransmittanceRestPipeline(const Context& ctx, const TransmittanceMaps& maps,
+                                                          VkDescriptorSetLayout alphaSetLayout) {
     VkDevice device = ctx.device.get();
     TransmittanceRestPipeline p;
     // transmit.frag reads D1 with texelFetch at its own texel: no filtering, no addressing.
@@ -201,8 +220,11 @@ TransmittanceRestPipeline createTransmittanceRestPipeline(const Context& ctx, co
                                      .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                                      .pImageInfo = &nearInfo};
     vkUpdateDescriptorSets(device, 1, &write, 0, nullptr);
-    p.layout = createTransmitLayout(ctx, setLayout);
-    p.pipeline = createTransmitPipeline(ctx, p.layout.get(), shaders::transmitFragRestSpirv());
+    p.alpha = alphaSetLayout != VK_NULL_HANDLE;
+    p.layout = createTransmitLayout(ctx, setLayout, alphaSetLayout);
+    p.pipeline = createTransmitPipeline(ctx, p.layout.get(),
+                                        p.alpha ? shaders::transmitFragRestAlphaSpirv() : shaders::transmitFragRestSpirv(),
+                                        p.alpha);
     return p;
 }
 
@@ -249,9 +271,14 @@ void drawTransmittanceLayers(VkCommandBuffer commands, const TransmittancePass& 
             if (rest)
                 vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, layout, 0, 1, &rest->set, 0,
                                         nullptr);
+            const bool alpha = rest ? rest->alpha : pass.pipeline->alpha;
+            if (alpha)
+                vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, layout, rest ? 1 : 0, 1,
+                                        &geometry.alphaSet, 0, nullptr);
             setViewport(commands, maps.size, maps.size);
             const VkDeviceSize offset = 0;
             vkCmdBindVertexBuffers(commands, 0, 1, &geometry.vertices, &offset);
+            if (alpha) vkCmdBindVertexBuffers(commands, 1, 1, &geometry.uvs, &offset);
             vkCmdBindIndexBuffer(commands, geometry.indices, 0, VK_INDEX_TYPE_UINT32);
             for (const TransparentDraw& object : geometry.transparent) {
                 const shaders::TransmitPush push{
@@ -371,6 +398,11 @@ void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, 
             vkCmdPushConstants(commands, pipeline.layout.get(), VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof push, &push);
             const VkDeviceSize offset = 0;
             vkCmdBindVertexBuffers(commands, 0, 1, &geometry.vertices, &offset);
+            if (pipeline.alpha) {
+                vkCmdBindVertexBuffers(commands, 1, 1, &geometry.uvs, &offset);
+                vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.layout.get(), 0, 1,
+                                        &geometry.alphaSet, 0, nullptr);
+            }
             vkCmdBindIndexBuffer(commands, geometry.indices, 0, VK_INDEX_TYPE_UINT32);
             if (layer < geometry.layerRanges.size()) {  // the casters left after culling
                 for (const auto& [first, count] : geometry.layerRanges[layer])

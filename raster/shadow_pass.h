@@ -19,10 +19,15 @@ struct ShadowPipeline {
     PipelineLayoutHandle layout;
     PipelineHandle pipeline;
     bool hardwareBias = false;  // depth bias dynamic: set per layer before drawing
+    // The SHADOWLAB_ALPHA shaders: UVs at vertex binding 1, DrawGeometry::alphaSet bound (set 0).
+    bool alpha = false;
 };
 // Without blockerIds: depth only, no fragment shader (much cheaper on lavapipe). hardwareBias:
-// depth bias on with dynamic factors (recordShadowPass sets each layer's).
-ShadowPipeline createShadowPipeline(const Context& ctx, bool blockerIds = true, bool hardwareBias = false);
+// depth bias on with dynamic factors (recordShadowPass sets each layer's). alphaSetLayout
+// (AlphaCasters::setLayout): alpha-tested casters, whose MASK texels below the cutoff the
+// fragment shader discards (then always with a fragment shader, also without blockerIds).
+ShadowPipeline createShadowPipeline(const Context& ctx, bool blockerIds = true, bool hardwareBias = false,
+                                    VkDescriptorSetLayout alphaSetLayout = VK_NULL_HANDLE);
 
 // The rasterizer's depth-bias factors of one layer (vkCmdSetDepthBias): the stored depth of a
 // primitive grows by constant·r + slope·max(|∂z/∂x|, |∂z/∂y|), r the depth format's minimum
@@ -67,6 +72,10 @@ struct DrawGeometry {
     // Shadow pass only: per layer, the index ranges (first, count) drawn into it (the casters
     // left after culling); layers past the end of this list draw every index.
     std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> layerRanges;
+    // Alpha-tested casters (raster/alpha_casters.h): the UV buffer and the records' set, used by
+    // pipelines made with an alpha set layout.
+    VkBuffer uvs = VK_NULL_HANDLE;
+    VkDescriptorSet alphaSet = VK_NULL_HANDLE;
 };
 
 // The transmittance map beside the depth map (made only for scenes with semi-transparent
@@ -94,7 +103,8 @@ TransmittanceMaps createTransmittanceMaps(const Context& ctx, std::uint32_t size
 
 // The transmittance pass: transmit.vert/.frag, depth test LESS against the depth map without
 // writing it, target 0 multiplied, target 1 MIN (needs the device's independentBlend).
-ShadowPipeline createTransmittancePipeline(const Context& ctx);
+// alphaSetLayout: the SHADOWLAB_ALPHA variant (per-fragment alpha of MASK and textured BLEND casters).
+ShadowPipeline createTransmittancePipeline(const Context& ctx, VkDescriptorSetLayout alphaSetLayout = VK_NULL_HANDLE);
 
 // The second transmittance pass (behind the nearest layer): the same draws and blending, with
 // transmit.frag's SHADOWLAB_REST_LAYER variant, which reads the first pass's nearest depths
@@ -106,8 +116,10 @@ struct TransmittanceRestPipeline {
     VkDescriptorSet set = VK_NULL_HANDLE;  // freed with the pool
     PipelineLayoutHandle layout;
     PipelineHandle pipeline;
+    bool alpha = false;  // the alpha records' set at index 1
 };
-TransmittanceRestPipeline createTransmittanceRestPipeline(const Context& ctx, const TransmittanceMaps& maps);
+TransmittanceRestPipeline createTransmittanceRestPipeline(const Context& ctx, const TransmittanceMaps& maps,
+                                                          VkDescriptorSetLayout alphaSetLayout = VK_NULL_HANDLE);
 
 // What recordShadowPass needs for the transmittance passes: the pipelines (both or neither), the
 // maps, and per layer the light it is drawn from (TransmitPush::light).

@@ -16,7 +16,8 @@ std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::Render
     std::uint64_t placements = 0;  // one BVH entry per object, and per mesh instance
     for (const scene::Object& o : scene.objects)
         if (const auto* m = std::get_if<scene::Mesh>(&o.shape)) placements += m->instances.size();
-    return kAllowance + scene::frameBytes(scene) + triangles * 100 +
+    // Texture coordinates: three per alpha-textured triangle, two Reals each (double: 48 bytes).
+    return kAllowance + scene::frameBytes(scene) + triangles * 100 + scene::alphaTexturedTriangles(scene) * 48 +
            (scene.objects.size() + placements) * scene::kBackendBytesPerObject;
 }
 

@@ -49,12 +49,13 @@ ShadowResult traceShadowRay(const Tracer<Real>& tracer, const Ray<Real>& ray, Re
     for (int i = 0; i < tracer.objectCount(); ++i) {
         Hit<Real> h;
         if (!tracer.intersectObject(i, ray, tMax, conservative, false, h)) continue;
-        const double opacity = tracer.opacity(i);
-        if (opacity >= 1.0) {
+        if (tracer.opaqueObject(i)) {
             opaqueHit = true;
             tMax = h.t;
         } else {
-            r.transmittance *= 1.0 - opacity;
+            // 1 − opacity, or for BLEND 1 − opacity·alpha at the object's nearest hit (MASK texels
+            // below the cutoff were skipped by the intersection itself).
+            r.transmittance *= tracer.transmittance(ray, h);
         }
         if (h.t <= nearest) {
             nearest = h.t;

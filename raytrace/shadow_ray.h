@@ -37,7 +37,8 @@ Vec3T<Real> shadowOrigin(const SurfacePoint<Real>& sp, const Vec3T<Real>& toward
 
 // One shadow ray over 0 < t < tMax. anyHit (opaque scenes only): stop at the first hit.
 // Otherwise every object on the segment multiplies by (1 − opacity) once, however many of its
-// surfaces the ray crosses, and the blocker is the nearest object hit.
+// surfaces the ray crosses (BLEND: 1 − opacity·alpha at its nearest hit), and the blocker is the
+// nearest object hit. MASK texels below the cutoff are no hit in either mode.
 template <typename Real>
 ShadowResult traceShadowRay(const Tracer<Real>& tracer, const Ray<Real>& ray, Real tMax,
                             bool anyHit, bool conservative);

@@ -44,10 +44,33 @@ struct SlotHit {
     std::uint32_t slot = 0;
 };
 
+// The alpha test of a MASK mesh's hits: a hit whose alpha (factor × texture at the
+// barycentric UV) is below the cutoff is no hit, and the walk goes on. Off (`on` false) for
+// every other mesh, which then pays one predictable branch per hit.
+template <typename Real>
+struct MaskFilter {
+    bool on = false;
+    Real cutoff = 0, factor = 1;
+    const scene::AlphaTexture* texture = nullptr;
+    const std::uint32_t* slotPrims = nullptr;  // the tree's slot → triangle
+    const std::uint32_t* indices = nullptr;
+    const glm::vec<2, Real, glm::defaultp>* uvs = nullptr;  // null: constant alpha
+    bool rejects(std::uint32_t slot, Real b0, Real b1, Real b2) const {
+        if (!on) return false;
+        Real alpha = factor;
+        if (texture && uvs) {
+            const std::uint32_t* ix = indices + 3 * std::size_t(slotPrims[slot]);
+            const auto uv = b0 * uvs[ix[0]] + b1 * uvs[ix[1]] + b2 * uvs[ix[2]];
+            alpha *= Real(scene::sampleAlpha(*texture, uv.x, uv.y));
+        }
+        return alpha < cutoff;  // glTF 3.9.4: alpha below the cutoff is fully transparent
+    }
+};
+
 template <typename BoxTest>
 inline bool traverseFloat(const Bvh8& bvh, const std::vector<TrianglePacket>& packets,
                           const Ray<float>& ray, float& tBest, bool conservative, bool anyHit,
-                          SlotHit& out) {
+                          SlotHit& out, const MaskFilter<float>& mask) {
     const Triangle4Ray r4(ray);
     return bvh.traverseWith<BoxTest>(ray, tBest, anyHit,
                                      [&](std::uint32_t first, std::uint32_t count, float& tm) {
@@ -64,6 +87,7 @@ inline bool traverseFloat(const Bvh8& bvh, const std::vector<TrianglePacket>& pa
                 if (!intersectTriangle(ray, pk.vertex(l, 0), pk.vertex(l, 1), pk.vertex(l, 2), tm,
                                        conservative, t, b0, b1, b2))
                     continue;
+                if (mask.rejects(base + std::uint32_t(l), b0, b1, b2)) continue;
                 tm = t;
                 out = SlotHit{t, b0, b1, b2, base + std::uint32_t(l)};
                 if (anyHit) return true;
@@ -81,8 +105,8 @@ inline bool traverseFloat(const Bvh8& bvh, const std::vector<TrianglePacket>& pa
 // "avx" enables no FMA, so the float results are the SSE path's, bit for bit.
 __attribute__((target("avx"), flatten)) bool traverseFloatAvx(
     const Bvh8& bvh, const std::vector<TrianglePacket>& packets, const Ray<float>& ray,
-    float& tBest, bool conservative, bool anyHit, SlotHit& out) {
-    return traverseFloat<detail::ChildBoxTestAvx8>(bvh, packets, ray, tBest, conservative, anyHit, out);
+    float& tBest, bool conservative, bool anyHit, SlotHit& out, const MaskFilter<float>& mask) {
+    return traverseFloat<detail::ChildBoxTestAvx8>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
 }
 #endif
 
@@ -120,6 +144,7 @@ Tracer<Real>::Tracer(const scene::Scene& scene) : id_(nextTracerId.fetch_add(1))
     for (std::size_t i = 0; i < scene.objects.size(); ++i) {
         const scene::Object& obj = scene.objects[i];
         const double opacity = scene.materialOf(obj).opacity;
+        const std::size_t objectIndex = objects_.size();
         if (const auto* s = std::get_if<scene::Sphere>(&obj.shape)) {
             objects_.push_back({ShapeKind::Sphere, int(spheres_.size()), opacity});
             spheres_.push_back({toReal<Real>(s->center), Real(s->radius)});
@@ -131,6 +156,8 @@ Tracer<Real>::Tracer(const scene::Scene& scene) : id_(nextTracerId.fetch_add(1))
             d.vAxis = toReal<Real>(q->vAxis);
             d.halfU = Real(0.5 * q->size.x);
             d.halfV = Real(0.5 * q->size.y);
+            d.uvMin = glm::vec<2, Real, glm::defaultp>(q->uvMin);
+            d.uvMax = glm::vec<2, Real, glm::defaultp>(q->uvMax);
             d.snapAxis = -1;
             for (int k = 0; k < 3; ++k)
                 if (std::abs(d.normal[k]) == Real(1) && d.normal[(k + 1) % 3] == Real(0) &&
@@ -145,7 +172,44 @@ Tracer<Real>::Tracer(const scene::Scene& scene) : id_(nextTracerId.fetch_add(1))
             objects_.push_back({ShapeKind::Mesh, int(meshObjects_.size()), opacity});
             meshObjects_.push_back(buildMeshObject(obj, *m, uses, blasOf));
         }
+        const scene::Material& mat = scene.materialOf(obj);
+        ObjectData& od = objects_[objectIndex];
+        od.opaque = mat.opaque();
+        if (mat.alphaMode != scene::AlphaMode::Opaque) {
+            od.alpha = int(alphas_.size());
+            alphas_.push_back({mat.alphaMode, Real(mat.alphaCutoff), Real(mat.alphaFactor), mat.alphaTexture, mat});
+        }
     }
+}
+
+template <typename Real>
+Real Tracer<Real>::textureAlpha(const ObjectData& od, const Ray<Real>& ray, const Hit<Real>& hit) const {
+    const AlphaData& a = alphas_[std::size_t(od.alpha)];
+    if (!a.texture) return Real(1);
+    if (od.kind == ShapeKind::Quad) {
+        // (u, v) from the point's offsets along the quad's axes, as intersectObject tests them.
+        const QuadData& q = quads_[od.index];
+        const Vec rel = ray.o + hit.t * ray.d - q.center;
+        const Real s = glm::dot(rel, q.uAxis) / (Real(2) * q.halfU) + Real(0.5);
+        const Real t = glm::dot(rel, q.vAxis) / (Real(2) * q.halfV) + Real(0.5);
+        return Real(scene::sampleAlpha(*a.texture, q.uvMin.x + s * (q.uvMax.x - q.uvMin.x),
+                                       q.uvMin.y + t * (q.uvMax.y - q.uvMin.y)));
+    }
+    if (od.kind != ShapeKind::Mesh) return Real(1);  // (the loader allows no texture on spheres and boxes)
+    const MeshObjectData& mo = meshObjects_[od.index];
+    const MeshData& m = meshes_[hit.instance >= 0 ? mo.instances[hit.instance].blas : mo.flat];
+    if (m.uvs.empty()) return Real(1);
+    const std::uint32_t* ix = &m.indices[3 * std::size_t(hit.prim)];
+    const auto uv = hit.b0 * m.uvs[ix[0]] + hit.b1 * m.uvs[ix[1]] + hit.b2 * m.uvs[ix[2]];
+    return Real(scene::sampleAlpha(*a.texture, uv.x, uv.y));
+}
+
+template <typename Real>
+double Tracer<Real>::transmittance(const Ray<Real>& ray, const Hit<Real>& hit) const {
+    const ObjectData& od = objects_[hit.object];
+    if (od.alpha < 0) return 1.0 - od.opacity;
+    const AlphaData& a = alphas_[std::size_t(od.alpha)];
+    return a.material.transmittance(a.mode == scene::AlphaMode::Blend ? double(textureAlpha(od, ray, hit)) : 1.0);
 }
 
 template <typename Real>
@@ -159,8 +223,9 @@ typename Tracer<Real>::MeshObjectData Tracer<Real>::buildMeshObject(
     // Meshes placed once are copied into world space and merged per object: one tree, no
     // transform per ray (docs/raytrace.md, "Instances").
     std::vector<scene::Vec3> positions, normals;
+    std::vector<scene::Vec2> uvs;
     std::vector<std::uint32_t> indices;
-    bool allNormals = true;
+    bool allNormals = true, allUvs = true;
     std::vector<scene::Bounds> instanceBounds;
     for (const scene::MeshInstance& inst : m.instances) {
         if (!inst.geometry)
@@ -175,11 +240,13 @@ typename Tracer<Real>::MeshObjectData Tracer<Real>::buildMeshObject(
                 const glm::dmat3 nm = scene::normalMatrix(inst.transform);
                 for (const scene::Vec3& n : g.normals) normals.push_back(glm::normalize(nm * n));
             }
+            allUvs = allUvs && g.uvs.size() == g.positions.size();
+            if (allUvs) uvs.insert(uvs.end(), g.uvs.begin(), g.uvs.end());
             for (std::uint32_t i : g.indices) indices.push_back(base + i);
             continue;
         }
         auto [it, added] = blasOf.emplace(&g, int(meshes_.size()));
-        if (added) buildMesh(g.positions, g.normals, g.indices);
+        if (added) buildMesh(g.positions, g.normals, g.indices, g.uvs);
         InstanceData in;
         in.blas = it->second;
         const glm::dmat4 toWorld(inst.transform);
@@ -223,7 +290,8 @@ typename Tracer<Real>::MeshObjectData Tracer<Real>::buildMeshObject(
     }
     if (!indices.empty()) {
         if (!allNormals) normals.clear();
-        mo.flat = buildMesh(positions, normals, indices);
+        if (!allUvs) uvs.clear();
+        mo.flat = buildMesh(positions, normals, indices, uvs);
     }
     if (!mo.instances.empty()) mo.top = Bvh8::build(instanceBounds);
     return mo;
@@ -232,8 +300,12 @@ typename Tracer<Real>::MeshObjectData Tracer<Real>::buildMeshObject(
 template <typename Real>
 int Tracer<Real>::buildMesh(const std::vector<scene::Vec3>& positions,
                             const std::vector<scene::Vec3>& normals,
-                            const std::vector<std::uint32_t>& indices) {
+                            const std::vector<std::uint32_t>& indices, const std::vector<scene::Vec2>& uvs) {
     MeshData d;
+    if (uvs.size() == positions.size()) {
+        d.uvs.reserve(uvs.size());
+        for (const scene::Vec2& uv : uvs) d.uvs.emplace_back(uv);
+    }
     d.positions.reserve(positions.size());
     for (const scene::Vec3& p : positions) d.positions.push_back(toReal<Real>(p));
     if (normals.size() == positions.size()) {
@@ -272,7 +344,17 @@ int Tracer<Real>::buildMesh(const std::vector<scene::Vec3>& positions,
 
 template <typename Real>
 bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& tBest,
-                                 bool conservative, bool anyHit, Hit<Real>& hit) const {
+                                 bool conservative, bool anyHit, Hit<Real>& hit, const AlphaData* alpha) const {
+    MaskFilter<Real> mask;
+    if (alpha && alpha->mode == scene::AlphaMode::Mask) {
+        mask.on = true;
+        mask.cutoff = alpha->cutoff;
+        mask.factor = alpha->factor;
+        mask.texture = alpha->texture.get();
+        mask.slotPrims = m.bvh.primitives().data();
+        mask.indices = m.indices.data();
+        mask.uvs = m.uvs.empty() ? nullptr : m.uvs.data();
+    }
     auto record = [&](std::uint32_t slot, Real t, Real b0, Real b1, Real b2) {
         hit.t = t;
         hit.prim = int(m.bvh.primitives()[slot]);
@@ -287,7 +369,8 @@ bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& 
         // blocked by the same triangles, so this often answers without a walk; a hit there is
         // a hit of the same exact test, so the boolean answer cannot change.
         OccluderCache::Entry* cached = nullptr;
-        if (anyHit && occluderCacheOn.load(std::memory_order_relaxed)) {
+        // (Not for MASK meshes: the cached packet would need the alpha test too; they walk.)
+        if (anyHit && !mask.on && occluderCacheOn.load(std::memory_order_relaxed)) {
             const std::uint32_t blas = std::uint32_t(&m - meshes_.data());
             cached = &occluderCache.entries[blas % OccluderCache::kEntries];
             if (cached->tracer != id_ || cached->blas != blas) {
@@ -314,12 +397,12 @@ bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& 
         }
 #if defined(SHADOWLAB_AVX_BOX_TEST)
         const bool found = detail::useAvx()
-                               ? traverseFloatAvx(m.bvh, m.packets, ray, tBest, conservative, anyHit, sh)
+                               ? traverseFloatAvx(m.bvh, m.packets, ray, tBest, conservative, anyHit, sh, mask)
                                : traverseFloat<detail::ChildBoxTest<float, 8>>(m.bvh, m.packets, ray, tBest,
-                                                                              conservative, anyHit, sh);
+                                                                              conservative, anyHit, sh, mask);
 #else
         const bool found = traverseFloat<detail::ChildBoxTest<float, 8>>(m.bvh, m.packets, ray, tBest,
-                                                                        conservative, anyHit, sh);
+                                                                        conservative, anyHit, sh, mask);
 #endif
         if (found) record(sh.slot, sh.t, sh.b0, sh.b1, sh.b2);
         if (cached) {
@@ -338,6 +421,7 @@ bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& 
                 Real t, b0, b1, b2;
                 if (!intersectTriangle(ray, v[0], v[1], v[2], tm, conservative, t, b0, b1, b2))
                     continue;
+                if (mask.rejects(slot, b0, b1, b2)) continue;
                 tm = t;
                 record(slot, t, b0, b1, b2);
                 if (anyHit) return true;
@@ -350,8 +434,15 @@ bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& 
 
 template <typename Real>
 bool Tracer<Real>::intersectObject(int object, const Ray<Real>& ray, Real tMax, bool conservative,
-                                   bool anyHit, Hit<Real>& hit) const {
+                                   bool anyHit, Hit<Real>& hit, bool alphaTest) const {
     const ObjectData& od = objects_[object];
+    const AlphaData* mask = alphaTest && od.alpha >= 0 && alphas_[std::size_t(od.alpha)].mode == scene::AlphaMode::Mask
+                                ? &alphas_[std::size_t(od.alpha)]
+                                : nullptr;
+    // An analytic shape's one hit, tested like a mesh's (a sphere's or box's alpha is constant).
+    auto cut = [&](Hit<Real>& h) {
+        return mask && mask->factor * (mask->texture ? textureAlpha(od, ray, h) : Real(1)) < mask->cutoff;
+    };
     switch (od.kind) {
         case ShapeKind::Sphere: {
             const SphereData& s = spheres_[od.index];
@@ -360,7 +451,7 @@ bool Tracer<Real>::intersectObject(int object, const Ray<Real>& ray, Real tMax, 
             hit.t = t;
             hit.object = object;
             hit.prim = 0;
-            return true;
+            return !cut(hit);
         }
         case ShapeKind::Quad: {
             const QuadData& q = quads_[od.index];
@@ -374,7 +465,7 @@ bool Tracer<Real>::intersectObject(int object, const Ray<Real>& ray, Real tMax, 
             hit.t = t;
             hit.object = object;
             hit.prim = 0;
-            return true;
+            return !cut(hit);
         }
         case ShapeKind::Box: {
             const BoxData& b = boxes_[od.index];
@@ -384,13 +475,13 @@ bool Tracer<Real>::intersectObject(int object, const Ray<Real>& ray, Real tMax, 
             hit.t = t;
             hit.object = object;
             hit.prim = face;
-            return true;
+            return !cut(hit);
         }
         case ShapeKind::Mesh: {
             const MeshObjectData& mo = meshObjects_[od.index];
             Real tBest = tMax;
             bool found = false;
-            if (mo.flat >= 0 && intersectMesh(meshes_[mo.flat], ray, tBest, conservative, anyHit, hit)) {
+            if (mo.flat >= 0 && intersectMesh(meshes_[mo.flat], ray, tBest, conservative, anyHit, hit, mask)) {
                 hit.object = object;
                 hit.instance = -1;
                 if (anyHit) return true;
@@ -405,7 +496,7 @@ bool Tracer<Real>::intersectObject(int object, const Ray<Real>& ray, Real tMax, 
                     const InstanceData& in = mo.instances[slots[slot]];
                     // The ray in object space: t keeps its meaning (affine map, d not normalized).
                     const Ray<Real> local(applyPoint(in.toObject, ray.o), applyVector(in.toObject, ray.d));
-                    if (!intersectMesh(meshes_[in.blas], local, tm, conservative, anyHit, hit)) continue;
+                    if (!intersectMesh(meshes_[in.blas], local, tm, conservative, anyHit, hit, mask)) continue;
                     hit.object = object;
                     hit.instance = int(slots[slot]);
                     if (anyHit) return true;
@@ -424,7 +515,7 @@ bool Tracer<Real>::closestHit(const Ray<Real>& ray, Real tMax, bool conservative
     bool found = false;
     for (int i = 0; i < objectCount(); ++i) {
         Hit<Real> h;
-        if (intersectObject(i, ray, tMax, conservative, false, h)) {
+        if (intersectObject(i, ray, tMax, conservative, false, h, false)) {
             tMax = h.t;
             hit = h;
             found = true;
@@ -581,7 +672,8 @@ std::size_t Tracer<Real>::meshBytes() const {
     for (const MeshData& m : meshes_)
         n += m.positions.capacity() * sizeof(Vec) + m.normals.capacity() * sizeof(Vec) +
              m.indices.capacity() * sizeof(std::uint32_t) + m.bvh.bytes() +
-             m.packets.capacity() * sizeof(TrianglePacket) + m.slotVertices.capacity() * sizeof(Vec);
+             m.packets.capacity() * sizeof(TrianglePacket) + m.slotVertices.capacity() * sizeof(Vec) +
+             m.uvs.capacity() * sizeof(m.uvs[0]);
     for (const MeshObjectData& mo : meshObjects_)
         n += mo.instances.capacity() * sizeof(InstanceData) + mo.top.bytes();
     return n;

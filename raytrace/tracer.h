@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <vector>
 
 #include "raytrace/wide_bvh.h"
@@ -55,11 +56,17 @@ public:
     // Nearest hit with 0 < t < tMax. Conservative: reject hits whose t could be <= 0 under
     // rounding (used with robust offsets).
     bool closestHit(const Ray<Real>& ray, Real tMax, bool conservative, Hit<Real>& hit) const;
-    // Any hit with 0 < t < tMax; `blocker` gets the object index of the first found.
+    // Any hit with 0 < t < tMax; `blocker` gets the object index of the first found. Shadow
+    // rays: alpha-tested (MASK) texels below their cutoff are no hit.
     bool anyHit(const Ray<Real>& ray, Real tMax, bool conservative, int& blocker) const;
     // Hits on one object only. With anyHit, the first hit found rather than the nearest.
+    // alphaTest: skip MASK texels below the cutoff (shadow rays); the camera sees every surface.
     bool intersectObject(int object, const Ray<Real>& ray, Real tMax, bool conservative,
-                         bool anyHit, Hit<Real>& hit) const;
+                         bool anyHit, Hit<Real>& hit, bool alphaTest = true) const;
+    // The light a hit on a non-opaque object lets through: 1 − opacity, or for BLEND
+    // 1 − opacity·alpha(uv) with the alpha at the hit (scene::Material::transmittance).
+    double transmittance(const Ray<Real>& ray, const Hit<Real>& hit) const;
+    bool opaqueObject(int object) const { return objects_[object].opaque; }
 
     // Position and normals of a hit. Plain mode is the lesson's p = o + t·d. Robust mode
     // recomputes p from the surface (sphere: reprojected; quad: projected onto its plane, axis-
@@ -85,7 +92,18 @@ private:
         ShapeKind kind;
         int index;  // into the array of its kind
         double opacity;
+        bool opaque = true;  // scene::Material::opaque()
+        int alpha = -1;      // into alphas_: a MASK or BLEND material
     };
+public:
+    // An object's alpha (MASK or BLEND); the texture is shared with the scene's material.
+    struct AlphaData {
+        scene::AlphaMode mode = scene::AlphaMode::Opaque;
+        Real cutoff = 0, factor = 1;
+        std::shared_ptr<const scene::AlphaTexture> texture;  // may be null (constant alpha)
+        scene::Material material;  // for transmittance(): the same formula as the scene's
+    };
+private:
     struct SphereData {
         Vec center;
         Real radius;
@@ -95,6 +113,7 @@ private:
         Vec normal;  // the plane is exactly {x : normal·(x − center) = 0} in Real
         Vec uAxis, vAxis;
         Real halfU, halfV;
+        glm::vec<2, Real, glm::defaultp> uvMin{0}, uvMax{1};  // texture coordinates at the −/+ corners
         int snapAxis;  // axis the normal is along, when the plane is axis-aligned; else -1
     };
     struct BoxData {
@@ -106,6 +125,7 @@ private:
         std::vector<Vec> positions;
         std::vector<Vec> normals;  // per vertex, may be empty
         std::vector<std::uint32_t> indices;
+        std::vector<glm::vec<2, Real, glm::defaultp>> uvs;  // per vertex, only for alpha textures
         Bvh8 bvh;
         // The triangles' vertices again in BVH slot order, so a leaf reads contiguous memory
         // with no index indirection: float keeps SSE packets of four triangles (one per four
@@ -136,9 +156,11 @@ private:
                                    const std::map<const scene::TriangleMesh*, int>& uses,
                                    std::map<const scene::TriangleMesh*, int>& blasOf);
     bool intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& tMax, bool conservative,
-                       bool anyHit, Hit<Real>& hit) const;
+                       bool anyHit, Hit<Real>& hit, const AlphaData* mask = nullptr) const;
     int buildMesh(const std::vector<scene::Vec3>& positions, const std::vector<scene::Vec3>& normals,
-                  const std::vector<std::uint32_t>& indices);
+                  const std::vector<std::uint32_t>& indices, const std::vector<scene::Vec2>& uvs = {});
+    // The texture's alpha at a hit (1 without a texture).
+    Real textureAlpha(const ObjectData& od, const Ray<Real>& ray, const Hit<Real>& hit) const;
 
     std::vector<ObjectData> objects_;
     std::vector<SphereData> spheres_;
@@ -146,6 +168,7 @@ private:
     std::vector<BoxData> boxes_;
     std::vector<MeshData> meshes_;
     std::vector<MeshObjectData> meshObjects_;
+    std::vector<AlphaData> alphas_;
     std::size_t triangles_ = 0;
     std::size_t uniqueTriangles_ = 0;
     std::uint64_t id_;  // unique per tracer, keys the per-thread occluder cache

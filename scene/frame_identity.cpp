@@ -42,7 +42,18 @@ std::string sceneHash(const Scene& scene) {
     h.vec(scene.background);
     h.value(scene.ambient);
     h.value(scene.materials.size());
-    for (const Material& m : scene.materials) h.vec(m.albedo), h.value(m.opacity);
+    for (const Material& m : scene.materials) {
+        h.vec(m.albedo), h.value(m.opacity);
+        // Alpha only where it is used, so that scenes without it keep their identities.
+        if (m.alphaMode != AlphaMode::Opaque) {
+            h.value(int(m.alphaMode)), h.value(m.alphaCutoff), h.value(m.alphaFactor), h.value(m.texCoord);
+            if (m.alphaTexture) {
+                h.value(m.alphaTexture->width), h.value(m.alphaTexture->height);
+                h.value(int(m.alphaTexture->wrapS)), h.value(int(m.alphaTexture->wrapT));
+                h.bytes(m.alphaTexture->alpha.data(), m.alphaTexture->alpha.size() * sizeof(float));
+            }
+        }
+    }
     h.value(scene.lights.size());
     for (const Light& l : scene.lights) {
         h.value(int(l.type));
@@ -57,6 +68,7 @@ std::string sceneHash(const Scene& scene) {
             h.vec(s->center), h.value(s->radius);
         } else if (const auto* q = std::get_if<Quad>(&o.shape)) {
             h.vec(q->center), h.vec(q->normal), h.value(q->size.x), h.value(q->size.y);
+            if (q->uvMin != Vec2(0, 0) || q->uvMax != Vec2(1, 1)) h.vec(Vec3(q->uvMin, 0)), h.vec(Vec3(q->uvMax, 0));
         } else if (const auto* b = std::get_if<Box>(&o.shape)) {
             h.vec(b->min), h.vec(b->max);
         } else if (const auto* m = std::get_if<Mesh>(&o.shape)) {
@@ -67,6 +79,7 @@ std::string sceneHash(const Scene& scene) {
                 h.value(g.positions.size());
                 h.bytes(g.positions.data(), g.positions.size() * sizeof(Vec3));
                 h.bytes(g.normals.data(), g.normals.size() * sizeof(Vec3));
+                if (!g.uvs.empty()) h.bytes(g.uvs.data(), g.uvs.size() * sizeof(Vec2));
                 h.value(g.indices.size());
                 h.bytes(g.indices.data(), g.indices.size() * sizeof(std::uint32_t));
             }

@@ -21,6 +21,7 @@
 #include "scene/model_view.h"
 #include "scene/scene_checks.h"
 #include "scene/settings.h"
+#include "scene/texture.h"
 
 namespace shadowlab::scene {
 
@@ -172,6 +173,46 @@ private:
     fs::path file_;
 };
 
+// A material's alpha keys (docs/scene-format.md, "Alpha-tested and blended casters"): the glTF
+// alphaMode, alphaCutoff, baseColorFactor alpha and baseColorTexture, by JSON names.
+void readAlpha(const Reader& r, const Json& node, const JsonPath& path, Material& m, TextureCache& textures) {
+    if (node.contains("alpha_mode")) {
+        const std::string mode = r.string(node["alpha_mode"], path / "alpha_mode");
+        if (mode == "opaque") m.alphaMode = AlphaMode::Opaque;
+        else if (mode == "mask") m.alphaMode = AlphaMode::Mask;
+        else if (mode == "blend") m.alphaMode = AlphaMode::Blend;
+        else r.fail(path / "alpha_mode", "unknown alpha mode '" + excerpt(mode) + "' (expected opaque, mask or blend)");
+    }
+    if (node.contains("alpha_cutoff")) {
+        if (m.alphaMode != AlphaMode::Mask)
+            r.fail(path / "alpha_cutoff", "applies only with \"alpha_mode\": \"mask\"");
+        m.alphaCutoff = r.unitInterval(node["alpha_cutoff"], path / "alpha_cutoff");
+    }
+    if (node.contains("alpha")) m.alphaFactor = r.unitInterval(node["alpha"], path / "alpha");
+    for (const char* key : {"wrap_s", "wrap_t", "texcoord"})
+        if (node.contains(key) && !node.contains("texture"))
+            r.fail(path / key, "applies only to a material with a \"texture\"");
+    if (!node.contains("texture")) return;
+    const std::string file = r.string(node["texture"], path / "texture");
+    if (file.empty()) r.fail(path / "texture", "must name an image file");
+    TextureWrap wrap[2] = {TextureWrap::Repeat, TextureWrap::Repeat};
+    for (int k = 0; k < 2; ++k) {
+        const char* key = k == 0 ? "wrap_s" : "wrap_t";
+        if (!node.contains(key)) continue;
+        const std::string w = r.string(node[key], path / key);
+        if (!textureWrapFromName(w, wrap[k]))
+            r.fail(path / key, "unknown wrap mode '" + excerpt(w) + "' (expected repeat, clamp_to_edge or mirrored_repeat)");
+    }
+    if (node.contains("texcoord")) m.texCoord = r.integer(node["texcoord"], path / "texcoord", 0, 64);
+    const fs::path base = r.file().has_parent_path() ? r.file().parent_path() : fs::path(".");
+    const fs::path resolved = fs::path(file).is_absolute() ? fs::path(file) : base / file;
+    try {
+        m.alphaTexture = loadAlphaTexture(resolved, wrap[0], wrap[1], &textures);
+    } catch (const InputFileError& e) {
+        r.fail(path / "texture", e.what());
+    }
+}
+
 Camera readCamera(const Reader& r, const Json& node, const JsonPath& path) {
     r.checkKeys(node, path, {"position", "look_at", "up", "fov_y", "resolution", "near", "far"});
     Camera c;
@@ -246,11 +287,22 @@ struct PendingCameras {
 };
 
 Object readObject(const Reader& r, const Json& node, const JsonPath& path,
-                  const std::map<std::string, int>& materials, MeshCache& meshCache,
-                  PendingCameras* pending = nullptr) {
+                  const std::map<std::string, int>& materials, const std::vector<Material>& sceneMaterials,
+                  MeshCache& meshCache, PendingCameras* pending = nullptr) {
     r.expectObject(node, path);
     Object o;
     const std::string type = r.string(r.require(node, path, "type"), path / "type");
+    auto lookupMaterial = [&] {
+        const std::string material = r.string(r.require(node, path, "material"), path / "material");
+        const auto it = materials.find(material);
+        if (it == materials.end()) {
+            std::string known;
+            for (const auto& [name, index] : materials) known += (known.empty() ? "" : ", ") + name;
+            r.fail(path / "material", "no material named '" + material + "' (defined: " +
+                                          (known.empty() ? "none" : known) + ")");
+        }
+        return it->second;
+    };
     if (type == "sphere") {
         r.checkKeys(node, path, {"type", "name", "material", "center", "radius"});
         Sphere s;
@@ -258,8 +310,10 @@ Object readObject(const Reader& r, const Json& node, const JsonPath& path,
         s.radius = r.positive(r.require(node, path, "radius"), path / "radius");
         o.shape = s;
     } else if (type == "quad") {
-        r.checkKeys(node, path, {"type", "name", "material", "center", "normal", "size"});
+        r.checkKeys(node, path, {"type", "name", "material", "center", "normal", "size", "uv_min", "uv_max"});
         Quad q;
+        if (node.contains("uv_min")) q.uvMin = r.vector<2>(node["uv_min"], path / "uv_min");
+        if (node.contains("uv_max")) q.uvMax = r.vector<2>(node["uv_max"], path / "uv_max");
         q.center = r.vector<3>(r.require(node, path, "center"), path / "center");
         q.normal = r.direction(r.require(node, path, "normal"), path / "normal");
         const Json& size = r.require(node, path, "size");
@@ -294,8 +348,12 @@ Object readObject(const Reader& r, const Json& node, const JsonPath& path,
         const fs::path base = r.file().has_parent_path() ? r.file().parent_path() : fs::path(".");
         m.file = fs::path(file).is_absolute() ? fs::path(file) : base / file;
         GltfExtras extras;
+        // A textured material decides whether the file is read with texture coordinates.
+        const Material& mat = sceneMaterials[std::size_t(lookupMaterial())];
+        MeshRequest request;
+        if (mat.alphaTextured()) request.uvSet = mat.texCoord;
         m.instances = loadMeshInstances(m.file, objectTransform(translate, rotate, scale), r.file(),
-                                        path / "file", pending ? &extras : nullptr, &meshCache);
+                                        path / "file", pending ? &extras : nullptr, &meshCache, request);
         if (pending) {
             pending->cameras = extras.cameras;
             pending->transform = objectTransform(translate, rotate, scale);
@@ -312,15 +370,12 @@ Object readObject(const Reader& r, const Json& node, const JsonPath& path,
         r.fail(path / "type", "unknown object type '" + type + "' (expected sphere, quad, box or mesh)");
     }
     o.name = node.contains("name") ? r.string(node["name"], path / "name") : path.str();
-    const std::string material = r.string(r.require(node, path, "material"), path / "material");
-    const auto it = materials.find(material);
-    if (it == materials.end()) {
-        std::string known;
-        for (const auto& [name, index] : materials) known += (known.empty() ? "" : ", ") + name;
-        r.fail(path / "material", "no material named '" + material + "' (defined: " +
-                                      (known.empty() ? "none" : known) + ")");
-    }
-    o.material = it->second;
+    o.material = lookupMaterial();
+    if ((std::holds_alternative<Sphere>(o.shape) || std::holds_alternative<Box>(o.shape)) &&
+        sceneMaterials[std::size_t(o.material)].alphaTextured())
+        r.fail(path / "material", "material '" + sceneMaterials[std::size_t(o.material)].name +
+                                      "' reads an alpha texture, which needs texture coordinates: only quads "
+                                      "and meshes have them (use a quad or a mesh, or alpha_mode opaque)");
     return o;
 }
 
@@ -535,18 +590,21 @@ Scene parseScene(const fs::path& file, const std::string& text) {
     if (doc.contains("description")) r.string(doc["description"], root / "description");
 
     std::map<std::string, int> materialIndex;
+    TextureCache textures;  // materials naming the same texture file share it
     const Json& materials = r.require(doc, root, "materials");
     r.expectObject(materials, root / "materials");
     if (materials.empty()) r.fail(root / "materials", "must define at least one material");
     for (const auto& [name, node] : materials.items()) {
         const JsonPath path = root / "materials" / name;
-        r.checkKeys(node, path, {"albedo", "opacity"});
+        r.checkKeys(node, path, {"albedo", "opacity", "alpha_mode", "alpha_cutoff", "alpha", "texture", "wrap_s",
+                                 "wrap_t", "texcoord"});
         Material m;
         m.name = name;
         m.albedo = r.color(node, path, "albedo", m.albedo);
         if (m.albedo.x > 1 || m.albedo.y > 1 || m.albedo.z > 1)
             r.fail(path / "albedo", "albedo components must be in 0..1 (energy conserving)");
         if (node.contains("opacity")) m.opacity = r.unitInterval(node["opacity"], path / "opacity");
+        readAlpha(r, node, path, m, textures);
         materialIndex[name] = int(scene.materials.size());
         scene.materials.push_back(m);
     }
@@ -566,7 +624,8 @@ Scene parseScene(const fs::path& file, const std::string& text) {
     bool picked = false;
     for (std::size_t i = 0; i < objects.size(); ++i) {
         PendingCameras p;
-        scene.objects.push_back(readObject(r, objects[i], root / "objects" / i, materialIndex, meshCache, &p));
+        scene.objects.push_back(
+            readObject(r, objects[i], root / "objects" / i, materialIndex, scene.materials, meshCache, &p));
         if (p.pick && picked) r.fail(p.pickPath, "only one mesh object may name the scene's camera");
         picked = picked || p.pick.has_value();
         if (!p.cameras.empty() || p.pick) pending.push_back(std::move(p));
@@ -589,11 +648,29 @@ Scene loadModelScene(const fs::path& file) {
     GltfExtras extras;
     Scene scene;
     scene.file = file;
-    scene.materials.push_back({"model", {0.8, 0.8, 0.8}, 1.0});
-    Mesh mesh;
-    mesh.file = file;
-    mesh.instances = loadMeshInstances(file, glm::dmat4(1.0), file, JsonPath(), &extras);
-    scene.objects.push_back({file.stem().string(), mesh, 0});
+    // One object per glTF material (docs/decisions.md, "A glTF model per material"): each keeps
+    // its alpha mode, cutoff and texture; a single-material file stays one object named by its stem.
+    MeshRequest request;
+    request.perMaterial = true;
+    const std::vector<MeshInstance> instances =
+        loadMeshInstances(file, glm::dmat4(1.0), file, JsonPath(), &extras, nullptr, request);
+    std::vector<int> order;  // glTF material indices in order of first use
+    for (const MeshInstance& inst : instances)
+        if (std::find(order.begin(), order.end(), inst.fileMaterial) == order.end()) order.push_back(inst.fileMaterial);
+    for (const int fileMaterial : order) {
+        Material m;
+        if (fileMaterial >= 0 && std::size_t(fileMaterial) < extras.materials.size()) m = extras.materials[std::size_t(fileMaterial)];
+        else m.name = "model";
+        m.albedo = {0.8, 0.8, 0.8};  // shadows are the point: every part the same grey
+        m.opacity = 1.0;
+        Mesh mesh;
+        mesh.file = file;
+        for (const MeshInstance& inst : instances)
+            if (inst.fileMaterial == fileMaterial) mesh.instances.push_back(inst);
+        const std::string name = order.size() == 1 ? file.stem().string() : file.stem().string() + "/" + m.name;
+        scene.materials.push_back(std::move(m));
+        scene.objects.push_back({name, std::move(mesh), int(scene.materials.size()) - 1});
+    }
     checkSceneExtent(scene, false);  // before the framing is computed from the bounds
     const Bounds b = scene.bounds();
     scene.origin.modelScene = true;

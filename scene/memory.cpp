@@ -34,11 +34,34 @@ std::uint64_t sceneBytes(const Scene& scene) {
                 if (!g || !geometries.insert(g).second) continue;
                 bytes += sizeof(TriangleMesh) + 32 /* shared_ptr control block */ +
                          (g->positions.capacity() + g->normals.capacity()) * sizeof(Vec3) +
-                         g->indices.capacity() * sizeof(std::uint32_t);
+                         g->indices.capacity() * sizeof(std::uint32_t) + g->uvs.capacity() * sizeof(Vec2);
             }
         }
     }
+    // Alpha textures, each shared one once.
+    std::set<const AlphaTexture*> textures;
+    for (const Material& m : scene.materials)
+        if (m.alphaTexture && textures.insert(m.alphaTexture.get()).second) bytes += m.alphaTexture->bytes();
     return bytes;
+}
+
+std::uint64_t alphaTextureBytes(const Scene& scene) {
+    std::set<const AlphaTexture*> textures;
+    std::uint64_t bytes = 0;
+    for (const Material& m : scene.materials)
+        if (m.alphaTextured() && textures.insert(m.alphaTexture.get()).second)
+            bytes += std::uint64_t(m.alphaTexture->alpha.size()) * 4;
+    return bytes;
+}
+
+std::uint64_t alphaTexturedTriangles(const Scene& scene) {
+    std::uint64_t n = 0;
+    for (const Object& o : scene.objects)
+        if (scene.materialOf(o).alphaTextured()) {
+            if (const auto* m = std::get_if<Mesh>(&o.shape)) n += m->triangleCount();
+            else n += 2;  // a quad
+        }
+    return n;
 }
 
 std::uint64_t peakResidentBytes() {

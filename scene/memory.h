@@ -25,6 +25,12 @@ std::uint64_t frameWriteBytes(const Scene& scene);
 // parsed tree, which the process keeps as resident memory once freed).
 std::uint64_t sceneBytes(const Scene& scene);
 
+// Alpha-tested and blended casters (docs/scene-format.md): the texels of the scene's alpha
+// textures (4 bytes each, each texture once), which the raster backend uploads, and the triangles
+// of objects whose material reads one (a triangle carries texture coordinates in both backends).
+std::uint64_t alphaTextureBytes(const Scene& scene);
+std::uint64_t alphaTexturedTriangles(const Scene& scene);
+
 // What each backend holds per object besides its geometry (its entries in the object and
 // instance lists, bounds and acceleration-structure nodes): an allowance, measured at about
 // 100 bytes an object for a million spheres and rounded up.

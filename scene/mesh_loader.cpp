@@ -21,6 +21,7 @@
 #include "scene/json_input.h"
 #include "scene/memory.h"
 #include "scene/scene_checks.h"
+#include "scene/texture.h"
 
 namespace shadowlab::scene {
 
@@ -119,7 +120,7 @@ private:
 };
 
 void loadObj(const fs::path& file, const std::string& text, TriangleMesh& mesh, const fs::path& sceneFile,
-             const JsonPath& path) {
+             const JsonPath& path, bool wantUvs) {
     checkObjText(text, file, sceneFile, path);
     tinyobj::attrib_t attribStorage;
     std::vector<tinyobj::shape_t> shapes;
@@ -159,6 +160,14 @@ void loadObj(const fs::path& file, const std::string& text, TriangleMesh& mesh, 
             if (!finite(p)) fail(sceneFile, path, file, "vertex " + std::to_string(idx.vertex_index + 1) + " is not finite");
             mesh.indices.push_back(std::uint32_t(mesh.positions.size()));
             mesh.positions.push_back(p);
+            if (wantUvs) {
+                // OBJ's vt has v up from the image's bottom; glTF's (and ours) runs down from its top.
+                if (idx.texcoord_index < 0 || 2 * std::size_t(idx.texcoord_index) + 1 >= attrib.texcoords.size())
+                    fail(sceneFile, path, file, "a face corner has no texture coordinate (vt), which the object's "
+                                                "alpha texture needs");
+                mesh.uvs.emplace_back(attrib.texcoords[2 * std::size_t(idx.texcoord_index)],
+                                      1.0 - attrib.texcoords[2 * std::size_t(idx.texcoord_index) + 1]);
+            }
             if (allHaveNormals)
                 mesh.normals.emplace_back(attrib.normals[3 * std::size_t(idx.normal_index)],
                                           attrib.normals[3 * std::size_t(idx.normal_index) + 1],
@@ -381,19 +390,93 @@ void collectCameraAnimations(const tinygltf::Model& model, const std::map<int, s
     }
 }
 
-// glTF textures are not needed for shadows: accept any image, even a missing one.
-bool ignoreImage(tinygltf::Image*, const int, std::string*, std::string*, int, int,
-                 const unsigned char*, int, void*) {
+// Images are decoded only where a MASK or BLEND material needs one's alpha (readMaterials), so
+// any image is accepted here, even a missing one; with `user` (a GltfImages) the bytes are kept.
+using GltfImages = std::map<int, std::vector<unsigned char>>;
+bool ignoreImage(tinygltf::Image*, const int index, std::string*, std::string*, int, int,
+                 const unsigned char* bytes, int size, void* user) {
+    if (user && bytes && size > 0) (*static_cast<GltfImages*>(user))[index].assign(bytes, bytes + size);
     return true;
 }
 
-// One glTF mesh (all its triangle primitives) in the mesh's own space.
+TextureWrap wrapOf(int glWrap) {
+    return glWrap == 33071 ? TextureWrap::ClampToEdge : glWrap == 33648 ? TextureWrap::MirroredRepeat : TextureWrap::Repeat;
+}
+
+// The file's materials as scene materials (grey albedo: shadows do not need its colours), with the
+// alpha texture of each MASK and BLEND material that has a baseColorTexture.
+std::vector<Material> readMaterials(const tinygltf::Model& model, const GltfImages& images, const fs::path& file,
+                                    const fs::path& sceneFile, const JsonPath& path) {
+    std::vector<Material> out;
+    std::map<std::tuple<int, int, int>, std::shared_ptr<const AlphaTexture>> decoded;
+    for (std::size_t i = 0; i < model.materials.size(); ++i) {
+        const tinygltf::Material& gm = model.materials[i];
+        const std::string at = "materials[" + std::to_string(i) + "]";
+        Material m;
+        m.name = gm.name.empty() ? at : gm.name;
+        m.alphaMode = gm.alphaMode == "MASK" ? AlphaMode::Mask : gm.alphaMode == "BLEND" ? AlphaMode::Blend : AlphaMode::Opaque;
+        if (gm.alphaMode != "OPAQUE" && gm.alphaMode != "MASK" && gm.alphaMode != "BLEND")
+            fail(sceneFile, path, file, at + ".alphaMode: unknown mode '" + excerpt(gm.alphaMode) +
+                                            "' (expected OPAQUE, MASK or BLEND)");
+        m.alphaCutoff = gm.alphaCutoff;
+        if (!(m.alphaCutoff >= 0.0))
+            fail(sceneFile, path, file, at + ".alphaCutoff: must be >= 0, got " + describeJson(gm.alphaCutoff));
+        const auto& factor = gm.pbrMetallicRoughness.baseColorFactor;
+        m.alphaFactor = factor.size() == 4 ? factor[3] : 1.0;
+        if (!(m.alphaFactor >= 0.0 && m.alphaFactor <= 1.0))
+            fail(sceneFile, path, file, at + ".pbrMetallicRoughness.baseColorFactor[3]: must be in 0..1");
+        const auto& info = gm.pbrMetallicRoughness.baseColorTexture;
+        if (m.alphaMode != AlphaMode::Opaque && info.index >= 0) {
+            const std::string texAt = at + ".pbrMetallicRoughness.baseColorTexture";
+            if (std::size_t(info.index) >= model.textures.size())
+                fail(sceneFile, path, file, texAt + ".index: names texture " + std::to_string(info.index) +
+                                                ", which does not exist");
+            const tinygltf::Texture& tex = model.textures[std::size_t(info.index)];
+            if (tex.source < 0 || std::size_t(tex.source) >= model.images.size())
+                fail(sceneFile, path, file, "textures[" + std::to_string(info.index) + "].source: names no image");
+            TextureWrap s = TextureWrap::Repeat, t = TextureWrap::Repeat;
+            if (tex.sampler >= 0 && std::size_t(tex.sampler) < model.samplers.size()) {
+                s = wrapOf(model.samplers[std::size_t(tex.sampler)].wrapS);
+                t = wrapOf(model.samplers[std::size_t(tex.sampler)].wrapT);
+            }
+            const tinygltf::Image& image = model.images[std::size_t(tex.source)];
+            const std::string imageAt = "images[" + std::to_string(tex.source) + "]" +
+                                        (image.uri.empty() || image.uri.rfind("data:", 0) == 0 ? "" : " (" + excerpt(image.uri) + ")");
+            const auto key = std::make_tuple(tex.source, int(s), int(t));
+            if (!decoded.count(key)) {
+                const auto bytes = images.find(tex.source);
+                if (bytes == images.end())
+                    fail(sceneFile, path, file, imageAt + ": could not be read, and " + texAt +
+                                                    " needs its alpha (" + m.name + " is " + gm.alphaMode + ")");
+                std::string ext = image.mimeType == "image/jpeg" ? ".jpg" : image.mimeType == "image/png" ? ".png" : "";
+                if (ext.empty()) ext = fs::path(image.uri).extension().string();
+                try {
+                    decoded[key] = loadAlphaTextureFromMemory(file.string() + "#" + imageAt, ext, bytes->second, s, t);
+                } catch (const InputFileError& e) {
+                    fail(sceneFile, path, file, imageAt + ": " + e.problem());
+                }
+            }
+            m.alphaTexture = decoded[key];
+            m.texCoord = info.texCoord;
+            if (m.texCoord < 0 || m.texCoord > 64)
+                fail(sceneFile, path, file, texAt + ".texCoord: must be in 0..64, got " + std::to_string(m.texCoord));
+        }
+        out.push_back(std::move(m));
+    }
+    return out;
+}
+
+// One glTF mesh's triangle primitives in the mesh's own space: all of them (material -2), or
+// those of one material; with TEXCOORD_`uvSet` per vertex when uvSet >= 0.
 void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& out,
-                    const fs::path& file, const fs::path& sceneFile, const JsonPath& path) {
+                    const fs::path& file, const fs::path& sceneFile, const JsonPath& path,
+                    int material = -2, int uvSet = -1) {
     if (meshIndex < 0 || std::size_t(meshIndex) >= model.meshes.size())
         fail(sceneFile, path, file, "node names mesh " + std::to_string(meshIndex) + ", which does not exist");
-    for (const auto& prim : model.meshes[meshIndex].primitives) {
+    for (std::size_t primIndex = 0; primIndex < model.meshes[meshIndex].primitives.size(); ++primIndex) {
+        const auto& prim = model.meshes[meshIndex].primitives[primIndex];
         if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != -1) continue;  // points/lines cast nothing
+        if (material != -2 && prim.material != material) continue;
         const auto pos = prim.attributes.find("POSITION");
         if (pos == prim.attributes.end()) fail(sceneFile, path, file, "a primitive has no POSITION");
         const std::vector<double> p = readAccessor(model, pos->second, 3, file, sceneFile, path);
@@ -402,6 +485,25 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
         if (const auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
             n = readAccessor(model, it->second, 3, file, sceneFile, path);
             if (n.size() != p.size()) n.clear();
+        }
+        std::vector<double> uv;
+        if (uvSet >= 0) {
+            const std::string name = "TEXCOORD_" + std::to_string(uvSet);
+            const auto it = prim.attributes.find(name);
+            const std::string at = "meshes[" + std::to_string(meshIndex) + "].primitives[" + std::to_string(primIndex) + "]";
+            if (it == prim.attributes.end())
+                fail(sceneFile, path, file, at + ": has no " + name + ", which its material's alpha texture needs");
+            uv = readAccessor(model, it->second, 2, file, sceneFile, path);
+            // Normalized integer coordinates (glTF 2.0, 3.7.2.1) are code / max.
+            const auto& acc = model.accessors[std::size_t(it->second)];
+            const double scale = !acc.normalized ? 1.0
+                                 : acc.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ? 1.0 / 255.0
+                                 : acc.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? 1.0 / 65535.0 : 1.0;
+            if (uv.size() != 2 * count) fail(sceneFile, path, file, at + ": " + name + " has not one element per vertex");
+            for (double& c : uv) {
+                c *= scale;
+                if (!std::isfinite(c)) fail(sceneFile, path, file, at + ": " + name + " holds a non-finite value");
+            }
         }
         std::vector<double> idx;
         if (prim.indices >= 0) {
@@ -420,6 +522,7 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
             if (!finite(v)) fail(sceneFile, path, file, "a vertex is not finite");
             out.positions.push_back(v);
             if (keepNormals) out.normals.emplace_back(n[3 * i], n[3 * i + 1], n[3 * i + 2]);
+            if (uvSet >= 0) out.uvs.emplace_back(uv[2 * i], uv[2 * i + 1]);
         }
         for (std::size_t i = 0; i + 2 < idx.size(); i += 3) {
             for (int k = 0; k < 3; ++k) {
@@ -486,6 +589,7 @@ void collectCameraAndLight(const tinygltf::Model& model, const tinygltf::Node& n
 struct RawInstance {
     std::shared_ptr<TriangleMesh> geometry;
     glm::dmat4 transform;
+    int material = -1;  // glTF material index (MeshRequest::perMaterial)
 };
 
 // Every file a glTF names (buffers, images) is read through the one input opener, relative to
@@ -533,7 +637,7 @@ std::string_view gltfJson(const std::string& bytes, bool binary) {
 }
 
 void loadGltf(const fs::path& file, const std::string& bytes, std::vector<RawInstance>& out, const fs::path& sceneFile,
-              const JsonPath& path, GltfExtras* extras) {
+              const JsonPath& path, GltfExtras* extras, const MeshRequest& request) {
     std::string ext = file.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
     const bool binary = ext == ".glb";
@@ -541,7 +645,8 @@ void loadGltf(const fs::path& file, const std::string& bytes, std::vector<RawIns
     if (const std::string problem = jsonNestingProblem(gltfJson(bytes, binary)); !problem.empty())
         fail(sceneFile, path, file, problem);
     tinygltf::TinyGLTF loader;
-    loader.SetImageLoader(ignoreImage, nullptr);
+    GltfImages images;  // kept only where materials may need them
+    loader.SetImageLoader(ignoreImage, request.perMaterial ? &images : nullptr);
     GltfFiles files{file.has_parent_path() ? file.parent_path().string() : std::string()};
     loader.SetFsCallbacks({gltfFileExists, gltfExpandPath, gltfReadFile, gltfWriteFile, &files});
     tinygltf::Model model;
@@ -553,6 +658,10 @@ void loadGltf(const fs::path& file, const std::string& bytes, std::vector<RawIns
                                             unsigned(std::min<std::size_t>(bytes.size(), UINT_MAX)), files.baseDir);
     if (!ok) fail(sceneFile, path, file, "not a readable glTF file: " + excerpt(err.empty() ? warn : err, 400));
 
+    std::vector<Material> materials;
+    if (request.perMaterial) materials = readMaterials(model, images, file, sceneFile, path);
+    images.clear();
+    if (extras) extras->materials = materials;
     // Walk the default scene's node tree (depth first, in document order) so each node that
     // uses a mesh places it once; a mesh used by several nodes is read once and shared.
     std::vector<int> roots;
@@ -560,6 +669,7 @@ void loadGltf(const fs::path& file, const std::string& bytes, std::vector<RawIns
     if (std::size_t(sceneIndex) < model.scenes.size()) roots = model.scenes[sceneIndex].nodes;
     else for (std::size_t i = 0; i < model.nodes.size(); ++i) roots.push_back(int(i));
     std::vector<std::shared_ptr<TriangleMesh>> meshes(model.meshes.size());
+    std::map<std::pair<int, int>, std::shared_ptr<TriangleMesh>> perMaterial;  // (mesh, material)
     std::vector<std::pair<int, glm::dmat4>> stack;
     for (auto r = roots.rbegin(); r != roots.rend(); ++r) stack.emplace_back(*r, glm::dmat4(1.0));
     // glTF nodes form a forest (glTF 2.0 spec, 3.5.3: a node has at most one parent and no
@@ -590,12 +700,33 @@ void loadGltf(const fs::path& file, const std::string& bytes, std::vector<RawIns
         if (node.mesh >= 0) {
             if (std::size_t(node.mesh) >= model.meshes.size())
                 fail(sceneFile, path, file, "node names mesh " + std::to_string(node.mesh) + ", which does not exist");
-            auto& geometry = meshes[node.mesh];
-            if (!geometry) {
-                geometry = std::make_shared<TriangleMesh>();
-                appendGltfMesh(model, node.mesh, *geometry, file, sceneFile, path);
+            if (!request.perMaterial) {
+                auto& geometry = meshes[node.mesh];
+                if (!geometry) {
+                    geometry = std::make_shared<TriangleMesh>();
+                    appendGltfMesh(model, node.mesh, *geometry, file, sceneFile, path, -2, request.uvSet);
+                }
+                out.push_back({geometry, world});
+            } else {
+                // One geometry per material the mesh uses, in the order its primitives name them.
+                std::vector<int> used;
+                for (const auto& prim : model.meshes[std::size_t(node.mesh)].primitives)
+                    if (std::find(used.begin(), used.end(), prim.material) == used.end()) used.push_back(prim.material);
+                for (const int material : used) {
+                    if (material >= int(materials.size()))
+                        fail(sceneFile, path, file, "a primitive of mesh " + std::to_string(node.mesh) +
+                                                        " names material " + std::to_string(material) +
+                                                        ", which does not exist");
+                    auto& geometry = perMaterial[{node.mesh, material}];
+                    if (!geometry) {
+                        geometry = std::make_shared<TriangleMesh>();
+                        const Material* m = material >= 0 ? &materials[std::size_t(material)] : nullptr;
+                        appendGltfMesh(model, node.mesh, *geometry, file, sceneFile, path, material,
+                                       m && m->alphaTextured() ? m->texCoord : -1);
+                    }
+                    out.push_back({geometry, world, material});
+                }
             }
-            out.push_back({geometry, world});
         }
         if (extras) {
             const std::size_t before = extras->cameras.size();
@@ -623,7 +754,8 @@ bool invertible(const glm::dmat4& m) {
 // its bytes, tinyobjloader's arrays (about three times an OBJ's text), or tinygltf's JSON tree
 // (twice: its parse tree and the model's copies), buffers and the accessors read as doubles.
 std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path& sceneFile,
-                                       const JsonPath& path, GltfExtras* extras, std::uint64_t& loadBytes) {
+                                       const JsonPath& path, GltfExtras* extras, std::uint64_t& loadBytes,
+                                       const MeshRequest& request) {
     std::string bytes;
     try {
         bytes = readInputFile(meshFile, kMaxMeshFileBytes);
@@ -641,9 +773,9 @@ std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path&
                                             std::to_string(available / kMiB) + " MiB available");
     if (ext == ".obj") {
         raw.push_back({std::make_shared<TriangleMesh>(), glm::dmat4(1.0)});
-        loadObj(meshFile, bytes, *raw.back().geometry, sceneFile, path);
+        loadObj(meshFile, bytes, *raw.back().geometry, sceneFile, path, request.uvSet >= 0);
     } else if (ext == ".gltf" || ext == ".glb") {
-        loadGltf(meshFile, bytes, raw, sceneFile, path, extras);
+        loadGltf(meshFile, bytes, raw, sceneFile, path, extras, request);
     } else {
         fail(sceneFile, path, meshFile, "unsupported format '" + excerpt(ext) + "': a mesh is .obj, .gltf or .glb (convert the model, e.g. to .obj or .glb)");
     }
@@ -664,7 +796,7 @@ std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path&
             dropped += r.geometry->triangleCount();
             continue;
         }
-        out.push_back({r.geometry, affineOf(r.transform)});
+        out.push_back({r.geometry, affineOf(r.transform), r.material});
     }
     if (triangles == 0 && dropped == 0) fail(sceneFile, path, meshFile, "has no triangles");
     if (out.empty())
@@ -725,13 +857,16 @@ void finalizeMesh(TriangleMesh& mesh) {
 
 std::vector<MeshInstance> loadMeshInstances(const fs::path& meshFile, const glm::dmat4& transform,
                                             const fs::path& sceneFile, const JsonPath& path,
-                                            GltfExtras* extras, MeshCache* cache) {
+                                            GltfExtras* extras, MeshCache* cache, const MeshRequest& request) {
     std::vector<MeshInstance> instances;
     std::string key;
     if (cache) {
         std::error_code ec;
         const fs::path canonical = fs::weakly_canonical(meshFile, ec);
         key = (ec ? meshFile : canonical).string();
+        // The same file read with texture coordinates is another set of geometries.
+        if (request.uvSet >= 0 || request.perMaterial)
+            key += "\n" + std::to_string(request.uvSet) + (request.perMaterial ? "m" : "");
         if (const auto it = cache->files.find(key); it != cache->files.end()) {
             instances = it->second;
             if (extras) *extras = cache->extras[key];  // the same cameras for every object naming the file
@@ -740,7 +875,8 @@ std::vector<MeshInstance> loadMeshInstances(const fs::path& meshFile, const glm:
     if (instances.empty()) {
         GltfExtras own;
         std::uint64_t loadBytes = 0;
-        instances = readMeshFile(meshFile, sceneFile, path, extras ? extras : (cache ? &own : nullptr), loadBytes);
+        instances = readMeshFile(meshFile, sceneFile, path, extras ? extras : (cache ? &own : nullptr), loadBytes,
+                                 request);
         if (cache) {
             cache->files.emplace(key, instances);
             cache->extras[key] = extras ? *extras : own;
@@ -766,7 +902,7 @@ std::vector<MeshInstance> loadMeshInstances(const fs::path& meshFile, const glm:
             if (!finite(Vec3(m * glm::dvec4(c, 1.0))))
                 fail(sceneFile, path, meshFile, "a vertex is not finite once placed");
         }
-        out.push_back({inst.geometry, affineOf(m)});
+        out.push_back({inst.geometry, affineOf(m), inst.fileMaterial});
     }
     if (out.empty())
         fail(sceneFile, path, meshFile, overflowed ? "the object's transform overflows (its scale is too large for "
@@ -778,7 +914,9 @@ std::vector<MeshInstance> loadMeshInstances(const fs::path& meshFile, const glm:
 TriangleMesh flattenInstances(const std::vector<MeshInstance>& instances) {
     TriangleMesh out;
     bool normals = true;
+    bool uvs = true;
     for (const MeshInstance& inst : instances) normals = normals && !inst.geometry->normals.empty();
+    for (const MeshInstance& inst : instances) uvs = uvs && inst.geometry->uvs.size() == inst.geometry->positions.size();
     for (const MeshInstance& inst : instances) {
         const TriangleMesh& g = *inst.geometry;
         const glm::dmat3 nm = normalMatrix(inst.transform);
@@ -787,6 +925,7 @@ TriangleMesh flattenInstances(const std::vector<MeshInstance>& instances) {
         if (normals)
             for (const Vec3& n : g.normals) out.normals.push_back(glm::normalize(nm * n));
         for (std::uint32_t i : g.indices) out.indices.push_back(base + i);
+        if (uvs) out.uvs.insert(out.uvs.end(), g.uvs.begin(), g.uvs.end());
         out.droppedDegenerate += g.droppedDegenerate;
     }
     return out;

@@ -38,7 +38,21 @@ struct GltfExtras {
     // Animations whose translation or rotation channels move a camera's node; `camera` indexes
     // `cameras` (scene/camera_animation.h samples them).
     std::vector<CameraAnimation> cameraAnimations;
+    // With MeshRequest::perMaterial: the file's materials in its order (alpha mode, cutoff,
+    // baseColorFactor alpha and, for MASK and BLEND, the baseColorTexture's alpha).
+    std::vector<Material> materials;
     std::uint64_t loadBytes = 0;  // the file's temporaries while it was read (text, trees, buffers)
+};
+
+// What to read besides positions and normals.
+struct MeshRequest {
+    // TEXCOORD_n (glTF) or vt (OBJ) for every triangle: the set a JSON object's textured
+    // material names; -1: none.
+    int uvSet = -1;
+    // glTF: one geometry per (mesh, material) with MeshInstance::fileMaterial set, the
+    // materials in GltfExtras::materials and the UVs each MASK/BLEND texture needs (a model
+    // given as the scene).
+    bool perMaterial = false;
 };
 
 // Each mesh file read once per scene: objects that name the same file share its geometries
@@ -58,7 +72,7 @@ std::vector<MeshInstance> loadMeshInstances(const std::filesystem::path& meshFil
                                             const glm::dmat4& transform,
                                             const std::filesystem::path& sceneFile,
                                             const JsonPath& path, GltfExtras* extras = nullptr,
-                                            MeshCache* cache = nullptr);
+                                            MeshCache* cache = nullptr, const MeshRequest& request = {});
 
 // Copies every instance into one world-space mesh (positions transformed, normals by the
 // inverse transpose): for tools and tests that want one flat triangle list.

@@ -53,6 +53,14 @@ bool Scene::allOpaque() const {
     return true;
 }
 
+bool Scene::hasAlphaCasters() const {
+    for (const Object& o : objects) {
+        const Material& m = materialOf(o);
+        if (m.alphaMode == AlphaMode::Mask || (m.alphaMode == AlphaMode::Blend && m.alphaTexture)) return true;
+    }
+    return false;
+}
+
 Bounds Scene::bounds() const {
     Bounds b;
     for (const Object& o : objects) b.extend(boundsOf(o.shape));

@@ -2,6 +2,7 @@
 // Nothing here knows about Vulkan or ray tracing: backends read this and write a Frame.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <limits>
@@ -33,13 +34,75 @@ struct Camera {
     double far = 100.0;
 };
 
+// glTF 2.0 alphaMode (3.9.4): OPAQUE ignores alpha, MASK cuts texels whose alpha is below the
+// cutoff out of the caster, BLEND lets 1 - alpha of the light through (docs/scene-format.md).
+enum class AlphaMode { Opaque, Mask, Blend };
+// glTF sampler wrap modes (10497 REPEAT, 33071 CLAMP_TO_EDGE, 33648 MIRRORED_REPEAT).
+enum class TextureWrap { Repeat, ClampToEdge, MirroredRepeat };
+
+// A material's alpha texture (the alpha of a glTF baseColorTexture, or of a JSON material's
+// "texture"), read once with OpenImageIO. Sampled nearest: texel (floor(u·width),
+// floor(v·height)) after wrapping, row 0 the image's first (top) row, so UV (0, 0) is the
+// image's top-left corner as glTF says; both backends sample it so (docs/scene-format.md).
+struct AlphaTexture {
+    std::filesystem::path file;
+    int width = 0, height = 0;
+    std::vector<float> alpha;  // width·height, row by row from the top; 1 where the image has no alpha
+    TextureWrap wrapS = TextureWrap::Repeat, wrapT = TextureWrap::Repeat;
+    std::size_t bytes() const { return sizeof(AlphaTexture) + alpha.capacity() * sizeof(float); }
+};
+
+// The texel index along one axis for coordinate `c` on an axis of `size` texels (nearest).
+// Templated so the float tracer evaluates it in float like the shaders, the reference in double.
+template <typename Real>
+inline int wrapTexel(Real c, int size, TextureWrap wrap) {
+    const Real scaled = std::floor(c * Real(size));
+    // Far outside the texture every wrap lands on a texel; clamp first so the cast is defined.
+    const Real limit = Real(1 << 30);
+    const long long i = (long long)(scaled < -limit ? -limit : scaled > limit ? limit : scaled);
+    const long long n = size;
+    switch (wrap) {
+        case TextureWrap::ClampToEdge: return int(i < 0 ? 0 : i >= n ? n - 1 : i);
+        case TextureWrap::MirroredRepeat: {
+            const long long m = ((i % (2 * n)) + 2 * n) % (2 * n);
+            return int(m < n ? m : 2 * n - 1 - m);
+        }
+        case TextureWrap::Repeat: break;
+    }
+    return int(((i % n) + n) % n);
+}
+
+template <typename Real>
+inline float sampleAlpha(const AlphaTexture& t, Real u, Real v) {
+    const int x = wrapTexel(u, t.width, t.wrapS), y = wrapTexel(v, t.height, t.wrapT);
+    return t.alpha[std::size_t(y) * std::size_t(t.width) + std::size_t(x)];
+}
+
 struct Material {
     std::string name;
     Vec3 albedo{0.8, 0.8, 0.8};
     // < 1 makes the material semi-transparent to shadow rays: each object a shadow ray
     // crosses multiplies the light by (1 - opacity) once. The camera never sees through it.
     double opacity = 1.0;
-    bool opaque() const { return opacity >= 1.0; }
+    // Alpha (docs/scene-format.md, "Alpha-tested and blended casters"): alpha(uv) = alphaFactor
+    // × the texture's alpha at uv (1 without a texture). Mask: a shadow ray passes where
+    // alpha(uv) < alphaCutoff; Blend: a hit lets 1 − opacity·alpha(uv) through (the opacity
+    // path, per hit). Shadows only: the camera sees every surface, as with opacity.
+    AlphaMode alphaMode = AlphaMode::Opaque;
+    double alphaCutoff = 0.5;
+    double alphaFactor = 1.0;  // glTF baseColorFactor[3]
+    std::shared_ptr<const AlphaTexture> alphaTexture;
+    int texCoord = 0;  // glTF TEXCOORD_n set of the texture (meshes); quads have their own
+    bool opaque() const { return opacity >= 1.0 && alphaMode != AlphaMode::Blend; }
+    // Alpha read per hit (a texture in MASK or BLEND); otherwise it is a constant.
+    bool alphaTextured() const { return alphaTexture && alphaMode != AlphaMode::Opaque; }
+    // Mask / blend decisions for any hit; `texAlpha` is the texture's alpha there (1 without).
+    double alphaAt(double texAlpha) const { return alphaFactor * texAlpha; }
+    bool masked(double texAlpha) const { return alphaMode == AlphaMode::Mask && alphaAt(texAlpha) < alphaCutoff; }
+    // The light a hit lets through: 1 − opacity, and for BLEND 1 − opacity·alpha(uv).
+    double transmittance(double texAlpha) const {
+        return alphaMode == AlphaMode::Blend ? 1.0 - opacity * alphaAt(texAlpha) : 1.0 - opacity;
+    }
 };
 
 enum class LightType { Directional, Point, Spot };
@@ -62,12 +125,16 @@ struct Sphere {
 // A rectangle centered at `center` with unit normal `normal`. Its edges run along `uAxis`
 // (size.x) and `vAxis` (size.y); see quadAxes() for how they follow from the normal.
 // Quads are two-sided: they block light and are seen from both sides.
+// Texture coordinates run from uvMin at center − size/2 (along uAxis, vAxis) to uvMax at
+// center + size/2 (the JSON keys "uv_min", "uv_max"; default the texture once).
 struct Quad {
     Vec3 center{0, 0, 0};
     Vec3 normal{0, 1, 0};
     Vec2 size{1, 1};
     Vec3 uAxis{1, 0, 0};
     Vec3 vAxis{0, 0, 1};
+    Vec2 uvMin{0, 0};
+    Vec2 uvMax{1, 1};
 };
 
 struct Box {
@@ -82,6 +149,8 @@ struct TriangleMesh {
     std::vector<Vec3> positions;
     std::vector<Vec3> normals;
     std::vector<std::uint32_t> indices;  // three per triangle
+    // Per vertex, only where a material reads an alpha texture (glTF TEXCOORD_n, OBJ vt); else empty.
+    std::vector<Vec2> uvs;
     std::size_t droppedDegenerate = 0;   // triangles removed on load (zero area / non-finite)
     std::size_t triangleCount() const { return indices.size() / 3; }
 };
@@ -100,6 +169,9 @@ inline Affine affineOf(const glm::dmat4& m) { return Affine(m); }
 struct MeshInstance {
     std::shared_ptr<const TriangleMesh> geometry;
     Affine transform{1.0};
+    // A glTF file read per material (a model given as the scene): the glTF material index of
+    // the geometry's primitives (-1: none); -1 otherwise.
+    int fileMaterial = -1;
 };
 
 // A mesh object: one scene object (one object id) whatever its file holds. An OBJ file is one
@@ -235,6 +307,9 @@ struct Scene {
 
     const Material& materialOf(const Object& o) const { return materials[o.material]; }
     bool allOpaque() const;
+    // Some object's material is MASK, or BLEND with a texture: the raster backend then reads
+    // alpha per fragment (raster/alpha_casters.h).
+    bool hasAlphaCasters() const;
     Bounds bounds() const;  // of every object
 };
 

@@ -8,9 +8,15 @@
 #include "lit_frag_lights.spv.h"
 #include "lit_vert.spv.h"
 #include "shadow_frag.spv.h"
+#include "shadow_frag_alpha.spv.h"
+#include "shadow_frag_alpha_depth.spv.h"
+#include "shadow_vert_alpha.spv.h"
 #include "shadow_vert.spv.h"
 #include "transmit_frag.spv.h"
+#include "transmit_frag_alpha.spv.h"
 #include "transmit_frag_rest.spv.h"
+#include "transmit_frag_rest_alpha.spv.h"
+#include "transmit_vert_alpha.spv.h"
 #include "transmit_vert.spv.h"
 
 namespace shadowlab::shaders {
@@ -20,6 +26,12 @@ std::span<const std::uint32_t> shadowFragSpirv() { return kShadowFragSpv; }
 std::span<const std::uint32_t> transmitVertSpirv() { return kTransmitVertSpv; }
 std::span<const std::uint32_t> transmitFragSpirv() { return kTransmitFragSpv; }
 std::span<const std::uint32_t> transmitFragRestSpirv() { return kTransmitFragRestSpv; }
+std::span<const std::uint32_t> shadowVertAlphaSpirv() { return kShadowVertAlphaSpv; }
+std::span<const std::uint32_t> shadowFragAlphaSpirv() { return kShadowFragAlphaSpv; }
+std::span<const std::uint32_t> shadowFragAlphaDepthSpirv() { return kShadowFragAlphaDepthSpv; }
+std::span<const std::uint32_t> transmitVertAlphaSpirv() { return kTransmitVertAlphaSpv; }
+std::span<const std::uint32_t> transmitFragAlphaSpirv() { return kTransmitFragAlphaSpv; }
+std::span<const std::uint32_t> transmitFragRestAlphaSpirv() { return kTransmitFragRestAlphaSpv; }
 std::span<const std::uint32_t> litVertSpirv() { return kLitVertSpv; }
 std::span<const std::uint32_t> litFragSpirv() { return kLitFragSpv; }
 std::span<const std::uint32_t> litFragLightsSpirv() { return kLitFragLightsSpv; }

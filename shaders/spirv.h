@@ -13,6 +13,14 @@ std::span<const std::uint32_t> transmitVertSpirv();
 std::span<const std::uint32_t> transmitFragSpirv();
 // transmit.frag compiled with SHADOWLAB_REST_LAYER: the second pass, behind the nearest layer.
 std::span<const std::uint32_t> transmitFragRestSpirv();
+// SHADOWLAB_ALPHA variants (alpha-tested and blended casters, shaders/alpha.glsl): the depth
+// pass with and without blocker ids, and both transmittance passes.
+std::span<const std::uint32_t> shadowVertAlphaSpirv();
+std::span<const std::uint32_t> shadowFragAlphaSpirv();
+std::span<const std::uint32_t> shadowFragAlphaDepthSpirv();
+std::span<const std::uint32_t> transmitVertAlphaSpirv();
+std::span<const std::uint32_t> transmitFragAlphaSpirv();
+std::span<const std::uint32_t> transmitFragRestAlphaSpirv();
 std::span<const std::uint32_t> litVertSpirv();
 std::span<const std::uint32_t> litFragSpirv();
 // lit.frag compiled with SHADOWLAB_LIGHT_OUTPUTS: two more targets with per-light visibility.

@@ -6,9 +6,22 @@
 // Compiled again with SHADOWLAB_REST_LAYER (kTransmitFragRestSpv): the second pass, which
 // reads the first pass's nearest depth D1 and counts only fragments behind it, so its targets hold
 // the product of everything behind the nearest layer (T_rest) and the nearest depth of that (D2).
+// With SHADOWLAB_ALPHA (and SHADOWLAB_REST_ALPHA, the second pass so) the object's alpha record
+// decides per fragment: MASK texels below the cutoff are discarded, textured BLEND lets
+// 1 − opacity·alpha(uv) through (scene::Material::transmittance).
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "interface.h"
+#ifdef SHADOWLAB_REST_ALPHA
+#define SHADOWLAB_REST_LAYER 1
+#define SHADOWLAB_ALPHA 1
+#define SHADOWLAB_ALPHA_SET 1
+#endif
+#ifdef SHADOWLAB_ALPHA
+#include "alpha.glsl"
+layout(location = 2) flat in uint inObjectId;
+layout(location = 3) in vec2 inUv;
+#endif
 
 layout(push_constant) uniform Push { TransmitPush push; };
 #ifdef SHADOWLAB_REST_LAYER
@@ -39,6 +52,12 @@ void main() {
     const float nearest = texelFetch(nearDepths, ivec3(ivec2(gl_FragCoord.xy), int(push.params.z)), 0).r;
     if (!(gl_FragCoord.z > nearest + push.params.w)) discard;
 #endif
+#ifdef SHADOWLAB_ALPHA
+    if (alphaMasked(inObjectId, inUv)) discard;
+    const AlphaRecord alpha = alphaRecords[inObjectId];
+    outTransmittance = alpha.params.x == 2.0 ? 1.0 - alpha.params.w * alphaAt(inObjectId, inUv) : push.params.x;
+#else
     outTransmittance = push.params.x;
+#endif
     outNearDepth = gl_FragCoord.z;
 }

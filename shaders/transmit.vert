@@ -1,5 +1,7 @@
 // shaders/transmit.vert: the transmittance pass from a light (raster/shadow_pass.h): the
 // semi-transparent casters, with their position and normal for the facing test of transmit.frag.
+// Compiled again with SHADOWLAB_ALPHA: also the object id and texture coordinates, for the alpha of
+// MASK and textured BLEND casters.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "interface.h"
@@ -11,9 +13,19 @@ layout(location = 1) in vec3 inNormal;
 
 layout(location = 0) out vec3 outPosition;
 layout(location = 1) out vec3 outNormal;
+#ifdef SHADOWLAB_ALPHA
+layout(location = 2) in uint inObjectId;
+layout(location = 3) in vec2 inUv;
+layout(location = 2) flat out uint outObjectId;
+layout(location = 3) out vec2 outUv;
+#endif
 
 void main() {
     outPosition = inPosition;
     outNormal = inNormal;
+#ifdef SHADOWLAB_ALPHA
+    outObjectId = inObjectId;
+    outUv = inUv;
+#endif
     gl_Position = push.lightMatrix * vec4(inPosition, 1.0);
 }

@@ -173,3 +173,28 @@ TEST(HostileApp, StandardExceptionsWhileReadingAnInputBecomeBadInputNamingIt) {
 
 }  // namespace
 }  // namespace shadowlab
+
+namespace shadowlab {
+namespace {
+
+TEST(HostileApp, ABadAlphaTextureIsBadInputNamingTheFileAndKeyAndWritesNothing) {
+    // The shipped foliage scene with its leaf texture renamed away, then with a text file as the image.
+    TempDir dir;
+    std::ifstream in(std::string(SHADOWLAB_SOURCE_DIR) + "/scenes/foliage.json");
+    std::ostringstream text;
+    text << in.rdbuf();
+    const fs::path scene = dir.write("foliage.json", text.str());
+    const fs::path frame = dir.path() / "frame.png";
+    Outcome r = run("render " + scene.string() + " -o " + frame.string());
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    EXPECT_NE(r.err.find(scene.string() + ": materials.leaf.texture: "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("leaf.png: no such file"), std::string::npos) << r.err;
+    dir.write("foliage/leaf.png", "not an image");
+    r = run("render " + scene.string() + " -o " + frame.string());
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    EXPECT_NE(r.err.find("not a readable image"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(frame));
+}
+
+}  // namespace
+}  // namespace shadowlab

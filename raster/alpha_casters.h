@@ -1,0 +1,27 @@
+// raster/alpha_casters.h: what the depth and transmittance passes need for alpha-tested (MASK)
+// and textured BLEND casters: a second vertex buffer of texture coordinates, one alpha record
+// per object id and every alpha texture's texels, in two storage buffers read by
+// shaders/alpha.glsl (set 0 in the depth pass and the first transmittance pass, set 1 in the
+// second). Made only for scenes that have such casters (scene::Scene::hasAlphaCasters).
+#pragma once
+
+#include "raster/geometry.h"
+#include "raster/resources.h"
+#include "scene/scene.h"
+
+namespace shadowlab::raster {
+
+struct AlphaCasters {
+    Buffer uvs;      // vertex binding 1, one vec2 per vertex of SceneGeometry
+    Buffer records;  // std430 AlphaRecord per object id (0: unused)
+    Buffer texels;   // every texture's alpha, one float a texel
+    DescriptorSetLayoutHandle setLayout;
+    DescriptorPoolHandle pool;
+    VkDescriptorSet set = VK_NULL_HANDLE;  // freed with the pool
+    std::size_t textureTexels = 0;
+};
+
+// `geometry` must have been tessellated with UVs.
+AlphaCasters createAlphaCasters(const Context& ctx, const scene::Scene& scene, const SceneGeometry& geometry);
+
+}  // namespace shadowlab::raster
