@@ -4,7 +4,7 @@
 // input. tools/slurm-local-check.sh uses it to check a merged sweep against the unsharded one.
 #include <iostream>
 
-#include "compare/merge.h"
+#include "studies/merge.h"
 #include "scene/error.h"
 
 int main(int argc, char** argv) {
