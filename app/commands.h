@@ -35,7 +35,7 @@ struct SceneOptions {
 
 struct RenderOptions {
     SceneOptions common;
-    std::string backend = "raytrace";
+    scene::Backend backend = scene::Backend::Raytrace;
     std::filesystem::path output;
     std::optional<std::string> view;  // raster debug view: shadow-map | cascades | texel-density | light-frustum
 };

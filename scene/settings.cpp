@@ -160,5 +160,10 @@ const char* toString(Backend b) {
     }
     return "?";
 }
+std::optional<Backend> parseBackend(const std::string& name) {
+    for (const Backend b : kBackends)
+        if (name == toString(b)) return b;
+    return std::nullopt;
+}
 
 }  // namespace shadowlab::scene

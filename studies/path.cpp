@@ -19,12 +19,11 @@
 #include "compare/svg_plot.h"
 #include "compare/text.h"
 #include "raster/light_frustum.h"
-#include "raster/renderer.h"
-#include "raytrace/renderer.h"
 #include "scene/camera.h"
 #include "scene/error.h"
 #include "scene/frame_io.h"
 #include "scene/render_plan.h"
+#include "studies/backend.h"
 
 namespace shadowlab::compare {
 
@@ -370,8 +369,7 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
     // One renderer per backend for the whole path, made for frame 0 (the raster vertex buffer is
     // relative to frame 0's camera: a resumed path renders exactly what an unbroken one does).
     const scene::RenderPlan plan = scene::makeRenderPlan(scenes[0], settings);
-    std::optional<raster::Renderer> rasterRenderer;
-    std::optional<raytrace::Renderer> tracer, reference;
+    std::unique_ptr<BackendRenderer> rasterRenderer, tracer, reference;
     std::map<std::string, double> setupMs;
     std::map<std::string, std::vector<double>> times;
     for (int t = 0; t < result.frames; ++t) {
@@ -384,23 +382,24 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
             continue;
         }
         const scene::Scene& s = scenes[std::size_t(t)];
-        const scene::RenderPlan framePlan = scene::makeRenderPlan(s, settings);
         Json line = {{"frame", t}, {"frame_ms", Json::object()}, {"setup_ms", Json::object()}};
         auto record = [&](const std::string& name, const scene::Frame& f, double setup) {
             scene::writeFrame(f, framesDir / frameName(t, name));
             line["frame_ms"][name] = frameMs(f);
             line["setup_ms"][name] = setup;
         };
-        if (!reference) reference.emplace(scenes[0], settings.raytrace, true);
-        record("reference", reference->render(s, framePlan), reference->setupMs());
+        if (!reference) reference = makeRenderer(scene::Backend::Reference, scenes[0], plan, settings);
+        reference->update(s);
+        record("reference", reference->render(), reference->setupMs());
         if (options.raytrace) {
-            if (!tracer) tracer.emplace(scenes[0], settings.raytrace, false);
-            record("raytrace", tracer->render(s, framePlan), tracer->setupMs());
+            if (!tracer) tracer = makeRenderer(scene::Backend::Raytrace, scenes[0], plan, settings);
+            tracer->update(s);
+            record("raytrace", tracer->render(), tracer->setupMs());
         }
         if (options.raster) {
             double setup = 0.0;
             if (!rasterRenderer) {
-                rasterRenderer.emplace(scenes[0], plan, settings.raster);
+                rasterRenderer = makeRenderer(scene::Backend::Raster, scenes[0], plan, settings);
                 setup = rasterRenderer->setupMs();
             }
             rasterRenderer->update(s);

@@ -15,9 +15,8 @@
 #include <unistd.h>
 
 #include "compare/compare.h"
+#include "studies/backend.h"
 #include "studies/machine.h"
-#include "raster/renderer.h"
-#include "raytrace/renderer.h"
 #include "scene/error.h"
 #include "scene/frame_identity.h"
 #include "scene/frame_io.h"
@@ -461,12 +460,9 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
 
 scene::Frame renderWithBackend(const scene::Scene& scene, const scene::RenderSettings& settings,
                                const std::string& backend) {
-    const scene::RenderPlan plan = scene::makeRenderPlan(scene, settings);
-    scene::Frame f;
-    if (backend == "raster") f = raster::render(scene, plan, settings.raster);
-    else if (backend == "raytrace") f = raytrace::render(scene, plan, settings.raytrace);
-    else if (backend == "reference") f = raytrace::renderReference(scene, plan, settings.raytrace);
-    else throw scene::InputError("unknown backend '" + backend + "'");
+    const std::optional<scene::Backend> b = scene::parseBackend(backend);
+    if (!b) throw scene::InputError("unknown backend '" + backend + "'");
+    scene::Frame f = renderFrame(*b, scene, scene::makeRenderPlan(scene, settings), settings);
     scene::recordIdentity(f, scene);
     return f;
 }
@@ -481,9 +477,9 @@ std::function<scene::Frame()> frameSource(const SweepOptions& options, const sce
                                           const scene::RenderSettings& settings, const std::string& backend) {
     using Fn = scene::Frame (*)(const scene::Scene&, const scene::RenderSettings&, const std::string&);
     const Fn* fn = options.render.target<Fn>();
-    if (backend == "raster" && fn && *fn == &renderWithBackend) {
-        auto renderer =
-            std::make_shared<raster::Renderer>(scene, scene::makeRenderPlan(scene, settings), settings.raster);
+    if (scene::parseBackend(backend) == scene::Backend::Raster && fn && *fn == &renderWithBackend) {
+        std::shared_ptr<BackendRenderer> renderer =
+            makeRenderer(scene::Backend::Raster, scene, scene::makeRenderPlan(scene, settings), settings);
         return [renderer, &scene] {
             scene::Frame f = renderer->render();
             scene::recordIdentity(f, scene);
