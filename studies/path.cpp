@@ -19,6 +19,7 @@
 #include "compare/svg_plot.h"
 #include "compare/text.h"
 #include "raster/light_frustum.h"
+#include "scene/append_line.h"
 #include "scene/camera.h"
 #include "scene/error.h"
 #include "scene/frame_io.h"
@@ -47,15 +48,7 @@ scene::Vec3 rotate(const scene::Vec3& v, const scene::Vec3& k, double degrees) {
 // A frame's time without its one-time setup: what a frame costs once the renderer exists.
 double frameMs(const scene::Frame& f) { return f.totalTimeMs() - f.timing("setup"); }
 
-void appendLine(const fs::path& file, const std::string& line) {
-    const int fd = ::open(file.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
-    if (fd < 0) throw scene::InputError(file.string() + ": cannot open for appending");
-    const std::string text = line + "\n";
-    const ssize_t written = ::write(fd, text.data(), text.size());
-    const bool ok = written == ssize_t(text.size()) && ::fsync(fd) == 0;
-    ::close(fd);
-    if (!ok) throw scene::InputError(file.string() + ": write failed (disk full?)");
-}
+using scene::appendLine;  // a finished line survives a kill or a power loss
 
 std::string frameName(int t, const std::string& what) {
     char buf[32];

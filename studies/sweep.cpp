@@ -17,6 +17,7 @@
 #include "compare/compare.h"
 #include "studies/backend.h"
 #include "studies/machine.h"
+#include "scene/append_line.h"
 #include "scene/error.h"
 #include "scene/frame_identity.h"
 #include "scene/frame_io.h"
@@ -133,17 +134,7 @@ SweepRow rowFromJson(const Json& j) {
     return r;
 }
 
-// Appends one line and forces it to disk before the sweep moves on: a finished row survives a
-// kill or a power loss. One write() per line, so a kill tears at most the last line.
-void appendLine(const fs::path& file, const std::string& line) {
-    const int fd = ::open(file.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
-    if (fd < 0) throw scene::InputError(file.string() + ": cannot open for appending");
-    const std::string text = line + "\n";
-    const ssize_t written = ::write(fd, text.data(), text.size());
-    const bool ok = written == ssize_t(text.size()) && ::fsync(fd) == 0;
-    ::close(fd);
-    if (!ok) throw scene::InputError(file.string() + ": write failed (disk full?)");
-}
+using scene::appendLine;  // a finished line survives a kill or a power loss
 
 std::string csvField(const std::string& s) {
     if (s.find_first_of(",\"\n") == std::string::npos) return s;
