@@ -55,7 +55,7 @@ struct SweepOptions {
     bool resume = false;
     bool quick = false;
     std::optional<int> repetitions;
-    std::optional<std::string> shard;  // "K/N": render only shard K of N (compare/shard.h)
+    std::optional<std::string> shard;  // "K/N": render only shard K of N (studies/shard.h)
 };
 
 struct MergeOptions {

@@ -1,4 +1,4 @@
-// compare/analytic.cpp: closed-form primary hits and hard shadows for spheres, quads and boxes
+// studies/analytic.cpp: closed-form primary hits and hard shadows for spheres, quads and boxes
 // (long double, camera-relative); written independently of raytrace/ so it can judge it.
 #include "studies/analytic.h"
 

@@ -1,4 +1,4 @@
-// compare/analytic.h: a closed-form oracle for scenes of spheres, quads and boxes under
+// studies/analytic.h: a closed-form oracle for scenes of spheres, quads and boxes under
 // directional lights: per pixel the primary hit and the hard-shadow visibility, computed in
 // long double relative to the camera, independent of raytrace/. The stability suite checks the
 // reference against it (docs/stability.md).

@@ -1,4 +1,4 @@
-// compare/auto_bias.cpp: groups sweep rows into bias series, finds each series' bias window and
+// studies/auto_bias.cpp: groups sweep rows into bias series, finds each series' bias window and
 // writes the recommended scene-file "shadow" block with the sentences that justify it.
 #include "studies/auto_bias.h"
 

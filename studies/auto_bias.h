@@ -1,4 +1,4 @@
-// compare/auto_bias.h: turns a sweep's bias series into a recommendation: the bias window of
+// studies/auto_bias.h: turns a sweep's bias series into a recommendation: the bias window of
 // each bias parameter (or "stiff"), the bias in the middle of each window, and a ready "shadow"
 // block for the scene file (see docs/compare.md, "Automatic bias").
 #pragma once

@@ -1,4 +1,4 @@
-// compare/check.cpp: suites, baselines and running the cases of `shadowlab check`.
+// studies/check.cpp: suites, baselines and running the cases of `shadowlab check`.
 #include "studies/check.h"
 
 #include <chrono>

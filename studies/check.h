@@ -1,4 +1,4 @@
-// compare/check.h: a check suite, the CI gate over many cases: each case (a scene, a backend,
+// studies/check.h: a check suite, the CI gate over many cases: each case (a scene, a backend,
 // settings, budgets) is rendered, compared with the reference, held to its budgets and to a
 // stored baseline of its metrics. Suites and baselines are JSON (docs/ci.md); the app writes
 // JUnit XML, a Markdown table and one JSON per case (check_report.h).

@@ -1,4 +1,4 @@
-// compare/check_report.cpp: JUnit XML, Markdown and per-case JSON of a check suite.
+// studies/check_report.cpp: JUnit XML, Markdown and per-case JSON of a check suite.
 #include "studies/check_report.h"
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// compare/check_report.h: what `shadowlab check` writes: JUnit XML (testsuites / testsuite /
+// studies/check_report.h: what `shadowlab check` writes: JUnit XML (testsuites / testsuite /
 // testcase with failure and error elements, as Jenkins, GitLab and GitHub test reporters read
 // it), a Markdown table for a CI job summary, and one JSON per case.
 #pragma once

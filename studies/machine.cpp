@@ -1,4 +1,4 @@
-// compare/machine.cpp: reads the host name, CPU model, usable cores and load average.
+// studies/machine.cpp: reads the host name, CPU model, usable cores and load average.
 #include "studies/machine.h"
 
 #include <cstdlib>

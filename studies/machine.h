@@ -1,4 +1,4 @@
-// compare/machine.h: the machine a sweep row was timed on (host, CPU model, cores, load), so a
+// studies/machine.h: the machine a sweep row was timed on (host, CPU model, cores, load), so a
 // report can tell when run times come from different machines and are not comparable.
 #pragma once
 

@@ -1,4 +1,4 @@
-// compare/merge.cpp: reads and checks shard folders, joins their journals in grid order, and
+// studies/merge.cpp: reads and checks shard folders, joins their journals in grid order, and
 // writes the merged sweep folder.
 #include "studies/merge.h"
 

@@ -1,4 +1,4 @@
-// compare/merge.h: joins the shards of one sweep (compare/shard.h) into the folder an unsharded
+// studies/merge.h: joins the shards of one sweep (studies/shard.h) into the folder an unsharded
 // sweep writes: results.jsonl, results.csv, results.json, images/, reference.exr/.png, and
 // merge.json (which shards, which machines); the app then writes the report from the rows.
 // Every input is read and checked before anything is written, and every file is written to a

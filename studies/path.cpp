@@ -1,4 +1,4 @@
-// compare/path.cpp: the path study's frames (camera and light paths), the render loop with one
+// studies/path.cpp: the path study's frames (camera and light paths), the render loop with one
 // Renderer and one acceleration structure per backend, the journal and resume, and the outputs:
 // metrics.json, the flicker plot, the animations (OpenImageIO's GIF writer) and report.html.
 #include "studies/path.h"

@@ -1,4 +1,4 @@
-// compare/path.h: the temporal study: a camera or light path through a scene, rendered frame by
+// studies/path.h: the temporal study: a camera or light path through a scene, rendered frame by
 // frame by the reference and both backends (each backend's setup made once and reused), measured
 // with compare/temporal.h and written as a resumable folder with a report (docs/temporal.md).
 #pragma once

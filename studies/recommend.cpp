@@ -1,4 +1,4 @@
-// compare/recommend.cpp: searches depth × slope bias in the user's own raster configuration,
+// studies/recommend.cpp: searches depth × slope bias in the user's own raster configuration,
 // verifies the best point and the sweep's ray-tracer choice at the requested resolution against
 // the user's defaults, and writes the block that never loses to them.
 #include "studies/recommend.h"

@@ -1,4 +1,4 @@
-// compare/recommend.h: the recommended scene-file "shadow" block, searched in the configuration
+// studies/recommend.h: the recommended scene-file "shadow" block, searched in the configuration
 // the user will run (their filter, map size, cascades and fitting as resolved; only the biases
 // change), over depth × slope bias together and refined around the best point, then rendered at
 // the requested resolution against the user's defaults. The defaults are recommended whenever

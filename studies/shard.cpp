@@ -1,4 +1,4 @@
-// compare/shard.cpp: the shard split, the sweep identity and its manifest, and the reference
+// studies/shard.cpp: the shard split, the sweep identity and its manifest, and the reference
 // shared by the shards of one output folder through an O_EXCL lock file.
 #include "studies/shard.h"
 

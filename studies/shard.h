@@ -1,8 +1,8 @@
-// compare/shard.h: one sweep split over N independent processes (`sweep --shard K/N`, a Slurm
+// studies/shard.h: one sweep split over N independent processes (`sweep --shard K/N`, a Slurm
 // job array, GNU parallel, a CI matrix). Rows are dealt round-robin over the sorted row keys,
 // so shards are disjoint, cover the grid and differ in size by at most one row. Each shard is a
 // sweep folder of its own (DIR/shard-K-of-N) with a manifest naming the sweep it belongs to; the
-// reference is rendered once per DIR and shared. compare/merge.h joins the shards.
+// reference is rendered once per DIR and shared. studies/merge.h joins the shards.
 #pragma once
 
 #include <filesystem>

@@ -1,4 +1,4 @@
-// compare/stability.cpp: runs one extreme case (reference, analytic oracle, both backends at
+// studies/stability.cpp: runs one extreme case (reference, analytic oracle, both backends at
 // defaults, bias search, both backends at best) and writes the suite's HTML/CSV/JSON report.
 #include "studies/stability.h"
 

@@ -1,4 +1,4 @@
-// compare/stability.h: the stability suite: runs one extreme case through the
+// studies/stability.h: the stability suite: runs one extreme case through the
 // reference, the analytic oracle and both backends at default and at searched-best settings,
 // and gives separate verdicts: the reference's (exact / wrong / unchecked), each backend's state
 // (clean, acne, leaks, stiff) and whether it ran cleanly (no wrong reference, NaN/Inf, failure or
@@ -38,7 +38,7 @@ struct StabilityOptions {
     int searchMapSize = 0;
     bool validate = false;                 // Vulkan validation on every raster render
     // The "best" renders use the recommendation searched in the case's own configuration
-    // (compare/recommend.h: depth × slope, never worse than the defaults); these are its grids.
+    // (studies/recommend.h: depth × slope, never worse than the defaults); these are its grids.
     std::vector<double> bestDepthSteps = RecommendOptions{}.depthSteps;
     std::vector<double> bestSlopeSteps = RecommendOptions{}.slopeSteps;
     std::vector<std::string> backends{"raster", "raytrace"};

@@ -1,4 +1,4 @@
-// compare/sweep.cpp: the sweep runner: grid, timing, the append-only journal and resume.
+// studies/sweep.cpp: the sweep runner: grid, timing, the append-only journal and resume.
 #include "studies/sweep.h"
 
 #include <algorithm>

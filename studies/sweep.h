@@ -1,4 +1,4 @@
-// compare/sweep.h: renders a grid of settings for both backends, times each (setup separated
+// studies/sweep.h: renders a grid of settings for both backends, times each (setup separated
 // from per-frame time, median of several runs after a warm-up), measures each against a cached
 // reference and appends one row per configuration as it finishes. A stopped sweep resumes
 // where it left off: finished rows are never lost or duplicated (see docs/sweep.md).
@@ -88,7 +88,7 @@ struct SweepOptions {
     RenderFn render = renderWithBackend;
     std::function<void(const SweepProgress&)> progress;
     // Where the reference comes from, given the scene at the sweep's resolution; unset: rendered
-    // once and cached as DIR/reference.exr. Shards share one (compare/shard.h).
+    // once and cached as DIR/reference.exr. Shards share one (studies/shard.h).
     std::function<scene::Frame(const scene::Scene&)> reference;
 };
 

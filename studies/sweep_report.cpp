@@ -1,4 +1,4 @@
-// compare/sweep_report.cpp: renders a sweep's rows as one self-contained HTML page with its
+// studies/sweep_report.cpp: renders a sweep's rows as one self-contained HTML page with its
 // plots as standalone SVG files beside it, and the summary the run report shows of a sweep.
 #include "studies/sweep_report.h"
 

@@ -1,7 +1,7 @@
-// compare/sweep_report.h: the HTML report of a sweep (`shadowlab sweep`, and the quick sweep
+// studies/sweep_report.h: the HTML report of a sweep (`shadowlab sweep`, and the quick sweep
 // `run` includes): reference, each backend's best and worst configuration with difference
 // images and zooms, error against per-frame time with Pareto fronts, the bias plots, every row
-// in a table, and the recommended "shadow" block (compare/auto_bias.h). Self-contained: inline
+// in a table, and the recommended "shadow" block (studies/auto_bias.h). Self-contained: inline
 // CSS and SVG, images by relative path, no scripts.
 #pragma once
 
@@ -29,7 +29,7 @@ struct SweepReportInput {
     int width = 0, height = 0;               // render size; 0 = read from the rows' metrics
     double threshold = kBiasWindowMaxRate;   // bias-window threshold
     // The block searched in the user's configuration and verified against their defaults
-    // (compare/recommend.h). Without it the page and recommended-shadow.json show the probe
+    // (studies/recommend.h). Without it the page and recommended-shadow.json show the probe
     // slice's block, marked as not measured against the defaults.
     std::optional<Recommendation> recommendation;
 };

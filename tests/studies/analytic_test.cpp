@@ -1,4 +1,4 @@
-// tests/compare/analytic_test.cpp: the analytic oracle against shadows derived by hand
+// tests/studies/analytic_test.cpp: the analytic oracle against shadows derived by hand
 // (a unit sphere under a vertical light casts the unit disk; a box's oblique shadow) and the
 // checker's counting.
 #include "studies/analytic.h"

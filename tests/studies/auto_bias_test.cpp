@@ -1,4 +1,4 @@
-// tests/compare/auto_bias_test.cpp: the recommended bias is the middle of each known window
+// tests/studies/auto_bias_test.cpp: the recommended bias is the middle of each known window
 // (geometric for log-spaced samples), stiff series name the artifact that dominates, robust
 // offsets win when they pass, and the shadow block is one the scene loader accepts.
 #include "studies/auto_bias.h"

@@ -1,4 +1,4 @@
-// tests/compare/check_shard_test.cpp: the split of `check --shard K/N`: every case in exactly one
+// tests/studies/check_shard_test.cpp: the split of `check --shard K/N`: every case in exactly one
 // shard, round-robin over the sorted case names, whatever order the suite file lists them in.
 #include <algorithm>
 #include <map>

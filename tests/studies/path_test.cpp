@@ -1,4 +1,4 @@
-// tests/compare/path_test.cpp: frames along paths on lavapipe with the validation layer: a raster
+// tests/studies/path_test.cpp: frames along paths on lavapipe with the validation layer: a raster
 // Renderer moved by update() draws what a fresh one draws; snapped fitted maps hold still under
 // sub-texel camera moves (bit-identical maps, no flicker) where unsnapped ones flicker; a cascade
 // seam under a dolly with and without blending; the ray tracer reused across cameras; and the

@@ -1,4 +1,4 @@
-// tests/compare/recommend_test.cpp: the recommended "shadow" block never loses to the user's
+// tests/studies/recommend_test.cpp: the recommended "shadow" block never loses to the user's
 // defaults. With a fake renderer whose error is a known function of the biases: the search finds
 // an optimum off the coarse grid by refinement, keeps the defaults when they are best, and keeps
 // them when the candidate loses at the requested resolution. With lavapipe (validation on) and

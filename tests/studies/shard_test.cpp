@@ -1,4 +1,4 @@
-// tests/compare/shard_test.cpp: the shard split (every row in exactly one shard), shards run
+// tests/studies/shard_test.cpp: the shard split (every row in exactly one shard), shards run
 // with a fake renderer and merged (equal to the unsharded run, reruns merged once, shards of
 // another sweep refused, missing and unfinished shards named, damaged journals refused), and the
 // reference shared by the shards of one folder (rendered once; a dead holder's lock taken over).

@@ -1,4 +1,4 @@
-// tests/compare/stability_test.cpp: every scenes/extreme case through the stability suite at
+// tests/studies/stability_test.cpp: every scenes/extreme case through the stability suite at
 // small resolution (reference, analytic oracle, lavapipe raster with validation, ray tracer,
 // a small bias search), asserting each case's expected outcome; plus the runner's failure
 // handling with a fake renderer.

@@ -1,4 +1,4 @@
-// tests/compare/sweep_report_demo.cpp: runs the real sweep runner (compare::runSweep) on the
+// tests/studies/sweep_report_demo.cpp: runs the real sweep runner (compare::runSweep) on the
 // default grid with a fake renderer that draws synthetic frames whose artifacts follow the
 // settings the way real ones do (acne falls and peter-panning grows with bias, coarse maps are
 // jagged, robust offsets are clean, one configuration fails), then writes the sweep report and

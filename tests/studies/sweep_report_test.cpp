@@ -1,4 +1,4 @@
-// tests/compare/sweep_report_test.cpp: the sweep report writes its page, plots and shadow
+// tests/studies/sweep_report_test.cpp: the sweep report writes its page, plots and shadow
 // block; shows each backend's best and worst configuration; plots every configuration that
 // rendered and lists (never plots) the failed ones; says in words which configuration is the
 // fastest under 1% mismatch; and the run report shows the summary of a sweep.

@@ -1,4 +1,4 @@
-// tests/compare/sweep_rows.h: hand-made sweep rows (no rendering) for the auto-bias and sweep
+// tests/studies/sweep_rows.h: hand-made sweep rows (no rendering) for the auto-bias and sweep
 // report tests and the sweep report demo: bias series with chosen rates, timed configurations.
 #pragma once
 

@@ -1,4 +1,4 @@
-// tests/compare/sweep_test.cpp: the sweep runner with a fake renderer (no Vulkan, no ray
+// tests/studies/sweep_test.cpp: the sweep runner with a fake renderer (no Vulkan, no ray
 // tracing): result files in grid order, refusal to overwrite, resume after a torn journal line,
 // refusal of another scene's folder, grid files, and timings as medians without the warm-up.
 #include "studies/sweep.h"
