@@ -12,6 +12,7 @@
 #include "app/commands.h"
 #include "app/guards.h"
 #include "raster/vulkan_error.h"
+#include "scene/backend.h"
 #include "scene/error.h"
 
 namespace {

@@ -160,10 +160,5 @@ const char* toString(Backend b) {
     }
     return "?";
 }
-std::optional<Backend> parseBackend(const std::string& name) {
-    for (const Backend b : kBackends)
-        if (name == toString(b)) return b;
-    return std::nullopt;
-}
 
 }  // namespace shadowlab::scene

@@ -11,7 +11,6 @@
 namespace shadowlab::scene {
 
 enum class Backend { Raster, Raytrace, Reference };
-inline constexpr Backend kBackends[] = {Backend::Raster, Backend::Raytrace, Backend::Reference};
 // none: nearest texel; pcf2x2: bilinear 2x2 compare filtering; pcf: mean of pcfSize x pcfSize
 // compare taps one texel apart; poisson: 16 compare taps on a per-pixel rotated Poisson disk of
 // diameter pcfSize texels (raster/ implements them; see docs/raster.md).
@@ -127,7 +126,5 @@ RaytraceSettings referenceSettings(const RaytraceSettings& base);
 const char* toString(ShadowFilter f);
 const char* toString(Precision p);
 const char* toString(Backend b);
-// The Backend whose toString() is `name`; nullopt for any other text (callers name the option).
-std::optional<Backend> parseBackend(const std::string& name);
 
 }  // namespace shadowlab::scene

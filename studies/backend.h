@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "scene/backend.h"
 #include "scene/frame.h"
 #include "scene/render_plan.h"
 #include "scene/scene.h"
