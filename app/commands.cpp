@@ -17,18 +17,19 @@
 
 #include <nlohmann/json.hpp>
 
-#include "compare/check.h"
-#include "compare/check_report.h"
+#include "studies/backend.h"
+#include "studies/check.h"
+#include "studies/check_report.h"
 #include "compare/compare.h"
 #include "compare/gates.h"
-#include "compare/machine.h"
-#include "compare/merge.h"
-#include "compare/path.h"
+#include "studies/machine.h"
+#include "studies/merge.h"
+#include "studies/path.h"
 #include "compare/report.h"
-#include "compare/shard.h"
-#include "compare/stability.h"
-#include "compare/sweep.h"
-#include "compare/sweep_report.h"
+#include "studies/shard.h"
+#include "studies/stability.h"
+#include "studies/sweep.h"
+#include "studies/sweep_report.h"
 #include "compare/text.h"
 #include "raster/cascades.h"
 #include "raster/debug_views.h"
@@ -201,18 +202,10 @@ void checkValidation(const scene::Frame& frame, const scene::RasterSettings& set
 }
 
 // `debug`: raster only, what the debug views need (every channel is read back with it).
-scene::Frame renderBackend(const Prepared& p, const std::string& backend,
+scene::Frame renderBackend(const Prepared& p, scene::Backend backend,
                            scene::ChannelMask channels = scene::kAllChannels, raster::RenderDebug* debug = nullptr) {
-    scene::Frame f;
-    if (backend == "raster") {
-        f = debug ? raster::render(p.scene, p.plan, p.settings.raster, debug)
-                  : raster::render(p.scene, p.plan, p.settings.raster, channels);
-        checkValidation(f, p.settings.raster);
-    } else if (backend == "raytrace") {
-        f = raytrace::render(p.scene, p.plan, p.settings.raytrace);
-    } else {
-        f = raytrace::renderReference(p.scene, p.plan, p.settings.raytrace);
-    }
+    scene::Frame f = compare::renderFrame(backend, p.scene, p.plan, p.settings, channels, debug);
+    if (backend == scene::Backend::Raster) checkValidation(f, p.settings.raster);
     f.attributes["scene"] = p.scene.file.string();
     for (const auto& [key, text] : p.scene.origin.choices) f.attributes["choice." + key] = text;
     f.attributes["version"] = SHADOWLAB_VERSION;
@@ -229,9 +222,8 @@ Json timingsJson(const scene::Frame& f) {
 
 // An upper estimate of the memory rendering `backend` takes (see scene/memory.h), without the
 // program itself and the Frame's writing.
-std::uint64_t backendMemory(const Prepared& p, const std::string& backend) {
-    return backend == "raster" ? raster::estimateMemoryBytes(p.scene, p.plan, p.settings.raster)
-                               : raytrace::estimateMemoryBytes(p.scene, p.plan);
+std::uint64_t backendMemory(const Prepared& p, scene::Backend backend) {
+    return compare::estimateMemoryBytes(backend, p.scene, p.plan, p.settings);
 }
 
 // "peak memory 412 MiB (estimated at most 530 MiB)", and the same figures for --json.
@@ -360,9 +352,10 @@ int render(const RenderOptions& o) {
     std::string ext = o.output.extension().string();
     if (ext != ".exr" && ext != ".png")
         throw scene::InputError(o.output.string() + ": unknown output type '" + ext + "' (use .exr or .png)");
-    if (o.view && (o.backend != "raster" || ext != ".png"))
+    const std::string backendName = scene::toString(o.backend);
+    if (o.view && (o.backend != scene::Backend::Raster || ext != ".png"))
         throw scene::InputError("--view " + *o.view + ": needs --backend raster and a .png output (a view is a "
-                                "display image of the shadow maps), got --backend " + o.backend + " and '" + ext + "'");
+                                "display image of the shadow maps), got --backend " + backendName + " and '" + ext + "'");
     checkOutputFile(o.output);  // before any work: an output that cannot be written fails now
     const Prepared p = prepare(o.common);
     // A view writes a display image, not the Frame; the shadow-map view holds every layer's depths.
@@ -374,7 +367,7 @@ int render(const RenderOptions& o) {
                                               std::to_string(p.scene.camera.width) + "x" +
                                               std::to_string(p.scene.camera.height)
                                         : "rendering " + std::to_string(p.scene.camera.width) + "x" +
-                                              std::to_string(p.scene.camera.height) + " with " + o.backend);
+                                              std::to_string(p.scene.camera.height) + " with " + backendName);
     // Only once the input is known to be good may the output's folder be created.
     createOutputFolder(o.output);
     if (o.view) {
@@ -388,17 +381,17 @@ int render(const RenderOptions& o) {
         stage.done(std::to_string(img.width) + "x" + std::to_string(img.height) + " -> " + o.output.string() +
                    ", " + memoryLine(estimate));
         if (o.common.json) {
-            Json j = {{"backend", o.backend}, {"view", *o.view}, {"output", o.output.string()},
+            Json j = {{"backend", backendName}, {"view", *o.view}, {"output", o.output.string()},
                       {"timings_ms", timingsJson(frame)}, {"attributes", frame.attributes},
                       {"memory", memoryJson(estimate)}};
             std::cout << j.dump(2) << "\n";
         }
         return 0;
     }
-    if (o.backend == "raster")
+    if (o.backend == scene::Backend::Raster)
         for (const std::string& w : hardFilterWarnings(p.scene, p.settings.raster))
             std::cerr << "shadowlab: warning: " << w << "\n";
-    Stage stage("rendering " + p.scene.file.filename().string() + " with " + o.backend);
+    Stage stage("rendering " + p.scene.file.filename().string() + " with " + backendName);
     // A PNG holds the beauty only, in 8-bit sRGB: the raster backend then renders nothing else,
     // into an 8-bit sRGB target.
     const scene::Frame frame = renderBackend(
@@ -407,7 +400,7 @@ int render(const RenderOptions& o) {
     stage.done(std::to_string(frame.width) + "x" + std::to_string(frame.height) + " -> " + o.output.string() +
                ", " + memoryLine(estimate));
     if (o.common.json) {
-        Json j = {{"backend", o.backend}, {"output", o.output.string()}, {"timings_ms", timingsJson(frame)},
+        Json j = {{"backend", backendName}, {"output", o.output.string()}, {"timings_ms", timingsJson(frame)},
                   {"attributes", frame.attributes}, {"memory", memoryJson(estimate)}};
         std::cout << j.dump(2) << "\n";
     }
@@ -474,8 +467,8 @@ int run(const RunOptions& o) {
     const bool views = !o.skipRaster && std::any_of(p.plan.lights.begin(), p.plan.lights.end(),
                                                      [](const scene::LightPlan& l) { return l.needsShadowTest; });
     const std::uint64_t estimate =
-        scene::kProgramBytes + scene::sceneBytes(p.scene) + backendMemory(p, "raytrace") + scene::frameBytes(p.scene) +
-        (o.skipRaster ? 0 : backendMemory(p, "raster")) + scene::frameWriteBytes(p.scene) +
+        scene::kProgramBytes + scene::sceneBytes(p.scene) + backendMemory(p, scene::Backend::Raytrace) + scene::frameBytes(p.scene) +
+        (o.skipRaster ? 0 : backendMemory(p, scene::Backend::Raster)) + scene::frameWriteBytes(p.scene) +
         2 * pixels * 3 * sizeof(float) +
         (views ? raster::debugViewBytes(p.scene, p.plan, p.settings.raster, "shadow-map") : 0);
     scene::checkMemory(estimate, "run at " + std::to_string(p.scene.camera.width) + "x" +
@@ -510,7 +503,7 @@ int run(const RunOptions& o) {
         if (!report.warnings.empty()) metrics["warnings"] = report.warnings;
     }
     Stage refStage("reference (double precision, robust offsets)");
-    const scene::Frame reference = renderBackend(p, "reference");
+    const scene::Frame reference = renderBackend(p, scene::Backend::Reference);
     scene::writeFrame(reference, dir / "reference.exr");
     scene::writePngLinear(dir / "reference.png", reference.width, reference.height, reference.beauty);
     written.insert(written.end(), {"reference.exr", "reference.png"});
@@ -520,14 +513,16 @@ int run(const RunOptions& o) {
 
     // The user's configuration at the requested resolution, kept for the recommendation's check.
     std::optional<scene::Frame> defaultsFrame[2];  // raytrace, raster
-    for (const std::string backend : {"raytrace", "raster"}) {
-        if (backend == "raster" && o.skipRaster) continue;
-        Stage stage(backend == "raster" ? "raster (Vulkan shadow map)" : "raytrace (shadow rays)");
+    for (const scene::Backend b : {scene::Backend::Raytrace, scene::Backend::Raster}) {
+        const bool isRaster = b == scene::Backend::Raster;
+        if (isRaster && o.skipRaster) continue;
+        const std::string backend = scene::toString(b);
+        Stage stage(isRaster ? "raster (Vulkan shadow map)" : "raytrace (shadow rays)");
         scene::Frame frame;
         raster::RenderDebug debug;
         debug.captureShadowMaps = views;
         try {
-            frame = renderBackend(p, backend, scene::kAllChannels, backend == "raster" && views ? &debug : nullptr);
+            frame = renderBackend(p, b, scene::kAllChannels, isRaster && views ? &debug : nullptr);
         } catch (const std::exception& e) {
             // One backend failing (no Vulkan driver, say) must not lose the other's results.
             std::cerr << "\nshadowlab: error: " << backend << " backend failed: " << e.what() << "\n";
@@ -536,7 +531,7 @@ int run(const RunOptions& o) {
             status = 1;
             continue;
         }
-        defaultsFrame[backend == "raster"] = frame;
+        defaultsFrame[isRaster] = frame;
         scene::writeFrame(frame, dir / (backend + ".exr"));
         scene::writePngLinear(dir / (backend + ".png"), frame.width, frame.height, frame.beauty);
         const compare::Comparison c = compare::compareFrames(frame, reference);
@@ -559,7 +554,7 @@ int run(const RunOptions& o) {
             written.push_back(method.lightHeatPngs.back());
         }
         report.methods.push_back(std::move(method));
-        if (backend == "raster" && views) {
+        if (isRaster && views) {
             for (const RunView& v : kRunViews) {
                 if (std::string_view(v.view) == "cascades" && debug.cascadeSplits.empty()) continue;
                 const raster::DisplayImage img = debugView(v.view, frame, p.scene, debug);

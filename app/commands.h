@@ -35,7 +35,7 @@ struct SceneOptions {
 
 struct RenderOptions {
     SceneOptions common;
-    std::string backend = "raytrace";
+    scene::Backend backend = scene::Backend::Raytrace;
     std::filesystem::path output;
     std::optional<std::string> view;  // raster debug view: shadow-map | cascades | texel-density | light-frustum
 };
@@ -55,7 +55,7 @@ struct SweepOptions {
     bool resume = false;
     bool quick = false;
     std::optional<int> repetitions;
-    std::optional<std::string> shard;  // "K/N": render only shard K of N (compare/shard.h)
+    std::optional<std::string> shard;  // "K/N": render only shard K of N (studies/shard.h)
     // The flicker axis: every row also along this path kind (--flicker [KIND], default subtexel).
     std::optional<std::string> flicker;
     std::optional<int> flickerFrames;

@@ -5,12 +5,14 @@
 #include <cstdio>
 #include <iostream>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "app/commands.h"
 #include "app/guards.h"
 #include "raster/vulkan_error.h"
+#include "scene/backend.h"
 #include "scene/error.h"
 
 namespace {
@@ -120,13 +122,17 @@ int main(int argc, char** argv) {
     addBudgetOptions(*runCmd, runOptions.budgets);
 
     shadowlab::app::RenderOptions renderOptions;
+    std::string backendName = shadowlab::scene::toString(renderOptions.backend);
+    std::vector<std::string> backendNames;
+    for (const shadowlab::scene::Backend b : shadowlab::scene::kBackends)
+        backendNames.push_back(shadowlab::scene::toString(b));
     auto* renderCmd = app.add_subcommand("render", "Render one backend into a Frame (.exr: every AOV and "
                                                    "metadata) or a beauty image (.png)");
     addSceneOptions(*renderCmd, renderOptions.common);
     auto* backendOption =
-        renderCmd->add_option("--backend", renderOptions.backend,
+        renderCmd->add_option("--backend", backendName,
                               "raster|raytrace|reference (default raytrace; raster with --view)")
-            ->check(CLI::IsMember({"raster", "raytrace", "reference"}));
+            ->check(CLI::IsMember(backendNames));
     renderCmd->add_option("-o,--output", renderOptions.output, "Output file, .exr or .png")->required();
     renderCmd->add_option("--view", renderOptions.view,
                           "raster debug view instead of the beauty image (.png only): shadow-map (every map "
@@ -260,7 +266,9 @@ int main(int argc, char** argv) {
         if (*runCmd) return finishStandardOutput(shadowlab::app::run(runOptions));
         if (*renderCmd) {
             // The debug views are views of the shadow maps: --view alone means the raster backend.
-            if (renderOptions.view && backendOption->count() == 0) renderOptions.backend = "raster";
+            // IsMember above has checked the name.
+            renderOptions.backend = *shadowlab::scene::parseBackend(backendName);
+            if (renderOptions.view && backendOption->count() == 0) renderOptions.backend = shadowlab::scene::Backend::Raster;
             return finishStandardOutput(shadowlab::app::render(renderOptions));
         }
         if (*compareCmd) return finishStandardOutput(shadowlab::app::compareFiles(compareOptions));

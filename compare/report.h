@@ -54,7 +54,7 @@ struct ReportFailure {
     std::string message;  // its error
 };
 
-// The small sweep `run` includes (compare/sweep_report.h summarizeSweep() fills it): shown as
+// The small sweep `run` includes (studies/sweep_report.h summarizeSweep() fills it): shown as
 // its own section with a link to the sweep's full report.
 struct SweepSummary {
     std::string href;                // the sweep's report, relative to report.html: "sweep/report.html"
@@ -91,7 +91,7 @@ std::string describeFindings(const ReportInput& input);
 // Writes dir/report.html atomically. The image files are not checked or copied.
 void writeReport(const std::filesystem::path& dir, const ReportInput& input);
 
-// Pieces of the page the sweep report (compare/sweep_report.cpp) reuses, so both pages look
+// Pieces of the page the sweep report (studies/sweep_report.cpp) reuses, so both pages look
 // and zoom alike.
 namespace html {
 // The page's stylesheet (inline in <style>).

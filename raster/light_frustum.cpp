@@ -465,30 +465,26 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
         for (const std::vector<Vec3>& v : visible)
             for (const Vec3& p : v) zMin = std::min(zMin, viewDepth(p));
         const double pixel = pixelAt(zMin);
-        double widest = 0.0;
+        // Each mapped directional light's map. A fitted map's snapped width shrinks (weakly) as N
+        // grows (its N/(N − 1) factor, then rounding up), so its width at the smallest candidate
+        // size bounds the width at the size chosen below.
+        std::vector<LightFrustum> maps;
         for (std::size_t i = 0; i < scene.lights.size(); ++i) {
             const scene::Light& l = scene.lights[i];
             if (l.type != scene::LightType::Directional || !mapped(i)) continue;
-            // A fitted map's snapped width shrinks (weakly) as N grows (its N/(N − 1) factor, then
-            // rounding up), so its width at the smallest candidate size bounds the width at the size
-            // chosen below.
-            const LightFrustum f = settings.fitLightFrustum
-                                       ? fitDirectionalLightToReceivers(scene, l.direction, kMinAutoShadowMapSize)
-                                       : fitDirectionalLight(scene.bounds(), l.direction, size);
-            widest = std::max(widest, 2.0 * f.halfWidth);
+            maps.push_back(settings.fitLightFrustum
+                               ? fitDirectionalLightToReceivers(scene, l.direction, kMinAutoShadowMapSize)
+                               : fitDirectionalLight(scene.bounds(), l.direction, size));
         }
+        double widest = 0.0;
+        for (const LightFrustum& f : maps) widest = std::max(widest, 2.0 * f.halfWidth);
         needed = widest / pixel;
         std::snprintf(buf, sizeof buf, "map width %.4g / smallest pixel footprint %.4g at view depth %.4g = %.0f texels",
                       widest, pixel, zMin, needed);
         why = buf;
         // The casters' detail: k texels across the smallest feature of any object that can shade a
         // visible receiver, in the widest map.
-        for (std::size_t i = 0; i < scene.lights.size(); ++i) {
-            const scene::Light& l = scene.lights[i];
-            if (l.type != scene::LightType::Directional || !mapped(i)) continue;
-            const LightFrustum f = settings.fitLightFrustum
-                                       ? fitDirectionalLightToReceivers(scene, l.direction, kMinAutoShadowMapSize)
-                                       : fitDirectionalLight(scene.bounds(), l.direction, size);
+        for (const LightFrustum& f : maps) {
             const std::vector<bool> casts = castsIntoView(scene, f, kCullMarginTexels);
             for (std::size_t o = 0; o < scene.objects.size(); ++o)
                 if (casts[o]) noteCaster(o, kTexelsPerCasterFeature * 2.0 * f.halfWidth / features[o]);

@@ -210,7 +210,7 @@ void probeInterior(const Tracer<float>& tracer, const scene::Bounds& b, ViewSear
     }
     // The eyes a view from inside starts from: where most sky shows, since that is where a sun
     // can shine in and cast shadows in sight (a stable sort keeps the grid order among equals).
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return sky[a] > sky[b]; });
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) { return sky[i] > sky[j]; });
     for (std::size_t k : order) enclosed.push_back(probes[k]);
     r.interior = r.enclosedPoints >= 3 && r.enclosedPoints >= kInteriorShare * r.probePoints;
 }

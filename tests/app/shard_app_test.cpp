@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "compare/merge.h"
+#include "studies/merge.h"
 #include "tests/app/subprocess.h"
 #include "tests/scene/test_files.h"
 

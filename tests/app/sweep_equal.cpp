@@ -7,8 +7,8 @@
 #include <filesystem>
 #include <iostream>
 
-#include "compare/path.h"
-#include "compare/merge.h"
+#include "studies/path.h"
+#include "studies/merge.h"
 #include "scene/error.h"
 
 int main(int argc, char** argv) {

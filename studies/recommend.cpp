@@ -1,0 +1,374 @@
+// studies/recommend.cpp: searches depth × slope bias in the user's own raster configuration,
+// verifies the best point and the sweep's ray-tracer choice at the requested resolution against
+// the user's defaults, and writes the block that never loses to them.
+#include "studies/recommend.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <set>
+
+#include "compare/compare.h"
+#include "compare/text.h"
+
+namespace shadowlab::compare {
+
+namespace {
+
+using Json = nlohmann::json;
+
+std::string sizeText(const scene::Scene& s) {
+    return std::to_string(s.camera.width) + "x" + std::to_string(s.camera.height);
+}
+
+// The smallest positive number of an attribute holding one value or several joined by ';'.
+double smallestPositive(const std::string& text) {
+    double best = 0.0;
+    std::size_t at = 0;
+    while (at < text.size()) {
+        const std::size_t end = std::min(text.find(';', at), text.size());
+        char* stop = nullptr;
+        const std::string part = text.substr(at, end - at);
+        const double v = std::strtod(part.c_str(), &stop);
+        if (stop != part.c_str() && std::isfinite(v) && v > 0.0 && (best == 0.0 || v < best)) best = v;
+        at = end + 1;
+    }
+    return best;
+}
+
+std::string attribute(const scene::Frame& f, const char* key) {
+    const auto it = f.attributes.find(key);
+    return it == f.attributes.end() ? std::string() : it->second;
+}
+
+// Renders one configuration; failures (exceptions, validation messages) are recorded in `error`.
+scene::Frame renderOne(const RecommendOptions& o, const scene::Scene& s, const scene::SettingsOverrides& overrides,
+                       const std::string& backend, std::string& error) {
+    try {
+        const scene::RenderSettings settings = scene::resolveSettings(s, overrides);
+        scene::Frame f = o.render(s, settings, backend);
+        const std::string messages = attribute(f, "validation_messages");
+        if (settings.raster.validate && backend == "raster" && messages != "0")
+            error = "the Vulkan validation layer reported " + (messages.empty() ? "an unknown number of" : messages) +
+                    " message(s)";
+        if (measureHealth(f).total() > 0) error = "non-finite values";
+        return f;
+    } catch (const std::exception& e) {
+        error = e.what();
+        return {};
+    }
+}
+
+Measured measureRender(const RecommendOptions& o, const scene::Scene& s, const scene::SettingsOverrides& overrides,
+                       const std::string& backend, const scene::Frame& reference, scene::Frame* keep = nullptr) {
+    std::string error;
+    scene::Frame f = renderOne(o, s, overrides, backend, error);
+    Measured m;
+    if (!error.empty()) {
+        m.error = error;
+        return m;
+    }
+    try {
+        m = measure(f, reference);
+    } catch (const std::exception& e) {
+        m.ok = false;
+        m.error = e.what();
+    }
+    if (keep) *keep = std::move(f);
+    return m;
+}
+
+Json measuredJson(const Measured& m) {
+    if (!m.ok) return {{"error", m.error}};
+    return {{"mismatch_rate", m.mismatchRate},         {"false_shadow_rate", m.falseShadowRate},
+            {"missed_shadow_rate", m.missedShadowRate}, {"shadow_iou", m.shadowIoU},
+            {"mean_abs_visibility_error", m.meanAbsVisibilityError}, {"soft_error_rate", m.softErrorRate}};
+}
+
+// The scene-file keys of the user's own settings (everything but the biases this file chooses),
+// so the block reproduces the configuration that was measured.
+Json userBlock(const scene::SettingsOverrides& u) {
+    Json j = Json::object();
+    if (u.shadowMapSize) j["shadow_map_size"] = *u.shadowMapSize;
+    if (u.filter) j["filter"] = *u.filter;
+    if (u.pcfSize) j["pcf_size"] = *u.pcfSize;
+    if (u.normalOffset) j["normal_offset"] = *u.normalOffset;
+    // The command line's flags arrive as false when not given: only an "on" is the user's choice.
+    if (u.receiverPlaneBias.value_or(false)) j["receiver_plane_bias"] = true;
+    if (u.hardwareBias.value_or(false)) j["hardware_bias"] = true;
+    if (u.fitLightFrustum.value_or(false)) j["fit_light_frustum"] = true;
+    if (u.cascades) j["cascades"] = *u.cascades;
+    if (u.cascadeBlend) j["cascade_blend"] = *u.cascadeBlend;
+    if (u.samples) j["samples"] = *u.samples;
+    return j;
+}
+
+void setRayBias(Json& block, const std::string& text) {
+    if (text == "robust") {
+        block["ray_bias"] = "robust";
+        return;
+    }
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    if (end && *end == '\0' && std::isfinite(v)) block["ray_bias"] = v;
+}
+
+// 3 significant digits, like auto_bias's values, so the block reads well; a bias keeps its sign.
+double tidy(double v) {
+    if (!std::isfinite(v) || v == 0.0) return v;
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g", v);
+    return std::strtod(buf, nullptr);
+}
+
+// The midpoint between two axis values: geometric when both are positive (biases act on a log
+// scale: the acne-to-leak trade-off spans decades), else arithmetic.
+double midpoint(double a, double b) { return a > 0.0 && b > 0.0 ? std::sqrt(a * b) : 0.5 * (a + b); }
+
+// The values to try around `v` on an axis: the midpoints to its neighbours, and beyond the largest
+// value twice it (the window may lie past the coarse grid).
+std::vector<double> around(const std::vector<double>& axis, double v) {
+    std::vector<double> out{v};
+    const auto it = std::lower_bound(axis.begin(), axis.end(), v);
+    if (it != axis.begin()) out.push_back(midpoint(*(it - 1), v));
+    if (it != axis.end() && it + 1 != axis.end()) out.push_back(midpoint(v, *(it + 1)));
+    else if (v > 0.0) out.push_back(2.0 * v);
+    return out;
+}
+
+std::string percentPair(const Measured& a, const Measured& b) {
+    return formatPercent(a.mismatchRate) + " mismatch (IoU " + formatFixed(a.shadowIoU, 3) + ") against the defaults' " +
+           formatPercent(b.mismatchRate) + " (IoU " + formatFixed(b.shadowIoU, 3) + ")";
+}
+
+}  // namespace
+
+Measured measure(const scene::Frame& method, const scene::Frame& reference) {
+    const Metrics k = compareFrames(method, reference).metrics;
+    Measured m;
+    m.ok = true;
+    m.mismatchRate = k.mismatchRate;
+    m.falseShadowRate = k.falseShadowRate;
+    m.missedShadowRate = k.missedShadowRate;
+    m.shadowIoU = k.shadowIoU;
+    m.meanAbsVisibilityError = k.meanAbsVisibilityError;
+    m.softErrorRate = k.softErrorRate;
+    return m;
+}
+
+bool better(const Measured& a, const Measured& b) {
+    if (!a.ok) return false;
+    if (!b.ok) return true;
+    if (a.mismatchRate != b.mismatchRate) return a.mismatchRate < b.mismatchRate;
+    return a.meanAbsVisibilityError < b.meanAbsVisibilityError;
+}
+
+bool beats(const Measured& c, const Measured& d) {
+    return c.ok && d.ok && better(c, d) && c.mismatchRate <= d.mismatchRate &&
+           c.meanAbsVisibilityError <= d.meanAbsVisibilityError;
+}
+
+Json rayCandidateOf(const AutoBias& bias) {
+    Json j = Json::object();
+    for (const char* key : {"ray_bias", "precision"})
+        if (bias.shadowBlock.contains(key)) j[key] = bias.shadowBlock[key];
+    return j;
+}
+
+Json Recommendation::toJson() const {
+    auto side = [&](const Verified& v, bool withPoints) {
+        Json j = {{"beats_defaults", v.beatsDefaults},
+                  {"searched", v.searched},
+                  {"candidate", v.candidate},
+                  {"defaults", measuredJson(v.defaults)},
+                  {"tried", v.searched ? measuredJson(v.tried) : Json(nullptr)},
+                  {"recommended", measuredJson(v.recommended)}};
+        j["mismatch_rate_gain"] = v.defaults.ok && v.recommended.ok
+                                      ? Json(v.defaults.mismatchRate - v.recommended.mismatchRate)
+                                      : Json(nullptr);
+        if (withPoints) j["searched_points"] = points.size();
+        return j;
+    };
+    return {{"shadow", shadowBlock},
+            {"measured",
+             {{"resolution", resolution},
+              {"search_resolution", searchResolution},
+              {"raster", side(raster, true)},
+              {"raytrace", side(raytrace, false)},
+              {"notes", notes}}}};
+}
+
+Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Frame& searchReference,
+                               const scene::Scene& scene, const scene::Frame& reference,
+                               const scene::Frame* rasterDefaults, const scene::Frame* raytraceDefaults,
+                               const Json& rayCandidate, const RecommendOptions& o) {
+    Recommendation r;
+    r.searchResolution = sizeText(searchScene);
+    r.resolution = sizeText(scene);
+    const scene::SettingsOverrides& user = o.user;
+    Json block = userBlock(user);
+
+    if (o.raster) {
+        // The user's defaults at the requested resolution, first: the automatic map size follows
+        // the image size, so the search holds the size this resolution resolves to (a bias in world
+        // units found with another map size would be another configuration).
+        Verified& v = r.raster;
+        scene::Frame fullDefaults;
+        v.defaults = rasterDefaults ? measure(*rasterDefaults, reference)
+                                    : measureRender(o, scene, user, "raster", reference, &fullDefaults);
+        scene::SettingsOverrides searchUser = user;
+        const std::string fullMap = attribute(rasterDefaults ? *rasterDefaults : fullDefaults, "shadow_map_size");
+        if (!user.shadowMapSize && !fullMap.empty()) {
+            char* end = nullptr;
+            const long size = std::strtol(fullMap.c_str(), &end, 10);
+            if (end && *end == '\0' && size >= 16 && size <= 16384) searchUser.shadowMapSize = int(size);
+        }
+
+        // The user's configuration as it is: the first point, and the scale of the search.
+        BiasPoint d;
+        d.defaults = true;
+        scene::Frame defaultsFrame;
+        d.at = measureRender(o, searchScene, searchUser, "raster", searchReference, &defaultsFrame);
+        const scene::RenderSettings resolved = scene::resolveSettings(searchScene, searchUser);
+        const std::string applied = attribute(defaultsFrame, "depth_bias");
+        double b0 = smallestPositive(applied);
+        if (!(b0 > 0.0)) b0 = resolved.raster.depthBias;
+        if (!(b0 > 0.0)) b0 = scene::defaultDepthBias(searchScene, resolved.raster.shadowMapSize);
+        const double s0 = resolved.raster.slopeBias > 0.0 ? resolved.raster.slopeBias : 1.0;
+        d.depthBias = b0;
+        d.slopeBias = resolved.raster.slopeBias;
+        r.points.push_back(d);
+        // One applied value: the explicit (b0, s0) point would render the defaults again.
+        const bool oneBias = applied.find(';') == std::string::npos && resolved.raster.slopeBias == s0;
+
+        std::set<std::pair<double, double>> done;
+        auto tryPoint = [&](double depth, double slope, bool refined) {
+            depth = tidy(depth);
+            slope = tidy(slope);
+            if (!done.insert({depth, slope}).second) return;
+            if (oneBias && depth == tidy(b0) && slope == tidy(s0)) return;
+            BiasPoint p;
+            p.depthBias = depth;
+            p.slopeBias = slope;
+            p.refined = refined;
+            scene::SettingsOverrides ov = searchUser;
+            ov.depthBias = depth;
+            ov.slopeBias = slope;
+            p.at = measureRender(o, searchScene, ov, "raster", searchReference);
+            r.points.push_back(p);
+        };
+        if (d.at.ok) {
+            std::vector<double> depthAxis, slopeAxis;
+            for (double k : o.depthSteps) depthAxis.push_back(tidy(k * b0));
+            for (double k : o.slopeSteps) slopeAxis.push_back(tidy(k * s0));
+            for (double depth : depthAxis)
+                for (double slope : slopeAxis) tryPoint(depth, slope, false);
+            // Only points that could replace the defaults compete (beats(): no larger mean |ΔV|).
+            auto bestIndex = [&] {
+                int best = 0;
+                for (int i = 1; i < int(r.points.size()); ++i)
+                    if (beats(r.points[i].at, r.points[0].at) && better(r.points[i].at, r.points[best].at)) best = i;
+                return best;
+            };
+            if (o.refine) {
+                const BiasPoint centre = r.points[bestIndex()];
+                const double cd = centre.defaults ? tidy(b0) : centre.depthBias;
+                const double cs = centre.defaults ? tidy(s0) : centre.slopeBias;
+                std::sort(depthAxis.begin(), depthAxis.end());
+                std::sort(slopeAxis.begin(), slopeAxis.end());
+                for (double depth : around(depthAxis, cd))
+                    for (double slope : around(slopeAxis, cs)) tryPoint(depth, slope, true);
+            }
+            r.best = bestIndex();
+        } else {
+            r.best = 0;
+        }
+
+        // At the requested resolution: the user's defaults against the best point.
+        const BiasPoint& best = r.points[r.best];
+        if (!best.defaults && best.at.ok) {
+            v.searched = true;
+            v.candidate = "depth bias " + formatShort(best.depthBias) + " world units, slope bias " +
+                          formatShort(best.slopeBias) + " texels";
+            scene::SettingsOverrides ov = user;
+            ov.depthBias = best.depthBias;
+            ov.slopeBias = best.slopeBias;
+            v.tried = measureRender(o, scene, ov, "raster", reference);
+            v.beatsDefaults = beats(v.tried, v.defaults);
+        }
+        v.recommended = v.beatsDefaults ? v.tried : v.defaults;
+        const std::string config = "filter " + attribute(defaultsFrame, "filter") + ", map " +
+                                   attribute(defaultsFrame, "shadow_map_size") + ", " +
+                                   (resolved.raster.cascades > 1 ? std::to_string(resolved.raster.cascades) + " cascades, " : "") +
+                                   (attribute(defaultsFrame, "light_frustum_fit") == "receivers" ? "fitted to the view"
+                                                                                                  : "bounding-sphere fit");
+        r.notes.push_back("The shadow map's biases were searched in the configuration you run (" + config + "): " +
+                          std::to_string(r.points.size()) + " renders at " + r.searchResolution +
+                          ", constant bias 0 .. " + formatShort(o.depthSteps.back() * b0) +
+                          " world units together with slope bias 0 .. " + formatShort(o.slopeSteps.back() * s0) +
+                          " texels, refined around the best point.");
+        if (v.beatsDefaults) {
+            block["depth_bias"] = best.depthBias;
+            block["slope_bias"] = best.slopeBias;
+            r.notes.push_back("At " + r.resolution + ", " + v.candidate + " gives " + percentPair(v.recommended, v.defaults) +
+                              ": " + formatPercent(v.defaults.mismatchRate - v.recommended.mismatchRate) +
+                              " of the counted pixels fewer wrong. The block recommends it.");
+        } else {
+            if (user.depthBias) block["depth_bias"] = *user.depthBias;
+            if (user.slopeBias) block["slope_bias"] = *user.slopeBias;
+            std::string why;
+            if (!v.defaults.ok)
+                why = "the defaults did not render (" + v.defaults.error + "), so no bias is recommended.";
+            else if (!v.searched)
+                why = "no searched bias beats the defaults (" + formatPercent(v.defaults.mismatchRate) + " mismatch, IoU " +
+                      formatFixed(v.defaults.shadowIoU, 3) + " at " + r.resolution + "): the block keeps them.";
+            else if (!v.tried.ok)
+                why = "the best searched point (" + v.candidate + ") failed at " + r.resolution + " (" +
+                      v.tried.error + "): the block keeps the defaults.";
+            else
+                why = "the best searched point (" + v.candidate + ") gives " + percentPair(v.tried, v.defaults) +
+                      " and mean |dV| " + formatFixed(v.tried.meanAbsVisibilityError, 4) + " against " +
+                      formatFixed(v.defaults.meanAbsVisibilityError, 4) + " at " + r.resolution +
+                      ", not better in every respect: the block keeps the defaults.";
+            r.notes.push_back("For the shadow map, " + why);
+        }
+    }
+
+    if (o.raytrace && rayCandidate.contains("ray_bias")) {
+        Verified& v = r.raytrace;
+        v.defaults = raytraceDefaults ? measure(*raytraceDefaults, reference)
+                                      : measureRender(o, scene, user, "raytrace", reference);
+        scene::SettingsOverrides ov = user;
+        const Json& rb = rayCandidate["ray_bias"];
+        if (rb.is_string()) {
+            ov.rayBias = rb.get<std::string>();
+        } else {
+            char buf[40];
+            std::snprintf(buf, sizeof buf, "%.9g", rb.get<double>());
+            ov.rayBias = buf;
+        }
+        if (rayCandidate.contains("precision")) ov.precision = rayCandidate["precision"].get<std::string>();
+        v.searched = true;
+        v.candidate = "ray bias " + *ov.rayBias + (ov.precision ? " (" + *ov.precision + ")" : "");
+        v.tried = measureRender(o, scene, ov, "raytrace", reference);
+        v.beatsDefaults = beats(v.tried, v.defaults);
+        v.recommended = v.beatsDefaults ? v.tried : v.defaults;
+        if (v.beatsDefaults) {
+            setRayBias(block, *ov.rayBias);
+            if (ov.precision) block["precision"] = *ov.precision;
+            r.notes.push_back("For the ray tracer, " + v.candidate + " gives " + percentPair(v.recommended, v.defaults) +
+                              " at " + r.resolution + ". The block recommends it.");
+        } else {
+            if (user.rayBias) setRayBias(block, *user.rayBias);
+            if (user.precision) block["precision"] = *user.precision;
+            r.notes.push_back("For the ray tracer, the sweep's pick (" + v.candidate + ") " +
+                              (v.tried.ok ? "gives " + percentPair(v.tried, v.defaults) + ", no better"
+                                          : "failed (" + v.tried.error + ")") +
+                              ": the block keeps the defaults.");
+        }
+    }
+    r.shadowBlock = block;
+    return r;
+}
+
+}  // namespace shadowlab::compare

@@ -1,0 +1,141 @@
+// studies/sweep.h: renders a grid of settings for both backends, times each (setup separated
+// from per-frame time, median of several runs after a warm-up), measures each against a cached
+// reference and appends one row per configuration as it finishes. A stopped sweep resumes
+// where it left off: finished rows are never lost or duplicated (see docs/sweep.md).
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "studies/path.h"
+#include "scene/frame.h"
+#include "scene/scene.h"
+#include "scene/settings.h"
+
+namespace shadowlab::compare {
+
+// One point of the grid: a backend and the settings that differ from the scene's defaults.
+struct SweepConfig {
+    std::string backend;  // "raster" | "raytrace"
+    scene::SettingsOverrides overrides;
+    // The bias parameter this configuration samples, for bias-window plots: "depth" (world
+    // units), "slope" (texels), "ray" (world units); empty when it samples none.
+    std::string biasKind;
+    double biasValue = std::numeric_limits<double>::quiet_NaN();
+
+    // Canonical text of backend + overrides, identical across runs: the resume key.
+    std::string key() const;
+    // Short text for tables and plot tooltips, e.g. "map 1024, none, depth 0.01, slope 0".
+    std::string label() const;
+};
+
+// The most configurations a grid file may multiply to, checked before they are built: far
+// beyond a sweep anyone would wait for (a configuration is at least one render), and small
+// enough that the grid and its rows fit in memory.
+inline constexpr std::size_t kMaxGridConfigurations = 100000;
+
+struct SweepGrid {
+    std::vector<SweepConfig> configs;
+    int repetitions = 3;                    // timed frames per configuration (after one warm-up)
+    std::optional<std::string> resolution;  // "WxH" for every render of the sweep
+    // The flicker axis (docs/sweep.md): every row is also rendered along this path (one path for
+    // the whole sweep, made with the scene's own settings) and measured with compare/temporal.h;
+    // unset, a sweep renders and writes exactly what it does without it.
+    std::optional<PathSpec> flicker;
+};
+
+// The flicker axis's path when a grid or the command line names none: four frames of sub-texel
+// camera steps of a tenth of min(texel, pixel), where a snapped map must hold still.
+PathSpec defaultFlickerPath();
+// The path's frames as the sweep renders them: pathScenes of `scene` (at the sweep's resolution)
+// with the scene's own settings, so every row moves along the same path. Throws scene::InputError.
+std::vector<scene::Scene> flickerScenes(const scene::Scene& scene, const PathSpec& path);
+// Canonical text of the path, in the sweep's identity (sweep.json, a shard's grid hash).
+std::string flickerKey(const PathSpec& path);
+
+// The grid `sweep` runs without --grid: shadow-map size × filter at default bias, a constant
+// and a slope depth-bias series, and a ray-bias series in float plus robust offsets in float and
+// double. `quick` is the smaller grid `run` includes in its report.
+SweepGrid defaultGrid(const scene::Scene& scene, bool quick);
+// A grid file (JSON, see docs/sweep.md). Throws scene::SceneError naming the file and the JSON
+// path of a bad value.
+SweepGrid loadGrid(const std::filesystem::path& file, const scene::Scene& scene);
+
+struct SweepRow {
+    SweepConfig config;
+    std::string key;
+    int repetitions = 0;
+    double setupMs = 0.0;                  // median over the runs
+    double frameMs = 0.0;                  // median per-frame time (total − setup)
+    double frameMsMin = 0.0, frameMsMax = 0.0;
+    nlohmann::json metrics;                // compare::toJson of the last run, or null on error
+    nlohmann::json settings;               // the settings applied (Frame attributes)
+    std::string error;                     // non-empty when the configuration failed
+    std::string image, diffImage;          // file names under DIR/images/
+    nlohmann::json machine;                // compare::toJson(MachineInfo) it was timed on; null in old journals
+    // With a flicker axis: the row along the path (flicker_rate, flicker_px, error_variation,
+    // swim_px, edge_offset_px, pairs; "held": the same for the raster held view on camera paths).
+    // Null without one.
+    nlohmann::json temporal;
+
+    double rate(const char* name) const;   // a metrics rate, NaN when absent
+    // A temporal figure (`held`: of the raster held view), NaN when absent.
+    double temporalValue(const char* name, bool held = false) const;
+};
+
+// Renders one configuration; the default calls the raster or raytrace backend.
+using RenderFn = std::function<scene::Frame(const scene::Scene&, const scene::RenderSettings&,
+                                            const std::string& backend)>;
+scene::Frame renderWithBackend(const scene::Scene& scene, const scene::RenderSettings& settings,
+                               const std::string& backend);
+
+struct SweepProgress {
+    std::size_t done = 0, total = 0, skipped = 0;  // skipped: already in the journal (resume)
+    const SweepRow* row = nullptr;                 // the row just finished
+    double elapsedSeconds = 0.0, etaSeconds = 0.0;
+};
+
+struct SweepOptions {
+    std::filesystem::path outputDir;
+    bool resume = false;
+    bool writeImages = true;
+    RenderFn render = renderWithBackend;
+    std::function<void(const SweepProgress&)> progress;
+    // Where the reference comes from, given the scene at the sweep's resolution; unset: rendered
+    // once and cached as DIR/reference.exr. Shards share one (studies/shard.h).
+    std::function<scene::Frame(const scene::Scene&)> reference;
+};
+
+struct SweepResult {
+    std::vector<SweepRow> rows;  // in grid order
+    scene::Frame reference;
+    double referenceMs = 0.0;
+};
+
+// Writes DIR/reference.exr (cached: reused when it matches the scene and resolution),
+// DIR/results.jsonl (the journal, one line per finished row, fsync'ed), and regenerates
+// DIR/results.csv and DIR/results.json after every row. Throws scene::InputError when DIR
+// already holds a sweep and `resume` is false, or holds one of another scene.
+SweepResult runSweep(const scene::Scene& scene, const SweepGrid& grid, const SweepOptions& options);
+
+// The scene a sweep renders: `scene` at the grid's resolution, when it sets one. Throws
+// scene::InputError on a bad resolution.
+scene::Scene sweepScene(const scene::Scene& scene, const SweepGrid& grid);
+
+// One journal line's JSON and back (merge reads journals strictly with these). rowFromJournal
+// throws nlohmann::json::exception on a line that is JSON but not a row.
+nlohmann::json journalRow(const SweepRow& row);
+SweepRow rowFromJournal(const nlohmann::json& line);
+
+// Reads the rows of a journal; a torn last line (a kill in the middle of a write) is ignored.
+std::vector<SweepRow> readJournal(const std::filesystem::path& file);
+std::string rowsToCsv(const std::vector<SweepRow>& rows);
+nlohmann::json rowsToJson(const std::vector<SweepRow>& rows);
+
+}  // namespace shadowlab::compare

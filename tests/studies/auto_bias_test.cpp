@@ -1,0 +1,233 @@
+// tests/studies/auto_bias_test.cpp: the recommended bias is the middle of each known window
+// (geometric for log-spaced samples), stiff series name the artifact that dominates, robust
+// offsets win when they pass, and the shadow block is one the scene loader accepts.
+#include "studies/auto_bias.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "scene/error.h"
+#include "scene/loader.h"
+#include "tests/studies/sweep_rows.h"
+
+namespace shadowlab::compare {
+namespace {
+
+namespace fs = std::filesystem;
+using test::depthRow;
+using test::rayRow;
+using test::robustRow;
+using test::slopeRow;
+
+constexpr double kTexel = 0.002;  // world size of a texel in these made-up series
+constexpr double kOk = 0.0002;    // a rate well under the 0.1% threshold
+constexpr double kBad = 0.02;     // a rate well over it
+
+// A depth series at 0, ¼, 1, 4, 16, 64 texels (defaultGrid's quick series) where 1..16 texels
+// are clean: acne below, leaks above.
+std::vector<SweepRow> depthSeriesWithWindow() {
+    return {depthRow(0, 0.3, 0), depthRow(0.25 * kTexel, kBad, 0), depthRow(1 * kTexel, kOk, 0),
+            depthRow(4 * kTexel, 0, 0), depthRow(16 * kTexel, 0, kOk), depthRow(64 * kTexel, 0, kBad)};
+}
+
+TEST(IsLogSpaced, TellsGeometricFromArithmeticSeries) {
+    EXPECT_TRUE(isLogSpaced({0, 0.25, 1, 4, 16, 64}));        // ratio 4, zero ignored
+    EXPECT_TRUE(isLogSpaced({1e-8, 1e-6, 1e-4, 1e-2}));
+    EXPECT_FALSE(isLogSpaced({0, 1, 2, 3, 4, 5}));            // step 1
+    EXPECT_FALSE(isLogSpaced({0.1, 0.2, 0.3, 0.4}));
+    EXPECT_TRUE(isLogSpaced({0.001, 0.01}));                   // two values a decade apart
+    EXPECT_FALSE(isLogSpaced({0.001, 0.002}));
+    EXPECT_FALSE(isLogSpaced({0, 0.5}));                       // one positive value
+}
+
+TEST(WindowMiddle, GeometricForLogSpacedPositiveWindowsElseArithmetic) {
+    EXPECT_DOUBLE_EQ(windowMiddle(1e-4, 1e-2, true), 1e-3);   // sqrt(1e-4 · 1e-2)
+    EXPECT_DOUBLE_EQ(windowMiddle(1e-4, 1e-2, false), 0.00505);
+    EXPECT_DOUBLE_EQ(windowMiddle(0.0, 1e-2, true), 0.005);   // lo = 0: no geometric middle
+}
+
+TEST(AutoBias, RecommendsTheGeometricMiddleOfALogSpacedWindow) {
+    const AutoBias a = recommendBias(depthSeriesWithWindow());
+    const BiasSeries* d = a.primary("depth");
+    ASSERT_NE(d, nullptr);
+    EXPECT_FALSE(d->window.stiff);
+    EXPECT_DOUBLE_EQ(d->window.lo, 1 * kTexel);
+    EXPECT_DOUBLE_EQ(d->window.hi, 16 * kTexel);
+    EXPECT_TRUE(d->logSpaced);
+    // sqrt(1 · 16) = 4 texels.
+    EXPECT_NEAR(d->recommended, 4 * kTexel, 1e-12);
+    EXPECT_NEAR(a.shadowBlock.at("depth_bias").get<double>(), 4 * kTexel, 1e-12);
+    // The series held slope bias at 0 on a 1024 map with no filter: the block keeps all three.
+    EXPECT_EQ(a.shadowBlock.at("slope_bias").get<double>(), 0.0);
+    EXPECT_EQ(a.shadowBlock.at("shadow_map_size").get<int>(), 1024);
+    EXPECT_EQ(a.shadowBlock.at("filter").get<std::string>(), "none");
+    EXPECT_FALSE(a.shadowBlock.contains("ray_bias"));
+    EXPECT_EQ(a.primary("slope"), nullptr);
+    EXPECT_EQ(a.primary("ray"), nullptr);
+}
+
+TEST(AutoBias, RecommendsTheArithmeticMiddleOfAnEvenlySpacedWindow) {
+    // Slope bias 0..5 texels in steps of 1; clean from 1 to 4: middle (1 + 4) / 2 = 2.5.
+    const AutoBias a = recommendBias({slopeRow(0, kBad, 0), slopeRow(1, kOk, 0), slopeRow(2, 0, 0), slopeRow(3, 0, 0),
+                                      slopeRow(4, 0, kOk), slopeRow(5, 0, kBad)});
+    const BiasSeries* s = a.primary("slope");
+    ASSERT_NE(s, nullptr);
+    EXPECT_FALSE(s->logSpaced);
+    EXPECT_DOUBLE_EQ(s->recommended, 2.5);
+    EXPECT_DOUBLE_EQ(a.shadowBlock.at("slope_bias").get<double>(), 2.5);
+    EXPECT_EQ(a.shadowBlock.at("depth_bias").get<double>(), 0.0);
+}
+
+TEST(AutoBias, AWindowStartingAtZeroUsesTheArithmeticMiddle) {
+    // Ray bias 0, 1e-6 .. 1e-3 (log-spaced), clean from 0 to 1e-4: (0 + 1e-4) / 2.
+    const AutoBias a = recommendBias({rayRow(0, 0, 0), rayRow(1e-6, 0, 0), rayRow(1e-5, 0, 0), rayRow(1e-4, 0, kOk),
+                                      rayRow(1e-3, 0, kBad)});
+    const BiasSeries* r = a.primary("ray");
+    ASSERT_NE(r, nullptr);
+    EXPECT_TRUE(r->logSpaced);
+    EXPECT_DOUBLE_EQ(r->window.lo, 0.0);
+    EXPECT_DOUBLE_EQ(r->recommended, 5e-5);
+    EXPECT_DOUBLE_EQ(a.shadowBlock.at("ray_bias").get<double>(), 5e-5);
+    EXPECT_EQ(a.shadowBlock.at("precision").get<std::string>(), "float");
+}
+
+TEST(AutoBias, AStiffSeriesNamesAcneWhenFalseShadowDominatesTheBestCompromise) {
+    // max(false, missed) per sample: 0.2, 0.05, 0.01, 0.03 -> best compromise at 4 texels,
+    // where false shadow (0.01) outweighs missed (0.002): acne dominates.
+    const AutoBias a = recommendBias({depthRow(1 * kTexel, 0.2, 0), depthRow(2 * kTexel, 0.05, 0),
+                                      depthRow(4 * kTexel, 0.01, 0.002), depthRow(8 * kTexel, 0.004, 0.03)});
+    const BiasSeries* d = a.primary("depth");
+    ASSERT_NE(d, nullptr);
+    EXPECT_TRUE(d->window.stiff);
+    EXPECT_EQ(d->dominant, "false");
+    EXPECT_DOUBLE_EQ(d->recommended, 4 * kTexel);
+    EXPECT_NE(d->describe().find("stiff"), std::string::npos);
+    EXPECT_NE(d->describe().find("acne"), std::string::npos);
+    EXPECT_DOUBLE_EQ(a.shadowBlock.at("depth_bias").get<double>(), 4 * kTexel);
+    bool saysStiff = false;
+    for (const auto& n : a.notes) saysStiff = saysStiff || n.find("shadow map is stiff") != std::string::npos;
+    EXPECT_TRUE(saysStiff);
+}
+
+TEST(AutoBias, AStiffSeriesNamesPeterPanningWhenMissedShadowDominates) {
+    // max: 0.02, 0.008, 0.05 -> best at 2 texels, where missed (0.008) > false (0.003).
+    const AutoBias a = recommendBias({slopeRow(1, 0.02, 0.001), slopeRow(2, 0.003, 0.008), slopeRow(4, 0, 0.05)});
+    const BiasSeries* s = a.primary("slope");
+    ASSERT_NE(s, nullptr);
+    EXPECT_TRUE(s->window.stiff);
+    EXPECT_EQ(s->dominant, "missed");
+    EXPECT_NE(s->describe().find("peter-panning"), std::string::npos);
+}
+
+TEST(AutoBias, PrefersTheRasterBiasKindWithTheWiderWindow) {
+    // Depth: one clean sample; slope: three. The slope bias wins, the depth bias stays at 0
+    // as it was when the slope series was measured.
+    std::vector<SweepRow> rows = {depthRow(0, kBad, 0), depthRow(kTexel, 0, 0), depthRow(4 * kTexel, 0, kBad),
+                                  slopeRow(0, kBad, 0), slopeRow(0.5, 0, 0), slopeRow(2, 0, 0),
+                                  slopeRow(8, 0, 0),    slopeRow(32, 0, kBad)};
+    const AutoBias a = recommendBias(rows);
+    EXPECT_DOUBLE_EQ(a.shadowBlock.at("slope_bias").get<double>(), 2.0);  // sqrt(0.5 · 8)
+    EXPECT_EQ(a.shadowBlock.at("depth_bias").get<double>(), 0.0);
+    // Reversed: depth has the wider window.
+    rows = {depthRow(0, kBad, 0),  depthRow(kTexel, 0, 0), depthRow(4 * kTexel, 0, 0), depthRow(16 * kTexel, 0, kBad),
+            slopeRow(0, kBad, 0), slopeRow(2, 0, 0),       slopeRow(8, 0, kBad)};
+    const AutoBias b = recommendBias(rows);
+    EXPECT_DOUBLE_EQ(b.shadowBlock.at("depth_bias").get<double>(), 2 * kTexel);  // sqrt(1 · 4) texels
+    EXPECT_EQ(b.shadowBlock.at("slope_bias").get<double>(), 0.0);
+}
+
+TEST(AutoBias, RecommendsRobustOffsetsWhenTheyPass) {
+    std::vector<SweepRow> rows = {rayRow(0, kBad, 0), rayRow(1e-4, 0, 0), rayRow(1e-2, 0, kBad),
+                                  robustRow("float", kOk, 0, 50.0), robustRow("double", 0, 0, 80.0)};
+    const AutoBias a = recommendBias(rows);
+    EXPECT_EQ(a.shadowBlock.at("ray_bias"), "robust");
+    EXPECT_EQ(a.shadowBlock.at("precision"), "float");  // both pass; float is faster
+    ASSERT_NE(a.robustPick(), nullptr);
+    bool said = false;
+    for (const auto& n : a.notes) said = said || n.find("\"ray_bias\": \"robust\"") != std::string::npos;
+    EXPECT_TRUE(said);
+    // When robust offsets leave acne above the threshold, the ray-bias window is used instead.
+    rows[3] = robustRow("float", kBad, 0);
+    rows[4] = robustRow("double", 0.002, 0);
+    const AutoBias b = recommendBias(rows);
+    EXPECT_EQ(b.robustPick(), nullptr);
+    EXPECT_DOUBLE_EQ(b.shadowBlock.at("ray_bias").get<double>(), 1e-4);
+}
+
+TEST(AutoBias, IgnoresFailedRowsAndRowsWithoutRates) {
+    // Without the failed row at 4 texels the series is stiff; a failed row (error set) must
+    // never open a window, even if it carries rates.
+    std::vector<SweepRow> rows = {depthRow(kTexel, kBad, 0), depthRow(16 * kTexel, 0, kBad)};
+    SweepRow failed = depthRow(4 * kTexel, 0, 0);
+    failed.error = "VK_ERROR_DEVICE_LOST";
+    rows.push_back(failed);
+    rows.push_back(test::failedRow(depthRow(2 * kTexel, 0, 0), "out of memory"));
+    const AutoBias a = recommendBias(rows);
+    ASSERT_NE(a.primary("depth"), nullptr);
+    EXPECT_EQ(a.primary("depth")->samples.size(), 2u);
+    EXPECT_TRUE(a.primary("depth")->window.stiff);
+}
+
+TEST(AutoBias, SplitsSeriesRunAtOtherSettingsAndUsesTheLongest) {
+    std::vector<SweepRow> rows = depthSeriesWithWindow();  // 6 samples at 1024
+    for (double k : {1.0, 4.0, 16.0}) rows.push_back(depthRow(k * kTexel, kBad, 0, 2048));
+    const AutoBias a = recommendBias(rows);
+    ASSERT_EQ(a.series.size(), 2u);
+    EXPECT_EQ(a.primary("depth")->samples.size(), 6u);
+    EXPECT_EQ(a.shadowBlock.at("shadow_map_size").get<int>(), 1024);
+    EXPECT_NEAR(a.shadowBlock.at("depth_bias").get<double>(), 4 * kTexel, 1e-12);
+}
+
+TEST(AutoBias, TheDepthSeriesZeroRowIsAlsoTheSlopeSeriesZeroSample) {
+    // defaultGrid renders depth 0 + slope 0 once, as a depth row; the slope series (depth held
+    // at 0, same map and filter) starts there too. A map-size row at default biases (no bias
+    // override) belongs to neither.
+    const std::vector<SweepRow> rows = {depthRow(0, 0.3, 0), depthRow(kTexel, 0, 0), slopeRow(0.5, 0.01, 0),
+                                        slopeRow(2, 0, 0), test::mapRow(1024, "none", 0.0, 0.0, 4.0)};
+    const AutoBias a = recommendBias(rows);
+    const BiasSeries* s = a.primary("slope");
+    ASSERT_NE(s, nullptr);
+    ASSERT_EQ(s->samples.size(), 3u);
+    EXPECT_EQ(s->samples[0].bias, 0.0);
+    EXPECT_EQ(s->samples[0].falseShadowRate, 0.3);
+    EXPECT_EQ(a.primary("depth")->samples.size(), 2u);
+}
+
+TEST(AutoBias, NoBiasRowsGiveAnEmptyBlockAndABadThresholdThrows) {
+    const AutoBias a = recommendBias({test::mapRow(1024, "none", 0.001, 0, 4.0)});
+    EXPECT_TRUE(a.series.empty());
+    EXPECT_TRUE(a.shadowBlock.empty());
+    EXPECT_THROW(recommendBias({}, -0.1), scene::InputError);
+    EXPECT_THROW(recommendBias({}, std::nan("")), scene::InputError);
+}
+
+TEST(AutoBias, TheShadowBlockIsAcceptedByTheSceneLoader) {
+    std::vector<SweepRow> rows = depthSeriesWithWindow();
+    for (double s : {0.0, 0.5, 2.0}) rows.push_back(slopeRow(s, s == 0 ? kBad : 0, 0));
+    rows.push_back(rayRow(1e-4, 0, 0));
+    rows.push_back(robustRow("double", 0, 0));
+    const AutoBias a = recommendBias(rows);
+    const nlohmann::json scene = {
+        {"camera", {{"position", {0, 2, 6}}, {"look_at", {0, 0.7, 0}}, {"up", {0, 1, 0}}, {"fov_y", 40},
+                    {"resolution", {64, 36}}, {"near", 0.1}, {"far", 100}}},
+        {"materials", {{"matte", {{"albedo", {0.8, 0.8, 0.8}}}}}},
+        {"lights", {{{"type", "directional"}, {"direction", {-1, -2, -1}}, {"color", {1, 1, 1}}, {"intensity", 3}}}},
+        {"objects", {{{"type", "sphere"}, {"center", {0, 1, 0}}, {"radius", 1}, {"material", "matte"}}}},
+        {"shadow", a.shadowBlock}};
+    const fs::path dir = fs::path(::testing::TempDir()) / "auto_bias_scene";
+    fs::create_directories(dir);
+    std::ofstream(dir / "scene.json") << scene.dump(2);
+    const scene::Scene loaded = scene::loadScene(dir / "scene.json");
+    ASSERT_TRUE(loaded.shadow.depthBias.has_value());
+    EXPECT_NEAR(*loaded.shadow.depthBias, 4 * kTexel, 1e-12);
+    ASSERT_TRUE(loaded.shadow.robustRayOffset.has_value());
+    EXPECT_TRUE(*loaded.shadow.robustRayOffset);
+    EXPECT_EQ(loaded.shadow.precision, std::optional<std::string>("double"));
+    EXPECT_EQ(loaded.shadow.shadowMapSize, std::optional<int>(1024));
+}
+
+}  // namespace
+}  // namespace shadowlab::compare

@@ -1,0 +1,221 @@
+// tests/studies/recommend_test.cpp: the recommended "shadow" block never loses to the user's
+// defaults. With a fake renderer whose error is a known function of the biases: the search finds
+// an optimum off the coarse grid by refinement, keeps the defaults when they are best, and keeps
+// them when the candidate loses at the requested resolution. With lavapipe (validation on) and
+// the reference: on the seed and on a stiff extreme case, the block pasted into the scene file
+// renders with no more mismatch than the defaults.
+#include "studies/recommend.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "compare/compare.h"
+#include "scene/loader.h"
+
+namespace shadowlab::compare {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+// A one-row scene-less "scene": the fake renderer only reads the camera size and the settings.
+scene::Scene fakeScene(int width) {
+    scene::Scene s = scene::loadScene(scene::findScene("seed"));
+    s.camera.width = width;
+    s.camera.height = 1;
+    return s;
+}
+
+// Every pixel is object 1 facing the light, lit in the reference; the fake method darkens the
+// first `wrong` pixels (false shadow), so its mismatch rate is wrong / width.
+scene::Frame row(int width, int wrong) {
+    scene::Frame f = scene::Frame::allocate(width, 1, false);
+    for (int i = 0; i < width; ++i) {
+        f.objectId[i] = 1.0f;
+        f.ndotl[i] = 1.0f;
+        f.visibility[i] = i < wrong ? 0.0f : 1.0f;
+        for (int c = 0; c < 3; ++c) f.beauty[3 * i + c] = 0.5f;
+    }
+    return f;
+}
+
+// The fake's error: 10 pixels per octave away from (depth*, slope*), 200 when a bias is 0.
+int octaves(double v, double target) { return v > 0.0 ? int(std::lround(10.0 * std::fabs(std::log2(v / target)))) : 200; }
+
+struct Fake {
+    double depthTarget = 0.0, slopeTarget = 2.0;
+    // Used at this width only: the candidate loses there (for the "never loses" case).
+    int loseAtWidth = 0;
+    int renders = 0;
+    scene::Frame operator()(const scene::Scene& s, const scene::RenderSettings& settings, const std::string& backend) {
+        ++renders;
+        const int w = s.camera.width;
+        if (backend == "reference") return row(w, 0);
+        int wrong = 0;
+        if (backend == "raster") {
+            wrong = octaves(settings.raster.depthBias, depthTarget) + octaves(settings.raster.slopeBias, slopeTarget);
+            if (w == loseAtWidth && !settings.raster.depthBiasIsDefault) wrong = w;
+        } else {
+            wrong = settings.raytrace.robustOffset ? 0 : 3;
+        }
+        scene::Frame f = row(w, std::min(wrong, w));
+        char buf[40];
+        std::snprintf(buf, sizeof buf, "%.9g", settings.raster.depthBias);
+        f.attributes["depth_bias"] = buf;
+        f.attributes["filter"] = "pcf2x2";
+        f.attributes["shadow_map_size"] = std::to_string(settings.raster.shadowMapSize);
+        return f;
+    }
+};
+
+TEST(Recommend, RefinementFindsTheOptimumBetweenCoarsePointsAndTheBlockHoldsIt) {
+    const scene::Scene s = fakeScene(1000);
+    const double b0 = scene::resolveSettings(s, {}).raster.depthBias;  // the default half texel
+    auto fake = std::make_shared<Fake>();
+    // Optimum at depth 2·b0, slope 2: off the coarse grid (b0 × {0,1,4,16}, slope {0,1,4}); the
+    // coarse best is (b0, 1) or (4b0, 4) at 20 px; its geometric midpoints reach (2b0, 2): 0 px.
+    fake->depthTarget = 2.0 * b0;
+    RecommendOptions o;
+    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, const std::string& b) { return (*fake)(sc, st, b); };
+    const scene::Frame ref = row(1000, 0);
+    const Recommendation r = recommendShadow(s, ref, s, ref, nullptr, nullptr, Json{{"ray_bias", "robust"}}, o);
+    ASSERT_GE(r.best, 0);
+    const BiasPoint& best = r.points[r.best];
+    EXPECT_TRUE(best.refined);
+    // Values are rounded to 3 significant digits: within half a unit of the third, 0.5% of the value.
+    EXPECT_NEAR(best.depthBias, 2.0 * b0, 5e-3 * 2.0 * b0);
+    EXPECT_EQ(best.slopeBias, 2.0);
+    EXPECT_TRUE(r.raster.beatsDefaults);
+    // Defaults: (b0, 1) is one octave off on each axis: 20 px of 1000.
+    EXPECT_DOUBLE_EQ(r.raster.defaults.mismatchRate, 0.02);
+    EXPECT_LE(r.raster.recommended.mismatchRate, 0.001);
+    EXPECT_NEAR(r.shadowBlock.at("depth_bias").get<double>(), 2.0 * b0, 5e-3 * 2.0 * b0);
+    EXPECT_EQ(r.shadowBlock.at("slope_bias").get<double>(), 2.0);
+    // The ray tracer's robust candidate (0 px against 3) wins too.
+    EXPECT_EQ(r.shadowBlock.at("ray_bias"), "robust");
+    // Bounded cost: 12 coarse points (one of them the defaults) + at most 8 refined, + 2 checks.
+    EXPECT_LE(r.points.size(), 20u);
+    const Json file = r.toJson();
+    EXPECT_DOUBLE_EQ(file["measured"]["raster"]["mismatch_rate_gain"].get<double>(),
+                     0.02 - r.raster.recommended.mismatchRate);
+    EXPECT_EQ(file["shadow"], r.shadowBlock);
+    // The block is a valid scene-file "shadow" block.
+    Json doc;
+    std::ifstream(scene::findScene("seed")) >> doc;
+    doc["shadow"] = r.shadowBlock;
+    const fs::path tmp = fs::temp_directory_path() / "shadowlab-recommend-block.json";
+    std::ofstream(tmp) << doc.dump();
+    EXPECT_NO_THROW(scene::loadScene(tmp));
+    fs::remove(tmp);
+}
+
+TEST(Recommend, KeepsTheDefaultsWhenNothingSearchedBeatsThem) {
+    const scene::Scene s = fakeScene(1000);
+    const double b0 = scene::resolveSettings(s, {}).raster.depthBias;
+    auto fake = std::make_shared<Fake>();
+    fake->depthTarget = b0;   // the defaults (b0, 1) are the optimum: 0 px
+    fake->slopeTarget = 1.0;
+    RecommendOptions o;
+    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, const std::string& b) { return (*fake)(sc, st, b); };
+    o.raytrace = false;
+    const scene::Frame ref = row(1000, 0);
+    const Recommendation r = recommendShadow(s, ref, s, ref, nullptr, nullptr, Json::object(), o);
+    EXPECT_TRUE(r.points[r.best].defaults);
+    EXPECT_FALSE(r.raster.beatsDefaults);
+    EXPECT_FALSE(r.shadowBlock.contains("depth_bias"));
+    EXPECT_FALSE(r.shadowBlock.contains("slope_bias"));
+    EXPECT_EQ(r.raster.recommended.mismatchRate, 0.0);
+}
+
+TEST(Recommend, ACandidateThatLosesAtTheRequestedResolutionIsNotRecommended) {
+    const scene::Scene search = fakeScene(1000), full = fakeScene(2000);
+    const double b0 = scene::resolveSettings(search, {}).raster.depthBias;
+    auto fake = std::make_shared<Fake>();
+    fake->depthTarget = 2.0 * b0;
+    fake->loseAtWidth = 2000;  // at 2000 px every explicit bias darkens everything
+    RecommendOptions o;
+    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, const std::string& b) { return (*fake)(sc, st, b); };
+    o.raytrace = false;
+    const Recommendation r = recommendShadow(search, row(1000, 0), full, row(2000, 0), nullptr, nullptr, Json::object(), o);
+    EXPECT_TRUE(r.raster.searched);
+    EXPECT_DOUBLE_EQ(r.raster.tried.mismatchRate, 1.0);
+    EXPECT_DOUBLE_EQ(r.raster.defaults.mismatchRate, 0.01);  // 20 px of 2000
+    EXPECT_FALSE(r.raster.beatsDefaults);
+    EXPECT_FALSE(r.shadowBlock.contains("depth_bias"));
+    EXPECT_DOUBLE_EQ(r.raster.recommended.mismatchRate, r.raster.defaults.mismatchRate);
+}
+
+TEST(Recommend, KeepsTheUsersOwnSettingsInTheBlock) {
+    const scene::Scene s = fakeScene(500);
+    auto fake = std::make_shared<Fake>();
+    fake->depthTarget = 1e-3;
+    RecommendOptions o;
+    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, const std::string& b) { return (*fake)(sc, st, b); };
+    o.user.filter = "pcf";
+    o.user.shadowMapSize = 1024;
+    o.user.fitLightFrustum = false;  // a flag not given: not the user's choice
+    o.raytrace = false;
+    const scene::Frame ref = row(500, 0);
+    const Recommendation r = recommendShadow(s, ref, s, ref, nullptr, nullptr, Json::object(), o);
+    EXPECT_EQ(r.shadowBlock.at("filter"), "pcf");
+    EXPECT_EQ(r.shadowBlock.at("shadow_map_size"), 1024);
+    EXPECT_FALSE(r.shadowBlock.contains("fit_light_frustum"));
+}
+
+// The real thing: lavapipe with validation, against the double-precision reference. The block is
+// pasted into the scene file (its "shadow" merged over the scene's) and rendered anew, so the
+// check does not trust the recommendation's own numbers.
+Measured pasted(const fs::path& sceneFile, const Json& block, int w, int h, const scene::Frame& reference) {
+    Json doc;
+    std::ifstream(sceneFile) >> doc;
+    if (!doc.contains("shadow")) doc["shadow"] = Json::object();
+    doc["shadow"].update(block);
+    const fs::path tmp = fs::temp_directory_path() / ("shadowlab-pasted-" + sceneFile.filename().string());
+    std::ofstream(tmp) << doc.dump();
+    scene::Scene s = scene::loadScene(tmp);
+    fs::remove(tmp);
+    s.camera.width = w;
+    s.camera.height = h;
+    scene::SettingsOverrides v;
+    v.validate = true;
+    const scene::Frame f = renderWithBackend(s, scene::resolveSettings(s, v), "raster");
+    EXPECT_EQ(f.attributes.at("validation_messages"), "0");
+    return measure(f, reference);
+}
+
+void checkNeverLoses(const std::string& name) {
+    const fs::path file = scene::findScene(name);
+    scene::Scene full = scene::loadScene(file), search = full;
+    full.camera.width = 160;
+    full.camera.height = 90;
+    search.camera.width = 80;
+    search.camera.height = 45;
+    const scene::Frame ref = renderWithBackend(full, scene::resolveSettings(full, {}), "reference");
+    const scene::Frame searchRef = renderWithBackend(search, scene::resolveSettings(search, {}), "reference");
+    RecommendOptions o;
+    o.user.validate = true;
+    o.raytrace = false;
+    const Recommendation r = recommendShadow(search, searchRef, full, ref, nullptr, nullptr, Json::object(), o);
+    ASSERT_TRUE(r.raster.defaults.ok) << r.raster.defaults.error;
+    scene::SettingsOverrides v;
+    v.validate = true;
+    const Measured defaults = measure(renderWithBackend(full, scene::resolveSettings(full, v), "raster"), ref);
+    const Measured block = pasted(file, r.shadowBlock, 160, 90, ref);
+    std::printf("%s: %zu points, defaults %.4f%% (IoU %.3f), block %.4f%% (IoU %.3f), block %s\n", name.c_str(),
+                r.points.size(), 100 * defaults.mismatchRate, defaults.shadowIoU, 100 * block.mismatchRate,
+                block.shadowIoU, r.shadowBlock.dump().c_str());
+    EXPECT_LE(block.mismatchRate, defaults.mismatchRate) << r.shadowBlock.dump();
+    EXPECT_LE(block.meanAbsVisibilityError, defaults.meanAbsVisibilityError) << r.shadowBlock.dump();
+    EXPECT_DOUBLE_EQ(r.raster.recommended.mismatchRate, block.mismatchRate);
+}
+
+TEST(RecommendOnLavapipe, TheSeedsBlockIsNoWorseThanItsDefaults) { checkNeverLoses("seed"); }
+
+TEST(RecommendOnLavapipe, AStiffCasesBlockIsNoWorseThanItsDefaults) { checkNeverLoses("extreme/grazing-1deg"); }
+
+}  // namespace
+}  // namespace shadowlab::compare
