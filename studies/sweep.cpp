@@ -18,6 +18,7 @@
 #include "studies/backend.h"
 #include "studies/machine.h"
 #include "scene/append_line.h"
+#include "scene/backend.h"
 #include "scene/error.h"
 #include "scene/frame_identity.h"
 #include "scene/frame_io.h"
@@ -609,22 +610,21 @@ Json rowTemporal(const SweepOptions& options, const PathSpec& spec, const std::v
     const Fn* fn = options.render.target<Fn>();
     const bool real = fn && *fn == &renderWithBackend;
     std::vector<scene::Frame> frames, held;
-    if (real && backend == "raster") {
-        raster::Renderer r(scenes[0], scene::makeRenderPlan(scenes[0], settings), settings.raster);
+    const std::optional<scene::Backend> seam = real ? scene::parseBackend(backend) : std::nullopt;
+    if (seam == scene::Backend::Raster || seam == scene::Backend::Raytrace) {
+        const std::unique_ptr<BackendRenderer> r =
+            makeRenderer(*seam, scenes[0], scene::makeRenderPlan(scenes[0], settings), settings);
         for (const scene::Scene& s : scenes) {
-            r.update(s);
-            frames.push_back(r.render());
-            if (isCameraPath(spec.kind)) {
-                r.update(s, scenes[0].camera);
-                held.push_back(r.render());
+            r->update(s);
+            frames.push_back(r->render());
+            if (*seam == scene::Backend::Raster && isCameraPath(spec.kind)) {
+                r->update(s, scenes[0].camera);
+                held.push_back(r->render());
             }
         }
-        if (settings.raster.validate && r.validationMessages() > 0)
-            throw std::runtime_error("the Vulkan validation layer reported " + std::to_string(r.validationMessages()) +
+        if (settings.raster.validate && r->validationMessages() > 0)
+            throw std::runtime_error("the Vulkan validation layer reported " + std::to_string(r->validationMessages()) +
                                      " message(s) along the flicker path (printed above)");
-    } else if (real && backend == "raytrace") {
-        const raytrace::Renderer tracer(scenes[0], settings.raytrace, false);
-        for (const scene::Scene& s : scenes) frames.push_back(tracer.render(s, scene::makeRenderPlan(s, settings)));
     } else {
         for (const scene::Scene& s : scenes) frames.push_back(options.render(s, settings, backend));
     }
