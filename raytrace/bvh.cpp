@@ -5,7 +5,10 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <numeric>
+
+#include <emmintrin.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -24,11 +27,66 @@ double surfaceArea(const scene::Bounds& b) {
     return 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
 }
 
+// A primitive's double bounds and its index, 64 bytes, moved by the partitions themselves so
+// that every pass over a range reads memory in order (an index into the bounds would gather
+// 48 scattered bytes per primitive). Lanes: lo x, y, z, index; hi x, y, z, unused. The bounds
+// are extended with SSE2 min/max, which pick exactly what glm::min / glm::max pick (the
+// accumulator unless the new value is smaller / larger), so nothing differs from scene::Bounds.
+struct alignas(64) PrimRef {
+    double lo[4];
+    double hi[4];
+    std::uint32_t index() const { return std::uint32_t(lo[3]); }
+    double centroid(int axis) const { return 0.5 * (lo[axis] + hi[axis]); }  // Bounds::center()
+};
+static_assert(sizeof(PrimRef) == 64, "PrimRef: one cache line");
+
+// Four-lane double box (lanes 0..2 used), the same min/max rule as scene::Bounds.
+struct Box4 {
+    __m128d lo01 = _mm_set1_pd(std::numeric_limits<double>::infinity()), lo2 = lo01;
+    __m128d hi01 = _mm_set1_pd(-std::numeric_limits<double>::infinity()), hi2 = hi01;
+    void extend(const PrimRef& r) {
+        // _mm_min_pd(new, acc) = new < acc ? new : acc = glm::min(acc, new); same for max.
+        lo01 = _mm_min_pd(_mm_load_pd(r.lo), lo01);
+        lo2 = _mm_min_pd(_mm_load_pd(r.lo + 2), lo2);
+        hi01 = _mm_max_pd(_mm_load_pd(r.hi), hi01);
+        hi2 = _mm_max_pd(_mm_load_pd(r.hi + 2), hi2);
+    }
+    void extend(const Box4& o) {
+        // For an empty o (lo = +inf, hi = −inf) this changes nothing, as Bounds::extend skips it.
+        lo01 = _mm_min_pd(o.lo01, lo01);
+        lo2 = _mm_min_pd(o.lo2, lo2);
+        hi01 = _mm_max_pd(o.hi01, hi01);
+        hi2 = _mm_max_pd(o.hi2, hi2);
+    }
+    // surfaceArea(bounds()), the same arithmetic.
+    double area() const {
+        alignas(16) double l[4], h[4];
+        _mm_store_pd(l, lo01);
+        _mm_store_pd(l + 2, lo2);
+        _mm_store_pd(h, hi01);
+        _mm_store_pd(h + 2, hi2);
+        if (!(l[0] <= h[0])) return 0.0;
+        const double x = h[0] - l[0], y = h[1] - l[1], z = h[2] - l[2];
+        return 2.0 * (x * y + y * z + z * x);
+    }
+    scene::Bounds bounds() const {
+        alignas(16) double l[4], h[4];
+        _mm_store_pd(l, lo01);
+        _mm_store_pd(l + 2, lo2);
+        _mm_store_pd(h, hi01);
+        _mm_store_pd(h + 2, hi2);
+        scene::Bounds b;
+        b.min = scene::Vec3(l[0], l[1], l[2]);
+        b.max = scene::Vec3(h[0], h[1], h[2]);
+        return b;
+    }
+};
+
 // Bins of one range on all three axes; merged with `add` (bounds unions and counts are exact,
 // so the merged bins do not depend on how the range was cut: the parallel build makes the
 // same tree as the sequential one).
 struct Bins {
-    std::array<std::array<scene::Bounds, kBvhBins>, 3> bounds;
+    std::array<std::array<Box4, kBvhBins>, 3> bounds;
     std::array<std::array<std::uint32_t, kBvhBins>, 3> count{};
     void add(const Bins& o) {
         for (int a = 0; a < 3; ++a)
@@ -44,48 +102,78 @@ struct RangeBounds {
 };
 
 struct Builder {
-    const std::vector<scene::Bounds>& bounds;
-    std::vector<scene::Vec3> centroids;
-    std::vector<std::uint32_t>& prims;
+    std::vector<PrimRef>& refs;
 
-    RangeBounds rangeBounds(std::uint32_t begin, std::uint32_t end) const {
-        auto body = [&](std::uint32_t b, std::uint32_t e, RangeBounds r) {
-            for (std::uint32_t i = b; i < e; ++i) {
-                r.all.extend(bounds[prims[i]]);
-                r.centroids.extend(centroids[prims[i]]);
-            }
-            return r;
+    scene::Bounds centroidBounds(std::uint32_t begin, std::uint32_t end) const {
+        auto body = [&](std::uint32_t b, std::uint32_t e, scene::Bounds c) {
+            for (std::uint32_t i = b; i < e; ++i)
+                c.extend(scene::Vec3(refs[i].centroid(0), refs[i].centroid(1), refs[i].centroid(2)));
+            return c;
         };
         if (end - begin < kBvhParallelCount) return body(begin, end, {});
         return tbb::parallel_reduce(
-            tbb::blocked_range<std::uint32_t>(begin, end, kBvhParallelGrain), RangeBounds{},
-            [&](const tbb::blocked_range<std::uint32_t>& r, RangeBounds acc) { return body(r.begin(), r.end(), acc); },
-            [](RangeBounds x, const RangeBounds& y) {
-                x.all.extend(y.all);
-                x.centroids.extend(y.centroids);
+            tbb::blocked_range<std::uint32_t>(begin, end, kBvhParallelGrain), scene::Bounds{},
+            [&](const tbb::blocked_range<std::uint32_t>& r, scene::Bounds acc) { return body(r.begin(), r.end(), acc); },
+            [](scene::Bounds x, const scene::Bounds& y) {
+                x.extend(y);
                 return x;
             });
     }
 
-    Bins bin(std::uint32_t begin, std::uint32_t end, const scene::Bounds& cb) const {
+    RangeBounds rangeBounds(std::uint32_t begin, std::uint32_t end) const {
+        auto body = [&](std::uint32_t b, std::uint32_t e, Box4 r) {
+            for (std::uint32_t i = b; i < e; ++i) r.extend(refs[i]);
+            return r;
+        };
+        Box4 all;
+        if (end - begin < kBvhParallelCount) {
+            all = body(begin, end, {});
+        } else {
+            all = tbb::parallel_reduce(
+                tbb::blocked_range<std::uint32_t>(begin, end, kBvhParallelGrain), Box4{},
+                [&](const tbb::blocked_range<std::uint32_t>& r, Box4 acc) { return body(r.begin(), r.end(), acc); },
+                [](Box4 x, const Box4& y) {
+                    x.extend(y);
+                    return x;
+                });
+        }
+        return {all.bounds(), centroidBounds(begin, end)};
+    }
+
+    void bin(std::uint32_t begin, std::uint32_t end, const scene::Bounds& cb, Bins& result) const {
         const scene::Vec3 ext = cb.extent();
+        const __m128d lo01 = _mm_set_pd(cb.min.y, cb.min.x), lo2 = _mm_set_sd(cb.min.z);
+        const __m128d ext01 = _mm_set_pd(ext.y, ext.x), ext2 = _mm_set_pd(1.0, ext.z);
+        const __m128d half = _mm_set1_pd(0.5), bins = _mm_set1_pd(double(kBvhBins));
+        const __m128i zero = _mm_setzero_si128(), last = _mm_set1_epi32(kBvhBins - 1);
         auto body = [&](std::uint32_t b, std::uint32_t e, Bins& out) {
             for (std::uint32_t i = b; i < e; ++i) {
-                const std::uint32_t p = prims[i];
+                const PrimRef& r = refs[i];
+                // binOf on all three axes at once: the same double operations in the same
+                // order (0.5·(lo + hi), − min, ÷ extent, × bins, truncate, clamp). An axis
+                // of zero extent gives garbage bins, never read (the sweep skips that axis).
+                const __m128d c01 = _mm_mul_pd(half, _mm_add_pd(_mm_load_pd(r.lo), _mm_load_pd(r.hi)));
+                const __m128d c2 = _mm_mul_pd(half, _mm_add_pd(_mm_load_pd(r.lo + 2), _mm_load_pd(r.hi + 2)));
+                const __m128d f01 = _mm_mul_pd(bins, _mm_div_pd(_mm_sub_pd(c01, lo01), ext01));
+                const __m128d f2 = _mm_mul_pd(bins, _mm_div_pd(_mm_sub_pd(c2, lo2), ext2));
+                __m128i k = _mm_unpacklo_epi64(_mm_cvttpd_epi32(f01), _mm_cvttpd_epi32(f2));
+                // Clamp to [0, bins − 1] (SSE2 has no 32-bit min/max: compare and select).
+                k = _mm_andnot_si128(_mm_cmplt_epi32(k, zero), k);
+                const __m128i over = _mm_cmpgt_epi32(k, last);
+                k = _mm_or_si128(_mm_and_si128(over, last), _mm_andnot_si128(over, k));
+                alignas(16) std::int32_t kk[4];
+                _mm_store_si128(reinterpret_cast<__m128i*>(kk), k);
                 for (int axis = 0; axis < 3; ++axis) {
-                    if (!(ext[axis] > 0)) continue;
-                    const int k = binOf(centroids[p][axis], cb.min[axis], ext[axis]);
-                    ++out.count[axis][k];
-                    out.bounds[axis][k].extend(bounds[p]);
+                    ++out.count[axis][kk[axis]];
+                    out.bounds[axis][kk[axis]].extend(r);
                 }
             }
         };
         if (end - begin < kBvhParallelCount) {
-            Bins out;
-            body(begin, end, out);
-            return out;
+            body(begin, end, result);
+            return;
         }
-        return tbb::parallel_reduce(
+        result = tbb::parallel_reduce(
             tbb::blocked_range<std::uint32_t>(begin, end, kBvhParallelGrain), Bins{},
             [&](const tbb::blocked_range<std::uint32_t>& r, Bins acc) {
                 body(r.begin(), r.end(), acc);
@@ -97,6 +185,43 @@ struct Builder {
             });
     }
 
+    // std::partition as libstdc++ implements it for bidirectional iterators (the same
+    // predicate calls and swaps, so the same order of primitives as the sequential build has
+    // always made), each primitive's centroid added to its side's bounds as it is classified:
+    // min and max of the same numbers, so the same bounds as a pass over each side afterwards
+    // (the sign of a zero may differ, which moves no centroid to another bin).
+    template <typename Pred>
+    std::uint32_t partition(std::uint32_t begin, std::uint32_t end, Pred pred, scene::Bounds& left,
+                            scene::Bounds& right) {
+        PrimRef* first = refs.data() + begin;
+        PrimRef* last = refs.data() + end;
+        auto centroid = [](const PrimRef& r) {
+            return scene::Vec3(r.centroid(0), r.centroid(1), r.centroid(2));
+        };
+        for (;;) {
+            for (;;) {
+                if (first == last) return std::uint32_t(first - refs.data());
+                if (!pred(*first)) break;
+                left.extend(centroid(*first));
+                ++first;
+            }
+            --last;
+            for (;;) {
+                if (first == last) {
+                    right.extend(centroid(*first));  // classified false above
+                    return std::uint32_t(first - refs.data());
+                }
+                if (pred(*last)) break;
+                right.extend(centroid(*last));
+                --last;
+            }
+            right.extend(centroid(*first));
+            left.extend(centroid(*last));
+            std::swap(*first, *last);
+            ++first;
+        }
+    }
+
     static std::uint32_t makeLeaf(std::vector<BvhNode>& nodes, std::uint32_t node, std::uint32_t begin,
                                   std::uint32_t end) {
         nodes[node].offset = begin;
@@ -105,14 +230,20 @@ struct Builder {
         return node;
     }
 
-    // Appends the subtree over prims[begin, end) to `nodes` in depth-first order; interior
+    // Appends the subtree over refs[begin, end) to `nodes` in depth-first order; interior
     // nodes' `offset` (second child) is an index into `nodes`. Returns the deepest level.
-    int build(std::vector<BvhNode>& nodes, std::uint32_t begin, std::uint32_t end, int depth) {
+    // `known`: the range's bounds when the parent's bins gave them (the union of the bins on
+    // the chosen side is the union of exactly these primitives), else null.
+    int build(std::vector<BvhNode>& nodes, std::uint32_t begin, std::uint32_t end, int depth,
+              const scene::Bounds* known, const scene::Bounds* knownCentroids) {
         const std::uint32_t node = std::uint32_t(nodes.size());
         nodes.emplace_back();
-        const RangeBounds rb = rangeBounds(begin, end);
+        RangeBounds rb;
+        if (known)
+            rb.all = *known;
+        else
+            rb = rangeBounds(begin, end);
         const scene::Bounds& all = rb.all;
-        const scene::Bounds& cb = rb.centroids;
         for (int k = 0; k < 3; ++k) {
             // Outward rounding keeps the float box around the double (and float) geometry.
             nodes[node].lo[k] = roundDown<float>(all.min[k]);
@@ -123,13 +254,16 @@ struct Builder {
             makeLeaf(nodes, node, begin, end);
             return depth;
         }
+        if (known) rb.centroids = *knownCentroids;
+        const scene::Bounds& cb = rb.centroids;
 
         int bestAxis = -1;
         int bestBin = -1;
         double bestCost = std::numeric_limits<double>::infinity();
         const scene::Vec3 ext = cb.extent();
+        Bins bins;
         if (depth < kBvhSahMaxDepth) {
-            const Bins bins = bin(begin, end, cb);
+            bin(begin, end, cb, bins);
             for (int axis = 0; axis < 3; ++axis) {
                 if (!(ext[axis] > 0)) continue;
                 const auto& binBounds = bins.bounds[axis];
@@ -137,22 +271,22 @@ struct Builder {
                 // Sweep from the right to get every right-hand side's area and count.
                 std::array<double, kBvhBins> rightArea{};
                 std::array<std::uint32_t, kBvhBins> rightCount{};
-                scene::Bounds acc;
+                Box4 acc;
                 std::uint32_t n = 0;
                 for (int b = kBvhBins - 1; b > 0; --b) {
                     acc.extend(binBounds[b]);
                     n += binCount[b];
-                    rightArea[b] = surfaceArea(acc);
+                    rightArea[b] = acc.area();
                     rightCount[b] = n;
                 }
-                scene::Bounds left;
+                Box4 left;
                 std::uint32_t nl = 0;
                 for (int b = 0; b < kBvhBins - 1; ++b) {
                     left.extend(binBounds[b]);
                     nl += binCount[b];
                     if (nl == 0 || rightCount[b + 1] == 0) continue;
                     const double cost =
-                        surfaceArea(left) * blocks(nl) + rightArea[b + 1] * blocks(rightCount[b + 1]);
+                        left.area() * blocks(nl) + rightArea[b + 1] * blocks(rightCount[b + 1]);
                     if (cost < bestCost) {
                         bestCost = cost;
                         bestAxis = axis;
@@ -172,21 +306,29 @@ struct Builder {
 
         std::uint32_t mid;
         int axis;
+        scene::Bounds leftAll, rightAll, leftCentroids, rightCentroids;
+        bool childBounds = false;
         if (bestAxis >= 0) {
             axis = bestAxis;
-            auto* midPtr = std::partition(
-                prims.data() + begin, prims.data() + end, [&](std::uint32_t p) {
-                    return binOf(centroids[p][axis], cb.min[axis], ext[axis]) <= bestBin;
-                });
-            mid = std::uint32_t(midPtr - prims.data());
+            // The same std::partition with the same predicate on the same sequence as over
+            // indices: the same swaps, so the same order of primitives.
+            mid = partition(begin, end, [&](const PrimRef& r) {
+                return binOf(r.centroid(axis), cb.min[axis], ext[axis]) <= bestBin;
+            }, leftCentroids, rightCentroids);
+            Box4 l, r;
+            for (int b = 0; b <= bestBin; ++b) l.extend(bins.bounds[axis][b]);
+            for (int b = bestBin + 1; b < kBvhBins; ++b) r.extend(bins.bounds[axis][b]);
+            leftAll = l.bounds();
+            rightAll = r.bounds();
+            childBounds = true;
         } else {
             // No usable SAH split (coincident centroids or too deep): halve by count so the
             // tree stays shallow and leaves stay small.
             axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
             mid = begin + count / 2;
-            std::nth_element(prims.data() + begin, prims.data() + mid, prims.data() + end,
-                             [&](std::uint32_t a, std::uint32_t b) {
-                                 return centroids[a][axis] < centroids[b][axis];
+            std::nth_element(refs.data() + begin, refs.data() + mid, refs.data() + end,
+                             [&](const PrimRef& a, const PrimRef& b) {
+                                 return a.centroid(axis) < b.centroid(axis);
                              });
         }
         int deepest;
@@ -196,10 +338,10 @@ struct Builder {
             // with its node indices shifted, so the layout is exactly the sequential one.
             std::vector<BvhNode> right;
             int dl = 0, dr = 0;
-            tbb::parallel_invoke([&] { dl = build(nodes, begin, mid, depth + 1); },
+            tbb::parallel_invoke([&] { dl = build(nodes, begin, mid, depth + 1, childBounds ? &leftAll : nullptr, &leftCentroids); },
                                  [&] {
                                      right.reserve(2 * std::size_t(end - mid));
-                                     dr = build(right, mid, end, depth + 1);
+                                     dr = build(right, mid, end, depth + 1, childBounds ? &rightAll : nullptr, &rightCentroids);
                                  });
             second = std::uint32_t(nodes.size());
             for (BvhNode& n : right)
@@ -207,9 +349,9 @@ struct Builder {
             nodes.insert(nodes.end(), right.begin(), right.end());
             deepest = std::max(dl, dr);
         } else {
-            const int dl = build(nodes, begin, mid, depth + 1);
+            const int dl = build(nodes, begin, mid, depth + 1, childBounds ? &leftAll : nullptr, &leftCentroids);
             second = std::uint32_t(nodes.size());
-            deepest = std::max(dl, build(nodes, mid, end, depth + 1));
+            deepest = std::max(dl, build(nodes, mid, end, depth + 1, childBounds ? &rightAll : nullptr, &rightCentroids));
         }
         nodes[node].offset = second;
         nodes[node].count = 0;
@@ -234,17 +376,21 @@ Bvh Bvh::build(const std::vector<scene::Bounds>& primitiveBounds) {
     Bvh bvh;
     const std::size_t n = primitiveBounds.size();
     if (n == 0) return bvh;
-    bvh.primitives_.resize(n);
-    std::iota(bvh.primitives_.begin(), bvh.primitives_.end(), 0u);
-    bvh.nodes_.reserve(2 * n);
-    Builder b{primitiveBounds, std::vector<scene::Vec3>(n), bvh.primitives_};
+    std::vector<PrimRef> refs(n);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kBvhParallelGrain),
                       [&](const tbb::blocked_range<std::size_t>& r) {
-                          for (std::size_t i = r.begin(); i != r.end(); ++i)
-                              b.centroids[i] = primitiveBounds[i].center();
+                          for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                              const scene::Bounds& b = primitiveBounds[i];
+                              refs[i] = PrimRef{{b.min.x, b.min.y, b.min.z, double(i)},
+                                                {b.max.x, b.max.y, b.max.z, 0.0}};
+                          }
                       });
-    bvh.depth_ = b.build(bvh.nodes_, 0, std::uint32_t(n), 0);
+    bvh.nodes_.reserve(2 * n);
+    Builder b{refs};
+    bvh.depth_ = b.build(bvh.nodes_, 0, std::uint32_t(n), 0, nullptr, nullptr);
     bvh.nodes_.shrink_to_fit();
+    bvh.primitives_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) bvh.primitives_[i] = refs[i].index();
     return bvh;
 }
 
