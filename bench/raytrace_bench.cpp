@@ -53,6 +53,8 @@ struct Workload {
     std::string name;
     scene::Scene scene;
     std::unique_ptr<raytrace::Tracer<Real>> tracer;
+    // The same float tracer on the reference's (double-built) trees: what the tree is worth.
+    std::unique_ptr<raytrace::Tracer<Real>> refTree;
     double ourSetupMs = 0;
     std::vector<raytrace::Ray<Real>> primary;
     std::vector<raytrace::Ray<Real>> shadow;  // origins offset by the robust bound
@@ -342,26 +344,28 @@ std::size_t embreeShadow(const Workload& w) {
 }
 #endif
 
-std::size_t ourPrimary(const Workload& w) {
+std::size_t ourPrimary(const Workload& w, const raytrace::Tracer<Real>* tracer = nullptr) {
+    if (!tracer) tracer = w.tracer.get();
     std::atomic<std::size_t> hits{0};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, w.primary.size(), kBlock), [&](auto r) {
         std::size_t local = 0;
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             raytrace::Hit<Real> h;
-            local += w.tracer->closestHit(w.primary[i], std::numeric_limits<Real>::infinity(), false, h);
+            local += tracer->closestHit(w.primary[i], std::numeric_limits<Real>::infinity(), false, h);
         }
         hits += local;
     });
     return hits;
 }
 
-std::size_t ourShadow(const Workload& w, bool conservative) {
+std::size_t ourShadow(const Workload& w, bool conservative, const raytrace::Tracer<Real>* tracer = nullptr) {
+    if (!tracer) tracer = w.tracer.get();
     std::atomic<std::size_t> blocked{0};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, w.shadow.size(), kBlock), [&](auto r) {
         std::size_t local = 0;
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             int b;
-            local += w.tracer->anyHit(w.shadow[i], std::numeric_limits<Real>::infinity(), conservative, b);
+            local += tracer->anyHit(w.shadow[i], std::numeric_limits<Real>::infinity(), conservative, b);
         }
         blocked += local;
     });
@@ -418,6 +422,9 @@ int main(int argc, char** argv) {
         const auto t0 = std::chrono::steady_clock::now();
         w->tracer = std::make_unique<raytrace::Tracer<Real>>(w->scene);
         w->ourSetupMs = msSince(t0);
+        raytrace::detail::setFastFloatBuild(false);
+        w->refTree = std::make_unique<raytrace::Tracer<Real>>(w->scene);
+        raytrace::detail::setFastFloatBuild(true);
         makeRays(*w);
 #ifdef SHADOWLAB_HAVE_EMBREE
         buildEmbree(*w);
@@ -474,6 +481,8 @@ int main(int argc, char** argv) {
         // The same walk without the AVX box test and/or the occluder cache, for the record.
         reg("primary/ours_sse", w->primary.size(), [](const Workload& x) { return variant(false, true, [&] { return ourPrimary(x); }); });
         reg("shadow/ours_nocache", w->shadow.size(), [](const Workload& x) { return variant(true, false, [&] { return ourShadow(x, false); }); });
+        reg("primary/ours_reftree", w->primary.size(), [](const Workload& x) { return ourPrimary(x, x.refTree.get()); });
+        reg("shadow/ours_nocache_reftree", w->shadow.size(), [](const Workload& x) { return variant(true, false, [&] { return ourShadow(x, false, x.refTree.get()); }); });
         reg("shadow/ours_sse_nocache", w->shadow.size(), [](const Workload& x) { return variant(false, false, [&] { return ourShadow(x, false); }); });
 #ifdef SHADOWLAB_HAVE_EMBREE
         reg("primary/embree", w->primary.size(), [](const Workload& x) { return embreePrimary(x); });
@@ -493,7 +502,8 @@ int main(int argc, char** argv) {
         const Workload& w = *wp;
         const std::vector<std::pair<const char*, const char*>> rows = {
             {"primary", "ours"}, {"primary", "ours_sse"}, {"shadow", "ours"},
-            {"shadow", "ours_nocache"}, {"shadow", "ours_sse_nocache"}};
+            {"shadow", "ours_nocache"}, {"shadow", "ours_sse_nocache"}, {"primary", "ours_reftree"},
+            {"shadow", "ours_nocache_reftree"}};
         for (const auto& [kind, who] : rows) {
             const bool prim = std::string(kind) == "primary";
             const std::size_t count = prim ? w.primary.size() : w.shadow.size();
@@ -502,7 +512,9 @@ int main(int argc, char** argv) {
             std::snprintf(oursText, sizeof oursText, "%.2f (%.2f-%.2f)", ours[0], ours[1], ours[2]);
             const bool avx = std::string(who).find("sse") == std::string::npos;
             const bool cache = std::string(who).find("nocache") == std::string::npos;
-            const std::size_t a = variant(avx, cache, [&] { return prim ? ourPrimary(w) : ourShadow(w, false); });
+            const raytrace::Tracer<Real>* tr =
+                std::string(who).find("reftree") != std::string::npos ? w.refTree.get() : w.tracer.get();
+            const std::size_t a = variant(avx, cache, [&] { return prim ? ourPrimary(w, tr) : ourShadow(w, false, tr); });
             const std::string label = std::string(kind) + "/" + who;
 #ifdef SHADOWLAB_HAVE_EMBREE
             const auto emb = reporter.stats(w.name + "/" + kind + "/embree");
@@ -525,13 +537,18 @@ int main(int argc, char** argv) {
         // Our setup (conversion, BVH build, collapse, packets) and Embree's (flattening,
         // conversion, rtcCommitScene), alternating, process CPU time and wall time of each.
         const int reps = envInt("SHADOWLAB_BENCH_SETUP_REPS", 5);
-        std::vector<double> oursCpu, oursWall, embCpu, embWall;
+        std::vector<double> oursCpu, oursWall, embCpu, embWall, refCpu;
         for (int i = 0; i < reps && w.tracer->triangleCount() > 0; ++i) {
             double c0 = cpuMs();
             auto t0 = std::chrono::steady_clock::now();
             { const raytrace::Tracer<Real> t(w.scene); }
             oursCpu.push_back(cpuMs() - c0);
             oursWall.push_back(msSince(t0));
+            raytrace::detail::setFastFloatBuild(false);
+            c0 = cpuMs();
+            { const raytrace::Tracer<Real> t(w.scene); }
+            refCpu.push_back(cpuMs() - c0);
+            raytrace::detail::setFastFloatBuild(true);
 #ifdef SHADOWLAB_HAVE_EMBREE
             c0 = cpuMs();
             t0 = std::chrono::steady_clock::now();
@@ -544,6 +561,10 @@ int main(int argc, char** argv) {
         }
         const auto oc = medianMinMax(oursCpu), ow = medianMinMax(oursWall);
         const auto ec = medianMinMax(embCpu), ew = medianMinMax(embWall);
+        const auto rc = medianMinMax(refCpu);
+        if (!refCpu.empty())
+            std::printf("%-8s setup with the reference's (double) build, CPU ms: %.1f (%.1f-%.1f), / embree %.2f\n",
+                        w.name.c_str(), rc[0], rc[1], rc[2], ec[0] > 0 ? rc[0] / ec[0] : 0.0);
         const std::size_t tris = w.tracer->uniqueTriangleCount();
         const double oursBpt = tris > 0 ? double(w.tracer->meshBytes()) / double(tris) : 0.0;
         double embBpt = 0;
@@ -562,34 +583,40 @@ int main(int argc, char** argv) {
                     "the build)\n", w.name.c_str(), tris, oursBpt, embBpt);
         // A fingerprint of every answer (primary: object, triangle, t and barycentric bits;
         // shadow: blocked or not), to show that two builds of the bench give the same hits.
-        std::uint64_t fp = 1469598103934665603ull;
-        auto mix = [&](std::uint64_t v) { fp = (fp ^ v) * 1099511628211ull; };
-        for (const auto& ray : w.primary) {
-            raytrace::Hit<Real> h;
-            const bool hit = w.tracer->closestHit(ray, std::numeric_limits<Real>::infinity(), false, h);
-            mix(hit);
-            if (!hit) continue;
-            std::uint32_t tb, bb;
-            std::memcpy(&tb, &h.t, 4);
-            std::memcpy(&bb, &h.b1, 4);
-            mix(std::uint64_t(h.object) << 32 | std::uint32_t(h.prim));
-            mix(std::uint64_t(tb) << 32 | bb);
-        }
-        raytrace::setOccluderCache(false);
-        for (const auto& ray : w.shadow) {
-            int blocker = -1;
-            mix(w.tracer->anyHit(ray, std::numeric_limits<Real>::infinity(), false, blocker));
-            mix(std::uint64_t(blocker + 1));
-        }
-        raytrace::setOccluderCache(true);
-        std::printf("%-8s hits fingerprint %016llx\n", w.name.c_str(), (unsigned long long)fp);
+        auto fingerprint = [&](const raytrace::Tracer<Real>& tracer) {
+            std::uint64_t fp = 1469598103934665603ull;
+            auto mix = [&](std::uint64_t v) { fp = (fp ^ v) * 1099511628211ull; };
+            for (const auto& ray : w.primary) {
+                raytrace::Hit<Real> h;
+                const bool hit = tracer.closestHit(ray, std::numeric_limits<Real>::infinity(), false, h);
+                mix(hit);
+                if (!hit) continue;
+                std::uint32_t tb, bb;
+                std::memcpy(&tb, &h.t, 4);
+                std::memcpy(&bb, &h.b1, 4);
+                mix(std::uint64_t(h.object) << 32 | std::uint32_t(h.prim));
+                mix(std::uint64_t(tb) << 32 | bb);
+            }
+            raytrace::setOccluderCache(false);
+            for (const auto& ray : w.shadow) {
+                int blocker = -1;
+                mix(tracer.anyHit(ray, std::numeric_limits<Real>::infinity(), false, blocker));
+                mix(std::uint64_t(blocker + 1));
+            }
+            raytrace::setOccluderCache(true);
+            return fp;
+        };
+        std::printf("%-8s hits fingerprint %016llx, on the reference's trees %016llx\n", w.name.c_str(),
+                    (unsigned long long)fingerprint(*w.tracer), (unsigned long long)fingerprint(*w.refTree));
         std::printf("SCALE | %s | %zu | setup cpu ms ours %.1f embree %.1f | bytes/tri ours %.1f embree %.1f | "
-                    "primary Mrays/s ours %.2f embree %.2f embree8 %.2f | shadow(no cache) ours %.2f embree %.2f "
-                    "embree8 %.2f\n",
+                    "primary Mrays/s ours %.2f embree %.2f embree8 %.2f reftree %.2f | shadow(no cache) ours %.2f embree %.2f "
+                    "embree8 %.2f reftree %.2f | setup cpu ms reftree %.1f\n",
                     w.name.c_str(), tris, oc[0], ec[0], oursBpt, embBpt,
                     reporter.stats(w.name + "/primary/ours")[0], reporter.stats(w.name + "/primary/embree")[0],
-                    reporter.stats(w.name + "/primary/embree8")[0], reporter.stats(w.name + "/shadow/ours_nocache")[0],
-                    reporter.stats(w.name + "/shadow/embree")[0], reporter.stats(w.name + "/shadow/embree8")[0]);
+                    reporter.stats(w.name + "/primary/embree8")[0], reporter.stats(w.name + "/primary/ours_reftree")[0],
+                    reporter.stats(w.name + "/shadow/ours_nocache")[0], reporter.stats(w.name + "/shadow/embree")[0],
+                    reporter.stats(w.name + "/shadow/embree8")[0], reporter.stats(w.name + "/shadow/ours_nocache_reftree")[0],
+                    rc[0]);
     }
 #ifdef SHADOWLAB_HAVE_EMBREE
     for (auto& wp : workloads) {
