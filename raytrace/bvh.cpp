@@ -9,6 +9,7 @@
 #include <cstring>
 #include <numeric>
 
+// SSE2 intrinsics: baseline on x86-64, the only target the builders are written for.
 #include <emmintrin.h>
 #include <xmmintrin.h>
 

@@ -57,13 +57,16 @@ inline bool traverseFloat(const Bvh8& bvh, const std::vector<TrianglePacket>& pa
         bool any = false;
         // After a hit, a hit at exactly the same t is also tested, and the lower triangle
         // index wins: the answer is the minimum of (t, index), whatever the tree's order.
-        float bound = tm;
-        if (have) {
+        // tm > 0 and finite once there is a hit: its bits + 1 are the next float up, so
+        // t < bound means t <= tm.
+        auto above = [](float x) {
             std::uint32_t bits;
-            std::memcpy(&bits, &tm, sizeof bits);
-            ++bits;  // tm > 0 and finite: the next float up, so t < bound means t <= tm
-            std::memcpy(&bound, &bits, sizeof bound);
-        }
+            std::memcpy(&bits, &x, sizeof bits);
+            ++bits;
+            std::memcpy(&x, &bits, sizeof x);
+            return x;
+        };
+        float bound = have ? above(tm) : tm;
         for (std::uint32_t base = first; base < first + count; base += 4) {
             const TrianglePacket& pk = packets[base / 4];
             const std::uint32_t lanes = std::min<std::uint32_t>(4, first + count - base);
@@ -80,14 +83,9 @@ inline bool traverseFloat(const Bvh8& bvh, const std::vector<TrianglePacket>& pa
                 if (have && !(t < tm || prims[slot] < prims[out.slot])) continue;
                 tm = t;
                 out = SlotHit{t, b0, b1, b2, slot};
-                if (!anyHit) {
-                    have = true;
-                    std::uint32_t bits;
-                    std::memcpy(&bits, &tm, sizeof bits);
-                    ++bits;
-                    std::memcpy(&bound, &bits, sizeof bound);
-                }
                 if (anyHit) return true;
+                have = true;
+                bound = above(tm);
                 any = true;
             }
         }
