@@ -16,6 +16,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -51,6 +53,8 @@ struct Workload {
     std::string name;
     scene::Scene scene;
     std::unique_ptr<raytrace::Tracer<Real>> tracer;
+    // The same float tracer on the reference's (double-built) trees: what the tree is worth.
+    std::unique_ptr<raytrace::Tracer<Real>> refTree;
     double ourSetupMs = 0;
     std::vector<raytrace::Ray<Real>> primary;
     std::vector<raytrace::Ray<Real>> shadow;  // origins offset by the robust bound
@@ -58,13 +62,15 @@ struct Workload {
     RTCDevice device = nullptr;
     RTCScene embree = nullptr;
     double embreeSetupMs = 0;
+    long long embreeBytes = 0;  // held by the device after the build (memory monitor)
 #endif
 };
 
 // A height field of kTerrainCells² quads (two triangles each) over [−50, 50]², with smooth
 // hills and sharp ridges so that shadow rays cross much of the terrain before they leave it.
 constexpr int kTerrainCells = 708;  // 2·708² = 1,002,528 triangles
-scene::Scene terrainScene() {
+scene::Scene terrainScene(int cells = kTerrainCells) {
+    const int kTerrainCells = cells;
     auto mesh = std::make_shared<scene::TriangleMesh>();
     const int n = kTerrainCells + 1;
     auto height = [](double x, double z) {
@@ -96,6 +102,25 @@ scene::Scene terrainScene() {
     o.shape = scene::Mesh::single("generated-terrain", mesh);
     s.objects.push_back(o);
     return s;
+}
+
+int envInt(const char* name, int fallback) {
+    const char* v = std::getenv(name);
+    return v && *v ? std::atoi(v) : fallback;
+}
+
+// Process CPU time (all threads) in ms: steadier than wall time on a shared machine.
+double cpuMs() {
+    timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return 1e3 * double(ts.tv_sec) + 1e-6 * double(ts.tv_nsec);
+}
+
+std::array<double, 3> medianMinMax(std::vector<double> v) {
+    if (v.empty()) return {0, 0, 0};
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return {n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]), v.front(), v.back()};
 }
 
 double msSince(std::chrono::steady_clock::time_point t0) {
@@ -142,11 +167,28 @@ void addEmbreeQuads(RTCDevice device, RTCScene scene, const std::vector<scene::V
     rtcReleaseGeometry(g);
 }
 
-void buildEmbree(Workload& w) {
-    const auto t0 = std::chrono::steady_clock::now();
+// Bytes Embree holds now and at most, counted by its memory monitor (all devices together).
+std::atomic<long long> embreeBytes{0}, embreePeakBytes{0};
+bool embreeMonitor(void*, ssize_t bytes, bool) {
+    const long long now = embreeBytes += bytes;
+    long long peak = embreePeakBytes.load();
+    while (now > peak && !embreePeakBytes.compare_exchange_weak(peak, now)) {
+    }
+    return true;
+}
+
+struct EmbreeScene {
+    RTCDevice device;
+    RTCScene scene;
+};
+
+// Device, geometry (converted to float) and the committed scene: what Embree's setup is.
+EmbreeScene embreeBuild(const scene::Scene& sc) {
+    EmbreeScene w;
     w.device = rtcNewDevice(nullptr);
-    w.embree = rtcNewScene(w.device);
-    for (const scene::Object& o : w.scene.objects) {
+    rtcSetDeviceMemoryMonitorFunction(w.device, embreeMonitor, nullptr);
+    w.scene = rtcNewScene(w.device);
+    for (const scene::Object& o : sc.objects) {
         if (const auto* s = std::get_if<scene::Sphere>(&o.shape)) {
             RTCGeometry g = rtcNewGeometry(w.device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
             auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
@@ -154,11 +196,11 @@ void buildEmbree(Workload& w) {
             v[0] = float(s->center.x), v[1] = float(s->center.y), v[2] = float(s->center.z);
             v[3] = float(s->radius);
             rtcCommitGeometry(g);
-            rtcAttachGeometry(w.embree, g);
+            rtcAttachGeometry(w.scene, g);
             rtcReleaseGeometry(g);
         } else if (const auto* q = std::get_if<scene::Quad>(&o.shape)) {
             const scene::Vec3 du = 0.5 * q->size.x * q->uAxis, dv = 0.5 * q->size.y * q->vAxis;
-            addEmbreeQuads(w.device, w.embree,
+            addEmbreeQuads(w.device, w.scene,
                            {q->center - du - dv, q->center + du - dv, q->center + du + dv,
                             q->center - du + dv});
         } else if (const auto* b = std::get_if<scene::Box>(&o.shape)) {
@@ -171,7 +213,7 @@ void buildEmbree(Workload& w) {
             std::vector<scene::Vec3> corners;
             for (const auto& f : faces)
                 for (int k : f) corners.push_back(c(k));
-            addEmbreeQuads(w.device, w.embree, corners);
+            addEmbreeQuads(w.device, w.scene, corners);
         } else if (const auto* m = std::get_if<scene::Mesh>(&o.shape)) {
             const scene::TriangleMesh tm = scene::flattenInstances(m->instances);
             RTCGeometry g = rtcNewGeometry(w.device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -183,12 +225,22 @@ void buildEmbree(Workload& w) {
                 g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), tm.triangleCount()));
             for (std::size_t i = 0; i < tm.indices.size(); ++i) idx[i] = tm.indices[i];
             rtcCommitGeometry(g);
-            rtcAttachGeometry(w.embree, g);
+            rtcAttachGeometry(w.scene, g);
             rtcReleaseGeometry(g);
         }
     }
-    rtcCommitScene(w.embree);
+    rtcCommitScene(w.scene);
+    return w;
+}
+
+void buildEmbree(Workload& w) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const long long before = embreeBytes.load();
+    const EmbreeScene e = embreeBuild(w.scene);
     w.embreeSetupMs = msSince(t0);
+    w.embreeBytes = embreeBytes.load() - before;
+    w.device = e.device;
+    w.embree = e.scene;
 }
 
 std::size_t embreePrimary(const Workload& w) {
@@ -214,6 +266,61 @@ std::size_t embreePrimary(const Workload& w) {
     return hits;
 }
 
+// Embree's 8-wide packets: eight consecutive rays of the list (neighbouring pixels of a row,
+// or shadow rays from them) per rtcIntersect8 / rtcOccluded8 call, the tail masked off.
+std::size_t embreePrimary8(const Workload& w) {
+    std::atomic<std::size_t> hits{0};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, w.primary.size(), kBlock), [&](auto r) {
+        RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        std::size_t local = 0;
+        for (std::size_t i = r.begin(); i < r.end(); i += 8) {
+            alignas(32) RTCRayHit8 rh{};
+            alignas(32) int valid[8];
+            for (int j = 0; j < 8; ++j) {
+                valid[j] = i + j < r.end() ? -1 : 0;
+                const auto& ray = w.primary[std::min(i + j, r.end() - 1)];
+                rh.ray.org_x[j] = ray.o.x, rh.ray.org_y[j] = ray.o.y, rh.ray.org_z[j] = ray.o.z;
+                rh.ray.dir_x[j] = ray.d.x, rh.ray.dir_y[j] = ray.d.y, rh.ray.dir_z[j] = ray.d.z;
+                rh.ray.tnear[j] = 0.0f;
+                rh.ray.tfar[j] = std::numeric_limits<float>::infinity();
+                rh.ray.mask[j] = ~0u;
+                rh.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
+            }
+            rtcIntersect8(valid, w.embree, &ctx, &rh);
+            for (int j = 0; j < 8; ++j) local += valid[j] && rh.hit.geomID[j] != RTC_INVALID_GEOMETRY_ID;
+        }
+        hits += local;
+    });
+    return hits;
+}
+
+std::size_t embreeShadow8(const Workload& w) {
+    std::atomic<std::size_t> blocked{0};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, w.shadow.size(), kBlock), [&](auto r) {
+        RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        std::size_t local = 0;
+        for (std::size_t i = r.begin(); i < r.end(); i += 8) {
+            alignas(32) RTCRay8 rr{};
+            alignas(32) int valid[8];
+            for (int j = 0; j < 8; ++j) {
+                valid[j] = i + j < r.end() ? -1 : 0;
+                const auto& ray = w.shadow[std::min(i + j, r.end() - 1)];
+                rr.org_x[j] = ray.o.x, rr.org_y[j] = ray.o.y, rr.org_z[j] = ray.o.z;
+                rr.dir_x[j] = ray.d.x, rr.dir_y[j] = ray.d.y, rr.dir_z[j] = ray.d.z;
+                rr.tnear[j] = 0.0f;
+                rr.tfar[j] = std::numeric_limits<float>::infinity();
+                rr.mask[j] = ~0u;
+            }
+            rtcOccluded8(valid, w.embree, &ctx, &rr);
+            for (int j = 0; j < 8; ++j) local += valid[j] && rr.tfar[j] < 0;
+        }
+        blocked += local;
+    });
+    return blocked;
+}
+
 std::size_t embreeShadow(const Workload& w) {
     std::atomic<std::size_t> blocked{0};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, w.shadow.size(), kBlock), [&](auto r) {
@@ -237,26 +344,28 @@ std::size_t embreeShadow(const Workload& w) {
 }
 #endif
 
-std::size_t ourPrimary(const Workload& w) {
+std::size_t ourPrimary(const Workload& w, const raytrace::Tracer<Real>* tracer = nullptr) {
+    if (!tracer) tracer = w.tracer.get();
     std::atomic<std::size_t> hits{0};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, w.primary.size(), kBlock), [&](auto r) {
         std::size_t local = 0;
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             raytrace::Hit<Real> h;
-            local += w.tracer->closestHit(w.primary[i], std::numeric_limits<Real>::infinity(), false, h);
+            local += tracer->closestHit(w.primary[i], std::numeric_limits<Real>::infinity(), false, h);
         }
         hits += local;
     });
     return hits;
 }
 
-std::size_t ourShadow(const Workload& w, bool conservative) {
+std::size_t ourShadow(const Workload& w, bool conservative, const raytrace::Tracer<Real>* tracer = nullptr) {
+    if (!tracer) tracer = w.tracer.get();
     std::atomic<std::size_t> blocked{0};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, w.shadow.size(), kBlock), [&](auto r) {
         std::size_t local = 0;
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             int b;
-            local += w.tracer->anyHit(w.shadow[i], std::numeric_limits<Real>::infinity(), conservative, b);
+            local += tracer->anyHit(w.shadow[i], std::numeric_limits<Real>::infinity(), conservative, b);
         }
         blocked += local;
     });
@@ -313,17 +422,25 @@ int main(int argc, char** argv) {
         const auto t0 = std::chrono::steady_clock::now();
         w->tracer = std::make_unique<raytrace::Tracer<Real>>(w->scene);
         w->ourSetupMs = msSince(t0);
+        raytrace::detail::setFastFloatBuild(false);
+        w->refTree = std::make_unique<raytrace::Tracer<Real>>(w->scene);
+        raytrace::detail::setFastFloatBuild(true);
         makeRays(*w);
 #ifdef SHADOWLAB_HAVE_EMBREE
         buildEmbree(*w);
 #endif
         workloads.push_back(std::move(w));
     };
-    add("seed", scene::loadScene(scene::findScene("seed")));
+    // SHADOWLAB_BENCH_SCENES: a comma list of seed, sponza, terrain (default all three);
+    // SHADOWLAB_BENCH_TERRAIN_TRIS: the terrain's size (two triangles per cell, rounded).
+    const char* only = std::getenv("SHADOWLAB_BENCH_SCENES");
+    auto wanted = [&](const char* name) { return !only || !*only || std::strstr(only, name) != nullptr; };
+    if (wanted("seed")) add("seed", scene::loadScene(scene::findScene("seed")));
     const char* env = std::getenv("SHADOWLAB_SPONZA");
     const std::string sponza = env && *env ? env : kDefaultSponzaPath;
     const char* kSponzaPath = sponza.c_str();
-    if (std::filesystem::exists(kSponzaPath)) {
+    if (!wanted("sponza")) {
+    } else if (std::filesystem::exists(kSponzaPath)) {
         scene::Scene s;
         s.file = kSponzaPath;
         s.camera.position = {-11, 1.5, -0.5};
@@ -342,7 +459,10 @@ int main(int argc, char** argv) {
         std::printf("Sponza: %s is absent (set SHADOWLAB_SPONZA to its .gltf); only the seed "
                     "scene is measured.\n", kSponzaPath);
     }
-    add("terrain", terrainScene());
+    if (wanted("terrain")) {
+        const int tris = envInt("SHADOWLAB_BENCH_TERRAIN_TRIS", 2 * kTerrainCells * kTerrainCells);
+        add("terrain", terrainScene(std::max(1, int(std::lround(std::sqrt(tris / 2.0))))));
+    }
 #ifndef SHADOWLAB_HAVE_EMBREE
     std::printf("Embree 3 was not found at configure time: our tracer is measured alone.\n");
 #endif
@@ -361,23 +481,29 @@ int main(int argc, char** argv) {
         // The same walk without the AVX box test and/or the occluder cache, for the record.
         reg("primary/ours_sse", w->primary.size(), [](const Workload& x) { return variant(false, true, [&] { return ourPrimary(x); }); });
         reg("shadow/ours_nocache", w->shadow.size(), [](const Workload& x) { return variant(true, false, [&] { return ourShadow(x, false); }); });
+        reg("primary/ours_reftree", w->primary.size(), [](const Workload& x) { return ourPrimary(x, x.refTree.get()); });
+        reg("shadow/ours_nocache_reftree", w->shadow.size(), [](const Workload& x) { return variant(true, false, [&] { return ourShadow(x, false, x.refTree.get()); }); });
         reg("shadow/ours_sse_nocache", w->shadow.size(), [](const Workload& x) { return variant(false, false, [&] { return ourShadow(x, false); }); });
 #ifdef SHADOWLAB_HAVE_EMBREE
         reg("primary/embree", w->primary.size(), [](const Workload& x) { return embreePrimary(x); });
         reg("shadow/embree", w->shadow.size(), [](const Workload& x) { return embreeShadow(x); });
+        reg("primary/embree8", w->primary.size(), [](const Workload& x) { return embreePrimary8(x); });
+        reg("shadow/embree8", w->shadow.size(), [](const Workload& x) { return embreeShadow8(x); });
 #endif
     }
     RatioReporter reporter;
     benchmark::RunSpecifiedBenchmarks(&reporter);
 
-    std::printf("\nMrays/s: median (min-max) over the repetitions; ratio = ours / Embree medians\n");
-    std::printf("%-8s %-22s %8s %20s %20s %7s %s\n", "scene", "rays", "count", "ours", "embree",
-                "ratio", "agreement");
+    std::printf("\nMrays/s: median (min-max) over the repetitions; ratio = ours / Embree medians "
+                "(embree: rtcIntersect1/rtcOccluded1, embree8: rtcIntersect8/rtcOccluded8)\n");
+    std::printf("%-8s %-22s %8s %20s %20s %7s %20s %7s %s\n", "scene", "rays", "count", "ours", "embree",
+                "ratio", "embree8", "ratio8", "agreement");
     for (const auto& wp : workloads) {
         const Workload& w = *wp;
         const std::vector<std::pair<const char*, const char*>> rows = {
             {"primary", "ours"}, {"primary", "ours_sse"}, {"shadow", "ours"},
-            {"shadow", "ours_nocache"}, {"shadow", "ours_sse_nocache"}};
+            {"shadow", "ours_nocache"}, {"shadow", "ours_sse_nocache"}, {"primary", "ours_reftree"},
+            {"shadow", "ours_nocache_reftree"}};
         for (const auto& [kind, who] : rows) {
             const bool prim = std::string(kind) == "primary";
             const std::size_t count = prim ? w.primary.size() : w.shadow.size();
@@ -386,50 +512,111 @@ int main(int argc, char** argv) {
             std::snprintf(oursText, sizeof oursText, "%.2f (%.2f-%.2f)", ours[0], ours[1], ours[2]);
             const bool avx = std::string(who).find("sse") == std::string::npos;
             const bool cache = std::string(who).find("nocache") == std::string::npos;
-            const std::size_t a = variant(avx, cache, [&] { return prim ? ourPrimary(w) : ourShadow(w, false); });
+            const raytrace::Tracer<Real>* tr =
+                std::string(who).find("reftree") != std::string::npos ? w.refTree.get() : w.tracer.get();
+            const std::size_t a = variant(avx, cache, [&] { return prim ? ourPrimary(w, tr) : ourShadow(w, false, tr); });
             const std::string label = std::string(kind) + "/" + who;
 #ifdef SHADOWLAB_HAVE_EMBREE
             const auto emb = reporter.stats(w.name + "/" + kind + "/embree");
             char embText[64];
             std::snprintf(embText, sizeof embText, "%.2f (%.2f-%.2f)", emb[0], emb[1], emb[2]);
+            const auto emb8 = reporter.stats(w.name + "/" + kind + "/embree8");
+            char emb8Text[64];
+            std::snprintf(emb8Text, sizeof emb8Text, "%.2f (%.2f-%.2f)", emb8[0], emb8[1], emb8[2]);
             const std::size_t b = prim ? embreePrimary(w) : embreeShadow(w);
-            std::printf("%-8s %-22s %8zu %20s %20s %7.3f hits ours %zu, embree %zu\n", w.name.c_str(),
-                        label.c_str(), count, oursText, embText, emb[0] > 0 ? ours[0] / emb[0] : 0.0, a, b);
+            const std::size_t b8 = prim ? embreePrimary8(w) : embreeShadow8(w);
+            std::printf("%-8s %-22s %8zu %20s %20s %7.3f %20s %7.3f hits ours %zu, embree %zu, embree8 %zu\n",
+                        w.name.c_str(), label.c_str(), count, oursText, embText,
+                        emb[0] > 0 ? ours[0] / emb[0] : 0.0, emb8Text, emb8[0] > 0 ? ours[0] / emb8[0] : 0.0,
+                        a, b, b8);
 #else
             std::printf("%-8s %-22s %8zu %20s %20s %7s hits ours %zu\n", w.name.c_str(), label.c_str(), count,
                         oursText, "-", "-", a);
 #endif
         }
-        if (w.tracer->triangleCount() > 0) {
-            // Setup (conversion, BVH build, collapse, packets) with 1 thread and with all,
-            // wall time, median of 3 each: what the parallel build buys.
-            auto setupMs = [&](int threads) {
-                tbb::task_arena arena(threads);
-                std::vector<double> ms;
-                for (int i = 0; i < 3; ++i) {
-                    arena.execute([&] {
-                        const auto t0 = std::chrono::steady_clock::now();
-                        const raytrace::Tracer<Real> t(w.scene);
-                        ms.push_back(msSince(t0));
-                    });
-                }
-                std::sort(ms.begin(), ms.end());
-                return ms[1];
-            };
-            const int all = tbb::this_task_arena::max_concurrency();
-            std::printf("%-8s setup median of 3: ours 1 thread %.1f ms, %d threads %.1f ms\n", w.name.c_str(),
-                        setupMs(1), all, setupMs(all));
-        }
-        std::printf("%-8s setup: ours %.1f ms", w.name.c_str(), w.ourSetupMs);
+        // Our setup (conversion, BVH build, collapse, packets) and Embree's (flattening,
+        // conversion, rtcCommitScene), alternating, process CPU time and wall time of each.
+        const int reps = envInt("SHADOWLAB_BENCH_SETUP_REPS", 5);
+        std::vector<double> oursCpu, oursWall, embCpu, embWall, refCpu;
+        for (int i = 0; i < reps && w.tracer->triangleCount() > 0; ++i) {
+            double c0 = cpuMs();
+            auto t0 = std::chrono::steady_clock::now();
+            { const raytrace::Tracer<Real> t(w.scene); }
+            oursCpu.push_back(cpuMs() - c0);
+            oursWall.push_back(msSince(t0));
+            raytrace::detail::setFastFloatBuild(false);
+            c0 = cpuMs();
+            { const raytrace::Tracer<Real> t(w.scene); }
+            refCpu.push_back(cpuMs() - c0);
+            raytrace::detail::setFastFloatBuild(true);
 #ifdef SHADOWLAB_HAVE_EMBREE
-        std::printf(", embree %.1f ms", w.embreeSetupMs);
+            c0 = cpuMs();
+            t0 = std::chrono::steady_clock::now();
+            const EmbreeScene e = embreeBuild(w.scene);
+            rtcReleaseScene(e.scene);
+            rtcReleaseDevice(e.device);
+            embCpu.push_back(cpuMs() - c0);
+            embWall.push_back(msSince(t0));
 #endif
-        // Memory per unique (stored) triangle: an instanced mesh counts once.
+        }
+        const auto oc = medianMinMax(oursCpu), ow = medianMinMax(oursWall);
+        const auto ec = medianMinMax(embCpu), ew = medianMinMax(embWall);
+        const auto rc = medianMinMax(refCpu);
+        if (!refCpu.empty())
+            std::printf("%-8s setup with the reference's (double) build, CPU ms: %.1f (%.1f-%.1f), / embree %.2f\n",
+                        w.name.c_str(), rc[0], rc[1], rc[2], ec[0] > 0 ? rc[0] / ec[0] : 0.0);
         const std::size_t tris = w.tracer->uniqueTriangleCount();
-        std::printf(" (%zu triangles", tris);
-        if (tris > 0)
-            std::printf(", BVH + mesh %.1f bytes/triangle", double(w.tracer->meshBytes()) / double(tris));
-        std::printf(")\n");
+        const double oursBpt = tris > 0 ? double(w.tracer->meshBytes()) / double(tris) : 0.0;
+        double embBpt = 0;
+#ifdef SHADOWLAB_HAVE_EMBREE
+        embBpt = tris > 0 ? double(w.embreeBytes) / double(tris) : 0.0;
+#endif
+        if (!oursCpu.empty()) {
+            std::printf("%-8s setup, %d alternating builds, CPU ms median (min-max): ours %.1f (%.1f-%.1f), "
+                        "embree %.1f (%.1f-%.1f), ratio %.2f; wall ms: ours %.1f (%.1f-%.1f), embree %.1f "
+                        "(%.1f-%.1f), ratio %.2f\n",
+                        w.name.c_str(), reps, oc[0], oc[1], oc[2], ec[0], ec[1], ec[2],
+                        ec[0] > 0 ? oc[0] / ec[0] : 0.0, ow[0], ow[1], ow[2], ew[0], ew[1], ew[2],
+                        ew[0] > 0 ? ow[0] / ew[0] : 0.0);
+        }
+        std::printf("%-8s %zu triangles: BVH + mesh %.1f bytes/triangle ours, %.1f embree (device bytes after "
+                    "the build)\n", w.name.c_str(), tris, oursBpt, embBpt);
+        // A fingerprint of every answer (primary: object, triangle, t and barycentric bits;
+        // shadow: blocked or not), to show that two builds of the bench give the same hits.
+        auto fingerprint = [&](const raytrace::Tracer<Real>& tracer) {
+            std::uint64_t fp = 1469598103934665603ull;
+            auto mix = [&](std::uint64_t v) { fp = (fp ^ v) * 1099511628211ull; };
+            for (const auto& ray : w.primary) {
+                raytrace::Hit<Real> h;
+                const bool hit = tracer.closestHit(ray, std::numeric_limits<Real>::infinity(), false, h);
+                mix(hit);
+                if (!hit) continue;
+                std::uint32_t tb, bb;
+                std::memcpy(&tb, &h.t, 4);
+                std::memcpy(&bb, &h.b1, 4);
+                mix(std::uint64_t(h.object) << 32 | std::uint32_t(h.prim));
+                mix(std::uint64_t(tb) << 32 | bb);
+            }
+            raytrace::setOccluderCache(false);
+            for (const auto& ray : w.shadow) {
+                int blocker = -1;
+                mix(tracer.anyHit(ray, std::numeric_limits<Real>::infinity(), false, blocker));
+                mix(std::uint64_t(blocker + 1));
+            }
+            raytrace::setOccluderCache(true);
+            return fp;
+        };
+        std::printf("%-8s hits fingerprint %016llx, on the reference's trees %016llx\n", w.name.c_str(),
+                    (unsigned long long)fingerprint(*w.tracer), (unsigned long long)fingerprint(*w.refTree));
+        std::printf("SCALE | %s | %zu | setup cpu ms ours %.1f embree %.1f | bytes/tri ours %.1f embree %.1f | "
+                    "primary Mrays/s ours %.2f embree %.2f embree8 %.2f reftree %.2f | shadow(no cache) ours %.2f embree %.2f "
+                    "embree8 %.2f reftree %.2f | setup cpu ms reftree %.1f\n",
+                    w.name.c_str(), tris, oc[0], ec[0], oursBpt, embBpt,
+                    reporter.stats(w.name + "/primary/ours")[0], reporter.stats(w.name + "/primary/embree")[0],
+                    reporter.stats(w.name + "/primary/embree8")[0], reporter.stats(w.name + "/primary/ours_reftree")[0],
+                    reporter.stats(w.name + "/shadow/ours_nocache")[0], reporter.stats(w.name + "/shadow/embree")[0],
+                    reporter.stats(w.name + "/shadow/embree8")[0], reporter.stats(w.name + "/shadow/ours_nocache_reftree")[0],
+                    rc[0]);
     }
 #ifdef SHADOWLAB_HAVE_EMBREE
     for (auto& wp : workloads) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <stdexcept>
@@ -72,25 +73,43 @@ inline bool traverseFloat(const Bvh8& bvh, const std::vector<TrianglePacket>& pa
                           const Ray<float>& ray, float& tBest, bool conservative, bool anyHit,
                           SlotHit& out, const MaskFilter<float>& mask) {
     const Triangle4Ray r4(ray);
+    const std::vector<std::uint32_t>& prims = bvh.primitives();
+    bool have = false;  // closest hit: `out` holds this walk's nearest hit so far
     return bvh.traverseWith<BoxTest>(ray, tBest, anyHit,
                                      [&](std::uint32_t first, std::uint32_t count, float& tm) {
         bool any = false;
+        // After a hit, a hit at exactly the same t is also tested, and the lower triangle
+        // index wins: the answer is the minimum of (t, index), whatever the tree's order.
+        // tm > 0 and finite once there is a hit: its bits + 1 are the next float up, so
+        // t < bound means t <= tm.
+        auto above = [](float x) {
+            std::uint32_t bits;
+            std::memcpy(&bits, &x, sizeof bits);
+            ++bits;
+            std::memcpy(&x, &bits, sizeof x);
+            return x;
+        };
+        float bound = have ? above(tm) : tm;
         for (std::uint32_t base = first; base < first + count; base += 4) {
             const TrianglePacket& pk = packets[base / 4];
             const std::uint32_t lanes = std::min<std::uint32_t>(4, first + count - base);
-            int cand = triangle4Candidates(r4, pk, tm, (1 << lanes) - 1);
+            int cand = triangle4Candidates(r4, pk, bound, (1 << lanes) - 1);
             // The scalar test decides, lane by lane in slot order as before.
             while (cand != 0) {
                 const int l = __builtin_ctz(unsigned(cand));
                 cand &= cand - 1;
                 float t, b0, b1, b2;
-                if (!intersectTriangle(ray, pk.vertex(l, 0), pk.vertex(l, 1), pk.vertex(l, 2), tm,
+                if (!intersectTriangle(ray, pk.vertex(l, 0), pk.vertex(l, 1), pk.vertex(l, 2), bound,
                                        conservative, t, b0, b1, b2))
                     continue;
-                if (mask.rejects(base + std::uint32_t(l), b0, b1, b2)) continue;
+                const std::uint32_t slot = base + std::uint32_t(l);
+                if (mask.rejects(slot, b0, b1, b2)) continue;
+                if (have && !(t < tm || prims[slot] < prims[out.slot])) continue;
                 tm = t;
-                out = SlotHit{t, b0, b1, b2, base + std::uint32_t(l)};
+                out = SlotHit{t, b0, b1, b2, slot};
                 if (anyHit) return true;
+                have = true;
+                bound = above(tm);
                 any = true;
             }
         }
@@ -316,7 +335,10 @@ int Tracer<Real>::buildMesh(const std::vector<scene::Vec3>& positions,
     std::vector<scene::Bounds> triBounds(indices.size() / 3);
     for (std::size_t t = 0; t < triBounds.size(); ++t)
         for (int k = 0; k < 3; ++k) triBounds[t].extend(positions[indices[3 * t + k]]);
-    d.bvh = Bvh8::build(triBounds);
+    // The reference keeps the double build's tree; the float tracer takes the float build's
+    // (closest-hit ties go to the lowest triangle index, so the hits do not depend on the tree).
+    d.bvh = std::is_same_v<Real, float> && detail::fastFloatBuild() ? Bvh8::buildFast(triBounds)
+                                                                    : Bvh8::build(triBounds);
     const std::vector<std::uint32_t>& slots = d.bvh.primitives();
     if constexpr (std::is_same_v<Real, float>) {
         d.packets.resize(slots.size() / WideRef::kLeafAlign);

@@ -106,6 +106,11 @@ WideBvh<N> WideBvh<N>::build(const std::vector<scene::Bounds>& primitiveBounds) 
     return collapse(Bvh::build(primitiveBounds));
 }
 
+template <int N>
+WideBvh<N> WideBvh<N>::buildFast(const std::vector<scene::Bounds>& primitiveBounds) {
+    return collapse(Bvh::buildFast(primitiveBounds));
+}
+
 template class WideBvh<4>;
 template class WideBvh<8>;
 
@@ -126,6 +131,12 @@ bool hasAvx() {
     return false;
 #endif
 }
+namespace {
+std::atomic<bool> fastFloatBuildOn{true};
+}  // namespace
+bool fastFloatBuild() { return fastFloatBuildOn.load(std::memory_order_relaxed); }
+void setFastFloatBuild(bool on) { fastFloatBuildOn.store(on, std::memory_order_relaxed); }
+
 bool useAvx() { return avxSwitch().load(std::memory_order_relaxed); }
 void setUseAvx(bool on) { avxSwitch().store(on && hasAvx(), std::memory_order_relaxed); }
 

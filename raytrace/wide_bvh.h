@@ -60,6 +60,8 @@ public:
     // Builds the binary SAH tree (Bvh::build) and collapses it. Throws std::length_error past
     // 2^26 primitives in one tree.
     static WideBvh build(const std::vector<scene::Bounds>& primitiveBounds);
+    // Bvh::buildFast collapsed: the float tracer's tree.
+    static WideBvh buildFast(const std::vector<scene::Bounds>& primitiveBounds);
     // Collapses a binary tree: each wide node takes a binary node's children and keeps opening
     // its interior child of largest surface area until it has N (the usual collapse, as
     // Embree's BVHNBuilder does; pbrt-v4 stays binary). The binary leaves are kept as they are.
@@ -206,6 +208,11 @@ struct ChildBoxTestAvx8 {
 bool hasAvx();
 bool useAvx();
 void setUseAvx(bool on);  // no effect (stays off) without AVX
+
+// Whether float tracers build their meshes with Bvh::buildFast (on by default) or with the
+// double build the reference uses; the bench switches it to measure what the tree is worth.
+bool fastFloatBuild();
+void setFastFloatBuild(bool on);
 
 }  // namespace detail
 

@@ -1,0 +1,183 @@
+// tests/raytrace/fast_build_test.cpp: the float build (Bvh::buildFast) the float tracer uses is
+// a valid tree over every primitive, independent of the thread count, and the float tracer's
+// answers are the same on its tree and on the reference's (double-built) tree, exact ties
+// included: a tie goes to the lowest triangle index whatever the tree's order.
+#include <algorithm>
+#include <cstring>
+#include <limits>
+#include <random>
+
+#include <gtest/gtest.h>
+#include <tbb/task_arena.h>
+
+#include "raytrace/bvh.h"
+#include "raytrace/tolerances.h"
+#include "raytrace/tracer.h"
+#include "raytrace/wide_bvh.h"
+#include "tests/raytrace/test_scenes.h"
+
+namespace shadowlab::raytrace {
+namespace {
+
+using scene::Vec3;
+
+std::vector<scene::Bounds> randomBoxes(int count, std::uint64_t seed) {
+    std::mt19937_64 g(seed);
+    std::uniform_real_distribution<double> pos(-100, 100), size(0.01, 3);
+    std::vector<scene::Bounds> out(count);
+    for (int i = 0; i < count; ++i) {
+        // Every tenth box shares one centroid: no SAH split among them (the halving path).
+        const Vec3 c = i % 10 == 0 ? Vec3(5, 5, 5) : Vec3(pos(g), pos(g), pos(g));
+        const Vec3 h(size(g), size(g), size(g));
+        out[i].extend(c - h);
+        out[i].extend(c + h);
+    }
+    return out;
+}
+
+TEST(FastBuild, TheTreeDoesNotDependOnTheThreadCount) {
+    const auto boxes = randomBoxes(60000, 5);
+    tbb::task_arena a1(1), a4(4);
+    Bvh t1, t4;
+    a1.execute([&] { t1 = Bvh::buildFast(boxes); });
+    a4.execute([&] { t4 = Bvh::buildFast(boxes); });
+    ASSERT_EQ(t1.nodes().size(), t4.nodes().size());
+    EXPECT_EQ(t1.primitives(), t4.primitives());
+    EXPECT_EQ(std::memcmp(t1.nodes().data(), t4.nodes().data(), t1.nodes().size() * sizeof(BvhNode)), 0);
+}
+
+TEST(FastBuild, HoldsEveryPrimitiveOnceInsideItsNodesBoxes) {
+    const auto boxes = randomBoxes(60000, 8);
+    const Bvh bvh = Bvh::buildFast(boxes);
+    std::vector<int> seen(boxes.size(), 0);
+    std::vector<std::uint32_t> stack = {0u};
+    std::size_t leafPrims = 0;
+    while (!stack.empty()) {
+        const std::uint32_t i = stack.back();
+        stack.pop_back();
+        ASSERT_LT(i, bvh.nodes().size());
+        const BvhNode& n = bvh.nodes()[i];
+        if (n.count > 0) {
+            EXPECT_LE(n.count, kBvhMaxLeafCount);
+            for (std::uint32_t s = n.offset; s < n.offset + n.count; ++s) {
+                const std::uint32_t p = bvh.primitives().at(s);
+                ++seen.at(p);
+                ++leafPrims;
+                // The float box contains the double box (outward rounding, exact unions).
+                for (int k = 0; k < 3; ++k)
+                    EXPECT_TRUE(double(n.lo[k]) <= boxes[p].min[k] && boxes[p].max[k] <= double(n.hi[k])) << p;
+            }
+            continue;
+        }
+        ASSERT_GT(n.offset, i + 1);
+        // A parent's box contains its children's.
+        for (std::uint32_t c : {i + 1, n.offset})
+            for (int k = 0; k < 3; ++k)
+                EXPECT_TRUE(n.lo[k] <= bvh.nodes()[c].lo[k] && bvh.nodes()[c].hi[k] <= n.hi[k]);
+        stack.push_back(n.offset);
+        stack.push_back(i + 1);
+    }
+    EXPECT_EQ(leafPrims, boxes.size());
+    for (std::size_t p = 0; p < seen.size(); ++p) ASSERT_EQ(seen[p], 1) << p;
+}
+
+// A soup of random triangles plus, scattered through the index list, several exact copies of
+// a few triangles (so the trees put copies in different leaves, in different orders) and a grid
+// of coplanar squares sharing edges (rays through shared edges and vertices hit two or more
+// triangles at one t).
+std::shared_ptr<scene::TriangleMesh> soupWithTies(std::mt19937_64& g) {
+    auto mesh = std::make_shared<scene::TriangleMesh>();
+    std::uniform_real_distribution<double> u(-10, 10), d(-1, 1);
+    auto tri = [&](Vec3 a, Vec3 b, Vec3 c) {
+        const std::uint32_t base = std::uint32_t(mesh->positions.size());
+        for (const Vec3& p : {a, b, c}) mesh->positions.push_back(p);
+        for (std::uint32_t k = 0; k < 3; ++k) mesh->indices.push_back(base + k);
+    };
+    std::vector<std::array<Vec3, 3>> copies;
+    for (int i = 0; i < 6; ++i) {
+        const Vec3 c(u(g), u(g), u(g));
+        copies.push_back({c + Vec3(-3, -3, 0.1 * i), c + Vec3(3, -3, 0), c + Vec3(0, 3, 0.2)});
+    }
+    for (int i = 0; i < 6000; ++i) {
+        if (i % 500 == 17) {
+            const auto& t = copies[(i / 500) % copies.size()];
+            tri(t[0], t[1], t[2]);
+            continue;
+        }
+        const Vec3 c(u(g), u(g), u(g));
+        tri(c + 0.4 * Vec3(d(g), d(g), d(g)), c + 0.4 * Vec3(d(g), d(g), d(g)), c + 0.4 * Vec3(d(g), d(g), d(g)));
+    }
+    for (int y = 0; y < 20; ++y)
+        for (int x = 0; x < 20; ++x) {
+            const Vec3 p(-10 + x, -10 + y, 11);
+            tri(p, p + Vec3(1, 0, 0), p + Vec3(1, 1, 0));
+            tri(p, p + Vec3(1, 1, 0), p + Vec3(0, 1, 0));
+        }
+    return mesh;
+}
+
+TEST(FastBuild, FloatTracerHitsAreTheSameOnItsTreeAndOnTheReferenceTree) {
+    std::mt19937_64 g(41);
+    scene::Scene s;
+    test::addMaterial(s, "matte");
+    test::addMesh(s, soupWithTies(g));
+    const Tracer<float> fast(s);
+    detail::setFastFloatBuild(false);
+    const Tracer<float> reference(s);
+    detail::setFastFloatBuild(true);
+    std::uniform_real_distribution<double> u(-12, 12);
+    std::vector<Ray<float>> rays;
+    for (int r = 0; r < 20000; ++r) {
+        const Vec3 from(u(g), u(g), -30), to(u(g), u(g), u(g));
+        rays.emplace_back(Vec3T<float>(from), Vec3T<float>(to - from));
+    }
+    // Rays down the grid's shared edges and through its vertices (integer x or y).
+    for (int k = 0; k < 400; ++k)
+        rays.emplace_back(Vec3T<float>(float(-10 + k % 20), float(-10 + 0.05 * k), -30.0f), Vec3T<float>(0, 0, 1));
+    int differ = 0, hits = 0;
+    for (const Ray<float>& ray : rays) {
+        for (bool conservative : {false, true}) {
+            Hit<float> a, b;
+            const bool fa = fast.closestHit(ray, std::numeric_limits<float>::infinity(), conservative, a);
+            const bool fb = reference.closestHit(ray, std::numeric_limits<float>::infinity(), conservative, b);
+            hits += fa;
+            differ += fa != fb || (fa && (std::memcmp(&a.t, &b.t, sizeof(float)) != 0 || a.prim != b.prim ||
+                                         std::memcmp(&a.b1, &b.b1, sizeof(float)) != 0));
+            int x = -1, y = -1;
+            differ += fast.anyHit(ray, std::numeric_limits<float>::infinity(), conservative, x) !=
+                      reference.anyHit(ray, std::numeric_limits<float>::infinity(), conservative, y);
+        }
+    }
+    EXPECT_EQ(differ, 0);
+    EXPECT_GT(hits, 10000);
+}
+
+TEST(FastBuild, AnExactTieGoesToTheLowestTriangleIndexOnEitherTree) {
+    std::mt19937_64 g(43);
+    const auto mesh = soupWithTies(g);
+    scene::Scene s;
+    test::addMaterial(s, "matte");
+    test::addMesh(s, mesh);
+    for (bool fastTree : {true, false}) {
+        detail::setFastFloatBuild(fastTree);
+        const Tracer<float> tracer(s);
+        detail::setFastFloatBuild(true);
+        // Along +z through each copy's centroid: both copies of its group are hit at one t.
+        int checked = 0;
+        for (std::size_t t = 17; t < 6000; t += 500) {
+            const std::size_t lowest = 17 + 500 * ((t / 500) % 6);  // the group's first copy
+            const Vec3 a = mesh->positions[mesh->indices[3 * t]];
+            const Vec3 m = (a + mesh->positions[mesh->indices[3 * t + 1]] + mesh->positions[mesh->indices[3 * t + 2]]) / 3.0;
+            const Ray<float> ray(Vec3T<float>(m + Vec3(0, 0, -40)), Vec3T<float>(0, 0, 1));
+            Hit<float> h;
+            ASSERT_TRUE(tracer.closestHit(ray, std::numeric_limits<float>::infinity(), false, h));
+            if (!(mesh->positions[mesh->indices[3 * std::size_t(h.prim)]] == a)) continue;  // a soup triangle in front
+            EXPECT_EQ(std::size_t(h.prim), lowest) << "triangle " << t << (fastTree ? " (fast tree)" : " (reference tree)");
+            ++checked;
+        }
+        EXPECT_GE(checked, 8);  // 10 of the 12 copies are not behind a soup triangle
+    }
+}
+
+}  // namespace
+}  // namespace shadowlab::raytrace
