@@ -11,6 +11,7 @@
 
 #include "studies/auto_bias.h"
 #include "studies/machine.h"
+#include "scene/append_line.h"
 #include "scene/error.h"
 #include "scene/frame_io.h"
 
@@ -31,30 +32,17 @@ struct ShardFolder {
 // line without its newline, which is what a kill in the middle of a write leaves (its row did not
 // finish and counts as missing).
 std::vector<SweepRow> readJournalStrict(const fs::path& file) {
-    std::vector<SweepRow> rows;
-    std::error_code ec;
-    if (!fs::exists(file, ec)) return rows;  // the shard started but finished no row
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw scene::InputError(file.string() + ": cannot read");
-    std::ostringstream all;
-    all << in.rdbuf();
-    const std::string text = all.str();
-    std::size_t begin = 0;
-    for (int line = 1; begin < text.size(); ++line) {
-        const std::size_t end = text.find('\n', begin);
-        const bool torn = end == std::string::npos;
-        const std::string s = text.substr(begin, torn ? std::string::npos : end - begin);
-        begin = torn ? text.size() : end + 1;
-        if (s.empty()) continue;
+    std::vector<SweepRow> rows;  // none when the shard started but finished no row
+    for (const scene::JournalLine& l : scene::readJournalLines(file)) {
         try {
-            SweepRow r = rowFromJournal(Json::parse(s));
+            SweepRow r = rowFromJournal(Json::parse(l.text));
             if (r.key.empty()) throw std::runtime_error("empty key");
             rows.push_back(std::move(r));
         } catch (const std::exception& e) {
-            if (torn) break;
+            if (l.torn) break;
             std::string what = e.what();
             if (const auto p = what.find("] "); p != std::string::npos) what = what.substr(p + 2);
-            throw scene::InputError(file.string() + ":" + std::to_string(line) +
+            throw scene::InputError(file.string() + ":" + std::to_string(l.number) +
                                     ": damaged journal line (not a sweep row: " + what + ")");
         }
     }

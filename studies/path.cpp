@@ -799,33 +799,21 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
             shardOf.emplace(index, d);
             // The journal, strictly: a damaged line is an error, a torn last line a frame not finished.
             const fs::path journal = d / "frames.jsonl";
-            if (!fs::exists(journal, ec)) continue;
-            std::ifstream in(journal, std::ios::binary);
-            std::ostringstream all;
-            all << in.rdbuf();
-            const std::string text = all.str();
-            std::size_t begin = 0;
-            for (int line = 1; begin < text.size(); ++line) {
-                const std::size_t end = text.find('\n', begin);
-                const bool torn = end == std::string::npos;
-                const std::string l = text.substr(begin, torn ? std::string::npos : end - begin);
-                begin = torn ? text.size() : end + 1;
-                if (l.empty()) continue;
+            for (const scene::JournalLine& l : scene::readJournalLines(journal)) {
+                const std::string at = journal.string() + ":" + std::to_string(l.number);
                 Json row;
                 int t = -1;
                 try {
-                    row = Json::parse(l);
+                    row = Json::parse(l.text);
                     t = row.at("frame").get<int>();
                     row.at("frame_ms").items();
                 } catch (const std::exception&) {
-                    if (torn) break;
-                    throw scene::InputError(journal.string() + ":" + std::to_string(line) +
-                                            ": damaged journal line (not a finished frame)");
+                    if (l.torn) break;
+                    throw scene::InputError(at + ": damaged journal line (not a finished frame)");
                 }
                 if (t < 0 || t >= frames || t % count != index)
-                    throw scene::InputError(journal.string() + ":" + std::to_string(line) + ": frame " +
-                                            std::to_string(t) + " does not belong to shard " + std::to_string(index) +
-                                            "/" + std::to_string(count));
+                    throw scene::InputError(at + ": frame " + std::to_string(t) + " does not belong to shard " +
+                                            std::to_string(index) + "/" + std::to_string(count));
                 if (lines.count(t)) {
                     ++merged.duplicates;
                     continue;
