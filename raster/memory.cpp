@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <variant>
 
+#include "raster/cascades.h"
 #include "raster/geometry.h"
 #include "scene/camera.h"
 #include "scene/memory.h"
@@ -61,13 +62,17 @@ std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::Render
 std::uint64_t shadowMapLayers(const scene::Scene& scene, const scene::RenderPlan& plan,
                               const scene::RasterSettings& settings) {
     std::uint64_t layers = 0;
+    int cascades = 0;  // chosen once, for the first shadowed directional light: one count serves all
     for (const scene::LightPlan& lp : plan.lights) {
         if (!lp.needsShadowTest) continue;
         // A point light's cube map has six layers; a directional light one per cascade (at
-        // most: fitCascades may fall back to one map).
+        // most: fitCascades may fall back to one map). With the default, the count the renderer
+        // will choose for this view (raster/cascades.h), which can be more than one.
         const scene::LightType type = scene.lights[lp.light].type;
+        if (type == scene::LightType::Directional && cascades == 0)
+            cascades = std::max(1, chooseCascades(scene, settings, &plan).count);
         layers += type == scene::LightType::Point         ? 6
-                  : type == scene::LightType::Directional ? std::uint64_t(std::max(1, settings.cascades))
+                  : type == scene::LightType::Directional ? std::uint64_t(cascades)
                                                           : 1;
     }
     return layers;

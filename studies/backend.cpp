@@ -1,6 +1,7 @@
 // studies/backend.cpp: the backends behind BackendRenderer, chosen by scene::Backend.
 #include "studies/backend.h"
 
+#include <malloc.h>
 #include <optional>
 #include <stdexcept>
 
@@ -10,6 +11,11 @@
 #include "raytrace/renderer.h"
 
 namespace shadowlab::compare {
+
+// The driver's and the tracers' many threads each free into their own malloc arena; without a
+// trim, renderers made one after another (sweep rows, the recommendation's checks) leave hundreds
+// of MiB resident that no estimate counts (docs/reliability.md, "Memory").
+BackendRenderer::~BackendRenderer() { malloc_trim(0); }
 
 namespace {
 
@@ -62,9 +68,10 @@ std::unique_ptr<BackendRenderer> makeRenderer(scene::Backend backend, const scen
     throw std::logic_error("makeRenderer: unknown backend");
 }
 
-scene::Frame renderFrame(scene::Backend backend, const scene::Scene& scene, const scene::RenderPlan& plan,
-                         const scene::RenderSettings& settings, scene::ChannelMask channels,
-                         raster::RenderDebug* debug) {
+namespace {
+scene::Frame renderOnce(scene::Backend backend, const scene::Scene& scene, const scene::RenderPlan& plan,
+                        const scene::RenderSettings& settings, scene::ChannelMask channels,
+                        raster::RenderDebug* debug) {
     switch (backend) {
         case scene::Backend::Raster:
             return debug ? raster::render(scene, plan, settings.raster, debug)
@@ -73,6 +80,15 @@ scene::Frame renderFrame(scene::Backend backend, const scene::Scene& scene, cons
         case scene::Backend::Reference: return raytrace::renderReference(scene, plan, settings.raytrace);
     }
     throw std::logic_error("renderFrame: unknown backend");
+}
+}  // namespace
+
+scene::Frame renderFrame(scene::Backend backend, const scene::Scene& scene, const scene::RenderPlan& plan,
+                         const scene::RenderSettings& settings, scene::ChannelMask channels,
+                         raster::RenderDebug* debug) {
+    scene::Frame frame = renderOnce(backend, scene, plan, settings, channels, debug);
+    malloc_trim(0);  // as after a BackendRenderer: the one-shot renderer is gone here
+    return frame;
 }
 
 std::uint64_t estimateMemoryBytes(scene::Backend backend, const scene::Scene& scene, const scene::RenderPlan& plan,

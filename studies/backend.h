@@ -23,7 +23,9 @@ namespace shadowlab::compare {
 // next frame's camera and lights, render() draws into a Frame.
 class BackendRenderer {
 public:
-    virtual ~BackendRenderer() = default;
+    // Returns the freed heap to the system (studies/backend.cpp): runs after the backend's members
+    // are gone, so a study's next renderer does not stack on the last one's fragments.
+    virtual ~BackendRenderer();
     // The next frame's scene: the objects, the number of lights and the resolution must be the
     // constructor's; the camera and the lights may differ. The scene given here (or to
     // makeRenderer) must outlive the render() calls that follow: the ray tracers read it there.
