@@ -34,6 +34,7 @@
 #include "raster/cascades.h"
 #include "raster/debug_views.h"
 #include "raster/memory.h"
+#include "raster/moment_maps.h"
 #include "raster/renderer.h"
 #include "raytrace/memory.h"
 #include "raytrace/renderer.h"
@@ -101,6 +102,15 @@ std::string explainAutomaticChoices(const Prepared& p) {
                                       : " (set by --fit-light-frustum or the scene)\n";
     out += "raster cascades: " + cascades.reason + "\n";
     out += "raster shadow-map size: " + size.reason + "\n";
+    if (scene::isFilterable(s.filter)) {
+        // What the filterable map adds to the frame (docs/raster.md "Filterable shadow maps").
+        const int side = size.size > 0 ? size.size : s.shadowMapSize;
+        out += "raster filter cost: " +
+               raster::describeMomentCost(s.filter, std::uint32_t(side),
+                                          std::uint32_t(raster::shadowMapLayers(p.scene, p.plan, s)),
+                                          s.moments.blurWidth) +
+               ", on top of the depth pass; the lit pass makes one linear lookup per light instead of compare taps\n";
+    }
     return out;
 }
 

@@ -29,9 +29,19 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
     cmd.add_option("--slope-bias", s.slopeBias,
                    "raster: slope-scaled bias in texels, times tan(angle to light) (default 1)");
     cmd.add_option("--filter", s.filter,
-                   "raster: shadow-map filter none|pcf2x2|pcf|poisson|pcss (default pcf2x2: bilinear 2x2 PCF; pcss: "
-                   "soft shadows sized by a spot/point light's radius)");
+                   "raster: shadow-map filter none|pcf2x2|pcf|poisson|pcss|vsm|evsm2|evsm4|esm|msm (default pcf2x2: "
+                   "bilinear 2x2 PCF; pcss: soft shadows sized by a spot/point light's radius; vsm..msm: filterable "
+                   "moment maps, docs/raster.md)");
     cmd.add_option("--pcf-size", s.pcfSize, "raster: pcf taps per side, or poisson kernel diameter in texels (default 3)");
+    cmd.add_option("--min-variance", s.minVariance, "raster: vsm/evsm variance floor, normalized depth² (default 1e-6)");
+    cmd.add_option("--bleeding-reduction", s.bleedReduction,
+                   "raster: vsm/evsm light-bleeding reduction, 0..0.99 of the visibility tail cut (default 0.2)");
+    cmd.add_option("--evsm-positive", s.evsmPositive, "raster: evsm positive warp exponent, 0..42 (default 40)");
+    cmd.add_option("--evsm-negative", s.evsmNegative, "raster: evsm4 negative warp exponent, 0..42 (default 5)");
+    cmd.add_option("--esm-exponent", s.esmExponent, "raster: esm exponent, 0..85 (default 80)");
+    cmd.add_option("--moment-bias", s.momentBias, "raster: msm moment bias (default 3e-5)");
+    cmd.add_option("--blur-width", s.blurWidth,
+                   "raster: vsm..msm box blur width in texels, odd, 1..63 (default 5)");
     cmd.add_option("--normal-offset", s.normalOffset,
                    "raster: move receivers along their normal by this many texels (default 0)");
     cmd.add_flag("--receiver-plane-bias", s.receiverPlaneBias,

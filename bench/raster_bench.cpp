@@ -11,6 +11,7 @@
 #include <exception>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -255,6 +256,57 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
 
 }  // namespace
 
+// SHADOWLAB_BENCH_FILTERS=1: instead of the series above, each shadow filter's frame (all
+// channels, as compare renders) against pcf2x2 and the bare baseline, interleaved repetition by
+// repetition in one process: what a filterable map's moment and blur passes cost.
+void benchFilters(const std::string& label, const fs::path& file, int repeats) {
+    scene::Scene s = scene::loadScene(file);
+    const auto [width, height] = benchResolution();
+    s.camera.width = width;
+    s.camera.height = height;
+    const std::vector<std::string> filters{"pcf2x2", "vsm", "evsm2", "evsm4", "esm", "msm"};
+    std::vector<std::unique_ptr<raster::Renderer>> renderers;
+    std::vector<scene::Frame> frames(filters.size());
+    std::vector<Series> series(filters.size());
+    scene::RenderSettings settings;
+    for (const std::string& filter : filters) {
+        scene::SettingsOverrides overrides;
+        overrides.shadowMapSize = kShadowMapSize;
+        overrides.fitLightFrustum = false;
+        overrides.cascades = 1;
+        overrides.filter = filter;
+        settings = scene::resolveSettings(s, overrides);
+        renderers.push_back(std::make_unique<raster::Renderer>(s, scene::makeRenderPlan(s, settings), settings.raster,
+                                                               rendererOptions()));
+    }
+    bench::BareRenderer bare(s, settings.raster);
+    std::vector<std::uint8_t> rgba;
+    for (std::size_t k = 0; k < filters.size(); ++k) renderers[k]->render(frames[k], scene::kAllChannels);  // warm-up
+    bare.render(rgba);
+    Series base;
+    for (int r = 0; r < repeats; ++r) {
+        for (std::size_t k = 0; k < filters.size(); ++k) {
+            renderers[k]->render(frames[k], scene::kAllChannels);
+            addOurs(series[k], frames[k]);
+        }
+        addBare(base, bare.render(rgba));
+    }
+    std::printf("\n=== filters, %s: %dx%d, shadow map %d, median of %d frames, ms (min-max) ===\n", label.c_str(),
+                width, height, kShadowMapSize, repeats);
+    std::printf("%-8s %-22s %-22s %-22s %9s %9s\n", "filter", "per_frame", "shadow_pass(+moments)", "lit_pass",
+                "/pcf2x2", "/bare");
+    auto row = [&](const std::string& name, const Series& x) {
+        const auto [lo, hi] = x.range("per_frame");
+        const auto [slo, shi] = x.range("shadow_pass");
+        const auto [llo, lhi] = x.range("lit_pass");
+        std::printf("%-8s %6.1f (%5.1f-%5.1f) %6.1f (%5.1f-%5.1f) %6.1f (%5.1f-%5.1f) %9.2f %9.2f\n", name.c_str(),
+                    x.med("per_frame"), lo, hi, x.med("shadow_pass"), slo, shi, x.med("lit_pass"), llo, lhi,
+                    x.med("per_frame") / series[0].med("per_frame"), x.med("per_frame") / base.med("per_frame"));
+    };
+    for (std::size_t k = 0; k < filters.size(); ++k) row(filters[k], series[k]);
+    row("bare", base);
+}
+
 int main(int argc, char** argv) {
     int repeats = 5;
     if (argc > 1) repeats = std::max(1, std::atoi(argv[1]));
@@ -271,6 +323,16 @@ int main(int argc, char** argv) {
         return rc == 0 ? 0 : 1;
     }
     std::printf("raster_bench: LP_NUM_THREADS=%s repeats=%d\n", std::getenv("LP_NUM_THREADS"), repeats);
+    if (const char* f = std::getenv("SHADOWLAB_BENCH_FILTERS"); f && std::string(f) == "1") {
+        try {
+            if (wantScene("seed")) benchFilters("seed", scene::findScene("seed"), repeats);
+            if (wantScene("Sponza") && fs::exists(kSponzaPath)) benchFilters("Sponza", kSponzaPath, repeats);
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "filters failed: %s\n", e.what());
+            return 1;
+        }
+        return 0;
+    }
     std::vector<fs::path> caches;
     int rc = 0;
     if (wantScene("seed")) try {

@@ -1,6 +1,7 @@
 // raster/lit_pass.cpp: the camera pass and the readback of its targets.
 #include "raster/lit_pass.h"
 
+#include <bit>
 #include <cstring>
 
 #include "raster/pipeline.h"
@@ -43,10 +44,13 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant) {
          .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
         {.binding = 8, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
+        // The filterable maps' blurred moments (raster/moment_maps.h), linearly filtered.
+        {.binding = 9, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
+         .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
     };
     const VkDescriptorSetLayoutCreateInfo setInfo{
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
-        .bindingCount = 9,
+        .bindingCount = 10,
         .pBindings = bindings,
     };
     LitPipeline p;
@@ -65,13 +69,19 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant) {
     // bits wide), 2: the light count, 3: the light kinds, 4: the cascade count, 5: transmittance
     // (bool), 6: receiver-plane bias (bool), 7: cascade blend bands (bool), 8: visibility in the
     // beauty's alpha (bool; not for the display target), 9: normal offset (bool), 10: the light's
-    // constants as flat vertex outputs (bool). Both stages get them all.
-    constexpr std::uint32_t kConstants = 11;
+    // constants as flat vertex outputs (bool), 11..16: the filterable maps' parameters (float bits:
+    // minimum variance, bleeding reduction, EVSM exponents, ESM exponent, MSM moment bias). Both
+    // stages get them all.
+    constexpr std::uint32_t kConstants = 17;
+    const scene::MomentSettings& m = variant.moments;
     const std::int32_t constants[kConstants] = {
         std::int32_t(variant.filter),     variant.blockerIds ? 1 : 0,       std::int32_t(variant.lightCount),
         std::int32_t(variant.lightKinds), std::int32_t(variant.cascades),   variant.transmittance ? 1 : 0,
         variant.receiverPlane ? 1 : 0,    variant.cascadeBlend ? 1 : 0,     variant.displayTarget ? 0 : 1,
-        variant.normalOffset ? 1 : 0,     variant.vertexLightConstants ? 1 : 0};
+        variant.normalOffset ? 1 : 0,     variant.vertexLightConstants ? 1 : 0,
+        std::bit_cast<std::int32_t>(float(m.minVariance)), std::bit_cast<std::int32_t>(float(m.bleedReduction)),
+        std::bit_cast<std::int32_t>(float(m.evsmPositive)), std::bit_cast<std::int32_t>(float(m.evsmNegative)),
+        std::bit_cast<std::int32_t>(float(m.esmExponent)), std::bit_cast<std::int32_t>(float(m.momentBias))};
     VkSpecializationMapEntry entries[kConstants];
     for (std::uint32_t i = 0; i < kConstants; ++i) entries[i] = {i, 4 * i, 4};
     const VkSpecializationInfo specialization{
@@ -130,7 +140,7 @@ LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32
 
 LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, const shaders::LitUniforms& uniforms,
                               const std::vector<glm::vec4>& albedos, const ShadowMaps& maps,
-                              const TransmittanceMaps& transmittance) {
+                              const TransmittanceMaps& transmittance, const MomentMaps& moments) {
     VkDevice device = ctx.device.get();
     LitBindings b;
     // A depth-compare sampler: result = (ref <= stored), i.e. "receiver depth - bias <= stored
@@ -170,13 +180,23 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
     VkSampler depthSampler = VK_NULL_HANDLE;
     VK_CHECK(vkCreateSampler(device, &depthSamplerInfo, nullptr, &depthSampler));
     b.depthSampler = SamplerHandle(device, depthSampler);
+
+    VkSamplerCreateInfo momentSamplerInfo = depthSamplerInfo;
+    momentSamplerInfo.magFilter = VK_FILTER_LINEAR;
+    momentSamplerInfo.minFilter = VK_FILTER_LINEAR;
+    momentSamplerInfo.addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    momentSamplerInfo.addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    momentSamplerInfo.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    VkSampler momentSampler = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateSampler(device, &momentSamplerInfo, nullptr, &momentSampler));
+    b.momentSampler = SamplerHandle(device, momentSampler);
     b.uniforms = uploadBuffer(ctx, &uniforms, sizeof uniforms, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
     b.albedos = uploadBuffer(ctx, albedos, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
 
     const VkDescriptorPoolSize sizes[] = {
         {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
         {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
-        {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 7},
+        {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 8},
     };
     const VkDescriptorPoolCreateInfo poolInfo{
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
@@ -210,6 +230,8 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
                                          VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkDescriptorImageInfo secondInfo{depthSampler, transmittance.secondDepth.view.get(),
                                            VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    const VkDescriptorImageInfo momentInfo{momentSampler, moments.moments.view.get(),
+                                           VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkWriteDescriptorSet writes[] = {
         {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 0, .descriptorCount = 1,
          .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .pBufferInfo = &uniformInfo},
@@ -229,8 +251,10 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
          .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &restInfo},
         {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 8, .descriptorCount = 1,
          .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &secondInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 9, .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &momentInfo},
     };
-    vkUpdateDescriptorSets(device, 9, writes, 0, nullptr);
+    vkUpdateDescriptorSets(device, 10, writes, 0, nullptr);
     return b;
 }
 

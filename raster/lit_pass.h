@@ -7,6 +7,7 @@
 
 #include <glm/glm.hpp>
 
+#include "raster/moment_maps.h"
 #include "raster/shadow_pass.h"
 #include "scene/settings.h"
 #include "shaders/interface.h"
@@ -39,6 +40,8 @@ struct LitVariant {
     // (shaders/lit_constants.glsl kVertexLightConstants); takes effect only where
     // usesVertexLightCoordinates().
     bool vertexLightConstants = false;
+    // The filterable filters' parameters (specialization constants 11..16; unused by the others).
+    scene::MomentSettings moments;
 };
 // Whether lit.frag takes light 0's map coordinates from lit.vert (lit_constants.glsl
 // kVertexLightCoordinates, the same condition): one light, directional with one map or a spot, and
@@ -81,6 +84,7 @@ struct LitBindings {
     SamplerHandle sampler;    // depth compare, for the shadow maps
     SamplerHandle idSampler;  // plain NEAREST, for the blocker ids
     SamplerHandle depthSampler;  // plain NEAREST, the maps' raw depths (PCSS blocker search)
+    SamplerHandle momentSampler;  // LINEAR, clamp to edge: the filterable maps' moments
     Buffer uniforms;
     Buffer albedos;
     DescriptorPoolHandle pool;
@@ -88,7 +92,7 @@ struct LitBindings {
 };
 LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, const shaders::LitUniforms& uniforms,
                               const std::vector<glm::vec4>& albedos, const ShadowMaps& maps,
-                              const TransmittanceMaps& transmittance);
+                              const TransmittanceMaps& transmittance, const MomentMaps& moments);
 
 // Records the pass; background pixels keep `background` (rgb, visibility 0) and zero AOVs.
 // Leaves every color target in TRANSFER_SRC_OPTIMAL for recordReadback(), or, for host-readable

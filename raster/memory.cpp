@@ -6,6 +6,7 @@
 
 #include "raster/cascades.h"
 #include "raster/geometry.h"
+#include "raster/moment_maps.h"
 #include "scene/camera.h"
 #include "scene/memory.h"
 
@@ -25,6 +26,10 @@ std::uint64_t litBytesPerPixel(std::size_t lights) {
 // A tessellated sphere (raster/geometry.cpp) stays well under this many triangles.
 constexpr std::uint64_t kSphereTriangles = 1 << 16;
 constexpr std::uint64_t kBytesPerTriangle = 3 * 32 + 3 * 4;  // vertices (position, normal, id) + indices
+// Filterable maps (raster/moment_maps.h): two RGBA32F arrays the size of the shadow maps, and the
+// compute pipeline's compilation, measured on lavapipe (Mesa 22.3) as about 97 MiB above the
+// arrays on the seed scene at 1024² (the arrays alone: 32 bytes a texel, as measured at 4096²).
+constexpr std::uint64_t kMomentPipelineAllowance = 112 * scene::kMiB;
 }  // namespace
 
 std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::RenderPlan& plan,
@@ -51,6 +56,9 @@ std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::Render
     }
     return kDriverAllowance + scene::frameBytes(scene) + pixels * litBytesPerPixel(scene.lights.size()) +
            layers * texels * (plan.needsTransmittanceMap ? 4 + 4 + 16 : 4 + 4) + triangles * kBytesPerTriangle +
+           (scene::isFilterable(settings.filter) && layers > 0
+                ? layers * texels * kMomentBytesPerTexel * kMomentArrays + kMomentPipelineAllowance
+                : 0) +
            // Alpha-tested casters: a UV per vertex (every vertex of the scene gets a slot in the
            // UV buffer, 3 · 8 bytes a triangle), the texels and one record per object.
            (scene.hasAlphaCasters()

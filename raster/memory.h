@@ -12,7 +12,7 @@
 namespace shadowlab::raster {
 
 // The Frame, the lit pass's color and depth targets and their readback copies, the shadow maps
-// (depth + blocker id, shadowMapLayers() layers) and the
+// (depth + blocker id, shadowMapLayers() layers), the filterable maps' moment arrays and the
 // geometry buffers, plus a fixed allowance for the driver (llvmpipe's compiled shaders, LLVM). The program
 // itself and writing the Frame are the caller's part (scene/memory.h).
 std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::RenderPlan& plan,

@@ -20,6 +20,7 @@
 #include "raster/geometry.h"
 #include "raster/light_frustum.h"
 #include "raster/lit_pass.h"
+#include "raster/moment_maps.h"
 #include "raster/shadow_pass.h"
 #include "raster/tolerances.h"
 #include "scene/camera.h"
@@ -136,8 +137,8 @@ const char* filterName(scene::ShadowFilter f) {
         case scene::ShadowFilter::Pcf: return "pcf";
         case scene::ShadowFilter::Poisson: return "poisson";
         case scene::ShadowFilter::Pcss: return "pcss";
+        default: return scene::toString(f);  // the filterable maps
     }
-    return "?";
 }
 
 }  // namespace
@@ -198,6 +199,10 @@ struct Renderer::Impl {
     ShadowPipeline transmitPipeline;
     TransmittanceMaps transmittanceMaps;
     TransmittanceRestPipeline transmitRestPipeline;  // the second pass, bound to transmittanceMaps
+    // Filterable maps (scene::isFilterable): the moment arrays (1x1x1 placeholders without) and
+    // their compute passes, made with the first frame's pipelines.
+    MomentMaps momentMaps;
+    MomentPipeline momentPipeline;
     std::vector<glm::vec4> layerLights;
     std::vector<DepthBiasFactors> layerBias;  // per shadow-map layer (settings.hardwareBias)
     LitPipeline litPipelines[4];
@@ -497,6 +502,9 @@ void Renderer::Impl::createTargets(const scene::Scene& scene, const RendererOpti
                                   : glm::vec4(glm::vec3(light.position - origin), 1.0f));
     }
     attributes["transmittance_map"] = transmit ? "made" : "none";
+    const bool moments = scene::isFilterable(settings.filter) && !lightMatrices.empty();
+    momentMaps = createMomentMaps(ctx, moments ? mapSize : 1, moments ? layers : 1);
+    if (moments) attributes["moment_maps"] = describeMomentCost(settings.filter, mapSize, layers, settings.moments.blurWidth);
     targets = createLitTargets(ctx, width, height, lightCount > 1 ? kLightTargets : 0, options.readTargetsInPlace);
     if (!targets.hostReadable) readback = createReadback(ctx, targets);
     // How the targets reach the Frame: read in place (lavapipe) or copied into buffers first.
@@ -532,6 +540,21 @@ void Renderer::Impl::describeLayers() {
     if (settings.filter == scene::ShadowFilter::Pcf || settings.filter == scene::ShadowFilter::Poisson ||
         settings.filter == scene::ShadowFilter::Pcss)
         attributes["pcf_size"] = std::to_string(settings.pcfSize);
+    if (scene::isFilterable(settings.filter)) {
+        const scene::MomentSettings& m = settings.moments;
+        attributes["blur_width"] = std::to_string(m.blurWidth);
+        if (settings.filter == scene::ShadowFilter::Vsm || settings.filter == scene::ShadowFilter::Evsm2 ||
+            settings.filter == scene::ShadowFilter::Evsm4) {
+            attributes["min_variance"] = formatNumber(m.minVariance);
+            attributes["light_bleeding_reduction"] = formatNumber(m.bleedReduction);
+        }
+        if (settings.filter == scene::ShadowFilter::Evsm2 || settings.filter == scene::ShadowFilter::Evsm4)
+            attributes["evsm_positive_exponent"] = formatNumber(m.evsmPositive);
+        if (settings.filter == scene::ShadowFilter::Evsm4)
+            attributes["evsm_negative_exponent"] = formatNumber(m.evsmNegative);
+        if (settings.filter == scene::ShadowFilter::Esm) attributes["esm_exponent"] = formatNumber(m.esmExponent);
+        if (settings.filter == scene::ShadowFilter::Msm) attributes["moment_bias"] = formatNumber(m.momentBias);
+    }
     attributes["normal_offset"] = formatNumber(settings.normalOffset);
     attributes["light_frustum_fit"] = settings.fitLightFrustum ? "receivers" : "bounding-sphere";
     attributes["light_frustum_fit_reason"] =
@@ -643,6 +666,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
         const VkDescriptorSetLayout alphaLayout = alpha.setLayout.get();  // VK_NULL_HANDLE without
         if (!shadowPipeline.pipeline)
             shadowPipeline = createShadowPipeline(ctx, wantIds, settings.hardwareBias, alphaLayout);
+        if (momentMaps.size > 1 && !momentPipeline.pipeline)
+            momentPipeline = createMomentPipeline(ctx, maps, momentMaps);
         if (transmit && !transmitPipeline.pipeline) transmitPipeline = createTransmittancePipeline(ctx, alphaLayout);
         if (transmit && !transmitRestPipeline.pipeline)
             transmitRestPipeline = createTransmittanceRestPipeline(ctx, transmittanceMaps, alphaLayout);
@@ -659,9 +684,10 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                                                             .transmittance = transmit,
                                                             .receiverPlane = settings.receiverPlaneBias,
                                                             .cascadeBlend = cascadeBlendUsed > 0.0,
-                                                            .vertexLightConstants = vertexLightConstants});
+                                                            .vertexLightConstants = vertexLightConstants,
+                                                            .moments = settings.moments});
         if (bindings.set == VK_NULL_HANDLE)
-            bindings = createLitBindings(ctx, litPipeline, uniforms, albedos, maps, transmittanceMaps);
+            bindings = createLitBindings(ctx, litPipeline, uniforms, albedos, maps, transmittanceMaps, momentMaps);
         setup += msSince(pipelineStart);
     }
 
@@ -681,6 +707,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     const TransmittancePass transmittancePass{transmit ? &transmitPipeline : nullptr, &transmittanceMaps, layerLights,
                                               transmit ? &transmitRestPipeline : nullptr};
     recordShadowPass(commands, shadowPipeline, maps, draw, lightMatrices, wantIds, &transmittancePass, &layerBias);
+    if (momentPipeline.pipeline) recordMomentPasses(commands, momentPipeline, maps, momentMaps, settings.filter, settings.moments);
     stamp(commands, 1);
     ctx.submitAndWait(commands);
     frame.timingsMs.emplace_back("shadow_pass", msSince(shadowStart));

@@ -69,6 +69,7 @@
     X(vkCreatePipelineLayout)                   \
     X(vkDestroyPipelineLayout)                  \
     X(vkCreateGraphicsPipelines)                \
+    X(vkCreateComputePipelines)                 \
     X(vkCreatePipelineCache)                    \
     X(vkDestroyPipelineCache)                   \
     X(vkGetPipelineCacheData)                   \
@@ -90,6 +91,7 @@
     X(vkCmdSetScissor)                          \
     X(vkCmdSetDepthBias)                        \
     X(vkCmdDrawIndexed)                         \
+    X(vkCmdDispatch)                            \
     X(vkCmdCopyBuffer)                          \
     X(vkCmdCopyImageToBuffer)
 

@@ -379,9 +379,18 @@ Object readObject(const Reader& r, const Json& node, const JsonPath& path,
     return o;
 }
 
+// A range bound for a message (shortest form: 0.99, 42, 1e-06).
+std::string numberText(double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+}
+
 ShadowDefaults readShadow(const Reader& r, const Json& node, const JsonPath& path) {
     r.checkKeys(node, path, {"shadow_map_size", "depth_bias", "slope_bias", "filter", "pcf_size", "normal_offset",
-                             "receiver_plane_bias", "hardware_bias", "fit_light_frustum", "cascades", "cascade_blend", "ray_bias", "precision", "samples"});
+                             "receiver_plane_bias", "hardware_bias", "fit_light_frustum", "cascades", "cascade_blend", "ray_bias", "precision", "samples",
+                             "min_variance", "light_bleeding_reduction", "evsm_positive_exponent",
+                             "evsm_negative_exponent", "esm_exponent", "moment_bias", "blur_width"});
     ShadowDefaults d;
     if (node.contains("shadow_map_size"))
         d.shadowMapSize = r.integer(node["shadow_map_size"], path / "shadow_map_size", 16, 16384);
@@ -396,10 +405,29 @@ ShadowDefaults readShadow(const Reader& r, const Json& node, const JsonPath& pat
     if (node.contains("filter")) {
         d.filter = r.string(node["filter"], path / "filter");
         if (*d.filter != "none" && *d.filter != "pcf2x2" && *d.filter != "pcf" && *d.filter != "poisson" &&
-            *d.filter != "pcss")
-            r.fail(path / "filter", "expected none, pcf2x2, pcf, poisson or pcss, got '" + *d.filter + "'");
+            *d.filter != "pcss" && *d.filter != "vsm" && *d.filter != "evsm2" && *d.filter != "evsm4" &&
+            *d.filter != "esm" && *d.filter != "msm")
+            r.fail(path / "filter", "expected none, pcf2x2, pcf, poisson, pcss, vsm, evsm2, evsm4, esm or msm, got '" +
+                                        *d.filter + "'");
     }
     if (node.contains("pcf_size")) d.pcfSize = r.integer(node["pcf_size"], path / "pcf_size", 1, 15);
+    // The filterable maps' parameters (scene::MomentSettings, with its ranges).
+    auto ranged = [&](std::optional<double>& into, const char* key, double lo, double hi, const char* unit) {
+        if (!node.contains(key)) return;
+        into = r.number(node[key], path / key);
+        if (!(*into >= lo && *into <= hi))
+            r.fail(path / key, "must be in " + numberText(lo) + ".." + numberText(hi) + " (" + unit + ")");
+    };
+    ranged(d.minVariance, "min_variance", 0.0, 1.0, "normalized depth squared");
+    ranged(d.bleedReduction, "light_bleeding_reduction", 0.0, 0.99, "fraction of the visibility range cut");
+    ranged(d.evsmPositive, "evsm_positive_exponent", 0.0, kMaxEvsmExponent, "float32 holds exp(2c) up to c = 42");
+    ranged(d.evsmNegative, "evsm_negative_exponent", 0.0, kMaxEvsmExponent, "float32 holds exp(2c) up to c = 42");
+    ranged(d.esmExponent, "esm_exponent", 0.0, kMaxEsmExponent, "float32 holds exp(c) up to c = 85");
+    ranged(d.momentBias, "moment_bias", 0.0, 1.0, "fraction");
+    if (node.contains("blur_width")) {
+        d.blurWidth = r.integer(node["blur_width"], path / "blur_width", 1, kMaxBlurWidth);
+        if (*d.blurWidth % 2 == 0) r.fail(path / "blur_width", "must be odd (texels), got " + std::to_string(*d.blurWidth));
+    }
     if (node.contains("normal_offset")) {
         d.normalOffset = r.number(node["normal_offset"], path / "normal_offset");
         if (*d.normalOffset < 0) r.fail(path / "normal_offset", "must be >= 0 (texels)");

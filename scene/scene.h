@@ -204,6 +204,10 @@ struct ShadowDefaults {
     std::optional<double> slopeBias;     // shadow-map texels
     std::optional<std::string> filter;   // "none" | "pcf2x2" | "pcf" | "poisson"
     std::optional<int> pcfSize;          // texels
+    // Filterable maps (MomentSettings): min_variance, light_bleeding_reduction,
+    // evsm_positive_exponent, evsm_negative_exponent, esm_exponent, moment_bias, blur_width.
+    std::optional<double> minVariance, bleedReduction, evsmPositive, evsmNegative, esmExponent, momentBias;
+    std::optional<int> blurWidth;
     std::optional<double> normalOffset;  // texels
     std::optional<bool> receiverPlaneBias;
     std::optional<bool> hardwareBias;

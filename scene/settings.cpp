@@ -18,7 +18,12 @@ ShadowFilter parseFilter(const std::string& text, const std::string& where) {
     if (text == "pcf") return ShadowFilter::Pcf;
     if (text == "poisson") return ShadowFilter::Poisson;
     if (text == "pcss") return ShadowFilter::Pcss;
-    throw InputError(where + ": expected none|pcf2x2|pcf|poisson|pcss, got '" + text + "'");
+    if (text == "vsm") return ShadowFilter::Vsm;
+    if (text == "evsm2") return ShadowFilter::Evsm2;
+    if (text == "evsm4") return ShadowFilter::Evsm4;
+    if (text == "esm") return ShadowFilter::Esm;
+    if (text == "msm") return ShadowFilter::Msm;
+    throw InputError(where + ": expected none|pcf2x2|pcf|poisson|pcss|vsm|evsm2|evsm4|esm|msm, got '" + text + "'");
 }
 
 Precision parsePrecision(const std::string& text, const std::string& where) {
@@ -75,6 +80,24 @@ RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& o) {
     s.raster.pcfSize = o.pcfSize.value_or(d.pcfSize.value_or(3));
     if (s.raster.pcfSize < 1 || s.raster.pcfSize > 15)
         throw InputError("--pcf-size: must be in 1..15 texels, got " + std::to_string(s.raster.pcfSize));
+    MomentSettings& m = s.raster.moments;
+    auto take = [](double& into, const std::optional<double>& option, const std::optional<double>& scene,
+                   const char* name, double lo, double hi) {
+        into = option.value_or(scene.value_or(into));
+        if (!(into >= lo && into <= hi))  // also rejects NaN
+            throw InputError(std::string(name) + ": must be in " + formatBlend(lo) + ".." + formatBlend(hi) +
+                             ", got " + formatBlend(into));
+    };
+    take(m.minVariance, o.minVariance, d.minVariance, "--min-variance", 0.0, 1.0);
+    take(m.bleedReduction, o.bleedReduction, d.bleedReduction, "--bleeding-reduction", 0.0, 0.99);
+    take(m.evsmPositive, o.evsmPositive, d.evsmPositive, "--evsm-positive", 0.0, kMaxEvsmExponent);
+    take(m.evsmNegative, o.evsmNegative, d.evsmNegative, "--evsm-negative", 0.0, kMaxEvsmExponent);
+    take(m.esmExponent, o.esmExponent, d.esmExponent, "--esm-exponent", 0.0, kMaxEsmExponent);
+    take(m.momentBias, o.momentBias, d.momentBias, "--moment-bias", 0.0, 1.0);
+    m.blurWidth = o.blurWidth.value_or(d.blurWidth.value_or(m.blurWidth));
+    if (m.blurWidth < 1 || m.blurWidth > kMaxBlurWidth || m.blurWidth % 2 == 0)
+        throw InputError("--blur-width: must be odd, in 1.." + std::to_string(kMaxBlurWidth) + " texels, got " +
+                         std::to_string(m.blurWidth));
     s.raster.normalOffset = o.normalOffset.value_or(d.normalOffset.value_or(0.0));
     if (!std::isfinite(s.raster.normalOffset) || s.raster.normalOffset < 0.0)
         throw InputError("--normal-offset: must be a finite value >= 0 (texels)");
@@ -148,6 +171,11 @@ const char* toString(ShadowFilter f) {
         case ShadowFilter::Pcf: return "pcf";
         case ShadowFilter::Poisson: return "poisson";
         case ShadowFilter::Pcss: return "pcss";
+        case ShadowFilter::Vsm: return "vsm";
+        case ShadowFilter::Evsm2: return "evsm2";
+        case ShadowFilter::Evsm4: return "evsm4";
+        case ShadowFilter::Esm: return "esm";
+        case ShadowFilter::Msm: return "msm";
     }
     return "?";
 }

@@ -16,7 +16,29 @@ enum class Backend { Raster, Raytrace, Reference };
 // diameter pcfSize texels (raster/ implements them; see docs/raster.md).
 // pcss: percentage-closer soft shadows for spot and point lights with a radius (Fernando 2005): a
 // blocker search, then a Poisson filter as wide as the penumbra; elsewhere it is `poisson`.
-enum class ShadowFilter { None, Pcf2x2, Pcf, Poisson, Pcss };
+// Filterable maps (raster/moment_maps.h, docs/raster.md): the depths become moments, blurred,
+// sampled with a linear filter. vsm: Chebyshev on (z, z²) with light-bleeding reduction; evsm2,
+// evsm4: Chebyshev on exponentially warped depths (positive; positive and negative); esm:
+// exp(c·(z_occluder − z_receiver)); msm: 4-moment Hamburger moment shadow map (Peters & Klein 2015).
+enum class ShadowFilter { None, Pcf2x2, Pcf, Poisson, Pcss, Vsm, Evsm2, Evsm4, Esm, Msm };
+inline bool isFilterable(ShadowFilter f) { return f >= ShadowFilter::Vsm; }
+
+// The filterable maps' parameters. Depths are the maps' normalized depths 0..1 (each map spans its
+// light's fitted depth range), so the defaults scale with the scene. See docs/raster.md.
+struct MomentSettings {
+    double minVariance = 1e-6;     // vsm, evsm: variance floor (normalized depth², warped for evsm)
+    double bleedReduction = 0.2;   // vsm, evsm: linstep(amount, 1, p) cuts this much of the tail
+    double evsmPositive = 40.0;    // evsm: exp(c·(2z−1)); ≤ kMaxEvsmExponent (float overflow of the square)
+    double evsmNegative = 5.0;     // evsm4: −exp(−c·(2z−1)); ≤ kMaxEvsmExponent
+    double esmExponent = 80.0;     // esm: exp(c·z) stored; ≤ kMaxEsmExponent
+    double momentBias = 3e-5;      // msm: moments pulled toward (0.5, 0.5, 0.5, 0.5) by this
+    int blurWidth = 5;             // box blur width in texels (odd, 1 = none), both directions
+};
+// float32 holds up to 3.4e38 = e^88.7: EVSM stores exp(2c) (the square at z = 1), so c ≤ 44, less
+// a margin for the blur's sums: 42. ESM stores exp(c) at z = 1: c ≤ 88, margin: 85.
+inline constexpr double kMaxEvsmExponent = 42.0;
+inline constexpr double kMaxEsmExponent = 85.0;
+inline constexpr int kMaxBlurWidth = 63;
 enum class Precision { Float, Double };
 
 // Cascaded shadow maps: at most this many cascades per directional light. Four is what engines
@@ -42,6 +64,7 @@ struct RasterSettings {
     double slopeBias = 0.0;     // texels: bias += slopeBias * texelWorldSize * tan(angle to light)
     ShadowFilter filter = ShadowFilter::Pcf2x2;
     int pcfSize = 3;            // pcf: taps per side; poisson: kernel diameter in texels (1..15)
+    MomentSettings moments;     // vsm, evsm2, evsm4, esm, msm
     double normalOffset = 0.0;  // texels: the receiver moves along its normal by this x texel world size
     // Receiver-plane depth bias (Isidoro 2006): each filter tap compares against the receiver's
     // plane extrapolated to the texel it reads, instead of the slope bias (see docs/raster.md).
@@ -98,6 +121,13 @@ struct SettingsOverrides {
     std::optional<double> slopeBias;
     std::optional<std::string> filter;
     std::optional<int> pcfSize;          // --pcf-size
+    std::optional<double> minVariance;     // --min-variance
+    std::optional<double> bleedReduction;  // --bleeding-reduction
+    std::optional<double> evsmPositive;    // --evsm-positive
+    std::optional<double> evsmNegative;    // --evsm-negative
+    std::optional<double> esmExponent;     // --esm-exponent
+    std::optional<double> momentBias;      // --moment-bias
+    std::optional<int> blurWidth;          // --blur-width
     std::optional<double> normalOffset;  // --normal-offset (texels)
     std::optional<bool> receiverPlaneBias;  // --receiver-plane-bias
     std::optional<bool> hardwareBias;       // --hardware-bias

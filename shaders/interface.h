@@ -16,6 +16,11 @@
 #define SHADOWLAB_FILTER_PCF 2
 #define SHADOWLAB_FILTER_POISSON 3
 #define SHADOWLAB_FILTER_PCSS 4
+#define SHADOWLAB_FILTER_VSM 5
+#define SHADOWLAB_FILTER_EVSM2 6
+#define SHADOWLAB_FILTER_EVSM4 7
+#define SHADOWLAB_FILTER_ESM 8
+#define SHADOWLAB_FILTER_MSM 9
 
 // Light kinds in LightData.kind.x.
 #define SHADOWLAB_LIGHT_DIRECTIONAL 0
@@ -27,6 +32,7 @@
 namespace shadowlab::shaders {
 using vec4 = glm::vec4;
 using mat4 = glm::mat4;
+using ivec4 = glm::ivec4;
 #endif
 
 // Push constants of the shadow (depth-only) pass.
@@ -42,6 +48,13 @@ struct TransmitPush {
     vec4 params;       // x: the object's transmittance 1 − opacity; y: 1 = closed (count only the
                        // surfaces facing the light), 0 = open (count every fragment); second pass
                        // only (behind the nearest layer): z: the layer, w: the depth separation
+};
+
+// Push constants of the moment passes (shaders/moments.comp, raster/moment_maps.h).
+struct MomentPush {
+    ivec4 info;   // x: filter code, y: pass (0: moments + blur along x, 1: blur along y), z: blur
+                  // radius in texels, w: the maps' side in texels
+    vec4 params;  // x: EVSM positive exponent, y: EVSM negative exponent, z: ESM exponent
 };
 
 struct LightData {
@@ -88,6 +101,7 @@ struct LitUniforms {
 
 #ifdef __cplusplus
 static_assert(sizeof(ShadowPush) == 64, "ShadowPush must match std430 push constants");
+static_assert(sizeof(MomentPush) == 2 * 16, "MomentPush must match std430 push constants");
 static_assert(sizeof(TransmitPush) == 64 + 2 * 16, "TransmitPush must match std430 push constants");
 static_assert(sizeof(LightData) == 64 + 6 * 16, "LightData must match std140");
 static_assert(sizeof(CascadeData) == 64 + 16, "CascadeData must match std140");

@@ -22,6 +22,8 @@ layout(set = 0, binding = 6) uniform sampler2DArray transparentDepths;
 // excluded): T_rest and D2, so that a receiver on the second layer gets the first layer's factor.
 layout(set = 0, binding = 7) uniform sampler2DArray restTransmittanceMaps;
 layout(set = 0, binding = 8) uniform sampler2DArray secondTransparentDepths;
+// The filterable maps' blurred moments (raster/moment_maps.h; LINEAR, clamp to edge).
+layout(set = 0, binding = 9) uniform sampler2DArray momentMaps;
 
 // PCSS: the blocker search looks at most this fraction of the map's side from the point, and the
 // penumbra filter is at most this fraction wide (diameter). The tap count is fixed (16 each), so
@@ -153,6 +155,61 @@ float reference(LightData light, Receiver r, float bias) {
         return far / (far - near) * (1.0 - near / max(r.axial - bias, near));
     }
     return r.axial - bias * light.bias.w;  // orthographic depth is linear: bias / depth range
+}
+
+// Filterable maps: the visibility of a receiver at map depth t from the filtered moments m.
+// linstep(a, 1, p) is the light-bleeding reduction: visibilities below a become 0, the rest is
+// stretched over 0..1 (Lauritzen 2007).
+float linstep(float lo, float hi, float v) { return clamp((v - lo) / (hi - lo), 0.0, 1.0); }
+// One-sided Chebyshev: P(z >= t) <= σ²/(σ² + (t − μ)²) for t > μ, 1 for t <= μ.
+float chebyshev(vec2 m, float t, float minVariance) {
+    if (t <= m.x) return 1.0;
+    const float variance = max(m.y - m.x * m.x, minVariance);
+    const float d = t - m.x;
+    return linstep(kBleedReduction, 1.0, variance / (variance + d * d));
+}
+// Hamburger 4-moment shadow map (Peters & Klein, "Moment Shadow Mapping", I3D 2015, algorithm 3):
+// the biased moments' 3x3 Hankel matrix solved by Cholesky for the polynomial whose roots z2, z3
+// with the receiver's depth are the support of the distribution that shadows most; G the bound.
+float hamburger(vec4 b, float t) {
+    b = mix(b, vec4(0.5), kMomentBias);
+    // B = [[1, b1, b2], [b1, b2, b3], [b2, b3, b4]] = L D Lᵀ, solve B c = (1, t, t²).
+    const float d2 = max(b.y - b.x * b.x, 1e-12);
+    const float l32 = (b.z - b.x * b.y) / d2;
+    const float d3 = max(b.w - b.y * b.y - l32 * l32 * d2, 1e-12);
+    const float y2 = t - b.x;
+    const float y3 = t * t - b.y - l32 * y2;
+    const float c3 = y3 / d3;
+    const float c2 = y2 / d2 - l32 * c3;
+    const float c1 = 1.0 - b.x * c2 - b.y * c3;
+    // c3 z² + c2 z + c1 = 0.
+    const float p = c2 / c3, q = c1 / c3;
+    const float r = sqrt(max(0.25 * p * p - q, 0.0));
+    const float z2 = -0.5 * p - r, z3 = -0.5 * p + r;
+    float shadow;
+    if (t <= z2) shadow = 0.0;
+    else if (t <= z3) shadow = (t * z3 - b.x * (t + z3) + b.y) / ((z3 - z2) * (t - z2));
+    else shadow = 1.0 - (z2 * z3 - b.x * (z2 + z3) + b.y) / ((t - z2) * (t - z3));
+    return clamp(1.0 - shadow, 0.0, 1.0);
+}
+float momentVisibility(vec4 m, float t) {
+    if (kFilter == SHADOWLAB_FILTER_VSM) return chebyshev(m.xy, t, kMinVariance);
+    if (kFilter == SHADOWLAB_FILTER_EVSM2 || kFilter == SHADOWLAB_FILTER_EVSM4) {
+        // The receiver warped as the moments were (moments.comp); the variance floor scaled by
+        // the warp's derivative, so it means the same depth spread as for vsm.
+        const float w = 2.0 * t - 1.0;
+        const float pt = exp(kEvsmPositive * w);
+        const float dp = 2.0 * kEvsmPositive * pt;
+        float v = chebyshev(m.xy, pt, kMinVariance * dp * dp);
+        if (kFilter == SHADOWLAB_FILTER_EVSM4) {
+            const float nt = -exp(-kEvsmNegative * w);
+            const float dn = 2.0 * kEvsmNegative * nt;
+            v = min(v, chebyshev(m.zw, nt, kMinVariance * dn * dn));
+        }
+        return v;
+    }
+    if (kFilter == SHADOWLAB_FILTER_ESM) return clamp(m.x * exp(-kEsmExponent * t), 0.0, 1.0);
+    return hamburger(m, t);
 }
 
 // A point light's cube face for the direction d from the light (its major axis: +X −X +Y −Y +Z
@@ -322,6 +379,16 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         receiverPlane(light, axis, q, dpdx, dpdy, size, texel, r);
         // The plane replaces the slope term; the constant bias stays.
         if (r.plane) r.biasWorld = light.bias.x;
+    }
+    if (filterCode >= SHADOWLAB_FILTER_VSM) {
+        // Filterable maps: one linear lookup of the blurred moments (the filter is in the blur),
+        // the receiver at the constant and slope bias as for `none`. Blocker ids and
+        // semi-transparent casters as one compare tap would give them.
+        const float ref = reference(light, r, r.biasWorld);
+        float v = momentVisibility(texture(momentMaps, vec3(r.uv, layer)), ref);
+        if (kBlockerIds && v < 0.5 && blocker == 0u) blocker = texture(blockerIds, vec3(r.uv, layer)).r;
+        if (kTransmittance) v *= transmittanceTap(r.uv, layer, ref);
+        return v;
     }
     if (filterCode == SHADOWLAB_FILTER_NONE) {
         if (kReceiverPlane && r.plane) return biasedTap(light, r, vec2(0.0), size, layer, blocker);

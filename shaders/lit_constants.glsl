@@ -52,3 +52,11 @@ const bool kAnyPerspective =
 layout(constant_id = 10) const bool kVertexLightConstantsAsked = false;
 const bool kVertexLightConstants = kVertexLightConstantsAsked && kVertexLightCoordinates;
 
+// The filterable maps' parameters (scene::MomentSettings, raster/moment_maps.h), read only by
+// the vsm, evsm2, evsm4, esm and msm filters.
+layout(constant_id = 11) const float kMinVariance = 1e-6;
+layout(constant_id = 12) const float kBleedReduction = 0.2;
+layout(constant_id = 13) const float kEvsmPositive = 40.0;
+layout(constant_id = 14) const float kEvsmNegative = 5.0;
+layout(constant_id = 15) const float kEsmExponent = 80.0;
+layout(constant_id = 16) const float kMomentBias = 3e-5;

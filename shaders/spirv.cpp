@@ -7,6 +7,7 @@
 #include "lit_frag_beauty.spv.h"
 #include "lit_frag_lights.spv.h"
 #include "lit_vert.spv.h"
+#include "moments_comp.spv.h"
 #include "shadow_frag.spv.h"
 #include "shadow_frag_alpha.spv.h"
 #include "shadow_frag_alpha_depth.spv.h"
@@ -36,5 +37,6 @@ std::span<const std::uint32_t> litVertSpirv() { return kLitVertSpv; }
 std::span<const std::uint32_t> litFragSpirv() { return kLitFragSpv; }
 std::span<const std::uint32_t> litFragLightsSpirv() { return kLitFragLightsSpv; }
 std::span<const std::uint32_t> litFragBeautySpirv() { return kLitFragBeautySpv; }
+std::span<const std::uint32_t> momentsCompSpirv() { return kMomentsCompSpv; }
 
 }  // namespace shadowlab::shaders

@@ -27,5 +27,7 @@ std::span<const std::uint32_t> litFragSpirv();
 std::span<const std::uint32_t> litFragLightsSpirv();
 // lit.frag compiled with SHADOWLAB_BEAUTY_ONLY: the beauty target only.
 std::span<const std::uint32_t> litFragBeautySpirv();
+// The filterable maps' moment and blur passes (raster/moment_maps.h).
+std::span<const std::uint32_t> momentsCompSpirv();
 
 }  // namespace shadowlab::shaders

@@ -145,7 +145,35 @@ TEST(Settings, BadValuesNameTheOption) {
     o.cascades = kMaxCascades + 1; expectError(o, "--cascades"); o = {};
     o.cascadeBlend = -0.01; expectError(o, "--cascade-blend"); o = {};
     o.cascadeBlend = 0.51; expectError(o, "--cascade-blend"); o = {};
-    o.cascadeBlend = std::nan(""); expectError(o, "--cascade-blend");
+    o.cascadeBlend = std::nan(""); expectError(o, "--cascade-blend"); o = {};
+    o.minVariance = -1e-9; expectError(o, "--min-variance"); o = {};
+    o.bleedReduction = 1.0; expectError(o, "--bleeding-reduction"); o = {};
+    o.evsmPositive = kMaxEvsmExponent + 1; expectError(o, "--evsm-positive"); o = {};
+    o.evsmNegative = std::nan(""); expectError(o, "--evsm-negative"); o = {};
+    o.esmExponent = kMaxEsmExponent + 1; expectError(o, "--esm-exponent"); o = {};
+    o.momentBias = -0.1; expectError(o, "--moment-bias"); o = {};
+    o.blurWidth = 6; expectError(o, "--blur-width"); o = {};
+    o.blurWidth = kMaxBlurWidth + 2; expectError(o, "--blur-width");
+}
+
+TEST(Settings, FilterableMapParametersComeFromTheCommandLineThenTheSceneThenTheDefaults) {
+    Scene s = unitScene(1.0);
+    s.shadow.filter = "evsm4";
+    s.shadow.evsmPositive = 30.0;
+    s.shadow.blurWidth = 7;
+    SettingsOverrides o;
+    o.blurWidth = 3;
+    const RasterSettings r = resolveSettings(s, o).raster;
+    EXPECT_EQ(r.filter, ShadowFilter::Evsm4);
+    EXPECT_TRUE(isFilterable(r.filter));
+    EXPECT_FALSE(isFilterable(ShadowFilter::Pcss));
+    EXPECT_EQ(r.moments.evsmPositive, 30.0);  // the scene's
+    EXPECT_EQ(r.moments.blurWidth, 3);        // the command line's
+    EXPECT_EQ(r.moments.evsmNegative, MomentSettings{}.evsmNegative);  // the default
+    for (const char* name : {"vsm", "evsm2", "evsm4", "esm", "msm"}) {
+        o.filter = name;
+        EXPECT_STREQ(toString(resolveSettings(s, o).raster.filter), name);
+    }
 }
 
 TEST(Settings, ReferenceIsDoubleRobustAndUnbiased) {

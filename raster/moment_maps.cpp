@@ -1,0 +1,185 @@
+// raster/moment_maps.cpp: the filterable maps' moment arrays and their two compute passes.
+#include "raster/moment_maps.h"
+
+#include <algorithm>
+#include <sstream>
+
+#include "raster/pipeline.h"
+#include "raster/vulkan_error.h"
+#include "shaders/interface.h"
+#include "shaders/spirv.h"
+
+namespace shadowlab::raster {
+
+namespace {
+
+constexpr std::uint32_t kGroup = 8;  // moments.comp's local size (x and y)
+
+void requireMomentFormat(const Context& ctx) {
+    requireFormat(ctx, kMomentFormat,
+                  VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT |
+                      VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT,
+                  "the filterable shadow maps' moments (VK_FORMAT_R32G32B32A32_SFLOAT as a storage image, "
+                  "sampled with a linear filter)");
+}
+
+}  // namespace
+
+MomentMaps createMomentMaps(const Context& ctx, std::uint32_t size, std::uint32_t layers) {
+    if (size > 1) requireMomentFormat(ctx);
+    requireDeviceMemory(ctx, VkDeviceSize(size) * size * layers * kMomentBytesPerTexel * kMomentArrays,
+                        std::to_string(layers) + " moment map(s) of " + std::to_string(size) + "x" +
+                            std::to_string(size));
+    MomentMaps m;
+    m.size = size;
+    m.layers = layers;
+    const VkImageUsageFlags usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    m.blurredX = createImage(ctx, kMomentFormat, size, size, layers, VK_IMAGE_USAGE_STORAGE_BIT,
+                             VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D_ARRAY);
+    m.moments = createImage(ctx, kMomentFormat, size, size, layers, usage, VK_IMAGE_ASPECT_COLOR_BIT,
+                            VK_IMAGE_VIEW_TYPE_2D_ARRAY);
+    // The lit pass's descriptor names the array in SHADER_READ_ONLY_OPTIMAL from the start: a
+    // render without a filterable filter never reads it (its code is compiled out).
+    VkCommandBuffer commands = ctx.beginCommands();
+    transition(commands, {{m.moments.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layers, VK_IMAGE_LAYOUT_UNDEFINED,
+                           VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
+                           VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT}});
+    ctx.submitAndWait(commands);
+    return m;
+}
+
+MomentPipeline createMomentPipeline(const Context& ctx, const ShadowMaps& maps, const MomentMaps& moments) {
+    requireMomentFormat(ctx);
+    VkDevice device = ctx.device.get();
+    MomentPipeline p;
+    const VkDescriptorSetLayoutBinding bindings[] = {
+        {.binding = 0, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
+         .stageFlags = VK_SHADER_STAGE_COMPUTE_BIT},
+        {.binding = 1, .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, .descriptorCount = 1,
+         .stageFlags = VK_SHADER_STAGE_COMPUTE_BIT},
+        {.binding = 2, .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, .descriptorCount = 1,
+         .stageFlags = VK_SHADER_STAGE_COMPUTE_BIT},
+    };
+    const VkDescriptorSetLayoutCreateInfo setInfo{
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 3, .pBindings = bindings};
+    VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &setLayout));
+    p.setLayout = DescriptorSetLayoutHandle(device, setLayout);
+    const VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(shaders::MomentPush)};
+    const VkPipelineLayoutCreateInfo layoutInfo{.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
+                                                .setLayoutCount = 1,
+                                                .pSetLayouts = &setLayout,
+                                                .pushConstantRangeCount = 1,
+                                                .pPushConstantRanges = &range};
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    VK_CHECK(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &layout));
+    p.layout = PipelineLayoutHandle(device, layout);
+
+    const ShaderModuleHandle module = createShaderModule(ctx, shaders::momentsCompSpirv());
+    const VkComputePipelineCreateInfo info{
+        .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
+        .stage = {.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+                  .stage = VK_SHADER_STAGE_COMPUTE_BIT,
+                  .module = module.get(),
+                  .pName = "main"},
+        .layout = layout,
+    };
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateComputePipelines(device, ctx.pipelineCache.get(), 1, &info, nullptr, &pipeline));
+    p.pipeline = PipelineHandle(device, pipeline);
+
+    const VkSamplerCreateInfo samplerInfo{
+        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
+        .magFilter = VK_FILTER_NEAREST,
+        .minFilter = VK_FILTER_NEAREST,
+        .mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
+        .addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .maxLod = 0.0f,
+    };
+    VkSampler sampler = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateSampler(device, &samplerInfo, nullptr, &sampler));
+    p.depthSampler = SamplerHandle(device, sampler);
+
+    const VkDescriptorPoolSize sizes[] = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1},
+                                          {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 2}};
+    const VkDescriptorPoolCreateInfo poolInfo{.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
+                                              .maxSets = 1,
+                                              .poolSizeCount = 2,
+                                              .pPoolSizes = sizes};
+    VkDescriptorPool pool = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateDescriptorPool(device, &poolInfo, nullptr, &pool));
+    p.pool = DescriptorPoolHandle(device, pool);
+    const VkDescriptorSetAllocateInfo allocInfo{.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
+                                                .descriptorPool = pool,
+                                                .descriptorSetCount = 1,
+                                                .pSetLayouts = &setLayout};
+    VK_CHECK(vkAllocateDescriptorSets(device, &allocInfo, &p.set));
+    const VkDescriptorImageInfo depthInfo{sampler, maps.depth.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    const VkDescriptorImageInfo xInfo{VK_NULL_HANDLE, moments.blurredX.view.get(), VK_IMAGE_LAYOUT_GENERAL};
+    const VkDescriptorImageInfo outInfo{VK_NULL_HANDLE, moments.moments.view.get(), VK_IMAGE_LAYOUT_GENERAL};
+    const VkWriteDescriptorSet writes[] = {
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = p.set, .dstBinding = 0, .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &depthInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = p.set, .dstBinding = 1, .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, .pImageInfo = &xInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = p.set, .dstBinding = 2, .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, .pImageInfo = &outInfo},
+    };
+    vkUpdateDescriptorSets(device, 3, writes, 0, nullptr);
+    return p;
+}
+
+void recordMomentPasses(VkCommandBuffer commands, const MomentPipeline& pipeline, const ShadowMaps& maps,
+                        const MomentMaps& moments, scene::ShadowFilter filter, const scene::MomentSettings& settings) {
+    const std::uint32_t layers = moments.layers;
+    // The depth pass's writes (its final barrier made them visible to fragment shaders and copies
+    // only) before the x pass's reads; both arrays' previous contents are not needed (UNDEFINED),
+    // but the previous frame's lit pass may still read the moments (a reused Renderer).
+    transition(commands,
+               {{maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, maps.layers, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                 VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT},
+                {moments.blurredX.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layers, VK_IMAGE_LAYOUT_UNDEFINED,
+                 VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE,
+                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT},
+                {moments.moments.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layers, VK_IMAGE_LAYOUT_UNDEFINED,
+                 VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_NONE,
+                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT}});
+    vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline.get());
+    vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.layout.get(), 0, 1, &pipeline.set, 0,
+                            nullptr);
+    const std::uint32_t groups = (moments.size + kGroup - 1) / kGroup;
+    shaders::MomentPush push{
+        .info = glm::ivec4(int(filter), 0, (settings.blurWidth - 1) / 2, int(moments.size)),
+        .params = glm::vec4(float(settings.evsmPositive), float(settings.evsmNegative), float(settings.esmExponent),
+                            0.0f)};
+    vkCmdPushConstants(commands, pipeline.layout.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+    vkCmdDispatch(commands, groups, groups, layers);
+    transition(commands, {{moments.blurredX.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layers, VK_IMAGE_LAYOUT_GENERAL,
+                           VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                           VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                           VK_ACCESS_2_SHADER_STORAGE_READ_BIT}});
+    push.info.y = 1;
+    vkCmdPushConstants(commands, pipeline.layout.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+    vkCmdDispatch(commands, groups, groups, layers);
+    transition(commands, {{moments.moments.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layers, VK_IMAGE_LAYOUT_GENERAL,
+                           VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                           VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                           VK_ACCESS_2_SHADER_SAMPLED_READ_BIT}});
+}
+
+std::string describeMomentCost(scene::ShadowFilter filter, std::uint32_t size, std::uint32_t layers, int blurWidth) {
+    const double mib = double(size) * size * layers * kMomentBytesPerTexel * kMomentArrays / (1024.0 * 1024.0);
+    std::ostringstream s;
+    s.precision(3);
+    s << scene::toString(filter) << ": 2 compute passes (moments and a " << blurWidth << "-texel box blur along x, "
+      << "then along y) over " << layers << " layer(s) of " << size << "x" << size << ", and " << kMomentArrays
+      << " RGBA32F moment arrays (" << mib << " MiB)";
+    return s.str();
+}
+
+}  // namespace shadowlab::raster

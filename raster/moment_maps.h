@@ -1,0 +1,59 @@
+// raster/moment_maps.h: the filterable shadow maps (vsm, evsm2, evsm4, esm, msm): after the depth
+// pass, two compute passes turn each layer's depths into the technique's moments and blur them
+// with a separable box of MomentSettings::blurWidth texels; the lit pass samples the result with
+// a linear filter (shaders/lit.frag momentVisibility). See docs/raster.md.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "raster/context.h"
+#include "raster/resources.h"
+#include "raster/shadow_pass.h"
+#include "scene/settings.h"
+
+namespace shadowlab::raster {
+
+// Every technique stores RGBA32F (the unused channels of vsm, evsm2 and esm included): one
+// storage-image format for the one compute shader, 32-bit because EVSM's exponents (up to 42) and
+// MSM's fourth power need it (16-bit floats hold e^11 at most and lose MSM's z⁴ to rounding), and
+// lavapipe filters it linearly. Checked at run time (requireMomentFormat).
+inline constexpr VkFormat kMomentFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+inline constexpr std::uint64_t kMomentBytesPerTexel = 16;
+
+// The moment arrays a render holds: the blurred moments (sampled by the lit pass) and the
+// intermediate after the x pass, both size x size x layers.
+inline constexpr std::uint64_t kMomentArrays = 2;
+
+struct MomentMaps {
+    Image blurredX;  // moments averaged along x (pass 0), read by pass 1
+    Image moments;   // the result, sampled by the lit pass (SHADER_READ_ONLY_OPTIMAL after the passes)
+    std::uint32_t size = 0;
+    std::uint32_t layers = 0;
+};
+// size 1, layers 1 for renders without a filterable map (keeps the lit pass's descriptor valid);
+// cleared to 0 there and left in SHADER_READ_ONLY_OPTIMAL.
+MomentMaps createMomentMaps(const Context& ctx, std::uint32_t size, std::uint32_t layers);
+
+struct MomentPipeline {
+    DescriptorSetLayoutHandle setLayout;
+    PipelineLayoutHandle layout;
+    PipelineHandle pipeline;
+    SamplerHandle depthSampler;  // NEAREST, for texelFetch of the depth array
+    DescriptorPoolHandle pool;
+    VkDescriptorSet set = VK_NULL_HANDLE;  // freed with the pool
+};
+// Throws RasterError naming kMomentFormat and the device when the format cannot be a storage
+// image or be filtered linearly.
+MomentPipeline createMomentPipeline(const Context& ctx, const ShadowMaps& maps, const MomentMaps& moments);
+
+// Records both passes for `filter` (a filterable one) after the depth pass: the depth array in
+// SHADER_READ_ONLY_OPTIMAL (written by the depth pass) to moments in SHADER_READ_ONLY_OPTIMAL,
+// ready for the lit pass's fragment shader.
+void recordMomentPasses(VkCommandBuffer commands, const MomentPipeline& pipeline, const ShadowMaps& maps,
+                        const MomentMaps& moments, scene::ShadowFilter filter, const scene::MomentSettings& settings);
+
+// For --explain and the Frame: the passes and memory the technique adds.
+std::string describeMomentCost(scene::ShadowFilter filter, std::uint32_t size, std::uint32_t layers, int blurWidth);
+
+}  // namespace shadowlab::raster

@@ -1,0 +1,52 @@
+// shaders/moments.comp: the filterable shadow maps' moments (raster/moment_maps.h), in two
+// passes of a separable box blur. Pass 0 turns each depth texel into the technique's moments and
+// averages `width` of them along x into the intermediate array; pass 1 averages `width` of those
+// along y into the moment array the lit pass samples. Texel coordinates are clamped to the map,
+// as the lit pass's clamp-to-edge sampler does.
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#include "interface.h"
+
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
+
+layout(set = 0, binding = 0) uniform sampler2DArray depths;  // the shadow maps (NEAREST, no compare)
+layout(set = 0, binding = 1, rgba32f) uniform image2DArray blurredX;
+layout(set = 0, binding = 2, rgba32f) uniform image2DArray moments;
+
+layout(push_constant) uniform Push { MomentPush push; };
+
+// The moments of one stored depth z (0..1) for the filter code.
+vec4 momentsOf(float z, int code) {
+    if (code == SHADOWLAB_FILTER_VSM) return vec4(z, z * z, 0.0, 0.0);
+    if (code == SHADOWLAB_FILTER_EVSM2 || code == SHADOWLAB_FILTER_EVSM4) {
+        // Warped to [-1, 1] first, so both exponents act on the same range (Lauritzen & McCool 2008).
+        const float w = 2.0 * z - 1.0;
+        const float p = exp(push.params.x * w);
+        const float n = -exp(-push.params.y * w);
+        return code == SHADOWLAB_FILTER_EVSM2 ? vec4(p, p * p, 0.0, 0.0) : vec4(p, p * p, n, n * n);
+    }
+    if (code == SHADOWLAB_FILTER_ESM) return vec4(exp(push.params.z * z), 0.0, 0.0, 0.0);
+    // MSM: the plain powers in 32-bit float (no optimised quantisation: nothing is 16-bit here).
+    const float z2 = z * z;
+    return vec4(z, z2, z2 * z, z2 * z2);
+}
+
+void main() {
+    const ivec3 size = ivec3(push.info.w, push.info.w, 0);
+    const ivec3 at = ivec3(gl_GlobalInvocationID);
+    if (at.x >= size.x || at.y >= size.y) return;
+    const int code = push.info.x;
+    const int radius = push.info.z;
+    vec4 sum = vec4(0.0);
+    if (push.info.y == 0) {
+        for (int k = -radius; k <= radius; ++k) {
+            const ivec3 t = ivec3(clamp(at.x + k, 0, size.x - 1), at.y, at.z);
+            sum += momentsOf(texelFetch(depths, t, 0).r, code);
+        }
+        imageStore(blurredX, at, sum / float(2 * radius + 1));
+    } else {
+        for (int k = -radius; k <= radius; ++k)
+            sum += imageLoad(blurredX, ivec3(at.x, clamp(at.y + k, 0, size.y - 1), at.z));
+        imageStore(moments, at, sum / float(2 * radius + 1));
+    }
+}
