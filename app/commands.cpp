@@ -42,6 +42,7 @@
 #include "scene/error.h"
 #include "scene/frame_identity.h"
 #include "scene/frame_io.h"
+#include "scene/gltf_export.h"
 #include "scene/input_file.h"
 #include "scene/loader.h"
 #include "scene/mask_io.h"
@@ -357,6 +358,29 @@ struct StagingFolder {
 };
 
 }  // namespace
+
+// The scene as glTF for other engines (docs/export.md): the scene as its file says, no view
+// search or ground, since another engine renders it from the file alone.
+int exportScene(const ExportOptions& o) {
+    std::string ext = o.output.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+    if (ext != ".glb" && ext != ".gltf")
+        throw scene::InputError(o.output.string() + ": unknown export type '" + o.output.extension().string() +
+                                "' (use .glb or .gltf)");
+    if (!(o.tolerance > 0.0 && o.tolerance < 0.5))
+        throw scene::InputError("--tolerance: must be in (0, 0.5) (a fraction of a sphere's radius), got " +
+                                std::to_string(o.tolerance));
+    checkOutputFile(o.output);
+    const scene::Scene s = readingInput(o.scene, [&] { return scene::loadScene(scene::findScene(o.scene)); });
+    createOutputFolder(o.output);
+    Stage stage("exporting " + s.file.filename().string());
+    const scene::ExportResult r = scene::exportGltf(s, o.output, {o.tolerance});
+    char tol[32];
+    std::snprintf(tol, sizeof tol, "%.3g", r.achievedTolerance);
+    stage.done(std::to_string(r.nodes) + " nodes, " + std::to_string(r.triangles) + " triangles, sphere sagitta " +
+               tol + " x radius -> " + o.output.string());
+    return 0;
+}
 
 int render(const RenderOptions& o) {
     std::string ext = o.output.extension().string();

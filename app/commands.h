@@ -117,7 +117,14 @@ struct PathCommandOptions {
     bool noHeldView = false;
 };
 
+struct ExportOptions {
+    std::string scene;  // path or shipped name
+    std::filesystem::path output;  // .glb or .gltf
+    double tolerance = 1e-3;  // a sphere's largest sagitta / radius
+};
+
 int render(const RenderOptions& options);
+int exportScene(const ExportOptions& options);
 int check(const CheckOptions& options);
 int path(const PathCommandOptions& options);
 int run(const RunOptions& options);

@@ -246,6 +246,14 @@ int main(int argc, char** argv) {
     compareCmd->add_flag("--mask-srgb", compareOptions.maskSrgb,
                          "METHOD is a shadow mask with sRGB-encoded values (default: linear)");
 
+    shadowlab::app::ExportOptions exportOptions;
+    auto* exportCmd = app.add_subcommand("export", "Write the scene as glTF 2.0 with KHR_lights_punctual (.glb or "
+                                                   ".gltf) for another engine (docs/export.md)");
+    exportCmd->add_option("SCENE", exportOptions.scene, "Scene file or shipped name")->required();
+    exportCmd->add_option("-o,--output", exportOptions.output, "The glTF file (.glb or .gltf)")->required();
+    exportCmd->add_option("--tolerance", exportOptions.tolerance,
+                          "Largest sagitta of a tessellated sphere, as a fraction of its radius (default 1e-3)");
+
     shadowlab::app::CheckOptions checkOptions;
     auto* checkCmd = app.add_subcommand(
         "check", "CI gate: run a suite of cases (scene, backend, settings, budgets) against the reference, their "
@@ -288,6 +296,7 @@ int main(int argc, char** argv) {
         if (*stabilityCmd) return finishStandardOutput(shadowlab::app::stability(stabilityOptions));
         if (*checkCmd) return finishStandardOutput(shadowlab::app::check(checkOptions));
         if (*pathCmd) return finishStandardOutput(shadowlab::app::path(pathOptions));
+        if (*exportCmd) return finishStandardOutput(shadowlab::app::exportScene(exportOptions));
     } catch (const shadowlab::scene::SceneError& e) {
         std::cerr << "shadowlab: error: " << e.what() << "\n";
         return 2;

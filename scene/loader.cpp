@@ -703,10 +703,22 @@ Scene loadModelScene(const fs::path& file) {
     const Bounds b = scene.bounds();
     scene.origin.modelScene = true;
     scene.origin.modelBounds = b;
-    for (const GltfCamera& c : extras.cameras)
-        scene.origin.cameras.push_back({c.name.empty() ? c.nodeName : c.name, file.filename().string(),
-                                        cameraFromGltf(c.position, c.forward, c.up, c.yfovRadians, c.znear, c.zfar,
-                                                       c.aspect, b, scene.camera)});
+    for (const GltfCamera& c : extras.cameras) {
+        Camera camera = cameraFromGltf(c.position, c.forward, c.up, c.yfovRadians, c.znear, c.zfar, c.aspect, b,
+                                       scene.camera);
+        if (c.width > 0 && c.height > 0 && static_cast<long long>(c.width) * c.height <= kMaxPixels) {
+            camera.width = c.width;  // a shadowlab export's image size (scene/gltf_export.h)
+            camera.height = c.height;
+        }
+        scene.origin.cameras.push_back({c.name.empty() ? c.nodeName : c.name, file.filename().string(), camera});
+    }
+    // A shadowlab export is a whole scene (docs/export.md): its ground, if any, is one of its
+    // objects, so none is added.
+    if (extras.shadowlabExport) {
+        scene.origin.ground = false;
+        scene.origin.choices.emplace_back("export", "a shadowlab export (" + file.filename().string() +
+                                                        "): its image size kept, no ground added");
+    }
     scene.origin.cameraAnimations = extras.cameraAnimations;
     if (!scene.origin.cameras.empty()) {
         scene.camera = scene.origin.cameras.front().camera;
@@ -734,6 +746,7 @@ Scene loadModelScene(const fs::path& file) {
             light.direction = l.direction;
             // glTF point intensity is in candela (irradiance I/d²); ours is I/(4π d²).
             light.intensity = 4.0 * kPi * l.intensity;
+            if (extras.shadowlabExport && l.radius > 0 && std::isfinite(l.radius)) light.radius = l.radius;
             if (light.type == LightType::Spot)
                 light.coneAngleDegrees = std::clamp(l.outerConeRadians * 180.0 / kPi, 0.1, 89.9);
         }

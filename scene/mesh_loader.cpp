@@ -556,6 +556,18 @@ void collectCameraAndLight(const tinygltf::Model& model, const tinygltf::Node& n
         c.znear = pc.znear;
         c.zfar = pc.zfar;
         c.aspect = pc.aspectRatio;
+        // A shadowlab export's image size (scene/gltf_export.cpp); anything else there is ignored.
+        const tinygltf::Value& extra = model.cameras[node.camera].extras;
+        if (extra.IsObject() && extra.Has("shadowlab") && extra.Get("shadowlab").Has("resolution")) {
+            const tinygltf::Value& res = extra.Get("shadowlab").Get("resolution");
+            if (res.IsArray() && res.ArrayLen() == 2 && res.Get(0).IsNumber() && res.Get(1).IsNumber()) {
+                const double w = res.Get(0).GetNumberAsDouble(), h = res.Get(1).GetNumberAsDouble();
+                if (w >= 1 && h >= 1 && w <= 16384 && h <= 16384 && w == std::floor(w) && h == std::floor(h)) {
+                    c.width = int(w);
+                    c.height = int(h);
+                }
+            }
+        }
         out.cameras.push_back(c);
     }
     const auto ext = node.extensions.find("KHR_lights_punctual");
@@ -582,6 +594,9 @@ void collectCameraAndLight(const tinygltf::Model& model, const tinygltf::Node& n
     if (l.color.size() == 3) light.color = Vec3(l.color[0], l.color[1], l.color[2]);
     light.intensity = l.intensity;
     light.outerConeRadians = l.spot.outerConeAngle;
+    if (l.extras.IsObject() && l.extras.Has("shadowlab") && l.extras.Get("shadowlab").Has("radius") &&
+        l.extras.Get("shadowlab").Get("radius").IsNumber())
+        light.radius = l.extras.Get("shadowlab").Get("radius").GetNumberAsDouble();
     out.lights.push_back(light);
 }
 
@@ -662,6 +677,7 @@ void loadGltf(const fs::path& file, const std::string& bytes, std::vector<RawIns
     if (request.perMaterial) materials = readMaterials(model, images, file, sceneFile, path);
     images.clear();
     if (extras) extras->materials = materials;
+    if (extras) extras->shadowlabExport = model.asset.extras.IsObject() && model.asset.extras.Has("shadowlab");
     // Walk the default scene's node tree (depth first, in document order) so each node that
     // uses a mesh places it once; a mesh used by several nodes is read once and shared.
     std::vector<int> roots;

@@ -24,6 +24,7 @@ struct GltfCamera {
     std::string name, nodeName;  // the camera's and its node's "name" ("" when unnamed)
     Vec3 position{0, 0, 0}, forward{0, 0, -1}, up{0, 1, 0};
     double yfovRadians = 0.0, znear = 0.0, zfar = 0.0, aspect = 0.0;  // zfar/aspect 0: unset
+    int width = 0, height = 0;  // extras.shadowlab.resolution of a shadowlab export; 0: unset
 };
 struct GltfLight {
     int index = -1;    // in KHR_lights_punctual.lights
@@ -31,6 +32,7 @@ struct GltfLight {
     Vec3 position{0, 0, 0}, direction{0, 0, -1}, color{1, 1, 1};
     double intensity = 1.0;         // lux (directional) or candela (point, spot)
     double outerConeRadians = 0.0;  // spot
+    double radius = 0.0;            // extras.shadowlab.radius of a shadowlab export (a spherical light)
 };
 struct GltfExtras {
     std::vector<GltfCamera> cameras;
@@ -41,6 +43,8 @@ struct GltfExtras {
     // With MeshRequest::perMaterial: the file's materials in its order (alpha mode, cutoff,
     // baseColorFactor alpha and, for MASK and BLEND, the baseColorTexture's alpha).
     std::vector<Material> materials;
+    // asset.extras.shadowlab is present: the file is a `shadowlab export` (scene/gltf_export.h).
+    bool shadowlabExport = false;
     std::uint64_t loadBytes = 0;  // the file's temporaries while it was read (text, trees, buffers)
 };
 

@@ -1,0 +1,35 @@
+// scene/gltf_export.h: a Scene as glTF 2.0 (.glb or .gltf) with KHR_lights_punctual, so that any
+// engine loads what shadowlab renders: analytic spheres, quads and boxes tessellated, the camera,
+// materials and opacity, the image size; a shadowlab load of the file gives back the same lights,
+// camera and image size (docs/export.md).
+#pragma once
+
+#include <filesystem>
+
+#include "scene/scene.h"
+
+namespace shadowlab::scene {
+
+struct ExportOptions {
+    // Largest sagitta of a sphere's tessellation (the distance from the true surface to the
+    // flat triangles), as a fraction of its radius.
+    double tolerance = 1e-3;
+};
+
+struct ExportResult {
+    double achievedTolerance = 0.0;  // the largest measured sagitta / radius over all spheres (0: none)
+    std::size_t triangles = 0;
+    std::size_t nodes = 0;
+};
+
+// The largest distance from a sphere of radius 1 to a UV tessellation with `segments` around and
+// `rings` from pole to pole (vertices on the sphere), measured over every triangle: 1 minus the
+// least distance from the centre to a triangle.
+double uvSphereSagitta(int segments, int rings);
+
+// Writes `scene` to `file` (.glb binary, .gltf with the buffer embedded as a data URI) through a
+// temporary name and a rename. Throws InputError for an unknown extension or a file that cannot
+// be written (nothing is left behind).
+ExportResult exportGltf(const Scene& scene, const std::filesystem::path& file, const ExportOptions& options = {});
+
+}  // namespace shadowlab::scene
