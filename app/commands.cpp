@@ -36,6 +36,7 @@
 #include "raster/memory.h"
 #include "raster/moment_maps.h"
 #include "raster/renderer.h"
+#include "raster/shadow_layers.h"
 #include "raytrace/memory.h"
 #include "raytrace/renderer.h"
 #include "raytrace/view_search.h"
@@ -165,6 +166,9 @@ Prepared prepare(const SceneOptions& o) {
                 std::cerr << "; cannot cast onto the receivers each map serves)\n";
             }
         }
+        std::cerr << raster::explainShadowLayers(
+            raster::planShadowLayers(p.scene, p.plan, raster::resolveAutomaticChoices(p.scene, p.settings.raster, &p.plan)),
+            p.scene.objects.size());
     }
     return p;
 }
@@ -590,7 +594,7 @@ int run(const RunOptions& o) {
         report.methods.push_back(std::move(method));
         if (isRaster && views) {
             for (const RunView& v : kRunViews) {
-                if (std::string_view(v.view) == "cascades" && debug.cascadeSplits.empty()) continue;
+                if (std::string_view(v.view) == "cascades" && raster::cascadeSplits(debug.layers).empty()) continue;
                 const raster::DisplayImage img = debugView(v.view, frame, p.scene, debug);
                 const std::string png = std::string("raster-") + v.view + ".png";
                 scene::writePngDisplay(dir / png, img.width, img.height, img.rgb);

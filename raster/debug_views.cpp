@@ -99,20 +99,21 @@ DisplayImage shadowMapView(const RenderDebug& debug) {
                 }
                 fill(img, x0 + tx, y0 + ty, 1, 1, c);
             }
-        if (std::size_t(l) < debug.layerLabels.size())
-            drawLabel(img, x0 + 2, y0 + 2, debug.layerLabels[std::size_t(l)], std::max(1, tile / 128));
+        if (std::size_t(l) < debug.layers.size())
+            drawLabel(img, x0 + 2, y0 + 2, debug.layers[std::size_t(l)].label, std::max(1, tile / 128));
     }
     return img;
 }
 
 std::vector<int> cascadeIndices(const scene::Frame& frame, const RenderDebug& debug) {
     std::vector<int> out(frame.pixelCount(), -1);
-    const std::size_t count = debug.cascadeSplits.empty() ? 1 : debug.cascadeSplits.size() - 1;
+    const std::vector<double> splits = cascadeSplits(debug.layers);
+    const std::size_t count = splits.empty() ? 1 : splits.size() - 1;
     for (std::size_t i = 0; i < out.size(); ++i) {
         if (!(frame.objectId[i] > 0.0f)) continue;
         int c = 0;
         for (std::size_t k = 0; k + 1 < count; ++k)
-            if (frame.depth[i] > float(debug.cascadeSplits[k + 1])) c = int(k) + 1;
+            if (frame.depth[i] > float(splits[k + 1])) c = int(k) + 1;
         out[i] = c;
     }
     return out;
@@ -144,15 +145,16 @@ double pixelWorldSize(const scene::CameraBasis& cam, double z) { return 2.0 * z 
 
 std::vector<double> texelToPixelRatios(const scene::Frame& frame, const scene::Scene& scene, const RenderDebug& debug) {
     std::vector<double> out(frame.pixelCount(), std::numeric_limits<double>::quiet_NaN());
-    if (debug.frusta.empty() || debug.layerLight.empty()) return out;
+    if (debug.layers.empty()) return out;
     scene::Camera camera = scene.camera;
     camera.width = frame.width;
     camera.height = frame.height;
     const scene::CameraBasis cam = scene::cameraBasis(camera);
-    const int light = debug.layerLight[0];
+    const int light = debug.layers[0].light;
     const scene::Light& l = scene.lights[std::size_t(light)];
     const std::vector<int> cascade = cascadeIndices(frame, debug);
-    const bool cascaded = l.type == scene::LightType::Directional && !debug.cascadeTexels.empty();
+    const std::vector<double> texels = cascadeTexels(debug.layers);
+    const bool cascaded = l.type == scene::LightType::Directional && !texels.empty();
     for (int y = 0; y < frame.height; ++y)
         for (int x = 0; x < frame.width; ++x) {
             const std::size_t i = std::size_t(y) * std::size_t(frame.width) + std::size_t(x);
@@ -161,13 +163,13 @@ std::vector<double> texelToPixelRatios(const scene::Frame& frame, const scene::S
             const scene::Vec3 p = cam.position + z * scene::pixelDirection(cam, x, y);
             double texel = 0.0;
             if (l.type == scene::LightType::Directional) {
-                texel = cascaded ? debug.cascadeTexels[std::size_t(std::max(cascade[i], 0))]
-                                 : debug.frusta[0].texelWorldSize();
+                texel = cascaded ? texels[std::size_t(std::max(cascade[i], 0))]
+                                 : debug.layers[0].frustum.texelWorldSize();
             } else if (l.type == scene::LightType::Spot) {
-                texel = debug.frusta[0].texelWorldSize() * glm::dot(p - l.position, debug.frusta[0].direction);
+                texel = debug.layers[0].frustum.texelWorldSize() * glm::dot(p - l.position, debug.layers[0].frustum.direction);
             } else {
                 const scene::Vec3 d = glm::abs(p - l.position);
-                texel = debug.frusta[0].texelWorldSize() * std::max(d.x, std::max(d.y, d.z));
+                texel = debug.layers[0].frustum.texelWorldSize() * std::max(d.x, std::max(d.y, d.z));
             }
             out[i] = texel / pixelWorldSize(cam, z);
         }
@@ -252,7 +254,7 @@ std::array<float, 3> lightTint(const scene::Light& light) {
 
 namespace {
 
-// The layers of one shadowed light: debug.frusta[first .. first + count).
+// The layers of one shadowed light: debug.layers[first .. first + count).
 struct LightLayers {
     int light = 0;
     int first = 0;
@@ -260,9 +262,9 @@ struct LightLayers {
 };
 std::vector<LightLayers> shadowedLights(const RenderDebug& debug) {
     std::vector<LightLayers> out;
-    for (std::size_t k = 0; k < debug.layerLight.size() && k < debug.frusta.size(); ++k) {
-        if (out.empty() || out.back().light != debug.layerLight[k])
-            out.push_back({debug.layerLight[k], int(k), 0});
+    for (std::size_t k = 0; k < debug.layers.size(); ++k) {
+        if (out.empty() || out.back().light != debug.layers[k].light)
+            out.push_back({debug.layers[k].light, int(k), 0});
         ++out.back().count;
     }
     return out;
@@ -315,7 +317,7 @@ std::vector<PixelCoverage> coverage(const scene::Frame& frame, const scene::Scen
             for (const LightLayers& ll : lights) {
                 const scene::Light& light = scene.lights[std::size_t(ll.light)];
                 const int layer = layerAt(ll, light, p, cascade[i]);
-                if (!insideLightMap(debug.frusta[std::size_t(layer)], p)) {
+                if (!insideLightMap(debug.layers[std::size_t(layer)].frustum, p)) {
                     uncovered = uncovered || (facing && reaches(light, p));
                     continue;
                 }
@@ -477,7 +479,7 @@ DisplayImage lightFrustumView(const scene::Frame& frame, const scene::Scene& sce
             const bool cascaded = light.type == scene::LightType::Directional && ll.count > 1;
             for (int k = 0; k < ll.count; ++k) {
                 const std::array<float, 3> color = cascaded ? cascadeTint(k) : lightTint(light);
-                const std::array<scene::Vec3, 8> corners = frustumCorners(debug.frusta[std::size_t(ll.first + k)]);
+                const std::array<scene::Vec3, 8> corners = frustumCorners(debug.layers[std::size_t(ll.first + k)].frustum);
                 for (const auto& e : kFrustumEdges)
                     if (const auto s = projectSegment(cam, scene.camera.near, corners[std::size_t(e[0])],
                                                       corners[std::size_t(e[1])]))

@@ -26,7 +26,7 @@ struct DisplayImage {
 // Tiles of every shadow-map layer (debug.layerDepths must be captured), in layer order left to
 // right, top to bottom: cols = ceil(sqrt(layers)), rows = ceil(layers / cols), each tile
 // shadowMapTileSize(mapSize) pixels, kShadowMapViewGap pixels apart, each labelled with
-// debug.layerLabels in its top-left corner. Depth as gray per layer: the texel nearest the
+// the layer's label in its top-left corner. Depth as gray per layer: the texel nearest the
 // light white, the farthest stored depth dark gray (normalized over the layer's stored range);
 // texels where nothing was drawn (cleared to depth 1) dark blue. A tile smaller than the map
 // shows the minimum depth of each block of texels, so thin casters stay visible.
@@ -35,7 +35,7 @@ int shadowMapTileSize(std::uint32_t mapSize);  // min(mapSize, 512)
 DisplayImage shadowMapView(const RenderDebug& debug);
 
 // The cascade each pixel's shadow test used: the number of cascade split depths (the inner ones,
-// debug.cascadeSplits[1..count-1]) its view depth exceeds, compared in float as lit.frag does; 0
+// cascadeSplits(debug.layers)[1..count-1]) its view depth exceeds, compared in float as lit.frag does; 0
 // for every receiver without cascades; -1 on the background.
 std::vector<int> cascadeIndices(const scene::Frame& frame, const RenderDebug& debug);
 // Display color of cascade c (0..3): red, green, blue, yellow.

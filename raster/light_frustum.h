@@ -188,19 +188,6 @@ inline constexpr double kCubeWrapReachFactor = 3.0;
 // mapSize: kCullMarginTexels, plus the PCSS reach for a spot or point light with a radius.
 double cullReachTexels(const scene::RasterSettings& settings, const scene::Light& light, int mapSize);
 
-// Per light, what culling leaves out of its depth passes with the frusta the renderer makes for
-// `settings` (and `plan`, when given: lights it gives no shadow test have no maps): per layer (one
-// for a single map, one per cascade, six cube faces) its label ("" for a single map, "C0".., "+X"..)
-// and how many objects its depth pass leaves out. No layers where nothing is culled: a light
-// without a map, settings.cullCasters off, or a transmittance map (plan.needsTransmittanceMap),
-// whose draw order is not per object.
-struct LightCulling {
-    std::vector<std::string> layers;
-    std::vector<int> culled;
-    int total() const;  // object draws left out over all the light's layers
-};
-std::vector<LightCulling> culledCasters(const scene::Scene& scene, const scene::RasterSettings& settings,
-                                        const scene::RenderPlan* plan = nullptr);
 // The objects drawn into one layer of `light` (f its frustum, receivers those that read it).
 std::vector<bool> layerCasters(const scene::Scene& scene, const scene::RasterSettings& settings,
                                const scene::Light& light, const LightFrustum& f,

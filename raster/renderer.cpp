@@ -21,6 +21,7 @@
 #include "raster/light_frustum.h"
 #include "raster/lit_pass.h"
 #include "raster/moment_maps.h"
+#include "raster/shadow_layers.h"
 #include "raster/shadow_pass.h"
 #include "raster/tolerances.h"
 #include "scene/camera.h"
@@ -110,13 +111,6 @@ std::vector<TransparentDraw> separateTransparent(const scene::Scene& scene, Scen
     return draws;
 }
 
-bool needsShadowTest(const scene::RenderPlan& plan, std::size_t light) {
-    // A plan made for another scene (or by hand) without this light: test, to be safe.
-    for (const scene::LightPlan& lp : plan.lights)
-        if (lp.light == int(light)) return lp.needsShadowTest;
-    return true;
-}
-
 void checkSupported(const scene::Scene& scene, const scene::RasterSettings& settings) {
     if (scene.lights.size() > SHADOWLAB_MAX_LIGHTS)
         throw RasterError("the scene has " + std::to_string(scene.lights.size()) +
@@ -163,14 +157,11 @@ struct Renderer::Impl {
     std::uint32_t lightKinds = 0;  // bit 1 << SHADOWLAB_LIGHT_* per kind present
     glm::vec3 background{0.0f};
     std::map<std::string, std::string> attributes;  // what every frame of this scene records
-    std::vector<glm::mat4> lightMatrices;           // one per shadow-map layer
-    // Per layer, for RenderDebug: its frustum, the light it belongs to and a short label.
-    std::vector<LightFrustum> frusta;
-    std::vector<int> layerLight;
-    std::vector<std::string> layerLabels;
-    // Cascades (the same for every cascaded directional light: they depend on the camera only):
-    // the split depths and each cascade's texel world size; empty without cascades.
-    std::vector<double> cascadeSplits, cascadeTexels;
+    // The shadow-map layers (planShadowLayers), in the array's order; what follows is derived.
+    std::vector<ShadowLayer> layers;
+    std::vector<glm::mat4> lightMatrices;  // per layer, recordShadowPass's input
+    // The split depths of the cascades (cascadeSplits(layers)); empty without cascades.
+    std::vector<double> splits;
     int cascadesUsed = 1;  // lit.frag's cascade count (specialization constant)
     // The blend band before each split (settings.cascadeBlend), 0 without cascades: when > 0,
     // lit.frag's blend code is compiled in (specialization constant) and reads it from counts.z.
@@ -203,8 +194,8 @@ struct Renderer::Impl {
     // their compute passes, made with the first frame's pipelines.
     MomentMaps momentMaps;
     MomentPipeline momentPipeline;
-    std::vector<glm::vec4> layerLights;
-    std::vector<DepthBiasFactors> layerBias;  // per shadow-map layer (settings.hardwareBias)
+    std::vector<glm::vec4> layerLights;       // per layer, its light (TransmittancePass)
+    std::vector<DepthBiasFactors> layerBias;  // per layer, recordShadowPass's input (settings.hardwareBias)
     LitPipeline litPipelines[4];
     LitBindings bindings;  // allocated with the first lit pipeline's (identical) set layout
     shaders::LitUniforms uniforms{};
@@ -214,7 +205,6 @@ struct Renderer::Impl {
     scene::Vec3 origin{0.0};  // the first camera's position: the vertex buffer is relative to it
     scene::RenderPlan plan;
     std::vector<std::uint32_t> objectFirstIndex;
-    std::vector<double> usedDepthBias;  // per shadow-mapped light (spot, directional)
     std::size_t triangles = 0;
     int sphereSegmentsUsed = 0;
     // The view depth of the camera the image is drawn from minus the depth the shaders compute
@@ -222,16 +212,17 @@ struct Renderer::Impl {
     // cascade splits (update()).
     double viewDepthOffset = 0.0;
     double pendingUpdateMs = 0.0;  // the last update()'s time, reported by the next frame as "update"
-    // Light frusta, cascades, caster culling and the lit pass's uniforms for `scene` (its camera
-    // fits the maps) drawn from `view`.
+    // The layers (light frusta, cascades, caster culling) and the lit pass's uniforms for `scene`
+    // (its camera fits the maps) drawn from `view`.
     void placeLights(const scene::Scene& scene, const scene::Camera& view);
+    void setLayerLights(const scene::Scene& scene);  // layerLights from layers
     // The rest of the constructor: shadow maps, targets, readback, queries, attributes.
     void createTargets(const scene::Scene& scene, const RendererOptions& options);
     void describeLayers();  // the attributes that follow the frusta
     void update(const scene::Scene& scene, const scene::Camera& view);
 };
 
-Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settingsIn,
+Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn, const scene::RasterSettings& settingsIn,
                      const RendererOptions& options, ValidationLog& log)
     : settings(settingsIn),
       ctx((checkSupported(scene, settingsIn),
@@ -247,11 +238,11 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
     SceneGeometry geometry = tessellateScene(scene, origin, scene.hasAlphaCasters());
     std::vector<TransparentDraw> transparentDraws;
     std::uint32_t opaqueIndexCount = ~0u;
-    if (plan.needsTransmittanceMap) transparentDraws = separateTransparent(scene, geometry, opaqueIndexCount);
+    if (planIn.needsTransmittanceMap) transparentDraws = separateTransparent(scene, geometry, opaqueIndexCount);
     triangles = geometry.triangleCount();
     sphereSegmentsUsed = geometry.maxSphereSegments;
     objectFirstIndex = geometry.objectFirstIndex;
-    this->plan = plan;
+    plan = planIn;
     // Device-local, uploaded once for every frame of this Renderer.
     vertexBuffer = uploadBuffer(ctx, geometry.vertices, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
     indexBuffer = uploadBuffer(ctx, geometry.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
@@ -279,14 +270,6 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& plan, c
 
 void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera& view) {
     const scene::CameraBasis cam = scene::cameraBasis(view);
-    lightMatrices.clear();
-    frusta.clear();
-    layerLight.clear();
-    layerLabels.clear();
-    layerBias.clear();
-    cascadeSplits.clear();
-    cascadeTexels.clear();
-    usedDepthBias.clear();
     draw.layerRanges.clear();
     cascadesUsed = 1;
     lightKinds = 0;
@@ -298,32 +281,15 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
     const scene::CameraBasis fitCam = scene::cameraBasis(scene.camera);
     viewDepthOffset = glm::dot(origin - fitCam.position, fitCam.forward);
 
-    // Caster culling: per culled layer, which objects are drawn into it, and how many are not.
-    // Not with a transmittance map: its index order (opaque casters first) is not per object.
-    const bool cull = settings.cullCasters && !plan.needsTransmittanceMap;
-    const std::vector<scene::Vec3> receivers = cull ? visibleReceiverPoints(scene) : std::vector<scene::Vec3>{};
-    std::map<std::size_t, std::vector<bool>> casters;
-    std::vector<int> culledPerLight(scene.lights.size(), 0);
-    std::vector<int> culledPerLayer;
-    auto cullLayer = [&](std::size_t light, const LightFrustum& lf, const std::vector<scene::Vec3>& layerReceivers) {
-        int n = 0;
-        if (cull) {
-            std::vector<bool> c = layerCasters(scene, settings, scene.lights[light], lf, layerReceivers);
-            for (const bool k : c) n += k ? 0 : 1;
-            casters[lightMatrices.size()] = std::move(c);  // called before the layer's matrix is added
-        }
-        culledPerLight[light] += n;
-        culledPerLayer.push_back(n);
-    };
+    layers = planShadowLayers(scene, plan, settings, origin);
+    lightMatrices.clear();
+    layerBias.clear();
+    for (const ShadowLayer& layer : layers) {
+        lightMatrices.push_back(layer.matrix);
+        layerBias.push_back(layer.hardwareBias);
+    }
+    splits = cascadeSplits(layers);
 
-    // The hardware bias of an orthographic map (settings.hardwareBias): the world constant bias
-    // in units of r (its depth is linear: bias / depth range), the slope bias in texels as it is
-    // (the rasterizer's slope is depth per texel, as the shader's slope term is per texel).
-    auto hardwareDepthBias = [&](double depthBias, const LightFrustum& map) {
-        return DepthBiasFactors{float(depthBias / map.depthRange() / kShadowDepthUnitR), float(settings.slopeBias)};
-    };
-    // One shadow-map layer per light that needs a shadow test.
-    const scene::Bounds bounds = scene.bounds();
     const glm::dmat4 viewProj = scene::projectionMatrix(cam, view.near, view.far) *
                                 scene::viewMatrix(cam, origin);
     uniforms.viewProj = glm::mat4(viewProj);
@@ -340,97 +306,47 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
         shaders::LightData& l = uniforms.lights[i];
         const double meanColor = (light.color.r + light.color.g + light.color.b) / 3.0;
         l.radiance = glm::vec4(glm::vec3(light.color * light.intensity), float(light.intensity * meanColor));
-        float layer = -1.0f;
-        LightFrustum f;
-        CascadeSet cascades;  // filled for a cascaded directional light
-        if (needsShadowTest(plan, i)) {
-            if (point) {
-                // Six layers, +X −X +Y −Y +Z −Z; the shader picks the face and builds its
-                // projection itself, so toShadow holds each face's near and far instead
-                // (shaders/interface.h: columns 0, 1 the nears, 2, 3 the fars, face k in row k % 4
-                // of column k / 4).
-                layer = float(lightMatrices.size());
-                l.toShadow = glm::mat4(0.0f);
-                for (int face = 0; face < kCubeFaces; ++face) {
-                    f = pointLightFaceFrustum(scene, settings, light, face, settings.shadowMapSize);
-                    l.toShadow[face / 4][face % 4] = float(f.near);
-                    l.toShadow[2 + face / 4][face % 4] = float(f.far);
-                    cullLayer(i, f, receivers);  // each face draws only its own casters
-                    lightMatrices.push_back(glm::mat4(f.toClip(origin)));
-                    layerBias.push_back({});  // a point light keeps the shader's bias
-                    frusta.push_back(f);
-                    static const char* const kFaces[] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
-                    layerLight.push_back(int(i));
-                    layerLabels.push_back("L" + std::to_string(i) + " " + kFaces[face]);
-                }
-                l.bias = glm::vec4(float(settings.depthBias), float(settings.slopeBias), float(f.texelWorldSize()), 0.0f);
-            } else if (spot)
-                f = spotLightFrustum(scene, settings, light, settings.shadowMapSize);
-            else if (settings.cascades > 1 &&
-                     !(cascades = fitCascades(scene, light.direction, settings.cascades, settings.shadowMapSize,
-                                                              cascadeBandCover(settings), settings.snapLightFrustum))
-                          .frusta.empty()) {
-                // Cascaded: one layer per slice; the shader picks the cascade by view depth
-                // (lit.frag cascadeOf). Cascades are fitted to their slices, so
-                // fitLightFrustum does not apply. A default constant bias is half of each
-                // cascade's texel, as for a fitted map.
-                layer = float(lightMatrices.size());
-                cascadesUsed = int(cascades.frusta.size());
-                cascadeSplits = cascades.splits;
-                cascadeTexels.clear();
-                for (std::size_t c = 0; c < cascades.frusta.size(); ++c) {
-                    const LightFrustum& cf = cascades.frusta[c];
-                    const double depthBias = settings.depthBiasIsDefault ? 0.5 * cf.texelWorldSize() : settings.depthBias;
-                    // Each cascade draws only the casters of the receivers of its own slice.
-                    cullLayer(i, cf, cull ? cascadeReceivers(scene, cascades.splits, c, cascadeBandCover(settings)) : std::vector<scene::Vec3>{});
-                    lightMatrices.push_back(glm::mat4(cf.toClip(origin)));
-                    layerBias.push_back(settings.hardwareBias ? hardwareDepthBias(depthBias, cf) : DepthBiasFactors{});
-                    frusta.push_back(cf);
-                    usedDepthBias.push_back(depthBias);
-                    cascadeTexels.push_back(cf.texelWorldSize());
-                    layerLight.push_back(int(i));
-                    layerLabels.push_back("L" + std::to_string(i) + " C" + std::to_string(c));
-                    shaders::CascadeData& cd = uniforms.cascades[i * SHADOWLAB_MAX_CASCADES + c];
-                    cd.toShadow = glm::mat4(cf.toTexture(origin));
-                    cd.params = glm::vec4(float(cascades.splits[c + 1] - viewDepthOffset), float(cf.texelWorldSize()),
-                                          float(1.0 / cf.depthRange()),
-                                          settings.hardwareBias ? 0.0f : float(depthBias));
-                }
-                // Cascade 0 also fills the light's own map fields (what count <= 1 would use).
-                f = cascades.frusta[0];
-                l.toShadow = uniforms.cascades[i * SHADOWLAB_MAX_CASCADES].toShadow;
-                l.bias = glm::vec4(settings.hardwareBias ? 0.0f
-                                                         : float(usedDepthBias[usedDepthBias.size() - cascades.frusta.size()]),
-                                   settings.hardwareBias ? 0.0f : float(settings.slopeBias), float(f.texelWorldSize()),
-                                   float(1.0 / f.depthRange()));
-            } else if (settings.fitLightFrustum)
-                f = fitDirectionalLightToReceivers(scene, light.direction, settings.shadowMapSize,
-                                                   settings.snapLightFrustum);
-            else
-                f = fitDirectionalLight(bounds, light.direction, settings.shadowMapSize);
-            if (!point && cascades.frusta.empty()) {
-                layerLight.push_back(int(i));
-                layerLabels.push_back("L" + std::to_string(i));
-                layer = float(lightMatrices.size());
-                // Objects that cannot cast onto the visible receivers stay out of this map.
-                cullLayer(i, f, receivers);
-                lightMatrices.push_back(glm::mat4(f.toClip(origin)));
-                l.toShadow = glm::mat4(f.toTexture(origin));
-                // The default constant bias is half a texel of the bounding-sphere map
-                // (scene::defaultDepthBias); a fitted map's texel is smaller, so the default
-                // becomes half of *its* texel. A bias the user gave is kept as given.
-                const double depthBias = settings.depthBiasIsDefault && settings.fitLightFrustum && !spot
-                                             ? 0.5 * f.texelWorldSize()
-                                             : settings.depthBias;
-                usedDepthBias.push_back(depthBias);
-                // With the hardware bias a directional map's depth pass applies both terms, and
-                // the lit shader none; a spot map keeps the shader's (docs/raster.md).
-                const bool hardware = settings.hardwareBias && !spot;
-                layerBias.push_back(hardware ? hardwareDepthBias(depthBias, f) : DepthBiasFactors{});
-                l.bias = glm::vec4(hardware ? 0.0f : float(depthBias), hardware ? 0.0f : float(settings.slopeBias),
-                                   float(f.texelWorldSize()), spot ? 0.0f : float(1.0 / f.depthRange()));
-                frusta.push_back(f);
+        // This light's layers: [first, end) of `layers`, none without a shadow test.
+        std::size_t first = 0;
+        while (first < layers.size() && layers[first].light != int(i)) ++first;
+        std::size_t end = first;
+        while (end < layers.size() && layers[end].light == int(i)) ++end;
+        const float layer = first < end ? float(first) : -1.0f;
+        LightFrustum f;  // the light's one map (a point light: its last face; default without)
+        if (first < end) f = layers[end - 1].frustum;
+        const ShadowLayer* const last = first < end ? &layers[end - 1] : nullptr;
+        const bool cascaded = last && last->reason == LayerReason::kCascade;
+        if (point && last) {
+            // The shader picks the face and builds its projection itself, so toShadow holds each
+            // face's near and far instead (shaders/interface.h: columns 0, 1 the nears, 2, 3 the
+            // fars, face k in row k % 4 of column k / 4).
+            l.toShadow = glm::mat4(0.0f);
+            for (std::size_t k = first; k < end; ++k) {
+                const int face = layers[k].index;
+                l.toShadow[face / 4][face % 4] = float(layers[k].frustum.near);
+                l.toShadow[2 + face / 4][face % 4] = float(layers[k].frustum.far);
             }
+            l.bias = glm::vec4(float(last->shaderDepthBias), float(last->shaderSlopeBias), float(f.texelWorldSize()), 0.0f);
+        } else if (cascaded) {
+            // One layer per slice; lit.frag picks the cascade by view depth (cascadeOf).
+            cascadesUsed = last->count;
+            for (std::size_t k = first; k < end; ++k) {
+                const ShadowLayer& c = layers[k];
+                shaders::CascadeData& cd = uniforms.cascades[i * SHADOWLAB_MAX_CASCADES + std::size_t(c.index)];
+                cd.toShadow = glm::mat4(c.frustum.toTexture(origin));
+                cd.params = glm::vec4(float(c.sliceFar - viewDepthOffset), float(c.frustum.texelWorldSize()),
+                                      float(1.0 / c.frustum.depthRange()), float(c.shaderDepthBias));
+            }
+            // Cascade 0 also fills the light's own map fields (what count <= 1 would use).
+            const ShadowLayer& c0 = layers[first];
+            f = c0.frustum;
+            l.toShadow = uniforms.cascades[i * SHADOWLAB_MAX_CASCADES].toShadow;
+            l.bias = glm::vec4(float(c0.shaderDepthBias), float(c0.shaderSlopeBias), float(f.texelWorldSize()),
+                               float(1.0 / f.depthRange()));
+        } else if (last) {
+            l.toShadow = glm::mat4(f.toTexture(origin));
+            l.bias = glm::vec4(float(last->shaderDepthBias), float(last->shaderSlopeBias), float(f.texelWorldSize()),
+                               spot ? 0.0f : float(1.0 / f.depthRange()));
         }
         if (point) {
             l.axis = glm::vec4(0.0f, 0.0f, 0.0f, float(2.0 * light.radius));  // w: light size (PCSS)
@@ -447,8 +363,7 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
             l.axis = glm::vec4(glm::vec3(glm::normalize(light.direction)), float(2.0 * light.radius));
         } else {
             l.toLight = glm::vec4(glm::vec3(-light.direction), layer);
-            l.kind = glm::vec4(float(SHADOWLAB_LIGHT_DIRECTIONAL),
-                               cascades.frusta.empty() ? 0.0f : float(cascades.frusta.size()), 0, 0);
+            l.kind = glm::vec4(float(SHADOWLAB_LIGHT_DIRECTIONAL), cascaded ? float(last->count) : 0.0f, 0, 0);
         }
         l.params = glm::vec4(float(kMaxSlopeTan), float(int(settings.filter)), float(settings.normalOffset),
                              float(settings.pcfSize));
@@ -461,50 +376,62 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
     // Each layer's index ranges: every object, or the culled layer's casters (runs of them merged).
     // Not with a transmittance map: its index order (opaque casters first) is not per object, so
     // the depth pass then draws every opaque caster (layerRanges empty).
-    for (std::size_t k = 0; k < lightMatrices.size() && !plan.needsTransmittanceMap; ++k) {
+    for (std::size_t k = 0; k < layers.size() && !plan.needsTransmittanceMap; ++k) {
         std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges;
-        const auto it = casters.find(k);
+        const std::vector<bool>& casters = layers[k].casters;
         for (std::size_t o = 0; o < scene.objects.size(); ++o) {
-            if (it != casters.end() && !it->second[o]) continue;
-            const std::uint32_t first = objectFirstIndex[o], end = objectFirstIndex[o + 1];
-            if (!ranges.empty() && ranges.back().first + ranges.back().second == first)
-                ranges.back().second += end - first;
+            if (!casters.empty() && !casters[o]) continue;
+            const std::uint32_t firstIndex = objectFirstIndex[o], endIndex = objectFirstIndex[o + 1];
+            if (!ranges.empty() && ranges.back().first + ranges.back().second == firstIndex)
+                ranges.back().second += endIndex - firstIndex;
             else
-                ranges.emplace_back(first, end - first);
+                ranges.emplace_back(firstIndex, endIndex - firstIndex);
         }
         draw.layerRanges.push_back(std::move(ranges));
+    }
+    std::vector<int> culledPerLight(scene.lights.size(), 0), culledPerLayer;
+    for (const ShadowLayer& layer : layers) {
+        culledPerLight[std::size_t(layer.light)] += layer.culled;
+        culledPerLayer.push_back(layer.culled);
     }
     const auto count = [](int n) { return std::to_string(n); };
     attributes["culled_casters"] = joined(culledPerLight, count);
     // Per layer (in layer order, as shadow_maps and light_frustum list them), when a light has more
     // than one (cascades, cube faces).
-    if (layerLight.size() > std::set<int>(layerLight.begin(), layerLight.end()).size())
-        attributes["culled_casters_per_layer"] = joined(culledPerLayer, count);
+    std::set<int> shadowed;
+    for (const ShadowLayer& layer : layers) shadowed.insert(layer.light);
+    if (layers.size() > shadowed.size()) attributes["culled_casters_per_layer"] = joined(culledPerLayer, count);
 }
 
-void Renderer::Impl::createTargets(const scene::Scene& scene, const RendererOptions& options) {
-    // Without a shadowed light a 1x1 cleared layer keeps the descriptor valid.
-    const auto mapSize = lightMatrices.empty() ? 1u : std::uint32_t(settings.shadowMapSize);
-    const auto layers = std::max<std::uint32_t>(1, std::uint32_t(lightMatrices.size()));
-    maps = createShadowMaps(ctx, mapSize, layers);
-    uniforms.counts.y = float(mapSize);  // lit.frag's map size, instead of a textureSize() per fragment
-    if (cascadesUsed > 1 && settings.cascadeBlend > 0.0) {
-        cascadeBlendUsed = settings.cascadeBlend;
-        uniforms.counts.z = float(cascadeBlendUsed);
-        uniforms.counts.w = float(cascadeSplits[0] - viewDepthOffset);  // cascade 0's slice starts here (the band's width)
-    }
-    transmit = !draw.transparent.empty() && !lightMatrices.empty();
-    transmittanceMaps = createTransmittanceMaps(ctx, transmit ? mapSize : 1, transmit ? layers : 1);
-    for (const int i : layerLight) {
-        const scene::Light& light = scene.lights[std::size_t(i)];
+void Renderer::Impl::setLayerLights(const scene::Scene& scene) {
+    layerLights.clear();
+    for (const ShadowLayer& layer : layers) {
+        const scene::Light& light = scene.lights[std::size_t(layer.light)];
         layerLights.push_back(light.type == scene::LightType::Directional
                                   ? glm::vec4(glm::vec3(-glm::normalize(light.direction)), 0.0f)
                                   : glm::vec4(glm::vec3(light.position - origin), 1.0f));
     }
+}
+
+void Renderer::Impl::createTargets(const scene::Scene& scene, const RendererOptions& options) {
+    // Without a shadowed light a 1x1 cleared layer keeps the descriptor valid.
+    const auto mapSize = layers.empty() ? 1u : std::uint32_t(settings.shadowMapSize);
+    const auto arrayLayers = std::max<std::uint32_t>(1, std::uint32_t(layers.size()));
+    maps = createShadowMaps(ctx, mapSize, arrayLayers);
+    uniforms.counts.y = float(mapSize);  // lit.frag's map size, instead of a textureSize() per fragment
+    if (cascadesUsed > 1 && settings.cascadeBlend > 0.0) {
+        cascadeBlendUsed = settings.cascadeBlend;
+        uniforms.counts.z = float(cascadeBlendUsed);
+        uniforms.counts.w = float(splits[0] - viewDepthOffset);  // cascade 0's slice starts here (the band's width)
+    }
+    transmit = !draw.transparent.empty() && !layers.empty();
+    transmittanceMaps = createTransmittanceMaps(ctx, transmit ? mapSize : 1, transmit ? arrayLayers : 1);
+    setLayerLights(scene);
     attributes["transmittance_map"] = transmit ? "made" : "none";
-    const bool moments = scene::isFilterable(settings.filter) && !lightMatrices.empty();
-    momentMaps = createMomentMaps(ctx, moments ? mapSize : 1, moments ? layers : 1);
-    if (moments) attributes["moment_maps"] = describeMomentCost(settings.filter, mapSize, layers, settings.moments.blurWidth);
+    const bool moments = scene::isFilterable(settings.filter) && !layers.empty();
+    momentMaps = createMomentMaps(ctx, moments ? mapSize : 1, moments ? arrayLayers : 1);
+    if (moments)
+        attributes["moment_maps"] = describeMomentCost(settings.filter, mapSize, arrayLayers, settings.moments.blurWidth);
     targets = createLitTargets(ctx, width, height, lightCount > 1 ? kLightTargets : 0, options.readTargetsInPlace);
     if (!targets.hostReadable) readback = createReadback(ctx, targets);
     // How the targets reach the Frame: read in place (lavapipe) or copied into buffers first.
@@ -560,8 +487,11 @@ void Renderer::Impl::describeLayers() {
     attributes["light_frustum_fit_reason"] =
         settings.fitLightFrustumIsDefault ? "default" : "set by --fit-light-frustum, the scene or code";
     if (!settings.snapLightFrustum) attributes["light_frustum_snap"] = "off";
-    // The constant bias actually used: one value, or one per light (';') when a default was
-    // re-derived per fitted map and the maps differ.
+    // The constant bias actually used: one value, or one per shadow-mapped light (';'; per cascade;
+    // point lights keep the setting) when a default was re-derived per fitted map and the maps differ.
+    std::vector<double> usedDepthBias;
+    for (const ShadowLayer& layer : layers)
+        if (layer.reason != LayerReason::kCubeFace) usedDepthBias.push_back(layer.depthBias);
     const bool oneBias = std::all_of(usedDepthBias.begin(), usedDepthBias.end(),
                                      [&](double b) { return b == usedDepthBias[0]; });
     attributes["depth_bias"] = usedDepthBias.empty() ? formatNumber(settings.depthBias)
@@ -585,18 +515,18 @@ void Renderer::Impl::describeLayers() {
     attributes["max_slope_tan"] = formatNumber(kMaxSlopeTan);
     attributes["triangles"] = std::to_string(triangles);
     attributes["sphere_segments"] = std::to_string(sphereSegmentsUsed);
-    attributes["shadow_maps"] = std::to_string(frusta.size());
-    if (!frusta.empty()) {
+    attributes["shadow_maps"] = std::to_string(layers.size());
+    if (!layers.empty()) {
         // A spot map's texel grows with distance: "<size per unit distance>*d".
-        attributes["texel_world_size"] = joined(frusta, [](const LightFrustum& f) {
-            return formatNumber(f.texelWorldSize()) + (f.perspective ? "*d" : "");
+        attributes["texel_world_size"] = joined(layers, [](const ShadowLayer& l) {
+            return formatNumber(l.frustum.texelWorldSize()) + (l.frustum.perspective ? "*d" : "");
         });
-        attributes["light_frustum"] = joined(frusta, [](const LightFrustum& f) { return f.describe(); }, "; ");
+        attributes["light_frustum"] = joined(layers, [](const ShadowLayer& l) { return l.frustum.describe(); }, "; ");
     }
     attributes["cascades"] = std::to_string(cascadesUsed);
-    if (!cascadeSplits.empty()) {
-        attributes["cascade_splits"] = joinedNumbers(cascadeSplits);
-        attributes["cascade_texel_world_size"] = joinedNumbers(cascadeTexels);
+    if (!splits.empty()) {
+        attributes["cascade_splits"] = joinedNumbers(splits);
+        attributes["cascade_texel_world_size"] = joinedNumbers(cascadeTexels(layers));
         attributes["cascade_blend"] = formatNumber(cascadeBlendUsed);
     }
 }
@@ -607,28 +537,22 @@ void Renderer::Impl::update(const scene::Scene& scene, const scene::Camera& view
         throw RasterError("Renderer::update: the scene must keep the objects, the number of lights and the "
                           "resolution the Renderer was made for");
     const auto updateStart = Clock::now();
-    const std::size_t layers = lightMatrices.size();
+    const std::size_t layerCount = lightMatrices.size();
     const int cascadeCount = cascadesUsed;
     const std::uint32_t kinds = lightKinds;
     const glm::vec4 counts = uniforms.counts;
     placeLights(scene, view);
     // The maps, pipelines and descriptor set were made for this many layers of these kinds.
-    if (lightMatrices.size() != layers || cascadesUsed != cascadeCount || lightKinds != kinds)
+    if (lightMatrices.size() != layerCount || cascadesUsed != cascadeCount || lightKinds != kinds)
         throw RasterError("Renderer::update: the new camera or lights change the number of shadow-map layers (" +
-                          std::to_string(layers) + " -> " + std::to_string(lightMatrices.size()) +
+                          std::to_string(layerCount) + " -> " + std::to_string(lightMatrices.size()) +
                           ") or cascades; make a new Renderer");
     uniforms.counts.y = counts.y;
     if (cascadeBlendUsed > 0.0) {
         uniforms.counts.z = counts.z;
-        uniforms.counts.w = float(cascadeSplits[0] - viewDepthOffset);
+        uniforms.counts.w = float(splits[0] - viewDepthOffset);
     }
-    layerLights.clear();
-    for (const int i : layerLight) {
-        const scene::Light& light = scene.lights[std::size_t(i)];
-        layerLights.push_back(light.type == scene::LightType::Directional
-                                  ? glm::vec4(glm::vec3(-glm::normalize(light.direction)), 0.0f)
-                                  : glm::vec4(glm::vec3(light.position - origin), 1.0f));
-    }
+    setLayerLights(scene);
     describeLayers();
     // The descriptor set's uniform buffer is device-local: refill it through a staging buffer.
     if (bindings.uniforms.buffer) {
@@ -714,12 +638,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     if (debug) {
         // What each layer holds (fixed by the constructor) and, when asked, its depths (read
         // back outside the pass timings).
-        debug->frusta = frusta;
-        debug->layerLight = layerLight;
-        debug->layerLabels = layerLabels;
-        debug->mapSize = frusta.empty() ? 1u : std::uint32_t(settings.shadowMapSize);
-        debug->cascadeSplits = cascadeSplits;
-        debug->cascadeTexels = cascadeTexels;
+        debug->layers = layers;
+        debug->mapSize = layers.empty() ? 1u : std::uint32_t(settings.shadowMapSize);
         debug->layerDepths.clear();
         if (debug->captureShadowMaps)
             for (std::uint32_t k = 0; k < std::uint32_t(lightMatrices.size()); ++k)

@@ -9,6 +9,7 @@
 
 #include "raster/devices.h"
 #include "raster/light_frustum.h"
+#include "raster/shadow_layers.h"
 #include "raster/vulkan_error.h"
 #include "scene/frame.h"
 #include "scene/render_plan.h"
@@ -22,19 +23,12 @@ struct ValidationLog;
 // What a render used, for the debug views (raster/debug_views.h) and tests.
 struct RenderDebug {
     bool captureShadowMaps = false;  // in: read every layer back after the shadow pass
-    // Out, one entry per shadow-map layer: its frustum, the light it belongs to, a short label
-    // ("L0", "L0 C2" for cascade 2, "L1 +X" for a point light's face) and, when captured, its
-    // depths (mapSize² floats, row 0 first; 1 = cleared, nothing there).
-    std::vector<LightFrustum> frusta;
-    std::vector<int> layerLight;
-    std::vector<std::string> layerLabels;
+    // Out: the shadow-map layers the render drew (raster/shadow_layers.h: frustum, light, label
+    // "L0", "L0 C2", "L1 +X", biases, casters; cascadeSplits(layers) for the cascades) and, when
+    // captured, each layer's depths (mapSize² floats, row 0 first; 1 = cleared, nothing there).
+    std::vector<ShadowLayer> layers;
     std::vector<std::vector<float>> layerDepths;
     std::uint32_t mapSize = 0;
-    // Cascades (the same for every directional light: they depend on the camera only): the
-    // count + 1 split depths along the view, and each cascade's texel world size. Empty without
-    // cascades.
-    std::vector<double> cascadeSplits;
-    std::vector<double> cascadeTexels;
 };
 
 // Where the lit pass's fragment shader reads the one light's constants, where it takes that

@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "raster/resources.h"
+#include "raster/shadow_layers.h"
 
 namespace shadowlab::raster {
 
@@ -29,16 +30,7 @@ struct ShadowPipeline {
 ShadowPipeline createShadowPipeline(const Context& ctx, bool blockerIds = true, bool hardwareBias = false,
                                     VkDescriptorSetLayout alphaSetLayout = VK_NULL_HANDLE);
 
-// The rasterizer's depth-bias factors of one layer (vkCmdSetDepthBias): the stored depth of a
-// primitive grows by constant·r + slope·max(|∂z/∂x|, |∂z/∂y|), r the depth format's minimum
-// resolvable difference at the primitive's depths (D32_SFLOAT: 2^(e − 23), e the exponent of
-// its largest depth), the slopes in depth per texel.
-struct DepthBiasFactors {
-    float constant = 0.0f;
-    float slope = 0.0f;
-};
-// D32_SFLOAT's r for depths in [0.5, 1): the unit the constant factor is converted in.
-inline constexpr double kShadowDepthUnitR = 1.0 / 16777216.0;  // 2^-24
+// DepthBiasFactors, kShadowDepthUnitR: raster/shadow_layers.h.
 
 struct ShadowMaps {
     Image depth;                             // size x size x layers; view: 2D array for sampling

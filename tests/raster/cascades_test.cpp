@@ -26,6 +26,12 @@ namespace {
 
 using test::Vec3;
 
+std::vector<std::string> labels(const RenderDebug& debug) {
+    std::vector<std::string> out;
+    for (const ShadowLayer& l : debug.layers) out.push_back(l.label);
+    return out;
+}
+
 // The practical split scheme (Zhang et al. 2006), written out here: C_i = λ n (f/n)^(i/N) +
 // (1 − λ)(n + (f − n) i/N).
 double zhangSplit(double n, double f, int i, int count, double lambda) {
@@ -375,7 +381,7 @@ TEST(RasterCascades, ShadowMapAndTexelDensityViewsHaveTheDocumentedSizes) {
     debug.captureShadowMaps = true;
     const scene::Frame f = renderChecked(s, cascadeSettings(3, 256), &debug);
     ASSERT_EQ(debug.layerDepths.size(), 3u);
-    ASSERT_EQ(debug.layerLabels, (std::vector<std::string>{"L0 C0", "L0 C1", "L0 C2"}));
+    ASSERT_EQ(labels(debug), (std::vector<std::string>{"L0 C0", "L0 C1", "L0 C2"}));
     // Three layers: 2 columns x 2 rows of 256-pixel tiles, 4 pixels apart.
     const DisplayImage map = shadowMapView(debug);
     EXPECT_EQ(map.width, 2 * 256 + kShadowMapViewGap);
@@ -393,7 +399,7 @@ TEST(RasterCascades, ShadowMapAndTexelDensityViewsHaveTheDocumentedSizes) {
             continue;
         }
         const double pixel = 2.0 * f.depth[i] * cam.tanHalfFovY / s.camera.height;
-        EXPECT_NEAR(ratio[i], debug.cascadeTexels[std::size_t(cascade[i])] / pixel, 1e-9 * ratio[i]);
+        EXPECT_NEAR(ratio[i], cascadeTexels(debug.layers)[std::size_t(cascade[i])] / pixel, 1e-9 * ratio[i]);
     }
 }
 
@@ -407,9 +413,9 @@ TEST(RasterCascades, RendererFramesOfEveryChannelMaskUseTheCascades) {
     debug.captureShadowMaps = true;
     const scene::Frame all = renderer.render(scene::kAllChannels, &debug);
     EXPECT_EQ(all.attributes.at("cascades"), "3");
-    ASSERT_EQ(debug.layerLabels, (std::vector<std::string>{"L0 C0", "L0 C1", "L0 C2"}));
+    ASSERT_EQ(labels(debug), (std::vector<std::string>{"L0 C0", "L0 C1", "L0 C2"}));
     ASSERT_EQ(debug.layerDepths.size(), 3u);
-    EXPECT_EQ(debug.cascadeSplits.size(), 4u);
+    EXPECT_EQ(cascadeSplits(debug.layers).size(), 4u);
     // The beauty-only variant (what `render -o x.png` uses) shades with the same cascades.
     const scene::Frame beautyOnly = renderer.render(scene::kChannelBeauty | scene::kChannelVisibility);
     EXPECT_TRUE(beautyOnly.objectId.empty());
@@ -542,17 +548,17 @@ TEST(RasterCascadeBlend, OutsideTheBandsUnchangedInsideTheLinearMixOfTheTwoCasca
     const scene::Frame plain = renderChecked(s, blendSettings(1e-9), &debug);
     const scene::Frame half = renderChecked(s, blendSettings(0.5));
     const scene::Frame quarter = renderChecked(s, blendSettings(0.25));
-    ASSERT_EQ(debug.cascadeSplits.size(), 4u);
+    ASSERT_EQ(cascadeSplits(debug.layers).size(), 4u);
     EXPECT_EQ(half.attributes.at("cascade_blend"), "0.5");
     EXPECT_EQ(quarter.attributes.at("cascade_blend"), "0.25");
     std::size_t outside = 0, checked = 0, mixed[2] = {0, 0}, exact = 0, notHeld = 0;
     const CascadeSet set = fitCascades(s, s.lights[0].direction, 3, 512, scene::kMaxCascadeBlend);
-    ASSERT_EQ(set.splits, debug.cascadeSplits);
+    ASSERT_EQ(set.splits, cascadeSplits(debug.layers));
     const scene::CameraBasis cam = scene::cameraBasis(s.camera);
     for (std::size_t i = 0; i < plain.pixelCount(); ++i) {
         if (!(plain.objectId[i] > 0.0f)) continue;
-        const BandPosition bh = bandPosition(plain, debug.cascadeSplits, 0.5, i);
-        const BandPosition bq = bandPosition(plain, debug.cascadeSplits, 0.25, i);
+        const BandPosition bh = bandPosition(plain, cascadeSplits(debug.layers), 0.5, i);
+        const BandPosition bq = bandPosition(plain, cascadeSplits(debug.layers), 0.25, i);
         const float vc = plain.visibility[i];
         if (bq.kind == BandPosition::Outside) {
             ASSERT_EQ(quarter.visibility[i], vc) << "pixel " << i;

@@ -246,8 +246,8 @@ TEST(FrustumView, SpotMapHoldsItsPyramidAndAForcedNarrowMapStripesLitPointsOutsi
     const scene::RasterSettings settings = test::validatedSettings(256, 0.01, 1.0, scene::ShadowFilter::Pcf2x2);
     RenderDebug debug;
     const scene::Frame f = renderChecked(c.s, settings, &debug);
-    ASSERT_EQ(debug.frusta.size(), 1u);
-    ASSERT_TRUE(debug.frusta[0].perspective);
+    ASSERT_EQ(debug.layers.size(), 1u);
+    ASSERT_TRUE(debug.layers[0].frustum.perspective);
     // The map's field of view is the cone widened by kSpotFovMargin (2%): tan(30.6°).
     const double tMap = std::tan(30.0 * kSpotFovMargin * kPi / 180.0);
     const double tCone = std::tan(30.0 * kPi / 180.0);
@@ -300,7 +300,7 @@ TEST(FrustumView, SpotMapHoldsItsPyramidAndAForcedNarrowMapStripesLitPointsOutsi
     {
         RenderDebug narrow = debug;
         const double tNarrow = std::tan(15.0 * kPi / 180.0);
-        narrow.frusta[0].tanHalfFov = tNarrow;
+        narrow.layers[0].frustum.tanHalfFov = tNarrow;
         const std::vector<Coverage> cov = lightMapCoverage(f, c.s, narrow);
         const DisplayImage img = lightFrustumView(f, c.s, narrow);
         maybeWritePng(img, "frustum_spot_forced");
@@ -347,7 +347,7 @@ TEST(FrustumView, CascadesHoldEverySliceAndEachReceiverCarriesItsCascadesTint) {
     settings.cascades = 3;
     RenderDebug debug;
     const scene::Frame f = renderChecked(s, settings, &debug);
-    ASSERT_EQ(debug.frusta.size(), 3u);
+    ASSERT_EQ(debug.layers.size(), 3u);
     const std::vector<Coverage> cov = lightMapCoverage(f, s, debug);
     const std::vector<int> cascade = cascadeIndices(f, debug);
     const DisplayImage img = lightFrustumView(f, s, debug);
@@ -368,7 +368,7 @@ TEST(FrustumView, CascadesHoldEverySliceAndEachReceiverCarriesItsCascadesTint) {
     EXPECT_GT(tinted, 0.9 * receivers);
     // Shrinking cascade 1's map to a tenth of its width leaves most of its slice uncovered.
     RenderDebug shrunk = debug;
-    shrunk.frusta[1].halfWidth *= 0.1;
+    shrunk.layers[1].frustum.halfWidth *= 0.1;
     const std::vector<Coverage> after = lightMapCoverage(f, s, shrunk);
     int slice = 0, uncovered = 0;
     for (std::size_t i = 0; i < after.size(); ++i)
@@ -392,7 +392,7 @@ TEST(FrustumView, PointLightGetsAMarkerAtItsPositionAndNoOutline) {
     RenderDebug debug;
     const scene::Frame f =
         renderChecked(s, test::validatedSettings(128, 0.01, 1.0, scene::ShadowFilter::Pcf2x2), &debug);
-    ASSERT_EQ(debug.frusta.size(), 6u);
+    ASSERT_EQ(debug.layers.size(), 6u);
     const std::vector<Coverage> cov = lightMapCoverage(f, s, debug);
     for (std::size_t i = 0; i < cov.size(); ++i)
         EXPECT_EQ(cov[i], f.objectId[i] > 0.0f ? Coverage::Covered : Coverage::Background) << i;

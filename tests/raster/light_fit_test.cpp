@@ -103,8 +103,8 @@ TEST(RasterSpotFit, TheFittedWindowHoldsEveryVisibleReceiverWithTheMargin) {
     const scene::Scene s = spotScene();
     RenderDebug debug;
     const scene::Frame frame = renderChecked(s, fitSettings(1024, true), &debug);
-    ASSERT_EQ(debug.frusta.size(), 1u);
-    const LightFrustum& f = debug.frusta[0];
+    ASSERT_EQ(debug.layers.size(), 1u);
+    const LightFrustum& f = debug.layers[0].frustum;
     EXPECT_NEAR(f.tanHalfFov, std::exp2(-1.5), 1e-12);
     char buf[64];
     std::snprintf(buf, sizeof buf, "%.9g*d", 2.0 * std::exp2(-1.5) / 1024);
@@ -201,8 +201,8 @@ TEST(RasterSpotFit, TheSnappedDepthRangeStillHoldsEveryVisibleReceiverAndCaster)
     const scene::Scene s = tiltedSpotScene(0.6);
     RenderDebug debug;
     const scene::Frame frame = renderChecked(s, fitSettings(1024, true), &debug);
-    ASSERT_EQ(debug.frusta.size(), 1u);
-    const LightFrustum& f = debug.frusta[0];
+    ASSERT_EQ(debug.layers.size(), 1u);
+    const LightFrustum& f = debug.layers[0].frustum;
     const Vec3 axis = glm::normalize(Vec3(1, -2, 0));
     const scene::CameraBasis cam = scene::cameraBasis(s.camera);
     double nearest = INFINITY, farthest = 0.0;
@@ -380,8 +380,8 @@ TEST(RasterPointFit, EachFaceTakesItsNearAndFarFromItsCastersAndReceivers) {
     RenderDebug debug;
     const scene::Frame fitted = renderChecked(s, fit, &debug);
     const scene::Frame wide = renderChecked(s, plain);
-    ASSERT_EQ(debug.frusta.size(), 6u);
-    EXPECT_NEAR(debug.frusta[3].near, down.near, 1e-12);
+    ASSERT_EQ(debug.layers.size(), 6u);
+    EXPECT_NEAR(debug.layers[3].frustum.near, down.near, 1e-12);
     int differ = 0, shadowed = 0;
     for (std::size_t i = 0; i < fitted.visibility.size(); ++i) {
         differ += std::abs(fitted.visibility[i] - wide.visibility[i]) > 0.5f;

@@ -1,0 +1,235 @@
+// tests/raster/shadow_layers_test.cpp: the shadow-layer plan (raster/shadow_layers.h) on its own,
+// without a device: which layers a scene gets and why, their frusta, biases and casters.
+#include "raster/shadow_layers.h"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "raster/cascades.h"
+#include "raster/tolerances.h"
+#include "tests/raster/test_scenes.h"
+
+namespace shadowlab::raster {
+namespace {
+
+using test::Vec3;
+
+// Settings with every automatic choice already made (as resolveAutomaticChoices leaves them).
+scene::RasterSettings fixedSettings(int mapSize = 512) {
+    scene::RasterSettings r;
+    r.shadowMapSize = mapSize;
+    r.shadowMapSizeIsDefault = false;
+    r.cascades = 1;
+    r.cascadesIsDefault = false;
+    r.depthBias = 0.01;
+    r.depthBiasIsDefault = false;
+    r.slopeBias = 1.5;
+    return r;
+}
+
+scene::Light pointLightAt(const Vec3& position) {
+    scene::Light l;
+    l.type = scene::LightType::Point;
+    l.position = position;
+    l.intensity = 30.0;
+    return l;
+}
+
+TEST(ShadowLayers, ADirectionalLightHasOneMapWithTheShaderBiasAsGiven) {
+    const scene::Scene s = test::makeScene({});
+    const scene::RasterSettings r = fixedSettings();
+    const std::vector<ShadowLayer> layers = planShadowLayers(s, test::planFor(s, r), r);
+    ASSERT_EQ(layers.size(), 1u);
+    const ShadowLayer& l = layers[0];
+    EXPECT_EQ(l.light, 0);
+    EXPECT_EQ(l.reason, LayerReason::kDirectional);
+    EXPECT_EQ(l.label, "L0");
+    EXPECT_FALSE(l.frustum.perspective);
+    EXPECT_EQ(l.frustum.mapSize, 512);
+    // The map looks along the light (straight down).
+    EXPECT_NEAR(l.frustum.direction.y, -1.0, 1e-12);
+    // A bias the user gave is kept as given, and the lit shader applies it.
+    EXPECT_EQ(l.depthBias, 0.01);
+    EXPECT_EQ(l.shaderDepthBias, 0.01);
+    EXPECT_EQ(l.shaderSlopeBias, 1.5);
+    EXPECT_FALSE(l.biasInDepthPass);
+    EXPECT_EQ(l.hardwareBias.constant, 0.0f);
+    EXPECT_EQ(l.hardwareBias.slope, 0.0f);
+}
+
+TEST(ShadowLayers, TheMatrixIsTheFrustumsClipTransformRelativeToTheCamera) {
+    // Camera-relative: the matrix takes p − eye; the map's center maps to clip (0, 0).
+    const scene::Scene s = test::makeScene({});
+    const scene::RasterSettings r = fixedSettings();
+    const ShadowLayer l = planShadowLayers(s, test::planFor(s, r), r).at(0);
+    const Vec3 eye = scene::cameraBasis(s.camera).position;
+    const glm::dvec4 c = glm::dmat4(l.matrix) * glm::dvec4(l.frustum.center - eye, 1.0);
+    EXPECT_NEAR(c.x / c.w, 0.0, 1e-5);
+    EXPECT_NEAR(c.y / c.w, 0.0, 1e-5);
+}
+
+TEST(ShadowLayers, ADefaultBiasOnAFittedMapIsHalfItsTexel) {
+    const scene::Scene s = test::makeScene({});
+    scene::RasterSettings r = fixedSettings();
+    r.depthBiasIsDefault = true;
+    r.fitLightFrustum = true;
+    const ShadowLayer l = planShadowLayers(s, test::planFor(s, r), r).at(0);
+    EXPECT_EQ(l.depthBias, 0.5 * l.frustum.texelWorldSize());
+    EXPECT_EQ(l.shaderDepthBias, l.depthBias);
+    // The bounding-sphere map keeps the setting.
+    r.fitLightFrustum = false;
+    EXPECT_EQ(planShadowLayers(s, test::planFor(s, r), r).at(0).depthBias, 0.01);
+}
+
+TEST(ShadowLayers, TheHardwareBiasMovesBothTermsIntoTheDepthPassInUnitsOfR) {
+    // Orthographic depth is linear: a world bias b is b / depthRange of the 0..1 depth, and the
+    // rasterizer's constant factor counts r = 2^-24 of it; the slope factor is the slope in texels.
+    const scene::Scene s = test::makeScene({});
+    scene::RasterSettings r = fixedSettings();
+    r.hardwareBias = true;
+    const ShadowLayer l = planShadowLayers(s, test::planFor(s, r), r).at(0);
+    EXPECT_TRUE(l.biasInDepthPass);
+    EXPECT_EQ(l.shaderDepthBias, 0.0);
+    EXPECT_EQ(l.shaderSlopeBias, 0.0);
+    EXPECT_FLOAT_EQ(l.hardwareBias.constant, float(0.01 / l.frustum.depthRange() * 16777216.0));
+    EXPECT_FLOAT_EQ(l.hardwareBias.slope, 1.5f);
+}
+
+TEST(ShadowLayers, ASpotLightKeepsTheShaderBiasEvenWithTheHardwareBias) {
+    scene::Scene s = test::makeScene({});
+    s.lights[0] = test::spotDown();
+    scene::RasterSettings r = fixedSettings();
+    r.hardwareBias = true;
+    const std::vector<ShadowLayer> layers = planShadowLayers(s, test::planFor(s, r), r);
+    ASSERT_EQ(layers.size(), 1u);
+    EXPECT_EQ(layers[0].reason, LayerReason::kSpot);
+    EXPECT_TRUE(layers[0].frustum.perspective);
+    EXPECT_FALSE(layers[0].biasInDepthPass);
+    EXPECT_EQ(layers[0].shaderDepthBias, 0.01);
+    EXPECT_EQ(layers[0].shaderSlopeBias, 1.5);
+}
+
+TEST(ShadowLayers, APointLightHasSixCubeFacesOfNinetyDegreesAlongTheAxes) {
+    scene::Scene s = test::makeScene({});
+    s.lights[0] = pointLightAt({0, 3, 0});
+    scene::RasterSettings r = fixedSettings(512);
+    r.fitLightFrustum = false;  // the faces' whole 90° (plus the margin), not a fitted window
+    const std::vector<ShadowLayer> layers = planShadowLayers(s, test::planFor(s, r), r);
+    ASSERT_EQ(layers.size(), 6u);
+    const char* const names[] = {"L0 +X", "L0 -X", "L0 +Y", "L0 -Y", "L0 +Z", "L0 -Z"};
+    const Vec3 axes[] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    // The face's 90° edge is tan 1 at (size/2) texels from the center; the map asks for
+    // kPointFaceMarginTexels more on each side: tan = size / (size − 2·margin).
+    const double tanHalf = 512.0 / (512.0 - 2.0 * kPointFaceMarginTexels);
+    for (int k = 0; k < 6; ++k) {
+        const ShadowLayer& l = layers[std::size_t(k)];
+        EXPECT_EQ(l.light, 0);
+        EXPECT_EQ(l.reason, LayerReason::kCubeFace);
+        EXPECT_EQ(l.index, k);
+        EXPECT_EQ(l.label, names[k]);
+        EXPECT_TRUE(l.frustum.perspective);
+        EXPECT_NEAR(glm::dot(l.frustum.direction, axes[k]), 1.0, 1e-12) << names[k];
+        EXPECT_NEAR(l.frustum.tanHalfFov, tanHalf, 1e-12) << names[k];
+        EXPECT_NEAR(l.frustum.windowU, 0.0, 1e-12);
+        EXPECT_NEAR(l.frustum.windowV, 0.0, 1e-12);
+        EXPECT_EQ(l.frustum.position, Vec3(0, 3, 0));
+        // A point light keeps the shader's bias.
+        EXPECT_EQ(l.shaderDepthBias, 0.01);
+        EXPECT_FALSE(l.biasInDepthPass);
+    }
+}
+
+TEST(ShadowLayers, CascadeSplitsFollowThePracticalSplitScheme) {
+    // C_i = λ n (f/n)^(i/N) + (1 − λ)(n + (f − n) i/N) over the visible depth range [n, f].
+    const scene::Scene s = test::makeLongPlane(64, 36);
+    scene::RasterSettings r = fixedSettings(1024);
+    r.cascades = 3;
+    const std::vector<ShadowLayer> layers = planShadowLayers(s, test::planFor(s, r), r);
+    ASSERT_EQ(layers.size(), 3u);
+    const auto range = visibleDepthRange(s);
+    ASSERT_TRUE(range.has_value());
+    const double n = (*range)[0], f = (*range)[1];
+    for (int c = 0; c < 3; ++c) {
+        const ShadowLayer& l = layers[std::size_t(c)];
+        EXPECT_EQ(l.reason, LayerReason::kCascade);
+        EXPECT_EQ(l.index, c);
+        EXPECT_EQ(l.count, 3);
+        EXPECT_EQ(l.label, "L0 C" + std::to_string(c));
+        const double lambda = kCascadeSplitLambda;
+        const double d0 = lambda * n * std::pow(f / n, c / 3.0) + (1 - lambda) * (n + (f - n) * c / 3.0);
+        const double d1 = lambda * n * std::pow(f / n, (c + 1) / 3.0) + (1 - lambda) * (n + (f - n) * (c + 1) / 3.0);
+        EXPECT_NEAR(l.sliceNear, d0, 1e-9 * f) << "cascade " << c;
+        EXPECT_NEAR(l.sliceFar, d1, 1e-9 * f) << "cascade " << c;
+    }
+    const std::vector<double> splits = cascadeSplits(layers);
+    ASSERT_EQ(splits.size(), 4u);
+    EXPECT_EQ(splits[0], layers[0].sliceNear);
+    for (std::size_t c = 0; c < 3; ++c) EXPECT_EQ(splits[c + 1], layers[c].sliceFar);
+    // Nearer slices are narrower, so their maps' texels are finer.
+    const std::vector<double> texels = cascadeTexels(layers);
+    ASSERT_EQ(texels.size(), 3u);
+    EXPECT_LT(texels[0], texels[1]);
+    EXPECT_LT(texels[1], texels[2]);
+}
+
+TEST(ShadowLayers, ACasterOutsideALayersFrustumIsCulledThere) {
+    // A point light at (0, 3, 0) over the plane: a sphere far out along +X (x = 3.5, at the
+    // light's height) lies in the +X face only; it cannot cast into −X, ±Y, ±Z faces, whose
+    // receivers it cannot shade, and the −Y face (down onto the plane) draws the plane's caster,
+    // the sphere at the center.
+    scene::Scene s = test::makeScene({});
+    s.lights[0] = pointLightAt({0, 3, 0});
+    scene::Object far;
+    far.name = "objects[2]";
+    far.shape = scene::Sphere{{3.5, 3, 0}, 0.2};
+    s.objects.push_back(far);
+    scene::RasterSettings r = fixedSettings(256);
+    r.cullCasters = true;
+    const std::vector<ShadowLayer> layers = planShadowLayers(s, test::planFor(s, r), r);
+    ASSERT_EQ(layers.size(), 6u);
+    const ShadowLayer& minusX = layers[1];
+    ASSERT_EQ(minusX.casters.size(), 3u);
+    EXPECT_FALSE(minusX.casters[2]) << "the sphere at x = 3.5 is behind the -X face";
+    const ShadowLayer& down = layers[3];
+    ASSERT_EQ(down.casters.size(), 3u);
+    EXPECT_TRUE(down.casters[0]) << "the center sphere shades the plane below the light";
+    int culled = 0;
+    for (const bool c : minusX.casters) culled += c ? 0 : 1;
+    EXPECT_EQ(minusX.culled, culled);
+    // Without culling every layer draws every object.
+    r.cullCasters = false;
+    for (const ShadowLayer& l : planShadowLayers(s, test::planFor(s, r), r)) {
+        EXPECT_TRUE(l.casters.empty());
+        EXPECT_EQ(l.culled, 0);
+    }
+}
+
+TEST(ShadowLayers, ALightThePlanGivesNoShadowTestHasNoLayer) {
+    scene::Scene s = test::makeScene({});
+    const scene::RasterSettings r = fixedSettings();
+    scene::RenderPlan plan = test::planFor(s, r);
+    ASSERT_FALSE(plan.lights.empty());
+    plan.lights[0].needsShadowTest = false;
+    EXPECT_TRUE(planShadowLayers(s, plan, r).empty());
+    EXPECT_EQ(explainShadowLayers({}, s.objects.size()), "raster shadow-map layers: none (no light needs a shadow test)\n");
+}
+
+TEST(ShadowLayers, LayersOfTwoLightsFollowTheLightOrder) {
+    scene::Scene s = test::makeScene({});
+    s.lights.push_back(pointLightAt({0, 3, 0}));
+    s.lights.push_back(test::spotDown());
+    const scene::RasterSettings r = fixedSettings();
+    const std::vector<ShadowLayer> layers = planShadowLayers(s, test::planFor(s, r), r);
+    ASSERT_EQ(layers.size(), 1u + 6u + 1u);
+    EXPECT_EQ(layers[0].label, "L0");
+    EXPECT_EQ(layers[1].label, "L1 +X");
+    EXPECT_EQ(layers[6].label, "L1 -Z");
+    EXPECT_EQ(layers[7].label, "L2");
+    EXPECT_EQ(layers[7].light, 2);
+}
+
+}  // namespace
+}  // namespace shadowlab::raster
