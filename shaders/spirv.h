@@ -27,5 +27,11 @@ std::span<const std::uint32_t> litFragSpirv();
 std::span<const std::uint32_t> litFragLightsSpirv();
 // lit.frag compiled with SHADOWLAB_BEAUTY_ONLY: the beauty target only.
 std::span<const std::uint32_t> litFragBeautySpirv();
+// SHADOWLAB_ALPHA variants of the lit pass (scenes with MASK or BLEND materials): the camera's
+// alpha test, UVs at vertex binding 1 and the alpha records at set 1.
+std::span<const std::uint32_t> litVertAlphaSpirv();
+std::span<const std::uint32_t> litFragAlphaSpirv();
+std::span<const std::uint32_t> litFragLightsAlphaSpirv();
+std::span<const std::uint32_t> litFragBeautyAlphaSpirv();
 
 }  // namespace shadowlab::shaders
