@@ -11,7 +11,7 @@ namespace {
 
 // shaders/alpha.glsl's AlphaRecord (std430: two 16-byte vectors).
 struct AlphaRecord {
-    glm::vec4 params{0.0f, 0.0f, 1.0f, 1.0f};  // mode, cutoff, factor, opacity
+    glm::vec4 params{0.0f, 0.0f, 1.0f, 1.0f};  // mode, the camera's cutoff, factor, opacity
     glm::uvec4 texture{0u};                     // first texel, width, height, wrapS + 4·wrapT
 };
 static_assert(sizeof(AlphaRecord) == 32, "AlphaRecord must match shaders/alpha.glsl (std430)");
@@ -29,7 +29,7 @@ AlphaCasters createAlphaCasters(const Context& ctx, const scene::Scene& scene, c
     for (std::size_t i = 0; i < scene.objects.size(); ++i) {
         const scene::Material& m = scene.materialOf(scene.objects[i]);
         AlphaRecord& r = records[i + 1];
-        r.params = glm::vec4(float(int(m.alphaMode)), float(m.alphaCutoff), float(m.alphaFactor), float(m.opacity));
+        r.params = glm::vec4(float(int(m.alphaMode)), float(m.cameraCutoff()), float(m.alphaFactor), float(m.opacity));
         if (!m.alphaTextured()) continue;
         const scene::AlphaTexture& t = *m.alphaTexture;
         auto [it, added] = first.emplace(&t, std::uint32_t(texels.size()));

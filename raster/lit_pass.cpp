@@ -16,7 +16,7 @@ bool usesVertexLightCoordinates(const LitVariant& variant) {
            variant.lightKinds == (1u << SHADOWLAB_LIGHT_SPOT);
 }
 
-LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant) {
+LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkDescriptorSetLayout alphaSetLayout) {
     requireFormat(ctx, kLitColorFormat,
                   VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_TRANSFER_SRC_BIT, "the lit pass targets");
     requireFormat(ctx, kLitDepthFormat, VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT, "the camera depth buffer");
@@ -57,10 +57,12 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant) {
     VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
     VK_CHECK(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &setLayout));
     p.setLayout = DescriptorSetLayoutHandle(device, setLayout);
+    p.alpha = alphaSetLayout != VK_NULL_HANDLE;
+    const VkDescriptorSetLayout setLayouts[2] = {setLayout, alphaSetLayout};  // shaders/alpha.glsl at set 1
     const VkPipelineLayoutCreateInfo layoutInfo{
         .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
-        .setLayoutCount = 1,
-        .pSetLayouts = &setLayout,
+        .setLayoutCount = p.alpha ? 2u : 1u,
+        .pSetLayouts = setLayouts,
     };
     VkPipelineLayout layout = VK_NULL_HANDLE;
     VK_CHECK(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &layout));
@@ -89,14 +91,20 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant) {
     std::vector<VkFormat> colorFormats{variant.displayTarget ? kLitDisplayFormat : kLitColorFormat};
     if (variant.aovTarget) colorFormats.insert(colorFormats.end(), 1 + variant.lightTargets, kLitColorFormat);
     p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{
-                                                 .vertexShader = shaders::litVertSpirv(),
-                                                 .fragmentShader = !variant.aovTarget ? shaders::litFragBeautySpirv()
-                                                                   : variant.lightTargets > 0
-                                                                       ? shaders::litFragLightsSpirv()
-                                                                       : shaders::litFragSpirv(),
+                                                 .vertexShader = p.alpha ? shaders::litVertAlphaSpirv()
+                                                                         : shaders::litVertSpirv(),
+                                                 .fragmentShader =
+                                                     !variant.aovTarget
+                                                         ? (p.alpha ? shaders::litFragBeautyAlphaSpirv()
+                                                                    : shaders::litFragBeautySpirv())
+                                                     : variant.lightTargets > 0
+                                                         ? (p.alpha ? shaders::litFragLightsAlphaSpirv()
+                                                                    : shaders::litFragLightsSpirv())
+                                                         : (p.alpha ? shaders::litFragAlphaSpirv() : shaders::litFragSpirv()),
                                                  .fragmentSpecialization = &specialization,
                                                  .vertexSpecialization = &specialization,
                                                  .layout = layout,
+                                                 .usesUv = p.alpha,
                                                  .colorFormats = colorFormats,
                                                  .depthFormat = kLitDepthFormat,
                                                  // Reversed Z: nearer is larger.
@@ -317,6 +325,11 @@ void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const 
                                 &bindings.set, 0, nullptr);
         const VkDeviceSize offset = 0;
         vkCmdBindVertexBuffers(commands, 0, 1, &geometry.vertices, &offset);
+        if (pipeline.alpha) {
+            vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.layout.get(), 1, 1,
+                                    &geometry.alphaSet, 0, nullptr);
+            vkCmdBindVertexBuffers(commands, 1, 1, &geometry.uvs, &offset);
+        }
         vkCmdBindIndexBuffer(commands, geometry.indices, 0, VK_INDEX_TYPE_UINT32);
         vkCmdDrawIndexed(commands, geometry.indexCount, 1, 0, 0, 0);
     }

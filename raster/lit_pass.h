@@ -54,8 +54,14 @@ struct LitPipeline {
     DescriptorSetLayoutHandle setLayout;
     PipelineLayoutHandle layout;
     PipelineHandle pipeline;
+    // The SHADOWLAB_ALPHA shaders (the camera's alpha test): UVs at vertex binding 1,
+    // DrawGeometry::alphaSet bound at set 1.
+    bool alpha = false;
 };
-LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant = {});
+// alphaSetLayout (raster/alpha_casters.h; VK_NULL_HANDLE: none): scenes with MASK or BLEND
+// materials, whose texels the camera looks through as camera rays do (docs/raster.md).
+LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant = {},
+                              VkDescriptorSetLayout alphaSetLayout = VK_NULL_HANDLE);
 
 struct LitTargets {
     Image beauty;  // rgb: linear color, a: visibility

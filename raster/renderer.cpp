@@ -174,7 +174,8 @@ struct Renderer::Impl {
     Context ctx;
     Buffer vertexBuffer;
     Buffer indexBuffer;
-    AlphaCasters alpha;  // alpha-tested casters only (set == VK_NULL_HANDLE otherwise)
+    AlphaCasters alpha;  // MASK or BLEND materials only (set == VK_NULL_HANDLE otherwise)
+    bool shadowAlpha = false;  // the shadow passes test alpha too (scene::Scene::hasAlphaCasters)
     DrawGeometry draw;
     ShadowMaps maps;
     LitTargets targets;
@@ -235,7 +236,8 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
     background = glm::vec3(scene.background);
     attributes["device"] = ctx.deviceReport.name;
 
-    SceneGeometry geometry = tessellateScene(scene, origin, scene.hasAlphaCasters());
+    // UVs and alpha records also where only the camera reads alpha (untextured BLEND).
+    SceneGeometry geometry = tessellateScene(scene, origin, scene.hasCameraAlpha());
     std::vector<TransparentDraw> transparentDraws;
     std::uint32_t opaqueIndexCount = ~0u;
     if (planIn.needsTransmittanceMap) transparentDraws = separateTransparent(scene, geometry, opaqueIndexCount);
@@ -248,11 +250,12 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
     indexBuffer = uploadBuffer(ctx, geometry.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
     draw = DrawGeometry{vertexBuffer.buffer.get(), indexBuffer.buffer.get(), std::uint32_t(geometry.indices.size()),
                         opaqueIndexCount, transparentDraws};
-    if (scene.hasAlphaCasters()) {
+    if (scene.hasCameraAlpha()) {
         alpha = createAlphaCasters(ctx, scene, geometry);
         draw.uvs = alpha.uvs.buffer.get();
         draw.alphaSet = alpha.set;
-        attributes["alpha_casters"] = "alpha-tested in the depth pass";  // only where there are some
+        shadowAlpha = scene.hasAlphaCasters();
+        if (shadowAlpha) attributes["alpha_casters"] = "alpha-tested in the depth pass";  // only where there are some
     }
 
     // The automatic choices: a default cascade count follows the view, then a default size follows
@@ -587,7 +590,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     pendingSetupMs = 0.0;
     if (!shadowPipeline.pipeline || !litPipeline.pipeline) {
         const auto pipelineStart = Clock::now();
-        const VkDescriptorSetLayout alphaLayout = alpha.setLayout.get();  // VK_NULL_HANDLE without
+        // VK_NULL_HANDLE without; the shadow passes only for MASK or textured BLEND casters.
+        const VkDescriptorSetLayout alphaLayout = shadowAlpha ? alpha.setLayout.get() : VK_NULL_HANDLE;
         if (!shadowPipeline.pipeline)
             shadowPipeline = createShadowPipeline(ctx, wantIds, settings.hardwareBias, alphaLayout);
         if (momentMaps.size > 1 && !momentPipeline.pipeline)
@@ -609,7 +613,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                                                             .receiverPlane = settings.receiverPlaneBias,
                                                             .cascadeBlend = cascadeBlendUsed > 0.0,
                                                             .vertexLightConstants = vertexLightConstants,
-                                                            .moments = settings.moments});
+                                                            .moments = settings.moments},
+                                          alpha.setLayout.get());
         if (bindings.set == VK_NULL_HANDLE)
             bindings = createLitBindings(ctx, litPipeline, uniforms, albedos, maps, transmittanceMaps, momentMaps);
         setup += msSince(pipelineStart);

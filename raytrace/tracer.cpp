@@ -196,7 +196,8 @@ Tracer<Real>::Tracer(const scene::Scene& scene) : id_(nextTracerId.fetch_add(1))
         od.opaque = mat.opaque();
         if (mat.alphaMode != scene::AlphaMode::Opaque) {
             od.alpha = int(alphas_.size());
-            alphas_.push_back({mat.alphaMode, Real(mat.alphaCutoff), Real(mat.alphaFactor), mat.alphaTexture, mat});
+            alphas_.push_back({mat.alphaMode, Real(mat.alphaCutoff), Real(mat.alphaFactor), mat.alphaTexture,
+                               Real(mat.cameraCutoff()), mat});
         }
     }
 }
@@ -366,11 +367,12 @@ int Tracer<Real>::buildMesh(const std::vector<scene::Vec3>& positions,
 
 template <typename Real>
 bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& tBest,
-                                 bool conservative, bool anyHit, Hit<Real>& hit, const AlphaData* alpha) const {
+                                 bool conservative, bool anyHit, Hit<Real>& hit, const AlphaData* alpha,
+                                 Real cutoff) const {
     MaskFilter<Real> mask;
-    if (alpha && alpha->mode == scene::AlphaMode::Mask) {
+    if (alpha) {
         mask.on = true;
-        mask.cutoff = alpha->cutoff;
+        mask.cutoff = cutoff;
         mask.factor = alpha->factor;
         mask.texture = alpha->texture.get();
         mask.slotPrims = m.bvh.primitives().data();
@@ -456,14 +458,25 @@ bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& 
 
 template <typename Real>
 bool Tracer<Real>::intersectObject(int object, const Ray<Real>& ray, Real tMax, bool conservative,
-                                   bool anyHit, Hit<Real>& hit, bool alphaTest) const {
+                                   bool anyHit, Hit<Real>& hit, scene::AlphaTest alphaTest) const {
     const ObjectData& od = objects_[object];
-    const AlphaData* mask = alphaTest && od.alpha >= 0 && alphas_[std::size_t(od.alpha)].mode == scene::AlphaMode::Mask
-                                ? &alphas_[std::size_t(od.alpha)]
-                                : nullptr;
+    // Shadow rays drop MASK texels below the cutoff (BLEND attenuates: transmittance()); camera
+    // rays drop those and BLEND texels below scene::kBlendVisibleAlpha (cameraCutoff).
+    const AlphaData* mask = nullptr;
+    Real cutoff = 0;
+    if (od.alpha >= 0) {
+        const AlphaData& a = alphas_[std::size_t(od.alpha)];
+        if (alphaTest == scene::AlphaTest::Shadow && a.mode == scene::AlphaMode::Mask) {
+            mask = &a;
+            cutoff = a.cutoff;
+        } else if (alphaTest == scene::AlphaTest::Camera) {
+            mask = &a;
+            cutoff = a.cameraCutoff;
+        }
+    }
     // An analytic shape's one hit, tested like a mesh's (a sphere's or box's alpha is constant).
     auto cut = [&](Hit<Real>& h) {
-        return mask && mask->factor * (mask->texture ? textureAlpha(od, ray, h) : Real(1)) < mask->cutoff;
+        return mask && mask->factor * (mask->texture ? textureAlpha(od, ray, h) : Real(1)) < cutoff;
     };
     switch (od.kind) {
         case ShapeKind::Sphere: {
@@ -503,7 +516,7 @@ bool Tracer<Real>::intersectObject(int object, const Ray<Real>& ray, Real tMax, 
             const MeshObjectData& mo = meshObjects_[od.index];
             Real tBest = tMax;
             bool found = false;
-            if (mo.flat >= 0 && intersectMesh(meshes_[mo.flat], ray, tBest, conservative, anyHit, hit, mask)) {
+            if (mo.flat >= 0 && intersectMesh(meshes_[mo.flat], ray, tBest, conservative, anyHit, hit, mask, cutoff)) {
                 hit.object = object;
                 hit.instance = -1;
                 if (anyHit) return true;
@@ -518,7 +531,7 @@ bool Tracer<Real>::intersectObject(int object, const Ray<Real>& ray, Real tMax, 
                     const InstanceData& in = mo.instances[slots[slot]];
                     // The ray in object space: t keeps its meaning (affine map, d not normalized).
                     const Ray<Real> local(applyPoint(in.toObject, ray.o), applyVector(in.toObject, ray.d));
-                    if (!intersectMesh(meshes_[in.blas], local, tm, conservative, anyHit, hit, mask)) continue;
+                    if (!intersectMesh(meshes_[in.blas], local, tm, conservative, anyHit, hit, mask, cutoff)) continue;
                     hit.object = object;
                     hit.instance = int(slots[slot]);
                     if (anyHit) return true;
@@ -537,7 +550,7 @@ bool Tracer<Real>::closestHit(const Ray<Real>& ray, Real tMax, bool conservative
     bool found = false;
     for (int i = 0; i < objectCount(); ++i) {
         Hit<Real> h;
-        if (intersectObject(i, ray, tMax, conservative, false, h, false)) {
+        if (intersectObject(i, ray, tMax, conservative, false, h, scene::AlphaTest::Camera)) {
             tMax = h.t;
             hit = h;
             found = true;

@@ -54,15 +54,16 @@ public:
     explicit Tracer(const scene::Scene& scene);
 
     // Nearest hit with 0 < t < tMax. Conservative: reject hits whose t could be <= 0 under
-    // rounding (used with robust offsets).
+    // rounding (used with robust offsets). Camera rays: MASK texels below the cutoff and BLEND
+    // texels below scene::kBlendVisibleAlpha are no hit (scene::Material::cameraSkips).
     bool closestHit(const Ray<Real>& ray, Real tMax, bool conservative, Hit<Real>& hit) const;
     // Any hit with 0 < t < tMax; `blocker` gets the object index of the first found. Shadow
     // rays: alpha-tested (MASK) texels below their cutoff are no hit.
     bool anyHit(const Ray<Real>& ray, Real tMax, bool conservative, int& blocker) const;
     // Hits on one object only. With anyHit, the first hit found rather than the nearest.
-    // alphaTest: skip MASK texels below the cutoff (shadow rays); the camera sees every surface.
+    // alpha: which hits the alpha test of scene::Material drops (scene::AlphaTest).
     bool intersectObject(int object, const Ray<Real>& ray, Real tMax, bool conservative,
-                         bool anyHit, Hit<Real>& hit, bool alphaTest = true) const;
+                         bool anyHit, Hit<Real>& hit, scene::AlphaTest alpha = scene::AlphaTest::Shadow) const;
     // The light a hit on a non-opaque object lets through: 1 − opacity, or for BLEND
     // 1 − opacity·alpha(uv) with the alpha at the hit (scene::Material::transmittance).
     double transmittance(const Ray<Real>& ray, const Hit<Real>& hit) const;
@@ -101,6 +102,7 @@ public:
         scene::AlphaMode mode = scene::AlphaMode::Opaque;
         Real cutoff = 0, factor = 1;
         std::shared_ptr<const scene::AlphaTexture> texture;  // may be null (constant alpha)
+        Real cameraCutoff = 0;  // the camera's: the cutoff (MASK) or scene::kBlendVisibleAlpha (BLEND)
         scene::Material material;  // for transmittance(): the same formula as the scene's
     };
 private:
@@ -156,7 +158,7 @@ private:
                                    const std::map<const scene::TriangleMesh*, int>& uses,
                                    std::map<const scene::TriangleMesh*, int>& blasOf);
     bool intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& tMax, bool conservative,
-                       bool anyHit, Hit<Real>& hit, const AlphaData* mask = nullptr) const;
+                       bool anyHit, Hit<Real>& hit, const AlphaData* mask = nullptr, Real cutoff = 0) const;
     int buildMesh(const std::vector<scene::Vec3>& positions, const std::vector<scene::Vec3>& normals,
                   const std::vector<std::uint32_t>& indices, const std::vector<scene::Vec2>& uvs = {});
     // The texture's alpha at a hit (1 without a texture).

@@ -61,6 +61,12 @@ bool Scene::hasAlphaCasters() const {
     return false;
 }
 
+bool Scene::hasCameraAlpha() const {
+    for (const Object& o : objects)
+        if (materialOf(o).alphaMode != AlphaMode::Opaque) return true;
+    return false;
+}
+
 Bounds Scene::bounds() const {
     Bounds b;
     for (const Object& o : objects) b.extend(boundsOf(o.shape));

@@ -37,6 +37,13 @@ struct Camera {
 // glTF 2.0 alphaMode (3.9.4): OPAQUE ignores alpha, MASK cuts texels whose alpha is below the
 // cutoff out of the caster, BLEND lets 1 - alpha of the light through (docs/scene-format.md).
 enum class AlphaMode { Opaque, Mask, Blend };
+// Which hits an alpha test drops: none, a shadow ray's (MASK below the cutoff) or a camera ray's
+// (Material::cameraSkips).
+enum class AlphaTest { Off, Shadow, Camera };
+// The camera's one visible surface per pixel (docs/raytrace.md, "What the camera sees"): a BLEND
+// texel is seen where its alpha is at least this, i.e. where it would weigh at least as much as
+// everything behind it in "over" compositing; below, the camera looks through it.
+inline constexpr double kBlendVisibleAlpha = 0.5;
 // glTF sampler wrap modes (10497 REPEAT, 33071 CLAMP_TO_EDGE, 33648 MIRRORED_REPEAT).
 enum class TextureWrap { Repeat, ClampToEdge, MirroredRepeat };
 
@@ -87,7 +94,8 @@ struct Material {
     // Alpha (docs/scene-format.md, "Alpha-tested and blended casters"): alpha(uv) = alphaFactor
     // × the texture's alpha at uv (1 without a texture). Mask: a shadow ray passes where
     // alpha(uv) < alphaCutoff; Blend: a hit lets 1 − opacity·alpha(uv) through (the opacity
-    // path, per hit). Shadows only: the camera sees every surface, as with opacity.
+    // path, per hit). The camera looks through MASK texels below the cutoff and BLEND texels
+    // below kBlendVisibleAlpha (cameraSkips); opacity alone never hides a surface from it.
     AlphaMode alphaMode = AlphaMode::Opaque;
     double alphaCutoff = 0.5;
     double alphaFactor = 1.0;  // glTF baseColorFactor[3]
@@ -99,6 +107,11 @@ struct Material {
     // Mask / blend decisions for any hit; `texAlpha` is the texture's alpha there (1 without).
     double alphaAt(double texAlpha) const { return alphaFactor * texAlpha; }
     bool masked(double texAlpha) const { return alphaMode == AlphaMode::Mask && alphaAt(texAlpha) < alphaCutoff; }
+    // The alpha below which the camera looks through a texel (no test for OPAQUE: -1).
+    double cameraCutoff() const {
+        return alphaMode == AlphaMode::Mask ? alphaCutoff : alphaMode == AlphaMode::Blend ? kBlendVisibleAlpha : -1.0;
+    }
+    bool cameraSkips(double texAlpha) const { return alphaMode != AlphaMode::Opaque && alphaAt(texAlpha) < cameraCutoff(); }
     // The light a hit lets through: 1 − opacity, and for BLEND 1 − opacity·alpha(uv).
     double transmittance(double texAlpha) const {
         return alphaMode == AlphaMode::Blend ? 1.0 - opacity * alphaAt(texAlpha) : 1.0 - opacity;
@@ -314,6 +327,9 @@ struct Scene {
     // Some object's material is MASK, or BLEND with a texture: the raster backend then reads
     // alpha per fragment (raster/alpha_casters.h).
     bool hasAlphaCasters() const;
+    // Some object's material is MASK or BLEND: the raster lit pass then tests alpha per
+    // fragment as camera rays do (Material::cameraSkips).
+    bool hasCameraAlpha() const;
     Bounds bounds() const;  // of every object
 };
 

@@ -7,7 +7,9 @@
 #endif
 
 struct AlphaRecord {
-    vec4 params;   // x: mode (0 opaque, 1 mask, 2 blend), y: cutoff, z: alpha factor, w: opacity
+    // x: mode (0 opaque, 1 mask, 2 blend), y: the camera's cutoff (scene::Material::cameraCutoff:
+    // MASK's alphaCutoff, BLEND's kBlendVisibleAlpha), z: alpha factor, w: opacity
+    vec4 params;
     uvec4 texture; // x: first texel, y: width (0: no texture), z: height, w: wrapS + 4·wrapT
 };
 layout(std430, set = SHADOWLAB_ALPHA_SET, binding = 0) readonly buffer AlphaRecords { AlphaRecord alphaRecords[]; };
@@ -41,4 +43,11 @@ float alphaAt(uint id, vec2 uv) {
 bool alphaMasked(uint id, vec2 uv) {
     const AlphaRecord r = alphaRecords[id];
     return r.params.x == 1.0 && alphaAt(id, uv) < r.params.y;
+}
+
+// The camera looks through the texel (scene::Material::cameraSkips): MASK below the cutoff,
+// BLEND below scene::kBlendVisibleAlpha; OPAQUE never.
+bool alphaCameraSkips(uint id, vec2 uv) {
+    const AlphaRecord r = alphaRecords[id];
+    return r.params.x != 0.0 && alphaAt(id, uv) < r.params.y;
 }

@@ -60,6 +60,13 @@ layout(location = 3) out vec4 outLights1;
 #endif
 
 #include "lit_constants.glsl"
+#ifdef SHADOWLAB_ALPHA
+// The *_alpha variants (scenes with MASK or BLEND materials): the camera looks through what
+// camera rays skip (shaders/alpha.glsl alphaCameraSkips), so the AOVs describe the surface behind.
+#define SHADOWLAB_ALPHA_SET 1
+#include "alpha.glsl"
+layout(location = 14) in vec2 inUv;
+#endif
 
 // Light i's constants and LitUniforms' forward and counts: the uniform buffer's, or the same values
 // as flat inputs from lit.vert (kVertexLightConstants, light 0 only). Fields lit.vert does not
@@ -584,6 +591,9 @@ void main() {
     // Receiver plane: the position's screen-space derivatives, here in uniform control flow.
     const vec3 dpdx = kReceiverPlane ? dFdx(inPosition) : vec3(0.0);
     const vec3 dpdy = kReceiverPlane ? dFdy(inPosition) : vec3(0.0);
+#ifdef SHADOWLAB_ALPHA
+    if (alphaCameraSkips(inObjectId, inUv)) discard;  // after the derivatives, which need the quad
+#endif
     vec3 n = normalize(inNormal);
     float nScale = kVertexLightCoordinates ? inversesqrt(dot(inNormal, inNormal)) : 1.0;
     // Two-sided surfaces: the normal faces the viewer (the ray tracer's rule: flip when N·ray > 0).

@@ -30,11 +30,20 @@ layout(location = 5) flat out vec4 outAlbedo;
 // 64 every Vulkan device must take, maxVertexOutputComponents and maxFragmentInputComponents.)
 layout(location = 6) flat out vec4 outLight[6];
 layout(location = 12) flat out vec4 outFrame[2];
+#ifdef SHADOWLAB_ALPHA
+// The lit_vert_alpha variant (scenes with MASK or BLEND materials): the texture coordinates of
+// vertex binding 1 for lit.frag's alpha test (58 components in all).
+layout(location = 3) in vec2 inUv;
+layout(location = 14) out vec2 outUv;
+#endif
 
 void main() {
     outPosition = inPosition;
     outNormal = inNormal;
     outObjectId = inObjectId;
+#ifdef SHADOWLAB_ALPHA
+    outUv = inUv;
+#endif
     outAlbedo = albedo[inObjectId - 1u];
     outLightCoordinates = u.lights[0].toShadow * vec4(inPosition, 1.0);
     outLightNormal = u.lights[0].toShadow * vec4(inNormal, 0.0);

@@ -4,10 +4,14 @@
 #include <cstdint>
 
 #include "lit_frag.spv.h"
+#include "lit_frag_alpha.spv.h"
 #include "lit_frag_beauty.spv.h"
+#include "lit_frag_beauty_alpha.spv.h"
 #include "lit_frag_lights.spv.h"
+#include "lit_frag_lights_alpha.spv.h"
 #include "lit_vert.spv.h"
 #include "moments_comp.spv.h"
+#include "lit_vert_alpha.spv.h"
 #include "shadow_frag.spv.h"
 #include "shadow_frag_alpha.spv.h"
 #include "shadow_frag_alpha_depth.spv.h"
@@ -38,5 +42,9 @@ std::span<const std::uint32_t> litFragSpirv() { return kLitFragSpv; }
 std::span<const std::uint32_t> litFragLightsSpirv() { return kLitFragLightsSpv; }
 std::span<const std::uint32_t> litFragBeautySpirv() { return kLitFragBeautySpv; }
 std::span<const std::uint32_t> momentsCompSpirv() { return kMomentsCompSpv; }
+std::span<const std::uint32_t> litVertAlphaSpirv() { return kLitVertAlphaSpv; }
+std::span<const std::uint32_t> litFragAlphaSpirv() { return kLitFragAlphaSpv; }
+std::span<const std::uint32_t> litFragLightsAlphaSpirv() { return kLitFragLightsAlphaSpv; }
+std::span<const std::uint32_t> litFragBeautyAlphaSpirv() { return kLitFragBeautyAlphaSpv; }
 
 }  // namespace shadowlab::shaders

@@ -29,5 +29,11 @@ std::span<const std::uint32_t> litFragLightsSpirv();
 std::span<const std::uint32_t> litFragBeautySpirv();
 // The filterable maps' moment and blur passes (raster/moment_maps.h).
 std::span<const std::uint32_t> momentsCompSpirv();
+// SHADOWLAB_ALPHA variants of the lit pass (scenes with MASK or BLEND materials): the camera's
+// alpha test, UVs at vertex binding 1 and the alpha records at set 1.
+std::span<const std::uint32_t> litVertAlphaSpirv();
+std::span<const std::uint32_t> litFragAlphaSpirv();
+std::span<const std::uint32_t> litFragLightsAlphaSpirv();
+std::span<const std::uint32_t> litFragBeautyAlphaSpirv();
 
 }  // namespace shadowlab::shaders
