@@ -251,7 +251,7 @@ TEST(AutoBias, AFilterableMapsParameterSeriesHasItsOwnWindow) {
     EXPECT_DOUBLE_EQ(m->recommended, 3.16e-5);
     EXPECT_EQ(m->name(), "min variance");
     const std::string d = m->describe();
-    EXPECT_NE(d.find("min variance (normalized depth squared; map 1024, filter vsm): parameter window"), std::string::npos) << d;
+    EXPECT_NE(d.find("min variance (normalized depth squared; filter vsm, map 1024): parameter window"), std::string::npos) << d;
     // No depth or slope series chose the block's filter: the parameter is not put in it, and a
     // sentence says with which filter it goes.
     EXPECT_FALSE(a.shadowBlock.contains("min_variance"));
