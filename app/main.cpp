@@ -107,6 +107,8 @@ void addBudgetOptions(CLI::App& cmd, shadowlab::app::BudgetOptions& o) {
         "Budget: self-shadow acne pixels (needs the method's blocker ids), a rate (0.5%) or a count (120px)",
         "Budget: mean |V_method - V_reference| over the counted pixels, 0..1 or a percentage",
         "Budget: least IoU of the shadowed sets, 0..1 or a percentage",
+        "Budget: light-bleeding pixels (missed shadow far from its blocker; needs the reference's blocker "
+        "distances), a rate (0.5%) or a count (120px)",
     };
     for (int k = 0; k < shadowlab::scene::kBudgetKindCount; ++k)
         cmd.add_option(budgetInfo(BudgetKind(k)).option, o.text[k],

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <limits>
 #include <map>
 
 #include "compare/text.h"
@@ -55,9 +57,58 @@ long long roundId(float id) { return static_cast<long long>(std::floor(id + kObj
 
 Timing timingOf(const Frame& f) { return {f.totalTimeMs(), f.timingsMs}; }
 
+// The largest number of a Frame attribute holding one or several (';'-separated) numbers; a
+// perspective map's "X*d" counts as X (its texel grows with the distance d from the light, which
+// compare does not know: docs/compare.md). NaN when there is none.
+double largestNumber(const std::string& text) {
+    double best = std::numeric_limits<double>::quiet_NaN();
+    std::size_t start = 0;
+    while (start <= text.size()) {
+        const std::size_t end = std::min(text.find(';', start), text.size());
+        const std::string part = text.substr(start, end - start);
+        char* stop = nullptr;
+        const double v = std::strtod(part.c_str(), &stop);
+        if (stop != part.c_str() && std::isfinite(v) && !(v <= best)) best = v;
+        start = end + 1;
+    }
+    return best;
+}
+
+// The contact distance's constant, texel and slope parts (thresholds.h): from the options, else
+// the method's attributes. The texel is NaN when the method is no shadow map.
+struct Contact {
+    double bias = std::numeric_limits<double>::quiet_NaN();
+    double texel = 0.0, slope = 0.0;
+    bool known() const { return std::isfinite(bias); }
+    double at(float ndotl) const {
+        const double n = std::clamp(double(ndotl), 1e-6, 1.0);
+        const double tanTheta = std::min(std::sqrt(std::max(0.0, 1.0 - n * n)) / n, kContactMaxTan);
+        return bias + (slope + kContactTexels) * texel * std::max(1.0, tanTheta);
+    }
+};
+
 std::string attribute(const Frame& f, const std::string& key) {
     const auto it = f.attributes.find(key);
     return it == f.attributes.end() ? std::string() : it->second;
+}
+
+Contact contactOf(const Frame& method, const CompareOptions& o) {
+    Contact c;
+    const std::string texel = attribute(method, "texel_world_size");
+    if (!texel.empty() || o.contactTexel) {
+        c.bias = o.contactBias.value_or(largestNumber(attribute(method, "depth_bias")));
+        c.texel = o.contactTexel.value_or(largestNumber(texel));
+        c.slope = o.contactSlope.value_or(largestNumber(attribute(method, "slope_bias")));
+        if (!std::isfinite(c.slope)) c.slope = 0.0;
+        if (!std::isfinite(c.texel)) c.bias = std::numeric_limits<double>::quiet_NaN();
+    } else if (o.contactBias) {
+        c.bias = *o.contactBias;
+    } else {
+        const std::string ray = attribute(method, "ray_bias");
+        if (ray == "robust") c.bias = 0.0;
+        else if (!ray.empty()) c.bias = kContactRayBiasFactor * largestNumber(ray);
+    }
+    return c;
 }
 
 float srgbLuminance(float r, float g, float b) {
@@ -266,6 +317,9 @@ Comparison compareFrames(const Frame& method, const Frame& reference,
     m.totalPixels = n;
     m.hasBlockerIds = !method.blockerId.empty();
     m.edgeRadius = options.edgeRadius;
+    const Contact contact = contactOf(method, options);
+    m.hasBlockerDistance = contact.known() && reference.blockerDistance.size() == n && reference.blockerId.size() == n;
+    if (m.hasBlockerDistance) m.contactDistance = contact.at(1.0f);
 
     const auto refState = referenceShadowState(reference);
     const auto edges = shadowEdges(reference, refState);
@@ -349,6 +403,14 @@ Comparison compareFrames(const Frame& method, const Frame& reference,
                 ++m.missedShadow;
                 ++obj.missedShadow;
                 if (nearEdge[i]) ++m.missedShadowNearEdge;
+                // The reference's blocker, by its distance from the receiver: within the contact
+                // distance, a bias leak; farther and away from the reference's shadow edges,
+                // bleeding (near an edge it is the edge's aliasing). Without a blocker neither.
+                if (m.hasBlockerDistance && roundId(reference.blockerId[i]) > 0 &&
+                    std::isfinite(reference.blockerDistance[i])) {
+                    if (double(reference.blockerDistance[i]) <= contact.at(nr)) ++m.biasLeak;
+                    else if (!nearEdge[i]) ++m.bleeding;
+                }
             } else if (c == PixelClass::AgreeLit) {
                 ++m.agreeLit;
             } else {
@@ -383,6 +445,8 @@ Comparison compareFrames(const Frame& method, const Frame& reference,
     m.shadowIoU = m.shadowedUnion ? double(m.shadowedIntersection) / double(m.shadowedUnion) : 1.0;
     m.silhouetteMismatchRate = rate(m.silhouetteMismatch, m.totalPixels);
     m.selfShadowAcneRate = rate(m.selfShadowAcne, m.counted);
+    m.bleedingRate = rate(m.bleeding, m.counted);
+    m.biasLeakRate = rate(m.biasLeak, m.counted);
     m.aliasingPixels = m.falseShadowNearEdge + m.missedShadowNearEdge;
     m.biasErrorPixels = wrong - m.aliasingPixels;
     m.aliasingRate = rate(m.aliasingPixels, m.counted);
@@ -472,6 +536,15 @@ nlohmann::json toJson(const Metrics& m) {
     } else {
         j["self_shadow_acne"] = nullptr;
         j["self_shadow_acne_rate"] = nullptr;
+    }
+    // Without the reference's blocker distances (older frames) bleeding is unknown, not zero.
+    for (const char* k : {"bleeding", "bias_leak", "bleeding_rate", "bias_leak_rate", "contact_distance"}) j[k] = nullptr;
+    if (m.hasBlockerDistance) {
+        j["bleeding"] = m.bleeding;
+        j["bias_leak"] = m.biasLeak;
+        j["bleeding_rate"] = m.bleedingRate;
+        j["bias_leak_rate"] = m.biasLeakRate;
+        j["contact_distance"] = m.contactDistance;
     }
     return j;
 }

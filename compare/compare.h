@@ -6,6 +6,7 @@
 #include <array>
 #include <cstddef>
 #include <map>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -127,6 +128,17 @@ struct Metrics {
     std::size_t selfShadowAcne = 0;
     double selfShadowAcneRate = 0.0;  // over counted
 
+    // Missed shadow split by the reference's blocker distance (Frame::blockerDistance): bias
+    // leaks where the blocker is within the contact distance of the receiver (thresholds.h
+    // kContactTexels), bleeding where it is farther and the pixel is away from the reference's
+    // shadow edges (near one, a far blocker's missed shadow is the edge's aliasing: neither). Needs the reference's distances and a contact
+    // distance from the method's bias and texel attributes (or CompareOptions); unknown, not
+    // zero, without them.
+    bool hasBlockerDistance = false;
+    double contactDistance = 0.0;  // D at tanθ ≤ 1 (the smallest it is), world units
+    std::size_t bleeding = 0, biasLeak = 0;
+    double bleedingRate = 0.0, biasLeakRate = 0.0;  // over counted
+
     // Edge-aware split of the wrong pixels: within edgeRadius pixels of a reference shadow
     // boundary they are aliasing (a resolution problem), elsewhere bias error.
     int edgeRadius = kDefaultEdgeRadiusPixels;
@@ -157,6 +169,10 @@ struct Metrics {
 struct CompareOptions {
     int edgeRadius = kDefaultEdgeRadiusPixels;
     int hotspotSize = 0;  // side of the hotspot window; 0 = min(width, height) / 6 in 16..96
+    // The contact distance's parts, world units (b + (s + kContactTexels)·t·max(1, tanθ)); unset:
+    // read from the method's attributes (raster: depth_bias, slope_bias, texel_world_size, the
+    // largest of several maps; ray tracer: kContactRayBiasFactor × ray_bias).
+    std::optional<double> contactBias, contactTexel, contactSlope;
 };
 
 struct Comparison {

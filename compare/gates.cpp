@@ -25,6 +25,7 @@ Measured measure(const Metrics& m, BudgetKind kind) {
         case BudgetKind::MaxSelfAcne: return {m.selfShadowAcneRate, m.selfShadowAcne};
         case BudgetKind::MaxMeanAbsDiff: return {m.meanAbsVisibilityError, 0, false};
         case BudgetKind::MinIoU: return {m.shadowIoU, 0, false};
+        case BudgetKind::MaxBleeding: return {m.bleedingRate, m.bleeding};
     }
     return {};
 }
@@ -37,6 +38,10 @@ std::vector<BudgetCheck> checkBudgets(const Metrics& m, const scene::Budgets& bu
     if (budgets[BudgetKind::MaxSelfAcne] && !m.hasBlockerIds)
         throw scene::InputError("--max-self-acne: the method frame has no blocker_id channel, so its self-shadow "
                                 "acne cannot be told from other false shadows (use --max-false-shadow)");
+    if (budgets[BudgetKind::MaxBleeding] && !m.hasBlockerDistance)
+        throw scene::InputError("--max-bleeding: the reference frame has no blocker_distance channel (rendered before "
+                                "it was written?) or the method frame no bias and texel size, so light bleeding cannot "
+                                "be told from bias leaks (render the reference again, or use --max-missed-shadow)");
     if (m.counted == 0) {
         BudgetCheck c;
         c.kind = BudgetKind::MaxMismatch;

@@ -138,6 +138,13 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
             const std::string on = dominantObject(in, m, m.missedShadow,
                                                   [](const ObjectErrors& o) { return o.missedShadow; });
             f += on.empty() ? ")" : ", mostly on " + on + ")";
+            // Far from its blocker, a missed shadow is the filter's (light bleeding), not the bias's.
+            if (m.hasBlockerDistance && m.bleeding > 0)
+                f += double(m.bleeding) > kMostlyShare * double(m.missedShadow)
+                         ? ", mostly light bleeding (" + formatPercent(double(m.bleeding) / double(m.missedShadow)) +
+                               " of it farther than " + formatShort(m.contactDistance) + " from its blocker)"
+                         : " (" + formatPercent(double(m.bleeding) / double(m.missedShadow)) +
+                               " of it light bleeding, farther than " + formatShort(m.contactDistance) + " from its blocker)";
             parts.push_back(f);
         } else {
             parts.push_back("no missed shadow");
@@ -349,6 +356,12 @@ std::string metricsTable(const ReportInput& in) {
         return m.hasBlockerIds ? countCell(m.selfShadowAcne, m.selfShadowAcneRate) : plain("n/a");
     });
     row("<span style=\"color:var(--missed)\">■</span> missed shadow", [&](const Metrics& m) { return countCell(m.missedShadow, m.missedShadowRate); });
+    row("&nbsp;&nbsp;of which light bleeding (blocker far)", [&](const Metrics& m) {
+        return m.hasBlockerDistance ? countCell(m.bleeding, m.bleedingRate) : plain("n/a");
+    });
+    row("&nbsp;&nbsp;of which bias leak (blocker within the contact distance)", [&](const Metrics& m) {
+        return m.hasBlockerDistance ? countCell(m.biasLeak, m.biasLeakRate) : plain("n/a");
+    });
     row("agree, lit", [&](const Metrics& m) { return countCell(m.agreeLit, double(m.agreeLit) / std::max<double>(1, m.counted)); });
     row("agree, shadow", [&](const Metrics& m) { return countCell(m.agreeShadow, double(m.agreeShadow) / std::max<double>(1, m.counted)); });
     row("mean |V<sub>M</sub> − V<sub>R</sub>|", [&](const Metrics& m) { return plain(formatFixed(m.meanAbsVisibilityError, 4)); });

@@ -53,6 +53,22 @@ inline constexpr double kNotableSoftErrorRate = 0.001;
 // several lights can round a hair inside the range (float epsilon is 1.2e-7).
 inline constexpr float kPenumbraMargin = 1e-6f;
 
+// Light bleeding against bias leaks (docs/compare.md): a missed-shadow pixel whose reference
+// blocker lies within the contact distance D of the receiver, along the shadow ray, is a bias
+// leak, else bleeding. A shadow map answers a receiver with the depth of the texel it reads,
+// minus the bias: the constant bias b and the slope term s·t·tanθ move the receiver that far
+// toward the light, and the texel's footprint holds depths up to t·tanθ from the receiver's own,
+// widened by the filter to a few texels (pcf2x2: 2, pcf 3×3: 3, the default moment blur: 5,
+// whose half-width 2.5 reaches that far). So D = b + (s + kContactTexels)·t·max(1, tanθ) with
+// tanθ capped as the slope bias caps it: a blocker that near can be lost to the bias and the
+// texel grid alone; one farther away cannot, and a lit answer there is the filter's (light
+// bleeding in the moment maps) or an edge's. Four texels is the middle of those footprints; at
+// the default bias (half a texel) D is 4.5 texels. A ray tracer's offset origin skips blockers
+// within about its offset: D = kContactRayBiasFactor × ray bias.
+inline constexpr double kContactTexels = 4.0;
+inline constexpr double kContactMaxTan = 10.0;  // raster/tolerances.h kMaxSlopeTan
+inline constexpr double kContactRayBiasFactor = 2.0;
+
 // Findings paragraph: an object or cause is named as "mostly" responsible when it holds more
 // than half of a class, i.e. when it is the majority, not merely the largest share.
 inline constexpr double kMostlyShare = 0.5;

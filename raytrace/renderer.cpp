@@ -57,6 +57,10 @@ scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan,
     const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
     const int width = cam.width, height = cam.height;
     scene::Frame frame = scene::Frame::allocate(width, height, true);
+    frame.blockerDistance.assign(frame.pixelCount(), 0.0f);
+    // The reference's blocker distance is the nearest blocker's (compare's bleeding test reads
+    // it); the ray tracer's any-hit rays give the found blocker's, at no extra ray.
+    const bool nearestDistance = std::string(backend) == "reference";
     // Per-light visibility only when it adds something: with one light it is `visibility`.
     if (scene.lights.size() > 1)
         frame.lightVisibility.assign(scene.lights.size(), std::vector<float>(frame.pixelCount(), 0.0f));
@@ -127,6 +131,7 @@ scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan,
         double weightSum = 0.0, weightedVisibility = 0.0;
         double maxNdotL = scene.lights.empty() ? 0.0 : -std::numeric_limits<double>::infinity();
         int blocker = 0;
+        double blockerDistance = 0.0;
         for (std::size_t li = 0; li < scene.lights.size(); ++li) {
             const scene::Light& light = scene.lights[li];
             const scene::LightSample<scene::Vec3> ls = scene::sampleLight(light, p);
@@ -136,9 +141,12 @@ scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan,
             double v = 1.0;
             if (needsShadowTest[li]) {
                 Rng rng(sampleSeed(i, int(li)));
-                const ShadowResult r = lightVisibility(tracer, light, sp, settings, anyHit, rng);
+                const ShadowResult r = lightVisibility(tracer, light, sp, settings, anyHit, rng, nearestDistance);
                 v = r.transmittance;
-                if (blocker == 0 && r.blocker >= 0) blocker = r.blocker + 1;
+                if (blocker == 0 && r.blocker >= 0) {
+                    blocker = r.blocker + 1;
+                    blockerDistance = r.distance;
+                }
             }
             if (!frame.lightVisibility.empty()) frame.lightVisibility[li][i] = float(v);
             // The visibility AOV weighs each light by what it would add unshadowed.
@@ -151,6 +159,7 @@ scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan,
         frame.visibility[i] = weightSum > 0 ? float(weightedVisibility / weightSum) : 0.0f;
         frame.ndotl[i] = float(maxNdotL);
         frame.blockerId[i] = float(blocker);
+        frame.blockerDistance[i] = float(blockerDistance);
     });
     frame.timingsMs.emplace_back("shadow", msSince(shadowStart));
 

@@ -32,13 +32,18 @@ void orthonormalBasis(const scene::Vec3& w, scene::Vec3& t1, scene::Vec3& t2) {
 
 template <typename Real>
 ShadowResult traceShadowRay(const Tracer<Real>& tracer, const Ray<Real>& ray, Real tMax,
-                            bool anyHit, bool conservative) {
+                            bool anyHit, bool conservative, bool nearestDistance) {
     ShadowResult r;
+    const double length = glm::length(scene::Vec3(ray.d));
     if (anyHit) {
         int blocker = -1;
         if (tracer.anyHit(ray, tMax, conservative, blocker)) {
             r.transmittance = 0.0;
             r.blocker = blocker;
+            Hit<Real> h;
+            const bool found = nearestDistance ? tracer.closestHit(ray, tMax, conservative, h)
+                                               : tracer.intersectObject(blocker, ray, tMax, conservative, false, h);
+            if (found) r.distance = double(h.t) * length;
         }
         return r;
     }
@@ -63,27 +68,28 @@ ShadowResult traceShadowRay(const Tracer<Real>& tracer, const Ray<Real>& ray, Re
         }
     }
     if (opaqueHit) r.transmittance = 0.0;
+    if (r.blocker >= 0) r.distance = double(nearest) * length;
     return r;
 }
 
 template <typename Real>
 ShadowResult lightVisibility(const Tracer<Real>& tracer, const scene::Light& light,
                              const SurfacePoint<Real>& sp, const scene::RaytraceSettings& settings,
-                             bool anyHit, Rng& rng) {
+                             bool anyHit, Rng& rng, bool nearestDistance) {
     using Vec = Vec3T<Real>;
     const bool conservative = settings.robustOffset;
     if (light.type == scene::LightType::Directional) {
         const Vec w(Real(-light.direction.x), Real(-light.direction.y), Real(-light.direction.z));
         const Ray<Real> ray(shadowOrigin(sp, w, settings), w);
         return traceShadowRay(tracer, ray, std::numeric_limits<Real>::infinity(), anyHit,
-                              conservative);
+                              conservative, nearestDistance);
     }
     const Vec lightPos(Real(light.position.x), Real(light.position.y), Real(light.position.z));
     if (!(light.radius > 0)) {
         // Segment to the light: d spans origin → light, so t runs 0..1.
         const Vec o = shadowOrigin(sp, lightPos - sp.p, settings);
         const Ray<Real> ray(o, lightPos - o);
-        return traceShadowRay(tracer, ray, Real(1), anyHit, conservative);
+        return traceShadowRay(tracer, ray, Real(1), anyHit, conservative, nearestDistance);
     }
 
     // Spherical light: sample directions uniformly in the cone it subtends (pbrt-v4
@@ -122,9 +128,12 @@ ShadowResult lightVisibility(const Tracer<Real>& tracer, const scene::Light& lig
             const Vec target(Real(q.x), Real(q.y), Real(q.z));
             const Vec o = shadowOrigin(sp, target - sp.p, settings);
             const Ray<Real> ray(o, target - o);
-            const ShadowResult r = traceShadowRay(tracer, ray, Real(1), anyHit, conservative);
+            const ShadowResult r = traceShadowRay(tracer, ray, Real(1), anyHit, conservative, nearestDistance);
             sum += r.transmittance;
-            if (result.blocker < 0) result.blocker = r.blocker;
+            if (result.blocker < 0 && r.blocker >= 0) {
+                result.blocker = r.blocker;
+                result.distance = r.distance;
+            }
         }
     }
     result.transmittance = sum / double(nx * ny);
@@ -132,14 +141,14 @@ ShadowResult lightVisibility(const Tracer<Real>& tracer, const scene::Light& lig
 }
 
 template ShadowResult traceShadowRay<float>(const Tracer<float>&, const Ray<float>&, float, bool,
-                                            bool);
+                                            bool, bool);
 template ShadowResult traceShadowRay<double>(const Tracer<double>&, const Ray<double>&, double,
-                                             bool, bool);
+                                             bool, bool, bool);
 template ShadowResult lightVisibility<float>(const Tracer<float>&, const scene::Light&,
                                              const SurfacePoint<float>&,
-                                             const scene::RaytraceSettings&, bool, Rng&);
+                                             const scene::RaytraceSettings&, bool, Rng&, bool);
 template ShadowResult lightVisibility<double>(const Tracer<double>&, const scene::Light&,
                                               const SurfacePoint<double>&,
-                                              const scene::RaytraceSettings&, bool, Rng&);
+                                              const scene::RaytraceSettings&, bool, Rng&, bool);
 
 }  // namespace shadowlab::raytrace

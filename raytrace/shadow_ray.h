@@ -13,6 +13,10 @@ namespace shadowlab::raytrace {
 struct ShadowResult {
     double transmittance = 1.0;  // 1 = unblocked, 0 = fully blocked
     int blocker = -1;            // object index of the first blocker found, -1 = none
+    // World distance from the ray's origin to the nearest hit on the ray (a blocker), 0 when none.
+    // Exact for closest-hit rays; for any-hit rays, the nearest hit of the blocker found (a bound
+    // from above when several objects block), or exact with nearestDistance.
+    double distance = 0.0;
 };
 
 // The shadow ray's origin for a surface point and a direction toward the light.
@@ -38,10 +42,12 @@ Vec3T<Real> shadowOrigin(const SurfacePoint<Real>& sp, const Vec3T<Real>& toward
 // One shadow ray over 0 < t < tMax. anyHit (opaque scenes only): stop at the first hit.
 // Otherwise every object on the segment multiplies by (1 − opacity) once, however many of its
 // surfaces the ray crosses (BLEND: 1 − opacity·alpha at its nearest hit), and the blocker is the
-// nearest object hit. MASK texels below the cutoff are no hit in either mode.
+// nearest object hit. MASK texels below the cutoff are no hit in either mode. nearestDistance:
+// a blocked any-hit ray traces once more for the nearest hit (the reference does, for
+// ShadowResult::distance).
 template <typename Real>
 ShadowResult traceShadowRay(const Tracer<Real>& tracer, const Ray<Real>& ray, Real tMax,
-                            bool anyHit, bool conservative);
+                            bool anyHit, bool conservative, bool nearestDistance = false);
 
 // Visibility of `light` from a surface point (N·L > 0 is the caller's business): one ray for
 // directional and point lights; settings.samples stratified rays toward a spherical light
@@ -49,6 +55,6 @@ ShadowResult traceShadowRay(const Tracer<Real>& tracer, const Ray<Real>& ray, Re
 template <typename Real>
 ShadowResult lightVisibility(const Tracer<Real>& tracer, const scene::Light& light,
                              const SurfacePoint<Real>& sp, const scene::RaytraceSettings& settings,
-                             bool anyHit, Rng& rng);
+                             bool anyHit, Rng& rng, bool nearestDistance = false);
 
 }  // namespace shadowlab::raytrace

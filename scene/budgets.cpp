@@ -17,6 +17,7 @@ constexpr BudgetInfo kBudgets[kBudgetKindCount] = {
     {BudgetKind::MaxSelfAcne, "--max-self-acne", "max_self_acne", true, false},
     {BudgetKind::MaxMeanAbsDiff, "--max-mean-abs-diff", "max_mean_abs_diff", false, false},
     {BudgetKind::MinIoU, "--min-iou", "min_iou", false, true},
+    {BudgetKind::MaxBleeding, "--max-bleeding", "max_bleeding", true, false},
 };
 
 // A decimal number filling all of `s` (strtod also takes "inf", "nan" and hex: all rejected

@@ -24,8 +24,8 @@ struct BudgetLimit {
 };
 
 // The budgets, by their option and JSON names. Each is absent unless set.
-enum class BudgetKind { MaxMismatch, MaxFalseShadow, MaxMissedShadow, MaxSelfAcne, MaxMeanAbsDiff, MinIoU };
-inline constexpr int kBudgetKindCount = 6;
+enum class BudgetKind { MaxMismatch, MaxFalseShadow, MaxMissedShadow, MaxSelfAcne, MaxMeanAbsDiff, MinIoU, MaxBleeding };
+inline constexpr int kBudgetKindCount = 7;
 struct BudgetInfo {
     BudgetKind kind;
     const char* option;    // "--max-mismatch"

@@ -48,6 +48,12 @@ struct Frame {
     // Object id (index + 1) of the first blocker the shadow test found, 0 = none. Empty when
     // the backend cannot tell.
     std::vector<float> blockerId;
+    // World distance along the shadow ray from its origin (the receiver, offset by the ray bias)
+    // to the nearest blocker of the light that named blockerId, where blockerId > 0; 0 elsewhere.
+    // The ray tracers and the reference write it (EXR channel "blocker_distance"); empty when the
+    // backend cannot tell (raster) and in frames written before it. compare tells light bleeding
+    // from bias leaks with it (docs/compare.md).
+    std::vector<float> blockerDistance;
     // Per-light visibility (0..1, the shadow test of light i alone; 0 where light i does not
     // reach the point: N·L <= 0 or outside a spot's cone), one vector per light in scene order.
     // Only when the scene has more than one light (with one it equals `visibility`); written to

@@ -336,12 +336,14 @@ void writeFrame(const Frame& frame, const fs::path& file) {
     for (const std::vector<float>& v : frame.lightVisibility)
         if (v.size() != n) throw std::invalid_argument(file.string() + ": a per-light visibility has the wrong size");
     const std::size_t lights = frame.lightVisibility.size();
-    const int channels = (withBlocker ? 8 : 7) + int(lights);
+    const bool withDistance = frame.blockerDistance.size() == n;
+    const int channels = (withBlocker ? 8 : 7) + int(lights) + (withDistance ? 1 : 0);
     ImageSpec spec(frame.width, frame.height, channels, TypeDesc::FLOAT);
     spec.channelnames = {"R", "G", "B", "visibility", "object_id", "ndotl", "Z"};
     if (withBlocker) spec.channelnames.push_back("blocker_id");
     // Per-light visibility, light i as "visibility.<i>" (an EXR layer "visibility").
     for (std::size_t l = 0; l < lights; ++l) spec.channelnames.push_back(lightVisibilityChannel(l));
+    if (withDistance) spec.channelnames.push_back("blocker_distance");  // last: optional, found by name
     spec.alpha_channel = -1;
     spec.z_channel = 6;
     spec.attribute("compression", "zip");
@@ -369,6 +371,7 @@ void writeFrame(const Frame& frame, const fs::path& file) {
         p[6] = frame.depth[i];
         if (withBlocker) p[7] = frame.blockerId[i];
         for (std::size_t l = 0; l < lights; ++l) p[firstLight + l] = frame.lightVisibility[l][i];
+        if (withDistance) p[channels - 1] = frame.blockerDistance[i];
     }
     writeAtomically(file, [&](const fs::path& tmp) {
         writeImage(tmp, spec, pixels.data(), TypeDesc::FLOAT);
@@ -403,7 +406,8 @@ Frame readFrame(const fs::path& file) {
     const int iR = channelIndex("R", true), iG = channelIndex("G", true),
               iB = channelIndex("B", true), iV = channelIndex("visibility", true),
               iId = channelIndex("object_id", true), iN = channelIndex("ndotl", true),
-              iZ = channelIndex("Z", true), iBl = channelIndex("blocker_id", false);
+              iZ = channelIndex("Z", true), iBl = channelIndex("blocker_id", false),
+              iBd = channelIndex("blocker_distance", false);
 
     // visibility.0, visibility.1, ... up to the first index that is missing.
     std::vector<int> iLights;
@@ -433,6 +437,7 @@ Frame readFrame(const fs::path& file) {
         if (y0 == 0) {
             f = Frame::allocate(spec.width, spec.height, iBl >= 0);
             f.lightVisibility.assign(iLights.size(), std::vector<float>(f.pixelCount()));
+            if (iBd >= 0) f.blockerDistance.assign(f.pixelCount(), 0.0f);
         }
         const std::size_t first = std::size_t(y0) * spec.width;
         const std::size_t count = std::size_t(y1 - y0) * spec.width;
@@ -448,6 +453,7 @@ Frame readFrame(const fs::path& file) {
             f.depth[i] = p[iZ];
             if (iBl >= 0) f.blockerId[i] = p[iBl];
             for (std::size_t l = 0; l < iLights.size(); ++l) f.lightVisibility[l][i] = p[iLights[l]];
+            if (iBd >= 0) f.blockerDistance[i] = p[iBd];
         }
     }
     const std::string prefix = kAttrPrefix;

@@ -16,10 +16,34 @@ namespace {
 
 using Json = nlohmann::json;
 
+// The filterable maps' parameter series, in the order their notes appear, with the scene-file
+// "shadow" key each sets (docs/scene-format.md) and the sweep axis that samples it.
+struct MomentKind {
+    const char* kind;  // the sweep axis and SweepConfig::biasKind
+    const char* key;   // the scene-file key
+    const char* name;  // for sentences
+    const char* unit;
+};
+constexpr MomentKind kMomentKinds[] = {
+    {"min_variance", "min_variance", "min variance", "normalized depth squared"},
+    {"bleeding_reduction", "light_bleeding_reduction", "light-bleeding reduction", "fraction"},
+    {"evsm_positive", "evsm_positive_exponent", "EVSM positive exponent", "exponent"},
+    {"evsm_negative", "evsm_negative_exponent", "EVSM negative exponent", "exponent"},
+    {"esm_exponent", "esm_exponent", "ESM exponent", "exponent"},
+    {"moment_bias", "moment_bias", "moment bias", "fraction"},
+};
+
+const MomentKind* momentKind(const std::string& kind) {
+    for (const MomentKind& m : kMomentKinds)
+        if (kind == m.kind) return &m;
+    return nullptr;
+}
+
 // The scene-file key a bias kind sets.
 const char* kindKey(const std::string& kind) {
     if (kind == "depth") return "depth_bias";
     if (kind == "slope") return "slope_bias";
+    if (const MomentKind* m = momentKind(kind)) return m->key;
     return "ray_bias";
 }
 
@@ -37,6 +61,10 @@ Json contextOf(const SweepConfig& c, const std::string& skipKey) {
         // The map a bias was found on: a recommended block carries it, so the bias is used on it.
         if (o.fitLightFrustum) j["fit_light_frustum"] = *o.fitLightFrustum;
         if (o.cascades) j["cascades"] = *o.cascades;
+        // A filterable map's parameters, so a series of one holds the others fixed.
+        for (const MomentKind& m : kMomentKinds)
+            if (const std::optional<double> v = momentOverride(o, m.kind)) j[m.key] = *v;
+        if (o.blurWidth) j["blur_width"] = *o.blurWidth;
     } else {
         if (o.rayBias) {
             // Scene files take a number or "robust"; the overrides keep the command-line text.
@@ -60,6 +88,7 @@ std::optional<double> biasOf(const SweepConfig& c, const std::string& kind) {
     const auto& o = c.overrides;
     if (kind == "depth" && c.backend == "raster") return o.depthBias;
     if (kind == "slope" && c.backend == "raster") return o.slopeBias;
+    if (momentKind(kind) && c.backend == "raster") return momentOverride(o, kind);
     if (kind == "ray" && c.backend == "raytrace" && o.rayBias && *o.rayBias != "robust") {
         char* end = nullptr;
         const double v = std::strtod(o.rayBias->c_str(), &end);
@@ -105,6 +134,8 @@ double worstOf(double a, double b) {
 }
 
 std::string artifactName(const std::string& dominant, const std::string& kind) {
+    if (momentKind(kind))
+        return dominant == "false" ? "over-darkening (false shadow)" : "light bleeding and leaks (missed shadow)";
     if (dominant == "false") return "acne (false shadow)";
     return kind == "ray" ? "light leaks (missed shadow)" : "peter-panning and light leaks (missed shadow)";
 }
@@ -112,6 +143,15 @@ std::string artifactName(const std::string& dominant, const std::string& kind) {
 std::string precisionText(const std::string& p) { return p.empty() ? "" : " (" + p + ")"; }
 
 }  // namespace
+
+const std::vector<std::string>& seriesKinds() {
+    static const std::vector<std::string> kinds = [] {
+        std::vector<std::string> k{"depth", "slope", "ray"};
+        for (const MomentKind& m : kMomentKinds) k.push_back(m.kind);
+        return k;
+    }();
+    return kinds;
+}
 
 double windowMiddle(double lo, double hi, bool logSpaced) {
     if (logSpaced && lo > 0.0 && hi > 0.0) return std::sqrt(lo * hi);
@@ -142,9 +182,15 @@ bool isLogSpaced(std::vector<double> values) {
     return variation(ratio) < variation(linear);
 }
 
-std::string BiasSeries::name() const { return kind + " bias"; }
+std::string BiasSeries::name() const {
+    if (const MomentKind* m = momentKind(kind)) return m->name;
+    return kind + " bias";
+}
 
-std::string BiasSeries::unit() const { return kind == "slope" ? "texels" : "world units"; }
+std::string BiasSeries::unit() const {
+    if (const MomentKind* m = momentKind(kind)) return m->unit;
+    return kind == "slope" ? "texels" : "world units";
+}
 
 std::string BiasSeries::describe() const {
     std::string s = name() + " (" + unit();
@@ -153,7 +199,7 @@ std::string BiasSeries::describe() const {
     s += "): ";
     const std::string limit = "both rates <= " + formatPercent(window.threshold);
     if (!window.stiff) {
-        s += "bias window " + formatShort(window.lo) + " .. " + formatShort(window.hi) + " (" + limit + ", " +
+        s += std::string(momentKind(kind) ? "parameter window " : "bias window ") + formatShort(window.lo) + " .. " + formatShort(window.hi) + " (" + limit + ", " +
              std::to_string(window.acceptableSamples) + " sample" + (window.acceptableSamples == 1 ? "" : "s") +
              "); recommended " + formatShort(recommended);
         if (window.lo != window.hi)
@@ -186,7 +232,7 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
     out.threshold = threshold;
 
     // Group the usable rows by kind and shared settings, in first-seen order per kind.
-    for (const char* kind : {"depth", "slope", "ray"}) {
+    for (const std::string& kind : seriesKinds()) {
         std::vector<BiasSeries> found;
         std::map<std::string, std::size_t> index;
         for (const SweepRow& r : rows) {
@@ -247,7 +293,7 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
     }
 
     // One sentence per primary series; others (the same kind at other settings) are mentioned.
-    for (const char* kind : {"depth", "slope", "ray"}) {
+    for (const std::string& kind : seriesKinds()) {
         const BiasSeries* p = out.primary(kind);
         if (!p) continue;
         out.notes.push_back(p->describe());
@@ -299,6 +345,23 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
             why = "On the probe slice: " + raster->name() + " " + formatShort(raster->recommended) + " " + raster->unit() + ".";
         }
         out.notes.push_back(why);
+    }
+
+    // The filterable maps' own parameters: into the block when it holds the filter they were
+    // measured with (each series held the others fixed), else a sentence says why not.
+    for (const MomentKind& m : kMomentKinds) {
+        const BiasSeries* p = out.primary(m.kind);
+        if (!p || p->window.stiff) continue;
+        const std::string filter = p->context.value("filter", std::string());
+        if (out.shadowBlock.value("filter", std::string()) == filter) {
+            out.shadowBlock[m.key] = p->recommended;
+        } else {
+            out.notes.push_back(std::string("The ") + m.name + " window was measured with filter " +
+                                (filter.empty() ? std::string("(scene default)") : filter) +
+                                "; the block's shadow map uses " + out.shadowBlock.value("filter", std::string("its default")) +
+                                ", so it does not carry \"" + m.key + "\": " + m.key + " " + formatShort(p->recommended) +
+                                " goes with that filter.");
+        }
     }
 
     // The ray tracer: robust offsets when they pass, else the ray-bias series.

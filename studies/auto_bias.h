@@ -19,7 +19,9 @@ namespace shadowlab::compare {
 // The rows of one bias kind that differ only in that bias ("map 1024, none, slope bias 0" for
 // a depth-bias series): only such rows show one parameter's acne-to-leak trade-off.
 struct BiasSeries {
-    std::string kind;     // "depth" | "slope" | "ray"
+    // "depth" | "slope" | "ray", or a filterable map's parameter (seriesKinds()): its window
+    // is read the same way, from the false- and missed-shadow rates along the series.
+    std::string kind;
     std::string backend;  // "raster" | "raytrace"
     // The overrides every row of the series shares (the bias itself left out), as scene-file
     // "shadow" keys: {"shadow_map_size": 1024, "filter": "none", "slope_bias": 0}.
@@ -34,7 +36,7 @@ struct BiasSeries {
     // peter-panning); empty when the series has a window.
     std::string dominant;
 
-    // "depth bias", "slope bias", "ray bias".
+    // "depth bias", "slope bias", "ray bias", "min variance", "ESM exponent", ...
     std::string name() const;
     // "world units" or "texels".
     std::string unit() const;
@@ -52,12 +54,13 @@ struct RobustResult {
 
 struct AutoBias {
     double threshold = kBiasWindowMaxRate;
-    std::vector<BiasSeries> series;     // every series found, kinds in the order depth, slope, ray
+    std::vector<BiasSeries> series;     // every series found, kinds in seriesKinds() order
     std::vector<RobustResult> robust;   // every robust-offset row that rendered
     // A valid scene-file "shadow" block (scene/loader.cpp readShadow accepts every key it holds):
     // the raster's chosen bias kind at its recommended value with the other kind at 0 (each was
     // measured alone), the shadow-map size and filter the series ran at, and the ray tracer's
-    // "robust" (when it passes) or recommended ray bias with its precision. Empty when the sweep
+    // "robust" (when it passes) or recommended ray bias with its precision; a filterable map's
+    // parameter window's middle when its series ran with the block's filter. Empty when the sweep
     // had no bias series and no robust rows.
     nlohmann::json shadowBlock = nlohmann::json::object();
     // The sentences behind the block, in order: one per primary series, the robust verdict, the
@@ -74,6 +77,11 @@ struct AutoBias {
 // false_shadow_rate / missed_shadow_rate). Rows with an error or without both rates are left
 // out. Throws scene::InputError when the threshold is not a finite rate ≥ 0.
 AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold = kBiasWindowMaxRate);
+
+// Every kind a series may have, in the order of the notes: "depth", "slope", "ray", then the
+// filterable maps' parameters "min_variance", "bleeding_reduction", "evsm_positive",
+// "evsm_negative", "esm_exponent", "moment_bias" (the sweep axes of those names).
+const std::vector<std::string>& seriesKinds();
 
 // The middle of [lo, hi]: geometric when lo > 0 and the samples are log-spaced, else arithmetic.
 double windowMiddle(double lo, double hi, bool logSpaced);

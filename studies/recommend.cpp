@@ -307,6 +307,12 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
                           ", constant bias 0 .. " + formatShort(o.depthSteps.back() * b0) +
                           " world units together with slope bias 0 .. " + formatShort(o.slopeSteps.back() * s0) +
                           " texels, refined around the best point.");
+        if (scene::isFilterable(resolved.raster.filter))
+            r.notes.push_back(std::string("Filter ") + scene::toString(resolved.raster.filter) +
+                              " biases the receiver's depth before its moment test as `none` does, so the same "
+                              "search applies; its own parameters (min variance, light-bleeding reduction, "
+                              "exponents, moment bias) are not searched here: give them as axes of a sweep grid, "
+                              "whose automatic bias reads their parameter windows (docs/sweep.md).");
         if (v.beatsDefaults) {
             block["depth_bias"] = best.depthBias;
             block["slope_bias"] = best.slopeBias;

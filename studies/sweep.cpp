@@ -72,6 +72,13 @@ Json overridesToJson(const scene::SettingsOverrides& o) {
     if (o.cascades) j["cascades"] = *o.cascades;
     if (o.snapLightFrustum) j["snap_light_frustum"] = *o.snapLightFrustum;
     if (o.cascadeBlend) j["cascade_blend"] = *o.cascadeBlend;
+    if (o.minVariance) j["min_variance"] = *o.minVariance;
+    if (o.bleedReduction) j["bleeding_reduction"] = *o.bleedReduction;
+    if (o.evsmPositive) j["evsm_positive"] = *o.evsmPositive;
+    if (o.evsmNegative) j["evsm_negative"] = *o.evsmNegative;
+    if (o.esmExponent) j["esm_exponent"] = *o.esmExponent;
+    if (o.momentBias) j["moment_bias"] = *o.momentBias;
+    if (o.blurWidth) j["blur_width"] = *o.blurWidth;
     return j;
 }
 
@@ -92,6 +99,13 @@ scene::SettingsOverrides overridesFromJson(const Json& j) {
     if (j.contains("cascades")) o.cascades = j["cascades"].get<int>();
     if (j.contains("snap_light_frustum")) o.snapLightFrustum = j["snap_light_frustum"].get<bool>();
     if (j.contains("cascade_blend")) o.cascadeBlend = j["cascade_blend"].get<double>();
+    if (j.contains("min_variance")) o.minVariance = j["min_variance"].get<double>();
+    if (j.contains("bleeding_reduction")) o.bleedReduction = j["bleeding_reduction"].get<double>();
+    if (j.contains("evsm_positive")) o.evsmPositive = j["evsm_positive"].get<double>();
+    if (j.contains("evsm_negative")) o.evsmNegative = j["evsm_negative"].get<double>();
+    if (j.contains("esm_exponent")) o.esmExponent = j["esm_exponent"].get<double>();
+    if (j.contains("moment_bias")) o.momentBias = j["moment_bias"].get<double>();
+    if (j.contains("blur_width")) o.blurWidth = j["blur_width"].get<int>();
     return o;
 }
 
@@ -157,6 +171,29 @@ std::string jsonNumber(const Json& metrics, const char* name) {
 
 }  // namespace
 
+bool isFilterableName(const std::string& filter) {
+    return filter == "vsm" || filter == "evsm2" || filter == "evsm4" || filter == "esm" || filter == "msm";
+}
+
+bool isMomentAxis(const std::string& name) {
+    return name == "min_variance" || name == "bleeding_reduction" || name == "evsm_positive" ||
+           name == "evsm_negative" || name == "esm_exponent" || name == "moment_bias" || name == "blur_width";
+}
+
+std::optional<double>& momentOverride(scene::SettingsOverrides& o, const std::string& name) {
+    if (name == "min_variance") return o.minVariance;
+    if (name == "bleeding_reduction") return o.bleedReduction;
+    if (name == "evsm_positive") return o.evsmPositive;
+    if (name == "evsm_negative") return o.evsmNegative;
+    if (name == "esm_exponent") return o.esmExponent;
+    if (name == "moment_bias") return o.momentBias;
+    throw std::logic_error("momentOverride: not a real-valued moment parameter: " + name);
+}
+
+std::optional<double> momentOverride(const scene::SettingsOverrides& o, const std::string& name) {
+    return momentOverride(const_cast<scene::SettingsOverrides&>(o), name);  // read only
+}
+
 std::string SweepConfig::key() const {
     std::string k = "backend=" + backend;
     const auto& o = overrides;
@@ -176,6 +213,13 @@ std::string SweepConfig::key() const {
     // Appended only when set, so the keys of rows without them stay as they were.
     if (o.snapLightFrustum) k += std::string(";snap=") + (*o.snapLightFrustum ? "1" : "0");
     if (o.cascadeBlend) k += ";cascade_blend=" + number(*o.cascadeBlend);
+    if (o.minVariance) k += ";min_variance=" + number(*o.minVariance);
+    if (o.bleedReduction) k += ";bleeding_reduction=" + number(*o.bleedReduction);
+    if (o.evsmPositive) k += ";evsm_positive=" + number(*o.evsmPositive);
+    if (o.evsmNegative) k += ";evsm_negative=" + number(*o.evsmNegative);
+    if (o.esmExponent) k += ";esm_exponent=" + number(*o.esmExponent);
+    if (o.momentBias) k += ";moment_bias=" + number(*o.momentBias);
+    if (o.blurWidth) k += ";blur_width=" + std::to_string(*o.blurWidth);
     return k;
 }
 
@@ -197,6 +241,13 @@ std::string SweepConfig::label() const {
     if (o.cascades) parts.push_back(std::to_string(*o.cascades) + (*o.cascades == 1 ? " cascade" : " cascades"));
     if (o.snapLightFrustum) parts.push_back(*o.snapLightFrustum ? "snapped" : "unsnapped");
     if (o.cascadeBlend) parts.push_back("blend " + number(*o.cascadeBlend));
+    if (o.minVariance) parts.push_back("min variance " + number(*o.minVariance));
+    if (o.bleedReduction) parts.push_back("bleeding reduction " + number(*o.bleedReduction));
+    if (o.evsmPositive) parts.push_back("evsm+ " + number(*o.evsmPositive));
+    if (o.evsmNegative) parts.push_back("evsm- " + number(*o.evsmNegative));
+    if (o.esmExponent) parts.push_back("esm exponent " + number(*o.esmExponent));
+    if (o.momentBias) parts.push_back("moment bias " + number(*o.momentBias));
+    if (o.blurWidth) parts.push_back("blur " + std::to_string(*o.blurWidth));
     std::string s = backend + ":";
     for (std::size_t i = 0; i < parts.size(); ++i) s += (i ? ", " : " ") + parts[i];
     if (parts.empty()) s += " defaults";
@@ -278,6 +329,10 @@ SweepGrid defaultGrid(const scene::Scene& scene, bool quick) {
         c.overrides.hardwareBias = true;
         g.configs.push_back(c);
     }
+    // The filterable maps, one row each at their default parameters beside pcf2x2 of the largest
+    // size (the same map), so the error-vs-time plot shows which technique buys the most per
+    // millisecond; their parameter windows are a grid file's axes (docs/sweep.md).
+    for (const char* filter : {"vsm", "evsm2", "evsm4", "esm", "msm"}) g.configs.push_back(raster(sizes.back(), filter));
     // The map fitted to what the camera sees (the default fitting, one cascade) against the
     // bounding-sphere maps above, at each size: what the fitted frustum gains on this view.
     for (int size : sizes) {
@@ -441,7 +496,8 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
         const std::vector<const char*> names = isRaster
             ? std::vector<const char*>{"shadow_map_size", "filter", "cascades", "cascade_blend", "fit_light_frustum",
                                        "snap_light_frustum", "receiver_plane_bias", "hardware_bias", "depth_bias",
-                                       "slope_bias"}
+                                       "slope_bias", "min_variance", "bleeding_reduction", "evsm_positive",
+                                       "evsm_negative", "esm_exponent", "moment_bias", "blur_width"}
             : std::vector<const char*>{"ray_bias", "precision", "samples"};
         for (const auto& [key, value] : block.items())
             if (std::none_of(names.begin(), names.end(), [&](const char* n) { return key == n; }))
@@ -478,8 +534,11 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
                         c.overrides.shadowMapSize = v.get<int>();
                     } else if (n == "filter") {
                         const std::string f = v.is_string() ? v.get<std::string>() : std::string();
-                        if (f != "none" && f != "pcf2x2" && f != "pcf" && f != "poisson" && f != "pcss")
-                            throw SceneError(file, at, "expected \"none\", \"pcf2x2\", \"pcf\", \"poisson\" or \"pcss\", got " +
+                        static const char* kFilters[] = {"none", "pcf2x2", "pcf", "poisson", "pcss", "vsm",
+                                                         "evsm2", "evsm4", "esm", "msm"};
+                        if (std::none_of(std::begin(kFilters), std::end(kFilters), [&](const char* k) { return f == k; }))
+                            throw SceneError(file, at, "expected \"none\", \"pcf2x2\", \"pcf\", \"poisson\", \"pcss\", "
+                                                       "\"vsm\", \"evsm2\", \"evsm4\", \"esm\" or \"msm\", got " +
                                                            scene::describeJson(v));
                         c.overrides.filter = f;
                     } else if (n == "cascade_blend") {
@@ -514,6 +573,32 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
                         if (c.biasKind.empty() || (depthValues == 1 && values.size() > 1)) {
                             c.biasKind = "slope";
                             c.biasValue = *c.overrides.slopeBias;
+                        }
+                    } else if (isMomentAxis(n)) {
+                        // A filterable map's own parameter: ranges as resolveSettings checks them
+                        // (below); an axis of several values is the series its window is read from.
+                        if (n == "blur_width") {
+                            if (!v.is_number_integer() || v.get<long long>() < 1 || v.get<long long>() > scene::kMaxBlurWidth ||
+                                v.get<long long>() % 2 == 0)
+                                throw SceneError(file, at, "expected an odd integer in 1.." + std::to_string(scene::kMaxBlurWidth) +
+                                                               " (texels), got " + scene::describeJson(v));
+                            c.overrides.blurWidth = v.get<int>();
+                        } else {
+                            // The ranges resolveSettings() accepts (scene/settings.cpp), checked
+                            // here so a bad value is named with its JSON path.
+                            const double hi = n == "min_variance" || n == "moment_bias" ? 1.0
+                                              : n == "bleeding_reduction"              ? 0.99
+                                              : n == "esm_exponent"                    ? scene::kMaxEsmExponent
+                                                                                       : scene::kMaxEvsmExponent;
+                            const double x = num(0.0);
+                            if (x > hi)
+                                throw SceneError(file, at, "expected a number in 0.." + number(hi) + ", got " +
+                                                               scene::describeJson(v));
+                            momentOverride(c.overrides, n) = x;
+                            if (values.size() > 1 && (c.biasKind.empty() || isFilterableName(c.overrides.filter.value_or("")))) {
+                                c.biasKind = n;
+                                c.biasValue = x;
+                            }
                         }
                     } else if (n == "ray_bias") {
                         if (v.is_string() && v.get<std::string>() == "robust") {

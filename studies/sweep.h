@@ -35,6 +35,17 @@ struct SweepConfig {
     std::string label() const;
 };
 
+// The filterable maps' parameters as sweep axes and grid-file keys (docs/sweep.md):
+// "min_variance", "bleeding_reduction", "evsm_positive", "evsm_negative", "esm_exponent",
+// "moment_bias", "blur_width".
+bool isMomentAxis(const std::string& name);
+// The override a real-valued moment axis sets (every one but "blur_width"); throws
+// std::logic_error for another name.
+std::optional<double>& momentOverride(scene::SettingsOverrides& o, const std::string& name);
+std::optional<double> momentOverride(const scene::SettingsOverrides& o, const std::string& name);
+// True for "vsm", "evsm2", "evsm4", "esm", "msm": filters that read no depth or slope bias.
+bool isFilterableName(const std::string& filter);
+
 // The most configurations a grid file may multiply to, checked before they are built: far
 // beyond a sweep anyone would wait for (a configuration is at least one render), and small
 // enough that the grid and its rows fit in memory.

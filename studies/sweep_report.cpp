@@ -21,7 +21,6 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
-constexpr const char* kKinds[] = {"depth", "slope", "ray"};
 
 // A row that rendered and was measured: it is plotted and ranked; the others are listed.
 bool usable(const SweepRow& r) {
@@ -500,10 +499,10 @@ std::string renderSweepReportHtml(const SweepReportInput& in) {
              "change is the shadow maps' own (zero for a map that holds still). Error is that of the still frame; "
              "hover a point for its run time.</p></div></div>\n";
     bool anyBias = false;
-    for (const char* kind : kKinds) anyBias = anyBias || bias.primary(kind);
+    for (const std::string& kind : seriesKinds()) anyBias = anyBias || bias.primary(kind);
     if (anyBias) {
         o << "<h2>False and missed shadow against bias</h2>\n<div class=\"plots\">";
-        for (const char* kind : kKinds) {
+        for (const std::string& kind : seriesKinds()) {
             const BiasSeries* s = bias.primary(kind);
             if (!s) continue;
             o << "<div>" << renderSvg(biasSeriesPlot(*s)) << "<p>" << escapeHtml(s->describe()) << "</p></div>";
@@ -537,7 +536,7 @@ void writeSweepReport(const fs::path& dir, const SweepReportInput& input) {
     const AutoBias bias = recommendBias(input.rows, input.threshold);
     scene::writeTextAtomic(dir / "error-time.svg", sweepErrorTimeSvg(input));
     if (hasFlicker(input)) scene::writeTextAtomic(dir / "flicker-error.svg", sweepFlickerSvg(input));
-    for (const char* kind : kKinds) {
+    for (const std::string& kind : seriesKinds()) {
         const BiasSeries* s = bias.primary(kind);
         if (s) {
             scene::writeTextAtomic(dir / svgName(kind), renderSvg(biasSeriesPlot(*s)));

@@ -398,5 +398,86 @@ TEST(CompareFrames, GivesTheSameAnswerOnFramesReadBackFromExr) {
     EXPECT_EQ(toJson(read).dump(), toJson(direct).dump());
 }
 
+// A 40×40 floor (id 1, N·L 1) whose left half the reference shadows by object 2: columns 0..9 with
+// the blocker 0.05 from the receiver, columns 10..19 with it 2.0 away; the method lights all of it.
+// Its attributes give the contact distance D = 0.02 + (0 + 4)·0.01·1 = 0.06 (N·L 1: tanθ 0).
+std::pair<Frame, Frame> bleedingPair(bool withDistance) {
+    Frame m = test::uniformFrame(40, 40, 1.0f, 1.0f, 1.0f, true);
+    Frame r = test::uniformFrame(40, 40, 1.0f, 1.0f, 1.0f, true);
+    if (withDistance) r.blockerDistance.assign(r.pixelCount(), 0.0f);
+    for (int y = 0; y < 40; ++y)
+        for (int x = 0; x < 20; ++x) {
+            const std::size_t i = std::size_t(y) * 40 + std::size_t(x);
+            r.visibility[i] = 0.0f;
+            r.blockerId[i] = 2.0f;
+            if (withDistance) r.blockerDistance[i] = x < 10 ? 0.05f : 2.0f;
+        }
+    m.attributes = {{"backend", "raster"}, {"depth_bias", "0.02"}, {"slope_bias", "0"}, {"texel_world_size", "0.01"}};
+    return {m, r};
+}
+
+TEST(Bleeding, MissedShadowFarFromItsBlockerIsBleedingAndNearItABiasLeak) {
+    const auto [m, r] = bleedingPair(true);
+    const Metrics x = compareFrames(m, r).metrics;
+    ASSERT_TRUE(x.hasBlockerDistance);
+    EXPECT_DOUBLE_EQ(x.contactDistance, 0.02 + 4 * 0.01);
+    EXPECT_EQ(x.missedShadow, 800u);
+    EXPECT_EQ(x.biasLeak, 400u);  // columns 0..9: 0.05 <= D
+    // Columns 10..19 are 2.0 away: bleeding, except those within the edge radius of the
+    // reference's shadow edge at x = 20, which are that edge's aliasing (all of them in this band).
+    EXPECT_GT(x.missedShadowNearEdge, 0u);
+    EXPECT_EQ(x.bleeding, 400u - x.missedShadowNearEdge);
+    EXPECT_DOUBLE_EQ(x.bleedingRate, double(x.bleeding) / 1600.0);
+    EXPECT_DOUBLE_EQ(x.biasLeakRate, 400.0 / 1600.0);
+    const nlohmann::json j = toJson(x);
+    EXPECT_EQ(j["bias_leak"], 400);
+    EXPECT_EQ(j["bleeding"], x.bleeding);
+    // A steeper receiver widens D by tanθ: at N·L = 0.6 (tanθ = 4/3), D = 0.02 + 4·0.01·4/3 = 0.0733.
+    auto [m2, r2] = bleedingPair(true);
+    for (std::size_t i = 0; i < r2.pixelCount(); ++i) {
+        r2.ndotl[i] = m2.ndotl[i] = 0.6f;
+        if (r2.blockerDistance[i] == 0.05f) r2.blockerDistance[i] = 0.07f;
+    }
+    EXPECT_EQ(compareFrames(m2, r2).metrics.biasLeak, 400u);
+    // A ray tracer's offset: D = 2 × 0.03 = 0.06.
+    Frame ray = m;
+    ray.attributes = {{"backend", "raytrace"}, {"ray_bias", "0.03"}};
+    const Metrics rx = compareFrames(ray, r).metrics;
+    EXPECT_DOUBLE_EQ(rx.contactDistance, 0.06);
+    EXPECT_EQ(rx.biasLeak, 400u);
+}
+
+TEST(Bleeding, WithoutTheReferencesBlockerDistancesItIsUnknownNotZero) {
+    const auto [m, r] = bleedingPair(false);  // a reference written before the channel
+    const Metrics x = compareFrames(m, r).metrics;
+    EXPECT_FALSE(x.hasBlockerDistance);
+    EXPECT_EQ(x.bleeding, 0u);
+    const nlohmann::json j = toJson(x);
+    EXPECT_TRUE(j["bleeding"].is_null());
+    EXPECT_TRUE(j["bias_leak_rate"].is_null());
+    // Nor without a contact distance: a method frame with no bias or texel attributes.
+    auto [m2, r2] = bleedingPair(true);
+    m2.attributes.clear();
+    EXPECT_FALSE(compareFrames(m2, r2).metrics.hasBlockerDistance);
+    CompareOptions o;
+    o.contactBias = 0.1;  // given by the caller instead
+    const Metrics given = compareFrames(m2, r2, o).metrics;
+    EXPECT_TRUE(given.hasBlockerDistance);
+    EXPECT_EQ(given.biasLeak, 400u);
+}
+
+TEST(Bleeding, TheBlockerDistanceSurvivesTheExrAndAnOlderFrameReadsWithout) {
+    auto [m, r] = bleedingPair(true);
+    const auto dir = std::filesystem::path(::testing::TempDir()) / "compare_bleeding_exr";
+    std::filesystem::create_directories(dir);
+    scene::writeFrame(r, dir / "r.exr");
+    scene::writeFrame(m, dir / "m.exr");  // no blocker_distance channel
+    const Frame rr = scene::readFrame(dir / "r.exr"), mr = scene::readFrame(dir / "m.exr");
+    std::filesystem::remove_all(dir);
+    EXPECT_EQ(rr.blockerDistance, r.blockerDistance);
+    EXPECT_TRUE(mr.blockerDistance.empty());
+    EXPECT_EQ(toJson(compareFrames(mr, rr).metrics).dump(), toJson(compareFrames(m, r).metrics).dump());
+}
+
 }  // namespace
 }  // namespace shadowlab::compare

@@ -71,6 +71,20 @@ TEST(Gates, NoBudgetNoCheckAndNothingCountedBreaks) {
     EXPECT_FALSE(checks[1].broken);
 }
 
+TEST(Gates, BleedingBudgetNeedsTheBlockerDistancesAndCountsBleeding) {
+    Metrics m = someMetrics();
+    m.hasBlockerDistance = false;
+    EXPECT_THROW(checkBudgets(m, budgets({{BudgetKind::MaxBleeding, "1%"}})), scene::InputError);
+    m.hasBlockerDistance = true;
+    m.bleeding = 30;
+    m.bleedingRate = 30.0 / double(m.counted);
+    const auto within = checkBudgets(m, budgets({{BudgetKind::MaxBleeding, "30px"}}));
+    ASSERT_EQ(within.size(), 1u);
+    EXPECT_FALSE(within[0].broken);
+    EXPECT_TRUE(anyBroken(checkBudgets(m, budgets({{BudgetKind::MaxBleeding, "29px"}}))));
+    EXPECT_EQ(scene::budgetInfo(BudgetKind::MaxBleeding).jsonKey, std::string("max_bleeding"));
+}
+
 TEST(Gates, SelfAcneBudgetWithoutBlockerIdsIsBadInput) {
     Metrics m = someMetrics();
     m.hasBlockerIds = false;

@@ -229,5 +229,79 @@ TEST(AutoBias, TheShadowBlockIsAcceptedByTheSceneLoader) {
     EXPECT_EQ(loaded.shadow.shadowMapSize, std::optional<int>(1024));
 }
 
+// A VSM min-variance series at 1e-7 .. 1e-2 (decades): too small a floor lets the blurred
+// receiver's own variance shadow it (false), too large a floor lets light through (missed).
+std::vector<SweepRow> minVarianceSeries() {
+    using test::momentRow;
+    return {momentRow("vsm", "min_variance", 1e-7, kBad, 0), momentRow("vsm", "min_variance", 1e-6, kOk, 0),
+            momentRow("vsm", "min_variance", 1e-5, 0, 0),    momentRow("vsm", "min_variance", 1e-4, 0, 0),
+            momentRow("vsm", "min_variance", 1e-3, 0, kOk), momentRow("vsm", "min_variance", 1e-2, 0, kBad)};
+}
+
+TEST(AutoBias, AFilterableMapsParameterSeriesHasItsOwnWindow) {
+    const AutoBias a = recommendBias(minVarianceSeries());
+    const BiasSeries* m = a.primary("min_variance");
+    ASSERT_NE(m, nullptr);
+    EXPECT_EQ(a.primary("depth"), nullptr);
+    EXPECT_FALSE(m->window.stiff);
+    EXPECT_DOUBLE_EQ(m->window.lo, 1e-6);
+    EXPECT_DOUBLE_EQ(m->window.hi, 1e-3);
+    EXPECT_TRUE(m->logSpaced);
+    // sqrt(1e-6 · 1e-3) = 3.1623e-5, to 3 digits.
+    EXPECT_DOUBLE_EQ(m->recommended, 3.16e-5);
+    EXPECT_EQ(m->name(), "min variance");
+    const std::string d = m->describe();
+    EXPECT_NE(d.find("min variance (normalized depth squared; filter vsm, map 1024): parameter window"), std::string::npos) << d;
+    // No depth or slope series chose the block's filter: the parameter is not put in it, and a
+    // sentence says with which filter it goes.
+    EXPECT_FALSE(a.shadowBlock.contains("min_variance"));
+    bool said = false;
+    for (const std::string& n : a.notes) said = said || (n.find("\"min_variance\"") != std::string::npos && n.find("vsm") != std::string::npos);
+    EXPECT_TRUE(said);
+}
+
+TEST(AutoBias, AStiffBleedingReductionSeriesNamesLightBleeding) {
+    using test::momentRow;
+    const AutoBias a = recommendBias({momentRow("vsm", "bleeding_reduction", 0.0, 0, 0.05),
+                                      momentRow("vsm", "bleeding_reduction", 0.2, 0, 0.03),
+                                      momentRow("vsm", "bleeding_reduction", 0.4, 0.01, 0.02)});
+    const BiasSeries* b = a.primary("bleeding_reduction");
+    ASSERT_NE(b, nullptr);
+    EXPECT_TRUE(b->window.stiff);
+    EXPECT_EQ(b->dominant, "missed");
+    EXPECT_DOUBLE_EQ(b->recommended, 0.4);  // the best compromise: worst rate 2%
+    EXPECT_NE(b->describe().find("light bleeding and leaks"), std::string::npos) << b->describe();
+}
+
+TEST(AutoBias, TheBlockCarriesTheParameterWhenItsSeriesRanWithTheBlocksFilter) {
+    // The depth series run with VSM (its receiver depth is biased as for `none`), beside the
+    // min-variance series: the block's filter is vsm, so the parameter window's middle joins it.
+    std::vector<SweepRow> rows;
+    for (SweepRow r : depthSeriesWithWindow()) {
+        r.config.overrides.filter = "vsm";
+        r.key = r.config.key();
+        rows.push_back(r);
+    }
+    for (const SweepRow& r : minVarianceSeries()) rows.push_back(r);
+    const AutoBias a = recommendBias(rows);
+    ASSERT_NE(a.primary("depth"), nullptr);
+    EXPECT_EQ(a.shadowBlock.at("filter").get<std::string>(), "vsm");
+    EXPECT_DOUBLE_EQ(a.shadowBlock.at("min_variance").get<double>(), 3.16e-5);
+    const nlohmann::json scene = {
+        {"camera", {{"position", {0, 2, 6}}, {"look_at", {0, 0.7, 0}}, {"up", {0, 1, 0}}, {"fov_y", 40},
+                    {"resolution", {64, 36}}, {"near", 0.1}, {"far", 100}}},
+        {"materials", {{"matte", {{"albedo", {0.8, 0.8, 0.8}}}}}},
+        {"lights", {{{"type", "directional"}, {"direction", {-1, -2, -1}}, {"color", {1, 1, 1}}, {"intensity", 3}}}},
+        {"objects", {{{"type", "sphere"}, {"center", {0, 1, 0}}, {"radius", 1}, {"material", "matte"}}}},
+        {"shadow", a.shadowBlock}};
+    const fs::path dir = fs::path(::testing::TempDir()) / "auto_bias_moment_scene";
+    fs::create_directories(dir);
+    std::ofstream(dir / "scene.json") << scene.dump(2);
+    const scene::Scene loaded = scene::loadScene(dir / "scene.json");
+    EXPECT_EQ(loaded.shadow.filter, std::optional<std::string>("vsm"));
+    ASSERT_TRUE(loaded.shadow.minVariance.has_value());
+    EXPECT_DOUBLE_EQ(*loaded.shadow.minVariance, 3.16e-5);
+}
+
 }  // namespace
 }  // namespace shadowlab::compare

@@ -62,6 +62,20 @@ inline SweepRow slopeRow(double bias, double falseRate, double missedRate, doubl
     return finish(c, falseRate, missedRate, frameMs);
 }
 
+// A raster row of a filterable map's parameter series (`kind` a sweep axis such as
+// "min_variance"), map 1024, the filter's other parameters at their defaults.
+inline SweepRow momentRow(const std::string& filter, const std::string& kind, double value, double falseRate,
+                          double missedRate, double frameMs = 6.0) {
+    SweepConfig c;
+    c.backend = "raster";
+    c.overrides.shadowMapSize = 1024;
+    c.overrides.filter = filter;
+    momentOverride(c.overrides, kind) = value;
+    c.biasKind = kind;
+    c.biasValue = value;
+    return finish(c, falseRate, missedRate, frameMs);
+}
+
 // A ray tracer row of the constant ray-bias series in float.
 inline SweepRow rayRow(double bias, double falseRate, double missedRate, double frameMs = 100.0) {
     SweepConfig c;

@@ -504,6 +504,84 @@ TEST_F(GridFile, DefaultGridComparesAFittedMapAtEverySize) {
     }
 }
 
+TEST_F(GridFile, KeysOfRowsWithoutMomentParametersAreUnchanged) {
+    // The resume key as journals written before the filterable maps hold it, spelled out from
+    // key()'s fields: a moment parameter appears only when a row sets it.
+    SweepConfig c = rasterConfig(1024, "pcf2x2");
+    c.overrides.depthBias = 0.01;
+    c.overrides.slopeBias = 0.0;
+    c.overrides.fitLightFrustum = false;
+    c.overrides.cascades = 1;
+    EXPECT_EQ(c.key(), "backend=raster;map=1024;filter=pcf2x2;depth_bias=0.01;slope_bias=0;fit_light_frustum=0;cascades=1");
+    EXPECT_EQ(c.label(), "raster: map 1024, pcf2x2, depth bias 0.01, slope bias 0, bounds frustum, 1 cascade");
+    c.overrides.filter = "vsm";
+    c.overrides.minVariance = 1e-5;
+    c.overrides.blurWidth = 7;
+    EXPECT_EQ(c.key(), "backend=raster;map=1024;filter=vsm;depth_bias=0.01;slope_bias=0;fit_light_frustum=0;cascades=1;"
+                       "min_variance=1e-05;blur_width=7");
+    EXPECT_NE(c.label().find("min variance 1e-05, blur 7"), std::string::npos) << c.label();
+}
+
+TEST_F(GridFile, MomentParameterAxesAreSeriesAndRoundTrip) {
+    const SweepGrid g = loadGrid(write(R"({ "raster": { "filter": ["vsm", "evsm4"], "min_variance": [1e-6, 1e-4, 1e-2],
+        "bleeding_reduction": [0.3], "evsm_positive": [20], "evsm_negative": [4], "esm_exponent": [60],
+        "moment_bias": [1e-4], "blur_width": [3] } })"),
+                                 scene);
+    ASSERT_EQ(g.configs.size(), 6u);  // 2 filters × 3 floors; the one-valued axes held fixed
+    std::set<std::string> keys;
+    for (const SweepConfig& c : g.configs) {
+        keys.insert(c.key());
+        EXPECT_EQ(c.biasKind, "min_variance") << c.label();  // the only axis of several values
+        EXPECT_EQ(c.biasValue, *c.overrides.minVariance);
+        EXPECT_EQ(c.overrides.bleedReduction, std::optional<double>(0.3));
+        EXPECT_EQ(c.overrides.evsmPositive, std::optional<double>(20));
+        EXPECT_EQ(c.overrides.evsmNegative, std::optional<double>(4));
+        EXPECT_EQ(c.overrides.esmExponent, std::optional<double>(60));
+        EXPECT_EQ(c.overrides.momentBias, std::optional<double>(1e-4));
+        EXPECT_EQ(c.overrides.blurWidth, std::optional<int>(3));
+        // The journal line gives back the same configuration, hence the same key.
+        SweepRow row;
+        row.config = c;
+        row.key = c.key();
+        const SweepRow back = rowFromJournal(journalRow(row));
+        EXPECT_EQ(back.config.key(), c.key());
+        EXPECT_EQ(back.config.biasKind, "min_variance");
+    }
+    EXPECT_EQ(keys.size(), 6u);
+    // Each filterable filter is a grid value; a one-valued parameter axis is no series.
+    const SweepGrid filters = loadGrid(write(R"({ "raster": { "filter": ["vsm", "evsm2", "evsm4", "esm", "msm"],
+        "esm_exponent": [40] } })"), scene);
+    ASSERT_EQ(filters.configs.size(), 5u);
+    for (const SweepConfig& c : filters.configs) EXPECT_EQ(c.biasKind, "") << c.label();
+    // With a depth series beside it, a swept parameter of a filterable filter is the series;
+    // a non-filterable one keeps the depth series (the parameter does nothing there).
+    const SweepGrid both = loadGrid(write(R"({ "raster": { "filter": ["pcf2x2", "vsm"], "depth_bias": [0, 0.01],
+        "bleeding_reduction": [0.1, 0.5] } })"), scene);
+    for (const SweepConfig& c : both.configs)
+        EXPECT_EQ(c.biasKind, *c.overrides.filter == "vsm" ? "bleeding_reduction" : "depth") << c.label();
+}
+
+TEST_F(GridFile, DefaultGridHasOneRowPerFilterableMapAtDefaultParameters) {
+    for (const bool quick : {true, false}) {
+        std::multiset<std::string> filters;
+        int largest = 0;
+        for (const auto& c : defaultGrid(scene, quick).configs)
+            if (c.backend == "raster") largest = std::max(largest, c.overrides.shadowMapSize.value_or(0));
+        for (const auto& c : defaultGrid(scene, quick).configs) {
+            const std::string f = c.overrides.filter.value_or("");
+            if (!isFilterableName(f)) continue;
+            filters.insert(f);
+            EXPECT_EQ(c.overrides.shadowMapSize, std::optional<int>(largest));
+            EXPECT_EQ(c.overrides.cascades, std::optional<int>(1));
+            EXPECT_FALSE(c.overrides.minVariance || c.overrides.bleedReduction || c.overrides.evsmPositive ||
+                         c.overrides.evsmNegative || c.overrides.esmExponent || c.overrides.momentBias ||
+                         c.overrides.blurWidth);
+            EXPECT_EQ(c.biasKind, "");
+        }
+        EXPECT_EQ(filters, (std::multiset<std::string>{"esm", "evsm2", "evsm4", "msm", "vsm"}));
+    }
+}
+
 TEST_F(GridFile, BadValuesAreRejectedWithTheirJsonPath) {
     const std::vector<std::pair<std::string, std::string>> cases = {
         {R"({ "raster": { "depth_bias": [0, 0.1, -1] } })", "raster.depth_bias[2]"},
@@ -525,6 +603,16 @@ TEST_F(GridFile, BadValuesAreRejectedWithTheirJsonPath) {
         {R"({ "raster": { "cascades": [2.5] } })", "raster.cascades[0]"},
         {R"({ "raster": { "cascades": ["3"] } })", "raster.cascades[0]"},
         {R"({ "raytrace": { "cascades": [3] } })", "raytrace.cascades"},
+        {R"({ "raster": { "min_variance": [1e-6, -1] } })", "raster.min_variance[1]"},
+        {R"({ "raster": { "bleeding_reduction": [1] } })", "raster.bleeding_reduction[0]"},
+        {R"({ "raster": { "evsm_positive": [43] } })", "raster.evsm_positive[0]"},
+        {R"({ "raster": { "evsm_negative": ["5"] } })", "raster.evsm_negative[0]"},
+        {R"({ "raster": { "esm_exponent": [86] } })", "raster.esm_exponent[0]"},
+        {R"({ "raster": { "moment_bias": [2] } })", "raster.moment_bias[0]"},
+        {R"({ "raster": { "blur_width": [4] } })", "raster.blur_width[0]"},
+        {R"({ "raster": { "blur_width": [65] } })", "raster.blur_width[0]"},
+        {R"({ "raytrace": { "min_variance": [1e-6] } })", "raytrace.min_variance"},
+        {R"({ "raster": { "filter": ["vsm", "vsm8"] } })", "raster.filter[1]"},
     };
     for (const auto& [text, path] : cases) {
         const fs::path file = write(text);
