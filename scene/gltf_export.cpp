@@ -61,10 +61,10 @@ glm::dvec3 uvVertex(int r, int s, int segments, int rings) {
     return {std::sin(theta) * std::cos(phi), std::cos(theta), -std::sin(theta) * std::sin(phi)};
 }
 
-// The two triangles of cell (ring r, segment s), counter-clockwise seen from outside; at the
-// poles one of them is degenerate and left out.
+// The two triangles of a cell of ring r (any segment: the corners are named a..d as below),
+// counter-clockwise seen from outside; at the poles one of them is degenerate and left out.
 template <typename Emit>
-void uvCell(int r, int s, int rings, Emit&& emit) {
+void uvCell(int r, int rings, Emit&& emit) {
     const int a = 0, b = 1, c = 2, d = 3;  // (r, s), (r+1, s), (r+1, s+1), (r, s+1)
     if (r != 0) emit(a, b, d);
     if (r != rings - 1) emit(b, c, d);
@@ -83,7 +83,7 @@ Geometry sphereGeometry(const Sphere& sp, int segments, int rings) {
     for (int r = 0; r < rings; ++r)
         for (int s = 0; s < segments; ++s) {
             const std::uint32_t v[4] = {at(r, s), at(r + 1, s), at(r + 1, s + 1), at(r, s + 1)};
-            uvCell(r, s, rings, [&](int i, int j, int k) { g.indices.insert(g.indices.end(), {v[i], v[j], v[k]}); });
+            uvCell(r, rings, [&](int i, int j, int k) { g.indices.insert(g.indices.end(), {v[i], v[j], v[k]}); });
         }
     return g;
 }
@@ -209,7 +209,7 @@ double uvSphereSagitta(int segments, int rings) {
     for (int r = 0; r < rings; ++r) {
         const glm::dvec3 v[4] = {uvVertex(r, 0, segments, rings), uvVertex(r + 1, 0, segments, rings),
                                  uvVertex(r + 1, 1, segments, rings), uvVertex(r, 1, segments, rings)};
-        uvCell(r, 0, rings, [&](int i, int j, int k) {
+        uvCell(r, rings, [&](int i, int j, int k) {
             worst = std::max(worst, 1.0 - glm::length(closestOnTriangle(glm::dvec3(0.0), v[i], v[j], v[k])));
         });
     }

@@ -50,19 +50,6 @@ scene::RasterSettings filterable(scene::ShadowFilter filter, int mapSize, double
     return r;
 }
 
-// Calls fn(q, visibility) for every floor pixel (object id 1), q its point on y = 0 from the
-// test's own ray–plane intersection.
-template <class Fn>
-void forEachFloorPixel(const scene::Scene& s, const scene::Frame& f, Fn fn) {
-    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
-    for (int y = 0; y < f.height; ++y)
-        for (int x = 0; x < f.width; ++x) {
-            const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
-            if (f.objectId[i] != 1.0f) continue;
-            const Vec3 d = test::pixelRay(cam, x, y);
-            fn(cam.position + (-cam.position.y / d.y) * d, double(f.visibility[i]));
-        }
-}
 
 TEST(MomentMaps, AloneThePlaneIsFullyLitByEveryFilterableFilter) {
     // One plane, no other caster: every texel holds the plane's own depth z, the blur of a constant
@@ -79,7 +66,7 @@ TEST(MomentMaps, AloneThePlaneIsFullyLitByEveryFilterableFilter) {
             const scene::Frame f = test::renderChecked(s, filterable(filter, 256, 0.02));
             EXPECT_EQ(f.attributes.at("filter"), scene::toString(filter));
             int pixels = 0, dark = 0;
-            forEachFloorPixel(s, f, [&](const Vec3&, double v) {
+            test::forEachFloorPixel(s, f, [&](const Vec3&, double v) {
                 ++pixels;
                 if (v != 1.0) ++dark;
             });
@@ -137,7 +124,7 @@ TEST(MomentMaps, VsmOfTwoParallelPlanesIsTheChebyshevBoundOfTheBlurredMoments) {
     const CpuMoments cpu{debug.layerDepths[0], int(debug.mapSize), 9};
     int penumbra = 0;
     double worst = 0.0;
-    forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
+    test::forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
         const glm::dvec4 t = toTexture * glm::dvec4(q, 1.0);
         const double mu = cpu.sample(t.x, t.y, 1), m2 = cpu.sample(t.x, t.y, 2);
         const double receiver = t.z - r.depthBias / frustum.depthRange();
@@ -171,7 +158,7 @@ TEST(MomentMaps, EsmBehindAPlaneIsExpOfMinusTheExponentTimesTheDepthGap) {
         const double expected = std::exp(-c * (1.0 - r.depthBias) / range);
         int pixels = 0;
         double worst = 0.0;
-        forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
+        test::forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
             if (std::abs(q.x) > 2.5 || std::abs(q.z) > 2.5) return;  // well inside the caster (blur 5 texels)
             ++pixels;
             worst = std::max(worst, std::abs(v / expected - 1.0));
@@ -190,7 +177,7 @@ TEST(MomentMaps, MsmLightsItsPlaneAndShadowsWhatLiesBehind) {
         const scene::Scene s = floorScene({}, Vec3(1.5, 5.0, 4.0), Vec3(0.0));
         const scene::Frame f = test::renderChecked(s, filterable(scene::ShadowFilter::Msm, 256, 0.02));
         double least = 1.0;
-        forEachFloorPixel(s, f, [&](const Vec3&, double v) { least = std::min(least, v); });
+        test::forEachFloorPixel(s, f, [&](const Vec3&, double v) { least = std::min(least, v); });
         EXPECT_GT(least, 0.98);
     }
     {
@@ -198,7 +185,7 @@ TEST(MomentMaps, MsmLightsItsPlaneAndShadowsWhatLiesBehind) {
         const scene::Frame f = test::renderChecked(s, filterable(scene::ShadowFilter::Msm, 256, 0.01));
         double most = 0.0;
         int pixels = 0;
-        forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
+        test::forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
             if (std::abs(q.x) > 2.5 || std::abs(q.z) > 2.5) return;
             ++pixels;
             most = std::max(most, v);

@@ -53,19 +53,6 @@ scene::Scene edgeScene(double hb) {
     return s;
 }
 
-// Calls fn(q, visibility) for every floor pixel (object id 1) with q its point on the floor y = 0,
-// found by the test's own ray–plane intersection, not the renderer's.
-template <class Fn>
-void forEachFloorPixel(const scene::Scene& s, const scene::Frame& f, Fn fn) {
-    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
-    for (int y = 0; y < f.height; ++y)
-        for (int x = 0; x < f.width; ++x) {
-            const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
-            if (f.objectId[i] != 1.0f) continue;
-            const Vec3 d = test::pixelRay(cam, x, y);
-            fn(cam.position + (-cam.position.y / d.y) * d, double(f.visibility[i]));
-        }
-}
 
 // The 10%–90% width of the visibility ramp across the edge, on the floor near z = 0: floor pixels
 // (found by the test's own ray–plane intersection) are binned by x, each bin's mean visibility
@@ -77,7 +64,7 @@ double rampWidth(const scene::Scene& s, const scene::Frame& f, double umbra = 0.
     const int bins = int((hi - lo) / bin);
     std::vector<double> sum(std::size_t(bins), 0.0);
     std::vector<int> count(std::size_t(bins), 0);
-    forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
+    test::forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
         if (std::abs(q.z) > 0.4 || q.x < lo || q.x >= hi) return;
         const int b = int((q.x - lo) / bin);
         sum[std::size_t(b)] += v;
@@ -150,7 +137,7 @@ TEST(RasterPcss, ASemiTransparentBlockerGetsTheSamePenumbraAtItsOwnDepth) {
         // penumbra is at most 1·4/6 = 0.67 wide, centered on x = 0.
         double umbra = 0.0, lit = 0.0;
         int nu = 0, nl = 0;
-        forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
+        test::forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
             if (std::abs(q.z) > 0.4) return;
             if (q.x > -1.2 && q.x < -0.6) umbra += v, ++nu;
             if (q.x > 0.6 && q.x < 1.2) lit += v, ++nl;
@@ -236,7 +223,7 @@ TEST(RasterPcss, APointLightPenumbraCrossesACubeFaceSeamWithoutACut) {
     // wrong (before the fix: a streak of light along the seam in the umbra, and a narrower penumbra).
     double err[2] = {0, 0};
     int count[2] = {0, 0};
-    forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
+    test::forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
         if (std::abs(q.x - kSeamH) > 0.3 || std::abs(q.x - kSeamH) < 0.02 || q.z < -2.5 || q.z > 0.8) return;
         const int side = q.x > kSeamH ? 1 : 0;
         err[side] += std::abs(v - diskVisibility(q));

@@ -150,6 +150,20 @@ inline Vec3 pixelRay(const scene::CameraBasis& c, int x, int y) {
     return c.forward + sx * c.right + sy * c.up;
 }
 
+// Calls fn(q, visibility) for every pixel that shows object id 1 (a floor at y = 0), q its point on
+// the floor from the test's own ray–plane intersection, not the renderer's.
+template <class Fn>
+void forEachFloorPixel(const scene::Scene& s, const scene::Frame& f, Fn fn) {
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    for (int y = 0; y < f.height; ++y)
+        for (int x = 0; x < f.width; ++x) {
+            const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
+            if (f.objectId[i] != 1.0f) continue;
+            const Vec3 d = pixelRay(cam, x, y);
+            fn(cam.position + (-cam.position.y / d.y) * d, double(f.visibility[i]));
+        }
+}
+
 inline PrimaryHit primaryHit(const SphereOverPlane& p, const scene::CameraBasis& c, int x, int y) {
     const Vec3 d = pixelRay(c, x, y);
     PrimaryHit hit;
