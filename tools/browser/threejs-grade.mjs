@@ -2,7 +2,7 @@
 // `shadowlab export`) in headless Chromium with software WebGL (SwiftShader), one per shadow-map
 // type (PCFShadowMap, PCFSoftShadowMap, VSMShadowMap), and its coverage image. Run it through
 // tools/threejs-grade.sh, which installs what it needs and grades the masks (docs/threejs.md).
-// Usage: node threejs-grade.mjs SCENE.glb OUTDIR [--map-size N] [--chromium PATH]
+// Usage: node threejs-grade.mjs SCENE.glb OUTDIR [--resolution WxH] [--map-size N] [--chromium PATH]
 // Writes OUTDIR/threejs-<type>.png (the mask: light visibility, 8-bit linear, 255 = lit),
 // OUTDIR/threejs-coverage.png (255 where three.js sees a mesh) and prints one JSON line with the
 // image size and three's revision. Exit 0, or 2 when the page or the browser fails.
@@ -59,13 +59,18 @@ function writeGreyPng(file, width, height, values) {
 const args = process.argv.slice(2);
 let chromiumPath = process.env.SHADOWLAB_CHROMIUM || '/usr/bin/chromium';
 let mapSize = 2048;
+let resolution = null;
 const pos = [];
 for (let i = 0; i < args.length; ++i) {
   if (args[i] === '--chromium') chromiumPath = args[++i];
   else if (args[i] === '--map-size') mapSize = Number(args[++i]);
+  else if (args[i] === '--resolution') {
+    resolution = (args[++i] || '').split('x').map(Number);
+    if (resolution.length !== 2 || !resolution.every((v) => Number.isInteger(v) && v > 0)) fail(`--resolution: not WxH: ${args[i]}`);
+  }
   else pos.push(args[i]);
 }
-if (pos.length !== 2 || !(mapSize > 0)) fail('usage: threejs-grade.mjs SCENE.glb OUTDIR [--map-size N] [--chromium PATH]');
+if (pos.length !== 2 || !(mapSize > 0)) fail('usage: threejs-grade.mjs SCENE.glb OUTDIR [--resolution WxH] [--map-size N] [--chromium PATH]');
 const [glb, outDir] = pos;
 if (!fs.existsSync(glb)) fail(`${glb}: no such file`);
 fs.mkdirSync(outDir, { recursive: true });
@@ -76,6 +81,7 @@ const kMime = { '.js': 'text/javascript', '.html': 'text/html', '.glb': 'model/g
 const server = http.createServer((req, res) => {
   const url = decodeURIComponent(req.url.split('?')[0]);
   let file = null;
+  if (url === '/favicon.ico') { res.writeHead(204); res.end(); return; }
   if (url === '/') file = path.join(here, 'threejs-grade.html');
   else if (url === '/scene.glb') file = glb;
   else if (url.startsWith('/three/')) file = path.join(threeDir, path.normalize(url.slice(7)));
@@ -102,14 +108,19 @@ try {
   await page.waitForFunction(() => window.pageReady === true, null, { timeout: 30000 });
   const info = await page.evaluate(() => window.sceneInfo('/scene.glb'));
   if (!info.resolution) throw new Error(`${glb}: no extras.shadowlab.resolution on its camera (not a shadowlab export)`);
-  const [w, h] = info.resolution;
+  const [w, h] = resolution || info.resolution;
   const renderer = await page.evaluate(() => {
     const g = document.createElement('canvas').getContext('webgl2');
     const d = g && g.getExtension('WEBGL_debug_renderer_info');
     return g ? g.getParameter(d ? d.UNMASKED_RENDERER_WEBGL : g.RENDERER) : null;
   });
   if (!renderer) throw new Error(`no WebGL 2 in Chromium with ${kGlFlags.join(' ')}`);
-  const pass = (type, mode) => page.evaluate(([t, m, s, ww, hh]) => window.renderPass('/scene.glb', ww, hh, t, m, s), [type, mode, mapSize, w, h]);
+  const pass = async (type, mode) => {
+    const b64 = await page.evaluate(([t, m, s, ww, hh]) => window.renderPass('/scene.glb', ww, hh, t, m, s), [type, mode, mapSize, w, h]);
+    const buf = Buffer.from(b64, 'base64');
+    return new Float32Array(buf.buffer, buf.byteOffset, w * h);
+  };
+  const t0 = Date.now();
   const coverage = await pass(null, 'coverage');
   writeGreyPng(path.join(outDir, 'threejs-coverage.png'), w, h, coverage);
   const unshadowed = await pass(null, 'unshadowed');
@@ -119,6 +130,7 @@ try {
     // where the unshadowed light is 0 (facing away, background) it is 1 (those pixels do not count)
     const mask = shadowed.map((s, i) => (unshadowed[i] > 1e-6 ? s / unshadowed[i] : 1));
     writeGreyPng(path.join(outDir, `threejs-${type}.png`), w, h, mask);
+    console.error(`threejs-grade: ${type} done after ${((Date.now() - t0) / 1000).toFixed(1)} s`);
   }
   if (errors.length) throw new Error(`page errors: ${errors.join(' | ')}`);
   const revision = await page.evaluate(() => window.threeRevision);
