@@ -9,7 +9,7 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 
-const nodeDir = process.env.SHADOWLAB_NODE_DIR || path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../../build/node');
+const nodeDir = process.env.SHADOWLAB_NODE_DIR ? path.resolve(process.env.SHADOWLAB_NODE_DIR) : path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../../build/node');
 const require = createRequire(path.join(nodeDir, 'node_modules', 'noop.js'));
 const validator = require('gltf-validator');
 

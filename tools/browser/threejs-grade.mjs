@@ -14,7 +14,7 @@ import zlib from 'node:zlib';
 import { fileURLToPath } from 'node:url';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
-const nodeDir = process.env.SHADOWLAB_NODE_DIR || path.resolve(here, '../../build/node');
+const nodeDir = process.env.SHADOWLAB_NODE_DIR ? path.resolve(process.env.SHADOWLAB_NODE_DIR) : path.resolve(here, '../../build/node');
 const require = createRequire(path.join(nodeDir, 'node_modules', 'noop.js'));
 const { chromium } = require('playwright-core');
 
