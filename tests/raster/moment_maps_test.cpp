@@ -119,7 +119,7 @@ TEST(MomentMaps, VsmOfTwoParallelPlanesIsTheChebyshevBoundOfTheBlurredMoments) {
     debug.captureShadowMaps = true;
     const scene::Frame f = test::renderChecked(s, r, &debug);
     ASSERT_EQ(debug.layerDepths.size(), 1u);
-    const LightFrustum& frustum = debug.frusta[0];
+    const LightFrustum& frustum = debug.layers[0].frustum;
     const glm::dmat4 toTexture = frustum.toTexture(Vec3(0.0));
     const CpuMoments cpu{debug.layerDepths[0], int(debug.mapSize), 9};
     int penumbra = 0;
@@ -153,8 +153,8 @@ TEST(MomentMaps, EsmBehindAPlaneIsExpOfMinusTheExponentTimesTheDepthGap) {
         r.moments.esmExponent = c;
         RenderDebug debug;
         const scene::Frame f = test::renderChecked(s, r, &debug);
-        ASSERT_EQ(debug.frusta.size(), 1u);
-        const double range = debug.frusta[0].depthRange();
+        ASSERT_EQ(debug.layers.size(), 1u);
+        const double range = debug.layers[0].frustum.depthRange();
         const double expected = std::exp(-c * (1.0 - r.depthBias) / range);
         int pixels = 0;
         double worst = 0.0;
