@@ -120,6 +120,7 @@ Prepared prepare(const SceneOptions& o) {
     Prepared p{readingInput(o.scene, [&] { return scene::loadScene(scene::findScene(o.scene)); }), {}, {}};
     if (o.resolution) applyResolution(p.scene, *o.resolution);
     chooseView(p.scene, &o);
+    for (const std::string& note : p.scene.origin.notes) std::cerr << "shadowlab: note: " << note << "\n";
     if (o.explain) std::cerr << scene::explainOrigin(p.scene);
     p.settings = scene::resolveSettings(p.scene, o.settings);
     p.plan = scene::makeRenderPlan(p.scene, p.settings);
@@ -223,6 +224,8 @@ scene::Frame renderBackend(const Prepared& p, scene::Backend backend,
     if (backend == scene::Backend::Raster) checkValidation(f, p.settings.raster);
     f.attributes["scene"] = p.scene.file.string();
     for (const auto& [key, text] : p.scene.origin.choices) f.attributes["choice." + key] = text;
+    for (std::size_t i = 0; i < p.scene.origin.notes.size(); ++i)
+        f.attributes["note." + std::to_string(i)] = p.scene.origin.notes[i];
     f.attributes["version"] = SHADOWLAB_VERSION;
     scene::recordIdentity(f, p.scene);
     return f;

@@ -771,6 +771,7 @@ Scene loadModelScene(const fs::path& file) {
     }
     checkSceneExtent(scene, false);
     scene.loadBytes = extras.loadBytes;
+    scene.origin.notes = extras.notes;
     return scene;
 }
 

@@ -406,7 +406,7 @@ TextureWrap wrapOf(int glWrap) {
 // The file's materials as scene materials (grey albedo: shadows do not need its colours), with the
 // alpha texture of each MASK and BLEND material that has a baseColorTexture.
 std::vector<Material> readMaterials(const tinygltf::Model& model, const GltfImages& images, const fs::path& file,
-                                    const fs::path& sceneFile, const JsonPath& path) {
+                                    const fs::path& sceneFile, const JsonPath& path, std::vector<std::string>& notes) {
     std::vector<Material> out;
     std::map<std::tuple<int, int, int>, std::shared_ptr<const AlphaTexture>> decoded;
     for (std::size_t i = 0; i < model.materials.size(); ++i) {
@@ -443,11 +443,18 @@ std::vector<Material> readMaterials(const tinygltf::Model& model, const GltfImag
             const std::string imageAt = "images[" + std::to_string(tex.source) + "]" +
                                         (image.uri.empty() || image.uri.rfind("data:", 0) == 0 ? "" : " (" + excerpt(image.uri) + ")");
             const auto key = std::make_tuple(tex.source, int(s), int(t));
+            const auto bytes = images.find(tex.source);
+            if (!decoded.count(key) && bytes == images.end()) {
+                // A model passed on without its image files is common (and the shadow of the
+                // rest of it is still worth grading): the material keeps its factor's alpha,
+                // and the user is told. An image that is there but broken is still an error.
+                notes.push_back(imageAt + " of " + file.filename().string() + " is missing, so " + m.name + " (" +
+                                gm.alphaMode + ") casts with its baseColorFactor alpha " +
+                                describeJson(m.alphaFactor) + " alone, without its texture's alpha");
+                out.push_back(std::move(m));
+                continue;
+            }
             if (!decoded.count(key)) {
-                const auto bytes = images.find(tex.source);
-                if (bytes == images.end())
-                    fail(sceneFile, path, file, imageAt + ": could not be read, and " + texAt +
-                                                    " needs its alpha (" + m.name + " is " + gm.alphaMode + ")");
                 std::string ext = image.mimeType == "image/jpeg" ? ".jpg" : image.mimeType == "image/png" ? ".png" : "";
                 if (ext.empty()) ext = fs::path(image.uri).extension().string();
                 try {
@@ -674,9 +681,11 @@ void loadGltf(const fs::path& file, const std::string& bytes, std::vector<RawIns
     if (!ok) fail(sceneFile, path, file, "not a readable glTF file: " + excerpt(err.empty() ? warn : err, 400));
 
     std::vector<Material> materials;
-    if (request.perMaterial) materials = readMaterials(model, images, file, sceneFile, path);
+    std::vector<std::string> notes;
+    if (request.perMaterial) materials = readMaterials(model, images, file, sceneFile, path, notes);
     images.clear();
     if (extras) extras->materials = materials;
+    if (extras) extras->notes = notes;
     if (extras) extras->shadowlabExport = model.asset.extras.IsObject() && model.asset.extras.Has("shadowlab");
     // Walk the default scene's node tree (depth first, in document order) so each node that
     // uses a mesh places it once; a mesh used by several nodes is read once and shared.

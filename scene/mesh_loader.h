@@ -45,6 +45,8 @@ struct GltfExtras {
     std::vector<Material> materials;
     // asset.extras.shadowlab is present: the file is a `shadowlab export` (scene/gltf_export.h).
     bool shadowlabExport = false;
+    // What reading had to assume, for the user to see (a texture whose image file is missing).
+    std::vector<std::string> notes;
     std::uint64_t loadBytes = 0;  // the file's temporaries while it was read (text, trees, buffers)
 };
 

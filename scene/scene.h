@@ -293,6 +293,9 @@ struct SceneOrigin {
     // ("view", "searched: ..."), ("sun", ...), ("ground", ...): printed by --explain, recorded
     // in every Frame as attributes "choice.view", "choice.sun", ...
     std::vector<std::pair<std::string, std::string>> choices;
+    // What loading had to assume, which every command prints as a note and every Frame records
+    // ("note.0", "note.1", ...): e.g. a texture whose image file is missing.
+    std::vector<std::string> notes;
 };
 
 // The optional "path" block: the camera or light path `shadowlab path` renders when the command

@@ -9,6 +9,7 @@
 
 #include "scene/loader.h"
 #include "scene/memory.h"
+#include "tests/scene/gltf_files.h"
 #include "tests/scene/test_files.h"
 
 namespace shadowlab::scene {
@@ -152,6 +153,46 @@ TEST(AlphaLoader, AGltfModelSceneKeepsEachMaterialAsItsOwnObject) {
         EXPECT_EQ(o.name, "AlphaBlendModeTest/" + m.name);
     }
     EXPECT_EQ(names.size(), 6u);
+}
+
+// The test box as a glTF model whose one material is BLEND with alpha factor 0.6 and a
+// baseColorTexture read from `imageUri`.
+std::string blendBoxGltf(const std::string& imageUri) {
+    std::string g = test::boxGltf(R"([{"mesh": 0}])", "[0]");
+    const std::string prim = R"("primitives": [{"attributes": {"POSITION": 0}, "indices": 1}])";
+    g.replace(g.find(prim), prim.size(), R"("primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}])");
+    const std::string asset = R"({"asset": {"version": "2.0"},)";
+    g.replace(g.find(asset), asset.size(), asset + R"( "materials": [{"name": "Lens", "alphaMode": "BLEND",
+        "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.6], "baseColorTexture": {"index": 0}}}],
+        "textures": [{"source": 0}], "images": [{"uri": ")" + imageUri + R"("}],)");
+    return g;
+}
+
+TEST(AlphaLoader, AGltfModelWhoseImageFileIsMissingCastsWithItsFactorAndSaysSo) {
+    // Models are often passed on without their image files; the rest of the model's shadow is
+    // still worth grading, so the material keeps its factor's alpha and the scene carries a note.
+    TempDir dir;
+    const Scene s = loadScene(dir.write("lens.gltf", blendBoxGltf("gone.png")));
+    ASSERT_EQ(s.objects.size(), 1u);
+    const Material& m = s.materialOf(s.objects[0]);
+    EXPECT_EQ(m.alphaMode, AlphaMode::Blend);
+    EXPECT_DOUBLE_EQ(m.alphaFactor, 0.6);
+    EXPECT_FALSE(m.alphaTexture);
+    EXPECT_DOUBLE_EQ(m.transmittance(1.0), 0.4);  // the factor alone: 1 − 0.6
+    ASSERT_EQ(s.origin.notes.size(), 1u);
+    const std::string& note = s.origin.notes[0];
+    EXPECT_NE(note.find("gone.png"), std::string::npos) << note;
+    EXPECT_NE(note.find("Lens"), std::string::npos) << note;
+    EXPECT_NE(note.find("missing"), std::string::npos) << note;
+}
+
+TEST(AlphaLoader, AGltfModelWhoseImageIsThereButBrokenIsBadInput) {
+    TempDir dir;
+    dir.write("broken.png", "this is text");
+    const std::filesystem::path file = dir.write("lens.gltf", blendBoxGltf("broken.png"));
+    const std::string e = errorOf([&] { loadScene(file); });
+    EXPECT_NE(e.find(file.string()), std::string::npos) << e;
+    EXPECT_NE(e.find("images[0] (broken.png)"), std::string::npos) << e;
 }
 
 }  // namespace
