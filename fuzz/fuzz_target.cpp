@@ -1,5 +1,5 @@
 // fuzz/fuzz_target.cpp: the libFuzzer entry point, built once per target with
-// SHADOWLAB_FUZZ_TARGET naming it ("scene_json", "obj", "gltf", "exr"; fuzz/targets.h says what
+// SHADOWLAB_FUZZ_TARGET naming it ("scene_json", "obj", "ply", "gltf", "exr"; fuzz/targets.h says what
 // each reads). JSON inputs (scenes, .gltf) also get a structure-aware mutator: byte mutations
 // rarely keep JSON valid, so it edits the parsed tree instead.
 #include <cstring>

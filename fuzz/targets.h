@@ -21,10 +21,11 @@
 
 namespace shadowlab::fuzz {
 
-// The file name an input of `target` is written under ("scene_json", "obj", "gltf", "exr").
+// The file name an input of `target` is written under ("scene_json", "obj", "ply", "gltf", "exr").
 inline std::string inputName(std::string_view target, const std::uint8_t* data, std::size_t size) {
     if (target == "scene_json") return "scene.json";
     if (target == "obj") return "mesh.obj";
+    if (target == "ply") return "mesh.ply";
     if (target == "gltf")  // GLB when it starts with the binary container's magic
         return size >= 4 && std::memcmp(data, "glTF", 4) == 0 ? "model.glb" : "model.gltf";
     return "frame.exr";
@@ -54,7 +55,7 @@ inline void makeIndirectFiles(const std::filesystem::path& dir) {
 inline void readAs(std::string_view target, const std::filesystem::path& file) {
     if (target == "scene_json" || target == "gltf") {  // a .gltf/.glb is a scene of its own
         (void)scene::loadScene(file);
-    } else if (target == "obj") {
+    } else if (target == "obj" || target == "ply") {
         (void)scene::loadMesh(file, glm::dmat4(1.0), file.parent_path() / "scene.json",
                               scene::JsonPath() / "objects" / 0 / "file");
     } else {

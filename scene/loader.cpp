@@ -668,9 +668,9 @@ Scene parseScene(const fs::path& file, const std::string& text) {
     return scene;
 }
 
-// A glTF/GLB file as the whole scene (DESIGN.md): its geometry as one mesh object, its first
-// perspective camera and its KHR_lights_punctual lights; a framed camera and a default sun
-// where it has none (docs/decisions.md).
+// A model file as the whole scene (DESIGN.md): its geometry as one mesh object per glTF material,
+// its first perspective camera and its KHR_lights_punctual lights; a framed camera and a default
+// sun where it has none, as an OBJ or PLY file never has (docs/decisions.md).
 Scene loadModelScene(const fs::path& file) {
     constexpr double kPi = 3.14159265358979323846;
     GltfExtras extras;
@@ -775,10 +775,16 @@ Scene loadModelScene(const fs::path& file) {
     return scene;
 }
 
+// Mesh files that can be the whole scene: glTF with its cameras and lights where it has them;
+// OBJ and PLY, which have neither, with a searched view and sun over a ground like a bare glTF.
+bool isModelFormat(const std::string& ext) {
+    return ext == ".gltf" || ext == ".glb" || ext == ".obj" || ext == ".ply";
+}
+
 // Model formats people try first that shadowlab does not read: named as such rather than
 // parsed as JSON (which would report a syntax error at byte 1).
 bool isOtherModelFormat(const std::string& ext) {
-    for (const char* e : {".ply", ".stl", ".fbx", ".dae", ".3ds", ".blend", ".usd", ".usda", ".usdc", ".usdz",
+    for (const char* e : {".stl", ".fbx", ".dae", ".3ds", ".blend", ".usd", ".usda", ".usdc", ".usdz",
                           ".off", ".x3d", ".wrl", ".abc"})
         if (ext == e) return true;
     return false;
@@ -791,19 +797,16 @@ Scene loadScene(const fs::path& file) {
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
     // Told by its name before any byte is read: a .ply read as JSON would be a parse error.
     if (isOtherModelFormat(ext))
-        throw SceneError(file, {}, "unsupported format '" + excerpt(ext) + "': a scene is a .json file or a .gltf/.glb "
-                                   "model, and a mesh is .obj, .gltf or .glb (convert the model, e.g. to .obj or .glb)");
+        throw SceneError(file, {}, "unsupported format '" + excerpt(ext) + "': a scene is a .json file or a .gltf, .glb, "
+                                   ".obj or .ply model (convert the model, e.g. to .obj or .glb)");
     std::string text;
     try {
-        if (ext == ".gltf" || ext == ".glb" || ext == ".obj") checkInputFile(file, kMaxMeshFileBytes);
+        if (isModelFormat(ext)) checkInputFile(file, kMaxMeshFileBytes);
         else text = readInputFile(file, kMaxJsonFileBytes);
     } catch (const InputFileError& e) {
         throw SceneError(file, {}, e.problem());
     }
-    if (ext == ".gltf" || ext == ".glb") return loadModelScene(file);
-    if (ext == ".obj")
-        throw SceneError(file, {}, "an OBJ file has no camera or light: reference it from a JSON scene "
-                                   "as {\"type\": \"mesh\", \"file\": \"" + excerpt(file.filename().string()) + "\"}");
+    if (isModelFormat(ext)) return loadModelScene(file);
     return parseScene(file, text);
 }
 

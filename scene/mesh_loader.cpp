@@ -1,5 +1,6 @@
 // scene/mesh_loader.cpp: tinyobjloader / tinygltf readers feeding one TriangleMesh format.
 #include "scene/mesh_loader.h"
+#include "scene/ply_loader.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -791,7 +792,7 @@ std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path&
     std::vector<RawInstance> raw;
     std::string ext = meshFile.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-    loadBytes = ext == ".obj" ? 4 * std::uint64_t(bytes.size())
+    loadBytes = ext == ".obj" || ext == ".ply" ? 4 * std::uint64_t(bytes.size())
                               : 5 * std::uint64_t(bytes.size()) + 2 * jsonTreeBytes(gltfJson(bytes, ext == ".glb"));
     if (const std::uint64_t available = availableMemoryBytes(); available != 0 && loadBytes > available)
         fail(sceneFile, path, meshFile, "reading it needs about " + std::to_string(loadBytes / kMiB) + " MiB, more than the " +
@@ -801,8 +802,17 @@ std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path&
         loadObj(meshFile, bytes, *raw.back().geometry, sceneFile, path, request.uvSet >= 0);
     } else if (ext == ".gltf" || ext == ".glb") {
         loadGltf(meshFile, bytes, raw, sceneFile, path, extras, request);
+    } else if (ext == ".ply") {
+        if (request.uvSet >= 0)
+            fail(sceneFile, path, meshFile, "a PLY mesh has no texture coordinates, which the object's alpha texture needs");
+        raw.push_back({std::make_shared<TriangleMesh>(), glm::dmat4(1.0)});
+        try {
+            loadPly(bytes, *raw.back().geometry);
+        } catch (const PlyError& e) {
+            fail(sceneFile, path, meshFile, e.what());
+        }
     } else {
-        fail(sceneFile, path, meshFile, "unsupported format '" + excerpt(ext) + "': a mesh is .obj, .gltf or .glb (convert the model, e.g. to .obj or .glb)");
+        fail(sceneFile, path, meshFile, "unsupported format '" + excerpt(ext) + "': a mesh is .obj, .ply, .gltf or .glb (convert the model, e.g. to .obj or .glb)");
     }
     // Degenerate triangles are judged in object space: an invertible affine map keeps a
     // triangle's area zero or non-zero.

@@ -2,7 +2,7 @@
 # tools/fuzz.sh: builds the libFuzzer targets of fuzz/ with clang (AddressSanitizer +
 # UndefinedBehaviorSanitizer) into build-fuzz/ and runs them.
 #
-#   tools/fuzz.sh [SECONDS] [TARGET...]     default: 60 s each, all of scene_json obj gltf exr
+#   tools/fuzz.sh [SECONDS] [TARGET...]     default: 60 s each, all of scene_json obj ply gltf exr
 #
 # Each target starts from the committed seed corpus fuzz/corpus/TARGET (with fuzz/dict/TARGET.dict,
 # the tokens of its format and values that break size arithmetic) and keeps what it learns in
@@ -15,7 +15,7 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 seconds="${1:-60}"
 shift || true
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(scene_json obj gltf exr)
+[ ${#targets[@]} -eq 0 ] && targets=(scene_json obj ply gltf exr)
 build="${SHADOWLAB_FUZZ_BUILD_DIR:-$root/build-fuzz}"
 
 "$root/tools/setup.sh" --packages-only

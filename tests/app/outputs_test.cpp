@@ -44,21 +44,32 @@ TEST(Outputs, RenderUnderAFileOrOntoAFolderIsBadInput) {
     EXPECT_NE(onto.err.find("is a folder"), std::string::npos) << onto.err;
 }
 
-TEST(Outputs, APlyModelIsAnUnsupportedFormatNotAJsonError) {
+TEST(Outputs, AnStlModelIsAnUnsupportedFormatNotAJsonError) {
     TempDir dir;
-    const auto ply = dir.write("bunny.ply", "ply\nformat ascii 1.0\nelement vertex 0\nend_header\n");
-    const auto r = runShadowlab({"render", ply.string(), "-o", (dir.path() / "x.png").string()});
+    const auto stl = dir.write("bunny.stl", "solid bunny\nendsolid bunny\n");
+    const auto r = runShadowlab({"render", stl.string(), "-o", (dir.path() / "x.png").string()});
     EXPECT_EQ(r.exitCode, 2);
-    EXPECT_NE(r.err.find("unsupported format '.ply'"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("unsupported format '.stl'"), std::string::npos) << r.err;
     EXPECT_EQ(r.err.find("JSON"), std::string::npos) << r.err;
     // Named as a mesh in a JSON scene, the same words, with the scene's JSON path.
     const auto scene = dir.write("s.json", R"({"camera": {"position": [0, 1, 5], "look_at": [0, 0, 0]},
         "materials": {"m": {}}, "lights": [{"type": "directional", "direction": [0, -1, 0]}],
-        "objects": [{"type": "mesh", "file": "bunny.ply", "material": "m"}]})");
+        "objects": [{"type": "mesh", "file": "bunny.stl", "material": "m"}]})");
     const auto m = runShadowlab({"render", scene.string(), "-o", (dir.path() / "x.png").string()});
     EXPECT_EQ(m.exitCode, 2);
-    EXPECT_NE(m.err.find("unsupported format '.ply'"), std::string::npos) << m.err;
+    EXPECT_NE(m.err.find("unsupported format '.stl'"), std::string::npos) << m.err;
     EXPECT_NE(m.err.find("objects[0].file"), std::string::npos) << m.err;
+    EXPECT_FALSE(fs::exists(dir.path() / "x.png"));
+}
+
+TEST(Outputs, APlyPointCloudIsRefusedAsAModelWithNoFaces) {
+    TempDir dir;
+    const auto ply = dir.write("cloud.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+                                            "property float y\nproperty float z\nend_header\n0 0 0\n");
+    const auto r = runShadowlab({"render", ply.string(), "-o", (dir.path() / "x.png").string()});
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.err.find(ply.string()), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("has no faces"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir.path() / "x.png"));
 }
 

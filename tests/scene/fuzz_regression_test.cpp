@@ -26,7 +26,7 @@ struct Replay {
 
 std::vector<Replay> replays() {
     std::vector<Replay> all;
-    for (const char* target : {"scene_json", "obj", "gltf", "exr"})
+    for (const char* target : {"scene_json", "obj", "ply", "gltf", "exr"})
         for (const bool finding : {true, false}) {
             const fs::path root = fs::path(SHADOWLAB_SOURCE_DIR) /
                                   (finding ? "tests/scene/fuzz_regressions" : "fuzz/corpus") / target;
