@@ -103,12 +103,20 @@ scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan,
     const auto primaryStart = Clock::now();
     const std::size_t n = frame.pixelCount();
     std::vector<SurfacePoint<Real>> points(n);
-    const Vec3T<Real> eye = toReal<Real>(cam.position);
+    // The near and far planes clip what the camera sees, as the raster pipeline clips there
+    // (view depth is t: a pixel direction's forward component is 1). Rays start on the near
+    // plane only where some geometry may lie nearer, so no other scene's rays change.
+    const scene::Bounds bounds = scene.bounds();
+    const scene::Vec3 closest = glm::clamp(cam.position, bounds.min, bounds.max);
+    const double tNear =
+        !bounds.empty() && glm::length(closest - cam.position) < scene.camera.near ? scene.camera.near : 0.0;
+    const Real tFar = Real(scene.camera.far - tNear);
     forEachPixel([&](int x, int y) {
         const std::size_t i = std::size_t(y) * width + x;
-        const Ray<Real> ray(eye, toReal<Real>(scene::pixelDirection(cam, x, y)));
+        const scene::Vec3 dir = scene::pixelDirection(cam, x, y);
+        const Ray<Real> ray(toReal<Real>(cam.position + tNear * dir), toReal<Real>(dir));
         Hit<Real> hit;
-        if (!tracer.closestHit(ray, std::numeric_limits<Real>::infinity(), false, hit)) {
+        if (!tracer.closestHit(ray, tFar, false, hit)) {
             for (int c = 0; c < 3; ++c) frame.beauty[3 * i + c] = float(scene.background[c]);
             return;
         }

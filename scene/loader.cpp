@@ -236,6 +236,7 @@ Camera readCamera(const Reader& r, const Json& node, const JsonPath& path) {
     }
     if (node.contains("near")) c.near = r.positive(node["near"], path / "near");
     if (node.contains("far")) c.far = r.positive(node["far"], path / "far");
+    else c.far = std::max(c.far, 2.0 * c.near);  // a placeholder: fitted to the scene's bounds once it is read
     if (!(c.far > c.near)) r.fail(path / "far", "must be greater than near");
     return c;
 }
@@ -609,7 +610,9 @@ Scene parseScene(const fs::path& file, const std::string& text) {
             nearFarGiven = node.contains("near") || node.contains("far");
         }
     } else {
-        scene.camera = readCamera(r, r.require(doc, root, "camera"), root / "camera");
+        const Json& camera = r.require(doc, root, "camera");
+        scene.camera = readCamera(r, camera, root / "camera");
+        scene.origin.farFromBounds = camera.is_object() && !camera.contains("far");
     }
     if (doc.contains("ground")) scene.origin.ground = r.boolean(doc["ground"], root / "ground");
     if (doc.contains("$schema")) r.string(doc["$schema"], root / "$schema");
@@ -659,6 +662,7 @@ Scene parseScene(const fs::path& file, const std::string& text) {
         if (!p.cameras.empty() || p.pick) pending.push_back(std::move(p));
     }
     addFileCameras(r, scene, pending, nearFarGiven);
+    fitFarToBounds(scene);
 
     if (doc.contains("shadow")) scene.shadow = readShadow(r, doc["shadow"], root / "shadow");
     if (doc.contains("budgets")) scene.budgets = readBudgets(file, doc["budgets"], root / "budgets");

@@ -147,6 +147,18 @@ void addGround(Scene& scene) {
     scene.objects.push_back({"ground", q, int(scene.materials.size()) - 1});
 }
 
+void fitFarToBounds(Scene& scene) {
+    const Bounds b = scene.bounds();
+    if (!scene.origin.farFromBounds || b.empty()) return;
+    double farthest = 0.0;
+    for (int k = 0; k < 8; ++k) {
+        const Vec3 corner((k & 1) ? b.max.x : b.min.x, (k & 2) ? b.max.y : b.min.y, (k & 4) ? b.max.z : b.min.z);
+        farthest = std::max(farthest, glm::length(corner - scene.camera.position));
+    }
+    // A hundredth beyond, so the depth of the farthest point does not round past the plane.
+    scene.camera.far = std::max(1.01 * farthest, 2.0 * scene.camera.near);
+}
+
 void applyGround(Scene& scene, std::optional<bool> option) {
     if (scene.origin.modelBounds.empty()) scene.origin.modelBounds = scene.bounds();
     bool on = false;
@@ -167,6 +179,7 @@ void applyGround(Scene& scene, std::optional<bool> option) {
     }
     if (on) {
         addGround(scene);
+        fitFarToBounds(scene);
         const Quad& q = std::get<Quad>(scene.objects.back().shape);
         why = "a " + fmt(q.size.x) + " x " + fmt(q.size.y) + " quad at y = " + fmt(q.center.y, "%.4g") + " (" + why + ")";
     } else if (option || scene.origin.ground) {

@@ -41,6 +41,10 @@ bool hasOwnGround(const Scene& scene);
 // cast under a sun 35° or more above the horizon stays on it), material "ground".
 void addGround(Scene& scene);
 
+// A JSON camera without "far" (SceneOrigin::farFromBounds) sees to the farthest corner of the
+// scene's bounds, so a large ground is never cut off by a guessed constant; no-op otherwise.
+void fitFarToBounds(Scene& scene);
+
 // Whether a ground is added and why: `option` (--ground / --no-ground), else the file's "ground"
 // key, else on for a glTF given as the scene that has no ground of its own (hasOwnGround), off
 // for a JSON scene (its author composed it). Records the choice in scene.origin.choices.

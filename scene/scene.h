@@ -289,6 +289,9 @@ struct SceneOrigin {
     bool chooseView = false;   // the camera is a placeholder: a view search replaces it
     bool chooseSun = false;    // lights[0] is a placeholder sun: a view search replaces its direction
     std::optional<bool> ground;  // the scene file's "ground" key
+    // The JSON camera gives no "far": it reaches the farthest corner of the scene's bounds,
+    // refitted when a ground is added (fitFarToBounds, scene/model_view.h).
+    bool farFromBounds = false;
     Bounds modelBounds;        // the objects without an added ground (what a view frames)
     // ("view", "searched: ..."), ("sun", ...), ("ground", ...): printed by --explain, recorded
     // in every Frame as attributes "choice.view", "choice.sun", ...

@@ -310,5 +310,41 @@ TEST(MethodRender, FillsEveryAovAndTheMetadata) {
     EXPECT_EQ(f.attributes.at("samples"), "1");
 }
 
+TEST(RaytraceRender, TheCameraSeesOnlyBetweenItsNearAndFarPlanesAsTheRasterPipelineClips) {
+    // Camera at the origin looking down −Z (view depth = −z). A small quad at depth 0.05 over the
+    // middle, a wall at depth 10 over the left half (x < 0), a wall at depth 30 over everything.
+    // Near 0.1, far 20: the small quad is clipped (the left wall shows through it), the right
+    // half sees nothing nearer than 30 and is background. Far 40 shows the far wall there; near
+    // 0.01 brings the small quad back.
+    scene::Scene s;
+    s.camera.position = Vec3(0);
+    s.camera.lookAt = Vec3(0, 0, -1);
+    s.camera.fovYDegrees = 40;
+    s.camera.width = 16;
+    s.camera.height = 8;
+    test::addMaterial(s, "m");
+    test::addDirectional(s, Vec3(0, 0, -1));
+    test::addQuad(s, Vec3(0, 0, -0.05), Vec3(0, 0, 1), 0.01, 0.01);    // id 1: pixels 7..8 across
+    test::addQuad(s, Vec3(-50, 0, -10), Vec3(0, 0, 1), 100, 100);       // id 2: x < 0
+    test::addQuad(s, Vec3(0, 0, -30), Vec3(0, 0, 1), 1000, 1000);       // id 3
+    const auto idAt = [](const scene::Frame& f, int x, int y) { return int(f.objectId[std::size_t(y) * f.width + x]); };
+    for (const auto& [near, far] : {std::pair{0.1, 20.0}, std::pair{0.1, 40.0}, std::pair{0.01, 20.0}}) {
+        s.camera.near = near;
+        s.camera.far = far;
+        SCOPED_TRACE("near " + std::to_string(near) + ", far " + std::to_string(far));
+        for (const bool reference : {false, true}) {
+            const scene::Frame f = reference ? renderReference(s, test::planFor(s), test::biasSettings(0, scene::Precision::Double))
+                                             : render(s, test::planFor(s), test::biasSettings(1e-4, scene::Precision::Float));
+            // Pixels 7 and 8 of rows 3 and 4 look through the small quad: its half-width 0.005 at
+            // depth 0.05 covers directions within ±0.1, and their centres are ±0.046 off the axis
+            // (a pixel is 2·tan 20°/8 = 0.091 across); pixel 7 leans left, onto the near wall.
+            EXPECT_EQ(idAt(f, 7, 3), near < 0.05 ? 1 : 2);
+            EXPECT_EQ(idAt(f, 0, 0), 2);
+            EXPECT_EQ(idAt(f, 15, 7), far > 30 ? 3 : 0);
+            EXPECT_EQ(idAt(f, 12, 3), far > 30 ? 3 : 0);
+        }
+    }
+}
+
 }  // namespace
 }  // namespace shadowlab::raytrace

@@ -176,6 +176,35 @@ TEST(ModelView, AJsonScenesGroundKeyAddsOne) {
     EXPECT_EQ(off.objects.size(), 1u);
 }
 
+TEST(ModelView, AJsonCameraWithoutFarSeesTheWholeSceneEvenAnAddedGround) {
+    // Camera at (30, 12, 40) over a 400 x 400 ground at y = 0: the farthest corner is
+    // (−200, 0, −200), √(230² + 12² + 240²) away; far is a hundredth beyond it. A given far stays.
+    test::TempDir dir;
+    const auto scene = [&](const std::string& cameraExtra, const std::string& ground) {
+        return R"({"camera": {"position": [30, 12, 40], "look_at": [0, 0, 0])" + cameraExtra + R"(}, )" + ground +
+               R"("materials": {"m": {}}, "lights": [{"type": "directional", "direction": [0, -1, 0]}],
+                  "objects": [{"type": "quad", "center": [0, 0, 0], "normal": [0, 1, 0], "size": [400, 400], "material": "m"},
+                              {"type": "sphere", "center": [0, 1, 0], "radius": 1, "material": "m"}]})";
+    };
+    const Scene fitted = loadScene(dir.write("a.json", scene("", "")));
+    EXPECT_NEAR(fitted.camera.far, 1.01 * std::sqrt(230.0 * 230 + 12 * 12 + 240.0 * 240), 1e-9);
+    const Scene given = loadScene(dir.write("b.json", scene(R"(, "far": 100)", "")));
+    EXPECT_EQ(given.camera.far, 100.0);
+    // A near beyond the old constant far is not an error when far is left to the scene.
+    const Scene nearOnly = loadScene(dir.write("c.json", scene(R"(, "near": 150)", "")));
+    EXPECT_GT(nearOnly.camera.far, 150.0);
+    // An added ground (sized from the bounds, larger than them) is refitted: every corner of
+    // it lies within far.
+    Scene grounded = loadScene(dir.write("d.json", scene("", R"("ground": true, )")));
+    applyGround(grounded, std::nullopt);
+    const Quad& q = std::get<Quad>(grounded.objects.back().shape);
+    for (const double u : {-0.5, 0.5})
+        for (const double v : {-0.5, 0.5}) {
+            const Vec3 corner = q.center + u * q.size.x * q.uAxis + v * q.size.y * q.vAxis;
+            EXPECT_LT(glm::length(corner - grounded.camera.position), grounded.camera.far);
+        }
+}
+
 TEST(ModelView, SunAzimuthRunsFromZTowardXAndElevationUpFromTheHorizon) {
     // Azimuth 0: the sun toward +Z, its light travelling toward −Z; azimuth 90: toward +X.
     expectNear(sunDirection(0, 0), {0, 0, -1});
