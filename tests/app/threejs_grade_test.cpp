@@ -1,0 +1,156 @@
+// tests/app/threejs_grade_test.cpp: tools/threejs-grade.sh end to end on the seed: three.js (the
+// pinned npm package, headless Chromium, SwiftShader) renders its shadow masks, `compare` grades
+// them, and the script writes report.html, which must pass tools/browser-check.sh. Registered as
+// the ctests threejs_grade_seed and threejs_grade_seed_bias (label browser, docs/ci.md), not
+// discovered: each is one run of the script.
+//
+// The seed's light: direction (-0.408, -0.816, -0.408), so θ = 35.3° from the ground's normal
+// (tan θ = 0.707). Its shadow camera (tools/browser/threejs-grade.html) is a box fitted to the
+// meshes' bounding sphere, radius R = 14.18 (the 20 x 20 ground), with a 2048² map: a texel is
+// 2R / 2048 = 0.01384 wide and the depth range far - near is 2R = 28.35.
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <sys/wait.h>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "tests/app/cli.h"
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+namespace shadowlab {
+namespace {
+
+const fs::path kSource = SHADOWLAB_SOURCE_DIR;
+const fs::path kBuild = SHADOWLAB_BINARY_DIR;
+
+std::string quote(const std::string& s) {
+    std::string q = "'";
+    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+struct ScriptRun {
+    int exitCode = -1;
+    std::string out, err;
+};
+
+ScriptRun runScript(const fs::path& script, const std::string& args) {
+    test::TempDir io;
+    const std::string cmd = "SHADOWLAB_BUILD_DIR=" + quote(kBuild.string()) + " SHADOWLAB_EXE=" +
+                            quote(SHADOWLAB_EXE) + " SHADOWLAB_BROWSER_SCREENSHOTS=" +
+                            quote((kBuild / "browser-check" / "screenshots" / "threejs-grade").string()) + " " +
+                            quote(script.string()) + " " + args + " >" + quote((io.path() / "out").string()) +
+                            " 2>" + quote((io.path() / "err").string());
+    const int status = std::system(cmd.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, test::slurpFile(io.path() / "out"),
+            test::slurpFile(io.path() / "err")};
+}
+
+ScriptRun grade(const fs::path& out, const std::string& options) {
+    return runScript(kSource / "tools" / "threejs-grade.sh", "seed " + quote(out.string()) + " " + options);
+}
+
+Json readJson(const fs::path& p) {
+    std::ifstream in(p);
+    EXPECT_TRUE(in) << p;
+    return Json::parse(in, nullptr, false);
+}
+
+// The page passes the browser check: no console error, every image loads, nothing overflows.
+void expectPageChecksOut(const fs::path& page) {
+    const ScriptRun r = runScript(kSource / "tools" / "browser-check.sh", quote(page.string()));
+    EXPECT_EQ(r.exitCode, 0) << r.out << r.err;
+    EXPECT_EQ(r.out, "") << r.err;
+}
+
+// The section of the page about one method, from its id to the end of its card.
+std::string sectionOf(const std::string& page, const std::string& method) {
+    const std::size_t at = page.find("<section class=\"card\" id=\"" + method + "\">");
+    if (at == std::string::npos) return "";
+    return page.substr(at, page.find("</section>", at) - at);
+}
+
+TEST(ThreejsGrade, SeedAtThreesDefaultsShowsAcneOnItsPage) {
+    const fs::path out = kBuild / "threejs-grade" / "seed";
+    const ScriptRun r = grade(out, "--resolution 320x180");
+    ASSERT_EQ(r.exitCode, 0) << r.out << r.err;
+
+    const Json three = readJson(out / "threejs.json");
+    EXPECT_EQ(three["width"], 320);
+    EXPECT_EQ(three["bias"], 0.0);
+    EXPECT_EQ(three["normalBias"], 0.0);
+    const Json sil = readJson(out / "silhouette.json");
+    EXPECT_LE(sil["differ"].get<double>(), 0.005 * sil["total"].get<double>());
+
+    // At bias 0 a lit receiver is tested against the map's depth at the centres of the texels
+    // around it, which differ from its own by tan θ times the offset to the centre, as often
+    // above as below: about half of PCF's 17 taps fail, the mask sits near 0.5, and about half
+    // the lit pixels (nearly all counted pixels here) come out as false shadow. 25% is far below
+    // that and far above the few edge pixels a biased map gets wrong.
+    for (const char* m : {"PCFShadowMap", "PCFSoftShadowMap"}) {
+        const Json j = readJson(out / (std::string(m) + ".json"));
+        EXPECT_GT(j["false_shadow_rate"].get<double>(), 0.25) << m;
+    }
+    // shadowlab's own raster of the same .glb, at its defaults, has no acne.
+    EXPECT_LT(readJson(out / "raster.json")["mismatch_rate"].get<double>(), 0.01);
+
+    const std::string page = test::slurpFile(out / "report.html");
+    EXPECT_NE(page.find("bias 0, normalBias 0 (three’s defaults)"), std::string::npos);
+    for (const char* m : {"PCFShadowMap", "PCFSoftShadowMap", "VSMShadowMap", "raster"}) {
+        const std::string s = sectionOf(page, m);
+        ASSERT_NE(s, "") << m;
+        for (const std::string& img : {std::string("diff-") + m + ".png", std::string("heat-") + m + ".png"})
+            EXPECT_NE(s.find(img), std::string::npos) << m << " " << img;
+    }
+    EXPECT_NE(sectionOf(page, "PCFShadowMap").find("Self-shadow acne"), std::string::npos);
+    EXPECT_EQ(sectionOf(page, "raster").find("acne"), std::string::npos);
+    expectPageChecksOut(out / "report.html");
+}
+
+TEST(ThreejsGrade, SeedWithAUsersBiasLosesTheAcne) {
+    const fs::path out = kBuild / "threejs-grade" / "seed-bias";
+    const ScriptRun r = grade(out, "--resolution 160x90 --bias -0.0005 --normal-bias 0.02");
+    ASSERT_EQ(r.exitCode, 0) << r.out << r.err;
+
+    const Json three = readJson(out / "threejs.json");
+    EXPECT_EQ(three["bias"], -0.0005);
+    EXPECT_EQ(three["normalBias"], 0.02);
+    ASSERT_EQ(three["lights"].size(), 1u);
+    EXPECT_EQ(three["lights"][0]["bias"], -0.0005);
+    EXPECT_EQ(three["lights"][0]["normalBias"], 0.02);
+
+    // The farthest PCF tap's texel centre is 1.5 texels from the receiver: a depth step of
+    // 0.707 * 1.5 * 0.01384 = 0.0147, 5.2e-4 of the depth range. The bias gives 5e-4 of it and the
+    // normal offset 0.02 * cos θ = 0.0163 (5.8e-4) more, 1.1e-3 in all: no tap fails on the flat
+    // ground. The price is light through gaps under 0.014 + 0.0163 = 0.03 between blocker and
+    // receiver: around the sphere's contact, ground within sqrt(2 * 1 * 0.03) = 0.25 of it, a few
+    // pixels at 160x90, most behind the sphere. 1% (92 of the 9190 counted pixels) bounds both.
+    for (const char* m : {"PCFShadowMap", "PCFSoftShadowMap", "VSMShadowMap"}) {
+        const Json j = readJson(out / (std::string(m) + ".json"));
+        EXPECT_LT(j["false_shadow_rate"].get<double>(), 0.01) << m;
+        EXPECT_LT(j["missed_shadow_rate"].get<double>(), 0.01) << m;
+    }
+    const std::string page = test::slurpFile(out / "report.html");
+    EXPECT_NE(page.find("bias -0.0005, normalBias 0.02"), std::string::npos);
+    EXPECT_EQ(page.find("Self-shadow acne"), std::string::npos);
+    expectPageChecksOut(out / "report.html");
+}
+
+TEST(ThreejsGrade, ABadBiasIsRefusedBeforeAnythingIsWritten) {
+    test::TempDir dir;
+    const fs::path out = dir.path() / "out";
+    for (const char* bad : {"--bias abc", "--normal-bias 1e", "--map-size 0", "--bias"}) {
+        const ScriptRun r = grade(out, std::string(bad));
+        EXPECT_EQ(r.exitCode, 2) << bad << r.err;
+        EXPECT_NE(r.err.find("threejs-grade: "), std::string::npos) << bad << r.err;
+        EXPECT_FALSE(fs::exists(out)) << bad;
+    }
+}
+
+}  // namespace
+}  // namespace shadowlab
