@@ -141,6 +141,70 @@ TEST(ThreejsGrade, SeedWithAUsersBiasLosesTheAcne) {
     expectPageChecksOut(out / "report.html");
 }
 
+// The page's words and numbers from hand-made grades (no browser): tools/browser/threejs-report.mjs
+// on an exported spot-light scene (objects sphere, box, ground: ids 1, 2, 3) with metrics chosen
+// so that each method has one thing wrong.
+Json grades(double falseShadow, double falseNearEdge, double missed, double missedNearEdge, const Json& perObject) {
+    const double n = 10000;
+    return {{"counted", n},
+            {"mismatch_rate", (falseShadow + missed) / n},
+            {"false_shadow", falseShadow},
+            {"false_shadow_rate", falseShadow / n},
+            {"false_shadow_near_edge", falseNearEdge},
+            {"missed_shadow", missed},
+            {"missed_shadow_rate", missed / n},
+            {"missed_shadow_near_edge", missedNearEdge},
+            {"per_object", perObject},
+            {"edge_radius", 2},
+            {"penumbra_pixels", 0},
+            {"mean_abs_visibility_error", (falseShadow + missed) / n},
+            {"mean_abs_visibility_error_penumbra", 0.0},
+            {"soft_error_pixels", 0},
+            {"soft_error_rate", 0.0},
+            {"shadow_iou", 0.5},
+            {"hotspot", {{"x", 0}, {"y", 0}, {"size", 16}, {"wrong_pixels", 0}}}};
+}
+
+TEST(ThreejsGrade, ThePageSaysWhatWentWrongAndWhatTheBiasIsInWorldUnits) {
+    test::TempDir dir;
+    const fs::path out = dir.path();
+    ASSERT_EQ(std::system((quote(SHADOWLAB_EXE) + " export lesson/spot-light -o " + quote((out / "scene.glb").string()) +
+                           " >/dev/null 2>&1").c_str()), 0);
+    // A spot's map holds perspective depth far (d - near) / (d (far - near)): at distance d a
+    // bias b spans b (far - near) d^2 / (far near) in world units, 0.001 * 16 * 64 / 80 = 0.0128.
+    const Json three = {{"width", 64}, {"height", 36}, {"three", "181"}, {"webgl", "test"}, {"mapSize", 1024},
+                        {"bias", -0.001}, {"normalBias", 0},
+                        {"lights", Json::array({{{"type", "SpotLight"}, {"near", 4}, {"far", 20}, {"fov", 64},
+                                                 {"distance", 8}, {"bias", -0.001}, {"normalBias", 0}}})}};
+    std::ofstream(out / "threejs.json") << three.dump();
+    std::ofstream(out / "silhouette.json") << R"({"differ": 0, "total": 2304})";
+    const Json acne = grades(3000, 0, 0, 0, Json::array({{{"object_id", 3}, {"false_shadow", 3000}, {"missed_shadow", 0}}}));
+    std::ofstream(out / "PCFShadowMap.json") << acne.dump();
+    std::ofstream(out / "PCFSoftShadowMap.json") << acne.dump();
+    std::ofstream(out / "VSMShadowMap.json")
+        << grades(0, 0, 500, 100,
+                  Json::array({{{"object_id", 1}, {"false_shadow", 0}, {"missed_shadow", 400}},
+                               {{"object_id", 3}, {"false_shadow", 0}, {"missed_shadow", 100}}}))
+               .dump();
+    std::ofstream(out / "raster.json")
+        << grades(10, 10, 10, 10, Json::array({{{"object_id", 3}, {"false_shadow", 10}, {"missed_shadow", 10}}})).dump();
+
+    const ScriptRun r = runScript("node", quote((kSource / "tools" / "browser" / "threejs-report.mjs").string()) + " " +
+                                              quote(out.string()) + " --scene spot");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const std::string page = test::slurpFile(out / "report.html");
+    EXPECT_NE(page.find("bias -0.001, normalBias 0"), std::string::npos);
+    EXPECT_NE(page.find("<td>0.0128 (at the scene's centre, 8 from the light)</td>"), std::string::npos);
+    // 3000 of 10000 false, none near an edge, all on the ground, at a non-zero bias: acne left.
+    EXPECT_NE(sectionOf(page, "PCFShadowMap").find("Acne remains over 30.00% of the counted pixels (all on “ground”)"),
+              std::string::npos);
+    // 400 of the 500 missed pixels away from the edges (4%), 400 of 500 on the sphere: VSM's bleeding.
+    const std::string vsm = sectionOf(page, "VSMShadowMap");
+    EXPECT_NE(vsm.find("Missed shadow away from the edges (4.00%, 80% of it on “sphere”): light bleeding"), std::string::npos);
+    EXPECT_EQ(vsm.find("acne"), std::string::npos);
+    EXPECT_NE(sectionOf(page, "raster").find("Close to the reference: 0.20%"), std::string::npos);
+}
+
 TEST(ThreejsGrade, ABadBiasIsRefusedBeforeAnythingIsWritten) {
     test::TempDir dir;
     const fs::path out = dir.path() / "out";

@@ -17,36 +17,47 @@ const esc = (s) => String(s).replace(/&/g, '&amp;').replace(/</g, '&lt;').replac
 const pc = (r) => (r === 0 ? '0%' : r < 0.0001 ? '<0.01%' : `${(100 * r).toFixed(2)}%`);
 const num = (v) => (Number.isInteger(v) ? String(v) : Number(v.toPrecision(4)).toString());
 
-// Object names by object id (1-based): shadowlab loads a .glb as one object per glTF material, in
-// the order of first use (scene/loader.cpp); the export gives each object its own material and
-// names its node after the object.
-function objectNames(glbFile) {
+// What the page needs from the .glb: object names by object id (1-based: shadowlab loads a .glb as
+// one object per glTF material, in the order of first use, scene/loader.cpp; the export gives each
+// object its own material and names its node after the object), which objects are semi-transparent
+// (alphaMode BLEND) and the largest light radius (extras.shadowlab.radius; docs/export.md).
+function sceneFacts(glbFile) {
   const b = fs.readFileSync(glbFile);
   if (b.length < 20 || b.readUInt32LE(0) !== 0x46546c67 || b.readUInt32LE(16) !== 0x4e4f534a)
     fail(`${glbFile}: not a .glb with a JSON chunk`);
   const gltf = JSON.parse(b.subarray(20, 20 + b.readUInt32LE(12)).toString('utf8'));
   const names = [];
+  const blend = [];
   const seen = new Set();
   const visit = (i) => {
     const n = gltf.nodes[i];
     const prims = n.mesh !== undefined ? gltf.meshes[n.mesh].primitives : [];
     for (const p of prims) {
       const m = p.material ?? -1;
-      if (!seen.has(m)) { seen.add(m); names.push(n.name || gltf.meshes[n.mesh].name || `object ${names.length + 1}`); }
+      if (seen.has(m)) continue;
+      seen.add(m);
+      names.push(n.name || gltf.meshes[n.mesh].name || `object ${names.length + 1}`);
+      if (m >= 0 && gltf.materials[m].alphaMode === 'BLEND') blend.push(names[names.length - 1]);
     }
     for (const c of n.children || []) visit(c);
   };
   for (const i of gltf.scenes[gltf.scene ?? 0].nodes) visit(i);
-  return names;
+  const lights = gltf.extensions?.KHR_lights_punctual?.lights || [];
+  const lightRadius = Math.max(0, ...lights.map((l) => l.extras?.shadowlab?.radius || 0));
+  return { names, blend, lightRadius };
 }
 
-// The object holding most of a count (per_object of compare's JSON), as "the ground (92%)".
-function mostOn(m, key, names) {
+// The object holding most of a count (per_object of compare's JSON): its name and share.
+function topObject(m, key, names) {
   const total = m.per_object.reduce((s, o) => s + o[key], 0);
-  if (total === 0) return '';
+  if (total === 0) return null;
   const top = m.per_object.reduce((a, o) => (o[key] > a[key] ? o : a));
-  const name = names[top.object_id - 1] || `object ${top.object_id}`;
-  return top[key] === total ? `all on “${name}”` : `${Math.round((100 * top[key]) / total)}% of it on “${name}”`;
+  return { name: names[top.object_id - 1] || `object ${top.object_id}`, share: top[key] / total };
+}
+function mostOn(m, key, names) {
+  const t = topObject(m, key, names);
+  if (!t) return '';
+  return t.share === 1 ? `all on “${t.name}”` : `${Math.round(100 * t.share)}% of it on “${t.name}”`;
 }
 
 // What a bias of three's means in world units, per light (three's shadow shaders: a directional
@@ -62,25 +73,36 @@ function biasInWorld(l, bias) {
   return { world: Math.abs(bias) * span, where: 'everywhere' };
 }
 
-function describe(method, m, three, names) {
+function describe(method, m, three, facts) {
+  const { names } = facts;
   const t = [];
   const counted = m.counted || 1;
   const falseAway = m.false_shadow - m.false_shadow_near_edge;
   const missedAway = m.missed_shadow - m.missed_shadow_near_edge;
   const biased = three.bias !== 0 || three.normalBias !== 0;
   const isThree = method !== 'raster';
+  // three has no VSM for point lights: getPointShadow takes the same PCF taps for every type.
+  const pointOnly = three.lights.length > 0 && three.lights.every((l) => l.type === 'PointLight');
+  const vsm = method === 'VSMShadowMap' && !pointOnly;
+  const dirLight = three.lights.find((l) => l.width);
+  const texel = dirLight ? ` (a texel of its map is ${num(dirLight.width / three.mapSize)} wide)` : '';
   t.push(m.mismatch_rate < 0.005
     ? `Close to the reference: ${pc(m.mismatch_rate)} of the counted pixels differ.`
     : `${pc(m.mismatch_rate)} of the counted pixels differ: false shadow ${pc(m.false_shadow_rate)}, missed shadow ${pc(m.missed_shadow_rate)}.`);
+  if (method === 'VSMShadowMap' && pointOnly)
+    t.push('three has no VSM for point lights: its point-light shadow takes the same PCF taps for every shadow-map type.');
+  const topFalse = topObject(m, 'false_shadow', names);
   if (falseAway / counted >= 0.002) {
     const where = mostOn(m, 'false_shadow', names);
-    if (method === 'VSMShadowMap') {
+    if (isThree && topFalse && facts.blend.includes(topFalse.name) && topFalse.share > 0.5) {
+      t.push(`False shadow away from the shadow edges (${pc(falseAway / counted)}, ${where}), a semi-transparent object: three's shadow map holds it as opaque, so it shadows itself fully where the reference lets part of the light through, and its mask is blended with what lies behind it. It cannot be graded there.`);
+    } else if (vsm) {
       t.push(`False shadow away from any shadow edge (${pc(falseAway / counted)}, ${where}): dark pixels along the lines where the surface's depth in the map steps. VSM stores the blurred depth and its deviation in about 16 bits each (two 8-bit channels, pack2HalfToRGBA): where a surface's depth barely varies across the blur the stored deviation rounds to 0 and the stored mean can fall just below the surface's own depth, so Chebyshev's bound says fully shadowed.` +
              (biased ? '' : ' A negative bias of more than one step (1/65025) removes it.'));
     } else if (isThree) {
       t.push(!biased
         ? `Self-shadow acne over ${pc(falseAway / counted)} of the counted pixels, ${where}: at bias 0 and normalBias 0 a lit surface is tested against its own depth in the map, rounded to the map's texels, and about half of those tests fail (moiré bands).`
-        : `Acne remains over ${pc(falseAway / counted)} of the counted pixels (${where}): bias ${three.bias} and normalBias ${three.normalBias} are less than the depth one texel spans there, which grows as the light grazes the surface (tan θ per texel).`);
+        : `Acne remains over ${pc(falseAway / counted)} of the counted pixels (${where}): bias ${three.bias} and normalBias ${three.normalBias} are less than the depth one texel${texel} spans there, which grows as the light grazes the surface (tan θ per texel).`);
       if (method === 'PCFSoftShadowMap' && !biased) t.push('PCFSoftShadowMap interpolates the same depth tests bilinearly: it blurs the acne, it does not remove it.');
     } else {
       t.push(`False shadow away from the shadow edges (${pc(falseAway / counted)}, ${where}): acne that shadowlab's own bias does not cover.`);
@@ -88,8 +110,8 @@ function describe(method, m, three, names) {
   }
   if (missedAway / counted >= 0.002) {
     const where = mostOn(m, 'missed_shadow', names);
-    if (method === 'VSMShadowMap')
-      t.push(`Missed shadow away from the edges (${pc(missedAway / counted)}, ${where}): light bleeding, where casters at different depths overlap in the blurred moments and Chebyshev's bound lets light through${biased ? ', and the bias moves the test toward the light' : ''}.`);
+    if (vsm)
+      t.push(`Missed shadow away from the edges (${pc(missedAway / counted)}, ${where}): light bleeding. The blurred moments of a caster that is narrow against the blur, or that overlaps another at a different depth, give a Chebyshev bound that lets light through${biased ? '; the bias moves the test toward the light too' : ''}.`);
     else if (isThree && biased)
       t.push(`Missed shadow away from the edges (${pc(missedAway / counted)}, ${where}): peter-panning, the cost of the bias: receivers just behind a blocker (contacts, thin casters) are pushed past it and come out lit.`);
     else
@@ -99,13 +121,19 @@ function describe(method, m, three, names) {
   const nearEdge = m.false_shadow_near_edge + m.missed_shadow_near_edge;
   if (nearEdge / counted >= 0.001 && nearEdge >= 0.2 * (m.false_shadow + m.missed_shadow))
     t.push(`${nearEdge} wrong pixels (${pc(nearEdge / counted)}) lie within ${m.edge_radius} px of the reference's shadow edges: ` +
-           (method === 'VSMShadowMap'
-             ? 'the blur of the moments moves the edge, and three cuts Chebyshev\'s bound below 0.3 (its light-bleeding reduction), which darkens the lit side of a soft edge.'
-             : 'the map\'s texels and the filter\'s blur of the edge.'));
-  if (m.penumbra_pixels / counted >= 0.005)
-    t.push(`The reference's light has a radius: its shadow has a penumbra over ${pc(m.penumbra_pixels / counted)} of the counted pixels, ` +
-           (isThree ? 'which three draws hard (KHR_lights_punctual has no light size: three\'s point and spot lights are points)'
-                    : 'which the raster backend\'s filter draws') + `; mean |ΔV| there ${m.mean_abs_visibility_error_penumbra.toFixed(3)}.`);
+           (vsm ? 'the blur of the moments moves the edge, and three cuts Chebyshev\'s bound below 0.3 (its light-bleeding reduction), which darkens the lit side of a soft edge.'
+                : isThree ? `the map's texels${texel} and the filter's blur of the edge.` : 'the map\'s texels and the filter\'s blur of the edge.'));
+  if (m.penumbra_pixels / counted >= 0.005) {
+    const why = facts.lightRadius > 0 && facts.blend.length ? 'the light has a radius and some objects are semi-transparent'
+      : facts.lightRadius > 0 ? `the light has radius ${num(facts.lightRadius)}` : facts.blend.length ? 'semi-transparent casters let part of the light through'
+      : 'partly lit';
+    const three_ = facts.lightRadius > 0 && facts.blend.length ? 'three draws both hard (KHR_lights_punctual has no light size, and shadow maps ignore opacity)'
+      : facts.lightRadius > 0 ? 'three draws it hard (KHR_lights_punctual has no light size: three\'s point and spot lights are points)'
+      : facts.blend.length ? 'three\'s shadow map holds such casters as opaque (it ignores opacity) and shadows fully'
+      : 'three draws it hard';
+    t.push(`The reference is partly lit over ${pc(m.penumbra_pixels / counted)} of the counted pixels (${why}); ` +
+           (isThree ? three_ : 'the raster backend\'s filter draws it') + `: mean |ΔV| there ${m.mean_abs_visibility_error_penumbra.toFixed(3)}.`);
+  }
   if (m.soft_error_pixels / counted >= 0.001)
     t.push(`${m.soft_error_pixels} pixels (${pc(m.soft_error_rate)}) are off by 0.25 to 0.5 in visibility: wrong, though not in class (the heat map shows them).`);
   return t.join(' ');
@@ -200,7 +228,7 @@ function main() {
   const three = read('threejs.json');
   const sil = read('silhouette.json');
   const metrics = Object.fromEntries(kMethods.map((m) => [m, read(`${m}.json`)]));
-  const names = objectNames(path.join(dir, 'scene.glb'));
+  const facts = sceneFacts(path.join(dir, 'scene.glb'));
   const { width: w, height: h } = three;
   const settings = three.bias === 0 && three.normalBias === 0 ? 'bias 0, normalBias 0 (three’s defaults)'
     : `bias ${three.bias}, normalBias ${three.normalBias}`;
@@ -265,7 +293,7 @@ function main() {
     const m = metrics[k];
     const mask = k === 'raster' ? 'raster-visibility.png' : `threejs-${k}.png`;
     const hot = m.hotspot && m.hotspot.wrong_pixels > 0 ? m.hotspot : null;
-    o.push(`<section class="card" id="${k}"><h3>${esc(kLabels[k])}</h3><p>${esc(describe(k, m, three, names))}</p><div class="${hot ? 'rowz' : 'row'}">`);
+    o.push(`<section class="card" id="${k}"><h3>${esc(kLabels[k])}</h3><p>${esc(describe(k, m, three, facts))}</p><div class="${hot ? 'rowz' : 'row'}">`);
     o.push(figure('mask', kMaskNotes[k], mask, w, h));
     o.push(figure('difference', `false ${m.false_shadow}, missed ${m.missed_shadow}`, `diff-${k}.png`, w, h, hot));
     o.push(figure('heat', `mean |ΔV| ${m.mean_abs_visibility_error.toFixed(4)}`, `heat-${k}.png`, w, h));
