@@ -298,7 +298,9 @@ function main() {
     const mask = k === 'raster' ? 'raster-visibility.png' : `threejs-${k}.png`;
     const hot = m.hotspot && m.hotspot.wrong_pixels > 0 ? m.hotspot : null;
     o.push(`<section class="card" id="${k}"><h3>${esc(kLabels[k])}</h3><p>${esc(describe(k, m, three, facts))}</p><div class="${hot ? 'rowz' : 'row'}">`);
-    o.push(figure('mask', kMaskNotes[k], mask, w, h));
+    const pointOnly = three.lights.length > 0 && three.lights.every((l) => l.type === 'PointLight');
+    const note = k === 'VSMShadowMap' && pointOnly ? 'three.js’s mask: a point light takes PCF’s taps for every type' : kMaskNotes[k];
+    o.push(figure('mask', note, mask, w, h));
     o.push(figure('difference', `false ${m.false_shadow}, missed ${m.missed_shadow}`, `diff-${k}.png`, w, h, hot));
     o.push(figure('heat', `mean |ΔV| ${m.mean_abs_visibility_error.toFixed(4)}`, `heat-${k}.png`, w, h));
     if (hot) o.push(zoom(`diff-${k}.png`, w, h, hot));
