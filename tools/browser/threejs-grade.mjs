@@ -2,10 +2,15 @@
 // `shadowlab export`) in headless Chromium with software WebGL (SwiftShader), one per shadow-map
 // type (PCFShadowMap, PCFSoftShadowMap, VSMShadowMap), and its coverage image. Run it through
 // tools/threejs-grade.sh, which installs what it needs and grades the masks (docs/threejs.md).
-// Usage: node threejs-grade.mjs SCENE.glb OUTDIR [--resolution WxH] [--map-size N] [--chromium PATH]
+// Usage: node threejs-grade.mjs SCENE.glb OUTDIR [--resolution WxH] [--map-size N] [--bias B]
+//        [--normal-bias N] [--chromium PATH]
+// --bias and --normal-bias set every light's shadow.bias and shadow.normalBias, in three's own units
+// (bias: added to the receiver's normalized shadow-map depth; normalBias: world units along the
+// normal); both default to three's 0.
 // Writes OUTDIR/threejs-<type>.png (the mask: light visibility, 8-bit linear, 255 = lit),
 // OUTDIR/threejs-coverage.png (255 where three.js sees a mesh) and prints one JSON line with the
-// image size and three's revision. Exit 0, or 2 when the page or the browser fails.
+// image size, three's revision, the settings and each light's shadow camera. Exit 0, or 2 when the
+// page or the browser fails.
 import { createRequire } from 'node:module';
 import fs from 'node:fs';
 import http from 'node:http';
@@ -60,17 +65,26 @@ const args = process.argv.slice(2);
 let chromiumPath = process.env.SHADOWLAB_CHROMIUM || '/usr/bin/chromium';
 let mapSize = 2048;
 let resolution = null;
+const shadow = { bias: 0, normalBias: 0 };
+const number = (flag, text) => {
+  const v = Number(text);
+  if (text === undefined || text === '' || !Number.isFinite(v)) fail(`${flag}: not a number: ${text}`);
+  return v;
+};
 const pos = [];
 for (let i = 0; i < args.length; ++i) {
   if (args[i] === '--chromium') chromiumPath = args[++i];
   else if (args[i] === '--map-size') mapSize = Number(args[++i]);
+  else if (args[i] === '--bias') shadow.bias = number('--bias', args[++i]);
+  else if (args[i] === '--normal-bias') shadow.normalBias = number('--normal-bias', args[++i]);
   else if (args[i] === '--resolution') {
     resolution = (args[++i] || '').split('x').map(Number);
     if (resolution.length !== 2 || !resolution.every((v) => Number.isInteger(v) && v > 0)) fail(`--resolution: not WxH: ${args[i]}`);
   }
   else pos.push(args[i]);
 }
-if (pos.length !== 2 || !(mapSize > 0)) fail('usage: threejs-grade.mjs SCENE.glb OUTDIR [--resolution WxH] [--map-size N] [--chromium PATH]');
+if (pos.length !== 2 || !(Number.isInteger(mapSize) && mapSize > 0))
+  fail('usage: threejs-grade.mjs SCENE.glb OUTDIR [--resolution WxH] [--map-size N] [--bias B] [--normal-bias N] [--chromium PATH]');
 const [glb, outDir] = pos;
 if (!fs.existsSync(glb)) fail(`${glb}: no such file`);
 fs.mkdirSync(outDir, { recursive: true });
@@ -116,25 +130,31 @@ try {
   });
   if (!renderer) throw new Error(`no WebGL 2 in Chromium with ${kGlFlags.join(' ')}`);
   const pass = async (type, mode) => {
-    const b64 = await page.evaluate(([t, m, s, ww, hh]) => window.renderPass('/scene.glb', ww, hh, t, m, s), [type, mode, mapSize, w, h]);
+    const b64 = await page.evaluate(([t, m, s, ww, hh, sh]) => window.renderPass('/scene.glb', ww, hh, t, m, s, sh),
+                                    [type, mode, mapSize, w, h, shadow]);
     const buf = Buffer.from(b64, 'base64');
     return new Float32Array(buf.buffer, buf.byteOffset, w * h);
   };
-  const t0 = Date.now();
+  const seconds = {};  // each shadow type's pass, wall-clock (SwiftShader compiles its programs on first use)
   const coverage = await pass(null, 'coverage');
   writeGreyPng(path.join(outDir, 'threejs-coverage.png'), w, h, coverage);
   const unshadowed = await pass(null, 'unshadowed');
   for (const type of kShadowTypes) {
+    const t0 = Date.now();
     const shadowed = await pass(type, 'shadowed');
     // visibility = shadowed / unshadowed Lambert (the irradiance-weighted visibility of the lights);
-    // where the unshadowed light is 0 (facing away, background) it is 1 (those pixels do not count)
-    const mask = shadowed.map((s, i) => (unshadowed[i] > 1e-6 ? s / unshadowed[i] : 1));
+    // where the unshadowed light is 0 no light arrives: 0, as in the reference's visibility. Outside
+    // a spot's cone those pixels count; facing away and on the background they do not.
+    const mask = shadowed.map((s, i) => (unshadowed[i] > 1e-6 ? s / unshadowed[i] : 0));
     writeGreyPng(path.join(outDir, `threejs-${type}.png`), w, h, mask);
-    console.error(`threejs-grade: ${type} done after ${((Date.now() - t0) / 1000).toFixed(1)} s`);
+    seconds[type] = (Date.now() - t0) / 1000;
+    console.error(`threejs-grade: ${type} done in ${seconds[type].toFixed(1)} s`);
   }
   if (errors.length) throw new Error(`page errors: ${errors.join(' | ')}`);
   const revision = await page.evaluate(() => window.threeRevision);
-  console.log(JSON.stringify({ width: w, height: h, three: revision, webgl: renderer, mapSize, flags: kGlFlags }));
+  const lights = await page.evaluate(() => window.shadowCameras());
+  console.log(JSON.stringify({ width: w, height: h, three: revision, webgl: renderer, mapSize, bias: shadow.bias,
+                               normalBias: shadow.normalBias, lights, flags: kGlFlags, seconds }));
 } catch (e) {
   await browser.close();
   server.close();
