@@ -39,6 +39,17 @@ constexpr double kSunElevations[] = {35.0, 55.0, 75.0};
 constexpr double kEnclosedShare = 0.9;
 constexpr double kInteriorAmbient = 0.15;
 constexpr double kInteriorShare = 0.25;
+// A surface seen within 60° of head-on (|cos| >= 0.5) shows its shadows whole; one seen nearer
+// edge-on squeezes them into a few pixels and counts for |cos| / 0.5 of a pixel.
+constexpr double kFullLegibility = 0.5;
+// A caster counts toward the variety of shadows in view when its shadow covers this share of the
+// lit-facing surface (and 0.1% of the image); up to kVarietyCasters casters are rewarded.
+constexpr double kCasterShare = 0.005;
+constexpr int kVarietyCasters = 4;
+// The best kRefineCandidates pairs are scored again at kRefineScale times the thumbnail width, so
+// that the holes of cut-outs and thin casters, lost at 64 pixels, decide between them.
+constexpr int kRefineCandidates = 8;
+constexpr int kRefineScale = 3;
 
 std::string fmt(double v, const char* f = "%.3g") {
     char buf[64];
@@ -51,6 +62,7 @@ struct Thumbnail {
     int width = 0, height = 0;
     std::vector<SurfacePoint<float>> points;  // object -1: background
     std::vector<float> distance;              // to the eye, for the near-wall test
+    std::vector<float> legibility;            // how well the pixel's surface is seen (kFullLegibility)
 };
 
 Thumbnail primaryHits(const Tracer<float>& tracer, const scene::Camera& camera, int width, int height) {
@@ -63,6 +75,7 @@ Thumbnail primaryHits(const Tracer<float>& tracer, const scene::Camera& camera, 
     t.height = height;
     t.points.resize(std::size_t(width) * height);
     t.distance.assign(t.points.size(), 0.0f);
+    t.legibility.assign(t.points.size(), 0.0f);
     tbb::parallel_for(0, height, [&](int y) {
         for (int x = 0; x < width; ++x) {
             const Vec3 d = glm::normalize(scene::pixelDirection(basis, x, y));
@@ -74,15 +87,23 @@ Thumbnail primaryHits(const Tracer<float>& tracer, const scene::Camera& camera, 
             sp = tracer.surfacePoint(ray, hit, false);
             sp.object = hit.object;
             t.distance[std::size_t(y) * width + x] = hit.t;
+            const double cosView = std::abs(glm::dot(Vec3(sp.ng), d));
+            t.legibility[std::size_t(y) * width + x] = float(std::min(1.0, cosView / kFullLegibility));
         }
     });
     return t;
 }
 
-// Per pixel: -1 background, 0 faces away from the light, 1 lit, 2 in cast shadow.
-std::vector<std::int8_t> shadowClasses(const Tracer<float>& tracer, const Thumbnail& t, const scene::Light& light,
-                                       double rayBias, bool anyHit) {
-    std::vector<std::int8_t> cls(t.points.size(), -1);
+// Per pixel: -1 background, 0 faces away from the light, 1 lit, 2 in cast shadow; and for the
+// shadowed ones the object that casts the shadow.
+struct Shading {
+    std::vector<std::int8_t> cls;
+    std::vector<int> blocker;
+};
+
+Shading shadowClasses(const Tracer<float>& tracer, const Thumbnail& t, const scene::Light& light, double rayBias,
+                      bool anyHit) {
+    Shading out{std::vector<std::int8_t>(t.points.size(), -1), std::vector<int>(t.points.size(), -1)};
     scene::RaytraceSettings settings;
     settings.rayBias = rayBias;
     settings.samples = 4;
@@ -99,21 +120,26 @@ std::vector<std::int8_t> shadowClasses(const Tracer<float>& tracer, const Thumbn
             bool reached = glm::dot(n, toLight) > 0;
             if (light.type == scene::LightType::Spot) reached = reached && glm::dot(-toLight, light.direction) >= cosCone;
             if (!reached) {
-                cls[i] = 0;
+                out.cls[i] = 0;
                 continue;
             }
             const ShadowResult r = lightVisibility(tracer, light, sp, settings, anyHit, rng);
-            cls[i] = r.transmittance < 0.5 ? 2 : 1;
+            out.cls[i] = r.transmittance < 0.5 ? 2 : 1;
+            if (out.cls[i] == 2) out.blocker[i] = r.blocker;
         }
     });
-    return cls;
+    return out;
 }
 
-// `ground`: the added ground's object index (-1 when none), left out of the model's own facing share.
-ViewScore score(const Thumbnail& t, const std::vector<std::int8_t>& cls, const Vec3& forward, const scene::Light& light,
-                double nearWall, int ground) {
+// `ground`: the added ground's object index (-1 when none), left out of the model's own facing
+// share. Shadow shares and edges count each pixel by its legibility (kFullLegibility).
+ViewScore score(const Thumbnail& t, const Shading& shading, const Vec3& forward, const scene::Light& light,
+                double nearWall, int ground, int casters) {
+    const std::vector<std::int8_t>& cls = shading.cls;
     ViewScore s;
-    std::size_t hit = 0, facing = 0, shadowed = 0, edges = 0, near = 0, model = 0, modelFacing = 0;
+    std::size_t hit = 0, facing = 0, near = 0, model = 0, modelFacing = 0;
+    double facingWeight = 0, shadowed = 0, edges = 0;
+    std::vector<double> castShadow(std::size_t(std::max(casters, 0)) + 1, 0.0);
     for (int y = 0; y < t.height; ++y)
         for (int x = 0; x < t.width; ++x) {
             const std::size_t i = std::size_t(y) * t.width + x;
@@ -125,16 +151,25 @@ ViewScore score(const Thumbnail& t, const std::vector<std::int8_t>& cls, const V
             modelFacing += onModel && cls[i] > 0;
             if (cls[i] == 0) continue;
             ++facing;
-            shadowed += cls[i] == 2;
-            if (x + 1 < t.width && cls[i + 1] > 0 && cls[i + 1] != cls[i]) ++edges;
-            if (y + 1 < t.height && cls[i + t.width] > 0 && cls[i + t.width] != cls[i]) ++edges;
+            const double w = t.legibility[i];
+            facingWeight += w;
+            if (cls[i] == 2) {
+                shadowed += w;
+                const int b = shading.blocker[i];
+                if (b >= 0 && std::size_t(b) < castShadow.size()) castShadow[std::size_t(b)] += w;
+            }
+            if (x + 1 < t.width && cls[i + 1] > 0 && cls[i + 1] != cls[i]) edges += std::min(w, double(t.legibility[i + 1]));
+            if (y + 1 < t.height && cls[i + t.width] > 0 && cls[i + t.width] != cls[i])
+                edges += std::min(w, double(t.legibility[i + t.width]));
         }
     const double pixels = double(t.points.size());
     s.coverage = hit / pixels;
     s.facing = hit ? double(facing) / double(hit) : 0.0;
-    s.shadowedShare = facing ? double(shadowed) / double(facing) : 0.0;
-    s.edgeLength = double(edges) / double(t.width + t.height);
+    s.shadowedShare = facingWeight > 0 ? shadowed / facingWeight : 0.0;
+    s.edgeLength = edges / double(t.width + t.height);
     s.sunSide = light.type == scene::LightType::Directional ? glm::dot(forward, light.direction) : 0.0;
+    const double enough = std::max(kCasterShare * facingWeight, 1e-3 * pixels);
+    for (double c : castShadow) s.casters += c >= enough;
     // Shadows a quarter to a third of the lit-facing surface read best; more is a dark picture.
     const double fShare = s.shadowedShare <= 0.35 ? s.shadowedShare / 0.35
                                                   : std::max(0.2, 1.0 - (s.shadowedShare - 0.35) / 0.4);
@@ -147,7 +182,11 @@ ViewScore score(const Thumbnail& t, const std::vector<std::int8_t>& cls, const V
     // From the sun's side every shadow hides behind its caster.
     const double fSide = 1.0 - 0.6 * std::max(0.0, s.sunSide);
     const double fNear = hit && near > hit / 2 ? 0.3 : 1.0;  // half the view is a wall in the face (4% of the size)
-    s.score = fCover * fFacing * (0.5 * fShare + 0.5 * fEdge) * fSide * fNear;
+    // Of several casters, a view that shows the shadows of more of them (a row of cut-out cards,
+    // not the one board behind them) tells more; a single caster's scene is not affected.
+    const int wanted = std::clamp(casters, 1, kVarietyCasters);
+    const double fVariety = 0.5 + 0.5 * std::min(1.0, double(s.casters) / double(wanted));
+    s.score = fCover * fFacing * (0.5 * fShare + 0.5 * fEdge) * fSide * fNear * fVariety;
     return s;
 }
 
@@ -275,6 +314,11 @@ int groundIndex(const scene::Scene& scene) {
     return int(scene.objects.size()) - 1;
 }
 
+// Objects that can cast a shadow the score counts: all but the added ground.
+int casterCount(const scene::Scene& scene) {
+    return int(scene.objects.size()) - (groundIndex(scene) >= 0 ? 1 : 0);
+}
+
 int thumbnailHeight(const scene::Camera& c, int width) {
     return std::clamp(int(std::lround(double(width) * c.height / std::max(1, c.width))), 16, 4 * width);
 }
@@ -289,7 +333,7 @@ ViewScore scoreScene(const scene::Scene& scene, int width, int threads) {
         const Thumbnail t = primaryHits(tracer, scene.camera, width, thumbnailHeight(scene.camera, width));
         const scene::CameraBasis basis = scene::cameraBasis(scene.camera);
         s = score(t, shadowClasses(tracer, t, scene.lights.front(), scene::defaultRayBias(scene), scene.allOpaque()),
-                  basis.forward, scene.lights.front(), 0.0, groundIndex(scene));
+                  basis.forward, scene.lights.front(), 0.0, groundIndex(scene), casterCount(scene));
     });
     return s;
 }
@@ -326,29 +370,55 @@ ViewSearchResult searchViewAndSun(const scene::Scene& scene, const ViewSearchOpt
         const double rayBias = scene::defaultRayBias(scene);
         const double nearWall = r.interior ? 0.04 * b.diagonal() : 0.0;
         const int ground = groundIndex(scene);
-        std::size_t bestView = 0, bestSun = 0;
-        ViewScore best;
-        best.score = -1;
+        const int casters = casterCount(scene);
+        struct Scored {
+            double score;
+            std::size_t view, sun;
+        };
+        std::vector<Scored> scored;
         for (std::size_t v = 0; v < views.size(); ++v) {
             const Thumbnail t = primaryHits(tracer, views[v].camera, r.width, r.height);
             const Vec3 forward = scene::cameraBasis(views[v].camera).forward;
             for (std::size_t s = 0; s < suns.size(); ++s) {
                 const ViewScore sc = score(t, shadowClasses(tracer, t, suns[s].first, rayBias, scene.allOpaque()),
-                                           forward, suns[s].first, nearWall, ground);
-                if (sc.score > best.score) {
-                    best = sc;
-                    bestView = v;
-                    bestSun = s;
-                }
+                                           forward, suns[s].first, nearWall, ground, casters);
+                scored.push_back({sc.score, v, s});
+            }
+        }
+        // The best few again at a finer size; a stable order keeps the first candidate among equals.
+        std::stable_sort(scored.begin(), scored.end(), [](const Scored& a, const Scored& b) { return a.score > b.score; });
+        scored.resize(std::min<std::size_t>(scored.size(), kRefineCandidates));
+        std::sort(scored.begin(), scored.end(),
+                  [](const Scored& a, const Scored& b) { return a.view != b.view ? a.view < b.view : a.sun < b.sun; });
+        const int fineWidth = kRefineScale * r.width, fineHeight = thumbnailHeight(scene.camera, fineWidth);
+        std::size_t bestView = 0, bestSun = 0;
+        ViewScore best;
+        best.score = -1;
+        std::size_t thumbnailView = views.size();
+        Thumbnail fine;
+        for (const Scored& c : scored) {
+            if (c.view != thumbnailView) {
+                fine = primaryHits(tracer, views[c.view].camera, fineWidth, fineHeight);
+                thumbnailView = c.view;
+            }
+            const Vec3 forward = scene::cameraBasis(views[c.view].camera).forward;
+            const ViewScore sc = score(fine, shadowClasses(tracer, fine, suns[c.sun].first, rayBias, scene.allOpaque()),
+                                       forward, suns[c.sun].first, nearWall, ground, casters);
+            if (sc.score > best.score) {
+                best = sc;
+                bestView = c.view;
+                bestSun = c.sun;
             }
         }
         r.best = best;
         r.camera = views[bestView].camera;
         r.sunDirection = suns[bestSun].first.direction;
         const std::string why = " (the best of " + std::to_string(r.views * r.suns) + " view x sun pairs, score " +
-                                fmt(best.score, "%.2f") + ", at " + std::to_string(r.width) + "x" + std::to_string(r.height) +
+                                fmt(best.score, "%.2f") + ", the best " + std::to_string(scored.size()) + " again at " +
+                                std::to_string(fineWidth) + "x" + std::to_string(fineHeight) +
                                 ": " + fmt(100 * best.shadowedShare, "%.0f") + "% of the lit-facing surface in shadow, " +
-                                fmt(best.edgeLength, "%.2f") + " shadow edge per image side, " +
+                                fmt(best.edgeLength, "%.2f") + " shadow edge per image side, the shadows of " +
+                                std::to_string(best.casters) + " caster(s), " +
                                 fmt(100 * best.coverage, "%.0f") + "% of the image on the model)";
         r.viewText = (options.chooseView ? "searched, " + views[bestView].text : views[bestView].text) +
                      (r.interior ? "; the model encloses its space (" + std::to_string(r.enclosedPoints) + " of " +

@@ -17,7 +17,8 @@ struct ViewSearchOptions {
     int threads = 0;         // 0 = all
 };
 
-// How one thumbnail (one view under one sun) scores. Shares are of the thumbnail's pixels.
+// How one thumbnail (one view under one sun) scores. Shares are of the thumbnail's pixels; the
+// shadowed share and the edges count a pixel seen near edge-on as part of one.
 struct ViewScore {
     double coverage = 0;       // pixels that see geometry
     double facing = 0;         // of those, the share whose surface faces the light (N·L > 0)
@@ -25,6 +26,7 @@ struct ViewScore {
     double shadowedShare = 0;  // of the facing ones, the share in cast shadow (transmittance < 0.5)
     double edgeLength = 0;     // lit–shadowed neighbour pairs (4-neighbours), per (width + height)
     double sunSide = 0;        // cosine between the view direction and the way light travels
+    int casters = 0;           // objects whose cast shadow covers a share of the view (kCasterShare)
     double score = 0;
 };
 
