@@ -1,7 +1,8 @@
 // raytrace/view_search.h: a view and a sun that show shadows, for a model whose file has no
 // camera or no light. Candidate views (around the model, or inside it when it encloses its
 // space, as Sponza does) and candidate suns are scored with the float ray tracer at thumbnail
-// size, and the best pair is kept (docs/decisions.md, "Views and suns for a model").
+// size, the best few again at 3 × that size, and the best pair is kept (docs/decisions.md,
+// "Views and suns for a model").
 #pragma once
 
 #include <string>
