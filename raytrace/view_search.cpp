@@ -39,6 +39,18 @@ constexpr double kSunElevations[] = {35.0, 55.0, 75.0};
 constexpr double kEnclosedShare = 0.9;
 constexpr double kInteriorAmbient = 0.15;
 constexpr double kInteriorShare = 0.25;
+// The variety of shadows in view is the effective number of casters whose shadow outlines are
+// seen; a view that shows the outlines of kVarietyCasters casters evenly is varied enough.
+constexpr int kVarietyCasters = 4;
+// Thumbnail::legibility: a surface seen within 60° of head-on shows its shadows' shapes.
+constexpr double kFullLegibility = 0.5;
+// The holes in a shadow (light through MASK texels below the cutoff, BLEND, opacity < 1) count
+// where the best candidate shows at least this much of their outline, in thumbnail pixel pairs:
+// one hole two pixels across.
+constexpr double kMinHoleEdges = 8.0;
+// The best ViewSearchOptions::refine pairs are scored again at kRefineScale times the thumbnail
+// width (192 × 108): a MASK board's holes or a strap's shadow, a pixel or two at 64, decide there.
+constexpr int kRefineScale = 3;
 
 std::string fmt(double v, const char* f = "%.3g") {
     char buf[64];
@@ -51,6 +63,22 @@ struct Thumbnail {
     int width = 0, height = 0;
     std::vector<SurfacePoint<float>> points;  // object -1: background
     std::vector<float> distance;              // to the eye, for the near-wall test
+    std::vector<float> cosView;               // |cos| between the view ray and the surface's normal
+    double pixelAngle = 0;                    // radians between neighbouring pixels' rays (at the center)
+
+    // A shadow on a surface seen at angle θ from head-on appears squeezed to cos θ of its width.
+    // Within 60° (squeezed at most in half) its shape still reads and the pixel counts whole;
+    // nearer edge-on it counts |cos| / 0.5 of one in the shadow share, the edges and the holes.
+    double legibility(std::size_t i) const { return std::min(1.0, double(cosView[i]) / kFullLegibility); }
+
+    // Neighbouring pixels i and j see one surface, not a silhouette against what lies behind it:
+    // the same object, at depths no further apart than a plane seen at their angle would put
+    // them (d·α·tanθ ≤ d·α / |cos|, twice that for curvature).
+    bool sameSurface(std::size_t i, std::size_t j) const {
+        if (points[i].object != points[j].object) return false;
+        const double c = std::max(0.05f, std::min(cosView[i], cosView[j]));
+        return std::abs(distance[i] - distance[j]) <= 2.0 * pixelAngle * std::max(distance[i], distance[j]) / c;
+    }
 };
 
 Thumbnail primaryHits(const Tracer<float>& tracer, const scene::Camera& camera, int width, int height) {
@@ -63,6 +91,8 @@ Thumbnail primaryHits(const Tracer<float>& tracer, const scene::Camera& camera, 
     t.height = height;
     t.points.resize(std::size_t(width) * height);
     t.distance.assign(t.points.size(), 0.0f);
+    t.cosView.assign(t.points.size(), 0.0f);
+    t.pixelAngle = 2.0 * std::tan(0.5 * c.fovYDegrees * kDegrees) / height;
     tbb::parallel_for(0, height, [&](int y) {
         for (int x = 0; x < width; ++x) {
             const Vec3 d = glm::normalize(scene::pixelDirection(basis, x, y));
@@ -74,15 +104,52 @@ Thumbnail primaryHits(const Tracer<float>& tracer, const scene::Camera& camera, 
             sp = tracer.surfacePoint(ray, hit, false);
             sp.object = hit.object;
             t.distance[std::size_t(y) * width + x] = hit.t;
+            const double cosView = std::abs(glm::dot(Vec3(sp.ng), d));
+            t.cosView[std::size_t(y) * width + x] = float(cosView);
         }
     });
     return t;
 }
 
-// Per pixel: -1 background, 0 faces away from the light, 1 lit, 2 in cast shadow.
-std::vector<std::int8_t> shadowClasses(const Tracer<float>& tracer, const Thumbnail& t, const scene::Light& light,
-                                       double rayBias, bool anyHit) {
-    std::vector<std::int8_t> cls(t.points.size(), -1);
+// Per pixel: -1 background, 0 faces away from the light, 1 lit, 2 in cast shadow, 3 lit through
+// a cut-out (its light crosses an object that lets light through: a hole in that object's
+// shadow); for the shadowed ones the object that casts the shadow.
+struct Shading {
+    std::vector<std::int8_t> cls;
+    std::vector<int> blocker;
+};
+
+// Objects whose shadow can have holes: MASK with a texture or an alpha below its cutoff, BLEND,
+// opacity < 1.
+std::vector<int> seeThroughObjects(const scene::Scene& scene) {
+    std::vector<int> out;
+    for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+        const scene::Material& m = scene.materialOf(scene.objects[i]);
+        const bool mask = m.alphaMode == scene::AlphaMode::Mask && (m.alphaTextured() || m.alphaFactor < m.alphaCutoff);
+        if (!m.opaque() || mask) out.push_back(int(i));
+    }
+    return out;
+}
+
+// A lit point's light crosses one of `seeThrough` (its surface, alpha ignored): one ray toward the
+// light's center, as for a point or directional light.
+bool litThrough(const Tracer<float>& tracer, const scene::Light& light, const SurfacePoint<float>& sp,
+                const scene::RaytraceSettings& settings, const std::vector<int>& seeThrough) {
+    const bool directional = light.type == scene::LightType::Directional;
+    const V w = directional ? V(-light.direction) : V(light.position) - sp.p;
+    const V o = shadowOrigin(sp, w, settings);
+    const Ray<float> ray(o, directional ? w : V(light.position) - o);
+    const float tMax = directional ? std::numeric_limits<float>::infinity() : 1.0f;
+    for (const int k : seeThrough) {
+        Hit<float> h;
+        if (tracer.intersectObject(k, ray, tMax, false, true, h, scene::AlphaTest::Off)) return true;
+    }
+    return false;
+}
+
+Shading shadowClasses(const Tracer<float>& tracer, const Thumbnail& t, const scene::Light& light, double rayBias,
+                      bool anyHit, const std::vector<int>& seeThrough) {
+    Shading out{std::vector<std::int8_t>(t.points.size(), -1), std::vector<int>(t.points.size(), -1)};
     scene::RaytraceSettings settings;
     settings.rayBias = rayBias;
     settings.samples = 4;
@@ -99,21 +166,31 @@ std::vector<std::int8_t> shadowClasses(const Tracer<float>& tracer, const Thumbn
             bool reached = glm::dot(n, toLight) > 0;
             if (light.type == scene::LightType::Spot) reached = reached && glm::dot(-toLight, light.direction) >= cosCone;
             if (!reached) {
-                cls[i] = 0;
+                out.cls[i] = 0;
                 continue;
             }
             const ShadowResult r = lightVisibility(tracer, light, sp, settings, anyHit, rng);
-            cls[i] = r.transmittance < 0.5 ? 2 : 1;
+            out.cls[i] = r.transmittance < 0.5 ? 2 : 1;
+            if (out.cls[i] == 2) out.blocker[i] = r.blocker;
+            else if (!seeThrough.empty() && litThrough(tracer, light, sp, settings, seeThrough)) out.cls[i] = 3;
         }
     });
-    return cls;
+    return out;
 }
 
-// `ground`: the added ground's object index (-1 when none), left out of the model's own facing share.
-ViewScore score(const Thumbnail& t, const std::vector<std::int8_t>& cls, const Vec3& forward, const scene::Light& light,
-                double nearWall, int ground) {
+// `ground`: the added ground's object index (-1 when none), left out of the model's own facing
+// share; `casters`: the objects that can cast (all but the ground). Shadow shares, edges and the
+// holes count each pixel by its legibility (Thumbnail::legibility).
+ViewScore score(const Thumbnail& t, const Shading& shading, const Vec3& forward, const scene::Light& light,
+                double nearWall, int ground, int casters) {
+    const std::vector<std::int8_t>& cls = shading.cls;
     ViewScore s;
-    std::size_t hit = 0, facing = 0, shadowed = 0, edges = 0, near = 0, model = 0, modelFacing = 0;
+    std::size_t hit = 0, facing = 0, near = 0, model = 0, modelFacing = 0;
+    double facingWeight = 0, shadowed = 0, edges = 0, holeEdges = 0;
+    // Per caster, the lit–shadowed pairs on the shadowed side of which it is the blocker: the
+    // outline of its shadow as the view shows it. A caster whose shadow lies inside another's
+    // shadow has none, however many pixels it would darken alone.
+    std::vector<double> outline(std::size_t(std::max(casters, 0)), 0.0);
     for (int y = 0; y < t.height; ++y)
         for (int x = 0; x < t.width; ++x) {
             const std::size_t i = std::size_t(y) * t.width + x;
@@ -125,16 +202,35 @@ ViewScore score(const Thumbnail& t, const std::vector<std::int8_t>& cls, const V
             modelFacing += onModel && cls[i] > 0;
             if (cls[i] == 0) continue;
             ++facing;
-            shadowed += cls[i] == 2;
-            if (x + 1 < t.width && cls[i + 1] > 0 && cls[i + 1] != cls[i]) ++edges;
-            if (y + 1 < t.height && cls[i + t.width] > 0 && cls[i + t.width] != cls[i]) ++edges;
+            const double w = t.legibility(i);
+            facingWeight += w;
+            shadowed += cls[i] == 2 ? w : 0.0;
+            for (const std::size_t j : {x + 1 < t.width ? i + 1 : i, y + 1 < t.height ? i + t.width : i}) {
+                // A shadow's outline: lit against shadowed on one surface (a lit caster seen against
+                // the shadow behind it is a silhouette, not an outline).
+                if (j == i || cls[j] <= 0 || (cls[i] == 2) == (cls[j] == 2) || !t.sameSurface(i, j)) continue;
+                const double e = std::min(w, t.legibility(j));
+                edges += e;
+                holeEdges += cls[i] == 3 || cls[j] == 3 ? e : 0.0;  // a hole's outline: lit through a cut-out
+                const int b = shading.blocker[cls[i] == 2 ? i : j];
+                if (b >= 0 && std::size_t(b) < outline.size()) outline[std::size_t(b)] += e;
+            }
         }
     const double pixels = double(t.points.size());
     s.coverage = hit / pixels;
     s.facing = hit ? double(facing) / double(hit) : 0.0;
-    s.shadowedShare = facing ? double(shadowed) / double(facing) : 0.0;
-    s.edgeLength = double(edges) / double(t.width + t.height);
+    s.shadowedShare = facingWeight > 0 ? shadowed / facingWeight : 0.0;
+    s.edgeLength = edges / double(t.width + t.height);
+    s.holeEdgeLength = holeEdges / double(t.width + t.height);
     s.sunSide = light.type == scene::LightType::Directional ? glm::dot(forward, light.direction) : 0.0;
+    // The effective number of casters (inverse Simpson index of their outline lengths): n casters
+    // with equal outlines give n, one long outline beside short ones gives little more than 1.
+    double sum = 0, sumSquares = 0;
+    for (const double o : outline) {
+        sum += o;
+        sumSquares += o * o;
+    }
+    s.casters = sumSquares > 0 ? sum * sum / sumSquares : 0.0;
     // Shadows a quarter to a third of the lit-facing surface read best; more is a dark picture.
     const double fShare = s.shadowedShare <= 0.35 ? s.shadowedShare / 0.35
                                                   : std::max(0.2, 1.0 - (s.shadowedShare - 0.35) / 0.4);
@@ -147,7 +243,12 @@ ViewScore score(const Thumbnail& t, const std::vector<std::int8_t>& cls, const V
     // From the sun's side every shadow hides behind its caster.
     const double fSide = 1.0 - 0.6 * std::max(0.0, s.sunSide);
     const double fNear = hit && near > hit / 2 ? 0.3 : 1.0;  // half the view is a wall in the face (4% of the size)
-    s.score = fCover * fFacing * (0.5 * fShare + 0.5 * fEdge) * fSide * fNear;
+    // Of several casters, a view that shows the outlines of more of them evenly (a row of cut-out
+    // cards, not the one wall whose shadow swallows theirs) tells more; a single caster's scene
+    // is not affected.
+    const int wanted = std::clamp(casters, 1, kVarietyCasters);
+    const double fVariety = 0.5 + 0.5 * std::min(1.0, s.casters / double(wanted));
+    s.score = fCover * fFacing * (0.5 * fShare + 0.5 * fEdge) * fSide * fNear * fVariety;
     return s;
 }
 
@@ -275,6 +376,11 @@ int groundIndex(const scene::Scene& scene) {
     return int(scene.objects.size()) - 1;
 }
 
+// Objects that can cast a shadow the score counts: all but the added ground.
+int casterCount(const scene::Scene& scene) {
+    return int(scene.objects.size()) - (groundIndex(scene) >= 0 ? 1 : 0);
+}
+
 int thumbnailHeight(const scene::Camera& c, int width) {
     return std::clamp(int(std::lround(double(width) * c.height / std::max(1, c.width))), 16, 4 * width);
 }
@@ -288,8 +394,10 @@ ViewScore scoreScene(const scene::Scene& scene, int width, int threads) {
         const Tracer<float> tracer(scene);
         const Thumbnail t = primaryHits(tracer, scene.camera, width, thumbnailHeight(scene.camera, width));
         const scene::CameraBasis basis = scene::cameraBasis(scene.camera);
-        s = score(t, shadowClasses(tracer, t, scene.lights.front(), scene::defaultRayBias(scene), scene.allOpaque()),
-                  basis.forward, scene.lights.front(), 0.0, groundIndex(scene));
+        s = score(t,
+                  shadowClasses(tracer, t, scene.lights.front(), scene::defaultRayBias(scene), scene.allOpaque(),
+                                seeThroughObjects(scene)),
+                  basis.forward, scene.lights.front(), 0.0, groundIndex(scene), casterCount(scene));
     });
     return s;
 }
@@ -326,29 +434,81 @@ ViewSearchResult searchViewAndSun(const scene::Scene& scene, const ViewSearchOpt
         const double rayBias = scene::defaultRayBias(scene);
         const double nearWall = r.interior ? 0.04 * b.diagonal() : 0.0;
         const int ground = groundIndex(scene);
-        std::size_t bestView = 0, bestSun = 0;
-        ViewScore best;
-        best.score = -1;
+        const int casters = casterCount(scene);
+        const std::vector<int> seeThrough = seeThroughObjects(scene);
+        struct Scored {
+            ViewScore score;
+            std::size_t view, sun;
+        };
+        // The holes in a shadow are what a model's cut-outs are for: where some candidate shows
+        // them, each candidate's score is multiplied by its hole outline relative to the most shown.
+        auto weighByHoles = [](std::vector<Scored>& list, bool holes) {
+            double most = 0;
+            for (const Scored& c : list) most = std::max(most, c.score.holeEdgeLength);
+            if (!holes || !(most > 0)) return;
+            for (Scored& c : list) c.score.score *= c.score.holeEdgeLength / most;
+        };
+        std::vector<Scored> scored;
         for (std::size_t v = 0; v < views.size(); ++v) {
             const Thumbnail t = primaryHits(tracer, views[v].camera, r.width, r.height);
             const Vec3 forward = scene::cameraBasis(views[v].camera).forward;
             for (std::size_t s = 0; s < suns.size(); ++s) {
-                const ViewScore sc = score(t, shadowClasses(tracer, t, suns[s].first, rayBias, scene.allOpaque()),
-                                           forward, suns[s].first, nearWall, ground);
-                if (sc.score > best.score) {
-                    best = sc;
-                    bestView = v;
-                    bestSun = s;
-                }
+                const ViewScore sc = score(t, shadowClasses(tracer, t, suns[s].first, rayBias, scene.allOpaque(), seeThrough),
+                                           forward, suns[s].first, nearWall, ground, casters);
+                scored.push_back({sc, v, s});
             }
         }
+        double mostHoles = 0;
+        for (const Scored& c : scored) mostHoles = std::max(mostHoles, c.score.holeEdgeLength);
+        r.holes = mostHoles * double(r.width + r.height) >= kMinHoleEdges;
+        weighByHoles(scored, r.holes);
+        // The best few again at a finer size, where the holes of cut-outs and thin casters lost
+        // at thumbnail size decide between them; a stable order keeps the first among equals.
+        std::stable_sort(scored.begin(), scored.end(),
+                         [](const Scored& a, const Scored& b) { return a.score.score > b.score.score; });
+        const std::size_t refined = std::min<std::size_t>(scored.size(), std::size_t(std::max(options.refine, 0)));
+        scored.resize(std::max<std::size_t>(refined, 1));
+        std::sort(scored.begin(), scored.end(),
+                  [](const Scored& a, const Scored& b) { return a.view != b.view ? a.view < b.view : a.sun < b.sun; });
+        r.fineWidth = kRefineScale * r.width;
+        r.fineHeight = thumbnailHeight(scene.camera, r.fineWidth);
+        r.refined = int(refined);
+        if (refined > 0) {
+            std::size_t thumbnailView = views.size();
+            Thumbnail fine;
+            for (Scored& c : scored) {
+                if (c.view != thumbnailView) {
+                    fine = primaryHits(tracer, views[c.view].camera, r.fineWidth, r.fineHeight);
+                    thumbnailView = c.view;
+                }
+                const Vec3 forward = scene::cameraBasis(views[c.view].camera).forward;
+                c.score = score(fine, shadowClasses(tracer, fine, suns[c.sun].first, rayBias, scene.allOpaque(), seeThrough),
+                                forward, suns[c.sun].first, nearWall, ground, casters);
+            }
+            weighByHoles(scored, r.holes);
+        }
+        std::size_t bestView = 0, bestSun = 0;
+        ViewScore best;
+        best.score = -1;
+        for (const Scored& c : scored)
+            if (c.score.score > best.score) {
+                best = c.score;
+                bestView = c.view;
+                bestSun = c.sun;
+            }
         r.best = best;
         r.camera = views[bestView].camera;
         r.sunDirection = suns[bestSun].first.direction;
-        const std::string why = " (the best of " + std::to_string(r.views * r.suns) + " view x sun pairs, score " +
-                                fmt(best.score, "%.2f") + ", at " + std::to_string(r.width) + "x" + std::to_string(r.height) +
-                                ": " + fmt(100 * best.shadowedShare, "%.0f") + "% of the lit-facing surface in shadow, " +
-                                fmt(best.edgeLength, "%.2f") + " shadow edge per image side, " +
+        const std::string refinedText = refined > 0 ? ", the best " + std::to_string(refined) + " again at " +
+                                                          std::to_string(r.fineWidth) + "x" + std::to_string(r.fineHeight)
+                                                    : "";
+        const std::string why = " (the best of " + std::to_string(r.views * r.suns) + " view x sun pairs at " +
+                                std::to_string(r.width) + "x" + std::to_string(r.height) + refinedText + ", score " +
+                                fmt(best.score, "%.2f") + ": " +
+                                fmt(100 * best.shadowedShare, "%.0f") + "% of the lit-facing surface in shadow, " +
+                                fmt(best.edgeLength, "%.2f") + " shadow edge per image side, the outlines of " +
+                                fmt(best.casters, "%.1f") + " caster(s), " +
+                                (r.holes ? fmt(best.holeEdgeLength, "%.2f") + " of it around holes (light through cut-outs), " : "") +
                                 fmt(100 * best.coverage, "%.0f") + "% of the image on the model)";
         r.viewText = (options.chooseView ? "searched, " + views[bestView].text : views[bestView].text) +
                      (r.interior ? "; the model encloses its space (" + std::to_string(r.enclosedPoints) + " of " +

@@ -21,6 +21,7 @@ namespace shadowlab::raytrace {
 namespace {
 
 using scene::Vec3;
+constexpr double kDegreesToRadians = 3.14159265358979323846 / 180.0;
 
 // Of the pixels the reference sees lit-facing (N·L > 0), the share in cast shadow (V < 0.5):
 // counted by the double-precision reference, not by the search's float thumbnails.
@@ -143,6 +144,170 @@ TEST(ViewSearch, ARoomIsSeenFromInsideWithTheSunComingInThroughItsOpening) {
     // Sun through a 2-wide opening of a 10-wide roof: most of the room is in shadow, not all.
     EXPECT_GT(share, 0.1);
     EXPECT_LT(share, 0.97);
+}
+
+// An N × N checkerboard alpha texture of 1 and 0: with MASK, half of a caster is holes.
+std::shared_ptr<scene::AlphaTexture> checkerHoles(int n) {
+    auto t = std::make_shared<scene::AlphaTexture>();
+    t->file = "checker";
+    t->width = t->height = n;
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) t->alpha.push_back((x + y) % 2 == 0 ? 1.0f : 0.0f);
+    return t;
+}
+
+scene::Quad uprightQuad(const Vec3& center, const scene::Vec2& size) {
+    scene::Quad q;
+    q.center = center;
+    q.normal = {0, 0, 1};
+    q.size = size;
+    scene::quadAxes(q.normal, q.uAxis, q.vAxis);
+    return q;
+}
+
+// A row of four upright cards (centers x = -3.3, -1.1, 1.1, 3.3; 1.6 wide, 2.4 tall, 0.8 above
+// the ground; facing ±Z) 1 in front of a wall (x = ±5, 4 tall, its face at z = -1), over a
+// ground. `holes`: the cards are BLEND with a 4 × 4 checkerboard of alpha 1 and 0, which casts as
+// MASK would and makes every shadow ray name its nearest blocker (closest hits, no any-hit).
+scene::Scene cardsBeforeAWall(bool holes) {
+    scene::Scene s;
+    s.materials.push_back({"plain", {0.8, 0.8, 0.8}, 1.0});
+    scene::Material cards{"cards", {0.8, 0.8, 0.8}, 1.0};
+    if (holes) {
+        cards.alphaMode = scene::AlphaMode::Blend;
+        cards.alphaTexture = checkerHoles(4);
+    }
+    s.materials.push_back(cards);
+    s.objects.push_back({"wall", scene::Box{{-5, 0, -1.2}, {5, 4, -1}}, 0});
+    for (int k = 0; k < 4; ++k) s.objects.push_back({"card", uprightQuad({-3.3 + 2.2 * k, 2.0, 0}, {1.6, 2.4}), 1});
+    s.lights.push_back({});
+    s.origin.modelBounds = s.bounds();
+    scene::Quad ground;
+    ground.size = {24, 24};
+    scene::quadAxes(ground.normal, ground.uAxis, ground.vAxis);
+    s.objects.push_back({"ground", ground, 0});  // last and so named: the view search's ground
+    return s;
+}
+
+TEST(ViewSearch, CasterVarietyCountsTheShadowsWhoseOutlinesShowNotThoseSwallowedByAnothers) {
+    // Seen from the front (azimuth 330, 20° up) under a sun from the front (azimuth 45, 35° up)
+    // each card casts its own shadow onto the wall's face, the four of equal size: an effective
+    // number of casters of 4, a little more where the wall's own shadow shows at its ends. Under
+    // a sun from behind (azimuth 180, 35° up) the wall's shadow on the ground reaches z =
+    // -1 + 4 / tan 35° = 4.7 and x = ±5: the cards (at most 3.2 tall, |x| <= 4.1) and their
+    // shadows lie inside it, so only the wall's outline shows: 1. (Counted by shadowed area, the
+    // ground in front of each card, whose nearest blocker is the card, would count for it.)
+    scene::Scene s = cardsBeforeAWall(true);
+    const double a = 330.0 * kDegreesToRadians, e = 20.0 * kDegreesToRadians;
+    s.camera = scene::framedCamera(s.origin.modelBounds, {std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a)},
+                                   40.0, s.camera);
+    s.lights[0].direction = scene::sunDirection(45.0, 35.0);
+    const ViewScore front = scoreScene(s, 192);
+    s.lights[0].direction = scene::sunDirection(180.0, 35.0);
+    const ViewScore behind = scoreScene(s, 192);
+    EXPECT_GE(front.casters, 3.5);
+    EXPECT_LE(front.casters, 5.0);
+    EXPECT_NEAR(behind.casters, 1.0, 0.05);
+    // The holes of the cards' shadows show under the front sun; under the sun from behind there
+    // is no light through them.
+    EXPECT_GT(front.holeEdgeLength, 0.1);
+    EXPECT_EQ(behind.holeEdgeLength, 0.0);
+    // Opaque cards have no holes: the same view counts none.
+    scene::Scene opaque = cardsBeforeAWall(false);
+    opaque.camera = s.camera;
+    opaque.lights[0].direction = scene::sunDirection(45.0, 35.0);
+    EXPECT_EQ(scoreScene(opaque, 192).holeEdgeLength, 0.0);
+}
+
+TEST(ViewSearch, ShadowEdgesSeenNearEdgeOnCountByTheirLegibility) {
+    // A wall (the plane z = 0, facing +Z) and, 3 in front of it, a 4 × 4 MASK screen of eight
+    // vertical stripes (alternately solid and holes); light travelling along (-1, 0, -1) lays the
+    // stripes on the wall at x = -5 .. -1. Narrow (4°) views of the point (-3, 0, 0) from 30° and
+    // 75° off the wall's normal (toward -X) see only the wall; from 20° toward +X the screen
+    // stands in front of part of it. The score counts each lit–shadowed pair on the wall by
+    // min(1, |cos| / 0.5) of the view ray against its normal: 1 at 20° and 30°, about cos 75° /
+    // 0.5 = 0.52 at 75°; a lit screen texel beside the shadowed wall is a silhouette and does not
+    // count. The expected value sums those weights over the wall's pairs in the double-precision
+    // reference at the same size.
+    scene::Scene s;
+    s.materials.push_back({"plain", {0.8, 0.8, 0.8}, 1.0});
+    scene::Material screen{"screen", {0.8, 0.8, 0.8}, 1.0};
+    screen.alphaMode = scene::AlphaMode::Mask;
+    auto stripes = std::make_shared<scene::AlphaTexture>();
+    stripes->file = "stripes";
+    stripes->width = 8;
+    stripes->height = 1;
+    for (int x = 0; x < 8; ++x) stripes->alpha.push_back(x % 2 == 0 ? 1.0f : 0.0f);
+    screen.alphaTexture = stripes;
+    s.materials.push_back(screen);
+    s.objects.push_back({"wall", uprightQuad({0, 0, 0}, {40, 40}), 0});
+    s.objects.push_back({"screen", uprightQuad({0, 0, 3}, {4, 4}), 1});
+    s.lights.push_back({});
+    s.lights[0].direction = glm::normalize(Vec3(-1, 0, -1));
+    const Vec3 target(-3, 0, 0), normal(0, 0, 1);
+    for (const double offNormal : {-20.0, 30.0, 75.0}) {
+        const double t = offNormal * kDegreesToRadians;
+        s.camera.position = target + 20.0 * Vec3(-std::sin(t), 0, std::cos(t));
+        s.camera.lookAt = target;
+        s.camera.up = {0, 1, 0};
+        s.camera.fovYDegrees = 4.0;
+        s.camera.near = 0.1;
+        s.camera.far = 100.0;
+        s.camera.width = 192;
+        s.camera.height = 108;
+        const ViewScore v = scoreScene(s, 192);
+
+        const scene::RenderSettings settings = scene::resolveSettings(s, {});
+        const scene::Frame f = renderReference(s, scene::makeRenderPlan(s, settings), settings.raytrace);
+        const scene::CameraBasis basis = scene::cameraBasis(s.camera);
+        auto legibility = [&](int x, int y) {
+            return std::min(1.0, std::abs(glm::dot(normal, glm::normalize(scene::pixelDirection(basis, x, y)))) / 0.5);
+        };
+        auto onWall = [&](std::size_t i) { return f.objectId[i] == 1.0f && f.ndotl[i] > 0; };
+        double weighted = 0, pairs = 0;
+        for (int y = 0; y < 108; ++y)
+            for (int x = 0; x < 192; ++x) {
+                const std::size_t i = std::size_t(y) * 192 + x;
+                for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}}) {
+                    if (x + dx >= 192 || y + dy >= 108) continue;
+                    const std::size_t j = std::size_t(y + dy) * 192 + x + dx;
+                    if (!onWall(i) || !onWall(j) || (f.visibility[i] < 0.5f) == (f.visibility[j] < 0.5f)) continue;
+                    ++pairs;
+                    weighted += std::min(legibility(x, y), legibility(x + dx, y + dy));
+                }
+            }
+        ASSERT_GT(pairs, 100.0) << offNormal << "°: the stripes' edges are in view";
+        EXPECT_NEAR(v.edgeLength, weighted / 300.0, 0.05 * weighted / 300.0) << offNormal << "° off the normal";
+        if (offNormal < 60.0) EXPECT_DOUBLE_EQ(weighted, pairs);  // within 60°: every pair counts whole
+        else EXPECT_LT(weighted, 0.6 * pairs);                     // squeezed: about half
+        if (offNormal < 0.0) {
+            std::size_t screen = 0;
+            for (std::size_t i = 0; i < f.pixelCount(); ++i) screen += f.objectId[i] == 2.0f;
+            EXPECT_GT(screen, 1000u) << "the screen is in view";
+        }
+    }
+}
+
+TEST(ViewSearch, AlphaBlendModeTestShowsItsBoardsCutOutShadowsFromTheFront) {
+    // The glTF sample's test boards stand in the plane z = 0 (facing ±Z), 0.47 in front of the
+    // face of a wall (z = -0.47, facing +Z, 2.3 tall, taller than the boards). Their cut-outs'
+    // shadows can only land on that face, under a sun from the front (light travelling -Z), and
+    // be seen from the front; seen along the row (±X) the face is edge-on, and under a sun from
+    // behind the wall's shadow covers the boards'. The chosen view is on the front side within
+    // 60° of the face's normal (azimuths 300..60), and shows holes in the shadows.
+    const std::filesystem::path file =
+        std::filesystem::path(SHADOWLAB_SHARED_SCENES) / "AlphaBlendModeTest" / "AlphaBlendModeTest.gltf";
+    if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " is not here";
+    scene::Scene s = scene::loadScene(file);
+    scene::applyGround(s, std::nullopt);
+    const ViewSearchResult r = searchViewAndSun(s, {});
+    EXPECT_LT(r.sunDirection.z, 0.0) << "a sun from the front";
+    const Vec3 forward = scene::cameraBasis(r.camera).forward;
+    const double horizontal = std::hypot(forward.x, forward.z);
+    ASSERT_GT(horizontal, 0.0);
+    EXPECT_GE(-forward.z / horizontal, 0.5 - 1e-9) << "within 60° of the wall's normal, from the front";
+    EXPECT_TRUE(r.holes);
+    EXPECT_GT(r.best.holeEdgeLength, 0.0);
 }
 
 TEST(ViewSearch, SponzaIsSeenFromInsideInSeconds) {
