@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "compare/compare.h"
+#include "compare/thresholds.h"
 #include "raster/renderer.h"
 #include "raytrace/renderer.h"
 #include "scene/camera.h"
@@ -54,7 +55,8 @@ scene::Scene lit(std::vector<scene::Object> casters, const Vec3& target) {
 
 struct Renders {
     Comparison c;
-    scene::Frame reference;
+    scene::Frame raster, reference;
+    double texel = 0;  // the shadow map's texel, world units
 };
 
 Renders compareRaster(const scene::Scene& s, const scene::SettingsOverrides& o) {
@@ -64,11 +66,13 @@ Renders compareRaster(const scene::Scene& s, const scene::SettingsOverrides& o) 
     scene::RenderSettings settings = scene::resolveSettings(s, ov);
     settings.raster.validate = true;
     const scene::RenderPlan plan = scene::makeRenderPlan(s, settings);
-    const scene::Frame raster = raster::render(s, plan, settings.raster);
-    EXPECT_EQ(raster.attributes.at("validation_messages"), "0") << "validation messages were printed above";
+    raster::RenderDebug debug;
     Renders r;
+    r.raster = raster::render(s, plan, settings.raster, scene::kAllChannels, &debug);
+    EXPECT_EQ(r.raster.attributes.at("validation_messages"), "0") << "validation messages were printed above";
+    if (!debug.layers.empty()) r.texel = debug.layers[0].frustum.texelWorldSize();
     r.reference = raytrace::renderReference(s, plan, scene::referenceSettings(settings.raytrace));
-    r.c = compareFrames(raster, r.reference);
+    r.c = compareFrames(r.raster, r.reference);
     return r;
 }
 
@@ -128,24 +132,48 @@ TEST(BleedingAgainstReference, VsmBleedsWhereTheUpperCastersEdgeCrossesTheLowerO
 }
 
 TEST(BleedingAgainstReference, AContactLeakUnderALargeConstantBiasIsABiasLeak) {
-    // A unit box on the floor; a constant bias of 0.3 moves each receiver 0.3 toward the light,
-    // past the box's face for floor points whose ray meets the face within 0.3: a band next to
-    // the box's base (x −0.71..−0.5). The contact distance is 0.3 plus 4 texels of the 1024² map
-    // (about 0.37): every such leak is within it.
+    // A unit box on the floor. A floor point (x, 0, z) with x in −1.5..−0.5 and |z| < 0.5 is
+    // shadowed by the box's face x = −0.5, d = √2·(−0.5 − x) away along the ray to the light
+    // (light at 45°). A constant bias b = 0.3 compares the receiver b nearer the light than it
+    // is, so the map lets light through where d < b: the band x in (−0.5 − b/√2, −0.5) =
+    // (−0.712, −0.5) leaks, the rest of the shadow stays. The face's depth varies by a texel per
+    // texel here (45°), so nearest texel and the 2x2 filter blur that edge by up to 2 texels of
+    // depth each side: δ = 2·√2·texel along the ray. Every leak lies within the contact distance
+    // D = b + 4 texels (compare/thresholds.h; tanθ = 1), so none of it may be read as light bleeding.
     const scene::Scene s = lit({{"box", scene::Box{Vec3(-0.5, 0, -0.5), Vec3(0.5, 1, 0.5)}, 0}}, Vec3(-1, 0, 0));
     scene::SettingsOverrides o;
     o.shadowMapSize = 1024;
     o.filter = "pcf2x2";
     o.depthBias = 0.3;
     o.slopeBias = 0.0;
-    const Metrics m = compareRaster(s, o).c.metrics;
-    std::printf("pcf2x2, bias 0.3: missed %zu, bleeding %zu, bias leak %zu, D %.4f\n", m.missedShadow, m.bleeding,
-                m.biasLeak, m.contactDistance);
-    // The band lies along the box's base, so most of its pixels are within the edge radius of the
-    // reference's shadow boundary there and count as neither class; what matters is that none of
-    // the leak is read as bleeding, and that what is classified is a bias leak.
+    const Renders r = compareRaster(s, o);
+    const Metrics& m = r.c.metrics;
     ASSERT_TRUE(m.hasBlockerDistance);
-    EXPECT_GT(m.missedShadow, 0u);
+    ASSERT_GT(r.texel, 0.0);
+    const double b = 0.3, delta = 2.0 * std::sqrt(2.0) * r.texel;
+    std::size_t band = 0, bandLit = 0, rest = 0, restShadowed = 0;
+    for (std::size_t i = 0; i < r.c.classes.size(); ++i) {
+        if (r.reference.objectId[i] != 1.0f) continue;
+        const Vec3 p = floorPoint(s, i);
+        if (std::abs(p.z) > 0.45 || p.x > -0.5 - delta || p.x < -1.5 + delta) continue;  // clear of the side faces
+        const double d = std::sqrt(2.0) * (-0.5 - p.x);
+        ASSERT_EQ(r.reference.visibility[i], 0.0f) << "the reference shadows the whole box shadow, at x " << p.x;
+        if (d < b - delta) {
+            ++band;
+            bandLit += r.raster.visibility[i] == 1.0f;
+        } else if (d > b + delta) {
+            ++rest;
+            restShadowed += r.raster.visibility[i] == 0.0f;
+        }
+    }
+    std::printf("pcf2x2, bias 0.3: band %zu (%zu lit), rest %zu (%zu shadowed); missed %zu, bleeding %zu, bias leak %zu, "
+                "D %.4f, texel %.4f\n",
+                band, bandLit, rest, restShadowed, m.missedShadow, m.bleeding, m.biasLeak, m.contactDistance, r.texel);
+    EXPECT_GT(band, 200u) << "the camera must see the band";
+    EXPECT_EQ(bandLit, band) << "the bias lets light through wherever the face is nearer than b";
+    EXPECT_GT(rest, 1000u);
+    EXPECT_EQ(restShadowed, rest) << "and nowhere else";
+    EXPECT_NEAR(m.contactDistance, b + kContactTexels * r.texel, 1e-3 * r.texel);  // its value for N·L = 1
     EXPECT_GT(m.biasLeak, 0u);
     EXPECT_EQ(m.bleeding, 0u);
 }
