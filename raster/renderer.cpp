@@ -636,7 +636,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     const TransmittancePass transmittancePass{transmit ? &transmitPipeline : nullptr, &transmittanceMaps, layerLights,
                                               transmit ? &transmitRestPipeline : nullptr};
     recordShadowPass(commands, shadowPipeline, maps, draw, lightMatrices, wantIds, &transmittancePass, &layerBias);
-    if (momentPipeline.pipeline) recordMomentPasses(commands, momentPipeline, maps, momentMaps, settings.filter, settings.moments);
+    if (momentPipeline.pipeline) recordMomentPasses(commands, momentPipeline, maps, momentMaps, layers, settings.filter, settings.moments);
     stamp(commands, 1);
     ctx.submitAndWait(commands);
     frame.timingsMs.emplace_back("shadow_pass", msSince(shadowStart));

@@ -44,8 +44,7 @@ scene::Scene floorScene(const std::vector<scene::Quad>& casters, const Vec3& eye
     l.intensity = 3.0;
     s.lights.push_back(l);
     s.objects.push_back({"floor", horizontalQuad(Vec3(0), 8.0, 8.0), 0});
-    for (std::size_t i = 0; i < casters.size(); ++i)
-        s.objects.push_back({"caster" + std::to_string(i), casters[i], 0});
+    for (std::size_t i = 0; i < casters.size(); ++i) s.objects.push_back({"caster" + std::to_string(i), casters[i], 0});
     return s;
 }
 
@@ -54,6 +53,18 @@ scene::RasterSettings filterable(scene::ShadowFilter filter, int mapSize, double
     return r;
 }
 
+// A render whose lights keep their shadow maps, with every object drawn into them: the plan
+// leaves out the map of a lone plane (one convex object cannot shadow itself) and caster culling
+// the plane from its own map, and then there would be no moments to test.
+scene::Frame renderWithMaps(const scene::Scene& s, scene::RasterSettings r, RenderDebug* debug = nullptr) {
+    r.cullCasters = false;
+    scene::RenderPlan plan = test::planFor(s, r);
+    for (scene::LightPlan& lp : plan.lights) lp.needsShadowTest = true;
+    scene::Frame f = render(s, plan, r, debug);
+    EXPECT_EQ(f.attributes["validation_messages"], "0") << "validation messages were printed above";
+    EXPECT_EQ(f.attributes["shadow_maps"], s.lights[0].type == scene::LightType::Point ? "6" : "1");
+    return f;
+}
 
 TEST(MomentMaps, AloneThePlaneIsFullyLitByEveryFilterableFilter) {
     // One plane, no other caster: every texel holds the plane's own depth z, the blur of a constant
@@ -67,7 +78,7 @@ TEST(MomentMaps, AloneThePlaneIsFullyLitByEveryFilterableFilter) {
         s.lights[0].direction = direction;
         for (const auto filter : {scene::ShadowFilter::Vsm, scene::ShadowFilter::Evsm2, scene::ShadowFilter::Evsm4,
                                   scene::ShadowFilter::Esm}) {
-            const scene::Frame f = test::renderChecked(s, filterable(filter, 256, 0.02));
+            const scene::Frame f = renderWithMaps(s, filterable(filter, 256, 0.02));
             EXPECT_EQ(f.attributes.at("filter"), scene::toString(filter));
             int pixels = 0, dark = 0;
             test::forEachFloorPixel(s, f, [&](const Vec3&, double v) {
@@ -102,7 +113,8 @@ struct CpuMoments {
         const int i0 = int(std::floor(tx)), j0 = int(std::floor(ty));
         const double fx = tx - i0, fy = ty - j0;
         auto c = [&](int i, int j) { return at(std::clamp(i, 0, size - 1), std::clamp(j, 0, size - 1), power); };
-        return (1 - fy) * ((1 - fx) * c(i0, j0) + fx * c(i0 + 1, j0)) + fy * ((1 - fx) * c(i0, j0 + 1) + fx * c(i0 + 1, j0 + 1));
+        return (1 - fy) * ((1 - fx) * c(i0, j0) + fx * c(i0 + 1, j0)) +
+               fy * ((1 - fx) * c(i0, j0 + 1) + fx * c(i0 + 1, j0 + 1));
     }
 };
 
@@ -113,8 +125,8 @@ TEST(MomentMaps, VsmOfTwoParallelPlanesIsTheChebyshevBoundOfTheBlurredMoments) {
     // gets p = σ²/(σ² + (t − μ)²) — here from the blur weights over the captured depths, with no
     // bleeding reduction and no variance floor. (With b → 0 that is 1 − α: the bound is tight
     // for two depths, so VSM equals box-filtered PCF there.)
-    const scene::Scene s = floorScene({horizontalQuad(Vec3(-2.0, 1.0, 0.0), 4.0, 8.0)}, Vec3(2.0, 3.0, 2.5),
-                                      Vec3(0.0, 0.0, 0.0));
+    const scene::Scene s =
+        floorScene({horizontalQuad(Vec3(-2.0, 1.0, 0.0), 4.0, 8.0)}, Vec3(2.0, 3.0, 2.5), Vec3(0.0, 0.0, 0.0));
     scene::RasterSettings r = filterable(scene::ShadowFilter::Vsm, 128, 0.01);
     r.moments.minVariance = 0.0;
     r.moments.bleedReduction = 0.0;
@@ -220,7 +232,8 @@ double msmSensitivity(const std::array<double, 4>& b, double t, double alpha) {
         std::array<double, 4> p = b;
         for (int k = 0; k < 4; ++k)
             p[k] += ((corner >> k) & 1 ? 1.0 : -1.0) * kUlps * std::abs(b[k]) * std::numeric_limits<float>::epsilon();
-        const double tp = t + ((corner >> 4) & 1 ? 1.0 : -1.0) * kUlps * std::abs(t) * std::numeric_limits<float>::epsilon();
+        const double tp =
+            t + ((corner >> 4) & 1 ? 1.0 : -1.0) * kUlps * std::abs(t) * std::numeric_limits<float>::epsilon();
         worst = std::max(worst, std::abs(msmVisibility(p, tp, alpha) - base));
     }
     return worst;
@@ -258,21 +271,21 @@ TEST(MomentMaps, MsmIsTheHamburgerBoundOfTheBlurredMoments) {
     const std::vector<Case> cases{
         {"lone plane", floorScene({}, Vec3(1.5, 5.0, 4.0), Vec3(0.0)), 256, 0.02, 0.0},
         {"under a caster", underACaster(), 256, 0.01, 2.5},
-        {"caster edge", floorScene({horizontalQuad(Vec3(-2.0, 1.0, 0.0), 4.0, 8.0)}, Vec3(2.0, 3.0, 2.5), Vec3(0.0)), 128,
-         0.01, 0.0},
+        {"caster edge", floorScene({horizontalQuad(Vec3(-2.0, 1.0, 0.0), 4.0, 8.0)}, Vec3(2.0, 3.0, 2.5), Vec3(0.0)),
+         128, 0.01, 0.0},
     };
     for (const Case& c : cases) {
         scene::RasterSettings r = filterable(scene::ShadowFilter::Msm, c.mapSize, c.bias);
         r.moments.blurWidth = 5;
         RenderDebug debug;
         debug.captureShadowMaps = true;
-        const scene::Frame f = test::renderChecked(c.scene, r, &debug);
+        const scene::Frame f = renderWithMaps(c.scene, r, &debug);
         ASSERT_EQ(debug.layerDepths.size(), 1u);
         const LightFrustum& frustum = debug.layers[0].frustum;
         const glm::dmat4 toTexture = frustum.toTexture(Vec3(0.0));
         const CpuMoments cpu{debug.layerDepths[0], int(debug.mapSize), r.moments.blurWidth};
         int pixels = 0, outside = 0;
-        double least = 1.0, most = 0.0, worstExcess = 0.0;
+        double least = 1.0, most = 0.0, worstExcess = 0.0, largestError = 0.0;
         test::forEachFloorPixel(c.scene, f, [&](const Vec3& q, double v) {
             if (c.farFromCasterEdge > 0 && (std::abs(q.x) > c.farFromCasterEdge || std::abs(q.z) > c.farFromCasterEdge))
                 return;
@@ -285,6 +298,7 @@ TEST(MomentMaps, MsmIsTheHamburgerBoundOfTheBlurredMoments) {
             // bound's slope across a texel times that, plus float's 8-bit-free output rounding.
             const double tolerance = msmSensitivity(m, t, r.moments.momentBias) + 2e-3;
             ++pixels;
+            largestError = std::max(largestError, std::abs(v - expected));
             least = std::min(least, expected);
             most = std::max(most, expected);
             const double excess = std::abs(v - expected) - tolerance;
@@ -293,21 +307,68 @@ TEST(MomentMaps, MsmIsTheHamburgerBoundOfTheBlurredMoments) {
                 worstExcess = std::max(worstExcess, excess);
             }
         });
-        std::printf("%s: %d pixels, expected %.4f..%.4f, %d outside the tolerance (worst by %.4g)\n", c.name, pixels,
-                    least, most, outside, worstExcess);
+        std::printf(
+            "%s: %d pixels, expected %.4f..%.4f, largest |v - expected| %.3g, %d outside the tolerance (worst "
+            "by %.4g)\n",
+            c.name, pixels, least, most, largestError, outside, worstExcess);
         EXPECT_GT(pixels, 1000) << c.name;
         // A handful of pixels at the floor's own silhouette sample texels the camera ray misses.
         EXPECT_LE(outside, pixels / 1000) << c.name;
     }
 }
 
+// A perspective layer's stored depths as the moments pass makes them linear, by another route
+// than the shader's: the distance d along the axis from z = far/(far − near)·(1 − near/d), then
+// (d − near)/(far − near).
+std::vector<float> linearDepths(const std::vector<float>& stored, const LightFrustum& f) {
+    std::vector<float> out(stored.size());
+    for (std::size_t i = 0; i < stored.size(); ++i) {
+        const double d = f.near / (1.0 - double(stored[i]) * (f.far - f.near) / f.far);
+        out[i] = float((d - f.near) / (f.far - f.near));
+    }
+    return out;
+}
+
+// Which of the render's layers holds floor point q of a spot (its one map) or a point light (the
+// face of q's major axis from the light: +X −X +Y −Y +Z −Z, as lit.frag cubeFace).
+std::size_t layerOf(const RenderDebug& debug, const scene::Light& light, const Vec3& q) {
+    if (light.type != scene::LightType::Point) return 0;
+    const Vec3 d = q - light.position, a = glm::abs(d);
+    const int k = a.x >= a.y && a.x >= a.z ? 0 : a.y >= a.z ? 1 : 2;
+    const int face = 2 * k + (d[k] < 0.0 ? 1 : 0);
+    for (std::size_t l = 0; l < debug.layers.size(); ++l)
+        if (debug.layers[l].index == face) return l;
+    ADD_FAILURE() << "no layer for face " << face;
+    return 0;
+}
+
 TEST(MomentMaps, SpotAndPointMapsLightTheirPlaneAndShadowBehindACaster) {
-    // A spot's and a point light's faces are perspective maps: the stored depth is affine in
-    // 1/distance along the face's axis, and 1/distance is affine in the map's (u, v) over a plane,
-    // so a plane's depth is linear across the map there too and the argument of the directional
-    // case holds: the lone floor is fully lit (MSM up to its moment bias). Under a caster 1 above
-    // the floor the gap in stored depth is small (perspective depth is compressed away from the
-    // light) but the variance of one depth is the floor's, so every filter still shadows.
+    // Perspective layers (a spot's map, a point light's cube faces) hold moments of the linear depth
+    // z = (d − near)/(far − near), d along the layer's axis, and the receiver is compared at
+    // (d − b − near)/(far − near). Closed forms:
+    // - The lone floor (light 5 above it): the point light's floor lies wholly in its −Y face
+    //   (|x − 0.5|, |z + 0.3| < 4.5 < 5), whose axis is the floor's normal, so every texel holds
+    //   d = 5: one depth, the receiver b in front of it: vsm, evsm2, evsm4 (t <= μ) and esm
+    //   (e^{c(z − t)} >= 1) give exactly 1. The spot's axis is 6° off the normal: there d is
+    //   c/(α + β·s) of the map's tangent s, convex, so the blurred and bilinearly sampled mean is
+    //   at least the point's own depth (Jensen; the weights are symmetric about the point) and
+    //   the receiver b in front of it is lit by the same rules (evsm4's negative warp −e^{−c₋w} is
+    //   concave, but its Jensen gap c₋²σ²/2 per unit of |warp| is far below the bias's c₋·2b/(far −
+    //   near) for a floor 5 away whose depth moves less than 1e-3 of the range over the footprint).
+    // - Under the caster y = 1 with the light at height 3: the ray from floor point q to the light
+    //   crosses the caster at 2/3 of q's distance, so along any axis the caster is at 2d/3 and the
+    //   normalized gap is g = (d/3 − b)/(far − near), ≈ 0.12 here. The caster's own depth spreads
+    //   by s (below) over the footprint (blur radius 2 + bilinear 1 texel): the point light's −Y
+    //   face holds the caster and the floor of |x|, |z| <= 1.5 (|q − L| has its major axis on −Y),
+    //   both perpendicular to its axis, so s = 0 there. Chebyshev: p <= max(σ², min_variance)/(g −
+    //   s)² ≈ 1e-6/0.0144, far below the bleeding reduction 0.2, so vsm, evsm2 and evsm4 (whose
+    //   warps only widen the gap against their scaled floors) give exactly 0. ESM: e^{−c·g} within
+    //   a factor e^{±c·s}, and the stored depth's float step, d²/(near·far)·2^-24 in z (a few 1e-6
+    //   here), times c. MSM: the Hamburger oracle on the captured depths made linear, as in
+    //   MsmIsTheHamburgerBoundOfTheBlurredMoments; it also covers the lone floor.
+    // (Moments of the stored depth far/(far − near)·(1 − near/d) would see the gap
+    // near·far/((far − near)·2d): 1.4e-3 for the bounding-sphere map here, near = far/1000 = 0.008,
+    // and esm would give e^{−80·1.4e-3} = 0.9 under the caster.)
     scene::Light spot;
     spot.type = scene::LightType::Spot;
     spot.position = Vec3(0.5, 5.0, -0.3);
@@ -317,6 +378,7 @@ TEST(MomentMaps, SpotAndPointMapsLightTheirPlaneAndShadowBehindACaster) {
     scene::Light point = spot;
     point.type = scene::LightType::Point;
     point.coneAngleDegrees = 0.0;
+    const int mapSize = 256, blurWidth = 5;
     for (const scene::Light& light : {spot, point}) {
         const char* kind = light.type == scene::LightType::Spot ? "spot" : "point";
         scene::Scene lone = floorScene({}, Vec3(1.5, 5.0, 4.0), Vec3(0.0));
@@ -328,32 +390,76 @@ TEST(MomentMaps, SpotAndPointMapsLightTheirPlaneAndShadowBehindACaster) {
         for (const auto filter : {scene::ShadowFilter::Vsm, scene::ShadowFilter::Evsm2, scene::ShadowFilter::Evsm4,
                                   scene::ShadowFilter::Esm, scene::ShadowFilter::Msm}) {
             const bool msm = filter == scene::ShadowFilter::Msm;
-            {
-                const scene::Frame f = test::renderChecked(lone, filterable(filter, 256, 0.02));
-                int pixels = 0, dark = 0;
-                test::forEachFloorPixel(lone, f, [&](const Vec3& q, double v) {
-                    // Inside the spot's cone by a blur width; the point light reaches all.
-                    const Vec3 d = glm::normalize(q - light.position);
-                    if (light.type == scene::LightType::Spot &&
-                        glm::dot(d, light.direction) < std::cos((light.coneAngleDegrees - 4.0) * test::kPi / 180.0))
+            for (const bool underCaster : {false, true}) {
+                const scene::Scene& s = underCaster ? covered : lone;
+                const scene::Light& l = s.lights[0];
+                scene::RasterSettings r = filterable(filter, mapSize, underCaster ? 0.01 : 0.02);
+                r.moments.blurWidth = blurWidth;
+                RenderDebug debug;
+                debug.captureShadowMaps = msm;
+                const scene::Frame f = renderWithMaps(s, r, &debug);
+                ASSERT_EQ(debug.layers.size(), light.type == scene::LightType::Point ? 6u : 1u);
+                std::vector<std::vector<float>> linear;
+                for (std::size_t k = 0; k < debug.layerDepths.size(); ++k)
+                    linear.push_back(linearDepths(debug.layerDepths[k], debug.layers[k].frustum));
+                int pixels = 0, wrong = 0;
+                double worst = 0.0;
+                test::forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
+                    if (underCaster && (std::abs(q.x) > 1.5 || std::abs(q.z) > 1.5)) return;  // 1.5 clear of its edge
+                    // Inside the spot's cone by more than the footprint; the point light reaches all.
+                    const Vec3 dir = glm::normalize(q - l.position);
+                    if (l.type == scene::LightType::Spot &&
+                        glm::dot(dir, l.direction) < std::cos((l.coneAngleDegrees - 4.0) * test::kPi / 180.0))
                         return;
+                    const std::size_t layer = layerOf(debug, l, q);
+                    const LightFrustum& frustum = debug.layers[layer].frustum;
+                    const double range = frustum.far - frustum.near;
+                    const glm::dvec4 tex = frustum.toTexture(Vec3(0.0)) * glm::dvec4(q, 1.0);
+                    const double d = tex.w;  // distance along the layer's axis
+                    const double t = (d - r.depthBias - frustum.near) / range;
+                    double expected = underCaster ? 0.0 : 1.0, tolerance = 0.0;
+                    if (msm) {
+                        const CpuMoments cpu{linear[layer], int(debug.mapSize), blurWidth};
+                        const double u = tex.x / tex.w, w = tex.y / tex.w;
+                        const std::array<double, 4> m{cpu.sample(u, w, 1), cpu.sample(u, w, 2), cpu.sample(u, w, 3),
+                                                      cpu.sample(u, w, 4)};
+                        expected = msmVisibility(m, t, r.moments.momentBias);
+                        tolerance = msmSensitivity(m, t, r.moments.momentBias) + 2e-3;
+                    } else if (underCaster && filter == scene::ShadowFilter::Esm) {
+                        // The caster's linear depth at the footprint's corners (3 texels each way):
+                        // the ray from the light along axis + s_u·right + s_v·up meets y = 1 at
+                        // distance (1 − L.y)/dir.y along the axis.
+                        const double texelTan = frustum.texelWorldSize();
+                        const double su = (2.0 * tex.x / tex.w - 1.0) * frustum.tanHalfFov + frustum.windowU;
+                        const double sv = (2.0 * tex.y / tex.w - 1.0) * frustum.tanHalfFov + frustum.windowV;
+                        auto casterDepth = [&](double a, double b) {
+                            const Vec3 ray = frustum.direction + a * frustum.right + b * frustum.up;
+                            return (1.0 - l.position.y) / ray.y;
+                        };
+                        const double dc = casterDepth(su, sv);
+                        double spread = 0.0;
+                        for (const double a : {-3.0, 3.0})
+                            for (const double b : {-3.0, 3.0})
+                                spread = std::max(
+                                    spread, std::abs(casterDepth(su + a * texelTan, sv + b * texelTan) - dc) / range);
+                        const double c = r.moments.esmExponent;
+                        const double quantum = 2.0 * dc * dc / (frustum.near * frustum.far) * std::ldexp(1.0, -24);
+                        expected = std::exp(-c * (t - (dc - frustum.near) / range));
+                        tolerance = expected * std::expm1(c * (spread + quantum) + 1e-5);
+                    }
                     ++pixels;
-                    if (v < (msm ? 0.98 : 1.0)) ++dark;
+                    const double error = std::abs(v - expected);
+                    worst = std::max(worst, error);
+                    if (error > tolerance) ++wrong;
                 });
-                EXPECT_GT(pixels, 10000) << kind;
-                EXPECT_EQ(dark, 0) << kind << " " << scene::toString(filter) << ": the lone plane";
-            }
-            {
-                const scene::Frame f = test::renderChecked(covered, filterable(filter, 256, 0.01));
-                int pixels = 0;
-                double most = 0.0;
-                test::forEachFloorPixel(covered, f, [&](const Vec3& q, double v) {
-                    if (std::abs(q.x) > 1.5 || std::abs(q.z) > 1.5) return;  // the caster's shadow, by 1.5 clear of its edge
-                    ++pixels;
-                    most = std::max(most, v);
-                });
-                EXPECT_GT(pixels, 1000) << kind;
-                EXPECT_LT(most, 0.05) << kind << " " << scene::toString(filter) << ": under the caster";
+                std::printf("%s %s %s: %d pixels, largest |v - expected| %.3g, %d beyond the tolerance\n", kind,
+                            scene::toString(filter), underCaster ? "under the caster" : "lone floor", pixels, worst,
+                            wrong);
+                EXPECT_GT(pixels, underCaster ? 1000 : 10000) << kind;
+                // MSM: as in MsmIsTheHamburgerBoundOfTheBlurredMoments, a handful at the floor's
+                // silhouette may sample texels the camera ray misses.
+                EXPECT_LE(wrong, msm ? pixels / 1000 : 0) << kind << " " << scene::toString(filter)
+                                                          << (underCaster ? ": under the caster" : ": the lone floor");
             }
         }
     }
