@@ -254,11 +254,11 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
                 oursCold, bareCold, oursWarmFirst, bareWarmFirst);
 }
 
-}  // namespace
-
 // SHADOWLAB_BENCH_FILTERS=1: instead of the series above, each shadow filter's frame (all
-// channels, as compare renders) against pcf2x2 and the bare baseline, interleaved repetition by
-// repetition in one process: what a filterable map's moment and blur passes cost.
+// channels, as compare renders) against pcf2x2 and the bare baseline, repetition by repetition in
+// one process (each repetition starts at the next series, so none always runs first): what a
+// filterable map's moment and blur passes cost. Wall and process CPU time per frame, medians and
+// min-max; the ratios are of the medians.
 void benchFilters(const std::string& label, const fs::path& file, int repeats) {
     scene::Scene s = scene::loadScene(file);
     const auto [width, height] = benchResolution();
@@ -267,11 +267,12 @@ void benchFilters(const std::string& label, const fs::path& file, int repeats) {
     const std::vector<std::string> filters{"pcf2x2", "vsm", "evsm2", "evsm4", "esm", "msm"};
     std::vector<std::unique_ptr<raster::Renderer>> renderers;
     std::vector<scene::Frame> frames(filters.size());
-    std::vector<Series> series(filters.size());
+    std::vector<Series> series(filters.size() + 1);  // the last: the bare baseline
     scene::RenderSettings settings;
     for (const std::string& filter : filters) {
         scene::SettingsOverrides overrides;
         overrides.shadowMapSize = kShadowMapSize;
+        // One map, as the bare two-pass baseline draws (the defaults would fit it and may cascade it).
         overrides.fitLightFrustum = false;
         overrides.cascades = 1;
         overrides.filter = filter;
@@ -281,31 +282,61 @@ void benchFilters(const std::string& label, const fs::path& file, int repeats) {
     }
     bench::BareRenderer bare(s, settings.raster);
     std::vector<std::uint8_t> rgba;
-    for (std::size_t k = 0; k < filters.size(); ++k) renderers[k]->render(frames[k], scene::kAllChannels);  // warm-up
+    // Warm-up: pipelines are made on the first frame.
+    for (std::size_t k = 0; k < filters.size(); ++k) renderers[k]->render(frames[k], scene::kAllChannels);
     bare.render(rgba);
-    Series base;
+    const std::size_t n = series.size();
     for (int r = 0; r < repeats; ++r) {
-        for (std::size_t k = 0; k < filters.size(); ++k) {
-            renderers[k]->render(frames[k], scene::kAllChannels);
-            addOurs(series[k], frames[k]);
+        for (std::size_t step = 0; step < n; ++step) {
+            const std::size_t k = (std::size_t(r) + step) % n;
+            const double c = cpuMs();
+            if (k < filters.size()) {
+                renderers[k]->render(frames[k], scene::kAllChannels);
+                series[k].add("cpu_per_frame", cpuMs() - c);
+                addOurs(series[k], frames[k]);
+            } else {
+                const bench::BareTimings t = bare.render(rgba);
+                series[k].add("cpu_per_frame", cpuMs() - c);
+                addBare(series[k], t);
+            }
         }
-        addBare(base, bare.render(rgba));
     }
-    std::printf("\n=== filters, %s: %dx%d, shadow map %d, median of %d frames, ms (min-max) ===\n", label.c_str(),
-                width, height, kShadowMapSize, repeats);
-    std::printf("%-8s %-22s %-22s %-22s %9s %9s\n", "filter", "per_frame", "shadow_pass(+moments)", "lit_pass",
-                "/pcf2x2", "/bare");
+    const Series& pcf = series[0];
+    const Series& base = series[n - 1];
+    std::printf("\n=== filters, %s: %s triangles, %dx%d, shadow map %d, LP_NUM_THREADS=%s, %d repetitions: median "
+                "(min-max), ms ===\n",
+                label.c_str(), frames[0].attributes["triangles"].c_str(), width, height, kShadowMapSize,
+                std::getenv("LP_NUM_THREADS") ? std::getenv("LP_NUM_THREADS") : "?", repeats);
+    std::printf("%-7s %-21s %-21s %-21s %-21s %-8s %-8s %-8s %-8s\n", "filter", "per_frame (wall)", "cpu_per_frame",
+                "shadow_pass(+moments)", "lit_pass", "wall/pcf", "cpu/pcf", "wall/bare", "cpu/bare");
+    auto cell = [](const Series& x, const char* stage) {
+        char buf[64];
+        const auto [lo, hi] = x.range(stage);
+        std::snprintf(buf, sizeof buf, "%.0f (%.0f-%.0f)", x.med(stage), lo, hi);
+        return std::string(buf);
+    };
     auto row = [&](const std::string& name, const Series& x) {
-        const auto [lo, hi] = x.range("per_frame");
-        const auto [slo, shi] = x.range("shadow_pass");
-        const auto [llo, lhi] = x.range("lit_pass");
-        std::printf("%-8s %6.1f (%5.1f-%5.1f) %6.1f (%5.1f-%5.1f) %6.1f (%5.1f-%5.1f) %9.2f %9.2f\n", name.c_str(),
-                    x.med("per_frame"), lo, hi, x.med("shadow_pass"), slo, shi, x.med("lit_pass"), llo, lhi,
-                    x.med("per_frame") / series[0].med("per_frame"), x.med("per_frame") / base.med("per_frame"));
+        std::printf("%-7s %-21s %-21s %-21s %-21s %-8.2f %-8.2f %-8.2f %-8.2f\n", name.c_str(),
+                    cell(x, "per_frame").c_str(), cell(x, "cpu_per_frame").c_str(), cell(x, "shadow_pass").c_str(),
+                    cell(x, "lit_pass").c_str(), x.med("per_frame") / pcf.med("per_frame"),
+                    x.med("cpu_per_frame") / pcf.med("cpu_per_frame"), x.med("per_frame") / base.med("per_frame"),
+                    x.med("cpu_per_frame") / base.med("cpu_per_frame"));
     };
     for (std::size_t k = 0; k < filters.size(); ++k) row(filters[k], series[k]);
     row("bare", base);
+    // One line per filter for docs/performance.md's table.
+    for (std::size_t k = 0; k < filters.size(); ++k) {
+        const Series& x = series[k];
+        std::printf("FILTER | %s | %s | %s | %s | %s | %.2f / %.2f | %.2f / %.2f |\n", label.c_str(), filters[k].c_str(),
+                    cell(x, "per_frame").c_str(), cell(x, "cpu_per_frame").c_str(), cell(x, "shadow_pass").c_str(),
+                    x.med("per_frame") / pcf.med("per_frame"), x.med("cpu_per_frame") / pcf.med("cpu_per_frame"),
+                    x.med("per_frame") / base.med("per_frame"), x.med("cpu_per_frame") / base.med("cpu_per_frame"));
+    }
+    std::printf("FILTER | %s | bare | %s | %s | %s | | |\n", label.c_str(), cell(base, "per_frame").c_str(),
+                cell(base, "cpu_per_frame").c_str(), cell(base, "shadow_pass").c_str());
 }
+
+}  // namespace
 
 int main(int argc, char** argv) {
     int repeats = 5;

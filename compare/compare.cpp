@@ -7,6 +7,11 @@
 #include <cstdlib>
 #include <limits>
 #include <map>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <glm/glm.hpp>
 
 #include "compare/text.h"
 #include "scene/error.h"
@@ -57,33 +62,66 @@ long long roundId(float id) { return static_cast<long long>(std::floor(id + kObj
 
 Timing timingOf(const Frame& f) { return {f.totalTimeMs(), f.timingsMs}; }
 
-// The largest number of a Frame attribute holding one or several (';'-separated) numbers; a
-// perspective map's "X*d" counts as X (its texel grows with the distance d from the light, which
-// compare does not know: docs/compare.md). NaN when there is none.
-double largestNumber(const std::string& text) {
-    double best = std::numeric_limits<double>::quiet_NaN();
+// The ';'-separated entries of an attribute, in order (one per shadow-map layer for the raster
+// backend's texel_world_size and texel_axis).
+std::vector<std::string> entries(const std::string& text) {
+    std::vector<std::string> out;
     std::size_t start = 0;
     while (start <= text.size()) {
         const std::size_t end = std::min(text.find(';', start), text.size());
-        const std::string part = text.substr(start, end - start);
-        char* stop = nullptr;
-        const double v = std::strtod(part.c_str(), &stop);
-        if (stop != part.c_str() && std::isfinite(v) && !(v <= best)) best = v;
+        out.push_back(text.substr(start, end - start));
         start = end + 1;
+    }
+    return out;
+}
+
+// The number an entry starts with; NaN when there is none.
+double leadingNumber(const std::string& part) {
+    char* stop = nullptr;
+    const double v = std::strtod(part.c_str(), &stop);
+    return stop != part.c_str() && std::isfinite(v) ? v : std::numeric_limits<double>::quiet_NaN();
+}
+
+// The largest number of a Frame attribute holding one or several (';'-separated) numbers. NaN
+// when there is none.
+double largestNumber(const std::string& text) {
+    double best = std::numeric_limits<double>::quiet_NaN();
+    for (const std::string& part : entries(text)) {
+        const double v = leadingNumber(part);
+        if (std::isfinite(v) && !(v <= best)) best = v;
     }
     return best;
 }
+
+// A perspective shadow map (a spot's, a point light's cube face): its texel at world point p is
+// perUnit·(p − apex)·axis (the raster backend's texel_world_size "X*d" and texel_axis).
+struct PerspectiveTexel {
+    double perUnit = 0.0;
+    glm::dvec3 apex{0.0}, axis{0.0};
+};
 
 // The contact distance's constant, texel and slope parts (thresholds.h): from the options, else
 // the method's attributes. The texel is NaN when the method is no shadow map.
 struct Contact {
     double bias = std::numeric_limits<double>::quiet_NaN();
-    double texel = 0.0, slope = 0.0;
+    double texel = 0.0, slope = 0.0;  // texel: the largest orthographic map's (or the option's)
+    // Perspective maps with their apex and axis, whose texel is taken at the pixel's distance;
+    // `fallback`: those whose texel_axis is missing (frames written before it), or every one when
+    // the pixel's position is unknown: their X·d counts as X, the largest.
+    std::vector<PerspectiveTexel> perspective;
+    double fallback = 0.0;
     bool known() const { return std::isfinite(bias); }
-    double at(float ndotl) const {
+    // The largest map's texel at world point p (none: unknown, `fallback` for every perspective map).
+    double texelAt(const glm::dvec3* p) const {
+        double t = std::max(texel, fallback);
+        for (const PerspectiveTexel& l : perspective)
+            t = std::max(t, p ? l.perUnit * std::max(0.0, glm::dot(*p - l.apex, l.axis)) : l.perUnit);
+        return t;
+    }
+    double at(float ndotl, double texelHere) const {
         const double n = std::clamp(double(ndotl), 1e-6, 1.0);
         const double tanTheta = std::min(std::sqrt(std::max(0.0, 1.0 - n * n)) / n, kContactMaxTan);
-        return bias + (slope + kContactTexels) * texel * std::max(1.0, tanTheta);
+        return bias + (slope + kContactTexels) * texelHere * std::max(1.0, tanTheta);
     }
 };
 
@@ -92,14 +130,54 @@ std::string attribute(const Frame& f, const std::string& key) {
     return it == f.attributes.end() ? std::string() : it->second;
 }
 
+// A texel_axis entry "x,y,z,dx,dy,dz"; false for "-" (orthographic) or anything else.
+bool parseAxis(const std::string& text, PerspectiveTexel& l) {
+    double v[6];
+    const char* at = text.c_str();
+    for (double& x : v) {
+        char* stop = nullptr;
+        x = std::strtod(at, &stop);
+        if (stop == at || !std::isfinite(x)) return false;
+        at = stop;
+        if (*at == ',') ++at;
+    }
+    l.apex = glm::dvec3(v[0], v[1], v[2]);
+    l.axis = glm::dvec3(v[3], v[4], v[5]);
+    return *at == '\0' && glm::length(l.axis) > 0.0;
+}
+
 Contact contactOf(const Frame& method, const CompareOptions& o) {
     Contact c;
     const std::string texel = attribute(method, "texel_world_size");
     if (!texel.empty() || o.contactTexel) {
         c.bias = o.contactBias.value_or(largestNumber(attribute(method, "depth_bias")));
-        c.texel = o.contactTexel.value_or(largestNumber(texel));
         c.slope = o.contactSlope.value_or(largestNumber(attribute(method, "slope_bias")));
         if (!std::isfinite(c.slope)) c.slope = 0.0;
+        if (o.contactTexel) {
+            c.texel = *o.contactTexel;
+        } else {
+            // Per layer: "X" (orthographic) or "X*d" (perspective, with its texel_axis entry).
+            const std::vector<std::string> sizes = entries(texel), axes = entries(attribute(method, "texel_axis"));
+            bool any = false;
+            for (std::size_t k = 0; k < sizes.size(); ++k) {
+                const double x = leadingNumber(sizes[k]);
+                if (!std::isfinite(x)) continue;
+                any = true;
+                if (sizes[k].find('*') == std::string::npos) {
+                    c.texel = std::max(c.texel, x);
+                    continue;
+                }
+                PerspectiveTexel l;
+                l.perUnit = x;
+                if (k < axes.size() && axes.size() == sizes.size() && parseAxis(axes[k], l)) {
+                    l.axis = glm::normalize(l.axis);
+                    c.perspective.push_back(l);
+                } else {
+                    c.fallback = std::max(c.fallback, x);
+                }
+            }
+            if (!any) c.bias = std::numeric_limits<double>::quiet_NaN();
+        }
         if (!std::isfinite(c.texel)) c.bias = std::numeric_limits<double>::quiet_NaN();
     } else if (o.contactBias) {
         c.bias = *o.contactBias;
@@ -110,6 +188,57 @@ Contact contactOf(const Frame& method, const CompareOptions& o) {
     }
     return c;
 }
+
+// World positions of a frame's pixels from its view depth (the Z channel) and its camera (the
+// worldToCamera and worldToNDC attributes, scene/frame_identity.h): OpenEXR's camera space has
+// z = view depth, so pixel (x, y) with NDC ((x + 0.5)/W, (y + 0.5)/H) and depth z solves two
+// linear equations for camera x, y. Unknown without the matrices or the depths.
+class PixelPositions {
+public:
+    PixelPositions(const Frame& depthFrame, const Frame& cameraFrame) : depth_(depthFrame.depth) {
+        const auto toCamera = cameraFrame.typedAttributes.find("worldToCamera");
+        const auto toNdc = cameraFrame.typedAttributes.find("worldToNDC");
+        if (toCamera == cameraFrame.typedAttributes.end() || toNdc == cameraFrame.typedAttributes.end()) return;
+        const auto* m = std::get_if<glm::mat4>(&toCamera->second);
+        const auto* n = std::get_if<glm::mat4>(&toNdc->second);
+        if (!m || !n || depth_.size() != depthFrame.pixelCount()) return;
+        cameraToWorld_ = glm::inverse(glm::dmat4(*m));
+        projection_ = glm::dmat4(*n) * cameraToWorld_;
+        width_ = depthFrame.width;
+        height_ = depthFrame.height;
+        known_ = true;
+    }
+    bool known() const { return known_; }
+    // Pixel i's world position; false where it has no finite depth.
+    bool at(std::size_t i, glm::dvec3& p) const {
+        const double z = depth_[i];
+        if (!known_ || !std::isfinite(z) || z <= 0.0) return false;
+        const double u = (double(i % std::size_t(width_)) + 0.5) / width_;
+        const double v = (double(i / std::size_t(width_)) + 0.5) / height_;
+        const glm::dmat4& P = projection_;  // P[column][row]
+        // Row r of P·(x, y, z, 1) minus its NDC coordinate times row 3: a·x + b·y = c.
+        auto row = [&](int r, double ndc, double& a, double& b, double& c) {
+            a = P[0][r] - ndc * P[0][3];
+            b = P[1][r] - ndc * P[1][3];
+            c = -((P[2][r] - ndc * P[2][3]) * z + (P[3][r] - ndc * P[3][3]));
+        };
+        double a0, b0, c0, a1, b1, c1;
+        row(0, u, a0, b0, c0);
+        row(1, v, a1, b1, c1);
+        const double det = a0 * b1 - a1 * b0;
+        if (!(std::abs(det) > 0.0)) return false;
+        const glm::dvec4 world =
+            cameraToWorld_ * glm::dvec4((c0 * b1 - c1 * b0) / det, (a0 * c1 - a1 * c0) / det, z, 1.0);
+        p = glm::dvec3(world);
+        return true;
+    }
+
+private:
+    const std::vector<float>& depth_;
+    glm::dmat4 cameraToWorld_{1.0}, projection_{1.0};
+    int width_ = 0, height_ = 0;
+    bool known_ = false;
+};
 
 float srgbLuminance(float r, float g, float b) {
     // Rec. 709 luminance of the linear color, then the sRGB curve, so the gray ramp of the
@@ -319,7 +448,19 @@ Comparison compareFrames(const Frame& method, const Frame& reference,
     m.edgeRadius = options.edgeRadius;
     const Contact contact = contactOf(method, options);
     m.hasBlockerDistance = contact.known() && reference.blockerDistance.size() == n && reference.blockerId.size() == n;
-    if (m.hasBlockerDistance) m.contactDistance = contact.at(1.0f);
+    // Perspective maps' texels at each pixel's distance: its position from the method's depths and
+    // the camera either frame records (the same camera: compare refuses two different ones).
+    const bool methodCamera = method.typedAttributes.count("worldToNDC") > 0;
+    const PixelPositions positions(method.depth.size() == n ? method : reference, methodCamera ? method : reference);
+    const bool perPixel = !contact.perspective.empty() && positions.known();
+    auto contactAt = [&](std::size_t i, float ndotl) {
+        glm::dvec3 p;
+        return contact.at(ndotl, contact.texelAt(perPixel && positions.at(i, p) ? &p : nullptr));
+    };
+    // D at tanθ ≤ 1: its smallest over the counted pixels where a perspective map's texel varies.
+    if (m.hasBlockerDistance)
+        m.contactDistance =
+            perPixel ? std::numeric_limits<double>::infinity() : contact.at(1.0f, contact.texelAt(nullptr));
 
     const auto refState = referenceShadowState(reference);
     const auto edges = shadowEdges(reference, refState);
@@ -360,6 +501,7 @@ Comparison compareFrames(const Frame& method, const Frame& reference,
         } else {
             c = classifyCounted(vm, vr);
             ++m.counted;
+            if (perPixel && m.hasBlockerDistance) m.contactDistance = std::min(m.contactDistance, contactAt(i, 1.0f));
             const double e = std::fabs(double(vm) - double(vr));
             sumAbs += e;
             m.maxAbsVisibilityError = std::max(m.maxAbsVisibilityError, e);
@@ -408,7 +550,7 @@ Comparison compareFrames(const Frame& method, const Frame& reference,
                 // bleeding (near an edge it is the edge's aliasing). Without a blocker neither.
                 if (m.hasBlockerDistance && roundId(reference.blockerId[i]) > 0 &&
                     std::isfinite(reference.blockerDistance[i])) {
-                    if (double(reference.blockerDistance[i]) <= contact.at(nr)) ++m.biasLeak;
+                    if (double(reference.blockerDistance[i]) <= contactAt(i, nr)) ++m.biasLeak;
                     else if (!nearEdge[i]) ++m.bleeding;
                 }
             } else if (c == PixelClass::AgreeLit) {
@@ -445,6 +587,7 @@ Comparison compareFrames(const Frame& method, const Frame& reference,
     m.shadowIoU = m.shadowedUnion ? double(m.shadowedIntersection) / double(m.shadowedUnion) : 1.0;
     m.silhouetteMismatchRate = rate(m.silhouetteMismatch, m.totalPixels);
     m.selfShadowAcneRate = rate(m.selfShadowAcne, m.counted);
+    if (std::isinf(m.contactDistance)) m.contactDistance = contact.at(1.0f, contact.texelAt(nullptr));  // none counted
     m.bleedingRate = rate(m.bleeding, m.counted);
     m.biasLeakRate = rate(m.biasLeak, m.counted);
     m.aliasingPixels = m.falseShadowNearEdge + m.missedShadowNearEdge;

@@ -135,7 +135,9 @@ struct Metrics {
     // distance from the method's bias and texel attributes (or CompareOptions); unknown, not
     // zero, without them.
     bool hasBlockerDistance = false;
-    double contactDistance = 0.0;  // D at tanθ ≤ 1 (the smallest it is), world units
+    // D at tanθ ≤ 1 (the smallest it is), world units; with a spot or point-light map, whose texel
+    // grows with the distance from the light, the smallest over the counted pixels.
+    double contactDistance = 0.0;
     std::size_t bleeding = 0, biasLeak = 0;
     double bleedingRate = 0.0, biasLeakRate = 0.0;  // over counted
 
@@ -171,7 +173,9 @@ struct CompareOptions {
     int hotspotSize = 0;  // side of the hotspot window; 0 = min(width, height) / 6 in 16..96
     // The contact distance's parts, world units (b + (s + kContactTexels)·t·max(1, tanθ)); unset:
     // read from the method's attributes (raster: depth_bias, slope_bias, texel_world_size, the
-    // largest of several maps; ray tracer: kContactRayBiasFactor × ray_bias).
+    // largest of several maps, a spot's or cube face's "X*d" taken at the pixel's distance d along
+    // its texel_axis, the pixel's position from the frame's depth and camera; ray tracer:
+    // kContactRayBiasFactor × ray_bias). contactTexel replaces every map's texel.
     std::optional<double> contactBias, contactTexel, contactSlope;
 };
 

@@ -59,7 +59,8 @@ inline constexpr float kPenumbraMargin = 1e-6f;
 // minus the bias: the constant bias b and the slope term s·t·tanθ move the receiver that far
 // toward the light, and the texel's footprint holds depths up to t·tanθ from the receiver's own,
 // widened by the filter to a few texels (pcf2x2: 2, pcf 3×3: 3, the default moment blur: 5,
-// whose half-width 2.5 reaches that far). So D = b + (s + kContactTexels)·t·max(1, tanθ) with
+// whose half-width 2.5 reaches that far). So D = b + (s + kContactTexels)·t·max(1, tanθ), t the
+// texel at the pixel (a spot's or cube face's grows with the distance from the light), with
 // tanθ capped as the slope bias caps it: a blocker that near can be lost to the bias and the
 // texel grid alone; one farther away cannot, and a lit answer there is the filter's (light
 // bleeding in the moment maps) or an edge's. Four texels is the middle of those footprints; at

@@ -132,8 +132,12 @@ MomentPipeline createMomentPipeline(const Context& ctx, const ShadowMaps& maps, 
 }
 
 void recordMomentPasses(VkCommandBuffer commands, const MomentPipeline& pipeline, const ShadowMaps& maps,
-                        const MomentMaps& moments, scene::ShadowFilter filter, const scene::MomentSettings& settings) {
-    const std::uint32_t layers = moments.layers;
+                        const MomentMaps& moments, const std::vector<ShadowLayer>& layers, scene::ShadowFilter filter,
+                        const scene::MomentSettings& settings) {
+    if (layers.size() != moments.layers)
+        throw RasterError("recordMomentPasses: " + std::to_string(layers.size()) + " layers planned for " +
+                          std::to_string(moments.layers) + " moment maps");
+    const std::uint32_t layerCount = moments.layers;
     // The depth pass's writes (its final barrier made them visible to fragment shaders and copies
     // only) before the x pass's reads; both arrays' previous contents are not needed (UNDEFINED),
     // but the previous frame's lit pass may still read the moments (a reused Renderer).
@@ -143,30 +147,37 @@ void recordMomentPasses(VkCommandBuffer commands, const MomentPipeline& pipeline
                  VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
                  VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                  VK_ACCESS_2_SHADER_SAMPLED_READ_BIT},
-                {moments.blurredX.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layers, VK_IMAGE_LAYOUT_UNDEFINED,
+                {moments.blurredX.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layerCount, VK_IMAGE_LAYOUT_UNDEFINED,
                  VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE,
                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT},
-                {moments.moments.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layers, VK_IMAGE_LAYOUT_UNDEFINED,
+                {moments.moments.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layerCount, VK_IMAGE_LAYOUT_UNDEFINED,
                  VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_NONE,
                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT}});
     vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline.get());
     vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.layout.get(), 0, 1, &pipeline.set, 0,
                             nullptr);
     const std::uint32_t groups = (moments.size + kGroup - 1) / kGroup;
-    shaders::MomentPush push{
-        .info = glm::ivec4(int(filter), 0, (settings.blurWidth - 1) / 2, int(moments.size)),
-        .params = glm::vec4(float(settings.evsmPositive), float(settings.evsmNegative), float(settings.esmExponent),
-                            0.0f)};
-    vkCmdPushConstants(commands, pipeline.layout.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-    vkCmdDispatch(commands, groups, groups, layers);
-    transition(commands, {{moments.blurredX.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layers, VK_IMAGE_LAYOUT_GENERAL,
+    // One dispatch per layer and pass: each layer's own near and far.
+    auto dispatch = [&](int pass) {
+        for (std::uint32_t k = 0; k < layerCount; ++k) {
+            const LightFrustum& f = layers[k].frustum;
+            const shaders::MomentPush push{
+                .info = glm::ivec4(int(filter), pass, (settings.blurWidth - 1) / 2, int(moments.size)),
+                .params = glm::vec4(float(settings.evsmPositive), float(settings.evsmNegative),
+                                    float(settings.esmExponent), 0.0f),
+                .layer = glm::ivec4(int(k), f.perspective ? 1 : 0, 0, 0),
+                .range = f.perspective ? glm::vec4(float(f.near), float(f.far), 0.0f, 0.0f) : glm::vec4(0.0f)};
+            vkCmdPushConstants(commands, pipeline.layout.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+            vkCmdDispatch(commands, groups, groups, 1);
+        }
+    };
+    dispatch(0);
+    transition(commands, {{moments.blurredX.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layerCount, VK_IMAGE_LAYOUT_GENERAL,
                            VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                            VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                            VK_ACCESS_2_SHADER_STORAGE_READ_BIT}});
-    push.info.y = 1;
-    vkCmdPushConstants(commands, pipeline.layout.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-    vkCmdDispatch(commands, groups, groups, layers);
-    transition(commands, {{moments.moments.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layers, VK_IMAGE_LAYOUT_GENERAL,
+    dispatch(1);
+    transition(commands, {{moments.moments.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layerCount, VK_IMAGE_LAYOUT_GENERAL,
                            VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                            VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
                            VK_ACCESS_2_SHADER_SAMPLED_READ_BIT}});

@@ -1,14 +1,16 @@
 // raster/moment_maps.h: the filterable shadow maps (vsm, evsm2, evsm4, esm, msm): after the depth
 // pass, two compute passes turn each layer's depths into the technique's moments and blur them
-// with a separable box of MomentSettings::blurWidth texels; the lit pass samples the result with
+// (of linear depth) with a separable box of MomentSettings::blurWidth texels; the lit pass samples the result with
 // a linear filter (shaders/lit.frag momentVisibility). See docs/raster.md.
 #pragma once
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "raster/context.h"
 #include "raster/resources.h"
+#include "raster/shadow_layers.h"
 #include "raster/shadow_pass.h"
 #include "scene/settings.h"
 
@@ -49,9 +51,13 @@ MomentPipeline createMomentPipeline(const Context& ctx, const ShadowMaps& maps, 
 
 // Records both passes for `filter` (a filterable one) after the depth pass: the depth array in
 // SHADER_READ_ONLY_OPTIMAL (written by the depth pass) to moments in SHADER_READ_ONLY_OPTIMAL,
-// ready for the lit pass's fragment shader.
+// ready for the lit pass's fragment shader. `layers` (the array's, in order) says which layers
+// are perspective and their near and far: their moments are of linear depth
+// (d − near)/(far − near), d along the layer's axis; orthographic layers' depths are linear
+// already and kept as stored.
 void recordMomentPasses(VkCommandBuffer commands, const MomentPipeline& pipeline, const ShadowMaps& maps,
-                        const MomentMaps& moments, scene::ShadowFilter filter, const scene::MomentSettings& settings);
+                        const MomentMaps& moments, const std::vector<ShadowLayer>& layers, scene::ShadowFilter filter,
+                        const scene::MomentSettings& settings);
 
 // For --explain and the Frame: the passes and memory the technique adds.
 std::string describeMomentCost(scene::ShadowFilter filter, std::uint32_t size, std::uint32_t layers, int blurWidth);

@@ -525,6 +525,16 @@ void Renderer::Impl::describeLayers() {
             return formatNumber(l.frustum.texelWorldSize()) + (l.frustum.perspective ? "*d" : "");
         });
         attributes["light_frustum"] = joined(layers, [](const ShadowLayer& l) { return l.frustum.describe(); }, "; ");
+        // Where a perspective map's texel grows from: its apex and unit axis in world coordinates,
+        // "x,y,z,dx,dy,dz", so that compare takes the texel at a pixel's distance (p − apex)·axis
+        // (docs/compare.md, contact distance); "-" for an orthographic map.
+        attributes["texel_axis"] = joined(layers, [](const ShadowLayer& l) {
+            if (!l.frustum.perspective) return std::string("-");
+            const scene::Vec3 a = l.frustum.position, d = l.frustum.direction;
+            char buf[160];
+            std::snprintf(buf, sizeof buf, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g", a.x, a.y, a.z, d.x, d.y, d.z);
+            return std::string(buf);
+        });
     }
     attributes["cascades"] = std::to_string(cascadesUsed);
     if (!splits.empty()) {
@@ -636,7 +646,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     const TransmittancePass transmittancePass{transmit ? &transmitPipeline : nullptr, &transmittanceMaps, layerLights,
                                               transmit ? &transmitRestPipeline : nullptr};
     recordShadowPass(commands, shadowPipeline, maps, draw, lightMatrices, wantIds, &transmittancePass, &layerBias);
-    if (momentPipeline.pipeline) recordMomentPasses(commands, momentPipeline, maps, momentMaps, settings.filter, settings.moments);
+    if (momentPipeline.pipeline) recordMomentPasses(commands, momentPipeline, maps, momentMaps, layers, settings.filter, settings.moments);
     stamp(commands, 1);
     ctx.submitAndWait(commands);
     frame.timingsMs.emplace_back("shadow_pass", msSince(shadowStart));

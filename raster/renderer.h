@@ -100,7 +100,7 @@ private:
 // the lit camera pass, then the readback. Fills every Frame AOV including blockerId, the
 // timings "setup", "shadow_pass", "lit_pass", "readback" and the attributes backend, device,
 // shadow_map_size, filter, pcf_size, depth_bias (the value used, see depthBiasIsDefault),
-// depth_bias_default, slope_bias, normal_offset, texel_world_size,
+// depth_bias_default, slope_bias, normal_offset, texel_world_size, texel_axis,
 // light_frustum, light_frustum_fit, triangles, sphere_segments and, with settings.validate,
 // validation_messages (the count; each is printed to stderr). Throws RasterError (no loader,
 // driver or device; bad settings) or VulkanError (a failed call). Call it from one thread at a time: the Vulkan

@@ -50,11 +50,15 @@ struct TransmitPush {
                        // only (behind the nearest layer): z: the layer, w: the depth separation
 };
 
-// Push constants of the moment passes (shaders/moments.comp, raster/moment_maps.h).
+// Push constants of the moment passes (shaders/moments.comp, raster/moment_maps.h), one
+// dispatch per layer and pass.
 struct MomentPush {
     ivec4 info;   // x: filter code, y: pass (0: moments + blur along x, 1: blur along y), z: blur
                   // radius in texels, w: the maps' side in texels
     vec4 params;  // x: EVSM positive exponent, y: EVSM negative exponent, z: ESM exponent
+    ivec4 layer;  // x: the array layer this dispatch writes; y: 1 = perspective (spot, cube face):
+                  // its stored depths are made linear over `range` first, 0 = orthographic (kept)
+    vec4 range;   // perspective layers: x: near, y: far (distances along the layer's axis)
 };
 
 struct LightData {
@@ -101,7 +105,7 @@ struct LitUniforms {
 
 #ifdef __cplusplus
 static_assert(sizeof(ShadowPush) == 64, "ShadowPush must match std430 push constants");
-static_assert(sizeof(MomentPush) == 2 * 16, "MomentPush must match std430 push constants");
+static_assert(sizeof(MomentPush) == 4 * 16, "MomentPush must match std430 push constants");
 static_assert(sizeof(TransmitPush) == 64 + 2 * 16, "TransmitPush must match std430 push constants");
 static_assert(sizeof(LightData) == 64 + 6 * 16, "LightData must match std140");
 static_assert(sizeof(CascadeData) == 64 + 16, "CascadeData must match std140");

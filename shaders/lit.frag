@@ -164,6 +164,17 @@ float reference(LightData light, Receiver r, float bias) {
     return r.axial - bias * light.bias.w;  // orthographic depth is linear: bias / depth range
 }
 
+// The filterable maps' depth of a receiver biased by `bias` world units toward the light: a
+// directional map's linear depth as reference() gives it; a perspective layer's moments are of
+// (d − near)/(far − near), d the distance along its axis (shaders/moments.comp linearDepth).
+float momentReference(LightData light, Receiver r, float bias) {
+    if (isPerspective(light)) {
+        const float near = light.kind.z, far = light.kind.w;
+        return (r.axial - bias - near) / (far - near);
+    }
+    return reference(light, r, bias);
+}
+
 // Filterable maps: the visibility of a receiver at map depth t from the filtered moments m.
 // linstep(a, 1, p) is the light-bleeding reduction: visibilities below a become 0, the rest is
 // stretched over 0..1 (Lauritzen 2007).
@@ -389,10 +400,11 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
     }
     if (filterCode >= SHADOWLAB_FILTER_VSM) {
         // Filterable maps: one linear lookup of the blurred moments (the filter is in the blur),
-        // the receiver at the constant and slope bias as for `none`. Blocker ids and
-        // semi-transparent casters as one compare tap would give them.
+        // the receiver at the constant and slope bias as for `none`, in the moments' linear depth.
+        // Blocker ids and semi-transparent casters as one compare tap would give them (the
+        // transmittance maps hold the depth pass's depths: `ref`).
         const float ref = reference(light, r, r.biasWorld);
-        float v = momentVisibility(texture(momentMaps, vec3(r.uv, layer)), ref);
+        float v = momentVisibility(texture(momentMaps, vec3(r.uv, layer)), momentReference(light, r, r.biasWorld));
         if (kBlockerIds && v < 0.5 && blocker == 0u) blocker = texture(blockerIds, vec3(r.uv, layer)).r;
         if (kTransmittance) v *= transmittanceTap(r.uv, layer, ref);
         return v;

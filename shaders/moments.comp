@@ -1,5 +1,6 @@
 // shaders/moments.comp: the filterable shadow maps' moments (raster/moment_maps.h), in two
-// passes of a separable box blur. Pass 0 turns each depth texel into the technique's moments and
+// passes of a separable box blur, one dispatch per layer. Pass 0 turns each depth texel into the
+// technique's moments (of linear depth: perspective layers' stored depths are made linear) and
 // averages `width` of them along x into the intermediate array; pass 1 averages `width` of those
 // along y into the moment array the lit pass samples. Texel coordinates are clamped to the map,
 // as the lit pass's clamp-to-edge sampler does.
@@ -14,6 +15,20 @@ layout(set = 0, binding = 1, rgba32f) uniform image2DArray blurredX;
 layout(set = 0, binding = 2, rgba32f) uniform image2DArray moments;
 
 layout(push_constant) uniform Push { MomentPush push; };
+
+// A perspective layer's stored depth z = far/(far − near)·(1 − near/d) of the distance d along
+// its axis, as (d − near)/(far − near): linear in d, so that a gap between caster and receiver
+// is its length over the depth range wherever it lies. The stored depth's slope is near·far/d²
+// times that (0.75% at 3 units from a light with near 0.008 and far 8.2), and the moments' bounds,
+// whose parameters are in units of the 0..1 range, then barely tell caster from receiver.
+// Cleared texels (1) stay 1.
+// Written as z·near / (far·(1 − z) + near·z): 1 − z is exact in float for z >= 0.5, so each term
+// rounds once (far − z·(far − near) would cancel to a few digits near z = 1, where the depths of
+// distant surfaces lie), and z = 1 gives exactly 1.
+float linearDepth(float z) {
+    const float near = push.range.x, far = push.range.y;
+    return z * near / (far * (1.0 - z) + near * z);
+}
 
 // The moments of one stored depth z (0..1) for the filter code.
 vec4 momentsOf(float z, int code) {
@@ -33,7 +48,7 @@ vec4 momentsOf(float z, int code) {
 
 void main() {
     const ivec3 size = ivec3(push.info.w, push.info.w, 0);
-    const ivec3 at = ivec3(gl_GlobalInvocationID);
+    const ivec3 at = ivec3(gl_GlobalInvocationID.xy, push.layer.x);
     if (at.x >= size.x || at.y >= size.y) return;
     const int code = push.info.x;
     const int radius = push.info.z;
@@ -41,7 +56,8 @@ void main() {
     if (push.info.y == 0) {
         for (int k = -radius; k <= radius; ++k) {
             const ivec3 t = ivec3(clamp(at.x + k, 0, size.x - 1), at.y, at.z);
-            sum += momentsOf(texelFetch(depths, t, 0).r, code);
+            const float z = texelFetch(depths, t, 0).r;
+            sum += momentsOf(push.layer.y != 0 ? linearDepth(z) : z, code);
         }
         imageStore(blurredX, at, sum / float(2 * radius + 1));
     } else {

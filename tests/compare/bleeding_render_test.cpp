@@ -1,14 +1,16 @@
 // tests/compare/bleeding_render_test.cpp: light bleeding told from bias leaks on real renders
 // (lavapipe with the validation layer, against the double-precision reference and its blocker
 // distances): two casters at different heights under VSM bleed where the upper one's edge
-// crosses the lower one's shadow, EVSM4 bleeds less there, and a box's contact leak under a large
-// constant bias is a bias leak, not bleeding.
+// crosses the lower one's shadow, EVSM4 bleeds less there, a wall's contact leak under a large
+// constant bias is a bias leak, not bleeding, and a box keeps its contact shadow under the same bias
+// (the map holds its top, not the face the reference's blocker distance measures).
 #include <cmath>
 #include <cstdio>
 
 #include <gtest/gtest.h>
 
 #include "compare/compare.h"
+#include "compare/thresholds.h"
 #include "raster/renderer.h"
 #include "raytrace/renderer.h"
 #include "scene/camera.h"
@@ -54,7 +56,8 @@ scene::Scene lit(std::vector<scene::Object> casters, const Vec3& target) {
 
 struct Renders {
     Comparison c;
-    scene::Frame reference;
+    scene::Frame raster, reference;
+    double texel = 0;  // the shadow map's texel, world units
 };
 
 Renders compareRaster(const scene::Scene& s, const scene::SettingsOverrides& o) {
@@ -64,11 +67,13 @@ Renders compareRaster(const scene::Scene& s, const scene::SettingsOverrides& o) 
     scene::RenderSettings settings = scene::resolveSettings(s, ov);
     settings.raster.validate = true;
     const scene::RenderPlan plan = scene::makeRenderPlan(s, settings);
-    const scene::Frame raster = raster::render(s, plan, settings.raster);
-    EXPECT_EQ(raster.attributes.at("validation_messages"), "0") << "validation messages were printed above";
+    raster::RenderDebug debug;
     Renders r;
+    r.raster = raster::render(s, plan, settings.raster, scene::kAllChannels, &debug);
+    EXPECT_EQ(r.raster.attributes.at("validation_messages"), "0") << "validation messages were printed above";
+    if (!debug.layers.empty()) r.texel = debug.layers[0].frustum.texelWorldSize();
     r.reference = raytrace::renderReference(s, plan, scene::referenceSettings(settings.raytrace));
-    r.c = compareFrames(raster, r.reference);
+    r.c = compareFrames(r.raster, r.reference);
     return r;
 }
 
@@ -89,8 +94,8 @@ TEST(BleedingAgainstReference, VsmBleedsWhereTheUpperCastersEdgeCrossesTheLowerO
     // to A) and Δ = 7√2 (A to B): 0.67 at w = 0.1, 0.55 at w = 0.3, lit where the reference is in
     // shadow. The contact distance is half a texel plus 4 texels (tanθ = 1): about 0.15 at 512²
     // over the scene's 17.5-wide bounding-sphere map, far below 1.41: bleeding.
-    const scene::Scene s = lit({horizontal("A", Vec3(0.4, 1, 0), 0.8, 4.0), horizontal("B", Vec3(5.2, 8, 0), 4.4, 4.0)},
-                               Vec3(-0.6, 0, 0));
+    const scene::Scene s =
+        lit({horizontal("A", Vec3(0.4, 1, 0), 0.8, 4.0), horizontal("B", Vec3(5.2, 8, 0), 4.4, 4.0)}, Vec3(-0.6, 0, 0));
     scene::SettingsOverrides o;
     o.shadowMapSize = 512;
     o.filter = "vsm";
@@ -107,8 +112,10 @@ TEST(BleedingAgainstReference, VsmBleedsWhereTheUpperCastersEdgeCrossesTheLowerO
         const Vec3 p = floorPoint(s, i);
         if (p.x > -0.62 && p.x < -0.2) ++inBand;
     }
-    std::printf("vsm: missed %zu, bleeding %zu, bias leak %zu, far-blocker missed on the floor %zu (%zu between x -0.62 and -0.2), D %.4f\n",
-                m.missedShadow, m.bleeding, m.biasLeak, far, inBand, m.contactDistance);
+    std::printf(
+        "vsm: missed %zu, bleeding %zu, bias leak %zu, far-blocker missed on the floor %zu (%zu between x -0.62 and "
+        "-0.2), D %.4f\n",
+        m.missedShadow, m.bleeding, m.biasLeak, far, inBand, m.contactDistance);
     EXPECT_GT(m.bleeding, 50u);
     EXPECT_GT(double(inBand), 0.9 * double(far));
     // Their blocker is A, at √2 along the ray (the reference's nearest blocker, not B).
@@ -127,26 +134,102 @@ TEST(BleedingAgainstReference, VsmBleedsWhereTheUpperCastersEdgeCrossesTheLowerO
     EXPECT_LT(e.bleeding, m.bleeding);
 }
 
+// A floor point (x, 0, z) with x in −1.5..−0.5 and |z| < 0.5 lies in the shadow of a unit-high
+// caster standing on the floor along x = −0.5, |z| < 0.5: its ray to the light (45°) meets the
+// plane x = −0.5 at height −0.5 − x, d = √2·(−0.5 − x) away, which is the reference's blocker
+// distance. The constant bias b moves the receiver b along the light toward it (lit.frag
+// reference(): bias·depth-per-world-unit of the orthographic map, not clamped, and the value given
+// is kept, not re-derived for the map), so the map answers "lit" where the surface it holds on that
+// ray, the one nearest the light, is within b of the receiver. pcf2x2 with no slope bias reads
+// texels up to 1.5 texels from the point, and a surface seen at 45° moves a texel in depth per
+// texel: the answer is exact outside δ = 2·√2·texel of where that distance equals b.
+struct ContactBand {
+    std::size_t band = 0, bandLit = 0, rest = 0, restShadowed = 0;
+};
+ContactBand contactBand(const scene::Scene& s, const Renders& r, double b) {
+    const double delta = 2.0 * std::sqrt(2.0) * r.texel;
+    ContactBand c;
+    for (std::size_t i = 0; i < r.c.classes.size(); ++i) {
+        if (r.reference.objectId[i] != 1.0f) continue;
+        const Vec3 p = floorPoint(s, i);
+        if (std::abs(p.z) > 0.45 || p.x > -0.5 - delta || p.x < -1.5 + delta) continue;  // clear of the side faces
+        const double d = std::sqrt(2.0) * (-0.5 - p.x);
+        EXPECT_EQ(r.reference.visibility[i], 0.0f) << "the reference shadows the whole shadow, at x " << p.x;
+        if (d < b - delta) {
+            ++c.band;
+            c.bandLit += r.raster.visibility[i] == 1.0f;
+        } else if (d > b + delta) {
+            ++c.rest;
+            c.restShadowed += r.raster.visibility[i] == 0.0f;
+        }
+    }
+    return c;
+}
+
 TEST(BleedingAgainstReference, AContactLeakUnderALargeConstantBiasIsABiasLeak) {
-    // A unit box on the floor; a constant bias of 0.3 moves each receiver 0.3 toward the light,
-    // past the box's face for floor points whose ray meets the face within 0.3: a band next to
-    // the box's base (x −0.71..−0.5). The contact distance is 0.3 plus 4 texels of the 1024² map
-    // (about 0.37): every such leak is within it.
+    // A wall (a vertical quad, x = −0.5, 1 high, |z| < 0.5) is the only surface on those rays, so
+    // the map holds the wall itself, d from the receiver: a bias b = 0.3 lets light through where
+    // d < b, the band x in (−0.5 − b/√2, −0.5) = (−0.712, −0.5), and nowhere else. Every such leak
+    // lies within the contact distance D = b + 4 texels (compare/thresholds.h; tanθ = 1) of its
+    // blocker, so it is a bias leak and none of it may be read as light bleeding.
+    scene::Quad wall;
+    wall.center = Vec3(-0.5, 0.5, 0.0);
+    wall.normal = Vec3(1, 0, 0);
+    scene::quadAxes(wall.normal, wall.uAxis, wall.vAxis);
+    wall.size = scene::Vec2(1.0, 1.0);  // square, so the order of quadAxes' u and v does not matter
+    const scene::Scene s = lit({{"wall", wall, 0}}, Vec3(-1, 0, 0));
+    scene::SettingsOverrides o;
+    o.shadowMapSize = 1024;
+    o.filter = "pcf2x2";
+    o.depthBias = 0.3;
+    o.slopeBias = 0.0;
+    const Renders r = compareRaster(s, o);
+    const Metrics& m = r.c.metrics;
+    ASSERT_TRUE(m.hasBlockerDistance);
+    ASSERT_GT(r.texel, 0.0);
+    const double b = 0.3;
+    const ContactBand c = contactBand(s, r, b);
+    std::printf(
+        "wall, pcf2x2, bias 0.3: band %zu (%zu lit), rest %zu (%zu shadowed); missed %zu (%zu near an edge), "
+        "bleeding %zu, bias leak %zu, D %.4f, texel %.4f\n",
+        c.band, c.bandLit, c.rest, c.restShadowed, m.missedShadow, m.missedShadowNearEdge, m.bleeding, m.biasLeak,
+        m.contactDistance, r.texel);
+    EXPECT_GT(c.band, 200u) << "the camera must see the band";
+    EXPECT_EQ(c.bandLit, c.band) << "the bias lets light through wherever the wall is nearer than b";
+    EXPECT_GT(c.rest, 1000u);
+    EXPECT_EQ(c.restShadowed, c.rest) << "and nowhere else";
+    EXPECT_NEAR(m.contactDistance, b + kContactTexels * r.texel, 1e-3 * r.texel);  // its value for N·L = 1
+    // Every lit band pixel is a missed shadow whose blocker lies within d < b < D.
+    EXPECT_GE(m.biasLeak, c.bandLit);
+    EXPECT_EQ(m.bleeding, 0u);
+}
+
+TEST(BleedingAgainstReference, ABoxKeepsItsContactShadowUnderTheSameBias) {
+    // The same rays through a unit box [−0.5, 0.5]³ on the floor (top at y = 1) meet its face
+    // x = −0.5 first (the reference's blocker, d away), but the map holds the surface nearest the
+    // light, where the ray leaves the box: its top, at height 1, √2 from every receiver of the
+    // shadow (x + 1 < 0.5, so the ray leaves through the top, not the face x = 0.5). b = 0.3 < √2:
+    // the whole shadow stays, the band included. What is missed lies at the shadow's edges (the
+    // texel grid's stair steps), none of it bleeding.
     const scene::Scene s = lit({{"box", scene::Box{Vec3(-0.5, 0, -0.5), Vec3(0.5, 1, 0.5)}, 0}}, Vec3(-1, 0, 0));
     scene::SettingsOverrides o;
     o.shadowMapSize = 1024;
     o.filter = "pcf2x2";
     o.depthBias = 0.3;
     o.slopeBias = 0.0;
-    const Metrics m = compareRaster(s, o).c.metrics;
-    std::printf("pcf2x2, bias 0.3: missed %zu, bleeding %zu, bias leak %zu, D %.4f\n", m.missedShadow, m.bleeding,
-                m.biasLeak, m.contactDistance);
-    // The band lies along the box's base, so most of its pixels are within the edge radius of the
-    // reference's shadow boundary there and count as neither class; what matters is that none of
-    // the leak is read as bleeding, and that what is classified is a bias leak.
+    const Renders r = compareRaster(s, o);
+    const Metrics& m = r.c.metrics;
     ASSERT_TRUE(m.hasBlockerDistance);
-    EXPECT_GT(m.missedShadow, 0u);
-    EXPECT_GT(m.biasLeak, 0u);
+    ASSERT_GT(r.texel, 0.0);
+    const ContactBand c = contactBand(s, r, 0.3);
+    std::printf(
+        "box, pcf2x2, bias 0.3: band %zu (%zu lit), rest %zu (%zu shadowed); missed %zu (%zu near an edge), "
+        "bleeding %zu, bias leak %zu\n",
+        c.band, c.bandLit, c.rest, c.restShadowed, m.missedShadow, m.missedShadowNearEdge, m.bleeding, m.biasLeak);
+    EXPECT_GT(c.band, 200u);
+    EXPECT_EQ(c.bandLit, 0u) << "the map holds the box's top, √2 > b from the receivers";
+    EXPECT_EQ(c.restShadowed, c.rest);
+    EXPECT_EQ(m.missedShadow, m.missedShadowNearEdge) << "missed shadow only along the shadow's edges";
     EXPECT_EQ(m.bleeding, 0u);
 }
 

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "scene/error.h"
+#include "scene/frame_identity.h"
 #include "scene/frame_io.h"
 #include "tests/compare/synthetic.h"
 
@@ -445,6 +446,67 @@ TEST(Bleeding, MissedShadowFarFromItsBlockerIsBleedingAndNearItABiasLeak) {
     const Metrics rx = compareFrames(ray, r).metrics;
     EXPECT_DOUBLE_EQ(rx.contactDistance, 0.06);
     EXPECT_EQ(rx.biasLeak, 400u);
+}
+
+// A perspective map's texel grows with the distance d along its axis (texel_world_size "X*d"),
+// so the contact distance is taken at each pixel's d: its position from the frame's view depth
+// and camera (the worldToCamera and worldToNDC attributes), the map's apex and axis from
+// texel_axis. A 40×40 camera 10 above a floor (id 1, N·L 1), looking straight down (+x to the
+// right, 40° field of view): pixel column c sees world x = 10·(2(c + 0.5)/40 − 1)·tan 20°. A spot
+// at (−10, 0.5, 0) looking along +x with X = 0.01: d = x + 10, from 6.45 (column 0) to 13.55, and
+// D = 0.02 + 4·0.01·d. The reference shadows every pixel with its blocker 0.4 away, and the method
+// lights them all: a bias leak where D >= 0.4, d >= 9.5, x >= −0.5, i.e. 2(c + 0.5)/40 − 1 >=
+// −0.05/tan 20° = −0.137, c >= 16.75: columns 17..39 (23 × 40 = 920 pixels); bleeding in columns
+// 0..16 (680; no shadow edge in the image). A point light's six faces at the same place give the
+// same: the floor lies in its +X face (|x + 10| >= 6.4 > |z|, 0.5), where d is the same.
+TEST(Bleeding, APerspectiveMapsContactDistanceGrowsWithTheDistanceFromTheLight) {
+    scene::Scene s;
+    s.camera.position = scene::Vec3(0, 10, 0);
+    s.camera.lookAt = scene::Vec3(0, 0, 0);
+    s.camera.up = scene::Vec3(0, 0, -1);
+    s.camera.fovYDegrees = 40.0;
+    s.camera.width = 40;
+    s.camera.height = 40;
+    Frame m = test::uniformFrame(40, 40, 1.0f, 1.0f, 1.0f, true);
+    Frame r = test::uniformFrame(40, 40, 1.0f, 1.0f, 0.0f, true);
+    m.depth.assign(m.pixelCount(), 10.0f);
+    r.blockerId.assign(r.pixelCount(), 2.0f);
+    r.blockerDistance.assign(r.pixelCount(), 0.4f);
+    scene::recordIdentity(m, s);
+    scene::recordIdentity(r, s);
+    m.attributes["backend"] = "raster";
+    m.attributes["depth_bias"] = "0.02";
+    m.attributes["slope_bias"] = "0";
+    const std::string spotAxis = "-10,0.5,0,1,0,0";
+    const std::string faces[] = {"-10,0.5,0,1,0,0",  "-10,0.5,0,-1,0,0", "-10,0.5,0,0,1,0",
+                                 "-10,0.5,0,0,-1,0", "-10,0.5,0,0,0,1",  "-10,0.5,0,0,0,-1"};
+    std::string pointAxes, pointSizes;
+    for (int k = 0; k < 6; ++k) {
+        pointAxes += (k ? ";" : "") + faces[k];
+        pointSizes += k ? ";0.01*d" : "0.01*d";
+    }
+    for (const bool point : {false, true}) {
+        m.attributes["texel_world_size"] = point ? pointSizes : "0.01*d";
+        m.attributes["texel_axis"] = point ? pointAxes : spotAxis;
+        const Metrics x = compareFrames(m, r).metrics;
+        ASSERT_TRUE(x.hasBlockerDistance);
+        EXPECT_EQ(x.missedShadow, 1600u);
+        EXPECT_EQ(x.biasLeak, 920u) << (point ? "point" : "spot");
+        EXPECT_EQ(x.bleeding, 680u) << (point ? "point" : "spot");
+        // contact_distance: the smallest D over the counted pixels, at column 0's d = 10 − 10·0.975·tan 20°.
+        EXPECT_NEAR(x.contactDistance, 0.02 + 0.04 * (10.0 - 9.75 * std::tan(20.0 * M_PI / 180.0)), 1e-5);
+    }
+    // Without the camera the pixels' distances are unknown: X·d counts as X (D = 0.06), all bleeding.
+    m.typedAttributes.clear();
+    r.typedAttributes.clear();
+    const Metrics unknown = compareFrames(m, r).metrics;
+    EXPECT_DOUBLE_EQ(unknown.contactDistance, 0.02 + 4 * 0.01);
+    EXPECT_EQ(unknown.bleeding, 1600u);
+    // An orthographic map beside it keeps its constant texel: the larger of the two counts.
+    scene::recordIdentity(m, s);
+    m.attributes["texel_world_size"] = "0.2;0.01*d";
+    m.attributes["texel_axis"] = "-;" + spotAxis;
+    EXPECT_EQ(compareFrames(m, r).metrics.biasLeak, 1600u);  // D >= 0.02 + 4·0.2 = 0.82 everywhere
 }
 
 TEST(Bleeding, WithoutTheReferencesBlockerDistancesItIsUnknownNotZero) {
