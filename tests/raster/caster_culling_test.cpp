@@ -173,6 +173,11 @@ TEST(RasterCasterCulling, PcssOfAnAreaPointLightReachesFartherAndStillLeavesTheI
     EXPECT_NE(culled.attributes.at("culled_casters"), "0");
     EXPECT_EQ(culled.visibility, all.visibility);
     EXPECT_EQ(culled.blockerId, all.blockerId);
+    // Equal frames say something only where they hold soft shadows: `kept` (id 4) shadows the
+    // visible ground, and the light's radius gives its shadow a penumbra.
+    EXPECT_GT(countOf(culled.blockerId, 4), 0);
+    EXPECT_GT(std::count_if(culled.visibility.begin(), culled.visibility.end(), [](float v) { return v > 0.0f && v < 1.0f; }),
+              0);
 }
 
 TEST(RasterCasterCulling, EachCascadeDrawsOnlyTheCastersOfItsOwnSlice) {
