@@ -4,24 +4,21 @@
 // the image. Also the spot map's size from receiver detail (raster::chooseShadowMapSize).
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "raster/cascades.h"
 #include "raster/renderer.h"
-#include "scene/loader.h"
 #include "scene/render_plan.h"
-#include "tests/raster/test_scenes.h"
+#include "tests/kit/render_checked.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::raster {
 namespace {
 
 scene::Scene seedWith(const scene::Vec3& center, double radius) {
-    scene::Scene s = scene::loadScene(std::filesystem::path(SHADOWLAB_SOURCE_DIR) / "scenes" / "seed.json");
-    s.camera.width = 160;
-    s.camera.height = 90;
+    scene::Scene s = test::loadSeed(160, 90);
     scene::Object extra = s.objects[0];  // the sphere's material
     extra.name = "extra";
     extra.shape = scene::Sphere{center, radius};
@@ -33,11 +30,8 @@ scene::Frame rasterRender(const scene::Scene& s, bool cull, int cascades = 1) {
     scene::SettingsOverrides o;
     o.cascades = cascades;
     scene::RenderSettings settings = scene::resolveSettings(s, o);
-    settings.raster.validate = true;
     settings.raster.cullCasters = cull;
-    scene::Frame f = render(s, scene::makeRenderPlan(s, settings), settings.raster);
-    EXPECT_EQ(f.attributes["validation_messages"], "0") << "validation messages were printed above";
-    return f;
+    return test::renderChecked(s, settings);
 }
 
 int countOf(const std::vector<float>& ids, int id) {
@@ -179,6 +173,11 @@ TEST(RasterCasterCulling, PcssOfAnAreaPointLightReachesFartherAndStillLeavesTheI
     EXPECT_NE(culled.attributes.at("culled_casters"), "0");
     EXPECT_EQ(culled.visibility, all.visibility);
     EXPECT_EQ(culled.blockerId, all.blockerId);
+    // Equal frames say something only where they hold soft shadows: `kept` (id 4) shadows the
+    // visible ground, and the light's radius gives its shadow a penumbra.
+    EXPECT_GT(countOf(culled.blockerId, 4), 0);
+    EXPECT_GT(std::count_if(culled.visibility.begin(), culled.visibility.end(), [](float v) { return v > 0.0f && v < 1.0f; }),
+              0);
 }
 
 TEST(RasterCasterCulling, EachCascadeDrawsOnlyTheCastersOfItsOwnSlice) {
@@ -301,7 +300,7 @@ scene::Scene spotFromAbove(int height) {
 }
 
 int expectedSpotSize(int height) {
-    constexpr double kPi = 3.14159265358979323846;
+    using test::kPi;
     const double needed = 2.0 * std::tan(30.6 * kPi / 180.0) * (10.0 / 8.0) / (2.0 * std::tan(20.0 * kPi / 180.0) / height);
     int size = 256;
     while (size < needed && size < 2048) size *= 2;

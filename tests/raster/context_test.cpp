@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "raster/vulkan_error.h"
+#include "tests/kit/render_checked.h"
 
 namespace shadowlab::raster {
 namespace {
@@ -191,6 +192,33 @@ TEST(Devices, SelectingByIndexAndByNameGivesTheSameDevice) {
     const Context byName(ContextOptions{.device = byIndex.deviceReport.name.substr(0, 5), .validate = true, .log = &log});
     EXPECT_EQ(byIndex.deviceReport.name, byName.deviceReport.name);
     EXPECT_EQ(log.count.load(), 0);
+}
+
+TEST(RasterContext, MemoryTypeIsTheFirstWithTheRequiredFlagsPreferringOneWithThePreferredToo) {
+    // context.h: a type allowed by typeBits with all of `required`; among those one with all of
+    // `preferred` when there is one; else the first; RasterError naming the device when none fits.
+    // A made-up table of four types, set on a real context (restored before it is destroyed).
+    test::ValidatedContext vc;
+    Context& ctx = vc.get();
+    const VkPhysicalDeviceMemoryProperties real = ctx.memoryProperties;
+    constexpr VkMemoryPropertyFlags local = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, visible = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT,
+                                    coherent = VK_MEMORY_PROPERTY_HOST_COHERENT_BIT, cached = VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
+    ctx.memoryProperties.memoryTypeCount = 4;
+    const VkMemoryPropertyFlags types[4] = {local, visible | coherent, visible | coherent | cached, local | visible};
+    for (int i = 0; i < 4; ++i) ctx.memoryProperties.memoryTypes[i] = {types[i], 0};
+    EXPECT_EQ(ctx.memoryType(0b1111, local), 0u);
+    EXPECT_EQ(ctx.memoryType(0b1111, visible), 1u);                      // the first that has it
+    EXPECT_EQ(ctx.memoryType(0b1111, visible, cached), 2u);              // one with the preferred too
+    EXPECT_EQ(ctx.memoryType(0b1011, visible, cached), 1u);              // type 2 not allowed: the first
+    EXPECT_EQ(ctx.memoryType(0b1110, local), 3u);                        // type 0 not allowed
+    EXPECT_EQ(ctx.memoryType(0b1111, visible | coherent, local), 1u);    // no type has both: the first
+    try {
+        ctx.memoryType(0b0111, local | visible);
+        ADD_FAILURE() << "expected RasterError";
+    } catch (const RasterError& e) {
+        EXPECT_NE(std::string(e.what()).find(ctx.deviceReport.name), std::string::npos) << e.what();
+    }
+    ctx.memoryProperties = real;
 }
 
 }  // namespace

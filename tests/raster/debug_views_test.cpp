@@ -16,7 +16,8 @@
 #include "raster/renderer.h"
 #include "raster/tolerances.h"
 #include "scene/frame_io.h"
-#include "tests/raster/test_scenes.h"
+#include "tests/kit/render_checked.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::raster {
 namespace {

@@ -16,12 +16,14 @@
 #include "scene/camera.h"
 #include "scene/render_plan.h"
 #include "scene/settings.h"
+#include "tests/kit/render_checked.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::raster {
 namespace {
 
 using scene::Vec3;
-constexpr double kPi = 3.14159265358979323846;
+using test::kPi;
 
 scene::Material material(const std::string& name, double opacity = 1.0) {
     scene::Material m;
@@ -32,32 +34,13 @@ scene::Material material(const std::string& name, double opacity = 1.0) {
 }
 
 scene::Object quad(const Vec3& center, double sx, double sz, int materialIndex) {
-    scene::Quad q;
-    q.center = center;
-    q.normal = Vec3(0, 1, 0);
-    q.size = scene::Vec2(sx, sz);
-    scene::quadAxes(q.normal, q.uAxis, q.vAxis);
-    scene::Object o;
-    o.name = "quad";
-    o.shape = q;
-    o.material = materialIndex;
-    return o;
+    return test::horizontalQuad("quad", center, sx, sz, materialIndex);
 }
 
 // A 1000 x 1000 ground (y = 0) under a sun `elevation` degrees above the horizon along +x, the
 // camera at `eye` looking at `at`, 320 x 180.
 scene::Scene largeGround(double elevationDegrees, const Vec3& eye, const Vec3& at) {
-    scene::Scene s;
-    s.camera.position = eye;
-    s.camera.lookAt = at;
-    s.camera.up = Vec3(0, 1, 0);
-    s.camera.fovYDegrees = 40.0;
-    s.camera.width = 320;
-    s.camera.height = 180;
-    s.camera.near = 0.1;
-    s.camera.far = 1000.0;
-    s.ambient = 0.05;
-    s.materials.push_back(material("matte"));
+    scene::Scene s = test::matteScene(eye, at, 320, 180, 1000.0);
     const double e = elevationDegrees * kPi / 180.0;
     scene::Light l;
     l.type = scene::LightType::Directional;
@@ -71,19 +54,12 @@ scene::Scene largeGround(double elevationDegrees, const Vec3& eye, const Vec3& a
 // The world point of pixel (x, y) on the ground y = 0 (the pixel center's ray), if it hits it.
 std::optional<Vec3> groundPoint(const scene::Scene& s, int x, int y) {
     const scene::CameraBasis c = scene::cameraBasis(s.camera);
-    const double sx = ((x + 0.5) / s.camera.width * 2.0 - 1.0) * c.tanHalfFovY * c.aspect;
-    const double sy = (1.0 - (y + 0.5) / s.camera.height * 2.0) * c.tanHalfFovY;
-    const Vec3 d = c.forward + sx * c.right + sy * c.up;
-    if (!(d.y < 0.0)) return std::nullopt;
-    return c.position - (c.position.y / d.y) * d;
+    if (!(test::pixelRay(c, x, y).y < 0.0)) return std::nullopt;
+    return test::floorPoint(c, x, y);
 }
 
 scene::Frame renderDefaults(const scene::Scene& s, const scene::SettingsOverrides& o = {}) {
-    scene::RenderSettings settings = scene::resolveSettings(s, o);
-    settings.raster.validate = true;
-    scene::Frame f = render(s, scene::makeRenderPlan(s, settings), settings.raster);
-    EXPECT_EQ(f.attributes["validation_messages"], "0") << "validation messages were printed above";
-    return f;
+    return test::renderChecked(s, scene::resolveSettings(s, o));
 }
 
 // Ground pixels the sphere's shadow covers and how the raster frame classifies them, judged by
@@ -290,13 +266,7 @@ TEST(RasterDefaults, TheAutomaticMapSizeResolvesTheThinnestCaster) {
 TEST(RasterDefaults, TheAutomaticSpotMapSizeResolvesTheThinnestCasterAtItsDistance) {
     scene::Scene s = largeGround(90.0, Vec3(0, 10, 0.001), Vec3(0, 0, 0));
     std::get<scene::Quad>(s.objects[0].shape).size = scene::Vec2(10, 10);
-    scene::Light spot;
-    spot.type = scene::LightType::Spot;
-    spot.position = {0, 8, 0};
-    spot.direction = {0, -1, 0};
-    spot.coneAngleDegrees = 60;
-    spot.intensity = 800;
-    s.lights = {spot};
+    s.lights = {test::spotDown()};
     s.camera.width = 32;
     s.camera.height = 18;
     scene::Object bar;

@@ -14,10 +14,10 @@
 #include "raster/debug_views.h"
 #include "raster/light_frustum.h"
 #include "raster/renderer.h"
-#include "raytrace/renderer.h"
 #include "scene/camera.h"
 #include "scene/render_plan.h"
-#include "tests/raster/test_scenes.h"
+#include "tests/kit/render_checked.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::raster {
 namespace {
@@ -27,21 +27,19 @@ using test::Vec3;
 
 double deg(double d) { return d * kPi / 180.0; }
 
+// makeScene's sphere (r = 0.5) at `center` over a 20 x 20 ground, seen from `eye` toward `lookAt`.
+scene::Scene sphereOnTheGround(const Vec3& center, const Vec3& eye, const Vec3& lookAt, int width, int height) {
+    return test::makeScene(test::SphereOverPlane{
+        .center = center, .radius = 0.5, .planeSize = 20.0, .eye = eye, .lookAt = lookAt, .width = width, .height = height});
+}
+
 // Spot at (0, 8, 0) straight down, cone 60° (the cone map's half-angle 61.2°, t0 = tan 61.2°),
 // over a 20 x 20 ground at y = 0 with a sphere r = 0.5 at (2, 0.5, 0); the camera at (cameraX, 4, 0)
 // looks straight down (up −z, fov 40°, 160 x 90), so it sees the ground x = cameraX ± 4·tan 20°·16/9,
 // z = ±4·tan 20°. The map's basis (the axis is vertical, so right = dir × X): right = +z, up = +x,
 // u = z/d, v = x/d with d = 8 − y.
 scene::Scene spotScene(double cameraX = 2.0, int width = 160, int height = 90) {
-    test::SphereOverPlane p;
-    p.width = width;
-    p.height = height;
-    p.center = {2, 0.5, 0};
-    p.radius = 0.5;
-    p.planeSize = 20.0;
-    p.eye = {cameraX, 4, 0};
-    p.lookAt = {cameraX, 0, 0};
-    scene::Scene s = test::makeScene(p);
+    scene::Scene s = sphereOnTheGround({2, 0.5, 0}, {cameraX, 4, 0}, {cameraX, 0, 0}, width, height);
     s.camera.up = {0, 0, -1};
     s.lights = {test::spotDown()};
     return s;
@@ -311,8 +309,7 @@ TEST(RasterSpotFit, TheFittedRenderIsNoWorseAgainstTheReference) {
     const scene::Scene s = spotScene(2.0, 320, 180);
     scene::RenderSettings settings;
     settings.raster = fitSettings(256, false);
-    const scene::Frame ref =
-        raytrace::renderReference(s, scene::makeRenderPlan(s, settings), scene::referenceSettings(settings.raytrace));
+    const scene::Frame ref = test::renderReference(s, settings);
     const scene::Frame cone = renderChecked(s, fitSettings(256, false));
     const scene::Frame fitted = renderChecked(s, fitSettings(256, true));
     const compare::Metrics a = compare::compareFrames(fitted, ref).metrics;
@@ -329,15 +326,7 @@ TEST(RasterSpotFit, TheFittedRenderIsNoWorseAgainstTheReference) {
 // Point light at (0, 4, 0) over the same ground and sphere (at (0, 0.5, 0) here), the camera at
 // (0, 3, 6) looking at the origin.
 scene::Scene pointScene(int width = 160, int height = 90) {
-    test::SphereOverPlane p;
-    p.width = width;
-    p.height = height;
-    p.center = {0, 0.5, 0};
-    p.radius = 0.5;
-    p.planeSize = 20.0;
-    p.eye = {0, 3, 6};
-    p.lookAt = {0, 0, 0};
-    scene::Scene s = test::makeScene(p);
+    scene::Scene s = sphereOnTheGround({0, 0.5, 0}, {0, 3, 6}, {0, 0, 0}, width, height);
     scene::Light l;
     l.type = scene::LightType::Point;
     l.position = {0, 4, 0};
@@ -401,8 +390,7 @@ TEST(RasterPointFit, EachFaceTakesItsNearAndFarFromItsCastersAndReceivers) {
     pcssFit.filter = pcssPlain.filter = scene::ShadowFilter::Pcss;
     scene::RenderSettings rs;
     rs.raster = pcssPlain;
-    const scene::Frame ref = raytrace::renderReference(soft, scene::makeRenderPlan(soft, rs),
-                                                       scene::referenceSettings(rs.raytrace));
+    const scene::Frame ref = test::renderReference(soft, rs);
     const compare::Metrics a = compare::compareFrames(renderChecked(soft, pcssFit), ref).metrics;
     const compare::Metrics b = compare::compareFrames(renderChecked(soft, pcssPlain), ref).metrics;
     std::printf("pcss: mean |dV| fitted %.4f, bounding-sphere range %.4f; wrong %zu, %zu\n", a.meanAbsVisibilityError,
@@ -481,11 +469,8 @@ TEST(RasterMapSize, APointLightsMapIsSizedByTheFinestReceiverDetail) {
     s.shadow.shadowMapSize = 1024;
     EXPECT_EQ(chooseShadowMapSize(s, scene::resolveSettings(s, {}).raster).size, 1024);
     // The render uses it (validated).
-    scene::RenderSettings rs = scene::resolveSettings(pointFromAbove(90), {});
-    rs.raster.validate = true;
     const scene::Scene p = pointFromAbove(90);
-    const scene::Frame f = render(p, scene::makeRenderPlan(p, rs), rs.raster);
-    EXPECT_EQ(f.attributes.at("validation_messages"), "0");
+    const scene::Frame f = renderChecked(p, scene::resolveSettings(p, {}));
     EXPECT_EQ(f.attributes.at("shadow_map_size"), "512");
 }
 

@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "raster/tolerances.h"
-#include "tests/raster/test_scenes.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::raster {
 namespace {

@@ -2,34 +2,23 @@
 // (raster::chooseShadowMapSize): a small render of the seed scene gets a smaller map with the same
 // shadow classification against the double-precision reference; a forced size is kept.
 #include <cmath>
-#include <filesystem>
 
 #include <gtest/gtest.h>
 
 #include "compare/compare.h"
 #include "raster/renderer.h"
-#include "raytrace/renderer.h"
-#include "scene/loader.h"
 #include "scene/render_plan.h"
+#include "tests/kit/render_checked.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::raster {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-scene::Scene seed(int width, int height) {
-    scene::Scene s = scene::loadScene(std::filesystem::path(SHADOWLAB_SOURCE_DIR) / "scenes" / "seed.json");
-    s.camera.width = width;
-    s.camera.height = height;
-    return s;
-}
+using test::kPi;
+using test::loadSeed;
 
 scene::Frame rasterRender(const scene::Scene& s, const scene::SettingsOverrides& o) {
-    scene::RenderSettings settings = scene::resolveSettings(s, o);
-    settings.raster.validate = true;
-    scene::Frame f = render(s, scene::makeRenderPlan(s, settings), settings.raster);
-    EXPECT_EQ(f.attributes["validation_messages"], "0") << "validation messages were printed above";
-    return f;
+    return test::renderChecked(s, scene::resolveSettings(s, o));
 }
 
 // The size the seed scene's receivers need at `height` rows, worked out from its numbers: camera
@@ -49,7 +38,7 @@ int expectedSize(int height) {
 
 TEST(RasterMapSize, ASmallRenderGetsASmallerMapWithTheSameShadows) {
     ASSERT_EQ(expectedSize(36), 512);  // 28.6 / 0.0713 ≈ 402 texels
-    const scene::Scene s = seed(64, 36);
+    const scene::Scene s = loadSeed(64, 36);
     scene::Frame automatic = rasterRender(s, {});
     EXPECT_EQ(automatic.attributes["shadow_map_size"], "512");
     EXPECT_NE(automatic.attributes["shadow_map_size_reason"].find("receiver detail"), std::string::npos);
@@ -59,9 +48,7 @@ TEST(RasterMapSize, ASmallRenderGetsASmallerMapWithTheSameShadows) {
     EXPECT_EQ(full.attributes["shadow_map_size"], "2048");
     EXPECT_NE(full.attributes["shadow_map_size_reason"].find("set by"), std::string::npos);
 
-    const scene::RenderSettings settings = scene::resolveSettings(s, {});
-    const scene::Frame ref = raytrace::renderReference(s, scene::makeRenderPlan(s, settings),
-                                                       scene::referenceSettings(settings.raytrace));
+    const scene::Frame ref = test::renderReference(s);
     const compare::Metrics a = compare::compareFrames(automatic, ref).metrics;
     const compare::Metrics b = compare::compareFrames(full, ref).metrics;
     std::printf("counted %zu, reference shadowed %zu; wrong: auto %zu, 2048 %zu\n", a.counted, a.shadowedReference,
@@ -74,13 +61,13 @@ TEST(RasterMapSize, ASmallRenderGetsASmallerMapWithTheSameShadows) {
 TEST(RasterMapSize, AFullSizeRenderKeepsTheDefault) {
     // At 720 rows the receivers need ≈ 8000 texels: capped at the default.
     EXPECT_EQ(expectedSize(720), 2048);
-    const scene::Scene s = seed(1280, 720);
+    const scene::Scene s = loadSeed(1280, 720);
     const ShadowMapSizeChoice c = chooseShadowMapSize(s, scene::resolveSettings(s, {}).raster);
     EXPECT_EQ(c.size, 2048);
 }
 
 TEST(RasterMapSize, ASizeFromTheSceneIsKept) {
-    scene::Scene s = seed(64, 36);
+    scene::Scene s = loadSeed(64, 36);
     s.shadow.shadowMapSize = 2048;
     EXPECT_EQ(chooseShadowMapSize(s, scene::resolveSettings(s, {}).raster).size, 2048);
     s.shadow.shadowMapSize.reset();
@@ -92,7 +79,7 @@ TEST(RasterMapSize, OnlyLightsWithAShadowPassAskForTexels) {
     // scene asks for far more: its texels are 2/(N − 24) per unit of axial distance (~500) and a
     // pixel at view depth ~6 is 6·2·tan 20°/36 = 0.12, so N ≈ 2·500/0.12 ≫ 2048, capped at the
     // default. When the plan gives that light no shadow pass, it asks for nothing.
-    scene::Scene s = seed(64, 36);
+    scene::Scene s = loadSeed(64, 36);
     scene::Light point;
     point.type = scene::LightType::Point;
     point.position = scene::Vec3(0, 500, 0);

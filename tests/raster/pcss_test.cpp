@@ -4,8 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <filesystem>
 #include <string>
 #include <variant>
 #include <vector>
@@ -13,8 +11,8 @@
 #include <gtest/gtest.h>
 
 #include "raster/renderer.h"
-#include "scene/frame_io.h"
-#include "tests/raster/test_scenes.h"
+#include "tests/kit/render_checked.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::raster {
 namespace {
@@ -40,16 +38,8 @@ scene::Scene edgeScene(double hb) {
     l.radius = 0.5 * kSize;
     l.intensity = 2000.0;
     s.lights.push_back(l);
-    auto quad = [](const Vec3& c, double side) {
-        scene::Quad q;
-        q.center = c;
-        q.normal = Vec3(0, 1, 0);
-        q.size = scene::Vec2(side, side);
-        scene::quadAxes(q.normal, q.uAxis, q.vAxis);
-        return q;
-    };
-    s.objects.push_back({"floor", quad(Vec3(0, 0, 0), 20.0), 0});
-    s.objects.push_back({"blocker", quad(Vec3(-3, hb, 0), 6.0), 0});
+    s.objects.push_back(test::horizontalQuad("floor", Vec3(0, 0, 0), 20.0, 20.0));
+    s.objects.push_back(test::horizontalQuad("blocker", Vec3(-3, hb, 0), 6.0, 6.0));
     return s;
 }
 
@@ -85,9 +75,7 @@ double rampWidth(const scene::Scene& s, const scene::Frame& f, double umbra = 0.
 }
 
 scene::Frame renderPcss(const scene::Scene& s) {
-    scene::RasterSettings r = test::validatedSettings(512, 0.01, 1.0, scene::ShadowFilter::Pcss);
-    scene::Frame f = render(s, test::planFor(s, r), r);
-    EXPECT_EQ(f.attributes["validation_messages"], "0") << "validation messages were printed above";
+    scene::Frame f = test::renderChecked(s, test::validatedSettings(512, 0.01, 1.0, scene::ShadowFilter::Pcss));
     EXPECT_EQ(f.attributes["filter"], "pcss");
     return f;
 }
@@ -159,10 +147,9 @@ TEST(RasterPcss, APointSizedLightKeepsTheHardShadowOfPoisson) {
     scene::RasterSettings pcss = test::validatedSettings(512, 0.01, 1.0, scene::ShadowFilter::Pcss);
     scene::RasterSettings poisson = pcss;
     poisson.filter = scene::ShadowFilter::Poisson;
-    const scene::Frame a = render(s, test::planFor(s, pcss), pcss);
-    const scene::Frame b = render(s, test::planFor(s, poisson), poisson);
+    const scene::Frame a = test::renderChecked(s, pcss);
+    const scene::Frame b = test::renderChecked(s, poisson);
     EXPECT_EQ(a.visibility, b.visibility);
-    EXPECT_EQ(a.attributes.at("validation_messages"), "0");
 }
 
 // A point light of diameter 1 at height 4 above the origin, a blocker quad at height 2 covering
@@ -238,9 +225,7 @@ TEST(RasterPcss, APointLightPenumbraCrossesACubeFaceSeamWithoutACut) {
         EXPECT_LT(mean, 0.04) << (side ? "+X" : "-Y") << " side of the seam";
     }
     EXPECT_LT(std::abs(err[0] / count[0] - err[1] / count[1]), 0.03);
-    if (const char* dir = std::getenv("SHADOWLAB_TEST_PNG_DIR")) {
-        scene::writePngLinear(std::filesystem::path(dir) / "pcss_point_seam.png", f.width, f.height, f.beauty);
-    }
+    test::writePngToLookAt(f, "pcss_point_seam");
 }
 
 }  // namespace

@@ -3,19 +3,16 @@
 // reference (raytrace::renderReference), on lavapipe with the validation layer.
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <filesystem>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "compare/compare.h"
 #include "raster/renderer.h"
-#include "raytrace/renderer.h"
-#include "scene/frame_io.h"
-#include "scene/loader.h"
 #include "scene/camera.h"
 #include "scene/render_plan.h"
+#include "tests/kit/render_checked.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::raster {
 namespace {
@@ -23,29 +20,17 @@ namespace {
 // The seed scene (sphere on a plane) at 160x90, its light lowered to `elevationDegrees` above
 // the plane, keeping the seed's azimuth (-1, ·, -1).
 scene::Scene grazingSeed(double elevationDegrees) {
-    scene::Scene s = scene::loadScene(std::filesystem::path(SHADOWLAB_SOURCE_DIR) / "scenes" / "seed.json");
-    s.camera.width = 160;
-    s.camera.height = 90;
-    const double e = elevationDegrees * 3.14159265358979323846 / 180.0;
+    scene::Scene s = test::loadSeed(160, 90);
+    const double e = elevationDegrees * test::kPi / 180.0;
     s.lights[0].direction = glm::normalize(scene::Vec3(-std::cos(e) / std::sqrt(2.0), -std::sin(e),
                                                        -std::cos(e) / std::sqrt(2.0)));
     return s;
 }
 
-scene::Frame rasterRender(const scene::Scene& s, scene::RasterSettings settings, const std::string& name) {
-    settings.validate = true;
-    scene::RenderSettings all;
-    all.raster = settings;
-    scene::Frame f = render(s, scene::makeRenderPlan(s, all), settings);
-    EXPECT_EQ(f.attributes["validation_messages"], "0") << "validation messages were printed above";
-    if (const char* dir = std::getenv("SHADOWLAB_TEST_PNG_DIR"))
-        scene::writePngLinear(std::filesystem::path(dir) / (name + ".png"), f.width, f.height, f.beauty);
+scene::Frame rasterRender(const scene::Scene& s, const scene::RasterSettings& settings, const std::string& name) {
+    scene::Frame f = test::renderChecked(s, settings);
+    test::writePngToLookAt(f, name);
     return f;
-}
-
-scene::Frame reference(const scene::Scene& s) {
-    const scene::RenderSettings settings = scene::resolveSettings(s, {});
-    return raytrace::renderReference(s, scene::makeRenderPlan(s, settings), scene::referenceSettings(settings.raytrace));
 }
 
 // pcf 5x5, no slope bias, the default constant bias (half a texel of the bounding-sphere map).
@@ -69,7 +54,7 @@ TEST(RasterReceiverPlane, RemovesThePcfAcneThatTheSameConstantBiasShowsAtGrazing
     // compares each tap against the plane's own depth at the tap's texel center: the plane no
     // longer shadows itself, while the sphere's shadow (≫ a texel deep) stays.
     const scene::Scene s = grazingSeed(8.0);
-    const scene::Frame ref = reference(s);
+    const scene::Frame ref = test::renderReference(s);
     const compare::Metrics off = compare::compareFrames(rasterRender(s, pcf5(s, false), "rpb-off"), ref).metrics;
     const compare::Metrics on = compare::compareFrames(rasterRender(s, pcf5(s, true), "rpb-on"), ref).metrics;
     std::printf("counted %zu, reference shadowed %zu; off: false %zu (self acne %zu) missed %zu; "
@@ -119,16 +104,8 @@ scene::Scene grazingSpot() {
     l.radius = 0.75;
     l.intensity = 800.0;
     s.lights.push_back(l);
-    auto quad = [](const scene::Vec3& c, double side) {
-        scene::Quad q;
-        q.center = c;
-        q.normal = {0, 1, 0};
-        q.size = scene::Vec2(side, side);
-        scene::quadAxes(q.normal, q.uAxis, q.vAxis);
-        return q;
-    };
-    s.objects.push_back({"floor", quad({0, 0, 0}, 20.0), 0});
-    s.objects.push_back({"caster", quad({2, 0.02, 0}, 1.5), 0});
+    s.objects.push_back(test::horizontalQuad("floor", {0, 0, 0}, 20.0, 20.0));
+    s.objects.push_back(test::horizontalQuad("caster", {2, 0.02, 0}, 1.5, 1.5));
     return s;
 }
 
@@ -151,7 +128,7 @@ PcssPlaneRun pcssWithThePlane(const scene::Scene& s, const std::string& name) {
     run.f = rasterRender(s, settings, name);
     scene::RenderSettings rs;
     rs.raster = settings;
-    run.ref = raytrace::renderReference(s, scene::makeRenderPlan(s, rs), scene::referenceSettings(rs.raytrace));
+    run.ref = test::renderReference(s, rs);
     run.cam = scene::cameraBasis(s.camera);
     return run;
 }
@@ -180,7 +157,7 @@ TEST(RasterReceiverPlane, PcssBlockerSearchDoesNotCountTheReceiverItself) {
             const scene::Vec3 q = cam.position + (-cam.position.y / d.y) * d;  // the test's own hit
             // Inside the cone (visibility 0 outside it), 1° to spare.
             const double cosAxis = glm::dot(glm::normalize(q - s.lights[0].position), s.lights[0].direction);
-            if (q.x < 1.0 && cosAxis > std::cos(29.0 * 3.14159265358979323846 / 180.0)) {
+            if (q.x < 1.0 && cosAxis > std::cos(29.0 * test::kPi / 180.0)) {
                 ++front;
                 refLit += ref.visibility[i] >= 0.999f;
                 darkened += f.visibility[i] < 1.0f;

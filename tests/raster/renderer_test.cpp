@@ -5,16 +5,15 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <cstdio>
-#include <filesystem>
 #include <utility>
 
 #include <gtest/gtest.h>
 
 #include "raster/cascades.h"
 #include "scene/frame_io.h"
-#include "tests/raster/test_scenes.h"
+#include "tests/kit/render_checked.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::raster {
 namespace {
@@ -22,15 +21,10 @@ namespace {
 using namespace test;
 using scene::ShadowFilter;
 
-void maybeWritePng(const scene::Frame& f, const std::string& name) {
-    if (const char* dir = std::getenv("SHADOWLAB_TEST_PNG_DIR"))
-        scene::writePngLinear(std::filesystem::path(dir) / (name + ".png"), f.width, f.height, f.beauty);
-}
-
+// renderChecked (validation on, no messages), and the beauty written to look at when asked.
 scene::Frame renderValidated(const scene::Scene& s, const scene::RasterSettings& settings, const std::string& name) {
-    scene::Frame f = render(s, planFor(s, settings), settings);
-    EXPECT_EQ(f.attributes["validation_messages"], "0") << "validation messages were printed above";
-    maybeWritePng(f, name);
+    scene::Frame f = renderChecked(s, settings);
+    writePngToLookAt(f, name);
     return f;
 }
 
@@ -122,38 +116,38 @@ struct ShadowErrors {
 };
 
 ShadowErrors shadowErrors(const SphereOverPlane& p, const scene::Scene& s, const scene::Frame& f, double bias = 0.0) {
-    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
     ShadowErrors e;
-    for (int y = 0; y < f.height; ++y)
-        for (int x = 0; x < f.width; ++x) {
-            const PrimaryHit h = primaryHit(p, cam, x, y);
-            const std::size_t i = at(f, x, y);
-            if (h.id != 2 || f.objectId[i] != 2.0f) continue;  // plane in both
-            ++e.counted;
-            const bool shadowed = planePointShadowed(p, h.p);
-            e.analyticShadowed += shadowed;
-            if (!shadowed && f.visibility[i] < 0.5f) ++e.falseShadow;
-            if (shadowed && f.visibility[i] > 0.5f) ++e.missedShadow;
-            const double behind = depthBehindCaster(p, h.p);
-            if (shadowed && behind < 0.95 * bias) {
-                ++e.predictedLeak;
-                e.leakedOfPredicted += f.visibility[i] > 0.5f;
-            } else if (shadowed && behind > 1.05 * bias) {
-                ++e.predictedKept;
-                e.keptOfPredicted += f.visibility[i] < 0.5f;
-            }
+    forEachPlanePixel(p, s, f, [&](std::size_t i, const Vec3& q) {
+        ++e.counted;
+        const bool shadowed = planePointShadowed(p, q);
+        e.analyticShadowed += shadowed;
+        if (!shadowed && f.visibility[i] < 0.5f) ++e.falseShadow;
+        if (shadowed && f.visibility[i] > 0.5f) ++e.missedShadow;
+        const double behind = depthBehindCaster(p, q);
+        if (shadowed && behind < 0.95 * bias) {
+            ++e.predictedLeak;
+            e.leakedOfPredicted += f.visibility[i] > 0.5f;
+        } else if (shadowed && behind > 1.05 * bias) {
+            ++e.predictedKept;
+            e.keptOfPredicted += f.visibility[i] < 0.5f;
         }
+    });
     return e;
 }
 
-// The sphere resting on the plane (center at its radius, 0.5), 320x180, light `elevation`° above
-// the plane.
-SphereOverPlane restingSphere(double elevation) {
+// The sphere over the plane at 320x180, light `elevation`° above the plane.
+SphereOverPlane litFrom(double elevation) {
     SphereOverPlane p;
-    p.center = Vec3(0, 0.5, 0);
     p.width = 320;
     p.height = 180;
     p.lightDirection = lightFromElevation(elevation);
+    return p;
+}
+
+// The same with the sphere resting on the plane (center at its radius, 0.5).
+SphereOverPlane restingSphere(double elevation) {
+    SphereOverPlane p = litFrom(elevation);
+    p.center = Vec3(0, 0.5, 0);
     return p;
 }
 
@@ -491,23 +485,22 @@ struct EdgeStats {
     int exactWrong = 0, fractional = 0, farFromEdge = 0;
 };
 
+// How far the plane point q lies across the light from the sphere's shadow outline (negative
+// inside the shadow): |(c − q) × L| − r.
+double acrossTheOutline(const SphereOverPlane& p, const Vec3& q) {
+    return glm::length(glm::cross(p.center - q, -glm::normalize(p.lightDirection))) - p.radius;
+}
+
 EdgeStats edgeStats(const SphereOverPlane& p, const scene::Scene& s, const scene::Frame& f, double band) {
-    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
-    const Vec3 l = -glm::normalize(p.lightDirection);
     EdgeStats e;
-    for (int y = 0; y < f.height; ++y)
-        for (int x = 0; x < f.width; ++x) {
-            const PrimaryHit h = primaryHit(p, cam, x, y);
-            const std::size_t i = at(f, x, y);
-            if (h.id != 2 || f.objectId[i] != 2.0f) continue;
-            const float v = f.visibility[i];
-            if (v > 0.0f && v < 1.0f) ++e.fractional;
-            const double across = glm::length(glm::cross(p.center - h.p, l)) - p.radius;
-            if (std::abs(across) <= band) continue;
-            ++e.farFromEdge;
-            const float expected = planePointShadowed(p, h.p) ? 0.0f : 1.0f;
-            if (v != expected) ++e.exactWrong;
-        }
+    forEachPlanePixel(p, s, f, [&](std::size_t i, const Vec3& q) {
+        const float v = f.visibility[i];
+        if (v > 0.0f && v < 1.0f) ++e.fractional;
+        if (std::abs(acrossTheOutline(p, q)) <= band) return;
+        ++e.farFromEdge;
+        const float expected = planePointShadowed(p, q) ? 0.0f : 1.0f;
+        if (v != expected) ++e.exactWrong;
+    });
     return e;
 }
 
@@ -535,10 +528,7 @@ TEST(RasterFilters, FiltersSoftenOnlyABandAroundTheShadowOutline) {
     // Taps reach at most (N−1)/2 texels (pcf) or N/2 texels (poisson) from the point, plus half a
     // texel of nearest-texel rounding: outside a band of N/2 + 1.5 texels around the outline
     // the visibility must be exactly 0 or 1, and inside it filtering makes fractions.
-    SphereOverPlane p;
-    p.lightDirection = lightFromElevation(60.0);
-    p.width = 320;
-    p.height = 180;
+    const SphereOverPlane p = litFrom(60.0);
     const scene::Scene s = makeScene(p);
     const double texel = 1.01 * s.bounds().diagonal() / 256;
     struct Case {
@@ -567,10 +557,7 @@ TEST(RasterFilters, Pcf2x2LiesBetweenTheHardResultsOfTheNeighbouringTexels) {
     // filters compare against the same reference, so per pixel: hard lit ⇒ pcf ≥ 1/4, hard
     // shadowed ⇒ pcf ≤ 3/4, and a pcf of exactly 0 or 1 (all four agree) equals the hard one.
     // A few pixels may see float rounding pick a different nearest texel: at most 0.1%.
-    SphereOverPlane p;
-    p.lightDirection = lightFromElevation(40.0);
-    p.width = 320;
-    p.height = 180;
+    const SphereOverPlane p = litFrom(40.0);
     const scene::Scene s = makeScene(p);
     const scene::Frame hard = renderValidated(s, validatedSettings(256, 0.02, 0.0, ShadowFilter::None), "between-hard");
     const scene::Frame soft = renderValidated(s, validatedSettings(256, 0.02, 0.0, ShadowFilter::Pcf2x2), "between-pcf");
@@ -589,28 +576,32 @@ TEST(RasterFilters, Pcf2x2LiesBetweenTheHardResultsOfTheNeighbouringTexels) {
 }
 
 TEST(RasterFilters, NoneHasNoFractionalVisibility) {
-    SphereOverPlane p;
-    p.lightDirection = lightFromElevation(60.0);
+    // The nearest-texel lookup answers 0 or 1 even where a filter answers a fraction: on the plane
+    // pixels within two texels (across the light) of the sphere's shadow outline, where pcf2x2 of
+    // the same scene is fractional, `none` must be exactly 0 or 1, and it must give both there
+    // (the band straddles the outline). The bounding-sphere map's texel is 1.01·diagonal/256.
+    const SphereOverPlane p = litFrom(60.0);
     const scene::Scene s = makeScene(p);
-    const scene::Frame f = renderValidated(s, filterSettings(ShadowFilter::None, 3), "filter-none-only");
-    // Over the objects, the frame must hold both answers (an all-lit frame would pass the binary
-    // check vacuously) and nothing between them.
-    std::size_t lit = 0, shadowed = 0, objects = 0;
-    for (std::size_t i = 0; i < f.visibility.size(); ++i) {
-        if (f.objectId[i] == 0.0f) continue;
-        ++objects;
-        const float v = f.visibility[i];
-        ASSERT_TRUE(v == 0.0f || v == 1.0f) << v << " at pixel " << i;
-        (v == 0.0f ? shadowed : lit) += 1;
-    }
-    EXPECT_GT(shadowed, objects / 100) << "no shadow to test the filter on";
-    EXPECT_GT(lit, objects / 10);
-    // The same scene through a filtering kernel has fractional values at the shadow's edge, so the
-    // scene can tell a nearest-texel lookup from a filter.
+    const double texel = 1.01 * s.bounds().diagonal() / 256;
+    const scene::Frame none = renderValidated(s, filterSettings(ShadowFilter::None, 3), "filter-none-only");
     const scene::Frame pcf = renderValidated(s, filterSettings(ShadowFilter::Pcf2x2, 3), "filter-pcf2x2-contrast");
-    const auto fractional = std::count_if(pcf.visibility.begin(), pcf.visibility.end(),
-                                          [](float v) { return v > 0.0f && v < 1.0f; });
-    EXPECT_GT(fractional, 0);
+    int band = 0, lit = 0, shadowed = 0, fractional = 0, pcfFractional = 0;
+    forEachPlanePixel(p, s, none, [&](std::size_t i, const Vec3& q) {
+        if (std::abs(acrossTheOutline(p, q)) > 2.0 * texel) return;
+        ++band;
+        const float v = none.visibility[i], w = pcf.visibility[i];
+        fractional += v > 0.0f && v < 1.0f;
+        lit += v == 1.0f;
+        shadowed += v == 0.0f;
+        pcfFractional += w > 0.0f && w < 1.0f;
+    });
+    // pcf2x2 is fractional where its 2x2 texels straddle the outline, a strip about one texel
+    // wide in this four-texel band: about a quarter of it; without those fractions the band could
+    // not tell a lookup from a filter.
+    ASSERT_GT(pcfFractional, band / 8) << "of " << band << " pixels at the outline";
+    EXPECT_EQ(fractional, 0) << "of " << band << " pixels at the outline";
+    EXPECT_GT(lit, band / 10);
+    EXPECT_GT(shadowed, band / 10);
 }
 
 TEST(RasterNormalOffset, NormalOffsetRemovesAcneWithoutDepthBias) {
@@ -619,10 +610,7 @@ TEST(RasterNormalOffset, NormalOffsetRemovesAcneWithoutDepthBias) {
     // δ/cos(θ) in front of the plane along the light, while the stored depth of a neighbouring
     // texel center differs from the plane's by at most (√2/2)·texel·tan(θ) (nearest texel, half a
     // diagonal away): k > (√2/2)·sin(θ) ≈ 0.61 suffices at θ = 60°; k = 1.5 leaves margin.
-    SphereOverPlane p;
-    p.lightDirection = lightFromElevation(30.0);
-    p.width = 320;
-    p.height = 180;
+    const SphereOverPlane p = litFrom(30.0);
     const scene::Scene s = makeScene(p);
     scene::RasterSettings settings = validatedSettings(512, 0.0, 0.0, ShadowFilter::None);
     const ShadowErrors without = shadowErrors(p, s, renderValidated(s, settings, "no-offset"));
@@ -643,42 +631,31 @@ TEST(RasterBlockerId, ShadowedPlanePixelsNameTheSphereAndAcneNamesThePlaneItself
     {
         const SphereOverPlane p;
         const scene::Scene s = makeScene(p);
-        const scene::CameraBasis cam = scene::cameraBasis(s.camera);
         const scene::Frame f = renderValidated(s, validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2), "blocker");
         ASSERT_EQ(f.blockerId.size(), f.pixelCount());
         int shadowedChecked = 0;
-        for (int y = 0; y < f.height; ++y)
-            for (int x = 0; x < f.width; ++x) {
-                const std::size_t i = at(f, x, y);
-                const PrimaryHit h = primaryHit(p, cam, x, y);
-                if (h.id != 2 || f.objectId[i] != 2.0f) continue;
-                if (f.visibility[i] == 0.0f) {
-                    EXPECT_EQ(f.blockerId[i], 1.0f);
-                    ++shadowedChecked;
-                }
-                if (f.visibility[i] == 1.0f) {
-                    EXPECT_EQ(f.blockerId[i], 0.0f);
-                }
+        forEachPlanePixel(p, s, f, [&](std::size_t i, const Vec3&) {
+            if (f.visibility[i] == 0.0f) {
+                EXPECT_EQ(f.blockerId[i], 1.0f);
+                ++shadowedChecked;
             }
+            if (f.visibility[i] == 1.0f) {
+                EXPECT_EQ(f.blockerId[i], 0.0f);
+            }
+        });
         EXPECT_GT(shadowedChecked, 50);
     }
     {
         SphereOverPlane p;
         p.lightDirection = lightFromElevation(10.0);
         const scene::Scene s = makeScene(p);
-        const scene::CameraBasis cam = scene::cameraBasis(s.camera);
         const scene::Frame f = renderValidated(s, validatedSettings(512, 0.0, 0.0, ShadowFilter::None), "blocker-acne");
         int acne = 0, selfBlocked = 0;
-        for (int y = 0; y < f.height; ++y)
-            for (int x = 0; x < f.width; ++x) {
-                const std::size_t i = at(f, x, y);
-                const PrimaryHit h = primaryHit(p, cam, x, y);
-                if (h.id != 2 || f.objectId[i] != 2.0f || planePointShadowed(p, h.p)) continue;
-                if (f.visibility[i] < 0.5f) {
-                    ++acne;
-                    selfBlocked += f.blockerId[i] == 2.0f;
-                }
-            }
+        forEachPlanePixel(p, s, f, [&](std::size_t i, const Vec3& q) {
+            if (planePointShadowed(p, q) || f.visibility[i] >= 0.5f) return;
+            ++acne;
+            selfBlocked += f.blockerId[i] == 2.0f;
+        });
         ASSERT_GT(acne, 1000);
         EXPECT_EQ(selfBlocked, acne);
     }
@@ -699,35 +676,30 @@ TEST(RasterSpotLight, PerspectiveShadowMatchesTheClosedForm) {
     s.lights[0].direction = Vec3(0, -1, 0);
     s.lights[0].coneAngleDegrees = cone;
     s.lights[0].intensity = 300.0;
-    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
     const scene::Frame f = renderValidated(s, validatedSettings(1024, 0.01, 1.0, ShadowFilter::Pcf2x2), "spot");
     const double cosCone = std::cos(cone * kPi / 180.0);
     int counted = 0, shadowed = 0, wrong = 0, dark = 0;
-    for (int y = 0; y < f.height; ++y)
-        for (int x = 0; x < f.width; ++x) {
-            const std::size_t i = at(f, x, y);
-            const PrimaryHit h = primaryHit(p, cam, x, y);
-            if (h.id != 2 || f.objectId[i] != 2.0f) continue;
-            const Vec3 toLight = lightPos - h.p;
-            const double cosAngle = glm::dot(-glm::normalize(toLight), Vec3(0, -1, 0));
-            if (cosAngle < cosCone - 0.01) {  // well outside the cone: no light at all
-                ++dark;
-                EXPECT_EQ(f.visibility[i], 0.0f);
-                EXPECT_NEAR(f.beauty[3 * i], 0.05 * 0.8, 1e-5);
-                continue;
-            }
-            if (cosAngle < cosCone + 0.01) continue;  // the rim
-            ++counted;
-            const auto t = raySphere(h.p, toLight, p.center, p.radius);
-            const bool inShadow = t && *t < 1.0;
-            shadowed += inShadow;
-            if ((f.visibility[i] > 0.5f) == inShadow) ++wrong;
-            if (!inShadow && f.visibility[i] == 1.0f) {
-                const double d2 = glm::dot(toLight, toLight);
-                const double ndotl = toLight.y / std::sqrt(d2);
-                EXPECT_NEAR(f.beauty[3 * i], 0.8 * 300.0 / (4 * kPi * d2) * ndotl + 0.05 * 0.8, 2e-4);
-            }
+    forEachPlanePixel(p, s, f, [&](std::size_t i, const Vec3& q) {
+        const Vec3 toLight = lightPos - q;
+        const double cosAngle = glm::dot(-glm::normalize(toLight), Vec3(0, -1, 0));
+        if (cosAngle < cosCone - 0.01) {  // well outside the cone: no light at all
+            ++dark;
+            EXPECT_EQ(f.visibility[i], 0.0f);
+            EXPECT_NEAR(f.beauty[3 * i], 0.05 * 0.8, 1e-5);
+            return;
         }
+        if (cosAngle < cosCone + 0.01) return;  // the rim
+        ++counted;
+        const auto t = raySphere(q, toLight, p.center, p.radius);
+        const bool inShadow = t && *t < 1.0;
+        shadowed += inShadow;
+        if ((f.visibility[i] > 0.5f) == inShadow) ++wrong;
+        if (!inShadow && f.visibility[i] == 1.0f) {
+            const double d2 = glm::dot(toLight, toLight);
+            const double ndotl = toLight.y / std::sqrt(d2);
+            EXPECT_NEAR(f.beauty[3 * i], 0.8 * 300.0 / (4 * kPi * d2) * ndotl + 0.05 * 0.8, 2e-4);
+        }
+    });
     EXPECT_GT(dark, 1000);
     EXPECT_GT(counted, 5000);
     EXPECT_GT(shadowed, 300);
@@ -761,23 +733,28 @@ TEST(RasterFittedFrustum, FittedMapIsFinerAndKeepsShadowsFromCastersOutsideTheVi
     EXPECT_LT(std::stod(fitted.attributes.at("texel_world_size")),
               0.75 * std::stod(sphereFit.attributes.at("texel_world_size")));
     // Closed form with both spheres.
-    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
     const Vec3 l = -glm::normalize(p.lightDirection);
     int counted = 0, shadowed = 0, shadowedByBehind = 0, wrong = 0;
-    for (int y = 0; y < fitted.height; ++y)
-        for (int x = 0; x < fitted.width; ++x) {
-            const std::size_t i = at(fitted, x, y);
-            const PrimaryHit h = primaryHit(p, cam, x, y);
-            if (h.id != 2 || fitted.objectId[i] != 2.0f) continue;
-            const bool byFirst = raySphere(h.p, l, p.center, p.radius).has_value();
-            const bool byBehind = raySphere(h.p, l, behindCenter, 0.8).has_value();
-            ++counted;
-            shadowed += byFirst || byBehind;
-            shadowedByBehind += byBehind;
-            if ((fitted.visibility[i] > 0.5f) == (byFirst || byBehind)) ++wrong;
-        }
+    forEachPlanePixel(p, s, fitted, [&](std::size_t i, const Vec3& q) {
+        const bool byFirst = raySphere(q, l, p.center, p.radius).has_value();
+        const bool byBehind = raySphere(q, l, behindCenter, 0.8).has_value();
+        ++counted;
+        shadowed += byFirst || byBehind;
+        shadowedByBehind += byBehind;
+        if ((fitted.visibility[i] > 0.5f) == (byFirst || byBehind)) ++wrong;
+    });
     ASSERT_GT(shadowedByBehind, 100) << "the test needs the unseen sphere's shadow in view";
     EXPECT_LT(wrong, shadowed / 20) << wrong << " wrong of " << counted;
+}
+
+// makeScene(p) with a second light, a copy of the first arriving from 40° above the plane.
+scene::Scene withASecondLightFrom40Degrees(const SphereOverPlane& p, double intensity = 3.0) {
+    scene::Scene s = makeScene(p);
+    scene::Light b = s.lights[0];
+    b.direction = lightFromElevation(40.0);
+    b.intensity = intensity;
+    s.lights.push_back(b);
+    return s;
 }
 
 TEST(RasterRender, TwoLightsWeighVisibilityByTheirUnshadowedIrradiance) {
@@ -786,11 +763,8 @@ TEST(RasterRender, TwoLightsWeighVisibilityByTheirUnshadowedIrradiance) {
     // w_B / (w_A + w_B) with w = intensity·N·L (docs/decisions.md), and the color is
     // ambient·albedo + albedo·1·N·L_B; N·L is the larger of the two.
     SphereOverPlane p;
-    scene::Scene s = makeScene(p);
-    scene::Light b = s.lights[0];
-    b.direction = lightFromElevation(40.0);
-    b.intensity = 1.0;
-    s.lights.push_back(b);
+    const scene::Scene s = withASecondLightFrom40Degrees(p, 1.0);
+    const scene::Light& b = s.lights[1];
     const scene::CameraBasis cam = scene::cameraBasis(s.camera);
     const scene::Frame f = renderValidated(s, validatedSettings(512, 0.01, 1.0, ShadowFilter::None), "two-lights");
     const Vec3 under(0.0, 0.0, 0.3);
@@ -817,11 +791,8 @@ TEST(RasterRender, TwoLightsKeepEachLightsVisibilityAndCombineThem) {
     SphereOverPlane p;
     p.width = 320;
     p.height = 180;
-    scene::Scene s = makeScene(p);
-    scene::Light b = s.lights[0];
-    b.direction = lightFromElevation(40.0);
-    b.intensity = 1.0;
-    s.lights.push_back(b);
+    const scene::Scene s = withASecondLightFrom40Degrees(p, 1.0);
+    const scene::Light& b = s.lights[1];
     SphereOverPlane pb = p;
     pb.lightDirection = b.direction;
     const scene::CameraBasis cam = scene::cameraBasis(s.camera);
@@ -1009,11 +980,7 @@ TEST(RasterRenderer, ChannelsNotAskedForAreLeftOutAndTheRestIsUnchanged) {
     // Beauty only (`render -o x.png`): the depth-only shadow pass and the lit variant without
     // blocker ids must give exactly the pixels of a full render; the other AOVs stay empty.
     // Visibility + ids without blocker ids: the same visibility too.
-    SphereOverPlane p;
-    scene::Scene s = makeScene(p);
-    scene::Light b = s.lights[0];
-    b.direction = lightFromElevation(40.0);
-    s.lights.push_back(b);
+    const scene::Scene s = withASecondLightFrom40Degrees(SphereOverPlane{});
     for (ShadowFilter filter : {ShadowFilter::None, ShadowFilter::Pcf2x2, ShadowFilter::Pcf, ShadowFilter::Poisson}) {
         scene::RasterSettings settings = validatedSettings(512, 0.01, 1.0, filter);
         settings.pcfSize = 3;
@@ -1041,12 +1008,8 @@ TEST(RasterRenderer, DisplayFramesGiveThePngCodesOfTheFloatBeautyWithinOne) {
     // differ only where the device's sRGB encoding and the writer's (float pow, round to nearest)
     // round the same value to neighbouring codes: by one code at most, and rarely; the
     // background (a clear, converted by the device) and black are exact.
-    SphereOverPlane p;
-    scene::Scene s = makeScene(p);
-    scene::Light b = s.lights[0];
-    b.direction = lightFromElevation(40.0);
-    b.color = {0.3, 0.6, 0.9};
-    s.lights.push_back(b);
+    scene::Scene s = withASecondLightFrom40Degrees(SphereOverPlane{});
+    s.lights[1].color = {0.3, 0.6, 0.9};
     s.background = {0.05, 0.1, 0.2};
     for (int lights : {1, 2})
         for (ShadowFilter filter : {ShadowFilter::None, ShadowFilter::Pcf2x2, ShadowFilter::Poisson}) {
@@ -1101,11 +1064,7 @@ TEST(RasterRenderer, DisplayFramesGiveThePngCodesOfTheFloatBeautyWithinOne) {
 TEST(RasterRenderer, ReadingTheTargetsInPlaceAndCopyingThemGiveTheSameFrame) {
     // lavapipe reads the lit targets in place; other devices copy them into buffers. Both paths,
     // on lavapipe, for every channel set, with several lights (per-light targets too).
-    SphereOverPlane p;
-    scene::Scene s = makeScene(p);
-    scene::Light b = s.lights[0];
-    b.direction = lightFromElevation(40.0);
-    s.lights.push_back(b);
+    const scene::Scene s = withASecondLightFrom40Degrees(SphereOverPlane{});
     const scene::RasterSettings settings = validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2);
     Renderer inPlace(s, planFor(s, settings), settings);
     Renderer copied(s, planFor(s, settings), settings, RendererOptions{.readTargetsInPlace = false});
@@ -1261,29 +1220,24 @@ TEST(RasterPointLight, SphereCastsTheTangentConeShadow) {
     s.lights[0].intensity = 300.0;
     const double alpha = std::asin(p.radius / (h - p.center.y));
     const double shadowRadius = h * std::tan(alpha);
-    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
     const scene::Frame f = renderValidated(s, validatedSettings(1024, 0.01, 1.0, ShadowFilter::None), "point_sphere");
     // One texel of the −Y face at the plane is 2·t/1024·h ≈ 0.005; skip a band of 0.03 around the rim.
     const double band = 0.03;
     int inside = 0, outside = 0, wrong = 0, sideFaces = 0;
-    for (int y = 0; y < f.height; ++y)
-        for (int x = 0; x < f.width; ++x) {
-            const std::size_t i = at(f, x, y);
-            const PrimaryHit hit = primaryHit(p, cam, x, y);
-            if (hit.id != 2 || f.objectId[i] != 2.0f) continue;
-            const double rho = std::hypot(hit.p.x, hit.p.z);
-            if (std::abs(rho - shadowRadius) < band) continue;
-            const bool shadowed = rho < shadowRadius;
-            (shadowed ? inside : outside) += 1;
-            if (std::max(std::abs(hit.p.x), std::abs(hit.p.z)) > h) ++sideFaces;
-            if ((f.visibility[i] < 0.5f) != shadowed) ++wrong;
-            if (!shadowed && f.visibility[i] == 1.0f) {
-                const Vec3 toLight = s.lights[0].position - hit.p;
-                const double d2 = glm::dot(toLight, toLight);
-                EXPECT_NEAR(f.beauty[3 * i], 0.8 * 300.0 / (4 * kPi * d2) * (toLight.y / std::sqrt(d2)) + 0.05 * 0.8,
-                            2e-4);
-            }
+    forEachPlanePixel(p, s, f, [&](std::size_t i, const Vec3& q) {
+        const double rho = std::hypot(q.x, q.z);
+        if (std::abs(rho - shadowRadius) < band) return;
+        const bool shadowed = rho < shadowRadius;
+        (shadowed ? inside : outside) += 1;
+        if (std::max(std::abs(q.x), std::abs(q.z)) > h) ++sideFaces;
+        if ((f.visibility[i] < 0.5f) != shadowed) ++wrong;
+        if (!shadowed && f.visibility[i] == 1.0f) {
+            const Vec3 toLight = s.lights[0].position - q;
+            const double d2 = glm::dot(toLight, toLight);
+            EXPECT_NEAR(f.beauty[3 * i], 0.8 * 300.0 / (4 * kPi * d2) * (toLight.y / std::sqrt(d2)) + 0.05 * 0.8,
+                        2e-4);
         }
+    });
     EXPECT_GT(inside, 500);
     EXPECT_GT(outside, 5000);
     EXPECT_GT(sideFaces, 1000) << "the view should reach the side faces";
@@ -1305,29 +1259,24 @@ TEST(RasterPointLight, OffAxisSphereShadowOnASideFaceMatchesTheSegmentTest) {
     s.lights[0].type = scene::LightType::Point;
     s.lights[0].position = lightPos;
     s.lights[0].intensity = 100.0;
-    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
     const scene::Frame f = renderValidated(s, validatedSettings(1024, 0.01, 1.0, ShadowFilter::None), "point_off_axis");
     int shadowed = 0, plusX = 0, counted = 0, wrong = 0;
-    for (int y = 0; y < f.height; ++y)
-        for (int x = 0; x < f.width; ++x) {
-            const std::size_t i = at(f, x, y);
-            const PrimaryHit hit = primaryHit(p, cam, x, y);
-            if (hit.id != 2 || f.objectId[i] != 2.0f) continue;
-            const Vec3 toLight = lightPos - hit.p;
-            // Skip the rim: plane points whose segment passes within 0.01 of the sphere's surface.
-            const Vec3 c = p.center - hit.p;
-            const double t = std::clamp(glm::dot(c, toLight) / glm::dot(toLight, toLight), 0.0, 1.0);
-            const double dist = glm::length(c - t * toLight);
-            if (std::abs(dist - p.radius) < 0.01) continue;
-            const bool inShadow = dist < p.radius;
-            ++counted;
-            if (inShadow) {
-                ++shadowed;
-                const Vec3 d = -toLight;
-                if (d.x > std::abs(d.y) && d.x > std::abs(d.z)) ++plusX;
-            }
-            if ((f.visibility[i] < 0.5f) != inShadow) ++wrong;
+    forEachPlanePixel(p, s, f, [&](std::size_t i, const Vec3& q) {
+        const Vec3 toLight = lightPos - q;
+        // Skip the rim: plane points whose segment passes within 0.01 of the sphere's surface.
+        const Vec3 c = p.center - q;
+        const double t = std::clamp(glm::dot(c, toLight) / glm::dot(toLight, toLight), 0.0, 1.0);
+        const double dist = glm::length(c - t * toLight);
+        if (std::abs(dist - p.radius) < 0.01) return;
+        const bool inShadow = dist < p.radius;
+        ++counted;
+        if (inShadow) {
+            ++shadowed;
+            const Vec3 d = -toLight;
+            if (d.x > std::abs(d.y) && d.x > std::abs(d.z)) ++plusX;
         }
+        if ((f.visibility[i] < 0.5f) != inShadow) ++wrong;
+    });
     EXPECT_GT(counted, 5000);
     EXPECT_GT(shadowed, 1000);
     EXPECT_GT(plusX, shadowed / 2) << "the shadow should lie mostly in the +X face";
@@ -1355,21 +1304,17 @@ TEST(RasterPointLight, CubeMapSeamsMakeNoFalseShadows) {
             settings.pcfSize = 5;
             const std::string name = std::string("point_seams_") + (side > 0 ? "floor_" : "ceiling_") + scene::toString(filter);
             const scene::Frame f = renderValidated(s, settings, name);
-            const scene::CameraBasis cam = scene::cameraBasis(s.camera);
             int counted = 0, falseShadow = 0, nearSeam = 0;
-            for (int y = 0; y < f.height; ++y)
-                for (int x = 0; x < f.width; ++x) {
-                    const std::size_t i = at(f, x, y);
-                    if (primaryHit(p, cam, x, y).id != 2 || f.objectId[i] != 1.0f) continue;
-                    ++counted;
-                    const Vec3 d = primaryHit(p, cam, x, y).p - s.lights[0].position;
-                    // Within 0.1 of a boundary between faces (where two axes are equally major).
-                    const double ax = std::abs(d.x), ay = std::abs(d.y), az = std::abs(d.z);
-                    const double m = std::max({ax, ay, az});
-                    const double second = ax + ay + az - m - std::min({ax, ay, az});
-                    if (m - second < 0.1) ++nearSeam;
-                    if (f.visibility[i] != 1.0f) ++falseShadow;
-                }
+            forEachPlanePixel(p, s, f, [&](std::size_t i, const Vec3& q) {
+                ++counted;
+                const Vec3 d = q - s.lights[0].position;
+                // Within 0.1 of a boundary between faces (where two axes are equally major).
+                const double ax = std::abs(d.x), ay = std::abs(d.y), az = std::abs(d.z);
+                const double m = std::max({ax, ay, az});
+                const double second = ax + ay + az - m - std::min({ax, ay, az});
+                if (m - second < 0.1) ++nearSeam;
+                if (f.visibility[i] != 1.0f) ++falseShadow;
+            }, 1.0f);  // the plane is object 1 here
             EXPECT_GT(counted, 5000) << name;
             EXPECT_GT(nearSeam, 300) << name << ": the view should cross the face boundaries";
             EXPECT_EQ(falseShadow, 0) << name << ": " << falseShadow << " of " << counted << " pixels falsely shadowed";

@@ -10,7 +10,7 @@
 
 #include "raster/cascades.h"
 #include "raster/tolerances.h"
-#include "tests/raster/test_scenes.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::raster {
 namespace {

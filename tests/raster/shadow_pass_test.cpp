@@ -7,7 +7,7 @@
 
 #include "raster/geometry.h"
 #include "raster/light_frustum.h"
-#include "tests/raster/test_scenes.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::raster {
 namespace {
@@ -20,14 +20,8 @@ TEST(ShadowPass, StoresTheClosedFormDepthOfWhatEachTexelSees) {
     // to exercise the camera-relative matrices.
     scene::Scene s = test::makeScene(test::SphereOverPlane{});
     s.objects.clear();
-    scene::Quad q;
-    q.center = Vec3(0);
-    q.normal = Vec3(0, 1, 0);
-    q.size = scene::Vec2(2, 2);
-    scene::quadAxes(q.normal, q.uAxis, q.vAxis);
-    const scene::Box box{Vec3(0.3, 0, -0.4), Vec3(0.9, 0.5, 0.2)};
-    s.objects.push_back({"objects[0]", q, 0});
-    s.objects.push_back({"objects[1]", box, 0});
+    test::addQuad(s, Vec3(0), Vec3(0, 1, 0), 2, 2);
+    test::addBox(s, Vec3(0.3, 0, -0.4), Vec3(0.9, 0.5, 0.2));
     const Vec3 dir = glm::normalize(Vec3(0.05, -1, 0.02));
     const Vec3 origin(3, 4, 5);
     const int size = 128;

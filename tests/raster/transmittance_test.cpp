@@ -5,16 +5,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <filesystem>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "raster/renderer.h"
-#include "scene/frame_io.h"
-#include "tests/raster/test_scenes.h"
+#include "tests/kit/render_checked.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::raster {
 namespace {
@@ -22,42 +20,17 @@ namespace {
 using test::Vec3;
 
 scene::Object quadObject(const std::string& name, const Vec3& center, double side, int material) {
-    scene::Quad q;
-    q.center = center;
-    q.normal = Vec3(0, 1, 0);
-    q.size = scene::Vec2(side, side);
-    scene::quadAxes(q.normal, q.uAxis, q.vAxis);
-    scene::Object o;
-    o.name = name;
-    o.shape = q;
-    o.material = material;
-    return o;
+    return test::horizontalQuad(name, center, side, side, material);
 }
 
 // Light straight down onto the floor y = 0 (20 x 20); a low camera looks at the floor under the
 // casters from below their height, so it sees the floor and none of them in front of it.
 scene::Scene floorScene() {
     scene::Scene s;
-    s.camera.position = Vec3(0, 0.5, 6);
-    s.camera.lookAt = Vec3(0, 0, 0);
-    s.camera.up = Vec3(0, 1, 0);
-    s.camera.fovYDegrees = 40.0;
-    s.camera.width = 200;
-    s.camera.height = 120;
-    s.camera.near = 0.1;
-    s.camera.far = 100.0;
-    scene::Material matte;
-    matte.name = "matte";
-    s.materials.push_back(matte);
-    scene::Material glass;
-    glass.name = "glass";
-    glass.opacity = 0.5;
-    s.materials.push_back(glass);
-    scene::Light l;
-    l.type = scene::LightType::Directional;
-    l.direction = Vec3(0, -1, 0);
-    l.intensity = 3.0;
-    s.lights.push_back(l);
+    s.camera = {.position = Vec3(0, 0.5, 6), .lookAt = Vec3(0), .width = 200, .height = 120};  // fov 40°, near 0.1
+    test::addMaterial(s, "matte");
+    test::addMaterial(s, "glass", 0.5);
+    test::addDirectional(s, Vec3(0, -1, 0), 3.0);
     s.objects.push_back(quadObject("floor", Vec3(0, 0, 0), 20.0, 0));
     return s;
 }
@@ -71,20 +44,12 @@ scene::Scene twoPanes() {
     return s;
 }
 
-// Where camera pixel (x, y) meets the floor.
-Vec3 floorPoint(const scene::CameraBasis& cam, int x, int y) {
-    const Vec3 d = test::pixelRay(cam, x, y);
-    return cam.position + (-cam.position.y / d.y) * d;
-}
-
 scene::Frame renderWith(const scene::Scene& s, scene::ShadowFilter filter, const std::string& name,
                         double depthBias = 0.02) {
     scene::RasterSettings r = test::validatedSettings(512, depthBias, 1.0, filter);
     r.pcfSize = 5;
-    const scene::Frame f = render(s, test::planFor(s, r), r);
-    EXPECT_EQ(f.attributes.at("validation_messages"), "0") << "validation messages were printed above";
-    if (const char* dir = std::getenv("SHADOWLAB_TEST_PNG_DIR"))
-        scene::writePngLinear(std::filesystem::path(dir) / (name + ".png"), f.width, f.height, f.beauty);
+    const scene::Frame f = test::renderChecked(s, r);
+    test::writePngToLookAt(f, name);
     return f;
 }
 
@@ -93,29 +58,24 @@ const scene::ShadowFilter kFilters[] = {scene::ShadowFilter::None, scene::Shadow
 
 TEST(RasterTransmittance, TwoHalfOpaquePanesLeaveAQuarterBehindBothAndAHalfBehindOne) {
     const scene::Scene s = twoPanes();
-    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
     for (const scene::ShadowFilter filter : kFilters) {
         const scene::Frame f = renderWith(s, filter, "transmittance_panes_" + std::to_string(int(filter)));
         EXPECT_EQ(f.attributes.at("transmittance_map"), "made");
         // Away from the panes' outlines (0.15: the texel is ~0.03, pcf 5 reaches 2.5 texels).
         constexpr double m = 0.15;
         int counted[3] = {0, 0, 0}, wrong = 0;
-        for (int y = 0; y < f.height; ++y)
-            for (int x = 0; x < f.width; ++x) {
-                const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
-                if (f.objectId[i] != 1.0f) continue;  // the floor
-                const Vec3 q = floorPoint(cam, x, y);
-                const bool inZ = std::abs(q.z) < 1.5 - m, outZ = std::abs(q.z) > 1.5 + m;
-                const bool underA = inZ && q.x > -2 + m && q.x < 1 - m, underB = inZ && q.x > -1 + m && q.x < 2 - m;
-                const bool clearA = outZ || q.x < -2 - m || q.x > 1 + m, clearB = outZ || q.x < -1 - m || q.x > 2 + m;
-                double expected;
-                if (underA && underB) expected = 0.25;
-                else if ((underA && clearB) || (underB && clearA)) expected = 0.5;
-                else if (clearA && clearB) expected = 1.0;
-                else continue;  // near an outline
-                ++counted[expected == 0.25 ? 0 : expected == 0.5 ? 1 : 2];
-                if (std::abs(f.visibility[i] - expected) > 1e-5) ++wrong;
-            }
+        test::forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
+            const bool inZ = std::abs(q.z) < 1.5 - m, outZ = std::abs(q.z) > 1.5 + m;
+            const bool underA = inZ && q.x > -2 + m && q.x < 1 - m, underB = inZ && q.x > -1 + m && q.x < 2 - m;
+            const bool clearA = outZ || q.x < -2 - m || q.x > 1 + m, clearB = outZ || q.x < -1 - m || q.x > 2 + m;
+            double expected;
+            if (underA && underB) expected = 0.25;
+            else if ((underA && clearB) || (underB && clearA)) expected = 0.5;
+            else if (clearA && clearB) expected = 1.0;
+            else return;  // near an outline
+            ++counted[expected == 0.25 ? 0 : expected == 0.5 ? 1 : 2];
+            if (std::abs(v - expected) > 1e-5) ++wrong;
+        });
         EXPECT_GT(counted[0], 200) << "filter " << int(filter);
         EXPECT_GT(counted[1], 200) << "filter " << int(filter);
         EXPECT_GT(counted[2], 200) << "filter " << int(filter);
@@ -137,8 +97,7 @@ TEST(RasterTransmittance, ALowerPaneGetsTheUpperPanesShadowNotItsOwn) {
             for (int x = 0; x < f.width; ++x) {
                 const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
                 if (f.objectId[i] != 3.0f || f.ndotl[i] <= 0.0f) continue;  // pane B's top
-                const Vec3 d = test::pixelRay(cam, x, y);
-                const Vec3 q = cam.position + ((1.0 - cam.position.y) / d.y) * d;
+                const Vec3 q = test::floorPoint(cam, x, y, 1.0);  // on pane B's plane
                 if (std::abs(q.z) > 1.35) continue;
                 double expected;
                 if (q.x > -0.85 && q.x < 0.85) expected = 0.5;
@@ -183,7 +142,7 @@ TEST(RasterTransmittance, AClosedSphereAttenuatesOnceNotOncePerSurface) {
                     }
                 }
                 if (f.objectId[i] != 1.0f) continue;
-                const Vec3 q = floorPoint(cam, x, y);
+                const Vec3 q = test::floorPoint(cam, x, y);
                 const double rho = std::hypot(q.x, q.z);  // the shadow is the disk of radius 0.8
                 double expected;
                 if (rho < 0.6) expected = 0.5;  // (the tessellated outline lies inside the circle)
@@ -212,25 +171,20 @@ TEST(RasterTransmittance, OpaqueAndSemiTransparentCastersCombine) {
     box.name = "box";
     box.shape = scene::Box{Vec3(-0.4, 2, -0.4), Vec3(0.4, 2.4, 0.4)};
     s.objects.push_back(box);
-    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
     const scene::Frame f = renderWith(s, scene::ShadowFilter::Pcf2x2, "transmittance_box_over_pane");
     int dark = 0, half = 0, wrong = 0;
-    for (int y = 0; y < f.height; ++y)
-        for (int x = 0; x < f.width; ++x) {
-            const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
-            if (f.objectId[i] != 1.0f) continue;
-            const Vec3 q = floorPoint(cam, x, y);
-            const bool underBox = std::abs(q.x) < 0.3 && std::abs(q.z) < 0.3;
-            const bool underPaneOnly = std::abs(q.z) < 1.3 && q.x > -1.8 && q.x < 0.8 &&
-                                       (std::abs(q.x) > 0.55 || std::abs(q.z) > 0.55);
-            if (underBox) {
-                ++dark;
-                if (f.visibility[i] > 1e-5) ++wrong;
-            } else if (underPaneOnly) {
-                ++half;
-                if (std::abs(f.visibility[i] - 0.5) > 1e-5) ++wrong;
-            }
+    test::forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
+        const bool underBox = std::abs(q.x) < 0.3 && std::abs(q.z) < 0.3;
+        const bool underPaneOnly = std::abs(q.z) < 1.3 && q.x > -1.8 && q.x < 0.8 &&
+                                   (std::abs(q.x) > 0.55 || std::abs(q.z) > 0.55);
+        if (underBox) {
+            ++dark;
+            if (v > 1e-5) ++wrong;
+        } else if (underPaneOnly) {
+            ++half;
+            if (std::abs(v - 0.5) > 1e-5) ++wrong;
         }
+    });
     EXPECT_GT(dark, 20);
     EXPECT_GT(half, 200);
     EXPECT_EQ(wrong, 0);
@@ -269,24 +223,19 @@ TEST(RasterTransmittance, APointLightsCubeFacesCarryTheTransmittanceToo) {
     s.lights[0].intensity = 200.0;
     s.objects.push_back(quadObject("pane", Vec3(0, 2, 0), 2.0, 1));
     s.camera.position = Vec3(0, 1.5, 7);
-    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
     for (const scene::ShadowFilter filter : kFilters) {
         const scene::Frame f = renderWith(s, filter, "transmittance_point_" + std::to_string(int(filter)));
         EXPECT_EQ(f.attributes.at("transmittance_map"), "made");
         int inside = 0, outside = 0, wrong = 0;
-        for (int y = 0; y < f.height; ++y)
-            for (int x = 0; x < f.width; ++x) {
-                const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
-                if (f.objectId[i] != 1.0f) continue;
-                const Vec3 q = floorPoint(cam, x, y);
-                const double m = std::max(std::abs(q.x), std::abs(q.z));
-                double expected;
-                if (m < 1.8) expected = 0.5;
-                else if (m > 2.2 && m < 6.0) expected = 1.0;
-                else continue;
-                ++(expected == 0.5 ? inside : outside);
-                if (std::abs(f.visibility[i] - expected) > 1e-5) ++wrong;
-            }
+        test::forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
+            const double m = std::max(std::abs(q.x), std::abs(q.z));
+            double expected;
+            if (m < 1.8) expected = 0.5;
+            else if (m > 2.2 && m < 6.0) expected = 1.0;
+            else return;
+            ++(expected == 0.5 ? inside : outside);
+            if (std::abs(v - expected) > 1e-5) ++wrong;
+        });
         EXPECT_GT(inside, 200) << "filter " << int(filter);
         EXPECT_GT(outside, 200) << "filter " << int(filter);
         EXPECT_EQ(wrong, 0) << "filter " << int(filter);
@@ -344,28 +293,23 @@ TEST(RasterTransmittance, TheFloorUnderPaneSpherePaneGetsEveryFactorOnce) {
     // is the unit disk: its tessellated outline lies inside, so ρ < 0.8), under the two panes only
     // 0.25 (|x|, |z| < 1.5, outside the disk), 1 beyond the panes.
     const scene::Scene s = paneSpherePane();
-    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
     for (const scene::ShadowFilter filter : kFilters) {
         const scene::Frame f = renderWith(s, filter, "transmittance_between_floor_" + std::to_string(int(filter)));
         // Away from outlines by the widest kernel's reach: Poisson's 2.4 texels plus half a texel
         // (nearest), 3 texels of 29.0 / 512 (the scene's bounding sphere, radius 14.36, × 1.01) = 0.17.
         constexpr double m = 0.2;
         int counted[3] = {0, 0, 0}, wrong = 0;
-        for (int y = 0; y < f.height; ++y)
-            for (int x = 0; x < f.width; ++x) {
-                const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
-                if (f.objectId[i] != 1.0f) continue;
-                const Vec3 q = floorPoint(cam, x, y);
-                const double rho = std::hypot(q.x, q.z);
-                const double box = std::max(std::abs(q.x), std::abs(q.z));
-                double expected;
-                if (rho < 0.8) expected = 0.125;
-                else if (rho > 1.0 + m && box < 1.5 - m) expected = 0.25;
-                else if (box > 1.5 + m) expected = 1.0;
-                else continue;
-                ++counted[expected == 0.125 ? 0 : expected == 0.25 ? 1 : 2];
-                if (std::abs(f.visibility[i] - expected) > 1e-5) ++wrong;
-            }
+        test::forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
+            const double rho = std::hypot(q.x, q.z);
+            const double box = std::max(std::abs(q.x), std::abs(q.z));
+            double expected;
+            if (rho < 0.8) expected = 0.125;
+            else if (rho > 1.0 + m && box < 1.5 - m) expected = 0.25;
+            else if (box > 1.5 + m) expected = 1.0;
+            else return;
+            ++counted[expected == 0.125 ? 0 : expected == 0.25 ? 1 : 2];
+            if (std::abs(v - expected) > 1e-5) ++wrong;
+        });
         EXPECT_GT(counted[0], 100) << "filter " << int(filter);
         EXPECT_GT(counted[1], 100) << "filter " << int(filter);
         EXPECT_GT(counted[2], 200) << "filter " << int(filter);
@@ -402,8 +346,7 @@ void expectPaneTop(const scene::Scene& base, float object, double height, scene:
         for (int x = 0; x < f.width; ++x) {
             const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
             if (f.objectId[i] != object || f.ndotl[i] <= 0.0f) continue;
-            const Vec3 d = test::pixelRay(cam, x, y);
-            const Vec3 q = cam.position + ((height - cam.position.y) / d.y) * d;
+            const Vec3 q = test::floorPoint(cam, x, y, height);
             if (std::max(std::abs(q.x), std::abs(q.z)) > 1.35) continue;
             ++counted;
             if (std::abs(f.visibility[i] - expected) > 1e-5) ++wrong;

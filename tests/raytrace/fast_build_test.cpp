@@ -14,26 +14,14 @@
 #include "raytrace/tolerances.h"
 #include "raytrace/tracer.h"
 #include "raytrace/wide_bvh.h"
-#include "tests/raytrace/test_scenes.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::raytrace {
 namespace {
 
 using scene::Vec3;
 
-std::vector<scene::Bounds> randomBoxes(int count, std::uint64_t seed) {
-    std::mt19937_64 g(seed);
-    std::uniform_real_distribution<double> pos(-100, 100), size(0.01, 3);
-    std::vector<scene::Bounds> out(count);
-    for (int i = 0; i < count; ++i) {
-        // Every tenth box shares one centroid: no SAH split among them (the halving path).
-        const Vec3 c = i % 10 == 0 ? Vec3(5, 5, 5) : Vec3(pos(g), pos(g), pos(g));
-        const Vec3 h(size(g), size(g), size(g));
-        out[i].extend(c - h);
-        out[i].extend(c + h);
-    }
-    return out;
-}
+using test::randomBoxes;
 
 TEST(FastBuild, TheTreeDoesNotDependOnTheThreadCount) {
     const auto boxes = randomBoxes(60000, 5);

@@ -11,7 +11,7 @@
 #include "raytrace/tracer.h"
 #include "scene/loader.h"
 #include "scene/mesh_loader.h"
-#include "tests/raytrace/test_scenes.h"
+#include "tests/kit/test_scenes.h"
 #include "tests/scene/gltf_files.h"
 #include "tests/scene/test_files.h"
 

@@ -9,26 +9,14 @@
 #include "raytrace/bvh.h"
 #include "raytrace/tolerances.h"
 #include "raytrace/wide_bvh.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::raytrace {
 namespace {
 
 using scene::Vec3;
 
-// Random small boxes, plus a run of boxes with one shared centroid (no SAH split exists among
-// them, so the build's halve-by-count path runs too).
-std::vector<scene::Bounds> primitiveBoxes(int count, std::uint64_t seed) {
-    std::mt19937_64 g(seed);
-    std::uniform_real_distribution<double> pos(-100, 100), size(0.01, 3);
-    std::vector<scene::Bounds> out(count);
-    for (int i = 0; i < count; ++i) {
-        const Vec3 c = i % 10 == 0 ? Vec3(5, 5, 5) : Vec3(pos(g), pos(g), pos(g));
-        const Vec3 h(size(g), size(g), size(g));
-        out[i].extend(c - h);
-        out[i].extend(c + h);
-    }
-    return out;
-}
+using test::randomBoxes;
 
 Bvh buildWith(int threads, const std::vector<scene::Bounds>& boxes) {
     tbb::task_arena arena(threads);
@@ -45,7 +33,7 @@ bool sameTree(const Bvh& a, const Bvh& b) {
 
 TEST(ParallelBuild, TheTreeDoesNotDependOnTheThreadCount) {
     // 60,000 primitives: far above kBvhParallelCount, so the top levels split into tasks.
-    const auto boxes = primitiveBoxes(60000, 99);
+    const auto boxes = randomBoxes(60000, 99);
     ASSERT_GT(boxes.size(), 8 * std::size_t(kBvhParallelCount));
     const Bvh one = buildWith(1, boxes);
     for (int threads : {2, 4, 8}) {
@@ -65,7 +53,7 @@ TEST(ParallelBuild, TheTreeDoesNotDependOnTheThreadCount) {
 }
 
 TEST(ParallelBuild, TheParallelTreeHoldsEveryPrimitiveOnceInsideItsNodesBoxes) {
-    const auto boxes = primitiveBoxes(60000, 7);
+    const auto boxes = randomBoxes(60000, 7);
     const Bvh bvh = buildWith(4, boxes);
     std::vector<int> seen(boxes.size(), 0);
     // Depth-first walk: node i's first child is i + 1, its second `offset` (> i + 1).

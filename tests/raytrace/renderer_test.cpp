@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "scene/settings.h"
-#include "tests/raytrace/test_scenes.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::raytrace {
 namespace {
@@ -15,7 +15,7 @@ using test::Analytic;
 using test::Vec3;
 
 TEST(ReferenceRender, SeedSceneVisibilityEqualsClosedFormAwayFromShadowEdge) {
-    const scene::Scene s = test::sphereOverPlane();
+    const scene::Scene s = test::seedScene();
     const scene::Frame f = renderReference(s, test::planFor(s), test::biasSettings(0, scene::Precision::Float));
     ASSERT_EQ(f.width, 160);
     ASSERT_EQ(f.height, 90);
@@ -55,7 +55,7 @@ TEST(ReferenceRender, TwoLightsKeepEachLightsVisibilityAndCombineThem) {
     // The seed scene plus light B along (1, -1, 0) (intensity 1). On the plane (N = +Y), light
     // i's visibility is 1 where the ray toward it misses the sphere (closed form), else 0; the
     // total is (w_A v_A + w_B v_B) / (w_A + w_B), w = intensity·N·L: w_A = 3·2/√6, w_B = 1/√2.
-    scene::Scene s = test::sphereOverPlane();
+    scene::Scene s = test::seedScene();
     test::addDirectional(s, Vec3(1, -1, 0), 1.0);
     const scene::Frame f = renderReference(s, test::planFor(s), test::biasSettings(0, scene::Precision::Float));
     ASSERT_EQ(f.lightVisibility.size(), 2u);
@@ -82,7 +82,7 @@ TEST(ReferenceRender, TwoLightsKeepEachLightsVisibilityAndCombineThem) {
     EXPECT_GT(shadowed[0], 200);
     EXPECT_GT(shadowed[1], 200);
     // One light: no per-light channels (they would equal `visibility`).
-    const scene::Scene one = test::sphereOverPlane();
+    const scene::Scene one = test::seedScene();
     EXPECT_TRUE(renderReference(one, test::planFor(one), test::biasSettings(0, scene::Precision::Float))
                     .lightVisibility.empty());
 }
@@ -117,7 +117,7 @@ test::Placement tiltedFarAway() {
 
 TEST(MethodRender, FloatWithZeroBiasShowsAcneOnTheLitPlaneAndReferenceDoesNot) {
     const test::Placement at = tiltedFarAway();
-    const scene::Scene s = test::sphereOverPlane(at);
+    const scene::Scene s = test::seedScene(at);
     const scene::RenderPlan plan = test::planFor(s);
     const scene::Frame method = render(s, plan, test::biasSettings(0.0, scene::Precision::Float));
     int lit = 0;
@@ -145,7 +145,7 @@ TEST(MethodRender, ATinyBiasIsEnoughInDoubleButNotInFloat) {
     // to a few ulps of 1000 (2⁻¹³ ≈ 1.2e-4), far more than the bias, so acne stays; a double one
     // by ~1e-13, far less, so the bias alone clears it.
     const test::Placement at = tiltedFarAway();
-    const scene::Scene s = test::sphereOverPlane(at);
+    const scene::Scene s = test::seedScene(at);
     const scene::RenderPlan plan = test::planFor(s);
     int lit = 0;
     const int floatAcne = falseShadowsOnPlane(s, at, render(s, plan, test::biasSettings(1e-8, scene::Precision::Float)), lit);
@@ -158,7 +158,7 @@ TEST(MethodRender, HugeBiasLiftsTheContactShadowExactlyAsTheShiftedOriginPredict
     // Bias 1.5·r moves the plane's shadow-ray origins to y = 1.5: points within 0.87 of the
     // contact start inside the sphere (still blocked), the rest of the shadow's far end sees
     // the light over the sphere. Closed form: the same ray test from p + 1.5·n.
-    const scene::Scene s = test::sphereOverPlane();
+    const scene::Scene s = test::seedScene();
     const scene::RenderPlan plan = test::planFor(s);
     const double bias = 1.5;
     for (scene::Precision precision : {scene::Precision::Double, scene::Precision::Float}) {
@@ -189,7 +189,7 @@ TEST(MethodRender, HugeBiasLiftsTheContactShadowExactlyAsTheShiftedOriginPredict
 TEST(MeshRender, FlatConvexMeshIsAcneFreeInTheReferenceAndAcneRiddenInFloatWithoutBias) {
     // A flat-shaded icosphere (no vertex normals: N is the face normal) replaces the seed's
     // sphere. Convex, with the plane below it: every mesh pixel facing the light is lit.
-    scene::Scene s = test::sphereOverPlane({}, 128, 72);
+    scene::Scene s = test::seedScene({}, 128, 72);
     auto mesh = test::icosphere(Vec3(0.37, 1.01, -0.23), 1.0, 3);
     mesh->normals.clear();
     s.objects[0].shape = scene::Mesh::single("icosphere", mesh);
@@ -210,7 +210,7 @@ TEST(MeshRender, FlatConvexMeshIsAcneFreeInTheReferenceAndAcneRiddenInFloatWitho
 }
 
 scene::Scene busyOpaqueScene() {
-    scene::Scene s = test::sphereOverPlane({}, 96, 64);
+    scene::Scene s = test::seedScene({}, 96, 64);
     test::addBox(s, Vec3(-2.5, 0, -1.5), Vec3(-1.5, 1.2, -0.5));
     test::addSphere(s, Vec3(1.6, 0.5, 0.8), 0.5);
     test::addQuad(s, Vec3(1.5, 2.2, -1), Vec3(0.3, -1, 0.2), 1.0, 0.7);
@@ -271,7 +271,7 @@ TEST(MethodRender, FramesDoNotDependOnTheThreadCount) {
 }
 
 TEST(MethodRender, FillsEveryAovAndTheMetadata) {
-    const scene::Scene s = test::sphereOverPlane({}, 64, 36);
+    const scene::Scene s = test::seedScene({}, 64, 36);
     scene::RaytraceSettings rs = test::biasSettings(1e-4, scene::Precision::Float);
     rs.threads = 1;
     const scene::Frame f = render(s, test::planFor(s), rs);

@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "raytrace/renderer.h"
-#include "tests/raytrace/test_scenes.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::raytrace {
 namespace {

@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "tests/raytrace/test_scenes.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::raytrace {
 namespace {

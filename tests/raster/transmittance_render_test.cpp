@@ -1,6 +1,7 @@
-// tests/compare/transmittance_render_test.cpp: semi-transparent casters: the raster
-// backend's transmittance map against the double-precision ray-traced reference, which multiplies
-// 1 − opacity once per object a shadow ray passes through, on lavapipe with the validation layer.
+// tests/raster/transmittance_render_test.cpp: semi-transparent casters: the raster backend's
+// transmittance map (raster/shadow_pass.cpp) against the double-precision ray-traced reference,
+// which multiplies 1 − opacity once per object a shadow ray passes through, compared with
+// compare's metrics, on lavapipe with the validation layer.
 #include <cmath>
 #include <cstdio>
 
@@ -8,20 +9,16 @@
 
 #include "compare/compare.h"
 #include "raster/renderer.h"
-#include "raytrace/renderer.h"
+#include "tests/kit/render_checked.h"
+#include "tests/kit/test_scenes.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::raster {
 namespace {
 
 using Vec3 = scene::Vec3;
 
 scene::Object quad(const Vec3& center, double side, int material) {
-    scene::Quad q;
-    q.center = center;
-    q.normal = Vec3(0, 1, 0);
-    q.size = scene::Vec2(side, side);
-    scene::quadAxes(q.normal, q.uAxis, q.vAxis);
-    return {"quad", q, material};
+    return test::horizontalQuad("quad", center, side, side, material);
 }
 
 // Two glass panes (opacity 0.5) at heights 2 and 1 overlapping in x, a glass sphere (0.6) and an
@@ -29,28 +26,11 @@ scene::Object quad(const Vec3& center, double side, int material) {
 // floor, the lower pane half-shadowed by the upper one.
 scene::Scene glassScene() {
     scene::Scene s;
-    s.camera.position = Vec3(5, 6, 7);
-    s.camera.lookAt = Vec3(0, 0.5, 0);
-    s.camera.up = Vec3(0, 1, 0);
-    s.camera.fovYDegrees = 40.0;
-    s.camera.width = 192;
-    s.camera.height = 108;
-    s.camera.near = 0.1;
-    s.camera.far = 100.0;
-    scene::Material matte;
-    matte.name = "matte";
-    scene::Material glass;
-    glass.name = "glass";
-    glass.opacity = 0.5;
-    scene::Material tinted;
-    tinted.name = "tinted";
-    tinted.opacity = 0.6;
-    s.materials = {matte, glass, tinted};
-    scene::Light l;
-    l.type = scene::LightType::Directional;
-    l.direction = glm::normalize(Vec3(-0.3, -2, -0.5));
-    l.intensity = 1.1;
-    s.lights.push_back(l);
+    s.camera = {.position = Vec3(5, 6, 7), .lookAt = Vec3(0, 0.5, 0), .width = 192, .height = 108};  // fov 40°, near 0.1
+    test::addMaterial(s, "matte");
+    test::addMaterial(s, "glass", 0.5);
+    test::addMaterial(s, "tinted", 0.6);
+    test::addDirectional(s, Vec3(-0.3, -2, -0.5), 1.1);
     s.objects.push_back(quad(Vec3(0, 0, 0), 12.0, 0));
     s.objects.push_back(quad(Vec3(-0.5, 2, 0), 3.0, 1));
     s.objects.push_back(quad(Vec3(0.8, 1, 0.5), 2.0, 1));
@@ -63,15 +43,11 @@ TEST(TransmittanceAgainstReference, RasterVisibilityMatchesTheReferenceAwayFromE
     const scene::Scene s = glassScene();
     scene::RenderSettings settings = scene::resolveSettings(s, {});
     settings.raster.shadowMapSize = 1024;
-    settings.raster.validate = true;
-    const scene::RenderPlan plan = scene::makeRenderPlan(s, settings);
-    ASSERT_TRUE(plan.needsTransmittanceMap);
-    const scene::Frame raster = raster::render(s, plan, settings.raster);
-    EXPECT_EQ(raster.attributes.at("validation_messages"), "0") << "validation messages were printed above";
+    ASSERT_TRUE(scene::makeRenderPlan(s, settings).needsTransmittanceMap);
+    const scene::Frame raster = test::renderChecked(s, settings);
     EXPECT_EQ(raster.attributes.at("transmittance_map"), "made");
-    const scene::Frame reference =
-        raytrace::renderReference(s, plan, scene::referenceSettings(settings.raytrace));
-    const Metrics m = compareFrames(raster, reference).metrics;
+    const scene::Frame reference = test::renderReference(s, settings);
+    const compare::Metrics m = compare::compareFrames(raster, reference).metrics;
     // Pixel by pixel where both see the same object lit from the front: the reference's
     // visibility takes the values 1, 0.5, 0.4, 0.25, 0.2, 0 here; the raster's must be the same
     // except in a band of shadow outlines (pcf2x2 ramps over a texel).
@@ -92,4 +68,4 @@ TEST(TransmittanceAgainstReference, RasterVisibilityMatchesTheReferenceAwayFromE
 }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::raster

@@ -1,4 +1,4 @@
-// tests/compare/alpha_casters_test.cpp: alpha-tested (MASK) and blended (BLEND) casters in the
+// tests/backends/alpha_casters_test.cpp: alpha-tested (MASK) and blended (BLEND) casters in the
 // raster depth and transmittance passes (lavapipe, validation layer on), the float ray tracer and
 // the double-precision reference, against what the glTF 2.0 alpha rules give by hand.
 //
@@ -14,66 +14,38 @@
 
 #include <gtest/gtest.h>
 
-#include "raster/renderer.h"
+#include "scene/camera.h"
 #include "scene/frame_io.h"
 #include "scene/loader.h"
-#include "raytrace/renderer.h"
-#include "scene/camera.h"
-#include "scene/render_plan.h"
 #include "scene/settings.h"
+#include "tests/kit/render_checked.h"
+#include "tests/kit/test_scenes.h"
 
-namespace shadowlab::compare {
+namespace shadowlab {
 namespace {
 
 using scene::Vec2;
 using scene::Vec3;
+using test::Frames;
 
 constexpr double kHeight = 3.0;
 constexpr double kSide = 2.0;
 
-std::shared_ptr<scene::AlphaTexture> texture(int w, int h, std::vector<float> alpha,
-                                             scene::TextureWrap s = scene::TextureWrap::Repeat,
-                                             scene::TextureWrap t = scene::TextureWrap::Repeat) {
-    auto tex = std::make_shared<scene::AlphaTexture>();
-    tex->file = "test-texture";
-    tex->width = w;
-    tex->height = h;
-    tex->alpha = std::move(alpha);
-    tex->wrapS = s;
-    tex->wrapT = t;
-    return tex;
-}
-
-// An N×N checkerboard of alpha `a` (texel x + y even) and `b`.
-std::shared_ptr<scene::AlphaTexture> checker(int n, float a, float b) {
-    std::vector<float> alpha;
-    for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x) alpha.push_back((x + y) % 2 == 0 ? a : b);
-    return texture(n, n, alpha);
-}
+using test::alphaTexture;
+using test::checkerTexture;
 
 scene::Object quad(const Vec3& center, double side, int material, Vec2 uvMin = Vec2(0), Vec2 uvMax = Vec2(1)) {
-    scene::Quad q;
-    q.center = center;
-    q.normal = Vec3(0, 1, 0);
-    q.size = Vec2(side, side);
-    q.uvMin = uvMin;
-    q.uvMax = uvMax;
-    scene::quadAxes(q.normal, q.uAxis, q.vAxis);
-    return {"quad", q, material};
+    scene::Object o = test::horizontalQuad("quad", center, side, side, material);
+    std::get<scene::Quad>(o.shape).uvMin = uvMin;
+    std::get<scene::Quad>(o.shape).uvMax = uvMax;
+    return o;
 }
 
 // Ground (material 0) and the caster material `caster` (index 1) on the 2×2 quad at height 3.
 scene::Scene stage(const scene::Material& caster, Vec2 uvMin = Vec2(0), Vec2 uvMax = Vec2(1)) {
     scene::Scene s;
-    s.camera.position = Vec3(3, 10, 0);
-    s.camera.lookAt = Vec3(3, 0, 0);
-    s.camera.up = Vec3(0, 0, -1);
-    s.camera.fovYDegrees = 30.0;
-    s.camera.width = 160;
-    s.camera.height = 160;
-    s.camera.near = 0.1;
-    s.camera.far = 100.0;
+    s.camera = {.position = Vec3(3, 10, 0), .lookAt = Vec3(3, 0, 0), .up = Vec3(0, 0, -1), .fovYDegrees = 30.0,
+                .width = 160, .height = 160};  // near 0.1, far 100
     scene::Material ground;
     ground.name = "ground";
     s.materials = {ground, caster};
@@ -86,18 +58,6 @@ scene::Scene stage(const scene::Material& caster, Vec2 uvMin = Vec2(0), Vec2 uvM
     return s;
 }
 
-// The pixel that sees ground point p (inverse of scene::pixelDirection).
-std::size_t pixelOf(const scene::Scene& s, const Vec3& p) {
-    const scene::CameraBasis c = scene::cameraBasis(s.camera);
-    const Vec3 d = p - c.position;
-    const double f = glm::dot(d, c.forward);
-    const double sx = glm::dot(d, c.right) / f / (c.tanHalfFovY * c.aspect);
-    const double sy = glm::dot(d, c.up) / f / c.tanHalfFovY;
-    const int x = int(std::floor((sx + 1.0) * 0.5 * c.width));
-    const int y = int(std::floor((1.0 - sy) * 0.5 * c.height));
-    return std::size_t(y) * std::size_t(c.width) + std::size_t(x);
-}
-
 // The ground point under the centre of the caster's texel cell (i, j) of an n×m grid over the
 // quad's (u, v) (u along uAxis = +x, v along vAxis = −z for a normal +y; scene/scene.h quadAxes).
 Vec3 groundUnderCell(int i, int j, int n, int m) {
@@ -106,22 +66,12 @@ Vec3 groundUnderCell(int i, int j, int n, int m) {
     return onCaster + Vec3(kHeight, -kHeight, 0);
 }
 
-struct Frames {
-    scene::Frame raster, raytrace, reference;
-};
-
+// The three backends with the scene's settings, a 1024 map and hard raster shadows.
 Frames renderAll(const scene::Scene& s) {
     scene::RenderSettings settings = scene::resolveSettings(s, {});
     settings.raster.shadowMapSize = 1024;
-    settings.raster.validate = true;
     settings.raster.filter = scene::ShadowFilter::None;
-    const scene::RenderPlan plan = scene::makeRenderPlan(s, settings);
-    Frames f;
-    f.raster = raster::render(s, plan, settings.raster);
-    EXPECT_EQ(f.raster.attributes.at("validation_messages"), "0") << "validation messages were printed above";
-    f.raytrace = raytrace::render(s, plan, settings.raytrace);
-    f.reference = raytrace::renderReference(s, plan, scene::referenceSettings(settings.raytrace));
-    return f;
+    return test::renderAll(s, settings);
 }
 
 // Every backend's visibility at the ground under each cell of an n×m grid equals expected(i, j).
@@ -129,7 +79,7 @@ template <typename Expected>
 void expectCells(const scene::Scene& s, const Frames& f, int n, int m, Expected expected, double tolerance = 1e-4) {
     for (int j = 0; j < m; ++j)
         for (int i = 0; i < n; ++i) {
-            const std::size_t px = pixelOf(s, groundUnderCell(i, j, n, m));
+            const std::size_t px = test::pixelIndexOf(s, groundUnderCell(i, j, n, m));
             ASSERT_EQ(f.reference.objectId[px], 1.0f) << "the camera must see the ground there";
             const double want = expected(i, j);
             EXPECT_NEAR(f.raster.visibility[px], want, tolerance) << "raster, cell " << i << "," << j;
@@ -139,19 +89,14 @@ void expectCells(const scene::Scene& s, const Frames& f, int n, int m, Expected 
 }
 
 scene::Material alphaMaterial(scene::AlphaMode mode, std::shared_ptr<const scene::AlphaTexture> tex, double cutoff = 0.5) {
-    scene::Material m;
-    m.name = "caster";
-    m.alphaMode = mode;
-    m.alphaCutoff = cutoff;
-    m.alphaTexture = std::move(tex);
-    return m;
+    return test::alphaMaterial("caster", mode, std::move(tex), cutoff);
 }
 
 TEST(AlphaCasters, AMaskedCheckerboardCastsTheCheckerboardAndAlphaAtTheCutoffIsOpaque) {
     // 4×4 checker of alpha 0.5 and 0.25, cutoff 0.5: glTF 3.9.4 says alpha < cutoff is
     // transparent, so the 0.5 cells (x + y even) cast and the 0.25 cells let the light through:
     // 8 shadowed and 8 lit cells on the ground, in the checker's pattern.
-    const scene::Scene s = stage(alphaMaterial(scene::AlphaMode::Mask, checker(4, 0.5f, 0.25f), 0.5));
+    const scene::Scene s = stage(alphaMaterial(scene::AlphaMode::Mask, checkerTexture(4, 0.5f, 0.25f), 0.5));
     const Frames f = renderAll(s);
     int shadowed = 0;
     expectCells(s, f, 4, 4, [&](int i, int j) {
@@ -164,13 +109,13 @@ TEST(AlphaCasters, AMaskedCheckerboardCastsTheCheckerboardAndAlphaAtTheCutoffIsO
 
 TEST(AlphaCasters, ACutoffJustAboveEveryAlphaLetsAllTheLightThrough) {
     // Both alphas (0.5, 0.25) below a cutoff of 0.50001: no cell casts.
-    const scene::Scene s = stage(alphaMaterial(scene::AlphaMode::Mask, checker(4, 0.5f, 0.25f), 0.50001));
+    const scene::Scene s = stage(alphaMaterial(scene::AlphaMode::Mask, checkerTexture(4, 0.5f, 0.25f), 0.50001));
     expectCells(s, renderAll(s), 4, 4, [](int, int) { return 1.0; });
 }
 
 TEST(AlphaCasters, OpaqueIgnoresTheAlpha) {
     // The same texture in OPAQUE (and a cutoff that would cut every texel): the whole quad casts.
-    const scene::Scene s = stage(alphaMaterial(scene::AlphaMode::Opaque, checker(4, 0.0f, 0.25f), 0.9));
+    const scene::Scene s = stage(alphaMaterial(scene::AlphaMode::Opaque, checkerTexture(4, 0.0f, 0.25f), 0.9));
     expectCells(s, renderAll(s), 4, 4, [](int, int) { return 0.0; });
 }
 
@@ -187,7 +132,7 @@ TEST(AlphaCasters, BlendWithConstantAlphaLetsOneMinusAlphaThroughPerLayer) {
     const Frames two = renderAll(s);
     for (double x : {2.25, 2.75, 3.25, 3.75, 4.25, 4.75})
         for (double z : {-0.5, 0.5}) {
-            const std::size_t px = pixelOf(s, Vec3(x, 0, z));
+            const std::size_t px = test::pixelIndexOf(s, Vec3(x, 0, z));
             // A quad at height h over x in [−1, 1] shadows ground x in [h − 1, h + 1]: the upper
             // [2, 4], the lower [1, 3]. Overlap [2, 3) → 0.49; [3, 4) the upper only → 0.7.
             const double want = x < 3.0 ? 0.49 : x < 4.0 ? 0.7 : 1.0;
@@ -199,7 +144,7 @@ TEST(AlphaCasters, BlendWithConstantAlphaLetsOneMinusAlphaThroughPerLayer) {
 
 TEST(AlphaCasters, BlendWithATextureLetsOneMinusTheTexelsAlphaThrough) {
     // BLEND with the 0.5 / 0.25 checker: 0.5 and 0.75 of the light in the checker's pattern.
-    const scene::Scene s = stage(alphaMaterial(scene::AlphaMode::Blend, checker(4, 0.5f, 0.25f)));
+    const scene::Scene s = stage(alphaMaterial(scene::AlphaMode::Blend, checkerTexture(4, 0.5f, 0.25f)));
     expectCells(s, renderAll(s), 4, 4, [](int i, int j) { return (i + j) % 2 == 0 ? 0.5 : 0.75; });
 }
 
@@ -213,7 +158,7 @@ TEST(AlphaCasters, WrapModesRepeatClampAndMirrorAKnownPattern) {
                                         scene::TextureWrap::MirroredRepeat};
     for (int k = 0; k < 3; ++k) {
         SCOPED_TRACE(k);
-        const scene::Scene s = stage(alphaMaterial(scene::AlphaMode::Mask, texture(2, 1, {1.0f, 0.0f}, modes[k])),
+        const scene::Scene s = stage(alphaMaterial(scene::AlphaMode::Mask, alphaTexture(2, 1, {1.0f, 0.0f}, modes[k])),
                                      Vec2(0, 0), Vec2(2, 1));
         expectCells(s, renderAll(s), 4, 2, [&](int i, int) { return want[std::size_t(k)][std::size_t(i)]; });
     }
@@ -326,4 +271,4 @@ TEST(AlphaCasters, AlphaBlendModeTestCastsWhatTheGltfAlphaRulesSay) {
 }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab

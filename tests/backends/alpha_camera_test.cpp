@@ -1,4 +1,4 @@
-// tests/compare/alpha_camera_test.cpp: what the camera sees through alpha (docs/raytrace.md,
+// tests/backends/alpha_camera_test.cpp: what the camera sees through alpha (docs/raytrace.md,
 // "What the camera sees"), in the raster lit pass (lavapipe, validation layer on), the float ray
 // tracer and the double-precision reference, against the visible surface worked out by hand.
 //
@@ -12,50 +12,29 @@
 
 #include <gtest/gtest.h>
 
-#include "raster/renderer.h"
-#include "raytrace/renderer.h"
 #include "scene/camera.h"
-#include "scene/render_plan.h"
 #include "scene/settings.h"
+#include "tests/kit/render_checked.h"
+#include "tests/kit/test_scenes.h"
 
-namespace shadowlab::compare {
+namespace shadowlab {
 namespace {
 
 using scene::Vec2;
 using scene::Vec3;
+using test::Frames;
 
 constexpr double kHeight = 3.0;
 constexpr int kPixels = 160;
 
-std::shared_ptr<scene::AlphaTexture> checker(int n, float a, float b) {
-    auto tex = std::make_shared<scene::AlphaTexture>();
-    tex->file = "test-texture";
-    tex->width = n;
-    tex->height = n;
-    for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x) tex->alpha.push_back((x + y) % 2 == 0 ? a : b);
-    return tex;
-}
-
 scene::Object quad(const Vec3& center, double side, int material) {
-    scene::Quad q;
-    q.center = center;
-    q.normal = Vec3(0, 1, 0);
-    q.size = Vec2(side, side);
-    scene::quadAxes(q.normal, q.uAxis, q.vAxis);
-    return {"quad", q, material};
+    return test::horizontalQuad("quad", center, side, side, material);
 }
 
 scene::Scene stage(const scene::Material& card) {
     scene::Scene s;
-    s.camera.position = Vec3(0, 10, 0);
-    s.camera.lookAt = Vec3(0, 0, 0);
-    s.camera.up = Vec3(0, 0, -1);
-    s.camera.fovYDegrees = 30.0;
-    s.camera.width = kPixels;
-    s.camera.height = kPixels;
-    s.camera.near = 0.1;
-    s.camera.far = 100.0;
+    s.camera = {.position = Vec3(0, 10, 0), .lookAt = Vec3(0), .up = Vec3(0, 0, -1), .fovYDegrees = 30.0,
+                .width = kPixels, .height = kPixels};  // near 0.1, far 100
     scene::Material ground;
     ground.name = "ground";
     s.materials = {ground, card};
@@ -69,29 +48,14 @@ scene::Scene stage(const scene::Material& card) {
 }
 
 scene::Material card(scene::AlphaMode mode, std::shared_ptr<const scene::AlphaTexture> tex, double cutoff = 0.5) {
-    scene::Material m;
-    m.name = "card";
-    m.alphaMode = mode;
-    m.alphaCutoff = cutoff;
-    m.alphaTexture = std::move(tex);
-    return m;
+    return test::alphaMaterial("card", mode, std::move(tex), cutoff);
 }
 
-struct Frames {
-    scene::Frame raster, raytrace, reference;
-};
-
+// The three backends with the scene's settings and a 1024 map.
 Frames renderAll(const scene::Scene& s) {
     scene::RenderSettings settings = scene::resolveSettings(s, {});
     settings.raster.shadowMapSize = 1024;
-    settings.raster.validate = true;
-    const scene::RenderPlan plan = scene::makeRenderPlan(s, settings);
-    Frames f;
-    f.raster = raster::render(s, plan, settings.raster);
-    EXPECT_EQ(f.raster.attributes.at("validation_messages"), "0") << "validation messages were printed above";
-    f.raytrace = raytrace::render(s, plan, settings.raytrace);
-    f.reference = raytrace::renderReference(s, plan, scene::referenceSettings(settings.raytrace));
-    return f;
+    return test::renderAll(s, settings);
 }
 
 // Which object a pixel's centre ray sees, by hand: the quad's cell (i, j) of an n×n texture
@@ -149,7 +113,7 @@ void expectVisible(const scene::Scene& s, const Frames& f, int n, OpaqueCell opa
 TEST(AlphaCamera, TheCameraSeesTheGroundThroughAMaskedCheckerboard) {
     // 4×4 checker of alpha 1 and 0, cutoff 0.5: the camera sees the card in the x + y even cells
     // and the ground (id 1, depth 10) in the others.
-    const scene::Scene s = stage(card(scene::AlphaMode::Mask, checker(4, 1.0f, 0.0f)));
+    const scene::Scene s = stage(card(scene::AlphaMode::Mask, test::checkerTexture(4, 1.0f, 0.0f)));
     const Frames f = renderAll(s);
     int opaque = 0;
     expectVisible(s, f, 4, [&](int i, int j) { return (i + j) % 2 == 0; });
@@ -163,22 +127,23 @@ TEST(AlphaCamera, TheCameraSeesTheGroundThroughAMaskedCheckerboard) {
             const std::size_t px = std::size_t(y) * kPixels + std::size_t(x);
             bool edge = false;
             expectedId(s, x, y, 4, [](int i, int j) { return (i + j) % 2 == 0; }, edge);
-            if (f.raster.objectId[px] != f.reference.objectId[px] || f.raytrace.objectId[px] != f.reference.objectId[px])
+            if (f.raster.objectId[px] != f.reference.objectId[px] || f.raytrace.objectId[px] != f.reference.objectId[px]) {
                 EXPECT_TRUE(edge) << "the backends disagree off the border band at pixel " << x << "," << y;
+            }
         }
 }
 
 TEST(AlphaCamera, TheCutoffDecidesWhatTheCameraSees) {
     // Alphas 0.6 and 0.3: cutoff 0.5 shows the 0.6 cells only; cutoff 0.2 the whole card.
-    const scene::Scene some = stage(card(scene::AlphaMode::Mask, checker(4, 0.6f, 0.3f), 0.5));
+    const scene::Scene some = stage(card(scene::AlphaMode::Mask, test::checkerTexture(4, 0.6f, 0.3f), 0.5));
     expectVisible(some, renderAll(some), 4, [](int i, int j) { return (i + j) % 2 == 0; });
-    const scene::Scene all = stage(card(scene::AlphaMode::Mask, checker(4, 0.6f, 0.3f), 0.2));
+    const scene::Scene all = stage(card(scene::AlphaMode::Mask, test::checkerTexture(4, 0.6f, 0.3f), 0.2));
     expectVisible(all, renderAll(all), 4, [](int, int) { return true; });
 }
 
 TEST(AlphaCamera, OpaqueIgnoresTheAlphaForTheCamera) {
     // A texture of zeros and a cutoff that would cut every texel: OPAQUE shows the whole card.
-    const scene::Scene s = stage(card(scene::AlphaMode::Opaque, checker(4, 0.0f, 0.1f), 0.9));
+    const scene::Scene s = stage(card(scene::AlphaMode::Opaque, test::checkerTexture(4, 0.0f, 0.1f), 0.9));
     expectVisible(s, renderAll(s), 4, [](int, int) { return true; });
 }
 
@@ -186,7 +151,7 @@ TEST(AlphaCamera, BlendIsSeenWhereItsAlphaIsAtLeastOneHalf) {
     // BLEND (no cutoff in glTF): the camera sees the texels of alpha ≥ kBlendVisibleAlpha = 0.5
     // and looks through the others; 0.5 itself is seen.
     static_assert(scene::kBlendVisibleAlpha == 0.5);
-    const scene::Scene s = stage(card(scene::AlphaMode::Blend, checker(4, 0.5f, 0.45f)));
+    const scene::Scene s = stage(card(scene::AlphaMode::Blend, test::checkerTexture(4, 0.5f, 0.45f)));
     expectVisible(s, renderAll(s), 4, [](int i, int j) { return (i + j) % 2 == 0; });
     // Untextured BLEND: the factor alone decides, for the whole card.
     scene::Material faint = card(scene::AlphaMode::Blend, nullptr);
@@ -199,4 +164,4 @@ TEST(AlphaCamera, BlendIsSeenWhereItsAlphaIsAtLeastOneHalf) {
 }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab

@@ -1,18 +1,21 @@
-// tests/compare/cascades_render_test.cpp: on a large scene (a 200-unit plane with spheres along
-// the view), three cascades get no more shadow pixels wrong against the double-precision reference
-// than one map over the whole scene, on lavapipe with the validation layer.
+// tests/raster/cascades_render_test.cpp: raster/cascades.cpp against the double-precision
+// reference: on a large scene (a 200-unit plane with spheres along the view), three cascades get
+// no more shadow pixels wrong than one map over the whole scene (counted with compare's metrics),
+// on lavapipe with the validation layer.
 #include <cstdio>
 
 #include <gtest/gtest.h>
 
 #include "compare/compare.h"
 #include "raster/renderer.h"
-#include "raytrace/renderer.h"
-#include "scene/frame_io.h"
-#include "tests/raster/test_scenes.h"
+#include "tests/kit/render_checked.h"
+#include "tests/kit/test_scenes.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::raster {
 namespace {
+
+using compare::compareFrames;
+using compare::Metrics;
 
 scene::Frame rasterWith(const scene::Scene& s, int cascades) {
     scene::RenderSettings settings = scene::resolveSettings(s, {});
@@ -22,17 +25,12 @@ scene::Frame rasterWith(const scene::Scene& s, int cascades) {
     settings.raster.cascadesIsDefault = false;  // as given, not chosen per view
     // One map over the whole scene: the bounding-sphere map, named (the default fits it to the view).
     settings.raster.fitLightFrustum = false;
-    settings.raster.validate = true;
-    scene::Frame f = raster::render(s, scene::makeRenderPlan(s, settings), settings.raster);
-    EXPECT_EQ(f.attributes["validation_messages"], "0") << "validation messages were printed above";
-    return f;
+    return test::renderChecked(s, settings);
 }
 
 TEST(CascadesAgainstReference, ThreeCascadesGetNoMoreShadowPixelsWrongThanOneMapOnALargeScene) {
-    const scene::Scene s = raster::test::makeLongPlane(160, 90);
-    const scene::RenderSettings settings = scene::resolveSettings(s, {});
-    const scene::Frame reference = raytrace::renderReference(s, scene::makeRenderPlan(s, settings),
-                                                             scene::referenceSettings(settings.raytrace));
+    const scene::Scene s = test::makeLongPlane(160, 90);
+    const scene::Frame reference = test::renderReference(s);
     const Metrics one = compareFrames(rasterWith(s, 1), reference).metrics;
     const Metrics three = compareFrames(rasterWith(s, 3), reference).metrics;
     const std::size_t wrongOne = one.falseShadow + one.missedShadow;
@@ -50,4 +48,4 @@ TEST(CascadesAgainstReference, ThreeCascadesGetNoMoreShadowPixelsWrongThanOneMap
 }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::raster

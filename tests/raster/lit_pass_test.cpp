@@ -1,0 +1,197 @@
+// tests/raster/lit_pass_test.cpp: the camera pass alone (raster/lit_pass.cpp) on lavapipe with the
+// validation layer: for a quad under one directional light without a shadow test, every pixel
+// holds what the geometry says, worked out here from the camera: the quad's id, N·L, view depth,
+// visibility 1 and its shading where the pixel's centre ray meets the quad, the background and
+// zero AOVs elsewhere; read in place and through the readback copy alike. Also the targets' size
+// limit and where lit.vert hands lit.frag the light's map coordinates.
+#include "raster/lit_pass.h"
+
+#include <cmath>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "raster/geometry.h"
+#include "raster/tolerances.h"
+#include "raster/vulkan_error.h"
+#include "scene/camera.h"
+#include "tests/kit/render_checked.h"
+#include "tests/kit/test_scenes.h"
+
+namespace shadowlab::raster {
+namespace {
+
+using test::Vec3;
+
+// A 3 x 3 floor quad (object 0, id 1) at y = 0, albedo (0.8, 0.6, 0.4), seen from (0, 3, 4) at 96 x 64;
+// a directional light toward L = (1, 2, 0.5)/|·| of intensity 2; ambient 0.05.
+constexpr int kWidth = 96, kHeight = 64;
+const Vec3 kAlbedo(0.8, 0.6, 0.4), kBackground(0.1, 0.2, 0.3);
+const Vec3 kToLight = glm::normalize(Vec3(1, 2, 0.5));
+constexpr double kAmbient = 0.05, kIntensity = 2.0;
+
+scene::Scene floorScene() {
+    scene::Scene s;
+    s.camera = {.position = Vec3(0, 3, 4), .lookAt = Vec3(0), .width = kWidth, .height = kHeight};  // fov 40°
+    s.ambient = kAmbient;
+    s.background = kBackground;
+    test::addMaterial(s, "floor");
+    s.materials[0].albedo = kAlbedo;
+    test::addDirectional(s, -kToLight, kIntensity);
+    test::addQuad(s, Vec3(0), Vec3(0, 1, 0), 3, 3);
+    return s;
+}
+
+// What the pass wrote, one pixel's beauty (rgb, visibility) and AOVs (id, N·L, depth, blocker).
+struct Pixels {
+    std::vector<glm::vec4> beauty, aovs;
+};
+
+// The lit pass of `s` alone: the light's uniforms as the renderer fills them for a directional
+// light, but with layer −1 (no shadow test), the placeholder maps a render without shadow layers
+// binds, the geometry relative to the camera; `draw` false draws nothing.
+Pixels litPass(const Context& ctx, const scene::Scene& s, bool readInPlace, bool draw = true) {
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    const SceneGeometry g = tessellateScene(s, cam.position);
+    const Buffer vb = uploadBuffer(ctx, g.vertices, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+    const Buffer ib = uploadBuffer(ctx, g.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+    const DrawGeometry geometry{vb.buffer.get(), ib.buffer.get(), draw ? std::uint32_t(g.indices.size()) : 0u};
+
+    shaders::LitUniforms u{};
+    u.viewProj = glm::mat4(scene::projectionMatrix(cam, s.camera.near, s.camera.far) * scene::viewMatrix(cam, cam.position));
+    u.forward = glm::vec4(glm::vec3(cam.forward), float(s.ambient));
+    u.background = glm::vec4(glm::vec3(s.background), 0.0f);
+    u.counts = glm::vec4(1.0f, 1.0f, 0.0f, 0.0f);
+    shaders::LightData& l = u.lights[0];
+    l.toShadow = glm::mat4(1.0f);
+    l.toLight = glm::vec4(glm::vec3(kToLight), -1.0f);  // w: no shadow-map layer
+    l.radiance = glm::vec4(float(kIntensity));
+    l.params = glm::vec4(float(kMaxSlopeTan), float(SHADOWLAB_FILTER_NONE), 0.0f, 1.0f);
+    l.kind = glm::vec4(float(SHADOWLAB_LIGHT_DIRECTIONAL), 0.0f, 0.0f, 0.0f);
+    const std::vector<glm::vec4> albedos = {glm::vec4(glm::vec3(kAlbedo), 1.0f)};
+
+    const LitPipeline pipeline = createLitPipeline(
+        ctx, LitVariant{.filter = scene::ShadowFilter::None, .normalOffset = false,
+                        .lightKinds = 1u << SHADOWLAB_LIGHT_DIRECTIONAL});
+    // Placeholders, moved to SHADER_READ_ONLY_OPTIMAL by a shadow pass of no layers.
+    const ShadowPipeline shadowPipeline = createShadowPipeline(ctx);
+    const ShadowMaps maps = createShadowMaps(ctx, 1, 1);
+    const TransmittanceMaps transmittance = createTransmittanceMaps(ctx, 1, 1);
+    const MomentMaps moments = createMomentMaps(ctx, 1, 1);
+    const TransmittancePass placeholders{nullptr, &transmittance, {}, nullptr};
+    const LitTargets targets = createLitTargets(ctx, kWidth, kHeight, 0, readInPlace);
+    EXPECT_EQ(targets.hostReadable, readInPlace) << "lavapipe reads its targets in place when asked";
+    const LitBindings bindings = createLitBindings(ctx, pipeline, u, albedos, maps, transmittance, moments);
+    const Readback readback = createReadback(ctx, targets);
+
+    VkCommandBuffer commands = ctx.beginCommands();
+    recordShadowPass(commands, shadowPipeline, maps, geometry, {}, true, &placeholders);
+    recordLitPass(commands, pipeline, bindings, targets, geometry, glm::vec3(s.background));
+    if (!targets.hostReadable) recordReadback(commands, targets, readback);
+    ctx.submitAndWait(commands);
+    if (!targets.hostReadable) {
+        invalidate(ctx, readback.beauty);
+        invalidate(ctx, readback.aovs);
+    }
+    // (lavapipe's host-visible memory is coherent: targets read in place need no invalidation.)
+    Pixels out;
+    for (const auto& [image, buffer, to] : {std::tuple{&targets.beauty, &readback.beauty, &out.beauty},
+                                            std::tuple{&targets.aovs, &readback.aovs, &out.aovs}}) {
+        const char* base = targets.hostReadable ? static_cast<const char*>(image->mapped)
+                                                : static_cast<const char*>(buffer->mapped);
+        const std::size_t pitch = targets.hostReadable ? std::size_t(image->rowPitch) : std::size_t(kWidth) * 16;
+        for (int y = 0; y < kHeight; ++y)
+            for (int x = 0; x < kWidth; ++x) to->push_back(reinterpret_cast<const glm::vec4*>(base + y * pitch)[x]);
+    }
+    return out;
+}
+
+TEST(RasterLitPass, DrawsTheQuadTheCameraSeesWithItsShadingAndAovs) {
+    // Per pixel, the centre ray eye + t·d meets y = 0 at q (test::floorPoint). On the quad
+    // (|q.x|, |q.z| < 1.5, more than 0.1 inside: a pixel's footprint there is under 0.06): id 1,
+    // N·L = L.y (the normal +y faces the camera above it), view depth (q − eye)·forward, visibility
+    // 1 (no shadow test), color albedo·(ambient + intensity·N·L). Past the quad by 0.1: the
+    // background color, visibility 0, zero AOVs.
+    const scene::Scene s = floorScene();
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    test::ValidatedContext vc;
+    for (const bool inPlace : {true, false}) {
+        SCOPED_TRACE(inPlace ? "read in place" : "copied");
+        const Pixels p = litPass(vc.get(), s, inPlace);
+        int onQuad = 0, off = 0, wrong = 0;
+        for (int y = 0; y < kHeight; ++y)
+            for (int x = 0; x < kWidth; ++x) {
+                const std::size_t i = std::size_t(y) * kWidth + std::size_t(x);
+                const Vec3 q = test::floorPoint(cam, x, y);
+                const double edge = std::max(std::abs(q.x), std::abs(q.z));
+                const bool down = test::pixelRay(cam, x, y).y < 0.0;
+                const glm::vec4 b = p.beauty[i], a = p.aovs[i];
+                if (down && edge < 1.4) {
+                    ++onQuad;
+                    const double ndotl = kToLight.y;
+                    const Vec3 color = kAlbedo * (kAmbient + kIntensity * ndotl);
+                    const double depth = glm::dot(q - cam.position, cam.forward);
+                    const bool ok = a.x == 1.0f && std::abs(a.y - ndotl) < 1e-5 && std::abs(a.z - depth) < 1e-4 &&
+                                    a.w == 0.0f && b.w == 1.0f && std::abs(b.r - color.r) < 1e-5 &&
+                                    std::abs(b.g - color.g) < 1e-5 && std::abs(b.b - color.b) < 1e-5;
+                    if (!ok && ++wrong <= 3)
+                        ADD_FAILURE() << "quad pixel " << x << "," << y << ": beauty " << b.r << " " << b.g << " " << b.b
+                                      << " " << b.w << ", aovs " << a.x << " " << a.y << " " << a.z << " " << a.w;
+                } else if (!down || edge > 1.6) {
+                    ++off;
+                    const bool ok = b == glm::vec4(glm::vec3(kBackground), 0.0f) && a == glm::vec4(0.0f);
+                    if (!ok && ++wrong <= 3) ADD_FAILURE() << "background pixel " << x << "," << y;
+                }
+            }
+        // The quad spans about 3/5 rad of the view's 57° across and is foreshortened (seen 37°
+        // above the plane): well over a thousand of the 6144 pixels; the corners show background.
+        EXPECT_GT(onQuad, 1000);
+        EXPECT_GT(off, 1000);
+        EXPECT_EQ(wrong, 0);
+    }
+}
+
+TEST(RasterLitPass, WithNothingToDrawEveryPixelIsTheBackgroundWithZeroAovs) {
+    test::ValidatedContext vc;
+    const Pixels p = litPass(vc.get(), floorScene(), true, false);
+    int wrong = 0;
+    for (std::size_t i = 0; i < p.beauty.size(); ++i)
+        wrong += p.beauty[i] != glm::vec4(glm::vec3(kBackground), 0.0f) || p.aovs[i] != glm::vec4(0.0f);
+    EXPECT_EQ(p.beauty.size(), std::size_t(kWidth) * kHeight);
+    EXPECT_EQ(wrong, 0);
+}
+
+TEST(RasterLitPass, TargetsLargerThanTheDeviceAllowsAreRefusedNamingTheLimit) {
+    test::ValidatedContext vc;
+    const Context& ctx = vc.get();
+    const std::uint32_t limit = ctx.properties.limits.maxImageDimension2D;
+    try {
+        createLitTargets(ctx, limit + 1, 4);
+        FAIL() << "expected RasterError";
+    } catch (const RasterError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find(std::to_string(limit + 1) + "x4"), std::string::npos) << what;
+        EXPECT_NE(what.find("limit of " + std::to_string(limit)), std::string::npos) << what;
+    }
+}
+
+TEST(RasterLitPass, TheLightsMapCoordinatesComeFromTheVertexShaderOnlyForOneDirectionalMapOrOneSpot) {
+    // lit.vert interpolates toShadow·p for light 0, which is right only when that one matrix serves
+    // every fragment: one light, directional with a single map or a spot, and no receiver plane
+    // (which needs each tap's own plane depth). Points pick a cube face per fragment, cascades a map.
+    constexpr std::uint32_t dir = 1u << SHADOWLAB_LIGHT_DIRECTIONAL, spot = 1u << SHADOWLAB_LIGHT_SPOT,
+                            point = 1u << SHADOWLAB_LIGHT_POINT;
+    EXPECT_TRUE(usesVertexLightCoordinates({.lightKinds = dir}));
+    EXPECT_TRUE(usesVertexLightCoordinates({.lightKinds = spot}));
+    EXPECT_FALSE(usesVertexLightCoordinates({.lightKinds = point}));
+    EXPECT_FALSE(usesVertexLightCoordinates({.lightKinds = dir, .cascades = 3}));
+    EXPECT_TRUE(usesVertexLightCoordinates({.lightKinds = spot, .cascades = 3}));  // cascades are directional only
+    EXPECT_FALSE(usesVertexLightCoordinates({.lightCount = 2, .lightKinds = dir}));
+    EXPECT_FALSE(usesVertexLightCoordinates({.lightKinds = spot, .receiverPlane = true}));
+    EXPECT_FALSE(usesVertexLightCoordinates({.lightKinds = dir | spot}));
+}
+
+}  // namespace
+}  // namespace shadowlab::raster
