@@ -95,12 +95,14 @@ inline void triangle4Test(const Triangle4Ray& r, const TrianglePacket& p, float 
                                     _mm_and_ps(_mm_cmplt_ps(tScaled, zero), _mm_cmpge_ps(tScaled, tMaxDet)));
     const __m128 okPos = _mm_and_ps(_mm_cmpgt_ps(det, zero),
                                     _mm_and_ps(_mm_cmpgt_ps(tScaled, zero), _mm_cmple_ps(tScaled, tMaxDet)));
+    const __m128 inside = _mm_andnot_ps(_mm_and_ps(anyNeg, anyPos), _mm_or_ps(okNeg, okPos));
+    out.zeroEdge = zeroEdge & valid;
+    out.pass = _mm_movemask_ps(inside) & valid & ~zeroEdge;
+    if (out.pass == 0) return;  // most packets: no lane left, no division needed
     const __m128 invDet = _mm_div_ps(_mm_set1_ps(1.0f), det);
     const __m128 t = _mm_mul_ps(tScaled, invDet);
     const __m128 tOk = _mm_and_ps(_mm_cmpgt_ps(t, zero), _mm_cmplt_ps(t, _mm_set1_ps(tMax)));
-    const __m128 pass = _mm_and_ps(_mm_andnot_ps(_mm_and_ps(anyNeg, anyPos), _mm_or_ps(okNeg, okPos)), tOk);
-    out.zeroEdge = zeroEdge & valid;
-    out.pass = _mm_movemask_ps(pass) & valid & ~zeroEdge;
+    out.pass &= _mm_movemask_ps(tOk);
     if (out.pass != 0) {
         _mm_store_ps(out.t, t);
         _mm_store_ps(out.e[0], e0);
