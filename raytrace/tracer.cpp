@@ -179,6 +179,16 @@ __attribute__((target("avx2"), flatten)) bool traverseFloatAvx2(
 }
 #endif
 
+#if defined(SHADOWLAB_AVX_BOX_TEST)
+// The double walk with the AVX box test (ChildBoxTestAvx8Double): the same walk (traverseWith)
+// and leaf, so the same visits in the same order as the scalar test's.
+template <typename LeafFn>
+__attribute__((target("avx"), flatten)) bool traverseDoubleAvx(const Bvh8& bvh, const Ray<double>& ray,
+                                                               double& tBest, bool anyHit, LeafFn& leaf) {
+    return bvh.traverseWith<detail::ChildBoxTestAvx8Double>(ray, tBest, anyHit, leaf);
+}
+#endif
+
 // Per thread: for a few trees, the packet that last blocked an any-hit ray. Keyed by the
 // tracer's unique id (never reused, unlike an address) and the tree's index.
 struct OccluderCache {
@@ -491,8 +501,7 @@ bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& 
         }
         return found;
     } else {
-        return m.bvh.traverse(ray, tBest, anyHit,
-                              [&](std::uint32_t first, std::uint32_t count, Real& tm) {
+        auto leaf = [&](std::uint32_t first, std::uint32_t count, Real& tm) {
             bool any = false;
             for (std::uint32_t slot = first; slot < first + count; ++slot) {
                 const Vec* v = &m.slotVertices[3 * std::size_t(slot)];
@@ -506,7 +515,11 @@ bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& 
                 any = true;
             }
             return any;
-        });
+        };
+#if defined(SHADOWLAB_AVX_BOX_TEST)
+        if (detail::useAvx()) return traverseDoubleAvx(m.bvh, ray, tBest, anyHit, leaf);
+#endif
+        return m.bvh.traverse(ray, tBest, anyHit, leaf);
     }
 }
 

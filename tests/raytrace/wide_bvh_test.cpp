@@ -365,6 +365,56 @@ TEST(WideBvh, AvxChildBoxTestEqualsTheSseTestBitForBit) {
 #endif
 }
 
+#if defined(SHADOWLAB_AVX_BOX_TEST)
+__attribute__((target("avx"))) int avxDoubleBoxTest(const Ray<double>& ray, const Bvh8Node& n, double tMax,
+                                                    double tn[8]) {
+    return detail::ChildBoxTestAvx8Double(ray)(n, tMax, tn);
+}
+#endif
+
+// The reference's AVX box test (doubles, four children a pass) gives the scalar double test's
+// masks and entry distances bit for bit on adversarial boxes (integer planes, origins on them,
+// axis-parallel rays, empty children), so the reference walks the same nodes in the same order.
+TEST(WideBvh, AvxDoubleChildBoxTestEqualsTheScalarTestBitForBit) {
+#if defined(SHADOWLAB_AVX_BOX_TEST)
+    if (!detail::hasAvx()) GTEST_SKIP() << "this CPU has no AVX";
+    std::mt19937_64 g(79);
+    std::uniform_real_distribution<double> u(-4, 4);
+    std::uniform_int_distribution<int> pick(0, 3);
+    Bvh8Node n{};
+    int differ = 0, entered = 0;
+    for (int trial = 0; trial < 40000; ++trial) {
+        for (int c = 0; c < 8; ++c)
+            for (int k = 0; k < 3; ++k) {
+                const float a = float(std::round(u(g))), b = float(std::round(u(g)));
+                n.bounds[k][c] = std::min(a, b);
+                n.bounds[3 + k][c] = std::max(a, b);
+            }
+        if (trial % 5 == 0)
+            for (int k = 0; k < 3; ++k) {
+                n.bounds[k][3] = std::numeric_limits<float>::infinity();
+                n.bounds[3 + k][3] = -std::numeric_limits<float>::infinity();
+            }
+        Vec3 o(std::round(u(g)), std::round(u(g)), std::round(u(g))), d(u(g), u(g), u(g));
+        for (int k = 0; k < 3; ++k)
+            if (pick(g) == 0) d[k] = pick(g) < 2 ? 0.0 : -0.0;
+        const Ray<double> ray(o, d);
+        const double tMax = trial % 2 ? std::numeric_limits<double>::infinity() : 3.0;
+        double tnScalar[8], tnAvx[8];
+        const int scalar = detail::ChildBoxTest<double, 8>(ray)(n, tMax, tnScalar);
+        const int avx = avxDoubleBoxTest(ray, n, tMax, tnAvx);
+        differ += scalar != avx;
+        for (int c = 0; c < 8; ++c)
+            if (scalar & (1 << c)) differ += std::memcmp(&tnScalar[c], &tnAvx[c], sizeof(double)) != 0;
+        entered += __builtin_popcount(unsigned(scalar));
+    }
+    EXPECT_EQ(differ, 0);
+    EXPECT_GT(entered, 40000);
+#else
+    GTEST_SKIP() << "not an x86-64 GCC build";
+#endif
+}
+
 // The AVX2 box test (integer min/max, for rays with a finite inverse direction) is its scalar
 // model bit for bit on adversarial boxes, and conservative: a box around a point of the ray
 // segment is always entered. Points are o + t·d in double with 0 < t < tMax, boxes reach from
@@ -490,6 +540,45 @@ TEST(WideBvh, TracerAnswersAreTheSameWithAvx2AvxOrSseAndWithOrWithoutTheOccluder
     EXPECT_GT(hits, 3000);
     // The grid's blocked rays: most are answered by the previous ray's triangle packet.
     EXPECT_GT(cacheAnswers, 2000u);
+}
+
+// The double tracer (the reference) gives the same closest hits (t, triangle, barycentrics, bit
+// for bit) and any-hit answers with the AVX box test or the scalar one, in plain and
+// conservative mode, on random and axis-parallel rays through a triangle soup.
+TEST(WideBvh, DoubleTracerAnswersAreTheSameWithAvxOrScalarBoxTests) {
+    std::mt19937_64 g(32);
+    const Soup soup = triangleSoup(20000, g);
+    auto mesh = std::make_shared<scene::TriangleMesh>();
+    for (const Vec3& p : soup.p) mesh->positions.push_back(p);
+    for (std::uint32_t i = 0; i < soup.p.size(); ++i) mesh->indices.push_back(i);
+    scene::Scene s;
+    test::addMaterial(s, "matte");
+    test::addMesh(s, mesh);
+    const Tracer<double> tracer(s);
+    std::uniform_real_distribution<double> u(-14, 14);
+    int hits = 0, differ = 0;
+    for (int r = 0; r < 12000; ++r) {
+        const Vec3 from(u(g), u(g), u(g));
+        Vec3 d = Vec3(u(g) / 2, u(g) / 2, u(g) / 2) - from;
+        if (r % 6 == 0) d = Vec3(0.0), d[r % 3] = r % 4 ? 1.0 : -1.0;
+        const Ray<double> ray(from, d);
+        const double tMax = r % 3 == 0 ? 0.6 : std::numeric_limits<double>::infinity();
+        Hit<double> h[2];
+        bool found[2], any[2];
+        for (int config = 0; config < 2; ++config) {
+            detail::setUseAvx(config == 0);
+            found[config] = tracer.closestHit(ray, tMax, r % 2 == 0, h[config]);
+            int blocker = -1;
+            any[config] = tracer.anyHit(ray, tMax, r % 2 == 0, blocker);
+        }
+        hits += found[0];
+        differ += found[0] != found[1] || any[0] != any[1] ||
+                  (found[0] && (std::memcmp(&h[0].t, &h[1].t, sizeof(double)) != 0 || h[0].prim != h[1].prim ||
+                                std::memcmp(&h[0].b1, &h[1].b1, sizeof(double)) != 0));
+    }
+    detail::setUseAvx(true);
+    EXPECT_EQ(differ, 0);
+    EXPECT_GT(hits, 3000);
 }
 
 }  // namespace
