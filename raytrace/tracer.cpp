@@ -480,9 +480,7 @@ bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& 
             }
         }
 #if defined(SHADOWLAB_AVX_BOX_TEST)
-        const bool finiteInv = std::isfinite(ray.invDir.x) && std::isfinite(ray.invDir.y) &&
-                               std::isfinite(ray.invDir.z);
-        const bool found = detail::useAvx() && detail::useAvx2() && finiteInv
+        const bool found = detail::useAvx() && detail::useAvx2() && detail::avx2BoxTestApplies(ray)
                                ? traverseFloatAvx2(m.bvh, m.packets, ray, tBest, conservative, anyHit, sh, mask)
                            : detail::useAvx()
                                ? traverseFloatAvx(m.bvh, m.packets, ray, tBest, conservative, anyHit, sh, mask)

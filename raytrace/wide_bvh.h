@@ -3,6 +3,7 @@
 // closest hit with a stack that skips entries beyond the current hit, any order for any hit.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <type_traits>
 #include <vector>
@@ -245,7 +246,6 @@ struct ChildBoxTestAvx8Octant {
         return _mm256_movemask_ps(_mm256_cmp_ps(tn, tf, _CMP_LE_OQ));
     }
 };
-#endif
 
 // The double reference's box test with AVX: four children per 256-bit pass of doubles (the
 // float planes widened exactly by _mm256_cvtps_pd), the scalar ChildBoxTest<double, 8>'s
@@ -285,7 +285,8 @@ struct ChildBoxTestAvx8Double {
 };
 
 // The box test of the float walk on CPUs with AVX2, for rays of one octant whose inverse
-// direction is finite in all three components (no slab value can be NaN). The far distances use
+// direction is finite in all three components, also times the widening factor
+// (avx2BoxTestApplies: no slab value can be NaN). The far distances use
 // the inverse direction times the widening factor, rounded once per ray (the same four roundings
 // as intersectBounds' (b − o)·inv·widen, so the same error bound), and the minimum and maximum
 // are taken on the floats' bit patterns as 32-bit integers, one cycle each instead of four:
@@ -321,6 +322,16 @@ struct ChildBoxTestAvx2Octant {
         return ~_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(tn, tf))) & 0xFF;
     }
 };
+
+#endif
+
+// Whether ChildBoxTestAvx2Octant may test this ray: its inverse direction, and that times the
+// widening factor, finite in all three components, so that no slab value can be NaN (0·inf).
+inline bool avx2BoxTestApplies(const Ray<float>& r) {
+    const float widen = 1 + 2 * gamma<float>(3);
+    return std::isfinite(r.invDir.x * widen) && std::isfinite(r.invDir.y * widen) &&
+           std::isfinite(r.invDir.z * widen);
+}
 
 // The octant of a ray's direction: bit i set when its component i is negative (dirIsNeg).
 template <typename Real>

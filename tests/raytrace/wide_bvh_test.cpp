@@ -503,10 +503,16 @@ TEST(WideBvh, TracerAnswersAreTheSameWithAvx2AvxOrSseAndWithOrWithoutTheOccluder
     for (int y = 0; y < 100; ++y)
         for (int x = 0; x < 100; ++x)
             rays.emplace_back(Vec3T<float>(-12.0f + 0.05f * x, -12.0f + 0.05f * y, -14.0f), Vec3T<float>(0.3f, 0.4f, 1.0f));
-    // Axis-parallel rays (an infinite inverse direction: the AVX2 walk hands them to the AVX one).
-    for (int r = 0; r < 2000; ++r) {
+    // Axis-parallel rays (an infinite inverse direction: the AVX2 walk hands them to the AVX one),
+    // and rays with a component so small that its inverse is finite but times the widening
+    // factor is not (also the AVX walk's) or just finite (the AVX2 walk's).
+    for (int r = 0; r < 3000; ++r) {
         Vec3T<float> d(0.0f);
         d[r % 3] = r % 2 ? 1.0f : -1.0f;
+        if (r >= 2000) {
+            d[(r + 1) % 3] = 0.4f;
+            d[(r + 2) % 3] = r % 4 < 2 ? 1.0f / std::numeric_limits<float>::max() : std::numeric_limits<float>::min();
+        }
         rays.emplace_back(Vec3T<float>(Vec3(u(g), u(g), u(g))), d);
     }
     int hits = 0, differ = 0;
