@@ -68,15 +68,20 @@ struct MaskFilter {
     }
 };
 
-template <typename BoxTest>
+// The float mesh walk (WideBvh::walk) with its leaf test: packets of four triangles through
+// triangle4Test, whose passing lanes are the scalar watertight test's answers bit for bit
+// (plain mode, no zero edge, the same bound); the other candidate lanes (an edge exactly 0,
+// conservative mode, or a bound lowered by a hit earlier in the packet) go to the scalar test.
+// Lanes are decided in slot order, as the scalar loop always did. Fills the last hit.
+template <bool kAnyHit, typename BoxTest>
 inline bool traverseFloat(const Bvh8& bvh, const std::vector<TrianglePacket>& packets,
-                          const Ray<float>& ray, float& tBest, bool conservative, bool anyHit,
-                          SlotHit& out, const MaskFilter<float>& mask) {
+                          const Ray<float>& ray, float& tBest, bool conservative, SlotHit& out,
+                          const MaskFilter<float>& mask) {
     const Triangle4Ray r4(ray);
-    const std::vector<std::uint32_t>& prims = bvh.primitives();
+    const BoxTest boxes(ray);
+    const std::uint32_t* prims = bvh.primitives().data();
     bool have = false;  // closest hit: `out` holds this walk's nearest hit so far
-    return bvh.traverseWith<BoxTest>(ray, tBest, anyHit,
-                                     [&](std::uint32_t first, std::uint32_t count, float& tm) {
+    return bvh.template walk<kAnyHit>(boxes, tBest, [&](std::uint32_t first, std::uint32_t count, float& tm) {
         bool any = false;
         // After a hit, a hit at exactly the same t is also tested, and the lower triangle
         // index wins: the answer is the minimum of (t, index), whatever the tree's order.
@@ -93,21 +98,29 @@ inline bool traverseFloat(const Bvh8& bvh, const std::vector<TrianglePacket>& pa
         for (std::uint32_t base = first; base < first + count; base += 4) {
             const TrianglePacket& pk = packets[base / 4];
             const std::uint32_t lanes = std::min<std::uint32_t>(4, first + count - base);
-            int cand = triangle4Candidates(r4, pk, bound, (1 << lanes) - 1);
-            // The scalar test decides, lane by lane in slot order as before.
+            Triangle4Result res;
+            triangle4Test(r4, pk, bound, (1 << lanes) - 1, res);
+            int cand = res.pass | res.zeroEdge;
+            const float packetBound = bound;
             while (cand != 0) {
                 const int l = __builtin_ctz(unsigned(cand));
                 cand &= cand - 1;
                 float t, b0, b1, b2;
-                if (!intersectTriangle(ray, pk.vertex(l, 0), pk.vertex(l, 1), pk.vertex(l, 2), bound,
-                                       conservative, t, b0, b1, b2))
+                if (!conservative && (res.pass >> l & 1) && bound == packetBound) {
+                    t = res.t[l];
+                    b0 = res.e[0][l] * res.invDet[l];
+                    b1 = res.e[1][l] * res.invDet[l];
+                    b2 = res.e[2][l] * res.invDet[l];
+                } else if (!intersectTriangle(ray, pk.vertex(l, 0), pk.vertex(l, 1), pk.vertex(l, 2), bound,
+                                              conservative, t, b0, b1, b2)) {
                     continue;
+                }
                 const std::uint32_t slot = base + std::uint32_t(l);
                 if (mask.rejects(slot, b0, b1, b2)) continue;
                 if (have && !(t < tm || prims[slot] < prims[out.slot])) continue;
                 tm = t;
                 out = SlotHit{t, b0, b1, b2, slot};
-                if (anyHit) return true;
+                if constexpr (kAnyHit) return true;
                 have = true;
                 bound = above(tm);
                 any = true;
@@ -117,15 +130,62 @@ inline bool traverseFloat(const Bvh8& bvh, const std::vector<TrianglePacket>& pa
     });
 }
 
+template <typename BoxTest>
+inline bool traverseFloat(const Bvh8& bvh, const std::vector<TrianglePacket>& packets,
+                          const Ray<float>& ray, float& tBest, bool conservative, bool anyHit,
+                          SlotHit& out, const MaskFilter<float>& mask) {
+    return anyHit ? traverseFloat<true, BoxTest>(bvh, packets, ray, tBest, conservative, out, mask)
+                  : traverseFloat<false, BoxTest>(bvh, packets, ray, tBest, conservative, out, mask);
+}
+
 #if defined(SHADOWLAB_AVX_BOX_TEST)
-// The same walk compiled for AVX: `flatten` inlines everything it calls (the walk, the leaf
-// test, the SSE packet filter, the scalar triangle test) into this one function, so the AVX
-// code exists only here and runs only after detail::useAvx() said the CPU has AVX. Target
-// "avx" enables no FMA, so the float results are the SSE path's, bit for bit.
+// The same walk compiled for AVX, one copy per ray octant (the box test's rows are constants):
+// `flatten` inlines everything it calls (the walk, the leaf test, the SSE packet filter, the
+// scalar triangle test) into this one function, so the AVX code exists only here and runs only
+// after detail::useAvx() said the CPU has AVX. Target "avx" enables no FMA, so the float
+// results are the SSE path's, bit for bit.
 __attribute__((target("avx"), flatten)) bool traverseFloatAvx(
     const Bvh8& bvh, const std::vector<TrianglePacket>& packets, const Ray<float>& ray,
     float& tBest, bool conservative, bool anyHit, SlotHit& out, const MaskFilter<float>& mask) {
-    return traverseFloat<detail::ChildBoxTestAvx8>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+    using detail::ChildBoxTestAvx8Octant;
+    switch (detail::octantOf(ray)) {
+        case 0: return traverseFloat<ChildBoxTestAvx8Octant<0>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 1: return traverseFloat<ChildBoxTestAvx8Octant<1>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 2: return traverseFloat<ChildBoxTestAvx8Octant<2>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 3: return traverseFloat<ChildBoxTestAvx8Octant<3>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 4: return traverseFloat<ChildBoxTestAvx8Octant<4>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 5: return traverseFloat<ChildBoxTestAvx8Octant<5>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 6: return traverseFloat<ChildBoxTestAvx8Octant<6>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        default: return traverseFloat<ChildBoxTestAvx8Octant<7>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+    }
+}
+
+// The walk with the AVX2 box test (ChildBoxTestAvx2Octant) for rays whose inverse direction is
+// finite; the others take traverseFloatAvx. Target "avx2" enables no FMA either.
+__attribute__((target("avx2"), flatten)) bool traverseFloatAvx2(
+    const Bvh8& bvh, const std::vector<TrianglePacket>& packets, const Ray<float>& ray,
+    float& tBest, bool conservative, bool anyHit, SlotHit& out, const MaskFilter<float>& mask) {
+    using detail::ChildBoxTestAvx2Octant;
+    switch (detail::octantOf(ray)) {
+        case 0: return traverseFloat<ChildBoxTestAvx2Octant<0>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 1: return traverseFloat<ChildBoxTestAvx2Octant<1>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 2: return traverseFloat<ChildBoxTestAvx2Octant<2>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 3: return traverseFloat<ChildBoxTestAvx2Octant<3>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 4: return traverseFloat<ChildBoxTestAvx2Octant<4>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 5: return traverseFloat<ChildBoxTestAvx2Octant<5>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 6: return traverseFloat<ChildBoxTestAvx2Octant<6>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        default: return traverseFloat<ChildBoxTestAvx2Octant<7>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+    }
+}
+#endif
+
+#if defined(SHADOWLAB_AVX_BOX_TEST)
+// The double walk with the AVX box test (ChildBoxTestAvx8Double): the same walk (traverseWith)
+// and leaf, so the same visits in the same order as the scalar test's.
+template <typename LeafFn>
+__attribute__((target("avx"), flatten)) bool traverseDoubleAvx(const Bvh8& bvh, const Ray<double>& ray,
+                                                               double& tBest, bool anyHit, LeafFn& leaf) {
+    return bvh.traverseWith<detail::ChildBoxTestAvx8Double>(ray, tBest, anyHit, leaf);
 }
 #endif
 
@@ -420,7 +480,9 @@ bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& 
             }
         }
 #if defined(SHADOWLAB_AVX_BOX_TEST)
-        const bool found = detail::useAvx()
+        const bool found = detail::useAvx() && detail::useAvx2() && detail::avx2BoxTestApplies(ray)
+                               ? traverseFloatAvx2(m.bvh, m.packets, ray, tBest, conservative, anyHit, sh, mask)
+                           : detail::useAvx()
                                ? traverseFloatAvx(m.bvh, m.packets, ray, tBest, conservative, anyHit, sh, mask)
                                : traverseFloat<detail::ChildBoxTest<float, 8>>(m.bvh, m.packets, ray, tBest,
                                                                               conservative, anyHit, sh, mask);
@@ -437,8 +499,7 @@ bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& 
         }
         return found;
     } else {
-        return m.bvh.traverse(ray, tBest, anyHit,
-                              [&](std::uint32_t first, std::uint32_t count, Real& tm) {
+        auto leaf = [&](std::uint32_t first, std::uint32_t count, Real& tm) {
             bool any = false;
             for (std::uint32_t slot = first; slot < first + count; ++slot) {
                 const Vec* v = &m.slotVertices[3 * std::size_t(slot)];
@@ -452,7 +513,11 @@ bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& 
                 any = true;
             }
             return any;
-        });
+        };
+#if defined(SHADOWLAB_AVX_BOX_TEST)
+        if (detail::useAvx()) return traverseDoubleAvx(m.bvh, ray, tBest, anyHit, leaf);
+#endif
+        return m.bvh.traverse(ray, tBest, anyHit, leaf);
     }
 }
 

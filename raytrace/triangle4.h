@@ -45,13 +45,22 @@ struct Triangle4Ray {
     }
 };
 
-// Returns the lanes of `valid` the scalar intersectTriangle must still decide: those that pass
-// the test's edge, determinant and t-range checks with the same float operations in the same
-// order (no FMA: SSE2 has none, and the compiler contracts nothing without -mfma), plus those
-// with an edge function exactly 0, which the scalar test recomputes in double. Every lane the
-// scalar test accepts is therefore returned; most misses are rejected here, four at a time.
-inline int triangle4Candidates(const Triangle4Ray& r, const TrianglePacket& p, float tMax,
-                               int valid) {
+// What the packet test found for four lanes. `pass`: lanes that pass the watertight test's edge,
+// determinant and t-range checks with the same float operations in the same order as the
+// scalar intersectTriangle (no FMA: SSE2 has none, and the compiler contracts nothing without
+// -mfma), so for those lanes t = t[l] and bᵢ = e[i][l]·invDet[l] are the scalar test's values bit
+// for bit. `zeroEdge`: lanes with an edge function exactly 0, which the scalar test recomputes in
+// double, so only it can decide them. Both are masked by `valid`.
+struct Triangle4Result {
+    int pass = 0;
+    int zeroEdge = 0;
+    alignas(16) float t[4];
+    alignas(16) float e[3][4];
+    alignas(16) float invDet[4];
+};
+
+inline void triangle4Test(const Triangle4Ray& r, const TrianglePacket& p, float tMax, int valid,
+                          Triangle4Result& out) {
 #if defined(__SSE2__)
     auto load = [&](int vertex, int k) { return _mm_load_ps(p.v[3 * vertex + r.row[k]]); };
     // a = p0 − o, b = p1 − o, c = p2 − o, permuted, then sheared: x += sx·z, y += sy·z.
@@ -86,16 +95,38 @@ inline int triangle4Candidates(const Triangle4Ray& r, const TrianglePacket& p, f
                                     _mm_and_ps(_mm_cmplt_ps(tScaled, zero), _mm_cmpge_ps(tScaled, tMaxDet)));
     const __m128 okPos = _mm_and_ps(_mm_cmpgt_ps(det, zero),
                                     _mm_and_ps(_mm_cmpgt_ps(tScaled, zero), _mm_cmple_ps(tScaled, tMaxDet)));
-    const __m128 t = _mm_mul_ps(tScaled, _mm_div_ps(_mm_set1_ps(1.0f), det));
+    const __m128 inside = _mm_andnot_ps(_mm_and_ps(anyNeg, anyPos), _mm_or_ps(okNeg, okPos));
+    out.zeroEdge = zeroEdge & valid;
+    out.pass = _mm_movemask_ps(inside) & valid & ~zeroEdge;
+    if (out.pass == 0) return;  // most packets: no lane left, no division needed
+    const __m128 invDet = _mm_div_ps(_mm_set1_ps(1.0f), det);
+    const __m128 t = _mm_mul_ps(tScaled, invDet);
     const __m128 tOk = _mm_and_ps(_mm_cmpgt_ps(t, zero), _mm_cmplt_ps(t, _mm_set1_ps(tMax)));
-    const __m128 pass = _mm_and_ps(_mm_andnot_ps(_mm_and_ps(anyNeg, anyPos), _mm_or_ps(okNeg, okPos)), tOk);
-    return (_mm_movemask_ps(pass) | zeroEdge) & valid;
+    out.pass &= _mm_movemask_ps(tOk);
+    if (out.pass != 0) {
+        _mm_store_ps(out.t, t);
+        _mm_store_ps(out.e[0], e0);
+        _mm_store_ps(out.e[1], e1);
+        _mm_store_ps(out.e[2], e2);
+        _mm_store_ps(out.invDet, invDet);
+    }
 #else
     (void)r;
     (void)p;
     (void)tMax;
-    return valid;
+    out.pass = 0;
+    out.zeroEdge = valid;  // no packet test: the scalar test decides every lane
 #endif
+}
+
+// Returns the lanes of `valid` the scalar intersectTriangle must still decide: those that pass
+// the packet test (triangle4Test) plus those with an edge function exactly 0. Every lane the
+// scalar test accepts is therefore returned; most misses are rejected here, four at a time.
+inline int triangle4Candidates(const Triangle4Ray& r, const TrianglePacket& p, float tMax,
+                               int valid) {
+    Triangle4Result res;
+    triangle4Test(r, p, tMax, valid, res);
+    return res.pass | res.zeroEdge;
 }
 
 }  // namespace shadowlab::raytrace

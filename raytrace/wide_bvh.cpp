@@ -131,6 +131,14 @@ bool hasAvx() {
     return false;
 #endif
 }
+bool hasAvx2() {
+#if defined(SHADOWLAB_AVX_BOX_TEST)
+    static const bool has = __builtin_cpu_supports("avx2");
+    return has;
+#else
+    return false;
+#endif
+}
 namespace {
 std::atomic<bool> fastFloatBuildOn{true};
 }  // namespace
@@ -139,6 +147,15 @@ void setFastFloatBuild(bool on) { fastFloatBuildOn.store(on, std::memory_order_r
 
 bool useAvx() { return avxSwitch().load(std::memory_order_relaxed); }
 void setUseAvx(bool on) { avxSwitch().store(on && hasAvx(), std::memory_order_relaxed); }
+
+namespace {
+std::atomic<bool>& avx2Switch() {
+    static std::atomic<bool> on{hasAvx2()};
+    return on;
+}
+}  // namespace
+bool useAvx2() { return avx2Switch().load(std::memory_order_relaxed); }
+void setUseAvx2(bool on) { avx2Switch().store(on && hasAvx2(), std::memory_order_relaxed); }
 
 }  // namespace detail
 

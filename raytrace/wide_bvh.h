@@ -3,6 +3,7 @@
 // closest hit with a stack that skips entries beyond the current hit, any order for any hit.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <type_traits>
 #include <vector>
@@ -89,6 +90,13 @@ public:
     // The same walk with a chosen child-box test (BoxTest(ray), box(node, tMax, tNear) → mask).
     template <typename BoxTest, typename Real, typename LeafFn>
     bool traverseWith(const Ray<Real>& ray, Real& tMax, bool anyHit, LeafFn&& leaf) const;
+
+    // The float tracer's walk (tracer.cpp), the same visits as traverseWith's with a leaner
+    // loop: closest hit (kAnyHit false) takes one entered child without touching the stack, two
+    // by one comparison, three or more by sorting them on the stack; any hit pushes in stored
+    // order. `boxes(node, tMax, tNear)` is a child-box test as above; `tNear` is 32-byte aligned.
+    template <bool kAnyHit, typename BoxTest, typename LeafFn>
+    bool walk(const BoxTest& boxes, float& tMax, LeafFn&& leaf) const;
 
 private:
     std::vector<Node> nodes_;
@@ -201,13 +209,145 @@ struct ChildBoxTestAvx8 {
         return _mm256_movemask_ps(_mm256_cmp_ps(tn, tf, _CMP_LE_OQ));
     }
 };
+
+// ChildBoxTestAvx8 for the rays of one octant (kOctant = octantOf(ray)): the near and far rows
+// are constants, so the walk keeps no per-ray row indices in registers and loads each row at a
+// fixed offset. The same operations in the same order: the same masks and entry distances.
+template <int kOctant>
+struct ChildBoxTestAvx8Octant {
+    __m256 o[3], inv[3], widen;
+    __attribute__((target("avx"))) explicit ChildBoxTestAvx8Octant(const Ray<float>& r) {
+        for (int i = 0; i < 3; ++i) {
+            o[i] = _mm256_set1_ps(r.o[i]);
+            inv[i] = _mm256_set1_ps(r.invDir[i]);
+        }
+        widen = _mm256_set1_ps(1 + 2 * gamma<float>(3));
+    }
+    static constexpr int nearRow(int i) { return (kOctant >> i) & 1 ? 3 + i : i; }
+    static constexpr int farRow(int i) { return (kOctant >> i) & 1 ? i : 3 + i; }
+    __attribute__((target("avx"))) int operator()(const WideNode<8>& n, float tMax, float tNear[8]) const {
+        __m256 tn = _mm256_setzero_ps(), tf = _mm256_set1_ps(tMax);
+        const __m256 ax = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[nearRow(0)]), o[0]), inv[0]);
+        const __m256 ay = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[nearRow(1)]), o[1]), inv[1]);
+        const __m256 az = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[nearRow(2)]), o[2]), inv[2]);
+        const __m256 bx = _mm256_mul_ps(
+            _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[farRow(0)]), o[0]), inv[0]), widen);
+        const __m256 by = _mm256_mul_ps(
+            _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[farRow(1)]), o[1]), inv[1]), widen);
+        const __m256 bz = _mm256_mul_ps(
+            _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[farRow(2)]), o[2]), inv[2]), widen);
+        tn = _mm256_max_ps(ax, tn);
+        tf = _mm256_min_ps(bx, tf);
+        tn = _mm256_max_ps(ay, tn);
+        tf = _mm256_min_ps(by, tf);
+        tn = _mm256_max_ps(az, tn);
+        tf = _mm256_min_ps(bz, tf);
+        _mm256_store_ps(tNear, tn);
+        return _mm256_movemask_ps(_mm256_cmp_ps(tn, tf, _CMP_LE_OQ));
+    }
+};
+
+// The double reference's box test with AVX: four children per 256-bit pass of doubles (the
+// float planes widened exactly by _mm256_cvtps_pd), the scalar ChildBoxTest<double, 8>'s
+// operations in the same order (_mm256_max_pd / _mm256_min_pd have its NaN rule; target "avx"
+// contracts no multiply-add), so the same masks and entry distances bit for bit, the same walk
+// order, and the reference's hits (ties included) unchanged.
+struct ChildBoxTestAvx8Double {
+    __m256d o[3], inv[3], widen;
+    int nearRow[3], farRow[3];
+    __attribute__((target("avx"))) explicit ChildBoxTestAvx8Double(const Ray<double>& r) {
+        for (int i = 0; i < 3; ++i) {
+            o[i] = _mm256_set1_pd(r.o[i]);
+            inv[i] = _mm256_set1_pd(r.invDir[i]);
+            nearRow[i] = r.dirIsNeg[i] ? 3 + i : i;
+            farRow[i] = r.dirIsNeg[i] ? i : 3 + i;
+        }
+        widen = _mm256_set1_pd(1 + 2 * gamma<double>(3));
+    }
+    __attribute__((target("avx"))) int operator()(const WideNode<8>& n, double tMax, double tNear[8]) const {
+        int mask = 0;
+        for (int q = 0; q < 8; q += 4) {
+            __m256d tn = _mm256_setzero_pd(), tf = _mm256_set1_pd(tMax);
+            for (int i = 0; i < 3; ++i) {
+                const __m256d a = _mm256_mul_pd(
+                    _mm256_sub_pd(_mm256_cvtps_pd(_mm_load_ps(&n.bounds[nearRow[i]][q])), o[i]), inv[i]);
+                const __m256d b = _mm256_mul_pd(
+                    _mm256_mul_pd(_mm256_sub_pd(_mm256_cvtps_pd(_mm_load_ps(&n.bounds[farRow[i]][q])), o[i]), inv[i]),
+                    widen);
+                tn = _mm256_max_pd(a, tn);
+                tf = _mm256_min_pd(b, tf);
+            }
+            _mm256_storeu_pd(tNear + q, tn);
+            mask |= _mm256_movemask_pd(_mm256_cmp_pd(tn, tf, _CMP_LE_OQ)) << q;
+        }
+        return mask;
+    }
+};
+
+// The box test of the float walk on CPUs with AVX2, for rays of one octant whose inverse
+// direction is finite in all three components, also times the widening factor
+// (avx2BoxTestApplies: no slab value can be NaN). The far distances use
+// the inverse direction times the widening factor, rounded once per ray (the same four roundings
+// as intersectBounds' (b − o)·inv·widen, so the same error bound), and the minimum and maximum
+// are taken on the floats' bit patterns as 32-bit integers, one cycle each instead of four:
+// the maximum with +0 is exact on floats ≥ 0 and ignores negative ones (as the float max with
+// 0 does); the minimum is exact when all far distances are ≥ +0 and negative as soon as one is
+// negative or −0, and the comparison is made on the integers too, so such a child is not
+// entered: its far plane lies at or behind the origin, where no hit with t > 0 can be.
+template <int kOctant>
+struct ChildBoxTestAvx2Octant {
+    __m256 o[3], inv[3], invFar[3];
+    __attribute__((target("avx2"))) explicit ChildBoxTestAvx2Octant(const Ray<float>& r) {
+        const float widen = 1 + 2 * gamma<float>(3);
+        for (int i = 0; i < 3; ++i) {
+            o[i] = _mm256_set1_ps(r.o[i]);
+            inv[i] = _mm256_set1_ps(r.invDir[i]);
+            invFar[i] = _mm256_set1_ps(r.invDir[i] * widen);
+        }
+    }
+    static constexpr int nearRow(int i) { return (kOctant >> i) & 1 ? 3 + i : i; }
+    static constexpr int farRow(int i) { return (kOctant >> i) & 1 ? i : 3 + i; }
+    __attribute__((target("avx2"))) int operator()(const WideNode<8>& n, float tMax, float tNear[8]) const {
+#define SHADOWLAB_SLAB(row, i, scale) \
+    _mm256_castps_si256(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[row]), o[i]), scale))
+        const __m256i ax = SHADOWLAB_SLAB(nearRow(0), 0, inv[0]), ay = SHADOWLAB_SLAB(nearRow(1), 1, inv[1]),
+                      az = SHADOWLAB_SLAB(nearRow(2), 2, inv[2]);
+        const __m256i bx = SHADOWLAB_SLAB(farRow(0), 0, invFar[0]), by = SHADOWLAB_SLAB(farRow(1), 1, invFar[1]),
+                      bz = SHADOWLAB_SLAB(farRow(2), 2, invFar[2]);
+#undef SHADOWLAB_SLAB
+        const __m256i tn = _mm256_max_epi32(_mm256_max_epi32(ax, ay), _mm256_max_epi32(az, _mm256_setzero_si256()));
+        const __m256i tf = _mm256_min_epi32(_mm256_min_epi32(bx, by),
+                                            _mm256_min_epi32(bz, _mm256_castps_si256(_mm256_set1_ps(tMax))));
+        _mm256_store_si256(reinterpret_cast<__m256i*>(tNear), tn);
+        return ~_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(tn, tf))) & 0xFF;
+    }
+};
+
 #endif
+
+// Whether ChildBoxTestAvx2Octant may test this ray: its inverse direction, and that times the
+// widening factor, finite in all three components, so that no slab value can be NaN (0·inf).
+inline bool avx2BoxTestApplies(const Ray<float>& r) {
+    const float widen = 1 + 2 * gamma<float>(3);
+    return std::isfinite(r.invDir.x * widen) && std::isfinite(r.invDir.y * widen) &&
+           std::isfinite(r.invDir.z * widen);
+}
+
+// The octant of a ray's direction: bit i set when its component i is negative (dirIsNeg).
+template <typename Real>
+inline int octantOf(const Ray<Real>& r) {
+    return r.dirIsNeg[0] | r.dirIsNeg[1] << 1 | r.dirIsNeg[2] << 2;
+}
 
 // Whether this CPU runs the AVX box test (checked once), and whether the tracer uses it:
 // on by default where available; tests and the bench switch it off to compare with SSE.
 bool hasAvx();
 bool useAvx();
 void setUseAvx(bool on);  // no effect (stays off) without AVX
+// The same for the AVX2 box test (ChildBoxTestAvx2Octant), used where useAvx() is on too.
+bool hasAvx2();
+bool useAvx2();
+void setUseAvx2(bool on);  // no effect (stays off) without AVX2
 
 // Whether float tracers build their meshes with Bvh::buildFast (on by default) or with the
 // double build the reference uses; the bench switches it to measure what the tree is worth.
@@ -301,6 +441,114 @@ bool WideBvh<N>::traverseWith(const Ray<Real>& ray, Real& tMax, bool anyHit, Lea
             const Entry& e = stack[--top];
             if (e.tNear <= tMax) {
                 ref = e.ref;
+                break;
+            }
+        }
+    }
+}
+
+template <int N>
+template <bool kAnyHit, typename BoxTest, typename LeafFn>
+bool WideBvh<N>::walk(const BoxTest& boxes, float& tMax, LeafFn&& leaf) const {
+    std::uint32_t ref = root_;
+    if (ref == kEmpty) return false;
+    const Node* nodes = nodes_.data();
+    // As traverseWith: at most N − 1 entries per level of at most 80, plus a node's N at once.
+    constexpr int kStackSize = 82 * N;
+    std::uint32_t stackRef[kStackSize];
+    float stackNear[kStackSize];
+    int top = 0;
+    bool hit = false;
+    for (;;) {
+        bool leafReached = true;
+        while (!isLeaf(ref)) {
+            const Node& node = nodes[ref];
+#if defined(__SSE2__)
+            // The child refs' line, fetched beside the bounds': the mask picks a ref from it next.
+            _mm_prefetch(reinterpret_cast<const char*>(node.ref), _MM_HINT_T0);
+#endif
+            alignas(32) float tn[N];
+            unsigned mask = unsigned(boxes(node, tMax, tn));
+            if (mask == 0) {
+                leafReached = false;
+                break;
+            }
+            int c = __builtin_ctz(mask);
+            mask &= mask - 1;
+            if (mask == 0) {  // one child: no stack traffic
+                ref = node.ref[c];
+                continue;
+            }
+            if constexpr (kAnyHit) {
+                // The first child in stored order, the others pushed; their node lines are
+                // prefetched, as they will be read soon.
+                ref = node.ref[c];
+                do {
+                    c = __builtin_ctz(mask);
+                    mask &= mask - 1;
+                    stackRef[top] = node.ref[c];
+                    stackNear[top] = tn[c];
+                    ++top;
+#if defined(__SSE2__)
+                    if (!isLeaf(node.ref[c])) {
+                        const char* p = reinterpret_cast<const char*>(&nodes[node.ref[c]]);
+                        for (std::size_t line = 0; line < sizeof(Node); line += 64)
+                            _mm_prefetch(p + line, _MM_HINT_T0);
+                    }
+#endif
+                } while (mask != 0);
+                continue;
+            } else {
+                const int c2 = __builtin_ctz(mask);
+                mask &= mask - 1;
+                if (mask == 0) {  // two children: the nearer next, the other pushed
+                    const bool swap = tn[c2] < tn[c];
+                    const int nearC = swap ? c2 : c, farC = swap ? c : c2;
+                    stackRef[top] = node.ref[farC];
+                    stackNear[top] = tn[farC];
+                    ++top;
+                    ref = node.ref[nearC];
+                    continue;
+                }
+                // Three or more: pushed, then that part of the stack sorted by entry distance,
+                // farthest at the bottom (insertion sort of at most N); the nearest is taken.
+                const int base = top;
+                stackRef[top] = node.ref[c];
+                stackNear[top] = tn[c];
+                ++top;
+                int k = top++;
+                // Insert c2 then the rest, keeping [base, top) in decreasing tNear.
+                auto insert = [&](int at, int child) {
+                    const float d = tn[child];
+                    const std::uint32_t r = node.ref[child];
+                    while (at > base && stackNear[at - 1] < d) {
+                        stackNear[at] = stackNear[at - 1];
+                        stackRef[at] = stackRef[at - 1];
+                        --at;
+                    }
+                    stackNear[at] = d;
+                    stackRef[at] = r;
+                };
+                insert(k, c2);
+                do {
+                    c = __builtin_ctz(mask);
+                    mask &= mask - 1;
+                    insert(top++, c);
+                } while (mask != 0);
+                ref = stackRef[--top];
+                continue;
+            }
+        }
+        if (leafReached && leaf(leafFirst(ref), leafCount(ref), tMax)) {
+            hit = true;
+            if constexpr (kAnyHit) return true;
+        }
+        // Pop, skipping entries that begin beyond the nearest hit so far.
+        for (;;) {
+            if (top == 0) return hit;
+            --top;
+            if (stackNear[top] <= tMax) {
+                ref = stackRef[top];
                 break;
             }
         }

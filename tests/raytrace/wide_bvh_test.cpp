@@ -269,10 +269,59 @@ __attribute__((target("avx"))) int avxBoxTest(const Ray<float>& ray, const Bvh8N
                                               float tn[8]) {
     return detail::ChildBoxTestAvx8(ray)(n, tMax, tn);
 }
+// The per-octant copy the tracer's walk runs, for the ray's own octant.
+template <int kOctant>
+__attribute__((target("avx"))) int avxOctantBoxTest(const Ray<float>& ray, const Bvh8Node& n, float tMax,
+                                                    float tn[8]) {
+    alignas(32) float t[8];
+    const int mask = detail::ChildBoxTestAvx8Octant<kOctant>(ray)(n, tMax, t);
+    std::memcpy(tn, t, sizeof t);
+    return mask;
+}
+template <int kOctant>
+__attribute__((target("avx2"))) int avx2OctantBoxTest(const Ray<float>& ray, const Bvh8Node& n, float tMax,
+                                                      float tn[8]) {
+    alignas(32) float t[8];
+    const int mask = detail::ChildBoxTestAvx2Octant<kOctant>(ray)(n, tMax, t);
+    std::memcpy(tn, t, sizeof t);
+    return mask;
+}
+using OctantBoxTest = int (*)(const Ray<float>&, const Bvh8Node&, float, float[8]);
+constexpr OctantBoxTest kAvxOctant[8] = {avxOctantBoxTest<0>, avxOctantBoxTest<1>, avxOctantBoxTest<2>,
+                                         avxOctantBoxTest<3>, avxOctantBoxTest<4>, avxOctantBoxTest<5>,
+                                         avxOctantBoxTest<6>, avxOctantBoxTest<7>};
+constexpr OctantBoxTest kAvx2Octant[8] = {avx2OctantBoxTest<0>, avx2OctantBoxTest<1>, avx2OctantBoxTest<2>,
+                                          avx2OctantBoxTest<3>, avx2OctantBoxTest<4>, avx2OctantBoxTest<5>,
+                                          avx2OctantBoxTest<6>, avx2OctantBoxTest<7>};
 #endif
 
-// The AVX 8-wide child-box test gives the SSE test's mask and entry distances bit for bit, on
-// the same adversarial boxes as above (integer planes, origins on them, axis-parallel rays).
+// What ChildBoxTestAvx2Octant computes for one child, written out in scalar code: slab
+// distances (b − o)·inv near and (b − o)·(inv·widen) far, their maximum with +0 and their
+// minimum with tMax taken on the bit patterns as signed 32-bit integers, compared as integers.
+int avx2Model(const Ray<float>& ray, const Bvh8Node& n, float tMax, float tn[8]) {
+    auto bits = [](float x) {
+        std::int32_t i;
+        std::memcpy(&i, &x, sizeof i);
+        return i;
+    };
+    const float widen = 1 + 2 * gamma<float>(3);
+    int mask = 0;
+    for (int c = 0; c < 8; ++c) {
+        std::int32_t near = 0, far = bits(tMax);
+        for (int i = 0; i < 3; ++i) {
+            const int nearRow = ray.dirIsNeg[i] ? 3 + i : i, farRow = ray.dirIsNeg[i] ? i : 3 + i;
+            near = std::max(near, bits((n.bounds[nearRow][c] - ray.o[i]) * ray.invDir[i]));
+            far = std::min(far, bits((n.bounds[farRow][c] - ray.o[i]) * (ray.invDir[i] * widen)));
+        }
+        std::memcpy(&tn[c], &near, sizeof near);
+        if (!(near > far)) mask |= 1 << c;
+    }
+    return mask;
+}
+
+// The AVX 8-wide child-box test, and its per-octant copies, give the SSE test's mask and entry
+// distances bit for bit, on the same adversarial boxes as above (integer planes, origins on
+// them, axis-parallel rays).
 TEST(WideBvh, AvxChildBoxTestEqualsTheSseTestBitForBit) {
 #if defined(SHADOWLAB_AVX_BOX_TEST)
     if (!detail::hasAvx()) GTEST_SKIP() << "this CPU has no AVX";
@@ -298,12 +347,15 @@ TEST(WideBvh, AvxChildBoxTestEqualsTheSseTestBitForBit) {
             if (pick(g) == 0) d[k] = pick(g) < 2 ? 0.0f : -0.0f;
         const Ray<float> ray(o, d);
         const float tMax = trial % 2 ? std::numeric_limits<float>::infinity() : 3.0f;
-        float tnSse[8], tnAvx[8];
+        float tnSse[8], tnAvx[8], tnOct[8];
         const int sse = detail::ChildBoxTest<float, 8>(ray)(n, tMax, tnSse);
         const int avx = avxBoxTest(ray, n, tMax, tnAvx);
-        differ += sse != avx;
+        const int oct = kAvxOctant[detail::octantOf(ray)](ray, n, tMax, tnOct);
+        differ += (sse != avx) + (sse != oct);
         for (int c = 0; c < 8; ++c)
-            if (sse & (1 << c)) differ += std::memcmp(&tnSse[c], &tnAvx[c], sizeof(float)) != 0;
+            if (sse & (1 << c))
+                differ += (std::memcmp(&tnSse[c], &tnAvx[c], sizeof(float)) != 0) +
+                          (std::memcmp(&tnSse[c], &tnOct[c], sizeof(float)) != 0);
         entered += __builtin_popcount(unsigned(sse));
     }
     EXPECT_EQ(differ, 0);
@@ -313,11 +365,126 @@ TEST(WideBvh, AvxChildBoxTestEqualsTheSseTestBitForBit) {
 #endif
 }
 
+#if defined(SHADOWLAB_AVX_BOX_TEST)
+__attribute__((target("avx"))) int avxDoubleBoxTest(const Ray<double>& ray, const Bvh8Node& n, double tMax,
+                                                    double tn[8]) {
+    return detail::ChildBoxTestAvx8Double(ray)(n, tMax, tn);
+}
+#endif
+
+// The reference's AVX box test (doubles, four children a pass) gives the scalar double test's
+// masks and entry distances bit for bit on adversarial boxes (integer planes, origins on them,
+// axis-parallel rays, empty children), so the reference walks the same nodes in the same order.
+TEST(WideBvh, AvxDoubleChildBoxTestEqualsTheScalarTestBitForBit) {
+#if defined(SHADOWLAB_AVX_BOX_TEST)
+    if (!detail::hasAvx()) GTEST_SKIP() << "this CPU has no AVX";
+    std::mt19937_64 g(79);
+    std::uniform_real_distribution<double> u(-4, 4);
+    std::uniform_int_distribution<int> pick(0, 3);
+    Bvh8Node n{};
+    int differ = 0, entered = 0;
+    for (int trial = 0; trial < 40000; ++trial) {
+        for (int c = 0; c < 8; ++c)
+            for (int k = 0; k < 3; ++k) {
+                const float a = float(std::round(u(g))), b = float(std::round(u(g)));
+                n.bounds[k][c] = std::min(a, b);
+                n.bounds[3 + k][c] = std::max(a, b);
+            }
+        if (trial % 5 == 0)
+            for (int k = 0; k < 3; ++k) {
+                n.bounds[k][3] = std::numeric_limits<float>::infinity();
+                n.bounds[3 + k][3] = -std::numeric_limits<float>::infinity();
+            }
+        Vec3 o(std::round(u(g)), std::round(u(g)), std::round(u(g))), d(u(g), u(g), u(g));
+        for (int k = 0; k < 3; ++k)
+            if (pick(g) == 0) d[k] = pick(g) < 2 ? 0.0 : -0.0;
+        const Ray<double> ray(o, d);
+        const double tMax = trial % 2 ? std::numeric_limits<double>::infinity() : 3.0;
+        double tnScalar[8], tnAvx[8];
+        const int scalar = detail::ChildBoxTest<double, 8>(ray)(n, tMax, tnScalar);
+        const int avx = avxDoubleBoxTest(ray, n, tMax, tnAvx);
+        differ += scalar != avx;
+        for (int c = 0; c < 8; ++c)
+            if (scalar & (1 << c)) differ += std::memcmp(&tnScalar[c], &tnAvx[c], sizeof(double)) != 0;
+        entered += __builtin_popcount(unsigned(scalar));
+    }
+    EXPECT_EQ(differ, 0);
+    EXPECT_GT(entered, 40000);
+#else
+    GTEST_SKIP() << "not an x86-64 GCC build";
+#endif
+}
+
+// The AVX2 box test (integer min/max, for rays with a finite inverse direction) is its scalar
+// model bit for bit on adversarial boxes, and conservative: a box around a point of the ray
+// segment is always entered. Points are o + t·d in double with 0 < t < tMax, boxes reach from
+// there by 0 to 2 units each way (a third of them flat on some axis), rounded outward to float,
+// so the exact segment meets every such box; the test must enter it whatever its rounding.
+TEST(WideBvh, Avx2ChildBoxTestIsItsScalarModelAndEntersEveryBoxTheSegmentMeets) {
+#if defined(SHADOWLAB_AVX_BOX_TEST)
+    if (!detail::hasAvx2()) GTEST_SKIP() << "this CPU has no AVX2";
+    std::mt19937_64 g(78);
+    std::uniform_real_distribution<float> u(-4, 4);
+    std::uniform_real_distribution<double> unit(0, 1);
+    std::uniform_int_distribution<int> pick(0, 3);
+    Bvh8Node n{};
+    int differ = 0, entered = 0, missedContaining = 0, containing = 0;
+    for (int trial = 0; trial < 40000; ++trial) {
+        Vec3T<float> o(std::round(u(g)), std::round(u(g)), std::round(u(g))), d(u(g), u(g), u(g));
+        for (int k = 0; k < 3; ++k)
+            if (pick(g) == 0) d[k] = std::round(d[k]) == 0 ? 0.25f : std::round(d[k]);  // exact slabs
+        const Ray<float> ray(o, d);
+        const float tMax = trial % 2 ? std::numeric_limits<float>::infinity() : 3.0f;
+        const bool around = trial % 2 == 0;  // boxes around points of the segment, else adversarial
+        int mustEnter = 0;
+        for (int c = 0; c < 8; ++c) {
+            if (around) {
+                const double t = (trial % 4 == 0 ? 3.0 : 6.0) * (0.001 + 0.998 * unit(g));
+                for (int k = 0; k < 3; ++k) {
+                    const double p = double(o[k]) + t * double(d[k]);
+                    const double lo = pick(g) == 0 ? p : p - 2 * unit(g), hi = pick(g) == 0 ? p : p + 2 * unit(g);
+                    n.bounds[k][c] = roundDown<float>(lo);
+                    n.bounds[3 + k][c] = roundUp<float>(hi);
+                }
+                if (t < double(tMax)) mustEnter |= 1 << c;
+            } else {
+                for (int k = 0; k < 3; ++k) {
+                    const float a = std::round(u(g)), b = std::round(u(g));
+                    n.bounds[k][c] = std::min(a, b);
+                    n.bounds[3 + k][c] = std::max(a, b);
+                }
+            }
+        }
+        if (trial % 5 == 0)
+            for (int k = 0; k < 3; ++k) {
+                n.bounds[k][7] = std::numeric_limits<float>::infinity();
+                n.bounds[3 + k][7] = -std::numeric_limits<float>::infinity();
+                mustEnter &= 0x7F;
+            }
+        float tnModel[8], tnAvx2[8];
+        const int model = avx2Model(ray, n, tMax, tnModel);
+        const int avx2 = kAvx2Octant[detail::octantOf(ray)](ray, n, tMax, tnAvx2);
+        differ += model != avx2;
+        for (int c = 0; c < 8; ++c)
+            if (model & (1 << c)) differ += std::memcmp(&tnModel[c], &tnAvx2[c], sizeof(float)) != 0;
+        entered += __builtin_popcount(unsigned(avx2));
+        containing += __builtin_popcount(unsigned(mustEnter));
+        missedContaining += __builtin_popcount(unsigned(mustEnter & ~avx2));
+    }
+    EXPECT_EQ(differ, 0);
+    EXPECT_EQ(missedContaining, 0);
+    EXPECT_GT(containing, 100000);
+    EXPECT_GT(entered, 120000);
+#else
+    GTEST_SKIP() << "not an x86-64 GCC build";
+#endif
+}
+
 // The float tracer gives the same closest hits (t, triangle, bits) and any-hit answers with the
-// AVX box test or the SSE one, and with or without the occluder cache: on random rays through a
-// triangle soup and on coherent rays (a grid of parallel rays, like a tile's shadow rays),
-// where the cache must answer most blocked rays.
-TEST(WideBvh, TracerAnswersAreTheSameWithAvxOrSseAndWithOrWithoutTheOccluderCache) {
+// AVX2, AVX or SSE box test, and with or without the occluder cache: on random rays through a
+// triangle soup, on coherent rays (a grid of parallel rays, like a tile's shadow rays), where
+// the cache must answer most blocked rays, and on axis-parallel rays.
+TEST(WideBvh, TracerAnswersAreTheSameWithAvx2AvxOrSseAndWithOrWithoutTheOccluderCache) {
     std::mt19937_64 g(31);
     const Soup soup = triangleSoup(20000, g);
     auto mesh = std::make_shared<scene::TriangleMesh>();
@@ -336,16 +503,29 @@ TEST(WideBvh, TracerAnswersAreTheSameWithAvxOrSseAndWithOrWithoutTheOccluderCach
     for (int y = 0; y < 100; ++y)
         for (int x = 0; x < 100; ++x)
             rays.emplace_back(Vec3T<float>(-12.0f + 0.05f * x, -12.0f + 0.05f * y, -14.0f), Vec3T<float>(0.3f, 0.4f, 1.0f));
+    // Axis-parallel rays (an infinite inverse direction: the AVX2 walk hands them to the AVX one),
+    // and rays with a component so small that its inverse is finite but times the widening
+    // factor is not (also the AVX walk's) or just finite (the AVX2 walk's).
+    for (int r = 0; r < 3000; ++r) {
+        Vec3T<float> d(0.0f);
+        d[r % 3] = r % 2 ? 1.0f : -1.0f;
+        if (r >= 2000) {
+            d[(r + 1) % 3] = 0.4f;
+            d[(r + 2) % 3] = r % 4 < 2 ? 1.0f / std::numeric_limits<float>::max() : std::numeric_limits<float>::min();
+        }
+        rays.emplace_back(Vec3T<float>(Vec3(u(g), u(g), u(g))), d);
+    }
     int hits = 0, differ = 0;
     std::uint64_t cacheAnswers = 0;
     for (std::size_t r = 0; r < rays.size(); ++r) {
         const Ray<float>& ray = rays[r];
         const float tMax = r % 3 == 0 ? 0.6f : std::numeric_limits<float>::infinity();
-        Hit<float> h[4];
-        bool found[4], any[4];
-        for (int config = 0; config < 4; ++config) {
+        Hit<float> h[8];
+        bool found[8], any[8];
+        for (int config = 0; config < 8; ++config) {
             detail::setUseAvx(config & 1);
             setOccluderCache(config & 2);
+            detail::setUseAvx2(config & 4);
             found[config] = tracer.closestHit(ray, tMax, r % 2 == 0, h[config]);
             int blocker = -1;
             const std::uint64_t before = occluderCacheHits();
@@ -353,18 +533,58 @@ TEST(WideBvh, TracerAnswersAreTheSameWithAvxOrSseAndWithOrWithoutTheOccluderCach
             cacheAnswers += occluderCacheHits() - before;
         }
         hits += found[0];
-        for (int config = 1; config < 4; ++config)
+        for (int config = 1; config < 8; ++config)
             differ += found[0] != found[config] || any[0] != any[config] ||
                       (found[0] && (std::memcmp(&h[0].t, &h[config].t, sizeof(float)) != 0 ||
                                     h[0].prim != h[config].prim));
         differ += any[0] != found[0];  // any hit exactly when a closest hit exists
     }
     detail::setUseAvx(true);
+    detail::setUseAvx2(true);
     setOccluderCache(true);
     EXPECT_EQ(differ, 0);
     EXPECT_GT(hits, 3000);
     // The grid's blocked rays: most are answered by the previous ray's triangle packet.
     EXPECT_GT(cacheAnswers, 2000u);
+}
+
+// The double tracer (the reference) gives the same closest hits (t, triangle, barycentrics, bit
+// for bit) and any-hit answers with the AVX box test or the scalar one, in plain and
+// conservative mode, on random and axis-parallel rays through a triangle soup.
+TEST(WideBvh, DoubleTracerAnswersAreTheSameWithAvxOrScalarBoxTests) {
+    std::mt19937_64 g(32);
+    const Soup soup = triangleSoup(20000, g);
+    auto mesh = std::make_shared<scene::TriangleMesh>();
+    for (const Vec3& p : soup.p) mesh->positions.push_back(p);
+    for (std::uint32_t i = 0; i < soup.p.size(); ++i) mesh->indices.push_back(i);
+    scene::Scene s;
+    test::addMaterial(s, "matte");
+    test::addMesh(s, mesh);
+    const Tracer<double> tracer(s);
+    std::uniform_real_distribution<double> u(-14, 14);
+    int hits = 0, differ = 0;
+    for (int r = 0; r < 12000; ++r) {
+        const Vec3 from(u(g), u(g), u(g));
+        Vec3 d = Vec3(u(g) / 2, u(g) / 2, u(g) / 2) - from;
+        if (r % 6 == 0) d = Vec3(0.0), d[r % 3] = r % 4 ? 1.0 : -1.0;
+        const Ray<double> ray(from, d);
+        const double tMax = r % 3 == 0 ? 0.6 : std::numeric_limits<double>::infinity();
+        Hit<double> h[2];
+        bool found[2], any[2];
+        for (int config = 0; config < 2; ++config) {
+            detail::setUseAvx(config == 0);
+            found[config] = tracer.closestHit(ray, tMax, r % 2 == 0, h[config]);
+            int blocker = -1;
+            any[config] = tracer.anyHit(ray, tMax, r % 2 == 0, blocker);
+        }
+        hits += found[0];
+        differ += found[0] != found[1] || any[0] != any[1] ||
+                  (found[0] && (std::memcmp(&h[0].t, &h[1].t, sizeof(double)) != 0 || h[0].prim != h[1].prim ||
+                                std::memcmp(&h[0].b1, &h[1].b1, sizeof(double)) != 0));
+    }
+    detail::setUseAvx(true);
+    EXPECT_EQ(differ, 0);
+    EXPECT_GT(hits, 3000);
 }
 
 }  // namespace
