@@ -68,24 +68,23 @@ struct Workload {
 #endif
 };
 
-// A height field of kTerrainCells² quads (two triangles each) over [−50, 50]², with smooth
+// A height field of cells² quads (two triangles each) over [−50, 50]², with smooth
 // hills and sharp ridges so that shadow rays cross much of the terrain before they leave it.
 constexpr int kTerrainCells = 708;  // 2·708² = 1,002,528 triangles
 scene::Scene terrainScene(int cells = kTerrainCells) {
-    const int kTerrainCells = cells;
     auto mesh = std::make_shared<scene::TriangleMesh>();
-    const int n = kTerrainCells + 1;
+    const int n = cells + 1;
     auto height = [](double x, double z) {
         return 3.0 * std::sin(0.11 * x) * std::cos(0.13 * z) + 1.5 * std::sin(0.37 * x + 0.5 * z) +
                4.0 * std::abs(std::sin(0.05 * (x - 2 * z)));
     };
     for (int j = 0; j < n; ++j)
         for (int i = 0; i < n; ++i) {
-            const double x = -50 + 100.0 * i / kTerrainCells, z = -50 + 100.0 * j / kTerrainCells;
+            const double x = -50 + 100.0 * i / cells, z = -50 + 100.0 * j / cells;
             mesh->positions.emplace_back(x, height(x, z), z);
         }
-    for (int j = 0; j < kTerrainCells; ++j)
-        for (int i = 0; i < kTerrainCells; ++i) {
+    for (int j = 0; j < cells; ++j)
+        for (int i = 0; i < cells; ++i) {
             const std::uint32_t a = std::uint32_t(j * n + i), b = a + 1, c = a + std::uint32_t(n),
                                 d = c + 1;
             for (std::uint32_t v : {a, c, b, b, c, d}) mesh->indices.push_back(v);

@@ -30,12 +30,12 @@ struct LitVariant {
     bool displayTarget = false;     // the beauty target is kLitDisplayFormat (implies !aovTarget)
     bool normalOffset = true;       // a normal offset is set (false: its code is left out)
     std::uint32_t lightTargets = 0;  // 0, or kLightTargets: per-light visibility targets
-    std::uint32_t lightCount = 1;    // = LitUniforms::counts.x
+    std::uint32_t lightCount = 1;    // = LitUniforms::lightCount
     std::uint32_t lightKinds = 7;    // bit (1 << SHADOWLAB_LIGHT_*) for each kind in the scene
     std::uint32_t cascades = 1;      // cascades of the cascaded directional lights (1: none cascaded)
     bool transmittance = false;      // semi-transparent casters: read the transmittance maps
     bool receiverPlane = false;      // receiver-plane depth bias in every filter tap
-    bool cascadeBlend = false;       // blend bands before the cascade splits (LitUniforms::counts.z)
+    bool cascadeBlend = false;       // blend bands before the cascade splits (LitUniforms::cascadeBlendBand)
     // Light 0's constants reach lit.frag as flat outputs of lit.vert instead of uniform reads
     // (shaders/lit_constants.glsl kVertexLightConstants); takes effect only where
     // usesVertexLightCoordinates().

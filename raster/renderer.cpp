@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <span>
 #include <tuple>
 #include <variant>
 
@@ -18,6 +19,7 @@
 #include "raster/context.h"
 #include "raster/alpha_casters.h"
 #include "raster/geometry.h"
+#include "raster/light_data.h"
 #include "raster/light_frustum.h"
 #include "raster/lit_pass.h"
 #include "raster/moment_maps.h"
@@ -164,7 +166,7 @@ struct Renderer::Impl {
     std::vector<double> splits;
     int cascadesUsed = 1;  // lit.frag's cascade count (specialization constant)
     // The blend band before each split (settings.cascadeBlend), 0 without cascades: when > 0,
-    // lit.frag's blend code is compiled in (specialization constant) and reads it from counts.z.
+    // lit.frag's blend code is compiled in (specialization constant) and reads it from cascadeBlendBand.
     double cascadeBlendUsed = 0.0;
     bool vertexLightConstants = false;  // LitVariant::vertexLightConstants of every lit pipeline
     double setupMs = 0.0;
@@ -296,80 +298,20 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
     const glm::dmat4 viewProj = scene::projectionMatrix(cam, view.near, view.far) *
                                 scene::viewMatrix(cam, origin);
     uniforms.viewProj = glm::mat4(viewProj);
-    uniforms.forward = glm::vec4(glm::vec3(fitCam.forward), float(scene.ambient));
-    uniforms.background = glm::vec4(glm::vec3(scene.background), 0.0f);
-    uniforms.counts = glm::vec4(float(scene.lights.size()), 0, 0, 0);
+    uniforms.forward = glm::vec3(fitCam.forward);
+    uniforms.ambient = float(scene.ambient);
+    uniforms.background = glm::vec3(scene.background);
+    uniforms.lightCount = int(scene.lights.size());
+    uniforms.mapSize = 0.0f;
+    uniforms.cascadeBlendBand = 0.0f;
+    uniforms.cascadeStart = 0.0f;
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {
-        const scene::Light& light = scene.lights[i];
-        const bool spot = light.type == scene::LightType::Spot;
-        const bool point = light.type == scene::LightType::Point;
-        lightKinds |= 1u << (point  ? SHADOWLAB_LIGHT_POINT
-                             : spot ? SHADOWLAB_LIGHT_SPOT
-                                    : SHADOWLAB_LIGHT_DIRECTIONAL);
-        shaders::LightData& l = uniforms.lights[i];
-        const double meanColor = (light.color.r + light.color.g + light.color.b) / 3.0;
-        l.radiance = glm::vec4(glm::vec3(light.color * light.intensity), float(light.intensity * meanColor));
-        // This light's layers: [first, end) of `layers`, none without a shadow test.
-        std::size_t first = 0;
-        while (first < layers.size() && layers[first].light != int(i)) ++first;
-        std::size_t end = first;
-        while (end < layers.size() && layers[end].light == int(i)) ++end;
-        const float layer = first < end ? float(first) : -1.0f;
-        LightFrustum f;  // the light's one map (a point light: its last face; default without)
-        if (first < end) f = layers[end - 1].frustum;
-        const ShadowLayer* const last = first < end ? &layers[end - 1] : nullptr;
-        const bool cascaded = last && last->reason == LayerReason::kCascade;
-        if (point && last) {
-            // The shader picks the face and builds its projection itself, so toShadow holds each
-            // face's near and far instead (shaders/interface.h: columns 0, 1 the nears, 2, 3 the
-            // fars, face k in row k % 4 of column k / 4).
-            l.toShadow = glm::mat4(0.0f);
-            for (std::size_t k = first; k < end; ++k) {
-                const int face = layers[k].index;
-                l.toShadow[face / 4][face % 4] = float(layers[k].frustum.near);
-                l.toShadow[2 + face / 4][face % 4] = float(layers[k].frustum.far);
-            }
-            l.bias = glm::vec4(float(last->shaderDepthBias), float(last->shaderSlopeBias), float(f.texelWorldSize()), 0.0f);
-        } else if (cascaded) {
-            // One layer per slice; lit.frag picks the cascade by view depth (cascadeOf).
-            cascadesUsed = last->count;
-            for (std::size_t k = first; k < end; ++k) {
-                const ShadowLayer& c = layers[k];
-                shaders::CascadeData& cd = uniforms.cascades[i * SHADOWLAB_MAX_CASCADES + std::size_t(c.index)];
-                cd.toShadow = glm::mat4(c.frustum.toTexture(origin));
-                cd.params = glm::vec4(float(c.sliceFar - viewDepthOffset), float(c.frustum.texelWorldSize()),
-                                      float(1.0 / c.frustum.depthRange()), float(c.shaderDepthBias));
-            }
-            // Cascade 0 also fills the light's own map fields (what count <= 1 would use).
-            const ShadowLayer& c0 = layers[first];
-            f = c0.frustum;
-            l.toShadow = uniforms.cascades[i * SHADOWLAB_MAX_CASCADES].toShadow;
-            l.bias = glm::vec4(float(c0.shaderDepthBias), float(c0.shaderSlopeBias), float(f.texelWorldSize()),
-                               float(1.0 / f.depthRange()));
-        } else if (last) {
-            l.toShadow = glm::mat4(f.toTexture(origin));
-            l.bias = glm::vec4(float(last->shaderDepthBias), float(last->shaderSlopeBias), float(f.texelWorldSize()),
-                               spot ? 0.0f : float(1.0 / f.depthRange()));
-        }
-        if (point) {
-            l.axis = glm::vec4(0.0f, 0.0f, 0.0f, float(2.0 * light.radius));  // w: light size (PCSS)
-            l.toLight = glm::vec4(glm::vec3(light.position - origin), layer);
-            // Without a shadow test f is default; near/far are then unused. With one, each face's
-            // are in toShadow (lit.frag faceRange); these are the last face's.
-            l.kind = glm::vec4(float(SHADOWLAB_LIGHT_POINT), float(cubeFaceTanHalfFov(settings.shadowMapSize)),
-                               float(f.near), float(f.far));
-        } else if (spot) {
-            constexpr double kPi = 3.14159265358979323846;
-            l.toLight = glm::vec4(glm::vec3(light.position - origin), layer);
-            l.kind = glm::vec4(float(SHADOWLAB_LIGHT_SPOT), float(std::cos(light.coneAngleDegrees * kPi / 180.0)),
-                               float(f.near), float(f.far));
-            l.axis = glm::vec4(glm::vec3(glm::normalize(light.direction)), float(2.0 * light.radius));
-        } else {
-            l.toLight = glm::vec4(glm::vec3(-light.direction), layer);
-            l.kind = glm::vec4(float(SHADOWLAB_LIGHT_DIRECTIONAL), cascaded ? float(last->count) : 0.0f, 0, 0);
-        }
-        l.params = glm::vec4(float(kMaxSlopeTan), float(int(settings.filter)), float(settings.normalOffset),
-                             float(settings.pcfSize));
+        const std::span<shaders::CascadeData, SHADOWLAB_MAX_CASCADES> cascades(
+            uniforms.cascades + i * SHADOWLAB_MAX_CASCADES, SHADOWLAB_MAX_CASCADES);
+        const shaders::LightData& l = uniforms.lights[i] =
+            lightData(scene.lights[i], int(i), layers, settings, origin, viewDepthOffset, cascades);
+        lightKinds |= 1u << l.kind;
+        if (l.cascadeCount > 0) cascadesUsed = l.cascadeCount;
     }
     albedos.clear();
     for (const scene::Object& o : scene.objects)
@@ -421,11 +363,11 @@ void Renderer::Impl::createTargets(const scene::Scene& scene, const RendererOpti
     const auto mapSize = layers.empty() ? 1u : std::uint32_t(settings.shadowMapSize);
     const auto arrayLayers = std::max<std::uint32_t>(1, std::uint32_t(layers.size()));
     maps = createShadowMaps(ctx, mapSize, arrayLayers);
-    uniforms.counts.y = float(mapSize);  // lit.frag's map size, instead of a textureSize() per fragment
+    uniforms.mapSize = float(mapSize);  // lit.frag's map size, instead of a textureSize() per fragment
     if (cascadesUsed > 1 && settings.cascadeBlend > 0.0) {
         cascadeBlendUsed = settings.cascadeBlend;
-        uniforms.counts.z = float(cascadeBlendUsed);
-        uniforms.counts.w = float(splits[0] - viewDepthOffset);  // cascade 0's slice starts here (the band's width)
+        uniforms.cascadeBlendBand = float(cascadeBlendUsed);
+        uniforms.cascadeStart = float(splits[0] - viewDepthOffset);  // cascade 0's slice starts here (the band's width)
     }
     transmit = !draw.transparent.empty() && !layers.empty();
     transmittanceMaps = createTransmittanceMaps(ctx, transmit ? mapSize : 1, transmit ? arrayLayers : 1);
@@ -553,17 +495,17 @@ void Renderer::Impl::update(const scene::Scene& scene, const scene::Camera& view
     const std::size_t layerCount = lightMatrices.size();
     const int cascadeCount = cascadesUsed;
     const std::uint32_t kinds = lightKinds;
-    const glm::vec4 counts = uniforms.counts;
+    const float mapSize = uniforms.mapSize, cascadeBlendBand = uniforms.cascadeBlendBand;
     placeLights(scene, view);
     // The maps, pipelines and descriptor set were made for this many layers of these kinds.
     if (lightMatrices.size() != layerCount || cascadesUsed != cascadeCount || lightKinds != kinds)
         throw RasterError("Renderer::update: the new camera or lights change the number of shadow-map layers (" +
                           std::to_string(layerCount) + " -> " + std::to_string(lightMatrices.size()) +
                           ") or cascades; make a new Renderer");
-    uniforms.counts.y = counts.y;
+    uniforms.mapSize = mapSize;
     if (cascadeBlendUsed > 0.0) {
-        uniforms.counts.z = counts.z;
-        uniforms.counts.w = float(splits[0] - viewDepthOffset);
+        uniforms.cascadeBlendBand = cascadeBlendBand;
+        uniforms.cascadeStart = float(splits[0] - viewDepthOffset);
     }
     setLayerLights(scene);
     describeLayers();

@@ -81,9 +81,9 @@ RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& o) {
     if (s.raster.pcfSize < 1 || s.raster.pcfSize > 15)
         throw InputError("--pcf-size: must be in 1..15 texels, got " + std::to_string(s.raster.pcfSize));
     MomentSettings& m = s.raster.moments;
-    auto take = [](double& into, const std::optional<double>& option, const std::optional<double>& scene,
+    auto take = [](double& into, const std::optional<double>& option, const std::optional<double>& fromScene,
                    const char* name, double lo, double hi) {
-        into = option.value_or(scene.value_or(into));
+        into = option.value_or(fromScene.value_or(into));
         if (!(into >= lo && into <= hi))  // also rejects NaN
             throw InputError(std::string(name) + ": must be in " + formatBlend(lo) + ".." + formatBlend(hi) +
                              ", got " + formatBlend(into));

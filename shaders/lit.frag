@@ -40,8 +40,8 @@ layout(location = 4) in vec4 inLightNormal;       // lit.vert: toShadow · (the 
 // The object's albedo (rgb) and 1 − opacity (a), which lit.vert reads from the per-object buffer
 // (binding 1): flat, so the same value as a read here, without a buffer lookup per fragment.
 layout(location = 5) flat in vec4 inAlbedo;
-// kVertexLightConstants: light 0's constants, and LitUniforms' forward and counts, from lit.vert
-// (lightAt(), forward(), counts()).
+// kVertexLightConstants: light 0's constants, and LitUniforms' forward, ambient and map size, from
+// lit.vert (lightAt(), viewForward(), ambient(), mapSize()).
 layout(location = 6) flat in vec4 inLight[6];
 layout(location = 12) flat in vec4 inFrame[2];
 
@@ -68,27 +68,47 @@ layout(location = 3) out vec4 outLights1;
 layout(location = 14) in vec2 inUv;
 #endif
 
-// Light i's constants and LitUniforms' forward and counts: the uniform buffer's, or the same values
-// as flat inputs from lit.vert (kVertexLightConstants, light 0 only). Fields lit.vert does not
-// pass are read from the buffer (where no code uses them, not at all).
+// Light i's constants: the uniform buffer's, or light 0's as flat inputs from lit.vert
+// (kVertexLightConstants: the one light), unpacked as lit.vert packs them. The members lit.vert does
+// not pass come from the buffer, and only where code reads them (none does).
 LightData lightAt(int i) {
     if (!kVertexLightConstants) return u.lights[i];
-    LightData light;
-    light.toShadow = u.lights[0].toShadow;
-    light.toLight = inLight[0];
-    light.radiance = inLight[1];
-    light.bias = inLight[2];
-    light.params = inLight[3];
-    light.kind = kVertexSpot ? inLight[4] : u.lights[0].kind;
-    light.axis = kVertexSpot ? inLight[5] : u.lights[0].axis;
+    LightData light = u.lights[0];
+    if (kVertexSpot) light.position = inLight[0].xyz;
+    else light.towardLight = inLight[0].xyz;
+    light.layer = inLight[0].w;
+    light.radiance = inLight[1].rgb;
+    light.visibilityWeight = inLight[1].w;
+    light.depthBiasWorld = inLight[2].x;
+    light.slopeBiasTexels = inLight[2].y;
+    light.texelWorldSize = inLight[2].z;
+    light.depthPerWorld = inLight[2].w;
+    light.maxSlopeTan = inLight[3].x;
+    light.normalOffsetTexels = inLight[3].y;
+    light.pcfSize = int(inLight[3].z);
+    if (kVertexSpot) {
+        light.spotDirection = inLight[4].xyz;
+        light.spotCosCone = inLight[4].w;
+        light.mapNear = inLight[5].x;
+        light.mapFar = inLight[5].y;
+        light.lightSize = inLight[5].z;
+    }
     return light;
 }
-vec4 forward() { return kVertexLightConstants ? inFrame[0] : u.forward; }
-vec4 counts() { return kVertexLightConstants ? inFrame[1] : u.counts; }
+// LitUniforms' members that lit.vert passes with the light.
+vec3 viewForward() { return kVertexLightConstants ? inFrame[0].xyz : u.forward; }
+float ambient() { return kVertexLightConstants ? inFrame[0].w : u.ambient; }
+float mapSize() { return kVertexLightConstants ? inFrame[1].x : u.mapSize; }
 
-// Constant false for a kind the scene lacks, which removes its code.
-bool isKind(LightData light, int kind) { return (kLightKinds & (1 << kind)) != 0 && int(light.kind.x) == kind; }
-bool isPerspective(LightData light) { return kAnyPerspective && int(light.kind.x) != SHADOWLAB_LIGHT_DIRECTIONAL; }
+// Whether the light is of this kind: constant false for a kind the scene lacks, which removes its
+// code, and constant true where the scene has lights of that kind only, so the kind is not read
+// (and lit.vert need not pass it).
+bool isKind(LightData light, int kind) {
+    if ((kLightKinds & (1 << kind)) == 0) return false;
+    if (kLightKinds == (1 << kind)) return true;
+    return light.kind == kind;
+}
+bool isPerspective(LightData light) { return kAnyPerspective && !isKind(light, SHADOWLAB_LIGHT_DIRECTIONAL); }
 
 const float kPi = 3.14159265358979323846;
 
@@ -158,10 +178,10 @@ float reference(LightData light, Receiver r, float bias) {
     if (isPerspective(light)) {
         // Perspective depth of a point at distance d along the axis: far/(far−near)·(1 − near/d);
         // the bias is subtracted from d, so it stays in world units at every distance.
-        const float near = light.kind.z, far = light.kind.w;
+        const float near = light.mapNear, far = light.mapFar;
         return far / (far - near) * (1.0 - near / max(r.axial - bias, near));
     }
-    return r.axial - bias * light.bias.w;  // orthographic depth is linear: bias / depth range
+    return r.axial - bias * light.depthPerWorld;  // orthographic depth is linear: bias / depth range
 }
 
 // The filterable maps' depth of a receiver biased by `bias` world units toward the light: a
@@ -246,11 +266,8 @@ int cubeFace(vec3 d, out vec3 axis, out vec3 right, out vec3 up) {
     return 2 * k + (negative ? 1 : 0);
 }
 
-// Near and far of a point light's cube face 0..5 (LightData.toShadow holds them; each face's
-// depth range is fitted on its own).
-vec2 faceRange(LightData light, int face) {
-    return vec2(light.toShadow[face / 4][face % 4], light.toShadow[2 + face / 4][face % 4]);
-}
+// Near and far of a point light's cube face 0..5 (each face's depth range is fitted on its own).
+vec2 faceRange(LightData light, int face) { return vec2(light.pointFaces[face].near, light.pointFaces[face].far); }
 
 // A PCSS tap of a point light at map coordinates uv of the receiver's face (basis axis, right,
 // up), which may lie past that face's edge: the tap's direction from the light is looked up in
@@ -260,14 +277,15 @@ vec2 faceRange(LightData light, int face) {
 // kPointFaceMarginTexels past its 90° edge; PCSS kernels reach up to 1/8 of the map, and without
 // this the taps beyond the margin read nothing (border: lit), cutting the penumbra along the seam.
 vec3 cubeTap(LightData light, vec3 axis, vec3 right, vec3 up, vec3 qd, vec2 uv, out float axial, out vec2 range) {
-    const vec2 s = (2.0 * uv - 1.0) * light.kind.y;  // tan of the tap's angles in the face
+    const vec2 s = (2.0 * uv - 1.0) * light.pointFaceTan;  // tan of the tap's angles in the face
     const vec3 d = axis + s.x * right + s.y * up;
     vec3 fAxis, fRight, fUp;
     const int face = cubeFace(d, fAxis, fRight, fUp);
     const float along = dot(d, fAxis);
     axial = dot(qd, fAxis);
     range = faceRange(light, face);
-    return vec3(0.5 + 0.5 * vec2(dot(d, fRight), dot(d, fUp)) / (along * light.kind.y), light.toLight.w + float(face));
+    return vec3(0.5 + 0.5 * vec2(dot(d, fRight), dot(d, fUp)) / (along * light.pointFaceTan),
+                light.layer + float(face));
 }
 
 // Map coordinates (u, v) and axial depth (as Receiver.uv, .axial) of camera-relative point q, for
@@ -277,13 +295,13 @@ vec3 mapCoordinates(LightData light, vec3 axis, vec3 q) {
         const vec3 ref = abs(axis.y) < 0.99 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0);
         const vec3 right = normalize(cross(axis, ref));
         const vec3 up = cross(right, axis);
-        const vec3 d = q - light.toLight.xyz;
+        const vec3 d = q - light.position;
         const float axial = dot(d, axis);
-        return vec3(0.5 + 0.5 * vec2(dot(d, right), dot(d, up)) / (axial * light.kind.y), axial);
+        return vec3(0.5 + 0.5 * vec2(dot(d, right), dot(d, up)) / (axial * light.pointFaceTan), axial);
     }
     const vec4 s = light.toShadow * vec4(q, 1.0);
     const bool perspective = isPerspective(light);
-    return vec3(perspective ? s.xy / s.w : s.xy, perspective ? dot(q - light.toLight.xyz, axis) : s.z);
+    return vec3(perspective ? s.xy / s.w : s.xy, perspective ? dot(q - light.position, axis) : s.z);
 }
 
 // Receiver-plane depth bias (Isidoro, "Shadow Mapping: GPU-based Tips and Techniques", GDC 2006).
@@ -302,14 +320,14 @@ void receiverPlane(LightData light, vec3 axis, vec3 q, vec3 dpdx, vec3 dpdy, flo
     const vec3 cy = mapCoordinates(light, axis, q + dpdy) - c;
     const vec2 ux = cx.xy * size, uy = cy.xy * size;  // texels per pixel
     // World units per unit of axial depth: orthographic depth is 0..1 over the depth range.
-    const float worldPerAxial = isPerspective(light) ? 1.0 : 1.0 / light.bias.w;
+    const float worldPerAxial = isPerspective(light) ? 1.0 : 1.0 / light.depthPerWorld;
     const float zx = cx.z * worldPerAxial, zy = cy.z * worldPerAxial;
     const float det = ux.x * uy.y - ux.y * uy.x;
     // Near singular: the two footprint vectors less than ~0.06° apart (|sin| < 1e-3).
     r.plane = abs(det) > 1e-3 * length(ux) * length(uy) && det != 0.0;
     if (!r.plane) return;
     vec2 g = vec2(uy.y * zx - ux.y * zy, ux.x * zy - uy.x * zx) / det;
-    const float cap = light.params.x * texel;
+    const float cap = light.maxSlopeTan * texel;
     const float len = length(g);
     if (!(len <= cap)) g = len > 0.0 && !isinf(len) ? g * (cap / len) : vec2(0.0);  // also NaN -> 0
     r.grad = g;
@@ -337,34 +355,35 @@ float biasedTap(LightData light, Receiver r, vec2 o, float size, float layer, in
 float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec3 dpdx, vec3 dpdy, inout uint blocker) {
     const bool perspective = isPerspective(light);
     const bool point = isKind(light, SHADOWLAB_LIGHT_POINT);
-    vec3 axis = light.axis.xyz;
+    vec3 axis = light.spotDirection;
     vec3 right = vec3(0.0), up = vec3(0.0);  // point: the face's basis
-    float layer = light.toLight.w;
+    float layer = light.layer;
     if (point) {
         // The cube face is the major axis of the direction from the light. Each face map
         // reaches a few texels past its edge, so the normal offset and the pcf/poisson taps
         // below stay inside this one face (PCSS taps may not: cubeTap).
-        const int face = cubeFace(p - light.toLight.xyz, axis, right, up);
+        const int face = cubeFace(p - light.position, axis, right, up);
         layer += float(face);
-        light.kind.zw = faceRange(light, face);  // reference() and PCSS read near, far there
+        light.mapNear = light.pointFaces[face].near;  // reference() and PCSS read them there
+        light.mapFar = light.pointFaces[face].far;
     }
     // World size of a texel at p: constant for an orthographic map, growing with distance
     // along the axis for a perspective one. (kVertexSpot: toShadow's w row is that distance,
     // (axis, −axis·L), so lit.vert's interpolated w is it.)
-    const float axialP = kVertexSpot ? inLightCoordinates.w : dot(p - light.toLight.xyz, axis);
-    const float texel = light.bias.z * (perspective ? axialP : 1.0);
+    const float axialP = kVertexSpot ? inLightCoordinates.w : dot(p - light.position, axis);
+    const float texel = light.texelWorldSize * (perspective ? axialP : 1.0);
     // Normal offset: look the map up from a point moved off the surface along its normal.
-    const vec3 q = kNormalOffset ? p + n * (light.params.z * texel) : p;
+    const vec3 q = kNormalOffset ? p + n * (light.normalOffsetTexels * texel) : p;
     // bias_world = depthBias + slopeBias * texel * min(tan(theta), maxTan), cos(theta) = N·L.
-    const float tanTheta = min(sqrt(max(1.0 - ndotl * ndotl, 0.0)) / ndotl, light.params.x);
+    const float tanTheta = min(sqrt(max(1.0 - ndotl * ndotl, 0.0)) / ndotl, light.maxSlopeTan);
     Receiver r;
-    r.slopeStep = light.bias.y * texel * tanTheta;
-    r.biasWorld = light.bias.x + r.slopeStep;
+    r.slopeStep = light.slopeBiasTexels * texel * tanTheta;
+    r.biasWorld = light.depthBiasWorld + r.slopeStep;
     if (point) {
         // The face's perspective map, as LightFrustum::toTexture.
-        const vec3 d = q - light.toLight.xyz;
+        const vec3 d = q - light.position;
         r.axial = dot(d, axis);
-        r.uv = 0.5 + 0.5 * vec2(dot(d, right), dot(d, up)) / (r.axial * light.kind.y);
+        r.uv = 0.5 + 0.5 * vec2(dot(d, right), dot(d, up)) / (r.axial * light.pointFaceTan);
     } else if (kVertexLightCoordinates) {
         // toShadow · (p + n·offset, 1) = toShadow · (p, 1) + offset · toShadow · (n, 0), and both
         // factors are linear in the position and the normal, so they interpolate exactly: lit.vert
@@ -378,8 +397,8 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         // offset point. Each component rounds at its own scale (x, y ≈ w·(u, v): ≈1e-7 of w, so
         // ≈1e-7 of the map after the divide; w ≈1e-7 of max(|p|, |L|) camera-relative, against a
         // bias of half a texel ≈ 1e-3·w at 2048²), as the per-fragment product does.
-        const vec4 s =
-            kNormalOffset ? inLightCoordinates + (light.params.z * texel * nScale) * inLightNormal : inLightCoordinates;
+        const vec4 s = kNormalOffset ? inLightCoordinates + (light.normalOffsetTexels * texel * nScale) * inLightNormal
+                                     : inLightCoordinates;
         r.uv = kVertexSpot ? s.xy / s.w : s.xy;
         r.axial = kVertexSpot ? s.w : s.z;
     } else {
@@ -387,16 +406,16 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         // Orthographic (directional): toShadow's last row is exactly (0, 0, 0, 1), so w = 1 and
         // the division would change nothing; without it the w row is not computed either.
         r.uv = perspective ? s.xy / s.w : s.xy;
-        r.axial = perspective ? dot(q - light.toLight.xyz, axis) : s.z;
+        r.axial = perspective ? dot(q - light.position, axis) : s.z;
     }
-    const int filterCode = kFilter;  // light.params.y holds the same code
-    const float size = counts().y;  // = textureSize(shadowMaps, 0).x, without a query per fragment
+    const int filterCode = kFilter;  // light.filterCode holds the same code
+    const float size = mapSize();  // = textureSize(shadowMaps, 0).x, without a query per fragment
     r.plane = false;
     r.grad = vec2(0.0);
     if (kReceiverPlane) {
         receiverPlane(light, axis, q, dpdx, dpdy, size, texel, r);
         // The plane replaces the slope term; the constant bias stays.
-        if (r.plane) r.biasWorld = light.bias.x;
+        if (r.plane) r.biasWorld = light.depthBiasWorld;
     }
     if (filterCode >= SHADOWLAB_FILTER_VSM) {
         // Filterable maps: one linear lookup of the blurred moments (the filter is in the blur),
@@ -457,20 +476,20 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
     // Wide kernels: a tap d texels from the point compares against a surface that a plane
     // tilted by θ has moved d·texel·tan(θ) along the light, so each tap's slope term grows
     // with its distance (a per-tap receiver-plane bias; without it wide kernels make acne).
-    float kernelTexels = light.params.w;  // poisson: the diameter given
-    const float lightSize = light.axis.w;
+    float kernelTexels = float(light.pcfSize);  // poisson: the diameter given
+    const float lightSize = light.lightSize;
     const bool pcss = filterCode == SHADOWLAB_FILTER_PCSS && perspective && lightSize > 0.0;
     const bool wrap = pcss && point;  // PCSS taps of a point light go on into the neighbouring faces
-    const vec3 qd = q - light.toLight.xyz;
+    const vec3 qd = q - light.position;
     if (pcss) {
         // Percentage-closer soft shadows (Fernando, "Percentage-Closer Soft Shadows", SIGGRAPH 2005
         // sketch). 1. Blocker search: a blocker at distance d along the axis, s to the side of the
         // receiver's ray, shadows the receiver (distance dr) from some point of a light of size w
         // when s <= (w/2)(dr − d)/dr; in the map that is s/(d·texelPerDistance) texels, largest at
         // the near plane, so the search covers that, capped at kPcssMaxSearchFraction of the map.
-        const float near = light.kind.z, far = light.kind.w;
+        const float near = light.mapNear, far = light.mapFar;
         const float dr = r.axial;
-        const float reach = 0.5 * lightSize * (dr - near) / dr / (near * light.bias.z);
+        const float reach = 0.5 * lightSize * (dr - near) / dr / (near * light.texelWorldSize);
         const float searchRadius = clamp(reach, 1.0, kPcssMaxSearchFraction * size);
         const float angle = 2.0 * kPi * interleavedGradientNoise(gl_FragCoord.xy);
         const mat2 rotation = mat2(cos(angle), sin(angle), -sin(angle), cos(angle));
@@ -520,7 +539,7 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         const float penumbra = (dr - db) * lightSize / db;
         kernelTexels = clamp(penumbra / texel, 1.0, kPcssMaxFilterFraction * size);
     }
-    const int taps = clamp(int(light.params.w), 1, 15);
+    const int taps = clamp(light.pcfSize, 1, 15);
     float sum = 0.0;
     if (filterCode == SHADOWLAB_FILTER_PCF) {
         // taps x taps texels one texel apart, centered on the point.
@@ -551,7 +570,8 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
                 sum += biasedTap(light, r, o, size, layer, blocker);
                 continue;
             }
-            lt.kind.zw = range;
+            lt.mapNear = range.x;
+            lt.mapFar = range.y;
             sum += tap(at.xy, at.z, reference(lt, rt, r.biasWorld + r.slopeStep * length(o)), blocker);
         } else {
             sum += biasedTap(light, r, o, size, layer, blocker);
@@ -565,32 +585,32 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
 LightData withCascade(LightData light, int first, int c) {
     const CascadeData cascade = u.cascades[first + c];
     light.toShadow = cascade.toShadow;
-    light.toLight.w += float(c);
-    light.bias.x = cascade.params.w;
-    light.bias.z = cascade.params.y;
-    light.bias.w = cascade.params.z;
+    light.layer += float(c);
+    light.depthBiasWorld = cascade.depthBiasWorld;
+    light.texelWorldSize = cascade.texelWorldSize;
+    light.depthPerWorld = cascade.depthPerWorld;
     return light;
 }
 
-// Cascaded shadow maps: a directional light with kind.y = kCascades > 1 cascades uses the cascade
-// c whose slice holds p's view depth z (the Frame's Z, same expression).
-// Blend bands (kCascadeBlend, F = u.counts.z): where z lies in the last F of slice c (split[c] to
-// split[c+1]) and c is not the last cascade, `next` gets cascade c + 1 and `blend` the position in
+// Cascaded shadow maps: a directional light with cascadeCount = kCascades > 1 cascades uses the
+// cascade c whose slice holds p's view depth z (the Frame's Z, same expression).
+// Blend bands (kCascadeBlend, F = u.cascadeBlendBand): where z lies in the last F of slice c
+// (split[c] to split[c+1]) and c is not the last cascade, `next` gets cascade c + 1 and `blend` the position in
 // the band, 0 at its start to 1 at the split, so the visibility goes over linearly to the next
 // cascade's and is continuous across the split; elsewhere blend = 0.
 LightData cascadeOf(LightData light, int lightIndex, vec3 p, out LightData next, out float blend) {
     const int first = lightIndex * SHADOWLAB_MAX_CASCADES;
-    const int count = min(kCascades, SHADOWLAB_MAX_CASCADES);  // = light.kind.y
-    const float z = dot(p, u.forward.xyz);
+    const int count = min(kCascades, SHADOWLAB_MAX_CASCADES);  // = light.cascadeCount
+    const float z = dot(p, u.forward);
     int c = 0;
     [[unroll]] for (int k = 0; k + 1 < count; ++k)
-        if (z > u.cascades[first + k].params.x) c = k + 1;
+        if (z > u.cascades[first + k].sliceFar) c = k + 1;
     blend = 0.0;
     next = light;
     if (kCascadeBlend && c + 1 < count) {
-        const float start = c == 0 ? u.counts.w : u.cascades[first + c - 1].params.x;  // split[c]
-        const float end = u.cascades[first + c].params.x;                              // split[c+1]
-        const float bandStart = end - u.counts.z * (end - start);
+        const float start = c == 0 ? u.cascadeStart : u.cascades[first + c - 1].sliceFar;  // split[c]
+        const float end = u.cascades[first + c].sliceFar;                            // split[c+1]
+        const float bandStart = end - u.cascadeBlendBand * (end - start);
         if (z > bandStart) {
             blend = clamp((z - bandStart) / (end - bandStart), 0.0, 1.0);
             next = withCascade(light, first, c + 1);
@@ -617,7 +637,7 @@ void main() {
     const vec4 objectAlbedo = inAlbedo;
     const vec3 albedoColor = objectAlbedo.rgb;
     if (kTransmittance) receiverTransmittance = max(objectAlbedo.a, 1e-6);
-    vec3 color = forward().w * albedoColor;
+    vec3 color = ambient() * albedoColor;
     float weightSum = 0.0;
     float weightedVisibility = 0.0;
     uint blocker = 0u;
@@ -628,23 +648,24 @@ void main() {
 #endif
     [[unroll]] for (int i = 0; i < lightCount; ++i) {
         LightData light = lightAt(i);
-        // A cascaded directional light (kind.y cascades; 0 without a shadow test) takes its
+        // A cascaded directional light (cascadeCount; 0 without a shadow test) takes its
         // cascade's map. The code exists only in pipelines made for cascades (kCascades > 1).
         LightData nextCascade;
         float cascadeBlend = 0.0;  // > 0: in a blend band, mix with nextCascade's visibility
-        if (kCascades > 1 && isKind(light, SHADOWLAB_LIGHT_DIRECTIONAL) && light.kind.y > 1.5)
+        if (kCascades > 1 && isKind(light, SHADOWLAB_LIGHT_DIRECTIONAL) && light.cascadeCount > 1)
             light = cascadeOf(light, i, inPosition, nextCascade, cascadeBlend);
         vec3 l;
         float irradiance;  // relative to radiance: 1 for directional lights
         if (isPerspective(light)) {
             // scene/shading.h: intensity / (4π d²); a spot is dark outside its cone.
-            const vec3 toLight = light.toLight.xyz - inPosition;
+            const vec3 toLight = light.position - inPosition;
             const float d2 = dot(toLight, toLight);
             l = toLight * inversesqrt(d2);
-            const bool outsideCone = isKind(light, SHADOWLAB_LIGHT_SPOT) && dot(-l, light.axis.xyz) < light.kind.y;
+            const bool outsideCone =
+                isKind(light, SHADOWLAB_LIGHT_SPOT) && dot(-l, light.spotDirection) < light.spotCosCone;
             irradiance = outsideCone ? 0.0 : 1.0 / (4.0 * kPi * d2);
         } else {
-            l = light.toLight.xyz;
+            l = light.towardLight;
             irradiance = 1.0;
         }
         const float ndotl = dot(n, l);
@@ -653,9 +674,9 @@ void main() {
         // continue, so that the loop unrolls.)
         if (ndotl > 0.0 && irradiance > 0.0) {
             uint lightBlocker = 0u;
-            float v = light.toLight.w >= 0.0 ? shadowTest(light, inPosition, n, nScale, ndotl, dpdx, dpdy, lightBlocker) : 1.0;
+            float v = light.layer >= 0.0 ? shadowTest(light, inPosition, n, nScale, ndotl, dpdx, dpdy, lightBlocker) : 1.0;
             if (kCascadeBlend && cascadeBlend > 0.0) {
-                // (A cascaded light always has a shadow test: kind.y > 1 only then.) The blocker
+                // (A cascaded light always has a shadow test: cascadeCount > 1 only then.) The blocker
                 // id stays the first cascade's when it found one.
                 uint nextBlocker = 0u;
                 const float vNext = shadowTest(nextCascade, inPosition, n, nScale, ndotl, dpdx, dpdy, nextBlocker);
@@ -667,16 +688,16 @@ void main() {
             lightVisibility[i / 4][i % 4] = v;
 #endif
             // The visibility AOV weighs each light by what it would add unshadowed (as raytrace/).
-            const float w = light.radiance.w * irradiance * ndotl;
+            const float w = light.visibilityWeight * irradiance * ndotl;
             weightSum += w;
             weightedVisibility += w * v;
-            color += albedoColor * light.radiance.rgb * (irradiance * ndotl * v);
+            color += albedoColor * light.radiance * (irradiance * ndotl * v);
         }
     }
     const float visibility = !kVisibility ? 1.0 : weightSum > 0.0 ? weightedVisibility / weightSum : 0.0;
     outBeauty = vec4(color, visibility);
 #ifndef SHADOWLAB_BEAUTY_ONLY
-    outAovs = vec4(float(inObjectId), maxNdotL, dot(inPosition, forward().xyz), float(blocker));
+    outAovs = vec4(float(inObjectId), maxNdotL, dot(inPosition, viewForward()), float(blocker));
 #endif
 #ifdef SHADOWLAB_LIGHT_OUTPUTS
     outLights0 = lightVisibility[0];

@@ -24,10 +24,11 @@ layout(location = 3) out vec4 outLightCoordinates;
 layout(location = 4) out vec4 outLightNormal;
 // The object's albedo (lit.frag's), read here once per vertex instead of once per fragment.
 layout(location = 5) flat out vec4 outAlbedo;
-// kVertexLightConstants (lit_constants.glsl): light 0's LightData after toShadow (toLight,
-// radiance, bias, params, kind, axis; kind and axis only for a spot, which alone reads them), and
-// LitUniforms' forward and counts; written only then. (Locations 0..13, 56 components: within the
-// 64 every Vulkan device must take, maxVertexOutputComponents and maxFragmentInputComponents.)
+// kVertexLightConstants (lit_constants.glsl): the members of light 0's LightData that lit.frag reads
+// there (its kind is a constant then: kLightKinds has one bit), packed into vec4s as lit.frag's
+// lightAt() unpacks them, and LitUniforms' forward, ambient and map size; written only then.
+// (Locations 0..13, 56 components: within the 64 every Vulkan device must take,
+// maxVertexOutputComponents and maxFragmentInputComponents.)
 layout(location = 6) flat out vec4 outLight[6];
 layout(location = 12) flat out vec4 outFrame[2];
 #ifdef SHADOWLAB_ALPHA
@@ -48,16 +49,17 @@ void main() {
     outLightCoordinates = u.lights[0].toShadow * vec4(inPosition, 1.0);
     outLightNormal = u.lights[0].toShadow * vec4(inNormal, 0.0);
     if (kVertexLightConstants) {
-        outLight[0] = u.lights[0].toLight;
-        outLight[1] = u.lights[0].radiance;
-        outLight[2] = u.lights[0].bias;
-        outLight[3] = u.lights[0].params;
+        const LightData light = u.lights[0];
+        outLight[0] = vec4(kVertexSpot ? light.position : light.towardLight, light.layer);
+        outLight[1] = vec4(light.radiance, light.visibilityWeight);
+        outLight[2] = vec4(light.depthBiasWorld, light.slopeBiasTexels, light.texelWorldSize, light.depthPerWorld);
+        outLight[3] = vec4(light.maxSlopeTan, light.normalOffsetTexels, float(light.pcfSize), 0.0);
         if (kVertexSpot) {
-            outLight[4] = u.lights[0].kind;
-            outLight[5] = u.lights[0].axis;
+            outLight[4] = vec4(light.spotDirection, light.spotCosCone);
+            outLight[5] = vec4(light.mapNear, light.mapFar, light.lightSize, 0.0);
         }
-        outFrame[0] = u.forward;
-        outFrame[1] = u.counts;
+        outFrame[0] = vec4(u.forward, u.ambient);
+        outFrame[1] = vec4(u.mapSize, 0.0, 0.0, 0.0);
     }
     gl_Position = u.viewProj * vec4(inPosition, 1.0);
 }

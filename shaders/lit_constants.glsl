@@ -6,7 +6,7 @@
 // creation, the dead paths are gone.
 layout(constant_id = 0) const int kFilter = SHADOWLAB_FILTER_PCF2X2;  // the filter of every light
 layout(constant_id = 1) const bool kBlockerIds = true;  // look up and write the blocker ids
-// The number of lights (u.counts.x holds the same), so the light loop unrolls and each light's
+// The number of lights (u.lightCount holds the same), so the light loop unrolls and each light's
 // uniforms are loaded from a constant index; and the light kinds present (bit 1 << kind), so
 // the spot and point-light paths are left out of scenes without such lights.
 layout(constant_id = 2) const int kLightCount = SHADOWLAB_MAX_LIGHTS;
@@ -20,15 +20,16 @@ layout(constant_id = 4) const int kCascades = 1;
 layout(constant_id = 5) const bool kTransmittance = false;
 // Receiver-plane depth bias in every tap (see shadowTest); off, its code is compiled out.
 layout(constant_id = 6) const bool kReceiverPlane = false;
-// Cascaded lights blend each cascade into the next over a band before the split (u.counts.z, the
-// band's fraction of the slice; see cascadeOf); off, the second shadow test is compiled out.
+// Cascaded lights blend each cascade into the next over a band before the split
+// (u.cascadeBlendBand, the band's fraction of the slice; see cascadeOf); off, the second shadow
+// test is compiled out.
 layout(constant_id = 7) const bool kCascadeBlend = false;
 // The beauty target's alpha holds the visibility AOV; off for the 8-bit display target (a PNG has
 // no alpha), which leaves out the weighting and the division per pixel.
 layout(constant_id = 8) const bool kVisibility = true;
-// A normal offset is set (LightData.params.z, the same for every light): off (the default), the
-// lookup point is the surface point itself, and the vertex path's map-space normal is not read
-// (one varying and its arithmetic less per pixel).
+// A normal offset is set (LightData::normalOffsetTexels, the same for every light): off (the
+// default), the lookup point is the surface point itself, and the vertex path's map-space normal
+// is not read (one varying and its arithmetic less per pixel).
 layout(constant_id = 9) const bool kNormalOffset = true;
 // One directional light with one map, or one spot light, and no receiver plane: its map
 // coordinates are interpolated from lit.vert (see shadowTest) instead of a matrix product per
@@ -41,14 +42,14 @@ const bool kVertexDirectional = kLightCount == 1 && kLightKinds == (1 << SHADOWL
 const bool kVertexLightCoordinates = !(!kVertexSpot && !kVertexDirectional);
 const bool kAnyPerspective =
     (kLightKinds & ((1 << SHADOWLAB_LIGHT_SPOT) | (1 << SHADOWLAB_LIGHT_POINT))) != 0;
-// The one light's constants (LightData after toShadow) and LitUniforms' forward (with the
-// ambient) and counts (with the map side) reach lit.frag as flat outputs of lit.vert instead of
-// uniform-buffer reads, where lit.frag takes that light's map coordinates from lit.vert too
-// (kVertexLightCoordinates). lavapipe (Mesa 22.3's llvmpipe) reads a uniform in a fragment shader
-// lane by lane, with a bounds check, for every eight pixels; a flat input is set up once per
-// triangle and then read as a constant (docs/performance.md: less CPU per frame on the seed scene
-// and on Sponza, down to half a pixel per triangle). The values are the same floats either way
-// (raster::LightConstants).
+// The one light's constants that lit.frag reads (the LightData members its kind uses, less
+// toShadow; the kind itself is a constant there, as kLightKinds has one bit) and LitUniforms'
+// forward, ambient and map size reach lit.frag as flat outputs of lit.vert instead of uniform-buffer reads, where lit.frag takes
+// that light's map coordinates from lit.vert too (kVertexLightCoordinates). lavapipe (Mesa 22.3's
+// llvmpipe) reads a uniform in a fragment shader lane by lane, with a bounds check, for every
+// eight pixels; a flat input is set up once per triangle and then read as a constant
+// (docs/performance.md: less CPU per frame on the seed scene and on Sponza, down to half a pixel
+// per triangle). The values are the same floats either way (raster::LightConstants).
 layout(constant_id = 10) const bool kVertexLightConstantsAsked = false;
 const bool kVertexLightConstants = kVertexLightConstantsAsked && kVertexLightCoordinates;
 

@@ -212,7 +212,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadRun{"path_bad_shard", {"path", "seed", "--shard", "2/2", "-o", "OUTDIR"}, "--shard"},
         BadRun{"sweep_bad_flicker_kind", {"sweep", "seed", "--quick", "--flicker", "spiral", "-o", "OUTDIR"},
                "--kind: expected orbit|"}),
-    [](const ::testing::TestParamInfo<BadRun>& info) { return std::string(info.param.name); });
+    [](const ::testing::TestParamInfo<BadRun>& testParam) { return std::string(testParam.param.name); });
 
 TEST(App, RenderViewsWriteImagesOfTheDocumentedSizes) {
     TempDir dir;

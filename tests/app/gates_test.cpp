@@ -354,7 +354,7 @@ INSTANTIATE_TEST_SUITE_P(
                  "base.json: cases.a.mismatch_rate: expected a number in 0..1"},
         BadSuite{"bad_baseline_version", std::string(R"({"baseline": "base.json", "cases": [)") + kCase + "]}",
                  R"({"shadowlab_check_baseline": 7, "cases": {}})", "base.json: shadowlab_check_baseline: expected 1"}),
-    [](const ::testing::TestParamInfo<BadSuite>& info) { return std::string(info.param.name); });
+    [](const ::testing::TestParamInfo<BadSuite>& testParam) { return std::string(testParam.param.name); });
 
 }  // namespace
 }  // namespace shadowlab

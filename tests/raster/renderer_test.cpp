@@ -893,7 +893,7 @@ TEST(RasterRender, InterpolatedLightCoordinatesMatchThePerFragmentProduct) {
 TEST(RasterRender, InterpolatedSpotLightCoordinatesMatchThePerFragmentProduct) {
     // The same comparison for one spot light: lit.vert interpolates toShadow·(p, 1) and
     // toShadow·(N, 0) (all four rows), lit.frag scales the second by k·texel(p) with texel(p) =
-    // bias.z·w(p), adds, and divides by w; with a second (dim) spot it multiplies the normal-offset
+    // texelWorldSize·w(p), adds, and divides by w; with a second (dim) spot it multiplies the normal-offset
     // point by toShadow per fragment. Algebraically the same (clip coordinates are linear in the
     // point, and the offset's two factors each in the position and the normal), so light 0's
     // visibility must agree up to rounding at the map's scale: the divided (u, v) ≈1e-7 of the map,

@@ -194,7 +194,7 @@ INSTANTIATE_TEST_SUITE_P(
                 "shadow.receiver_plane_bias", "expected"},
         BadCase{"fractional_cascades", sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"cascades": 2.5})"),
                 "shadow.cascades", "expected an integer"}),
-    [](const ::testing::TestParamInfo<BadCase>& info) { return std::string(info.param.name); });
+    [](const ::testing::TestParamInfo<BadCase>& testParam) { return std::string(testParam.param.name); });
 
 TEST(SceneLoader, AGltfFileIsASceneWithAFramedCameraAndADefaultSun) {
     // The Khronos Box has no camera and no light: the loader frames its bounding sphere
