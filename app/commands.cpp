@@ -219,7 +219,7 @@ void checkValidation(const scene::Frame& frame, const scene::RasterSettings& set
 // `debug`: raster only, what the debug views need (every channel is read back with it).
 scene::Frame renderBackend(const Prepared& p, scene::Backend backend,
                            scene::ChannelMask channels = scene::kAllChannels, raster::RenderDebug* debug = nullptr) {
-    scene::Frame f = compare::renderFrame(backend, p.scene, p.plan, p.settings, channels, debug);
+    scene::Frame f = studies::renderFrame(backend, p.scene, p.plan, p.settings, channels, debug);
     if (backend == scene::Backend::Raster) checkValidation(f, p.settings.raster);
     f.attributes["scene"] = p.scene.file.string();
     for (const auto& [key, text] : p.scene.origin.choices) f.attributes["choice." + key] = text;
@@ -238,7 +238,7 @@ Json timingsJson(const scene::Frame& f) {
 // An upper estimate of the memory rendering `backend` takes (see scene/memory.h), without the
 // program itself and the Frame's writing.
 std::uint64_t backendMemory(const Prepared& p, scene::Backend backend) {
-    return compare::estimateMemoryBytes(backend, p.scene, p.plan, p.settings);
+    return studies::estimateMemoryBytes(backend, p.scene, p.plan, p.settings);
 }
 
 // "peak memory 412 MiB (estimated at most 530 MiB)", and the same figures for --json.
@@ -251,9 +251,9 @@ Json memoryJson(std::uint64_t estimate) {
 }
 
 // Sweep progress: a bar with ETA on a terminal, one plain line per configuration otherwise.
-std::function<void(const compare::SweepProgress&)> sweepProgressPrinter() {
+std::function<void(const studies::SweepProgress&)> sweepProgressPrinter() {
     const bool tty = isatty(STDERR_FILENO);
-    return [tty](const compare::SweepProgress& pr) {
+    return [tty](const studies::SweepProgress& pr) {
         const std::string what = pr.row ? pr.row->config.label() : "";
         const std::string outcome = pr.row && !pr.row->error.empty() ? "failed: " + pr.row->error
                                     : pr.row ? "mismatch " + std::to_string(100.0 * pr.row->rate("mismatch_rate")).substr(0, 5) + "%"
@@ -609,42 +609,42 @@ int run(const RunOptions& o) {
         // the report. It starts fresh in a temporary folder (rows of an earlier build must not mix
         // with this one's) that replaces sweep/ in one step when it is complete, so a run killed
         // in the middle leaves the old sweep/ whole.
-        compare::SweepGrid grid = compare::defaultGrid(p.scene, true);
+        studies::SweepGrid grid = studies::defaultGrid(p.scene, true);
         grid.resolution = std::to_string(std::max(16, p.scene.camera.width / 2)) + "x" +
                           std::to_string(std::max(16, p.scene.camera.height / 2));
-        for (compare::SweepConfig& c : grid.configs) {
+        for (studies::SweepConfig& c : grid.configs) {
             if (o.skipRaster && c.backend == "raster") c.backend.clear();
             c.overrides.threads = o.common.settings.threads;
             c.overrides.device = o.common.settings.device;
             c.overrides.validate = o.common.settings.validate;
         }
-        std::erase_if(grid.configs, [](const compare::SweepConfig& c) { return c.backend.empty(); });
-        compare::SweepOptions options;
+        std::erase_if(grid.configs, [](const studies::SweepConfig& c) { return c.backend.empty(); });
+        studies::SweepOptions options;
         options.outputDir = scene::temporarySibling(dir / "sweep");
         options.progress = sweepProgressPrinter();
         Stage stage("quick sweep of " + std::to_string(grid.configs.size()) + " configurations at " + *grid.resolution);
-        const compare::SweepResult result = compare::runSweep(p.scene, grid, options);
-        compare::SweepReportInput input = compare::makeSweepReportInput(report.sceneName, report.scenePath, result);
+        const studies::SweepResult result = studies::runSweep(p.scene, grid, options);
+        studies::SweepReportInput input = studies::makeSweepReportInput(report.sceneName, report.scenePath, result);
         {
             Stage rec("recommended shadow block: biases searched in this configuration, checked at " +
                       std::to_string(p.scene.camera.width) + "x" + std::to_string(p.scene.camera.height));
             scene::Scene half = p.scene;
             half.camera.width = result.reference.width;
             half.camera.height = result.reference.height;
-            compare::RecommendOptions ro;
+            studies::RecommendOptions ro;
             ro.user = o.common.settings;
             ro.raster = !o.skipRaster;
-            input.recommendation = compare::recommendShadow(
+            input.recommendation = studies::recommendShadow(
                 half, result.reference, p.scene, reference, defaultsFrame[1] ? &*defaultsFrame[1] : nullptr,
                 defaultsFrame[0] ? &*defaultsFrame[0] : nullptr,
-                compare::rayCandidateOf(compare::recommendBias(result.rows)), ro);
+                studies::rayCandidateOf(studies::recommendBias(result.rows)), ro);
             rec.done(std::to_string(input.recommendation->points.size()) + " raster points");
             for (const std::string& note : input.recommendation->notes) std::cerr << "shadowlab: " << note << "\n";
         }
-        compare::writeSweepReport(options.outputDir, input);
+        studies::writeSweepReport(options.outputDir, input);
         scene::replaceDirectory(options.outputDir, dir / "sweep");
         written.push_back("sweep/");
-        report.sweep = compare::summarizeSweep(input, "sweep/report.html");
+        report.sweep = studies::summarizeSweep(input, "sweep/report.html");
         stage.done("sweep/report.html");
         metrics["sweep"] = {{"configurations", result.rows.size()}, {"report", "sweep/report.html"},
                             {"results", "sweep/results.csv"},
@@ -674,26 +674,26 @@ int run(const RunOptions& o) {
 namespace {
 
 // One shard of a sweep: its rows only, into DIR/shard-K-of-N; the report comes from `merge`.
-int sweepShard(const SweepOptions& o, const scene::Scene& scene, const compare::SweepGrid& grid,
-               const compare::SweepOptions& options) {
-    const compare::Shard shard = compare::parseShard(*o.shard);
-    const std::size_t mine = compare::shardGrid(grid, shard).configs.size();
-    const fs::path dir = o.outputDir / compare::shardFolderName(shard);
+int sweepShard(const SweepOptions& o, const scene::Scene& scene, const studies::SweepGrid& grid,
+               const studies::SweepOptions& options) {
+    const studies::Shard shard = studies::parseShard(*o.shard);
+    const std::size_t mine = studies::shardGrid(grid, shard).configs.size();
+    const fs::path dir = o.outputDir / studies::shardFolderName(shard);
     // One writer per shard folder: the same shard started twice would duplicate its journal's keys.
     fs::create_directories(dir);
     const scene::FolderLock lock(dir, "sweep --shard");
     std::cerr << "shadowlab: sweep shard " << shard.index << "/" << shard.count << ": " << mine << " of "
-              << compare::gridKeys(grid).size() << " configurations, " << grid.repetitions
+              << studies::gridKeys(grid).size() << " configurations, " << grid.repetitions
               << " timed frames each, into " << dir.string() << "\n";
-    compare::SharedReferenceOptions ref;
+    studies::SharedReferenceOptions ref;
     ref.log = [](const std::string& line) { std::cerr << "shadowlab: " << line << "\n"; };
-    const compare::SweepResult result = compare::runShard(scene, grid, shard, options, ref);
+    const studies::SweepResult result = studies::runShard(scene, grid, shard, options, ref);
     std::size_t failed = 0;
     for (const auto& r : result.rows) failed += r.error.empty() ? 0 : 1;
     std::cerr << "shadowlab: wrote " << dir.string() << " (" << result.rows.size() << " rows"
               << (failed ? ", " + std::to_string(failed) + " failed" : "") << "); when every shard is done: shadowlab merge "
               << o.outputDir.string() << "\n";
-    if (o.common.json) std::cout << compare::rowsToJson(result.rows).dump(2) << "\n";
+    if (o.common.json) std::cout << studies::rowsToJson(result.rows).dump(2) << "\n";
     return failed ? 1 : 0;
 }
 
@@ -703,18 +703,18 @@ namespace {
 
 // `merge` of check shards: the junit.xml, summary.md and cases/ of the unsharded check, and its exit code.
 int mergeCheck(const MergeOptions& o) {
-    const compare::MergedCheck merged = compare::readCheckShards(o.inputs);
+    const studies::MergedCheck merged = studies::readCheckShards(o.inputs);
     fs::path out;
     if (o.outputDir) out = *o.outputDir;
     else if (o.inputs.size() == 1 && !fs::exists(o.inputs.front() / "shard.json")) out = o.inputs.front();
     else
         throw scene::InputError("merge: give the merged folder with -o (the inputs are " +
                                 std::string(o.inputs.size() == 1 ? "a shard folder" : "several folders") + ")");
-    compare::writeMergedCheck(merged, out);
+    studies::writeMergedCheck(merged, out);
     std::size_t failed = 0, errors = 0;
-    for (const compare::CasePart& p : merged.parts) {
-        failed += p.verdict == compare::CaseVerdict::Failed ? 1 : 0;
-        errors += p.verdict == compare::CaseVerdict::Error ? 1 : 0;
+    for (const studies::CasePart& p : merged.parts) {
+        failed += p.verdict == studies::CaseVerdict::Failed ? 1 : 0;
+        errors += p.verdict == studies::CaseVerdict::Error ? 1 : 0;
     }
     std::cerr << "shadowlab: merged " << merged.shardDirs.size() << " check shards of " << merged.identity.suiteName
               << ": " << merged.parts.size() - failed - errors << " passed, " << failed << " failed, " << errors
@@ -726,8 +726,8 @@ int mergeCheck(const MergeOptions& o) {
 
 namespace {
 
-void printPathSummary(const compare::PathResult& result) {
-    for (const compare::PathMethod& m : result.methods)
+void printPathSummary(const studies::PathResult& result) {
+    for (const studies::PathMethod& m : result.methods)
         std::cerr << "shadowlab: " << m.name << ": mean flicker " << compare::formatPercent(m.temporal.meanFlickerRate)
                   << " (" << m.temporal.totalFlicker << " px over " << m.temporal.pairs.size() << " pairs), swim "
                   << compare::formatFixed(m.temporal.meanSwimPixels, 3) << " px, edge offset "
@@ -742,23 +742,23 @@ int mergePath(const MergeOptions& o) {
     else
         throw scene::InputError("merge: give the merged folder with -o (the inputs are " +
                                 std::string(o.inputs.size() == 1 ? "a shard folder" : "several folders") + ")");
-    const compare::MergedPath merged = compare::mergePathShards(o.inputs, out);
+    const studies::MergedPath merged = studies::mergePathShards(o.inputs, out);
     std::cerr << "shadowlab: merged " << merged.shardCount << " path shards (" << merged.shardDirs.size() << " folders, "
               << merged.result.frames << " frames"
               << (merged.duplicates ? ", " + std::to_string(merged.duplicates) + " duplicate frames merged once" : "")
               << ")\n";
     printPathSummary(merged.result);
     std::cerr << "shadowlab: wrote " << (out / "report.html").string() << " and metrics.json\n";
-    if (o.json) std::cout << compare::toJson(merged.result).dump(2) << "\n";
+    if (o.json) std::cout << studies::toJson(merged.result).dump(2) << "\n";
     return 0;
 }
 
 }  // namespace
 
 int merge(const MergeOptions& o) {
-    if (compare::holdsCheckShards(o.inputs)) return mergeCheck(o);
-    if (compare::holdsPathShards(o.inputs)) return mergePath(o);
-    const compare::MergedSweep merged = compare::readShards(o.inputs);
+    if (studies::holdsCheckShards(o.inputs)) return mergeCheck(o);
+    if (studies::holdsPathShards(o.inputs)) return mergePath(o);
+    const studies::MergedSweep merged = studies::readShards(o.inputs);
     fs::path out;
     if (o.outputDir) {
         out = *o.outputDir;
@@ -768,41 +768,41 @@ int merge(const MergeOptions& o) {
         throw scene::InputError("merge: give the merged folder with -o (the inputs are " +
                                 std::string(o.inputs.size() == 1 ? "a shard folder" : "several folders") + ")");
     }
-    compare::writeMerged(merged, out);
-    compare::writeSweepReport(out, compare::mergedReportInput(merged, out));
+    studies::writeMerged(merged, out);
+    studies::writeSweepReport(out, studies::mergedReportInput(merged, out));
     std::size_t failed = 0;
     std::set<std::string> machines;
     for (const auto& r : merged.rows) {
         failed += r.error.empty() ? 0 : 1;
-        machines.insert(compare::machineFromJson(r.machine).id());
+        machines.insert(studies::machineFromJson(r.machine).id());
     }
     std::cerr << "shadowlab: merged " << merged.shardCount << " shards (" << merged.shardDirs.size() << " folders, "
               << merged.rows.size() << " rows" << (failed ? ", " + std::to_string(failed) + " failed" : "")
               << (merged.duplicates ? ", " + std::to_string(merged.duplicates) + " duplicate rows merged once" : "")
               << (machines.size() > 1 ? ", timed on " + std::to_string(machines.size()) + " machines" : "")
               << "): wrote " << (out / "report.html").string() << ", results.csv and results.json\n";
-    if (o.json) std::cout << compare::rowsToJson(merged.rows).dump(2) << "\n";
+    if (o.json) std::cout << studies::rowsToJson(merged.rows).dump(2) << "\n";
     return failed ? 1 : 0;
 }
 
 int sweep(const SweepOptions& o) {
     checkOutputFolder(o.outputDir);
     const Prepared p = prepare(o.common);
-    compare::SweepGrid grid = o.grid ? readingInput(o.grid->string(), [&] { return compare::loadGrid(*o.grid, p.scene); })
-                                     : compare::defaultGrid(p.scene, o.quick);
+    studies::SweepGrid grid = o.grid ? readingInput(o.grid->string(), [&] { return studies::loadGrid(*o.grid, p.scene); })
+                                     : studies::defaultGrid(p.scene, o.quick);
     if (o.repetitions) grid.repetitions = *o.repetitions;
     if (o.common.resolution) grid.resolution = o.common.resolution;
     if (o.flicker || o.flickerFrames) {
-        compare::PathSpec path = grid.flicker.value_or(compare::defaultFlickerPath());
+        studies::PathSpec path = grid.flicker.value_or(studies::defaultFlickerPath());
         // Given without a value, CLI11 reports the flag as "true": the default kind.
-        if (o.flicker && !o.flicker->empty() && *o.flicker != "true") path.kind = compare::parsePathKind(*o.flicker);
+        if (o.flicker && !o.flicker->empty() && *o.flicker != "true") path.kind = studies::parsePathKind(*o.flicker);
         if (o.flickerFrames) path.frames = *o.flickerFrames;
-        compare::flickerScenes(compare::sweepScene(p.scene, grid), path);  // a bad path fails before anything is written
+        studies::flickerScenes(studies::sweepScene(p.scene, grid), path);  // a bad path fails before anything is written
         grid.flicker = path;
     }
     // Settings given on the command line apply to every configuration that does not vary them.
     const scene::SettingsOverrides& base = o.common.settings;
-    for (compare::SweepConfig& c : grid.configs) {
+    for (studies::SweepConfig& c : grid.configs) {
         auto& v = c.overrides;
         if (!v.shadowMapSize) v.shadowMapSize = base.shadowMapSize;
         if (!v.depthBias) v.depthBias = base.depthBias;
@@ -819,7 +819,7 @@ int sweep(const SweepOptions& o) {
         v.validate = base.validate;
     }
 
-    compare::SweepOptions options;
+    studies::SweepOptions options;
     options.outputDir = o.outputDir;
     options.resume = o.resume;
     options.progress = sweepProgressPrinter();
@@ -830,54 +830,54 @@ int sweep(const SweepOptions& o) {
     const scene::FolderLock lock(o.outputDir, "sweep");
     std::cerr << "shadowlab: sweep of " << grid.configs.size() << " configurations, " << grid.repetitions
               << " timed frames each, into " << o.outputDir.string() << "\n";
-    const compare::SweepResult result = compare::runSweep(p.scene, grid, options);
-    compare::SweepReportInput input =
-        compare::makeSweepReportInput(p.scene.file.stem().string(), p.scene.file.string(), result);
+    const studies::SweepResult result = studies::runSweep(p.scene, grid, options);
+    studies::SweepReportInput input =
+        studies::makeSweepReportInput(p.scene.file.stem().string(), p.scene.file.string(), result);
     {
         // The recommendation is searched and checked at the sweep's resolution, in the settings
         // given on the command line (the grid's own rows vary them; the user runs these).
         scene::Scene at = p.scene;
         at.camera.width = result.reference.width;
         at.camera.height = result.reference.height;
-        compare::RecommendOptions ro;
+        studies::RecommendOptions ro;
         ro.user = o.common.settings;
         ro.raster = std::any_of(grid.configs.begin(), grid.configs.end(),
-                                [](const compare::SweepConfig& c) { return c.backend == "raster"; });
+                                [](const studies::SweepConfig& c) { return c.backend == "raster"; });
         ro.raytrace = std::any_of(grid.configs.begin(), grid.configs.end(),
-                                  [](const compare::SweepConfig& c) { return c.backend == "raytrace"; });
+                                  [](const studies::SweepConfig& c) { return c.backend == "raytrace"; });
         Stage rec("recommended shadow block: biases searched in this configuration");
-        input.recommendation = compare::recommendShadow(at, result.reference, at, result.reference, nullptr, nullptr,
-                                                        compare::rayCandidateOf(compare::recommendBias(result.rows)), ro);
+        input.recommendation = studies::recommendShadow(at, result.reference, at, result.reference, nullptr, nullptr,
+                                                        studies::rayCandidateOf(studies::recommendBias(result.rows)), ro);
         rec.done();
         for (const std::string& note : input.recommendation->notes) std::cerr << "shadowlab: " << note << "\n";
     }
-    compare::writeSweepReport(o.outputDir, input);
+    studies::writeSweepReport(o.outputDir, input);
     std::size_t failed = 0;
     for (const auto& r : result.rows) failed += r.error.empty() ? 0 : 1;
     std::cerr << "shadowlab: wrote " << (o.outputDir / "report.html").string() << ", results.csv and results.json ("
               << result.rows.size() << " rows" << (failed ? ", " + std::to_string(failed) + " failed" : "") << ")\n";
-    if (o.common.json) std::cout << compare::rowsToJson(result.rows).dump(2) << "\n";
+    if (o.common.json) std::cout << studies::rowsToJson(result.rows).dump(2) << "\n";
     return failed ? 1 : 0;
 }
 
 int check(const CheckOptions& o) {
     // The suite, every scene it names and the baseline are read and checked before anything runs.
-    const compare::CheckSuite fullSuite = compare::loadSuite(o.suite);
-    compare::CheckSuite suite = fullSuite;
+    const studies::CheckSuite fullSuite = studies::loadSuite(o.suite);
+    studies::CheckSuite suite = fullSuite;
     const std::optional<fs::path> baselineFile = o.baseline ? o.baseline : suite.baseline;
     if (o.updateBaseline && !baselineFile)
         throw scene::InputError(o.suite.string() + ": --update-baseline: the suite names no \"baseline\" file and "
                                 "--baseline gives none");
-    std::optional<compare::Baseline> baseline;
+    std::optional<studies::Baseline> baseline;
     if (baselineFile && !o.updateBaseline) {
         if (!fs::exists(*baselineFile))
             throw scene::InputError(baselineFile->string() + ": no such baseline (write one with --update-baseline)");
-        baseline = compare::loadBaseline(*baselineFile);
+        baseline = studies::loadBaseline(*baselineFile);
     }
-    std::optional<compare::Shard> shard;
-    compare::CheckShardManifest manifest;
+    std::optional<studies::Shard> shard;
+    studies::CheckShardManifest manifest;
     if (o.shard) {
-        shard = compare::parseShard(*o.shard);
+        shard = studies::parseShard(*o.shard);
         // N shards writing one baseline would race; a baseline comes from an unsharded run.
         if (o.updateBaseline)
             throw scene::InputError("check --shard: --update-baseline is not sharded; update the baseline with an "
@@ -885,29 +885,29 @@ int check(const CheckOptions& o) {
         manifest.version = SHADOWLAB_VERSION;
         manifest.suite = o.suite.string();
         manifest.suiteName = suite.name;
-        manifest.suiteHash = compare::fileHash(o.suite);
-        manifest.baselineHash = baseline ? compare::fileHash(*baselineFile) : "none";
+        manifest.suiteHash = studies::fileHash(o.suite);
+        manifest.baselineHash = baseline ? studies::fileHash(*baselineFile) : "none";
         manifest.shard = *shard;
         for (const auto& c : fullSuite.cases) manifest.suiteCases.push_back(c.name);
-        suite = compare::shardSuite(fullSuite, *shard);
+        suite = studies::shardSuite(fullSuite, *shard);
         for (const auto& c : suite.cases) manifest.cases.push_back(c.name);
         std::cerr << "shadowlab: check shard " << shard->index << "/" << shard->count << ": " << suite.cases.size()
                   << " of " << fullSuite.cases.size() << " cases\n";
     }
     std::cerr << "shadowlab: check " << suite.name << ": " << suite.cases.size() << " cases"
               << (baseline ? " against " + baselineFile->string() : std::string(" without a baseline")) << "\n";
-    const auto results = compare::runSuite(
-        suite, baseline ? &*baseline : nullptr, [&](std::size_t done, const compare::CaseResult& r) {
-            std::string what = r.verdict == compare::CaseVerdict::Error ? "ERROR: " + r.error
+    const auto results = studies::runSuite(
+        suite, baseline ? &*baseline : nullptr, [&](std::size_t done, const studies::CaseResult& r) {
+            std::string what = r.verdict == studies::CaseVerdict::Error ? "ERROR: " + r.error
                                : r.metrics ? compare::summaryLine(*r.metrics) : "";
-            if (r.verdict == compare::CaseVerdict::Failed) what = "FAILED: " + r.failures.front() + "; " + what;
+            if (r.verdict == studies::CaseVerdict::Failed) what = "FAILED: " + r.failures.front() + "; " + what;
             std::cerr << "shadowlab: check [" << done << "/" << suite.cases.size() << "] " << r.name << ": " << what
                       << "\n";
         });
 
     // Everything goes to a fresh folder that replaces DIR in one step: no file of an earlier run
     // (a difference image of a case that failed then) survives next to this run's.
-    const fs::path dir = shard ? o.outputDir / compare::shardFolderName(*shard) : o.outputDir;
+    const fs::path dir = shard ? o.outputDir / studies::shardFolderName(*shard) : o.outputDir;
     if (dir.has_parent_path()) fs::create_directories(dir.parent_path());
     // Not beside a shard: the shared folder may hold other machines' live temporaries, whose
     // writers this host cannot see.
@@ -916,40 +916,40 @@ int check(const CheckOptions& o) {
     fs::create_directories(tmp / "cases");
     std::size_t failed = 0, errors = 0;
     for (std::size_t i = 0; i < results.size(); ++i) {
-        const compare::CaseResult& r = results[i];
-        failed += r.verdict == compare::CaseVerdict::Failed ? 1 : 0;
-        errors += r.verdict == compare::CaseVerdict::Error ? 1 : 0;
-        scene::writeTextAtomic(tmp / "cases" / (r.name + ".json"), compare::caseJson(suite.cases[i], r).dump(2) + "\n");
+        const studies::CaseResult& r = results[i];
+        failed += r.verdict == studies::CaseVerdict::Failed ? 1 : 0;
+        errors += r.verdict == studies::CaseVerdict::Error ? 1 : 0;
+        scene::writeTextAtomic(tmp / "cases" / (r.name + ".json"), studies::caseJson(suite.cases[i], r).dump(2) + "\n");
         if (!r.diffRgb.empty())
             scene::writePngDisplay(tmp / "cases" / (r.name + "-diff.png"), r.width, r.height, r.diffRgb);
     }
-    scene::writeTextAtomic(tmp / "junit.xml", compare::junitXml(suite, results));
-    scene::writeTextAtomic(tmp / "summary.md", compare::markdownSummary(suite, results, o.updateBaseline));
+    scene::writeTextAtomic(tmp / "junit.xml", studies::junitXml(suite, results));
+    scene::writeTextAtomic(tmp / "summary.md", studies::markdownSummary(suite, results, o.updateBaseline));
     std::set<std::string> withDiff;
-    for (const compare::CaseResult& r : results)
+    for (const studies::CaseResult& r : results)
         if (!r.diffRgb.empty()) withDiff.insert(r.name);
     scene::writeTextAtomic(tmp / "summary.html",
-                           compare::htmlSummary(suite.name, compare::caseParts(suite, results), o.updateBaseline, withDiff));
+                           studies::htmlSummary(suite.name, studies::caseParts(suite, results), o.updateBaseline, withDiff));
     if (shard) {
         nlohmann::json parts = nlohmann::json::array();
-        for (const compare::CasePart& part : compare::caseParts(suite, results)) parts.push_back(compare::toJson(part));
+        for (const studies::CasePart& part : studies::caseParts(suite, results)) parts.push_back(studies::toJson(part));
         scene::writeTextAtomic(tmp / "shard-parts.json", parts.dump(1) + "\n");
-        scene::writeTextAtomic(tmp / "shard.json", compare::toJson(manifest).dump(1) + "\n");
+        scene::writeTextAtomic(tmp / "shard.json", studies::toJson(manifest).dump(1) + "\n");
     }
     scene::replaceDirectory(tmp, dir);
     if (o.updateBaseline) {
         // Cases that could not render keep their old entry; cases no longer in the suite go.
-        compare::Baseline old, next;
+        studies::Baseline old, next;
         try {
-            if (fs::exists(*baselineFile)) old = compare::loadBaseline(*baselineFile);
+            if (fs::exists(*baselineFile)) old = studies::loadBaseline(*baselineFile);
         } catch (const scene::SceneError&) {
             // A damaged baseline is being replaced.
         }
-        for (const compare::CaseResult& r : results) {
-            if (r.metrics) next[r.name] = compare::baselineEntry(*r.metrics);
+        for (const studies::CaseResult& r : results) {
+            if (r.metrics) next[r.name] = studies::baselineEntry(*r.metrics);
             else if (old.count(r.name)) next[r.name] = old[r.name];
         }
-        scene::writeTextAtomic(*baselineFile, compare::baselineJson(suite.name, next).dump(2) + "\n");
+        scene::writeTextAtomic(*baselineFile, studies::baselineJson(suite.name, next).dump(2) + "\n");
         std::cerr << "shadowlab: wrote the baseline " << baselineFile->string() << "\n";
     }
     std::cerr << "shadowlab: check " << suite.name << ": " << results.size() - failed - errors << " passed, " << failed
@@ -961,49 +961,49 @@ int path(const PathCommandOptions& o) {
     const Prepared p = prepare(o.common);
     // The command line's path replaces the scene's "path" block when it names a kind; otherwise the
     // block is used, with --frames, --amount and --light over its values.
-    compare::PathSpec spec;
+    studies::PathSpec spec;
     const bool cliKind = o.kind || o.cameraAnimation;
-    if (!cliKind && p.scene.path) spec = compare::pathSpecOf(*p.scene.path);
-    if (o.kind) spec.kind = compare::parsePathKind(*o.kind);
+    if (!cliKind && p.scene.path) spec = studies::pathSpecOf(*p.scene.path);
+    if (o.kind) spec.kind = studies::parsePathKind(*o.kind);
     if (o.cameraAnimation) {
-        if (o.kind && spec.kind != compare::PathKind::GltfAnimation)
+        if (o.kind && spec.kind != studies::PathKind::GltfAnimation)
             throw scene::InputError("--camera-animation: follows a glTF animation; it cannot go with --kind " + *o.kind);
-        spec.kind = compare::PathKind::GltfAnimation;
+        spec.kind = studies::PathKind::GltfAnimation;
         // Given without a value, CLI11 reports the flag as "true": the first animation.
         spec.animation = *o.cameraAnimation == "true" ? std::string() : *o.cameraAnimation;
     }
     if (o.frames) spec.frames = *o.frames;
     if (o.amount) spec.amount = o.amount;
     if (o.light) spec.light = *o.light;
-    compare::pathScenes(p.scene, p.settings, spec);  // bad paths fail before anything is written
-    compare::PathRunOptions options;
+    studies::pathScenes(p.scene, p.settings, spec);  // bad paths fail before anything is written
+    studies::PathRunOptions options;
     options.outputDir = o.outputDir;
     options.resume = o.resume;
     options.raster = !o.skipRaster;
     options.raytrace = !o.skipRaytrace;
     options.heldView = !o.noHeldView;
     options.progress = [](const std::string& line) { std::cerr << "shadowlab: path " << line << "\n"; };
-    const std::string kind = compare::toString(spec.kind);
+    const std::string kind = studies::toString(spec.kind);
     if (o.shard) {
-        const compare::Shard shard = compare::parseShard(*o.shard);
+        const studies::Shard shard = studies::parseShard(*o.shard);
         options.shardIndex = shard.index;
         options.shardCount = shard.count;
-        const fs::path dir = o.outputDir / compare::shardFolderName(shard);
+        const fs::path dir = o.outputDir / studies::shardFolderName(shard);
         fs::create_directories(dir);
         const scene::FolderLock lock(dir, "path --shard");
         std::cerr << "shadowlab: " << kind << " path shard " << shard.index << "/" << shard.count << ": "
-                  << compare::pathShardFrames(spec.frames, shard.index, shard.count).size() << " of " << spec.frames
+                  << studies::pathShardFrames(spec.frames, shard.index, shard.count).size() << " of " << spec.frames
                   << " frames into " << dir.string() << "\n";
-        const compare::PathResult result = compare::runPath(p.scene, p.settings, spec, options);
+        const studies::PathResult result = studies::runPath(p.scene, p.settings, spec, options);
         std::cerr << "shadowlab: wrote " << dir.string() << " (" << result.resumedFrames << " frames resumed); when every "
                   << "shard is done: shadowlab merge " << o.outputDir.string() << "\n";
         return 0;
     }
     std::cerr << "shadowlab: " << kind << " path of " << spec.frames << " frames into " << o.outputDir.string() << "\n";
-    const compare::PathResult result = compare::runPath(p.scene, p.settings, spec, options);
+    const studies::PathResult result = studies::runPath(p.scene, p.settings, spec, options);
     printPathSummary(result);
     std::cerr << "shadowlab: wrote " << (o.outputDir / "report.html").string() << " and metrics.json\n";
-    if (o.common.json) std::cout << compare::toJson(result).dump(2) << "\n";
+    if (o.common.json) std::cout << studies::toJson(result).dump(2) << "\n";
     return 0;
 }
 
@@ -1028,7 +1028,7 @@ int stability(const StabilityCommandOptions& o) {
     fs::create_directories(o.outputDir);
     const scene::FolderLock lock(o.outputDir, "stability");
 
-    compare::StabilityOptions options;
+    studies::StabilityOptions options;
     options.width = probe.camera.width;
     options.height = probe.camera.height;
     options.shadowMapSize = o.shadowMapSize;
@@ -1036,29 +1036,29 @@ int stability(const StabilityCommandOptions& o) {
     options.quick = !o.fullGrid;
     options.validate = o.validate;
 
-    std::vector<compare::StabilityCase> cases;
+    std::vector<studies::StabilityCase> cases;
     for (std::size_t i = 0; i < scenes.size(); ++i) {
         const std::string name = files[i].stem().string();
         Stage stage("stability case " + std::to_string(i + 1) + "/" + std::to_string(scenes.size()) + " " + name);
-        cases.push_back(compare::runStabilityCase(scenes[i], options, name, compare::readDescription(files[i])));
+        cases.push_back(studies::runStabilityCase(scenes[i], options, name, studies::readDescription(files[i])));
         // The reference's verdict and each backend's state, not one PASS that hides acne.
-        const compare::StabilityCase& c = cases.back();
+        const studies::StabilityCase& c = cases.back();
         std::string note = std::string(c.failed() ? "FAILED to run cleanly; " : "") + "reference " + c.referenceVerdict();
         for (const char* backend : {"raster", "raytrace"})
             for (const char* variant : {"defaults", "best"})
-                if (const compare::BackendRun* r = c.run(backend, variant))
+                if (const studies::BackendRun* r = c.run(backend, variant))
                     note += std::string("; ") + backend + " at " + variant + ": " +
-                            compare::stateOf(r, std::string(variant) == "best").text;
+                            studies::stateOf(r, std::string(variant) == "best").text;
         stage.done(note);
     }
-    compare::writeStabilityReport(o.outputDir, cases);
+    studies::writeStabilityReport(o.outputDir, cases);
     std::cerr << "shadowlab: wrote " << (o.outputDir / "stability.html").string() << "\n";
     if (o.json) {
         Json all = Json::array();
-        for (const auto& c : cases) all.push_back(compare::toJson(c));
+        for (const auto& c : cases) all.push_back(studies::toJson(c));
         std::cout << all.dump(2) << "\n";
     }
-    if (!compare::suitePassed(cases)) {
+    if (!studies::suitePassed(cases)) {
         std::cerr << "shadowlab: stability: at least one case failed (see the report)\n";
         return 1;
     }

@@ -12,7 +12,7 @@
 #include "scene/loader.h"
 #include "scene/settings.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 namespace {
 
@@ -196,7 +196,7 @@ const std::vector<TrackedMetric>& trackedMetrics() {
     return kMetrics;
 }
 
-BaselineEntry baselineEntry(const Metrics& m) {
+BaselineEntry baselineEntry(const compare::Metrics& m) {
     BaselineEntry e;
     e.metrics = {{"mismatch_rate", m.mismatchRate},
                  {"false_shadow_rate", m.falseShadowRate},
@@ -253,7 +253,7 @@ CheckSuite shardSuite(const CheckSuite& suite, const Shard& shard) {
     return s;
 }
 
-std::vector<MetricDrift> compareWithBaseline(const Metrics& m, const BaselineEntry& entry, const CheckTolerance& t) {
+std::vector<MetricDrift> compareWithBaseline(const compare::Metrics& m, const BaselineEntry& entry, const CheckTolerance& t) {
     const BaselineEntry now = baselineEntry(m);
     std::vector<MetricDrift> out;
     for (const TrackedMetric& tm : trackedMetrics()) {
@@ -304,10 +304,10 @@ std::vector<CaseResult> runSuite(const CheckSuite& suite, const Baseline* baseli
                 ref = references.emplace(refKey, renderWithBackend(k.scene, settings, "reference")).first;
             const auto start = Clock::now();
             const scene::Frame method = renderWithBackend(k.scene, settings, k.backend);
-            Comparison c = compareFrames(method, ref->second);
+            compare::Comparison c = compare::compareFrames(method, ref->second);
             r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-            r.budgets = checkBudgets(c.metrics, k.budgets);
-            for (const BudgetCheck& b : r.budgets)
+            r.budgets = compare::checkBudgets(c.metrics, k.budgets);
+            for (const compare::BudgetCheck& b : r.budgets)
                 if (b.broken) r.failures.push_back("budget " + describe(b));
             if (baseline) {
                 if (const auto e = baseline->find(k.name); e != baseline->end()) {
@@ -338,4 +338,4 @@ std::vector<CaseResult> runSuite(const CheckSuite& suite, const Baseline* baseli
     return results;
 }
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

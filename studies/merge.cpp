@@ -15,7 +15,7 @@
 #include "scene/error.h"
 #include "scene/frame_io.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 namespace {
 
@@ -341,4 +341,4 @@ std::vector<SweepRow> readResults(const fs::path& dir) {
     return rows;
 }
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

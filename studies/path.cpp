@@ -28,7 +28,7 @@
 #include "scene/render_plan.h"
 #include "studies/backend.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 namespace {
 
@@ -150,8 +150,8 @@ double median(std::vector<double> v) {
 }
 
 // The square window (side `size`) holding the most set pixels of `mask` (a summed-area table).
-ErrorHotspot densestWindow(const std::vector<unsigned char>& mask, int w, int h, int size) {
-    ErrorHotspot best;
+compare::ErrorHotspot densestWindow(const std::vector<unsigned char>& mask, int w, int h, int size) {
+    compare::ErrorHotspot best;
     size = std::max(1, std::min({size, w, h}));
     best.size = size;
     std::vector<std::size_t> sat(std::size_t(w + 1) * (h + 1), 0);
@@ -381,12 +381,12 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
     result.referenceFrameMs = times["reference"];
     std::vector<const scene::Frame*> refPointers;
     for (const scene::Frame& f : refs) refPointers.push_back(&f);
-    result.referenceTemporal = measureTemporal(refPointers, refPointers);
+    result.referenceTemporal = compare::measureTemporal(refPointers, refPointers);
 
     const int w = refs[0].width, h = refs[0].height;
     const int fps = 8;
     std::string gifs, zooms;
-    ScatterPlot plot;
+    compare::ScatterPlot plot;
     plot.title = "Flicker per frame pair";  // the definition is in the text above the plot
     plot.x.title = "frame pair (t, t+1)";
     plot.x.min = 0.0;  // pairs 0 .. frames - 2, not a fitted margin past the last one
@@ -403,17 +403,17 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
         m.frameMs = times[name];
         const std::vector<scene::Frame> frames = load(name);
         // The held view compares with frame 0's reference: it is drawn from frame 0's camera.
-        std::vector<Comparison> comparisons;
+        std::vector<compare::Comparison> comparisons;
         std::vector<const scene::Frame*> methodPointers, heldRefs;
-        std::vector<const std::vector<PixelClass>*> classes;
+        std::vector<const std::vector<compare::PixelClass>*> classes;
         for (int t = 0; t < result.frames; ++t) {
             const scene::Frame& r = name == "raster-held" ? refs[0] : refs[std::size_t(t)];
-            comparisons.push_back(compareFrames(frames[std::size_t(t)], r));
+            comparisons.push_back(compare::compareFrames(frames[std::size_t(t)], r));
             m.metrics.push_back(comparisons.back().metrics);
             methodPointers.push_back(&frames[std::size_t(t)]);
             heldRefs.push_back(&r);
         }
-        for (const Comparison& c : comparisons) classes.push_back(&c.classes);
+        for (const compare::Comparison& c : comparisons) classes.push_back(&c.classes);
         m.temporal = measureTemporal(methodPointers, heldRefs, classes);
 
         // The animation: method, reference, difference side by side.
@@ -427,7 +427,7 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
         // Small frames are magnified by a whole factor (crisp pixels) so their shadows can be seen.
         const int shown = gw > 1200 ? 1200 : gw * std::max(1, 960 / gw);
         gifs += "<figure><img src=\"" + name + ".gif\" alt=\"" + name + "\" style=\"width:" + std::to_string(shown) +
-                "px;image-rendering:pixelated\"><figcaption><b>" + escapeHtml(name) +
+                "px;image-rendering:pixelated\"><figcaption><b>" + compare::escapeHtml(name) +
                 "</b>: method | reference | difference, " + std::to_string(fps) + " frames/s</figcaption></figure>\n";
 
         // The worst pair: its flicker pixels (red) over the method's frame t, the densest window zoomed.
@@ -437,12 +437,12 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
             const scene::Frame& f1 = frames[std::size_t(t) + 1];
             const scene::Frame& r0 = *heldRefs[std::size_t(t)];
             const scene::Frame& r1 = *heldRefs[std::size_t(t) + 1];
-            const std::vector<unsigned char> mask = flickerMask(f0, f1, r0, r1, comparisons[std::size_t(t)].classes,
+            const std::vector<unsigned char> mask = compare::flickerMask(f0, f1, r0, r1, comparisons[std::size_t(t)].classes,
                                                                 comparisons[std::size_t(t) + 1].classes);
             std::vector<float> map = displayBeauty(f0);
             for (std::size_t i = 0; i < mask.size(); ++i)
                 if (mask[i]) map[3 * i] = 1.0f, map[3 * i + 1] = 0.08f, map[3 * i + 2] = 0.05f;
-            const ErrorHotspot win = densestWindow(mask, w, h, std::max(16, std::min(w, h) / 5));
+            const compare::ErrorHotspot win = densestWindow(mask, w, h, std::max(16, std::min(w, h) / 5));
             // Zoom: frame t, frame t + 1 and the flicker map of the window, magnified 6x.
             const int z = 6, side = win.size * z;
             auto crop = [&](const std::vector<float>& rgb) {
@@ -462,56 +462,56 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
             const std::string zoomName = name + "-worst-pair.png";
             scene::writePngDisplay(dir / zoomName, zw, side, zoomFloat);
             zooms += "<figure><img src=\"" + zoomName + "\" alt=\"worst pair of " + name +
-                     "\"><figcaption><b>" + escapeHtml(name) + "</b>, worst pair (" + std::to_string(t) + ", " +
+                     "\"><figcaption><b>" + compare::escapeHtml(name) + "</b>, worst pair (" + std::to_string(t) + ", " +
                      std::to_string(t + 1) + "): frame t | frame t+1 | flicker pixels in red; window " +
                      std::to_string(win.size) + " px at (" + std::to_string(win.x) + ", " + std::to_string(win.y) +
-                     "), " + formatCount(win.wrongPixels) + " of the pair's " +
-                     formatCount(m.temporal.pairs[std::size_t(t)].flicker) + " flicker pixels</figcaption></figure>\n";
+                     "), " + compare::formatCount(win.wrongPixels) + " of the pair's " +
+                     compare::formatCount(m.temporal.pairs[std::size_t(t)].flicker) + " flicker pixels</figcaption></figure>\n";
         }
 
-        PlotSeries series;
+        compare::PlotSeries series;
         series.name = name;
-        series.color = backendColor(name == "raster-held" ? "raster held view" : name, mi);
+        series.color = compare::backendColor(name == "raster-held" ? "raster held view" : name, mi);
         series.connect = true;
         series.dashed = name == "raster-held";
-        for (const PairStability& p : m.temporal.pairs)
+        for (const compare::PairStability& p : m.temporal.pairs)
             series.points.push_back({double(p.first), p.flickerRate, "",
-                                     name + " pair " + std::to_string(p.first) + ": " + formatCount(p.flicker) + " px"});
+                                     name + " pair " + std::to_string(p.first) + ": " + compare::formatCount(p.flicker) + " px"});
         plot.series.push_back(series);
         result.methods.push_back(std::move(m));
     }
-    const std::string svg = renderSvg(plot);
+    const std::string svg = compare::renderSvg(plot);
     scene::writeTextAtomic(dir / "flicker.svg", svg);
     scene::writeTextAtomic(dir / "metrics.json", toJson(result).dump(2) + "\n");
 
     // The report.
     std::ostringstream html;
-    html << "<!doctype html><html><head><meta charset=\"utf-8\"><title>shadowlab path: " << escapeHtml(toString(spec.kind))
+    html << "<!doctype html><html><head><meta charset=\"utf-8\"><title>shadowlab path: " << compare::escapeHtml(toString(spec.kind))
          << "</title><style>body{font-family:sans-serif;margin:1.5em;max-width:1300px}table{border-collapse:collapse}"
             "td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}th{background:#eee}"
             "td,tr th:first-child{white-space:nowrap}figure{margin:1em 0}"
             "</style></head><body>\n";
-    html << "<h1>Temporal stability: " << escapeHtml(toString(spec.kind)) << " path</h1>\n<p>Scene <code>"
-         << escapeHtml(sceneFile) << "</code>, " << result.frames << " frames at " << w << "x" << h
-         << ", amount " << formatShort(result.amount) << ". Pixels are compared between frames at the same image "
+    html << "<h1>Temporal stability: " << compare::escapeHtml(toString(spec.kind)) << " path</h1>\n<p>Scene <code>"
+         << compare::escapeHtml(sceneFile) << "</code>, " << result.frames << " frames at " << w << "x" << h
+         << ", amount " << compare::formatShort(result.amount) << ". Pixels are compared between frames at the same image "
          << "position; flicker counts the counted pixels whose lit/shadow state changes while the reference's does "
          << "not (docs/temporal.md).</p>\n";
     html << "<table><tr><th>method</th><th>setup</th><th>median per frame</th><th>mean flicker</th><th>max flicker</th>"
             "<th>flicker px</th><th>error variation</th><th>swim (px)</th><th>edge offset (px)</th>"
             "<th>mean mismatch</th></tr>\n";
-    auto row = [&](const std::string& name, double setup, const std::vector<double>& ms, const TemporalSummary& tsum,
+    auto row = [&](const std::string& name, double setup, const std::vector<double>& ms, const compare::TemporalSummary& tsum,
                    double mismatch) {
-        html << "<tr><th>" << escapeHtml(name) << "</th><td>" << formatDuration(setup) << "</td><td>"
-             << formatDuration(median(ms)) << "</td><td>" << formatPercent(tsum.meanFlickerRate) << "</td><td>"
-             << formatPercent(tsum.maxFlickerRate) << "</td><td>" << formatCount(tsum.totalFlicker) << "</td><td>"
-             << formatFixed(tsum.meanErrorVariation, 5) << "</td><td>" << formatFixed(tsum.meanSwimPixels, 3)
-             << "</td><td>" << formatFixed(tsum.meanEdgeOffset, 3) << "</td><td>"
-             << (mismatch < 0 ? std::string("-") : formatPercent(mismatch)) << "</td></tr>\n";
+        html << "<tr><th>" << compare::escapeHtml(name) << "</th><td>" << compare::formatDuration(setup) << "</td><td>"
+             << compare::formatDuration(median(ms)) << "</td><td>" << compare::formatPercent(tsum.meanFlickerRate) << "</td><td>"
+             << compare::formatPercent(tsum.maxFlickerRate) << "</td><td>" << compare::formatCount(tsum.totalFlicker) << "</td><td>"
+             << compare::formatFixed(tsum.meanErrorVariation, 5) << "</td><td>" << compare::formatFixed(tsum.meanSwimPixels, 3)
+             << "</td><td>" << compare::formatFixed(tsum.meanEdgeOffset, 3) << "</td><td>"
+             << (mismatch < 0 ? std::string("-") : compare::formatPercent(mismatch)) << "</td></tr>\n";
     };
     row("reference", result.referenceSetupMs, result.referenceFrameMs, result.referenceTemporal, -1.0);
     for (const PathMethod& m : result.methods) {
         double mismatch = 0.0;
-        for (const Metrics& x : m.metrics) mismatch += x.mismatchRate;
+        for (const compare::Metrics& x : m.metrics) mismatch += x.mismatchRate;
         row(m.name, m.setupMs, m.frameMs, m.temporal, m.metrics.empty() ? 0.0 : mismatch / double(m.metrics.size()));
     }
     html << "</table>\n<p>Setup is paid once for the path (the raster Renderer with its device, buffers and "
@@ -916,4 +916,4 @@ std::vector<std::string> pathDifferences(const fs::path& a, const fs::path& b) {
     return out;
 }
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -23,7 +23,7 @@
 #include "scene/frame_io.h"
 #include "scene/settings.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 namespace {
 
@@ -362,4 +362,4 @@ SweepResult runShard(const scene::Scene& baseScene, const SweepGrid& grid, const
     return runSweep(scene, mine, o);
 }
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

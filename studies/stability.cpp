@@ -19,7 +19,7 @@
 #include "scene/loader.h"
 #include "scene/settings.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
@@ -88,11 +88,11 @@ BackendRun renderRun(const scene::Scene& scene, const scene::Frame& reference,
         const scene::Frame frame = options.render(scene, settings, backend);
         run.timeMs = msSince(t0);
         run.ok = true;
-        run.health = measureHealth(frame);
+        run.health = compare::measureHealth(frame);
         run.blackFrame = isBlack(frame);
         if (auto it = frame.attributes.find("validation_messages"); it != frame.attributes.end())
             run.validationMessages = std::stoi(it->second);
-        const Comparison cmp = compareFrames(frame, reference);
+        const compare::Comparison cmp = compare::compareFrames(frame, reference);
         run.counted = cmp.metrics.counted;
         run.falseShadowRate = cmp.metrics.falseShadowRate;
         run.missedShadowRate = cmp.metrics.missedShadowRate;
@@ -107,7 +107,7 @@ BackendRun renderRun(const scene::Scene& scene, const scene::Frame& reference,
 }
 
 // The bias search: each grid point rendered once and measured (the sweep's warm-up, repeated
-// timing and journal are not needed to find a window), then compare::recommendBias.
+// timing and journal are not needed to find a window), then recommendBias.
 AutoBias searchBias(const scene::Scene& scene, const scene::Frame& reference,
                     const StabilityOptions& options) {
     SweepGrid grid = defaultGrid(scene, options.quick);
@@ -130,8 +130,8 @@ AutoBias searchBias(const scene::Scene& scene, const scene::Frame& reference,
             const scene::Frame frame = options.render(scene, settings, config.backend);
             row.frameMs = msSince(t0);
             // A NaN frame must not look like a good bias: its rates become NaN (failing samples).
-            Json m = toJson(compareFrames(frame, reference).metrics);
-            if (measureHealth(frame).total() > 0) {
+            Json m = toJson(compare::compareFrames(frame, reference).metrics);
+            if (compare::measureHealth(frame).total() > 0) {
                 m["false_shadow_rate"] = nullptr;
                 m["missed_shadow_rate"] = nullptr;
                 row.error = "non-finite values";
@@ -191,7 +191,7 @@ StabilityCase runStabilityCase(const scene::Scene& sceneIn, const StabilityOptio
         c.reference = options.render(scene, settings, "reference");
         c.referenceMs = msSince(t0);
         c.referenceOk = true;
-        c.referenceHealth = measureHealth(c.reference);
+        c.referenceHealth = compare::measureHealth(c.reference);
         c.referenceBlack = isBlack(c.reference);
     } catch (const std::exception& e) {
         c.referenceError = e.what();
@@ -334,11 +334,11 @@ BackendState stateOf(const BackendRun* r, bool atBest) {
                                                   : std::to_string(r->validationMessages) + " validation messages";
         return {"failed", "failed: " + why};
     }
-    const bool acne = r->falseShadowRate > kBiasWindowMaxRate, leaks = r->missedShadowRate > kBiasWindowMaxRate;
+    const bool acne = r->falseShadowRate > compare::kBiasWindowMaxRate, leaks = r->missedShadowRate > compare::kBiasWindowMaxRate;
     if (!acne && !leaks) return {"clean", "clean"};
     std::string text;
-    if (acne) text = "acne " + formatPercent(r->falseShadowRate);
-    if (leaks) text += std::string(acne ? ", " : "") + "leaks " + formatPercent(r->missedShadowRate);
+    if (acne) text = "acne " + compare::formatPercent(r->falseShadowRate);
+    if (leaks) text += std::string(acne ? ", " : "") + "leaks " + compare::formatPercent(r->missedShadowRate);
     if (atBest) return {"stiff", "stiff: " + text};
     return {acne && leaks ? "acne+leaks" : acne ? "acne" : "leaks", text};
 }
@@ -437,7 +437,7 @@ std::string stateCell(const BackendState& st) {
     std::string cls = st.state;
     std::replace(cls.begin(), cls.end(), '+', '-');
     std::replace(cls.begin(), cls.end(), ' ', '-');
-    return "<td class=\"st-" + cls + "\">" + escapeHtml(st.text) + "</td>";
+    return "<td class=\"st-" + cls + "\">" + compare::escapeHtml(st.text) + "</td>";
 }
 
 std::string referenceCell(const std::string& verdict) {
@@ -456,7 +456,7 @@ void writeStabilityReport(const fs::path& dir, const std::vector<StabilityCase>&
         wrong += c.referenceVerdict() == "wrong" ? 1 : 0;
     }
     h << "<!doctype html><html><head><meta charset=\"utf-8\"><title>shadowlab stability</title><style>"
-      << html::css()
+      << compare::html::css()
       << " table.st td,table.st th{padding:3px 8px;border-bottom:1px solid #ddd;text-align:left}"
          " .fail{color:#b00;font-weight:bold} .pass{color:#070;font-weight:bold}"
          " .st-clean,.ref-exact{background:#d3f9d8;color:#1b5e20} .st-acne{background:#ffe3e3;color:#a51111}"
@@ -472,45 +472,45 @@ void writeStabilityReport(const fs::path& dir, const std::vector<StabilityCase>&
          " spheres, quads and boxes under directional lights), and each backend at its defaults and at"
          " its best bias (searched in its own configuration over depth × slope, never worse than the defaults)."
          " A backend's state: <span class=st-clean>clean</span> (false and missed shadow both ≤ "
-      << formatPercent(kBiasWindowMaxRate) << " of the counted pixels), <span class=st-acne>acne x%</span> (false shadow),"
+      << compare::formatPercent(compare::kBiasWindowMaxRate) << " of the counted pixels), <span class=st-acne>acne x%</span> (false shadow),"
          " <span class=st-leaks>leaks y%</span> (missed shadow: light leaking, peter-panning),"
          " <span class=st-acne-leaks>both</span>, and at the best bias <span class=st-stiff>stiff</span>: no searched"
          " bias makes it clean. <span class=st-failed>failed</span>: crash, NaN/Inf, black frame or validation messages."
          "</p><table class=st><tr><th>case</th><th>reference</th><th>raster at defaults</th><th>raster at best</th>"
          "<th>raytrace at defaults</th><th>raytrace at best</th><th>raster window</th><th>raytrace window</th></tr>";
     for (const StabilityCase& c : cases) {
-        h << "<tr><td><a href=\"#" << escapeHtml(c.name) << "\">" << escapeHtml(c.name) << "</a></td>"
+        h << "<tr><td><a href=\"#" << compare::escapeHtml(c.name) << "\">" << compare::escapeHtml(c.name) << "</a></td>"
           << referenceCell(c.referenceVerdict());
         for (const char* backend : {"raster", "raytrace"})
             for (const char* variant : {"defaults", "best"})
                 h << stateCell(stateOf(c.run(backend, variant), std::string(variant) == "best"));
-        h << "<td>" << escapeHtml(windowText(c.biasOf("raster"))) << "</td><td>"
-          << escapeHtml(windowText(c.biasOf("raytrace"))) << "</td></tr>";
+        h << "<td>" << compare::escapeHtml(windowText(c.biasOf("raster"))) << "</td><td>"
+          << compare::escapeHtml(windowText(c.biasOf("raytrace"))) << "</td></tr>";
     }
-    h << "</table>" << html::diffLegend();
+    h << "</table>" << compare::html::diffLegend();
     for (const StabilityCase& c : cases) {
-        h << "<section id=\"" << escapeHtml(c.name) << "\"><h2>" << escapeHtml(c.name) << "</h2><table class=st><tr>"
+        h << "<section id=\"" << compare::escapeHtml(c.name) << "\"><h2>" << compare::escapeHtml(c.name) << "</h2><table class=st><tr>"
           << "<th>reference</th><th>raster at defaults</th><th>raster at best</th><th>raytrace at defaults</th>"
              "<th>raytrace at best</th></tr><tr>" << referenceCell(c.referenceVerdict());
         for (const char* backend : {"raster", "raytrace"})
             for (const char* variant : {"defaults", "best"})
                 h << stateCell(stateOf(c.run(backend, variant), std::string(variant) == "best"));
         h << "</tr></table>";
-        if (!c.description.empty()) h << "<p>" << escapeHtml(c.description) << "</p>";
-        for (const std::string& f : c.failures) h << "<p class=fail>" << escapeHtml(f) << "</p>";
+        if (!c.description.empty()) h << "<p>" << compare::escapeHtml(c.description) << "</p>";
+        for (const std::string& f : c.failures) h << "<p class=fail>" << compare::escapeHtml(f) << "</p>";
         h << "<p>Reference: " << fmt(c.referenceMs) << " ms, " << c.referenceHealth.total() << " NaN/Inf. Analytic: "
-          << escapeHtml(c.analytic ? c.analytic->summary() : "not analytic (" + c.notAnalytic + ")") << ".</p>";
+          << compare::escapeHtml(c.analytic ? c.analytic->summary() : "not analytic (" + c.notAnalytic + ")") << ".</p>";
         h << "<table class=st><tr><th>backend</th><th>settings</th><th>state</th><th>NaN/Inf</th><th>acne</th>"
              "<th>leak</th><th>time ms</th></tr>";
         for (const BackendRun& r : c.runs)
-            h << "<tr><td>" << r.backend << "</td><td>" << escapeHtml(r.variant + ": " + r.settings) << "</td>"
+            h << "<tr><td>" << r.backend << "</td><td>" << compare::escapeHtml(r.variant + ": " + r.settings) << "</td>"
               << stateCell(stateOf(&r, r.variant == "best")) << "<td>"
               << r.health.total() << "</td><td>" << fmt(100 * r.falseShadowRate, 3) << "%</td><td>"
               << fmt(100 * r.missedShadowRate, 3) << "%</td><td>" << fmt(r.timeMs) << "</td></tr>";
         h << "</table>";
         for (const MethodBias& b : c.bias)
-            h << "<p><b>" << b.backend << "</b> (probe slice): " << escapeHtml(windowText(&b)) << ". " << escapeHtml(b.text) << "</p>";
-        for (const std::string& note : c.bestNotes) h << "<p>" << escapeHtml(note) << "</p>";
+            h << "<p><b>" << b.backend << "</b> (probe slice): " << compare::escapeHtml(windowText(&b)) << ". " << compare::escapeHtml(b.text) << "</p>";
+        for (const std::string& note : c.bestNotes) h << "<p>" << compare::escapeHtml(note) << "</p>";
         h << "<div class=figs>";
         // Every image at one width (figures in a flex row would shrink to their captions), small
         // renders magnified with crisp pixels so their shadows can be seen.
@@ -540,4 +540,4 @@ void writeStabilityReport(const fs::path& dir, const std::vector<StabilityCase>&
                            Json{{"passed", suitePassed(cases)}, {"cases", all}}.dump(2) + "\n");
 }
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -21,7 +21,7 @@
 #include "scene/frame.h"
 #include "scene/scene.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 // A beauty whose brightest channel stays below this (linear) is black. The ambient term alone
 // (0.05 · albedo ≥ ~0.01 in every shipped scene) is far above it, so only a broken render trips it.
@@ -31,7 +31,7 @@ struct StabilityOptions {
     int width = 160, height = 90;          // every render of the case
     std::optional<int> shadowMapSize;      // overrides the default settings' map size (tests: 512)
     bool search = true;                    // run the bias search and the best-settings renders
-    bool quick = true;                     // compare::defaultGrid(scene, quick)
+    bool quick = true;                     // defaultGrid(scene, quick)
     // Keep only the bias series and robust rows of the grid (drop the map-size × filter block),
     // and use this map size for the raster series (0: the grid's own): the tests' small search.
     bool biasSeriesOnly = false;
@@ -53,7 +53,7 @@ struct BackendRun {
     bool ok = false;         // rendered without throwing
     std::string error;       // the exception's message when !ok
     bool blackFrame = false;
-    FrameHealth health;
+    compare::FrameHealth health;
     int validationMessages = -1;  // -1 when the frame does not say
     double timeMs = 0.0;
     std::size_t counted = 0;
@@ -89,7 +89,7 @@ struct StabilityCase {
     bool referenceOk = false;
     std::string referenceError;
     double referenceMs = 0.0;
-    FrameHealth referenceHealth;
+    compare::FrameHealth referenceHealth;
     bool referenceBlack = false;
     scene::Frame reference;   // kept for the report's images
     std::string notAnalytic;  // why there is no analytic answer; empty when there is one
@@ -134,4 +134,4 @@ void writeStabilityReport(const std::filesystem::path& dir, const std::vector<St
 // The suite's verdict: true when no case failed (the app exits non-zero otherwise).
 bool suitePassed(const std::vector<StabilityCase>& cases);
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -26,7 +26,7 @@
 #include "scene/json_input.h"
 #include "scene/render_plan.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 namespace {
 
@@ -675,9 +675,9 @@ std::vector<const scene::Frame*> pointersTo(const std::vector<scene::Frame>& fra
     return p;
 }
 
-Json temporalFigures(const TemporalSummary& t) {
+Json temporalFigures(const compare::TemporalSummary& t) {
     Json pairs = Json::array();
-    for (const PairStability& p : t.pairs) pairs.push_back(p.flicker);
+    for (const compare::PairStability& p : t.pairs) pairs.push_back(p.flicker);
     return {{"flicker_rate", t.meanFlickerRate},     {"max_flicker_rate", t.maxFlickerRate},
             {"flicker_px", t.totalFlicker},          {"error_variation", t.meanErrorVariation},
             {"swim_px", t.meanSwimPixels},           {"edge_offset_px", t.meanEdgeOffset},
@@ -713,12 +713,12 @@ Json rowTemporal(const SweepOptions& options, const PathSpec& spec, const std::v
     } else {
         for (const scene::Scene& s : scenes) frames.push_back(options.render(s, settings, backend));
     }
-    Json j = temporalFigures(measureTemporal(pointersTo(frames), pointersTo(refs)));
+    Json j = temporalFigures(compare::measureTemporal(pointersTo(frames), pointersTo(refs)));
     j["path"] = toString(spec.kind);
     j["frames"] = int(scenes.size());
     if (!held.empty()) {
         const std::vector<const scene::Frame*> still(held.size(), &refs[0]);
-        j["held"] = temporalFigures(measureTemporal(pointersTo(held), still));
+        j["held"] = temporalFigures(compare::measureTemporal(pointersTo(held), still));
     }
     return j;
 }
@@ -950,7 +950,7 @@ SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const
             row.frameMs = median(frames);
             row.frameMsMin = *std::min_element(frames.begin(), frames.end());
             row.frameMsMax = *std::max_element(frames.begin(), frames.end());
-            const Comparison c = compareFrames(frame, result.reference);
+            const compare::Comparison c = compare::compareFrames(frame, result.reference);
             row.metrics = toJson(c.metrics);
             if (grid.flicker)
                 row.temporal = rowTemporal(options, *grid.flicker, pathFrames, pathReferencesReady(), settings, config.backend);
@@ -988,4 +988,4 @@ SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const
     return result;
 }
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

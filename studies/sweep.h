@@ -18,7 +18,7 @@
 #include "scene/scene.h"
 #include "scene/settings.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 // One point of the grid: a backend and the settings that differ from the scene's defaults.
 struct SweepConfig {
@@ -89,7 +89,7 @@ struct SweepRow {
     nlohmann::json settings;               // the settings applied (Frame attributes)
     std::string error;                     // non-empty when the configuration failed
     std::string image, diffImage;          // file names under DIR/images/
-    nlohmann::json machine;                // compare::toJson(MachineInfo) it was timed on; null in old journals
+    nlohmann::json machine;                // toJson(MachineInfo) it was timed on; null in old journals
     // With a flicker axis: the row along the path (flicker_rate, flicker_px, error_variation,
     // swim_px, edge_offset_px, pairs; "held": the same for the raster held view on camera paths).
     // Null without one.
@@ -149,4 +149,4 @@ std::vector<SweepRow> readJournal(const std::filesystem::path& file);
 std::string rowsToCsv(const std::vector<SweepRow>& rows);
 nlohmann::json rowsToJson(const std::vector<SweepRow>& rows);
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

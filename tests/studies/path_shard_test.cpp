@@ -21,7 +21,7 @@
 #include "tests/raster/test_scenes.h"
 #include "tests/scene/animated_gltf.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 namespace {
 
 namespace fs = std::filesystem;
@@ -64,7 +64,7 @@ Json measured(const PathResult& r) {
     Json methods = Json::array();
     for (const PathMethod& m : r.methods) {
         Json frames = Json::array();
-        for (const Metrics& x : m.metrics) {
+        for (const compare::Metrics& x : m.metrics) {
             Json j = toJson(x);
             j.erase("method_timing");
             j.erase("reference_timing");
@@ -305,4 +305,4 @@ TEST(SweepFlickerAxis, SnappedFittedMapsHoldStillInTheHeldViewWhereUnsnappedOnes
 }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -16,7 +16,7 @@
 #include "compare/compare.h"
 #include "scene/loader.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 namespace {
 
 namespace fs = std::filesystem;
@@ -218,4 +218,4 @@ TEST(RecommendOnLavapipe, TheSeedsBlockIsNoWorseThanItsDefaults) { checkNeverLos
 TEST(RecommendOnLavapipe, AStiffCasesBlockIsNoWorseThanItsDefaults) { checkNeverLoses("extreme/grazing-1deg"); }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

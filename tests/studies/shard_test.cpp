@@ -23,7 +23,7 @@
 #include "scene/loader.h"
 #include "tests/compare/synthetic.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 namespace {
 
 namespace fs = std::filesystem;
@@ -57,7 +57,7 @@ struct FakeRenderer {
                                      std::to_string(s.raytrace.rayBias);
             const int n = calls[what]++;
             const float v = backend == "raster" && s.raster.shadowMapSize == 512 ? 0.0f : 1.0f;
-            scene::Frame f = test::uniformFrame(sc.camera.width, sc.camera.height, 1.0f, 0.6f, v);
+            scene::Frame f = compare::test::uniformFrame(sc.camera.width, sc.camera.height, 1.0f, 0.6f, v);
             f.timingsMs = {{"setup", 2.0}, {"render", n == 0 ? 50.0 : 10.0 + n}};
             return f;
         };
@@ -358,7 +358,7 @@ TEST(SharedReference, ASecondShardWaitsForTheFirstAndReusesItsReference) {
     auto slowRender = [&] {
         ++renders;
         std::this_thread::sleep_for(std::chrono::milliseconds(300));
-        scene::Frame fr = test::uniformFrame(scene.camera.width, scene.camera.height, 1.0f, 0.6f, 1.0f);
+        scene::Frame fr = compare::test::uniformFrame(scene.camera.width, scene.camera.height, 1.0f, 0.6f, 1.0f);
         fr.timingsMs = {{"render", 7.0}};
         return fr;
     };
@@ -382,7 +382,7 @@ TEST(SharedReference, ASecondShardWaitsForTheFirstAndReusesItsReference) {
 TEST(SharedReference, TheLockOfAStoppedShardIsTakenOver) {
     Folder f;
     const scene::Scene scene = scene::loadScene(writeScene(f.path / "scene"));
-    auto render = [&] { return test::uniformFrame(scene.camera.width, scene.camera.height, 1.0f, 0.6f, 1.0f); };
+    auto render = [&] { return compare::test::uniformFrame(scene.camera.width, scene.camera.height, 1.0f, 0.6f, 1.0f); };
     SharedReferenceOptions o;
     o.pollSeconds = 0.02;
     o.staleSeconds = 0.3;
@@ -449,4 +449,4 @@ TEST(Machine, DescribesThisMachineAndSurvivesJson) {
 }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -15,7 +15,7 @@
 
 #include "scene/loader.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 namespace {
 namespace fs = std::filesystem;
 
@@ -316,4 +316,4 @@ TEST(StabilityVerdicts, TheBestBiasIsCleanWhenTheSearchFindsOneAndStiffWhenNot) 
 }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

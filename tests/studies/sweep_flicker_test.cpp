@@ -17,7 +17,7 @@
 #include "scene/loader.h"
 #include "tests/compare/synthetic.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 namespace {
 
 namespace fs = std::filesystem;
@@ -52,7 +52,7 @@ struct PanFake {
     RenderFn fn() {
         return [this](const scene::Scene& s, const scene::RenderSettings& settings, const std::string& backend) {
             ++renders;
-            scene::Frame f = test::uniformFrame(s.camera.width, s.camera.height, 1.0f, 0.6f, 1.0f);
+            scene::Frame f = compare::test::uniformFrame(s.camera.width, s.camera.height, 1.0f, 0.6f, 1.0f);
             f.timingsMs = {{"setup", 1.0}, {"render", 2.0}};
             // raster map 512: the stripe in every frame (a fixed wrong offset); map 1024: in odd frames.
             const bool stripe = backend == "raster" && (settings.raster.shadowMapSize == 512 ||
@@ -226,4 +226,4 @@ TEST_F(FlickerGridFile, BadValuesAreRejectedWithTheirJsonPath) {
 }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

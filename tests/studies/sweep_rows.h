@@ -9,7 +9,7 @@
 
 #include "studies/sweep.h"
 
-namespace shadowlab::compare::test {
+namespace shadowlab::studies::test {
 
 // Metrics JSON with the fields the sweep report and auto bias read (compare::toJson names).
 inline nlohmann::json rowMetrics(double falseRate, double missedRate, int width = 64, int height = 36) {
@@ -114,4 +114,4 @@ inline SweepRow failedRow(SweepRow r, const std::string& error) {
     return r;
 }
 
-}  // namespace shadowlab::compare::test
+}  // namespace shadowlab::studies::test

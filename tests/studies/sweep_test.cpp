@@ -19,7 +19,7 @@
 #include "scene/loader.h"
 #include "tests/compare/synthetic.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 namespace {
 
 namespace fs = std::filesystem;
@@ -57,7 +57,7 @@ struct FakeRenderer {
             }
             if (backend == "raster" && s.raster.depthBias == failDepthBias)
                 throw std::runtime_error("VK_ERROR_DEVICE_LOST (fake)");
-            scene::Frame f = test::uniformFrame(sc.camera.width, sc.camera.height, 1.0f, 0.6f, 1.0f);
+            scene::Frame f = compare::test::uniformFrame(sc.camera.width, sc.camera.height, 1.0f, 0.6f, 1.0f);
             f.attributes["backend"] = backend;
             if (backend == "reference" || n == 0) {
                 f.timingsMs = {{"setup", kWarmUpSetupMs}, {"render", kWarmUpFrameMs}};
@@ -670,4 +670,4 @@ TEST_F(GridFile, HostileFilesAreRefusedBeforeTheyAreReadOrExpanded) {
 }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies
