@@ -542,12 +542,13 @@ int run(const RunOptions& o) {
     }
     Stage refStage("reference (double precision, robust offsets)");
     const scene::Frame reference = renderBackend(p, scene::Backend::Reference);
-    scene::writeFrame(reference, dir / "reference.exr");
-    scene::writePngLinear(dir / "reference.png", reference.width, reference.height, reference.beauty);
-    written.insert(written.end(), {"reference.exr", "reference.png"});
+    const std::string referenceName = scene::toString(scene::Backend::Reference);
+    scene::writeFrame(reference, dir / (referenceName + ".exr"));
+    scene::writePngLinear(dir / (referenceName + ".png"), reference.width, reference.height, reference.beauty);
+    written.insert(written.end(), {referenceName + ".exr", referenceName + ".png"});
     refStage.done();
-    metrics["reference"] = {{"timings_ms", timingsJson(reference)}, {"attributes", reference.attributes}};
-    report.reference = {"reference", "reference.png", reference};
+    metrics[referenceName] = {{"timings_ms", timingsJson(reference)}, {"attributes", reference.attributes}};
+    report.reference = {referenceName, referenceName + ".png", reference};
 
     // The user's configuration at the requested resolution, kept for the recommendation's check.
     std::optional<scene::Frame> defaultsFrame[2];  // raytrace, raster
@@ -612,13 +613,13 @@ int run(const RunOptions& o) {
         studies::SweepGrid grid = studies::defaultGrid(p.scene, true);
         grid.resolution = std::to_string(std::max(16, p.scene.camera.width / 2)) + "x" +
                           std::to_string(std::max(16, p.scene.camera.height / 2));
+        if (o.skipRaster)
+            std::erase_if(grid.configs, [](const studies::SweepConfig& c) { return c.backend == scene::Backend::Raster; });
         for (studies::SweepConfig& c : grid.configs) {
-            if (o.skipRaster && c.backend == "raster") c.backend.clear();
             c.overrides.threads = o.common.settings.threads;
             c.overrides.device = o.common.settings.device;
             c.overrides.validate = o.common.settings.validate;
         }
-        std::erase_if(grid.configs, [](const studies::SweepConfig& c) { return c.backend.empty(); });
         studies::SweepOptions options;
         options.outputDir = scene::temporarySibling(dir / "sweep");
         options.progress = sweepProgressPrinter();
@@ -842,9 +843,9 @@ int sweep(const SweepOptions& o) {
         studies::RecommendOptions ro;
         ro.user = o.common.settings;
         ro.raster = std::any_of(grid.configs.begin(), grid.configs.end(),
-                                [](const studies::SweepConfig& c) { return c.backend == "raster"; });
+                                [](const studies::SweepConfig& c) { return c.backend == scene::Backend::Raster; });
         ro.raytrace = std::any_of(grid.configs.begin(), grid.configs.end(),
-                                  [](const studies::SweepConfig& c) { return c.backend == "raytrace"; });
+                                  [](const studies::SweepConfig& c) { return c.backend == scene::Backend::Raytrace; });
         Stage rec("recommended shadow block: biases searched in this configuration");
         input.recommendation = studies::recommendShadow(at, result.reference, at, result.reference, nullptr, nullptr,
                                                         studies::rayCandidateOf(studies::recommendBias(result.rows)), ro);
@@ -1044,10 +1045,10 @@ int stability(const StabilityCommandOptions& o) {
         // The reference's verdict and each backend's state, not one PASS that hides acne.
         const studies::StabilityCase& c = cases.back();
         std::string note = std::string(c.failed() ? "FAILED to run cleanly; " : "") + "reference " + c.referenceVerdict();
-        for (const char* backend : {"raster", "raytrace"})
+        for (const scene::Backend backend : {scene::Backend::Raster, scene::Backend::Raytrace})
             for (const char* variant : {"defaults", "best"})
                 if (const studies::BackendRun* r = c.run(backend, variant))
-                    note += std::string("; ") + backend + " at " + variant + ": " +
+                    note += std::string("; ") + scene::toString(backend) + " at " + variant + ": " +
                             studies::stateOf(r, std::string(variant) == "best").text;
         stage.done(note);
     }

@@ -53,7 +53,7 @@ const char* kindKey(const std::string& kind) {
 Json contextOf(const SweepConfig& c, const std::string& skipKey) {
     const auto& o = c.overrides;
     Json j = Json::object();
-    if (c.backend == "raster") {
+    if (c.backend == scene::Backend::Raster) {
         if (o.shadowMapSize) j["shadow_map_size"] = *o.shadowMapSize;
         if (o.filter) j["filter"] = *o.filter;
         if (o.depthBias) j["depth_bias"] = *o.depthBias;
@@ -86,10 +86,11 @@ Json contextOf(const SweepConfig& c, const std::string& skipKey) {
 // The value a configuration sets for a bias kind, if it sets one (a numeric ray bias only).
 std::optional<double> biasOf(const SweepConfig& c, const std::string& kind) {
     const auto& o = c.overrides;
-    if (kind == "depth" && c.backend == "raster") return o.depthBias;
-    if (kind == "slope" && c.backend == "raster") return o.slopeBias;
-    if (momentKind(kind) && c.backend == "raster") return momentOverride(o, kind);
-    if (kind == "ray" && c.backend == "raytrace" && o.rayBias && *o.rayBias != "robust") {
+    const bool raster = c.backend == scene::Backend::Raster;
+    if (kind == "depth" && raster) return o.depthBias;
+    if (kind == "slope" && raster) return o.slopeBias;
+    if (momentKind(kind) && raster) return momentOverride(o, kind);
+    if (kind == "ray" && c.backend == scene::Backend::Raytrace && o.rayBias && *o.rayBias != "robust") {
         char* end = nullptr;
         const double v = std::strtod(o.rayBias->c_str(), &end);
         if (end && *end == '\0' && std::isfinite(v)) return v;
@@ -234,13 +235,13 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
     // Group the usable rows by kind and shared settings, in first-seen order per kind.
     for (const std::string& kind : seriesKinds()) {
         std::vector<BiasSeries> found;
-        std::map<std::string, std::size_t> index;
+        std::map<std::pair<scene::Backend, std::string>, std::size_t> index;  // by backend and context
         for (const SweepRow& r : rows) {
             if (r.config.biasKind != kind || !r.error.empty() || !std::isfinite(r.config.biasValue)) continue;
             const double f = r.rate("false_shadow_rate"), m = r.rate("missed_shadow_rate");
             if (!std::isfinite(f) || !std::isfinite(m)) continue;
             const Json context = contextOf(r.config, kindKey(kind));
-            const std::string groupKey = r.config.backend + "|" + context.dump();
+            const std::pair<scene::Backend, std::string> groupKey{r.config.backend, context.dump()};
             auto it = index.find(groupKey);
             if (it == index.end()) {
                 BiasSeries s;
@@ -260,7 +261,7 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
             const std::optional<double> bias = biasOf(r.config, kind);
             const double f = r.rate("false_shadow_rate"), m = r.rate("missed_shadow_rate");
             if (!bias || !std::isfinite(f) || !std::isfinite(m)) continue;
-            const auto it = index.find(r.config.backend + "|" + contextOf(r.config, kindKey(kind)).dump());
+            const auto it = index.find({r.config.backend, contextOf(r.config, kindKey(kind)).dump()});
             if (it == index.end()) continue;
             auto& samples = found[it->second].samples;
             if (std::none_of(samples.begin(), samples.end(), [&](const compare::BiasSample& b) { return b.bias == *bias; }))
@@ -284,7 +285,7 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
     }
 
     for (const SweepRow& r : rows) {
-        if (r.config.backend != "raytrace" || r.config.overrides.rayBias != std::optional<std::string>("robust") ||
+        if (r.config.backend != scene::Backend::Raytrace || r.config.overrides.rayBias != std::optional<std::string>("robust") ||
             !r.error.empty())
             continue;
         const double f = r.rate("false_shadow_rate"), m = r.rate("missed_shadow_rate");

@@ -22,7 +22,7 @@ struct BiasSeries {
     // "depth" | "slope" | "ray", or a filterable map's parameter (seriesKinds()): its window
     // is read the same way, from the false- and missed-shadow rates along the series.
     std::string kind;
-    std::string backend;  // "raster" | "raytrace"
+    scene::Backend backend = scene::Backend::Raster;  // Raster or Raytrace
     // The overrides every row of the series shares (the bias itself left out), as scene-file
     // "shadow" keys: {"shadow_map_size": 1024, "filter": "none", "slope_bias": 0}.
     nlohmann::json context = nlohmann::json::object();

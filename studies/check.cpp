@@ -8,6 +8,7 @@
 #include <set>
 
 #include "studies/sweep.h"
+#include "scene/backend.h"
 #include "scene/error.h"
 #include "scene/loader.h"
 #include "scene/settings.h"
@@ -154,9 +155,13 @@ CheckSuite loadSuite(const fs::path& file) {
                 throw SceneError(file, p / "scene", e.what());
             }
         }
-        k.backend = c.contains("backend") ? stringAt(file, c["backend"], p / "backend") : "raster";
-        if (k.backend != "raster" && k.backend != "raytrace")
-            throw SceneError(file, p / "backend", "expected raster or raytrace, got '" + k.backend + "'");
+        if (c.contains("backend")) {
+            const std::string name = stringAt(file, c["backend"], p / "backend");
+            const std::optional<scene::Backend> b = scene::parseBackend(name);
+            if (b != scene::Backend::Raster && b != scene::Backend::Raytrace)
+                throw SceneError(file, p / "backend", "expected raster or raytrace, got '" + name + "'");
+            k.backend = *b;
+        }
         if (c.contains("device")) k.device = stringAt(file, c["device"], p / "device");
         k.scene = scene::loadScene(k.sceneFile);
         const Json* res = c.contains("resolution") ? &c["resolution"] : defaultResolution ? &*defaultResolution : nullptr;
@@ -301,7 +306,7 @@ std::vector<CaseResult> runSuite(const CheckSuite& suite, const Baseline* baseli
                                        std::to_string(settings.raytrace.samples);
             auto ref = references.find(refKey);
             if (ref == references.end())
-                ref = references.emplace(refKey, renderWithBackend(k.scene, settings, "reference")).first;
+                ref = references.emplace(refKey, renderWithBackend(k.scene, settings, scene::Backend::Reference)).first;
             const auto start = Clock::now();
             const scene::Frame method = renderWithBackend(k.scene, settings, k.backend);
             compare::Comparison c = compare::compareFrames(method, ref->second);

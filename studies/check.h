@@ -33,7 +33,7 @@ struct CheckTolerance {
 struct CheckCase {
     std::string name;          // the case's key: unique in the suite, [A-Za-z0-9._-]
     std::filesystem::path sceneFile;
-    std::string backend;       // raster | raytrace
+    scene::Backend backend = scene::Backend::Raster;  // Raster or Raytrace; Raster when the suite names none
     scene::Scene scene;        // loaded, resolution applied, case settings merged into its "shadow"
     std::string resolution;    // "WxH"
     std::string device;        // raster: Vulkan device ("" = the default)

@@ -76,14 +76,14 @@ CasePart casePart(const CheckSuite& suite, const CheckCase& c, const CaseResult&
           << escapeXml(text) << "</failure>\n";
     }
     if (r.metrics)
-        x << "      <system-out>" << escapeXml(c.sceneFile.filename().string() + " " + c.backend + " " +
+        x << "      <system-out>" << escapeXml(c.sceneFile.filename().string() + " " + scene::toString(c.backend) + " " +
                                                c.resolution + ": " + compare::summaryLine(*r.metrics))
           << "</system-out>\n";
     x << "    </testcase>\n";
     p.junit = x.str();
 
     std::ostringstream m;
-    m << "| " << cell(r.name) << " | " << cell(c.sceneFile.stem().string()) << " | " << c.backend << " | "
+    m << "| " << cell(r.name) << " | " << cell(c.sceneFile.stem().string()) << " | " << scene::toString(c.backend) << " | "
       << (r.verdict == CaseVerdict::Passed ? "passed" : r.verdict == CaseVerdict::Failed ? "**FAILED**" : "**ERROR**")
       << " | ";
     if (r.metrics) {
@@ -287,7 +287,7 @@ nlohmann::json caseJson(const CheckCase& c, const CaseResult& r) {
                          {"tolerance", d.tolerance}, {"regressed", d.regressed}, {"improved", d.improved}});
     nlohmann::json j = {{"name", c.name},
                         {"scene", c.sceneFile.string()},
-                        {"backend", c.backend},
+                        {"backend", scene::toString(c.backend)},
                         {"resolution", c.resolution},
                         {"settings", c.settings},
                         {"budgets", scene::toJson(c.budgets)},

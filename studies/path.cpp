@@ -52,6 +52,11 @@ double frameMs(const scene::Frame& f) { return f.totalTimeMs() - f.timing("setup
 
 using scene::appendLine;  // a finished line survives a kill or a power loss
 
+// A method's name in frame files, the journal, path.json, metrics.json and the report: its
+// backend's name, and for the raster backend's held view that name with "-held".
+std::string nameOf(scene::Backend b) { return scene::toString(b); }
+std::string heldViewName() { return nameOf(scene::Backend::Raster) + "-held"; }
+
 std::string frameName(int t, const std::string& what) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%04d-", t);
@@ -121,8 +126,8 @@ Json manifestOf(const scene::Scene& base, const PathSpec& spec, double amount, c
             {"amount", amount},
             {"light", spec.light},
             {"animation", spec.kind == PathKind::GltfAnimation ? Json(spec.animation) : Json(nullptr)},
-            {"raster", o.raster},
-            {"raytrace", o.raytrace},
+            {nameOf(scene::Backend::Raster), o.raster},
+            {nameOf(scene::Backend::Raytrace), o.raytrace},
             {"held_view", o.heldView},
             {"settings",
              {{"shadow_map_size", r.shadowMapSize},
@@ -335,12 +340,12 @@ namespace {
 // Method names in report order, from a folder's manifest (path.json).
 std::vector<std::string> methodNames(const Json& manifest) {
     std::vector<std::string> names;
-    const bool raster = manifest.at("raster").get<bool>();
+    const bool raster = manifest.at(nameOf(scene::Backend::Raster)).get<bool>();
     const bool held = raster && manifest.at("held_view").get<bool>() &&
                       isCameraPath(parsePathKind(manifest.at("kind").get<std::string>()));
-    if (raster) names.push_back("raster");
-    if (held) names.push_back("raster-held");
-    if (manifest.at("raytrace").get<bool>()) names.push_back("raytrace");
+    if (raster) names.push_back(nameOf(scene::Backend::Raster));
+    if (held) names.push_back(heldViewName());
+    if (manifest.at(nameOf(scene::Backend::Raytrace)).get<bool>()) names.push_back(nameOf(scene::Backend::Raytrace));
     return names;
 }
 
@@ -376,9 +381,10 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
         for (int t = 0; t < result.frames; ++t) frames.push_back(scene::readFrame(framesDir / frameName(t, name)));
         return frames;
     };
-    const std::vector<scene::Frame> refs = load("reference");
-    result.referenceSetupMs = setupMs["reference"];
-    result.referenceFrameMs = times["reference"];
+    const std::string referenceName = nameOf(scene::Backend::Reference);
+    const std::vector<scene::Frame> refs = load(referenceName);
+    result.referenceSetupMs = setupMs[referenceName];
+    result.referenceFrameMs = times[referenceName];
     std::vector<const scene::Frame*> refPointers;
     for (const scene::Frame& f : refs) refPointers.push_back(&f);
     result.referenceTemporal = compare::measureTemporal(refPointers, refPointers);
@@ -407,7 +413,7 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
         std::vector<const scene::Frame*> methodPointers, heldRefs;
         std::vector<const std::vector<compare::PixelClass>*> classes;
         for (int t = 0; t < result.frames; ++t) {
-            const scene::Frame& r = name == "raster-held" ? refs[0] : refs[std::size_t(t)];
+            const scene::Frame& r = name == heldViewName() ? refs[0] : refs[std::size_t(t)];
             comparisons.push_back(compare::compareFrames(frames[std::size_t(t)], r));
             m.metrics.push_back(comparisons.back().metrics);
             methodPointers.push_back(&frames[std::size_t(t)]);
@@ -471,9 +477,10 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
 
         compare::PlotSeries series;
         series.name = name;
-        series.color = compare::backendColor(name == "raster-held" ? "raster held view" : name, mi);
+        const bool heldView = name == heldViewName();
+        series.color = compare::backendColor(heldView ? nameOf(scene::Backend::Raster) + " held view" : name, mi);
         series.connect = true;
-        series.dashed = name == "raster-held";
+        series.dashed = heldView;
         for (const compare::PairStability& p : m.temporal.pairs)
             series.points.push_back({double(p.first), p.flickerRate, "",
                                      name + " pair " + std::to_string(p.first) + ": " + compare::formatCount(p.flicker) + " px"});
@@ -508,7 +515,7 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
              << "</td><td>" << compare::formatFixed(tsum.meanEdgeOffset, 3) << "</td><td>"
              << (mismatch < 0 ? std::string("-") : compare::formatPercent(mismatch)) << "</td></tr>\n";
     };
-    row("reference", result.referenceSetupMs, result.referenceFrameMs, result.referenceTemporal, -1.0);
+    row(nameOf(scene::Backend::Reference), result.referenceSetupMs, result.referenceFrameMs, result.referenceTemporal, -1.0);
     for (const PathMethod& m : result.methods) {
         double mismatch = 0.0;
         for (const compare::Metrics& x : m.metrics) mismatch += x.mismatchRate;
@@ -613,11 +620,11 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
         };
         if (!reference) reference = makeRenderer(scene::Backend::Reference, scenes[0], plan, settings);
         reference->update(s);
-        record("reference", reference->render(), reference->setupMs());
+        record(nameOf(scene::Backend::Reference), reference->render(), reference->setupMs());
         if (options.raytrace) {
             if (!tracer) tracer = makeRenderer(scene::Backend::Raytrace, scenes[0], plan, settings);
             tracer->update(s);
-            record("raytrace", tracer->render(), tracer->setupMs());
+            record(nameOf(scene::Backend::Raytrace), tracer->render(), tracer->setupMs());
         }
         if (options.raster) {
             double setup = 0.0;
@@ -628,10 +635,10 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
             rasterRenderer->update(s);
             scene::Frame f = rasterRenderer->render();
             setup += f.timing("setup");  // pipelines made by the first frame
-            record("raster", f, setup);
+            record(nameOf(scene::Backend::Raster), f, setup);
             if (held) {
                 rasterRenderer->update(s, scenes[0].camera);
-                record("raster-held", rasterRenderer->render(), 0.0);
+                record(heldViewName(), rasterRenderer->render(), 0.0);
             }
             if (settings.raster.validate && rasterRenderer->validationMessages() > 0)
                 throw std::runtime_error("the Vulkan validation layer reported " +
@@ -671,7 +678,7 @@ Json toJson(const PathResult& r) {
             {"amount", r.amount},
             {"light", r.spec.light},
             {"resumed_frames", r.resumedFrames},
-            {"reference", {{"setup_ms", r.referenceSetupMs},
+            {nameOf(scene::Backend::Reference), {{"setup_ms", r.referenceSetupMs},
                            {"median_frame_ms", median(r.referenceFrameMs)},
                            {"frame_ms", r.referenceFrameMs},
                            {"temporal", toJson(r.referenceTemporal)}}},
@@ -847,7 +854,7 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
     }
     const std::vector<std::string> names = methodNames(manifest);
     std::vector<std::string> all = names;
-    all.push_back("reference");
+    all.push_back(nameOf(scene::Backend::Reference));
     for (const auto& [t, entry] : lines)
         for (const std::string& name : all)
             if (!fs::exists(entry.first / "frames" / frameName(t, name), ec))

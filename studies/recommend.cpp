@@ -43,12 +43,12 @@ std::string attribute(const scene::Frame& f, const char* key) {
 
 // Renders one configuration; failures (exceptions, validation messages) are recorded in `error`.
 scene::Frame renderOne(const RecommendOptions& o, const scene::Scene& s, const scene::SettingsOverrides& overrides,
-                       const std::string& backend, std::string& error) {
+                       scene::Backend backend, std::string& error) {
     try {
         const scene::RenderSettings settings = scene::resolveSettings(s, overrides);
         scene::Frame f = o.render(s, settings, backend);
         const std::string messages = attribute(f, "validation_messages");
-        if (settings.raster.validate && backend == "raster" && messages != "0")
+        if (settings.raster.validate && backend == scene::Backend::Raster && messages != "0")
             error = "the Vulkan validation layer reported " + (messages.empty() ? "an unknown number of" : messages) +
                     " message(s)";
         if (compare::measureHealth(f).total() > 0) error = "non-finite values";
@@ -60,7 +60,7 @@ scene::Frame renderOne(const RecommendOptions& o, const scene::Scene& s, const s
 }
 
 Measured measureRender(const RecommendOptions& o, const scene::Scene& s, const scene::SettingsOverrides& overrides,
-                       const std::string& backend, const scene::Frame& reference, scene::Frame* keep = nullptr) {
+                       scene::Backend backend, const scene::Frame& reference, scene::Frame* keep = nullptr) {
     std::string error;
     scene::Frame f = renderOne(o, s, overrides, backend, error);
     Measured m;
@@ -193,8 +193,8 @@ Json Recommendation::toJson() const {
             {"measured",
              {{"resolution", resolution},
               {"search_resolution", searchResolution},
-              {"raster", side(raster, true)},
-              {"raytrace", side(raytrace, false)},
+              {scene::toString(scene::Backend::Raster), side(raster, true)},
+              {scene::toString(scene::Backend::Raytrace), side(raytrace, false)},
               {"notes", notes}}}};
 }
 
@@ -215,7 +215,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
         Verified& v = r.raster;
         scene::Frame fullDefaults;
         v.defaults = rasterDefaults ? measure(*rasterDefaults, reference)
-                                    : measureRender(o, scene, user, "raster", reference, &fullDefaults);
+                                    : measureRender(o, scene, user, scene::Backend::Raster, reference, &fullDefaults);
         scene::SettingsOverrides searchUser = user;
         const std::string fullMap = attribute(rasterDefaults ? *rasterDefaults : fullDefaults, "shadow_map_size");
         if (!user.shadowMapSize && !fullMap.empty()) {
@@ -228,7 +228,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
         BiasPoint d;
         d.defaults = true;
         scene::Frame defaultsFrame;
-        d.at = measureRender(o, searchScene, searchUser, "raster", searchReference, &defaultsFrame);
+        d.at = measureRender(o, searchScene, searchUser, scene::Backend::Raster, searchReference, &defaultsFrame);
         const scene::RenderSettings resolved = scene::resolveSettings(searchScene, searchUser);
         const std::string applied = attribute(defaultsFrame, "depth_bias");
         double b0 = smallestPositive(applied);
@@ -254,7 +254,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
             scene::SettingsOverrides ov = searchUser;
             ov.depthBias = depth;
             ov.slopeBias = slope;
-            p.at = measureRender(o, searchScene, ov, "raster", searchReference);
+            p.at = measureRender(o, searchScene, ov, scene::Backend::Raster, searchReference);
             r.points.push_back(p);
         };
         if (d.at.ok) {
@@ -293,7 +293,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
             scene::SettingsOverrides ov = user;
             ov.depthBias = best.depthBias;
             ov.slopeBias = best.slopeBias;
-            v.tried = measureRender(o, scene, ov, "raster", reference);
+            v.tried = measureRender(o, scene, ov, scene::Backend::Raster, reference);
             v.beatsDefaults = beats(v.tried, v.defaults);
         }
         v.recommended = v.beatsDefaults ? v.tried : v.defaults;
@@ -343,7 +343,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
     if (o.raytrace && rayCandidate.contains("ray_bias")) {
         Verified& v = r.raytrace;
         v.defaults = raytraceDefaults ? measure(*raytraceDefaults, reference)
-                                      : measureRender(o, scene, user, "raytrace", reference);
+                                      : measureRender(o, scene, user, scene::Backend::Raytrace, reference);
         scene::SettingsOverrides ov = user;
         const Json& rb = rayCandidate["ray_bias"];
         if (rb.is_string()) {
@@ -356,7 +356,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
         if (rayCandidate.contains("precision")) ov.precision = rayCandidate["precision"].get<std::string>();
         v.searched = true;
         v.candidate = "ray bias " + *ov.rayBias + (ov.precision ? " (" + *ov.precision + ")" : "");
-        v.tried = measureRender(o, scene, ov, "raytrace", reference);
+        v.tried = measureRender(o, scene, ov, scene::Backend::Raytrace, reference);
         v.beatsDefaults = beats(v.tried, v.defaults);
         v.recommended = v.beatsDefaults ? v.tried : v.defaults;
         if (v.beatsDefaults) {

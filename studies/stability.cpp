@@ -60,11 +60,11 @@ scene::SettingsOverrides overridesFromBlock(const Json& block) {
     return o;
 }
 
-std::string describeOverrides(const Json& block, const std::string& backend) {
+std::string describeOverrides(const Json& block, scene::Backend backend) {
     std::string s;
     for (const auto& [k, v] : block.items()) {
         const bool rayKey = k == "ray_bias" || k == "precision";
-        if (rayKey != (backend == "raytrace")) continue;
+        if (rayKey != (backend == scene::Backend::Raytrace)) continue;
         if (!s.empty()) s += ", ";
         s += k + " " + (v.is_string() ? v.get<std::string>() : v.dump());
     }
@@ -73,7 +73,7 @@ std::string describeOverrides(const Json& block, const std::string& backend) {
 
 BackendRun renderRun(const scene::Scene& scene, const scene::Frame& reference,
                      const scene::SettingsOverrides& overrides, const StabilityOptions& options,
-                     const std::string& backend, const std::string& variant, const std::string& label,
+                     scene::Backend backend, const std::string& variant, const std::string& label,
                      scene::Frame* keep = nullptr) {
     BackendRun run;
     run.backend = backend;
@@ -117,7 +117,7 @@ AutoBias searchBias(const scene::Scene& scene, const scene::Frame& reference,
             continue;
         const bool isSeries = !config.biasKind.empty() || config.overrides.rayBias == std::optional<std::string>("robust");
         if (options.biasSeriesOnly && !isSeries) continue;
-        if (options.searchMapSize > 0 && config.backend == "raster") config.overrides.shadowMapSize = options.searchMapSize;
+        if (options.searchMapSize > 0 && config.backend == scene::Backend::Raster) config.overrides.shadowMapSize = options.searchMapSize;
         SweepRow row;
         row.config = config;
         row.key = config.key();
@@ -147,13 +147,13 @@ AutoBias searchBias(const scene::Scene& scene, const scene::Frame& reference,
 
 }  // namespace
 
-const BackendRun* StabilityCase::run(const std::string& backend, const std::string& variant) const {
+const BackendRun* StabilityCase::run(scene::Backend backend, const std::string& variant) const {
     for (const BackendRun& r : runs)
         if (r.backend == backend && r.variant == variant) return &r;
     return nullptr;
 }
 
-const MethodBias* StabilityCase::biasOf(const std::string& backend) const {
+const MethodBias* StabilityCase::biasOf(scene::Backend backend) const {
     for (const MethodBias& b : bias)
         if (b.backend == backend) return &b;
     return nullptr;
@@ -188,7 +188,7 @@ StabilityCase runStabilityCase(const scene::Scene& sceneIn, const StabilityOptio
     try {
         const scene::RenderSettings settings = scene::resolveSettings(scene, {});
         const auto t0 = std::chrono::steady_clock::now();
-        c.reference = options.render(scene, settings, "reference");
+        c.reference = options.render(scene, settings, scene::Backend::Reference);
         c.referenceMs = msSince(t0);
         c.referenceOk = true;
         c.referenceHealth = compare::measureHealth(c.reference);
@@ -214,15 +214,15 @@ StabilityCase runStabilityCase(const scene::Scene& sceneIn, const StabilityOptio
     }
 
     // Backends at their defaults (kept: the recommendation is checked against them).
-    std::map<std::string, scene::Frame> defaultsFrames;
-    for (const std::string& backend : options.backends)
+    std::map<scene::Backend, scene::Frame> defaultsFrames;
+    for (const scene::Backend backend : options.backends)
         c.runs.push_back(renderRun(scene, c.reference, {}, options, backend, "defaults", "defaults",
                                    &defaultsFrames[backend]));
-    auto defaultsOf = [&](const std::string& backend) -> const scene::Frame* {
+    auto defaultsOf = [&](scene::Backend backend) -> const scene::Frame* {
         const auto it = defaultsFrames.find(backend);
         return it == defaultsFrames.end() || it->second.pixelCount() == 0 ? nullptr : &it->second;
     };
-    auto hasBackend = [&](const char* b) {
+    auto hasBackend = [&](scene::Backend b) {
         return std::find(options.backends.begin(), options.backends.end(), b) != options.backends.end();
     };
 
@@ -235,15 +235,16 @@ StabilityCase runStabilityCase(const scene::Scene& sceneIn, const StabilityOptio
         ro.render = options.render;
         ro.user.shadowMapSize = options.shadowMapSize;
         ro.user.validate = options.validate;
-        ro.raster = hasBackend("raster");
-        ro.raytrace = hasBackend("raytrace");
+        ro.raster = hasBackend(scene::Backend::Raster);
+        ro.raytrace = hasBackend(scene::Backend::Raytrace);
         ro.depthSteps = options.bestDepthSteps;
         ro.slopeSteps = options.bestSlopeSteps;
-        const Recommendation rec = recommendShadow(scene, c.reference, scene, c.reference, defaultsOf("raster"),
-                                                   defaultsOf("raytrace"), rayCandidateOf(ab), ro);
+        const Recommendation rec =
+            recommendShadow(scene, c.reference, scene, c.reference, defaultsOf(scene::Backend::Raster),
+                            defaultsOf(scene::Backend::Raytrace), rayCandidateOf(ab), ro);
         c.bestShadowBlock = rec.shadowBlock;
         c.bestNotes = rec.notes;
-        for (const std::string& backend : options.backends) {
+        for (const scene::Backend backend : options.backends) {
             MethodBias mb;
             mb.backend = backend;
             const BiasSeries* chosen = nullptr;
@@ -264,7 +265,7 @@ StabilityCase runStabilityCase(const scene::Scene& sceneIn, const StabilityOptio
             } else {
                 mb.text = "no bias series rendered";
             }
-            if (backend == "raytrace")
+            if (backend == scene::Backend::Raytrace)
                 for (const RobustResult& r : ab.robust)
                     mb.text += " Robust offsets (" + (r.precision.empty() ? std::string("default") : r.precision) +
                                "): false " + fmt(100 * r.falseShadowRate, 3) + "%, missed " +
@@ -276,7 +277,7 @@ StabilityCase runStabilityCase(const scene::Scene& sceneIn, const StabilityOptio
     }
 
     for (const BackendRun& r : c.runs) {
-        const std::string who = r.backend + " (" + r.variant + ")";
+        const std::string who = std::string(scene::toString(r.backend)) + " (" + r.variant + ")";
         if (!r.ok) c.failures.push_back(who + " failed: " + r.error);
         else {
             if (r.health.total() > 0) c.failures.push_back(who + " has " + std::to_string(r.health.total()) + " NaN/Inf values");
@@ -358,14 +359,14 @@ Json toJson(const StabilityCase& c) {
     j["states"] = Json::object();
     for (const BackendRun& r : c.runs) {
         const BackendState st = stateOf(&r, r.variant == "best");
-        j["states"][r.backend][r.variant] = {{"state", st.state}, {"text", st.text},
+        j["states"][scene::toString(r.backend)][r.variant] = {{"state", st.state}, {"text", st.text},
                                              {"false_shadow_rate", r.falseShadowRate},
                                              {"missed_shadow_rate", r.missedShadowRate}};
     }
     j["best_notes"] = c.bestNotes;
     j["failures"] = c.failures;
     j["resolution"] = std::to_string(c.width) + "x" + std::to_string(c.height);
-    j["reference"] = {{"ok", c.referenceOk}, {"error", c.referenceError}, {"time_ms", c.referenceMs},
+    j[scene::toString(scene::Backend::Reference)] = {{"ok", c.referenceOk}, {"error", c.referenceError}, {"time_ms", c.referenceMs},
                       {"non_finite", c.referenceHealth.total()}};
     if (c.analytic) {
         const AnalyticCheck& a = *c.analytic;
@@ -379,7 +380,7 @@ Json toJson(const StabilityCase& c) {
     }
     j["runs"] = Json::array();
     for (const BackendRun& r : c.runs)
-        j["runs"].push_back({{"backend", r.backend}, {"variant", r.variant}, {"settings", r.settings},
+        j["runs"].push_back({{"backend", scene::toString(r.backend)}, {"variant", r.variant}, {"settings", r.settings},
                              {"ok", r.ok}, {"error", r.error}, {"black_frame", r.blackFrame},
                              {"nan", r.health.beauty.nan + r.health.visibility.nan + r.health.objectId.nan +
                                          r.health.ndotl.nan + r.health.depth.nan + r.health.blockerId.nan},
@@ -389,7 +390,7 @@ Json toJson(const StabilityCase& c) {
                              {"missed_shadow_rate", r.missedShadowRate}});
     j["bias"] = Json::array();
     for (const MethodBias& b : c.bias)
-        j["bias"].push_back({{"backend", b.backend}, {"stiff", b.stiff}, {"kind", b.kind}, {"lo", b.lo},
+        j["bias"].push_back({{"backend", scene::toString(b.backend)}, {"stiff", b.stiff}, {"kind", b.kind}, {"lo", b.lo},
                              {"hi", b.hi}, {"recommended", b.recommended}, {"dominant", b.dominant},
                              {"text", b.text}});
     j["best_shadow_block"] = c.bestShadowBlock;
@@ -419,7 +420,7 @@ std::string stabilityCsv(const std::vector<StabilityCase>& cases) {
         const std::string analytic = c.analytic ? (c.analytic->passed() ? "exact" : "MISSED") : "n/a";
         for (const BackendRun& r : c.runs)
             s << c.name << ',' << (c.failed() ? "failed" : "ok") << ',' << c.referenceVerdict() << ',' << analytic << ','
-              << c.referenceMs << ',' << r.backend << ',' << r.variant << ',' << csvField(stateOf(&r, r.variant == "best").text)
+              << c.referenceMs << ',' << scene::toString(r.backend) << ',' << r.variant << ',' << csvField(stateOf(&r, r.variant == "best").text)
               << ',' << csvField(r.settings) << ',' << r.ok << ',' << r.blackFrame
               << ',' << r.health.total() << ',' << r.falseShadowRate << ',' << r.missedShadowRate << ','
               << r.timeMs << ',' << csvField(windowText(c.biasOf(r.backend))) << '\n';
@@ -481,18 +482,18 @@ void writeStabilityReport(const fs::path& dir, const std::vector<StabilityCase>&
     for (const StabilityCase& c : cases) {
         h << "<tr><td><a href=\"#" << compare::escapeHtml(c.name) << "\">" << compare::escapeHtml(c.name) << "</a></td>"
           << referenceCell(c.referenceVerdict());
-        for (const char* backend : {"raster", "raytrace"})
+        for (const scene::Backend backend : {scene::Backend::Raster, scene::Backend::Raytrace})
             for (const char* variant : {"defaults", "best"})
                 h << stateCell(stateOf(c.run(backend, variant), std::string(variant) == "best"));
-        h << "<td>" << compare::escapeHtml(windowText(c.biasOf("raster"))) << "</td><td>"
-          << compare::escapeHtml(windowText(c.biasOf("raytrace"))) << "</td></tr>";
+        h << "<td>" << compare::escapeHtml(windowText(c.biasOf(scene::Backend::Raster))) << "</td><td>"
+          << compare::escapeHtml(windowText(c.biasOf(scene::Backend::Raytrace))) << "</td></tr>";
     }
     h << "</table>" << compare::html::diffLegend();
     for (const StabilityCase& c : cases) {
         h << "<section id=\"" << compare::escapeHtml(c.name) << "\"><h2>" << compare::escapeHtml(c.name) << "</h2><table class=st><tr>"
           << "<th>reference</th><th>raster at defaults</th><th>raster at best</th><th>raytrace at defaults</th>"
              "<th>raytrace at best</th></tr><tr>" << referenceCell(c.referenceVerdict());
-        for (const char* backend : {"raster", "raytrace"})
+        for (const scene::Backend backend : {scene::Backend::Raster, scene::Backend::Raytrace})
             for (const char* variant : {"defaults", "best"})
                 h << stateCell(stateOf(c.run(backend, variant), std::string(variant) == "best"));
         h << "</tr></table>";
@@ -503,13 +504,13 @@ void writeStabilityReport(const fs::path& dir, const std::vector<StabilityCase>&
         h << "<table class=st><tr><th>backend</th><th>settings</th><th>state</th><th>NaN/Inf</th><th>acne</th>"
              "<th>leak</th><th>time ms</th></tr>";
         for (const BackendRun& r : c.runs)
-            h << "<tr><td>" << r.backend << "</td><td>" << compare::escapeHtml(r.variant + ": " + r.settings) << "</td>"
+            h << "<tr><td>" << scene::toString(r.backend) << "</td><td>" << compare::escapeHtml(r.variant + ": " + r.settings) << "</td>"
               << stateCell(stateOf(&r, r.variant == "best")) << "<td>"
               << r.health.total() << "</td><td>" << fmt(100 * r.falseShadowRate, 3) << "%</td><td>"
               << fmt(100 * r.missedShadowRate, 3) << "%</td><td>" << fmt(r.timeMs) << "</td></tr>";
         h << "</table>";
         for (const MethodBias& b : c.bias)
-            h << "<p><b>" << b.backend << "</b> (probe slice): " << compare::escapeHtml(windowText(&b)) << ". " << compare::escapeHtml(b.text) << "</p>";
+            h << "<p><b>" << scene::toString(b.backend) << "</b> (probe slice): " << compare::escapeHtml(windowText(&b)) << ". " << compare::escapeHtml(b.text) << "</p>";
         for (const std::string& note : c.bestNotes) h << "<p>" << compare::escapeHtml(note) << "</p>";
         h << "<div class=figs>";
         // Every image at one width (figures in a flex row would shrink to their captions), small
@@ -524,10 +525,10 @@ void writeStabilityReport(const fs::path& dir, const std::vector<StabilityCase>&
         for (const BackendRun& r : c.runs) {
             if (r.diffRgb.empty()) continue;
             const std::string png =
-                "stability/" + c.name + "-" + r.backend + (r.variant == "defaults" ? "" : "-" + r.variant) + "-diff.png";
+                "stability/" + c.name + "-" + scene::toString(r.backend) + (r.variant == "defaults" ? "" : "-" + r.variant) + "-diff.png";
             scene::writePngDisplay(dir / png, c.width, c.height, r.diffRgb);
-            h << "<figure><img src=\"" << png << "\" " << size << " class=upscale alt=\"" << r.backend << " difference\"><figcaption>"
-              << r.backend << " at " << r.variant << " vs reference</figcaption></figure>";
+            h << "<figure><img src=\"" << png << "\" " << size << " class=upscale alt=\"" << scene::toString(r.backend) << " difference\"><figcaption>"
+              << scene::toString(r.backend) << " at " << r.variant << " vs reference</figcaption></figure>";
         }
         h << "</div></section>";
     }

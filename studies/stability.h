@@ -41,13 +41,13 @@ struct StabilityOptions {
     // (studies/recommend.h: depth × slope, never worse than the defaults); these are its grids.
     std::vector<double> bestDepthSteps = RecommendOptions{}.depthSteps;
     std::vector<double> bestSlopeSteps = RecommendOptions{}.slopeSteps;
-    std::vector<std::string> backends{"raster", "raytrace"};
+    std::vector<scene::Backend> backends{scene::Backend::Raster, scene::Backend::Raytrace};
     RenderFn render = renderWithBackend;   // tests may pass a fake
 };
 
 // One backend render of the case and what it measured.
 struct BackendRun {
-    std::string backend;     // "raster" | "raytrace"
+    scene::Backend backend = scene::Backend::Raster;  // Raster or Raytrace
     std::string variant;     // "defaults" | "best"
     std::string settings;    // short text of the overrides applied
     bool ok = false;         // rendered without throwing
@@ -64,7 +64,7 @@ struct BackendRun {
 
 // The bias search's verdict for one method: a window, or "stiff" with what dominates.
 struct MethodBias {
-    std::string backend;     // "raster" | "raytrace"
+    scene::Backend backend = scene::Backend::Raster;  // Raster or Raytrace
     bool stiff = true;       // no series of this backend has a window
     std::string kind;        // the series the verdict comes from ("depth", "slope", "ray")
     double lo = 0.0, hi = 0.0, recommended = 0.0;
@@ -104,8 +104,8 @@ struct StabilityCase {
     // The reference's verdict: "exact" (matches the analytic answer), "wrong" (misses it, failed,
     // NaN/Inf or black), "unchecked" (no analytic answer for this scene, healthy).
     std::string referenceVerdict() const;
-    const BackendRun* run(const std::string& backend, const std::string& variant) const;
-    const MethodBias* biasOf(const std::string& backend) const;
+    const BackendRun* run(scene::Backend backend, const std::string& variant) const;
+    const MethodBias* biasOf(scene::Backend backend) const;
 };
 
 // Never throws for a render failure (recorded in the case); throws scene::InputError for bad

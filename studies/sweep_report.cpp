@@ -72,8 +72,8 @@ std::string settingsOf(const SweepRow& r) {
     return s;
 }
 
-std::vector<std::string> backendsOf(const std::vector<SweepRow>& rows) {
-    std::vector<std::string> b;
+std::vector<scene::Backend> backendsOf(const std::vector<SweepRow>& rows) {
+    std::vector<scene::Backend> b;
     for (const auto& r : rows)
         if (std::find(b.begin(), b.end(), r.config.backend) == b.end()) b.push_back(r.config.backend);
     return b;
@@ -135,10 +135,14 @@ compare::ErrorHotspot hotspotOf(const SweepRow& r) {
     return h;
 }
 
-std::string backendTitle(const std::string& backend) {
-    if (backend == "raster") return "the shadow map (raster)";
-    if (backend == "raytrace") return "the ray tracer (raytrace)";
-    return backend;
+std::string backendTitle(scene::Backend backend) {
+    const std::string name = scene::toString(backend);
+    switch (backend) {
+        case scene::Backend::Raster: return "the shadow map (" + name + ")";
+        case scene::Backend::Raytrace: return "the ray tracer (" + name + ")";
+        case scene::Backend::Reference: break;
+    }
+    return name;
 }
 
 // Best: least mismatch, then faster. Worst: most mismatch, then slower. Indices into rows.
@@ -146,7 +150,7 @@ struct Extremes {
     std::ptrdiff_t best = -1, worst = -1;
 };
 
-Extremes extremesOf(const std::vector<SweepRow>& rows, const std::string& backend) {
+Extremes extremesOf(const std::vector<SweepRow>& rows, scene::Backend backend) {
     Extremes e;
     for (std::size_t i = 0; i < rows.size(); ++i) {
         const SweepRow& r = rows[i];
@@ -165,7 +169,7 @@ Extremes extremesOf(const std::vector<SweepRow>& rows, const std::string& backen
 // Row indices on each backend's Pareto front of (per-frame time, mismatch).
 std::vector<bool> frontRows(const std::vector<SweepRow>& rows) {
     std::vector<bool> on(rows.size(), false);
-    for (const std::string& backend : backendsOf(rows)) {
+    for (const scene::Backend backend : backendsOf(rows)) {
         std::vector<compare::TimeErrorPoint> pts;
         std::vector<std::size_t> index;
         for (std::size_t i = 0; i < rows.size(); ++i)
@@ -228,7 +232,7 @@ bool hasFlicker(const SweepReportInput& in) {
 }
 
 std::string rowsTable(const SweepReportInput& in, const std::vector<bool>& front) {
-    std::map<std::string, Extremes> ext;
+    std::map<scene::Backend, Extremes> ext;
     for (const auto& b : backendsOf(in.rows)) ext[b] = extremesOf(in.rows, b);
     const Machines machines = machinesOf(in.rows);
     const bool perMachine = machines.list.size() > 1;
@@ -245,7 +249,7 @@ std::string rowsTable(const SweepReportInput& in, const std::vector<bool>& front
         if (!usable(r)) continue;
         const Extremes& e = ext[r.config.backend];
         o << "<tr" << (front[i] ? " class=\"front\"" : "") << "><td>" << i + 1 << "</td><td>"
-          << compare::escapeHtml(r.config.backend) << "</td><td>" << compare::escapeHtml(rowTitle(r));
+          << scene::toString(r.config.backend) << "</td><td>" << compare::escapeHtml(rowTitle(r));
         if (front[i]) o << " <span class=\"tag front\" title=\"on the Pareto front\">front</span>";
         if (std::ptrdiff_t(i) == e.best) o << " <span class=\"tag best\">best</span>";
         if (std::ptrdiff_t(i) == e.worst && e.worst != e.best) o << " <span class=\"tag worst\">worst</span>";
@@ -325,7 +329,7 @@ std::string sweepErrorTimeSvg(const SweepReportInput& in) {
     for (std::size_t i = 0; i < in.rows.size(); ++i) {
         const SweepRow& r = in.rows[i];
         if (usable(r))
-            points.push_back({r.config.backend, r.frameMs, r.rate("mismatch_rate"), rowTitle(r),
+            points.push_back({scene::toString(r.config.backend), r.frameMs, r.rate("mismatch_rate"), rowTitle(r),
                               machines.label(machines.ofRow[i])});
     }
     compare::ErrorTimeOptions o;
@@ -355,11 +359,11 @@ std::string sweepFlickerSvg(const SweepReportInput& in) {
         for (bool held : {false, true}) {
             const double f = r.temporalValue("flicker_rate", held);
             if (!std::isfinite(f)) continue;
-            const std::string name = r.config.backend + (held ? " held view" : "");
+            const std::string name = std::string(scene::toString(r.config.backend)) + (held ? " held view" : "");
             if (!series.count(name)) {
                 names.push_back(name);
                 series[name].name = name;
-                series[name].color = compare::backendColor(held ? "raster held view" : r.config.backend, names.size() - 1);
+                series[name].color = compare::backendColor(held ? name : scene::toString(r.config.backend), names.size() - 1);
                 series[name].shape = held ? 1 : 0;
             }
             series[name].points.push_back(
@@ -375,7 +379,7 @@ std::string sweepFlickerSvg(const SweepReportInput& in) {
 
 std::vector<std::string> describeSweep(const SweepReportInput& in, const AutoBias& bias) {
     std::vector<std::string> lines;
-    for (const std::string& backend : backendsOf(in.rows)) {
+    for (const scene::Backend backend : backendsOf(in.rows)) {
         const SweepRow* fastest = nullptr;
         for (const SweepRow& r : in.rows)
             if (r.config.backend == backend && usable(r) && r.rate("mismatch_rate") <= compare::kSweepGoodMismatchRate &&
@@ -470,7 +474,7 @@ std::string renderSweepReportHtml(const SweepReportInput& in) {
     o << "</div></div>\n";
 
     // Best and worst configuration of each backend.
-    for (const std::string& backend : backendsOf(in.rows)) {
+    for (const scene::Backend backend : backendsOf(in.rows)) {
         const Extremes e = extremesOf(in.rows, backend);
         if (e.best < 0) continue;
         o << "<h2>" << compare::escapeHtml(backendTitle(backend)) << ": best and worst configuration</h2>\n<div class=\"backend\">"
@@ -524,7 +528,7 @@ std::string renderSweepReportHtml(const SweepReportInput& in) {
         for (std::size_t i = 0; i < in.rows.size(); ++i) {
             const SweepRow& r = in.rows[i];
             if (usable(r)) continue;
-            o << "<div class=\"failure\"><b>#" << i + 1 << " " << compare::escapeHtml(r.config.backend + ": " + rowTitle(r)) << ":</b> "
+            o << "<div class=\"failure\"><b>#" << i + 1 << " " << compare::escapeHtml(std::string(scene::toString(r.config.backend)) + ": " + rowTitle(r)) << ":</b> "
               << compare::escapeHtml(r.error.empty() ? std::string("no metrics recorded") : r.error) << "</div>\n";
         }
     }

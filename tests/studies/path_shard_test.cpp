@@ -264,7 +264,7 @@ TEST(SweepFlickerAxis, SnappedFittedMapsHoldStillInTheHeldViewWhereUnsnappedOnes
     grid.flicker = spec;
     for (bool snap : {true, false}) {
         SweepConfig c;
-        c.backend = "raster";
+        c.backend = scene::Backend::Raster;
         c.overrides.shadowMapSize = kMap;
         c.overrides.filter = "pcf2x2";
         c.overrides.fitLightFrustum = true;
@@ -274,7 +274,7 @@ TEST(SweepFlickerAxis, SnappedFittedMapsHoldStillInTheHeldViewWhereUnsnappedOnes
         grid.configs.push_back(c);
     }
     SweepConfig rt;
-    rt.backend = "raytrace";
+    rt.backend = scene::Backend::Raytrace;
     grid.configs.push_back(rt);
     const TempFolder dir("sweep-flicker");
     SweepOptions options;

@@ -51,12 +51,12 @@ struct FakeRenderer {
     int referenceCalls = 0;
     std::map<std::string, int> calls;
     RenderFn fn() {
-        return [this](const scene::Scene& sc, const scene::RenderSettings& s, const std::string& backend) {
-            if (backend == "reference") ++referenceCalls;
-            const std::string what = backend + std::to_string(s.raster.shadowMapSize) + std::to_string(s.raster.depthBias) +
+        return [this](const scene::Scene& sc, const scene::RenderSettings& s, scene::Backend backend) {
+            if (backend == scene::Backend::Reference) ++referenceCalls;
+            const std::string what = scene::toString(backend) + std::to_string(s.raster.shadowMapSize) + std::to_string(s.raster.depthBias) +
                                      std::to_string(s.raytrace.rayBias);
             const int n = calls[what]++;
-            const float v = backend == "raster" && s.raster.shadowMapSize == 512 ? 0.0f : 1.0f;
+            const float v = backend == scene::Backend::Raster && s.raster.shadowMapSize == 512 ? 0.0f : 1.0f;
             scene::Frame f = compare::test::uniformFrame(sc.camera.width, sc.camera.height, 1.0f, 0.6f, v);
             f.timingsMs = {{"setup", 2.0}, {"render", n == 0 ? 50.0 : 10.0 + n}};
             return f;
@@ -85,7 +85,7 @@ SweepGrid grid(int n) {
     g.resolution = "24x16";
     for (int i = 0; i < n; ++i) {
         SweepConfig c;
-        c.backend = "raster";
+        c.backend = scene::Backend::Raster;
         c.overrides.shadowMapSize = i % 2 ? 1024 : 512;
         c.overrides.filter = "none";
         c.overrides.depthBias = 0.001 * (i + 1);
@@ -96,7 +96,7 @@ SweepGrid grid(int n) {
     }
     for (const char* bias : {"0.001", "robust"}) {
         SweepConfig c;
-        c.backend = "raytrace";
+        c.backend = scene::Backend::Raytrace;
         c.overrides.rayBias = bias;
         c.overrides.precision = "float";
         g.configs.push_back(c);

@@ -44,17 +44,17 @@ const char* kScene = R"({
 // Deterministic jitter of a few percent, so repeated frames do not time identically.
 double jitter(int call) { return 1.0 + 0.06 * (compare::test::hashNoise(call, 7) - 0.5); }
 
-scene::Frame fakeRender(const scene::Scene& s, const scene::RenderSettings& settings, const std::string& backend) {
+scene::Frame fakeRender(const scene::Scene& s, const scene::RenderSettings& settings, scene::Backend backend) {
     static int call = 0;
     ++call;
     compare::test::SyntheticOptions o;
     o.width = s.camera.width;
     o.height = s.camera.height;
     scene::Frame f;
-    if (backend == "reference") {
+    if (backend == scene::Backend::Reference) {
         f = compare::test::syntheticFrame(o);
         f.timingsMs = {{"setup", 3.1}, {"primary", 210.0}, {"shadow", 690.0}};
-    } else if (backend == "raster") {
+    } else if (backend == scene::Backend::Raster) {
         const auto& r = settings.raster;
         if (r.shadowMapSize >= 4096 && r.filter == scene::ShadowFilter::Pcf2x2)
             throw std::runtime_error("VK_ERROR_OUT_OF_DEVICE_MEMORY: vkAllocateMemory for the 4096² shadow map (fake)");
@@ -95,7 +95,7 @@ scene::Frame fakeRender(const scene::Scene& s, const scene::RenderSettings& sett
         f.timingsMs = {{"setup", 2.8 * jitter(call)}, {"primary", 30.0 * scale * jitter(call + 1)},
                        {"shadow", (t.robustOffset ? 68.0 : 62.0) * scale * jitter(call + 2)}};
     }
-    f.attributes["backend"] = backend;
+    f.attributes["backend"] = scene::toString(backend);
     return f;
 }
 
@@ -144,11 +144,12 @@ int main(int argc, char** argv) {
         report.scenePath = (dir / "scene.json").string();
         report.objectNames = {"sphere", "ground"};
         const scene::RenderSettings defaults = scene::resolveSettings(s, {});
-        const scene::Frame reference = fakeRender(s, defaults, "reference");
+        const scene::Frame reference = fakeRender(s, defaults, scene::Backend::Reference);
         scene::writePngLinear(dir / "reference.png", reference.width, reference.height, reference.beauty);
         report.reference = {"reference", "reference.png", reference};
-        for (const std::string backend : {"raytrace", "raster"}) {
-            const scene::Frame frame = fakeRender(s, defaults, backend);
+        for (const scene::Backend b : {scene::Backend::Raytrace, scene::Backend::Raster}) {
+            const std::string backend = scene::toString(b);
+            const scene::Frame frame = fakeRender(s, defaults, b);
             scene::writePngLinear(dir / (backend + ".png"), frame.width, frame.height, frame.beauty);
             const compare::Comparison c = compare::compareFrames(frame, reference);
             scene::writePngDisplay(dir / ("diff-" + backend + ".png"), c.width, c.height, c.diffRgb);
