@@ -12,6 +12,7 @@
 #include <optional>
 #include <cstdio>
 #include <iostream>
+#include <memory>
 #include <set>
 #include <unistd.h>
 
@@ -25,7 +26,7 @@
 #include "studies/machine.h"
 #include "studies/merge.h"
 #include "studies/path.h"
-#include "compare/report.h"
+#include "studies/run.h"
 #include "studies/shard.h"
 #include "studies/stability.h"
 #include "studies/sweep.h"
@@ -33,18 +34,15 @@
 #include "compare/text.h"
 #include "raster/cascades.h"
 #include "raster/debug_views.h"
+#include "raster/devices.h"
 #include "raster/memory.h"
-#include "raster/moment_maps.h"
 #include "raster/renderer.h"
 #include "raster/shadow_layers.h"
-#include "raytrace/memory.h"
-#include "raytrace/renderer.h"
 #include "raytrace/view_search.h"
 #include "scene/error.h"
 #include "scene/frame_identity.h"
 #include "scene/frame_io.h"
 #include "scene/gltf_export.h"
-#include "scene/input_file.h"
 #include "scene/loader.h"
 #include "scene/mask_io.h"
 #include "scene/memory.h"
@@ -89,33 +87,6 @@ void chooseView(scene::Scene& s, const SceneOptions* o) {
     raytrace::chooseViewAndSun(s, o && o->settings.threads ? *o->settings.threads : 0);
 }
 
-// The raster backend's automatic choices, each with its reason (--explain; the Frame records the
-// same reasons): light-frustum fitting, the cascade count, the map size.
-std::string explainAutomaticChoices(const Prepared& p) {
-    const scene::RasterSettings& s = p.settings.raster;
-    raster::CascadeChoice cascades;
-    raster::ShadowMapSizeChoice size;
-    raster::resolveAutomaticChoices(p.scene, s, &p.plan, &cascades, &size);
-    std::string out = "raster light frustum: ";
-    out += s.fitLightFrustum ? "fitted to what the camera sees (visible receivers and the casters that can shade "
-                               "them), snapped so it holds still"
-                             : "the scene's bounding sphere";
-    out += s.fitLightFrustumIsDefault ? " (default; --no-fit-light-frustum for the bounding sphere)\n"
-                                      : " (set by --fit-light-frustum or the scene)\n";
-    out += "raster cascades: " + cascades.reason + "\n";
-    out += "raster shadow-map size: " + size.reason + "\n";
-    if (scene::isFilterable(s.filter)) {
-        // What the filterable map adds to the frame (docs/raster.md "Filterable shadow maps").
-        const int side = size.size > 0 ? size.size : s.shadowMapSize;
-        out += "raster filter cost: " +
-               raster::describeMomentCost(s.filter, std::uint32_t(side),
-                                          std::uint32_t(raster::shadowMapLayers(p.scene, p.plan, s)),
-                                          s.moments.blurWidth) +
-               ", on top of the depth pass; the lit pass makes one linear lookup per light instead of compare taps\n";
-    }
-    return out;
-}
-
 Prepared prepare(const SceneOptions& o) {
     Prepared p{readingInput(o.scene, [&] { return scene::loadScene(scene::findScene(o.scene)); }), {}, {}};
     if (o.resolution) applyResolution(p.scene, *o.resolution);
@@ -126,7 +97,7 @@ Prepared prepare(const SceneOptions& o) {
     if (o.explain)
         std::cerr << "render plan for " << p.scene.file.string() << ":\n"
                   << p.plan.explain()
-                  << explainAutomaticChoices(p)
+                  << studies::explainAutomaticChoices(p.scene, p.plan, p.settings.raster)
                   << "raster bias: constant " << p.settings.raster.depthBias << " world units"
                   << (p.settings.raster.depthBiasIsDefault
                           ? (p.settings.raster.fitLightFrustum
@@ -173,19 +144,6 @@ Prepared prepare(const SceneOptions& o) {
     return p;
 }
 
-// A light with a radius casts soft shadows; in the raster backend only pcss estimates them, every
-// other filter gives a hard (or PCF-blurred) edge whose penumbra error the classes barely see.
-std::vector<std::string> hardFilterWarnings(const scene::Scene& s, const scene::RasterSettings& r) {
-    std::vector<std::string> out;
-    if (r.filter == scene::ShadowFilter::Pcss) return out;
-    for (std::size_t i = 0; i < s.lights.size(); ++i)
-        if (s.lights[i].radius > 0.0 && s.lights[i].type != scene::LightType::Directional)
-            out.push_back("light " + std::to_string(i) + " has a radius (" + compare::formatShort(s.lights[i].radius) +
-                          ") and casts soft shadows, but the raster backend renders it with the hard filter '" +
-                          scene::toString(r.filter) + "': its penumbra is wrong (see the continuous error); use --filter pcss.");
-    return out;
-}
-
 // Progress on stderr: long work says what it is doing and how long it took.
 class Stage {
 public:
@@ -207,47 +165,10 @@ private:
     Clock::time_point start_;
 };
 
-void checkValidation(const scene::Frame& frame, const scene::RasterSettings& settings) {
-    if (!settings.validate) return;
-    const auto it = frame.attributes.find("validation_messages");
-    if (it == frame.attributes.end() || it->second != "0")
-        throw std::runtime_error("the Vulkan validation layer reported " +
-                                 (it == frame.attributes.end() ? std::string("an unknown number of") : it->second) +
-                                 " message(s) (printed above)");
-}
-
-// `debug`: raster only, what the debug views need (every channel is read back with it).
-scene::Frame renderBackend(const Prepared& p, scene::Backend backend,
-                           scene::ChannelMask channels = scene::kAllChannels, raster::RenderDebug* debug = nullptr) {
-    scene::Frame f = studies::renderFrame(backend, p.scene, p.plan, p.settings, channels, debug);
-    if (backend == scene::Backend::Raster) checkValidation(f, p.settings.raster);
-    f.attributes["scene"] = p.scene.file.string();
-    for (const auto& [key, text] : p.scene.origin.choices) f.attributes["choice." + key] = text;
-    f.attributes["version"] = SHADOWLAB_VERSION;
-    scene::recordIdentity(f, p.scene);
-    return f;
-}
-
-Json timingsJson(const scene::Frame& f) {
-    Json t = Json::object();
-    for (const auto& [stage, ms] : f.timingsMs) t[stage] = ms;
-    t["total"] = f.totalTimeMs();
-    return t;
-}
-
-// An upper estimate of the memory rendering `backend` takes (see scene/memory.h), without the
-// program itself and the Frame's writing.
-std::uint64_t backendMemory(const Prepared& p, scene::Backend backend) {
-    return studies::estimateMemoryBytes(backend, p.scene, p.plan, p.settings);
-}
-
-// "peak memory 412 MiB (estimated at most 530 MiB)", and the same figures for --json.
+// "peak memory 412 MiB (estimated at most 530 MiB)"; studies::memoryJson has the same figures for --json.
 std::string memoryLine(std::uint64_t estimate) {
     return "peak memory " + std::to_string(scene::peakResidentBytes() / scene::kMiB) + " MiB (estimated at most " +
            std::to_string(estimate / scene::kMiB) + " MiB)";
-}
-Json memoryJson(std::uint64_t estimate) {
-    return {{"peak_mib", scene::peakResidentBytes() / scene::kMiB}, {"estimate_mib", estimate / scene::kMiB}};
 }
 
 // Sweep progress: a bar with ETA on a terminal, one plain line per configuration otherwise.
@@ -273,35 +194,6 @@ std::function<void(const studies::SweepProgress&)> sweepProgressPrinter() {
     };
 }
 
-// The display image of a `--view` (raster/debug_views.h), from a raster Frame and its RenderDebug
-// (the shadow-map view needs debug.captureShadowMaps).
-raster::DisplayImage debugView(const std::string& view, const scene::Frame& frame, const scene::Scene& scene,
-                               const raster::RenderDebug& debug) {
-    if (view == "shadow-map") return raster::shadowMapView(debug);
-    if (view == "cascades") return raster::cascadeView(frame, debug);
-    if (view == "light-frustum") return raster::lightFrustumView(frame, scene, debug);
-    return raster::texelDensityView(frame, scene, debug);
-}
-
-// What each view the run report shows is for, under its image.
-struct RunView {
-    const char* view;
-    const char* title;
-    const char* caption;
-};
-constexpr RunView kRunViews[] = {
-    {"shadow-map", "shadow maps",
-     "Every shadow-map layer as depth: near the light white, far dark gray, nothing drawn dark blue."},
-    {"light-frustum", "light frustum",
-     "What each map holds, tinted over the scene, and its frustum's edges (dashed where hidden); lit points no "
-     "map holds are striped magenta: no shadow can fall there."},
-    {"texel-density", "texel density",
-     "Shadow-map texel against screen pixel at every visible point: green 1:1, yellow to red texels larger "
-     "(blocky shadows), cyan to blue smaller (map resolution wasted)."},
-    {"cascades", "cascades", "The cascade each pixel's shadow test used: red, green, blue, yellow from near to far."},
-};
-
-
 // `render -o` into a missing folder: created once the input is known to be good, and the user is
 // told (docs/decisions.md, "Output paths"); app::checkOutputFile has refused what cannot be used.
 void createOutputFolder(const fs::path& output) {
@@ -311,27 +203,6 @@ void createOutputFolder(const fs::path& output) {
     fs::create_directories(output.parent_path());
     std::cerr << "shadowlab: created the folder " << output.parent_path().string() << " for " << output.filename().string()
               << "\n";
-}
-
-// The run folder's manifest: every file and folder a run wrote, relative to the folder. The next
-// run into the same folder removes what the manifest lists and it did not write again (an earlier
-// run's raster-cascades.png, or raster.exr before --no-raster), so the folder holds only what its
-// report owns; nothing else in the folder is touched (docs/decisions.md, "Run folders").
-constexpr const char* kRunManifest = ".shadowlab-run.json";
-
-std::vector<std::string> readRunManifest(const fs::path& dir) {
-    std::vector<std::string> names;
-    std::error_code ec;
-    if (!fs::exists(dir / kRunManifest, ec)) return names;
-    try {
-        // Through the input opener: a FIFO or a huge file in its place is refused, not waited on.
-        const Json j = Json::parse(scene::readInputFile(dir / kRunManifest, scene::kMaxJsonFileBytes));
-        for (const Json& n : j.at("files"))
-            if (n.is_string()) names.push_back(n.get<std::string>());
-    } catch (const std::exception&) {
-        return {};  // not ours, or damaged: the names run writes are still replaced
-    }
-    return names;
 }
 
 scene::Budgets parseBudgets(const BudgetOptions& o) {
@@ -351,14 +222,29 @@ bool reportBudgets(const std::string& method, const std::vector<compare::BudgetC
     return compare::anyBroken(checks);
 }
 
-// A run's staging folder: removed when the run ends without committing it.
-struct StagingFolder {
-    fs::path dir;
-    bool committed = false;
-    ~StagingFolder() {
-        std::error_code ignored;
-        if (!committed) fs::remove_all(dir, ignored);
+// What `run` tells as it goes, on stderr: its stages with their times, warnings, a backend's
+// failure, the budgets, the sweep's progress and the recommendation's sentences.
+class RunPrinter final : public studies::RunProgress {
+public:
+    void begin(const std::string& stage) override { stages_.push_back(std::make_unique<Stage>(stage)); }
+    void end(const std::string& note) override {
+        stages_.back()->done(note);
+        stages_.pop_back();
     }
+    void backendFailed(scene::Backend backend, const std::string& error) override {
+        stages_.pop_back();
+        std::cerr << "\nshadowlab: error: " << scene::toString(backend) << " backend failed: " << error << "\n";
+    }
+    void warning(const std::string& text) override { std::cerr << "shadowlab: warning: " << text << "\n"; }
+    void budgets(const std::string& method, const std::vector<compare::BudgetCheck>& checks) override {
+        reportBudgets(method, checks);
+    }
+    void sweep(const studies::SweepProgress& progress) override { sweepProgress_(progress); }
+    void note(const std::string& text) override { std::cerr << "shadowlab: " << text << "\n"; }
+
+private:
+    std::vector<std::unique_ptr<Stage>> stages_;
+    std::function<void(const studies::SweepProgress&)> sweepProgress_ = sweepProgressPrinter();
 };
 
 }  // namespace
@@ -398,7 +284,8 @@ int render(const RenderOptions& o) {
     const Prepared p = prepare(o.common);
     // A view writes a display image, not the Frame; the shadow-map view holds every layer's depths.
     const std::uint64_t estimate =
-        scene::kProgramBytes + scene::sceneBytes(p.scene) + backendMemory(p, o.backend) +
+        scene::kProgramBytes + scene::sceneBytes(p.scene) +
+        studies::estimateMemoryBytes(o.backend, p.scene, p.plan, p.settings) +
         (o.view ? raster::debugViewBytes(p.scene, p.plan, p.settings.raster, *o.view)
                 : scene::frameWriteBytes(p.scene));
     scene::checkMemory(estimate, o.view ? "rendering the " + *o.view + " view of " +
@@ -413,33 +300,34 @@ int render(const RenderOptions& o) {
         raster::RenderDebug debug;
         debug.captureShadowMaps = *o.view == "shadow-map";
         const scene::Frame frame = raster::render(p.scene, p.plan, p.settings.raster, &debug);
-        checkValidation(frame, p.settings.raster);
-        const raster::DisplayImage img = debugView(*o.view, frame, p.scene, debug);
+        studies::checkValidation(frame, p.settings.raster);
+        const raster::DisplayImage img = studies::debugView(*o.view, frame, p.scene, debug);
         scene::writePngDisplay(o.output, img.width, img.height, img.rgb);
         stage.done(std::to_string(img.width) + "x" + std::to_string(img.height) + " -> " + o.output.string() +
                    ", " + memoryLine(estimate));
         if (o.common.json) {
             Json j = {{"backend", backendName}, {"view", *o.view}, {"output", o.output.string()},
-                      {"timings_ms", timingsJson(frame)}, {"attributes", frame.attributes},
-                      {"memory", memoryJson(estimate)}};
+                      {"timings_ms", studies::timingsJson(frame)}, {"attributes", frame.attributes},
+                      {"memory", studies::memoryJson(estimate)}};
             std::cout << j.dump(2) << "\n";
         }
         return 0;
     }
     if (o.backend == scene::Backend::Raster)
-        for (const std::string& w : hardFilterWarnings(p.scene, p.settings.raster))
+        for (const std::string& w : studies::hardFilterWarnings(p.scene, p.settings.raster))
             std::cerr << "shadowlab: warning: " << w << "\n";
     Stage stage("rendering " + p.scene.file.filename().string() + " with " + backendName);
     // A PNG holds the beauty only, in 8-bit sRGB: the raster backend then renders nothing else,
     // into an 8-bit sRGB target.
-    const scene::Frame frame = renderBackend(
-        p, o.backend, ext == ".png" ? scene::kChannelBeauty | scene::kBeautyForDisplay : scene::kAllChannels);
+    const scene::Frame frame =
+        studies::renderForOutput(p.scene, p.plan, p.settings, o.backend,
+                                 ext == ".png" ? scene::kChannelBeauty | scene::kBeautyForDisplay : scene::kAllChannels);
     scene::writeFrame(frame, o.output);
     stage.done(std::to_string(frame.width) + "x" + std::to_string(frame.height) + " -> " + o.output.string() +
                ", " + memoryLine(estimate));
     if (o.common.json) {
-        Json j = {{"backend", backendName}, {"output", o.output.string()}, {"timings_ms", timingsJson(frame)},
-                  {"attributes", frame.attributes}, {"memory", memoryJson(estimate)}};
+        Json j = {{"backend", backendName}, {"output", o.output.string()}, {"timings_ms", studies::timingsJson(frame)},
+                  {"attributes", frame.attributes}, {"memory", studies::memoryJson(estimate)}};
         std::cout << j.dump(2) << "\n";
     }
     return 0;
@@ -493,183 +381,21 @@ int info(bool validate) {
 
 int run(const RunOptions& o) {
     checkOutputFolder(o.outputDir);
-    const scene::Budgets cliBudgets = parseBudgets(o.budgets);
+    studies::RunStudyOptions options;
+    options.outputDir = o.outputDir;
+    options.raster = !o.skipRaster;
+    options.sweep = !o.skipSweep;
+    options.budgets = parseBudgets(o.budgets);
+    options.user = o.common.settings;
     const Prepared p = prepare(o.common);
-    const scene::Budgets budgets = p.scene.budgets.overriddenBy(cliBudgets);
-    bool budgetBroken = false;
-    // The reference, the ray-traced and the raster Frames are all held until the report is
-    // written, with a difference image for each method (the half-size sweep needs less).
-    const std::uint64_t pixels = std::uint64_t(p.scene.camera.width) * std::uint64_t(p.scene.camera.height);
-    // The raster backend's debug views for the report: its shadow maps read back, and one display
-    // image at a time (a view's bytes hold the maps and the image being written).
-    const bool views = !o.skipRaster && std::any_of(p.plan.lights.begin(), p.plan.lights.end(),
-                                                     [](const scene::LightPlan& l) { return l.needsShadowTest; });
-    const std::uint64_t estimate =
-        scene::kProgramBytes + scene::sceneBytes(p.scene) + backendMemory(p, scene::Backend::Raytrace) + scene::frameBytes(p.scene) +
-        (o.skipRaster ? 0 : backendMemory(p, scene::Backend::Raster)) + scene::frameWriteBytes(p.scene) +
-        2 * pixels * 3 * sizeof(float) +
-        (views ? raster::debugViewBytes(p.scene, p.plan, p.settings.raster, "shadow-map") : 0);
-    scene::checkMemory(estimate, "run at " + std::to_string(p.scene.camera.width) + "x" +
-                                     std::to_string(p.scene.camera.height));
-    fs::create_directories(o.outputDir);
-    const scene::FolderLock lock(o.outputDir, "run");
-    // The run's files are made in a fresh folder beside the output folder, which they replace as
-    // a set once all are written (the commit at the end): a folder never mixes two runs, and a run that
-    // fails half-way (a full disk) leaves the previous one whole.
-    const fs::path target = fs::canonical(o.outputDir);
-    scene::removeStaleTemporaries(target.parent_path());  // what an earlier run that was killed left behind
-    scene::removeStaleTemporaries(target);
-    const fs::path dir = scene::temporarySibling(target);
-    fs::create_directory(dir);
-    StagingFolder staging{dir};
-    const std::vector<std::string> earlierFiles = readRunManifest(target);
-    std::vector<std::string> written;  // for the manifest
-    int status = 0;
-
-    Json metrics = {{"scene", p.scene.file.string()},
-                    {"resolution", {p.scene.camera.width, p.scene.camera.height}},
-                    {"version", SHADOWLAB_VERSION}};
-    compare::ReportInput report;
-    report.sceneName = p.scene.file.stem().string();
-    report.scenePath = p.scene.file.string();
-    report.planText = p.plan.explain() + explainAutomaticChoices(p);  // and the raster backend's choices
-    for (const scene::Object& object : p.scene.objects) report.objectNames.push_back(object.name);
-
-    if (!o.skipRaster) {
-        report.warnings = hardFilterWarnings(p.scene, p.settings.raster);
-        for (const std::string& w : report.warnings) std::cerr << "shadowlab: warning: " << w << "\n";
-        if (!report.warnings.empty()) metrics["warnings"] = report.warnings;
-    }
-    Stage refStage("reference (double precision, robust offsets)");
-    const scene::Frame reference = renderBackend(p, scene::Backend::Reference);
-    const std::string referenceName = scene::toString(scene::Backend::Reference);
-    scene::writeFrame(reference, dir / (referenceName + ".exr"));
-    scene::writePngLinear(dir / (referenceName + ".png"), reference.width, reference.height, reference.beauty);
-    written.insert(written.end(), {referenceName + ".exr", referenceName + ".png"});
-    refStage.done();
-    metrics[referenceName] = {{"timings_ms", timingsJson(reference)}, {"attributes", reference.attributes}};
-    report.reference = {referenceName, referenceName + ".png", reference};
-
-    // The user's configuration at the requested resolution, kept for the recommendation's check.
-    std::optional<scene::Frame> defaultsFrame[2];  // raytrace, raster
-    for (const scene::Backend b : {scene::Backend::Raytrace, scene::Backend::Raster}) {
-        const bool isRaster = b == scene::Backend::Raster;
-        if (isRaster && o.skipRaster) continue;
-        const std::string backend = scene::toString(b);
-        Stage stage(isRaster ? "raster (Vulkan shadow map)" : "raytrace (shadow rays)");
-        scene::Frame frame;
-        raster::RenderDebug debug;
-        debug.captureShadowMaps = views;
-        try {
-            frame = renderBackend(p, b, scene::kAllChannels, isRaster && views ? &debug : nullptr);
-        } catch (const std::exception& e) {
-            // One backend failing (no Vulkan driver, say) must not lose the other's results.
-            std::cerr << "\nshadowlab: error: " << backend << " backend failed: " << e.what() << "\n";
-            metrics["methods"][backend] = {{"error", e.what()}};
-            report.failures.push_back({backend, e.what()});
-            status = 1;
-            continue;
-        }
-        defaultsFrame[isRaster] = frame;
-        scene::writeFrame(frame, dir / (backend + ".exr"));
-        scene::writePngLinear(dir / (backend + ".png"), frame.width, frame.height, frame.beauty);
-        const compare::Comparison c = compare::compareFrames(frame, reference);
-        scene::writePngDisplay(dir / ("diff-" + backend + ".png"), c.width, c.height, c.diffRgb);
-        written.insert(written.end(), {backend + ".exr", backend + ".png", "diff-" + backend + ".png"});
-        stage.done(compare::summaryLine(c.metrics));
-        metrics["methods"][backend] = {{"metrics", compare::toJson(c.metrics)},
-                                       {"timings_ms", timingsJson(frame)},
-                                       {"attributes", frame.attributes}};
-        const std::vector<compare::BudgetCheck> checks = compare::checkBudgets(c.metrics, budgets);
-        if (!checks.empty()) metrics["methods"][backend]["budgets"] = compare::toJson(checks);
-        budgetBroken = reportBudgets(backend, checks) || budgetBroken;
-        compare::ReportMethod method{backend, backend + ".png", "diff-" + backend + ".png", frame, c.metrics};
-        method.heatPng = "heat-" + backend + ".png";
-        scene::writePngDisplay(dir / method.heatPng, c.width, c.height, c.heatRgb);
-        written.push_back(method.heatPng);
-        for (std::size_t l = 0; l < c.lightHeatRgb.size(); ++l) {
-            method.lightHeatPngs.push_back("heat-" + backend + "-light" + std::to_string(l) + ".png");
-            scene::writePngDisplay(dir / method.lightHeatPngs.back(), c.width, c.height, c.lightHeatRgb[l]);
-            written.push_back(method.lightHeatPngs.back());
-        }
-        report.methods.push_back(std::move(method));
-        if (isRaster && views) {
-            for (const RunView& v : kRunViews) {
-                if (std::string_view(v.view) == "cascades" && raster::cascadeSplits(debug.layers).empty()) continue;
-                const raster::DisplayImage img = debugView(v.view, frame, p.scene, debug);
-                const std::string png = std::string("raster-") + v.view + ".png";
-                scene::writePngDisplay(dir / png, img.width, img.height, img.rgb);
-                written.push_back(png);
-                report.shadowMapViews.push_back({v.title, png, img.width, img.height, v.caption});
-            }
-        }
-    }
-
-    if (!o.skipSweep) {
-        // A small sweep at half resolution puts error against run time and the bias windows into
-        // the report. It starts fresh in a temporary folder (rows of an earlier build must not mix
-        // with this one's) that replaces sweep/ in one step when it is complete, so a run killed
-        // in the middle leaves the old sweep/ whole.
-        studies::SweepGrid grid = studies::defaultGrid(p.scene, true);
-        grid.resolution = std::to_string(std::max(16, p.scene.camera.width / 2)) + "x" +
-                          std::to_string(std::max(16, p.scene.camera.height / 2));
-        if (o.skipRaster)
-            std::erase_if(grid.configs, [](const studies::SweepConfig& c) { return c.backend == scene::Backend::Raster; });
-        for (studies::SweepConfig& c : grid.configs) {
-            c.overrides.threads = o.common.settings.threads;
-            c.overrides.device = o.common.settings.device;
-            c.overrides.validate = o.common.settings.validate;
-        }
-        studies::SweepOptions options;
-        options.outputDir = scene::temporarySibling(dir / "sweep");
-        options.progress = sweepProgressPrinter();
-        Stage stage("quick sweep of " + std::to_string(grid.configs.size()) + " configurations at " + *grid.resolution);
-        const studies::SweepResult result = studies::runSweep(p.scene, grid, options);
-        studies::SweepReportInput input = studies::makeSweepReportInput(report.sceneName, report.scenePath, result);
-        {
-            Stage rec("recommended shadow block: biases searched in this configuration, checked at " +
-                      std::to_string(p.scene.camera.width) + "x" + std::to_string(p.scene.camera.height));
-            scene::Scene half = p.scene;
-            half.camera.width = result.reference.width;
-            half.camera.height = result.reference.height;
-            studies::RecommendOptions ro;
-            ro.user = o.common.settings;
-            ro.raster = !o.skipRaster;
-            input.recommendation = studies::recommendShadow(
-                half, result.reference, p.scene, reference, defaultsFrame[1] ? &*defaultsFrame[1] : nullptr,
-                defaultsFrame[0] ? &*defaultsFrame[0] : nullptr,
-                studies::rayCandidateOf(studies::recommendBias(result.rows)), ro);
-            rec.done(std::to_string(input.recommendation->points.size()) + " raster points");
-            for (const std::string& note : input.recommendation->notes) std::cerr << "shadowlab: " << note << "\n";
-        }
-        studies::writeSweepReport(options.outputDir, input);
-        scene::replaceDirectory(options.outputDir, dir / "sweep");
-        written.push_back("sweep/");
-        report.sweep = studies::summarizeSweep(input, "sweep/report.html");
-        stage.done("sweep/report.html");
-        metrics["sweep"] = {{"configurations", result.rows.size()}, {"report", "sweep/report.html"},
-                            {"results", "sweep/results.csv"},
-                            {"recommended", input.recommendation->toJson()}};
-    }
-
-    metrics["memory"] = memoryJson(estimate);
-    scene::writeTextAtomic(dir / "metrics.json", metrics.dump(2) + "\n");
-    compare::writeReport(dir, report);
-    written.insert(written.end(), {"metrics.json", "report.html"});
-    scene::writeTextAtomic(dir / kRunManifest, Json{{"files", written}}.dump(2) + "\n");
-    // The commit: this run's files replace the previous run's as a set. What stays is the user's
-    // own: neither a name run writes nor one the earlier run's manifest lists (and the lock).
-    auto earlierRun = [&](const std::string& name) {
-        return std::find(earlierFiles.begin(), earlierFiles.end(), name) != earlierFiles.end() ||
-               std::find(earlierFiles.begin(), earlierFiles.end(), name + "/") != earlierFiles.end();
-    };
-    scene::replaceFolderContents(dir, target,
-                                 [&](const std::string& name) { return !isRunOutput(name) && !earlierRun(name); });
-    staging.committed = true;
-    std::cerr << "shadowlab: wrote " << (o.outputDir / "report.html").string() << "; " << memoryLine(estimate) << "\n";
-    if (o.common.json) std::cout << metrics.dump(2) << "\n";
+    RunPrinter printer;
+    options.progress = &printer;
+    const studies::RunStudyResult r = studies::runStudy(p.scene, p.settings, p.plan, options);
+    std::cerr << "shadowlab: wrote " << (o.outputDir / "report.html").string() << "; " << memoryLine(r.memoryEstimate)
+              << "\n";
+    if (o.common.json) std::cout << r.metrics.dump(2) << "\n";
     // A failure (1) says more than a broken budget: a method that did not render measured nothing.
-    return status != 0 ? status : budgetBroken ? kExitBudgetBroken : 0;
+    return r.backendFailed ? 1 : r.budgetBroken ? kExitBudgetBroken : 0;
 }
 
 namespace {

@@ -468,7 +468,7 @@ std::string renderSweepReportHtml(const SweepReportInput& in) {
         compare::FrameInfo ref;
         ref.width = width;
         ref.height = height;
-        o << compare::html::figure("reference", in.referenceMs > 0.0 ? compare::formatDuration(in.referenceMs) : "", in.referencePng, ref,
+        o << compare::html::figure(scene::toString(scene::Backend::Reference), in.referenceMs > 0.0 ? compare::formatDuration(in.referenceMs) : "", in.referencePng, ref,
                           nullptr);
     }
     o << "</div></div>\n";
