@@ -105,7 +105,7 @@ struct PathCommandOptions {
     SceneOptions common;
     std::filesystem::path outputDir;
     // Unset kind, frames, amount, light: the scene's "path" block, else orbit, 12, the kind's default, 0.
-    std::optional<std::string> kind;  // compare::PathKind
+    std::optional<std::string> kind;  // studies::PathKind
     std::optional<int> frames;
     std::optional<double> amount;
     std::optional<int> light;

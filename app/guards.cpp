@@ -50,20 +50,6 @@ void checkOutputFolder(const fs::path& dir, const std::string& option) {
     checkParent(dir, option);
 }
 
-bool isRunOutput(const std::string& name) {
-    static const char* const kExact[] = {"reference.exr", "reference.png", "raytrace.exr", "raytrace.png",
-                                         "raster.exr",    "raster.png",    "metrics.json", "report.html",
-                                         "sweep",         ".shadowlab-run.json"};
-    for (const char* n : kExact)
-        if (name == n) return true;
-    auto startsEnds = [&](const char* prefix, const char* suffix) {
-        const std::string p = prefix, s = suffix;
-        return name.size() > p.size() + s.size() && name.compare(0, p.size(), p) == 0 &&
-               name.compare(name.size() - s.size(), s.size(), s) == 0;
-    };
-    return startsEnds("diff-", ".png") || startsEnds("raster-", ".png") || startsEnds("heat-", ".png");
-}
-
 int finishStandardOutput(int status) {
     errno = 0;
     std::cout.flush();

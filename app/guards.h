@@ -42,10 +42,6 @@ void checkOutputFile(const std::filesystem::path& file, const std::string& optio
 // writable folder.
 void checkOutputFolder(const std::filesystem::path& dir, const std::string& option = "-o");
 
-// The names `run` writes into its folder (at the top level): what a new run replaces as a set.
-// Anything else in the folder is the user's and is kept.
-bool isRunOutput(const std::string& name);
-
 // Flushes standard output and returns `status`, or prints why the write failed (a full disk,
 // a closed pipe) and returns 1: results that did not reach their reader are a failure.
 int finishStandardOutput(int status);

@@ -10,7 +10,7 @@
 #include "scene/camera.h"
 #include "scene/error.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 namespace {
 
 using Real = long double;
@@ -298,4 +298,4 @@ AnalyticCheck checkAgainstAnalytic(const scene::Frame& reference, const Analytic
     return c;
 }
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -13,7 +13,7 @@
 #include "scene/frame.h"
 #include "scene/scene.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 // Knife-edge margins of the oracle. A pixel whose answer would flip if a length moved by less
 // than this is not judged: the double reference may round either way there.
@@ -65,4 +65,4 @@ struct AnalyticCheck {
 // missing.
 AnalyticCheck checkAgainstAnalytic(const scene::Frame& reference, const AnalyticFrame& answer);
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

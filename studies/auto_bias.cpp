@@ -10,7 +10,7 @@
 #include "compare/text.h"
 #include "scene/error.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 namespace {
 
@@ -53,7 +53,7 @@ const char* kindKey(const std::string& kind) {
 Json contextOf(const SweepConfig& c, const std::string& skipKey) {
     const auto& o = c.overrides;
     Json j = Json::object();
-    if (c.backend == "raster") {
+    if (c.backend == scene::Backend::Raster) {
         if (o.shadowMapSize) j["shadow_map_size"] = *o.shadowMapSize;
         if (o.filter) j["filter"] = *o.filter;
         if (o.depthBias) j["depth_bias"] = *o.depthBias;
@@ -86,10 +86,11 @@ Json contextOf(const SweepConfig& c, const std::string& skipKey) {
 // The value a configuration sets for a bias kind, if it sets one (a numeric ray bias only).
 std::optional<double> biasOf(const SweepConfig& c, const std::string& kind) {
     const auto& o = c.overrides;
-    if (kind == "depth" && c.backend == "raster") return o.depthBias;
-    if (kind == "slope" && c.backend == "raster") return o.slopeBias;
-    if (momentKind(kind) && c.backend == "raster") return momentOverride(o, kind);
-    if (kind == "ray" && c.backend == "raytrace" && o.rayBias && *o.rayBias != "robust") {
+    const bool raster = c.backend == scene::Backend::Raster;
+    if (kind == "depth" && raster) return o.depthBias;
+    if (kind == "slope" && raster) return o.slopeBias;
+    if (momentKind(kind) && raster) return momentOverride(o, kind);
+    if (kind == "ray" && c.backend == scene::Backend::Raytrace && o.rayBias && *o.rayBias != "robust") {
         char* end = nullptr;
         const double v = std::strtod(o.rayBias->c_str(), &end);
         if (end && *end == '\0' && std::isfinite(v)) return v;
@@ -100,7 +101,7 @@ std::optional<double> biasOf(const SweepConfig& c, const std::string& kind) {
 // A setting's value for sentences: integers as integers ("1024"), others with 3 digits.
 std::string valueText(const Json& value) {
     if (value.is_number_integer()) return std::to_string(value.get<long long>());
-    if (value.is_number()) return formatShort(value.get<double>());
+    if (value.is_number()) return compare::formatShort(value.get<double>());
     if (value.is_string()) return value.get<std::string>();
     return value.dump();
 }
@@ -197,18 +198,18 @@ std::string BiasSeries::describe() const {
     const std::string ctx = contextLabel(context);
     if (!ctx.empty()) s += "; " + ctx;
     s += "): ";
-    const std::string limit = "both rates <= " + formatPercent(window.threshold);
+    const std::string limit = "both rates <= " + compare::formatPercent(window.threshold);
     if (!window.stiff) {
-        s += std::string(momentKind(kind) ? "parameter window " : "bias window ") + formatShort(window.lo) + " .. " + formatShort(window.hi) + " (" + limit + ", " +
+        s += std::string(momentKind(kind) ? "parameter window " : "bias window ") + compare::formatShort(window.lo) + " .. " + compare::formatShort(window.hi) + " (" + limit + ", " +
              std::to_string(window.acceptableSamples) + " sample" + (window.acceptableSamples == 1 ? "" : "s") +
-             "); recommended " + formatShort(recommended);
+             "); recommended " + compare::formatShort(recommended);
         if (window.lo != window.hi)
             s += std::string(" (") + (logSpaced && window.lo > 0.0 ? "geometric" : "arithmetic") + " middle)";
         return s + ".";
     }
-    return s + "stiff: no sampled value keeps " + limit + ". At the best compromise, " + formatShort(window.bestBias) +
-           ", " + artifactName(dominant, kind) + " dominates (" + formatPercent(window.bestFalseShadowRate) +
-           " false, " + formatPercent(window.bestMissedShadowRate) + " missed).";
+    return s + "stiff: no sampled value keeps " + limit + ". At the best compromise, " + compare::formatShort(window.bestBias) +
+           ", " + artifactName(dominant, kind) + " dominates (" + compare::formatPercent(window.bestFalseShadowRate) +
+           " false, " + compare::formatPercent(window.bestMissedShadowRate) + " missed).";
 }
 
 const BiasSeries* AutoBias::primary(const std::string& kind) const {
@@ -227,20 +228,20 @@ const RobustResult* AutoBias::robustPick() const {
 
 AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
     if (!std::isfinite(threshold) || threshold < 0.0)
-        throw scene::InputError("automatic bias: threshold must be a finite rate >= 0, got " + formatShort(threshold));
+        throw scene::InputError("automatic bias: threshold must be a finite rate >= 0, got " + compare::formatShort(threshold));
     AutoBias out;
     out.threshold = threshold;
 
     // Group the usable rows by kind and shared settings, in first-seen order per kind.
     for (const std::string& kind : seriesKinds()) {
         std::vector<BiasSeries> found;
-        std::map<std::string, std::size_t> index;
+        std::map<std::pair<scene::Backend, std::string>, std::size_t> index;  // by backend and context
         for (const SweepRow& r : rows) {
             if (r.config.biasKind != kind || !r.error.empty() || !std::isfinite(r.config.biasValue)) continue;
             const double f = r.rate("false_shadow_rate"), m = r.rate("missed_shadow_rate");
             if (!std::isfinite(f) || !std::isfinite(m)) continue;
             const Json context = contextOf(r.config, kindKey(kind));
-            const std::string groupKey = r.config.backend + "|" + context.dump();
+            const std::pair<scene::Backend, std::string> groupKey{r.config.backend, context.dump()};
             auto it = index.find(groupKey);
             if (it == index.end()) {
                 BiasSeries s;
@@ -260,16 +261,16 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
             const std::optional<double> bias = biasOf(r.config, kind);
             const double f = r.rate("false_shadow_rate"), m = r.rate("missed_shadow_rate");
             if (!bias || !std::isfinite(f) || !std::isfinite(m)) continue;
-            const auto it = index.find(r.config.backend + "|" + contextOf(r.config, kindKey(kind)).dump());
+            const auto it = index.find({r.config.backend, contextOf(r.config, kindKey(kind)).dump()});
             if (it == index.end()) continue;
             auto& samples = found[it->second].samples;
-            if (std::none_of(samples.begin(), samples.end(), [&](const BiasSample& b) { return b.bias == *bias; }))
+            if (std::none_of(samples.begin(), samples.end(), [&](const compare::BiasSample& b) { return b.bias == *bias; }))
                 samples.push_back({*bias, f, m});
         }
         for (BiasSeries& s : found) {
             std::stable_sort(s.samples.begin(), s.samples.end(),
-                             [](const BiasSample& a, const BiasSample& b) { return a.bias < b.bias; });
-            s.window = findBiasWindow(s.samples, threshold);
+                             [](const compare::BiasSample& a, const compare::BiasSample& b) { return a.bias < b.bias; });
+            s.window = compare::findBiasWindow(s.samples, threshold);
             std::vector<double> biases;
             for (const auto& b : s.samples) biases.push_back(b.bias);
             s.logSpaced = isLogSpaced(biases);
@@ -284,7 +285,7 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
     }
 
     for (const SweepRow& r : rows) {
-        if (r.config.backend != "raytrace" || r.config.overrides.rayBias != std::optional<std::string>("robust") ||
+        if (r.config.backend != scene::Backend::Raytrace || r.config.overrides.rayBias != std::optional<std::string>("robust") ||
             !r.error.empty())
             continue;
         const double f = r.rate("false_shadow_rate"), m = r.rate("missed_shadow_rate");
@@ -330,11 +331,11 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
         if (raster->window.stiff) {
             why = "On the probe slice the shadow map is stiff for this scene: no " +
                   std::string(other ? "depth or slope bias" : raster->name()) + " keeps both rates <= " +
-                  formatPercent(threshold) + ". Its best compromise is " +
-                  raster->name() + " " + formatShort(raster->recommended) + ", where " +
+                  compare::formatPercent(threshold) + ". Its best compromise is " +
+                  raster->name() + " " + compare::formatShort(raster->recommended) + ", where " +
                   artifactName(raster->dominant, raster->kind) + " dominates.";
         } else if (other) {
-            why = "On the probe slice the " + raster->name() + " is the pick (" + formatShort(raster->recommended) +
+            why = "On the probe slice the " + raster->name() + " is the pick (" + compare::formatShort(raster->recommended) +
                   " " + raster->unit() + "): ";
             why += other->window.stiff ? "the " + other->name() + " has no window."
                                        : "its window holds " + std::to_string(raster->window.acceptableSamples) +
@@ -342,7 +343,7 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
                                              " for the " + other->name() + ".";
             why += " Each was measured with the other held fixed.";
         } else {
-            why = "On the probe slice: " + raster->name() + " " + formatShort(raster->recommended) + " " + raster->unit() + ".";
+            why = "On the probe slice: " + raster->name() + " " + compare::formatShort(raster->recommended) + " " + raster->unit() + ".";
         }
         out.notes.push_back(why);
     }
@@ -359,7 +360,7 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
             out.notes.push_back(std::string("The ") + m.name + " window was measured with filter " +
                                 (filter.empty() ? std::string("(scene default)") : filter) +
                                 "; the block's shadow map uses " + out.shadowBlock.value("filter", std::string("its default")) +
-                                ", so it does not carry \"" + m.key + "\": " + m.key + " " + formatShort(p->recommended) +
+                                ", so it does not carry \"" + m.key + "\": " + m.key + " " + compare::formatShort(p->recommended) +
                                 " goes with that filter.");
         }
     }
@@ -371,19 +372,19 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
         out.shadowBlock["ray_bias"] = "robust";
         if (!pick->precision.empty()) out.shadowBlock["precision"] = pick->precision;
         out.notes.push_back("Robust ray offsets" + precisionText(pick->precision) + " keep both rates <= " +
-                            formatPercent(threshold) + " (" + formatPercent(pick->falseShadowRate) + " false, " +
-                            formatPercent(pick->missedShadowRate) + " missed) with no bias to tune: the ray tracer "
+                            compare::formatPercent(threshold) + " (" + compare::formatPercent(pick->falseShadowRate) + " false, " +
+                            compare::formatPercent(pick->missedShadowRate) + " missed) with no bias to tune: the ray tracer "
                             "should use \"ray_bias\": \"robust\".");
     } else {
         for (const RobustResult& r : out.robust)
             out.notes.push_back("Robust ray offsets" + precisionText(r.precision) + " do not pass: " +
-                                formatPercent(r.falseShadowRate) + " false, " + formatPercent(r.missedShadowRate) + " missed.");
+                                compare::formatPercent(r.falseShadowRate) + " false, " + compare::formatPercent(r.missedShadowRate) + " missed.");
         if (ray) {
             for (const auto& [key, value] : ray->context.items()) out.shadowBlock[key] = value;
             out.shadowBlock["ray_bias"] = ray->recommended;
             if (ray->window.stiff)
                 out.notes.push_back("The ray tracer is stiff for this scene with a constant ray bias; the block uses the "
-                                    "best compromise, " + formatShort(ray->recommended) + " world units, where " +
+                                    "best compromise, " + compare::formatShort(ray->recommended) + " world units, where " +
                                     artifactName(ray->dominant, "ray") + " dominates.");
         } else if (!out.robust.empty()) {
             const auto best = std::min_element(out.robust.begin(), out.robust.end(), [](const auto& a, const auto& b) {
@@ -396,4 +397,4 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
     return out;
 }
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -14,7 +14,7 @@
 #include "studies/sweep.h"
 #include "compare/thresholds.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 // The rows of one bias kind that differ only in that bias ("map 1024, none, slope bias 0" for
 // a depth-bias series): only such rows show one parameter's acne-to-leak trade-off.
@@ -22,12 +22,12 @@ struct BiasSeries {
     // "depth" | "slope" | "ray", or a filterable map's parameter (seriesKinds()): its window
     // is read the same way, from the false- and missed-shadow rates along the series.
     std::string kind;
-    std::string backend;  // "raster" | "raytrace"
+    scene::Backend backend = scene::Backend::Raster;  // Raster or Raytrace
     // The overrides every row of the series shares (the bias itself left out), as scene-file
     // "shadow" keys: {"shadow_map_size": 1024, "filter": "none", "slope_bias": 0}.
     nlohmann::json context = nlohmann::json::object();
-    std::vector<BiasSample> samples;  // in bias order; failed rows left out
-    BiasWindow window;
+    std::vector<compare::BiasSample> samples;  // in bias order; failed rows left out
+    compare::BiasWindow window;
     bool logSpaced = false;  // the positive samples are closer to a geometric than an arithmetic series
     // The middle of the window (geometric when lo > 0 and logSpaced, else arithmetic), or the
     // best compromise when the series is stiff.
@@ -53,7 +53,7 @@ struct RobustResult {
 };
 
 struct AutoBias {
-    double threshold = kBiasWindowMaxRate;
+    double threshold = compare::kBiasWindowMaxRate;
     std::vector<BiasSeries> series;     // every series found, kinds in seriesKinds() order
     std::vector<RobustResult> robust;   // every robust-offset row that rendered
     // A valid scene-file "shadow" block (scene/loader.cpp readShadow accepts every key it holds):
@@ -76,7 +76,7 @@ struct AutoBias {
 // Reads the bias series out of sweep rows (SweepConfig::biasKind / biasValue and the metrics'
 // false_shadow_rate / missed_shadow_rate). Rows with an error or without both rates are left
 // out. Throws scene::InputError when the threshold is not a finite rate ≥ 0.
-AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold = kBiasWindowMaxRate);
+AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold = compare::kBiasWindowMaxRate);
 
 // Every kind a series may have, in the order of the notes: "depth", "slope", "ray", then the
 // filterable maps' parameters "min_variance", "bleeding_reduction", "evsm_positive",
@@ -89,4 +89,4 @@ double windowMiddle(double lo, double hi, bool logSpaced);
 // difference; false for fewer than two positive values, and for two unless they span a decade.
 bool isLogSpaced(std::vector<double> values);
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -10,7 +10,7 @@
 #include "raytrace/memory.h"
 #include "raytrace/renderer.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 // The driver's and the tracers' many threads each free into their own malloc arena; without a
 // trim, renderers made one after another (sweep rows, the recommendation's checks) leave hundreds
@@ -97,4 +97,4 @@ std::uint64_t estimateMemoryBytes(scene::Backend backend, const scene::Scene& sc
                                              : raytrace::estimateMemoryBytes(scene, plan);
 }
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

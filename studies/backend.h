@@ -16,7 +16,7 @@ namespace shadowlab::raster {
 struct RenderDebug;
 }
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 // A backend's renderer for one scene's objects, reused across frames: the constructor does the
 // setup once (the raster device, maps and buffers; the ray tracer's trees), update() takes the
@@ -59,4 +59,4 @@ scene::Frame renderFrame(scene::Backend backend, const scene::Scene& scene, cons
 std::uint64_t estimateMemoryBytes(scene::Backend backend, const scene::Scene& scene, const scene::RenderPlan& plan,
                                   const scene::RenderSettings& settings);
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -8,11 +8,12 @@
 #include <set>
 
 #include "studies/sweep.h"
+#include "scene/backend.h"
 #include "scene/error.h"
 #include "scene/loader.h"
 #include "scene/settings.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 namespace {
 
@@ -154,9 +155,13 @@ CheckSuite loadSuite(const fs::path& file) {
                 throw SceneError(file, p / "scene", e.what());
             }
         }
-        k.backend = c.contains("backend") ? stringAt(file, c["backend"], p / "backend") : "raster";
-        if (k.backend != "raster" && k.backend != "raytrace")
-            throw SceneError(file, p / "backend", "expected raster or raytrace, got '" + k.backend + "'");
+        if (c.contains("backend")) {
+            const std::string name = stringAt(file, c["backend"], p / "backend");
+            const std::optional<scene::Backend> b = scene::parseBackend(name);
+            if (b != scene::Backend::Raster && b != scene::Backend::Raytrace)
+                throw SceneError(file, p / "backend", "expected raster or raytrace, got '" + name + "'");
+            k.backend = *b;
+        }
         if (c.contains("device")) k.device = stringAt(file, c["device"], p / "device");
         k.scene = scene::loadScene(k.sceneFile);
         const Json* res = c.contains("resolution") ? &c["resolution"] : defaultResolution ? &*defaultResolution : nullptr;
@@ -196,7 +201,7 @@ const std::vector<TrackedMetric>& trackedMetrics() {
     return kMetrics;
 }
 
-BaselineEntry baselineEntry(const Metrics& m) {
+BaselineEntry baselineEntry(const compare::Metrics& m) {
     BaselineEntry e;
     e.metrics = {{"mismatch_rate", m.mismatchRate},
                  {"false_shadow_rate", m.falseShadowRate},
@@ -253,7 +258,7 @@ CheckSuite shardSuite(const CheckSuite& suite, const Shard& shard) {
     return s;
 }
 
-std::vector<MetricDrift> compareWithBaseline(const Metrics& m, const BaselineEntry& entry, const CheckTolerance& t) {
+std::vector<MetricDrift> compareWithBaseline(const compare::Metrics& m, const BaselineEntry& entry, const CheckTolerance& t) {
     const BaselineEntry now = baselineEntry(m);
     std::vector<MetricDrift> out;
     for (const TrackedMetric& tm : trackedMetrics()) {
@@ -301,13 +306,13 @@ std::vector<CaseResult> runSuite(const CheckSuite& suite, const Baseline* baseli
                                        std::to_string(settings.raytrace.samples);
             auto ref = references.find(refKey);
             if (ref == references.end())
-                ref = references.emplace(refKey, renderWithBackend(k.scene, settings, "reference")).first;
+                ref = references.emplace(refKey, renderWithBackend(k.scene, settings, scene::Backend::Reference)).first;
             const auto start = Clock::now();
             const scene::Frame method = renderWithBackend(k.scene, settings, k.backend);
-            Comparison c = compareFrames(method, ref->second);
+            compare::Comparison c = compare::compareFrames(method, ref->second);
             r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-            r.budgets = checkBudgets(c.metrics, k.budgets);
-            for (const BudgetCheck& b : r.budgets)
+            r.budgets = compare::checkBudgets(c.metrics, k.budgets);
+            for (const compare::BudgetCheck& b : r.budgets)
                 if (b.broken) r.failures.push_back("budget " + describe(b));
             if (baseline) {
                 if (const auto e = baseline->find(k.name); e != baseline->end()) {
@@ -338,4 +343,4 @@ std::vector<CaseResult> runSuite(const CheckSuite& suite, const Baseline* baseli
     return results;
 }
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -19,7 +19,7 @@
 #include "scene/budgets.h"
 #include "scene/scene.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 // How far a metric may move the wrong way from its baseline before the case fails. Absolute:
 // the same program renders the same suite bit for bit on one machine; the slack is for other
@@ -33,7 +33,7 @@ struct CheckTolerance {
 struct CheckCase {
     std::string name;          // the case's key: unique in the suite, [A-Za-z0-9._-]
     std::filesystem::path sceneFile;
-    std::string backend;       // raster | raytrace
+    scene::Backend backend = scene::Backend::Raster;  // Raster or Raytrace; Raster when the suite names none
     scene::Scene scene;        // loaded, resolution applied, case settings merged into its "shadow"
     std::string resolution;    // "WxH"
     std::string device;        // raster: Vulkan device ("" = the default)
@@ -68,7 +68,7 @@ struct TrackedMetric {
     bool higherIsBetter;
 };
 const std::vector<TrackedMetric>& trackedMetrics();
-BaselineEntry baselineEntry(const Metrics& metrics);
+BaselineEntry baselineEntry(const compare::Metrics& metrics);
 
 struct MetricDrift {
     std::string metric;
@@ -85,8 +85,8 @@ struct CaseResult {
     CaseVerdict verdict = CaseVerdict::Passed;
     std::string error;                    // Error: what went wrong
     std::vector<std::string> failures;    // Failed: one line per broken budget or regression
-    std::optional<Metrics> metrics;
-    std::vector<BudgetCheck> budgets;
+    std::optional<compare::Metrics> metrics;
+    std::vector<compare::BudgetCheck> budgets;
     bool hasBaseline = false;
     std::vector<MetricDrift> drift;
     double seconds = 0.0;                 // rendering and comparing (the reference excluded)
@@ -102,12 +102,12 @@ std::vector<CaseResult> runSuite(const CheckSuite& suite, const Baseline* baseli
                                  const std::function<void(std::size_t done, const CaseResult&)>& progress);
 
 // The cases of `shard` (`check --shard K/N`), in file order: case names are sorted and dealt
-// round-robin (compare::assignShards, the rule of sweep shards), so the split depends only on
+// round-robin (assignShards, the rule of sweep shards), so the split depends only on
 // the set of names.
 CheckSuite shardSuite(const CheckSuite& suite, const Shard& shard);
 
 // The drift of `metrics` from `entry`.
-std::vector<MetricDrift> compareWithBaseline(const Metrics& metrics, const BaselineEntry& entry,
+std::vector<MetricDrift> compareWithBaseline(const compare::Metrics& metrics, const BaselineEntry& entry,
                                              const CheckTolerance& tolerance);
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

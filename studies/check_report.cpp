@@ -13,7 +13,7 @@
 #include "scene/error.h"
 #include "scene/frame_io.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 namespace {
 
@@ -76,27 +76,27 @@ CasePart casePart(const CheckSuite& suite, const CheckCase& c, const CaseResult&
           << escapeXml(text) << "</failure>\n";
     }
     if (r.metrics)
-        x << "      <system-out>" << escapeXml(c.sceneFile.filename().string() + " " + c.backend + " " +
-                                               c.resolution + ": " + summaryLine(*r.metrics))
+        x << "      <system-out>" << escapeXml(c.sceneFile.filename().string() + " " + scene::toString(c.backend) + " " +
+                                               c.resolution + ": " + compare::summaryLine(*r.metrics))
           << "</system-out>\n";
     x << "    </testcase>\n";
     p.junit = x.str();
 
     std::ostringstream m;
-    m << "| " << cell(r.name) << " | " << cell(c.sceneFile.stem().string()) << " | " << c.backend << " | "
+    m << "| " << cell(r.name) << " | " << cell(c.sceneFile.stem().string()) << " | " << scene::toString(c.backend) << " | "
       << (r.verdict == CaseVerdict::Passed ? "passed" : r.verdict == CaseVerdict::Failed ? "**FAILED**" : "**ERROR**")
       << " | ";
     if (r.metrics) {
-        const Metrics& v = *r.metrics;
-        m << formatPercent(v.mismatchRate) << " | " << formatPercent(v.falseShadowRate) << " | "
-          << formatPercent(v.missedShadowRate) << " | "
-          << (v.hasBlockerIds ? formatPercent(v.selfShadowAcneRate) : "n/a") << " | " << formatFixed(v.shadowIoU, 3)
-          << " | " << formatFixed(v.meanAbsVisibilityError, 4) << " | ";
+        const compare::Metrics& v = *r.metrics;
+        m << compare::formatPercent(v.mismatchRate) << " | " << compare::formatPercent(v.falseShadowRate) << " | "
+          << compare::formatPercent(v.missedShadowRate) << " | "
+          << (v.hasBlockerIds ? compare::formatPercent(v.selfShadowAcneRate) : "n/a") << " | " << compare::formatFixed(v.shadowIoU, 3)
+          << " | " << compare::formatFixed(v.meanAbsVisibilityError, 4) << " | ";
         std::string drift;
         for (const MetricDrift& d : r.drift)
             if (d.regressed || d.improved) drift += (drift.empty() ? "" : ", ") + d.metric + (d.regressed ? " worse" : " better");
         m << (!r.hasBaseline ? "no baseline" : drift.empty() ? "within tolerance" : drift) << " | "
-          << formatDuration(1000.0 * r.seconds) << " |\n";
+          << compare::formatDuration(1000.0 * r.seconds) << " |\n";
     } else {
         m << "| | | | | | " << cell(r.error.substr(0, 120)) << " | |\n";
     }
@@ -172,7 +172,7 @@ std::string inlineHtml(const std::string& md) {
             bold = !bold;
             ++i;
         } else {
-            out += escapeHtml(std::string(1, md[i]));
+            out += compare::escapeHtml(std::string(1, md[i]));
         }
     }
     if (code) out += "</code>";
@@ -201,12 +201,12 @@ std::string htmlSummary(const std::string& suiteName, const std::vector<CasePart
     const std::size_t failed = count(parts, CaseVerdict::Failed), errors = count(parts, CaseVerdict::Error);
     std::ostringstream h;
     h << "<!doctype html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>shadowlab check: "
-      << escapeHtml(suiteName) << "</title>\n<style>" << html::css()
+      << compare::escapeHtml(suiteName) << "</title>\n<style>" << compare::html::css()
       << " td.passed{color:#1b5e20} td.failed,td.error{color:#a51111;font-weight:600}"
          " .diffs{grid-template-columns:repeat(auto-fill,minmax(300px,1fr))} .why li{margin-bottom:4px}"
          " .scroll{overflow-x:auto} table.cases td{white-space:nowrap} table.cases :is(td,th){padding:6px 8px}"
          " table.cases :is(td,th):is(:nth-child(-n+4),:nth-child(11)){text-align:left}</style>\n</head>\n<body>\n<main>\n";
-    h << "<header><h1>shadowlab check: " << escapeHtml(suiteName) << "</h1><div class=\"sub\">"
+    h << "<header><h1>shadowlab check: " << compare::escapeHtml(suiteName) << "</h1><div class=\"sub\">"
       << (failed + errors == 0 ? "All " + std::to_string(parts.size()) + " cases passed."
                                : std::to_string(parts.size() - failed - errors) + " passed, " +
                                      std::to_string(failed) + " failed, " + std::to_string(errors) + " errors.")
@@ -220,7 +220,7 @@ std::string htmlSummary(const std::string& suiteName, const std::vector<CasePart
         const char* verdict = p.verdict == CaseVerdict::Passed ? "passed" : p.verdict == CaseVerdict::Failed ? "failed" : "error";
         h << "<tr>";
         for (std::size_t i = 0; i < cells.size(); ++i) {
-            if (i == 0) h << "<td><a href=\"cases/" << escapeHtml(p.name) << ".json\">" << escapeHtml(p.name) << "</a></td>";
+            if (i == 0) h << "<td><a href=\"cases/" << compare::escapeHtml(p.name) << ".json\">" << compare::escapeHtml(p.name) << "</a></td>";
             else if (i == 3) h << "<td class=\"" << verdict << "\">" << verdict << "</td>";
             else h << "<td>" << inlineHtml(cells[i]) << "</td>";
         }
@@ -241,15 +241,15 @@ std::string htmlSummary(const std::string& suiteName, const std::vector<CasePart
         if (!withDiff.count(p.name)) continue;
         if (!any) {
             // No hotspot zooms here: the legend's sentence about them goes.
-            std::string legend = html::diffLegend();
+            std::string legend = compare::html::diffLegend();
             const auto a = legend.find(" The yellow square"), b = legend.find("</p>", a);
             if (a != std::string::npos && b != std::string::npos) legend.erase(a, b - a);
             h << "<h2>Difference images of the failing cases</h2>\n" << legend << "\n<div class=\"grid diffs\">\n";
         }
         any = true;
         const std::string png = "cases/" + p.name + "-diff.png";
-        h << "<figure><figcaption>" << escapeHtml(p.name) << "</figcaption><a href=\"" << escapeHtml(png)
-          << "\"><img src=\"" << escapeHtml(png) << "\" alt=\"" << escapeHtml(p.name) << " difference\" class=\"upscale\"></a></figure>\n";
+        h << "<figure><figcaption>" << compare::escapeHtml(p.name) << "</figcaption><a href=\"" << compare::escapeHtml(png)
+          << "\"><img src=\"" << compare::escapeHtml(png) << "\" alt=\"" << compare::escapeHtml(p.name) << " difference\" class=\"upscale\"></a></figure>\n";
     }
     if (any) h << "</div>\n";
     h << "</main>\n</body>\n</html>\n";
@@ -287,7 +287,7 @@ nlohmann::json caseJson(const CheckCase& c, const CaseResult& r) {
                          {"tolerance", d.tolerance}, {"regressed", d.regressed}, {"improved", d.improved}});
     nlohmann::json j = {{"name", c.name},
                         {"scene", c.sceneFile.string()},
-                        {"backend", c.backend},
+                        {"backend", scene::toString(c.backend)},
                         {"resolution", c.resolution},
                         {"settings", c.settings},
                         {"budgets", scene::toJson(c.budgets)},
@@ -508,4 +508,4 @@ void writeMergedCheck(const MergedCheck& merged, const fs::path& out) {
     scene::writeTextAtomic(out / "summary.html", htmlSummary(merged.identity.suiteName, merged.parts, false, withDiff));
 }
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

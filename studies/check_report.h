@@ -12,7 +12,7 @@
 
 #include "studies/check.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 std::string junitXml(const CheckSuite& suite, const std::vector<CaseResult>& results);
 
@@ -80,4 +80,4 @@ MergedCheck readCheckShards(const std::vector<std::filesystem::path>& inputs);
 // Refuses a shard folder as `out`.
 void writeMergedCheck(const MergedCheck& merged, const std::filesystem::path& out);
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -6,7 +6,7 @@
 #include <sched.h>
 #include <unistd.h>
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 namespace {
 
@@ -70,4 +70,4 @@ MachineInfo machineFromJson(const nlohmann::json& j) {
     return m;
 }
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

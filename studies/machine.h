@@ -6,7 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 struct MachineInfo {
     std::string host;       // gethostname()
@@ -28,4 +28,4 @@ nlohmann::json toJson(const MachineInfo& m);
 // Fields that are absent stay empty/zero: rows of older journals have no machine.
 MachineInfo machineFromJson(const nlohmann::json& j);
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

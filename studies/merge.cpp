@@ -15,7 +15,7 @@
 #include "scene/error.h"
 #include "scene/frame_io.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 namespace {
 
@@ -124,7 +124,7 @@ Json comparable(const SweepRow& r) {
 // A bias verdict as compared: the window or "stiff", the recommended value and the dominant artifact.
 Json verdictOf(const BiasSeries& s) {
     auto num = [](double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); };  // NaN ≠ NaN
-    return {{"kind", s.kind}, {"backend", s.backend}, {"context", s.context}, {"stiff", s.window.stiff},
+    return {{"kind", s.kind}, {"backend", scene::toString(s.backend)}, {"context", s.context}, {"stiff", s.window.stiff},
             {"lo", num(s.window.lo)}, {"hi", num(s.window.hi)}, {"recommended", num(s.recommended)},
             {"dominant", s.dominant}};
 }
@@ -335,10 +335,10 @@ std::vector<SweepRow> readResults(const fs::path& dir) {
     std::vector<SweepRow> rows;
     try {
         for (const Json& j : Json::parse(in)) rows.push_back(rowFromJournal(j));
-    } catch (const Json::exception& e) {
+    } catch (const std::exception& e) {  // JSON that is not rows, or a backend no build has
         throw scene::InputError(file.string() + ": not a sweep's results (" + std::string(e.what()) + ")");
     }
     return rows;
 }
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -14,7 +14,7 @@
 #include "studies/sweep.h"
 #include "studies/sweep_report.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 struct MergedSweep {
     SweepIdentity identity;
@@ -54,4 +54,4 @@ std::vector<std::string> verdictDifferences(const std::vector<SweepRow>& a, cons
 // The rows of a finished sweep or merged folder (DIR/results.json). Throws scene::InputError.
 std::vector<SweepRow> readResults(const std::filesystem::path& dir);
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -28,7 +28,7 @@
 #include "scene/render_plan.h"
 #include "studies/backend.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 namespace {
 
@@ -51,6 +51,11 @@ scene::Vec3 rotate(const scene::Vec3& v, const scene::Vec3& k, double degrees) {
 double frameMs(const scene::Frame& f) { return f.totalTimeMs() - f.timing("setup"); }
 
 using scene::appendLine;  // a finished line survives a kill or a power loss
+
+// A method's name in frame files, the journal, path.json, metrics.json and the report: its
+// backend's name, and for the raster backend's held view that name with "-held".
+std::string nameOf(scene::Backend b) { return scene::toString(b); }
+std::string heldViewName() { return nameOf(scene::Backend::Raster) + "-held"; }
 
 std::string frameName(int t, const std::string& what) {
     char buf[32];
@@ -121,8 +126,8 @@ Json manifestOf(const scene::Scene& base, const PathSpec& spec, double amount, c
             {"amount", amount},
             {"light", spec.light},
             {"animation", spec.kind == PathKind::GltfAnimation ? Json(spec.animation) : Json(nullptr)},
-            {"raster", o.raster},
-            {"raytrace", o.raytrace},
+            {nameOf(scene::Backend::Raster), o.raster},
+            {nameOf(scene::Backend::Raytrace), o.raytrace},
             {"held_view", o.heldView},
             {"settings",
              {{"shadow_map_size", r.shadowMapSize},
@@ -150,8 +155,8 @@ double median(std::vector<double> v) {
 }
 
 // The square window (side `size`) holding the most set pixels of `mask` (a summed-area table).
-ErrorHotspot densestWindow(const std::vector<unsigned char>& mask, int w, int h, int size) {
-    ErrorHotspot best;
+compare::ErrorHotspot densestWindow(const std::vector<unsigned char>& mask, int w, int h, int size) {
+    compare::ErrorHotspot best;
     size = std::max(1, std::min({size, w, h}));
     best.size = size;
     std::vector<std::size_t> sat(std::size_t(w + 1) * (h + 1), 0);
@@ -335,12 +340,12 @@ namespace {
 // Method names in report order, from a folder's manifest (path.json).
 std::vector<std::string> methodNames(const Json& manifest) {
     std::vector<std::string> names;
-    const bool raster = manifest.at("raster").get<bool>();
+    const bool raster = manifest.at(nameOf(scene::Backend::Raster)).get<bool>();
     const bool held = raster && manifest.at("held_view").get<bool>() &&
                       isCameraPath(parsePathKind(manifest.at("kind").get<std::string>()));
-    if (raster) names.push_back("raster");
-    if (held) names.push_back("raster-held");
-    if (manifest.at("raytrace").get<bool>()) names.push_back("raytrace");
+    if (raster) names.push_back(nameOf(scene::Backend::Raster));
+    if (held) names.push_back(heldViewName());
+    if (manifest.at(nameOf(scene::Backend::Raytrace)).get<bool>()) names.push_back(nameOf(scene::Backend::Raytrace));
     return names;
 }
 
@@ -376,17 +381,18 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
         for (int t = 0; t < result.frames; ++t) frames.push_back(scene::readFrame(framesDir / frameName(t, name)));
         return frames;
     };
-    const std::vector<scene::Frame> refs = load("reference");
-    result.referenceSetupMs = setupMs["reference"];
-    result.referenceFrameMs = times["reference"];
+    const std::string referenceName = nameOf(scene::Backend::Reference);
+    const std::vector<scene::Frame> refs = load(referenceName);
+    result.referenceSetupMs = setupMs[referenceName];
+    result.referenceFrameMs = times[referenceName];
     std::vector<const scene::Frame*> refPointers;
     for (const scene::Frame& f : refs) refPointers.push_back(&f);
-    result.referenceTemporal = measureTemporal(refPointers, refPointers);
+    result.referenceTemporal = compare::measureTemporal(refPointers, refPointers);
 
     const int w = refs[0].width, h = refs[0].height;
     const int fps = 8;
     std::string gifs, zooms;
-    ScatterPlot plot;
+    compare::ScatterPlot plot;
     plot.title = "Flicker per frame pair";  // the definition is in the text above the plot
     plot.x.title = "frame pair (t, t+1)";
     plot.x.min = 0.0;  // pairs 0 .. frames - 2, not a fitted margin past the last one
@@ -403,17 +409,17 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
         m.frameMs = times[name];
         const std::vector<scene::Frame> frames = load(name);
         // The held view compares with frame 0's reference: it is drawn from frame 0's camera.
-        std::vector<Comparison> comparisons;
+        std::vector<compare::Comparison> comparisons;
         std::vector<const scene::Frame*> methodPointers, heldRefs;
-        std::vector<const std::vector<PixelClass>*> classes;
+        std::vector<const std::vector<compare::PixelClass>*> classes;
         for (int t = 0; t < result.frames; ++t) {
-            const scene::Frame& r = name == "raster-held" ? refs[0] : refs[std::size_t(t)];
-            comparisons.push_back(compareFrames(frames[std::size_t(t)], r));
+            const scene::Frame& r = name == heldViewName() ? refs[0] : refs[std::size_t(t)];
+            comparisons.push_back(compare::compareFrames(frames[std::size_t(t)], r));
             m.metrics.push_back(comparisons.back().metrics);
             methodPointers.push_back(&frames[std::size_t(t)]);
             heldRefs.push_back(&r);
         }
-        for (const Comparison& c : comparisons) classes.push_back(&c.classes);
+        for (const compare::Comparison& c : comparisons) classes.push_back(&c.classes);
         m.temporal = measureTemporal(methodPointers, heldRefs, classes);
 
         // The animation: method, reference, difference side by side.
@@ -427,7 +433,7 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
         // Small frames are magnified by a whole factor (crisp pixels) so their shadows can be seen.
         const int shown = gw > 1200 ? 1200 : gw * std::max(1, 960 / gw);
         gifs += "<figure><img src=\"" + name + ".gif\" alt=\"" + name + "\" style=\"width:" + std::to_string(shown) +
-                "px;image-rendering:pixelated\"><figcaption><b>" + escapeHtml(name) +
+                "px;image-rendering:pixelated\"><figcaption><b>" + compare::escapeHtml(name) +
                 "</b>: method | reference | difference, " + std::to_string(fps) + " frames/s</figcaption></figure>\n";
 
         // The worst pair: its flicker pixels (red) over the method's frame t, the densest window zoomed.
@@ -437,12 +443,12 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
             const scene::Frame& f1 = frames[std::size_t(t) + 1];
             const scene::Frame& r0 = *heldRefs[std::size_t(t)];
             const scene::Frame& r1 = *heldRefs[std::size_t(t) + 1];
-            const std::vector<unsigned char> mask = flickerMask(f0, f1, r0, r1, comparisons[std::size_t(t)].classes,
+            const std::vector<unsigned char> mask = compare::flickerMask(f0, f1, r0, r1, comparisons[std::size_t(t)].classes,
                                                                 comparisons[std::size_t(t) + 1].classes);
             std::vector<float> map = displayBeauty(f0);
             for (std::size_t i = 0; i < mask.size(); ++i)
                 if (mask[i]) map[3 * i] = 1.0f, map[3 * i + 1] = 0.08f, map[3 * i + 2] = 0.05f;
-            const ErrorHotspot win = densestWindow(mask, w, h, std::max(16, std::min(w, h) / 5));
+            const compare::ErrorHotspot win = densestWindow(mask, w, h, std::max(16, std::min(w, h) / 5));
             // Zoom: frame t, frame t + 1 and the flicker map of the window, magnified 6x.
             const int z = 6, side = win.size * z;
             auto crop = [&](const std::vector<float>& rgb) {
@@ -462,56 +468,57 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
             const std::string zoomName = name + "-worst-pair.png";
             scene::writePngDisplay(dir / zoomName, zw, side, zoomFloat);
             zooms += "<figure><img src=\"" + zoomName + "\" alt=\"worst pair of " + name +
-                     "\"><figcaption><b>" + escapeHtml(name) + "</b>, worst pair (" + std::to_string(t) + ", " +
+                     "\"><figcaption><b>" + compare::escapeHtml(name) + "</b>, worst pair (" + std::to_string(t) + ", " +
                      std::to_string(t + 1) + "): frame t | frame t+1 | flicker pixels in red; window " +
                      std::to_string(win.size) + " px at (" + std::to_string(win.x) + ", " + std::to_string(win.y) +
-                     "), " + formatCount(win.wrongPixels) + " of the pair's " +
-                     formatCount(m.temporal.pairs[std::size_t(t)].flicker) + " flicker pixels</figcaption></figure>\n";
+                     "), " + compare::formatCount(win.wrongPixels) + " of the pair's " +
+                     compare::formatCount(m.temporal.pairs[std::size_t(t)].flicker) + " flicker pixels</figcaption></figure>\n";
         }
 
-        PlotSeries series;
+        compare::PlotSeries series;
         series.name = name;
-        series.color = backendColor(name == "raster-held" ? "raster held view" : name, mi);
+        const bool heldView = name == heldViewName();
+        series.color = compare::backendColor(heldView ? nameOf(scene::Backend::Raster) + " held view" : name, mi);
         series.connect = true;
-        series.dashed = name == "raster-held";
-        for (const PairStability& p : m.temporal.pairs)
+        series.dashed = heldView;
+        for (const compare::PairStability& p : m.temporal.pairs)
             series.points.push_back({double(p.first), p.flickerRate, "",
-                                     name + " pair " + std::to_string(p.first) + ": " + formatCount(p.flicker) + " px"});
+                                     name + " pair " + std::to_string(p.first) + ": " + compare::formatCount(p.flicker) + " px"});
         plot.series.push_back(series);
         result.methods.push_back(std::move(m));
     }
-    const std::string svg = renderSvg(plot);
+    const std::string svg = compare::renderSvg(plot);
     scene::writeTextAtomic(dir / "flicker.svg", svg);
     scene::writeTextAtomic(dir / "metrics.json", toJson(result).dump(2) + "\n");
 
     // The report.
     std::ostringstream html;
-    html << "<!doctype html><html><head><meta charset=\"utf-8\"><title>shadowlab path: " << escapeHtml(toString(spec.kind))
+    html << "<!doctype html><html><head><meta charset=\"utf-8\"><title>shadowlab path: " << compare::escapeHtml(toString(spec.kind))
          << "</title><style>body{font-family:sans-serif;margin:1.5em;max-width:1300px}table{border-collapse:collapse}"
             "td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}th{background:#eee}"
             "td,tr th:first-child{white-space:nowrap}figure{margin:1em 0}"
             "</style></head><body>\n";
-    html << "<h1>Temporal stability: " << escapeHtml(toString(spec.kind)) << " path</h1>\n<p>Scene <code>"
-         << escapeHtml(sceneFile) << "</code>, " << result.frames << " frames at " << w << "x" << h
-         << ", amount " << formatShort(result.amount) << ". Pixels are compared between frames at the same image "
+    html << "<h1>Temporal stability: " << compare::escapeHtml(toString(spec.kind)) << " path</h1>\n<p>Scene <code>"
+         << compare::escapeHtml(sceneFile) << "</code>, " << result.frames << " frames at " << w << "x" << h
+         << ", amount " << compare::formatShort(result.amount) << ". Pixels are compared between frames at the same image "
          << "position; flicker counts the counted pixels whose lit/shadow state changes while the reference's does "
          << "not (docs/temporal.md).</p>\n";
     html << "<table><tr><th>method</th><th>setup</th><th>median per frame</th><th>mean flicker</th><th>max flicker</th>"
             "<th>flicker px</th><th>error variation</th><th>swim (px)</th><th>edge offset (px)</th>"
             "<th>mean mismatch</th></tr>\n";
-    auto row = [&](const std::string& name, double setup, const std::vector<double>& ms, const TemporalSummary& tsum,
+    auto row = [&](const std::string& name, double setup, const std::vector<double>& ms, const compare::TemporalSummary& tsum,
                    double mismatch) {
-        html << "<tr><th>" << escapeHtml(name) << "</th><td>" << formatDuration(setup) << "</td><td>"
-             << formatDuration(median(ms)) << "</td><td>" << formatPercent(tsum.meanFlickerRate) << "</td><td>"
-             << formatPercent(tsum.maxFlickerRate) << "</td><td>" << formatCount(tsum.totalFlicker) << "</td><td>"
-             << formatFixed(tsum.meanErrorVariation, 5) << "</td><td>" << formatFixed(tsum.meanSwimPixels, 3)
-             << "</td><td>" << formatFixed(tsum.meanEdgeOffset, 3) << "</td><td>"
-             << (mismatch < 0 ? std::string("-") : formatPercent(mismatch)) << "</td></tr>\n";
+        html << "<tr><th>" << compare::escapeHtml(name) << "</th><td>" << compare::formatDuration(setup) << "</td><td>"
+             << compare::formatDuration(median(ms)) << "</td><td>" << compare::formatPercent(tsum.meanFlickerRate) << "</td><td>"
+             << compare::formatPercent(tsum.maxFlickerRate) << "</td><td>" << compare::formatCount(tsum.totalFlicker) << "</td><td>"
+             << compare::formatFixed(tsum.meanErrorVariation, 5) << "</td><td>" << compare::formatFixed(tsum.meanSwimPixels, 3)
+             << "</td><td>" << compare::formatFixed(tsum.meanEdgeOffset, 3) << "</td><td>"
+             << (mismatch < 0 ? std::string("-") : compare::formatPercent(mismatch)) << "</td></tr>\n";
     };
-    row("reference", result.referenceSetupMs, result.referenceFrameMs, result.referenceTemporal, -1.0);
+    row(nameOf(scene::Backend::Reference), result.referenceSetupMs, result.referenceFrameMs, result.referenceTemporal, -1.0);
     for (const PathMethod& m : result.methods) {
         double mismatch = 0.0;
-        for (const Metrics& x : m.metrics) mismatch += x.mismatchRate;
+        for (const compare::Metrics& x : m.metrics) mismatch += x.mismatchRate;
         row(m.name, m.setupMs, m.frameMs, m.temporal, m.metrics.empty() ? 0.0 : mismatch / double(m.metrics.size()));
     }
     html << "</table>\n<p>Setup is paid once for the path (the raster Renderer with its device, buffers and "
@@ -613,11 +620,11 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
         };
         if (!reference) reference = makeRenderer(scene::Backend::Reference, scenes[0], plan, settings);
         reference->update(s);
-        record("reference", reference->render(), reference->setupMs());
+        record(nameOf(scene::Backend::Reference), reference->render(), reference->setupMs());
         if (options.raytrace) {
             if (!tracer) tracer = makeRenderer(scene::Backend::Raytrace, scenes[0], plan, settings);
             tracer->update(s);
-            record("raytrace", tracer->render(), tracer->setupMs());
+            record(nameOf(scene::Backend::Raytrace), tracer->render(), tracer->setupMs());
         }
         if (options.raster) {
             double setup = 0.0;
@@ -628,10 +635,10 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
             rasterRenderer->update(s);
             scene::Frame f = rasterRenderer->render();
             setup += f.timing("setup");  // pipelines made by the first frame
-            record("raster", f, setup);
+            record(nameOf(scene::Backend::Raster), f, setup);
             if (held) {
                 rasterRenderer->update(s, scenes[0].camera);
-                record("raster-held", rasterRenderer->render(), 0.0);
+                record(heldViewName(), rasterRenderer->render(), 0.0);
             }
             if (settings.raster.validate && rasterRenderer->validationMessages() > 0)
                 throw std::runtime_error("the Vulkan validation layer reported " +
@@ -671,7 +678,7 @@ Json toJson(const PathResult& r) {
             {"amount", r.amount},
             {"light", r.spec.light},
             {"resumed_frames", r.resumedFrames},
-            {"reference", {{"setup_ms", r.referenceSetupMs},
+            {nameOf(scene::Backend::Reference), {{"setup_ms", r.referenceSetupMs},
                            {"median_frame_ms", median(r.referenceFrameMs)},
                            {"frame_ms", r.referenceFrameMs},
                            {"temporal", toJson(r.referenceTemporal)}}},
@@ -847,7 +854,7 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
     }
     const std::vector<std::string> names = methodNames(manifest);
     std::vector<std::string> all = names;
-    all.push_back("reference");
+    all.push_back(nameOf(scene::Backend::Reference));
     for (const auto& [t, entry] : lines)
         for (const std::string& name : all)
             if (!fs::exists(entry.first / "frames" / frameName(t, name), ec))
@@ -916,4 +923,4 @@ std::vector<std::string> pathDifferences(const fs::path& a, const fs::path& b) {
     return out;
 }
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -16,7 +16,7 @@
 #include "scene/scene.h"
 #include "scene/settings.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 // orbit: the camera turns about the world's Y axis through its look-at point; dolly: it moves
 // toward the look-at point; pan: camera and look-at move along the view's right axis; subtexel:
@@ -79,8 +79,8 @@ struct PathMethod {
     std::string name;  // raster | raster-held | raytrace
     double setupMs = 0.0;                // the one-time setup (Renderer, acceleration structure)
     std::vector<double> frameMs;         // per frame, setup excluded (update included)
-    std::vector<Metrics> metrics;        // per frame, against that frame's reference
-    TemporalSummary temporal;
+    std::vector<compare::Metrics> metrics;        // per frame, against that frame's reference
+    compare::TemporalSummary temporal;
 };
 
 struct PathResult {
@@ -90,7 +90,7 @@ struct PathResult {
     int resumedFrames = 0;  // frames taken from the journal
     double referenceSetupMs = 0.0;
     std::vector<double> referenceFrameMs;
-    TemporalSummary referenceTemporal;  // zero by definition; computed as a check
+    compare::TemporalSummary referenceTemporal;  // zero by definition; computed as a check
     std::vector<PathMethod> methods;
 };
 
@@ -129,4 +129,4 @@ MergedPath mergePathShards(const std::vector<std::filesystem::path>& inputs, con
 // (a JSON pointer and both values), empty when they hold the same figures. Throws scene::InputError.
 std::vector<std::string> pathDifferences(const std::filesystem::path& a, const std::filesystem::path& b);
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -11,7 +11,7 @@
 #include "compare/compare.h"
 #include "compare/text.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 namespace {
 
@@ -43,15 +43,15 @@ std::string attribute(const scene::Frame& f, const char* key) {
 
 // Renders one configuration; failures (exceptions, validation messages) are recorded in `error`.
 scene::Frame renderOne(const RecommendOptions& o, const scene::Scene& s, const scene::SettingsOverrides& overrides,
-                       const std::string& backend, std::string& error) {
+                       scene::Backend backend, std::string& error) {
     try {
         const scene::RenderSettings settings = scene::resolveSettings(s, overrides);
         scene::Frame f = o.render(s, settings, backend);
         const std::string messages = attribute(f, "validation_messages");
-        if (settings.raster.validate && backend == "raster" && messages != "0")
+        if (settings.raster.validate && backend == scene::Backend::Raster && messages != "0")
             error = "the Vulkan validation layer reported " + (messages.empty() ? "an unknown number of" : messages) +
                     " message(s)";
-        if (measureHealth(f).total() > 0) error = "non-finite values";
+        if (compare::measureHealth(f).total() > 0) error = "non-finite values";
         return f;
     } catch (const std::exception& e) {
         error = e.what();
@@ -60,7 +60,7 @@ scene::Frame renderOne(const RecommendOptions& o, const scene::Scene& s, const s
 }
 
 Measured measureRender(const RecommendOptions& o, const scene::Scene& s, const scene::SettingsOverrides& overrides,
-                       const std::string& backend, const scene::Frame& reference, scene::Frame* keep = nullptr) {
+                       scene::Backend backend, const scene::Frame& reference, scene::Frame* keep = nullptr) {
     std::string error;
     scene::Frame f = renderOne(o, s, overrides, backend, error);
     Measured m;
@@ -137,14 +137,14 @@ std::vector<double> around(const std::vector<double>& axis, double v) {
 }
 
 std::string percentPair(const Measured& a, const Measured& b) {
-    return formatPercent(a.mismatchRate) + " mismatch (IoU " + formatFixed(a.shadowIoU, 3) + ") against the defaults' " +
-           formatPercent(b.mismatchRate) + " (IoU " + formatFixed(b.shadowIoU, 3) + ")";
+    return compare::formatPercent(a.mismatchRate) + " mismatch (IoU " + compare::formatFixed(a.shadowIoU, 3) + ") against the defaults' " +
+           compare::formatPercent(b.mismatchRate) + " (IoU " + compare::formatFixed(b.shadowIoU, 3) + ")";
 }
 
 }  // namespace
 
 Measured measure(const scene::Frame& method, const scene::Frame& reference) {
-    const Metrics k = compareFrames(method, reference).metrics;
+    const compare::Metrics k = compare::compareFrames(method, reference).metrics;
     Measured m;
     m.ok = true;
     m.mismatchRate = k.mismatchRate;
@@ -193,8 +193,8 @@ Json Recommendation::toJson() const {
             {"measured",
              {{"resolution", resolution},
               {"search_resolution", searchResolution},
-              {"raster", side(raster, true)},
-              {"raytrace", side(raytrace, false)},
+              {scene::toString(scene::Backend::Raster), side(raster, true)},
+              {scene::toString(scene::Backend::Raytrace), side(raytrace, false)},
               {"notes", notes}}}};
 }
 
@@ -215,7 +215,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
         Verified& v = r.raster;
         scene::Frame fullDefaults;
         v.defaults = rasterDefaults ? measure(*rasterDefaults, reference)
-                                    : measureRender(o, scene, user, "raster", reference, &fullDefaults);
+                                    : measureRender(o, scene, user, scene::Backend::Raster, reference, &fullDefaults);
         scene::SettingsOverrides searchUser = user;
         const std::string fullMap = attribute(rasterDefaults ? *rasterDefaults : fullDefaults, "shadow_map_size");
         if (!user.shadowMapSize && !fullMap.empty()) {
@@ -228,7 +228,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
         BiasPoint d;
         d.defaults = true;
         scene::Frame defaultsFrame;
-        d.at = measureRender(o, searchScene, searchUser, "raster", searchReference, &defaultsFrame);
+        d.at = measureRender(o, searchScene, searchUser, scene::Backend::Raster, searchReference, &defaultsFrame);
         const scene::RenderSettings resolved = scene::resolveSettings(searchScene, searchUser);
         const std::string applied = attribute(defaultsFrame, "depth_bias");
         double b0 = smallestPositive(applied);
@@ -254,7 +254,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
             scene::SettingsOverrides ov = searchUser;
             ov.depthBias = depth;
             ov.slopeBias = slope;
-            p.at = measureRender(o, searchScene, ov, "raster", searchReference);
+            p.at = measureRender(o, searchScene, ov, scene::Backend::Raster, searchReference);
             r.points.push_back(p);
         };
         if (d.at.ok) {
@@ -288,12 +288,12 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
         const BiasPoint& best = r.points[r.best];
         if (!best.defaults && best.at.ok) {
             v.searched = true;
-            v.candidate = "depth bias " + formatShort(best.depthBias) + " world units, slope bias " +
-                          formatShort(best.slopeBias) + " texels";
+            v.candidate = "depth bias " + compare::formatShort(best.depthBias) + " world units, slope bias " +
+                          compare::formatShort(best.slopeBias) + " texels";
             scene::SettingsOverrides ov = user;
             ov.depthBias = best.depthBias;
             ov.slopeBias = best.slopeBias;
-            v.tried = measureRender(o, scene, ov, "raster", reference);
+            v.tried = measureRender(o, scene, ov, scene::Backend::Raster, reference);
             v.beatsDefaults = beats(v.tried, v.defaults);
         }
         v.recommended = v.beatsDefaults ? v.tried : v.defaults;
@@ -304,8 +304,8 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
                                                                                                   : "bounding-sphere fit");
         r.notes.push_back("The shadow map's biases were searched in the configuration you run (" + config + "): " +
                           std::to_string(r.points.size()) + " renders at " + r.searchResolution +
-                          ", constant bias 0 .. " + formatShort(o.depthSteps.back() * b0) +
-                          " world units together with slope bias 0 .. " + formatShort(o.slopeSteps.back() * s0) +
+                          ", constant bias 0 .. " + compare::formatShort(o.depthSteps.back() * b0) +
+                          " world units together with slope bias 0 .. " + compare::formatShort(o.slopeSteps.back() * s0) +
                           " texels, refined around the best point.");
         if (scene::isFilterable(resolved.raster.filter))
             r.notes.push_back(std::string("Filter ") + scene::toString(resolved.raster.filter) +
@@ -317,7 +317,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
             block["depth_bias"] = best.depthBias;
             block["slope_bias"] = best.slopeBias;
             r.notes.push_back("At " + r.resolution + ", " + v.candidate + " gives " + percentPair(v.recommended, v.defaults) +
-                              ": " + formatPercent(v.defaults.mismatchRate - v.recommended.mismatchRate) +
+                              ": " + compare::formatPercent(v.defaults.mismatchRate - v.recommended.mismatchRate) +
                               " of the counted pixels fewer wrong. The block recommends it.");
         } else {
             if (user.depthBias) block["depth_bias"] = *user.depthBias;
@@ -326,15 +326,15 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
             if (!v.defaults.ok)
                 why = "the defaults did not render (" + v.defaults.error + "), so no bias is recommended.";
             else if (!v.searched)
-                why = "no searched bias beats the defaults (" + formatPercent(v.defaults.mismatchRate) + " mismatch, IoU " +
-                      formatFixed(v.defaults.shadowIoU, 3) + " at " + r.resolution + "): the block keeps them.";
+                why = "no searched bias beats the defaults (" + compare::formatPercent(v.defaults.mismatchRate) + " mismatch, IoU " +
+                      compare::formatFixed(v.defaults.shadowIoU, 3) + " at " + r.resolution + "): the block keeps them.";
             else if (!v.tried.ok)
                 why = "the best searched point (" + v.candidate + ") failed at " + r.resolution + " (" +
                       v.tried.error + "): the block keeps the defaults.";
             else
                 why = "the best searched point (" + v.candidate + ") gives " + percentPair(v.tried, v.defaults) +
-                      " and mean |dV| " + formatFixed(v.tried.meanAbsVisibilityError, 4) + " against " +
-                      formatFixed(v.defaults.meanAbsVisibilityError, 4) + " at " + r.resolution +
+                      " and mean |dV| " + compare::formatFixed(v.tried.meanAbsVisibilityError, 4) + " against " +
+                      compare::formatFixed(v.defaults.meanAbsVisibilityError, 4) + " at " + r.resolution +
                       ", not better in every respect: the block keeps the defaults.";
             r.notes.push_back("For the shadow map, " + why);
         }
@@ -343,7 +343,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
     if (o.raytrace && rayCandidate.contains("ray_bias")) {
         Verified& v = r.raytrace;
         v.defaults = raytraceDefaults ? measure(*raytraceDefaults, reference)
-                                      : measureRender(o, scene, user, "raytrace", reference);
+                                      : measureRender(o, scene, user, scene::Backend::Raytrace, reference);
         scene::SettingsOverrides ov = user;
         const Json& rb = rayCandidate["ray_bias"];
         if (rb.is_string()) {
@@ -356,7 +356,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
         if (rayCandidate.contains("precision")) ov.precision = rayCandidate["precision"].get<std::string>();
         v.searched = true;
         v.candidate = "ray bias " + *ov.rayBias + (ov.precision ? " (" + *ov.precision + ")" : "");
-        v.tried = measureRender(o, scene, ov, "raytrace", reference);
+        v.tried = measureRender(o, scene, ov, scene::Backend::Raytrace, reference);
         v.beatsDefaults = beats(v.tried, v.defaults);
         v.recommended = v.beatsDefaults ? v.tried : v.defaults;
         if (v.beatsDefaults) {
@@ -377,4 +377,4 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
     return r;
 }
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -17,7 +17,7 @@
 #include "scene/scene.h"
 #include "scene/settings.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 // The measurement of one configuration against the reference.
 struct Measured {
@@ -97,4 +97,4 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
 // The shadow block of an AutoBias limited to the ray tracer's keys (ray_bias, precision).
 nlohmann::json rayCandidateOf(const AutoBias& bias);
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -23,7 +23,7 @@
 #include "scene/frame_io.h"
 #include "scene/settings.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 namespace {
 
@@ -354,7 +354,7 @@ SweepResult runShard(const scene::Scene& baseScene, const SweepGrid& grid, const
     o.reference = [render, shared, referenceOptions](const scene::Scene& sc) {
         return sharedReference(shared, sc, [&] {
             const scene::RenderSettings settings = scene::resolveSettings(sc, {});
-            scene::Frame f = render(sc, settings, "reference");
+            scene::Frame f = render(sc, settings, scene::Backend::Reference);
             f.attributes["scene"] = sc.file.string();
             return f;
         }, referenceOptions);
@@ -362,4 +362,4 @@ SweepResult runShard(const scene::Scene& baseScene, const SweepGrid& grid, const
     return runSweep(scene, mine, o);
 }
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

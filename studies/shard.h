@@ -14,7 +14,7 @@
 
 #include "studies/sweep.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 struct Shard {
     int index = 0;  // K, 0-based (a Slurm array task id)
@@ -87,4 +87,4 @@ std::string referenceTag(const SweepIdentity& identity);
 SweepResult runShard(const scene::Scene& scene, const SweepGrid& grid, const Shard& shard, const SweepOptions& options,
                      const SharedReferenceOptions& referenceOptions = {});
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

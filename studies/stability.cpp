@@ -19,7 +19,7 @@
 #include "scene/loader.h"
 #include "scene/settings.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
@@ -60,11 +60,11 @@ scene::SettingsOverrides overridesFromBlock(const Json& block) {
     return o;
 }
 
-std::string describeOverrides(const Json& block, const std::string& backend) {
+std::string describeOverrides(const Json& block, scene::Backend backend) {
     std::string s;
     for (const auto& [k, v] : block.items()) {
         const bool rayKey = k == "ray_bias" || k == "precision";
-        if (rayKey != (backend == "raytrace")) continue;
+        if (rayKey != (backend == scene::Backend::Raytrace)) continue;
         if (!s.empty()) s += ", ";
         s += k + " " + (v.is_string() ? v.get<std::string>() : v.dump());
     }
@@ -73,7 +73,7 @@ std::string describeOverrides(const Json& block, const std::string& backend) {
 
 BackendRun renderRun(const scene::Scene& scene, const scene::Frame& reference,
                      const scene::SettingsOverrides& overrides, const StabilityOptions& options,
-                     const std::string& backend, const std::string& variant, const std::string& label,
+                     scene::Backend backend, const std::string& variant, const std::string& label,
                      scene::Frame* keep = nullptr) {
     BackendRun run;
     run.backend = backend;
@@ -88,11 +88,11 @@ BackendRun renderRun(const scene::Scene& scene, const scene::Frame& reference,
         const scene::Frame frame = options.render(scene, settings, backend);
         run.timeMs = msSince(t0);
         run.ok = true;
-        run.health = measureHealth(frame);
+        run.health = compare::measureHealth(frame);
         run.blackFrame = isBlack(frame);
         if (auto it = frame.attributes.find("validation_messages"); it != frame.attributes.end())
             run.validationMessages = std::stoi(it->second);
-        const Comparison cmp = compareFrames(frame, reference);
+        const compare::Comparison cmp = compare::compareFrames(frame, reference);
         run.counted = cmp.metrics.counted;
         run.falseShadowRate = cmp.metrics.falseShadowRate;
         run.missedShadowRate = cmp.metrics.missedShadowRate;
@@ -107,7 +107,7 @@ BackendRun renderRun(const scene::Scene& scene, const scene::Frame& reference,
 }
 
 // The bias search: each grid point rendered once and measured (the sweep's warm-up, repeated
-// timing and journal are not needed to find a window), then compare::recommendBias.
+// timing and journal are not needed to find a window), then recommendBias.
 AutoBias searchBias(const scene::Scene& scene, const scene::Frame& reference,
                     const StabilityOptions& options) {
     SweepGrid grid = defaultGrid(scene, options.quick);
@@ -117,7 +117,7 @@ AutoBias searchBias(const scene::Scene& scene, const scene::Frame& reference,
             continue;
         const bool isSeries = !config.biasKind.empty() || config.overrides.rayBias == std::optional<std::string>("robust");
         if (options.biasSeriesOnly && !isSeries) continue;
-        if (options.searchMapSize > 0 && config.backend == "raster") config.overrides.shadowMapSize = options.searchMapSize;
+        if (options.searchMapSize > 0 && config.backend == scene::Backend::Raster) config.overrides.shadowMapSize = options.searchMapSize;
         SweepRow row;
         row.config = config;
         row.key = config.key();
@@ -130,8 +130,8 @@ AutoBias searchBias(const scene::Scene& scene, const scene::Frame& reference,
             const scene::Frame frame = options.render(scene, settings, config.backend);
             row.frameMs = msSince(t0);
             // A NaN frame must not look like a good bias: its rates become NaN (failing samples).
-            Json m = toJson(compareFrames(frame, reference).metrics);
-            if (measureHealth(frame).total() > 0) {
+            Json m = toJson(compare::compareFrames(frame, reference).metrics);
+            if (compare::measureHealth(frame).total() > 0) {
                 m["false_shadow_rate"] = nullptr;
                 m["missed_shadow_rate"] = nullptr;
                 row.error = "non-finite values";
@@ -147,13 +147,13 @@ AutoBias searchBias(const scene::Scene& scene, const scene::Frame& reference,
 
 }  // namespace
 
-const BackendRun* StabilityCase::run(const std::string& backend, const std::string& variant) const {
+const BackendRun* StabilityCase::run(scene::Backend backend, const std::string& variant) const {
     for (const BackendRun& r : runs)
         if (r.backend == backend && r.variant == variant) return &r;
     return nullptr;
 }
 
-const MethodBias* StabilityCase::biasOf(const std::string& backend) const {
+const MethodBias* StabilityCase::biasOf(scene::Backend backend) const {
     for (const MethodBias& b : bias)
         if (b.backend == backend) return &b;
     return nullptr;
@@ -188,10 +188,10 @@ StabilityCase runStabilityCase(const scene::Scene& sceneIn, const StabilityOptio
     try {
         const scene::RenderSettings settings = scene::resolveSettings(scene, {});
         const auto t0 = std::chrono::steady_clock::now();
-        c.reference = options.render(scene, settings, "reference");
+        c.reference = options.render(scene, settings, scene::Backend::Reference);
         c.referenceMs = msSince(t0);
         c.referenceOk = true;
-        c.referenceHealth = measureHealth(c.reference);
+        c.referenceHealth = compare::measureHealth(c.reference);
         c.referenceBlack = isBlack(c.reference);
     } catch (const std::exception& e) {
         c.referenceError = e.what();
@@ -214,15 +214,15 @@ StabilityCase runStabilityCase(const scene::Scene& sceneIn, const StabilityOptio
     }
 
     // Backends at their defaults (kept: the recommendation is checked against them).
-    std::map<std::string, scene::Frame> defaultsFrames;
-    for (const std::string& backend : options.backends)
+    std::map<scene::Backend, scene::Frame> defaultsFrames;
+    for (const scene::Backend backend : options.backends)
         c.runs.push_back(renderRun(scene, c.reference, {}, options, backend, "defaults", "defaults",
                                    &defaultsFrames[backend]));
-    auto defaultsOf = [&](const std::string& backend) -> const scene::Frame* {
+    auto defaultsOf = [&](scene::Backend backend) -> const scene::Frame* {
         const auto it = defaultsFrames.find(backend);
         return it == defaultsFrames.end() || it->second.pixelCount() == 0 ? nullptr : &it->second;
     };
-    auto hasBackend = [&](const char* b) {
+    auto hasBackend = [&](scene::Backend b) {
         return std::find(options.backends.begin(), options.backends.end(), b) != options.backends.end();
     };
 
@@ -235,15 +235,16 @@ StabilityCase runStabilityCase(const scene::Scene& sceneIn, const StabilityOptio
         ro.render = options.render;
         ro.user.shadowMapSize = options.shadowMapSize;
         ro.user.validate = options.validate;
-        ro.raster = hasBackend("raster");
-        ro.raytrace = hasBackend("raytrace");
+        ro.raster = hasBackend(scene::Backend::Raster);
+        ro.raytrace = hasBackend(scene::Backend::Raytrace);
         ro.depthSteps = options.bestDepthSteps;
         ro.slopeSteps = options.bestSlopeSteps;
-        const Recommendation rec = recommendShadow(scene, c.reference, scene, c.reference, defaultsOf("raster"),
-                                                   defaultsOf("raytrace"), rayCandidateOf(ab), ro);
+        const Recommendation rec =
+            recommendShadow(scene, c.reference, scene, c.reference, defaultsOf(scene::Backend::Raster),
+                            defaultsOf(scene::Backend::Raytrace), rayCandidateOf(ab), ro);
         c.bestShadowBlock = rec.shadowBlock;
         c.bestNotes = rec.notes;
-        for (const std::string& backend : options.backends) {
+        for (const scene::Backend backend : options.backends) {
             MethodBias mb;
             mb.backend = backend;
             const BiasSeries* chosen = nullptr;
@@ -264,7 +265,7 @@ StabilityCase runStabilityCase(const scene::Scene& sceneIn, const StabilityOptio
             } else {
                 mb.text = "no bias series rendered";
             }
-            if (backend == "raytrace")
+            if (backend == scene::Backend::Raytrace)
                 for (const RobustResult& r : ab.robust)
                     mb.text += " Robust offsets (" + (r.precision.empty() ? std::string("default") : r.precision) +
                                "): false " + fmt(100 * r.falseShadowRate, 3) + "%, missed " +
@@ -276,7 +277,7 @@ StabilityCase runStabilityCase(const scene::Scene& sceneIn, const StabilityOptio
     }
 
     for (const BackendRun& r : c.runs) {
-        const std::string who = r.backend + " (" + r.variant + ")";
+        const std::string who = std::string(scene::toString(r.backend)) + " (" + r.variant + ")";
         if (!r.ok) c.failures.push_back(who + " failed: " + r.error);
         else {
             if (r.health.total() > 0) c.failures.push_back(who + " has " + std::to_string(r.health.total()) + " NaN/Inf values");
@@ -334,11 +335,11 @@ BackendState stateOf(const BackendRun* r, bool atBest) {
                                                   : std::to_string(r->validationMessages) + " validation messages";
         return {"failed", "failed: " + why};
     }
-    const bool acne = r->falseShadowRate > kBiasWindowMaxRate, leaks = r->missedShadowRate > kBiasWindowMaxRate;
+    const bool acne = r->falseShadowRate > compare::kBiasWindowMaxRate, leaks = r->missedShadowRate > compare::kBiasWindowMaxRate;
     if (!acne && !leaks) return {"clean", "clean"};
     std::string text;
-    if (acne) text = "acne " + formatPercent(r->falseShadowRate);
-    if (leaks) text += std::string(acne ? ", " : "") + "leaks " + formatPercent(r->missedShadowRate);
+    if (acne) text = "acne " + compare::formatPercent(r->falseShadowRate);
+    if (leaks) text += std::string(acne ? ", " : "") + "leaks " + compare::formatPercent(r->missedShadowRate);
     if (atBest) return {"stiff", "stiff: " + text};
     return {acne && leaks ? "acne+leaks" : acne ? "acne" : "leaks", text};
 }
@@ -358,14 +359,14 @@ Json toJson(const StabilityCase& c) {
     j["states"] = Json::object();
     for (const BackendRun& r : c.runs) {
         const BackendState st = stateOf(&r, r.variant == "best");
-        j["states"][r.backend][r.variant] = {{"state", st.state}, {"text", st.text},
+        j["states"][scene::toString(r.backend)][r.variant] = {{"state", st.state}, {"text", st.text},
                                              {"false_shadow_rate", r.falseShadowRate},
                                              {"missed_shadow_rate", r.missedShadowRate}};
     }
     j["best_notes"] = c.bestNotes;
     j["failures"] = c.failures;
     j["resolution"] = std::to_string(c.width) + "x" + std::to_string(c.height);
-    j["reference"] = {{"ok", c.referenceOk}, {"error", c.referenceError}, {"time_ms", c.referenceMs},
+    j[scene::toString(scene::Backend::Reference)] = {{"ok", c.referenceOk}, {"error", c.referenceError}, {"time_ms", c.referenceMs},
                       {"non_finite", c.referenceHealth.total()}};
     if (c.analytic) {
         const AnalyticCheck& a = *c.analytic;
@@ -379,7 +380,7 @@ Json toJson(const StabilityCase& c) {
     }
     j["runs"] = Json::array();
     for (const BackendRun& r : c.runs)
-        j["runs"].push_back({{"backend", r.backend}, {"variant", r.variant}, {"settings", r.settings},
+        j["runs"].push_back({{"backend", scene::toString(r.backend)}, {"variant", r.variant}, {"settings", r.settings},
                              {"ok", r.ok}, {"error", r.error}, {"black_frame", r.blackFrame},
                              {"nan", r.health.beauty.nan + r.health.visibility.nan + r.health.objectId.nan +
                                          r.health.ndotl.nan + r.health.depth.nan + r.health.blockerId.nan},
@@ -389,7 +390,7 @@ Json toJson(const StabilityCase& c) {
                              {"missed_shadow_rate", r.missedShadowRate}});
     j["bias"] = Json::array();
     for (const MethodBias& b : c.bias)
-        j["bias"].push_back({{"backend", b.backend}, {"stiff", b.stiff}, {"kind", b.kind}, {"lo", b.lo},
+        j["bias"].push_back({{"backend", scene::toString(b.backend)}, {"stiff", b.stiff}, {"kind", b.kind}, {"lo", b.lo},
                              {"hi", b.hi}, {"recommended", b.recommended}, {"dominant", b.dominant},
                              {"text", b.text}});
     j["best_shadow_block"] = c.bestShadowBlock;
@@ -419,7 +420,7 @@ std::string stabilityCsv(const std::vector<StabilityCase>& cases) {
         const std::string analytic = c.analytic ? (c.analytic->passed() ? "exact" : "MISSED") : "n/a";
         for (const BackendRun& r : c.runs)
             s << c.name << ',' << (c.failed() ? "failed" : "ok") << ',' << c.referenceVerdict() << ',' << analytic << ','
-              << c.referenceMs << ',' << r.backend << ',' << r.variant << ',' << csvField(stateOf(&r, r.variant == "best").text)
+              << c.referenceMs << ',' << scene::toString(r.backend) << ',' << r.variant << ',' << csvField(stateOf(&r, r.variant == "best").text)
               << ',' << csvField(r.settings) << ',' << r.ok << ',' << r.blackFrame
               << ',' << r.health.total() << ',' << r.falseShadowRate << ',' << r.missedShadowRate << ','
               << r.timeMs << ',' << csvField(windowText(c.biasOf(r.backend))) << '\n';
@@ -437,7 +438,7 @@ std::string stateCell(const BackendState& st) {
     std::string cls = st.state;
     std::replace(cls.begin(), cls.end(), '+', '-');
     std::replace(cls.begin(), cls.end(), ' ', '-');
-    return "<td class=\"st-" + cls + "\">" + escapeHtml(st.text) + "</td>";
+    return "<td class=\"st-" + cls + "\">" + compare::escapeHtml(st.text) + "</td>";
 }
 
 std::string referenceCell(const std::string& verdict) {
@@ -456,7 +457,7 @@ void writeStabilityReport(const fs::path& dir, const std::vector<StabilityCase>&
         wrong += c.referenceVerdict() == "wrong" ? 1 : 0;
     }
     h << "<!doctype html><html><head><meta charset=\"utf-8\"><title>shadowlab stability</title><style>"
-      << html::css()
+      << compare::html::css()
       << " table.st td,table.st th{padding:3px 8px;border-bottom:1px solid #ddd;text-align:left}"
          " .fail{color:#b00;font-weight:bold} .pass{color:#070;font-weight:bold}"
          " .st-clean,.ref-exact{background:#d3f9d8;color:#1b5e20} .st-acne{background:#ffe3e3;color:#a51111}"
@@ -472,45 +473,45 @@ void writeStabilityReport(const fs::path& dir, const std::vector<StabilityCase>&
          " spheres, quads and boxes under directional lights), and each backend at its defaults and at"
          " its best bias (searched in its own configuration over depth × slope, never worse than the defaults)."
          " A backend's state: <span class=st-clean>clean</span> (false and missed shadow both ≤ "
-      << formatPercent(kBiasWindowMaxRate) << " of the counted pixels), <span class=st-acne>acne x%</span> (false shadow),"
+      << compare::formatPercent(compare::kBiasWindowMaxRate) << " of the counted pixels), <span class=st-acne>acne x%</span> (false shadow),"
          " <span class=st-leaks>leaks y%</span> (missed shadow: light leaking, peter-panning),"
          " <span class=st-acne-leaks>both</span>, and at the best bias <span class=st-stiff>stiff</span>: no searched"
          " bias makes it clean. <span class=st-failed>failed</span>: crash, NaN/Inf, black frame or validation messages."
          "</p><table class=st><tr><th>case</th><th>reference</th><th>raster at defaults</th><th>raster at best</th>"
          "<th>raytrace at defaults</th><th>raytrace at best</th><th>raster window</th><th>raytrace window</th></tr>";
     for (const StabilityCase& c : cases) {
-        h << "<tr><td><a href=\"#" << escapeHtml(c.name) << "\">" << escapeHtml(c.name) << "</a></td>"
+        h << "<tr><td><a href=\"#" << compare::escapeHtml(c.name) << "\">" << compare::escapeHtml(c.name) << "</a></td>"
           << referenceCell(c.referenceVerdict());
-        for (const char* backend : {"raster", "raytrace"})
+        for (const scene::Backend backend : {scene::Backend::Raster, scene::Backend::Raytrace})
             for (const char* variant : {"defaults", "best"})
                 h << stateCell(stateOf(c.run(backend, variant), std::string(variant) == "best"));
-        h << "<td>" << escapeHtml(windowText(c.biasOf("raster"))) << "</td><td>"
-          << escapeHtml(windowText(c.biasOf("raytrace"))) << "</td></tr>";
+        h << "<td>" << compare::escapeHtml(windowText(c.biasOf(scene::Backend::Raster))) << "</td><td>"
+          << compare::escapeHtml(windowText(c.biasOf(scene::Backend::Raytrace))) << "</td></tr>";
     }
-    h << "</table>" << html::diffLegend();
+    h << "</table>" << compare::html::diffLegend();
     for (const StabilityCase& c : cases) {
-        h << "<section id=\"" << escapeHtml(c.name) << "\"><h2>" << escapeHtml(c.name) << "</h2><table class=st><tr>"
+        h << "<section id=\"" << compare::escapeHtml(c.name) << "\"><h2>" << compare::escapeHtml(c.name) << "</h2><table class=st><tr>"
           << "<th>reference</th><th>raster at defaults</th><th>raster at best</th><th>raytrace at defaults</th>"
              "<th>raytrace at best</th></tr><tr>" << referenceCell(c.referenceVerdict());
-        for (const char* backend : {"raster", "raytrace"})
+        for (const scene::Backend backend : {scene::Backend::Raster, scene::Backend::Raytrace})
             for (const char* variant : {"defaults", "best"})
                 h << stateCell(stateOf(c.run(backend, variant), std::string(variant) == "best"));
         h << "</tr></table>";
-        if (!c.description.empty()) h << "<p>" << escapeHtml(c.description) << "</p>";
-        for (const std::string& f : c.failures) h << "<p class=fail>" << escapeHtml(f) << "</p>";
+        if (!c.description.empty()) h << "<p>" << compare::escapeHtml(c.description) << "</p>";
+        for (const std::string& f : c.failures) h << "<p class=fail>" << compare::escapeHtml(f) << "</p>";
         h << "<p>Reference: " << fmt(c.referenceMs) << " ms, " << c.referenceHealth.total() << " NaN/Inf. Analytic: "
-          << escapeHtml(c.analytic ? c.analytic->summary() : "not analytic (" + c.notAnalytic + ")") << ".</p>";
+          << compare::escapeHtml(c.analytic ? c.analytic->summary() : "not analytic (" + c.notAnalytic + ")") << ".</p>";
         h << "<table class=st><tr><th>backend</th><th>settings</th><th>state</th><th>NaN/Inf</th><th>acne</th>"
              "<th>leak</th><th>time ms</th></tr>";
         for (const BackendRun& r : c.runs)
-            h << "<tr><td>" << r.backend << "</td><td>" << escapeHtml(r.variant + ": " + r.settings) << "</td>"
+            h << "<tr><td>" << scene::toString(r.backend) << "</td><td>" << compare::escapeHtml(r.variant + ": " + r.settings) << "</td>"
               << stateCell(stateOf(&r, r.variant == "best")) << "<td>"
               << r.health.total() << "</td><td>" << fmt(100 * r.falseShadowRate, 3) << "%</td><td>"
               << fmt(100 * r.missedShadowRate, 3) << "%</td><td>" << fmt(r.timeMs) << "</td></tr>";
         h << "</table>";
         for (const MethodBias& b : c.bias)
-            h << "<p><b>" << b.backend << "</b> (probe slice): " << escapeHtml(windowText(&b)) << ". " << escapeHtml(b.text) << "</p>";
-        for (const std::string& note : c.bestNotes) h << "<p>" << escapeHtml(note) << "</p>";
+            h << "<p><b>" << scene::toString(b.backend) << "</b> (probe slice): " << compare::escapeHtml(windowText(&b)) << ". " << compare::escapeHtml(b.text) << "</p>";
+        for (const std::string& note : c.bestNotes) h << "<p>" << compare::escapeHtml(note) << "</p>";
         h << "<div class=figs>";
         // Every image at one width (figures in a flex row would shrink to their captions), small
         // renders magnified with crisp pixels so their shadows can be seen.
@@ -524,10 +525,10 @@ void writeStabilityReport(const fs::path& dir, const std::vector<StabilityCase>&
         for (const BackendRun& r : c.runs) {
             if (r.diffRgb.empty()) continue;
             const std::string png =
-                "stability/" + c.name + "-" + r.backend + (r.variant == "defaults" ? "" : "-" + r.variant) + "-diff.png";
+                "stability/" + c.name + "-" + scene::toString(r.backend) + (r.variant == "defaults" ? "" : "-" + r.variant) + "-diff.png";
             scene::writePngDisplay(dir / png, c.width, c.height, r.diffRgb);
-            h << "<figure><img src=\"" << png << "\" " << size << " class=upscale alt=\"" << r.backend << " difference\"><figcaption>"
-              << r.backend << " at " << r.variant << " vs reference</figcaption></figure>";
+            h << "<figure><img src=\"" << png << "\" " << size << " class=upscale alt=\"" << scene::toString(r.backend) << " difference\"><figcaption>"
+              << scene::toString(r.backend) << " at " << r.variant << " vs reference</figcaption></figure>";
         }
         h << "</div></section>";
     }
@@ -540,4 +541,4 @@ void writeStabilityReport(const fs::path& dir, const std::vector<StabilityCase>&
                            Json{{"passed", suitePassed(cases)}, {"cases", all}}.dump(2) + "\n");
 }
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

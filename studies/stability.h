@@ -21,7 +21,7 @@
 #include "scene/frame.h"
 #include "scene/scene.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 // A beauty whose brightest channel stays below this (linear) is black. The ambient term alone
 // (0.05 · albedo ≥ ~0.01 in every shipped scene) is far above it, so only a broken render trips it.
@@ -31,7 +31,7 @@ struct StabilityOptions {
     int width = 160, height = 90;          // every render of the case
     std::optional<int> shadowMapSize;      // overrides the default settings' map size (tests: 512)
     bool search = true;                    // run the bias search and the best-settings renders
-    bool quick = true;                     // compare::defaultGrid(scene, quick)
+    bool quick = true;                     // defaultGrid(scene, quick)
     // Keep only the bias series and robust rows of the grid (drop the map-size × filter block),
     // and use this map size for the raster series (0: the grid's own): the tests' small search.
     bool biasSeriesOnly = false;
@@ -41,19 +41,19 @@ struct StabilityOptions {
     // (studies/recommend.h: depth × slope, never worse than the defaults); these are its grids.
     std::vector<double> bestDepthSteps = RecommendOptions{}.depthSteps;
     std::vector<double> bestSlopeSteps = RecommendOptions{}.slopeSteps;
-    std::vector<std::string> backends{"raster", "raytrace"};
+    std::vector<scene::Backend> backends{scene::Backend::Raster, scene::Backend::Raytrace};
     RenderFn render = renderWithBackend;   // tests may pass a fake
 };
 
 // One backend render of the case and what it measured.
 struct BackendRun {
-    std::string backend;     // "raster" | "raytrace"
+    scene::Backend backend = scene::Backend::Raster;  // Raster or Raytrace
     std::string variant;     // "defaults" | "best"
     std::string settings;    // short text of the overrides applied
     bool ok = false;         // rendered without throwing
     std::string error;       // the exception's message when !ok
     bool blackFrame = false;
-    FrameHealth health;
+    compare::FrameHealth health;
     int validationMessages = -1;  // -1 when the frame does not say
     double timeMs = 0.0;
     std::size_t counted = 0;
@@ -64,7 +64,7 @@ struct BackendRun {
 
 // The bias search's verdict for one method: a window, or "stiff" with what dominates.
 struct MethodBias {
-    std::string backend;     // "raster" | "raytrace"
+    scene::Backend backend = scene::Backend::Raster;  // Raster or Raytrace
     bool stiff = true;       // no series of this backend has a window
     std::string kind;        // the series the verdict comes from ("depth", "slope", "ray")
     double lo = 0.0, hi = 0.0, recommended = 0.0;
@@ -89,7 +89,7 @@ struct StabilityCase {
     bool referenceOk = false;
     std::string referenceError;
     double referenceMs = 0.0;
-    FrameHealth referenceHealth;
+    compare::FrameHealth referenceHealth;
     bool referenceBlack = false;
     scene::Frame reference;   // kept for the report's images
     std::string notAnalytic;  // why there is no analytic answer; empty when there is one
@@ -104,8 +104,8 @@ struct StabilityCase {
     // The reference's verdict: "exact" (matches the analytic answer), "wrong" (misses it, failed,
     // NaN/Inf or black), "unchecked" (no analytic answer for this scene, healthy).
     std::string referenceVerdict() const;
-    const BackendRun* run(const std::string& backend, const std::string& variant) const;
-    const MethodBias* biasOf(const std::string& backend) const;
+    const BackendRun* run(scene::Backend backend, const std::string& variant) const;
+    const MethodBias* biasOf(scene::Backend backend) const;
 };
 
 // Never throws for a render failure (recorded in the case); throws scene::InputError for bad
@@ -134,4 +134,4 @@ void writeStabilityReport(const std::filesystem::path& dir, const std::vector<St
 // The suite's verdict: true when no case failed (the app exits non-zero otherwise).
 bool suitePassed(const std::vector<StabilityCase>& cases);
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -12,6 +12,7 @@
 #include <memory>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 #include <unistd.h>
 
 #include "compare/compare.h"
@@ -26,7 +27,7 @@
 #include "scene/json_input.h"
 #include "scene/render_plan.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 namespace {
 
@@ -109,9 +110,17 @@ scene::SettingsOverrides overridesFromJson(const Json& j) {
     return o;
 }
 
+// A journal's or results file's backend name, parsed once where the text is read.
+scene::Backend backendFromJson(const Json& name) {
+    const std::string text = name.get<std::string>();
+    const std::optional<scene::Backend> b = scene::parseBackend(text);
+    if (!b) throw std::invalid_argument("unknown backend '" + text + "'");
+    return *b;
+}
+
 Json rowToJson(const SweepRow& r) {
     Json j = {{"key", r.key},
-              {"backend", r.config.backend},
+              {"backend", scene::toString(r.config.backend)},
               {"label", r.config.label()},
               {"overrides", overridesToJson(r.config.overrides)},
               {"bias_kind", r.config.biasKind},
@@ -133,7 +142,7 @@ Json rowToJson(const SweepRow& r) {
 
 SweepRow rowFromJson(const Json& j) {
     SweepRow r;
-    r.config.backend = j.at("backend").get<std::string>();
+    r.config.backend = backendFromJson(j.at("backend"));
     r.config.overrides = overridesFromJson(j.at("overrides"));
     r.config.biasKind = j.value("bias_kind", "");
     r.config.biasValue = j.contains("bias_value") && j["bias_value"].is_number()
@@ -195,7 +204,7 @@ std::optional<double> momentOverride(const scene::SettingsOverrides& o, const st
 }
 
 std::string SweepConfig::key() const {
-    std::string k = "backend=" + backend;
+    std::string k = std::string("backend=") + scene::toString(backend);
     const auto& o = overrides;
     if (o.shadowMapSize) k += ";map=" + std::to_string(*o.shadowMapSize);
     if (o.filter) k += ";filter=" + *o.filter;
@@ -248,7 +257,7 @@ std::string SweepConfig::label() const {
     if (o.esmExponent) parts.push_back("esm exponent " + number(*o.esmExponent));
     if (o.momentBias) parts.push_back("moment bias " + number(*o.momentBias));
     if (o.blurWidth) parts.push_back("blur " + std::to_string(*o.blurWidth));
-    std::string s = backend + ":";
+    std::string s = std::string(scene::toString(backend)) + ":";
     for (std::size_t i = 0; i < parts.size(); ++i) s += (i ? ", " : " ") + parts[i];
     if (parts.empty()) s += " defaults";
     return s;
@@ -299,7 +308,7 @@ SweepGrid defaultGrid(const scene::Scene& scene, bool quick) {
     // each row, and the texel unit of the bias series below, means the same on every view.
     auto raster = [&](int size, const std::string& filter) {
         SweepConfig c;
-        c.backend = "raster";
+        c.backend = scene::Backend::Raster;
         c.overrides.shadowMapSize = size;
         c.overrides.filter = filter;
         c.overrides.fitLightFrustum = false;
@@ -371,7 +380,7 @@ SweepGrid defaultGrid(const scene::Scene& scene, bool quick) {
     for (int d : decades) rayBiases.push_back(extent * std::pow(10.0, d));
     for (double b : rayBiases) {
         SweepConfig c;
-        c.backend = "raytrace";
+        c.backend = scene::Backend::Raytrace;
         c.overrides.rayBias = number(b);
         c.overrides.precision = "float";
         c.biasKind = "ray";
@@ -380,7 +389,7 @@ SweepGrid defaultGrid(const scene::Scene& scene, bool quick) {
     }
     for (const char* precision : {"float", "double"}) {
         SweepConfig c;
-        c.backend = "raytrace";
+        c.backend = scene::Backend::Raytrace;
         c.overrides.rayBias = "robust";
         c.overrides.precision = precision;
         g.configs.push_back(c);
@@ -402,8 +411,13 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
     if (!doc.is_object()) throw SceneError(file, root, "expected an object");
     SweepGrid g;
     g.configs.clear();
+    // A backend's block is named by the backend (scene::parseBackend); the reference has none.
+    auto backendBlock = [](const std::string& key) {
+        const std::optional<scene::Backend> b = scene::parseBackend(key);
+        return b == scene::Backend::Raster || b == scene::Backend::Raytrace;
+    };
     for (const auto& [key, value] : doc.items()) {
-        if (key != "repetitions" && key != "resolution" && key != "raster" && key != "raytrace" && key != "include_default" &&
+        if (key != "repetitions" && key != "resolution" && !backendBlock(key) && key != "include_default" &&
             key != "flicker")
             throw SceneError(file, root / key,
                              "unknown key; allowed: repetitions, resolution, raster, raytrace, include_default, flicker");
@@ -487,12 +501,13 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
         for (std::size_t i = 0; i < v.size(); ++i) values.push_back(v[i]);
         return values;
     };
-    for (const char* backend : {"raster", "raytrace"}) {
-        if (!doc.contains(backend)) continue;
-        const Json& block = doc[backend];
-        const JsonPath path = root / backend;
+    for (const scene::Backend backend : {scene::Backend::Raster, scene::Backend::Raytrace}) {
+        const std::string section = scene::toString(backend);
+        if (!doc.contains(section)) continue;
+        const Json& block = doc[section];
+        const JsonPath path = root / section;
         if (!block.is_object()) throw SceneError(file, path, "expected an object of axes");
-        const bool isRaster = std::string(backend) == "raster";
+        const bool isRaster = backend == scene::Backend::Raster;
         const std::vector<const char*> names = isRaster
             ? std::vector<const char*>{"shadow_map_size", "filter", "cascades", "cascade_blend", "fit_light_frustum",
                                        "snap_light_frustum", "receiver_plane_bias", "hardware_bias", "depth_bias",
@@ -501,7 +516,7 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
             : std::vector<const char*>{"ray_bias", "precision", "samples"};
         for (const auto& [key, value] : block.items())
             if (std::none_of(names.begin(), names.end(), [&](const char* n) { return key == n; }))
-                throw SceneError(file, path / key, std::string("unknown axis for ") + backend);
+                throw SceneError(file, path / key, "unknown axis for " + section);
         std::vector<SweepConfig> configs{SweepConfig{backend}};
         // A bias axis with one value holds that bias fixed; it is not the series the rows sample.
         std::size_t depthValues = 0;
@@ -632,17 +647,15 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
         try {
             scene::resolveSettings(scene, g.configs[i].overrides);
         } catch (const scene::InputError& e) {
-            throw SceneError(file, root / g.configs[i].backend, std::string("configuration ") + g.configs[i].label() + ": " + e.what());
+            throw SceneError(file, root / scene::toString(g.configs[i].backend), std::string("configuration ") + g.configs[i].label() + ": " + e.what());
         }
     }
     return g;
 }
 
 scene::Frame renderWithBackend(const scene::Scene& scene, const scene::RenderSettings& settings,
-                               const std::string& backend) {
-    const std::optional<scene::Backend> b = scene::parseBackend(backend);
-    if (!b) throw scene::InputError("unknown backend '" + backend + "'");
-    scene::Frame f = renderFrame(*b, scene, scene::makeRenderPlan(scene, settings), settings);
+                               scene::Backend backend) {
+    scene::Frame f = renderFrame(backend, scene, scene::makeRenderPlan(scene, settings), settings);
     scene::recordIdentity(f, scene);
     return f;
 }
@@ -654,10 +667,10 @@ namespace {
 // geometry and shadow maps are set up once (the warm-up frame's "setup"), as a program that
 // renders frames would; other backends (and fakes passed in by tests) render each frame anew.
 std::function<scene::Frame()> frameSource(const SweepOptions& options, const scene::Scene& scene,
-                                          const scene::RenderSettings& settings, const std::string& backend) {
-    using Fn = scene::Frame (*)(const scene::Scene&, const scene::RenderSettings&, const std::string&);
+                                          const scene::RenderSettings& settings, scene::Backend backend) {
+    using Fn = scene::Frame (*)(const scene::Scene&, const scene::RenderSettings&, scene::Backend);
     const Fn* fn = options.render.target<Fn>();
-    if (scene::parseBackend(backend) == scene::Backend::Raster && fn && *fn == &renderWithBackend) {
+    if (backend == scene::Backend::Raster && fn && *fn == &renderWithBackend) {
         std::shared_ptr<BackendRenderer> renderer =
             makeRenderer(scene::Backend::Raster, scene, scene::makeRenderPlan(scene, settings), settings);
         return [renderer, &scene] {
@@ -675,9 +688,9 @@ std::vector<const scene::Frame*> pointersTo(const std::vector<scene::Frame>& fra
     return p;
 }
 
-Json temporalFigures(const TemporalSummary& t) {
+Json temporalFigures(const compare::TemporalSummary& t) {
     Json pairs = Json::array();
-    for (const PairStability& p : t.pairs) pairs.push_back(p.flicker);
+    for (const compare::PairStability& p : t.pairs) pairs.push_back(p.flicker);
     return {{"flicker_rate", t.meanFlickerRate},     {"max_flicker_rate", t.maxFlickerRate},
             {"flicker_px", t.totalFlicker},          {"error_variation", t.meanErrorVariation},
             {"swim_px", t.meanSwimPixels},           {"edge_offset_px", t.meanEdgeOffset},
@@ -690,19 +703,18 @@ Json temporalFigures(const TemporalSummary& t) {
 // shadow setup drawn from frame 0's camera, docs/temporal.md); other render functions render each
 // frame anew and have no held view.
 Json rowTemporal(const SweepOptions& options, const PathSpec& spec, const std::vector<scene::Scene>& scenes,
-                 const std::vector<scene::Frame>& refs, const scene::RenderSettings& settings, const std::string& backend) {
-    using Fn = scene::Frame (*)(const scene::Scene&, const scene::RenderSettings&, const std::string&);
+                 const std::vector<scene::Frame>& refs, const scene::RenderSettings& settings, scene::Backend backend) {
+    using Fn = scene::Frame (*)(const scene::Scene&, const scene::RenderSettings&, scene::Backend);
     const Fn* fn = options.render.target<Fn>();
     const bool real = fn && *fn == &renderWithBackend;
     std::vector<scene::Frame> frames, held;
-    const std::optional<scene::Backend> seam = real ? scene::parseBackend(backend) : std::nullopt;
-    if (seam == scene::Backend::Raster || seam == scene::Backend::Raytrace) {
+    if (real && (backend == scene::Backend::Raster || backend == scene::Backend::Raytrace)) {
         const std::unique_ptr<BackendRenderer> r =
-            makeRenderer(*seam, scenes[0], scene::makeRenderPlan(scenes[0], settings), settings);
+            makeRenderer(backend, scenes[0], scene::makeRenderPlan(scenes[0], settings), settings);
         for (const scene::Scene& s : scenes) {
             r->update(s);
             frames.push_back(r->render());
-            if (*seam == scene::Backend::Raster && isCameraPath(spec.kind)) {
+            if (backend == scene::Backend::Raster && isCameraPath(spec.kind)) {
                 r->update(s, scenes[0].camera);
                 held.push_back(r->render());
             }
@@ -713,12 +725,12 @@ Json rowTemporal(const SweepOptions& options, const PathSpec& spec, const std::v
     } else {
         for (const scene::Scene& s : scenes) frames.push_back(options.render(s, settings, backend));
     }
-    Json j = temporalFigures(measureTemporal(pointersTo(frames), pointersTo(refs)));
+    Json j = temporalFigures(compare::measureTemporal(pointersTo(frames), pointersTo(refs)));
     j["path"] = toString(spec.kind);
     j["frames"] = int(scenes.size());
     if (!held.empty()) {
         const std::vector<const scene::Frame*> still(held.size(), &refs[0]);
-        j["held"] = temporalFigures(measureTemporal(pointersTo(held), still));
+        j["held"] = temporalFigures(compare::measureTemporal(pointersTo(held), still));
     }
     return j;
 }
@@ -763,7 +775,7 @@ std::string rowsToCsv(const std::vector<SweepRow>& rows) {
     s << "\n";
     for (const SweepRow& r : rows) {
         const auto& o = r.config.overrides;
-        s << csvField(r.key) << "," << r.config.backend << "," << csvField(r.config.label()) << ","
+        s << csvField(r.key) << "," << scene::toString(r.config.backend) << "," << csvField(r.config.label()) << ","
           << (o.shadowMapSize ? std::to_string(*o.shadowMapSize) : "") << "," << o.filter.value_or("") << ","
           << (o.cascades ? std::to_string(*o.cascades) : "") << ","
           << (o.depthBias ? number(*o.depthBias) : "") << "," << (o.slopeBias ? number(*o.slopeBias) : "") << ","
@@ -868,7 +880,7 @@ SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const
         result.reference = options.reference(scene);
     } else if (!haveReference) {
         const scene::RenderSettings settings = scene::resolveSettings(scene, {});
-        result.reference = options.render(scene, settings, "reference");
+        result.reference = options.render(scene, settings, scene::Backend::Reference);
         result.reference.attributes["scene"] = scene.file.string();
         scene::writeFrame(result.reference, refFile);
         scene::writePngLinear(dir / "reference.png", result.reference.width, result.reference.height,
@@ -903,7 +915,7 @@ SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const
                 }
             }
             if (!cached) {
-                f = options.render(pathFrames[t], scene::resolveSettings(pathFrames[t], {}), "reference");
+                f = options.render(pathFrames[t], scene::resolveSettings(pathFrames[t], {}), scene::Backend::Reference);
                 scene::writeFrame(f, file);
             }
             pathReferences.push_back(std::move(f));
@@ -950,13 +962,13 @@ SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const
             row.frameMs = median(frames);
             row.frameMsMin = *std::min_element(frames.begin(), frames.end());
             row.frameMsMax = *std::max_element(frames.begin(), frames.end());
-            const Comparison c = compareFrames(frame, result.reference);
+            const compare::Comparison c = compare::compareFrames(frame, result.reference);
             row.metrics = toJson(c.metrics);
             if (grid.flicker)
                 row.temporal = rowTemporal(options, *grid.flicker, pathFrames, pathReferencesReady(), settings, config.backend);
             row.settings = frame.attributes;
             if (options.writeImages) {
-                const std::string name = config.backend + "-" + shortHash(key);
+                const std::string name = std::string(scene::toString(config.backend)) + "-" + shortHash(key);
                 row.image = "images/" + name + ".png";
                 row.diffImage = "images/" + name + "-diff.png";
                 scene::writePngLinear(dir / row.image, frame.width, frame.height, frame.beauty);
@@ -988,4 +1000,4 @@ SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const
     return result;
 }
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

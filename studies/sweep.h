@@ -14,15 +14,16 @@
 #include <nlohmann/json.hpp>
 
 #include "studies/path.h"
+#include "scene/backend.h"
 #include "scene/frame.h"
 #include "scene/scene.h"
 #include "scene/settings.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 // One point of the grid: a backend and the settings that differ from the scene's defaults.
 struct SweepConfig {
-    std::string backend;  // "raster" | "raytrace"
+    scene::Backend backend = scene::Backend::Raster;  // Raster or Raytrace
     scene::SettingsOverrides overrides;
     // The bias parameter this configuration samples, for bias-window plots: "depth" (world
     // units), "slope" (texels), "ray" (world units); empty when it samples none.
@@ -89,7 +90,7 @@ struct SweepRow {
     nlohmann::json settings;               // the settings applied (Frame attributes)
     std::string error;                     // non-empty when the configuration failed
     std::string image, diffImage;          // file names under DIR/images/
-    nlohmann::json machine;                // compare::toJson(MachineInfo) it was timed on; null in old journals
+    nlohmann::json machine;                // toJson(MachineInfo) it was timed on; null in old journals
     // With a flicker axis: the row along the path (flicker_rate, flicker_px, error_variation,
     // swim_px, edge_offset_px, pairs; "held": the same for the raster held view on camera paths).
     // Null without one.
@@ -100,11 +101,12 @@ struct SweepRow {
     double temporalValue(const char* name, bool held = false) const;
 };
 
-// Renders one configuration; the default calls the raster or raytrace backend.
-using RenderFn = std::function<scene::Frame(const scene::Scene&, const scene::RenderSettings&,
-                                            const std::string& backend)>;
+// Renders one configuration (or the reference); tests pass fakes. The default renders through
+// the backend seam (studies/backend.h) and records the scene's identity in the Frame.
+using RenderFn =
+    std::function<scene::Frame(const scene::Scene&, const scene::RenderSettings&, scene::Backend backend)>;
 scene::Frame renderWithBackend(const scene::Scene& scene, const scene::RenderSettings& settings,
-                               const std::string& backend);
+                               scene::Backend backend);
 
 struct SweepProgress {
     std::size_t done = 0, total = 0, skipped = 0;  // skipped: already in the journal (resume)
@@ -139,8 +141,9 @@ SweepResult runSweep(const scene::Scene& scene, const SweepGrid& grid, const Swe
 // scene::InputError on a bad resolution.
 scene::Scene sweepScene(const scene::Scene& scene, const SweepGrid& grid);
 
-// One journal line's JSON and back (merge reads journals strictly with these). rowFromJournal
-// throws nlohmann::json::exception on a line that is JSON but not a row.
+// One journal line's JSON and back (merge reads journals strictly with these); the backend is
+// written as its name (scene::toString). rowFromJournal throws nlohmann::json::exception on a line
+// that is JSON but not a row, and std::invalid_argument on a backend name no build has.
 nlohmann::json journalRow(const SweepRow& row);
 SweepRow rowFromJournal(const nlohmann::json& line);
 
@@ -149,4 +152,4 @@ std::vector<SweepRow> readJournal(const std::filesystem::path& file);
 std::string rowsToCsv(const std::vector<SweepRow>& rows);
 nlohmann::json rowsToJson(const std::vector<SweepRow>& rows);
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -14,7 +14,7 @@
 #include "compare/text.h"
 #include "scene/frame_io.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 namespace {
 
@@ -72,8 +72,8 @@ std::string settingsOf(const SweepRow& r) {
     return s;
 }
 
-std::vector<std::string> backendsOf(const std::vector<SweepRow>& rows) {
-    std::vector<std::string> b;
+std::vector<scene::Backend> backendsOf(const std::vector<SweepRow>& rows) {
+    std::vector<scene::Backend> b;
     for (const auto& r : rows)
         if (std::find(b.begin(), b.end(), r.config.backend) == b.end()) b.push_back(r.config.backend);
     return b;
@@ -113,8 +113,8 @@ Machines machinesOf(const std::vector<SweepRow>& rows) {
     return m;
 }
 
-FrameInfo frameOf(const SweepRow& r, const SweepReportInput& in) {
-    FrameInfo f;
+compare::FrameInfo frameOf(const SweepRow& r, const SweepReportInput& in) {
+    compare::FrameInfo f;
     f.width = in.width;
     f.height = in.height;
     if (r.metrics.is_object()) {
@@ -124,8 +124,8 @@ FrameInfo frameOf(const SweepRow& r, const SweepReportInput& in) {
     return f;
 }
 
-ErrorHotspot hotspotOf(const SweepRow& r) {
-    ErrorHotspot h;
+compare::ErrorHotspot hotspotOf(const SweepRow& r) {
+    compare::ErrorHotspot h;
     if (!r.metrics.is_object() || !r.metrics.contains("hotspot") || !r.metrics["hotspot"].is_object()) return h;
     const Json& j = r.metrics["hotspot"];
     h.x = j.value("x", 0);
@@ -135,10 +135,14 @@ ErrorHotspot hotspotOf(const SweepRow& r) {
     return h;
 }
 
-std::string backendTitle(const std::string& backend) {
-    if (backend == "raster") return "the shadow map (raster)";
-    if (backend == "raytrace") return "the ray tracer (raytrace)";
-    return backend;
+std::string backendTitle(scene::Backend backend) {
+    const std::string name = scene::toString(backend);
+    switch (backend) {
+        case scene::Backend::Raster: return "the shadow map (" + name + ")";
+        case scene::Backend::Raytrace: return "the ray tracer (" + name + ")";
+        case scene::Backend::Reference: break;
+    }
+    return name;
 }
 
 // Best: least mismatch, then faster. Worst: most mismatch, then slower. Indices into rows.
@@ -146,7 +150,7 @@ struct Extremes {
     std::ptrdiff_t best = -1, worst = -1;
 };
 
-Extremes extremesOf(const std::vector<SweepRow>& rows, const std::string& backend) {
+Extremes extremesOf(const std::vector<SweepRow>& rows, scene::Backend backend) {
     Extremes e;
     for (std::size_t i = 0; i < rows.size(); ++i) {
         const SweepRow& r = rows[i];
@@ -165,23 +169,23 @@ Extremes extremesOf(const std::vector<SweepRow>& rows, const std::string& backen
 // Row indices on each backend's Pareto front of (per-frame time, mismatch).
 std::vector<bool> frontRows(const std::vector<SweepRow>& rows) {
     std::vector<bool> on(rows.size(), false);
-    for (const std::string& backend : backendsOf(rows)) {
-        std::vector<TimeErrorPoint> pts;
+    for (const scene::Backend backend : backendsOf(rows)) {
+        std::vector<compare::TimeErrorPoint> pts;
         std::vector<std::size_t> index;
         for (std::size_t i = 0; i < rows.size(); ++i)
             if (rows[i].config.backend == backend && usable(rows[i])) {
                 pts.push_back({rows[i].frameMs, rows[i].rate("mismatch_rate")});
                 index.push_back(i);
             }
-        for (const std::size_t k : paretoFront(pts)) on[index[k]] = true;
+        for (const std::size_t k : compare::paretoFront(pts)) on[index[k]] = true;
     }
     return on;
 }
 
-ScatterPlot biasSeriesPlot(const BiasSeries& s) {
-    ScatterPlot p = biasPlot(s.samples, s.window, s.name() + " (" + s.unit() + ")", s.logSpaced);
+compare::ScatterPlot biasSeriesPlot(const BiasSeries& s) {
+    compare::ScatterPlot p = biasPlot(s.samples, s.window, s.name() + " (" + s.unit() + ")", s.logSpaced);
     if (!s.window.stiff) {
-        if (!p.bands.empty()) p.bands.front().label = "window · recommended " + formatShort(s.recommended);
+        if (!p.bands.empty()) p.bands.front().label = "window · recommended " + compare::formatShort(s.recommended);
         p.markers.push_back({s.recommended, ""});
     } else {
         p.markers.push_back({s.recommended, "best compromise"});
@@ -194,27 +198,27 @@ std::string rowTitle(const SweepRow& r) {
 }
 
 std::string ratesNote(const SweepRow& r) {
-    return formatPercent(r.rate("false_shadow_rate")) + " false, " + formatPercent(r.rate("missed_shadow_rate")) +
-           " missed · " + formatDuration(r.frameMs) + " per frame";
+    return compare::formatPercent(r.rate("false_shadow_rate")) + " false, " + compare::formatPercent(r.rate("missed_shadow_rate")) +
+           " missed · " + compare::formatDuration(r.frameMs) + " per frame";
 }
 
 // One configuration: caption, its image and difference image side by side, and the zooms.
 std::string configCard(const SweepRow& r, const std::string& tag, const SweepReportInput& in) {
-    const FrameInfo f = frameOf(r, in);
-    const ErrorHotspot hot = hotspotOf(r);
+    const compare::FrameInfo f = frameOf(r, in);
+    const compare::ErrorHotspot hot = hotspotOf(r);
     std::ostringstream o;
     o << "<div class=\"cfg\"><div class=\"cfghead\"><span class=\"tag " << tag << "\">" << tag << "</span> <b>"
-      << escapeHtml(rowTitle(r)) << "</b><div class=\"small\">" << escapeHtml(ratesNote(r)) << "</div></div>"
+      << compare::escapeHtml(rowTitle(r)) << "</b><div class=\"small\">" << compare::escapeHtml(ratesNote(r)) << "</div></div>"
       << "<div class=\"pair\">";
-    if (!r.image.empty()) o << html::figure("image", "", r.image, f, nullptr);
+    if (!r.image.empty()) o << compare::html::figure("image", "", r.image, f, nullptr);
     if (!r.diffImage.empty())
-        o << html::figure("difference", formatPercent(r.rate("mismatch_rate")) + " wrong", r.diffImage, f, &hot);
+        o << compare::html::figure("difference", compare::formatPercent(r.rate("mismatch_rate")) + " wrong", r.diffImage, f, &hot);
     o << "</div>";
     if (hot.wrongPixels > 0 && hot.size > 0 && f.width > 0 && f.height > 0 && !r.image.empty() && !r.diffImage.empty()) {
-        o << "<div class=\"crops\">" << html::zoomCrop(r.image, f, hot, rowTitle(r) + " zoom")
-          << html::zoomCrop(r.diffImage, f, hot, rowTitle(r) + " difference zoom")
+        o << "<div class=\"crops\">" << compare::html::zoomCrop(r.image, f, hot, rowTitle(r) + " zoom")
+          << compare::html::zoomCrop(r.diffImage, f, hot, rowTitle(r) + " difference zoom")
           << "<div class=\"small\">Zoom into the " << hot.size << "×" << hot.size << " px region at (" << hot.x << ", "
-          << hot.y << ") with the most errors (" << formatCount(hot.wrongPixels) << " px), marked yellow above: "
+          << hot.y << ") with the most errors (" << compare::formatCount(hot.wrongPixels) << " px), marked yellow above: "
           << "the image, then its difference.</div></div>";
     } else if (hot.wrongPixels == 0) {
         o << "<div class=\"small\">No wrong pixel: nothing to zoom into.</div>";
@@ -228,7 +232,7 @@ bool hasFlicker(const SweepReportInput& in) {
 }
 
 std::string rowsTable(const SweepReportInput& in, const std::vector<bool>& front) {
-    std::map<std::string, Extremes> ext;
+    std::map<scene::Backend, Extremes> ext;
     for (const auto& b : backendsOf(in.rows)) ext[b] = extremesOf(in.rows, b);
     const Machines machines = machinesOf(in.rows);
     const bool perMachine = machines.list.size() > 1;
@@ -245,29 +249,29 @@ std::string rowsTable(const SweepReportInput& in, const std::vector<bool>& front
         if (!usable(r)) continue;
         const Extremes& e = ext[r.config.backend];
         o << "<tr" << (front[i] ? " class=\"front\"" : "") << "><td>" << i + 1 << "</td><td>"
-          << escapeHtml(r.config.backend) << "</td><td>" << escapeHtml(rowTitle(r));
+          << scene::toString(r.config.backend) << "</td><td>" << compare::escapeHtml(rowTitle(r));
         if (front[i]) o << " <span class=\"tag front\" title=\"on the Pareto front\">front</span>";
         if (std::ptrdiff_t(i) == e.best) o << " <span class=\"tag best\">best</span>";
         if (std::ptrdiff_t(i) == e.worst && e.worst != e.best) o << " <span class=\"tag worst\">worst</span>";
         o << "</td><td>" << ms(r.setupMs) << "</td><td>" << ms(r.frameMs) << " <span class=\"small\">[" << ms(r.frameMsMin)
           << "–" << ms(r.frameMsMax) << "]</span></td><td>";
         if (perMachine) {
-            o << escapeHtml(machines.label(machines.ofRow[i])) << " <span class=\"small\">load " << formatFixed(machineFromJson(r.machine).load, 1)
+            o << compare::escapeHtml(machines.label(machines.ofRow[i])) << " <span class=\"small\">load " << compare::formatFixed(machineFromJson(r.machine).load, 1)
               << "</span></td><td>";
         }
-        o << formatPercent(r.rate("false_shadow_rate")) << "</td><td>"
-          << formatPercent(r.rate("missed_shadow_rate")) << "</td><td><b>" << formatPercent(r.rate("mismatch_rate"))
-          << "</b></td><td>" << formatFixed(r.rate("shadow_iou"), 3) << "</td><td>";
+        o << compare::formatPercent(r.rate("false_shadow_rate")) << "</td><td>"
+          << compare::formatPercent(r.rate("missed_shadow_rate")) << "</td><td><b>" << compare::formatPercent(r.rate("mismatch_rate"))
+          << "</b></td><td>" << compare::formatFixed(r.rate("shadow_iou"), 3) << "</td><td>";
         if (temporal) {
             auto cell = [&](double v, bool percent) {
-                return std::isfinite(v) ? (percent ? formatPercent(v) : formatFixed(v, 3)) : std::string("–");
+                return std::isfinite(v) ? (percent ? compare::formatPercent(v) : compare::formatFixed(v, 3)) : std::string("–");
             };
             o << cell(r.temporalValue("flicker_rate"), true) << "</td><td>" << cell(r.temporalValue("flicker_rate", true), true)
               << "</td><td>" << cell(r.temporalValue("swim_px"), false) << "</td><td>";
         }
-        if (!r.image.empty()) o << "<a href=\"" << escapeHtml(r.image) << "\">image</a>";
+        if (!r.image.empty()) o << "<a href=\"" << compare::escapeHtml(r.image) << "\">image</a>";
         if (!r.image.empty() && !r.diffImage.empty()) o << " · ";
-        if (!r.diffImage.empty()) o << "<a href=\"" << escapeHtml(r.diffImage) << "\">diff</a>";
+        if (!r.diffImage.empty()) o << "<a href=\"" << compare::escapeHtml(r.diffImage) << "\">diff</a>";
         o << "</td></tr>\n";
     }
     o << "</tbody></table>\n";
@@ -320,22 +324,22 @@ SweepReportInput makeSweepReportInput(const std::string& sceneName, const std::s
 }
 
 std::string sweepErrorTimeSvg(const SweepReportInput& in) {
-    std::vector<SweepPoint> points;
+    std::vector<compare::SweepPoint> points;
     const Machines machines = machinesOf(in.rows);
     for (std::size_t i = 0; i < in.rows.size(); ++i) {
         const SweepRow& r = in.rows[i];
         if (usable(r))
-            points.push_back({r.config.backend, r.frameMs, r.rate("mismatch_rate"), rowTitle(r),
+            points.push_back({scene::toString(r.config.backend), r.frameMs, r.rate("mismatch_rate"), rowTitle(r),
                               machines.label(machines.ofRow[i])});
     }
-    ErrorTimeOptions o;
+    compare::ErrorTimeOptions o;
     o.title = "Shadow error against per-frame time";
     o.errorName = "mismatch rate (false + missed)";
-    return renderSvg(errorTimePlot(points, in.referenceMs, o));
+    return compare::renderSvg(compare::errorTimePlot(points, in.referenceMs, o));
 }
 
 std::string sweepFlickerSvg(const SweepReportInput& in) {
-    ScatterPlot plot;
+    compare::ScatterPlot plot;
     std::string path;
     for (const SweepRow& r : in.rows)
         if (usable(r) && r.temporal.is_object()) path = r.temporal.value("path", "") + " path, " +
@@ -349,36 +353,36 @@ std::string sweepFlickerSvg(const SweepReportInput& in) {
     plot.y.min = 0.0;
     // One series per backend (the moving view), and the raster held view where the path has one.
     std::vector<std::string> names;
-    std::map<std::string, PlotSeries> series;
+    std::map<std::string, compare::PlotSeries> series;
     for (const SweepRow& r : in.rows) {
         if (!usable(r) || !r.temporal.is_object()) continue;
         for (bool held : {false, true}) {
             const double f = r.temporalValue("flicker_rate", held);
             if (!std::isfinite(f)) continue;
-            const std::string name = r.config.backend + (held ? " held view" : "");
+            const std::string name = std::string(scene::toString(r.config.backend)) + (held ? " held view" : "");
             if (!series.count(name)) {
                 names.push_back(name);
                 series[name].name = name;
-                series[name].color = backendColor(held ? "raster held view" : r.config.backend, names.size() - 1);
+                series[name].color = compare::backendColor(held ? name : scene::toString(r.config.backend), names.size() - 1);
                 series[name].shape = held ? 1 : 0;
             }
             series[name].points.push_back(
                 {r.rate("mismatch_rate"), f, "",
-                 rowTitle(r) + ": " + formatPercent(f) + " flicker, " + formatFixed(r.temporalValue("swim_px", held), 3) +
-                     " px swim, " + formatPercent(r.rate("mismatch_rate")) + " wrong, " + formatDuration(r.frameMs) +
+                 rowTitle(r) + ": " + compare::formatPercent(f) + " flicker, " + compare::formatFixed(r.temporalValue("swim_px", held), 3) +
+                     " px swim, " + compare::formatPercent(r.rate("mismatch_rate")) + " wrong, " + compare::formatDuration(r.frameMs) +
                      " per frame"});
         }
     }
     for (const std::string& n : names) plot.series.push_back(series[n]);
-    return renderSvg(plot);
+    return compare::renderSvg(plot);
 }
 
 std::vector<std::string> describeSweep(const SweepReportInput& in, const AutoBias& bias) {
     std::vector<std::string> lines;
-    for (const std::string& backend : backendsOf(in.rows)) {
+    for (const scene::Backend backend : backendsOf(in.rows)) {
         const SweepRow* fastest = nullptr;
         for (const SweepRow& r : in.rows)
-            if (r.config.backend == backend && usable(r) && r.rate("mismatch_rate") <= kSweepGoodMismatchRate &&
+            if (r.config.backend == backend && usable(r) && r.rate("mismatch_rate") <= compare::kSweepGoodMismatchRate &&
                 (!fastest || r.frameMs < fastest->frameMs))
                 fastest = &r;
         const Extremes e = extremesOf(in.rows, backend);
@@ -386,18 +390,18 @@ std::vector<std::string> describeSweep(const SweepReportInput& in, const AutoBia
         if (e.best < 0) {
             s += "no configuration rendered.";
         } else if (fastest) {
-            s += "the fastest configuration under " + formatPercent(kSweepGoodMismatchRate) + " mismatch is " +
-                 rowTitle(*fastest) + ": " + formatDuration(fastest->frameMs) + " per frame, " +
-                 formatPercent(fastest->rate("mismatch_rate")) + " wrong.";
+            s += "the fastest configuration under " + compare::formatPercent(compare::kSweepGoodMismatchRate) + " mismatch is " +
+                 rowTitle(*fastest) + ": " + compare::formatDuration(fastest->frameMs) + " per frame, " +
+                 compare::formatPercent(fastest->rate("mismatch_rate")) + " wrong.";
             const SweepRow& b = in.rows[e.best];
             if (&b != fastest)
-                s += " The most accurate, " + rowTitle(b) + ", has " + formatPercent(b.rate("mismatch_rate")) + " at " +
-                     formatDuration(b.frameMs) + ".";
+                s += " The most accurate, " + rowTitle(b) + ", has " + compare::formatPercent(b.rate("mismatch_rate")) + " at " +
+                     compare::formatDuration(b.frameMs) + ".";
         } else {
             const SweepRow& b = in.rows[e.best];
-            s += "no configuration stays under " + formatPercent(kSweepGoodMismatchRate) +
-                 " mismatch; the most accurate, " + rowTitle(b) + ", has " + formatPercent(b.rate("mismatch_rate")) +
-                 " at " + formatDuration(b.frameMs) + " per frame.";
+            s += "no configuration stays under " + compare::formatPercent(compare::kSweepGoodMismatchRate) +
+                 " mismatch; the most accurate, " + rowTitle(b) + ", has " + compare::formatPercent(b.rate("mismatch_rate")) +
+                 " at " + compare::formatDuration(b.frameMs) + " per frame.";
         }
         lines.push_back(s);
     }
@@ -444,42 +448,42 @@ std::string renderSweepReportHtml(const SweepReportInput& in) {
     std::ostringstream o;
     o << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
       << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
-      << "<title>" << escapeHtml(title) << "</title>\n<style>" << html::css() << kSweepCss
+      << "<title>" << compare::escapeHtml(title) << "</title>\n<style>" << compare::html::css() << kSweepCss
       << "</style>\n</head>\n<body>\n<main>\n";
-    o << "<header><h1>" << escapeHtml(title) << "</h1><div class=\"sub\">";
-    if (!in.scenePath.empty()) o << "<code>" << escapeHtml(in.scenePath) << "</code> · ";
+    o << "<header><h1>" << compare::escapeHtml(title) << "</h1><div class=\"sub\">";
+    if (!in.scenePath.empty()) o << "<code>" << compare::escapeHtml(in.scenePath) << "</code> · ";
     if (width > 0) o << width << "×" << height << " px · ";
-    o << formatCount(in.rows.size()) << " configurations";
-    if (failed > 0) o << " (" << formatCount(failed) << " failed)";
+    o << compare::formatCount(in.rows.size()) << " configurations";
+    if (failed > 0) o << " (" << compare::formatCount(failed) << " failed)";
     o << " · each timed as the median of its frames after a warm-up, and measured against the "
          "double-precision reference</div></header>\n";
 
     // Summary in words beside the reference.
     o << "<div class=\"top\"><div class=\"findings\"><ul>";
-    for (const std::string& line : describeSweep(in, bias)) o << "<li>" << escapeHtml(line) << "</li>";
+    for (const std::string& line : describeSweep(in, bias)) o << "<li>" << compare::escapeHtml(line) << "</li>";
     o << "</ul><p style=\"margin-top:10px\">Recommended <code>\"shadow\"</code> block for the scene file "
          "(also in <code>recommended-shadow.json</code>):</p><pre>"
-      << escapeHtml(recommendedBlock(in, bias).dump(2)) << "</pre></div>\n<div>";
+      << compare::escapeHtml(recommendedBlock(in, bias).dump(2)) << "</pre></div>\n<div>";
     if (!in.referencePng.empty()) {
-        FrameInfo ref;
+        compare::FrameInfo ref;
         ref.width = width;
         ref.height = height;
-        o << html::figure("reference", in.referenceMs > 0.0 ? formatDuration(in.referenceMs) : "", in.referencePng, ref,
+        o << compare::html::figure(scene::toString(scene::Backend::Reference), in.referenceMs > 0.0 ? compare::formatDuration(in.referenceMs) : "", in.referencePng, ref,
                           nullptr);
     }
     o << "</div></div>\n";
 
     // Best and worst configuration of each backend.
-    for (const std::string& backend : backendsOf(in.rows)) {
+    for (const scene::Backend backend : backendsOf(in.rows)) {
         const Extremes e = extremesOf(in.rows, backend);
         if (e.best < 0) continue;
-        o << "<h2>" << escapeHtml(backendTitle(backend)) << ": best and worst configuration</h2>\n<div class=\"backend\">"
+        o << "<h2>" << compare::escapeHtml(backendTitle(backend)) << ": best and worst configuration</h2>\n<div class=\"backend\">"
           << configCard(in.rows[e.best], "best", in);
         if (e.worst != e.best) o << configCard(in.rows[e.worst], "worst", in);
         o << "</div>\n";
     }
     if (!in.rows.empty())
-        o << "<details><summary>Colors of the difference images</summary>" << html::diffLegend() << "</details>\n";
+        o << "<details><summary>Colors of the difference images</summary>" << compare::html::diffLegend() << "</details>\n";
 
     // Plots.
     o << "<h2>Error against run time</h2>\n<div class=\"plots\"><div>" << sweepErrorTimeSvg(in)
@@ -505,12 +509,12 @@ std::string renderSweepReportHtml(const SweepReportInput& in) {
         for (const std::string& kind : seriesKinds()) {
             const BiasSeries* s = bias.primary(kind);
             if (!s) continue;
-            o << "<div>" << renderSvg(biasSeriesPlot(*s)) << "<p>" << escapeHtml(s->describe()) << "</p></div>";
+            o << "<div>" << compare::renderSvg(biasSeriesPlot(*s)) << "<p>" << compare::escapeHtml(s->describe()) << "</p></div>";
         }
         o << "</div>\n<p class=\"small\">Too little bias gives false shadow (acne, red); too much gives missed "
              "shadow (peter-panning and light leaks, blue). The green band is the bias window: the sampled "
              "values where both stay at or under "
-          << formatPercent(bias.threshold) << " of the counted pixels. Without one, the scene is stiff for that "
+          << compare::formatPercent(bias.threshold) << " of the counted pixels. Without one, the scene is stiff for that "
              "method.</p>\n";
     }
 
@@ -524,8 +528,8 @@ std::string renderSweepReportHtml(const SweepReportInput& in) {
         for (std::size_t i = 0; i < in.rows.size(); ++i) {
             const SweepRow& r = in.rows[i];
             if (usable(r)) continue;
-            o << "<div class=\"failure\"><b>#" << i + 1 << " " << escapeHtml(r.config.backend + ": " + rowTitle(r)) << ":</b> "
-              << escapeHtml(r.error.empty() ? std::string("no metrics recorded") : r.error) << "</div>\n";
+            o << "<div class=\"failure\"><b>#" << i + 1 << " " << compare::escapeHtml(std::string(scene::toString(r.config.backend)) + ": " + rowTitle(r)) << ":</b> "
+              << compare::escapeHtml(r.error.empty() ? std::string("no metrics recorded") : r.error) << "</div>\n";
         }
     }
     o << "</main>\n</body>\n</html>\n";
@@ -539,7 +543,7 @@ void writeSweepReport(const fs::path& dir, const SweepReportInput& input) {
     for (const std::string& kind : seriesKinds()) {
         const BiasSeries* s = bias.primary(kind);
         if (s) {
-            scene::writeTextAtomic(dir / svgName(kind), renderSvg(biasSeriesPlot(*s)));
+            scene::writeTextAtomic(dir / svgName(kind), compare::renderSvg(biasSeriesPlot(*s)));
         } else {
             std::error_code ec;
             fs::remove(dir / svgName(kind), ec);
@@ -551,9 +555,9 @@ void writeSweepReport(const fs::path& dir, const SweepReportInput& input) {
     scene::writeTextAtomic(dir / "report.html", renderSweepReportHtml(input));
 }
 
-SweepSummary summarizeSweep(const SweepReportInput& input, const std::string& href) {
+compare::SweepSummary summarizeSweep(const SweepReportInput& input, const std::string& href) {
     const AutoBias bias = recommendBias(input.rows, input.threshold);
-    SweepSummary s;
+    compare::SweepSummary s;
     s.href = href;
     s.errorTimeSvg = sweepErrorTimeSvg(input);
     s.lines = describeSweep(input, bias);
@@ -570,4 +574,4 @@ SweepSummary summarizeSweep(const SweepReportInput& input, const std::string& hr
     return s;
 }
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -18,7 +18,7 @@
 #include "studies/sweep.h"
 #include "compare/thresholds.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 
 struct SweepReportInput {
     std::string sceneName;  // the title
@@ -27,7 +27,7 @@ struct SweepReportInput {
     std::string referencePng = "reference.png";  // relative to the report's folder; "" = none
     double referenceMs = 0.0;                // the reference's render time (a marker on the plot)
     int width = 0, height = 0;               // render size; 0 = read from the rows' metrics
-    double threshold = kBiasWindowMaxRate;   // bias-window threshold
+    double threshold = compare::kBiasWindowMaxRate;   // bias-window threshold
     // The block searched in the user's configuration and verified against their defaults
     // (studies/recommend.h). Without it the page and recommended-shadow.json show the probe
     // slice's block, marked as not measured against the defaults.
@@ -59,6 +59,6 @@ void writeSweepReport(const std::filesystem::path& dir, const SweepReportInput& 
 
 // What the run report shows of a sweep (ReportInput::sweep); `href` is the sweep report's path
 // relative to the run report, e.g. "sweep/report.html".
-SweepSummary summarizeSweep(const SweepReportInput& input, const std::string& href);
+compare::SweepSummary summarizeSweep(const SweepReportInput& input, const std::string& href);
 
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -57,11 +57,11 @@ TEST(ShardedSweep, ThreeProcessesAtOnceMergeToTheUnshardedSweep) {
     for (pid_t pid : pids) EXPECT_EQ(test::waitFor(pid), 0);
     ASSERT_EQ(runShadowlab({"merge", (dir.path() / "sh").string()}), 0);
 
-    const auto whole = compare::readResults(dir.path() / "whole");
-    const auto merged = compare::readResults(dir.path() / "sh");
+    const auto whole = studies::readResults(dir.path() / "whole");
+    const auto merged = studies::readResults(dir.path() / "sh");
     EXPECT_EQ(whole.size(), kQuickRows);
-    EXPECT_EQ(compare::rowDifferences(whole, merged), std::vector<std::string>{});
-    EXPECT_EQ(compare::verdictDifferences(whole, merged), std::vector<std::string>{});
+    EXPECT_EQ(studies::rowDifferences(whole, merged), std::vector<std::string>{});
+    EXPECT_EQ(studies::verdictDifferences(whole, merged), std::vector<std::string>{});
     for (const char* f : {"report.html", "results.csv", "error-time.svg", "recommended-shadow.json", "reference.png"})
         EXPECT_TRUE(fs::exists(dir.path() / "sh" / f)) << f;
     // One reference for the three shards, beside them, not one in each.
@@ -93,7 +93,7 @@ TEST(ShardedSweep, AKilledShardIsNamedByMergeAndItsResumeCompletesTheSweep) {
 
     ASSERT_EQ(runShadowlab(with(sweepArgs(out), {"--shard", "0/2", "--resume"})), 0);
     ASSERT_EQ(runShadowlab({"merge", out.string()}), 0);
-    const auto rows = compare::readResults(out);
+    const auto rows = studies::readResults(out);
     EXPECT_EQ(rows.size(), kQuickRows);
     std::set<std::string> keys;
     for (const auto& r : rows) EXPECT_TRUE(keys.insert(r.key).second) << r.key;

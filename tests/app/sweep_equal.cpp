@@ -17,7 +17,7 @@ int main(int argc, char** argv) {
         return 2;
     }
     try {
-        using namespace shadowlab::compare;
+        using namespace shadowlab::studies;
         namespace fs = std::filesystem;
         if (fs::exists(fs::path(argv[1]) / "path.json") && fs::exists(fs::path(argv[2]) / "path.json")) {
             const auto diffs = pathDifferences(argv[1], argv[2]);

@@ -10,7 +10,7 @@
 #include "scene/camera.h"
 #include "scene/error.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 namespace {
 
 using scene::Vec3;
@@ -191,4 +191,4 @@ TEST(AnalyticTest, CheckCountsMismatchesOutsideKnifeEdges) {
 }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -13,7 +13,7 @@
 #include "scene/loader.h"
 #include "tests/studies/sweep_rows.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 namespace {
 
 namespace fs = std::filesystem;
@@ -304,4 +304,4 @@ TEST(AutoBias, TheBlockCarriesTheParameterWhenItsSeriesRanWithTheBlocksFilter) {
 }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

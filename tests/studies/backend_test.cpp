@@ -9,7 +9,7 @@
 
 #include "scene/loader.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 namespace {
 
 scene::Scene smallSeed() {
@@ -74,4 +74,4 @@ TEST(BackendSeam, TheRasterRendererDrawsWhatTheOneShotRasterDraws) {
 }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -11,7 +11,7 @@
 #include "studies/check.h"
 #include "studies/check_report.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 namespace {
 
 CheckSuite suiteOf(const std::vector<std::string>& names) {
@@ -111,4 +111,4 @@ TEST(CheckSummaryHtml, OneRowPerCaseWithItsVerdictReasonsAndOnlyTheNamedDifferen
 }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -21,7 +21,7 @@
 #include "tests/raster/test_scenes.h"
 #include "tests/scene/animated_gltf.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 namespace {
 
 namespace fs = std::filesystem;
@@ -64,7 +64,7 @@ Json measured(const PathResult& r) {
     Json methods = Json::array();
     for (const PathMethod& m : r.methods) {
         Json frames = Json::array();
-        for (const Metrics& x : m.metrics) {
+        for (const compare::Metrics& x : m.metrics) {
             Json j = toJson(x);
             j.erase("method_timing");
             j.erase("reference_timing");
@@ -264,7 +264,7 @@ TEST(SweepFlickerAxis, SnappedFittedMapsHoldStillInTheHeldViewWhereUnsnappedOnes
     grid.flicker = spec;
     for (bool snap : {true, false}) {
         SweepConfig c;
-        c.backend = "raster";
+        c.backend = scene::Backend::Raster;
         c.overrides.shadowMapSize = kMap;
         c.overrides.filter = "pcf2x2";
         c.overrides.fitLightFrustum = true;
@@ -274,7 +274,7 @@ TEST(SweepFlickerAxis, SnappedFittedMapsHoldStillInTheHeldViewWhereUnsnappedOnes
         grid.configs.push_back(c);
     }
     SweepConfig rt;
-    rt.backend = "raytrace";
+    rt.backend = scene::Backend::Raytrace;
     grid.configs.push_back(rt);
     const TempFolder dir("sweep-flicker");
     SweepOptions options;
@@ -305,4 +305,4 @@ TEST(SweepFlickerAxis, SnappedFittedMapsHoldStillInTheHeldViewWhereUnsnappedOnes
 }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -15,8 +15,9 @@
 
 #include "compare/compare.h"
 #include "scene/loader.h"
+#include "tests/raster/test_scenes.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 namespace {
 
 namespace fs = std::filesystem;
@@ -51,12 +52,12 @@ struct Fake {
     // Used at this width only: the candidate loses there (for the "never loses" case).
     int loseAtWidth = 0;
     int renders = 0;
-    scene::Frame operator()(const scene::Scene& s, const scene::RenderSettings& settings, const std::string& backend) {
+    scene::Frame operator()(const scene::Scene& s, const scene::RenderSettings& settings, scene::Backend backend) {
         ++renders;
         const int w = s.camera.width;
-        if (backend == "reference") return row(w, 0);
+        if (backend == scene::Backend::Reference) return row(w, 0);
         int wrong = 0;
-        if (backend == "raster") {
+        if (backend == scene::Backend::Raster) {
             wrong = octaves(settings.raster.depthBias, depthTarget) + octaves(settings.raster.slopeBias, slopeTarget);
             if (w == loseAtWidth && !settings.raster.depthBiasIsDefault) wrong = w;
         } else {
@@ -80,7 +81,7 @@ TEST(Recommend, RefinementFindsTheOptimumBetweenCoarsePointsAndTheBlockHoldsIt) 
     // coarse best is (b0, 1) or (4b0, 4) at 20 px; its geometric midpoints reach (2b0, 2): 0 px.
     fake->depthTarget = 2.0 * b0;
     RecommendOptions o;
-    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, const std::string& b) { return (*fake)(sc, st, b); };
+    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) { return (*fake)(sc, st, b); };
     const scene::Frame ref = row(1000, 0);
     const Recommendation r = recommendShadow(s, ref, s, ref, nullptr, nullptr, Json{{"ray_bias", "robust"}}, o);
     ASSERT_GE(r.best, 0);
@@ -120,7 +121,7 @@ TEST(Recommend, KeepsTheDefaultsWhenNothingSearchedBeatsThem) {
     fake->depthTarget = b0;   // the defaults (b0, 1) are the optimum: 0 px
     fake->slopeTarget = 1.0;
     RecommendOptions o;
-    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, const std::string& b) { return (*fake)(sc, st, b); };
+    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) { return (*fake)(sc, st, b); };
     o.raytrace = false;
     const scene::Frame ref = row(1000, 0);
     const Recommendation r = recommendShadow(s, ref, s, ref, nullptr, nullptr, Json::object(), o);
@@ -138,7 +139,7 @@ TEST(Recommend, ACandidateThatLosesAtTheRequestedResolutionIsNotRecommended) {
     fake->depthTarget = 2.0 * b0;
     fake->loseAtWidth = 2000;  // at 2000 px every explicit bias darkens everything
     RecommendOptions o;
-    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, const std::string& b) { return (*fake)(sc, st, b); };
+    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) { return (*fake)(sc, st, b); };
     o.raytrace = false;
     const Recommendation r = recommendShadow(search, row(1000, 0), full, row(2000, 0), nullptr, nullptr, Json::object(), o);
     EXPECT_TRUE(r.raster.searched);
@@ -154,7 +155,7 @@ TEST(Recommend, KeepsTheUsersOwnSettingsInTheBlock) {
     auto fake = std::make_shared<Fake>();
     fake->depthTarget = 1e-3;
     RecommendOptions o;
-    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, const std::string& b) { return (*fake)(sc, st, b); };
+    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) { return (*fake)(sc, st, b); };
     o.user.filter = "pcf";
     o.user.shadowMapSize = 1024;
     o.user.fitLightFrustum = false;  // a flag not given: not the user's choice
@@ -182,9 +183,7 @@ Measured pasted(const fs::path& sceneFile, const Json& block, int w, int h, cons
     s.camera.height = h;
     scene::SettingsOverrides v;
     v.validate = true;
-    const scene::Frame f = renderWithBackend(s, scene::resolveSettings(s, v), "raster");
-    EXPECT_EQ(f.attributes.at("validation_messages"), "0");
-    return measure(f, reference);
+    return measure(raster::test::renderChecked(s, scene::resolveSettings(s, v).raster), reference);
 }
 
 void checkNeverLoses(const std::string& name) {
@@ -194,8 +193,8 @@ void checkNeverLoses(const std::string& name) {
     full.camera.height = 90;
     search.camera.width = 80;
     search.camera.height = 45;
-    const scene::Frame ref = renderWithBackend(full, scene::resolveSettings(full, {}), "reference");
-    const scene::Frame searchRef = renderWithBackend(search, scene::resolveSettings(search, {}), "reference");
+    const scene::Frame ref = renderWithBackend(full, scene::resolveSettings(full, {}), scene::Backend::Reference);
+    const scene::Frame searchRef = renderWithBackend(search, scene::resolveSettings(search, {}), scene::Backend::Reference);
     RecommendOptions o;
     o.user.validate = true;
     o.raytrace = false;
@@ -203,7 +202,7 @@ void checkNeverLoses(const std::string& name) {
     ASSERT_TRUE(r.raster.defaults.ok) << r.raster.defaults.error;
     scene::SettingsOverrides v;
     v.validate = true;
-    const Measured defaults = measure(renderWithBackend(full, scene::resolveSettings(full, v), "raster"), ref);
+    const Measured defaults = measure(raster::test::renderChecked(full, scene::resolveSettings(full, v).raster), ref);
     const Measured block = pasted(file, r.shadowBlock, 160, 90, ref);
     std::printf("%s: %zu points, defaults %.4f%% (IoU %.3f), block %.4f%% (IoU %.3f), block %s\n", name.c_str(),
                 r.points.size(), 100 * defaults.mismatchRate, defaults.shadowIoU, 100 * block.mismatchRate,
@@ -218,4 +217,4 @@ TEST(RecommendOnLavapipe, TheSeedsBlockIsNoWorseThanItsDefaults) { checkNeverLos
 TEST(RecommendOnLavapipe, AStiffCasesBlockIsNoWorseThanItsDefaults) { checkNeverLoses("extreme/grazing-1deg"); }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -23,7 +23,7 @@
 #include "scene/loader.h"
 #include "tests/compare/synthetic.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 namespace {
 
 namespace fs = std::filesystem;
@@ -51,13 +51,13 @@ struct FakeRenderer {
     int referenceCalls = 0;
     std::map<std::string, int> calls;
     RenderFn fn() {
-        return [this](const scene::Scene& sc, const scene::RenderSettings& s, const std::string& backend) {
-            if (backend == "reference") ++referenceCalls;
-            const std::string what = backend + std::to_string(s.raster.shadowMapSize) + std::to_string(s.raster.depthBias) +
+        return [this](const scene::Scene& sc, const scene::RenderSettings& s, scene::Backend backend) {
+            if (backend == scene::Backend::Reference) ++referenceCalls;
+            const std::string what = scene::toString(backend) + std::to_string(s.raster.shadowMapSize) + std::to_string(s.raster.depthBias) +
                                      std::to_string(s.raytrace.rayBias);
             const int n = calls[what]++;
-            const float v = backend == "raster" && s.raster.shadowMapSize == 512 ? 0.0f : 1.0f;
-            scene::Frame f = test::uniformFrame(sc.camera.width, sc.camera.height, 1.0f, 0.6f, v);
+            const float v = backend == scene::Backend::Raster && s.raster.shadowMapSize == 512 ? 0.0f : 1.0f;
+            scene::Frame f = compare::test::uniformFrame(sc.camera.width, sc.camera.height, 1.0f, 0.6f, v);
             f.timingsMs = {{"setup", 2.0}, {"render", n == 0 ? 50.0 : 10.0 + n}};
             return f;
         };
@@ -85,7 +85,7 @@ SweepGrid grid(int n) {
     g.resolution = "24x16";
     for (int i = 0; i < n; ++i) {
         SweepConfig c;
-        c.backend = "raster";
+        c.backend = scene::Backend::Raster;
         c.overrides.shadowMapSize = i % 2 ? 1024 : 512;
         c.overrides.filter = "none";
         c.overrides.depthBias = 0.001 * (i + 1);
@@ -96,7 +96,7 @@ SweepGrid grid(int n) {
     }
     for (const char* bias : {"0.001", "robust"}) {
         SweepConfig c;
-        c.backend = "raytrace";
+        c.backend = scene::Backend::Raytrace;
         c.overrides.rayBias = bias;
         c.overrides.precision = "float";
         g.configs.push_back(c);
@@ -358,7 +358,7 @@ TEST(SharedReference, ASecondShardWaitsForTheFirstAndReusesItsReference) {
     auto slowRender = [&] {
         ++renders;
         std::this_thread::sleep_for(std::chrono::milliseconds(300));
-        scene::Frame fr = test::uniformFrame(scene.camera.width, scene.camera.height, 1.0f, 0.6f, 1.0f);
+        scene::Frame fr = compare::test::uniformFrame(scene.camera.width, scene.camera.height, 1.0f, 0.6f, 1.0f);
         fr.timingsMs = {{"render", 7.0}};
         return fr;
     };
@@ -382,7 +382,7 @@ TEST(SharedReference, ASecondShardWaitsForTheFirstAndReusesItsReference) {
 TEST(SharedReference, TheLockOfAStoppedShardIsTakenOver) {
     Folder f;
     const scene::Scene scene = scene::loadScene(writeScene(f.path / "scene"));
-    auto render = [&] { return test::uniformFrame(scene.camera.width, scene.camera.height, 1.0f, 0.6f, 1.0f); };
+    auto render = [&] { return compare::test::uniformFrame(scene.camera.width, scene.camera.height, 1.0f, 0.6f, 1.0f); };
     SharedReferenceOptions o;
     o.pollSeconds = 0.02;
     o.staleSeconds = 0.3;
@@ -449,4 +449,4 @@ TEST(Machine, DescribesThisMachineAndSurvivesJson) {
 }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

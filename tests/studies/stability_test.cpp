@@ -15,7 +15,7 @@
 
 #include "scene/loader.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 namespace {
 namespace fs = std::filesystem;
 
@@ -79,26 +79,27 @@ TEST_P(ExtremeCase, MeetsItsExpectedOutcome) {
         ASSERT_TRUE(c.analytic.has_value()) << c.notAnalytic;
         EXPECT_TRUE(c.analytic->passed()) << c.analytic->summary();
     }
-    for (const char* backend : {"raster", "raytrace"})
+    for (const scene::Backend backend : {scene::Backend::Raster, scene::Backend::Raytrace})
         for (const char* variant : {"defaults", "best"}) {
             const BackendRun* r = c.run(backend, variant);
-            ASSERT_NE(r, nullptr) << backend << " " << variant;
-            EXPECT_TRUE(r->ok) << backend << " " << variant << ": " << r->error;
-            EXPECT_EQ(r->health.total(), 0u) << backend << " " << variant;
-            EXPECT_FALSE(r->blackFrame) << backend << " " << variant;
-            if (std::string(backend) == "raster") {
+            const std::string what = std::string(scene::toString(backend)) + " " + variant;
+            ASSERT_NE(r, nullptr) << what;
+            EXPECT_TRUE(r->ok) << what << ": " << r->error;
+            EXPECT_EQ(r->health.total(), 0u) << what;
+            EXPECT_FALSE(r->blackFrame) << what;
+            if (backend == scene::Backend::Raster) {
                 EXPECT_EQ(r->validationMessages, 0) << variant;
             }
         }
     // The best settings never lose to the defaults (they are searched and then checked against them).
-    for (const char* backend : {"raster", "raytrace"}) {
+    for (const scene::Backend backend : {scene::Backend::Raster, scene::Backend::Raytrace}) {
         const BackendRun* d = c.run(backend, "defaults");
         const BackendRun* b = c.run(backend, "best");
         if (d && b) {
-            EXPECT_LE(b->mismatchRate, d->mismatchRate) << backend << " " << c.bestShadowBlock.dump();
+            EXPECT_LE(b->mismatchRate, d->mismatchRate) << scene::toString(backend) << " " << c.bestShadowBlock.dump();
         }
     }
-    const MethodBias* raster = c.biasOf("raster");
+    const MethodBias* raster = c.biasOf(scene::Backend::Raster);
     ASSERT_NE(raster, nullptr);
     if (kRasterStiff.count(GetParam())) {
         EXPECT_TRUE(raster->stiff) << raster->text;
@@ -106,7 +107,7 @@ TEST_P(ExtremeCase, MeetsItsExpectedOutcome) {
     if (kRasterWindow.count(GetParam())) {
         EXPECT_FALSE(raster->stiff) << raster->text;
     }
-    const MethodBias* ray = c.biasOf("raytrace");
+    const MethodBias* ray = c.biasOf(scene::Backend::Raytrace);
     ASSERT_NE(ray, nullptr);
     if (kRaytraceStiff.count(GetParam())) {
         EXPECT_TRUE(ray->stiff) << ray->text;
@@ -118,7 +119,7 @@ TEST_P(ExtremeCase, MeetsItsExpectedOutcome) {
     }
     EXPECT_FALSE(c.failed());
     std::cout << GetParam() << ": raster " << raster->text << "\n  raytrace "
-              << (c.biasOf("raytrace") ? c.biasOf("raytrace")->text : "") << "\n";
+              << (c.biasOf(scene::Backend::Raytrace) ? c.biasOf(scene::Backend::Raytrace)->text : "") << "\n";
 }
 
 std::string paramName(const ::testing::TestParamInfo<std::string>& info) {
@@ -146,9 +147,9 @@ TEST(StabilityTest, DISABLED_WriteReport) {
         cases.push_back(runStabilityCase(scene::loadScene(file), o, name, readDescription(file)));
         const StabilityCase& c = cases.back();
         std::cout << name << ": reference " << c.referenceVerdict() << "; raster "
-                  << stateOf(c.run("raster", "defaults"), false).text << " / " << stateOf(c.run("raster", "best"), true).text
-                  << "; raytrace " << stateOf(c.run("raytrace", "defaults"), false).text << " / "
-                  << stateOf(c.run("raytrace", "best"), true).text << (c.failed() ? "; FAILED to run cleanly" : "")
+                  << stateOf(c.run(scene::Backend::Raster, "defaults"), false).text << " / " << stateOf(c.run(scene::Backend::Raster, "best"), true).text
+                  << "; raytrace " << stateOf(c.run(scene::Backend::Raytrace, "defaults"), false).text << " / "
+                  << stateOf(c.run(scene::Backend::Raytrace, "best"), true).text << (c.failed() ? "; FAILED to run cleanly" : "")
                   << std::endl;
     }
     writeStabilityReport(out, cases);
@@ -207,27 +208,27 @@ TEST(StabilityTest, CrashNanAndBlackFramesFailTheCase) {
     o.width = 8;
     o.height = 4;
     o.search = false;
-    o.render = [](const scene::Scene& s, const scene::RenderSettings&, const std::string& backend) {
-        if (backend == "raster") throw std::runtime_error("device lost");
-        scene::Frame f = fakeFrame(s.camera.width, s.camera.height, backend == "reference" ? 0.5f : 0.0f);
+    o.render = [](const scene::Scene& s, const scene::RenderSettings&, scene::Backend backend) {
+        if (backend == scene::Backend::Raster) throw std::runtime_error("device lost");
+        scene::Frame f = fakeFrame(s.camera.width, s.camera.height, backend == scene::Backend::Reference ? 0.5f : 0.0f);
         return f;
     };
     StabilityCase c = runStabilityCase(tinyScene(), o, "fake");
-    ASSERT_NE(c.run("raster", "defaults"), nullptr);
-    EXPECT_FALSE(c.run("raster", "defaults")->ok);
-    EXPECT_EQ(c.run("raster", "defaults")->error, "device lost");
-    EXPECT_TRUE(c.run("raytrace", "defaults")->blackFrame);
+    ASSERT_NE(c.run(scene::Backend::Raster, "defaults"), nullptr);
+    EXPECT_FALSE(c.run(scene::Backend::Raster, "defaults")->ok);
+    EXPECT_EQ(c.run(scene::Backend::Raster, "defaults")->error, "device lost");
+    EXPECT_TRUE(c.run(scene::Backend::Raytrace, "defaults")->blackFrame);
     EXPECT_TRUE(c.failed());
     EXPECT_FALSE(suitePassed({c}));
 
-    o.render = [](const scene::Scene& s, const scene::RenderSettings&, const std::string& backend) {
+    o.render = [](const scene::Scene& s, const scene::RenderSettings&, scene::Backend backend) {
         scene::Frame f = fakeFrame(s.camera.width, s.camera.height, 0.5f);
-        if (backend == "raytrace") f.ndotl[3] = std::numeric_limits<float>::quiet_NaN();
+        if (backend == scene::Backend::Raytrace) f.ndotl[3] = std::numeric_limits<float>::quiet_NaN();
         return f;
     };
     c = runStabilityCase(tinyScene(), o, "fake");
-    EXPECT_EQ(c.run("raytrace", "defaults")->health.total(), 1u);
-    EXPECT_FALSE(c.run("raster", "defaults")->failed());
+    EXPECT_EQ(c.run(scene::Backend::Raytrace, "defaults")->health.total(), 1u);
+    EXPECT_FALSE(c.run(scene::Backend::Raster, "defaults")->failed());
     ASSERT_EQ(c.failures.size(), 1u);
     EXPECT_NE(c.failures[0].find("NaN"), std::string::npos);
 }
@@ -237,7 +238,7 @@ TEST(StabilityTest, ReportFilesAreWritten) {
     o.width = 8;
     o.height = 4;
     o.search = false;
-    o.render = [](const scene::Scene& s, const scene::RenderSettings&, const std::string&) {
+    o.render = [](const scene::Scene& s, const scene::RenderSettings&, scene::Backend) {
         return fakeFrame(s.camera.width, s.camera.height, 0.5f);
     };
     const StabilityCase c = runStabilityCase(tinyScene(), o, "fake");
@@ -262,9 +263,9 @@ StabilityOptions acneOptions(double cleanFrom) {
     StabilityOptions o;
     o.width = 20;
     o.height = 10;
-    o.render = [cleanFrom](const scene::Scene& s, const scene::RenderSettings& settings, const std::string& backend) {
+    o.render = [cleanFrom](const scene::Scene& s, const scene::RenderSettings& settings, scene::Backend backend) {
         scene::Frame f = fakeFrame(s.camera.width, s.camera.height, 0.5f);
-        if (backend == "raster" && settings.raster.depthBias < cleanFrom)
+        if (backend == scene::Backend::Raster && settings.raster.depthBias < cleanFrom)
             for (int i = 0; i < 26; ++i) f.visibility[i] = 0.0f;
         f.attributes["validation_messages"] = "0";
         return f;
@@ -278,10 +279,10 @@ TEST(StabilityVerdicts, InjectedAcneAtDefaultsShowsTheAcneStateNotAPass) {
     const StabilityCase c = runStabilityCase(tinyScene(), o, "acne");
     EXPECT_FALSE(c.failed());  // nothing crashed: the run is healthy, the shadows are not
     EXPECT_EQ(c.referenceVerdict(), "unchecked");  // a point light: no analytic answer
-    const BackendState raster = stateOf(c.run("raster", "defaults"), false);
+    const BackendState raster = stateOf(c.run(scene::Backend::Raster, "defaults"), false);
     EXPECT_EQ(raster.state, "acne");
     EXPECT_EQ(raster.text, "acne 13.0%");  // 26 / 200
-    EXPECT_EQ(stateOf(c.run("raytrace", "defaults"), false).state, "clean");
+    EXPECT_EQ(stateOf(c.run(scene::Backend::Raytrace, "defaults"), false).state, "clean");
     const nlohmann::json j = toJson(c);
     EXPECT_EQ(j["states"]["raster"]["defaults"]["state"], "acne");
     EXPECT_EQ(j["states"]["raytrace"]["defaults"]["state"], "clean");
@@ -304,16 +305,16 @@ TEST(StabilityVerdicts, TheBestBiasIsCleanWhenTheSearchFindsOneAndStiffWhenNot) 
     s.camera.height = 10;
     const double b0 = scene::resolveSettings(s, {}).raster.depthBias;
     StabilityCase c = runStabilityCase(tinyScene(), acneOptions(3.0 * b0), "fixable");
-    EXPECT_EQ(stateOf(c.run("raster", "defaults"), false).state, "acne");
-    EXPECT_EQ(stateOf(c.run("raster", "best"), true).state, "clean") << c.bestShadowBlock.dump();
+    EXPECT_EQ(stateOf(c.run(scene::Backend::Raster, "defaults"), false).state, "acne");
+    EXPECT_EQ(stateOf(c.run(scene::Backend::Raster, "best"), true).state, "clean") << c.bestShadowBlock.dump();
     EXPECT_GE(c.bestShadowBlock.at("depth_bias").get<double>(), 3.0 * b0);
     // Never clean: the best bias is stiff, and says what remains.
     c = runStabilityCase(tinyScene(), acneOptions(1e30), "stiff");
-    const BackendState best = stateOf(c.run("raster", "best"), true);
+    const BackendState best = stateOf(c.run(scene::Backend::Raster, "best"), true);
     EXPECT_EQ(best.state, "stiff");
     EXPECT_EQ(best.text, "stiff: acne 13.0%");
     EXPECT_FALSE(c.bestShadowBlock.contains("depth_bias"));  // nothing beat the defaults
 }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -17,7 +17,7 @@
 #include "scene/loader.h"
 #include "tests/compare/synthetic.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 namespace {
 
 namespace fs = std::filesystem;
@@ -50,12 +50,12 @@ struct PanFake {
         return int(std::lround(moved / (amount * distance) * (frames - 1)));
     }
     RenderFn fn() {
-        return [this](const scene::Scene& s, const scene::RenderSettings& settings, const std::string& backend) {
+        return [this](const scene::Scene& s, const scene::RenderSettings& settings, scene::Backend backend) {
             ++renders;
-            scene::Frame f = test::uniformFrame(s.camera.width, s.camera.height, 1.0f, 0.6f, 1.0f);
+            scene::Frame f = compare::test::uniformFrame(s.camera.width, s.camera.height, 1.0f, 0.6f, 1.0f);
             f.timingsMs = {{"setup", 1.0}, {"render", 2.0}};
             // raster map 512: the stripe in every frame (a fixed wrong offset); map 1024: in odd frames.
-            const bool stripe = backend == "raster" && (settings.raster.shadowMapSize == 512 ||
+            const bool stripe = backend == scene::Backend::Raster && (settings.raster.shadowMapSize == 512 ||
                                                         (settings.raster.shadowMapSize == 1024 && frameOf(s) % 2 == 1));
             if (stripe)
                 for (int y = 0; y < f.height; ++y)
@@ -79,12 +79,12 @@ protected:
         g.repetitions = 2;
         for (int size : {512, 1024}) {
             SweepConfig c;
-            c.backend = "raster";
+            c.backend = scene::Backend::Raster;
             c.overrides.shadowMapSize = size;
             g.configs.push_back(c);
         }
         SweepConfig rt;
-        rt.backend = "raytrace";
+        rt.backend = scene::Backend::Raytrace;
         g.configs.push_back(rt);
         if (flicker) {
             PathSpec p;
@@ -226,4 +226,4 @@ TEST_F(FlickerGridFile, BadValuesAreRejectedWithTheirJsonPath) {
 }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

@@ -1,4 +1,4 @@
-// tests/studies/sweep_report_demo.cpp: runs the real sweep runner (compare::runSweep) on the
+// tests/studies/sweep_report_demo.cpp: runs the real sweep runner (studies::runSweep) on the
 // default grid with a fake renderer that draws synthetic frames whose artifacts follow the
 // settings the way real ones do (acne falls and peter-panning grows with bias, coarse maps are
 // jagged, robust offsets are clean, one configuration fails), then writes the sweep report and
@@ -22,7 +22,8 @@
 #include "scene/settings.h"
 #include "tests/compare/synthetic.h"
 
-namespace sc = shadowlab::compare;
+namespace studies = shadowlab::studies;
+namespace compare = shadowlab::compare;
 namespace scene = shadowlab::scene;
 namespace fs = std::filesystem;
 
@@ -41,19 +42,19 @@ const char* kScene = R"({
 })";
 
 // Deterministic jitter of a few percent, so repeated frames do not time identically.
-double jitter(int call) { return 1.0 + 0.06 * (sc::test::hashNoise(call, 7) - 0.5); }
+double jitter(int call) { return 1.0 + 0.06 * (compare::test::hashNoise(call, 7) - 0.5); }
 
-scene::Frame fakeRender(const scene::Scene& s, const scene::RenderSettings& settings, const std::string& backend) {
+scene::Frame fakeRender(const scene::Scene& s, const scene::RenderSettings& settings, scene::Backend backend) {
     static int call = 0;
     ++call;
-    sc::test::SyntheticOptions o;
+    compare::test::SyntheticOptions o;
     o.width = s.camera.width;
     o.height = s.camera.height;
     scene::Frame f;
-    if (backend == "reference") {
-        f = sc::test::syntheticFrame(o);
+    if (backend == scene::Backend::Reference) {
+        f = compare::test::syntheticFrame(o);
         f.timingsMs = {{"setup", 3.1}, {"primary", 210.0}, {"shadow", 690.0}};
-    } else if (backend == "raster") {
+    } else if (backend == scene::Backend::Raster) {
         const auto& r = settings.raster;
         if (r.shadowMapSize >= 4096 && r.filter == scene::ShadowFilter::Pcf2x2)
             throw std::runtime_error("VK_ERROR_OUT_OF_DEVICE_MEMORY: vkAllocateMemory for the 4096² shadow map (fake)");
@@ -69,7 +70,7 @@ scene::Frame fakeRender(const scene::Scene& s, const scene::RenderSettings& sett
         o.shadowShiftPx = shift;
         o.jaggies = r.shadowMapSize < 1024;
         o.texelPx = std::max(1, 1024 / r.shadowMapSize) * (r.filter == scene::ShadowFilter::Pcf2x2 ? 1 : 2);
-        f = sc::test::syntheticFrame(o);
+        f = compare::test::syntheticFrame(o);
         const double size = r.shadowMapSize;
         const double shadow = 0.4 + size * size * 1.1e-6 * (r.filter == scene::ShadowFilter::Pcf2x2 ? 1.5 : 1.0);
         f.timingsMs = {{"setup", 38.0 * jitter(call)}, {"shadow_pass", shadow * jitter(call + 1)},
@@ -89,12 +90,12 @@ scene::Frame fakeRender(const scene::Scene& s, const scene::RenderSettings& sett
             o.shiftShadow = shift > 0;
             o.shadowShiftPx = shift;
         }
-        f = sc::test::syntheticFrame(o);
+        f = compare::test::syntheticFrame(o);
         const double scale = t.precision == scene::Precision::Double ? 1.7 : 1.0;
         f.timingsMs = {{"setup", 2.8 * jitter(call)}, {"primary", 30.0 * scale * jitter(call + 1)},
                        {"shadow", (t.robustOffset ? 68.0 : 62.0) * scale * jitter(call + 2)}};
     }
-    f.attributes["backend"] = backend;
+    f.attributes["backend"] = scene::toString(backend);
     return f;
 }
 
@@ -108,15 +109,15 @@ int main(int argc, char** argv) {
     try {
         if (std::string(argv[1]) == "--from") {
             const fs::path dir = argv[2];
-            sc::SweepResult result;
-            result.rows = sc::readJournal(dir / "results.jsonl");
+            studies::SweepResult result;
+            result.rows = studies::readJournal(dir / "results.jsonl");
             result.reference = scene::readFrame(dir / "reference.exr");
             result.referenceMs = result.reference.totalTimeMs();
             const auto scenePath = result.reference.attributes.count("scene") ? result.reference.attributes.at("scene") : "";
-            const sc::SweepReportInput input =
-                sc::makeSweepReportInput(fs::path(scenePath).stem().string(), scenePath, result);
-            sc::writeSweepReport(dir, input);
-            for (const auto& line : sc::describeSweep(input, sc::recommendBias(input.rows))) std::cout << line << "\n";
+            const studies::SweepReportInput input =
+                studies::makeSweepReportInput(fs::path(scenePath).stem().string(), scenePath, result);
+            studies::writeSweepReport(dir, input);
+            for (const auto& line : studies::describeSweep(input, studies::recommendBias(input.rows))) std::cout << line << "\n";
             std::cout << "wrote " << (dir / "report.html").string() << "\n";
             return 0;
         }
@@ -126,35 +127,36 @@ int main(int argc, char** argv) {
         const scene::Scene s = scene::loadScene(dir / "scene.json");
 
         // The sweep, as `run` does it: the default grid at half resolution into DIR/sweep/.
-        sc::SweepGrid grid = sc::defaultGrid(s, false);
+        studies::SweepGrid grid = studies::defaultGrid(s, false);
         grid.resolution = "320x180";
-        sc::SweepOptions options;
+        studies::SweepOptions options;
         options.outputDir = dir / "sweep";
         options.resume = true;  // a second run of the demo reuses the rows
         options.render = fakeRender;
-        const sc::SweepResult result = sc::runSweep(s, grid, options);
-        const sc::SweepReportInput input = sc::makeSweepReportInput("demo", (dir / "scene.json").string(), result);
-        sc::writeSweepReport(dir / "sweep", input);
-        for (const auto& line : sc::describeSweep(input, sc::recommendBias(input.rows))) std::cout << line << "\n";
+        const studies::SweepResult result = studies::runSweep(s, grid, options);
+        const studies::SweepReportInput input = studies::makeSweepReportInput("demo", (dir / "scene.json").string(), result);
+        studies::writeSweepReport(dir / "sweep", input);
+        for (const auto& line : studies::describeSweep(input, studies::recommendBias(input.rows))) std::cout << line << "\n";
 
         // The run report at full resolution, with the sweep's summary.
-        sc::ReportInput report;
+        compare::ReportInput report;
         report.sceneName = "demo";
         report.scenePath = (dir / "scene.json").string();
         report.objectNames = {"sphere", "ground"};
         const scene::RenderSettings defaults = scene::resolveSettings(s, {});
-        const scene::Frame reference = fakeRender(s, defaults, "reference");
+        const scene::Frame reference = fakeRender(s, defaults, scene::Backend::Reference);
         scene::writePngLinear(dir / "reference.png", reference.width, reference.height, reference.beauty);
         report.reference = {"reference", "reference.png", reference};
-        for (const std::string backend : {"raytrace", "raster"}) {
-            const scene::Frame frame = fakeRender(s, defaults, backend);
+        for (const scene::Backend b : {scene::Backend::Raytrace, scene::Backend::Raster}) {
+            const std::string backend = scene::toString(b);
+            const scene::Frame frame = fakeRender(s, defaults, b);
             scene::writePngLinear(dir / (backend + ".png"), frame.width, frame.height, frame.beauty);
-            const sc::Comparison c = sc::compareFrames(frame, reference);
+            const compare::Comparison c = compare::compareFrames(frame, reference);
             scene::writePngDisplay(dir / ("diff-" + backend + ".png"), c.width, c.height, c.diffRgb);
             report.methods.push_back({backend, backend + ".png", "diff-" + backend + ".png", frame, c.metrics});
         }
-        report.sweep = sc::summarizeSweep(input, "sweep/report.html");
-        sc::writeReport(dir, report);
+        report.sweep = studies::summarizeSweep(input, "sweep/report.html");
+        compare::writeReport(dir, report);
         std::cout << "wrote " << (dir / "report.html").string() << " and " << (dir / "sweep" / "report.html").string()
                   << "\n";
     } catch (const std::exception& e) {

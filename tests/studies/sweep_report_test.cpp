@@ -15,7 +15,7 @@
 #include "compare/text.h"
 #include "tests/studies/sweep_rows.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 namespace {
 
 namespace fs = std::filesystem;
@@ -152,7 +152,7 @@ TEST(SweepReport, SummarySaysTheFastestUnderOnePercentAndTheBiasVerdicts) {
     std::string text;
     for (const auto& l : lines) text += l + "\n";
     // Raster: 512 is faster but 3% wrong; 1024 (4 ms, 0.5%) is the fastest under 1%.
-    const std::string under = "the fastest configuration under " + formatPercent(kSweepGoodMismatchRate) + " mismatch is ";
+    const std::string under = "the fastest configuration under " + compare::formatPercent(compare::kSweepGoodMismatchRate) + " mismatch is ";
     EXPECT_NE(text.find(under + "map 1024, none"), std::string::npos) << text;
     EXPECT_NE(text.find("most accurate, map 4096, pcf2x2"), std::string::npos) << text;
     // Raytrace: only the robust row (0.02%) is under 1%.
@@ -185,27 +185,27 @@ TEST(SweepReport, SaysWhenNoConfigurationOfABackendIsUnderOnePercent) {
     const auto lines = describeSweep(in, recommendBias(in.rows));
     ASSERT_FALSE(lines.empty());
     EXPECT_NE(lines[0].find("no configuration stays under"), std::string::npos) << lines[0];
-    EXPECT_NE(lines[0].find("map 2048, none, has " + formatPercent(0.02)), std::string::npos) << lines[0];
+    EXPECT_NE(lines[0].find("map 2048, none, has " + compare::formatPercent(0.02)), std::string::npos) << lines[0];
 }
 
 TEST(SweepReport, TheRunReportShowsTheSweepSummary) {
     const SweepReportInput in = syntheticSweep();
-    ReportInput run;
+    compare::ReportInput run;
     run.sceneName = "synthetic";
-    run.reference = {"reference", "reference.png", FrameInfo{}};
-    const std::string without = renderReportHtml(run);
+    run.reference = {"reference", "reference.png", compare::FrameInfo{}};
+    const std::string without = compare::renderReportHtml(run);
     EXPECT_EQ(without.find("Quick sweep"), std::string::npos);
 
     run.sweep = summarizeSweep(in, "sweep/report.html");
     EXPECT_EQ(run.sweep->configurations, 14u);
     EXPECT_EQ(run.sweep->failed, 1u);
     EXPECT_EQ(run.sweep->resolution, "64x36");  // from the rows' metrics
-    const std::string html = renderReportHtml(run);
+    const std::string html = compare::renderReportHtml(run);
     EXPECT_NE(html.find("Quick sweep"), std::string::npos);
     EXPECT_NE(html.find("href=\"sweep/report.html\""), std::string::npos);
-    EXPECT_NE(html.find(escapeHtml(recommendBias(in.rows).shadowBlock.dump(2))), std::string::npos);
+    EXPECT_NE(html.find(compare::escapeHtml(recommendBias(in.rows).shadowBlock.dump(2))), std::string::npos);
     EXPECT_NE(html.find("Shadow error against per-frame time"), std::string::npos);  // the inline plot
-    for (const auto& line : run.sweep->lines) EXPECT_NE(html.find(escapeHtml(line)), std::string::npos) << line;
+    for (const auto& line : run.sweep->lines) EXPECT_NE(html.find(compare::escapeHtml(line)), std::string::npos) << line;
 }
 
 TEST(SweepReport, AnEmptySweepStillWritesAPage) {
@@ -236,9 +236,9 @@ TEST(SweepReport, AVerifiedRecommendationIsWhatTheFileAndThePageHold) {
     EXPECT_DOUBLE_EQ(file.at("measured").at("raster").at("mismatch_rate_gain").get<double>(), 0.004 - 0.001);
     const std::string html = readText(dir / "report.html");
     EXPECT_NE(html.find("At 320x180 the searched point gains 0.3%."), std::string::npos);
-    EXPECT_NE(html.find(escapeHtml(r.shadowBlock.dump(2))), std::string::npos);
+    EXPECT_NE(html.find(compare::escapeHtml(r.shadowBlock.dump(2))), std::string::npos);
     EXPECT_EQ(summarizeSweep(in, "sweep/report.html").shadowBlockJson, r.shadowBlock.dump(2));
 }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies

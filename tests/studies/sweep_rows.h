@@ -9,7 +9,7 @@
 
 #include "studies/sweep.h"
 
-namespace shadowlab::compare::test {
+namespace shadowlab::studies::test {
 
 // Metrics JSON with the fields the sweep report and auto bias read (compare::toJson names).
 inline nlohmann::json rowMetrics(double falseRate, double missedRate, int width = 64, int height = 36) {
@@ -39,7 +39,7 @@ inline SweepRow finish(SweepConfig c, double falseRate, double missedRate, doubl
 // defaultGrid builds them.
 inline SweepRow depthRow(double bias, double falseRate, double missedRate, int mapSize = 1024, double frameMs = 5.0) {
     SweepConfig c;
-    c.backend = "raster";
+    c.backend = scene::Backend::Raster;
     c.overrides.shadowMapSize = mapSize;
     c.overrides.filter = "none";
     c.overrides.depthBias = bias;
@@ -52,7 +52,7 @@ inline SweepRow depthRow(double bias, double falseRate, double missedRate, int m
 // A raster row of a slope-bias series (constant depth bias held at 0).
 inline SweepRow slopeRow(double bias, double falseRate, double missedRate, double frameMs = 5.0) {
     SweepConfig c;
-    c.backend = "raster";
+    c.backend = scene::Backend::Raster;
     c.overrides.shadowMapSize = 1024;
     c.overrides.filter = "none";
     c.overrides.depthBias = 0.0;
@@ -67,7 +67,7 @@ inline SweepRow slopeRow(double bias, double falseRate, double missedRate, doubl
 inline SweepRow momentRow(const std::string& filter, const std::string& kind, double value, double falseRate,
                           double missedRate, double frameMs = 6.0) {
     SweepConfig c;
-    c.backend = "raster";
+    c.backend = scene::Backend::Raster;
     c.overrides.shadowMapSize = 1024;
     c.overrides.filter = filter;
     momentOverride(c.overrides, kind) = value;
@@ -79,7 +79,7 @@ inline SweepRow momentRow(const std::string& filter, const std::string& kind, do
 // A ray tracer row of the constant ray-bias series in float.
 inline SweepRow rayRow(double bias, double falseRate, double missedRate, double frameMs = 100.0) {
     SweepConfig c;
-    c.backend = "raytrace";
+    c.backend = scene::Backend::Raytrace;
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.9g", bias);
     c.overrides.rayBias = buf;
@@ -92,7 +92,7 @@ inline SweepRow rayRow(double bias, double falseRate, double missedRate, double 
 // A ray tracer row with robust offsets (no bias parameter).
 inline SweepRow robustRow(const std::string& precision, double falseRate, double missedRate, double frameMs = 120.0) {
     SweepConfig c;
-    c.backend = "raytrace";
+    c.backend = scene::Backend::Raytrace;
     c.overrides.rayBias = "robust";
     c.overrides.precision = precision;
     return finish(c, falseRate, missedRate, frameMs);
@@ -101,7 +101,7 @@ inline SweepRow robustRow(const std::string& precision, double falseRate, double
 // A raster row at the default biases with a given map size and filter.
 inline SweepRow mapRow(int size, const std::string& filter, double falseRate, double missedRate, double frameMs) {
     SweepConfig c;
-    c.backend = "raster";
+    c.backend = scene::Backend::Raster;
     c.overrides.shadowMapSize = size;
     c.overrides.filter = filter;
     return finish(c, falseRate, missedRate, frameMs);
@@ -114,4 +114,4 @@ inline SweepRow failedRow(SweepRow r, const std::string& error) {
     return r;
 }
 
-}  // namespace shadowlab::compare::test
+}  // namespace shadowlab::studies::test

@@ -19,7 +19,7 @@
 #include "scene/loader.h"
 #include "tests/compare/synthetic.h"
 
-namespace shadowlab::compare {
+namespace shadowlab::studies {
 namespace {
 
 namespace fs = std::filesystem;
@@ -32,9 +32,9 @@ constexpr double kFrameMs[] = {10.0, 30.0, 20.0, 40.0};
 constexpr double kWarmUpSetupMs = 1000.0, kWarmUpFrameMs = 9000.0;
 
 // What a render was asked for, as text: one entry per distinct configuration.
-std::string describe(const scene::RenderSettings& s, const std::string& backend) {
+std::string describe(const scene::RenderSettings& s, scene::Backend backend) {
     std::ostringstream o;
-    o << backend << " map=" << s.raster.shadowMapSize << " filter=" << scene::toString(s.raster.filter)
+    o << scene::toString(backend) << " map=" << s.raster.shadowMapSize << " filter=" << scene::toString(s.raster.filter)
       << " depth=" << s.raster.depthBias << " slope=" << s.raster.slopeBias << " ray=" << s.raytrace.rayBias
       << " robust=" << s.raytrace.robustOffset << " precision=" << scene::toString(s.raytrace.precision);
     return o.str();
@@ -48,18 +48,18 @@ struct FakeRenderer {
     double failDepthBias = -1.0;       // a raster render with this depth bias throws
 
     RenderFn fn() {
-        return [this](const scene::Scene& sc, const scene::RenderSettings& s, const std::string& backend) {
+        return [this](const scene::Scene& sc, const scene::RenderSettings& s, scene::Backend backend) {
             const int n = calls[describe(s, backend)]++;
-            if (backend == "reference") {
+            if (backend == scene::Backend::Reference) {
                 ++referenceCalls;
             } else {
                 ++methodCalls;
             }
-            if (backend == "raster" && s.raster.depthBias == failDepthBias)
+            if (backend == scene::Backend::Raster && s.raster.depthBias == failDepthBias)
                 throw std::runtime_error("VK_ERROR_DEVICE_LOST (fake)");
-            scene::Frame f = test::uniformFrame(sc.camera.width, sc.camera.height, 1.0f, 0.6f, 1.0f);
-            f.attributes["backend"] = backend;
-            if (backend == "reference" || n == 0) {
+            scene::Frame f = compare::test::uniformFrame(sc.camera.width, sc.camera.height, 1.0f, 0.6f, 1.0f);
+            f.attributes["backend"] = scene::toString(backend);
+            if (backend == scene::Backend::Reference || n == 0) {
                 f.timingsMs = {{"setup", kWarmUpSetupMs}, {"render", kWarmUpFrameMs}};
             } else {
                 f.timingsMs = {{"setup", kSetupMs[(n - 1) % 4]}, {"render", kFrameMs[(n - 1) % 4]}};
@@ -85,7 +85,7 @@ fs::path writeSceneFile(const fs::path& dir, const std::string& name) {
 
 SweepConfig rasterConfig(int size, const std::string& filter) {
     SweepConfig c;
-    c.backend = "raster";
+    c.backend = scene::Backend::Raster;
     c.overrides.shadowMapSize = size;
     c.overrides.filter = filter;
     return c;
@@ -105,14 +105,14 @@ SweepGrid smallGrid() {
     depth.biasValue = 0.01;
     g.configs.push_back(depth);
     SweepConfig ray;
-    ray.backend = "raytrace";
+    ray.backend = scene::Backend::Raytrace;
     ray.overrides.rayBias = "0.001";
     ray.overrides.precision = "float";
     ray.biasKind = "ray";
     ray.biasValue = 0.001;
     g.configs.push_back(ray);
     SweepConfig robust;
-    robust.backend = "raytrace";
+    robust.backend = scene::Backend::Raytrace;
     robust.overrides.rayBias = "robust";
     robust.overrides.precision = "double";
     g.configs.push_back(robust);
@@ -254,6 +254,74 @@ TEST_F(Sweep, ResumeAfterATornLastLineRendersExactlyTheMissingConfigurations) {
     for (std::size_t i = 0; i < keys.size(); ++i) EXPECT_EQ(json[i].at("key"), keys[i]);
 }
 
+TEST_F(Sweep, ResumesAJournalWrittenInTheJournalFormatAndRewritesItsLinesUnchanged) {
+    // A journal as docs/sweep.md describes it, written by hand rather than by this build: one JSON
+    // object per line, keys sorted, the backend and the key naming the backend by its name. The
+    // keys are SweepConfig::key() of smallGrid()'s first and fourth rows: "backend=" + the name,
+    // then map, filter, ..., ray_bias, precision, each only when set.
+    const SweepGrid grid = smallGrid();
+    const std::string rasterLine =
+        R"({"backend":"raster","bias_kind":"","bias_value":null,"diff_image":"images/raster-a-diff.png",)"
+        R"("error":"","frame_ms":2.5,"frame_ms_max":3.0,"frame_ms_min":2.0,"image":"images/raster-a.png",)"
+        R"("key":"backend=raster;map=512;filter=none","label":"raster: map 512, none",)"
+        R"("machine":{"cores":8,"cpu":"test cpu","host":"journal-host","load":0.5,"online_cores":8},)"
+        R"("metrics":{"false_shadow_rate":0.125,"mismatch_rate":0.25,"missed_shadow_rate":0.125},)"
+        R"("overrides":{"filter":"none","shadow_map_size":512},"repetitions":3,"settings":{},"setup_ms":1.5})";
+    const std::string rayLine =
+        R"({"backend":"raytrace","bias_kind":"ray","bias_value":0.001,"diff_image":"images/raytrace-b-diff.png",)"
+        R"("error":"","frame_ms":4.0,"frame_ms_max":5.0,"frame_ms_min":3.0,"image":"images/raytrace-b.png",)"
+        R"("key":"backend=raytrace;ray_bias=0.001;precision=float","label":"raytrace: ray bias 0.001, float",)"
+        R"("machine":{"cores":8,"cpu":"test cpu","host":"journal-host","load":0.5,"online_cores":8},)"
+        R"("metrics":{"false_shadow_rate":0.5,"mismatch_rate":0.5,"missed_shadow_rate":0.0},)"
+        R"("overrides":{"precision":"float","ray_bias":"0.001"},"repetitions":3,"settings":{},"setup_ms":0.5})";
+    ASSERT_EQ(grid.configs[0].key(), "backend=raster;map=512;filter=none");
+    ASSERT_EQ(grid.configs[3].key(), "backend=raytrace;ray_bias=0.001;precision=float");
+    fs::create_directories(dir);
+    // The folder's identity: the scene file and the grid's resolution (24x16).
+    std::ofstream(dir / "sweep.json") << Json{{"scene", scene.file.string()}, {"resolution", {24, 16}}}.dump(2) << "\n";
+    std::ofstream(dir / "results.jsonl") << rasterLine << "\n" << rayLine << "\n";
+
+    FakeRenderer resumed;
+    const SweepResult result = run(resumed, grid, true);
+
+    // Only the three rows the journal lacks render (a warm-up and three timed frames each).
+    EXPECT_EQ(resumed.methodCalls, 3 * (1 + grid.repetitions));
+    for (const std::size_t i : {std::size_t(0), std::size_t(3)}) {
+        const auto settings = scene::resolveSettings(scene, grid.configs[i].overrides);
+        EXPECT_EQ(resumed.calls.count(describe(settings, grid.configs[i].backend)), 0u) << grid.configs[i].label();
+    }
+    // The journal's rows come back as written: their backends, timings and metrics (the fake
+    // renders every method like the reference, so a re-rendered row would have no mismatch).
+    ASSERT_EQ(result.rows.size(), grid.configs.size());
+    EXPECT_EQ(result.rows[0].config.backend, scene::Backend::Raster);
+    EXPECT_EQ(result.rows[0].frameMs, 2.5);
+    EXPECT_EQ(result.rows[0].rate("mismatch_rate"), 0.25);
+    EXPECT_EQ(result.rows[3].config.backend, scene::Backend::Raytrace);
+    EXPECT_EQ(result.rows[3].config.biasKind, "ray");
+    EXPECT_EQ(result.rows[3].rate("mismatch_rate"), 0.5);
+    EXPECT_EQ(result.rows[1].rate("mismatch_rate"), 0.0);
+    // The resume rewrites the journal before appending: the two lines come out byte for byte.
+    const auto journal = readLines(dir / "results.jsonl");
+    ASSERT_EQ(journal.size(), grid.configs.size());
+    EXPECT_EQ(journal[0], rasterLine);
+    EXPECT_EQ(journal[1], rayLine);
+    // And the results files name each backend as the journal does.
+    const auto csv = readLines(dir / "results.csv");
+    ASSERT_EQ(csv.size(), grid.configs.size() + 1);
+    EXPECT_EQ(csv[1].rfind("backend=raster;map=512;filter=none,raster,", 0), 0u) << csv[1];
+    EXPECT_EQ(csv[4].rfind("backend=raytrace;ray_bias=0.001;precision=float,raytrace,", 0), 0u) << csv[4];
+    EXPECT_EQ(Json::parse(readText(dir / "results.json"))[3].at("backend"), "raytrace");
+}
+
+TEST_F(Sweep, AJournalLineNamingAnUnknownBackendIsNotARow) {
+    // readJournal skips what is not a row (as a torn line); merge reads journals strictly and
+    // names the line (ShardMerge tests). Both go through rowFromJournal.
+    Json line = {{"backend", "pathtracer"}, {"key", "backend=pathtracer"}, {"overrides", Json::object()}};
+    EXPECT_THROW(rowFromJournal(line), std::invalid_argument);
+    line["backend"] = "raster";
+    EXPECT_EQ(rowFromJournal(line).config.backend, scene::Backend::Raster);
+}
+
 TEST_F(Sweep, ResumeRefusesAFolderHoldingAnotherScenesSweep) {
     FakeRenderer first;
     run(first, smallGrid(), false);
@@ -364,7 +432,7 @@ TEST_F(GridFile, AxesBecomeTheirCartesianProduct) {
     for (const char* ray : {"0.001", "robust"})
         for (const char* precision : {"float", "double"}) {
             SweepConfig c;
-            c.backend = "raytrace";
+            c.backend = scene::Backend::Raytrace;
             c.overrides.rayBias = ray;
             c.overrides.precision = precision;
             expected.insert(c.key());
@@ -374,7 +442,7 @@ TEST_F(GridFile, AxesBecomeTheirCartesianProduct) {
     EXPECT_EQ(g.configs.size(), 12u);
     EXPECT_EQ(got, expected);
     for (const auto& c : g.configs) {
-        if (c.backend == "raster") {
+        if (c.backend == scene::Backend::Raster) {
             EXPECT_EQ(c.biasKind, "depth");
             EXPECT_EQ(c.biasValue, *c.overrides.depthBias);
         } else if (c.overrides.rayBias == std::optional<std::string>("robust")) {
@@ -491,7 +559,7 @@ TEST_F(GridFile, DefaultGridComparesAFittedMapAtEverySize) {
     for (const bool quick : {true, false}) {
         std::set<int> fittedSizes, sizes;
         for (const auto& c : defaultGrid(scene, quick).configs) {
-            if (c.backend != "raster" || !c.overrides.shadowMapSize) continue;
+            if (c.backend != scene::Backend::Raster || !c.overrides.shadowMapSize) continue;
             sizes.insert(*c.overrides.shadowMapSize);
             if (c.overrides.fitLightFrustum.value_or(false)) {
                 fittedSizes.insert(*c.overrides.shadowMapSize);
@@ -566,7 +634,7 @@ TEST_F(GridFile, DefaultGridHasOneRowPerFilterableMapAtDefaultParameters) {
         std::multiset<std::string> filters;
         int largest = 0;
         for (const auto& c : defaultGrid(scene, quick).configs)
-            if (c.backend == "raster") largest = std::max(largest, c.overrides.shadowMapSize.value_or(0));
+            if (c.backend == scene::Backend::Raster) largest = std::max(largest, c.overrides.shadowMapSize.value_or(0));
         for (const auto& c : defaultGrid(scene, quick).configs) {
             const std::string f = c.overrides.filter.value_or("");
             if (!isFilterableName(f)) continue;
@@ -670,4 +738,4 @@ TEST_F(GridFile, HostileFilesAreRefusedBeforeTheyAreReadOrExpanded) {
 }
 
 }  // namespace
-}  // namespace shadowlab::compare
+}  // namespace shadowlab::studies
