@@ -3,6 +3,10 @@
 
 #include <cstdint>
 
+#include "background_frag.spv.h"
+#include "background_frag_beauty.spv.h"
+#include "background_frag_lights.spv.h"
+#include "background_vert.spv.h"
 #include "lit_frag.spv.h"
 #include "lit_frag_alpha.spv.h"
 #include "lit_frag_beauty.spv.h"
@@ -46,5 +50,9 @@ std::span<const std::uint32_t> litVertAlphaSpirv() { return kLitVertAlphaSpv; }
 std::span<const std::uint32_t> litFragAlphaSpirv() { return kLitFragAlphaSpv; }
 std::span<const std::uint32_t> litFragLightsAlphaSpirv() { return kLitFragLightsAlphaSpv; }
 std::span<const std::uint32_t> litFragBeautyAlphaSpirv() { return kLitFragBeautyAlphaSpv; }
+std::span<const std::uint32_t> backgroundVertSpirv() { return kBackgroundVertSpv; }
+std::span<const std::uint32_t> backgroundFragSpirv() { return kBackgroundFragSpv; }
+std::span<const std::uint32_t> backgroundFragBeautySpirv() { return kBackgroundFragBeautySpv; }
+std::span<const std::uint32_t> backgroundFragLightsSpirv() { return kBackgroundFragLightsSpv; }
 
 }  // namespace shadowlab::shaders

@@ -35,5 +35,11 @@ std::span<const std::uint32_t> litVertAlphaSpirv();
 std::span<const std::uint32_t> litFragAlphaSpirv();
 std::span<const std::uint32_t> litFragLightsAlphaSpirv();
 std::span<const std::uint32_t> litFragBeautyAlphaSpirv();
+// The lit pass's background (pixels no object covers): a triangle over the image, and the values
+// for the float targets of the AOV, beauty-only and per-light variants.
+std::span<const std::uint32_t> backgroundVertSpirv();
+std::span<const std::uint32_t> backgroundFragSpirv();
+std::span<const std::uint32_t> backgroundFragBeautySpirv();
+std::span<const std::uint32_t> backgroundFragLightsSpirv();
 
 }  // namespace shadowlab::shaders
