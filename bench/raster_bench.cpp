@@ -75,6 +75,9 @@ struct Series {
 void addOurs(Series& s, const scene::Frame& f) {
     for (const char* stage : {"shadow_pass", "lit_pass", "readback"}) s.add(stage, f.timing(stage));
     s.add("per_frame", f.totalTimeMs() - f.timing("setup"));
+    for (const char* stage : {"shadow_pass", "lit_pass"})
+        if (const auto it = f.attributes.find(std::string("cpu_") + stage + "_ms"); it != f.attributes.end())
+            s.add(std::string("cpu_") + stage, std::stod(it->second));
 }
 
 void addBare(Series& s, const bench::BareTimings& t) {
@@ -82,6 +85,8 @@ void addBare(Series& s, const bench::BareTimings& t) {
     s.add("lit_pass", t.litPass);
     s.add("readback", t.readback);
     s.add("per_frame", t.perFrame());
+    s.add("cpu_shadow_pass", t.cpuShadowPass);
+    s.add("cpu_lit_pass", t.cpuLitPass);
 }
 
 // A fresh, empty Mesa shader cache, so that the next device's pipelines compile from scratch.
@@ -135,6 +140,13 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
     raster::Renderer ours(s, plan, settings.raster, rendererOptions());
     scene::Frame frame = ours.render();
     const double oursCold = msSince(t0);
+    if (const char* profile = std::getenv("SHADOWLAB_BENCH_PROFILE"); profile && std::string(profile) == "cold") {
+        // Only our cold first frame (construction + first frame): a process to run under `perf record`.
+        std::printf("cold first frame %.1f ms (construction %.1f; shadow pass %.1f, lit pass %.1f, readback %.1f)\n",
+                    oursCold, ours.setupMs(), frame.timing("shadow_pass"), frame.timing("lit_pass"),
+                    frame.timing("readback"));
+        return;
+    }
     std::vector<std::uint8_t> rgba;
     t0 = Clock::now();
     bench::BareRenderer bare(s, settings.raster);
@@ -221,7 +233,8 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
     std::printf("median of %d warm frames, ms (min-max)\n", repeats);
     std::printf("  %-12s %22s %22s %22s %22s %9s %9s %9s\n", "stage", "ours (all channels)", "ours (float beauty)",
                 "ours (png)", "bare baseline", "all/bare", "bty/bare", "png/bare");
-    for (const char* stage : {"shadow_pass", "lit_pass", "readback", "per_frame", "cpu_per_frame"}) {
+    for (const char* stage :
+         {"shadow_pass", "lit_pass", "readback", "per_frame", "cpu_shadow_pass", "cpu_lit_pass", "cpu_per_frame"}) {
         auto cell = [&](const Series& x) {
             char buf[64];
             const auto [lo, hi] = x.range(stage);
@@ -307,6 +320,86 @@ void benchFilters(const std::string& label, const fs::path& file, int repeats) {
     row("bare", base);
 }
 
+// SHADOWLAB_BENCH_TRANSMIT=1: the shadow pass with a transmittance map against the same scene
+// opaque: a glass sphere (opacity 0.5, radius 1) beside an opaque box on a 20x20 plane under a
+// spot and a point light, so 1 + 6 shadow maps of 2048² (the spot's and the point light's cube),
+// 640x360, all channels, pcf2x2, unfitted maps; `opaque` makes the sphere opaque (no
+// transmittance pass). The two renderers interleaved repetition by repetition in one process.
+scene::Scene glassScene(bool opaque) {
+    scene::Scene s;
+    s.camera.position = {0, 3, 7.5};
+    s.camera.lookAt = {0, 0.6, 0};
+    s.camera.width = 640;
+    s.camera.height = 360;
+    s.materials = {{.name = "glass", .albedo = {0.55, 0.75, 0.9}, .opacity = opaque ? 1.0 : 0.5},
+                   {.name = "box", .albedo = {0.3, 0.5, 0.8}},
+                   {.name = "ground", .albedo = {0.75, 0.75, 0.75}}};
+    s.lights = {{.type = scene::LightType::Spot, .direction = glm::normalize(scene::Vec3(3.2, -5.5, -2.6)),
+                 .position = {-3, 5.5, 2}, .color = {1, 0.95, 0.85}, .intensity = 700, .coneAngleDegrees = 32},
+                {.type = scene::LightType::Point, .position = {2.5, 4, 1.5}, .color = {0.9, 0.9, 1}, .intensity = 300}};
+    s.objects = {{.name = "glass sphere", .shape = scene::Sphere{{0, 1, 0}, 1.0}, .material = 0},
+                 {.name = "box", .shape = scene::Box{{-2.4, 0, 0.2}, {-1.6, 1.2, 1.0}}, .material = 1},
+                 {.name = "ground", .shape = scene::Quad{.center = {0, 0, 0}, .normal = {0, 1, 0}, .size = {20, 20}},
+                  .material = 2}};
+    return s;
+}
+
+void benchTransmittance(int repeats) {
+    struct Case {
+        const char* label;
+        scene::Scene scene;
+        scene::RenderSettings settings;
+        std::unique_ptr<raster::Renderer> renderer;
+        scene::Frame frame;
+        Series series;
+        double firstMs = 0.0, firstShadowMs = 0.0;
+    };
+    Case cases[2] = {{"glass", glassScene(false)}, {"opaque", glassScene(true)}};
+    for (Case& c : cases) {
+        scene::SettingsOverrides overrides;
+        overrides.shadowMapSize = kShadowMapSize;
+        overrides.fitLightFrustum = false;
+        c.settings = scene::resolveSettings(c.scene, overrides);
+        const auto t0 = Clock::now();
+        c.renderer = std::make_unique<raster::Renderer>(c.scene, scene::makeRenderPlan(c.scene, c.settings),
+                                                        c.settings.raster, rendererOptions());
+        c.renderer->render(c.frame, scene::kAllChannels);
+        c.firstMs = msSince(t0);
+        c.firstShadowMs = c.frame.timing("shadow_pass");
+    }
+    for (int i = 0; i < repeats; ++i)
+        for (Case& c : cases) {
+            const double cpu = cpuMs();
+            c.renderer->render(c.frame, scene::kAllChannels);
+            c.series.add("cpu_per_frame", cpuMs() - cpu);
+            addOurs(c.series, c.frame);
+            c.series.add("gpu_shadow_pass", std::stod(c.frame.attributes.at("gpu_shadow_pass_ms")));
+            c.series.add("cpu_shadow_pass", std::stod(c.frame.attributes.at("cpu_shadow_pass_ms")));
+        }
+    std::printf("\n=== transmittance: %s shadow maps of %d, 640x360, median of %d frames, ms (min-max) ===\n",
+                cases[0].frame.attributes.at("shadow_maps").c_str(), kShadowMapSize, repeats);
+    std::printf("  %-16s %22s %22s %9s\n", "stage", "glass", "opaque", "ratio");
+    for (const char* stage : {"shadow_pass", "gpu_shadow_pass", "cpu_shadow_pass", "lit_pass", "per_frame", "cpu_per_frame"}) {
+        auto cell = [&](const Series& x) {
+            char buf[64];
+            const auto [lo, hi] = x.range(stage);
+            std::snprintf(buf, sizeof buf, "%.1f (%.1f-%.1f)", x.med(stage), lo, hi);
+            return std::string(buf);
+        };
+        std::printf("  %-16s %22s %22s %9.2f\n", stage, cell(cases[0].series).c_str(), cell(cases[1].series).c_str(),
+                    cases[0].series.med(stage) / cases[1].series.med(stage));
+    }
+    std::printf("  first frame incl. setup (this process's shader cache): glass %.1f (shadow pass %.1f), opaque %.1f "
+                "(shadow pass %.1f)\n",
+                cases[0].firstMs, cases[0].firstShadowMs, cases[1].firstMs, cases[1].firstShadowMs);
+    std::printf("TRANSMIT | %s | %.1f | %.1f | %.2f | %.1f | %.1f | %.2f | %.2f |\n", std::getenv("LP_NUM_THREADS"),
+                cases[0].series.med("shadow_pass"), cases[1].series.med("shadow_pass"),
+                cases[0].series.med("shadow_pass") / cases[1].series.med("shadow_pass"),
+                cases[0].series.med("cpu_shadow_pass"), cases[1].series.med("cpu_shadow_pass"),
+                cases[0].series.med("cpu_shadow_pass") / cases[1].series.med("cpu_shadow_pass"),
+                cases[0].series.med("cpu_per_frame") / cases[1].series.med("cpu_per_frame"));
+}
+
 int main(int argc, char** argv) {
     int repeats = 5;
     if (argc > 1) repeats = std::max(1, std::atoi(argv[1]));
@@ -323,6 +416,15 @@ int main(int argc, char** argv) {
         return rc == 0 ? 0 : 1;
     }
     std::printf("raster_bench: LP_NUM_THREADS=%s repeats=%d\n", std::getenv("LP_NUM_THREADS"), repeats);
+    if (const char* t = std::getenv("SHADOWLAB_BENCH_TRANSMIT"); t && std::string(t) == "1") {
+        try {
+            benchTransmittance(repeats);
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "transmittance failed: %s\n", e.what());
+            return 1;
+        }
+        return 0;
+    }
     if (const char* f = std::getenv("SHADOWLAB_BENCH_FILTERS"); f && std::string(f) == "1") {
         try {
             if (wantScene("seed")) benchFilters("seed", scene::findScene("seed"), repeats);
@@ -333,6 +435,12 @@ int main(int argc, char** argv) {
         }
         return 0;
     }
+    // The Vulkan loader and lavapipe (with LLVM) are loaded and relocated once per process, by the
+    // first instance: here, so that neither renderer's cold first frame pays it (the first one
+    // measured would otherwise carry 80-150 ms that the other does not).
+    const auto loadStart = Clock::now();
+    raster::enumerateDevices(false);
+    std::printf("driver loaded in %.1f ms (before any timing)\n", msSince(loadStart));
     std::vector<fs::path> caches;
     int rc = 0;
     if (wantScene("seed")) try {
