@@ -326,7 +326,7 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
 
 void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const LitBindings& bindings,
                    const LitTargets& targets, const LitAttachments& attachments, const DrawGeometry& geometry,
-                   const glm::vec3& background, LitOutputs outputs) {
+                   const glm::vec3& background, LitOutputs outputs, const LitPipeline* alphaPipeline) {
     const VkPipelineStageFlags2 colorStage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
     const VkPipelineStageFlags2 depthStages =
         VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
@@ -375,18 +375,30 @@ void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const 
     vkCmdBeginRendering(commands, &rendering);
     setViewport(commands, targets.width, targets.height);
     if (geometry.indexCount > 0) {
-        vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.pipeline.get());
-        vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.layout.get(), 0, 1,
-                                &bindings.set, 0, nullptr);
         const VkDeviceSize offset = 0;
         vkCmdBindVertexBuffers(commands, 0, 1, &geometry.vertices, &offset);
-        if (pipeline.alpha) {
-            vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.layout.get(), 1, 1,
-                                    &geometry.alphaSet, 0, nullptr);
-            vkCmdBindVertexBuffers(commands, 1, 1, &geometry.uvs, &offset);
-        }
+        if (geometry.uvs != VK_NULL_HANDLE) vkCmdBindVertexBuffers(commands, 1, 1, &geometry.uvs, &offset);
         vkCmdBindIndexBuffer(commands, geometry.indices, 0, VK_INDEX_TYPE_UINT32);
-        vkCmdDrawIndexed(commands, geometry.indexCount, 1, 0, 0, 0);
+        const LitPipeline* bound = nullptr;
+        auto use = [&](const LitPipeline& p) {
+            if (bound == &p) return;
+            bound = &p;
+            vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, p.pipeline.get());
+            vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, p.layout.get(), 0, 1, &bindings.set, 0,
+                                    nullptr);
+            if (p.alpha)
+                vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, p.layout.get(), 1, 1,
+                                        &geometry.alphaSet, 0, nullptr);
+        };
+        if (geometry.litRanges.empty()) {
+            use(pipeline);
+            vkCmdDrawIndexed(commands, geometry.indexCount, 1, 0, 0, 0);
+        }
+        for (const IndexRange& r : geometry.litRanges) {
+            if (r.count == 0) continue;
+            use(r.alpha && alphaPipeline ? *alphaPipeline : pipeline);
+            vkCmdDrawIndexed(commands, r.count, 1, r.first, 0, 0);
+        }
     }
     if (!clear) {
         vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.background.get());

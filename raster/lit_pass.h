@@ -147,9 +147,12 @@ struct LitAttachments {
 // the background pipeline (float targets) or a clear (the display target). Leaves every color
 // attachment in TRANSFER_SRC_OPTIMAL for recordReadback(), or, for host-readable targets, in
 // GENERAL and visible to host reads once the submission has finished.
+// alphaPipeline: the SHADOWLAB_ALPHA variant of `pipeline` for DrawGeometry::litRanges with
+// IndexRange::alpha (null: `pipeline` draws them).
 void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const LitBindings& bindings,
                    const LitTargets& targets, const LitAttachments& attachments, const DrawGeometry& geometry,
-                   const glm::vec3& background, LitOutputs outputs = LitOutputs::kAll);
+                   const glm::vec3& background, LitOutputs outputs = LitOutputs::kAll,
+                   const LitPipeline* alphaPipeline = nullptr);
 
 struct Readback {
     std::array<Buffer, kLitPlanes> planes;

@@ -207,8 +207,9 @@ struct Renderer::Impl {
     bool timestamps = false;
     QueryPoolHandle queries;
     // Made on first use. Shadow: without and with blocker ids (index 0, 1). Lit: beauty target
-    // only, all targets without blocker ids, all with, the display target only (index 0..3).
-    ShadowPipeline shadowPipelines[2];
+    // only, all targets without blocker ids, all with, the display target only (index 0..3). The
+    // second index: without the alpha test, with it (DrawObject::depthAlpha, cameraAlpha).
+    ShadowPipeline shadowPipelines[2][2];
     // Semi-transparent casters (RenderPlan::needsTransmittanceMap): the transmittance pass, its
     // maps (1x1x1 placeholders without), and per layer the light it is drawn from.
     bool transmit = false;
@@ -223,7 +224,7 @@ struct Renderer::Impl {
     std::vector<TexelRect> transmitWindows;   // per layer, its window (TransmittancePass)
     shaders::TransmitWindows transmitWindowData{};  // the same for lit.frag (LitBindings)
     std::vector<DepthBiasFactors> layerBias;  // per layer, recordShadowPass's input (settings.hardwareBias)
-    LitPipeline litPipelines[4];
+    LitPipeline litPipelines[4][2];
     LitBindings bindings;  // allocated with the first lit pipeline's (identical) set layout
     shaders::LitUniforms uniforms{};
     std::vector<glm::vec4> albedos;
@@ -232,6 +233,16 @@ struct Renderer::Impl {
     scene::Vec3 origin{0.0};  // the first camera's position: the vertex buffer is relative to it
     scene::RenderPlan plan;
     std::vector<std::uint32_t> objectFirstIndex;
+    // The objects in index-buffer order, where each one's triangles are and which passes test its
+    // alpha (the constructor); placeLights() draws the depth pass's ranges from them.
+    struct DrawObject {
+        std::uint32_t object = 0;
+        std::uint32_t first = 0, count = 0;
+        bool depthAlpha = false;   // a MASK caster: the depth pass's alpha-tested pipeline
+        bool cameraAlpha = false;  // MASK or BLEND: the lit pass's alpha-tested pipeline
+        bool depthPass = true;     // drawn by the depth pass (not a semi-transparent caster)
+    };
+    std::vector<DrawObject> drawObjects;
     std::size_t triangles = 0;
     int sphereSegmentsUsed = 0;
     // The view depth of the camera the image is drawn from minus the depth the shaders compute
@@ -284,6 +295,43 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
         draw.alphaSet = alpha.set;
         shadowAlpha = scene.hasAlphaCasters();
         if (shadowAlpha) attributes["alpha_casters"] = "alpha-tested in the depth pass";  // only where there are some
+    }
+    // Each object's triangles in the index buffer (reordered with a transmittance map: the opaque
+    // objects' first, in object order, then each semi-transparent one's) and the objects in that
+    // order; which pass tests its alpha: the depth pass a MASK caster's, the camera MASK and BLEND.
+    drawObjects.clear();
+    const std::size_t objectCount = scene.objects.size();
+    std::uint32_t opaqueCursor = 0;
+    std::size_t nextTransparent = 0;
+    std::vector<DrawObject> transparentObjects;
+    for (std::size_t o = 0; o < objectCount; ++o) {
+        const scene::Material& m = scene.materialOf(scene.objects[o]);
+        DrawObject d{.object = std::uint32_t(o),
+                     .first = objectFirstIndex[o],
+                     .count = objectFirstIndex[o + 1] - objectFirstIndex[o],
+                     .depthAlpha = shadowAlpha && m.alphaMode == scene::AlphaMode::Mask,
+                     .cameraAlpha = m.alphaMode != scene::AlphaMode::Opaque,
+                     .depthPass = true};
+        if (planIn.needsTransmittanceMap && !m.opaque()) {
+            if (d.count == 0) continue;  // (separateTransparent makes no draw for it)
+            d.first = transparentDraws[nextTransparent++].firstIndex;  // (in object order)
+            d.depthPass = false;
+            transparentObjects.push_back(d);
+            continue;
+        }
+        if (planIn.needsTransmittanceMap) {
+            d.first = opaqueCursor;
+            opaqueCursor += d.count;
+        }
+        drawObjects.push_back(d);
+    }
+    drawObjects.insert(drawObjects.end(), transparentObjects.begin(), transparentObjects.end());
+    for (const DrawObject& d : drawObjects) {
+        if (!draw.litRanges.empty() && draw.litRanges.back().alpha == d.cameraAlpha &&
+            draw.litRanges.back().first + draw.litRanges.back().count == d.first)
+            draw.litRanges.back().count += d.count;
+        else
+            draw.litRanges.push_back(IndexRange{d.first, d.count, d.cameraAlpha});
     }
 
     // The automatic choices: a default cascade count follows the view, then a default size follows
@@ -404,19 +452,18 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
         // a: 1 − opacity, divided out of a semi-transparent receiver's own transmittance (lit.frag).
         albedos.emplace_back(glm::vec3(scene.materialOf(o).albedo),
                              scene.materialOf(o).opaque() ? 1.0f : float(scene.materialOf(o).transmittance(1.0)));
-    // Each layer's index ranges: every object, or the culled layer's casters (runs of them merged).
-    // Not with a transmittance map: its index order (opaque casters first) is not per object, so
-    // the depth pass then draws every opaque caster (layerRanges empty).
-    for (std::size_t k = 0; k < layers.size() && !plan.needsTransmittanceMap; ++k) {
-        std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges;
+    // Each layer's index ranges: every object the depth pass draws, or the culled layer's casters,
+    // in index order, runs of them merged where they take the same pipeline.
+    for (std::size_t k = 0; k < layers.size(); ++k) {
+        std::vector<IndexRange> ranges;
         const std::vector<bool>& casters = layers[k].casters;
-        for (std::size_t o = 0; o < scene.objects.size(); ++o) {
-            if (!casters.empty() && !casters[o]) continue;
-            const std::uint32_t firstIndex = objectFirstIndex[o], endIndex = objectFirstIndex[o + 1];
-            if (!ranges.empty() && ranges.back().first + ranges.back().second == firstIndex)
-                ranges.back().second += endIndex - firstIndex;
+        for (const DrawObject& d : drawObjects) {
+            if (!d.depthPass || (!casters.empty() && !casters[d.object])) continue;
+            if (!ranges.empty() && ranges.back().alpha == d.depthAlpha &&
+                ranges.back().first + ranges.back().count == d.first)
+                ranges.back().count += d.count;
             else
-                ranges.emplace_back(firstIndex, endIndex - firstIndex);
+                ranges.push_back(IndexRange{d.first, d.count, d.depthAlpha});
         }
         draw.layerRanges.push_back(std::move(ranges));
     }
@@ -632,45 +679,58 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     const bool wantLights = (channels & kChannelLightVisibility) != 0 && !targets.lights.empty();
 
     // --- setup still owed: the pipelines this frame needs (shader compilation) ---
-    ShadowPipeline& shadowPipeline = shadowPipelines[wantIds ? 1 : 0];
+    // Which pipelines the objects need: with and without the alpha test.
+    bool depthPlain = false, depthAlpha = false, litPlain = false, litAlpha = false;
+    for (const DrawObject& d : drawObjects) {
+        (d.depthAlpha ? depthAlpha : depthPlain) |= d.depthPass;
+        (d.cameraAlpha ? litAlpha : litPlain) = true;
+    }
+    ShadowPipeline* const shadowPipeline = shadowPipelines[wantIds ? 1 : 0];
     const bool beautyOnly = !wantAovs && !wantLights;  // the beauty target alone
     // Only the beauty, only for an 8-bit sRGB image: the display target, where there is one.
     const bool display = beautyOnly && (channels & kBeautyForDisplay) && targets.display.image;
     const LitOutputs outputs = display ? LitOutputs::kDisplay : beautyOnly ? LitOutputs::kBeauty : LitOutputs::kAll;
-    LitPipeline& litPipeline = litPipelines[display ? 3 : beautyOnly ? 0 : wantIds ? 2 : 1];
+    LitPipeline* const litPipeline = litPipelines[display ? 3 : beautyOnly ? 0 : wantIds ? 2 : 1];
     double setup = pendingSetupMs;  // 0 for a frame that creates nothing
     pendingSetupMs = 0.0;
-    if (!shadowPipeline.pipeline || !litPipeline.pipeline) {
+    // (A scene without objects, or without any drawn by the depth pass, still gets each pass's
+    // pipeline without the alpha test.)
+    const bool needDepthPlain = depthPlain || !depthAlpha, needLitPlain = litPlain || !litAlpha;
+    if ((needDepthPlain && !shadowPipeline[0].pipeline) || (depthAlpha && !shadowPipeline[1].pipeline) ||
+        (needLitPlain && !litPipeline[0].pipeline) || (litAlpha && !litPipeline[1].pipeline)) {
         const auto pipelineStart = Clock::now();
-        // VK_NULL_HANDLE without; the shadow passes only for MASK or textured BLEND casters.
+        for (int a = 0; a < 2; ++a)
+            if ((a ? depthAlpha : needDepthPlain) && !shadowPipeline[a].pipeline)
+                shadowPipeline[a] = createShadowPipeline(ctx, wantIds, settings.hardwareBias,
+                                                         a ? alpha.setLayout.get() : VK_NULL_HANDLE);
+        // The transmittance passes test alpha for every caster when the scene has alpha casters.
         const VkDescriptorSetLayout alphaLayout = shadowAlpha ? alpha.setLayout.get() : VK_NULL_HANDLE;
-        if (!shadowPipeline.pipeline)
-            shadowPipeline = createShadowPipeline(ctx, wantIds, settings.hardwareBias, alphaLayout);
         if (momentMaps.size > 1 && !momentPipeline.pipeline)
             momentPipeline = createMomentPipeline(ctx, maps, momentMaps);
         if (transmit && !transmitPipeline.pipeline) transmitPipeline = createTransmittancePipeline(ctx, alphaLayout);
         if (transmit && !transmitRestPipeline.pipeline)
             transmitRestPipeline = createTransmittanceRestPipeline(ctx, transmittanceMaps, alphaLayout);
-        if (!litPipeline.pipeline)
-            litPipeline = createLitPipeline(ctx, LitVariant{.filter = settings.filter,
-                                                            .blockerIds = wantIds,
-                                                            .aovTarget = !beautyOnly,
-                                                            .displayTarget = display,
-                                                            .normalOffset = settings.normalOffset != 0.0,
-                                                            .beautyFormat = targets.beautyFormat,
-                                                            .lightTargets = std::uint32_t(targets.lights.size()),
-                                                            .lightCount = std::uint32_t(lightCount),
-                                                            .lightKinds = lightKinds,
-                                                            .cascades = std::uint32_t(cascadesUsed),
-                                                            .transmittance = transmit,
-                                                            .receiverPlane = settings.receiverPlaneBias,
-                                                            .cascadeBlend = cascadeBlendUsed > 0.0,
-                                                            .vertexLightConstants = vertexLightConstants,
-                                                            .moments = settings.moments},
-                                          alpha.setLayout.get(), background);
+        for (int a = 0; a < 2; ++a)
+            if ((a ? litAlpha : needLitPlain) && !litPipeline[a].pipeline)
+                litPipeline[a] = createLitPipeline(ctx, LitVariant{.filter = settings.filter,
+                                                                   .blockerIds = wantIds,
+                                                                   .aovTarget = !beautyOnly,
+                                                                   .displayTarget = display,
+                                                                   .normalOffset = settings.normalOffset != 0.0,
+                                                                   .beautyFormat = targets.beautyFormat,
+                                                                   .lightTargets = std::uint32_t(targets.lights.size()),
+                                                                   .lightCount = std::uint32_t(lightCount),
+                                                                   .lightKinds = lightKinds,
+                                                                   .cascades = std::uint32_t(cascadesUsed),
+                                                                   .transmittance = transmit,
+                                                                   .receiverPlane = settings.receiverPlaneBias,
+                                                                   .cascadeBlend = cascadeBlendUsed > 0.0,
+                                                                   .vertexLightConstants = vertexLightConstants,
+                                                                   .moments = settings.moments},
+                                                   a ? alpha.setLayout.get() : VK_NULL_HANDLE, background);
         if (bindings.set == VK_NULL_HANDLE)
-            bindings = createLitBindings(ctx, litPipeline, uniforms, transmitWindowData, albedos, maps,
-                                         transmittanceMaps, momentMaps);
+            bindings = createLitBindings(ctx, litPipeline[litPipeline[0].pipeline ? 0 : 1], uniforms,
+                                         transmitWindowData, albedos, maps, transmittanceMaps, momentMaps);
         setup += msSince(pipelineStart);
     }
 
@@ -690,7 +750,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     stamp(commands, 0);
     const TransmittancePass transmittancePass{transmit ? &transmitPipeline : nullptr, &transmittanceMaps, layerLights,
                                               transmit ? &transmitRestPipeline : nullptr, transmitWindows};
-    recordShadowPass(commands, shadowPipeline, maps, draw, lightMatrices, wantIds, &transmittancePass, &layerBias);
+    recordShadowPass(commands, shadowPipeline[shadowPipeline[0].pipeline ? 0 : 1], maps, draw, lightMatrices, wantIds,
+                     &transmittancePass, &layerBias, shadowPipeline[1].pipeline ? &shadowPipeline[1] : nullptr);
     if (momentPipeline.pipeline) recordMomentPasses(commands, momentPipeline, maps, momentMaps, settings.filter, settings.moments);
     stamp(commands, 1);
     ctx.submitAndWait(commands);
@@ -720,7 +781,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     const double litCpuStart = processCpuMs();
     commands = ctx.beginCommands();
     stamp(commands, 2);
-    recordLitPass(commands, litPipeline, bindings, targets, attachments, draw, background, outputs);
+    recordLitPass(commands, litPipeline[litPipeline[0].pipeline ? 0 : 1], bindings, targets, attachments, draw,
+                  background, outputs, litPipeline[1].pipeline ? &litPipeline[1] : nullptr);
     stamp(commands, 3);
     ctx.submitAndWait(commands);
     frame.timingsMs.emplace_back("lit_pass", msSince(litStart));

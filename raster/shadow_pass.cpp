@@ -418,7 +418,7 @@ void recordTransmittance(VkCommandBuffer commands, const TransmittancePass& pass
 void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, const ShadowMaps& maps,
                       const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices,
                       bool blockerIds, const TransmittancePass* transmittance,
-                      const std::vector<DepthBiasFactors>* layerBias) {
+                      const std::vector<DepthBiasFactors>* layerBias, const ShadowPipeline* alphaPipeline) {
     // Source stage: the previous frame's lit pass sampled both arrays (a reused Renderer).
     transition(commands, {{maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, maps.layers,
                            VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
@@ -458,27 +458,35 @@ void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, 
         };
         vkCmdBeginRendering(commands, &rendering);
         if (layer < lightMatrices.size() && geometry.depthPassIndexCount() > 0) {
-            vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.pipeline.get());
             setViewport(commands, maps.size, maps.size);
-            if (pipeline.hardwareBias) {
-                const DepthBiasFactors b =
-                    layerBias && layer < layerBias->size() ? (*layerBias)[layer] : DepthBiasFactors{};
-                vkCmdSetDepthBias(commands, b.constant, 0.0f, b.slope);
-            }
-            const shaders::ShadowPush push{.lightMatrix = lightMatrices[layer]};
-            vkCmdPushConstants(commands, pipeline.layout.get(), VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof push, &push);
             const VkDeviceSize offset = 0;
             vkCmdBindVertexBuffers(commands, 0, 1, &geometry.vertices, &offset);
-            if (pipeline.alpha) {
-                vkCmdBindVertexBuffers(commands, 1, 1, &geometry.uvs, &offset);
-                vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.layout.get(), 0, 1,
-                                        &geometry.alphaSet, 0, nullptr);
-            }
+            if (geometry.uvs != VK_NULL_HANDLE) vkCmdBindVertexBuffers(commands, 1, 1, &geometry.uvs, &offset);
             vkCmdBindIndexBuffer(commands, geometry.indices, 0, VK_INDEX_TYPE_UINT32);
+            const ShadowPipeline* bound = nullptr;
+            auto use = [&](const ShadowPipeline& p) {
+                if (bound == &p) return;
+                bound = &p;
+                vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, p.pipeline.get());
+                if (p.hardwareBias) {
+                    const DepthBiasFactors b =
+                        layerBias && layer < layerBias->size() ? (*layerBias)[layer] : DepthBiasFactors{};
+                    vkCmdSetDepthBias(commands, b.constant, 0.0f, b.slope);
+                }
+                const shaders::ShadowPush push{.lightMatrix = lightMatrices[layer]};
+                vkCmdPushConstants(commands, p.layout.get(), VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof push, &push);
+                if (p.alpha)
+                    vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, p.layout.get(), 0, 1,
+                                            &geometry.alphaSet, 0, nullptr);
+            };
             if (layer < geometry.layerRanges.size()) {  // the casters left after culling
-                for (const auto& [first, count] : geometry.layerRanges[layer])
-                    if (count > 0) vkCmdDrawIndexed(commands, count, 1, first, 0, 0);
+                for (const IndexRange& r : geometry.layerRanges[layer]) {
+                    if (r.count == 0) continue;
+                    use(r.alpha && alphaPipeline ? *alphaPipeline : pipeline);
+                    vkCmdDrawIndexed(commands, r.count, 1, r.first, 0, 0);
+                }
             } else {
+                use(pipeline);
                 vkCmdDrawIndexed(commands, geometry.depthPassIndexCount(), 1, 0, 0, 0);
             }
         }

@@ -67,6 +67,17 @@ struct TexelRect {
 TexelRect transmittanceWindow(const glm::mat4& lightMatrix, const std::vector<TransparentDraw>& casters,
                               std::uint32_t size);
 
+// A run of the index buffer drawn with one pipeline: `alpha` = the SHADOWLAB_ALPHA variant, for
+// objects whose texels the pass tests (MASK casters in the depth pass; MASK and BLEND surfaces in
+// the lit pass). Objects that test nothing are drawn without it: a fragment shader that can
+// discard keeps lavapipe from testing depth before shading and from a depth-only pass without
+// any fragment shader, and reads the alpha records per fragment.
+struct IndexRange {
+    std::uint32_t first = 0;
+    std::uint32_t count = 0;
+    bool alpha = false;
+};
+
 // Index and vertex buffers of the whole scene (raster/geometry.h layout).
 struct DrawGeometry {
     VkBuffer vertices = VK_NULL_HANDLE;
@@ -78,9 +89,12 @@ struct DrawGeometry {
     std::uint32_t opaqueIndexCount = ~0u;
     std::vector<TransparentDraw> transparent;
     std::uint32_t depthPassIndexCount() const { return opaqueIndexCount < indexCount ? opaqueIndexCount : indexCount; }
-    // Shadow pass only: per layer, the index ranges (first, count) drawn into it (the casters
-    // left after culling); layers past the end of this list draw every index.
-    std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> layerRanges;
+    // Shadow pass only: per layer, the index ranges drawn into it (the casters left after culling,
+    // in index order); layers past the end of this list draw every index of the depth pass.
+    std::vector<std::vector<IndexRange>> layerRanges;
+    // Lit pass: every index in order, split where the camera's alpha test starts or stops (empty:
+    // one draw of every index with the pass's pipeline).
+    std::vector<IndexRange> litRanges;
     // Alpha-tested casters (raster/alpha_casters.h): the UV buffer and the records' set, used by
     // pipelines made with an alpha set layout.
     VkBuffer uvs = VK_NULL_HANDLE;
@@ -157,10 +171,13 @@ struct TransmittancePass {
 // end in SHADER_READ_ONLY_OPTIMAL either way (undefined outside the windows, and everywhere with
 // `transmittance.pipeline` null, for a lit pass that does not read them).
 // layerBias: a pipeline made with hardwareBias needs each drawn layer's factors (missing ones: 0).
+// alphaPipeline: the SHADOWLAB_ALPHA variant of `pipeline`, for ranges with IndexRange::alpha
+// (null: `pipeline` draws them).
 void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, const ShadowMaps& maps,
                       const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices,
                       bool blockerIds = true, const TransmittancePass* transmittance = nullptr,
-                      const std::vector<DepthBiasFactors>* layerBias = nullptr);
+                      const std::vector<DepthBiasFactors>* layerBias = nullptr,
+                      const ShadowPipeline* alphaPipeline = nullptr);
 // Diagnostics and tests: the depths of one layer after recordShadowPass() has run, row 0 first.
 std::vector<float> readShadowMap(const Context& ctx, const ShadowMaps& maps, std::uint32_t layer);
 std::vector<std::uint32_t> readBlockerIds(const Context& ctx, const ShadowMaps& maps, std::uint32_t layer);
