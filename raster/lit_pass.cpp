@@ -16,6 +16,26 @@ bool usesVertexLightCoordinates(const LitVariant& variant) {
            variant.lightKinds == (1u << SHADOWLAB_LIGHT_SPOT);
 }
 
+namespace {
+
+// lit.frag's SPIR-V for the variant: its outputs (beauty only, the AOVs, the per-light targets),
+// the camera's alpha test, and for none and pcf2x2 the *_taps build without the other filters' code
+// (lavapipe turns all of a module into NIR before the specialization constants remove what a
+// pipeline does not run: the full module doubled the lit pipeline's creation).
+std::span<const std::uint32_t> litFragment(const LitVariant& v, bool alpha) {
+    const bool taps = v.filter == scene::ShadowFilter::None || v.filter == scene::ShadowFilter::Pcf2x2;
+    if (!v.aovTarget)
+        return taps ? (alpha ? shaders::litFragBeautyAlphaTapsSpirv() : shaders::litFragBeautyTapsSpirv())
+                    : (alpha ? shaders::litFragBeautyAlphaSpirv() : shaders::litFragBeautySpirv());
+    if (v.lightTargets > 0)
+        return taps ? (alpha ? shaders::litFragLightsAlphaTapsSpirv() : shaders::litFragLightsTapsSpirv())
+                    : (alpha ? shaders::litFragLightsAlphaSpirv() : shaders::litFragLightsSpirv());
+    return taps ? (alpha ? shaders::litFragAlphaTapsSpirv() : shaders::litFragTapsSpirv())
+                : (alpha ? shaders::litFragAlphaSpirv() : shaders::litFragSpirv());
+}
+
+}  // namespace
+
 LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkDescriptorSetLayout alphaSetLayout,
                               const glm::vec3& background) {
     requireFormat(ctx, kLitDepthFormat, VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT, "the camera depth buffer");
@@ -98,14 +118,7 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkD
     p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{
                                                  .vertexShader = p.alpha ? shaders::litVertAlphaSpirv()
                                                                          : shaders::litVertSpirv(),
-                                                 .fragmentShader =
-                                                     !variant.aovTarget
-                                                         ? (p.alpha ? shaders::litFragBeautyAlphaSpirv()
-                                                                    : shaders::litFragBeautySpirv())
-                                                     : variant.lightTargets > 0
-                                                         ? (p.alpha ? shaders::litFragLightsAlphaSpirv()
-                                                                    : shaders::litFragLightsSpirv())
-                                                         : (p.alpha ? shaders::litFragAlphaSpirv() : shaders::litFragSpirv()),
+                                                 .fragmentShader = litFragment(variant, p.alpha),
                                                  .fragmentSpecialization = &specialization,
                                                  .vertexSpecialization = &specialization,
                                                  .layout = layout,

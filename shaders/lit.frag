@@ -405,6 +405,7 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         // The plane replaces the slope term; the constant bias stays.
         if (r.plane) r.biasWorld = light.bias.x;
     }
+#ifndef SHADOWLAB_TAPS_ONLY
     if (filterCode >= SHADOWLAB_FILTER_VSM) {
         // Filterable maps: one linear lookup of the blurred moments (the filter is in the blur),
         // the receiver at the constant and slope bias as for `none`. Blocker ids and
@@ -415,6 +416,7 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         if (kTransmittance) v *= transmittanceTap(r.uv, layer, ref);
         return v;
     }
+#endif
     if (filterCode == SHADOWLAB_FILTER_NONE) {
         if (kReceiverPlane && r.plane) return biasedTap(light, r, vec2(0.0), size, layer, blocker);
         return tap(r.uv, layer, reference(light, r, r.biasWorld), blocker);
@@ -465,6 +467,11 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         }
         return mix(mix(g.w, g.z, f.x), mix(g.x, g.y, f.x), f.y);
     }
+#ifdef SHADOWLAB_TAPS_ONLY
+    // (The lit_frag*_taps variants, for none and pcf2x2: the wide kernels' and the filterable maps'
+    // code left out of the SPIR-V, which halves what lavapipe compiles when the pipeline is made.)
+    return 1.0;
+#else
     // Wide kernels: a tap d texels from the point compares against a surface that a plane
     // tilted by θ has moved d·texel·tan(θ) along the light, so each tap's slope term grows
     // with its distance (a per-tap receiver-plane bias; without it wide kernels make acne).
@@ -569,6 +576,7 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         }
     }
     return sum / 16.0;
+#endif
 }
 
 // Cascade c's map, texel size, depth scale and constant bias in place of the light's; its layer
