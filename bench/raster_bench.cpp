@@ -134,24 +134,55 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
     const scene::RenderPlan plan = scene::makeRenderPlan(s, settings);
 
     // Cold first frames: construction + first frame with an empty shader cache. Ours and the
-    // bare renderer compile different shaders, so both are cold in the same cache.
-    freshShaderCache(caches);
+    // bare renderer compile different shaders, so both are cold in the same cache. Wall and
+    // process CPU time. SHADOWLAB_BENCH_BARE_FIRST=1 measures the bare one first (to see that the
+    // order does not favour either).
+    // SHADOWLAB_BENCH_PROFILE=first: the same as cold, with the shader cache as it is (warm after a run).
+    const char* profileName = std::getenv("SHADOWLAB_BENCH_PROFILE");
+    const bool warmProfile = profileName && std::string(profileName) == "first";
+    if (!warmProfile) {
+        // The first shader a process compiles also pays LLVM's one-time set-up (25-30 ms of CPU
+        // measured): a throwaway 16x9 bare frame in a cache of its own takes it, so that neither
+        // cold frame below carries it. Then an empty cache for the two measured.
+        freshShaderCache(caches);
+        scene::Scene tiny = s;
+        tiny.camera.width = 16;
+        tiny.camera.height = 9;
+        std::vector<std::uint8_t> pixels;
+        bench::BareRenderer(tiny, settings.raster).render(pixels);
+        freshShaderCache(caches);
+    }
+    const bool bareFirst = std::getenv("SHADOWLAB_BENCH_BARE_FIRST") && std::string(std::getenv("SHADOWLAB_BENCH_BARE_FIRST")) == "1";
+    std::vector<std::uint8_t> rgba;
+    double bareCold = 0, bareColdCpu = 0;
+    auto coldBare = [&] {
+        const auto t = Clock::now();
+        const double c = cpuMs();
+        bench::BareRenderer first(s, settings.raster);
+        first.render(rgba);
+        bareCold = msSince(t);
+        bareColdCpu = cpuMs() - c;
+    };
+    if (bareFirst) coldBare();
     auto t0 = Clock::now();
+    double c0 = cpuMs();
     raster::Renderer ours(s, plan, settings.raster, rendererOptions());
     scene::Frame frame = ours.render();
     const double oursCold = msSince(t0);
-    if (const char* profile = std::getenv("SHADOWLAB_BENCH_PROFILE"); profile && std::string(profile) == "cold") {
-        // Only our cold first frame (construction + first frame): a process to run under `perf record`.
-        std::printf("cold first frame %.1f ms (construction %.1f; shadow pass %.1f, lit pass %.1f, readback %.1f)\n",
-                    oursCold, ours.setupMs(), frame.timing("shadow_pass"), frame.timing("lit_pass"),
-                    frame.timing("readback"));
+    const double oursColdCpu = cpuMs() - c0;
+    if (profileName && (std::string(profileName) == "cold" || warmProfile)) {
+        // Only our cold (or warm: first) first frame (construction + first frame): a process to run
+        // under `perf record`.
+        std::printf("first frame %.1f ms, CPU %.1f ms (construction %.1f, setup with the pipelines %.1f; shadow pass "
+                    "%.1f, CPU %s; lit pass %.1f, CPU %s; readback %.1f)\n",
+                    oursCold, oursColdCpu, ours.setupMs(), frame.timing("setup"), frame.timing("shadow_pass"),
+                    frame.attributes["cpu_shadow_pass_ms"].c_str(), frame.timing("lit_pass"),
+                    frame.attributes["cpu_lit_pass_ms"].c_str(), frame.timing("readback"));
         return;
     }
-    std::vector<std::uint8_t> rgba;
-    t0 = Clock::now();
+    if (!bareFirst) coldBare();
     bench::BareRenderer bare(s, settings.raster);
     bare.render(rgba);
-    const double bareCold = msSince(t0);
     // The same bare passes writing an sRGB target, as ours does for a PNG: what the device's
     // sRGB encoding on store costs (the headline ratios are against the UNORM one above).
     bench::BareRenderer bareSrgb(s, settings.raster, true);
@@ -170,18 +201,19 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
         scene::writePngDisplay(fs::path(dir) / (label + "-bare.png"), width, height, rgb);
     }
 
-    // SHADOWLAB_BENCH_PROFILE=all|beauty|png|bare|bare-srgb: only that series, `repeats` frames,
+    // SHADOWLAB_BENCH_PROFILE=all|no-ids|beauty|png|bare|bare-srgb: only that series, `repeats` frames,
     // nothing printed: a process to run under `perf record` (docs/performance.md).
     if (const char* profile = std::getenv("SHADOWLAB_BENCH_PROFILE"); profile && *profile) {
         const std::string which = profile;
         scene::Frame into;
         for (int i = 0; i < repeats; ++i) {
             if (which == "all") ours.render(into, scene::kAllChannels);
+            else if (which == "no-ids") ours.render(into, scene::kAllChannels & ~scene::kChannelBlockerId);
             else if (which == "beauty") ours.render(into, scene::kChannelBeauty);
             else if (which == "png") ours.render(into, scene::kChannelBeauty | scene::kBeautyForDisplay);
             else if (which == "bare") bare.render(rgba);
             else if (which == "bare-srgb") bareSrgb.render(rgba);
-            else throw std::runtime_error("SHADOWLAB_BENCH_PROFILE: expected all, beauty, png, bare or bare-srgb, got " + which);
+            else throw std::runtime_error("SHADOWLAB_BENCH_PROFILE: expected all, no-ids, beauty, png, bare or bare-srgb, got " + which);
         }
         return;
     }
@@ -218,17 +250,21 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
 
     // Warm first frames: a new renderer (new device) whose shaders are now in the cache.
     t0 = Clock::now();
+    c0 = cpuMs();
     {
         raster::Renderer again(s, plan, settings.raster, rendererOptions());
         again.render();
     }
     const double oursWarmFirst = msSince(t0);
+    const double oursWarmFirstCpu = cpuMs() - c0;
     t0 = Clock::now();
+    c0 = cpuMs();
     {
         bench::BareRenderer again(s, settings.raster);
         again.render(rgba);
     }
     const double bareWarmFirst = msSince(t0);
+    const double bareWarmFirstCpu = cpuMs() - c0;
 
     std::printf("median of %d warm frames, ms (min-max)\n", repeats);
     std::printf("  %-12s %22s %22s %22s %22s %9s %9s %9s\n", "stage", "ours (all channels)", "ours (float beauty)",
@@ -252,8 +288,11 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
     std::printf("  ours (all channels) into a new Frame each time: per_frame %.1f, readback %.1f\n",
                 fresh.med("per_frame"), fresh.med("readback"));
     std::printf("  setup (construction): ours %.1f, bare %.1f\n", ours.setupMs(), bare.setupMs());
-    std::printf("  first frame incl. setup: cold ours %.1f, bare %.1f; warm ours %.1f, bare %.1f\n", oursCold,
-                bareCold, oursWarmFirst, bareWarmFirst);
+    std::printf("  first frame incl. setup: cold ours %.1f, bare %.1f; warm ours %.1f, bare %.1f (%s first)\n",
+                oursCold, bareCold, oursWarmFirst, bareWarmFirst, bareFirst ? "bare" : "ours");
+    std::printf("  first frame, process CPU: cold ours %.1f, bare %.1f (%.2f); warm ours %.1f, bare %.1f (%.2f)\n",
+                oursColdCpu, bareColdCpu, oursColdCpu / bareColdCpu, oursWarmFirstCpu, bareWarmFirstCpu,
+                oursWarmFirstCpu / bareWarmFirstCpu);
     std::printf("  gpu timestamps: first frame shadow %s, lit %s; last warm frame (all channels) shadow %s, lit %s\n",
                 frame.attributes["gpu_shadow_pass_ms"].c_str(), frame.attributes["gpu_lit_pass_ms"].c_str(),
                 allFrame.attributes["gpu_shadow_pass_ms"].c_str(), allFrame.attributes["gpu_lit_pass_ms"].c_str());
