@@ -169,6 +169,13 @@ LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32
         throw RasterError("image " + std::to_string(width) + "x" + std::to_string(height) +
                           " exceeds the device's limit of " + std::to_string(limit) + " per side (" +
                           ctx.deviceReport.name + ")");
+    // A target per channel, and two for eight lights' visibility: 6 + 2 attachments.
+    const std::uint32_t attachments = kLitPlanes + lightTargets;
+    if (ctx.properties.limits.maxColorAttachments < attachments)
+        throw RasterError("the lit pass renders into " + std::to_string(attachments) + " color targets (one per Frame " +
+                          "channel" + (lightTargets ? ", and the per-light visibility" : "") + "), and " +
+                          ctx.deviceReport.name + " allows " +
+                          std::to_string(ctx.properties.limits.maxColorAttachments) + "; choose another device with --device");
     LitTargets t;
     t.width = width;
     t.height = height;
