@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <cstring>
+#include <ctime>
 
 #include "bare_depth_vert.spv.h"
 #include "bare_lit_frag.spv.h"
@@ -23,6 +24,11 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+double cpuMs() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+}
 
 struct Uniforms {
     glm::mat4 viewProj;
@@ -198,6 +204,7 @@ BareTimings BareRenderer::render(std::vector<std::uint8_t>& rgba) {
     const VkDeviceSize zero = 0;
 
     auto start = Clock::now();
+    double cpuStart = cpuMs();
     VkCommandBuffer cb = ctx.beginCommands();
     transition(cb, {{m.map.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
                      VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_NONE,
@@ -227,8 +234,10 @@ BareTimings BareRenderer::render(std::vector<std::uint8_t>& rgba) {
                      VK_ACCESS_2_SHADER_SAMPLED_READ_BIT}});
     ctx.submitAndWait(cb);
     t.shadowPass = msSince(start);
+    t.cpuShadowPass = cpuMs() - cpuStart;
 
     start = Clock::now();
+    cpuStart = cpuMs();
     cb = ctx.beginCommands();
     transition(cb, {{m.color.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
                      VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_NONE,
@@ -269,6 +278,7 @@ BareTimings BareRenderer::render(std::vector<std::uint8_t>& rgba) {
                      VK_ACCESS_2_TRANSFER_READ_BIT}});
     ctx.submitAndWait(cb);
     t.litPass = msSince(start);
+    t.cpuLitPass = cpuMs() - cpuStart;
 
     start = Clock::now();
     cb = ctx.beginCommands();

@@ -21,6 +21,7 @@ namespace shadowlab::bench {
 
 struct BareTimings {
     double setup = 0, shadowPass = 0, litPass = 0, readback = 0;
+    double cpuShadowPass = 0, cpuLitPass = 0;  // process CPU time during each pass (all threads)
     double perFrame() const { return shadowPass + litPass + readback; }
 };
 

@@ -75,6 +75,9 @@ struct Series {
 void addOurs(Series& s, const scene::Frame& f) {
     for (const char* stage : {"shadow_pass", "lit_pass", "readback"}) s.add(stage, f.timing(stage));
     s.add("per_frame", f.totalTimeMs() - f.timing("setup"));
+    for (const char* stage : {"shadow_pass", "lit_pass"})
+        if (const auto it = f.attributes.find(std::string("cpu_") + stage + "_ms"); it != f.attributes.end())
+            s.add(std::string("cpu_") + stage, std::stod(it->second));
 }
 
 void addBare(Series& s, const bench::BareTimings& t) {
@@ -82,6 +85,8 @@ void addBare(Series& s, const bench::BareTimings& t) {
     s.add("lit_pass", t.litPass);
     s.add("readback", t.readback);
     s.add("per_frame", t.perFrame());
+    s.add("cpu_shadow_pass", t.cpuShadowPass);
+    s.add("cpu_lit_pass", t.cpuLitPass);
 }
 
 // A fresh, empty Mesa shader cache, so that the next device's pipelines compile from scratch.
@@ -129,17 +134,55 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
     const scene::RenderPlan plan = scene::makeRenderPlan(s, settings);
 
     // Cold first frames: construction + first frame with an empty shader cache. Ours and the
-    // bare renderer compile different shaders, so both are cold in the same cache.
-    freshShaderCache(caches);
+    // bare renderer compile different shaders, so both are cold in the same cache. Wall and
+    // process CPU time. SHADOWLAB_BENCH_BARE_FIRST=1 measures the bare one first (to see that the
+    // order does not favour either).
+    // SHADOWLAB_BENCH_PROFILE=first: the same as cold, with the shader cache as it is (warm after a run).
+    const char* profileName = std::getenv("SHADOWLAB_BENCH_PROFILE");
+    const bool warmProfile = profileName && std::string(profileName) == "first";
+    if (!warmProfile) {
+        // The first shader a process compiles also pays LLVM's one-time set-up (25-30 ms of CPU
+        // measured): a throwaway 16x9 bare frame in a cache of its own takes it, so that neither
+        // cold frame below carries it. Then an empty cache for the two measured.
+        freshShaderCache(caches);
+        scene::Scene tiny = s;
+        tiny.camera.width = 16;
+        tiny.camera.height = 9;
+        std::vector<std::uint8_t> pixels;
+        bench::BareRenderer(tiny, settings.raster).render(pixels);
+        freshShaderCache(caches);
+    }
+    const bool bareFirst = std::getenv("SHADOWLAB_BENCH_BARE_FIRST") && std::string(std::getenv("SHADOWLAB_BENCH_BARE_FIRST")) == "1";
+    std::vector<std::uint8_t> rgba;
+    double bareCold = 0, bareColdCpu = 0;
+    auto coldBare = [&] {
+        const auto t = Clock::now();
+        const double c = cpuMs();
+        bench::BareRenderer first(s, settings.raster);
+        first.render(rgba);
+        bareCold = msSince(t);
+        bareColdCpu = cpuMs() - c;
+    };
+    if (bareFirst) coldBare();
     auto t0 = Clock::now();
+    double c0 = cpuMs();
     raster::Renderer ours(s, plan, settings.raster, rendererOptions());
     scene::Frame frame = ours.render();
     const double oursCold = msSince(t0);
-    std::vector<std::uint8_t> rgba;
-    t0 = Clock::now();
+    const double oursColdCpu = cpuMs() - c0;
+    if (profileName && (std::string(profileName) == "cold" || warmProfile)) {
+        // Only our cold (or warm: first) first frame (construction + first frame): a process to run
+        // under `perf record`.
+        std::printf("first frame %.1f ms, CPU %.1f ms (construction %.1f, setup with the pipelines %.1f; shadow pass "
+                    "%.1f, CPU %s; lit pass %.1f, CPU %s; readback %.1f)\n",
+                    oursCold, oursColdCpu, ours.setupMs(), frame.timing("setup"), frame.timing("shadow_pass"),
+                    frame.attributes["cpu_shadow_pass_ms"].c_str(), frame.timing("lit_pass"),
+                    frame.attributes["cpu_lit_pass_ms"].c_str(), frame.timing("readback"));
+        return;
+    }
+    if (!bareFirst) coldBare();
     bench::BareRenderer bare(s, settings.raster);
     bare.render(rgba);
-    const double bareCold = msSince(t0);
     // The same bare passes writing an sRGB target, as ours does for a PNG: what the device's
     // sRGB encoding on store costs (the headline ratios are against the UNORM one above).
     bench::BareRenderer bareSrgb(s, settings.raster, true);
@@ -158,18 +201,19 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
         scene::writePngDisplay(fs::path(dir) / (label + "-bare.png"), width, height, rgb);
     }
 
-    // SHADOWLAB_BENCH_PROFILE=all|beauty|png|bare|bare-srgb: only that series, `repeats` frames,
+    // SHADOWLAB_BENCH_PROFILE=all|no-ids|beauty|png|bare|bare-srgb: only that series, `repeats` frames,
     // nothing printed: a process to run under `perf record` (docs/performance.md).
     if (const char* profile = std::getenv("SHADOWLAB_BENCH_PROFILE"); profile && *profile) {
         const std::string which = profile;
         scene::Frame into;
         for (int i = 0; i < repeats; ++i) {
             if (which == "all") ours.render(into, scene::kAllChannels);
+            else if (which == "no-ids") ours.render(into, scene::kAllChannels & ~scene::kChannelBlockerId);
             else if (which == "beauty") ours.render(into, scene::kChannelBeauty);
             else if (which == "png") ours.render(into, scene::kChannelBeauty | scene::kBeautyForDisplay);
             else if (which == "bare") bare.render(rgba);
             else if (which == "bare-srgb") bareSrgb.render(rgba);
-            else throw std::runtime_error("SHADOWLAB_BENCH_PROFILE: expected all, beauty, png, bare or bare-srgb, got " + which);
+            else throw std::runtime_error("SHADOWLAB_BENCH_PROFILE: expected all, no-ids, beauty, png, bare or bare-srgb, got " + which);
         }
         return;
     }
@@ -206,22 +250,27 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
 
     // Warm first frames: a new renderer (new device) whose shaders are now in the cache.
     t0 = Clock::now();
+    c0 = cpuMs();
     {
         raster::Renderer again(s, plan, settings.raster, rendererOptions());
         again.render();
     }
     const double oursWarmFirst = msSince(t0);
+    const double oursWarmFirstCpu = cpuMs() - c0;
     t0 = Clock::now();
+    c0 = cpuMs();
     {
         bench::BareRenderer again(s, settings.raster);
         again.render(rgba);
     }
     const double bareWarmFirst = msSince(t0);
+    const double bareWarmFirstCpu = cpuMs() - c0;
 
     std::printf("median of %d warm frames, ms (min-max)\n", repeats);
     std::printf("  %-12s %22s %22s %22s %22s %9s %9s %9s\n", "stage", "ours (all channels)", "ours (float beauty)",
                 "ours (png)", "bare baseline", "all/bare", "bty/bare", "png/bare");
-    for (const char* stage : {"shadow_pass", "lit_pass", "readback", "per_frame", "cpu_per_frame"}) {
+    for (const char* stage :
+         {"shadow_pass", "lit_pass", "readback", "per_frame", "cpu_shadow_pass", "cpu_lit_pass", "cpu_per_frame"}) {
         auto cell = [&](const Series& x) {
             char buf[64];
             const auto [lo, hi] = x.range(stage);
@@ -239,8 +288,11 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
     std::printf("  ours (all channels) into a new Frame each time: per_frame %.1f, readback %.1f\n",
                 fresh.med("per_frame"), fresh.med("readback"));
     std::printf("  setup (construction): ours %.1f, bare %.1f\n", ours.setupMs(), bare.setupMs());
-    std::printf("  first frame incl. setup: cold ours %.1f, bare %.1f; warm ours %.1f, bare %.1f\n", oursCold,
-                bareCold, oursWarmFirst, bareWarmFirst);
+    std::printf("  first frame incl. setup: cold ours %.1f, bare %.1f; warm ours %.1f, bare %.1f (%s first)\n",
+                oursCold, bareCold, oursWarmFirst, bareWarmFirst, bareFirst ? "bare" : "ours");
+    std::printf("  first frame, process CPU: cold ours %.1f, bare %.1f (%.2f); warm ours %.1f, bare %.1f (%.2f)\n",
+                oursColdCpu, bareColdCpu, oursColdCpu / bareColdCpu, oursWarmFirstCpu, bareWarmFirstCpu,
+                oursWarmFirstCpu / bareWarmFirstCpu);
     std::printf("  gpu timestamps: first frame shadow %s, lit %s; last warm frame (all channels) shadow %s, lit %s\n",
                 frame.attributes["gpu_shadow_pass_ms"].c_str(), frame.attributes["gpu_lit_pass_ms"].c_str(),
                 allFrame.attributes["gpu_shadow_pass_ms"].c_str(), allFrame.attributes["gpu_lit_pass_ms"].c_str());
@@ -336,6 +388,87 @@ void benchFilters(const std::string& label, const fs::path& file, int repeats) {
                 cell(base, "cpu_per_frame").c_str(), cell(base, "shadow_pass").c_str());
 }
 
+// SHADOWLAB_BENCH_TRANSMIT=1: the shadow pass with a transmittance map against the same scene
+// opaque: a glass sphere (opacity 0.5, radius 1) beside an opaque box on a 20x20 plane under a
+// spot and a point light, so 1 + 6 shadow maps of 2048² (the spot's and the point light's cube),
+// 640x360, all channels, pcf2x2, unfitted maps; `opaque` makes the sphere opaque (no
+// transmittance pass). The two renderers interleaved repetition by repetition in one process.
+scene::Scene glassScene(bool opaque) {
+    scene::Scene s;
+    s.camera.position = {0, 3, 7.5};
+    s.camera.lookAt = {0, 0.6, 0};
+    s.camera.width = 640;
+    s.camera.height = 360;
+    s.materials = {{.name = "glass", .albedo = {0.55, 0.75, 0.9}, .opacity = opaque ? 1.0 : 0.5},
+                   {.name = "box", .albedo = {0.3, 0.5, 0.8}},
+                   {.name = "ground", .albedo = {0.75, 0.75, 0.75}}};
+    s.lights = {{.type = scene::LightType::Spot, .direction = glm::normalize(scene::Vec3(3.2, -5.5, -2.6)),
+                 .position = {-3, 5.5, 2}, .color = {1, 0.95, 0.85}, .intensity = 700, .coneAngleDegrees = 32},
+                {.type = scene::LightType::Point, .position = {2.5, 4, 1.5}, .color = {0.9, 0.9, 1}, .intensity = 300}};
+    s.objects = {{.name = "glass sphere", .shape = scene::Sphere{{0, 1, 0}, 1.0}, .material = 0},
+                 {.name = "box", .shape = scene::Box{{-2.4, 0, 0.2}, {-1.6, 1.2, 1.0}}, .material = 1},
+                 {.name = "ground", .shape = scene::Quad{.center = {0, 0, 0}, .normal = {0, 1, 0}, .size = {20, 20}},
+                  .material = 2}};
+    return s;
+}
+
+void benchTransmittance(int repeats) {
+    struct Case {
+        const char* label;
+        scene::Scene scene;
+        scene::RenderSettings settings;
+        std::unique_ptr<raster::Renderer> renderer;
+        scene::Frame frame;
+        Series series;
+        double firstMs = 0.0, firstShadowMs = 0.0;
+    };
+    Case cases[2] = {{"glass", glassScene(false)}, {"opaque", glassScene(true)}};
+    for (Case& c : cases) {
+        scene::SettingsOverrides overrides;
+        overrides.shadowMapSize = kShadowMapSize;
+        overrides.fitLightFrustum = false;
+        c.settings = scene::resolveSettings(c.scene, overrides);
+        const auto t0 = Clock::now();
+        c.renderer = std::make_unique<raster::Renderer>(c.scene, scene::makeRenderPlan(c.scene, c.settings),
+                                                        c.settings.raster, rendererOptions());
+        c.renderer->render(c.frame, scene::kAllChannels);
+        c.firstMs = msSince(t0);
+        c.firstShadowMs = c.frame.timing("shadow_pass");
+    }
+    for (int i = 0; i < repeats; ++i)
+        for (Case& c : cases) {
+            const double cpu = cpuMs();
+            c.renderer->render(c.frame, scene::kAllChannels);
+            c.series.add("cpu_per_frame", cpuMs() - cpu);
+            addOurs(c.series, c.frame);
+            c.series.add("gpu_shadow_pass", std::stod(c.frame.attributes.at("gpu_shadow_pass_ms")));
+            if (const auto it = c.frame.attributes.find("cpu_shadow_pass_ms"); it != c.frame.attributes.end())
+                c.series.add("cpu_shadow_pass", std::stod(it->second));
+        }
+    std::printf("\n=== transmittance: %s shadow maps of %d, 640x360, median of %d frames, ms (min-max) ===\n",
+                cases[0].frame.attributes.at("shadow_maps").c_str(), kShadowMapSize, repeats);
+    std::printf("  %-16s %22s %22s %9s\n", "stage", "glass", "opaque", "ratio");
+    for (const char* stage : {"shadow_pass", "gpu_shadow_pass", "cpu_shadow_pass", "lit_pass", "per_frame", "cpu_per_frame"}) {
+        auto cell = [&](const Series& x) {
+            char buf[64];
+            const auto [lo, hi] = x.range(stage);
+            std::snprintf(buf, sizeof buf, "%.1f (%.1f-%.1f)", x.med(stage), lo, hi);
+            return std::string(buf);
+        };
+        std::printf("  %-16s %22s %22s %9.2f\n", stage, cell(cases[0].series).c_str(), cell(cases[1].series).c_str(),
+                    cases[0].series.med(stage) / cases[1].series.med(stage));
+    }
+    std::printf("  first frame incl. setup (this process's shader cache): glass %.1f (shadow pass %.1f), opaque %.1f "
+                "(shadow pass %.1f)\n",
+                cases[0].firstMs, cases[0].firstShadowMs, cases[1].firstMs, cases[1].firstShadowMs);
+    std::printf("TRANSMIT | %s | %.1f | %.1f | %.2f | %.1f | %.1f | %.2f | %.2f |\n", std::getenv("LP_NUM_THREADS"),
+                cases[0].series.med("shadow_pass"), cases[1].series.med("shadow_pass"),
+                cases[0].series.med("shadow_pass") / cases[1].series.med("shadow_pass"),
+                cases[0].series.med("cpu_shadow_pass"), cases[1].series.med("cpu_shadow_pass"),
+                cases[0].series.med("cpu_shadow_pass") / cases[1].series.med("cpu_shadow_pass"),
+                cases[0].series.med("cpu_per_frame") / cases[1].series.med("cpu_per_frame"));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -354,6 +487,15 @@ int main(int argc, char** argv) {
         return rc == 0 ? 0 : 1;
     }
     std::printf("raster_bench: LP_NUM_THREADS=%s repeats=%d\n", std::getenv("LP_NUM_THREADS"), repeats);
+    if (const char* t = std::getenv("SHADOWLAB_BENCH_TRANSMIT"); t && std::string(t) == "1") {
+        try {
+            benchTransmittance(repeats);
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "transmittance failed: %s\n", e.what());
+            return 1;
+        }
+        return 0;
+    }
     if (const char* f = std::getenv("SHADOWLAB_BENCH_FILTERS"); f && std::string(f) == "1") {
         try {
             if (wantScene("seed")) benchFilters("seed", scene::findScene("seed"), repeats);
@@ -364,6 +506,12 @@ int main(int argc, char** argv) {
         }
         return 0;
     }
+    // The Vulkan loader and lavapipe (with LLVM) are loaded and relocated once per process, by the
+    // first instance: here, so that neither renderer's cold first frame pays it (the first one
+    // measured would otherwise carry 80-150 ms that the other does not).
+    const auto loadStart = Clock::now();
+    raster::enumerateDevices(false);
+    std::printf("driver loaded in %.1f ms (before any timing)\n", msSince(loadStart));
     std::vector<fs::path> caches;
     int rc = 0;
     if (wantScene("seed")) try {

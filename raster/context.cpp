@@ -384,11 +384,29 @@ Context::Context(const ContextOptions& options) {
         .pNext = &features13,
     };
     features.features.independentBlend = independentBlend ? VK_TRUE : VK_FALSE;
+    std::uint32_t extensionCount = 0;
+    VK_CHECK(vkEnumerateDeviceExtensionProperties(physicalDevice, nullptr, &extensionCount, nullptr));
+    std::vector<VkExtensionProperties> available(extensionCount);
+    VK_CHECK(vkEnumerateDeviceExtensionProperties(physicalDevice, nullptr, &extensionCount, available.data()));
+    std::vector<const char*> extensions;
+    for (const VkExtensionProperties& e : available)
+        if (std::strcmp(e.extensionName, VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME) == 0 &&
+            vkGetMemoryHostPointerPropertiesEXT) {
+            VkPhysicalDeviceExternalMemoryHostPropertiesEXT host{
+                .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_EXTERNAL_MEMORY_HOST_PROPERTIES_EXT};
+            VkPhysicalDeviceProperties2 props{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, .pNext = &host};
+            vkGetPhysicalDeviceProperties2(physicalDevice, &props);
+            hostPointerImport = host.minImportedHostPointerAlignment > 0;
+            minImportedHostPointerAlignment = host.minImportedHostPointerAlignment;
+            if (hostPointerImport) extensions.push_back(VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME);
+        }
     const VkDeviceCreateInfo deviceInfo{
         .sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO,
         .pNext = &features,
         .queueCreateInfoCount = 1,
         .pQueueCreateInfos = &queueInfo,
+        .enabledExtensionCount = std::uint32_t(extensions.size()),
+        .ppEnabledExtensionNames = extensions.data(),
     };
     VkDevice d = VK_NULL_HANDLE;
     VK_CHECK(vkCreateDevice(physicalDevice, &deviceInfo, nullptr, &d));

@@ -45,6 +45,10 @@ struct Context {
     VkPhysicalDeviceProperties properties{};
     VkPhysicalDeviceMemoryProperties memoryProperties{};
     bool independentBlend = false;  // enabled when supported (the transmittance pass needs it)
+    // VK_EXT_external_memory_host, enabled when supported (lavapipe): images over host memory the
+    // program owns, so the lit pass renders straight into a Frame's vectors (raster/lit_pass.h).
+    bool hostPointerImport = false;
+    VkDeviceSize minImportedHostPointerAlignment = 0;
     std::uint32_t queueFamily = 0;
     LogicalDeviceHandle device;
     VkQueue queue = VK_NULL_HANDLE;

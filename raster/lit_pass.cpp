@@ -16,9 +16,28 @@ bool usesVertexLightCoordinates(const LitVariant& variant) {
            variant.lightKinds == (1u << SHADOWLAB_LIGHT_SPOT);
 }
 
-LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkDescriptorSetLayout alphaSetLayout) {
-    requireFormat(ctx, kLitColorFormat,
-                  VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_TRANSFER_SRC_BIT, "the lit pass targets");
+namespace {
+
+// lit.frag's SPIR-V for the variant: its outputs (beauty only, the AOVs, the per-light targets),
+// the camera's alpha test, and for none and pcf2x2 the *_taps build without the other filters' code
+// (lavapipe turns all of a module into NIR before the specialization constants remove what a
+// pipeline does not run: the full module doubled the lit pipeline's creation).
+std::span<const std::uint32_t> litFragment(const LitVariant& v, bool alpha) {
+    const bool taps = v.filter == scene::ShadowFilter::None || v.filter == scene::ShadowFilter::Pcf2x2;
+    if (!v.aovTarget)
+        return taps ? (alpha ? shaders::litFragBeautyAlphaTapsSpirv() : shaders::litFragBeautyTapsSpirv())
+                    : (alpha ? shaders::litFragBeautyAlphaSpirv() : shaders::litFragBeautySpirv());
+    if (v.lightTargets > 0)
+        return taps ? (alpha ? shaders::litFragLightsAlphaTapsSpirv() : shaders::litFragLightsTapsSpirv())
+                    : (alpha ? shaders::litFragLightsAlphaSpirv() : shaders::litFragLightsSpirv());
+    return taps ? (alpha ? shaders::litFragAlphaTapsSpirv() : shaders::litFragTapsSpirv())
+                : (alpha ? shaders::litFragAlphaSpirv() : shaders::litFragSpirv());
+}
+
+}  // namespace
+
+LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkDescriptorSetLayout alphaSetLayout,
+                              const glm::vec3& background) {
     requireFormat(ctx, kLitDepthFormat, VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT, "the camera depth buffer");
     VkDevice device = ctx.device.get();
     const VkDescriptorSetLayoutBinding bindings[] = {
@@ -47,10 +66,13 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkD
         // The filterable maps' blurred moments (raster/moment_maps.h), linearly filtered.
         {.binding = 9, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
+        // Each layer's transmittance window (shaders::TransmitWindows).
+        {.binding = 10, .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .descriptorCount = 1,
+         .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
     };
     const VkDescriptorSetLayoutCreateInfo setInfo{
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
-        .bindingCount = 10,
+        .bindingCount = 11,
         .pBindings = bindings,
     };
     LitPipeline p;
@@ -88,19 +110,15 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkD
     for (std::uint32_t i = 0; i < kConstants; ++i) entries[i] = {i, 4 * i, 4};
     const VkSpecializationInfo specialization{
         .mapEntryCount = kConstants, .pMapEntries = entries, .dataSize = sizeof constants, .pData = constants};
-    std::vector<VkFormat> colorFormats{variant.displayTarget ? kLitDisplayFormat : kLitColorFormat};
-    if (variant.aovTarget) colorFormats.insert(colorFormats.end(), 1 + variant.lightTargets, kLitColorFormat);
+    std::vector<VkFormat> colorFormats{variant.displayTarget ? kLitDisplayFormat : variant.beautyFormat};
+    if (variant.aovTarget) {
+        colorFormats.insert(colorFormats.end(), kLitPlanes - 1, kLitPlaneFormat);
+        colorFormats.insert(colorFormats.end(), variant.lightTargets, kLitLightsFormat);
+    }
     p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{
                                                  .vertexShader = p.alpha ? shaders::litVertAlphaSpirv()
                                                                          : shaders::litVertSpirv(),
-                                                 .fragmentShader =
-                                                     !variant.aovTarget
-                                                         ? (p.alpha ? shaders::litFragBeautyAlphaSpirv()
-                                                                    : shaders::litFragBeautySpirv())
-                                                     : variant.lightTargets > 0
-                                                         ? (p.alpha ? shaders::litFragLightsAlphaSpirv()
-                                                                    : shaders::litFragLightsSpirv())
-                                                         : (p.alpha ? shaders::litFragAlphaSpirv() : shaders::litFragSpirv()),
+                                                 .fragmentShader = litFragment(variant, p.alpha),
                                                  .fragmentSpecialization = &specialization,
                                                  .vertexSpecialization = &specialization,
                                                  .layout = layout,
@@ -110,7 +128,38 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkD
                                                  // Reversed Z: nearer is larger.
                                                  .depthCompare = VK_COMPARE_OP_GREATER,
                                              });
+    if (!variant.displayTarget) {
+        // The background: where the depth is still the cleared far plane (0), which no fragment
+        // of the scene can leave there (GREATER than 0 to be drawn). Its color as specialization
+        // constants (the bits of the floats the clear used).
+        const VkPipelineLayoutCreateInfo emptyLayout{.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+        VkPipelineLayout backgroundLayout = VK_NULL_HANDLE;
+        VK_CHECK(vkCreatePipelineLayout(device, &emptyLayout, nullptr, &backgroundLayout));
+        p.backgroundLayout = PipelineLayoutHandle(device, backgroundLayout);
+        const float color[3] = {background.r, background.g, background.b};
+        const VkSpecializationMapEntry colorEntries[3] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}};
+        const VkSpecializationInfo colorInfo{
+            .mapEntryCount = 3, .pMapEntries = colorEntries, .dataSize = sizeof color, .pData = color};
+        p.background = createGraphicsPipeline(ctx, PipelineDesc{
+                                                       .vertexShader = shaders::backgroundVertSpirv(),
+                                                       .fragmentShader = !variant.aovTarget ? shaders::backgroundFragBeautySpirv()
+                                                                         : variant.lightTargets > 0
+                                                                             ? shaders::backgroundFragLightsSpirv()
+                                                                             : shaders::backgroundFragSpirv(),
+                                                       .fragmentSpecialization = &colorInfo,
+                                                       .layout = backgroundLayout,
+                                                       .vertexBuffer = false,
+                                                       .colorFormats = colorFormats,
+                                                       .depthFormat = kLitDepthFormat,
+                                                       .depthCompare = VK_COMPARE_OP_EQUAL,
+                                                       .depthWrite = false,
+                                                   });
+    }
     return p;
+}
+
+std::size_t litPlaneTexelBytes(const LitTargets& targets, LitPlane plane) {
+    return plane == LitPlane::kBeauty ? targets.beautyTexelBytes : 4;
 }
 
 LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32_t height,
@@ -120,35 +169,60 @@ LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32
         throw RasterError("image " + std::to_string(width) + "x" + std::to_string(height) +
                           " exceeds the device's limit of " + std::to_string(limit) + " per side (" +
                           ctx.deviceReport.name + ")");
-    // Two (plus lightTargets) RGBA32F targets, D32 depth, as many RGBA32F readback buffers, and
-    // the RGBA8 display target.
-    requireDeviceMemory(ctx, VkDeviceSize(width) * height * ((2 + lightTargets) * 16 * 2 + 4 + 4),
-                        "a " + std::to_string(width) + "x" + std::to_string(height) + " image");
+    // A target per channel, and two for eight lights' visibility: 6 + 2 attachments.
+    const std::uint32_t attachments = kLitPlanes + lightTargets;
+    if (ctx.properties.limits.maxColorAttachments < attachments)
+        throw RasterError("the lit pass renders into " + std::to_string(attachments) + " color targets (one per Frame " +
+                          "channel" + (lightTargets ? ", and the per-light visibility" : "") + "), and " +
+                          ctx.deviceReport.name + " allows " +
+                          std::to_string(ctx.properties.limits.maxColorAttachments) + "; choose another device with --device");
     LitTargets t;
     t.width = width;
     t.height = height;
-    const VkImageUsageFlags colorUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-    t.hostReadable = readInPlace && canReadImagesOnHost(ctx, kLitColorFormat, colorUsage);
-    t.beauty = createImage(ctx, kLitColorFormat, width, height, 1, colorUsage, VK_IMAGE_ASPECT_COLOR_BIT,
-                           VK_IMAGE_VIEW_TYPE_2D, t.hostReadable);
-    t.aovs = createImage(ctx, kLitColorFormat, width, height, 1, colorUsage, VK_IMAGE_ASPECT_COLOR_BIT,
-                         VK_IMAGE_VIEW_TYPE_2D, t.hostReadable);
+    // The beauty as three floats where the device renders RGB32F (lavapipe), else four.
+    VkFormatProperties rgb{};
+    vkGetPhysicalDeviceFormatProperties(ctx.physicalDevice, kLitBeautyFormat, &rgb);
+    const VkFormatFeatureFlags needed = VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_TRANSFER_SRC_BIT;
+    t.hostReadable = readInPlace && canReadImagesOnHost(ctx, kLitPlaneFormat, kLitTargetUsage) &&
+                     canReadImagesOnHost(ctx, kLitLightsFormat, kLitTargetUsage);
+    const bool rgbTarget = ((t.hostReadable ? rgb.linearTilingFeatures : rgb.optimalTilingFeatures) & needed) == needed;
+    t.beautyFormat = rgbTarget ? kLitBeautyFormat : kLitBeautyFallbackFormat;
+    t.beautyTexelBytes = rgbTarget ? 12 : 16;
+    requireFormat(ctx, t.beautyFormat, needed, "the lit pass's beauty target");
+    requireFormat(ctx, kLitPlaneFormat, needed, "the lit pass's AOV targets");
+    requireFormat(ctx, kLitLightsFormat, needed, "the lit pass's per-light visibility targets");
+    requireFormat(ctx, kLitDepthFormat, VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT, "the camera depth buffer");
+    // The planes (the beauty and five floats), the light targets, D32 depth, as many readback
+    // buffers, and the RGBA8 display target.
+    requireDeviceMemory(ctx,
+                        VkDeviceSize(width) * height * ((t.beautyTexelBytes + 20 + lightTargets * 16) * 2 + 4 + 4),
+                        "a " + std::to_string(width) + "x" + std::to_string(height) + " image");
+    for (std::uint32_t p = 0; p < kLitPlanes; ++p) {
+        const VkFormat format = p == 0 ? t.beautyFormat : kLitPlaneFormat;
+        t.planes[p] = createImage(ctx, format, width, height, 1, kLitTargetUsage, VK_IMAGE_ASPECT_COLOR_BIT,
+                                  VK_IMAGE_VIEW_TYPE_2D, t.hostReadable);
+        // Rendering into a Frame's memory needs the Frame's layout: the host-readable path, RGB
+        // beauty, rows without padding.
+        if (t.hostReadable && (p > 0 || rgbTarget))
+            t.frameImageBytes[p] = hostImageBytes(ctx, format, width, height, kLitTargetUsage,
+                                                  litPlaneTexelBytes(t, LitPlane(p)));
+    }
     t.depth = createImage(ctx, kLitDepthFormat, width, height, 1, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
                           VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_VIEW_TYPE_2D);
     for (std::uint32_t i = 0; i < lightTargets; ++i)
-        t.lights.push_back(createImage(ctx, kLitColorFormat, width, height, 1, colorUsage, VK_IMAGE_ASPECT_COLOR_BIT,
-                                       VK_IMAGE_VIEW_TYPE_2D, t.hostReadable));
-    // (lavapipe allocates host memory on first touch, so a display target never rendered costs
-    // address space only.)
-    if (t.hostReadable && canReadImagesOnHost(ctx, kLitDisplayFormat, colorUsage))
-        t.display = createImage(ctx, kLitDisplayFormat, width, height, 1, colorUsage, VK_IMAGE_ASPECT_COLOR_BIT,
+        t.lights.push_back(createImage(ctx, kLitLightsFormat, width, height, 1, kLitTargetUsage,
+                                       VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D, t.hostReadable));
+    // (lavapipe allocates host memory on first touch, so a target never rendered costs address
+    // space only.)
+    if (t.hostReadable && canReadImagesOnHost(ctx, kLitDisplayFormat, kLitTargetUsage))
+        t.display = createImage(ctx, kLitDisplayFormat, width, height, 1, kLitTargetUsage, VK_IMAGE_ASPECT_COLOR_BIT,
                                 VK_IMAGE_VIEW_TYPE_2D, true);
     return t;
 }
 
 LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, const shaders::LitUniforms& uniforms,
-                              const std::vector<glm::vec4>& albedos, const ShadowMaps& maps,
-                              const TransmittanceMaps& transmittance, const MomentMaps& moments) {
+                              const shaders::TransmitWindows& windows, const std::vector<glm::vec4>& albedos,
+                              const ShadowMaps& maps, const TransmittanceMaps& transmittance, const MomentMaps& moments) {
     VkDevice device = ctx.device.get();
     LitBindings b;
     // A depth-compare sampler: result = (ref <= stored), i.e. "receiver depth - bias <= stored
@@ -199,10 +273,11 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
     VK_CHECK(vkCreateSampler(device, &momentSamplerInfo, nullptr, &momentSampler));
     b.momentSampler = SamplerHandle(device, momentSampler);
     b.uniforms = uploadBuffer(ctx, &uniforms, sizeof uniforms, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+    b.transmitWindows = uploadBuffer(ctx, &windows, sizeof windows, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
     b.albedos = uploadBuffer(ctx, albedos, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
 
     const VkDescriptorPoolSize sizes[] = {
-        {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
+        {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2},
         {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1},
         {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 8},
     };
@@ -226,6 +301,7 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
 
     const VkDescriptorBufferInfo uniformInfo{b.uniforms.buffer.get(), 0, VK_WHOLE_SIZE};
     const VkDescriptorBufferInfo albedoInfo{b.albedos.buffer.get(), 0, VK_WHOLE_SIZE};
+    const VkDescriptorBufferInfo windowInfo{b.transmitWindows.buffer.get(), 0, VK_WHOLE_SIZE};
     const VkDescriptorImageInfo imageInfo{sampler, maps.depth.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkDescriptorImageInfo idInfo{idSampler, maps.ids.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkDescriptorImageInfo depthInfo{depthSampler, maps.depth.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
@@ -261,36 +337,35 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
          .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &secondInfo},
         {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 9, .descriptorCount = 1,
          .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &momentInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 10, .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .pBufferInfo = &windowInfo},
     };
-    vkUpdateDescriptorSets(device, 10, writes, 0, nullptr);
+    vkUpdateDescriptorSets(device, 11, writes, 0, nullptr);
     return b;
 }
 
 void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const LitBindings& bindings,
-                   const LitTargets& targets, const DrawGeometry& geometry, const glm::vec3& background,
-                   LitOutputs outputs) {
+                   const LitTargets& targets, const LitAttachments& attachments, const DrawGeometry& geometry,
+                   const glm::vec3& background, LitOutputs outputs, const LitPipeline* alphaPipeline) {
     const VkPipelineStageFlags2 colorStage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
     const VkPipelineStageFlags2 depthStages =
         VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
-    const Image* beautyImage = outputs == LitOutputs::kDisplay ? &targets.display : &targets.beauty;
-    std::vector<const Image*> colorImages{beautyImage};
-    if (outputs == LitOutputs::kAll) {
-        colorImages.push_back(&targets.aovs);
-        for (const Image& l : targets.lights) colorImages.push_back(&l);
-    }
-    // The previous frame's copy read them: the barrier orders this frame's writes after it.
+    // The float targets are not cleared: the background pipeline writes every pixel the scene
+    // leaves uncovered (their old contents are discarded). The display target is cleared.
+    const bool clear = outputs == LitOutputs::kDisplay || !pipeline.background;
+    // The previous frame's copy or host read read them: the barrier orders this frame's writes after it.
     std::vector<ImageTransition> before;
     std::vector<VkRenderingAttachmentInfo> colors;
-    for (const Image* image : colorImages) {
-        before.push_back({image->image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+    for (std::size_t i = 0; i < attachments.images.size(); ++i) {
+        before.push_back({attachments.images[i], VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
                           VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                           targets.hostReadable ? VK_PIPELINE_STAGE_2_HOST_BIT : VK_PIPELINE_STAGE_2_COPY_BIT,
                           VK_ACCESS_2_NONE, colorStage, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT});
-        const bool isBeauty = image == beautyImage;  // (the sRGB target encodes the linear clear color)
+        const bool isBeauty = i == 0;  // (the sRGB target encodes the linear clear color)
         colors.push_back({.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
-                          .imageView = image->view.get(),
+                          .imageView = attachments.views[i],
                           .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                          .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+                          .loadOp = clear ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_DONT_CARE,
                           .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
                           .clearValue = {.color = {.float32 = {isBeauty ? background.r : 0.0f,
                                                                isBeauty ? background.g : 0.0f,
@@ -318,45 +393,59 @@ void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const 
         .pDepthAttachment = &depth,
     };
     vkCmdBeginRendering(commands, &rendering);
+    setViewport(commands, targets.width, targets.height);
     if (geometry.indexCount > 0) {
-        vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.pipeline.get());
-        setViewport(commands, targets.width, targets.height);
-        vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.layout.get(), 0, 1,
-                                &bindings.set, 0, nullptr);
         const VkDeviceSize offset = 0;
         vkCmdBindVertexBuffers(commands, 0, 1, &geometry.vertices, &offset);
-        if (pipeline.alpha) {
-            vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.layout.get(), 1, 1,
-                                    &geometry.alphaSet, 0, nullptr);
-            vkCmdBindVertexBuffers(commands, 1, 1, &geometry.uvs, &offset);
-        }
+        if (geometry.uvs != VK_NULL_HANDLE) vkCmdBindVertexBuffers(commands, 1, 1, &geometry.uvs, &offset);
         vkCmdBindIndexBuffer(commands, geometry.indices, 0, VK_INDEX_TYPE_UINT32);
-        vkCmdDrawIndexed(commands, geometry.indexCount, 1, 0, 0, 0);
+        const LitPipeline* bound = nullptr;
+        auto use = [&](const LitPipeline& p) {
+            if (bound == &p) return;
+            bound = &p;
+            vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, p.pipeline.get());
+            vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, p.layout.get(), 0, 1, &bindings.set, 0,
+                                    nullptr);
+            if (p.alpha)
+                vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, p.layout.get(), 1, 1,
+                                        &geometry.alphaSet, 0, nullptr);
+        };
+        if (geometry.litRanges.empty()) {
+            use(pipeline);
+            vkCmdDrawIndexed(commands, geometry.indexCount, 1, 0, 0, 0);
+        }
+        for (const IndexRange& r : geometry.litRanges) {
+            if (r.count == 0) continue;
+            use(r.alpha && alphaPipeline ? *alphaPipeline : pipeline);
+            vkCmdDrawIndexed(commands, r.count, 1, r.first, 0, 0);
+        }
+    }
+    if (!clear) {
+        vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.background.get());
+        vkCmdDraw(commands, 3, 1, 0, 0);
     }
     vkCmdEndRendering(commands);
     std::vector<ImageTransition> after;
-    for (const Image* image : colorImages)
+    for (VkImage image : attachments.images)
         // Host access to a linear image needs GENERAL (Vulkan spec); the display target is
         // host-readable whenever it exists.
         if (targets.hostReadable)
-            after.push_back({image->image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1,
-                             VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL, colorStage,
-                             VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
-                             VK_ACCESS_2_HOST_READ_BIT});
+            after.push_back({image, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                             VK_IMAGE_LAYOUT_GENERAL, colorStage, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                             VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT});
         else
-            after.push_back({image->image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1,
-                             VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                             colorStage, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
-                             VK_ACCESS_2_TRANSFER_READ_BIT});
+            after.push_back({image, VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                             VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, colorStage, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                             VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT});
     transition(commands, after);
 }
 
 Readback createReadback(const Context& ctx, const LitTargets& targets) {
-    const VkDeviceSize bytes = VkDeviceSize(targets.width) * targets.height * 4 * sizeof(float);
+    const VkDeviceSize pixels = VkDeviceSize(targets.width) * targets.height;
     Readback r;
-    r.beauty = createReadbackBuffer(ctx, bytes);
-    r.aovs = createReadbackBuffer(ctx, bytes);
-    for (std::size_t i = 0; i < targets.lights.size(); ++i) r.lights.push_back(createReadbackBuffer(ctx, bytes));
+    for (std::uint32_t p = 0; p < kLitPlanes; ++p)
+        r.planes[p] = createReadbackBuffer(ctx, pixels * litPlaneTexelBytes(targets, LitPlane(p)));
+    for (std::size_t i = 0; i < targets.lights.size(); ++i) r.lights.push_back(createReadbackBuffer(ctx, pixels * 16));
     return r;
 }
 
@@ -367,12 +456,10 @@ void recordReadback(VkCommandBuffer commands, const LitTargets& targets, const R
                              .layerCount = 1},
         .imageExtent = {targets.width, targets.height, 1},
     };
-    if (selection.beauty)
-        vkCmdCopyImageToBuffer(commands, targets.beauty.image.get(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                               readback.beauty.buffer.get(), 1, &region);
-    if (selection.aovs)
-        vkCmdCopyImageToBuffer(commands, targets.aovs.image.get(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                               readback.aovs.buffer.get(), 1, &region);
+    for (std::uint32_t p = 0; p < kLitPlanes; ++p)
+        if (selection.planes[p])
+            vkCmdCopyImageToBuffer(commands, targets.planes[p].image.get(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                   readback.planes[p].buffer.get(), 1, &region);
     if (selection.lights)
         for (std::size_t i = 0; i < targets.lights.size(); ++i)
             vkCmdCopyImageToBuffer(commands, targets.lights[i].image.get(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,

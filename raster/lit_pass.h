@@ -1,7 +1,8 @@
 // raster/lit_pass.h: the camera pass: reversed-Z depth, shading with the shadow-map test per
-// light (shaders/lit.frag), and the Frame's AOVs in two RGBA32F targets, then the readback.
+// light (shaders/lit.frag), and the Frame's channels in one color target each, then the readback.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -14,10 +15,20 @@
 
 namespace shadowlab::raster {
 
-inline constexpr VkFormat kLitColorFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+// The lit pass's float color targets, in attachment order: one per Frame channel, each in the
+// Frame's own layout (three floats of beauty, one float of each AOV per pixel). So on lavapipe the
+// pass renders straight into a Frame's vectors (importHostImage, no readback at all), and
+// elsewhere a readback is a copy of rows. The beauty-only variants attach the beauty alone.
+enum class LitPlane : std::uint32_t { kBeauty, kVisibility, kObjectId, kNdotL, kDepth, kBlockerId };
+inline constexpr std::uint32_t kLitPlanes = 6;
+inline constexpr VkFormat kLitBeautyFormat = VK_FORMAT_R32G32B32_SFLOAT;
+// Devices that cannot render into RGB32F (most GPUs) get RGBA32F, whose RGB the readback copies.
+inline constexpr VkFormat kLitBeautyFallbackFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+inline constexpr VkFormat kLitPlaneFormat = VK_FORMAT_R32_SFLOAT;  // visibility, object id, N·L, Z, blocker id
+inline constexpr VkFormat kLitLightsFormat = VK_FORMAT_R32G32B32A32_SFLOAT;  // four lights' visibility
 inline constexpr VkFormat kLitDepthFormat = VK_FORMAT_D32_SFLOAT;
 // The beauty of frames that are only written as an 8-bit PNG (scene::kBeautyForDisplay): the
-// device encodes sRGB on store, 4 bytes a pixel instead of 16 (docs/raster.md "Display target").
+// device encodes sRGB on store, 4 bytes a pixel instead of 12 (docs/raster.md "Display target").
 inline constexpr VkFormat kLitDisplayFormat = VK_FORMAT_R8G8B8A8_SRGB;
 
 // What is fixed when the lit pipeline is created (lit.frag's specialization constants and
@@ -29,6 +40,7 @@ struct LitVariant {
     bool aovTarget = true;          // false: the beauty target only (no AOVs, no per-light targets)
     bool displayTarget = false;     // the beauty target is kLitDisplayFormat (implies !aovTarget)
     bool normalOffset = true;       // a normal offset is set (false: its code is left out)
+    VkFormat beautyFormat = kLitBeautyFormat;  // the float beauty target's (LitTargets::beautyFormat)
     std::uint32_t lightTargets = 0;  // 0, or kLightTargets: per-light visibility targets
     std::uint32_t lightCount = 1;    // = LitUniforms::lightCount
     std::uint32_t lightKinds = 7;    // bit (1 << SHADOWLAB_LIGHT_*) for each kind in the scene
@@ -57,15 +69,28 @@ struct LitPipeline {
     // The SHADOWLAB_ALPHA shaders (the camera's alpha test): UVs at vertex binding 1,
     // DrawGeometry::alphaSet bound at set 1.
     bool alpha = false;
+    // The float variants' background (shaders/background.frag): after the scene, a triangle over
+    // the image at the far plane, depth test EQUAL, writes the background into the pixels nothing
+    // covered, so the float targets need no clear (lavapipe clears texels wider than 4 bytes one
+    // memcpy at a time). The display variant clears its 4-byte target instead (null here).
+    PipelineLayoutHandle backgroundLayout;
+    PipelineHandle background;
 };
 // alphaSetLayout (raster/alpha_casters.h; VK_NULL_HANDLE: none): scenes with MASK or BLEND
 // materials, whose texels the camera looks through as camera rays do (docs/raster.md).
+// background: the scene's background color (linear), for the background pipeline.
 LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant = {},
-                              VkDescriptorSetLayout alphaSetLayout = VK_NULL_HANDLE);
+                              VkDescriptorSetLayout alphaSetLayout = VK_NULL_HANDLE,
+                              const glm::vec3& background = glm::vec3(0.0f));
 
 struct LitTargets {
-    Image beauty;  // rgb: linear color, a: visibility
-    Image aovs;    // x: object id, y: N·L, z: view depth, w: blocker id
+    // The Renderer's own targets for each plane (LitPlane order): rendered into when a frame
+    // does not ask for that channel, or cannot render it into the Frame's memory.
+    std::array<Image, kLitPlanes> planes;
+    VkFormat beautyFormat = kLitBeautyFormat;  // or kLitBeautyFallbackFormat
+    std::size_t beautyTexelBytes = 12;         // 12 or 16
+    // Per plane, hostImageBytes() for an image over a Frame's vector (0: not possible here).
+    std::array<std::size_t, kLitPlanes> frameImageBytes{};
     Image depth;   // reversed Z (cleared to 0 = far)
     // With lightTargets: light i's visibility in component i % 4 of lights[i / 4].
     std::vector<Image> lights;
@@ -82,6 +107,10 @@ struct LitTargets {
 // readInPlace: make the color targets host-readable where the device allows it.
 LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32_t height,
                             std::uint32_t lightTargets = 0, bool readInPlace = true);
+// The usage of every float color target (the Renderer's and those over a Frame).
+inline constexpr VkImageUsageFlags kLitTargetUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+// Bytes a texel of `plane` (the beauty: targets.beautyTexelBytes).
+std::size_t litPlaneTexelBytes(const LitTargets& targets, LitPlane plane);
 
 // The lit pass's descriptor set: uniforms, per-object albedo, shadow maps behind a NEAREST
 // depth-compare sampler (lit.frag builds the filters from its taps), blocker ids, and the
@@ -92,37 +121,50 @@ struct LitBindings {
     SamplerHandle depthSampler;  // plain NEAREST, the maps' raw depths (PCSS blocker search)
     SamplerHandle momentSampler;  // LINEAR, clamp to edge: the filterable maps' moments
     Buffer uniforms;
+    Buffer transmitWindows;  // shaders::TransmitWindows
     Buffer albedos;
     DescriptorPoolHandle pool;
     VkDescriptorSet set = VK_NULL_HANDLE;  // freed with the pool
 };
 LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, const shaders::LitUniforms& uniforms,
-                              const std::vector<glm::vec4>& albedos, const ShadowMaps& maps,
-                              const TransmittanceMaps& transmittance, const MomentMaps& moments);
+                              const shaders::TransmitWindows& windows, const std::vector<glm::vec4>& albedos,
+                              const ShadowMaps& maps, const TransmittanceMaps& transmittance, const MomentMaps& moments);
 
-// Records the pass; background pixels keep `background` (rgb, visibility 0) and zero AOVs.
-// Leaves every color target in TRANSFER_SRC_OPTIMAL for recordReadback(), or, for host-readable
-// targets, in GENERAL and visible to host reads once the submission has finished.
 // Which targets a frame renders into, as its pipeline was made: every target, the float beauty
 // only (a pipeline without aovTarget), or the 8-bit display beauty only (displayTarget).
 enum class LitOutputs { kAll, kBeauty, kDisplay };
+// One frame's color attachments in the pipeline's order (the planes, then the light targets; or
+// the display target): each an image and its view, the targets' own or one over the Frame.
+struct LitAttachments {
+    std::vector<VkImage> images;
+    std::vector<VkImageView> views;
+    void add(const Image& image) {
+        images.push_back(image.image.get());
+        views.push_back(image.view.get());
+    }
+};
+// Records the pass; background pixels get `background` (rgb, visibility 0) and zero AOVs, from
+// the background pipeline (float targets) or a clear (the display target). Leaves every color
+// attachment in TRANSFER_SRC_OPTIMAL for recordReadback(), or, for host-readable targets, in
+// GENERAL and visible to host reads once the submission has finished.
+// alphaPipeline: the SHADOWLAB_ALPHA variant of `pipeline` for DrawGeometry::litRanges with
+// IndexRange::alpha (null: `pipeline` draws them).
 void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const LitBindings& bindings,
-                   const LitTargets& targets, const DrawGeometry& geometry, const glm::vec3& background,
-                   LitOutputs outputs = LitOutputs::kAll);
+                   const LitTargets& targets, const LitAttachments& attachments, const DrawGeometry& geometry,
+                   const glm::vec3& background, LitOutputs outputs = LitOutputs::kAll,
+                   const LitPipeline* alphaPipeline = nullptr);
 
 struct Readback {
-    Buffer beauty;
-    Buffer aovs;
+    std::array<Buffer, kLitPlanes> planes;
     std::vector<Buffer> lights;  // one per LitTargets::lights
 };
 Readback createReadback(const Context& ctx, const LitTargets& targets);
 // Copies the targets that are asked for (the others are left alone, which saves their copy).
 struct ReadbackSelection {
-    bool beauty = true;
-    bool aovs = true;
-    bool lights = true;
+    std::array<bool, kLitPlanes> planes{};
+    bool lights = false;
 };
 void recordReadback(VkCommandBuffer commands, const LitTargets& targets, const Readback& readback,
-                    const ReadbackSelection& selection = {});
+                    const ReadbackSelection& selection);
 
 }  // namespace shadowlab::raster

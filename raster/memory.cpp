@@ -16,9 +16,11 @@ namespace {
 // Measured on lavapipe (Mesa 22.3): a 16x9 raster render of the seed scene peaks 108 MiB above
 // a ray-traced one, nearly all of it the driver and LLVM; the allowance is rounded up.
 constexpr std::uint64_t kDriverAllowance = 160 * scene::kMiB;
-// The lit pass writes two RGBA32F targets (beauty, AOVs), and with more than one light one more
-// for each four lights' visibility, over a D32 depth buffer; devices that cannot read the targets
-// in place copy them into host-visible buffers of the same size (counted, as an upper bound).
+// The lit pass has a target per channel, the RGB32F beauty and five R32F AOV planes (32 bytes a
+// pixel, as two RGBA32F targets), and with more than one light an RGBA32F target for each four
+// lights' visibility, over a D32 depth buffer; devices that cannot read the targets in place copy
+// them into host-visible buffers of the same size (counted, as an upper bound; on lavapipe the
+// planes asked for are rendered into the Frame, and the Renderer's own are then never touched).
 std::uint64_t litBytesPerPixel(std::size_t lights) {
     const std::uint64_t targets = 2 + (lights > 1 ? (lights + 3) / 4 : 0);
     return targets * 16 * 2 + 4;

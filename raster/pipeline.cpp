@@ -54,9 +54,9 @@ PipelineHandle createGraphicsPipeline(const Context& ctx, const PipelineDesc& de
         attributes.push_back({.location = 3, .binding = 1, .format = VK_FORMAT_R32G32_SFLOAT, .offset = 0});
     const VkPipelineVertexInputStateCreateInfo vertexInput{
         .sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
-        .vertexBindingDescriptionCount = desc.usesUv ? 2u : 1u,
+        .vertexBindingDescriptionCount = !desc.vertexBuffer ? 0u : desc.usesUv ? 2u : 1u,
         .pVertexBindingDescriptions = bindings,
-        .vertexAttributeDescriptionCount = std::uint32_t(attributes.size()),
+        .vertexAttributeDescriptionCount = desc.vertexBuffer ? std::uint32_t(attributes.size()) : 0u,
         .pVertexAttributeDescriptions = attributes.data(),
     };
     const VkPipelineInputAssemblyStateCreateInfo inputAssembly{

@@ -23,6 +23,8 @@ struct PipelineDesc {
     // Declare vertex location 3, the texture coordinates (vec2) of vertex binding 1 (alpha-tested
     // casters, raster/alpha_casters.h).
     bool usesUv = false;
+    // false: no vertex buffer at all (a shader that makes its vertices from gl_VertexIndex).
+    bool vertexBuffer = true;
     std::vector<VkFormat> colorFormats;
     VkFormat depthFormat = VK_FORMAT_D32_SFLOAT;
     VkCompareOp depthCompare = VK_COMPARE_OP_LESS;

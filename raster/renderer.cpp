@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <map>
 #include <memory>
 #include <set>
@@ -40,6 +41,14 @@ using Clock = std::chrono::steady_clock;
 
 double msSince(Clock::time_point start) {
     return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// Process CPU time (every thread, lavapipe's included), ms: on a machine shared with other work
+// steadier than the wall clock around a pass.
+double processCpuMs() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
 }
 
 std::string formatNumber(double v) {
@@ -102,6 +111,13 @@ std::vector<TransparentDraw> separateTransparent(const scene::Scene& scene, Scen
         // 1 − opacity (BLEND: 1 − opacity·factor; a textured BLEND's fragments take their own).
         d.transmittance = float(scene.materialOf(scene.objects[o]).transmittance(1.0));
         g.indices.insert(g.indices.end(), perObject[o].begin(), perObject[o].end());
+        d.boundsMin = d.boundsMax = g.vertices[perObject[o][0]].position;
+        for (const std::uint32_t i : perObject[o]) {
+            d.boundsMin = glm::min(d.boundsMin, g.vertices[i].position);
+            d.boundsMax = glm::max(d.boundsMax, g.vertices[i].position);
+        }
+        if (perObject[o].size() / 3 <= kTransmittanceWindowTriangles)
+            for (const std::uint32_t i : perObject[o]) d.triangles.push_back(g.vertices[i].position);
         // Quads are open (one surface: every crossing counts); spheres and boxes closed; a mesh
         // by its edges.
         const scene::Shape& shape = scene.objects[o].shape;
@@ -145,7 +161,13 @@ struct Renderer::Impl {
     Impl(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settingsIn,
          const RendererOptions& options, ValidationLog& log);
     void render(scene::Frame& frame, scene::ChannelMask channels, const ValidationLog& log, RenderDebug* debug);
-    void readPixels(scene::Frame& frame, scene::ChannelMask channels) const;
+    // The Frame's vectors for `channels` sized (the others emptied), and where each plane of the
+    // frame's pipeline is rendered: `frameImages` over the Frame's vectors where possible (their
+    // planes set in `intoFrame`), the Renderer's own targets for the rest.
+    void prepareFrame(scene::Frame& frame, scene::ChannelMask channels, LitOutputs outputs,
+                      LitAttachments& attachments, std::vector<Image>& frameImages,
+                      std::array<bool, kLitPlanes>& intoFrame) const;
+    void readPixels(scene::Frame& frame, scene::ChannelMask channels, const std::array<bool, kLitPlanes>& intoFrame) const;
     void readDisplayPixels(scene::Frame& frame) const;
     void invalidateMemory(VkDeviceMemory memory) const {
         const VkMappedMemoryRange range{.sType = VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE, .memory = memory, .size = VK_WHOLE_SIZE};
@@ -169,6 +191,8 @@ struct Renderer::Impl {
     // lit.frag's blend code is compiled in (specialization constant) and reads it from cascadeBlendBand.
     double cascadeBlendUsed = 0.0;
     bool vertexLightConstants = false;  // LitVariant::vertexLightConstants of every lit pipeline
+    bool renderIntoFrame = true;        // RendererOptions::renderIntoFrame
+    bool transmittanceWindows = true;   // RendererOptions::transmittanceWindows
     double setupMs = 0.0;
     double pendingSetupMs = 0.0;  // setup not yet reported in a frame (the constructor's)
 
@@ -185,8 +209,9 @@ struct Renderer::Impl {
     bool timestamps = false;
     QueryPoolHandle queries;
     // Made on first use. Shadow: without and with blocker ids (index 0, 1). Lit: beauty target
-    // only, all targets without blocker ids, all with, the display target only (index 0..3).
-    ShadowPipeline shadowPipelines[2];
+    // only, all targets without blocker ids, all with, the display target only (index 0..3). The
+    // second index: without the alpha test, with it (DrawObject::depthAlpha, cameraAlpha).
+    ShadowPipeline shadowPipelines[2][2];
     // Semi-transparent casters (RenderPlan::needsTransmittanceMap): the transmittance pass, its
     // maps (1x1x1 placeholders without), and per layer the light it is drawn from.
     bool transmit = false;
@@ -198,8 +223,10 @@ struct Renderer::Impl {
     MomentMaps momentMaps;
     MomentPipeline momentPipeline;
     std::vector<glm::vec4> layerLights;       // per layer, its light (TransmittancePass)
+    std::vector<TexelRect> transmitWindows;   // per layer, its window (TransmittancePass)
+    shaders::TransmitWindows transmitWindowData{};  // the same for lit.frag (LitBindings)
     std::vector<DepthBiasFactors> layerBias;  // per layer, recordShadowPass's input (settings.hardwareBias)
-    LitPipeline litPipelines[4];
+    LitPipeline litPipelines[4][2];
     LitBindings bindings;  // allocated with the first lit pipeline's (identical) set layout
     shaders::LitUniforms uniforms{};
     std::vector<glm::vec4> albedos;
@@ -208,6 +235,16 @@ struct Renderer::Impl {
     scene::Vec3 origin{0.0};  // the first camera's position: the vertex buffer is relative to it
     scene::RenderPlan plan;
     std::vector<std::uint32_t> objectFirstIndex;
+    // The objects in index-buffer order, where each one's triangles are and which passes test its
+    // alpha (the constructor); placeLights() draws the depth pass's ranges from them.
+    struct DrawObject {
+        std::uint32_t object = 0;
+        std::uint32_t first = 0, count = 0;
+        bool depthAlpha = false;   // a MASK caster: the depth pass's alpha-tested pipeline
+        bool cameraAlpha = false;  // MASK or BLEND: the lit pass's alpha-tested pipeline
+        bool depthPass = true;     // drawn by the depth pass (not a semi-transparent caster)
+    };
+    std::vector<DrawObject> drawObjects;
     std::size_t triangles = 0;
     int sphereSegmentsUsed = 0;
     // The view depth of the camera the image is drawn from minus the depth the shaders compute
@@ -222,6 +259,7 @@ struct Renderer::Impl {
     // The rest of the constructor: shadow maps, targets, readback, queries, attributes.
     void createTargets(const scene::Scene& scene, const RendererOptions& options);
     void describeLayers();  // the attributes that follow the frusta
+    void describeTransmitWindows();  // transmittance_windows: each layer's window (x0,y0,x1,y1 or none)
     void update(const scene::Scene& scene, const scene::Camera& view);
 };
 
@@ -231,6 +269,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
       ctx((checkSupported(scene, settingsIn),
            ContextOptions{.device = settingsIn.device, .validate = settingsIn.validate, .log = &log})) {
     const auto setupStart = Clock::now();
+    transmittanceWindows = options.transmittanceWindows;
     origin = scene::cameraBasis(scene.camera).position;  // camera-relative rendering
     width = std::uint32_t(scene.camera.width);
     height = std::uint32_t(scene.camera.height);
@@ -258,6 +297,43 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
         draw.alphaSet = alpha.set;
         shadowAlpha = scene.hasAlphaCasters();
         if (shadowAlpha) attributes["alpha_casters"] = "alpha-tested in the depth pass";  // only where there are some
+    }
+    // Each object's triangles in the index buffer (reordered with a transmittance map: the opaque
+    // objects' first, in object order, then each semi-transparent one's) and the objects in that
+    // order; which pass tests its alpha: the depth pass a MASK caster's, the camera MASK and BLEND.
+    drawObjects.clear();
+    const std::size_t objectCount = scene.objects.size();
+    std::uint32_t opaqueCursor = 0;
+    std::size_t nextTransparent = 0;
+    std::vector<DrawObject> transparentObjects;
+    for (std::size_t o = 0; o < objectCount; ++o) {
+        const scene::Material& m = scene.materialOf(scene.objects[o]);
+        DrawObject d{.object = std::uint32_t(o),
+                     .first = objectFirstIndex[o],
+                     .count = objectFirstIndex[o + 1] - objectFirstIndex[o],
+                     .depthAlpha = shadowAlpha && m.alphaMode == scene::AlphaMode::Mask,
+                     .cameraAlpha = m.alphaMode != scene::AlphaMode::Opaque,
+                     .depthPass = true};
+        if (planIn.needsTransmittanceMap && !m.opaque()) {
+            if (d.count == 0) continue;  // (separateTransparent makes no draw for it)
+            d.first = transparentDraws[nextTransparent++].firstIndex;  // (in object order)
+            d.depthPass = false;
+            transparentObjects.push_back(d);
+            continue;
+        }
+        if (planIn.needsTransmittanceMap) {
+            d.first = opaqueCursor;
+            opaqueCursor += d.count;
+        }
+        drawObjects.push_back(d);
+    }
+    drawObjects.insert(drawObjects.end(), transparentObjects.begin(), transparentObjects.end());
+    for (const DrawObject& d : drawObjects) {
+        if (!draw.litRanges.empty() && draw.litRanges.back().alpha == d.cameraAlpha &&
+            draw.litRanges.back().first + draw.litRanges.back().count == d.first)
+            draw.litRanges.back().count += d.count;
+        else
+            draw.litRanges.push_back(IndexRange{d.first, d.count, d.cameraAlpha});
     }
 
     // The automatic choices: a default cascade count follows the view, then a default size follows
@@ -318,19 +394,18 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
         // a: 1 − opacity, divided out of a semi-transparent receiver's own transmittance (lit.frag).
         albedos.emplace_back(glm::vec3(scene.materialOf(o).albedo),
                              scene.materialOf(o).opaque() ? 1.0f : float(scene.materialOf(o).transmittance(1.0)));
-    // Each layer's index ranges: every object, or the culled layer's casters (runs of them merged).
-    // Not with a transmittance map: its index order (opaque casters first) is not per object, so
-    // the depth pass then draws every opaque caster (layerRanges empty).
-    for (std::size_t k = 0; k < layers.size() && !plan.needsTransmittanceMap; ++k) {
-        std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges;
+    // Each layer's index ranges: every object the depth pass draws, or the culled layer's casters,
+    // in index order, runs of them merged where they take the same pipeline.
+    for (std::size_t k = 0; k < layers.size(); ++k) {
+        std::vector<IndexRange> ranges;
         const std::vector<bool>& casters = layers[k].casters;
-        for (std::size_t o = 0; o < scene.objects.size(); ++o) {
-            if (!casters.empty() && !casters[o]) continue;
-            const std::uint32_t firstIndex = objectFirstIndex[o], endIndex = objectFirstIndex[o + 1];
-            if (!ranges.empty() && ranges.back().first + ranges.back().second == firstIndex)
-                ranges.back().second += endIndex - firstIndex;
+        for (const DrawObject& d : drawObjects) {
+            if (!d.depthPass || (!casters.empty() && !casters[d.object])) continue;
+            if (!ranges.empty() && ranges.back().alpha == d.depthAlpha &&
+                ranges.back().first + ranges.back().count == d.first)
+                ranges.back().count += d.count;
             else
-                ranges.emplace_back(firstIndex, endIndex - firstIndex);
+                ranges.push_back(IndexRange{d.first, d.count, d.depthAlpha});
         }
         draw.layerRanges.push_back(std::move(ranges));
     }
@@ -350,6 +425,16 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
 
 void Renderer::Impl::setLayerLights(const scene::Scene& scene) {
     layerLights.clear();
+    transmitWindows.clear();
+    shaders::TransmitWindows& windows = transmitWindowData;
+    windows = shaders::TransmitWindows{};
+    for (std::size_t k = 0; k < layers.size() && transmit; ++k) {
+        const std::uint32_t size = std::uint32_t(settings.shadowMapSize);
+        transmitWindows.push_back(transmittanceWindows ? transmittanceWindow(lightMatrices[k], draw.transparent, size)
+                                                       : TexelRect{0, 0, size, size});
+        const TexelRect& w = transmitWindows.back();
+        windows.rect[k] = glm::vec4(float(w.x0), float(w.y0), float(w.x1), float(w.y1));
+    }
     for (const ShadowLayer& layer : layers) {
         const scene::Light& light = scene.lights[std::size_t(layer.light)];
         layerLights.push_back(light.type == scene::LightType::Directional
@@ -373,11 +458,13 @@ void Renderer::Impl::createTargets(const scene::Scene& scene, const RendererOpti
     transmittanceMaps = createTransmittanceMaps(ctx, transmit ? mapSize : 1, transmit ? arrayLayers : 1);
     setLayerLights(scene);
     attributes["transmittance_map"] = transmit ? "made" : "none";
+    describeTransmitWindows();
     const bool moments = scene::isFilterable(settings.filter) && !layers.empty();
     momentMaps = createMomentMaps(ctx, moments ? mapSize : 1, moments ? arrayLayers : 1);
     if (moments)
         attributes["moment_maps"] = describeMomentCost(settings.filter, mapSize, arrayLayers, settings.moments.blurWidth);
     targets = createLitTargets(ctx, width, height, lightCount > 1 ? kLightTargets : 0, options.readTargetsInPlace);
+    renderIntoFrame = options.renderIntoFrame;
     if (!targets.hostReadable) readback = createReadback(ctx, targets);
     // How the targets reach the Frame: read in place (lavapipe) or copied into buffers first.
     attributes["readback"] = targets.hostReadable ? "in-place" : "copy";
@@ -403,6 +490,15 @@ void Renderer::Impl::createTargets(const scene::Scene& scene, const RendererOpti
     vertexLightConstants = vertexCoordinates && options.lightConstants == LightConstants::kVertexOutputs;
     attributes["light_constants"] = vertexLightConstants ? "vertex-outputs" : "uniform-buffer";
     describeLayers();
+}
+
+void Renderer::Impl::describeTransmitWindows() {
+    if (!transmit) return;
+    attributes["transmittance_windows"] = joined(transmitWindows, [](const TexelRect& w) {
+        return w.empty() ? std::string("none")
+                         : std::to_string(w.x0) + "," + std::to_string(w.y0) + "," + std::to_string(w.x1) + "," +
+                               std::to_string(w.y1);
+    });
 }
 
 void Renderer::Impl::describeLayers() {
@@ -509,14 +605,18 @@ void Renderer::Impl::update(const scene::Scene& scene, const scene::Camera& view
     }
     setLayerLights(scene);
     describeLayers();
-    // The descriptor set's uniform buffer is device-local: refill it through a staging buffer.
+    describeTransmitWindows();
+    // The descriptor set's uniform buffers are device-local: refill them through a staging buffer.
     if (bindings.uniforms.buffer) {
-        Buffer staging = createBuffer(ctx, sizeof uniforms, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+        Buffer staging = createBuffer(ctx, sizeof uniforms + sizeof transmitWindowData, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                       VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
         std::memcpy(staging.mapped, &uniforms, sizeof uniforms);
+        std::memcpy(static_cast<char*>(staging.mapped) + sizeof uniforms, &transmitWindowData, sizeof transmitWindowData);
         VkCommandBuffer commands = ctx.beginCommands();
         const VkBufferCopy region{.size = sizeof uniforms};
         vkCmdCopyBuffer(commands, staging.buffer.get(), bindings.uniforms.buffer.get(), 1, &region);
+        const VkBufferCopy windowRegion{.srcOffset = sizeof uniforms, .size = sizeof transmitWindowData};
+        vkCmdCopyBuffer(commands, staging.buffer.get(), bindings.transmitWindows.buffer.get(), 1, &windowRegion);
         ctx.submitAndWait(commands);  // the fence makes the copy visible to the next submission
     }
     pendingUpdateMs = msSince(updateStart);
@@ -526,49 +626,63 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                             RenderDebug* debug) {
     using namespace scene;
     const bool wantIds = (channels & kChannelBlockerId) != 0;
-    const bool wantAovs = (channels & (kChannelObjectId | kChannelNdotL | kChannelDepth | kChannelBlockerId)) != 0;
-    const bool wantBeauty = (channels & (kChannelBeauty | kChannelVisibility)) != 0;
+    const bool wantAovs =
+        (channels & (kChannelVisibility | kChannelObjectId | kChannelNdotL | kChannelDepth | kChannelBlockerId)) != 0;
     const bool wantLights = (channels & kChannelLightVisibility) != 0 && !targets.lights.empty();
 
     // --- setup still owed: the pipelines this frame needs (shader compilation) ---
-    ShadowPipeline& shadowPipeline = shadowPipelines[wantIds ? 1 : 0];
-    const bool beautyOnly = !wantAovs && !wantLights;  // the beauty target holds visibility too
+    // Which pipelines the objects need: with and without the alpha test.
+    bool depthPlain = false, depthAlpha = false, litPlain = false, litAlpha = false;
+    for (const DrawObject& d : drawObjects) {
+        (d.depthAlpha ? depthAlpha : depthPlain) |= d.depthPass;
+        (d.cameraAlpha ? litAlpha : litPlain) = true;
+    }
+    ShadowPipeline* const shadowPipeline = shadowPipelines[wantIds ? 1 : 0];
+    const bool beautyOnly = !wantAovs && !wantLights;  // the beauty target alone
     // Only the beauty, only for an 8-bit sRGB image: the display target, where there is one.
-    const bool display = beautyOnly && (channels & kBeautyForDisplay) && !(channels & kChannelVisibility) &&
-                         targets.display.image;
+    const bool display = beautyOnly && (channels & kBeautyForDisplay) && targets.display.image;
     const LitOutputs outputs = display ? LitOutputs::kDisplay : beautyOnly ? LitOutputs::kBeauty : LitOutputs::kAll;
-    LitPipeline& litPipeline = litPipelines[display ? 3 : beautyOnly ? 0 : wantIds ? 2 : 1];
+    LitPipeline* const litPipeline = litPipelines[display ? 3 : beautyOnly ? 0 : wantIds ? 2 : 1];
     double setup = pendingSetupMs;  // 0 for a frame that creates nothing
     pendingSetupMs = 0.0;
-    if (!shadowPipeline.pipeline || !litPipeline.pipeline) {
+    // (A scene without objects, or without any drawn by the depth pass, still gets each pass's
+    // pipeline without the alpha test.)
+    const bool needDepthPlain = depthPlain || !depthAlpha, needLitPlain = litPlain || !litAlpha;
+    if ((needDepthPlain && !shadowPipeline[0].pipeline) || (depthAlpha && !shadowPipeline[1].pipeline) ||
+        (needLitPlain && !litPipeline[0].pipeline) || (litAlpha && !litPipeline[1].pipeline)) {
         const auto pipelineStart = Clock::now();
-        // VK_NULL_HANDLE without; the shadow passes only for MASK or textured BLEND casters.
+        for (int a = 0; a < 2; ++a)
+            if ((a ? depthAlpha : needDepthPlain) && !shadowPipeline[a].pipeline)
+                shadowPipeline[a] = createShadowPipeline(ctx, wantIds, settings.hardwareBias,
+                                                         a ? alpha.setLayout.get() : VK_NULL_HANDLE);
+        // The transmittance passes test alpha for every caster when the scene has alpha casters.
         const VkDescriptorSetLayout alphaLayout = shadowAlpha ? alpha.setLayout.get() : VK_NULL_HANDLE;
-        if (!shadowPipeline.pipeline)
-            shadowPipeline = createShadowPipeline(ctx, wantIds, settings.hardwareBias, alphaLayout);
         if (momentMaps.size > 1 && !momentPipeline.pipeline)
             momentPipeline = createMomentPipeline(ctx, maps, momentMaps);
         if (transmit && !transmitPipeline.pipeline) transmitPipeline = createTransmittancePipeline(ctx, alphaLayout);
         if (transmit && !transmitRestPipeline.pipeline)
             transmitRestPipeline = createTransmittanceRestPipeline(ctx, transmittanceMaps, alphaLayout);
-        if (!litPipeline.pipeline)
-            litPipeline = createLitPipeline(ctx, LitVariant{.filter = settings.filter,
-                                                            .blockerIds = wantIds,
-                                                            .aovTarget = !beautyOnly,
-                                                            .displayTarget = display,
-                                                            .normalOffset = settings.normalOffset != 0.0,
-                                                            .lightTargets = std::uint32_t(targets.lights.size()),
-                                                            .lightCount = std::uint32_t(lightCount),
-                                                            .lightKinds = lightKinds,
-                                                            .cascades = std::uint32_t(cascadesUsed),
-                                                            .transmittance = transmit,
-                                                            .receiverPlane = settings.receiverPlaneBias,
-                                                            .cascadeBlend = cascadeBlendUsed > 0.0,
-                                                            .vertexLightConstants = vertexLightConstants,
-                                                            .moments = settings.moments},
-                                          alpha.setLayout.get());
+        for (int a = 0; a < 2; ++a)
+            if ((a ? litAlpha : needLitPlain) && !litPipeline[a].pipeline)
+                litPipeline[a] = createLitPipeline(ctx, LitVariant{.filter = settings.filter,
+                                                                   .blockerIds = wantIds,
+                                                                   .aovTarget = !beautyOnly,
+                                                                   .displayTarget = display,
+                                                                   .normalOffset = settings.normalOffset != 0.0,
+                                                                   .beautyFormat = targets.beautyFormat,
+                                                                   .lightTargets = std::uint32_t(targets.lights.size()),
+                                                                   .lightCount = std::uint32_t(lightCount),
+                                                                   .lightKinds = lightKinds,
+                                                                   .cascades = std::uint32_t(cascadesUsed),
+                                                                   .transmittance = transmit,
+                                                                   .receiverPlane = settings.receiverPlaneBias,
+                                                                   .cascadeBlend = cascadeBlendUsed > 0.0,
+                                                                   .vertexLightConstants = vertexLightConstants,
+                                                                   .moments = settings.moments},
+                                                   a ? alpha.setLayout.get() : VK_NULL_HANDLE, background);
         if (bindings.set == VK_NULL_HANDLE)
-            bindings = createLitBindings(ctx, litPipeline, uniforms, albedos, maps, transmittanceMaps, momentMaps);
+            bindings = createLitBindings(ctx, litPipeline[litPipeline[0].pipeline ? 0 : 1], uniforms,
+                                         transmitWindowData, albedos, maps, transmittanceMaps, momentMaps);
         setup += msSince(pipelineStart);
     }
 
@@ -582,16 +696,19 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
 
     // --- shadow pass ---
     const auto shadowStart = Clock::now();
+    const double shadowCpuStart = processCpuMs();
     VkCommandBuffer commands = ctx.beginCommands();
     if (timestamps) vkCmdResetQueryPool(commands, queries.get(), 0, 4);
     stamp(commands, 0);
     const TransmittancePass transmittancePass{transmit ? &transmitPipeline : nullptr, &transmittanceMaps, layerLights,
-                                              transmit ? &transmitRestPipeline : nullptr};
-    recordShadowPass(commands, shadowPipeline, maps, draw, lightMatrices, wantIds, &transmittancePass, &layerBias);
+                                              transmit ? &transmitRestPipeline : nullptr, transmitWindows};
+    recordShadowPass(commands, shadowPipeline[shadowPipeline[0].pipeline ? 0 : 1], maps, draw, lightMatrices, wantIds,
+                     &transmittancePass, &layerBias, shadowPipeline[1].pipeline ? &shadowPipeline[1] : nullptr);
     if (momentPipeline.pipeline) recordMomentPasses(commands, momentPipeline, maps, momentMaps, layers, settings.filter, settings.moments);
     stamp(commands, 1);
     ctx.submitAndWait(commands);
     frame.timingsMs.emplace_back("shadow_pass", msSince(shadowStart));
+    frame.attributes["cpu_shadow_pass_ms"] = formatNumber(processCpuMs() - shadowCpuStart);
     if (debug) {
         // What each layer holds (fixed by the constructor) and, when asked, its depths (read
         // back outside the pass timings).
@@ -604,39 +721,63 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     }
 
     // --- lit pass ---
+    // The Frame's vectors first (counted as readback: where they are new, their pages are faulted
+    // in and zeroed here), and the images over them.
+    const auto prepareStart = Clock::now();
+    LitAttachments attachments;
+    std::vector<Image> frameImages;  // over the Frame's vectors, released after this frame
+    std::array<bool, kLitPlanes> intoFrame{};
+    prepareFrame(frame, channels, outputs, attachments, frameImages, intoFrame);
+    const double prepareMs = msSince(prepareStart);
     const auto litStart = Clock::now();
+    const double litCpuStart = processCpuMs();
     commands = ctx.beginCommands();
     stamp(commands, 2);
-    recordLitPass(commands, litPipeline, bindings, targets, draw, background, outputs);
+    recordLitPass(commands, litPipeline[litPipeline[0].pipeline ? 0 : 1], bindings, targets, attachments, draw,
+                  background, outputs, litPipeline[1].pipeline ? &litPipeline[1] : nullptr);
     stamp(commands, 3);
     ctx.submitAndWait(commands);
     frame.timingsMs.emplace_back("lit_pass", msSince(litStart));
+    frame.attributes["cpu_lit_pass_ms"] = formatNumber(processCpuMs() - litCpuStart);
 
-    // --- readback of the targets holding what was asked for ---
+    // --- readback of what was asked for and not rendered into the Frame ---
     const auto readStart = Clock::now();
-    if (targets.hostReadable) {
-        // The lit pass's barrier made the writes visible to the host; coherent memory needs no
-        // invalidation, the rest does.
-        for (const Image* image : {&targets.beauty, &targets.aovs}) invalidateMemory(image->memory.get());
-        if (display) invalidateMemory(targets.display.memory.get());
-        for (const Image& image : targets.lights) invalidateMemory(image.memory.get());
-    } else {
-        commands = ctx.beginCommands();
-        recordReadback(commands, targets, readback,
-                       ReadbackSelection{.beauty = wantBeauty, .aovs = wantAovs, .lights = wantLights});
-        ctx.submitAndWait(commands);
-        if (wantBeauty) invalidate(ctx, readback.beauty);
-        if (wantAovs) invalidate(ctx, readback.aovs);
-        if (wantLights)
-            for (const Buffer& b : readback.lights) invalidate(ctx, b);
-    }
     if (display) {
+        invalidateMemory(targets.display.memory.get());
         readDisplayPixels(frame);
         frame.attributes["beauty_precision"] = "srgb8";
     } else {
-        readPixels(frame, channels);
+        std::array<bool, kLitPlanes> copy{};
+        const ChannelMask planeChannels[kLitPlanes] = {kChannelBeauty, kChannelVisibility, kChannelObjectId,
+                                                       kChannelNdotL, kChannelDepth, kChannelBlockerId};
+        for (std::uint32_t p = 0; p < kLitPlanes; ++p)
+            // Z needs the object ids (the background's Z gets no offset) when it is offset.
+            copy[p] = !intoFrame[p] && ((channels & planeChannels[p]) ||
+                                        (p == std::uint32_t(LitPlane::kObjectId) && (channels & kChannelDepth) &&
+                                         viewDepthOffset != 0.0));
+        if (targets.hostReadable) {
+            // The lit pass's barrier made the writes visible to the host; coherent memory needs no
+            // invalidation, the rest does.
+            for (std::uint32_t p = 0; p < kLitPlanes; ++p)
+                if (copy[p]) invalidateMemory(targets.planes[p].memory.get());
+            if (wantLights)
+                for (const Image& image : targets.lights) invalidateMemory(image.memory.get());
+        } else {
+            commands = ctx.beginCommands();
+            recordReadback(commands, targets, readback, ReadbackSelection{.planes = copy, .lights = wantLights});
+            ctx.submitAndWait(commands);
+            for (std::uint32_t p = 0; p < kLitPlanes; ++p)
+                if (copy[p]) invalidate(ctx, readback.planes[p]);
+            if (wantLights)
+                for (const Buffer& b : readback.lights) invalidate(ctx, b);
+        }
+        readPixels(frame, channels, intoFrame);
+        bool allIntoFrame = true;
+        for (std::uint32_t p = 0; p < kLitPlanes; ++p) allIntoFrame = allIntoFrame && (!(channels & planeChannels[p]) || intoFrame[p]);
+        frame.attributes["readback"] = !targets.hostReadable ? "copy" : allIntoFrame ? "into-frame" : "in-place";
     }
-    frame.timingsMs.emplace_back("readback", msSince(readStart));
+    frameImages.clear();  // the images over the Frame's memory go before anything can free it
+    frame.timingsMs.emplace_back("readback", prepareMs + msSince(readStart));
     if (timestamps) {
         std::uint64_t ticks[4] = {};
         VK_CHECK(vkGetQueryPoolResults(ctx.device.get(), queries.get(), 0, 4, sizeof ticks, ticks,
@@ -648,76 +789,120 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     if (settings.validate) frame.attributes["validation_messages"] = std::to_string(log.count.load());
 }
 
-// Rows come out top first, as the Frame wants them. Only the channels asked for are filled:
-// one pass over each target, in parallel over blocks of rows.
-void Renderer::Impl::readPixels(scene::Frame& frame, scene::ChannelMask channels) const {
+namespace {
+
+// The Frame's vector for a plane: sized for `pixels` (`perPixel` floats each) when the channel is
+// asked for, with room for `reserveBytes` (a driver may want more behind an image than its rows),
+// else emptied; null when not asked for.
+float* framePlane(std::vector<float>& v, bool wanted, std::size_t pixels, std::size_t perPixel,
+                  std::size_t reserveBytes) {
+    if (!wanted) {
+        v.clear();
+        return nullptr;
+    }
+    v.reserve(std::max(perPixel * pixels, (reserveBytes + sizeof(float) - 1) / sizeof(float)));
+    v.resize(perPixel * pixels);
+    return v.data();
+}
+
+}  // namespace
+
+void Renderer::Impl::prepareFrame(scene::Frame& frame, scene::ChannelMask channels, LitOutputs outputs,
+                                  LitAttachments& attachments, std::vector<Image>& frameImages,
+                                  std::array<bool, kLitPlanes>& intoFrame) const {
     using namespace scene;
     frame.width = int(width);
     frame.height = int(height);
     const std::size_t n = frame.pixelCount();
+    intoFrame.fill(false);
+    if (outputs == LitOutputs::kDisplay) {
+        attachments.add(targets.display);
+        return;  // readDisplayPixels sizes the Frame
+    }
     // A reused frame keeps its vectors' memory: no new pages to fault in and zero (on a
-    // 1920x1080 frame that cost more than the copy and this loop together).
-    auto output = [n, channels](std::vector<float>& v, ChannelMask bit, std::size_t perPixel = 1) -> float* {
-        if (!(channels & bit)) {
-            v.clear();
-            return nullptr;
-        }
-        v.resize(perPixel * n);
-        return v.data();
-    };
-    float* const rgb = output(frame.beauty, kChannelBeauty, 3);
-    float* const visibility = output(frame.visibility, kChannelVisibility);
-    float* const objectId = output(frame.objectId, kChannelObjectId);
-    float* const ndotl = output(frame.ndotl, kChannelNdotL);
-    float* const depth = output(frame.depth, kChannelDepth);
-    float* const blockerId = output(frame.blockerId, kChannelBlockerId);
-    std::vector<float*> lights;
+    // 1920x1080 frame that cost more than rendering it).
+    std::vector<float>* const vectors[kLitPlanes] = {&frame.beauty, &frame.visibility, &frame.objectId,
+                                                     &frame.ndotl,  &frame.depth,      &frame.blockerId};
+    const ChannelMask bits[kLitPlanes] = {kChannelBeauty, kChannelVisibility, kChannelObjectId,
+                                          kChannelNdotL,  kChannelDepth,      kChannelBlockerId};
+    const std::uint32_t planes = outputs == LitOutputs::kAll ? kLitPlanes : 1;
+    for (std::uint32_t p = 0; p < kLitPlanes; ++p) {
+        const bool wanted = (channels & bits[p]) != 0;
+        const bool direct = wanted && p < planes && renderIntoFrame && targets.frameImageBytes[p] > 0;
+        float* data = framePlane(*vectors[p], wanted, n, p == 0 ? 3 : 1, direct ? targets.frameImageBytes[p] : 0);
+        if (!direct) continue;
+        Image image = importHostImage(ctx, p == 0 ? targets.beautyFormat : kLitPlaneFormat, width, height,
+                                      kLitTargetUsage, litPlaneTexelBytes(targets, LitPlane(p)), data,
+                                      vectors[p]->capacity() * sizeof(float));
+        if (!image.image) continue;  // a pointer the device cannot import: the Renderer's target
+        intoFrame[p] = true;
+        frameImages.push_back(std::move(image));
+    }
+    std::size_t next = 0;
+    for (std::uint32_t p = 0; p < planes; ++p) attachments.add(intoFrame[p] ? frameImages[next++] : targets.planes[p]);
+    if (outputs == LitOutputs::kAll)
+        for (const Image& l : targets.lights) attachments.add(l);
     frame.lightVisibility.resize((channels & kChannelLightVisibility) && !targets.lights.empty() ? lightCount : 0);
-    for (std::vector<float>& v : frame.lightVisibility) lights.push_back(output(v, kChannelLightVisibility));
+    for (std::vector<float>& v : frame.lightVisibility) framePlane(v, true, n, 1, 0);
+}
+
+// Copies the planes asked for that were not rendered into the Frame (from the targets in place,
+// or from their readback buffers), rows top first as the Frame wants them, and the per-light
+// visibility out of its four-light targets; adds the view-depth offset of a held view to Z.
+void Renderer::Impl::readPixels(scene::Frame& frame, scene::ChannelMask channels,
+                                const std::array<bool, kLitPlanes>& intoFrame) const {
+    using namespace scene;
+    const std::size_t w = width;
     // Where each target's rows are: the targets themselves (host-readable) or their buffers.
     struct Rows {
-        const char* base;
-        std::size_t pitch;
+        const char* base = nullptr;
+        std::size_t pitch = 0;
         const float* row(std::size_t y) const { return reinterpret_cast<const float*>(base + y * pitch); }
     };
-    const std::size_t tightPitch = std::size_t(width) * 4 * sizeof(float);
-    auto rows = [&](const Image& image, const Buffer* buffer) {
+    auto rows = [&](const Image& image, const Buffer* buffer, std::size_t texelBytes) {
         return targets.hostReadable ? Rows{static_cast<const char*>(image.mapped), std::size_t(image.rowPitch)}
-                                    : Rows{static_cast<const char*>(buffer->mapped), tightPitch};
+                                    : Rows{static_cast<const char*>(buffer->mapped), w * texelBytes};
     };
-    const Rows beauty = rows(targets.beauty, &readback.beauty);
-    const Rows aovs = rows(targets.aovs, &readback.aovs);
+    std::vector<float>* const vectors[kLitPlanes] = {&frame.beauty, &frame.visibility, &frame.objectId,
+                                                     &frame.ndotl,  &frame.depth,      &frame.blockerId};
+    const ChannelMask bits[kLitPlanes] = {kChannelBeauty, kChannelVisibility, kChannelObjectId,
+                                          kChannelNdotL,  kChannelDepth,      kChannelBlockerId};
+    std::array<Rows, kLitPlanes> source;
+    for (std::uint32_t p = 0; p < kLitPlanes; ++p)
+        source[p] = rows(targets.planes[p], targets.hostReadable ? nullptr : &readback.planes[p],
+                         litPlaneTexelBytes(targets, LitPlane(p)));
     std::vector<Rows> lightRows;
     for (std::size_t t = 0; t < targets.lights.size(); ++t)
-        lightRows.push_back(rows(targets.lights[t], targets.hostReadable ? nullptr : &readback.lights[t]));
-    const std::size_t w = width;
+        lightRows.push_back(rows(targets.lights[t], targets.hostReadable ? nullptr : &readback.lights[t], 16));
+    const bool rgba = targets.beautyTexelBytes == 16;
+    // The object ids that tell the background (no Z offset) where Z is offset: the Frame's or the target's.
     const float depthOffset = float(viewDepthOffset);  // 0 for the camera the Renderer was made for
+    const bool offsetDepth = (channels & kChannelDepth) && depthOffset != 0.0f;
+    const bool idsInFrame = (channels & kChannelObjectId) != 0;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, height, 16), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t y = r.begin(); y < r.end(); ++y) {
-            const std::size_t o = y * w;  // first pixel of the row in the Frame
-            if (rgb || visibility) {
-                const float* p = beauty.row(y);
-                for (std::size_t x = 0; x < w; ++x) {
-                    if (rgb) {
-                        rgb[3 * (o + x) + 0] = p[4 * x + 0];
-                        rgb[3 * (o + x) + 1] = p[4 * x + 1];
-                        rgb[3 * (o + x) + 2] = p[4 * x + 2];
-                    }
-                    if (visibility) visibility[o + x] = p[4 * x + 3];
+            for (std::uint32_t p = 0; p < kLitPlanes; ++p) {
+                if (!(channels & bits[p]) || intoFrame[p]) continue;
+                float* out = vectors[p]->data() + y * w * (p == 0 ? 3 : 1);
+                const float* in = source[p].row(y);
+                if (p == 0 && rgba) {
+                    for (std::size_t x = 0; x < w; ++x)
+                        for (std::size_t c = 0; c < 3; ++c) out[3 * x + c] = in[4 * x + c];
+                } else {
+                    std::memcpy(out, in, w * (p == 0 ? 3 : 1) * sizeof(float));
                 }
             }
-            if (objectId || ndotl || depth || blockerId) {
-                const float* p = aovs.row(y);
-                for (std::size_t x = 0; x < w; ++x) {
-                    if (objectId) objectId[o + x] = p[4 * x + 0];
-                    if (ndotl) ndotl[o + x] = p[4 * x + 1];
-                    if (depth) depth[o + x] = p[4 * x + 0] != 0.0f ? p[4 * x + 2] + depthOffset : p[4 * x + 2];
-                    if (blockerId) blockerId[o + x] = p[4 * x + 3];
-                }
+            if (offsetDepth) {
+                float* z = frame.depth.data() + y * w;
+                const float* id = idsInFrame ? frame.objectId.data() + y * w
+                                             : source[std::size_t(LitPlane::kObjectId)].row(y);
+                for (std::size_t x = 0; x < w; ++x)
+                    if (id[x] != 0.0f) z[x] += depthOffset;
             }
-            for (std::size_t l = 0; l < lights.size(); ++l) {
+            for (std::size_t l = 0; l < frame.lightVisibility.size(); ++l) {
                 const float* p = lightRows[l / 4].row(y) + l % 4;
-                for (std::size_t x = 0; x < w; ++x) lights[l][o + x] = p[4 * x];
+                float* out = frame.lightVisibility[l].data() + y * w;
+                for (std::size_t x = 0; x < w; ++x) out[x] = p[4 * x];
             }
         }
     });

@@ -43,6 +43,14 @@ struct RendererOptions {
     // Read the targets in place where the device's memory is the host's (lavapipe); false
     // copies them into readback buffers first, as on other devices (tests compare the two).
     bool readTargetsInPlace = true;
+    // Where the targets are read in place and the device imports host memory (lavapipe): render
+    // each channel asked for straight into the Frame's vector, so there is nothing to read back;
+    // false renders into the Renderer's own targets and copies them (tests compare the two).
+    bool renderIntoFrame = true;
+    // Semi-transparent casters: draw each layer's transmittance maps only within the casters'
+    // window (raster/shadow_pass.h transmittanceWindow); false draws every layer whole, as a map
+    // without windows (tests compare the two).
+    bool transmittanceWindows = true;
     LightConstants lightConstants = LightConstants::kVertexOutputs;
 };
 

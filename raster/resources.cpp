@@ -153,6 +153,121 @@ Image createImage(const Context& ctx, VkFormat format, std::uint32_t width, std:
     return img;
 }
 
+namespace {
+
+constexpr VkExternalMemoryHandleTypeFlagBits kHostAllocation = VK_EXTERNAL_MEMORY_HANDLE_TYPE_HOST_ALLOCATION_BIT_EXT;
+
+// A linear image that may be bound to imported host memory (its memory not yet bound).
+ImageHandle createHostImportImage(const Context& ctx, VkFormat format, std::uint32_t width, std::uint32_t height,
+                                  VkImageUsageFlags usage) {
+    const VkExternalMemoryImageCreateInfo external{
+        .sType = VK_STRUCTURE_TYPE_EXTERNAL_MEMORY_IMAGE_CREATE_INFO, .handleTypes = kHostAllocation};
+    const VkImageCreateInfo info{
+        .sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO,
+        .pNext = &external,
+        .imageType = VK_IMAGE_TYPE_2D,
+        .format = format,
+        .extent = {width, height, 1},
+        .mipLevels = 1,
+        .arrayLayers = 1,
+        .samples = VK_SAMPLE_COUNT_1_BIT,
+        .tiling = VK_IMAGE_TILING_LINEAR,
+        .usage = usage,
+        .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
+        .initialLayout = VK_IMAGE_LAYOUT_UNDEFINED,
+    };
+    VkImage image = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateImage(ctx.device.get(), &info, nullptr, &image));
+    return ImageHandle(ctx.device.get(), image);
+}
+
+// The bytes an importable image needs from its first texel on, or 0 when its rows are padded.
+std::size_t tightImageBytes(const Context& ctx, VkImage image, std::uint32_t width, std::size_t texelBytes,
+                            VkMemoryRequirements& req) {
+    vkGetImageMemoryRequirements(ctx.device.get(), image, &req);
+    const VkImageSubresource subresource{.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT, .mipLevel = 0, .arrayLayer = 0};
+    VkSubresourceLayout layout{};
+    vkGetImageSubresourceLayout(ctx.device.get(), image, &subresource, &layout);
+    if (layout.offset != 0 || layout.rowPitch != VkDeviceSize(width) * texelBytes) return 0;
+    return std::size_t(req.size);
+}
+
+}  // namespace
+
+std::size_t hostImageBytes(const Context& ctx, VkFormat format, std::uint32_t width, std::uint32_t height,
+                           VkImageUsageFlags usage, std::size_t texelBytes) {
+    if (!ctx.hostPointerImport) return 0;
+    const VkPhysicalDeviceExternalImageFormatInfo externalInfo{
+        .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_EXTERNAL_IMAGE_FORMAT_INFO, .handleType = kHostAllocation};
+    const VkPhysicalDeviceImageFormatInfo2 formatInfo{
+        .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_IMAGE_FORMAT_INFO_2,
+        .pNext = &externalInfo,
+        .format = format,
+        .type = VK_IMAGE_TYPE_2D,
+        .tiling = VK_IMAGE_TILING_LINEAR,
+        .usage = usage,
+    };
+    VkExternalImageFormatProperties external{.sType = VK_STRUCTURE_TYPE_EXTERNAL_IMAGE_FORMAT_PROPERTIES};
+    VkImageFormatProperties2 props{.sType = VK_STRUCTURE_TYPE_IMAGE_FORMAT_PROPERTIES_2, .pNext = &external};
+    if (vkGetPhysicalDeviceImageFormatProperties2(ctx.physicalDevice, &formatInfo, &props) != VK_SUCCESS) return 0;
+    if (!(external.externalMemoryProperties.externalMemoryFeatures & VK_EXTERNAL_MEMORY_FEATURE_IMPORTABLE_BIT) ||
+        !(external.externalMemoryProperties.compatibleHandleTypes & kHostAllocation) ||
+        props.imageFormatProperties.maxExtent.width < width || props.imageFormatProperties.maxExtent.height < height)
+        return 0;
+    const ImageHandle probe = createHostImportImage(ctx, format, width, height, usage);
+    VkMemoryRequirements req{};
+    return tightImageBytes(ctx, probe.get(), width, texelBytes, req);
+}
+
+Image importHostImage(const Context& ctx, VkFormat format, std::uint32_t width, std::uint32_t height,
+                      VkImageUsageFlags usage, std::size_t texelBytes, void* data, std::size_t bytes) {
+    Image img;
+    if (!ctx.hostPointerImport || !data) return img;
+    VkDevice device = ctx.device.get();
+    ImageHandle image = createHostImportImage(ctx, format, width, height, usage);
+    VkMemoryRequirements req{};
+    const std::size_t needed = tightImageBytes(ctx, image.get(), width, texelBytes, req);
+    if (needed == 0 || needed > bytes) return img;
+    // The import starts at the page (minImportedHostPointerAlignment) holding `data` and covers
+    // whole pages: memory of this process around the caller's, which the device never touches
+    // (the image is bound at data's offset in it and rendered only within its extent).
+    const VkDeviceSize align = ctx.minImportedHostPointerAlignment;
+    const auto address = reinterpret_cast<std::uintptr_t>(data);
+    const std::uintptr_t base = address - address % align;
+    const VkDeviceSize offset = address - base;
+    if (req.alignment == 0 || offset % req.alignment != 0) return img;
+    const VkDeviceSize size = (offset + needed + align - 1) / align * align;
+    VkMemoryHostPointerPropertiesEXT pointerProps{.sType = VK_STRUCTURE_TYPE_MEMORY_HOST_POINTER_PROPERTIES_EXT};
+    if (vkGetMemoryHostPointerPropertiesEXT(device, kHostAllocation, reinterpret_cast<void*>(base), &pointerProps) !=
+        VK_SUCCESS)
+        return img;
+    // Coherent memory: the host reads the rendered texels after the fence with no invalidation.
+    const std::uint32_t typeBits = pointerProps.memoryTypeBits & req.memoryTypeBits;
+    std::uint32_t type = UINT32_MAX;
+    for (std::uint32_t i = 0; i < ctx.memoryProperties.memoryTypeCount && type == UINT32_MAX; ++i)
+        if ((typeBits & (1u << i)) &&
+            (ctx.memoryProperties.memoryTypes[i].propertyFlags & VK_MEMORY_PROPERTY_HOST_COHERENT_BIT))
+            type = i;
+    if (type == UINT32_MAX) return img;
+    const VkImportMemoryHostPointerInfoEXT import{
+        .sType = VK_STRUCTURE_TYPE_IMPORT_MEMORY_HOST_POINTER_INFO_EXT,
+        .handleType = kHostAllocation,
+        .pHostPointer = reinterpret_cast<void*>(base),
+    };
+    const VkMemoryAllocateInfo alloc{
+        .sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, .pNext = &import, .allocationSize = size, .memoryTypeIndex = type};
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    if (vkAllocateMemory(device, &alloc, nullptr, &memory) != VK_SUCCESS) return img;
+    MemoryHandle memoryHandle(device, memory);
+    VK_CHECK(vkBindImageMemory(device, image.get(), memory, offset));
+    img.view = createView(ctx, image.get(), format, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D, 0, 1);
+    img.image = std::move(image);
+    img.memory = std::move(memoryHandle);
+    img.mapped = data;
+    img.rowPitch = VkDeviceSize(width) * texelBytes;
+    return img;
+}
+
 void transition(VkCommandBuffer commands, const std::vector<ImageTransition>& transitions) {
     std::vector<VkImageMemoryBarrier2> barriers;
     for (const ImageTransition& t : transitions)

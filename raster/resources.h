@@ -61,6 +61,18 @@ Image createImage(const Context& ctx, VkFormat format, std::uint32_t width, std:
 // that is the device's own: true on lavapipe, whose "device memory" is host memory, so the host
 // can read rendered targets in place instead of copying them into a buffer first.
 bool canReadImagesOnHost(const Context& ctx, VkFormat format, VkImageUsageFlags usage);
+// Images over host memory the program owns (VK_EXT_external_memory_host, Context::hostPointerImport):
+// a 2D color image with linear tiling whose texel (0, 0) is at `data` and whose rows follow each
+// other with no padding (row pitch = width · texelBytes), in memory the device reads and writes
+// where the host does. hostImageBytes() is how many bytes from `data` on such an image needs (the
+// driver may round the rows up; the caller owns them all), or 0 when the device cannot make one of
+// this format and size (no import, rows padded, the format not importable with linear tiling).
+// importHostImage() makes it; no image (Image::image empty) when the pointer's alignment does not
+// suit the device. The memory must stay valid until the Image is destroyed.
+std::size_t hostImageBytes(const Context& ctx, VkFormat format, std::uint32_t width, std::uint32_t height,
+                           VkImageUsageFlags usage, std::size_t texelBytes);
+Image importHostImage(const Context& ctx, VkFormat format, std::uint32_t width, std::uint32_t height,
+                      VkImageUsageFlags usage, std::size_t texelBytes, void* data, std::size_t bytes);
 ImageViewHandle createView(const Context& ctx, VkImage image, VkFormat format, VkImageAspectFlags aspect,
                            VkImageViewType viewType, std::uint32_t firstLayer, std::uint32_t layerCount);
 

@@ -30,7 +30,9 @@ std::vector<ShadowLayer> planShadowLayers(const scene::Scene& scene, const scene
                                           const scene::RasterSettings& settings, const scene::Vec3& origin) {
     std::vector<ShadowLayer> layers;
     // Caster culling: per layer, which objects are drawn into it, and how many are not.
-    // Not with a transmittance map: its index order (opaque casters first) is not per object.
+    // Not with a transmittance map: an opaque caster left out would let semi-transparent ones
+    // behind it into the map, and a receiver between the two would get the nearer layer's factor
+    // with one more rounding (T_all / T_rest), so the frame would not stay the same bit for bit.
     const bool cull = settings.cullCasters && !plan.needsTransmittanceMap;
     const std::vector<scene::Vec3> receivers = cull ? visibleReceiverPoints(scene) : std::vector<scene::Vec3>{};
     // The hardware bias of an orthographic map (settings.hardwareBias): the world constant bias

@@ -76,8 +76,8 @@ std::vector<double> cascadeTexels(const std::vector<ShadowLayer>& layers);
 // `settings` (and `plan`, when given: lights it gives no shadow test have no maps): per layer (one
 // for a single map, one per cascade, six cube faces) its label ("" for a single map, "C0".., "+X"..)
 // and how many objects its depth pass leaves out. No layers where nothing is culled: a light
-// without a map, settings.cullCasters off, or a transmittance map (plan.needsTransmittanceMap),
-// whose draw order is not per object.
+// without a map, settings.cullCasters off, or a transmittance map (plan.needsTransmittanceMap,
+// which draws every caster: raster/shadow_layers.cpp says why).
 struct LightCulling {
     std::vector<std::string> layers;
     std::vector<int> culled;

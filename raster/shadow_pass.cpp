@@ -2,6 +2,8 @@
 // the two transmittance passes after it.
 #include "raster/shadow_pass.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include "raster/pipeline.h"
@@ -144,7 +146,7 @@ PipelineLayoutHandle createTransmitLayout(const Context& ctx, VkDescriptorSetLay
     if (!ctx.independentBlend)
         throw RasterError("semi-transparent casters need the independentBlend feature, which " + ctx.deviceReport.name +
                           " lacks (the transmittance map blends its two targets differently)");
-    const VkPushConstantRange push{.stageFlags = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+    const VkPushConstantRange push{.stageFlags = VK_SHADER_STAGE_VERTEX_BIT,  // transmit.frag takes them flat
                                    .offset = 0,
                                    .size = sizeof(shaders::TransmitPush)};
     // The second pass's D1 set first, the alpha records' after it (shaders/alpha.glsl's set).
@@ -228,11 +230,73 @@ TransmittanceRestPipeline createTransmittanceRestPipeline(const Context& ctx, co
     return p;
 }
 
+TexelRect transmittanceWindow(const glm::mat4& lightMatrix, const std::vector<TransparentDraw>& casters,
+                              std::uint32_t size) {
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    const glm::dmat4 m(lightMatrix);
+    auto add = [&](const glm::dvec4& p) {
+        // Framebuffer texels: (ndc + 1) / 2 · size on both axes (the depth pass's viewport).
+        for (int a = 0; a < 2; ++a) {
+            const double t = (p[a] / p.w + 1.0) * 0.5 * double(size);
+            lo[a] = std::min(lo[a], t);
+            hi[a] = std::max(hi[a], t);
+        }
+    };
+    // What the rasterizer keeps of a convex polygon or polyhedron lies on the light's side of the
+    // near plane (clip z >= 0, where a perspective map's w > 0 too): its projection lies in the hull
+    // of the projected corners on that side and of the points where its edges cross the plane.
+    bool unbounded = false;
+    auto corner = [&](const glm::dvec4& p) {
+        if (p.z < 0.0) return;
+        if (!(p.w > 0.0)) unbounded = true;  // (not a projection we know)
+        else add(p);
+    };
+    auto edge = [&](const glm::dvec4& a, const glm::dvec4& b) {
+        if ((a.z < 0.0) == (b.z < 0.0)) return;
+        const glm::dvec4 p = a + (b - a) * (a.z / (a.z - b.z));
+        if (!(p.w > 0.0)) unbounded = true;
+        else add(p);
+    };
+    for (const TransparentDraw& c : casters) {
+        if (!c.triangles.empty()) {
+            for (std::size_t t = 0; t + 2 < c.triangles.size(); t += 3) {
+                glm::dvec4 v[3];
+                for (int k = 0; k < 3; ++k) v[k] = m * glm::dvec4(glm::dvec3(c.triangles[t + std::size_t(k)]), 1.0);
+                for (int k = 0; k < 3; ++k) {
+                    corner(v[k]);
+                    edge(v[k], v[(k + 1) % 3]);
+                }
+            }
+            continue;
+        }
+        glm::dvec4 box[8];
+        for (int k = 0; k < 8; ++k)
+            box[k] = m * glm::dvec4(k & 1 ? c.boundsMax.x : c.boundsMin.x, k & 2 ? c.boundsMax.y : c.boundsMin.y,
+                                    k & 4 ? c.boundsMax.z : c.boundsMin.z, 1.0);
+        for (int k = 0; k < 8; ++k) {
+            corner(box[k]);
+            for (int bit = 1; bit < 8; bit <<= 1)  // the edges from corner k to a corner with one more bit
+                if (!(k & bit)) edge(box[k], box[k | bit]);
+        }
+    }
+    if (unbounded) return TexelRect{0, 0, size, size};
+    if (lo[0] > hi[0]) return {};  // nothing on the light's side of the plane
+    // A fragment of texel i has its center i + 0.5 inside the projection, so floor(lo) <= i <= floor(hi).
+    std::uint32_t r[4];
+    for (int a = 0; a < 2; ++a) {
+        const double margin = double(kTransmittanceWindowMarginTexels);
+        r[a] = std::uint32_t(std::clamp(std::floor(lo[a]) - margin, 0.0, double(size)));
+        r[a + 2] = std::uint32_t(std::clamp(std::floor(hi[a]) + 1.0 + margin, 0.0, double(size)));
+    }
+    return TexelRect{r[0], r[1], r[2], r[3]};
+}
+
 namespace {
 
-// One transmittance pass over every layer: the product and nearest-depth targets (per layer
-// views) cleared to 1 and the semi-transparent casters drawn with `pipeline`, depth-tested against
-// the layer's opaque depths; with `rest`, the second pass (its descriptor set bound).
+// One transmittance pass over every layer with a window: the product and nearest-depth targets (per
+// layer views) cleared to 1 within the window and the semi-transparent casters drawn with
+// `pipeline`, depth-tested against the layer's opaque depths; with `rest`, the second pass (its
+// descriptor set bound).
 void drawTransmittanceLayers(VkCommandBuffer commands, const TransmittancePass& pass, VkPipeline pipeline,
                              VkPipelineLayout layout, const TransmittanceRestPipeline* rest,
                              const std::vector<ImageViewHandle>& productViews,
@@ -240,6 +304,8 @@ void drawTransmittanceLayers(VkCommandBuffer commands, const TransmittancePass& 
                              const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices) {
     const TransmittanceMaps& maps = *pass.maps;
     for (std::uint32_t layer = 0; layer < maps.layers; ++layer) {
+        if (layer >= pass.windows.size() || pass.windows[layer].empty()) continue;  // nothing to draw, nothing read
+        const TexelRect& window = pass.windows[layer];
         VkRenderingAttachmentInfo colors[2];
         for (int k = 0; k < 2; ++k)
             colors[k] = VkRenderingAttachmentInfo{
@@ -259,7 +325,8 @@ void drawTransmittanceLayers(VkCommandBuffer commands, const TransmittancePass& 
         };
         const VkRenderingInfo rendering{
             .sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
-            .renderArea = {{0, 0}, {maps.size, maps.size}},
+            .renderArea = {{std::int32_t(window.x0), std::int32_t(window.y0)},
+                           {window.x1 - window.x0, window.y1 - window.y0}},
             .layerCount = 1,
             .colorAttachmentCount = 2,
             .pColorAttachments = colors,
@@ -275,7 +342,11 @@ void drawTransmittanceLayers(VkCommandBuffer commands, const TransmittancePass& 
             if (alpha)
                 vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, layout, rest ? 1 : 0, 1,
                                         &geometry.alphaSet, 0, nullptr);
+            // The whole map's viewport (the depth pass's texels), cut to the window.
             setViewport(commands, maps.size, maps.size);
+            const VkRect2D scissor{{std::int32_t(window.x0), std::int32_t(window.y0)},
+                                   {window.x1 - window.x0, window.y1 - window.y0}};
+            vkCmdSetScissor(commands, 0, 1, &scissor);
             const VkDeviceSize offset = 0;
             vkCmdBindVertexBuffers(commands, 0, 1, &geometry.vertices, &offset);
             if (alpha) vkCmdBindVertexBuffers(commands, 1, 1, &geometry.uvs, &offset);
@@ -286,7 +357,7 @@ void drawTransmittanceLayers(VkCommandBuffer commands, const TransmittancePass& 
                     .light = pass.layerLights[layer],
                     .params = glm::vec4(object.transmittance, object.closed ? 1.0f : 0.0f, float(layer),
                                         kTransmittanceLayerSeparation)};
-                vkCmdPushConstants(commands, layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                vkCmdPushConstants(commands, layout, VK_SHADER_STAGE_VERTEX_BIT, 0,
                                    sizeof push, &push);
                 vkCmdDrawIndexed(commands, object.indexCount, 1, object.firstIndex, 0, 0);
             }
@@ -347,7 +418,7 @@ void recordTransmittance(VkCommandBuffer commands, const TransmittancePass& pass
 void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, const ShadowMaps& maps,
                       const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices,
                       bool blockerIds, const TransmittancePass* transmittance,
-                      const std::vector<DepthBiasFactors>* layerBias) {
+                      const std::vector<DepthBiasFactors>* layerBias, const ShadowPipeline* alphaPipeline) {
     // Source stage: the previous frame's lit pass sampled both arrays (a reused Renderer).
     transition(commands, {{maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, maps.layers,
                            VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
@@ -387,27 +458,35 @@ void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, 
         };
         vkCmdBeginRendering(commands, &rendering);
         if (layer < lightMatrices.size() && geometry.depthPassIndexCount() > 0) {
-            vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.pipeline.get());
             setViewport(commands, maps.size, maps.size);
-            if (pipeline.hardwareBias) {
-                const DepthBiasFactors b =
-                    layerBias && layer < layerBias->size() ? (*layerBias)[layer] : DepthBiasFactors{};
-                vkCmdSetDepthBias(commands, b.constant, 0.0f, b.slope);
-            }
-            const shaders::ShadowPush push{.lightMatrix = lightMatrices[layer]};
-            vkCmdPushConstants(commands, pipeline.layout.get(), VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof push, &push);
             const VkDeviceSize offset = 0;
             vkCmdBindVertexBuffers(commands, 0, 1, &geometry.vertices, &offset);
-            if (pipeline.alpha) {
-                vkCmdBindVertexBuffers(commands, 1, 1, &geometry.uvs, &offset);
-                vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.layout.get(), 0, 1,
-                                        &geometry.alphaSet, 0, nullptr);
-            }
+            if (geometry.uvs != VK_NULL_HANDLE) vkCmdBindVertexBuffers(commands, 1, 1, &geometry.uvs, &offset);
             vkCmdBindIndexBuffer(commands, geometry.indices, 0, VK_INDEX_TYPE_UINT32);
+            const ShadowPipeline* bound = nullptr;
+            auto use = [&](const ShadowPipeline& p) {
+                if (bound == &p) return;
+                bound = &p;
+                vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, p.pipeline.get());
+                if (p.hardwareBias) {
+                    const DepthBiasFactors b =
+                        layerBias && layer < layerBias->size() ? (*layerBias)[layer] : DepthBiasFactors{};
+                    vkCmdSetDepthBias(commands, b.constant, 0.0f, b.slope);
+                }
+                const shaders::ShadowPush push{.lightMatrix = lightMatrices[layer]};
+                vkCmdPushConstants(commands, p.layout.get(), VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof push, &push);
+                if (p.alpha)
+                    vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, p.layout.get(), 0, 1,
+                                            &geometry.alphaSet, 0, nullptr);
+            };
             if (layer < geometry.layerRanges.size()) {  // the casters left after culling
-                for (const auto& [first, count] : geometry.layerRanges[layer])
-                    if (count > 0) vkCmdDrawIndexed(commands, count, 1, first, 0, 0);
+                for (const IndexRange& r : geometry.layerRanges[layer]) {
+                    if (r.count == 0) continue;
+                    use(r.alpha && alphaPipeline ? *alphaPipeline : pipeline);
+                    vkCmdDrawIndexed(commands, r.count, 1, r.first, 0, 0);
+                }
             } else {
+                use(pipeline);
                 vkCmdDrawIndexed(commands, geometry.depthPassIndexCount(), 1, 0, 0, 0);
             }
         }
@@ -461,20 +540,6 @@ std::vector<float> readShadowMap(const Context& ctx, const ShadowMaps& maps, std
     std::vector<float> depths(std::size_t(maps.size) * maps.size);
     readLayer(ctx, maps, maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, layer, depths.data());
     return depths;
-}
-
-std::vector<float> readTransmittance(const Context& ctx, const TransmittanceMaps& maps, std::uint32_t layer,
-                                     TransmittanceArray array) {
-    ShadowMaps shape;  // readLayer needs only the size and layer count
-    shape.size = maps.size;
-    shape.layers = maps.layers;
-    const Image& image = array == TransmittanceArray::All         ? maps.transmittance
-                         : array == TransmittanceArray::NearDepth ? maps.nearDepth
-                         : array == TransmittanceArray::Rest      ? maps.restTransmittance
-                                                                  : maps.secondDepth;
-    std::vector<float> values(std::size_t(maps.size) * maps.size);
-    readLayer(ctx, shape, image.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layer, values.data());
-    return values;
 }
 
 std::vector<std::uint32_t> readBlockerIds(const Context& ctx, const ShadowMaps& maps, std::uint32_t layer) {

@@ -48,6 +48,34 @@ struct TransparentDraw {
     std::uint32_t indexCount = 0;
     float transmittance = 1.0f;  // 1 − opacity
     bool closed = true;          // count only its surfaces facing the light (transmit.frag)
+    glm::vec3 boundsMin{0.0f}, boundsMax{0.0f};  // its vertices' box (camera-relative, as uploaded)
+    // Its triangles' corners, three a triangle, as uploaded (transmittanceWindow projects them);
+    // empty for a caster of more than kTransmittanceWindowTriangles triangles (its box is used).
+    std::vector<glm::vec3> triangles;
+};
+
+// Texels [x0, x1) × [y0, y1) of a shadow-map layer.
+struct TexelRect {
+    std::uint32_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    bool empty() const { return x0 >= x1 || y0 >= y1; }
+};
+// The window of a size² layer drawn with `lightMatrix` that holds every texel the semi-transparent
+// casters can cover (the part of their triangles, or of the boxes of casters with too many to
+// project each frame, on the light's side of the map's near plane, projected), with
+// kTransmittanceWindowMarginTexels of margin, within the map; empty without casters, or where they
+// lie wholly behind the near plane or project off the map.
+TexelRect transmittanceWindow(const glm::mat4& lightMatrix, const std::vector<TransparentDraw>& casters,
+                              std::uint32_t size);
+
+// A run of the index buffer drawn with one pipeline: `alpha` = the SHADOWLAB_ALPHA variant, for
+// objects whose texels the pass tests (MASK casters in the depth pass; MASK and BLEND surfaces in
+// the lit pass). Objects that test nothing are drawn without it: a fragment shader that can
+// discard keeps lavapipe from testing depth before shading and from a depth-only pass without
+// any fragment shader, and reads the alpha records per fragment.
+struct IndexRange {
+    std::uint32_t first = 0;
+    std::uint32_t count = 0;
+    bool alpha = false;
 };
 
 // Index and vertex buffers of the whole scene (raster/geometry.h layout).
@@ -61,9 +89,12 @@ struct DrawGeometry {
     std::uint32_t opaqueIndexCount = ~0u;
     std::vector<TransparentDraw> transparent;
     std::uint32_t depthPassIndexCount() const { return opaqueIndexCount < indexCount ? opaqueIndexCount : indexCount; }
-    // Shadow pass only: per layer, the index ranges (first, count) drawn into it (the casters
-    // left after culling); layers past the end of this list draw every index.
-    std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> layerRanges;
+    // Shadow pass only: per layer, the index ranges drawn into it (the casters left after culling,
+    // in index order); layers past the end of this list draw every index of the depth pass.
+    std::vector<std::vector<IndexRange>> layerRanges;
+    // Lit pass: every index in order, split where the camera's alpha test starts or stops (empty:
+    // one draw of every index with the pass's pipeline).
+    std::vector<IndexRange> litRanges;
     // Alpha-tested casters (raster/alpha_casters.h): the UV buffer and the records' set, used by
     // pipelines made with an alpha set layout.
     VkBuffer uvs = VK_NULL_HANDLE;
@@ -114,12 +145,18 @@ TransmittanceRestPipeline createTransmittanceRestPipeline(const Context& ctx, co
                                                           VkDescriptorSetLayout alphaSetLayout = VK_NULL_HANDLE);
 
 // What recordShadowPass needs for the transmittance passes: the pipelines (both or neither), the
-// maps, and per layer the light it is drawn from (TransmitPush::light).
+// maps, and per layer the light it is drawn from (TransmitPush::light) and its window
+// (transmittanceWindow; layers past its end: empty). Each layer's passes draw and clear only its
+// window, and a layer with an empty window has none: what lies outside is never read as such
+// (lit.frag reads TransmitWindows), so the maps need no clear there. At 2048² a whole layer is
+// 4 × 16 MiB of clears; the casters' window is usually a small part of it, and most layers of a
+// point light's cube see none of them.
 struct TransmittancePass {
     const ShadowPipeline* pipeline = nullptr;
     const TransmittanceMaps* maps = nullptr;
     std::vector<glm::vec4> layerLights;
     const TransmittanceRestPipeline* rest = nullptr;
+    std::vector<TexelRect> windows;
 };
 
 // Records: every layer cleared to depth 1 (far: lit) and id 0, and layer i drawn with
@@ -127,21 +164,20 @@ struct TransmittancePass {
 // made readable by fragment shaders (SHADER_READ_ONLY_OPTIMAL). Without blockerIds (the
 // pipeline made so) the id array is not rendered, only moved to SHADER_READ_ONLY_OPTIMAL with
 // undefined contents, for a lit pass that does not read it. The depth pass draws only
-// geometry.depthPassIndexCount() indices. With `transmittance`, each drawn layer then gets the
-// transmittance pass (its targets cleared to 1, the semi-transparent casters drawn, depth-tested
-// against the layer's opaque depths), and after all layers' the second pass behind the nearest
-// layer (reading the first's nearest depths); its maps end in SHADER_READ_ONLY_OPTIMAL either way
-// (with `transmittance.pipeline` null: undefined contents, for a lit pass that does not read them).
+// geometry.depthPassIndexCount() indices. With `transmittance`, each drawn layer with a window
+// then gets the transmittance pass (within the window: its targets cleared to 1, the
+// semi-transparent casters drawn, depth-tested against the layer's opaque depths), and after all
+// layers' the second pass behind the nearest layer (reading the first's nearest depths); its maps
+// end in SHADER_READ_ONLY_OPTIMAL either way (undefined outside the windows, and everywhere with
+// `transmittance.pipeline` null, for a lit pass that does not read them).
 // layerBias: a pipeline made with hardwareBias needs each drawn layer's factors (missing ones: 0).
+// alphaPipeline: the SHADOWLAB_ALPHA variant of `pipeline`, for ranges with IndexRange::alpha
+// (null: `pipeline` draws them).
 void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, const ShadowMaps& maps,
                       const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices,
                       bool blockerIds = true, const TransmittancePass* transmittance = nullptr,
-                      const std::vector<DepthBiasFactors>* layerBias = nullptr);
-// One layer of one of the four transmittance arrays (tests and diagnostics), row 0 first.
-enum class TransmittanceArray { All, NearDepth, Rest, SecondDepth };
-std::vector<float> readTransmittance(const Context& ctx, const TransmittanceMaps& maps, std::uint32_t layer,
-                                     TransmittanceArray array = TransmittanceArray::All);
-
+                      const std::vector<DepthBiasFactors>* layerBias = nullptr,
+                      const ShadowPipeline* alphaPipeline = nullptr);
 // Diagnostics and tests: the depths of one layer after recordShadowPass() has run, row 0 first.
 std::vector<float> readShadowMap(const Context& ctx, const ShadowMaps& maps, std::uint32_t layer);
 std::vector<std::uint32_t> readBlockerIds(const Context& ctx, const ShadowMaps& maps, std::uint32_t layer);

@@ -1,6 +1,9 @@
 // raster/tolerances.h: the raster backend's few non-derived constants, each with its reason.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
+
 namespace shadowlab::raster {
 
 // Sphere tessellation: the chord of each UV-sphere segment may deviate from the true sphere by
@@ -47,6 +50,17 @@ inline constexpr double kPointFaceMarginTexels = 12.0;
 // 2.5e-7·d²/near at distance d, at most 2.5e-4·far with kSpotMinNearOverFar. Layers closer than
 // that are one layer, which changes only the factor a receiver between them gets.
 inline constexpr float kTransmittanceLayerSeparation = 2.5e-7f;
+// The transmittance maps are drawn (and cleared) only within a window of each layer around the
+// semi-transparent casters (the projection of their bounding boxes), and lit.frag takes a texel
+// outside the window as "nothing semi-transparent". The window keeps this many texels of margin
+// around the casters' projected extent, so that a texel on its edge holds "nothing" either way:
+// one for the rasterizer's pixel centers and the float rounding of the corners' projection (a few
+// 1e-7 of the map), one for lit.frag's texel index (floor(uv · size)) against the sampler's.
+inline constexpr std::uint32_t kTransmittanceWindowMarginTexels = 2;
+// The window comes from the casters' triangles projected into each layer (a sphere's box projects to
+// up to about three times the sphere's area in a spot's map), for casters of up to this many
+// triangles: projecting them costs well under a millisecond a frame. Larger casters use their box.
+inline constexpr std::size_t kTransmittanceWindowTriangles = 1 << 16;
 
 // The slope bias grows with tan(theta), which is infinite at grazing light; clamping it at
 // 10 (theta ~ 84°) keeps the bias finite where a receiver is nearly edge-on to the light and

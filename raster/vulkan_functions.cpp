@@ -58,14 +58,16 @@ void loadInstanceFunctions(VkInstance instance) {
     // The loader returns trampolines that dispatch on the object they are given, so pointers
     // from one instance work for every other. An extension function missing from this instance
     // (debug utils without validation) keeps the pointer an earlier instance loaded, which a
-    // still-living messenger of that instance needs to be destroyed.
+    // still-living messenger of that instance needs to be destroyed. The host-pointer import
+    // (VK_EXT_external_memory_host) is optional too: without it the lit pass's targets are copied.
 #define SHADOWLAB_VK_LOAD_INSTANCE(name)                                                    \
     if (const auto p_ = reinterpret_cast<PFN_##name>(vkGetInstanceProcAddr(instance, #name))) name = p_; \
-    if (!name && !missing && std::string_view(#name).find("DebugUtils") == std::string_view::npos) \
+    if (!name && !missing && std::string_view(#name).find("DebugUtils") == std::string_view::npos && \
+        std::string_view(#name).find("HostPointer") == std::string_view::npos)                        \
         missing = #name;
     SHADOWLAB_VK_INSTANCE_FUNCTIONS(SHADOWLAB_VK_LOAD_INSTANCE)
 #undef SHADOWLAB_VK_LOAD_INSTANCE
-    // The debug-utils functions exist only when the extension is enabled; the rest are core.
+    // The extension functions above may be missing; the rest are core.
     if (missing)
         throw RasterError(std::string("the Vulkan loader does not provide ") + missing +
                           " (Vulkan 1.3 is required); update libvulkan1 and mesa-vulkan-drivers");

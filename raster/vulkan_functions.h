@@ -24,6 +24,8 @@
     X(vkGetPhysicalDeviceQueueFamilyProperties) \
     X(vkGetPhysicalDeviceMemoryProperties)      \
     X(vkGetPhysicalDeviceFormatProperties)      \
+    X(vkGetPhysicalDeviceImageFormatProperties2) \
+    X(vkEnumerateDeviceExtensionProperties)     \
     X(vkCreateDebugUtilsMessengerEXT)           \
     X(vkDestroyDebugUtilsMessengerEXT)          \
     X(vkCreateDevice)                           \
@@ -48,6 +50,7 @@
     X(vkDestroyImage)                           \
     X(vkGetImageMemoryRequirements)             \
     X(vkGetImageSubresourceLayout)              \
+    X(vkGetMemoryHostPointerPropertiesEXT)      \
     X(vkBindImageMemory)                        \
     X(vkCreateImageView)                        \
     X(vkDestroyImageView)                       \
@@ -90,6 +93,7 @@
     X(vkCmdSetViewport)                         \
     X(vkCmdSetScissor)                          \
     X(vkCmdSetDepthBias)                        \
+    X(vkCmdDraw)                                \
     X(vkCmdDrawIndexed)                         \
     X(vkCmdDispatch)                            \
     X(vkCmdCopyBuffer)                          \

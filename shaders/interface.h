@@ -18,6 +18,8 @@
 #define SHADOWLAB_MAX_LIGHTS 8
 // Cascaded shadow maps per directional light (scene::kMaxCascades; raster/ static_asserts that).
 #define SHADOWLAB_MAX_CASCADES 4
+// Shadow-map layers: a point light has six (its cube faces), a cascaded light four.
+#define SHADOWLAB_MAX_LAYERS (SHADOWLAB_MAX_LIGHTS * 6)
 
 // Filter codes (LightData::filterCode, MomentPush.info.x); the values follow scene::ShadowFilter.
 #define SHADOWLAB_FILTER_NONE 0
@@ -145,7 +147,15 @@ struct LitUniforms {
     CascadeData cascades[SHADOWLAB_MAX_LIGHTS * SHADOWLAB_MAX_CASCADES];  // light i: i*MAX_CASCADES + c
 };
 
+// Per shadow-map layer, the texels its transmittance maps hold this frame (raster/shadow_pass.h
+// TransmittanceMaps): x0, y0, x1, y1, x1 and y1 excluded (empty: nothing). Outside it the maps are
+// neither drawn nor cleared, and lit.frag reads "nothing semi-transparent" there.
+struct TransmitWindows {
+    vec4 rect[SHADOWLAB_MAX_LAYERS];
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(TransmitWindows) == SHADOWLAB_MAX_LAYERS * 16, "TransmitWindows must match std140");
 static_assert(sizeof(ShadowPush) == 64, "ShadowPush must match std430 push constants");
 static_assert(sizeof(MomentPush) == 4 * 16, "MomentPush must match std430 push constants");
 static_assert(sizeof(TransmitPush) == 64 + 2 * 16, "TransmitPush must match std430 push constants");

@@ -24,6 +24,8 @@ layout(set = 0, binding = 7) uniform sampler2DArray restTransmittanceMaps;
 layout(set = 0, binding = 8) uniform sampler2DArray secondTransparentDepths;
 // The filterable maps' blurred moments (raster/moment_maps.h; LINEAR, clamp to edge).
 layout(set = 0, binding = 9) uniform sampler2DArray momentMaps;
+// Each layer's transmittance window: the four maps above are drawn only there (raster/shadow_pass.h).
+layout(set = 0, binding = 10, std140) uniform TransmitWindowBlock { TransmitWindows transmitWindows; };
 
 // PCSS: the blocker search looks at most this fraction of the map's side from the point, and the
 // penumbra filter is at most this fraction wide (diameter). The tap count is fixed (16 each), so
@@ -45,18 +47,24 @@ layout(location = 5) flat in vec4 inAlbedo;
 layout(location = 6) flat in vec4 inLight[6];
 layout(location = 12) flat in vec4 inFrame[2];
 
-layout(location = 0) out vec4 outBeauty;  // rgb: linear color; a: visibility
+// One color attachment per Frame channel (raster/lit_pass.h LitPlane), so that each is the
+// Frame's own layout and lavapipe can render into the Frame's memory (no readback copy).
+layout(location = 0) out vec4 outBeauty;  // rgb: linear color (an RGB target keeps only that)
 #ifndef SHADOWLAB_BEAUTY_ONLY
-// (The lit_beauty.frag variant, for frames that want only beauty and visibility, has no AOV
-// target: one RGBA32F target less to write.)
-layout(location = 1) out vec4 outAovs;    // x: object id; y: N·L (max over lights); z: view depth; w: blocker id
+// (The lit_beauty.frag variant, for frames that want only the beauty, float or the 8-bit display
+// target, has no AOV outputs: the targets it would leave unwritten are not attached.)
+layout(location = 1) out float outVisibility;
+layout(location = 2) out float outObjectId;
+layout(location = 3) out float outNdotL;  // max over lights
+layout(location = 4) out float outDepth;  // view depth
+layout(location = 5) out float outBlockerId;
 #endif
 #ifdef SHADOWLAB_LIGHT_OUTPUTS
 // Per-light visibility (the lit_lights.frag variant, for scenes with more than one light):
 // light i in component i % 4 of target i / 4; 0 where the light does not reach (N·L <= 0,
 // outside a spot's cone), as the total's weights.
-layout(location = 2) out vec4 outLights0;
-layout(location = 3) out vec4 outLights1;
+layout(location = 6) out vec4 outLights0;
+layout(location = 7) out vec4 outLights1;
 #endif
 
 #include "lit_constants.glsl"
@@ -145,12 +153,22 @@ vec4 layeredTransmittance(vec4 all, vec4 near, vec4 rest, vec4 second, float ref
     const vec4 behindNearest = mix(nearestOnly, behindAll, greaterThan(vec4(ref), second));
     return mix(vec4(1.0), behindNearest, greaterThan(vec4(ref), near));
 }
+// Whether texel (x, y) of `layer` lies in the layer's transmittance window. Outside it the maps
+// hold nothing defined, and nothing semi-transparent is there: T 1, depths 1, which
+// layeredTransmittance turns into 1 (so a tap there is 1, as a map cleared to 1 gave). The window
+// keeps a margin of such texels around the casters (raster/tolerances.h), so a texel on its edge
+// gives 1 either way, whichever of two neighbours floor(uv · size) and the sampler pick.
+bool inTransmitWindow(vec2 texel, float layer) {
+    const vec4 w = transmitWindows.rect[int(layer)];
+    return all(greaterThanEqual(texel, w.xy)) && all(lessThan(texel, w.zw));
+}
 float transmittanceTap(vec2 uv, float layer, float ref) {
     const vec3 at = vec3(uv, layer);
-    return layeredTransmittance(vec4(texture(transmittanceMaps, at).r), vec4(texture(transparentDepths, at).r),
-                                vec4(texture(restTransmittanceMaps, at).r),
-                                vec4(texture(secondTransparentDepths, at).r), ref)
-        .x;
+    const float t = layeredTransmittance(vec4(texture(transmittanceMaps, at).r), vec4(texture(transparentDepths, at).r),
+                                         vec4(texture(restTransmittanceMaps, at).r),
+                                         vec4(texture(secondTransparentDepths, at).r), ref)
+                        .x;
+    return inTransmitWindow(floor(uv * counts().y), layer) ? t : 1.0;
 }
 
 // One compare tap; records the object stored there when it shadows and none was found yet
@@ -417,6 +435,7 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         // The plane replaces the slope term; the constant bias stays.
         if (r.plane) r.biasWorld = light.depthBiasWorld;
     }
+#ifndef SHADOWLAB_TAPS_ONLY
     if (filterCode >= SHADOWLAB_FILTER_VSM) {
         // Filterable maps: one linear lookup of the blurred moments (the filter is in the blur),
         // the receiver at the constant and slope bias as for `none`, in the moments' linear depth.
@@ -428,6 +447,7 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         if (kTransmittance) v *= transmittanceTap(r.uv, layer, ref);
         return v;
     }
+#endif
     if (filterCode == SHADOWLAB_FILTER_NONE) {
         if (kReceiverPlane && r.plane) return biasedTap(light, r, vec2(0.0), size, layer, blocker);
         return tap(r.uv, layer, reference(light, r, r.biasWorld), blocker);
@@ -467,12 +487,22 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         }
         if (kTransmittance) {
             // The same four texels' transmittance, each by where the receiver lies among their layers.
-            g *= layeredTransmittance(textureGather(transmittanceMaps, corner), textureGather(transparentDepths, corner),
-                                      textureGather(restTransmittanceMaps, corner),
-                                      textureGather(secondTransparentDepths, corner), ref);
+            const vec4 layered = layeredTransmittance(textureGather(transmittanceMaps, corner),
+                                                      textureGather(transparentDepths, corner),
+                                                      textureGather(restTransmittanceMaps, corner),
+                                                      textureGather(secondTransparentDepths, corner), ref);
+            // Texels outside the layer's window give 1 (inTransmitWindow).
+            const bvec4 inside = bvec4(inTransmitWindow(i0 + vec2(0.0, 1.0), layer), inTransmitWindow(i0 + 1.0, layer),
+                                       inTransmitWindow(i0 + vec2(1.0, 0.0), layer), inTransmitWindow(i0, layer));
+            g *= mix(vec4(1.0), layered, inside);
         }
         return mix(mix(g.w, g.z, f.x), mix(g.x, g.y, f.x), f.y);
     }
+#ifdef SHADOWLAB_TAPS_ONLY
+    // (The lit_frag*_taps variants, for none and pcf2x2: the wide kernels' and the filterable maps'
+    // code left out of the SPIR-V, which halves what lavapipe compiles when the pipeline is made.)
+    return 1.0;
+#else
     // Wide kernels: a tap d texels from the point compares against a surface that a plane
     // tilted by θ has moved d·texel·tan(θ) along the light, so each tap's slope term grows
     // with its distance (a per-tap receiver-plane bias; without it wide kernels make acne).
@@ -523,7 +553,7 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
             // The nearest caster of the texel: the opaque depth or, with semi-transparent casters,
             // the nearest of those when it is nearer, so their shadows are softened too.
             float z = texture(shadowDepths, at).r;
-            if (kTransmittance) z = min(z, texture(transparentDepths, at).r);
+            if (kTransmittance && inTransmitWindow(floor(at.xy * size), at.z)) z = min(z, texture(transparentDepths, at).r);
             if (z >= 1.0) continue;  // nothing drawn there
             // Stored perspective depth back to distance: z = far/(far−near)(1 − near/d).
             const float d = range.x / max(1.0 - z * (range.y - range.x) / range.y, 1e-7);
@@ -578,6 +608,7 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         }
     }
     return sum / 16.0;
+#endif
 }
 
 // Cascade c's map, texel size, depth scale and constant bias in place of the light's; its layer
@@ -697,7 +728,11 @@ void main() {
     const float visibility = !kVisibility ? 1.0 : weightSum > 0.0 ? weightedVisibility / weightSum : 0.0;
     outBeauty = vec4(color, visibility);
 #ifndef SHADOWLAB_BEAUTY_ONLY
-    outAovs = vec4(float(inObjectId), maxNdotL, dot(inPosition, viewForward()), float(blocker));
+    outVisibility = visibility;
+    outObjectId = float(inObjectId);
+    outNdotL = maxNdotL;
+    outDepth = dot(inPosition, viewForward());
+    outBlockerId = float(blocker);
 #endif
 #ifdef SHADOWLAB_LIGHT_OUTPUTS
     outLights0 = lightVisibility[0];

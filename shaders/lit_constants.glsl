@@ -24,8 +24,8 @@ layout(constant_id = 6) const bool kReceiverPlane = false;
 // (u.cascadeBlendBand, the band's fraction of the slice; see cascadeOf); off, the second shadow
 // test is compiled out.
 layout(constant_id = 7) const bool kCascadeBlend = false;
-// The beauty target's alpha holds the visibility AOV; off for the 8-bit display target (a PNG has
-// no alpha), which leaves out the weighting and the division per pixel.
+// The visibility AOV is computed (the AOV variants); off for the beauty-only variants (the float
+// beauty and the 8-bit display target), which leaves out the weighting and the division per pixel.
 layout(constant_id = 8) const bool kVisibility = true;
 // A normal offset is set (LightData::normalOffsetTexels, the same for every light): off (the
 // default), the lookup point is the surface point itself, and the vertex path's map-space normal

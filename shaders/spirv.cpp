@@ -3,7 +3,17 @@
 
 #include <cstdint>
 
+#include "background_frag.spv.h"
+#include "background_frag_beauty.spv.h"
+#include "background_frag_lights.spv.h"
+#include "background_vert.spv.h"
 #include "lit_frag.spv.h"
+#include "lit_frag_alpha_taps.spv.h"
+#include "lit_frag_beauty_alpha_taps.spv.h"
+#include "lit_frag_beauty_taps.spv.h"
+#include "lit_frag_lights_alpha_taps.spv.h"
+#include "lit_frag_lights_taps.spv.h"
+#include "lit_frag_taps.spv.h"
 #include "lit_frag_alpha.spv.h"
 #include "lit_frag_beauty.spv.h"
 #include "lit_frag_beauty_alpha.spv.h"
@@ -46,5 +56,15 @@ std::span<const std::uint32_t> litVertAlphaSpirv() { return kLitVertAlphaSpv; }
 std::span<const std::uint32_t> litFragAlphaSpirv() { return kLitFragAlphaSpv; }
 std::span<const std::uint32_t> litFragLightsAlphaSpirv() { return kLitFragLightsAlphaSpv; }
 std::span<const std::uint32_t> litFragBeautyAlphaSpirv() { return kLitFragBeautyAlphaSpv; }
+std::span<const std::uint32_t> litFragTapsSpirv() { return kLitFragTapsSpv; }
+std::span<const std::uint32_t> litFragAlphaTapsSpirv() { return kLitFragAlphaTapsSpv; }
+std::span<const std::uint32_t> litFragLightsTapsSpirv() { return kLitFragLightsTapsSpv; }
+std::span<const std::uint32_t> litFragLightsAlphaTapsSpirv() { return kLitFragLightsAlphaTapsSpv; }
+std::span<const std::uint32_t> litFragBeautyTapsSpirv() { return kLitFragBeautyTapsSpv; }
+std::span<const std::uint32_t> litFragBeautyAlphaTapsSpirv() { return kLitFragBeautyAlphaTapsSpv; }
+std::span<const std::uint32_t> backgroundVertSpirv() { return kBackgroundVertSpv; }
+std::span<const std::uint32_t> backgroundFragSpirv() { return kBackgroundFragSpv; }
+std::span<const std::uint32_t> backgroundFragBeautySpirv() { return kBackgroundFragBeautySpv; }
+std::span<const std::uint32_t> backgroundFragLightsSpirv() { return kBackgroundFragLightsSpv; }
 
 }  // namespace shadowlab::shaders

@@ -35,5 +35,18 @@ std::span<const std::uint32_t> litVertAlphaSpirv();
 std::span<const std::uint32_t> litFragAlphaSpirv();
 std::span<const std::uint32_t> litFragLightsAlphaSpirv();
 std::span<const std::uint32_t> litFragBeautyAlphaSpirv();
+// Each lit.frag variant above compiled with SHADOWLAB_TAPS_ONLY: only the none and pcf2x2 filters.
+std::span<const std::uint32_t> litFragTapsSpirv();
+std::span<const std::uint32_t> litFragAlphaTapsSpirv();
+std::span<const std::uint32_t> litFragLightsTapsSpirv();
+std::span<const std::uint32_t> litFragLightsAlphaTapsSpirv();
+std::span<const std::uint32_t> litFragBeautyTapsSpirv();
+std::span<const std::uint32_t> litFragBeautyAlphaTapsSpirv();
+// The lit pass's background (pixels no object covers): a triangle over the image, and the values
+// for the float targets of the AOV, beauty-only and per-light variants.
+std::span<const std::uint32_t> backgroundVertSpirv();
+std::span<const std::uint32_t> backgroundFragSpirv();
+std::span<const std::uint32_t> backgroundFragBeautySpirv();
+std::span<const std::uint32_t> backgroundFragLightsSpirv();
 
 }  // namespace shadowlab::shaders

@@ -23,7 +23,6 @@ layout(location = 2) flat in uint inObjectId;
 layout(location = 3) in vec2 inUv;
 #endif
 
-layout(push_constant) uniform Push { TransmitPush push; };
 #ifdef SHADOWLAB_REST_LAYER
 // The first pass's nearest depths (TransmittanceMaps::nearDepth), read at this fragment's texel.
 layout(set = 0, binding = 0) uniform sampler2DArray nearDepths;
@@ -31,6 +30,9 @@ layout(set = 0, binding = 0) uniform sampler2DArray nearDepths;
 
 layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
+// TransmitPush's light and params (shaders/interface.h), from transmit.vert.
+layout(location = 4) flat in vec4 inLight;
+layout(location = 5) flat in vec4 inParams;
 
 layout(location = 0) out float outTransmittance;
 layout(location = 1) out float outNearDepth;
@@ -41,23 +43,23 @@ void main() {
     // surface facing the light, so a closed object counts only those (decided by its normal, not
     // by the winding, so it holds for every mesh's index order); an open surface (a quad) counts
     // every fragment (a ray crosses it once).
-    if (push.params.y > 0.5) {
-        const vec3 toLight = push.light.w > 0.5 ? push.light.xyz - inPosition : push.light.xyz;
+    if (inParams.y > 0.5) {
+        const vec3 toLight = inLight.w > 0.5 ? inLight.xyz - inPosition : inLight.xyz;
         if (dot(inNormal, toLight) <= 0.0) discard;
     }
 #ifdef SHADOWLAB_REST_LAYER
     // Only fragments clearly behind the nearest layer: the nearest layer's own fragment is drawn
     // by the same vertex shader and matrix in both passes and has exactly D1 (params.w, the
     // separation raster/tolerances.h gives, only absorbs rounding differences between pipelines).
-    const float nearest = texelFetch(nearDepths, ivec3(ivec2(gl_FragCoord.xy), int(push.params.z)), 0).r;
-    if (!(gl_FragCoord.z > nearest + push.params.w)) discard;
+    const float nearest = texelFetch(nearDepths, ivec3(ivec2(gl_FragCoord.xy), int(inParams.z)), 0).r;
+    if (!(gl_FragCoord.z > nearest + inParams.w)) discard;
 #endif
 #ifdef SHADOWLAB_ALPHA
     if (alphaMasked(inObjectId, inUv)) discard;
     const AlphaRecord alpha = alphaRecords[inObjectId];
-    outTransmittance = alpha.params.x == 2.0 ? 1.0 - alpha.params.w * alphaAt(inObjectId, inUv) : push.params.x;
+    outTransmittance = alpha.params.x == 2.0 ? 1.0 - alpha.params.w * alphaAt(inObjectId, inUv) : inParams.x;
 #else
-    outTransmittance = push.params.x;
+    outTransmittance = inParams.x;
 #endif
     outNearDepth = gl_FragCoord.z;
 }

@@ -13,6 +13,10 @@ layout(location = 1) in vec3 inNormal;
 
 layout(location = 0) out vec3 outPosition;
 layout(location = 1) out vec3 outNormal;
+// The push constants transmit.frag reads, as flat outputs: lavapipe reads a push constant in a
+// fragment shader lane by lane for every eight fragments, a flat input once per triangle.
+layout(location = 4) flat out vec4 outLight;
+layout(location = 5) flat out vec4 outParams;
 #ifdef SHADOWLAB_ALPHA
 layout(location = 2) in uint inObjectId;
 layout(location = 3) in vec2 inUv;
@@ -23,6 +27,8 @@ layout(location = 3) out vec2 outUv;
 void main() {
     outPosition = inPosition;
     outNormal = inNormal;
+    outLight = push.light;
+    outParams = push.params;
 #ifdef SHADOWLAB_ALPHA
     outObjectId = inObjectId;
     outUv = inUv;

@@ -3,10 +3,12 @@
 // blocker-id map the id of that surface's object.
 #include "raster/shadow_pass.h"
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
 #include "raster/geometry.h"
 #include "raster/light_frustum.h"
+#include "raster/tolerances.h"
 #include "tests/kit/test_scenes.h"
 
 namespace shadowlab::raster {
@@ -90,6 +92,83 @@ TEST(ShadowPass, StoresTheClosedFormDepthOfWhatEachTexelSees) {
         for (float d : unused) ASSERT_EQ(d, 1.0f);  // a layer without a light is only cleared
     }
     EXPECT_EQ(log.count.load(), 0);
+}
+
+// The transmittance window (raster/shadow_pass.h) of casters given by their boxes or triangles.
+TransparentDraw boxCaster(const glm::vec3& lo, const glm::vec3& hi) {
+    TransparentDraw d;
+    d.boundsMin = lo;
+    d.boundsMax = hi;
+    return d;
+}
+
+TEST(TransmittanceWindow, HoldsTheCastersProjectionWithItsMarginAndNoMore) {
+    // An orthographic light whose clip space is the world (x, y in [-1, 1] across the 64² map, z in
+    // [0, 1] along it). The box x in [-0.5, 0.5], y in [-0.25, 0.25] projects to texels x in
+    // [(−0.5 + 1)/2·64, (0.5 + 1)/2·64] = [16, 48] and y in [24, 40]; a texel i is covered when its
+    // center i + 0.5 lies inside, so i in [16, 47] and [24, 39]. The window is floor(lo) − 2 to
+    // floor(hi) + 1 + 2 (the margin of kTransmittanceWindowMarginTexels = 2, one texel more at an
+    // edge that falls on a texel boundary): [14, 51) x [22, 43).
+    static_assert(kTransmittanceWindowMarginTexels == 2);
+    const glm::mat4 identity(1.0f);
+    const TexelRect w = transmittanceWindow(identity, {boxCaster({-0.5f, -0.25f, 0.2f}, {0.5f, 0.25f, 0.3f})}, 64);
+    EXPECT_EQ(w.x0, 14u);
+    EXPECT_EQ(w.y0, 22u);
+    EXPECT_EQ(w.x1, 51u);
+    EXPECT_EQ(w.y1, 43u);
+    // Two casters: the window of both; none: empty; off the map: empty; past its edge: clamped.
+    const TexelRect both = transmittanceWindow(
+        identity, {boxCaster({-0.5f, -0.25f, 0.2f}, {0.5f, 0.25f, 0.3f}), boxCaster({0.6f, 0.6f, 0.5f}, {0.7f, 0.7f, 0.6f})},
+        64);
+    // The second projects to x, y in [51.2, 54.4]: floor + 3 = 57, floor(51.2) − 2 = 49.
+    EXPECT_EQ(both.x0, 14u);
+    EXPECT_EQ(both.y0, 22u);
+    EXPECT_EQ(both.x1, 57u);
+    EXPECT_EQ(both.y1, 57u);
+    EXPECT_TRUE(transmittanceWindow(identity, {}, 64).empty());
+    EXPECT_TRUE(transmittanceWindow(identity, {boxCaster({2.0f, 2.0f, 0.5f}, {3.0f, 3.0f, 0.6f})}, 64).empty());
+    const TexelRect edge = transmittanceWindow(identity, {boxCaster({0.9f, -0.1f, 0.5f}, {1.5f, 0.1f, 0.6f})}, 64);
+    EXPECT_EQ(edge.x1, 64u);
+    EXPECT_EQ(edge.x0, 58u);  // floor((0.9 + 1)/2·64 = 60.8) − 2
+}
+
+TEST(TransmittanceWindow, ACasterBehindAPerspectiveLightIsLeftOutAndOneAcrossItsPlaneIsCutThere) {
+    // A spot at the origin looking down −z (glm's right-handed view), 90° field of view, near 0.1,
+    // far 10, depth 0..1: its clip z is >= 0 only in front of the near plane.
+    const glm::mat4 m = glm::perspectiveRH_ZO(glm::radians(90.0f), 1.0f, 0.1f, 10.0f);
+    const std::uint32_t size = 256;
+    // Wholly behind the light (z > 0): nothing of it is drawn.
+    EXPECT_TRUE(transmittanceWindow(m, {boxCaster({-1.0f, -1.0f, 1.0f}, {1.0f, 1.0f, 2.0f})}, size).empty());
+    // Across the light's plane, x in [0.55, 1.5], y in [-0.25, 0.25], z in [-2, 1]: its part in front
+    // of the near plane (z <= -0.1) projects to u = x/(-z) in [0.55/2, 1.5/0.1] (clamped to the
+    // map's right edge, 1) and v = y/(-z) in [-2.5, 2.5] (clamped: the whole height). Its left edge
+    // is where x is least and -z largest, u = 0.275: texel (0.275 + 1)/2·256 = 163.2, floor − 2 = 161.
+    const TexelRect across = transmittanceWindow(m, {boxCaster({0.55f, -0.25f, -2.0f}, {1.5f, 0.25f, 1.0f})}, size);
+    EXPECT_EQ(across.x0, 161u);
+    EXPECT_EQ(across.x1, size);
+    EXPECT_EQ(across.y0, 0u);
+    EXPECT_EQ(across.y1, size);
+}
+
+TEST(TransmittanceWindow, ACastersTrianglesGiveATighterWindowThanItsBox) {
+    // One triangle (0, 0), (0.5, 0), (0, 0.5) at z 0.5 under the world-as-clip-space light of the
+    // first test, 64²: texels x and y in [32, 48], window [30, 51); the caster's box, given larger
+    // (to 0.9: texel 60.8, window to 63), is not what the window follows.
+    TransparentDraw d = boxCaster({0.0f, 0.0f, 0.5f}, {0.9f, 0.9f, 0.5f});
+    d.triangles = {{0.0f, 0.0f, 0.5f}, {0.5f, 0.0f, 0.5f}, {0.0f, 0.5f, 0.5f}};
+    const TexelRect w = transmittanceWindow(glm::mat4(1.0f), {d}, 64);
+    EXPECT_EQ(w.x0, 30u);
+    EXPECT_EQ(w.y0, 30u);
+    EXPECT_EQ(w.x1, 51u);
+    EXPECT_EQ(w.y1, 51u);
+    // A spot's view of a triangle crossing its plane: the triangles' part in front, like a box's.
+    const glm::mat4 m = glm::perspectiveRH_ZO(glm::radians(90.0f), 1.0f, 0.1f, 10.0f);
+    d.triangles = {{0.55f, 0.0f, -2.0f}, {0.55f, 0.2f, -2.0f}, {0.55f, 0.0f, 1.0f}};
+    d.boundsMin = {0.55f, 0.0f, -2.0f};
+    d.boundsMax = {0.55f, 0.2f, 1.0f};
+    const TexelRect across = transmittanceWindow(m, {d}, 256);
+    EXPECT_EQ(across.x0, 161u);  // u = 0.55/2 at its far end, as for the box above
+    EXPECT_EQ(across.x1, 256u);
 }
 
 }  // namespace

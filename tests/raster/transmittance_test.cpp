@@ -369,6 +369,64 @@ TEST(RasterTransmittance, FourLayersTheThirdAlsoGetsTheFourthsFactorTheKnownLimi
     expectPaneTop(s, 1.0f, 0.0, scene::ShadowFilter::Pcf2x2, 0.12, "transmittance_four_floor");
 }
 
+TEST(RasterTransmittance, MapsDrawnOnlyInTheCastersWindowsGiveTheFramesOfWholeMaps) {
+    // Each layer's transmittance maps are drawn and cleared only in the window the semi-transparent
+    // casters project to, and lit.frag takes texels outside it as "nothing semi-transparent": the
+    // frames must be those of maps drawn whole, bit for bit, under a spot and a
+    // point light (whose cube faces hold the casters in some faces, part of them in others, none
+    // in the rest), two glass layers (pane, sphere, pane) and an opaque caster, also after the
+    // lights move (the windows follow them).
+    scene::Scene s = paneSpherePane();
+    s.objects.push_back(quadObject("opaque", Vec3(2.5, 1.5, 1.0), 1.0, 0));
+    s.lights[0].type = scene::LightType::Point;
+    s.lights[0].position = Vec3(0.5, 7, 0.5);
+    s.lights[0].intensity = 300.0;
+    s.lights[0].radius = 0.3;
+    scene::Light spot;
+    spot.type = scene::LightType::Spot;
+    spot.position = Vec3(-4, 6, 3);
+    spot.direction = glm::normalize(Vec3(4, -6, -3));
+    spot.coneAngleDegrees = 35.0;
+    spot.intensity = 300.0;
+    spot.radius = 0.2;
+    s.lights.push_back(spot);
+    s.camera.position = Vec3(0, 3, 8);
+    // The three ways lit.frag reads the maps: one tap (none; pcf, poisson and the filterable maps
+    // take the same), the gather of pcf2x2, and PCSS's blocker search over the nearest depths.
+    for (const scene::ShadowFilter filter :
+         {scene::ShadowFilter::None, scene::ShadowFilter::Pcf2x2, scene::ShadowFilter::Pcss}) {
+        scene::RasterSettings r = test::validatedSettings(512, 0.02, 1.0, filter);
+        Renderer windowed(s, test::planFor(s, r), r);
+        Renderer whole(s, test::planFor(s, r), r, RendererOptions{.transmittanceWindows = false});
+        scene::Scene moved = s;
+        moved.lights[0].position += Vec3(1.0, -1.0, 0.5);
+        moved.lights[1].position += Vec3(0.5, 0.5, -0.5);
+        for (int frame = 0; frame < 2; ++frame) {
+            if (frame == 1) {
+                windowed.update(moved);
+                whole.update(moved);
+            }
+            const scene::Frame a = windowed.render();
+            const scene::Frame b = whole.render();
+            const std::string windows = a.attributes.at("transmittance_windows");
+            // Both kinds of layer are there: with no window (a face seeing no glass) and with one
+            // smaller than the map.
+            EXPECT_NE(windows.find("none"), std::string::npos) << windows;
+            EXPECT_NE(windows.find(','), std::string::npos) << windows;
+            EXPECT_EQ(windows.find("0,0,512,512"), std::string::npos) << windows;
+            EXPECT_EQ(a.beauty, b.beauty) << "filter " << int(filter) << " frame " << frame;
+            EXPECT_EQ(a.visibility, b.visibility) << "filter " << int(filter) << " frame " << frame;
+            EXPECT_EQ(a.lightVisibility, b.lightVisibility) << "filter " << int(filter) << " frame " << frame;
+            EXPECT_EQ(a.blockerId, b.blockerId) << "filter " << int(filter) << " frame " << frame;
+            // The glass does shadow: some floor pixel gets a factor strictly between 0 and 1.
+            EXPECT_TRUE(std::any_of(a.visibility.begin(), a.visibility.end(),
+                                    [](float v) { return v > 0.05f && v < 0.95f; }));
+        }
+        EXPECT_EQ(windowed.validationMessages(), 0);
+        EXPECT_EQ(whole.validationMessages(), 0);
+    }
+}
+
 TEST(RasterTransmittance, ExplainSaysWhetherTheMapIsMade) {
     const scene::RasterSettings r = test::validatedSettings(256, 0.02, 1.0, scene::ShadowFilter::Pcf2x2);
     const std::string withPanes = test::planFor(twoPanes(), r).explain();
