@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <functional>
 #include <optional>
@@ -14,6 +15,7 @@
 #include <iostream>
 #include <memory>
 #include <set>
+#include <sstream>
 #include <unistd.h>
 
 #include <nlohmann/json.hpp>
@@ -38,6 +40,7 @@
 #include "raster/memory.h"
 #include "raster/renderer.h"
 #include "raster/shadow_layers.h"
+#include "raster/tolerances.h"
 #include "raytrace/view_search.h"
 #include "scene/error.h"
 #include "scene/frame_identity.h"
@@ -87,6 +90,25 @@ void chooseView(scene::Scene& s, const SceneOptions* o) {
     raytrace::chooseViewAndSun(s, o && o->settings.threads ? *o->settings.threads : 0);
 }
 
+std::string formatNumberShort(double v) {
+    std::ostringstream o;
+    o << v;
+    return o.str();
+}
+
+// --explain's words for the slope bias past its cap (lit.frag; docs/raster.md "Grazing light").
+std::string grazingLiftText(const scene::RasterSettings& r) {
+    if (!(r.slopeBias > 0.0)) return "";
+    std::ostringstream o;
+    o << "; past tan " << raster::kMaxSlopeTan << " (" << std::round(std::atan(raster::kMaxSlopeTan) * 1800.0 / 3.14159265358979) / 10.0
+      << " deg between normal and light) the slope term goes on as a lift along the normal, slope x texel x (sin - "
+      << raster::kMaxSlopeTan
+      << " cos): the same margin from the receiver's own plane with the lookup moved less than a texel per texel of "
+         "slope, where that margin along the light would pass through casters (grazing_normal_offset in the Frame"
+      << (r.hardwareBias ? "; spot and point maps only: the rasterizer's slope term is not capped)" : ")");
+    return o.str();
+}
+
 Prepared prepare(const SceneOptions& o) {
     Prepared p{readingInput(o.scene, [&] { return scene::loadScene(scene::findScene(o.scene)); }), {}, {}};
     if (o.resolution) applyResolution(p.scene, *o.resolution);
@@ -113,6 +135,10 @@ Prepared prepare(const SceneOptions& o) {
                           : "in the lit shader")
                   << (p.settings.raster.receiverPlaneBias ? "; the receiver plane replaces the slope term in the shader"
                                                           : "")
+                  << grazingLiftText(p.settings.raster)
+                  << (p.settings.raster.normalOffset > 0.0
+                          ? "; normal offset " + formatNumberShort(p.settings.raster.normalOffset) + " texels"
+                          : std::string())
                   << "\n";
     if (o.explain) {
         const std::vector<raster::LightCulling> culled = raster::culledCasters(p.scene, p.settings.raster, &p.plan);

@@ -27,7 +27,8 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
     cmd.add_option("--depth-bias", s.depthBias,
                    "raster: constant depth bias in world units (default: half a shadow-map texel)");
     cmd.add_option("--slope-bias", s.slopeBias,
-                   "raster: slope-scaled bias in texels, times tan(angle to light) (default 1)");
+                   "raster: slope-scaled bias in texels, times tan(angle to light) up to tan 10; past that the rest "
+                   "lifts the lookup along the normal, so a grazing plane keeps its margin (default 1)");
     cmd.add_option("--filter", s.filter,
                    "raster: shadow-map filter none|pcf2x2|pcf|poisson|pcss|vsm|evsm2|evsm4|esm|msm (default pcf2x2: "
                    "bilinear 2x2 PCF; pcss: soft shadows sized by a spot/point light's radius; vsm..msm: filterable "
@@ -43,7 +44,8 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
     cmd.add_option("--blur-width", s.blurWidth,
                    "raster: vsm..msm box blur width in texels, odd, 1..63 (default 5)");
     cmd.add_option("--normal-offset", s.normalOffset,
-                   "raster: move receivers along their normal by this many texels (default 0)");
+                   "raster: move receivers along their normal by this many texels, on top of the slope bias's lift "
+                   "past tan 10 (default 0)");
     cmd.add_flag("--receiver-plane-bias", s.receiverPlaneBias,
                  "raster: compare each filter tap against the receiver's plane (from screen-space derivatives) "
                  "instead of the slope bias");

@@ -697,8 +697,12 @@ double cullReachTexels(const scene::RasterSettings& settings, const scene::Light
     return reach;
 }
 
+double lookupOffsetTexels(const scene::RasterSettings& settings) {
+    return settings.normalOffset + std::max(0.0, settings.slopeBias - 1.0);
+}
+
 double fitMarginTexels(const scene::RasterSettings& settings, const scene::Light& light, int mapSize, double t) {
-    return cullReachTexels(settings, light, mapSize) + 2.0 * settings.normalOffset * std::sqrt(1.0 + t * t);
+    return cullReachTexels(settings, light, mapSize) + 2.0 * lookupOffsetTexels(settings) * std::sqrt(1.0 + t * t);
 }
 
 double snapWindowHalfSize(double half) {
@@ -837,7 +841,7 @@ LightFrustum pointLightFaceFrustum(const scene::Scene& scene, const scene::Raste
 
 std::vector<bool> layerCasters(const scene::Scene& scene, const scene::RasterSettings& settings,
                                const scene::Light& light, const LightFrustum& f, const std::vector<Vec3>& receivers) {
-    return castsOnto(scene, f, receivers, cullReachTexels(settings, light, f.mapSize), settings.normalOffset);
+    return castsOnto(scene, f, receivers, cullReachTexels(settings, light, f.mapSize), lookupOffsetTexels(settings));
 }
 
 }  // namespace shadowlab::raster

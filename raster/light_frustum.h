@@ -109,8 +109,12 @@ LightFrustum fitSpotLight(const scene::Bounds& bounds, const scene::Vec3& positi
 // The cone map when the camera sees none of the scene or no receiver lies in front of the light.
 LightFrustum fitSpotLightToReceivers(const scene::Scene& scene, const scene::Light& light, int mapSize,
                                      double marginTexels);
+// How far lit.frag moves a lookup point along its normal beyond what kCullMarginTexels holds, in
+// texels: the normal offset, and the slope bias's lift past its cap (under slopeBias texels)
+// beyond the first texel.
+double lookupOffsetTexels(const scene::RasterSettings& settings);
 // The margin fitSpotLightToReceivers and fitPointLightFaceToReceivers keep around the receivers,
-// in texels of a map of mapSize: cullReachTexels plus the normal offset, counted 2·√(1 + t²)
+// in texels of a map of mapSize: cullReachTexels plus lookupOffsetTexels, counted 2·√(1 + t²)
 // times (t: tangent of the widest direction the map holds; castsOnto says why).
 double fitMarginTexels(const scene::RasterSettings& settings, const scene::Light& light, int mapSize, double t);
 // The fitted spot map when settings.fitLightFrustum, else the cone map.
@@ -173,7 +177,8 @@ std::vector<bool> castsOnto(const scene::Scene& scene, const LightFrustum& f, co
 // castsOnto() with every receiver the camera sees (visibleReceiverPoints(scene)).
 std::vector<bool> castsIntoView(const scene::Scene& scene, const LightFrustum& f, double reachTexels,
                                 double normalOffsetTexels = 0.0);
-// The widest filter reach in texels (a 15-tap kernel's half, pcf2x2's extra texel, rounding).
+// The widest filter reach in texels (a 15-tap kernel's half, pcf2x2's extra texel, rounding: 8.7)
+// and one texel of the slope bias's lift past its cap (lit.frag; the default slope bias's most).
 inline constexpr double kCullMarginTexels = 10.0;
 // PCSS of a spot or point light with a size looks up to this fraction of the map's side from the
 // point, in its blocker search and its widest kernel (shaders/lit.frag kPcssMaxSearchFraction,

@@ -71,6 +71,13 @@ std::string joinedNumbers(const std::vector<double>& values) {
     return joined(values, [](double v) { return formatNumber(v); });
 }
 
+// Whether lit.frag moves the lookup point along the normal: for the user's normal offset, and for
+// the slope bias beyond its cap (kMaxSlopeTan) wherever a layer applies its slope bias in the shader.
+bool normalOffsetUsed(const scene::RasterSettings& settings, const std::vector<ShadowLayer>& layers) {
+    return settings.normalOffset != 0.0 ||
+           std::any_of(layers.begin(), layers.end(), [](const ShadowLayer& l) { return l.shaderSlopeBias > 0.0; });
+}
+
 // A closed surface: every edge (a pair of positions) is shared by exactly two of its triangles.
 // Meshes repeat positions at seams of normals or texture coordinates, so edges are compared by
 // position, not by vertex index.
@@ -540,6 +547,16 @@ void Renderer::Impl::describeLayers() {
                                                     : joinedNumbers(usedDepthBias);
     attributes["depth_bias_default"] = settings.depthBiasIsDefault ? "true" : "false";
     attributes["slope_bias"] = formatNumber(settings.slopeBias);
+    // The slope bias that lit.frag continues along the normal past max_slope_tan (texels; its lift
+    // is that x texel x max(0, sin θ − max_slope_tan·cos θ)): the shader's slope bias, 0 in layers
+    // whose slope bias the rasterizer applies. One value, or one per layer where they differ.
+    std::vector<double> grazing;
+    for (const ShadowLayer& layer : layers) grazing.push_back(layer.shaderSlopeBias);
+    const bool oneGrazing =
+        std::all_of(grazing.begin(), grazing.end(), [&](double g) { return g == grazing[0]; });
+    attributes["grazing_normal_offset"] = grazing.empty() ? "0"
+                                          : oneGrazing    ? formatNumber(grazing[0])
+                                                          : joinedNumbers(grazing);
     // On, the receiver's plane replaces the slope term in every tap (lit.frag), so slope_bias is unused.
     attributes["receiver_plane_bias"] = settings.receiverPlaneBias ? "true" : "false";
     // Where the constant and slope bias are applied, and with the hardware bias the factors each
@@ -668,7 +685,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                                                                    .blockerIds = wantIds,
                                                                    .aovTarget = !beautyOnly,
                                                                    .displayTarget = display,
-                                                                   .normalOffset = settings.normalOffset != 0.0,
+                                                                   .normalOffset = normalOffsetUsed(settings, layers),
                                                                    .beautyFormat = targets.beautyFormat,
                                                                    .lightTargets = std::uint32_t(targets.lights.size()),
                                                                    .lightCount = std::uint32_t(lightCount),

@@ -65,7 +65,9 @@ inline constexpr std::size_t kTransmittanceWindowTriangles = 1 << 16;
 // The slope bias grows with tan(theta), which is infinite at grazing light; clamping it at
 // 10 (theta ~ 84°) keeps the bias finite where a receiver is nearly edge-on to the light and
 // its N·L shading is close to zero anyway (a common clamp: Microsoft's "Common Techniques to
-// Improve Shadow Depth Maps" and most engines use a similar bound).
+// Improve Shadow Depth Maps" and most engines use a similar bound). Past it lit.frag applies the
+// rest of the slope bias as a lift along the normal, which gives the receiver's own plane the same
+// margin without carrying the compare point along the light (docs/raster.md "Grazing light").
 inline constexpr double kMaxSlopeTan = 10.0;
 
 // Largest pcf kernel (taps per side; the Poisson diameter in texels): 15x15 = 225 taps per

@@ -61,11 +61,13 @@ struct RasterSettings {
     // True when depthBias is defaultDepthBias() (no option, no scene value): the raster backend
     // then re-derives it as half a texel of each fitted map (fitLightFrustum), see docs/raster.md.
     bool depthBiasIsDefault = false;
-    double slopeBias = 0.0;     // texels: bias += slopeBias * texelWorldSize * tan(angle to light)
+    // texels: bias += slopeBias * texelWorldSize * min(tan(angle to light), 10); past the cap the
+    // raster shader lifts the lookup along the normal by slopeBias * texel * (sin - 10 cos)
+    double slopeBias = 0.0;
     ShadowFilter filter = ShadowFilter::Pcf2x2;
     int pcfSize = 3;            // pcf: taps per side; poisson: kernel diameter in texels (1..15)
     MomentSettings moments;     // vsm, evsm2, evsm4, esm, msm
-    double normalOffset = 0.0;  // texels: the receiver moves along its normal by this x texel world size
+    double normalOffset = 0.0;  // texels: the receiver moves along its normal by this x texel world size (plus the lift above)
     // Receiver-plane depth bias (Isidoro 2006): each filter tap compares against the receiver's
     // plane extrapolated to the texel it reads, instead of the slope bias (see docs/raster.md).
     bool receiverPlaneBias = false;

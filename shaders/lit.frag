@@ -390,10 +390,15 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
     // (axis, −axis·L), so lit.vert's interpolated w is it.)
     const float axialP = kVertexSpot ? inLightCoordinates.w : dot(p - light.position, axis);
     const float texel = light.texelWorldSize * (perspective ? axialP : 1.0);
-    // Normal offset: look the map up from a point moved off the surface along its normal.
-    const vec3 q = kNormalOffset ? p + n * (light.normalOffsetTexels * texel) : p;
+    // Normal offset: look the map up from a point moved off the surface along its normal, by the
+    // user's k texels plus the slope bias beyond its cap: s·texel·(sin θ − maxTan·cos θ) puts the
+    // point s·texel·(tan θ − maxTan) in front of its own plane along the light while moving it
+    // less than s texels, where the same margin along the light would pass through casters.
+    const float sinTheta = sqrt(max(1.0 - ndotl * ndotl, 0.0));
+    const float offset = (light.normalOffsetTexels + light.slopeBiasTexels * max(sinTheta - light.maxSlopeTan * ndotl, 0.0)) * texel;
+    const vec3 q = kNormalOffset ? p + n * offset : p;
     // bias_world = depthBias + slopeBias * texel * min(tan(theta), maxTan), cos(theta) = N·L.
-    const float tanTheta = min(sqrt(max(1.0 - ndotl * ndotl, 0.0)) / ndotl, light.maxSlopeTan);
+    const float tanTheta = min(sinTheta / ndotl, light.maxSlopeTan);
     Receiver r;
     r.slopeStep = light.slopeBiasTexels * texel * tanTheta;
     r.biasWorld = light.depthBiasWorld + r.slopeStep;
@@ -408,15 +413,15 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         // computes them per vertex. In float the sum differs from the product of the interpolated
         // position by rounding at the scale of the map's coordinates (≈1e-7 of its extent), not of
         // the camera-relative position: far below a texel (2048 of them) and the depth bias.
-        // A spot: offset = k·texel(p) is not constant, but texel(p) = bias.z·w(p) with w the
-        // interpolated (linear) distance along the axis, so offset · toShadow · (n, 0) is a
-        // product of two interpolated factors, formed here; the clip coordinates are linear before
+        // A spot: offset = k'·texel(p) is not constant (k' depends on the fragment's N·L), but
+        // texel(p) = bias.z·w(p) with w the interpolated (linear) distance along the axis, so
+        // offset · toShadow · (n, 0) is a product of interpolated factors, formed here; the clip coordinates are linear before
         // the divide, which is done per fragment, and w = (q − L)·axis is the axial distance of the
         // offset point. Each component rounds at its own scale (x, y ≈ w·(u, v): ≈1e-7 of w, so
         // ≈1e-7 of the map after the divide; w ≈1e-7 of max(|p|, |L|) camera-relative, against a
         // bias of half a texel ≈ 1e-3·w at 2048²), as the per-fragment product does.
-        const vec4 s = kNormalOffset ? inLightCoordinates + (light.normalOffsetTexels * texel * nScale) * inLightNormal
-                                     : inLightCoordinates;
+        const vec4 s =
+            kNormalOffset ? inLightCoordinates + (offset * nScale) * inLightNormal : inLightCoordinates;
         r.uv = kVertexSpot ? s.xy / s.w : s.xy;
         r.axial = kVertexSpot ? s.w : s.z;
     } else {

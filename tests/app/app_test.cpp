@@ -281,14 +281,24 @@ TEST(App, ExplainSaysWhereTheBiasIsApplied) {
                           "--depth-bias", "0.02", "--slope-bias", "1.5", "-o", out});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.err.find("raster bias: constant 0.02 world units, slope 1.5 texels x tan(angle to light), in the "
-                         "lit shader\n"),
+                         "lit shader; past tan 10 (84.3 deg between normal and light) the slope term goes on as a "
+                         "lift along the normal"),
               std::string::npos)
         << r.err;
+    EXPECT_EQ(r.err.find("normal offset"), std::string::npos) << r.err;  // none given
     r = shadowlab({"render", "seed", "--backend", "raster", "--explain", "--resolution", "96x54", "--hardware-bias",
-                   "-o", out});
+                   "--normal-offset", "0.5", "-o", out});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.err.find("(default: half a texel of each map as fitted or cascaded"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("through the rasterizer's depth-bias state"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("spot and point maps only: the rasterizer's slope term is not capped"), std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("; normal offset 0.5 texels\n"), std::string::npos) << r.err;
+    // Without a slope bias there is nothing to continue past the cap.
+    r = shadowlab({"render", "seed", "--backend", "raster", "--explain", "--resolution", "96x54", "--slope-bias", "0",
+                   "-o", out});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_EQ(r.err.find("lift along the normal"), std::string::npos) << r.err;
 }
 
 TEST(App, ExplainGivesEveryAutomaticRasterChoiceAndEachCanBeForced) {

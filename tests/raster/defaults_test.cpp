@@ -125,6 +125,70 @@ TEST(RasterDefaults, ALowSunOverALargeGroundKeepsTheSmallSpheresEllipse) {
     EXPECT_LT(b.insideShadowed, n.inside / 2) << b.insideShadowed << " of " << b.inside;
 }
 
+// The same sphere under a sun 1° high, at the defaults: the ground must be lit wherever the sphere
+// does not shadow it. The ground's depth along the light changes by texel·tan θ per texel of the
+// map (tan 89° = 57.3). pcf2x2 mixes the four texels around the lookup point bilinearly; a texel
+// center at offset o (texels, |o_x|, |o_y| < 1) stores the ground o·ĝ·texel·tan θ nearer than the
+// point (ĝ the unit gradient). The defaults give each of the four a margin of half a texel plus
+// 2·min(tan θ, 10) texels of slope bias (the gather's texels reach one texel further than the
+// point) plus the slope bias past its cap along the normal: a lookup point lifted by
+// texel·(sin θ − 10 cos θ) lies texel·(tan θ − 10) in front of its own plane. In all
+// texel·(tan θ + 10.5) ≥ texel·tan θ, so a texel compares false only where o·ĝ > 1, i.e.
+// o_x² + o_y² > 1, where its weight (1 − |o_x|)(1 − |o_y|) is at most (1 − 1/√2)² = 0.086; only
+// the one texel diagonally toward the light can be that far. So every lit ground pixel keeps
+// V ≥ 1 − 0.086. (Without the part past the cap the margin is 20.5 texels of depth against 57.3:
+// stripes across the ground where V < 0.5, 13% of scenes/extreme/grazing-1deg.)
+TEST(RasterDefaults, ASunOneDegreeHighLeavesTheLitGroundLitAndKeepsTheShadow) {
+    const Vec3 c(0, 0.5, 0);
+    const double r = 0.5;
+    scene::Scene s = largeGround(1.0, Vec3(-4, 3, 6), Vec3(6, 0, 0));
+    scene::Object sphere;
+    sphere.name = "sphere";
+    sphere.shape = scene::Sphere{c, r};
+    s.objects.insert(s.objects.begin(), sphere);
+    scene::RenderSettings settings = scene::resolveSettings(s, {});
+    settings.raster.validate = true;
+    const scene::Frame f = test::renderChecked(s, settings.raster);
+
+    // Pixels within three texels of the ellipse's edge (in distance from the light's axis through
+    // the sphere's center, a distance across the map) are left out: pcf2x2 spreads an edge over a
+    // texel, the lift (at most one texel) widens the shadow by about as much, and the sphere's
+    // facets move its outline a little more. The whole ellipse (28.6 long, at most ~33 from the
+    // camera) lies in the first map, whose texel is the first texel_world_size.
+    const double texel = std::stod(f.attributes.at("texel_world_size"));
+    const double margin = 3.0 * texel;
+    ASSERT_LT(margin, 0.5 * r);
+    const double bound = 1.0 - (1.0 - 1.0 / std::sqrt(2.0)) * (1.0 - 1.0 / std::sqrt(2.0));
+    const Vec3 L = s.lights[0].direction;
+    int lit = 0, below = 0, inside = 0, insideShadowed = 0;
+    float worst = 1.0f;
+    for (int y = 0; y < f.height; ++y)
+        for (int x = 0; x < f.width; ++x) {
+            const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
+            if (f.objectId[i] != 2.0f) continue;  // the ground
+            const auto p = groundPoint(s, x, y);
+            if (!p) continue;
+            const Vec3 d = *p - c;
+            const double along = glm::dot(d, L);
+            const double across = glm::length(d - along * L);
+            if (along > 0.0 && across < r - margin) {
+                ++inside;
+                insideShadowed += f.visibility[i] < 0.5f ? 1 : 0;
+            } else if (along < -margin || across > r + margin) {
+                ++lit;
+                worst = std::min(worst, f.visibility[i]);
+                below += f.visibility[i] < float(bound) ? 1 : 0;
+            }
+        }
+    ASSERT_GT(lit, f.width * f.height / 4);
+    ASSERT_GT(inside, 200);  // the ribbon of shadow seen from its side
+    EXPECT_EQ(below, 0) << "lit ground pixels under " << bound << " (acne): " << below << " of " << lit
+                        << ", least visibility " << worst;
+    EXPECT_GE(insideShadowed, int(0.97 * inside)) << insideShadowed << " of " << inside;
+    EXPECT_EQ(f.attributes.at("slope_bias"), "1");
+    EXPECT_EQ(f.attributes.at("grazing_normal_offset"), "1");
+}
+
 // The cascade rule: one map is kept while its texel is at most 2 pixels at the nearest visible
 // receiver. On the low-sun ground the single fitted map is at least as wide, across the light, as
 // the distance across the light between two visible ground points, and the nearest receiver is no
