@@ -465,11 +465,11 @@ ViewSearchResult searchViewAndSun(const scene::Scene& scene, const ViewSearchOpt
         // The best few again at a finer size, where the holes of cut-outs and thin casters lost
         // at thumbnail size decide between them; a stable order keeps the first among equals.
         std::stable_sort(scored.begin(), scored.end(),
-                         [](const Scored& a, const Scored& b) { return a.score.score > b.score.score; });
+                         [](const Scored& x, const Scored& y) { return x.score.score > y.score.score; });
         const std::size_t refined = std::min<std::size_t>(scored.size(), std::size_t(std::max(options.refine, 0)));
         scored.resize(std::max<std::size_t>(refined, 1));
         std::sort(scored.begin(), scored.end(),
-                  [](const Scored& a, const Scored& b) { return a.view != b.view ? a.view < b.view : a.sun < b.sun; });
+                  [](const Scored& x, const Scored& y) { return x.view != y.view ? x.view < y.view : x.sun < y.sun; });
         r.fineWidth = kRefineScale * r.width;
         r.fineHeight = thumbnailHeight(scene.camera, r.fineWidth);
         r.refined = int(refined);

@@ -168,7 +168,7 @@ float transmittanceTap(vec2 uv, float layer, float ref) {
                                          vec4(texture(restTransmittanceMaps, at).r),
                                          vec4(texture(secondTransparentDepths, at).r), ref)
                         .x;
-    return inTransmitWindow(floor(uv * counts().y), layer) ? t : 1.0;
+    return inTransmitWindow(floor(uv * mapSize()), layer) ? t : 1.0;
 }
 
 // One compare tap; records the object stored there when it shadows and none was found yet
@@ -207,7 +207,7 @@ float reference(LightData light, Receiver r, float bias) {
 // (d − near)/(far − near), d the distance along its axis (shaders/moments.comp linearDepth).
 float momentReference(LightData light, Receiver r, float bias) {
     if (isPerspective(light)) {
-        const float near = light.kind.z, far = light.kind.w;
+        const float near = light.mapNear, far = light.mapFar;
         return (r.axial - bias - near) / (far - near);
     }
     return reference(light, r, bias);

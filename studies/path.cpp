@@ -34,12 +34,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
-using Clock = std::chrono::steady_clock;
 constexpr double kPi = 3.14159265358979323846;
-
-double msSince(Clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // v turned by `degrees` about the unit axis `k` (Rodrigues).
 scene::Vec3 rotate(const scene::Vec3& v, const scene::Vec3& k, double degrees) {

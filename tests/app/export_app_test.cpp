@@ -81,10 +81,12 @@ TEST(ExportApp, AnExportLoadsBackWithTheSceneCameraSizeAndLights) {
             EXPECT_NEAR(b.lights[i].intensity, a.lights[i].intensity, 1e-9 * a.lights[i].intensity) << name;
             EXPECT_NEAR(b.lights[i].coneAngleDegrees, a.lights[i].coneAngleDegrees, 1e-9) << name;
             EXPECT_NEAR(b.lights[i].radius, a.lights[i].radius, 1e-12) << name;
-            if (a.lights[i].type != scene::LightType::Point)
+            if (a.lights[i].type != scene::LightType::Point) {
                 EXPECT_NEAR(glm::length(b.lights[i].direction - a.lights[i].direction), 0.0, 1e-9) << name;
-            if (a.lights[i].type != scene::LightType::Directional)
+            }
+            if (a.lights[i].type != scene::LightType::Directional) {
                 EXPECT_NEAR(glm::length(b.lights[i].position - a.lights[i].position), 0.0, 1e-9) << name;
+            }
         }
     }
 }

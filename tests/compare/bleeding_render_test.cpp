@@ -14,6 +14,7 @@
 #include "raster/renderer.h"
 #include "raytrace/renderer.h"
 #include "scene/camera.h"
+#include "tests/kit/render_checked.h"
 
 namespace shadowlab::compare {
 namespace {
@@ -65,12 +66,10 @@ Renders compareRaster(const scene::Scene& s, const scene::SettingsOverrides& o) 
     ov.fitLightFrustum = false;  // the bounding-sphere map: its texel is known below
     ov.cascades = 1;
     scene::RenderSettings settings = scene::resolveSettings(s, ov);
-    settings.raster.validate = true;
     const scene::RenderPlan plan = scene::makeRenderPlan(s, settings);
     raster::RenderDebug debug;
     Renders r;
-    r.raster = raster::render(s, plan, settings.raster, scene::kAllChannels, &debug);
-    EXPECT_EQ(r.raster.attributes.at("validation_messages"), "0") << "validation messages were printed above";
+    r.raster = test::renderChecked(s, settings, &debug);
     if (!debug.layers.empty()) r.texel = debug.layers[0].frustum.texelWorldSize();
     r.reference = raytrace::renderReference(s, plan, scene::referenceSettings(settings.raytrace));
     r.c = compareFrames(r.raster, r.reference);

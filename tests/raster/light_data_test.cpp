@@ -11,7 +11,8 @@
 
 #include "raster/tolerances.h"
 #include "scene/camera.h"
-#include "tests/raster/test_scenes.h"
+#include "tests/kit/render_checked.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::raster {
 namespace {

@@ -8,7 +8,7 @@
 
 #include <cmath>
 #include <string>
-#include <tuple>
+#include <array>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -44,66 +44,91 @@ scene::Scene floorScene() {
     return s;
 }
 
-// What the pass wrote, one pixel's beauty (rgb, visibility) and AOVs (id, N·L, depth, blocker).
+// What the pass wrote: per pixel the beauty (rgb) and each AOV plane (LitPlane order: visibility,
+// object id, N·L, view depth, blocker id at index 1..5; index 0 unused).
 struct Pixels {
-    std::vector<glm::vec4> beauty, aovs;
+    std::vector<glm::vec3> beauty;
+    std::array<std::vector<float>, kLitPlanes> planes;
+    float at(LitPlane plane, std::size_t i) const { return planes[std::size_t(plane)][i]; }
 };
 
 // The lit pass of `s` alone: the light's uniforms as the renderer fills them for a directional
 // light, but with layer −1 (no shadow test), the placeholder maps a render without shadow layers
-// binds, the geometry relative to the camera; `draw` false draws nothing.
+// binds, the geometry relative to the camera, the pass rendering into its own targets; `draw`
+// false draws nothing.
 Pixels litPass(const Context& ctx, const scene::Scene& s, bool readInPlace, bool draw = true) {
     const scene::CameraBasis cam = scene::cameraBasis(s.camera);
     const SceneGeometry g = tessellateScene(s, cam.position);
     const Buffer vb = uploadBuffer(ctx, g.vertices, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
     const Buffer ib = uploadBuffer(ctx, g.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
-    const DrawGeometry geometry{vb.buffer.get(), ib.buffer.get(), draw ? std::uint32_t(g.indices.size()) : 0u};
+    DrawGeometry geometry;
+    geometry.vertices = vb.buffer.get();
+    geometry.indices = ib.buffer.get();
+    geometry.indexCount = draw ? std::uint32_t(g.indices.size()) : 0u;
 
     shaders::LitUniforms u{};
     u.viewProj = glm::mat4(scene::projectionMatrix(cam, s.camera.near, s.camera.far) * scene::viewMatrix(cam, cam.position));
-    u.forward = glm::vec4(glm::vec3(cam.forward), float(s.ambient));
-    u.background = glm::vec4(glm::vec3(s.background), 0.0f);
-    u.counts = glm::vec4(1.0f, 1.0f, 0.0f, 0.0f);
+    u.forward = glm::vec3(cam.forward);
+    u.ambient = float(s.ambient);
+    u.background = glm::vec3(s.background);
+    u.lightCount = 1;
+    u.mapSize = 1.0f;
     shaders::LightData& l = u.lights[0];
     l.toShadow = glm::mat4(1.0f);
-    l.toLight = glm::vec4(glm::vec3(kToLight), -1.0f);  // w: no shadow-map layer
-    l.radiance = glm::vec4(float(kIntensity));
-    l.params = glm::vec4(float(kMaxSlopeTan), float(SHADOWLAB_FILTER_NONE), 0.0f, 1.0f);
-    l.kind = glm::vec4(float(SHADOWLAB_LIGHT_DIRECTIONAL), 0.0f, 0.0f, 0.0f);
+    l.towardLight = glm::vec3(kToLight);
+    l.layer = -1.0f;  // no shadow test
+    l.radiance = glm::vec3(float(kIntensity));
+    l.visibilityWeight = float(kIntensity);
+    l.maxSlopeTan = float(kMaxSlopeTan);
+    l.filterCode = SHADOWLAB_FILTER_NONE;
+    l.pcfSize = 1;
+    l.kind = SHADOWLAB_LIGHT_DIRECTIONAL;
     const std::vector<glm::vec4> albedos = {glm::vec4(glm::vec3(kAlbedo), 1.0f)};
 
-    const LitPipeline pipeline = createLitPipeline(
-        ctx, LitVariant{.filter = scene::ShadowFilter::None, .normalOffset = false,
-                        .lightKinds = 1u << SHADOWLAB_LIGHT_DIRECTIONAL});
+    const LitPipeline pipeline =
+        createLitPipeline(ctx,
+                          LitVariant{.filter = scene::ShadowFilter::None, .normalOffset = false,
+                                     .lightKinds = 1u << SHADOWLAB_LIGHT_DIRECTIONAL},
+                          VK_NULL_HANDLE, glm::vec3(s.background));
     // Placeholders, moved to SHADER_READ_ONLY_OPTIMAL by a shadow pass of no layers.
     const ShadowPipeline shadowPipeline = createShadowPipeline(ctx);
     const ShadowMaps maps = createShadowMaps(ctx, 1, 1);
     const TransmittanceMaps transmittance = createTransmittanceMaps(ctx, 1, 1);
     const MomentMaps moments = createMomentMaps(ctx, 1, 1);
-    const TransmittancePass placeholders{nullptr, &transmittance, {}, nullptr};
+    const TransmittancePass placeholders{nullptr, &transmittance, {}, nullptr, {}};
     const LitTargets targets = createLitTargets(ctx, kWidth, kHeight, 0, readInPlace);
     EXPECT_EQ(targets.hostReadable, readInPlace) << "lavapipe reads its targets in place when asked";
-    const LitBindings bindings = createLitBindings(ctx, pipeline, u, albedos, maps, transmittance, moments);
+    const LitBindings bindings =
+        createLitBindings(ctx, pipeline, u, shaders::TransmitWindows{}, albedos, maps, transmittance, moments);
     const Readback readback = createReadback(ctx, targets);
+    LitAttachments attachments;
+    for (const Image& plane : targets.planes) attachments.add(plane);
 
     VkCommandBuffer commands = ctx.beginCommands();
     recordShadowPass(commands, shadowPipeline, maps, geometry, {}, true, &placeholders);
-    recordLitPass(commands, pipeline, bindings, targets, geometry, glm::vec3(s.background));
-    if (!targets.hostReadable) recordReadback(commands, targets, readback);
+    recordLitPass(commands, pipeline, bindings, targets, attachments, geometry, glm::vec3(s.background));
+    ReadbackSelection all;
+    all.planes.fill(true);
+    if (!targets.hostReadable) recordReadback(commands, targets, readback, all);
     ctx.submitAndWait(commands);
-    if (!targets.hostReadable) {
-        invalidate(ctx, readback.beauty);
-        invalidate(ctx, readback.aovs);
-    }
+    if (!targets.hostReadable)
+        for (const Buffer& b : readback.planes) invalidate(ctx, b);
     // (lavapipe's host-visible memory is coherent: targets read in place need no invalidation.)
     Pixels out;
-    for (const auto& [image, buffer, to] : {std::tuple{&targets.beauty, &readback.beauty, &out.beauty},
-                                            std::tuple{&targets.aovs, &readback.aovs, &out.aovs}}) {
-        const char* base = targets.hostReadable ? static_cast<const char*>(image->mapped)
-                                                : static_cast<const char*>(buffer->mapped);
-        const std::size_t pitch = targets.hostReadable ? std::size_t(image->rowPitch) : std::size_t(kWidth) * 16;
+    for (std::uint32_t p = 0; p < kLitPlanes; ++p) {
+        const std::size_t texel = litPlaneTexelBytes(targets, LitPlane(p));
+        const char* base = targets.hostReadable ? static_cast<const char*>(targets.planes[p].mapped)
+                                                : static_cast<const char*>(readback.planes[p].mapped);
+        const std::size_t pitch =
+            targets.hostReadable ? std::size_t(targets.planes[p].rowPitch) : std::size_t(kWidth) * texel;
         for (int y = 0; y < kHeight; ++y)
-            for (int x = 0; x < kWidth; ++x) to->push_back(reinterpret_cast<const glm::vec4*>(base + y * pitch)[x]);
+            for (int x = 0; x < kWidth; ++x) {
+                const float* v = reinterpret_cast<const float*>(base + std::size_t(y) * pitch + std::size_t(x) * texel);
+                if (p == 0)
+                    out.beauty.emplace_back(v[0], v[1], v[2]);
+                else
+                    out.planes[p].push_back(v[0]);
+            }
     }
     return out;
 }
@@ -127,21 +152,25 @@ TEST(RasterLitPass, DrawsTheQuadTheCameraSeesWithItsShadingAndAovs) {
                 const Vec3 q = test::floorPoint(cam, x, y);
                 const double edge = std::max(std::abs(q.x), std::abs(q.z));
                 const bool down = test::pixelRay(cam, x, y).y < 0.0;
-                const glm::vec4 b = p.beauty[i], a = p.aovs[i];
+                const glm::vec3 b = p.beauty[i];
+                const float id = p.at(LitPlane::kObjectId, i), nl = p.at(LitPlane::kNdotL, i),
+                            z = p.at(LitPlane::kDepth, i), blocker = p.at(LitPlane::kBlockerId, i),
+                            v = p.at(LitPlane::kVisibility, i);
                 if (down && edge < 1.4) {
                     ++onQuad;
                     const double ndotl = kToLight.y;
                     const Vec3 color = kAlbedo * (kAmbient + kIntensity * ndotl);
                     const double depth = glm::dot(q - cam.position, cam.forward);
-                    const bool ok = a.x == 1.0f && std::abs(a.y - ndotl) < 1e-5 && std::abs(a.z - depth) < 1e-4 &&
-                                    a.w == 0.0f && b.w == 1.0f && std::abs(b.r - color.r) < 1e-5 &&
+                    const bool ok = id == 1.0f && std::abs(nl - ndotl) < 1e-5 && std::abs(z - depth) < 1e-4 &&
+                                    blocker == 0.0f && v == 1.0f && std::abs(b.r - color.r) < 1e-5 &&
                                     std::abs(b.g - color.g) < 1e-5 && std::abs(b.b - color.b) < 1e-5;
                     if (!ok && ++wrong <= 3)
                         ADD_FAILURE() << "quad pixel " << x << "," << y << ": beauty " << b.r << " " << b.g << " " << b.b
-                                      << " " << b.w << ", aovs " << a.x << " " << a.y << " " << a.z << " " << a.w;
+                                      << ", visibility " << v << ", aovs " << id << " " << nl << " " << z << " " << blocker;
                 } else if (!down || edge > 1.6) {
                     ++off;
-                    const bool ok = b == glm::vec4(glm::vec3(kBackground), 0.0f) && a == glm::vec4(0.0f);
+                    const bool ok = b == glm::vec3(kBackground) && v == 0.0f && id == 0.0f && nl == 0.0f &&
+                                    z == 0.0f && blocker == 0.0f;
                     if (!ok && ++wrong <= 3) ADD_FAILURE() << "background pixel " << x << "," << y;
                 }
             }
@@ -157,8 +186,11 @@ TEST(RasterLitPass, WithNothingToDrawEveryPixelIsTheBackgroundWithZeroAovs) {
     test::ValidatedContext vc;
     const Pixels p = litPass(vc.get(), floorScene(), true, false);
     int wrong = 0;
-    for (std::size_t i = 0; i < p.beauty.size(); ++i)
-        wrong += p.beauty[i] != glm::vec4(glm::vec3(kBackground), 0.0f) || p.aovs[i] != glm::vec4(0.0f);
+    for (std::size_t i = 0; i < p.beauty.size(); ++i) {
+        bool zero = true;
+        for (std::uint32_t plane = 1; plane < kLitPlanes; ++plane) zero = zero && p.planes[plane][i] == 0.0f;
+        wrong += p.beauty[i] != glm::vec3(kBackground) || !zero;
+    }
     EXPECT_EQ(p.beauty.size(), std::size_t(kWidth) * kHeight);
     EXPECT_EQ(wrong, 0);
 }

@@ -14,7 +14,8 @@
 #include <gtest/gtest.h>
 
 #include "raster/renderer.h"
-#include "tests/raster/test_scenes.h"
+#include "tests/kit/render_checked.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::raster {
 namespace {

@@ -281,9 +281,9 @@ TEST(ViewSearch, ShadowEdgesSeenNearEdgeOnCountByTheirLegibility) {
         if (offNormal < 60.0) EXPECT_DOUBLE_EQ(weighted, pairs);  // within 60°: every pair counts whole
         else EXPECT_LT(weighted, 0.6 * pairs);                     // squeezed: about half
         if (offNormal < 0.0) {
-            std::size_t screen = 0;
-            for (std::size_t i = 0; i < f.pixelCount(); ++i) screen += f.objectId[i] == 2.0f;
-            EXPECT_GT(screen, 1000u) << "the screen is in view";
+            std::size_t screenPixels = 0;
+            for (std::size_t i = 0; i < f.pixelCount(); ++i) screenPixels += f.objectId[i] == 2.0f;
+            EXPECT_GT(screenPixels, 1000u) << "the screen is in view";
         }
     }
 }

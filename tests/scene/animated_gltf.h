@@ -68,8 +68,8 @@ inline std::filesystem::path writeAnimatedGltf(const TempDir& dir, const std::st
     const int t3 = b.add({0, 1, 2}, "SCALAR", 3, true);
     const int tr3 = b.add({0, 1, 5, 1, 1, 5, 2, 1, 5}, "VEC3", 3);
     const int t2 = b.add({0, 2}, "SCALAR", 2, true);
-    const double kPi = 3.14159265358979323846;
-    const float s45 = float(std::sin(kPi / 4)), c45 = float(std::cos(kPi / 4));
+    const double quarterTurn = 3.14159265358979323846 / 2;
+    const float s45 = float(std::sin(quarterTurn / 2)), c45 = float(std::cos(quarterTurn / 2));
     const int rot2 = b.add({0, 0, 0, 1, 0, s45, 0, c45}, "VEC4", 2);
     const int ts = b.add({0, 1}, "SCALAR", 2, true);
     const int stepValues = b.add({0, 1, 5, 0, 3, 5}, "VEC3", 2);

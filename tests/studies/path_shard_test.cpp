@@ -18,7 +18,8 @@
 #include "scene/camera.h"
 #include "scene/error.h"
 #include "scene/loader.h"
-#include "tests/raster/test_scenes.h"
+#include "tests/kit/render_checked.h"
+#include "tests/kit/test_scenes.h"
 #include "tests/scene/animated_gltf.h"
 
 namespace shadowlab::studies {
@@ -40,11 +41,11 @@ scene::RenderSettings settingsFor(const scene::Scene& s, int mapSize) {
 }
 
 scene::Scene slantedSphere(int width, int height) {
-    raster::test::SphereOverPlane p;
+    shadowlab::test::SphereOverPlane p;
     p.lightDirection = Vec3(-1, -2, -1);
     p.width = width;
     p.height = height;
-    scene::Scene s = raster::test::makeScene(p);
+    scene::Scene s = shadowlab::test::makeScene(p);
     s.file = "test-scene.json";  // no such file: its hash is that of the name, the same in every shard
     return s;
 }

@@ -19,13 +19,14 @@
 #include "raster/renderer.h"
 #include "raytrace/renderer.h"
 #include "scene/error.h"
-#include "tests/raster/test_scenes.h"
+#include "tests/kit/render_checked.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::studies {
 namespace {
 
 namespace fs = std::filesystem;
-using raster::test::SphereOverPlane;
+using shadowlab::test::SphereOverPlane;
 using scene::Vec3;
 
 scene::RenderSettings settingsFor(const scene::Scene& s, int mapSize) {
@@ -43,7 +44,7 @@ scene::Scene slantedSphere(int width, int height) {
     p.lightDirection = Vec3(-1, -2, -1);
     p.width = width;
     p.height = height;
-    return raster::test::makeScene(p);
+    return shadowlab::test::makeScene(p);
 }
 
 std::vector<const scene::Frame*> pointers(const std::vector<scene::Frame>& frames) {
@@ -104,14 +105,14 @@ TEST(RasterRendererUpdate, AMovedCameraDrawsWhatAFreshRendererForThatCameraDraws
     moved.render();
     moved.update(s1);
     const scene::Frame a = moved.render();
-    const scene::Frame b = raster::test::renderChecked(s1, settings.raster);
+    const scene::Frame b = shadowlab::test::renderChecked(s1, settings.raster);
     EXPECT_EQ(a.attributes.at("light_frustum"), b.attributes.at("light_frustum"));
     expectSameImage(a, b, 2.0f);
     EXPECT_EQ(moved.validationMessages(), 0);
 }
 
 TEST(RasterRendererUpdate, CascadesFollowTheMovedCameraAsAFreshRenderersDo) {
-    const scene::Scene s0 = raster::test::makeLongPlane(96, 54);
+    const scene::Scene s0 = shadowlab::test::makeLongPlane(96, 54);
     scene::Scene s1 = s0;
     s1.camera.position += 0.2 * (s0.camera.lookAt - s0.camera.position);  // dolly in
     scene::RenderSettings settings = settingsFor(s0, 512);
@@ -121,7 +122,7 @@ TEST(RasterRendererUpdate, CascadesFollowTheMovedCameraAsAFreshRenderersDo) {
     moved.render();
     moved.update(s1);
     const scene::Frame a = moved.render();
-    const scene::Frame b = raster::test::renderChecked(s1, settings.raster);
+    const scene::Frame b = shadowlab::test::renderChecked(s1, settings.raster);
     EXPECT_EQ(a.attributes.at("cascade_splits"), b.attributes.at("cascade_splits"));
     EXPECT_EQ(a.attributes.at("light_frustum"), b.attributes.at("light_frustum"));
     expectSameImage(a, b, 1.0f);
@@ -129,7 +130,7 @@ TEST(RasterRendererUpdate, CascadesFollowTheMovedCameraAsAFreshRenderersDo) {
 }
 
 TEST(RasterRendererUpdate, AChangeThatNeedsOtherMapsIsRefused) {
-    const scene::Scene s0 = raster::test::makeLongPlane(64, 36);
+    const scene::Scene s0 = shadowlab::test::makeLongPlane(64, 36);
     scene::Scene s1 = s0;
     s1.camera.lookAt = s0.camera.position + Vec3(0, 0, 10);  // looks away: no cascades, one map
     scene::RenderSettings settings = settingsFor(s0, 256);
@@ -284,7 +285,7 @@ Seam seamFlicker(const scene::Frame& m0, const scene::Frame& m1, const scene::Fr
 
 TEST(PathStability, CascadeSeamFlickerUnderADollyWithAndWithoutBlending) {
     // The long plane with a rail along the view: its shadow's edge runs through every split.
-    scene::Scene base = raster::test::makeLongPlane(160, 90);
+    scene::Scene base = shadowlab::test::makeLongPlane(160, 90);
     scene::Object rail;
     rail.name = "rail";
     rail.shape = scene::Box{Vec3(0.8, 0.0, -190.0), Vec3(1.4, 1.0, -2.5)};
@@ -398,7 +399,7 @@ TEST(PathScenes, PathsMoveWhatTheySayAndRejectWhatTheSceneCannotHave) {
     EXPECT_NEAR(glm::length(d4), glm::length(d0), 1e-12);
     EXPECT_NEAR(d4.y, d0.y, 1e-12);
     EXPECT_NEAR(std::acos(glm::dot(glm::normalize(Vec3(d0.x, 0, d0.z)), glm::normalize(Vec3(d4.x, 0, d4.z)))) * 180 /
-                    raster::test::kPi,
+                    shadowlab::test::kPi,
                 40.0, 1e-9);
     spec.kind = PathKind::SubTexel;
     spec.amount = 0.5;

@@ -15,7 +15,8 @@
 
 #include "compare/compare.h"
 #include "scene/loader.h"
-#include "tests/raster/test_scenes.h"
+#include "tests/kit/render_checked.h"
+#include "tests/kit/test_scenes.h"
 
 namespace shadowlab::studies {
 namespace {
@@ -183,7 +184,7 @@ Measured pasted(const fs::path& sceneFile, const Json& block, int w, int h, cons
     s.camera.height = h;
     scene::SettingsOverrides v;
     v.validate = true;
-    return measure(raster::test::renderChecked(s, scene::resolveSettings(s, v).raster), reference);
+    return measure(shadowlab::test::renderChecked(s, scene::resolveSettings(s, v).raster), reference);
 }
 
 void checkNeverLoses(const std::string& name) {
@@ -202,7 +203,7 @@ void checkNeverLoses(const std::string& name) {
     ASSERT_TRUE(r.raster.defaults.ok) << r.raster.defaults.error;
     scene::SettingsOverrides v;
     v.validate = true;
-    const Measured defaults = measure(raster::test::renderChecked(full, scene::resolveSettings(full, v).raster), ref);
+    const Measured defaults = measure(shadowlab::test::renderChecked(full, scene::resolveSettings(full, v).raster), ref);
     const Measured block = pasted(file, r.shadowBlock, 160, 90, ref);
     std::printf("%s: %zu points, defaults %.4f%% (IoU %.3f), block %.4f%% (IoU %.3f), block %s\n", name.c_str(),
                 r.points.size(), 100 * defaults.mismatchRate, defaults.shadowIoU, 100 * block.mismatchRate,

@@ -153,7 +153,9 @@ TEST(ShardSplit, EveryRowIsInExactlyOneShardForOneToEightShards) {
             for (const auto& [key, count] : seen) EXPECT_EQ(count, 1) << key << " with " << n << " shards";
             EXPECT_LE(largest - smallest, 1u) << rows << " rows, " << n << " shards";
             // More shards than rows: exactly `rows` shards hold one row, the rest none.
-            if (n > rows) EXPECT_EQ(largest, 1u);
+            if (n > rows) {
+                EXPECT_EQ(largest, 1u);
+            }
         }
     }
 }
