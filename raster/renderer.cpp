@@ -509,7 +509,7 @@ void Renderer::Impl::describeTransmitWindows() {
 }
 
 void Renderer::Impl::describeLayers() {
-    attributes["backend"] = "raster";
+    attributes["backend"] = scene::toString(scene::Backend::Raster);
     attributes["shadow_map_size"] = std::to_string(settings.shadowMapSize);
     attributes["filter"] = filterName(settings.filter);
     if (settings.filter == scene::ShadowFilter::Pcf || settings.filter == scene::ShadowFilter::Poisson ||

@@ -52,7 +52,7 @@ std::uint64_t sampleSeed(std::size_t pixel, int light) {
 // With `prebuilt`, its acceleration structures are used and "setup" is 0 (Renderer).
 template <typename Real>
 scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan,
-                     const scene::RaytraceSettings& settings, const char* backend,
+                     const scene::RaytraceSettings& settings, scene::Backend backend,
                      const Tracer<Real>* prebuilt = nullptr) {
     const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
     const int width = cam.width, height = cam.height;
@@ -60,7 +60,7 @@ scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan,
     frame.blockerDistance.assign(frame.pixelCount(), 0.0f);
     // The reference's blocker distance is the nearest blocker's (compare's bleeding test reads
     // it); the ray tracer's any-hit rays give the found blocker's, at no extra ray.
-    const bool nearestDistance = std::string(backend) == "reference";
+    const bool nearestDistance = backend == scene::Backend::Reference;
     // Per-light visibility only when it adds something: with one light it is `visibility`.
     if (scene.lights.size() > 1)
         frame.lightVisibility.assign(scene.lights.size(), std::vector<float>(frame.pixelCount(), 0.0f));
@@ -171,7 +171,7 @@ scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan,
     });
     frame.timingsMs.emplace_back("shadow", msSince(shadowStart));
 
-    frame.attributes["backend"] = backend;
+    frame.attributes["backend"] = scene::toString(backend);
     frame.attributes["precision"] = scene::toString(settings.precision);
     frame.attributes["ray_bias"] = robust ? "robust" : formatNumber(settings.rayBias);
     frame.attributes["samples"] = std::to_string(plan.hasAreaLights ? settings.samples : 1);
@@ -182,7 +182,7 @@ scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan,
 }
 
 scene::Frame renderWith(const scene::Scene& scene, const scene::RenderPlan& plan,
-                        const scene::RaytraceSettings& settings, const char* backend) {
+                        const scene::RaytraceSettings& settings, scene::Backend backend) {
     if (settings.precision == scene::Precision::Double)
         return renderT<double>(scene, plan, settings, backend);
     return renderT<float>(scene, plan, settings, backend);
@@ -192,17 +192,17 @@ scene::Frame renderWith(const scene::Scene& scene, const scene::RenderPlan& plan
 
 scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan,
                     const scene::RaytraceSettings& settings) {
-    return renderWith(scene, plan, settings, "raytrace");
+    return renderWith(scene, plan, settings, scene::Backend::Raytrace);
 }
 
 scene::Frame renderReference(const scene::Scene& scene, const scene::RenderPlan& plan,
                              const scene::RaytraceSettings& base) {
-    return renderWith(scene, plan, scene::referenceSettings(base), "reference");
+    return renderWith(scene, plan, scene::referenceSettings(base), scene::Backend::Reference);
 }
 
 struct Renderer::Impl {
     scene::RaytraceSettings settings;
-    const char* backend;
+    scene::Backend backend = scene::Backend::Raytrace;
     std::unique_ptr<Tracer<float>> single;
     std::unique_ptr<Tracer<double>> twice;
     double setupMs = 0.0;
@@ -211,7 +211,7 @@ struct Renderer::Impl {
 Renderer::Renderer(const scene::Scene& scene, const scene::RaytraceSettings& settings, bool reference)
     : impl_(std::make_unique<Impl>()) {
     impl_->settings = reference ? scene::referenceSettings(settings) : settings;
-    impl_->backend = reference ? "reference" : "raytrace";
+    impl_->backend = reference ? scene::Backend::Reference : scene::Backend::Raytrace;
     const auto start = Clock::now();
     if (impl_->settings.precision == scene::Precision::Double)
         impl_->twice = std::make_unique<Tracer<double>>(scene);
