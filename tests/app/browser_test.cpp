@@ -25,11 +25,7 @@ namespace {
 const fs::path kSource = SHADOWLAB_SOURCE_DIR;
 const fs::path kBuild = SHADOWLAB_BINARY_DIR;
 
-std::string quote(const std::string& s) {
-    std::string q = "'";
-    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-}
+using test::shellQuote;
 
 struct CheckResult {
     int exitCode = -1;
@@ -40,14 +36,14 @@ struct CheckResult {
 // Runs tools/browser-check.sh on the inputs, screenshots into shots.
 CheckResult browserCheck(const std::vector<fs::path>& inputs, const fs::path& shots) {
     test::TempDir io;
-    std::string cmd = "SHADOWLAB_BUILD_DIR=" + quote(kBuild.string()) +
-                      " SHADOWLAB_BROWSER_SCREENSHOTS=" + quote(shots.string()) + " " +
-                      quote((kSource / "tools" / "browser-check.sh").string());
+    std::string cmd = "SHADOWLAB_BUILD_DIR=" + shellQuote(kBuild.string()) +
+                      " SHADOWLAB_BROWSER_SCREENSHOTS=" + shellQuote(shots.string()) + " " +
+                      shellQuote((kSource / "tools" / "browser-check.sh").string());
     for (const auto& p : inputs) {
         cmd += ' ';
-        cmd += quote(p.string());
+        cmd += shellQuote(p.string());
     }
-    cmd += " >" + quote((io.path() / "out").string()) + " 2>" + quote((io.path() / "err").string());
+    cmd += " >" + shellQuote((io.path() / "out").string()) + " 2>" + shellQuote((io.path() / "err").string());
     const int status = std::system(cmd.c_str());
     CheckResult r;
     r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -163,7 +159,7 @@ TEST(BrowserCheck, EveryPageShadowlabWritesLoadsRendersAndFits) {
     // The demos' synthetic reports reach what small real runs may not: a hotspot zoom on every
     // method, the default sweep grid, configurations that failed.
     for (const auto& [exe, folder] : {std::pair{REPORT_DEMO, "demo-run"}, std::pair{SWEEP_REPORT_DEMO, "demo-sweep"}}) {
-        const std::string cmd = quote(exe) + " " + quote((pages / folder).string()) + " >/dev/null 2>&1";
+        const std::string cmd = shellQuote(exe) + " " + shellQuote((pages / folder).string()) + " >/dev/null 2>&1";
         EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
     }
 

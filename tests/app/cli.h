@@ -27,23 +27,25 @@ inline std::string slurpFile(const std::filesystem::path& p) {
     return s.str();
 }
 
+// `s` as one word for /bin/sh: in single quotes, each ' written as '\''.
+inline std::string shellQuote(const std::string& s) {
+    std::string q = "'";
+    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
 inline CliResult runShadowlab(const std::vector<std::string>& args) {
-    auto quote = [](const std::string& s) {
-        std::string q = "'";
-        for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-        return q + "'";
-    };
     TempDir io;
-    std::string cmd = quote(SHADOWLAB_EXE);
+    std::string cmd = shellQuote(SHADOWLAB_EXE);
     // (appended piece by piece: GCC 12 warns falsely, -Wrestrict, on " " + std::string)
     for (const auto& a : args) {
         cmd += ' ';
-        cmd += quote(a);
+        cmd += shellQuote(a);
     }
     cmd += " >";
-    cmd += quote((io.path() / "out").string());
+    cmd += shellQuote((io.path() / "out").string());
     cmd += " 2>";
-    cmd += quote((io.path() / "err").string());
+    cmd += shellQuote((io.path() / "err").string());
     const int status = std::system(cmd.c_str());
     CliResult r;
     r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

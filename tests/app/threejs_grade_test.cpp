@@ -28,11 +28,7 @@ namespace {
 const fs::path kSource = SHADOWLAB_SOURCE_DIR;
 const fs::path kBuild = SHADOWLAB_BINARY_DIR;
 
-std::string quote(const std::string& s) {
-    std::string q = "'";
-    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-}
+using test::shellQuote;
 
 struct ScriptRun {
     int exitCode = -1;
@@ -41,18 +37,18 @@ struct ScriptRun {
 
 ScriptRun runScript(const fs::path& script, const std::string& args) {
     test::TempDir io;
-    const std::string cmd = "SHADOWLAB_BUILD_DIR=" + quote(kBuild.string()) + " SHADOWLAB_EXE=" +
-                            quote(SHADOWLAB_EXE) + " SHADOWLAB_BROWSER_SCREENSHOTS=" +
-                            quote((kBuild / "browser-check" / "screenshots" / "threejs-grade").string()) + " " +
-                            quote(script.string()) + " " + args + " >" + quote((io.path() / "out").string()) +
-                            " 2>" + quote((io.path() / "err").string());
+    const std::string cmd = "SHADOWLAB_BUILD_DIR=" + shellQuote(kBuild.string()) + " SHADOWLAB_EXE=" +
+                            shellQuote(SHADOWLAB_EXE) + " SHADOWLAB_BROWSER_SCREENSHOTS=" +
+                            shellQuote((kBuild / "browser-check" / "screenshots" / "threejs-grade").string()) + " " +
+                            shellQuote(script.string()) + " " + args + " >" + shellQuote((io.path() / "out").string()) +
+                            " 2>" + shellQuote((io.path() / "err").string());
     const int status = std::system(cmd.c_str());
     return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, test::slurpFile(io.path() / "out"),
             test::slurpFile(io.path() / "err")};
 }
 
 ScriptRun grade(const fs::path& out, const std::string& options) {
-    return runScript(kSource / "tools" / "threejs-grade.sh", "seed " + quote(out.string()) + " " + options);
+    return runScript(kSource / "tools" / "threejs-grade.sh", "seed " + shellQuote(out.string()) + " " + options);
 }
 
 Json readJson(const fs::path& p) {
@@ -63,7 +59,7 @@ Json readJson(const fs::path& p) {
 
 // The page passes the browser check: no console error, every image loads, nothing overflows.
 void expectPageChecksOut(const fs::path& page) {
-    const ScriptRun r = runScript(kSource / "tools" / "browser-check.sh", quote(page.string()));
+    const ScriptRun r = runScript(kSource / "tools" / "browser-check.sh", shellQuote(page.string()));
     EXPECT_EQ(r.exitCode, 0) << r.out << r.err;
     EXPECT_EQ(r.out, "") << r.err;
 }
@@ -170,7 +166,7 @@ Json grades(double falseShadow, double falseNearEdge, double missed, double miss
 TEST(ThreejsGrade, ThePageSaysWhatWentWrongAndWhatTheBiasIsInWorldUnits) {
     test::TempDir dir;
     const fs::path out = dir.path();
-    ASSERT_EQ(std::system((quote(SHADOWLAB_EXE) + " export lesson/spot-light -o " + quote((out / "scene.glb").string()) +
+    ASSERT_EQ(std::system((shellQuote(SHADOWLAB_EXE) + " export lesson/spot-light -o " + shellQuote((out / "scene.glb").string()) +
                            " >/dev/null 2>&1").c_str()), 0);
     // A spot's map holds perspective depth far (d - near) / (d (far - near)): at distance d a
     // bias b spans b (far - near) d^2 / (far near) in world units, 0.001 * 16 * 64 / 80 = 0.0128.
@@ -191,8 +187,8 @@ TEST(ThreejsGrade, ThePageSaysWhatWentWrongAndWhatTheBiasIsInWorldUnits) {
     std::ofstream(out / "raster.json")
         << grades(10, 10, 10, 10, Json::array({{{"object_id", 3}, {"false_shadow", 10}, {"missed_shadow", 10}}})).dump();
 
-    const ScriptRun r = runScript("node", quote((kSource / "tools" / "browser" / "threejs-report.mjs").string()) + " " +
-                                              quote(out.string()) + " --scene spot");
+    const ScriptRun r = runScript("node", shellQuote((kSource / "tools" / "browser" / "threejs-report.mjs").string()) + " " +
+                                              shellQuote(out.string()) + " --scene spot");
     ASSERT_EQ(r.exitCode, 0) << r.err;
     const std::string page = test::slurpFile(out / "report.html");
     EXPECT_NE(page.find("bias -0.001, normalBias 0"), std::string::npos);

@@ -299,6 +299,20 @@ inline scene::Light spotDown() {
     return l;
 }
 
+// Raster settings with every automatic choice already made (as resolveAutomaticChoices leaves
+// them): a square map of `mapSize`, one cascade, depth bias 0.01 and slope bias 1.5.
+inline scene::RasterSettings fixedSettings(int mapSize = 512) {
+    scene::RasterSettings r;
+    r.shadowMapSize = mapSize;
+    r.shadowMapSizeIsDefault = false;
+    r.cascades = 1;
+    r.cascadesIsDefault = false;
+    r.depthBias = 0.01;
+    r.depthBiasIsDefault = false;
+    r.slopeBias = 1.5;
+    return r;
+}
+
 // The plan of `s` with RenderSettings{} (and `raster` in place of its raster part).
 inline scene::RenderPlan planFor(const scene::Scene& s) { return scene::makeRenderPlan(s, scene::RenderSettings{}); }
 inline scene::RenderPlan planFor(const scene::Scene& s, const scene::RasterSettings& raster) {

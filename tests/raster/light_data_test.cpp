@@ -19,16 +19,10 @@ namespace {
 
 using test::Vec3;
 
-// Settings with every automatic choice already made (as resolveAutomaticChoices leaves them).
+// test::fixedSettings with a filter, kernel and normal offset that are not the defaults, so each
+// reaches LightData visibly.
 scene::RasterSettings fixedSettings(int mapSize = 512) {
-    scene::RasterSettings r;
-    r.shadowMapSize = mapSize;
-    r.shadowMapSizeIsDefault = false;
-    r.cascades = 1;
-    r.cascadesIsDefault = false;
-    r.depthBias = 0.01;
-    r.depthBiasIsDefault = false;
-    r.slopeBias = 1.5;
+    scene::RasterSettings r = test::fixedSettings(mapSize);
     r.filter = scene::ShadowFilter::Poisson;
     r.pcfSize = 7;
     r.normalOffset = 0.75;

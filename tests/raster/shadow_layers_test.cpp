@@ -15,20 +15,8 @@
 namespace shadowlab::raster {
 namespace {
 
+using test::fixedSettings;
 using test::Vec3;
-
-// Settings with every automatic choice already made (as resolveAutomaticChoices leaves them).
-scene::RasterSettings fixedSettings(int mapSize = 512) {
-    scene::RasterSettings r;
-    r.shadowMapSize = mapSize;
-    r.shadowMapSizeIsDefault = false;
-    r.cascades = 1;
-    r.cascadesIsDefault = false;
-    r.depthBias = 0.01;
-    r.depthBiasIsDefault = false;
-    r.slopeBias = 1.5;
-    return r;
-}
 
 scene::Light pointLightAt(const Vec3& position) {
     scene::Light l;
