@@ -29,7 +29,7 @@ using namespace shadowlab;
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-// The image: 1920x1080 (the issue's), or SHADOWLAB_BENCH_RESOLUTION=WxH.
+// The image: 1920x1080 (full HD, where per-pixel costs dominate), or SHADOWLAB_BENCH_RESOLUTION=WxH.
 std::pair<int, int> benchResolution() {
     int w = 1920, h = 1080;
     if (const char* v = std::getenv("SHADOWLAB_BENCH_RESOLUTION"); v && *v)

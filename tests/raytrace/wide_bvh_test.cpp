@@ -246,9 +246,9 @@ TYPED_TEST(WideBvhTraversal, ClosestAndAnyHitEqualTheBinaryTreeAndBruteForce) {
     EXPECT_GT(hits, 300);
 }
 
-// The memory bound: vertices, normals, indices, BVH and the slot-ordered triangle
-// copies together stay under 100 bytes per triangle on a closed mesh with normals (the common
-// case: about half a vertex per triangle).
+// The memory aim (docs/performance.md, "Setup time and memory per triangle"): vertices, normals,
+// indices, BVH and the slot-ordered triangle copies together stay under 100 bytes per triangle on
+// a closed mesh with normals (the common case: about half a vertex per triangle).
 TEST(WideBvh, FloatTracerHoldsUnder100BytesPerTriangle) {
     scene::Scene s;
     test::addMaterial(s, "matte");
