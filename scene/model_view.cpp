@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 #include "scene/error.h"
 #include "scene/loader.h"
@@ -31,6 +32,24 @@ std::string fmt(double v, const char* f = "%.3g") {
     char buf[64];
     std::snprintf(buf, sizeof buf, f, v);
     return buf;
+}
+
+// Sine and cosine of an angle in degrees, exact at multiples of 90°: the angle is reduced to
+// within 45° of a quarter turn first, so sin 180° is 0, not sin(π) = 1.2e-16. A sun at azimuth
+// 180 must travel in the YZ plane: a residue there gives every face that is edge-on to the light
+// (an axis-aligned model's sides) an N·L of ±1e-16, and so a sign, a shadow test and a class.
+std::pair<double, double> sinCosDegrees(double degrees) {
+    double r = std::fmod(degrees, 360.0);
+    if (r < 0) r += 360.0;
+    const double quarter = std::round(r / 90.0);
+    const double x = (r - 90.0 * quarter) * kDegrees;  // |x| ≤ π/4
+    const double s = std::sin(x), c = std::cos(x);
+    switch (int(quarter) % 4) {
+        case 0: return {s, c};
+        case 1: return {c, -s};
+        case 2: return {-s, -c};
+        default: return {-c, s};
+    }
 }
 
 }  // namespace
@@ -189,8 +208,9 @@ void applyGround(Scene& scene, std::optional<bool> option) {
 }
 
 Vec3 sunDirection(double azimuthDegrees, double elevationDegrees) {
-    const double a = azimuthDegrees * kDegrees, e = elevationDegrees * kDegrees;
-    return -Vec3(std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a));
+    const auto [sinA, cosA] = sinCosDegrees(azimuthDegrees);
+    const auto [sinE, cosE] = sinCosDegrees(elevationDegrees);
+    return -Vec3(cosE * sinA, sinE, cosE * cosA);
 }
 
 glm::dvec2 sunAngles(const Vec3& direction) {

@@ -51,7 +51,8 @@ void fitFarToBounds(Scene& scene);
 void applyGround(Scene& scene, std::optional<bool> option);
 
 // The way a sun's light travels for a sun at `azimuthDegrees` (in the ground plane from +Z toward
-// +X) and `elevationDegrees` above the horizon: −(cos e · sin a, sin e, cos e · cos a).
+// +X) and `elevationDegrees` above the horizon: −(cos e · sin a, sin e, cos e · cos a), exact at
+// multiples of 90° (a sun at azimuth 180 travels in the YZ plane, edge-on to faces along X).
 Vec3 sunDirection(double azimuthDegrees, double elevationDegrees);
 // The inverse: a sun's azimuth (0..360) and elevation of a direction light travels.
 glm::dvec2 sunAngles(const Vec3& direction);

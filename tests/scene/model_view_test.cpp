@@ -216,6 +216,34 @@ TEST(ModelView, SunAzimuthRunsFromZTowardXAndElevationUpFromTheHorizon) {
     EXPECT_NEAR(a.y, 40, 1e-9);
 }
 
+TEST(ModelView, SunAtAQuarterTurnTravelsExactlyInAnAxisPlane) {
+    // sin(180° in radians) is 1.2e-16 in double, not 0: a sun at azimuth 180 computed that way
+    // gives a face whose normal is exactly +X an N·L of 1e-16 instead of 0, so a face edge-on to
+    // the light would count as lit-facing. At every quarter turn the off-plane component is 0.
+    for (const double el : {0.0, 35.0, 55.0, 75.0, -20.0}) {
+        EXPECT_EQ(sunDirection(0, el).x, 0.0) << el;
+        EXPECT_EQ(sunDirection(180, el).x, 0.0) << el;
+        EXPECT_EQ(sunDirection(-180, el).x, 0.0) << el;
+        EXPECT_EQ(sunDirection(360, el).x, 0.0) << el;
+        EXPECT_EQ(sunDirection(90, el).z, 0.0) << el;
+        EXPECT_EQ(sunDirection(270, el).z, 0.0) << el;
+        EXPECT_EQ(sunDirection(-90, el).z, 0.0) << el;
+        EXPECT_EQ(glm::dot(Vec3(1, 0, 0), -sunDirection(180, el)), 0.0) << el;
+    }
+    for (const double az : {0.0, 45.0, 135.0, 180.0, 300.0}) {
+        EXPECT_EQ(sunDirection(az, 90).x, 0.0) << az;
+        EXPECT_EQ(sunDirection(az, 90).z, 0.0) << az;
+        EXPECT_EQ(sunDirection(az, 90).y, -1.0) << az;
+    }
+    // Between quarter turns the formula is the usual one: at 45° both components are cos e·√½,
+    // at 225° both negated, the direction stays a unit vector.
+    const double h = std::cos(35 * kPi / 180) * std::sqrt(0.5);
+    expectNear(sunDirection(45, 35), {-h, -std::sin(35 * kPi / 180), -h});
+    expectNear(sunDirection(225, 35), {h, -std::sin(35 * kPi / 180), h});
+    for (const double az : {10.0, 100.0, 190.0, 280.0, 359.0})
+        EXPECT_NEAR(glm::length(sunDirection(az, 35)), 1.0, 1e-15) << az;
+}
+
 TEST(ModelView, SunOptionPointsTheDirectionalLightAndRefusesBadText) {
     test::TempDir dir;
     Scene s = loadScene(dir.write("box.gltf", test::cameraBoxGltf(false)));
