@@ -28,6 +28,14 @@ Camera cameraFromGltf(const Vec3& position, const Vec3& forward, const Vec3& up,
 // length) toward its center; near and far just around the sphere.
 Camera framedCamera(const Bounds& bounds, const Vec3& fromDirection, double fovYDegrees, const Camera& base);
 
+// `framed` (a framedCamera of `bounds`) moved back along its own view direction, and its target
+// moved to the middle of what it must show, so that the shadow `bounds` casts under a directional
+// light travelling along `lightDirection` (its corners projected along the light onto the plane
+// of its base, where the added ground lies) fits the image too, each point at least 1/1.1 of the
+// half-width and half-height from the center's edge. Unchanged when that shadow already fits, or
+// the light does not travel downward; never closer than `framed`.
+Camera framedWithShadow(const Camera& framed, const Bounds& bounds, const Vec3& lightDirection);
+
 // --camera N|NAME|auto: N or NAME puts that file camera in place of the view; auto asks for a
 // view search even where the file has cameras. Throws InputError listing the cameras there are.
 void applyCameraOption(Scene& scene, const std::string& spec);
