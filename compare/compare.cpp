@@ -554,7 +554,7 @@ Comparison compareFrames(const Frame& method, const Frame& reference,
                     if (double(reference.blockerDistance[i]) <= contactAt(i, nr)) {
                         ++m.biasLeak;
                         if (nearEdge[i]) ++m.biasLeakNearEdge;
-                    } else if (!nearEdge[i]) {
+                    } else if (!nearEdge[i] && !m.pointSampled) {  // bleeding is a filter's; a ray has none
                         ++m.bleeding;
                     }
                 }

@@ -131,7 +131,8 @@ struct Metrics {
     // Missed shadow split by the reference's blocker distance (Frame::blockerDistance): bias
     // leaks where the blocker is within the contact distance of the receiver (thresholds.h
     // kContactTexels), bleeding where it is farther and the pixel is away from the reference's
-    // shadow edges (near one, a far blocker's missed shadow is the edge's aliasing: neither). Needs the reference's distances and a contact
+    // shadow edges (near one, a far blocker's missed shadow is the edge's aliasing: neither), and
+    // never for a point-sampled method, which has no filter to bleed. Needs the reference's distances and a contact
     // distance from the method's bias and texel attributes (or CompareOptions); unknown, not
     // zero, without them.
     bool hasBlockerDistance = false;

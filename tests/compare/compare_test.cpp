@@ -368,6 +368,30 @@ TEST(EdgeAwareError, AThinShadowLostWholeToTheBiasIsABiasLeakNotAliasing) {
     EXPECT_EQ(k.aliasingPixels, 20u);   // the far blocker's column only
     EXPECT_EQ(k.biasErrorPixels, 40u);  // the thin strip, lost to the bias
     EXPECT_EQ(toJson(k)["bias_leak_near_edge"], 40);
+    // A far blocker's missed shadow away from every edge is a filter's light bleeding: one pixel
+    // (5, 10) inside a wide shadow (x = 0..14, its edge at 14|15, 9 columns away) whose blocker
+    // is 1 away. A ray tracer missing it (its frame records a ray bias and no texel) has no
+    // filter: no bleeding, and bias error rather than aliasing.
+    Frame wide = test::uniformFrame(20, 20, 1, 0.5f, 1), miss = wide;
+    wide.blockerId.assign(wide.pixelCount(), 0.0f);
+    wide.blockerDistance.assign(wide.pixelCount(), 0.0f);
+    for (int y = 0; y < 20; ++y)
+        for (int x = 0; x < 15; ++x) {
+            const std::size_t i = std::size_t(y) * 20 + x;
+            wide.visibility[i] = miss.visibility[i] = 0.0f;
+            wide.blockerId[i] = 2.0f;
+            wide.blockerDistance[i] = 1.0f;
+        }
+    miss.visibility[10 * 20 + 5] = 1.0f;
+    miss.attributes = m.attributes;  // the shadow map's
+    EXPECT_EQ(compareFrames(miss, wide).metrics.bleeding, 1u);
+    miss.attributes = {{"ray_bias", "0.001"}};
+    const Metrics ray = compareFrames(miss, wide).metrics;
+    EXPECT_TRUE(ray.pointSampled);
+    EXPECT_EQ(ray.missedShadow, 1u);
+    EXPECT_EQ(ray.bleeding, 0u);
+    EXPECT_EQ(ray.biasErrorPixels, 1u);
+    EXPECT_EQ(ray.aliasingPixels, 0u);
 }
 
 TEST(EdgeAwareError, ABoundaryBetweenTwoObjectsIsNotAShadowEdge) {
