@@ -447,6 +447,7 @@ Comparison compareFrames(const Frame& method, const Frame& reference,
     m.hasBlockerIds = !method.blockerId.empty();
     m.edgeRadius = options.edgeRadius;
     const Contact contact = contactOf(method, options);
+    m.pointSampled = !attribute(method, "ray_bias").empty() && attribute(method, "texel_world_size").empty();
     m.hasBlockerDistance = contact.known() && reference.blockerDistance.size() == n && reference.blockerId.size() == n;
     // Perspective maps' texels at each pixel's distance: its position from the method's depths and
     // the camera either frame records (the same camera: compare refuses two different ones).
@@ -550,8 +551,12 @@ Comparison compareFrames(const Frame& method, const Frame& reference,
                 // bleeding (near an edge it is the edge's aliasing). Without a blocker neither.
                 if (m.hasBlockerDistance && roundId(reference.blockerId[i]) > 0 &&
                     std::isfinite(reference.blockerDistance[i])) {
-                    if (double(reference.blockerDistance[i]) <= contactAt(i, nr)) ++m.biasLeak;
-                    else if (!nearEdge[i]) ++m.bleeding;
+                    if (double(reference.blockerDistance[i]) <= contactAt(i, nr)) {
+                        ++m.biasLeak;
+                        if (nearEdge[i]) ++m.biasLeakNearEdge;
+                    } else if (!nearEdge[i] && !m.pointSampled) {  // bleeding is a filter's; a ray has none
+                        ++m.bleeding;
+                    }
                 }
             } else if (c == PixelClass::AgreeLit) {
                 ++m.agreeLit;
@@ -590,7 +595,7 @@ Comparison compareFrames(const Frame& method, const Frame& reference,
     if (std::isinf(m.contactDistance)) m.contactDistance = contact.at(1.0f, contact.texelAt(nullptr));  // none counted
     m.bleedingRate = rate(m.bleeding, m.counted);
     m.biasLeakRate = rate(m.biasLeak, m.counted);
-    m.aliasingPixels = m.falseShadowNearEdge + m.missedShadowNearEdge;
+    m.aliasingPixels = m.pointSampled ? 0 : m.falseShadowNearEdge + m.missedShadowNearEdge - m.biasLeakNearEdge;
     m.biasErrorPixels = wrong - m.aliasingPixels;
     m.aliasingRate = rate(m.aliasingPixels, m.counted);
     m.biasErrorRate = rate(m.biasErrorPixels, m.counted);
@@ -650,6 +655,7 @@ nlohmann::json toJson(const Metrics& m) {
         {"reference_shadow_edge_pixels", m.referenceShadowEdgePixels},
         {"false_shadow_near_edge", m.falseShadowNearEdge},
         {"missed_shadow_near_edge", m.missedShadowNearEdge},
+        {"point_sampled", m.pointSampled},
         {"aliasing_pixels", m.aliasingPixels},
         {"bias_error_pixels", m.biasErrorPixels},
         {"aliasing_rate", m.aliasingRate},
@@ -681,10 +687,12 @@ nlohmann::json toJson(const Metrics& m) {
         j["self_shadow_acne_rate"] = nullptr;
     }
     // Without the reference's blocker distances (older frames) bleeding is unknown, not zero.
-    for (const char* k : {"bleeding", "bias_leak", "bleeding_rate", "bias_leak_rate", "contact_distance"}) j[k] = nullptr;
+    for (const char* k : {"bleeding", "bias_leak", "bias_leak_near_edge", "bleeding_rate", "bias_leak_rate", "contact_distance"})
+        j[k] = nullptr;
     if (m.hasBlockerDistance) {
         j["bleeding"] = m.bleeding;
         j["bias_leak"] = m.biasLeak;
+        j["bias_leak_near_edge"] = m.biasLeakNearEdge;
         j["bleeding_rate"] = m.bleedingRate;
         j["bias_leak_rate"] = m.biasLeakRate;
         j["contact_distance"] = m.contactDistance;

@@ -131,7 +131,8 @@ struct Metrics {
     // Missed shadow split by the reference's blocker distance (Frame::blockerDistance): bias
     // leaks where the blocker is within the contact distance of the receiver (thresholds.h
     // kContactTexels), bleeding where it is farther and the pixel is away from the reference's
-    // shadow edges (near one, a far blocker's missed shadow is the edge's aliasing: neither). Needs the reference's distances and a contact
+    // shadow edges (near one, a far blocker's missed shadow is the edge's aliasing: neither), and
+    // never for a point-sampled method, which has no filter to bleed. Needs the reference's distances and a contact
     // distance from the method's bias and texel attributes (or CompareOptions); unknown, not
     // zero, without them.
     bool hasBlockerDistance = false;
@@ -142,12 +143,20 @@ struct Metrics {
     double bleedingRate = 0.0, biasLeakRate = 0.0;  // over counted
 
     // Edge-aware split of the wrong pixels: within edgeRadius pixels of a reference shadow
-    // boundary they are aliasing (a resolution problem), elsewhere bias error.
+    // boundary they are aliasing (a resolution problem), elsewhere bias error. Two exceptions:
+    // a missed-shadow pixel near an edge whose reference blocker lies within the contact
+    // distance is a bias leak (a shadow thinner than the edge radius, lost whole to the bias,
+    // lies near its own edges), and a point-sampled method has no aliasing at all.
     int edgeRadius = kDefaultEdgeRadiusPixels;
     std::size_t referenceShadowEdgePixels = 0;
     std::size_t falseShadowNearEdge = 0, missedShadowNearEdge = 0;
-    std::size_t aliasingPixels = 0;   // falseShadowNearEdge + missedShadowNearEdge
-    std::size_t biasErrorPixels = 0;  // wrong pixels away from any reference shadow edge
+    std::size_t biasLeakNearEdge = 0;  // of missedShadowNearEdge, the bias leaks
+    // The method tests each pixel's own point, as the reference does (a ray tracer: its frame
+    // records a ray_bias and no shadow-map texel), so nothing of its error is a sampling grid's.
+    bool pointSampled = false;
+    // falseShadowNearEdge + missedShadowNearEdge − biasLeakNearEdge; 0 when pointSampled.
+    std::size_t aliasingPixels = 0;
+    std::size_t biasErrorPixels = 0;  // the other wrong pixels
     double aliasingRate = 0.0, biasErrorRate = 0.0;  // over counted
 
     std::vector<ObjectErrors> perObject;  // objects with any counted pixel, by id

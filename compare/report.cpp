@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <set>
 #include <sstream>
 
@@ -97,6 +98,20 @@ std::string describeContinuous(const Metrics& m) {
     return s;
 }
 
+// Where the default map size was capped below what the receivers and casters ask for (the raster
+// frame's shadow_map_size_needed against shadow_map_size), the words that say so; else "".
+std::string cappedMapText(const FrameInfo& frame) {
+    auto number = [&](const char* key) {
+        const auto it = frame.attributes.find(key);
+        return it == frame.attributes.end() ? 0.0 : std::atof(it->second.c_str());
+    };
+    const double needed = number("shadow_map_size_needed"), size = number("shadow_map_size");
+    if (!(size > 0.0) || !(needed > size)) return "";
+    return " (the receivers and casters ask for " + formatCount(std::size_t(needed)) + " texels across the map, the " +
+           "default caps it at " + formatCount(std::size_t(size)) +
+           ": a larger --shadow-map-size shrinks the texels and the contact distance with them)";
+}
+
 std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
     const Metrics& m = rm.metrics;
     const std::string who = methodTitle(rm.label);
@@ -138,8 +153,14 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
             const std::string on = dominantObject(in, m, m.missedShadow,
                                                   [](const ObjectErrors& o) { return o.missedShadow; });
             f += on.empty() ? ")" : ", mostly on " + on + ")";
-            // Far from its blocker, a missed shadow is the filter's (light bleeding), not the bias's.
-            if (m.hasBlockerDistance && m.bleeding > 0)
+            // Near its blocker, a missed shadow is the bias's and the texel grid's; far from it, the
+            // filter's (light bleeding).
+            if (m.hasBlockerDistance && !m.pointSampled && double(m.biasLeak) > kMostlyShare * double(m.missedShadow))
+                f += ", " + formatPercent(double(m.biasLeak) / double(m.missedShadow)) +
+                     " of it within the contact distance of its blocker (" + formatShort(m.contactDistance) +
+                     " with the light head-on, more at grazing light): a caster that close to its receiver is lost "
+                     "to the bias and the map's texels" + cappedMapText(rm.frame);
+            else if (m.hasBlockerDistance && m.bleeding > 0)
                 f += double(m.bleeding) > kMostlyShare * double(m.missedShadow)
                          ? ", mostly light bleeding (" + formatPercent(double(m.bleeding) / double(m.missedShadow)) +
                                " of it farther than " + formatShort(m.contactDistance) + " from its blocker)"
@@ -151,13 +172,28 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
         }
         s += parts[0] + " and " + parts[1] + ".";
         const std::size_t wrong = m.falseShadow + m.missedShadow;
-        const double nearShare = double(m.aliasingPixels) / double(wrong);
-        if (nearShare > kMostlyShare)
-            s += " Most wrong pixels (" + formatPercent(nearShare) + ") lie within " +
-                 std::to_string(m.edgeRadius) + " px of a reference shadow edge: edge aliasing rather than bias.";
-        else if (m.aliasingPixels > 0)
-            s += " " + formatPercent(1.0 - nearShare) + " of the wrong pixels lie away from shadow edges (bias error), the rest within " +
-                 std::to_string(m.edgeRadius) + " px of one (aliasing).";
+        const std::string within = " within " + std::to_string(m.edgeRadius) + " px of a reference shadow edge";
+        if (m.pointSampled) {
+            // A ray tracer tests the very point the reference tests: where it disagrees, its origin
+            // offset or its arithmetic put the ray on the other side of a blocker's edge.
+            const double nearShare = double(m.falseShadowNearEdge + m.missedShadowNearEdge) / double(wrong);
+            s += " It tests each pixel's own point, as the reference does, so none of this is aliasing: it is its "
+                 "ray offset and precision";
+            s += nearShare > kMostlyShare ? " (" + formatPercent(nearShare) + " of the wrong pixels lie" + within +
+                                                ", where a ray started off its surface passes a blocker's edge on the "
+                                                "other side)."
+                                          : ".";
+        } else {
+            const double nearShare = double(m.aliasingPixels) / double(wrong);
+            if (nearShare > kMostlyShare)
+                s += " Most wrong pixels (" + formatPercent(nearShare) + ") lie" + within +
+                     ": edge aliasing rather than bias.";
+            else if (m.aliasingPixels > 0)
+                s += " " + formatPercent(1.0 - nearShare) +
+                     " of the wrong pixels are bias error (away from shadow edges" +
+                     (m.biasLeakNearEdge > 0 ? ", or missed within the contact distance of their blocker" : "") +
+                     "), the rest lie" + within + " (aliasing).";
+        }
         s += " Its shadowed area overlaps the reference's with IoU " + formatFixed(m.shadowIoU, 3) + ".";
     }
     if (m.counted > 0) s += " " + describeContinuous(m);

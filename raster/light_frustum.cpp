@@ -456,6 +456,7 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
         if (texels > casterNeeded) casterNeeded = texels, casterObject = o;
     };
     double needed = 0.0;  // texels, rounded up to a power of two below
+    double asked = 0.0;   // the same before a fitted spot's own size bounds it: what the cap cuts
     int neededSize = 0;     // a size some light needs as it is (fitted spot windows)
     std::string why;
     char buf[320];
@@ -515,6 +516,7 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
                       pixelAt(1.0), spotNeeded);
         why += buf;
         needed = std::max(needed, std::min(spotNeeded, double(n)));
+        asked = std::max(asked, spotNeeded);
         neededSize = std::max(neededSize, n);
         // Casters: a texel at distance d is d·window/N, so N ≥ k·window·d/feature at the object's
         // farthest distance along the axis (its box's farthest corner, where its texels are widest).
@@ -568,10 +570,13 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
     int chosen = std::max(kMinAutoShadowMapSize, neededSize);
     while (chosen < needed && chosen < size) chosen *= 2;
     chosen = std::min(chosen, size);
-    return ShadowMapSizeChoice{chosen, std::to_string(chosen) + " (" +
-                                           (chosen < size ? "from receiver detail and caster features: " : "default: ") + why +
-                                           (chosen < size ? ", rounded up to a power of two" : ", capped at the default") +
-                                           ")"};
+    asked = std::max(asked, needed);
+    const bool capped = asked > size;
+    return ShadowMapSizeChoice{chosen,
+                               std::to_string(chosen) + " (" +
+                                   (chosen < size ? "from receiver detail and caster features: " : "default: ") + why +
+                                   (capped ? ", capped at the default" : ", rounded up to a power of two") + ")",
+                               asked};
 }
 
 namespace {

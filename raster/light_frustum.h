@@ -236,6 +236,9 @@ double casterFeatureSize(const scene::Object& object);
 struct ShadowMapSizeChoice {
     int size = 0;
     std::string reason;
+    // The texels the receivers and casters ask for (more than `size` where the default caps it);
+    // 0 where the size is kept as set, with cascades, or with no receiver in view.
+    double needed = 0.0;
 };
 // With a plan, only the lights it gives a shadow pass count (without: every light).
 ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::RasterSettings& settings,

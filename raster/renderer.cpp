@@ -349,6 +349,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
     ShadowMapSizeChoice mapChoice;
     settings = resolveAutomaticChoices(scene, settings, &plan, &cascadeChoice, &mapChoice);
     attributes["shadow_map_size_reason"] = mapChoice.reason;
+    if (mapChoice.needed > 0.0) attributes["shadow_map_size_needed"] = std::to_string(int(std::ceil(mapChoice.needed)));
     attributes["cascades_reason"] = cascadeChoice.reason;
     placeLights(scene, scene.camera);
     createTargets(scene, options);

@@ -319,6 +319,7 @@ void probeInterior(const Tracer<float>& tracer, const scene::Bounds& b, ViewSear
 struct Candidate {
     scene::Camera camera;
     std::string text;
+    bool framed = false;  // a view from outside framing the model (framedCamera), not a file's camera
 };
 
 // With --camera auto the file's own cameras compete too (a city model's first camera may face a
@@ -340,7 +341,7 @@ std::vector<Candidate> viewCandidates(const scene::Scene& scene, const scene::Bo
                 const Vec3 from(std::cos(el * kDegrees) * std::sin(az * kDegrees), std::sin(el * kDegrees),
                                 std::cos(el * kDegrees) * std::cos(az * kDegrees));
                 out.push_back({scene::framedCamera(b, from, 40.0, scene.camera),
-                               "from outside, azimuth " + fmt(az) + ", elevation " + fmt(el) + " degrees"});
+                               "from outside, azimuth " + fmt(az) + ", elevation " + fmt(el) + " degrees", true});
             }
         addFileCameras(scene, out);
         return out;
@@ -499,6 +500,14 @@ ViewSearchResult searchViewAndSun(const scene::Scene& scene, const ViewSearchOpt
         r.best = best;
         r.camera = views[bestView].camera;
         r.sunDirection = suns[bestSun].first.direction;
+        // A view framing the model alone cuts off the shadow it casts under a low sun (the box's,
+        // 1.4 heights long at 35°): the chosen view moves back until that shadow fits too.
+        bool widened = false;
+        if (views[bestView].framed && suns[bestSun].first.type == scene::LightType::Directional) {
+            const scene::Camera c = scene::framedWithShadow(r.camera, b, r.sunDirection);
+            widened = c.position != r.camera.position || c.lookAt != r.camera.lookAt;
+            r.camera = c;
+        }
         const std::string refinedText = refined > 0 ? ", the best " + std::to_string(refined) + " again at " +
                                                           std::to_string(r.fineWidth) + "x" + std::to_string(r.fineHeight)
                                                     : "";
@@ -513,7 +522,8 @@ ViewSearchResult searchViewAndSun(const scene::Scene& scene, const ViewSearchOpt
         r.viewText = (options.chooseView ? "searched, " + views[bestView].text : views[bestView].text) +
                      (r.interior ? "; the model encloses its space (" + std::to_string(r.enclosedPoints) + " of " +
                                        std::to_string(r.probePoints) + " probe points walled in)"
-                                 : "") + why;
+                                 : "") + why +
+                     (widened ? ", then moved back to hold the model's whole shadow under that sun" : "");
         r.sunText = options.chooseSun ? "searched, " + suns[bestSun].second : suns[bestSun].second;
     });
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

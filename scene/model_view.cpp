@@ -4,7 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
+#include <vector>
 
+#include "scene/camera.h"
 #include "scene/error.h"
 #include "scene/loader.h"
 
@@ -14,6 +17,8 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegrees = kPi / 180.0;
+// framedWithShadow: the points it must show stay this factor inside the image's half-extents.
+constexpr double kShadowFrameMargin = 1.1;
 
 std::string describeCamera(const std::vector<FileCamera>& cameras, std::size_t i) {
     const FileCamera& c = cameras[i];
@@ -31,6 +36,24 @@ std::string fmt(double v, const char* f = "%.3g") {
     char buf[64];
     std::snprintf(buf, sizeof buf, f, v);
     return buf;
+}
+
+// Sine and cosine of an angle in degrees, exact at multiples of 90°: the angle is reduced to
+// within 45° of a quarter turn first, so sin 180° is 0, not sin(π) = 1.2e-16. A sun at azimuth
+// 180 must travel in the YZ plane: a residue there gives every face that is edge-on to the light
+// (an axis-aligned model's sides) an N·L of ±1e-16, and so a sign, a shadow test and a class.
+std::pair<double, double> sinCosDegrees(double degrees) {
+    double r = std::fmod(degrees, 360.0);
+    if (r < 0) r += 360.0;
+    const double quarter = std::round(r / 90.0);
+    const double x = (r - 90.0 * quarter) * kDegrees;  // |x| ≤ π/4
+    const double s = std::sin(x), c = std::cos(x);
+    switch (int(quarter) % 4) {
+        case 0: return {s, c};
+        case 1: return {c, -s};
+        case 2: return {-s, -c};
+        default: return {-c, s};
+    }
 }
 
 }  // namespace
@@ -75,6 +98,52 @@ Camera framedCamera(const Bounds& bounds, const Vec3& fromDirection, double fovY
     cam.near = std::max(distance - 2.0 * radius, distance * 1e-3);
     cam.far = distance + 2.0 * radius;
     return cam;
+}
+
+Camera framedWithShadow(const Camera& framed, const Bounds& bounds, const Vec3& lightDirection) {
+    // The shadow of the bounds' box on the plane of its base contains the model's shadow there.
+    const Vec3 l = glm::normalize(lightDirection);
+    if (bounds.empty() || !(l.y < -1e-9)) return framed;
+    std::vector<Vec3> points;
+    for (int k = 0; k < 8; ++k) {
+        const Vec3 c((k & 1) ? bounds.max.x : bounds.min.x, (k & 2) ? bounds.max.y : bounds.min.y,
+                     (k & 4) ? bounds.max.z : bounds.min.z);
+        points.push_back(c);
+        points.push_back(c + ((bounds.min.y - c.y) / l.y) * l);
+    }
+    const CameraBasis cam = cameraBasis(framed);
+    const double tanV = cam.tanHalfFovY / kShadowFrameMargin, tanH = tanV * cam.aspect;
+    // The image holds p where its depth z = D − (p − c)·d (d toward the camera, D the camera's
+    // distance from the target c) is at least |x|/tanH and |y|/tanV: D ≥ (p − c)·d + max(...).
+    auto fits = [&](const Vec3& target, double distance) {
+        for (const Vec3& p : points) {
+            const Vec3 q = p - target;
+            const double z = distance + glm::dot(q, cam.forward);
+            if (std::abs(glm::dot(q, cam.right)) > tanH * z * (1 + 1e-9) ||
+                std::abs(glm::dot(q, cam.up)) > tanV * z * (1 + 1e-9))
+                return false;
+        }
+        return true;
+    };
+    const double framedDistance = glm::length(framed.lookAt - framed.position);
+    if (fits(framed.lookAt, framedDistance)) return framed;
+    Bounds all;
+    for (const Vec3& p : points) all.extend(p);
+    const Vec3 target = all.center();
+    double distance = framedDistance, radius = 0.5 * bounds.diagonal();
+    for (const Vec3& p : points) {
+        const Vec3 q = p - target;
+        distance = std::max(distance, -glm::dot(q, cam.forward) +
+                                          std::max(std::abs(glm::dot(q, cam.right)) / tanH,
+                                                   std::abs(glm::dot(q, cam.up)) / tanV));
+        radius = std::max(radius, glm::length(q));
+    }
+    Camera c = framed;
+    c.lookAt = target;
+    c.position = target - distance * cam.forward;
+    c.near = std::max(distance - 2.0 * radius, distance * 1e-3);
+    c.far = distance + 2.0 * radius;
+    return c;
 }
 
 void recordChoice(Scene& scene, const std::string& key, const std::string& text) {
@@ -189,8 +258,9 @@ void applyGround(Scene& scene, std::optional<bool> option) {
 }
 
 Vec3 sunDirection(double azimuthDegrees, double elevationDegrees) {
-    const double a = azimuthDegrees * kDegrees, e = elevationDegrees * kDegrees;
-    return -Vec3(std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a));
+    const auto [sinA, cosA] = sinCosDegrees(azimuthDegrees);
+    const auto [sinE, cosE] = sinCosDegrees(elevationDegrees);
+    return -Vec3(cosE * sinA, sinE, cosE * cosA);
 }
 
 glm::dvec2 sunAngles(const Vec3& direction) {

@@ -28,6 +28,14 @@ Camera cameraFromGltf(const Vec3& position, const Vec3& forward, const Vec3& up,
 // length) toward its center; near and far just around the sphere.
 Camera framedCamera(const Bounds& bounds, const Vec3& fromDirection, double fovYDegrees, const Camera& base);
 
+// `framed` (a framedCamera of `bounds`) moved back along its own view direction, and its target
+// moved to the middle of what it must show, so that the shadow `bounds` casts under a directional
+// light travelling along `lightDirection` (its corners projected along the light onto the plane
+// of its base, where the added ground lies) fits the image too, each point at least 1/1.1 of the
+// half-width and half-height from the center's edge. Unchanged when that shadow already fits, or
+// the light does not travel downward; never closer than `framed`.
+Camera framedWithShadow(const Camera& framed, const Bounds& bounds, const Vec3& lightDirection);
+
 // --camera N|NAME|auto: N or NAME puts that file camera in place of the view; auto asks for a
 // view search even where the file has cameras. Throws InputError listing the cameras there are.
 void applyCameraOption(Scene& scene, const std::string& spec);
@@ -51,7 +59,8 @@ void fitFarToBounds(Scene& scene);
 void applyGround(Scene& scene, std::optional<bool> option);
 
 // The way a sun's light travels for a sun at `azimuthDegrees` (in the ground plane from +Z toward
-// +X) and `elevationDegrees` above the horizon: −(cos e · sin a, sin e, cos e · cos a).
+// +X) and `elevationDegrees` above the horizon: −(cos e · sin a, sin e, cos e · cos a), exact at
+// multiples of 90° (a sun at azimuth 180 travels in the YZ plane, edge-on to faces along X).
 Vec3 sunDirection(double azimuthDegrees, double elevationDegrees);
 // The inverse: a sun's azimuth (0..360) and elevation of a direction light travels.
 glm::dvec2 sunAngles(const Vec3& direction);

@@ -656,16 +656,27 @@ LightData cascadeOf(LightData light, int lightIndex, vec3 p, out LightData next,
 }
 
 void main() {
-    // Receiver plane: the position's screen-space derivatives, here in uniform control flow.
-    const vec3 dpdx = kReceiverPlane ? dFdx(inPosition) : vec3(0.0);
-    const vec3 dpdy = kReceiverPlane ? dFdy(inPosition) : vec3(0.0);
+    // The position's screen-space derivatives, here in uniform control flow: vectors in the
+    // triangle's plane (the position is linear across it), for its facet normal below and the
+    // receiver plane.
+    const vec3 ex = dFdx(inPosition), ey = dFdy(inPosition);
+    const vec3 dpdx = kReceiverPlane ? ex : vec3(0.0);
+    const vec3 dpdy = kReceiverPlane ? ey : vec3(0.0);
 #ifdef SHADOWLAB_ALPHA
     if (alphaCameraSkips(inObjectId, inUv)) discard;  // after the derivatives, which need the quad
 #endif
     vec3 n = normalize(inNormal);
     float nScale = kVertexLightCoordinates ? inversesqrt(dot(inNormal, inNormal)) : 1.0;
-    // Two-sided surfaces: the normal faces the viewer (the ray tracer's rule: flip when N·ray > 0).
-    if (dot(n, inPosition) > 0.0) {
+    // Two-sided surfaces, the ray tracer's rule (raytrace/tracer.cpp, surfacePoint): the facet's
+    // normal turned toward the viewer, the shading normal into that normal's half-space. Turning
+    // the shading normal toward the viewer by itself flips it across the facet where it leans away
+    // from the viewer while the facet faces it (smooth normals near a silhouette, a rough mesh's
+    // normals), which negates N·L there. A facet seen edge-on has no normal here: the shading
+    // normal decides.
+    vec3 facet = cross(ex, ey);
+    if (dot(facet, inPosition) > 0.0) facet = -facet;
+    const float side = dot(facet, facet) > 0.0 ? dot(n, facet) : -dot(n, inPosition);
+    if (side < 0.0) {
         n = -n;
         nScale = -nScale;
     }

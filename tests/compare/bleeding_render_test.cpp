@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "compare/compare.h"
+#include "compare/report.h"
 #include "compare/thresholds.h"
 #include "raster/renderer.h"
 #include "raytrace/renderer.h"
@@ -230,6 +231,58 @@ TEST(BleedingAgainstReference, ABoxKeepsItsContactShadowUnderTheSameBias) {
     EXPECT_EQ(c.restShadowed, c.rest);
     EXPECT_EQ(m.missedShadow, m.missedShadowNearEdge) << "missed shadow only along the shadow's edges";
     EXPECT_EQ(m.bleeding, 0u);
+}
+
+TEST(BleedingAgainstReference, ALowCurbsThinShadowLostToTheDefaultBiasIsABiasLeakNotAliasing) {
+    // A curb h high, [−0.1, 0] × [0, h] × [−0.5, 0.5], under the 45° light: the reference shadows
+    // the floor strip x in (−0.1 − h, −0.1), its blocker the face x = −0.1, √2·(−0.1 − x) ≤ √2·h
+    // away. The map holds the curb's top on those rays (the ray leaves through it), √2·h from the
+    // receiver; the default biases move the receiver half a texel plus 1 texel × tanθ (= 1) toward
+    // the light, 1.5 texels, so with √2·h < 1.5 texels the whole strip is lit: a shadow a step
+    // casts, lost to the bias (the milk truck's window trim on its glass). The strip is two pixels
+    // wide, so each of its pixels lies within 2 px of its edge, yet none is aliasing: every
+    // blocker is within the contact distance D = 0.5 + 5 texels.
+    const double h = 0.02;
+    scene::Scene s = lit({{"curb", scene::Box{Vec3(-0.1, 0, -0.5), Vec3(0, h, 0.5)}, 0}}, Vec3(-0.3, 0, 0));
+    s.camera.width = 640;
+    s.camera.height = 360;
+    scene::SettingsOverrides o;
+    o.shadowMapSize = 256;  // defaults otherwise: half a texel of constant bias, slope bias 1, pcf2x2
+    const Renders r = compareRaster(s, o);
+    const Metrics& m = r.c.metrics;
+    ASSERT_TRUE(m.hasBlockerDistance);
+    ASSERT_LT(std::sqrt(2.0) * h, 1.5 * r.texel) << "the curb must be lower than the bias reaches";
+    std::size_t strip = 0, stripMissed = 0, elsewhere = 0;
+    for (std::size_t i = 0; i < r.c.classes.size(); ++i) {
+        if (r.reference.objectId[i] != 1.0f || r.reference.visibility[i] != 0.0f) continue;
+        const Vec3 p = floorPoint(s, i);
+        if (p.x > -0.1 - h - 0.01 && p.x < -0.1 + 0.01 && std::abs(p.z) < 0.51) {
+            ++strip;
+            stripMissed += r.c.classes[i] == PixelClass::MissedShadow;
+        } else {
+            ++elsewhere;
+        }
+    }
+    std::printf("curb h %.3f, texel %.4f: strip %zu px (%zu missed); missed %zu (%zu near an edge), bias leak %zu "
+                "(%zu near an edge), aliasing %zu, D %.4f\n",
+                h, r.texel, strip, stripMissed, m.missedShadow, m.missedShadowNearEdge, m.biasLeak, m.biasLeakNearEdge,
+                m.aliasingPixels, m.contactDistance);
+    EXPECT_GT(strip, 100u) << "the camera must see the strip";
+    EXPECT_EQ(elsewhere, 0u) << "the reference shadows the strip and nothing else";
+    EXPECT_GE(double(stripMissed), 0.9 * double(strip)) << "the bias loses the strip";
+    EXPECT_EQ(m.biasLeak, m.missedShadow) << "every blocker within D";
+    EXPECT_GE(double(m.missedShadowNearEdge), 0.9 * double(m.missedShadow)) << "a strip narrower than the edge radius";
+    EXPECT_EQ(m.biasLeakNearEdge, m.missedShadowNearEdge);
+    EXPECT_EQ(m.aliasingPixels, m.falseShadowNearEdge) << "no missed pixel of the strip is aliasing";
+    // The findings say so.
+    ReportInput in;
+    in.sceneName = "curb";
+    in.objectNames = {"floor", "curb"};
+    in.reference = {"reference", "reference.png", r.reference};
+    in.methods.push_back({"raster", "raster.png", "diff-raster.png", r.raster, m});
+    const std::string text = describeFindings(in);
+    EXPECT_NE(text.find("of it within the contact distance of its blocker"), std::string::npos) << text;
+    EXPECT_EQ(text.find("aliasing rather than bias"), std::string::npos) << text;
 }
 
 }  // namespace

@@ -316,6 +316,84 @@ TEST(EdgeAwareError, WrongPixelsNextToAReferenceShadowEdgeAreAliasing) {
     EXPECT_DOUBLE_EQ(k1.biasErrorRate, 2.0 / 400.0);
 }
 
+TEST(EdgeAwareError, APointSampledMethodHasNoAliasing) {
+    // The same wrong pixels as above (columns 10 and 11, a speckle, a missed pixel), from a ray
+    // tracer: its frame records a ray bias and no shadow-map texel, so it tests each pixel's own
+    // point as the reference does and no wrong pixel is a sampling grid's. Near-edge counts stay
+    // as measured; none of them is aliasing.
+    auto [m, r] = halfShadow(12);
+    m.visibility[5 * 20 + 18] = 0.0f;
+    m.visibility[0] = 1.0f;
+    m.attributes["ray_bias"] = "0.001";
+    const Metrics k = compareFrames(m, r).metrics;
+    EXPECT_TRUE(k.pointSampled);
+    EXPECT_EQ(k.falseShadowNearEdge, 40u);  // columns 10 and 11 (radius 2 from the edge at 9|10)
+    EXPECT_EQ(k.aliasingPixels, 0u);
+    EXPECT_EQ(k.biasErrorPixels, 42u);
+    // A frame that also records a shadow-map texel looks its shadows up on a grid: aliasing again.
+    m.attributes["texel_world_size"] = "0.01";
+    const Metrics map = compareFrames(m, r).metrics;
+    EXPECT_FALSE(map.pointSampled);
+    EXPECT_EQ(map.aliasingPixels, 40u);
+    EXPECT_EQ(map.biasErrorPixels, 2u);
+}
+
+TEST(EdgeAwareError, AThinShadowLostWholeToTheBiasIsABiasLeakNotAliasing) {
+    // Reference: a shadow two columns wide (x = 10, 11) on a lit floor, its blocker 0.01 away
+    // along the ray; the method (a shadow map: texel 0.01, bias 0.005, slope 1) misses all of it.
+    // Contact distance D = b + (s + 4)·t·max(1, tanθ) with N·L = 0.5 (tanθ = √3) is
+    // 0.005 + 5·0.01·√3 = 0.092 > 0.01, so every missed pixel is a bias leak; all of them lie
+    // within 2 px of the strip's edges (columns 9|10 and 11|12), so by distance alone they would
+    // all be aliasing. A missed pixel x = 15 whose blocker is 1 away (beyond D) in a second strip
+    // (x = 15, rows 0..19) stays aliasing: it is a far blocker's shadow, near its edge.
+    Frame r = test::uniformFrame(20, 20, 1, 0.5f, 1), m = r;
+    r.blockerId.assign(r.pixelCount(), 0.0f);
+    r.blockerDistance.assign(r.pixelCount(), 0.0f);
+    for (int y = 0; y < 20; ++y)
+        for (const int x : {10, 11, 15}) {
+            const std::size_t i = std::size_t(y) * 20 + x;
+            r.visibility[i] = 0.0f;
+            r.blockerId[i] = 2.0f;
+            r.blockerDistance[i] = x == 15 ? 1.0f : 0.01f;
+        }
+    m.attributes = {{"texel_world_size", "0.01"}, {"depth_bias", "0.005"}, {"slope_bias", "1"}};
+    const Metrics k = compareFrames(m, r).metrics;
+    ASSERT_TRUE(k.hasBlockerDistance);
+    EXPECT_FALSE(k.pointSampled);
+    EXPECT_NEAR(k.contactDistance, 0.005 + 5 * 0.01, 1e-9);  // at tanθ ≤ 1
+    EXPECT_EQ(k.missedShadow, 60u);
+    EXPECT_EQ(k.missedShadowNearEdge, 60u);
+    EXPECT_EQ(k.biasLeak, 40u);
+    EXPECT_EQ(k.biasLeakNearEdge, 40u);
+    EXPECT_EQ(k.aliasingPixels, 20u);   // the far blocker's column only
+    EXPECT_EQ(k.biasErrorPixels, 40u);  // the thin strip, lost to the bias
+    EXPECT_EQ(toJson(k)["bias_leak_near_edge"], 40);
+    // A far blocker's missed shadow away from every edge is a filter's light bleeding: one pixel
+    // (5, 10) inside a wide shadow (x = 0..14, its edge at 14|15, 9 columns away) whose blocker
+    // is 1 away. A ray tracer missing it (its frame records a ray bias and no texel) has no
+    // filter: no bleeding, and bias error rather than aliasing.
+    Frame wide = test::uniformFrame(20, 20, 1, 0.5f, 1), miss = wide;
+    wide.blockerId.assign(wide.pixelCount(), 0.0f);
+    wide.blockerDistance.assign(wide.pixelCount(), 0.0f);
+    for (int y = 0; y < 20; ++y)
+        for (int x = 0; x < 15; ++x) {
+            const std::size_t i = std::size_t(y) * 20 + x;
+            wide.visibility[i] = miss.visibility[i] = 0.0f;
+            wide.blockerId[i] = 2.0f;
+            wide.blockerDistance[i] = 1.0f;
+        }
+    miss.visibility[10 * 20 + 5] = 1.0f;
+    miss.attributes = m.attributes;  // the shadow map's
+    EXPECT_EQ(compareFrames(miss, wide).metrics.bleeding, 1u);
+    miss.attributes = {{"ray_bias", "0.001"}};
+    const Metrics ray = compareFrames(miss, wide).metrics;
+    EXPECT_TRUE(ray.pointSampled);
+    EXPECT_EQ(ray.missedShadow, 1u);
+    EXPECT_EQ(ray.bleeding, 0u);
+    EXPECT_EQ(ray.biasErrorPixels, 1u);
+    EXPECT_EQ(ray.aliasingPixels, 0u);
+}
+
 TEST(EdgeAwareError, ABoundaryBetweenTwoObjectsIsNotAShadowEdge) {
     // Left half object 1 shadowed, right half object 2 lit: a contact, not a shadow edge, so a
     // missing contact shadow stays bias error (peter-panning).

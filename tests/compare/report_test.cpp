@@ -122,6 +122,51 @@ TEST(Report, FindingsNameTheDominantErrorAndWhere) {
     EXPECT_NE(overall.find("the ray tracer is closer"), std::string::npos) << overall;
 }
 
+TEST(Report, FindingsSayAThinShadowLostToTheBiasIsBiasAndARayTracerDoesNotAlias) {
+    // Reference: two columns of shadow on a lit floor (N·L = 0.5), the blocker 0.01 away along
+    // the ray. A shadow map (texel 0.01, bias 0.005, slope 1; D = 0.005 + 5·0.01·√3 = 0.092 at
+    // this pixel) misses all of it: a bias leak, though every missed pixel lies within 2 px of
+    // the strip's edges. Its frame says the receivers and casters asked for 4096 texels where the
+    // default capped the map at 2048. A ray tracer misses the same strip: no aliasing there.
+    scene::Frame ref = test::uniformFrame(20, 20, 1, 0.5f, 1);
+    ref.blockerId.assign(ref.pixelCount(), 0.0f);
+    ref.blockerDistance.assign(ref.pixelCount(), 0.0f);
+    for (int y = 0; y < 20; ++y)
+        for (const int x : {10, 11}) {
+            ref.visibility[std::size_t(y) * 20 + x] = 0.0f;
+            ref.blockerId[std::size_t(y) * 20 + x] = 2.0f;
+            ref.blockerDistance[std::size_t(y) * 20 + x] = 0.01f;
+        }
+    scene::Frame map = test::uniformFrame(20, 20, 1, 0.5f, 1), ray = map;
+    map.attributes = {{"backend", "raster"},       {"texel_world_size", "0.01"},   {"depth_bias", "0.005"},
+                      {"slope_bias", "1"},         {"shadow_map_size", "2048"},    {"shadow_map_size_needed", "4096"}};
+    ray.attributes = {{"backend", "raytrace"}, {"ray_bias", "0.001"}};
+    ReportInput in;
+    in.sceneName = "strip";
+    in.objectNames = {"floor", "trim"};
+    in.reference = {"reference", "reference.png", ref};
+    in.methods.push_back({"raytrace", "raytrace.png", "diff-raytrace.png", ray, compareFrames(ray, ref).metrics});
+    in.methods.push_back({"raster", "raster.png", "diff-raster.png", map, compareFrames(map, ref).metrics});
+    std::istringstream lines(describeFindings(in));
+    std::string rayText, mapText;
+    std::getline(lines, rayText);
+    std::getline(lines, mapText);
+    EXPECT_EQ(rayText.find("aliasing rather than bias"), std::string::npos) << rayText;
+    EXPECT_NE(rayText.find("none of this is aliasing"), std::string::npos) << rayText;
+    EXPECT_EQ(mapText.find("aliasing rather than bias"), std::string::npos) << mapText;
+    EXPECT_NE(mapText.find("100% of it within the contact distance of its blocker"), std::string::npos) << mapText;
+    EXPECT_NE(mapText.find("ask for 4,096 texels"), std::string::npos) << mapText;
+    EXPECT_NE(mapText.find("caps it at 2,048"), std::string::npos) << mapText;
+    // Without the cap (the map as large as asked for) the contact-distance words stay, the size
+    // advice goes.
+    in.methods[1].frame.attributes["shadow_map_size"] = "4096";
+    std::istringstream again(describeFindings(in));
+    std::getline(again, rayText);
+    std::getline(again, mapText);
+    EXPECT_NE(mapText.find("within the contact distance"), std::string::npos) << mapText;
+    EXPECT_EQ(mapText.find("--shadow-map-size"), std::string::npos) << mapText;
+}
+
 TEST(Report, FindingsSayAnExactMatchAndAFailure) {
     ReportInput in = syntheticRun();
     in.methods.resize(1);

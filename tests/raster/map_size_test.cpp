@@ -26,13 +26,16 @@ scene::Frame rasterRender(const scene::Scene& s, const scene::SettingsOverrides&
 // bottom edge meets the ground y = 0: that ray is 20° + atan(1.3/6) below the horizon, hits the
 // ground 2/sin(that) away, at view depth (distance)·cos 20°. A pixel there is 2·tan 20°·z/height
 // wide. The map (bounding sphere of the ±10 x 0..2 x ±10 box, 1.01 margin) is 1.01·√804 wide.
-int expectedSize(int height) {
+double neededTexels(int height) {
     const double below = (20.0 * kPi / 180.0) + std::atan(1.3 / 6.0);
     const double z = 2.0 / std::sin(below) * std::cos(20.0 * kPi / 180.0);
     const double pixel = 2.0 * std::tan(20.0 * kPi / 180.0) * z / height;
     const double width = 1.01 * std::sqrt(804.0);
+    return width / pixel;
+}
+int expectedSize(int height) {
     int size = 256;
-    while (size < width / pixel && size < 2048) size *= 2;
+    while (size < neededTexels(height) && size < 2048) size *= 2;
     return size;
 }
 
@@ -42,11 +45,15 @@ TEST(RasterMapSize, ASmallRenderGetsASmallerMapWithTheSameShadows) {
     scene::Frame automatic = rasterRender(s, {});
     EXPECT_EQ(automatic.attributes["shadow_map_size"], "512");
     EXPECT_NE(automatic.attributes["shadow_map_size_reason"].find("receiver detail"), std::string::npos);
+    // 512 rounds up what the receivers ask for, so they asked for more than 256 and at most 512.
+    EXPECT_GT(std::stod(automatic.attributes["shadow_map_size_needed"]), 256.0);
+    EXPECT_LE(std::stod(automatic.attributes["shadow_map_size_needed"]), 512.0);
     scene::SettingsOverrides forced;
     forced.shadowMapSize = 2048;
     scene::Frame full = rasterRender(s, forced);
     EXPECT_EQ(full.attributes["shadow_map_size"], "2048");
     EXPECT_NE(full.attributes["shadow_map_size_reason"].find("set by"), std::string::npos);
+    EXPECT_EQ(full.attributes.count("shadow_map_size_needed"), 0u);
 
     const scene::Frame ref = test::renderReference(s);
     const compare::Metrics a = compare::compareFrames(automatic, ref).metrics;
@@ -64,6 +71,33 @@ TEST(RasterMapSize, AFullSizeRenderKeepsTheDefault) {
     const scene::Scene s = loadSeed(1280, 720);
     const ShadowMapSizeChoice c = chooseShadowMapSize(s, scene::resolveSettings(s, {}).raster);
     EXPECT_EQ(c.size, 2048);
+}
+
+TEST(RasterMapSize, TheTexelsAskedForAreRecordedAndTheCapIsNamedOnlyWhenTheyExceedIt) {
+    // The bounding-sphere map (not fitted, so its width is 1.01·√804 as above). The sphere
+    // (diameter 2) asks for 4 texels across it, 4·28.6/2 = 57: the receivers decide. At 36 rows
+    // they ask for ≈ 402 texels, rounded up to 512; at 360 rows for ≈ 4000, more than the
+    // default 2048, which caps it.
+    scene::SettingsOverrides unfitted;
+    unfitted.fitLightFrustum = false;
+    const scene::Scene small = loadSeed(64, 36);
+    const ShadowMapSizeChoice a = chooseShadowMapSize(small, scene::resolveSettings(small, unfitted).raster);
+    EXPECT_EQ(a.size, 512);
+    EXPECT_NEAR(a.needed, neededTexels(36), 0.01 * neededTexels(36));
+    EXPECT_EQ(a.reason.find("capped"), std::string::npos) << a.reason;
+    EXPECT_NE(a.reason.find("rounded up to a power of two"), std::string::npos) << a.reason;
+    const scene::Scene large = loadSeed(640, 360);
+    scene::RenderSettings settings = scene::resolveSettings(large, unfitted);
+    settings.raster.cascades = 1;  // one map, so the size follows the receivers
+    const ShadowMapSizeChoice b = chooseShadowMapSize(large, settings.raster);
+    ASSERT_GT(neededTexels(360), 2048.0);
+    EXPECT_EQ(b.size, 2048);
+    EXPECT_NEAR(b.needed, neededTexels(360), 0.01 * neededTexels(360));
+    EXPECT_NE(b.reason.find("capped at the default"), std::string::npos) << b.reason;
+    // A forced size asks for nothing.
+    scene::SettingsOverrides forced = unfitted;
+    forced.shadowMapSize = 1024;
+    EXPECT_EQ(chooseShadowMapSize(small, scene::resolveSettings(small, forced).raster).needed, 0.0);
 }
 
 TEST(RasterMapSize, ASizeFromTheSceneIsKept) {

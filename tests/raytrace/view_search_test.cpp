@@ -72,6 +72,23 @@ TEST(ViewSearch, AModelOutsideIsSeenFromOutsideUnderASunAboveTheHorizonWithItsSh
     EXPECT_GT(share, 0.08);
     EXPECT_LT(share, 0.9);
     EXPECT_GT(groundShadow, 0.02);  // the box's shadow on the ground fills 2% of the image or more
+    // The whole shadow is in view: no pixel on the image's border is the ground in shadow.
+    {
+        scene::Scene v = s;
+        v.camera.width = 160;
+        v.camera.height = 90;
+        const scene::RenderSettings settings = scene::resolveSettings(v, {});
+        const scene::Frame f = renderReference(v, scene::makeRenderPlan(v, settings), settings.raytrace);
+        const float groundId = float(v.objects.size());
+        std::size_t cut = 0;
+        for (int y = 0; y < 90; ++y)
+            for (int x = 0; x < 160; ++x) {
+                if (x > 0 && x < 159 && y > 0 && y < 89) continue;
+                const std::size_t i = std::size_t(y) * 160 + x;
+                cut += f.objectId[i] == groundId && f.ndotl[i] > 0 && f.visibility[i] < 0.5f;
+            }
+        EXPECT_EQ(cut, 0u) << "the box's shadow runs off the image";
+    }
     bool recorded = false;
     for (const auto& [key, text] : s.origin.choices) recorded = recorded || (key == "view" && text.find("searched") == 0);
     EXPECT_TRUE(recorded);

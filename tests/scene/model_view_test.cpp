@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "scene/camera.h"
 #include "scene/error.h"
 #include "scene/loader.h"
 #include "tests/scene/camera_gltf.h"
@@ -214,6 +215,82 @@ TEST(ModelView, SunAzimuthRunsFromZTowardXAndElevationUpFromTheHorizon) {
     const glm::dvec2 a = sunAngles(sunDirection(225, 40));
     EXPECT_NEAR(a.x, 225, 1e-9);
     EXPECT_NEAR(a.y, 40, 1e-9);
+}
+
+TEST(ModelView, SunAtAQuarterTurnTravelsExactlyInAnAxisPlane) {
+    // sin(180° in radians) is 1.2e-16 in double, not 0: a sun at azimuth 180 computed that way
+    // gives a face whose normal is exactly +X an N·L of 1e-16 instead of 0, so a face edge-on to
+    // the light would count as lit-facing. At every quarter turn the off-plane component is 0.
+    for (const double el : {0.0, 35.0, 55.0, 75.0, -20.0}) {
+        EXPECT_EQ(sunDirection(0, el).x, 0.0) << el;
+        EXPECT_EQ(sunDirection(180, el).x, 0.0) << el;
+        EXPECT_EQ(sunDirection(-180, el).x, 0.0) << el;
+        EXPECT_EQ(sunDirection(360, el).x, 0.0) << el;
+        EXPECT_EQ(sunDirection(90, el).z, 0.0) << el;
+        EXPECT_EQ(sunDirection(270, el).z, 0.0) << el;
+        EXPECT_EQ(sunDirection(-90, el).z, 0.0) << el;
+        EXPECT_EQ(glm::dot(Vec3(1, 0, 0), -sunDirection(180, el)), 0.0) << el;
+    }
+    for (const double az : {0.0, 45.0, 135.0, 180.0, 300.0}) {
+        EXPECT_EQ(sunDirection(az, 90).x, 0.0) << az;
+        EXPECT_EQ(sunDirection(az, 90).z, 0.0) << az;
+        EXPECT_EQ(sunDirection(az, 90).y, -1.0) << az;
+    }
+    // Between quarter turns the formula is the usual one: at 45° both components are cos e·√½,
+    // at 225° both negated, the direction stays a unit vector.
+    const double h = std::cos(35 * kPi / 180) * std::sqrt(0.5);
+    expectNear(sunDirection(45, 35), {-h, -std::sin(35 * kPi / 180), -h});
+    expectNear(sunDirection(225, 35), {h, -std::sin(35 * kPi / 180), h});
+    for (const double az : {10.0, 100.0, 190.0, 280.0, 359.0})
+        EXPECT_NEAR(glm::length(sunDirection(az, 35)), 1.0, 1e-15) << az;
+}
+
+TEST(ModelView, AFramedViewMovesBackJustEnoughToHoldTheModelsShadow) {
+    // A unit cube [−0.5, 0.5]³ seen from azimuth 30, 20° up (the view search's framing, 16:9).
+    // A sun 25° up at azimuth 300 sends its light along h = (−sin 300°, 0, −cos 300°) =
+    // (0.866, 0, −0.5) and down: a corner Δ above the base y = −0.5 casts its shadow on that
+    // plane Δ/tan 25° along h, up to 2.14 beyond the cube, off to the side of this view. Straight
+    // overhead the cube casts under itself, and the framing stays as it was.
+    Bounds b;
+    b.extend(Vec3(-0.5, -0.5, -0.5));
+    b.extend(Vec3(0.5, 0.5, 0.5));
+    Camera base;
+    base.width = 1280;
+    base.height = 720;
+    const double a = 30 * kPi / 180, e = 20 * kPi / 180;
+    const Camera framed = framedCamera(b, {std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a)}, 40.0, base);
+    const Camera overhead = framedWithShadow(framed, b, sunDirection(300, 90));
+    EXPECT_EQ(overhead.position, framed.position);
+    EXPECT_EQ(overhead.lookAt, framed.lookAt);
+
+    const Camera low = framedWithShadow(framed, b, sunDirection(300, 25));
+    const CameraBasis f = cameraBasis(framed), c = cameraBasis(low);
+    EXPECT_NEAR(glm::dot(f.forward, c.forward), 1.0, 1e-12) << "the same view direction";
+    EXPECT_GE(glm::length(low.lookAt - low.position), glm::length(framed.lookAt - framed.position));
+    // Where a point lies in a view: the larger of |x| and |y| over the image's half-extent at its depth.
+    auto reach = [](const CameraBasis& v, const Vec3& p) {
+        const Vec3 q = p - v.position;
+        const double z = glm::dot(q, v.forward);
+        return std::max(std::abs(glm::dot(q, v.right)) / (z * v.tanHalfFovY * v.aspect),
+                        std::abs(glm::dot(q, v.up)) / (z * v.tanHalfFovY));
+    };
+    // Every corner and every corner's shadow within 1/1.1 of the half-extents, the tightest of
+    // them on that margin (no farther back than needed); in the framed view some shadow corner
+    // lay outside the image.
+    const Vec3 h(std::sqrt(3.0) / 2, 0, -0.5);
+    double tightest = 0, framedReach = 0;
+    for (int k = 0; k < 8; ++k) {
+        const Vec3 corner((k & 1) ? 0.5 : -0.5, (k & 2) ? 0.5 : -0.5, (k & 4) ? 0.5 : -0.5);
+        const double above = corner.y + 0.5;
+        const Vec3 shadow = corner + (above / std::tan(25 * kPi / 180)) * h - Vec3(0, above, 0);
+        for (const Vec3& p : {corner, shadow}) {
+            EXPECT_LE(reach(c, p), 1 / 1.1 + 1e-9) << p.x << " " << p.y << " " << p.z;
+            tightest = std::max(tightest, reach(c, p));
+            framedReach = std::max(framedReach, reach(f, p));
+        }
+    }
+    EXPECT_NEAR(tightest, 1 / 1.1, 1e-9);
+    EXPECT_GT(framedReach, 1.0);
 }
 
 TEST(ModelView, SunOptionPointsTheDirectionalLightAndRefusesBadText) {
