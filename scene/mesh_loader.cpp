@@ -236,6 +236,9 @@ std::vector<double> readElements(const tinygltf::Model& model, int viewIndex, st
                 case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { std::uint32_t u; std::memcpy(&u, p, 4); v = u; break; }
                 case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { std::uint16_t u; std::memcpy(&u, p, 2); v = u; break; }
                 case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: v = *p; break;
+                // Signed types: KHR_mesh_quantization's positions, normals and texture coordinates.
+                case TINYGLTF_COMPONENT_TYPE_SHORT: { std::int16_t u; std::memcpy(&u, p, 2); v = u; break; }
+                case TINYGLTF_COMPONENT_TYPE_BYTE: v = double(std::int8_t(*p)); break;
                 default: bad(where + ".componentType", "unsupported component type " + std::to_string(componentType));
             }
             out[i * std::size_t(nComp) + std::size_t(c)] = v;
@@ -244,9 +247,27 @@ std::vector<double> readElements(const tinygltf::Model& model, int viewIndex, st
     return out;
 }
 
+// A normalized integer accessor's values as glTF 2.0, 3.11 maps them: unsigned c / (2^n - 1),
+// signed max(c / (2^(n-1) - 1), -1), so both -128 and -127 are -1.
+void normalize(std::vector<double>& values, int componentType, const std::string& at, const fs::path& file,
+               const fs::path& sceneFile, const JsonPath& path) {
+    double scale = 0, lowest = 0;
+    switch (componentType) {
+        case TINYGLTF_COMPONENT_TYPE_BYTE: scale = 127.0; lowest = -1.0; break;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: scale = 255.0; break;
+        case TINYGLTF_COMPONENT_TYPE_SHORT: scale = 32767.0; lowest = -1.0; break;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: scale = 65535.0; break;
+        default:
+            fail(sceneFile, path, file, at + ".normalized: must not be true for component type " +
+                                            std::to_string(componentType) + " (only bytes and shorts are normalized)");
+    }
+    for (double& v : values) v = std::max(v / scale, lowest);
+}
+
 // Reads one accessor as doubles (`components` per element): its buffer view's elements, or
 // zeros where it has none, with a sparse accessor's replacements applied (glTF 2.0, 3.6.2.3:
-// `count` strictly increasing indices into the accessor, and as many packed values).
+// `count` strictly increasing indices into the accessor, and as many packed values), and
+// normalized integers mapped to -1..1 or 0..1.
 std::vector<double> readAccessor(const tinygltf::Model& model, int accessorIndex, int components,
                                  const fs::path& file, const fs::path& sceneFile, const JsonPath& path) {
     const std::string at = "accessors[" + std::to_string(accessorIndex) + "]";
@@ -272,6 +293,7 @@ std::vector<double> readAccessor(const tinygltf::Model& model, int accessorIndex
                                    std::to_string(available / kMiB) + " MiB available");
         out.assign(values, 0.0);
     }
+    if (acc.normalized) normalize(out, acc.componentType, at, file, sceneFile, path);
     if (!acc.sparse.isSparse) return out;
     const auto& sparse = acc.sparse;
     const std::string sparseAt = at + ".sparse";
@@ -286,9 +308,10 @@ std::vector<double> readAccessor(const tinygltf::Model& model, int accessorIndex
     const std::vector<double> indices =
         readElements(model, sparse.indices.bufferView, std::uint64_t(sparse.indices.byteOffset), std::uint64_t(sparse.count),
                      indexType, 1, true, sparseAt + ".indices", file, sceneFile, path);
-    const std::vector<double> values =
+    std::vector<double> values =
         readElements(model, sparse.values.bufferView, std::uint64_t(sparse.values.byteOffset), std::uint64_t(sparse.count),
                      acc.componentType, nComp, true, sparseAt + ".values", file, sceneFile, path);
+    if (acc.normalized) normalize(values, acc.componentType, at, file, sceneFile, path);
     for (std::size_t k = 0; k < indices.size(); ++k) {
         const double index = indices[k];
         if (index >= double(acc.count) || (k > 0 && !(index > indices[k - 1])))
@@ -502,19 +525,15 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
             if (it == prim.attributes.end())
                 fail(sceneFile, path, file, at + ": has no " + name + ", which its material's alpha texture needs");
             uv = readAccessor(model, it->second, 2, file, sceneFile, path);
-            // Normalized integer coordinates (glTF 2.0, 3.7.2.1) are code / max.
-            const auto& acc = model.accessors[std::size_t(it->second)];
-            const double scale = !acc.normalized ? 1.0
-                                 : acc.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ? 1.0 / 255.0
-                                 : acc.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? 1.0 / 65535.0 : 1.0;
             if (uv.size() != 2 * count) fail(sceneFile, path, file, at + ": " + name + " has not one element per vertex");
-            for (double& c : uv) {
-                c *= scale;
+            for (const double c : uv)
                 if (!std::isfinite(c)) fail(sceneFile, path, file, at + ": " + name + " holds a non-finite value");
-            }
         }
         std::vector<double> idx;
         if (prim.indices >= 0) {
+            if (std::size_t(prim.indices) < model.accessors.size() && model.accessors[std::size_t(prim.indices)].normalized)
+                fail(sceneFile, path, file, "accessors[" + std::to_string(prim.indices) +
+                                                "].normalized: indices must not be normalized");
             idx = readAccessor(model, prim.indices, 1, file, sceneFile, path);
         } else {
             idx.resize(count);
