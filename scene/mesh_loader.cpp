@@ -18,6 +18,7 @@
 #include <tiny_gltf.h>
 #include <tiny_obj_loader.h>
 
+#include "scene/gltf_extensions.h"
 #include "scene/input_file.h"
 #include "scene/json_input.h"
 #include "scene/memory.h"
@@ -428,10 +429,13 @@ TextureWrap wrapOf(int glWrap) {
 }
 
 // The file's materials as scene materials (grey albedo: shadows do not need its colours), with the
-// alpha texture of each MASK and BLEND material that has a baseColorTexture.
+// alpha texture of each MASK and BLEND material that has a baseColorTexture, and in `uvTransforms`
+// that texture's KHR_texture_transform (one per material).
 std::vector<Material> readMaterials(const tinygltf::Model& model, const GltfImages& images, const fs::path& file,
-                                    const fs::path& sceneFile, const JsonPath& path, std::vector<std::string>& notes) {
+                                    const fs::path& sceneFile, const JsonPath& path, std::vector<std::string>& notes,
+                                    std::vector<UvTransform>& uvTransforms) {
     std::vector<Material> out;
+    uvTransforms.assign(model.materials.size(), UvTransform{});
     std::map<std::tuple<int, int, int>, std::shared_ptr<const AlphaTexture>> decoded;
     for (std::size_t i = 0; i < model.materials.size(); ++i) {
         const tinygltf::Material& gm = model.materials[i];
@@ -456,18 +460,36 @@ std::vector<Material> readMaterials(const tinygltf::Model& model, const GltfImag
                 fail(sceneFile, path, file, texAt + ".index: names texture " + std::to_string(info.index) +
                                                 ", which does not exist");
             const tinygltf::Texture& tex = model.textures[std::size_t(info.index)];
-            if (tex.source < 0 || std::size_t(tex.source) >= model.images.size())
-                fail(sceneFile, path, file, "textures[" + std::to_string(info.index) + "].source: names no image");
+            int source = tex.source;
+            const std::string texturesAt = "textures[" + std::to_string(info.index) + "]";
+            // An image only in another format (the texture's own source is the fallback): WebP
+            // is decoded like PNG; KTX2 (Basis Universal) is not, nor AVIF (OpenImageIO 2.4
+            // reads it from files only, and a glTF image may be in a buffer).
+            for (const char* format : {"EXT_texture_webp", "EXT_texture_avif", "KHR_texture_basisu"}) {
+                const auto it = tex.extensions.find(format);
+                if (source >= 0 || it == tex.extensions.end() || !it->second.Has("source")) continue;
+                if (std::string(format) != "EXT_texture_webp")
+                    fail(sceneFile, path, file, texturesAt + ".extensions." + format + ": the alpha of " + m.name +
+                                                    " (" + gm.alphaMode + ") is only in a" +
+                                                    (std::string(format) == "EXT_texture_avif" ? "n AVIF" : " KTX2") +
+                                                    " image, which shadowlab does not decode "
+                                                    "(give the texture a PNG or JPEG source)");
+                const tinygltf::Value& v = it->second.Get("source");
+                const double d = v.IsNumber() || v.IsInt() ? v.GetNumberAsDouble() : -1.0;
+                source = d >= 0 && d < double(model.images.size()) && d == std::floor(d) ? int(d) : -1;
+            }
+            if (source < 0 || std::size_t(source) >= model.images.size())
+                fail(sceneFile, path, file, texturesAt + ".source: names no image");
             TextureWrap s = TextureWrap::Repeat, t = TextureWrap::Repeat;
             if (tex.sampler >= 0 && std::size_t(tex.sampler) < model.samplers.size()) {
                 s = wrapOf(model.samplers[std::size_t(tex.sampler)].wrapS);
                 t = wrapOf(model.samplers[std::size_t(tex.sampler)].wrapT);
             }
-            const tinygltf::Image& image = model.images[std::size_t(tex.source)];
-            const std::string imageAt = "images[" + std::to_string(tex.source) + "]" +
+            const tinygltf::Image& image = model.images[std::size_t(source)];
+            const std::string imageAt = "images[" + std::to_string(source) + "]" +
                                         (image.uri.empty() || image.uri.rfind("data:", 0) == 0 ? "" : " (" + excerpt(image.uri) + ")");
-            const auto key = std::make_tuple(tex.source, int(s), int(t));
-            const auto bytes = images.find(tex.source);
+            const auto key = std::make_tuple(source, int(s), int(t));
+            const auto bytes = images.find(source);
             if (!decoded.count(key) && bytes == images.end()) {
                 // A model passed on without its image files is common (and the shadow of the
                 // rest of it is still worth grading): the material keeps its factor's alpha,
@@ -479,7 +501,8 @@ std::vector<Material> readMaterials(const tinygltf::Model& model, const GltfImag
                 continue;
             }
             if (!decoded.count(key)) {
-                std::string ext = image.mimeType == "image/jpeg" ? ".jpg" : image.mimeType == "image/png" ? ".png" : "";
+                std::string ext = image.mimeType == "image/jpeg" ? ".jpg" : image.mimeType == "image/png" ? ".png"
+                                  : image.mimeType == "image/webp" ? ".webp" : "";
                 if (ext.empty()) ext = fs::path(image.uri).extension().string();
                 try {
                     decoded[key] = loadAlphaTextureFromMemory(file.string() + "#" + imageAt, ext, bytes->second, s, t);
@@ -488,7 +511,11 @@ std::vector<Material> readMaterials(const tinygltf::Model& model, const GltfImag
                 }
             }
             m.alphaTexture = decoded[key];
-            m.texCoord = info.texCoord;
+            try {
+                uvTransforms[i] = readTextureTransform(info, texAt, m.texCoord);
+            } catch (const GltfExtensionError& e) {
+                fail(sceneFile, path, file, e.what());
+            }
             if (m.texCoord < 0 || m.texCoord > 64)
                 fail(sceneFile, path, file, texAt + ".texCoord: must be in 0..64, got " + std::to_string(m.texCoord));
         }
@@ -498,10 +525,11 @@ std::vector<Material> readMaterials(const tinygltf::Model& model, const GltfImag
 }
 
 // One glTF mesh's triangle primitives in the mesh's own space: all of them (material -2), or
-// those of one material; with TEXCOORD_`uvSet` per vertex when uvSet >= 0.
+// those of one material; with TEXCOORD_`uvSet` per vertex when uvSet >= 0, moved by
+// `uvTransform` (the material's alpha texture's KHR_texture_transform).
 void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& out,
                     const fs::path& file, const fs::path& sceneFile, const JsonPath& path,
-                    int material = -2, int uvSet = -1) {
+                    int material = -2, int uvSet = -1, const UvTransform& uvTransform = {}) {
     if (meshIndex < 0 || std::size_t(meshIndex) >= model.meshes.size())
         fail(sceneFile, path, file, "node names mesh " + std::to_string(meshIndex) + ", which does not exist");
     for (std::size_t primIndex = 0; primIndex < model.meshes[meshIndex].primitives.size(); ++primIndex) {
@@ -526,8 +554,15 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
                 fail(sceneFile, path, file, at + ": has no " + name + ", which its material's alpha texture needs");
             uv = readAccessor(model, it->second, 2, file, sceneFile, path);
             if (uv.size() != 2 * count) fail(sceneFile, path, file, at + ": " + name + " has not one element per vertex");
-            for (const double c : uv)
-                if (!std::isfinite(c)) fail(sceneFile, path, file, at + ": " + name + " holds a non-finite value");
+            for (std::size_t i = 0; i < uv.size(); i += 2) {
+                // KHR_texture_transform moves where the alpha is sampled; both backends
+                // interpolate these per-vertex coordinates, and the transform is affine.
+                const Vec2 t = uvTransform.apply(Vec2(uv[i], uv[i + 1]));
+                uv[i] = t.x;
+                uv[i + 1] = t.y;
+                if (!std::isfinite(t.x) || !std::isfinite(t.y))
+                    fail(sceneFile, path, file, at + ": " + name + " holds a non-finite value");
+            }
         }
         std::vector<double> idx;
         if (prim.indices >= 0) {
@@ -554,8 +589,11 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
         for (std::size_t i = 0; i + 2 < idx.size(); i += 3) {
             for (int k = 0; k < 3; ++k) {
                 if (idx[i + k] >= double(count))
-                    fail(sceneFile, path, file, "index " + std::to_string(std::uint64_t(idx[i + k])) +
-                                                    " is out of range (" + std::to_string(count) + " vertices)");
+                    fail(sceneFile, path, file, "meshes[" + std::to_string(meshIndex) + "].primitives[" +
+                                                    std::to_string(primIndex) + "].indices (accessors[" +
+                                                    std::to_string(prim.indices) + "]): index " +
+                                                    std::to_string(std::uint64_t(idx[i + k])) + " is out of range (" +
+                                                    std::to_string(count) + " vertices)");
                 out.indices.push_back(base + std::uint32_t(idx[i + k]));
             }
         }
@@ -666,26 +704,22 @@ bool gltfWriteFile(std::string* err, const std::string&, const std::vector<unsig
     return false;
 }
 
-// The JSON of a .gltf file, or of a GLB's first chunk (GLB header: magic, version, length; then
-// chunk length and type "JSON"), for the nesting check; empty when the header is not a GLB's
-// (tinygltf then says what is wrong).
-std::string_view gltfJson(const std::string& bytes, bool binary) {
-    if (!binary) return bytes;
-    if (bytes.size() < 20 || bytes.compare(0, 4, "glTF") != 0) return {};
-    std::uint32_t chunkLength = 0;
-    std::memcpy(&chunkLength, bytes.data() + 12, 4);
-    if (bytes.compare(16, 4, "JSON") != 0 || chunkLength > bytes.size() - 20) return {};
-    return std::string_view(bytes.data() + 20, chunkLength);
-}
-
-void loadGltf(const fs::path& file, const std::string& bytes, std::vector<RawInstance>& out, const fs::path& sceneFile,
-              const JsonPath& path, GltfExtras* extras, const MeshRequest& request) {
+// `decodedBytes`: what decoding compressed geometry added to the file's buffers.
+void loadGltf(const fs::path& file, const std::string& fileBytes, std::vector<RawInstance>& out, const fs::path& sceneFile,
+              const JsonPath& path, GltfExtras* extras, const MeshRequest& request, std::uint64_t& decodedBytes) {
     std::string ext = file.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
     const bool binary = ext == ".glb";
     // tinygltf parses extras and extensions recursively: nesting is bounded before it sees them.
-    if (const std::string problem = jsonNestingProblem(gltfJson(bytes, binary)); !problem.empty())
+    if (const std::string problem = jsonNestingProblem(gltfJsonChunk(fileBytes, binary)); !problem.empty())
         fail(sceneFile, path, file, problem);
+    GltfPrepared prepared;
+    try {
+        prepared = prepareGltf(fileBytes, binary);
+    } catch (const GltfExtensionError& e) {
+        fail(sceneFile, path, file, e.what());
+    }
+    const std::string& bytes = prepared.rewritten.empty() ? fileBytes : prepared.rewritten;
     tinygltf::TinyGLTF loader;
     GltfImages images;  // kept only where materials may need them
     loader.SetImageLoader(ignoreImage, request.perMaterial ? &images : nullptr);
@@ -699,10 +733,18 @@ void loadGltf(const fs::path& file, const std::string& bytes, std::vector<RawIns
                : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(),
                                             unsigned(std::min<std::size_t>(bytes.size(), UINT_MAX)), files.baseDir);
     if (!ok) fail(sceneFile, path, file, "not a readable glTF file: " + excerpt(err.empty() ? warn : err, 400));
+    prepared.rewritten.clear();
+    prepared.rewritten.shrink_to_fit();
+    try {
+        decodedBytes = decodeCompressedGeometry(model, prepared);
+    } catch (const GltfExtensionError& e) {
+        fail(sceneFile, path, file, e.what());
+    }
 
     std::vector<Material> materials;
-    std::vector<std::string> notes;
-    if (request.perMaterial) materials = readMaterials(model, images, file, sceneFile, path, notes);
+    std::vector<UvTransform> uvTransforms;
+    std::vector<std::string> notes = prepared.notes;
+    if (request.perMaterial) materials = readMaterials(model, images, file, sceneFile, path, notes, uvTransforms);
     images.clear();
     if (extras) extras->materials = materials;
     if (extras) extras->notes = notes;
@@ -767,7 +809,8 @@ void loadGltf(const fs::path& file, const std::string& bytes, std::vector<RawIns
                         geometry = std::make_shared<TriangleMesh>();
                         const Material* m = material >= 0 ? &materials[std::size_t(material)] : nullptr;
                         appendGltfMesh(model, node.mesh, *geometry, file, sceneFile, path, material,
-                                       m && m->alphaTextured() ? m->texCoord : -1);
+                                       m && m->alphaTextured() ? m->texCoord : -1,
+                                       m && m->alphaTextured() ? uvTransforms[std::size_t(material)] : UvTransform{});
                     }
                     out.push_back({geometry, world, material});
                 }
@@ -812,7 +855,7 @@ std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path&
     std::string ext = meshFile.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
     loadBytes = ext == ".obj" || ext == ".ply" ? 4 * std::uint64_t(bytes.size())
-                              : 5 * std::uint64_t(bytes.size()) + 2 * jsonTreeBytes(gltfJson(bytes, ext == ".glb"));
+                              : 5 * std::uint64_t(bytes.size()) + 2 * jsonTreeBytes(gltfJsonChunk(bytes, ext == ".glb"));
     if (const std::uint64_t available = availableMemoryBytes(); available != 0 && loadBytes > available)
         fail(sceneFile, path, meshFile, "reading it needs about " + std::to_string(loadBytes / kMiB) + " MiB, more than the " +
                                             std::to_string(available / kMiB) + " MiB available");
@@ -820,7 +863,11 @@ std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path&
         raw.push_back({std::make_shared<TriangleMesh>(), glm::dmat4(1.0)});
         loadObj(meshFile, bytes, *raw.back().geometry, sceneFile, path, request.uvSet >= 0);
     } else if (ext == ".gltf" || ext == ".glb") {
-        loadGltf(meshFile, bytes, raw, sceneFile, path, extras, request);
+        std::uint64_t decodedBytes = 0;
+        loadGltf(meshFile, bytes, raw, sceneFile, path, extras, request, decodedBytes);
+        // Decoded geometry is held beside the file like its buffers, and read as doubles (at
+        // most 8 a byte, for byte components).
+        loadBytes += 9 * decodedBytes;
     } else if (ext == ".ply") {
         if (request.uvSet >= 0)
             fail(sceneFile, path, meshFile, "a PLY mesh has no texture coordinates, which the object's alpha texture needs");
