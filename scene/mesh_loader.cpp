@@ -227,6 +227,8 @@ std::vector<double> readElements(const tinygltf::Model& model, int viewIndex, st
                        std::to_string(values * sizeof(double) / kMiB) + " MiB, more than the " +
                        std::to_string(available / kMiB) + " MiB available");
     std::vector<double> out(values);
+    // No element: the offsets were not checked against the view and may point anywhere.
+    if (count == 0) return out;
     const unsigned char* base = buffer.data.data() + view.byteOffset + byteOffset;
     for (std::size_t i = 0; i < count; ++i) {
         for (int c = 0; c < nComp; ++c) {
