@@ -568,9 +568,18 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
         }
         std::vector<double> idx;
         if (prim.indices >= 0) {
-            if (std::size_t(prim.indices) < model.accessors.size() && model.accessors[std::size_t(prim.indices)].normalized)
-                fail(sceneFile, path, file, "accessors[" + std::to_string(prim.indices) +
-                                                "].normalized: indices must not be normalized");
+            if (std::size_t(prim.indices) < model.accessors.size()) {
+                // glTF 2.0, 3.7.2.1: unsigned and not normalized (the signed types of
+                // KHR_mesh_quantization are for attributes only).
+                const tinygltf::Accessor& ia = model.accessors[std::size_t(prim.indices)];
+                const std::string iaAt = "accessors[" + std::to_string(prim.indices) + "]";
+                if (ia.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+                    ia.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+                    ia.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+                    fail(sceneFile, path, file, iaAt + ".componentType: indices must be an unsigned byte, short or int, got " +
+                                                    std::to_string(ia.componentType));
+                if (ia.normalized) fail(sceneFile, path, file, iaAt + ".normalized: indices must not be normalized");
+            }
             idx = readAccessor(model, prim.indices, 1, file, sceneFile, path);
         } else {
             idx.resize(count);

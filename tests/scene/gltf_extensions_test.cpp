@@ -219,7 +219,7 @@ TEST(GltfQuantization, NormalizedIntegersFollowTheSpecsRules) {
     EXPECT_DOUBLE_EQ(m.positions[8].y, 2.0);
 }
 
-TEST(GltfQuantization, NormalizedFloatsAndIndicesAreRefused) {
+TEST(GltfQuantization, NormalizedFloatsAndSignedOrNormalizedIndicesAreRefused) {
     std::string g = test::boxGltf(R"([{"mesh": 0}])", "[0]");
     std::string floats = g;
     floats.replace(floats.find(R"("componentType": 5126,)"), 22, R"("componentType": 5126, "normalized": true,)");
@@ -230,6 +230,12 @@ TEST(GltfQuantization, NormalizedFloatsAndIndicesAreRefused) {
     indices.replace(indices.find(R"("componentType": 5123,)"), 22, R"("componentType": 5123, "normalized": true,)");
     e = errorOf([&] { loaded(dir.write("i.gltf", indices)); });
     EXPECT_NE(e.find("accessors[1].normalized: indices must not be normalized"), std::string::npos) << e;
+    // Signed indices (glTF allows unsigned ones only; a negative one would name no vertex).
+    std::string signedIndices = g;
+    signedIndices.replace(signedIndices.find(R"("componentType": 5123,)"), 22, R"("componentType": 5122,)");
+    e = errorOf([&] { loaded(dir.write("s.gltf", signedIndices)); });
+    EXPECT_NE(e.find("accessors[1].componentType: indices must be an unsigned byte, short or int, got 5122"),
+              std::string::npos) << e;
 }
 
 // ---- EXT_meshopt_compression / KHR_meshopt_compression ------------------------------------
