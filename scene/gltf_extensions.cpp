@@ -368,6 +368,27 @@ std::string_view gltfJsonChunk(const std::string& bytes, bool binary) {
     return std::string_view(bytes.data() + 20, chunkLength);
 }
 
+std::string glbLayoutProblem(const std::string& bytes) {
+    if (bytes.size() < 12 || bytes.compare(0, 4, "glTF") != 0) return {};
+    // Bytes after the declared length are ignored, as tinygltf ignores them.
+    const std::uint64_t declared = readU32(bytes, 8);
+    if (declared > bytes.size())
+        return "GLB header: declares " + std::to_string(declared) + " bytes, but the file has only " +
+               std::to_string(bytes.size()) + " (cut short?)";
+    // Chunk by chunk: length (4 bytes), type (4), data; the JSON chunk first, then BIN.
+    std::uint64_t at = 12;
+    for (int chunk = 0; at < declared; ++chunk) {
+        const std::string name = "GLB chunk " + std::to_string(chunk) + (chunk == 0 ? " (JSON)" : chunk == 1 ? " (BIN)" : "");
+        if (declared - at < 8) return name + ": its 8-byte header is cut short at byte " + std::to_string(at);
+        const std::uint64_t length = readU32(bytes, std::size_t(at));
+        if (length > declared - at - 8)
+            return name + ": declares " + std::to_string(length) + " bytes, but only " + std::to_string(declared - at - 8) +
+                   " follow its header";
+        at += 8 + length;
+    }
+    return {};
+}
+
 GltfPrepared prepareGltf(const std::string& bytes, bool binary) {
     GltfPrepared out;
     const std::string_view text = gltfJsonChunk(bytes, binary);

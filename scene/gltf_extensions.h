@@ -65,4 +65,10 @@ UvTransform readTextureTransform(const tinygltf::TextureInfo& info, const std::s
 // is wrong).
 std::string_view gltfJsonChunk(const std::string& bytes, bool binary);
 
+// What is wrong with a GLB container's sizes (glTF 2.0, 4.4): the header's length must lie in
+// the file, and each chunk within that length; empty when they do, or when the bytes are not a
+// GLB at all (tinygltf says so). tinygltf 2.7 copies a BIN chunk of the length its header
+// declares, past the end of a file cut short.
+std::string glbLayoutProblem(const std::string& bytes);
+
 }  // namespace shadowlab::scene

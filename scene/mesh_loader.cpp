@@ -722,6 +722,8 @@ void loadGltf(const fs::path& file, const std::string& fileBytes, std::vector<Ra
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
     const bool binary = ext == ".glb";
     // tinygltf parses extras and extensions recursively: nesting is bounded before it sees them.
+    if (binary)
+        if (const std::string problem = glbLayoutProblem(fileBytes); !problem.empty()) fail(sceneFile, path, file, problem);
     if (const std::string problem = jsonNestingProblem(gltfJsonChunk(fileBytes, binary)); !problem.empty())
         fail(sceneFile, path, file, problem);
     GltfPrepared prepared;

@@ -538,6 +538,44 @@ TEST(GltfDraco, CutOrMismatchedDataIsAnErrorNamingThePrimitive) {
     EXPECT_NE(e.find("Draco attribute 7 is not in the data"), std::string::npos) << e;
 }
 
+// ---- the GLB container ---------------------------------------------------------------------
+
+TEST(GltfContainer, ChunksThatReachPastTheFileAreRefusedBeforeTinygltfReadsThem) {
+    // The tetrahedron's meshopt file is only a vehicle: a GLB with a JSON and a BIN chunk.
+    const MeshoptFile f = meshoptTetra(gridOf(tetra(), 14), "EXT_meshopt_compression", "TRIANGLES");
+    const std::string good = glb(f.doc, f.bin);
+    TempDir dir;
+    EXPECT_NO_THROW(loaded(dir.write("good.glb", good)));
+    auto setU32 = [](std::string& bytes, std::size_t at, std::uint32_t v) { std::memcpy(bytes.data() + at, &v, 4); };
+    {
+        // The last 4 bytes cut off, the header's length made to agree: the BIN chunk's own length
+        // then reaches 4 bytes past the end (tinygltf 2.7 would copy them).
+        std::string cut = good.substr(0, good.size() - 4);
+        setU32(cut, 8, std::uint32_t(cut.size()));
+        const fs::path file = dir.write("cut.glb", cut);
+        const std::string e = errorOf([&] { loaded(file); });
+        EXPECT_NE(e.find(file.string() + ": GLB chunk 1 (BIN): declares " + std::to_string(f.bin.size()) +
+                         " bytes, but only " + std::to_string(f.bin.size() - 4) + " follow its header"),
+                  std::string::npos) << e;
+    }
+    {
+        // The header's length is past the file's end.
+        std::string longer = good;
+        setU32(longer, 8, std::uint32_t(good.size() + 8));
+        const std::string e = errorOf([&] { loaded(dir.write("length.glb", longer)); });
+        EXPECT_NE(e.find("GLB header: declares " + std::to_string(good.size() + 8) + " bytes, but the file has only " +
+                         std::to_string(good.size())),
+                  std::string::npos) << e;
+    }
+    {
+        // A JSON chunk longer than the file.
+        std::string json = good;
+        setU32(json, 12, std::uint32_t(good.size()));
+        const std::string e = errorOf([&] { loaded(dir.write("json.glb", json)); });
+        EXPECT_NE(e.find("GLB chunk 0 (JSON): declares"), std::string::npos) << e;
+    }
+}
+
 // ---- extensionsRequired and extensionsUsed -----------------------------------------------
 
 std::string boxWith(const std::string& extensionsJson) {
