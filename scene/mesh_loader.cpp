@@ -18,6 +18,7 @@
 #include <tiny_gltf.h>
 #include <tiny_obj_loader.h>
 
+#include "scene/gltf_extensions.h"
 #include "scene/input_file.h"
 #include "scene/json_input.h"
 #include "scene/memory.h"
@@ -226,6 +227,8 @@ std::vector<double> readElements(const tinygltf::Model& model, int viewIndex, st
                        std::to_string(values * sizeof(double) / kMiB) + " MiB, more than the " +
                        std::to_string(available / kMiB) + " MiB available");
     std::vector<double> out(values);
+    // No element: the offsets were not checked against the view and may point anywhere.
+    if (count == 0) return out;
     const unsigned char* base = buffer.data.data() + view.byteOffset + byteOffset;
     for (std::size_t i = 0; i < count; ++i) {
         for (int c = 0; c < nComp; ++c) {
@@ -236,6 +239,9 @@ std::vector<double> readElements(const tinygltf::Model& model, int viewIndex, st
                 case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { std::uint32_t u; std::memcpy(&u, p, 4); v = u; break; }
                 case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { std::uint16_t u; std::memcpy(&u, p, 2); v = u; break; }
                 case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: v = *p; break;
+                // Signed types: KHR_mesh_quantization's positions, normals and texture coordinates.
+                case TINYGLTF_COMPONENT_TYPE_SHORT: { std::int16_t u; std::memcpy(&u, p, 2); v = u; break; }
+                case TINYGLTF_COMPONENT_TYPE_BYTE: v = double(std::int8_t(*p)); break;
                 default: bad(where + ".componentType", "unsupported component type " + std::to_string(componentType));
             }
             out[i * std::size_t(nComp) + std::size_t(c)] = v;
@@ -244,9 +250,27 @@ std::vector<double> readElements(const tinygltf::Model& model, int viewIndex, st
     return out;
 }
 
+// A normalized integer accessor's values as glTF 2.0, 3.11 maps them: unsigned c / (2^n - 1),
+// signed max(c / (2^(n-1) - 1), -1), so both -128 and -127 are -1.
+void normalize(std::vector<double>& values, int componentType, const std::string& at, const fs::path& file,
+               const fs::path& sceneFile, const JsonPath& path) {
+    double scale = 0, lowest = 0;
+    switch (componentType) {
+        case TINYGLTF_COMPONENT_TYPE_BYTE: scale = 127.0; lowest = -1.0; break;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: scale = 255.0; break;
+        case TINYGLTF_COMPONENT_TYPE_SHORT: scale = 32767.0; lowest = -1.0; break;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: scale = 65535.0; break;
+        default:
+            fail(sceneFile, path, file, at + ".normalized: must not be true for component type " +
+                                            std::to_string(componentType) + " (only bytes and shorts are normalized)");
+    }
+    for (double& v : values) v = std::max(v / scale, lowest);
+}
+
 // Reads one accessor as doubles (`components` per element): its buffer view's elements, or
 // zeros where it has none, with a sparse accessor's replacements applied (glTF 2.0, 3.6.2.3:
-// `count` strictly increasing indices into the accessor, and as many packed values).
+// `count` strictly increasing indices into the accessor, and as many packed values), and
+// normalized integers mapped to -1..1 or 0..1.
 std::vector<double> readAccessor(const tinygltf::Model& model, int accessorIndex, int components,
                                  const fs::path& file, const fs::path& sceneFile, const JsonPath& path) {
     const std::string at = "accessors[" + std::to_string(accessorIndex) + "]";
@@ -272,6 +296,7 @@ std::vector<double> readAccessor(const tinygltf::Model& model, int accessorIndex
                                    std::to_string(available / kMiB) + " MiB available");
         out.assign(values, 0.0);
     }
+    if (acc.normalized) normalize(out, acc.componentType, at, file, sceneFile, path);
     if (!acc.sparse.isSparse) return out;
     const auto& sparse = acc.sparse;
     const std::string sparseAt = at + ".sparse";
@@ -286,9 +311,10 @@ std::vector<double> readAccessor(const tinygltf::Model& model, int accessorIndex
     const std::vector<double> indices =
         readElements(model, sparse.indices.bufferView, std::uint64_t(sparse.indices.byteOffset), std::uint64_t(sparse.count),
                      indexType, 1, true, sparseAt + ".indices", file, sceneFile, path);
-    const std::vector<double> values =
+    std::vector<double> values =
         readElements(model, sparse.values.bufferView, std::uint64_t(sparse.values.byteOffset), std::uint64_t(sparse.count),
                      acc.componentType, nComp, true, sparseAt + ".values", file, sceneFile, path);
+    if (acc.normalized) normalize(values, acc.componentType, at, file, sceneFile, path);
     for (std::size_t k = 0; k < indices.size(); ++k) {
         const double index = indices[k];
         if (index >= double(acc.count) || (k > 0 && !(index > indices[k - 1])))
@@ -405,10 +431,13 @@ TextureWrap wrapOf(int glWrap) {
 }
 
 // The file's materials as scene materials (grey albedo: shadows do not need its colours), with the
-// alpha texture of each MASK and BLEND material that has a baseColorTexture.
+// alpha texture of each MASK and BLEND material that has a baseColorTexture, and in `uvTransforms`
+// that texture's KHR_texture_transform (one per material).
 std::vector<Material> readMaterials(const tinygltf::Model& model, const GltfImages& images, const fs::path& file,
-                                    const fs::path& sceneFile, const JsonPath& path, std::vector<std::string>& notes) {
+                                    const fs::path& sceneFile, const JsonPath& path, std::vector<std::string>& notes,
+                                    std::vector<UvTransform>& uvTransforms) {
     std::vector<Material> out;
+    uvTransforms.assign(model.materials.size(), UvTransform{});
     std::map<std::tuple<int, int, int>, std::shared_ptr<const AlphaTexture>> decoded;
     for (std::size_t i = 0; i < model.materials.size(); ++i) {
         const tinygltf::Material& gm = model.materials[i];
@@ -433,18 +462,36 @@ std::vector<Material> readMaterials(const tinygltf::Model& model, const GltfImag
                 fail(sceneFile, path, file, texAt + ".index: names texture " + std::to_string(info.index) +
                                                 ", which does not exist");
             const tinygltf::Texture& tex = model.textures[std::size_t(info.index)];
-            if (tex.source < 0 || std::size_t(tex.source) >= model.images.size())
-                fail(sceneFile, path, file, "textures[" + std::to_string(info.index) + "].source: names no image");
+            int source = tex.source;
+            const std::string texturesAt = "textures[" + std::to_string(info.index) + "]";
+            // An image only in another format (the texture's own source is the fallback): WebP
+            // is decoded like PNG; KTX2 (Basis Universal) is not, nor AVIF (OpenImageIO 2.4
+            // reads it from files only, and a glTF image may be in a buffer).
+            for (const char* format : {"EXT_texture_webp", "EXT_texture_avif", "KHR_texture_basisu"}) {
+                const auto it = tex.extensions.find(format);
+                if (source >= 0 || it == tex.extensions.end() || !it->second.Has("source")) continue;
+                if (std::string(format) != "EXT_texture_webp")
+                    fail(sceneFile, path, file, texturesAt + ".extensions." + format + ": the alpha of " + m.name +
+                                                    " (" + gm.alphaMode + ") is only in a" +
+                                                    (std::string(format) == "EXT_texture_avif" ? "n AVIF" : " KTX2") +
+                                                    " image, which shadowlab does not decode "
+                                                    "(give the texture a PNG or JPEG source)");
+                const tinygltf::Value& v = it->second.Get("source");
+                const double d = v.IsNumber() || v.IsInt() ? v.GetNumberAsDouble() : -1.0;
+                source = d >= 0 && d < double(model.images.size()) && d == std::floor(d) ? int(d) : -1;
+            }
+            if (source < 0 || std::size_t(source) >= model.images.size())
+                fail(sceneFile, path, file, texturesAt + ".source: names no image");
             TextureWrap s = TextureWrap::Repeat, t = TextureWrap::Repeat;
             if (tex.sampler >= 0 && std::size_t(tex.sampler) < model.samplers.size()) {
                 s = wrapOf(model.samplers[std::size_t(tex.sampler)].wrapS);
                 t = wrapOf(model.samplers[std::size_t(tex.sampler)].wrapT);
             }
-            const tinygltf::Image& image = model.images[std::size_t(tex.source)];
-            const std::string imageAt = "images[" + std::to_string(tex.source) + "]" +
+            const tinygltf::Image& image = model.images[std::size_t(source)];
+            const std::string imageAt = "images[" + std::to_string(source) + "]" +
                                         (image.uri.empty() || image.uri.rfind("data:", 0) == 0 ? "" : " (" + excerpt(image.uri) + ")");
-            const auto key = std::make_tuple(tex.source, int(s), int(t));
-            const auto bytes = images.find(tex.source);
+            const auto key = std::make_tuple(source, int(s), int(t));
+            const auto bytes = images.find(source);
             if (!decoded.count(key) && bytes == images.end()) {
                 // A model passed on without its image files is common (and the shadow of the
                 // rest of it is still worth grading): the material keeps its factor's alpha,
@@ -456,7 +503,8 @@ std::vector<Material> readMaterials(const tinygltf::Model& model, const GltfImag
                 continue;
             }
             if (!decoded.count(key)) {
-                std::string ext = image.mimeType == "image/jpeg" ? ".jpg" : image.mimeType == "image/png" ? ".png" : "";
+                std::string ext = image.mimeType == "image/jpeg" ? ".jpg" : image.mimeType == "image/png" ? ".png"
+                                  : image.mimeType == "image/webp" ? ".webp" : "";
                 if (ext.empty()) ext = fs::path(image.uri).extension().string();
                 try {
                     decoded[key] = loadAlphaTextureFromMemory(file.string() + "#" + imageAt, ext, bytes->second, s, t);
@@ -465,7 +513,11 @@ std::vector<Material> readMaterials(const tinygltf::Model& model, const GltfImag
                 }
             }
             m.alphaTexture = decoded[key];
-            m.texCoord = info.texCoord;
+            try {
+                uvTransforms[i] = readTextureTransform(info, texAt, m.texCoord);
+            } catch (const GltfExtensionError& e) {
+                fail(sceneFile, path, file, e.what());
+            }
             if (m.texCoord < 0 || m.texCoord > 64)
                 fail(sceneFile, path, file, texAt + ".texCoord: must be in 0..64, got " + std::to_string(m.texCoord));
         }
@@ -475,10 +527,11 @@ std::vector<Material> readMaterials(const tinygltf::Model& model, const GltfImag
 }
 
 // One glTF mesh's triangle primitives in the mesh's own space: all of them (material -2), or
-// those of one material; with TEXCOORD_`uvSet` per vertex when uvSet >= 0.
+// those of one material; with TEXCOORD_`uvSet` per vertex when uvSet >= 0, moved by
+// `uvTransform` (the material's alpha texture's KHR_texture_transform).
 void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& out,
                     const fs::path& file, const fs::path& sceneFile, const JsonPath& path,
-                    int material = -2, int uvSet = -1) {
+                    int material = -2, int uvSet = -1, const UvTransform& uvTransform = {}) {
     if (meshIndex < 0 || std::size_t(meshIndex) >= model.meshes.size())
         fail(sceneFile, path, file, "node names mesh " + std::to_string(meshIndex) + ", which does not exist");
     for (std::size_t primIndex = 0; primIndex < model.meshes[meshIndex].primitives.size(); ++primIndex) {
@@ -502,19 +555,31 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
             if (it == prim.attributes.end())
                 fail(sceneFile, path, file, at + ": has no " + name + ", which its material's alpha texture needs");
             uv = readAccessor(model, it->second, 2, file, sceneFile, path);
-            // Normalized integer coordinates (glTF 2.0, 3.7.2.1) are code / max.
-            const auto& acc = model.accessors[std::size_t(it->second)];
-            const double scale = !acc.normalized ? 1.0
-                                 : acc.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ? 1.0 / 255.0
-                                 : acc.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? 1.0 / 65535.0 : 1.0;
             if (uv.size() != 2 * count) fail(sceneFile, path, file, at + ": " + name + " has not one element per vertex");
-            for (double& c : uv) {
-                c *= scale;
-                if (!std::isfinite(c)) fail(sceneFile, path, file, at + ": " + name + " holds a non-finite value");
+            for (std::size_t i = 0; i < uv.size(); i += 2) {
+                // KHR_texture_transform moves where the alpha is sampled; both backends
+                // interpolate these per-vertex coordinates, and the transform is affine.
+                const Vec2 t = uvTransform.apply(Vec2(uv[i], uv[i + 1]));
+                uv[i] = t.x;
+                uv[i + 1] = t.y;
+                if (!std::isfinite(t.x) || !std::isfinite(t.y))
+                    fail(sceneFile, path, file, at + ": " + name + " holds a non-finite value");
             }
         }
         std::vector<double> idx;
         if (prim.indices >= 0) {
+            if (std::size_t(prim.indices) < model.accessors.size()) {
+                // glTF 2.0, 3.7.2.1: unsigned and not normalized (the signed types of
+                // KHR_mesh_quantization are for attributes only).
+                const tinygltf::Accessor& ia = model.accessors[std::size_t(prim.indices)];
+                const std::string iaAt = "accessors[" + std::to_string(prim.indices) + "]";
+                if (ia.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+                    ia.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+                    ia.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+                    fail(sceneFile, path, file, iaAt + ".componentType: indices must be an unsigned byte, short or int, got " +
+                                                    std::to_string(ia.componentType));
+                if (ia.normalized) fail(sceneFile, path, file, iaAt + ".normalized: indices must not be normalized");
+            }
             idx = readAccessor(model, prim.indices, 1, file, sceneFile, path);
         } else {
             idx.resize(count);
@@ -535,8 +600,11 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
         for (std::size_t i = 0; i + 2 < idx.size(); i += 3) {
             for (int k = 0; k < 3; ++k) {
                 if (idx[i + k] >= double(count))
-                    fail(sceneFile, path, file, "index " + std::to_string(std::uint64_t(idx[i + k])) +
-                                                    " is out of range (" + std::to_string(count) + " vertices)");
+                    fail(sceneFile, path, file, "meshes[" + std::to_string(meshIndex) + "].primitives[" +
+                                                    std::to_string(primIndex) + "].indices (accessors[" +
+                                                    std::to_string(prim.indices) + "]): index " +
+                                                    std::to_string(std::uint64_t(idx[i + k])) + " is out of range (" +
+                                                    std::to_string(count) + " vertices)");
                 out.indices.push_back(base + std::uint32_t(idx[i + k]));
             }
         }
@@ -647,26 +715,24 @@ bool gltfWriteFile(std::string* err, const std::string&, const std::vector<unsig
     return false;
 }
 
-// The JSON of a .gltf file, or of a GLB's first chunk (GLB header: magic, version, length; then
-// chunk length and type "JSON"), for the nesting check; empty when the header is not a GLB's
-// (tinygltf then says what is wrong).
-std::string_view gltfJson(const std::string& bytes, bool binary) {
-    if (!binary) return bytes;
-    if (bytes.size() < 20 || bytes.compare(0, 4, "glTF") != 0) return {};
-    std::uint32_t chunkLength = 0;
-    std::memcpy(&chunkLength, bytes.data() + 12, 4);
-    if (bytes.compare(16, 4, "JSON") != 0 || chunkLength > bytes.size() - 20) return {};
-    return std::string_view(bytes.data() + 20, chunkLength);
-}
-
-void loadGltf(const fs::path& file, const std::string& bytes, std::vector<RawInstance>& out, const fs::path& sceneFile,
-              const JsonPath& path, GltfExtras* extras, const MeshRequest& request) {
+// `decodedBytes`: what decoding compressed geometry added to the file's buffers.
+void loadGltf(const fs::path& file, const std::string& fileBytes, std::vector<RawInstance>& out, const fs::path& sceneFile,
+              const JsonPath& path, GltfExtras* extras, const MeshRequest& request, std::uint64_t& decodedBytes) {
     std::string ext = file.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
     const bool binary = ext == ".glb";
     // tinygltf parses extras and extensions recursively: nesting is bounded before it sees them.
-    if (const std::string problem = jsonNestingProblem(gltfJson(bytes, binary)); !problem.empty())
+    if (binary)
+        if (const std::string problem = glbLayoutProblem(fileBytes); !problem.empty()) fail(sceneFile, path, file, problem);
+    if (const std::string problem = jsonNestingProblem(gltfJsonChunk(fileBytes, binary)); !problem.empty())
         fail(sceneFile, path, file, problem);
+    GltfPrepared prepared;
+    try {
+        prepared = prepareGltf(fileBytes, binary);
+    } catch (const GltfExtensionError& e) {
+        fail(sceneFile, path, file, e.what());
+    }
+    const std::string& bytes = prepared.rewritten.empty() ? fileBytes : prepared.rewritten;
     tinygltf::TinyGLTF loader;
     GltfImages images;  // kept only where materials may need them
     loader.SetImageLoader(ignoreImage, request.perMaterial ? &images : nullptr);
@@ -680,10 +746,18 @@ void loadGltf(const fs::path& file, const std::string& bytes, std::vector<RawIns
                : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(),
                                             unsigned(std::min<std::size_t>(bytes.size(), UINT_MAX)), files.baseDir);
     if (!ok) fail(sceneFile, path, file, "not a readable glTF file: " + excerpt(err.empty() ? warn : err, 400));
+    prepared.rewritten.clear();
+    prepared.rewritten.shrink_to_fit();
+    try {
+        decodedBytes = decodeCompressedGeometry(model, prepared);
+    } catch (const GltfExtensionError& e) {
+        fail(sceneFile, path, file, e.what());
+    }
 
     std::vector<Material> materials;
-    std::vector<std::string> notes;
-    if (request.perMaterial) materials = readMaterials(model, images, file, sceneFile, path, notes);
+    std::vector<UvTransform> uvTransforms;
+    std::vector<std::string> notes = prepared.notes;
+    if (request.perMaterial) materials = readMaterials(model, images, file, sceneFile, path, notes, uvTransforms);
     images.clear();
     if (extras) extras->materials = materials;
     if (extras) extras->notes = notes;
@@ -748,7 +822,8 @@ void loadGltf(const fs::path& file, const std::string& bytes, std::vector<RawIns
                         geometry = std::make_shared<TriangleMesh>();
                         const Material* m = material >= 0 ? &materials[std::size_t(material)] : nullptr;
                         appendGltfMesh(model, node.mesh, *geometry, file, sceneFile, path, material,
-                                       m && m->alphaTextured() ? m->texCoord : -1);
+                                       m && m->alphaTextured() ? m->texCoord : -1,
+                                       m && m->alphaTextured() ? uvTransforms[std::size_t(material)] : UvTransform{});
                     }
                     out.push_back({geometry, world, material});
                 }
@@ -793,7 +868,7 @@ std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path&
     std::string ext = meshFile.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
     loadBytes = ext == ".obj" || ext == ".ply" ? 4 * std::uint64_t(bytes.size())
-                              : 5 * std::uint64_t(bytes.size()) + 2 * jsonTreeBytes(gltfJson(bytes, ext == ".glb"));
+                              : 5 * std::uint64_t(bytes.size()) + 2 * jsonTreeBytes(gltfJsonChunk(bytes, ext == ".glb"));
     if (const std::uint64_t available = availableMemoryBytes(); available != 0 && loadBytes > available)
         fail(sceneFile, path, meshFile, "reading it needs about " + std::to_string(loadBytes / kMiB) + " MiB, more than the " +
                                             std::to_string(available / kMiB) + " MiB available");
@@ -801,7 +876,11 @@ std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path&
         raw.push_back({std::make_shared<TriangleMesh>(), glm::dmat4(1.0)});
         loadObj(meshFile, bytes, *raw.back().geometry, sceneFile, path, request.uvSet >= 0);
     } else if (ext == ".gltf" || ext == ".glb") {
-        loadGltf(meshFile, bytes, raw, sceneFile, path, extras, request);
+        std::uint64_t decodedBytes = 0;
+        loadGltf(meshFile, bytes, raw, sceneFile, path, extras, request, decodedBytes);
+        // Decoded geometry is held beside the file like its buffers, and read as doubles (at
+        // most 8 a byte, for byte components).
+        loadBytes += 9 * decodedBytes;
     } else if (ext == ".ply") {
         if (request.uvSet >= 0)
             fail(sceneFile, path, meshFile, "a PLY mesh has no texture coordinates, which the object's alpha texture needs");
