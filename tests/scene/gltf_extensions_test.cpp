@@ -569,9 +569,9 @@ TEST(GltfContainer, ChunksThatReachPastTheFileAreRefusedBeforeTinygltfReadsThem)
     }
     {
         // A JSON chunk longer than the file.
-        std::string json = good;
-        setU32(json, 12, std::uint32_t(good.size()));
-        const std::string e = errorOf([&] { loaded(dir.write("json.glb", json)); });
+        std::string longJson = good;
+        setU32(longJson, 12, std::uint32_t(good.size()));
+        const std::string e = errorOf([&] { loaded(dir.write("json.glb", longJson)); });
         EXPECT_NE(e.find("GLB chunk 0 (JSON): declares"), std::string::npos) << e;
     }
 }
