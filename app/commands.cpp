@@ -5,34 +5,23 @@
 #include "app/guards.h"
 #include "scene/folder_lock.h"
 
+#include <unistd.h>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <functional>
-#include <optional>
-#include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <set>
 #include <sstream>
-#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
-#include "studies/backend.h"
-#include "studies/check.h"
-#include "studies/check_report.h"
 #include "compare/compare.h"
 #include "compare/gates.h"
-#include "studies/machine.h"
-#include "studies/merge.h"
-#include "studies/path.h"
-#include "studies/run.h"
-#include "studies/shard.h"
-#include "studies/stability.h"
-#include "studies/sweep.h"
-#include "studies/sweep_report.h"
 #include "compare/text.h"
 #include "raster/cascades.h"
 #include "raster/debug_views.h"
@@ -51,6 +40,17 @@
 #include "scene/memory.h"
 #include "scene/model_view.h"
 #include "scene/render_plan.h"
+#include "studies/backend.h"
+#include "studies/check.h"
+#include "studies/check_report.h"
+#include "studies/machine.h"
+#include "studies/merge.h"
+#include "studies/path.h"
+#include "studies/run.h"
+#include "studies/shard.h"
+#include "studies/stability.h"
+#include "studies/sweep.h"
+#include "studies/sweep_report.h"
 
 namespace shadowlab::app {
 
@@ -74,9 +74,8 @@ void applyResolution(scene::Scene& s, const std::string& text) {
         throw scene::InputError("--resolution: expected WxH (e.g. 640x360), got '" + text + "'");
     if (w < 1 || h < 1 || w > scene::kMaxResolution || h > scene::kMaxResolution ||
         static_cast<long long>(w) * h > scene::kMaxPixels)
-        throw scene::InputError("--resolution: " + text + " is outside 1x1.." +
-                                std::to_string(scene::kMaxResolution) + " per side and " +
-                                std::to_string(scene::kMaxPixels) + " pixels in all");
+        throw scene::InputError("--resolution: " + text + " is outside 1x1.." + std::to_string(scene::kMaxResolution) +
+                                " per side and " + std::to_string(scene::kMaxPixels) + " pixels in all");
     s.camera.width = w;
     s.camera.height = h;
 }
@@ -100,7 +99,8 @@ std::string formatNumberShort(double v) {
 std::string grazingLiftText(const scene::RasterSettings& r) {
     if (!(r.slopeBias > 0.0)) return "";
     std::ostringstream o;
-    o << "; past tan " << raster::kMaxSlopeTan << " (" << std::round(std::atan(raster::kMaxSlopeTan) * 1800.0 / 3.14159265358979) / 10.0
+    o << "; past tan " << raster::kMaxSlopeTan << " ("
+      << std::round(std::atan(raster::kMaxSlopeTan) * 1800.0 / 3.14159265358979) / 10.0
       << " deg between normal and light) the slope term goes on as a lift along the normal, slope x texel x (sin - "
       << raster::kMaxSlopeTan
       << " cos): the same margin from the receiver's own plane with the lookup moved less than a texel per texel of "
@@ -118,28 +118,27 @@ Prepared prepare(const SceneOptions& o) {
     p.settings = scene::resolveSettings(p.scene, o.settings);
     p.plan = scene::makeRenderPlan(p.scene, p.settings);
     if (o.explain)
-        std::cerr << "render plan for " << p.scene.file.string() << ":\n"
-                  << p.plan.explain()
-                  << studies::explainAutomaticChoices(p.scene, p.plan, p.settings.raster)
-                  << "raster bias: constant " << p.settings.raster.depthBias << " world units"
-                  << (p.settings.raster.depthBiasIsDefault
-                          ? (p.settings.raster.fitLightFrustum
-                                 ? " (default: half a texel of each map as fitted or cascaded; this value for a "
-                                   "bounding-sphere map and spot and point maps)"
-                                 : " (default: half a texel of the bounding-sphere map; of each cascade's with cascades)")
-                          : "")
-                  << ", slope " << p.settings.raster.slopeBias << " texels x tan(angle to light), "
-                  << (p.settings.raster.hardwareBias
-                          ? "through the rasterizer's depth-bias state in directional maps' depth pass (converted per "
-                            "layer, recorded in the Frame; spot and point maps in the lit shader)"
-                          : "in the lit shader")
-                  << (p.settings.raster.receiverPlaneBias ? "; the receiver plane replaces the slope term in the shader"
-                                                          : "")
-                  << grazingLiftText(p.settings.raster)
-                  << (p.settings.raster.normalOffset > 0.0
-                          ? "; normal offset " + formatNumberShort(p.settings.raster.normalOffset) + " texels"
-                          : std::string())
-                  << "\n";
+        std::cerr
+            << "render plan for " << p.scene.file.string() << ":\n"
+            << p.plan.explain() << studies::explainAutomaticChoices(p.scene, p.plan, p.settings.raster)
+            << "raster bias: constant " << p.settings.raster.depthBias << " world units"
+            << (p.settings.raster.depthBiasIsDefault
+                    ? (p.settings.raster.fitLightFrustum
+                           ? " (default: half a texel of each map as fitted or cascaded; this value for a "
+                             "bounding-sphere map and spot and point maps)"
+                           : " (default: half a texel of the bounding-sphere map; of each cascade's with cascades)")
+                    : "")
+            << ", slope " << p.settings.raster.slopeBias << " texels x tan(angle to light), "
+            << (p.settings.raster.hardwareBias
+                    ? "through the rasterizer's depth-bias state in directional maps' depth pass (converted per "
+                      "layer, recorded in the Frame; spot and point maps in the lit shader)"
+                    : "in the lit shader")
+            << (p.settings.raster.receiverPlaneBias ? "; the receiver plane replaces the slope term in the shader" : "")
+            << grazingLiftText(p.settings.raster)
+            << (p.settings.raster.normalOffset > 0.0
+                    ? "; normal offset " + formatNumberShort(p.settings.raster.normalOffset) + " texels"
+                    : std::string())
+            << "\n";
     if (o.explain) {
         const std::vector<raster::LightCulling> culled = raster::culledCasters(p.scene, p.settings.raster, &p.plan);
         const std::size_t objects = p.scene.objects.size();
@@ -165,7 +164,8 @@ Prepared prepare(const SceneOptions& o) {
             }
         }
         std::cerr << raster::explainShadowLayers(
-            raster::planShadowLayers(p.scene, p.plan, raster::resolveAutomaticChoices(p.scene, p.settings.raster, &p.plan)),
+            raster::planShadowLayers(p.scene, p.plan,
+                                     raster::resolveAutomaticChoices(p.scene, p.settings.raster, &p.plan)),
             p.scene.objects.size());
     }
     return p;
@@ -182,8 +182,10 @@ public:
         const double s = std::chrono::duration<double>(Clock::now() - start_).count();
         char buf[64];
         std::snprintf(buf, sizeof buf, "%.2f s", s);
-        if (isatty(STDERR_FILENO)) std::cerr << " " << buf;
-        else std::cerr << "shadowlab: " << what_ << ": " << buf;
+        if (isatty(STDERR_FILENO))
+            std::cerr << " " << buf;
+        else
+            std::cerr << "shadowlab: " << what_ << ": " << buf;
         std::cerr << (note.empty() ? "" : ", " + note) << "\n";
     }
 
@@ -203,9 +205,10 @@ std::function<void(const studies::SweepProgress&)> sweepProgressPrinter() {
     const bool tty = isatty(STDERR_FILENO);
     return [tty](const studies::SweepProgress& pr) {
         const std::string what = pr.row ? pr.row->config.label() : "";
-        const std::string outcome = pr.row && !pr.row->error.empty() ? "failed: " + pr.row->error
-                                    : pr.row ? "mismatch " + std::to_string(100.0 * pr.row->rate("mismatch_rate")).substr(0, 5) + "%"
-                                             : "";
+        const std::string outcome =
+            pr.row && !pr.row->error.empty() ? "failed: " + pr.row->error
+            : pr.row ? "mismatch " + std::to_string(100.0 * pr.row->rate("mismatch_rate")).substr(0, 5) + "%"
+                     : "";
         const int eta = int(pr.etaSeconds + 0.5);
         char line[512];
         std::snprintf(line, sizeof line, "[%zu/%zu] %s: %s, ETA %dm%02ds", pr.done, pr.total, what.c_str(),
@@ -228,8 +231,8 @@ void createOutputFolder(const fs::path& output) {
     std::error_code ec;
     if (fs::is_directory(output.parent_path(), ec)) return;
     fs::create_directories(output.parent_path());
-    std::cerr << "shadowlab: created the folder " << output.parent_path().string() << " for " << output.filename().string()
-              << "\n";
+    std::cerr << "shadowlab: created the folder " << output.parent_path().string() << " for "
+              << output.filename().string() << "\n";
 }
 
 scene::Budgets parseBudgets(const BudgetOptions& o) {
@@ -244,8 +247,7 @@ scene::Budgets parseBudgets(const BudgetOptions& o) {
 // Prints every budget checked for `method` on stderr (broken ones say so); true when one broke.
 bool reportBudgets(const std::string& method, const std::vector<compare::BudgetCheck>& checks) {
     for (const compare::BudgetCheck& c : checks)
-        std::cerr << "shadowlab: budget: " << method << ": "
-                  << compare::describe(c) << "\n";
+        std::cerr << "shadowlab: budget: " << method << ": " << compare::describe(c) << "\n";
     return compare::anyBroken(checks);
 }
 
@@ -305,21 +307,22 @@ int render(const RenderOptions& o) {
         throw scene::InputError(o.output.string() + ": unknown output type '" + ext + "' (use .exr or .png)");
     const std::string backendName = scene::toString(o.backend);
     if (o.view && (o.backend != scene::Backend::Raster || ext != ".png"))
-        throw scene::InputError("--view " + *o.view + ": needs --backend raster and a .png output (a view is a "
-                                "display image of the shadow maps), got --backend " + backendName + " and '" + ext + "'");
+        throw scene::InputError("--view " + *o.view +
+                                ": needs --backend raster and a .png output (a view is a "
+                                "display image of the shadow maps), got --backend " +
+                                backendName + " and '" + ext + "'");
     checkOutputFile(o.output);  // before any work: an output that cannot be written fails now
     const Prepared p = prepare(o.common);
     // A view writes a display image, not the Frame; the shadow-map view holds every layer's depths.
-    const std::uint64_t estimate =
-        scene::kProgramBytes + scene::sceneBytes(p.scene) +
-        studies::estimateMemoryBytes(o.backend, p.scene, p.plan, p.settings) +
-        (o.view ? raster::debugViewBytes(p.scene, p.plan, p.settings.raster, *o.view)
-                : scene::frameWriteBytes(p.scene));
-    scene::checkMemory(estimate, o.view ? "rendering the " + *o.view + " view of " +
-                                              std::to_string(p.scene.camera.width) + "x" +
-                                              std::to_string(p.scene.camera.height)
-                                        : "rendering " + std::to_string(p.scene.camera.width) + "x" +
-                                              std::to_string(p.scene.camera.height) + " with " + backendName);
+    const std::uint64_t estimate = scene::kProgramBytes + scene::sceneBytes(p.scene) +
+                                   studies::estimateMemoryBytes(o.backend, p.scene, p.plan, p.settings) +
+                                   (o.view ? raster::debugViewBytes(p.scene, p.plan, p.settings.raster, *o.view)
+                                           : scene::frameWriteBytes(p.scene));
+    scene::checkMemory(estimate, o.view
+                                     ? "rendering the " + *o.view + " view of " + std::to_string(p.scene.camera.width) +
+                                           "x" + std::to_string(p.scene.camera.height)
+                                     : "rendering " + std::to_string(p.scene.camera.width) + "x" +
+                                           std::to_string(p.scene.camera.height) + " with " + backendName);
     // Only once the input is known to be good may the output's folder be created.
     createOutputFolder(o.output);
     if (o.view) {
@@ -330,12 +333,12 @@ int render(const RenderOptions& o) {
         studies::checkValidation(frame, p.settings.raster);
         const raster::DisplayImage img = studies::debugView(*o.view, frame, p.scene, debug);
         scene::writePngDisplay(o.output, img.width, img.height, img.rgb);
-        stage.done(std::to_string(img.width) + "x" + std::to_string(img.height) + " -> " + o.output.string() +
-                   ", " + memoryLine(estimate));
+        stage.done(std::to_string(img.width) + "x" + std::to_string(img.height) + " -> " + o.output.string() + ", " +
+                   memoryLine(estimate));
         if (o.common.json) {
-            Json j = {{"backend", backendName}, {"view", *o.view}, {"output", o.output.string()},
-                      {"timings_ms", studies::timingsJson(frame)}, {"attributes", frame.attributes},
-                      {"memory", studies::memoryJson(estimate)}};
+            Json j = {{"backend", backendName},         {"view", *o.view},
+                      {"output", o.output.string()},    {"timings_ms", studies::timingsJson(frame)},
+                      {"attributes", frame.attributes}, {"memory", studies::memoryJson(estimate)}};
             std::cout << j.dump(2) << "\n";
         }
         return 0;
@@ -346,15 +349,18 @@ int render(const RenderOptions& o) {
     Stage stage("rendering " + p.scene.file.filename().string() + " with " + backendName);
     // A PNG holds the beauty only, in 8-bit sRGB: the raster backend then renders nothing else,
     // into an 8-bit sRGB target.
-    const scene::Frame frame =
-        studies::renderForOutput(p.scene, p.plan, p.settings, o.backend,
-                                 ext == ".png" ? scene::kChannelBeauty | scene::kBeautyForDisplay : scene::kAllChannels);
+    const scene::Frame frame = studies::renderForOutput(
+        p.scene, p.plan, p.settings, o.backend,
+        ext == ".png" ? scene::kChannelBeauty | scene::kBeautyForDisplay : scene::kAllChannels);
     scene::writeFrame(frame, o.output);
-    stage.done(std::to_string(frame.width) + "x" + std::to_string(frame.height) + " -> " + o.output.string() +
-               ", " + memoryLine(estimate));
+    stage.done(std::to_string(frame.width) + "x" + std::to_string(frame.height) + " -> " + o.output.string() + ", " +
+               memoryLine(estimate));
     if (o.common.json) {
-        Json j = {{"backend", backendName}, {"output", o.output.string()}, {"timings_ms", studies::timingsJson(frame)},
-                  {"attributes", frame.attributes}, {"memory", studies::memoryJson(estimate)}};
+        Json j = {{"backend", backendName},
+                  {"output", o.output.string()},
+                  {"timings_ms", studies::timingsJson(frame)},
+                  {"attributes", frame.attributes},
+                  {"memory", studies::memoryJson(estimate)}};
         std::cout << j.dump(2) << "\n";
     }
     return 0;
@@ -445,8 +451,8 @@ int sweepShard(const SweepOptions& o, const scene::Scene& scene, const studies::
     std::size_t failed = 0;
     for (const auto& r : result.rows) failed += r.error.empty() ? 0 : 1;
     std::cerr << "shadowlab: wrote " << dir.string() << " (" << result.rows.size() << " rows"
-              << (failed ? ", " + std::to_string(failed) + " failed" : "") << "); when every shard is done: shadowlab merge "
-              << o.outputDir.string() << "\n";
+              << (failed ? ", " + std::to_string(failed) + " failed" : "")
+              << "); when every shard is done: shadowlab merge " << o.outputDir.string() << "\n";
     if (o.common.json) std::cout << studies::rowsToJson(result.rows).dump(2) << "\n";
     return failed ? 1 : 0;
 }
@@ -459,8 +465,10 @@ namespace {
 int mergeCheck(const MergeOptions& o) {
     const studies::MergedCheck merged = studies::readCheckShards(o.inputs);
     fs::path out;
-    if (o.outputDir) out = *o.outputDir;
-    else if (o.inputs.size() == 1 && !fs::exists(o.inputs.front() / "shard.json")) out = o.inputs.front();
+    if (o.outputDir)
+        out = *o.outputDir;
+    else if (o.inputs.size() == 1 && !fs::exists(o.inputs.front() / "shard.json"))
+        out = o.inputs.front();
     else
         throw scene::InputError("merge: give the merged folder with -o (the inputs are " +
                                 std::string(o.inputs.size() == 1 ? "a shard folder" : "several folders") + ")");
@@ -491,14 +499,16 @@ void printPathSummary(const studies::PathResult& result) {
 // `merge` of path shards: the frames, metrics.json and report of the unsharded path.
 int mergePath(const MergeOptions& o) {
     fs::path out;
-    if (o.outputDir) out = *o.outputDir;
-    else if (o.inputs.size() == 1 && !fs::exists(o.inputs.front() / "shard.json")) out = o.inputs.front();
+    if (o.outputDir)
+        out = *o.outputDir;
+    else if (o.inputs.size() == 1 && !fs::exists(o.inputs.front() / "shard.json"))
+        out = o.inputs.front();
     else
         throw scene::InputError("merge: give the merged folder with -o (the inputs are " +
                                 std::string(o.inputs.size() == 1 ? "a shard folder" : "several folders") + ")");
     const studies::MergedPath merged = studies::mergePathShards(o.inputs, out);
-    std::cerr << "shadowlab: merged " << merged.shardCount << " path shards (" << merged.shardDirs.size() << " folders, "
-              << merged.result.frames << " frames"
+    std::cerr << "shadowlab: merged " << merged.shardCount << " path shards (" << merged.shardDirs.size()
+              << " folders, " << merged.result.frames << " frames"
               << (merged.duplicates ? ", " + std::to_string(merged.duplicates) + " duplicate frames merged once" : "")
               << ")\n";
     printPathSummary(merged.result);
@@ -542,8 +552,9 @@ int merge(const MergeOptions& o) {
 int sweep(const SweepOptions& o) {
     checkOutputFolder(o.outputDir);
     const Prepared p = prepare(o.common);
-    studies::SweepGrid grid = o.grid ? readingInput(o.grid->string(), [&] { return studies::loadGrid(*o.grid, p.scene); })
-                                     : studies::defaultGrid(p.scene, o.quick);
+    studies::SweepGrid grid = o.grid
+                                  ? readingInput(o.grid->string(), [&] { return studies::loadGrid(*o.grid, p.scene); })
+                                  : studies::defaultGrid(p.scene, o.quick);
     if (o.repetitions) grid.repetitions = *o.repetitions;
     if (o.common.resolution) grid.resolution = o.common.resolution;
     if (o.flicker || o.flickerFrames) {
@@ -551,7 +562,8 @@ int sweep(const SweepOptions& o) {
         // Given without a value, CLI11 reports the flag as "true": the default kind.
         if (o.flicker && !o.flicker->empty() && *o.flicker != "true") path.kind = studies::parsePathKind(*o.flicker);
         if (o.flickerFrames) path.frames = *o.flickerFrames;
-        studies::flickerScenes(studies::sweepScene(p.scene, grid), path);  // a bad path fails before anything is written
+        studies::flickerScenes(studies::sweepScene(p.scene, grid),
+                               path);  // a bad path fails before anything is written
         grid.flicker = path;
     }
     // Settings given on the command line apply to every configuration that does not vary them.
@@ -600,8 +612,9 @@ int sweep(const SweepOptions& o) {
         ro.raytrace = std::any_of(grid.configs.begin(), grid.configs.end(),
                                   [](const studies::SweepConfig& c) { return c.backend == scene::Backend::Raytrace; });
         Stage rec("recommended shadow block: biases searched in this configuration");
-        input.recommendation = studies::recommendShadow(at, result.reference, at, result.reference, nullptr, nullptr,
-                                                        studies::rayCandidateOf(studies::recommendBias(result.rows)), ro);
+        input.recommendation =
+            studies::recommendShadow(at, result.reference, at, result.reference, nullptr, nullptr,
+                                     studies::rayCandidateOf(studies::recommendBias(result.rows)), ro);
         rec.done();
         for (const std::string& note : input.recommendation->notes) std::cerr << "shadowlab: " << note << "\n";
     }
@@ -620,7 +633,8 @@ int check(const CheckOptions& o) {
     studies::CheckSuite suite = fullSuite;
     const std::optional<fs::path> baselineFile = o.baseline ? o.baseline : suite.baseline;
     if (o.updateBaseline && !baselineFile)
-        throw scene::InputError(o.suite.string() + ": --update-baseline: the suite names no \"baseline\" file and "
+        throw scene::InputError(o.suite.string() +
+                                ": --update-baseline: the suite names no \"baseline\" file and "
                                 "--baseline gives none");
     std::optional<studies::Baseline> baseline;
     if (baselineFile && !o.updateBaseline) {
@@ -634,8 +648,9 @@ int check(const CheckOptions& o) {
         shard = studies::parseShard(*o.shard);
         // N shards writing one baseline would race; a baseline comes from an unsharded run.
         if (o.updateBaseline)
-            throw scene::InputError("check --shard: --update-baseline is not sharded; update the baseline with an "
-                                    "unsharded `check`");
+            throw scene::InputError(
+                "check --shard: --update-baseline is not sharded; update the baseline with an "
+                "unsharded `check`");
         manifest.version = SHADOWLAB_VERSION;
         manifest.suite = o.suite.string();
         manifest.suiteName = suite.name;
@@ -650,10 +665,11 @@ int check(const CheckOptions& o) {
     }
     std::cerr << "shadowlab: check " << suite.name << ": " << suite.cases.size() << " cases"
               << (baseline ? " against " + baselineFile->string() : std::string(" without a baseline")) << "\n";
-    const auto results = studies::runSuite(
-        suite, baseline ? &*baseline : nullptr, [&](std::size_t done, const studies::CaseResult& r) {
+    const auto results =
+        studies::runSuite(suite, baseline ? &*baseline : nullptr, [&](std::size_t done, const studies::CaseResult& r) {
             std::string what = r.verdict == studies::CaseVerdict::Error ? "ERROR: " + r.error
-                               : r.metrics ? compare::summaryLine(*r.metrics) : "";
+                               : r.metrics                              ? compare::summaryLine(*r.metrics)
+                                                                        : "";
             if (r.verdict == studies::CaseVerdict::Failed) what = "FAILED: " + r.failures.front() + "; " + what;
             std::cerr << "shadowlab: check [" << done << "/" << suite.cases.size() << "] " << r.name << ": " << what
                       << "\n";
@@ -682,8 +698,8 @@ int check(const CheckOptions& o) {
     std::set<std::string> withDiff;
     for (const studies::CaseResult& r : results)
         if (!r.diffRgb.empty()) withDiff.insert(r.name);
-    scene::writeTextAtomic(tmp / "summary.html",
-                           studies::htmlSummary(suite.name, studies::caseParts(suite, results), o.updateBaseline, withDiff));
+    scene::writeTextAtomic(tmp / "summary.html", studies::htmlSummary(suite.name, studies::caseParts(suite, results),
+                                                                      o.updateBaseline, withDiff));
     if (shard) {
         nlohmann::json parts = nlohmann::json::array();
         for (const studies::CasePart& part : studies::caseParts(suite, results)) parts.push_back(studies::toJson(part));
@@ -700,14 +716,17 @@ int check(const CheckOptions& o) {
             // A damaged baseline is being replaced.
         }
         for (const studies::CaseResult& r : results) {
-            if (r.metrics) next[r.name] = studies::baselineEntry(*r.metrics);
-            else if (old.count(r.name)) next[r.name] = old[r.name];
+            if (r.metrics)
+                next[r.name] = studies::baselineEntry(*r.metrics);
+            else if (old.count(r.name))
+                next[r.name] = old[r.name];
         }
         scene::writeTextAtomic(*baselineFile, studies::baselineJson(suite.name, next).dump(2) + "\n");
         std::cerr << "shadowlab: wrote the baseline " << baselineFile->string() << "\n";
     }
     std::cerr << "shadowlab: check " << suite.name << ": " << results.size() - failed - errors << " passed, " << failed
-              << " failed, " << errors << " errors; wrote " << (dir / "junit.xml").string() << ", summary.md, summary.html, cases/\n";
+              << " failed, " << errors << " errors; wrote " << (dir / "junit.xml").string()
+              << ", summary.md, summary.html, cases/\n";
     return errors ? 1 : failed ? kExitBudgetBroken : 0;
 }
 
@@ -721,7 +740,8 @@ int path(const PathCommandOptions& o) {
     if (o.kind) spec.kind = studies::parsePathKind(*o.kind);
     if (o.cameraAnimation) {
         if (o.kind && spec.kind != studies::PathKind::GltfAnimation)
-            throw scene::InputError("--camera-animation: follows a glTF animation; it cannot go with --kind " + *o.kind);
+            throw scene::InputError("--camera-animation: follows a glTF animation; it cannot go with --kind " +
+                                    *o.kind);
         spec.kind = studies::PathKind::GltfAnimation;
         // Given without a value, CLI11 reports the flag as "true": the first animation.
         spec.animation = *o.cameraAnimation == "true" ? std::string() : *o.cameraAnimation;
@@ -749,7 +769,8 @@ int path(const PathCommandOptions& o) {
                   << studies::pathShardFrames(spec.frames, shard.index, shard.count).size() << " of " << spec.frames
                   << " frames into " << dir.string() << "\n";
         const studies::PathResult result = studies::runPath(p.scene, p.settings, spec, options);
-        std::cerr << "shadowlab: wrote " << dir.string() << " (" << result.resumedFrames << " frames resumed); when every "
+        std::cerr << "shadowlab: wrote " << dir.string() << " (" << result.resumedFrames
+                  << " frames resumed); when every "
                   << "shard is done: shadowlab merge " << o.outputDir.string() << "\n";
         return 0;
     }
@@ -797,7 +818,8 @@ int stability(const StabilityCommandOptions& o) {
         cases.push_back(studies::runStabilityCase(scenes[i], options, name, studies::readDescription(files[i])));
         // The reference's verdict and each backend's state, not one PASS that hides acne.
         const studies::StabilityCase& c = cases.back();
-        std::string note = std::string(c.failed() ? "FAILED to run cleanly; " : "") + "reference " + c.referenceVerdict();
+        std::string note =
+            std::string(c.failed() ? "FAILED to run cleanly; " : "") + "reference " + c.referenceVerdict();
         for (const scene::Backend backend : {scene::Backend::Raster, scene::Backend::Raytrace})
             for (const char* variant : {"defaults", "best"})
                 if (const studies::BackendRun* r = c.run(backend, variant))

@@ -23,14 +23,14 @@ struct BudgetOptions {
 
 // Options every rendering command shares.
 struct SceneOptions {
-    std::string scene;                    // path or shipped name
+    std::string scene;                      // path or shipped name
     std::optional<std::string> resolution;  // "WxH" overrides the scene's camera
     scene::SettingsOverrides settings;
-    std::optional<std::string> camera;    // --camera N|NAME|auto: a file camera, or search a view
-    std::optional<bool> ground;           // --ground / --no-ground
-    std::optional<std::string> sun;       // --sun AZIMUTH,ELEVATION (degrees)
-    bool explain = false;                 // print the RenderPlan before rendering
-    bool json = false;                    // machine-readable results on stdout
+    std::optional<std::string> camera;  // --camera N|NAME|auto: a file camera, or search a view
+    std::optional<bool> ground;         // --ground / --no-ground
+    std::optional<std::string> sun;     // --sun AZIMUTH,ELEVATION (degrees)
+    bool explain = false;               // print the RenderPlan before rendering
+    bool json = false;                  // machine-readable results on stdout
 };
 
 struct RenderOptions {
@@ -62,7 +62,7 @@ struct SweepOptions {
 };
 
 struct MergeOptions {
-    std::vector<std::filesystem::path> inputs;  // shard folders, or folders holding shard-K-of-N folders
+    std::vector<std::filesystem::path> inputs;       // shard folders, or folders holding shard-K-of-N folders
     std::optional<std::filesystem::path> outputDir;  // default: the one input folder
     bool json = false;
 };
@@ -118,9 +118,9 @@ struct PathCommandOptions {
 };
 
 struct ExportOptions {
-    std::string scene;  // path or shipped name
+    std::string scene;             // path or shipped name
     std::filesystem::path output;  // .glb or .gltf
-    double tolerance = 1e-3;  // a sphere's largest sagitta / radius
+    double tolerance = 1e-3;       // a sphere's largest sagitta / radius
 };
 
 int render(const RenderOptions& options);

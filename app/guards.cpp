@@ -1,11 +1,11 @@
 // app/guards.cpp: input, output and standard-output checks (see guards.h).
 #include "app/guards.h"
 
+#include <unistd.h>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <iostream>
-#include <unistd.h>
 
 namespace shadowlab::app {
 
@@ -41,10 +41,13 @@ void checkOutputFolder(const fs::path& dir, const std::string& option) {
     std::error_code ec;
     if (fs::exists(dir, ec)) {
         if (!fs::is_directory(dir, ec))
-            throw scene::InputError(option + " " + dir.string() + ": is a file, not a folder; this command writes a "
-                                    "folder of outputs, so " + option + " must name a folder");
+            throw scene::InputError(option + " " + dir.string() +
+                                    ": is a file, not a folder; this command writes a "
+                                    "folder of outputs, so " +
+                                    option + " must name a folder");
         if (::access(dir.c_str(), W_OK | X_OK) != 0)
-            throw scene::InputError(option + " " + dir.string() + ": cannot write in it (" + std::strerror(errno) + ")");
+            throw scene::InputError(option + " " + dir.string() + ": cannot write in it (" + std::strerror(errno) +
+                                    ")");
         return;
     }
     checkParent(dir, option);

@@ -33,16 +33,17 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
                    "raster: shadow-map filter none|pcf2x2|pcf|poisson|pcss|vsm|evsm2|evsm4|esm|msm (default pcf2x2: "
                    "bilinear 2x2 PCF; pcss: soft shadows sized by a spot/point light's radius; vsm..msm: filterable "
                    "moment maps, docs/raster.md)");
-    cmd.add_option("--pcf-size", s.pcfSize, "raster: pcf taps per side, or poisson kernel diameter in texels (default 3)");
-    cmd.add_option("--min-variance", s.minVariance, "raster: vsm/evsm variance floor, normalized depth² (default 1e-6)");
+    cmd.add_option("--pcf-size", s.pcfSize,
+                   "raster: pcf taps per side, or poisson kernel diameter in texels (default 3)");
+    cmd.add_option("--min-variance", s.minVariance,
+                   "raster: vsm/evsm variance floor, normalized depth² (default 1e-6)");
     cmd.add_option("--bleeding-reduction", s.bleedReduction,
                    "raster: vsm/evsm light-bleeding reduction, 0..0.99 of the visibility tail cut (default 0.2)");
     cmd.add_option("--evsm-positive", s.evsmPositive, "raster: evsm positive warp exponent, 0..42 (default 40)");
     cmd.add_option("--evsm-negative", s.evsmNegative, "raster: evsm4 negative warp exponent, 0..42 (default 5)");
     cmd.add_option("--esm-exponent", s.esmExponent, "raster: esm exponent, 0..85 (default 80)");
     cmd.add_option("--moment-bias", s.momentBias, "raster: msm moment bias (default 3e-5)");
-    cmd.add_option("--blur-width", s.blurWidth,
-                   "raster: vsm..msm box blur width in texels, odd, 1..63 (default 5)");
+    cmd.add_option("--blur-width", s.blurWidth, "raster: vsm..msm box blur width in texels, odd, 1..63 (default 5)");
     cmd.add_option("--normal-offset", s.normalOffset,
                    "raster: move receivers along their normal by this many texels, on top of the slope bias's lift "
                    "past tan 10 (default 0)");
@@ -60,12 +61,16 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
                  "raster: fit each light's map to the casters of visible receivers (default on; "
                  "--fit-light-frustum=off or --no-fit-light-frustum: the scene's bounding sphere)")
         ->each([&s](const std::string& v) {
-            if (v == "on" || v == "true" || v == "1") s.fitLightFrustum = true;
-            else if (v == "off" || v == "false" || v == "0") s.fitLightFrustum = false;
-            else throw CLI::ValidationError("--fit-light-frustum: expected on or off, got '" + v + "'");
+            if (v == "on" || v == "true" || v == "1")
+                s.fitLightFrustum = true;
+            else if (v == "off" || v == "false" || v == "0")
+                s.fitLightFrustum = false;
+            else
+                throw CLI::ValidationError("--fit-light-frustum: expected on or off, got '" + v + "'");
         });
-    cmd.add_flag_callback("--no-fit-light-frustum", [&s] { s.fitLightFrustum = false; },
-                          "raster: the scene's bounding-sphere map (and the whole spot cone and cube), not fitted");
+    cmd.add_flag_callback(
+        "--no-fit-light-frustum", [&s] { s.fitLightFrustum = false; },
+        "raster: the scene's bounding-sphere map (and the whole spot cone and cube), not fitted");
     cmd.add_flag_callback(
         "--no-snap", [&s] { s.snapLightFrustum = false; },
         "raster: leave fitted directional maps and cascades unsnapped (they then swim as the camera moves; for "
@@ -89,9 +94,10 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
                    "View: a camera of the scene's glTF file by index (0, 1, ...) or name, or 'auto' to search a view "
                    "that shows shadows (default: the file's first camera; a search where it has none)");
     cmd.add_flag_function(
-           "--ground", [&o](std::int64_t) { o.ground = true; },
-           "Put a ground under the model, sized from its bounds (default for a glTF scene without a floor of its own)");
-    cmd.add_flag_function("--no-ground", [&o](std::int64_t) { o.ground = false; }, "No added ground");
+        "--ground", [&o](std::int64_t) { o.ground = true; },
+        "Put a ground under the model, sized from its bounds (default for a glTF scene without a floor of its own)");
+    cmd.add_flag_function(
+        "--no-ground", [&o](std::int64_t) { o.ground = false; }, "No added ground");
     cmd.add_option("--sun", o.sun,
                    "AZIMUTH,ELEVATION in degrees: the directional light's direction (azimuth in the ground plane from "
                    "+Z toward +X, elevation above the horizon; default: the scene's, or a search)");
@@ -100,8 +106,8 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
 }
 
 void addBudgetOptions(CLI::App& cmd, shadowlab::app::BudgetOptions& o) {
-    using shadowlab::scene::BudgetKind;
     using shadowlab::scene::budgetInfo;
+    using shadowlab::scene::BudgetKind;
     const char* help[shadowlab::scene::kBudgetKindCount] = {
         "Budget: false + missed shadow pixels, as a rate of the counted pixels (0.005 or 0.5%) or a count (120px)",
         "Budget: false-shadow (acne) pixels, a rate (0.5%) or a count (120px)",
@@ -113,26 +119,28 @@ void addBudgetOptions(CLI::App& cmd, shadowlab::app::BudgetOptions& o) {
         "distances), a rate (0.5%) or a count (120px)",
     };
     for (int k = 0; k < shadowlab::scene::kBudgetKindCount; ++k)
-        cmd.add_option(budgetInfo(BudgetKind(k)).option, o.text[k],
-                       std::string(help[k]) + "; a broken budget exits 3");
+        cmd.add_option(budgetInfo(BudgetKind(k)).option, o.text[k], std::string(help[k]) + "; a broken budget exits 3");
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-    CLI::App app{"shadowlab: renders a scene with a Vulkan shadow map and a CPU ray tracer and shows,\n"
-                 "with difference images and numbers, how each gets its shadows wrong against a\n"
-                 "double-precision ray-traced reference."};
+    CLI::App app{
+        "shadowlab: renders a scene with a Vulkan shadow map and a CPU ray tracer and shows,\n"
+        "with difference images and numbers, how each gets its shadows wrong against a\n"
+        "double-precision ray-traced reference."};
     app.require_subcommand(1);
     app.set_version_flag("--version", std::string("shadowlab ") + SHADOWLAB_VERSION);
 
     shadowlab::app::RunOptions runOptions;
-    auto* runCmd = app.add_subcommand("run", "The main job: reference, both backends, difference images, "
-                                             "metrics.json and report.html in one folder");
+    auto* runCmd = app.add_subcommand("run",
+                                      "The main job: reference, both backends, difference images, "
+                                      "metrics.json and report.html in one folder");
     addSceneOptions(*runCmd, runOptions.common);
     runCmd->add_option("-o,--output", runOptions.outputDir, "Output folder (created)")->required();
     runCmd->add_flag("--no-raster", runOptions.skipRaster, "Skip the Vulkan backend (no Vulkan on this machine)");
-    runCmd->add_flag("--no-sweep", runOptions.skipSweep, "Skip the small settings sweep (error against run time, bias windows)");
+    runCmd->add_flag("--no-sweep", runOptions.skipSweep,
+                     "Skip the small settings sweep (error against run time, bias windows)");
     addBudgetOptions(*runCmd, runOptions.budgets);
 
     shadowlab::app::RenderOptions renderOptions;
@@ -140,64 +148,76 @@ int main(int argc, char** argv) {
     std::vector<std::string> backendNames;
     for (const shadowlab::scene::Backend b : shadowlab::scene::kBackends)
         backendNames.push_back(shadowlab::scene::toString(b));
-    auto* renderCmd = app.add_subcommand("render", "Render one backend into a Frame (.exr: every AOV and "
-                                                   "metadata) or a beauty image (.png)");
+    auto* renderCmd = app.add_subcommand("render",
+                                         "Render one backend into a Frame (.exr: every AOV and "
+                                         "metadata) or a beauty image (.png)");
     addSceneOptions(*renderCmd, renderOptions.common);
     auto* backendOption =
-        renderCmd->add_option("--backend", backendName,
-                              "raster|raytrace|reference (default raytrace; raster with --view)")
+        renderCmd
+            ->add_option("--backend", backendName, "raster|raytrace|reference (default raytrace; raster with --view)")
             ->check(CLI::IsMember(backendNames));
     renderCmd->add_option("-o,--output", renderOptions.output, "Output file, .exr or .png")->required();
-    renderCmd->add_option("--view", renderOptions.view,
-                          "raster debug view instead of the beauty image (.png only): shadow-map (every map "
-                          "layer as depth), cascades (beauty tinted by cascade), texel-density (shadow texel vs "
-                          "screen pixel size), light-frustum (each map's frustum drawn over the scene; what it "
-                          "covers tinted, lit points outside it striped magenta)")
+    renderCmd
+        ->add_option("--view", renderOptions.view,
+                     "raster debug view instead of the beauty image (.png only): shadow-map (every map "
+                     "layer as depth), cascades (beauty tinted by cascade), texel-density (shadow texel vs "
+                     "screen pixel size), light-frustum (each map's frustum drawn over the scene; what it "
+                     "covers tinted, lit points outside it striped magenta)")
         ->check(CLI::IsMember({"shadow-map", "cascades", "texel-density", "light-frustum"}));
 
     shadowlab::app::SweepOptions sweepOptions;
-    auto* sweepCmd = app.add_subcommand("sweep", "Render a grid of settings for both backends, time each and "
-                                                 "measure each against the reference: results.csv, results.json, "
-                                                 "plots and report.html");
+    auto* sweepCmd = app.add_subcommand("sweep",
+                                        "Render a grid of settings for both backends, time each and "
+                                        "measure each against the reference: results.csv, results.json, "
+                                        "plots and report.html");
     addSceneOptions(*sweepCmd, sweepOptions.common);
     sweepCmd->add_option("-o,--output", sweepOptions.outputDir, "Output folder (created)")->required();
-    sweepCmd->add_option("--grid", sweepOptions.grid, "Grid file (JSON, see docs/sweep.md); default: the built-in grid");
+    sweepCmd->add_option("--grid", sweepOptions.grid,
+                         "Grid file (JSON, see docs/sweep.md); default: the built-in grid");
     sweepCmd->add_flag("--resume", sweepOptions.resume, "Continue a stopped sweep in the same folder");
     sweepCmd->add_flag("--quick", sweepOptions.quick, "The small built-in grid (what `run` includes)");
     sweepCmd->add_option("--repetitions", sweepOptions.repetitions, "Timed frames per configuration (default 3)")
         ->check(CLI::Range(1, 100));
-    sweepCmd->add_option("--shard", sweepOptions.shard,
-                         "K/N: render only shard K (from 0) of N into OUTPUT/shard-K-of-N, sharing OUTPUT/reference.exr; "
-                         "join the shards with `shadowlab merge` (docs/sweep.md)");
-    sweepCmd->add_option("--flicker", sweepOptions.flicker,
-                         "The flicker axis: also render every row along a short path (KIND, default subtexel: "
-                         "sub-texel camera steps) and record flicker, error variation and swim (docs/sweep.md)")
+    sweepCmd->add_option(
+        "--shard", sweepOptions.shard,
+        "K/N: render only shard K (from 0) of N into OUTPUT/shard-K-of-N, sharing OUTPUT/reference.exr; "
+        "join the shards with `shadowlab merge` (docs/sweep.md)");
+    sweepCmd
+        ->add_option("--flicker", sweepOptions.flicker,
+                     "The flicker axis: also render every row along a short path (KIND, default subtexel: "
+                     "sub-texel camera steps) and record flicker, error variation and swim (docs/sweep.md)")
         ->expected(0, 1);
     sweepCmd->add_option("--flicker-frames", sweepOptions.flickerFrames, "Frames of the flicker path (default 4)")
         ->check(CLI::Range(2, 64));
 
     shadowlab::app::MergeOptions mergeOptions;
-    auto* mergeCmd = app.add_subcommand("merge", "Join the shards of a sweep (`sweep --shard K/N`) into the results.csv, "
-                                                 "results.json, plots and report.html of the whole sweep, those of a "
-                                                 "check (`check --shard K/N`) into its junit.xml, summary.md, summary.html and cases/, "
-                                                 "or those of a path (`path --shard K/N`) into its metrics and report");
-    mergeCmd->add_option("DIRS", mergeOptions.inputs,
-                         "Shard folders, or folders holding shard-K-of-N folders (the -o of `sweep`, `check` or `path --shard`)")
+    auto* mergeCmd =
+        app.add_subcommand("merge",
+                           "Join the shards of a sweep (`sweep --shard K/N`) into the results.csv, "
+                           "results.json, plots and report.html of the whole sweep, those of a "
+                           "check (`check --shard K/N`) into its junit.xml, summary.md, summary.html and cases/, "
+                           "or those of a path (`path --shard K/N`) into its metrics and report");
+    mergeCmd
+        ->add_option(
+            "DIRS", mergeOptions.inputs,
+            "Shard folders, or folders holding shard-K-of-N folders (the -o of `sweep`, `check` or `path --shard`)")
         ->required();
     mergeCmd->add_option("-o,--output", mergeOptions.outputDir, "Merged folder (default: the one input folder)");
     mergeCmd->add_flag("--json", mergeOptions.json, "Print the merged rows as JSON on stdout");
 
     shadowlab::app::PathCommandOptions pathOptions;
-    auto* pathCmd = app.add_subcommand("path", "Render frames along a camera or light path with the reference and "
-                                               "both backends and measure flicker and swimming (docs/temporal.md)");
+    auto* pathCmd = app.add_subcommand("path",
+                                       "Render frames along a camera or light path with the reference and "
+                                       "both backends and measure flicker and swimming (docs/temporal.md)");
     addSceneOptions(*pathCmd, pathOptions.common);
     pathCmd->add_option("-o,--output", pathOptions.outputDir, "Output folder (created)")->required();
     pathCmd->add_option("--kind", pathOptions.kind,
                         "orbit|dolly|pan|subtexel|sun-azimuth|sun-elevation|light-move|gltf-animation (default: the "
                         "scene's \"path\" block, else orbit)");
-    pathCmd->add_option("--camera-animation", pathOptions.cameraAnimation,
-                        "Follow a glTF camera animation of a .gltf/.glb scene (NAME or INDEX; empty: the first); "
-                        "the same as --kind gltf-animation")
+    pathCmd
+        ->add_option("--camera-animation", pathOptions.cameraAnimation,
+                     "Follow a glTF camera animation of a .gltf/.glb scene (NAME or INDEX; empty: the first); "
+                     "the same as --kind gltf-animation")
         ->expected(0, 1);
     pathCmd->add_option("--frames", pathOptions.frames, "Frames along the path (default 12)");
     pathCmd->add_option("--amount", pathOptions.amount,
@@ -215,10 +235,11 @@ int main(int argc, char** argv) {
                       "Camera paths: skip the raster frames drawn from frame 0's camera");
 
     shadowlab::app::StabilityCommandOptions stabilityOptions;
-    auto* stabilityCmd = app.add_subcommand(
-        "stability", "Run stiff and extreme cases through the reference and both backends (defaults and best "
-                     "bias): acne and leak rates, bias windows or 'stiff', NaN/Inf, analytic check; exits 1 "
-                     "when the reference misses an analytic answer or a backend gives NaN/Inf or fails");
+    auto* stabilityCmd =
+        app.add_subcommand("stability",
+                           "Run stiff and extreme cases through the reference and both backends (defaults and best "
+                           "bias): acne and leak rates, bias windows or 'stiff', NaN/Inf, analytic check; exits 1 "
+                           "when the reference misses an analytic answer or a backend gives NaN/Inf or fails");
     stabilityCmd->add_option("SCENES", stabilityOptions.scenes,
                              "Scene files or shipped names (default: every scenes/extreme case)");
     stabilityCmd->add_option("-o,--output", stabilityOptions.outputDir, "Output folder (created)")->required();
@@ -230,16 +251,19 @@ int main(int argc, char** argv) {
     stabilityCmd->add_flag("--json", stabilityOptions.json, "Print the cases as JSON on stdout");
 
     shadowlab::app::CompareOptions compareOptions;
-    auto* compareCmd = app.add_subcommand("compare", "Classify a method's shadows against a reference Frame "
-                                                     "and write the difference image");
-    compareCmd->add_option("METHOD", compareOptions.method,
-                           "Method Frame (.exr from `render`), or a shadow mask (.png, or with --mask-*)")
+    auto* compareCmd = app.add_subcommand("compare",
+                                          "Classify a method's shadows against a reference Frame "
+                                          "and write the difference image");
+    compareCmd
+        ->add_option("METHOD", compareOptions.method,
+                     "Method Frame (.exr from `render`), or a shadow mask (.png, or with --mask-*)")
         ->required();
     compareCmd->add_option("REFERENCE", compareOptions.reference, "Reference Frame (.exr)")->required();
     compareCmd->add_option("-o,--output", compareOptions.output, "Difference image (.png)")->required();
     compareCmd->add_flag("--json", compareOptions.json, "Print the metrics as JSON on stdout");
-    compareCmd->add_option("--heat", compareOptions.heat,
-                           "Also write the |V_method - V_reference| heat map (.png; docs/compare.md has its color scale)");
+    compareCmd->add_option(
+        "--heat", compareOptions.heat,
+        "Also write the |V_method - V_reference| heat map (.png; docs/compare.md has its color scale)");
     addBudgetOptions(*compareCmd, compareOptions.budgets);
     compareCmd->add_flag("--allow-different-scene", compareOptions.allowDifferentScene,
                          "Compare frames that record different scenes, cameras (a warning instead of exit 2)");
@@ -251,8 +275,9 @@ int main(int argc, char** argv) {
                          "METHOD is a shadow mask with sRGB-encoded values (default: linear)");
 
     shadowlab::app::ExportOptions exportOptions;
-    auto* exportCmd = app.add_subcommand("export", "Write the scene as glTF 2.0 with KHR_lights_punctual (.glb or "
-                                                   ".gltf) for another engine (docs/export.md)");
+    auto* exportCmd = app.add_subcommand("export",
+                                         "Write the scene as glTF 2.0 with KHR_lights_punctual (.glb or "
+                                         ".gltf) for another engine (docs/export.md)");
     exportCmd->add_option("SCENE", exportOptions.scene, "Scene file or shipped name")->required();
     exportCmd->add_option("-o,--output", exportOptions.output, "The glTF file (.glb or .gltf)")->required();
     exportCmd->add_option("--tolerance", exportOptions.tolerance,
@@ -260,9 +285,10 @@ int main(int argc, char** argv) {
 
     shadowlab::app::CheckOptions checkOptions;
     auto* checkCmd = app.add_subcommand(
-        "check", "CI gate: run a suite of cases (scene, backend, settings, budgets) against the reference, their "
-                 "budgets and a stored baseline; writes junit.xml, summary.md, summary.html and one JSON per case; exits 3 "
-                 "when a case fails, 1 when one cannot render");
+        "check",
+        "CI gate: run a suite of cases (scene, backend, settings, budgets) against the reference, their "
+        "budgets and a stored baseline; writes junit.xml, summary.md, summary.html and one JSON per case; exits 3 "
+        "when a case fails, 1 when one cannot render");
     checkCmd->add_option("SUITE", checkOptions.suite, "Suite file (JSON, see docs/ci.md)")->required();
     checkCmd->add_option("-o,--output", checkOptions.outputDir, "Output folder (replaced as a whole)")->required();
     checkCmd->add_option("--baseline", checkOptions.baseline, "Baseline file instead of the suite's \"baseline\"");
@@ -290,7 +316,8 @@ int main(int argc, char** argv) {
             // The debug views are views of the shadow maps: --view alone means the raster backend.
             // IsMember above has checked the name.
             renderOptions.backend = *shadowlab::scene::parseBackend(backendName);
-            if (renderOptions.view && backendOption->count() == 0) renderOptions.backend = shadowlab::scene::Backend::Raster;
+            if (renderOptions.view && backendOption->count() == 0)
+                renderOptions.backend = shadowlab::scene::Backend::Raster;
             return finishStandardOutput(shadowlab::app::render(renderOptions));
         }
         if (*compareCmd) return finishStandardOutput(shadowlab::app::compareFiles(compareOptions));

@@ -111,9 +111,12 @@ raster::RendererOptions rendererOptions() {
     raster::RendererOptions o;
     if (const char* v = std::getenv("SHADOWLAB_BENCH_LIGHT_CONSTANTS"); v && *v) {
         const std::string which = v;
-        if (which == "uniform") o.lightConstants = raster::LightConstants::kUniformBuffer;
-        else if (which == "vertex") o.lightConstants = raster::LightConstants::kVertexOutputs;
-        else throw std::runtime_error("SHADOWLAB_BENCH_LIGHT_CONSTANTS: expected uniform or vertex, got " + which);
+        if (which == "uniform")
+            o.lightConstants = raster::LightConstants::kUniformBuffer;
+        else if (which == "vertex")
+            o.lightConstants = raster::LightConstants::kVertexOutputs;
+        else
+            throw std::runtime_error("SHADOWLAB_BENCH_LIGHT_CONSTANTS: expected uniform or vertex, got " + which);
     }
     return o;
 }
@@ -152,7 +155,8 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
         bench::BareRenderer(tiny, settings.raster).render(pixels);
         freshShaderCache(caches);
     }
-    const bool bareFirst = std::getenv("SHADOWLAB_BENCH_BARE_FIRST") && std::string(std::getenv("SHADOWLAB_BENCH_BARE_FIRST")) == "1";
+    const bool bareFirst =
+        std::getenv("SHADOWLAB_BENCH_BARE_FIRST") && std::string(std::getenv("SHADOWLAB_BENCH_BARE_FIRST")) == "1";
     std::vector<std::uint8_t> rgba;
     double bareCold = 0, bareColdCpu = 0;
     auto coldBare = [&] {
@@ -173,11 +177,12 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
     if (profileName && (std::string(profileName) == "cold" || warmProfile)) {
         // Only our cold (or warm: first) first frame (construction + first frame): a process to run
         // under `perf record`.
-        std::printf("first frame %.1f ms, CPU %.1f ms (construction %.1f, setup with the pipelines %.1f; shadow pass "
-                    "%.1f, CPU %s; lit pass %.1f, CPU %s; readback %.1f)\n",
-                    oursCold, oursColdCpu, ours.setupMs(), frame.timing("setup"), frame.timing("shadow_pass"),
-                    frame.attributes["cpu_shadow_pass_ms"].c_str(), frame.timing("lit_pass"),
-                    frame.attributes["cpu_lit_pass_ms"].c_str(), frame.timing("readback"));
+        std::printf(
+            "first frame %.1f ms, CPU %.1f ms (construction %.1f, setup with the pipelines %.1f; shadow pass "
+            "%.1f, CPU %s; lit pass %.1f, CPU %s; readback %.1f)\n",
+            oursCold, oursColdCpu, ours.setupMs(), frame.timing("setup"), frame.timing("shadow_pass"),
+            frame.attributes["cpu_shadow_pass_ms"].c_str(), frame.timing("lit_pass"),
+            frame.attributes["cpu_lit_pass_ms"].c_str(), frame.timing("readback"));
         return;
     }
     if (!bareFirst) coldBare();
@@ -188,11 +193,11 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
     bench::BareRenderer bareSrgb(s, settings.raster, true);
     bareSrgb.render(rgba);
 
-    std::printf("\n=== %s: %s triangles, %dx%d, shadow map %d, filter %s, light constants: %s, bare PCF: "
-                "%s ===\n",
-                label.c_str(), frame.attributes["triangles"].c_str(), width, height, kShadowMapSize,
-                frame.attributes["filter"].c_str(), frame.attributes["light_constants"].c_str(),
-                bare.pcfKind().c_str());
+    std::printf(
+        "\n=== %s: %s triangles, %dx%d, shadow map %d, filter %s, light constants: %s, bare PCF: "
+        "%s ===\n",
+        label.c_str(), frame.attributes["triangles"].c_str(), width, height, kShadowMapSize,
+        frame.attributes["filter"].c_str(), frame.attributes["light_constants"].c_str(), bare.pcfKind().c_str());
     if (const char* dir = std::getenv("SHADOWLAB_BENCH_PNG_DIR")) {
         scene::writePngLinear(fs::path(dir) / (label + "-ours.png"), frame.width, frame.height, frame.beauty);
         std::vector<float> rgb(std::size_t(width) * height * 3);
@@ -207,13 +212,21 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
         const std::string which = profile;
         scene::Frame into;
         for (int i = 0; i < repeats; ++i) {
-            if (which == "all") ours.render(into, scene::kAllChannels);
-            else if (which == "no-ids") ours.render(into, scene::kAllChannels & ~scene::kChannelBlockerId);
-            else if (which == "beauty") ours.render(into, scene::kChannelBeauty);
-            else if (which == "png") ours.render(into, scene::kChannelBeauty | scene::kBeautyForDisplay);
-            else if (which == "bare") bare.render(rgba);
-            else if (which == "bare-srgb") bareSrgb.render(rgba);
-            else throw std::runtime_error("SHADOWLAB_BENCH_PROFILE: expected all, no-ids, beauty, png, bare or bare-srgb, got " + which);
+            if (which == "all")
+                ours.render(into, scene::kAllChannels);
+            else if (which == "no-ids")
+                ours.render(into, scene::kAllChannels & ~scene::kChannelBlockerId);
+            else if (which == "beauty")
+                ours.render(into, scene::kChannelBeauty);
+            else if (which == "png")
+                ours.render(into, scene::kChannelBeauty | scene::kBeautyForDisplay);
+            else if (which == "bare")
+                bare.render(rgba);
+            else if (which == "bare-srgb")
+                bareSrgb.render(rgba);
+            else
+                throw std::runtime_error(
+                    "SHADOWLAB_BENCH_PROFILE: expected all, no-ids, beauty, png, bare or bare-srgb, got " + which);
         }
         return;
     }
@@ -281,10 +294,11 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
                     cell(png).c_str(), cell(base).c_str(), all.med(stage) / base.med(stage),
                     beauty.med(stage) / base.med(stage), png.med(stage) / base.med(stage));
     }
-    std::printf("  bare with an sRGB target: per_frame %.1f, lit_pass %.1f, cpu_per_frame %.1f; png / bare sRGB: "
-                "per_frame %.2f, cpu %.2f\n",
-                baseSrgb.med("per_frame"), baseSrgb.med("lit_pass"), baseSrgb.med("cpu_per_frame"),
-                png.med("per_frame") / baseSrgb.med("per_frame"), png.med("cpu_per_frame") / baseSrgb.med("cpu_per_frame"));
+    std::printf(
+        "  bare with an sRGB target: per_frame %.1f, lit_pass %.1f, cpu_per_frame %.1f; png / bare sRGB: "
+        "per_frame %.2f, cpu %.2f\n",
+        baseSrgb.med("per_frame"), baseSrgb.med("lit_pass"), baseSrgb.med("cpu_per_frame"),
+        png.med("per_frame") / baseSrgb.med("per_frame"), png.med("cpu_per_frame") / baseSrgb.med("cpu_per_frame"));
     std::printf("  ours (all channels) into a new Frame each time: per_frame %.1f, readback %.1f\n",
                 fresh.med("per_frame"), fresh.med("readback"));
     std::printf("  setup (construction): ours %.1f, bare %.1f\n", ours.setupMs(), bare.setupMs());
@@ -297,13 +311,14 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
                 frame.attributes["gpu_shadow_pass_ms"].c_str(), frame.attributes["gpu_lit_pass_ms"].c_str(),
                 allFrame.attributes["gpu_shadow_pass_ms"].c_str(), allFrame.attributes["gpu_lit_pass_ms"].c_str());
     const char* threads = std::getenv("LP_NUM_THREADS");
-    std::printf("ROW | %s | %s | %.1f | %.1f | %.1f | %.1f | %.2f | %.2f | %.2f | %.2f | %.2f | %.1f | %.1f | %.1f / %.1f | %.1f / %.1f |\n",
-                label.c_str(), threads ? threads : "?", all.med("per_frame"), beauty.med("per_frame"),
-                png.med("per_frame"), base.med("per_frame"), all.med("per_frame") / base.med("per_frame"),
-                beauty.med("per_frame") / base.med("per_frame"), png.med("per_frame") / base.med("per_frame"),
-                all.med("cpu_per_frame") / base.med("cpu_per_frame"), png.med("cpu_per_frame") / base.med("cpu_per_frame"),
-                all.med("lit_pass"), base.med("lit_pass"),
-                oursCold, bareCold, oursWarmFirst, bareWarmFirst);
+    std::printf(
+        "ROW | %s | %s | %.1f | %.1f | %.1f | %.1f | %.2f | %.2f | %.2f | %.2f | %.2f | %.1f | %.1f | %.1f / %.1f | "
+        "%.1f / %.1f |\n",
+        label.c_str(), threads ? threads : "?", all.med("per_frame"), beauty.med("per_frame"), png.med("per_frame"),
+        base.med("per_frame"), all.med("per_frame") / base.med("per_frame"),
+        beauty.med("per_frame") / base.med("per_frame"), png.med("per_frame") / base.med("per_frame"),
+        all.med("cpu_per_frame") / base.med("cpu_per_frame"), png.med("cpu_per_frame") / base.med("cpu_per_frame"),
+        all.med("lit_pass"), base.med("lit_pass"), oursCold, bareCold, oursWarmFirst, bareWarmFirst);
 }
 
 // SHADOWLAB_BENCH_FILTERS=1: instead of the series above, each shadow filter's frame (all
@@ -355,10 +370,11 @@ void benchFilters(const std::string& label, const fs::path& file, int repeats) {
     }
     const Series& pcf = series[0];
     const Series& base = series[n - 1];
-    std::printf("\n=== filters, %s: %s triangles, %dx%d, shadow map %d, LP_NUM_THREADS=%s, %d repetitions: median "
-                "(min-max), ms ===\n",
-                label.c_str(), frames[0].attributes["triangles"].c_str(), width, height, kShadowMapSize,
-                std::getenv("LP_NUM_THREADS") ? std::getenv("LP_NUM_THREADS") : "?", repeats);
+    std::printf(
+        "\n=== filters, %s: %s triangles, %dx%d, shadow map %d, LP_NUM_THREADS=%s, %d repetitions: median "
+        "(min-max), ms ===\n",
+        label.c_str(), frames[0].attributes["triangles"].c_str(), width, height, kShadowMapSize,
+        std::getenv("LP_NUM_THREADS") ? std::getenv("LP_NUM_THREADS") : "?", repeats);
     std::printf("%-7s %-21s %-21s %-21s %-21s %-8s %-8s %-8s %-8s\n", "filter", "per_frame (wall)", "cpu_per_frame",
                 "shadow_pass(+moments)", "lit_pass", "wall/pcf", "cpu/pcf", "wall/bare", "cpu/bare");
     auto cell = [](const Series& x, const char* stage) {
@@ -379,10 +395,11 @@ void benchFilters(const std::string& label, const fs::path& file, int repeats) {
     // One line per filter for docs/performance.md's table.
     for (std::size_t k = 0; k < filters.size(); ++k) {
         const Series& x = series[k];
-        std::printf("FILTER | %s | %s | %s | %s | %s | %.2f / %.2f | %.2f / %.2f |\n", label.c_str(), filters[k].c_str(),
-                    cell(x, "per_frame").c_str(), cell(x, "cpu_per_frame").c_str(), cell(x, "shadow_pass").c_str(),
-                    x.med("per_frame") / pcf.med("per_frame"), x.med("cpu_per_frame") / pcf.med("cpu_per_frame"),
-                    x.med("per_frame") / base.med("per_frame"), x.med("cpu_per_frame") / base.med("cpu_per_frame"));
+        std::printf("FILTER | %s | %s | %s | %s | %s | %.2f / %.2f | %.2f / %.2f |\n", label.c_str(),
+                    filters[k].c_str(), cell(x, "per_frame").c_str(), cell(x, "cpu_per_frame").c_str(),
+                    cell(x, "shadow_pass").c_str(), x.med("per_frame") / pcf.med("per_frame"),
+                    x.med("cpu_per_frame") / pcf.med("cpu_per_frame"), x.med("per_frame") / base.med("per_frame"),
+                    x.med("cpu_per_frame") / base.med("cpu_per_frame"));
     }
     std::printf("FILTER | %s | bare | %s | %s | %s | | |\n", label.c_str(), cell(base, "per_frame").c_str(),
                 cell(base, "cpu_per_frame").c_str(), cell(base, "shadow_pass").c_str());
@@ -402,12 +419,17 @@ scene::Scene glassScene(bool opaque) {
     s.materials = {{.name = "glass", .albedo = {0.55, 0.75, 0.9}, .opacity = opaque ? 1.0 : 0.5},
                    {.name = "box", .albedo = {0.3, 0.5, 0.8}},
                    {.name = "ground", .albedo = {0.75, 0.75, 0.75}}};
-    s.lights = {{.type = scene::LightType::Spot, .direction = glm::normalize(scene::Vec3(3.2, -5.5, -2.6)),
-                 .position = {-3, 5.5, 2}, .color = {1, 0.95, 0.85}, .intensity = 700, .coneAngleDegrees = 32},
+    s.lights = {{.type = scene::LightType::Spot,
+                 .direction = glm::normalize(scene::Vec3(3.2, -5.5, -2.6)),
+                 .position = {-3, 5.5, 2},
+                 .color = {1, 0.95, 0.85},
+                 .intensity = 700,
+                 .coneAngleDegrees = 32},
                 {.type = scene::LightType::Point, .position = {2.5, 4, 1.5}, .color = {0.9, 0.9, 1}, .intensity = 300}};
     s.objects = {{.name = "glass sphere", .shape = scene::Sphere{{0, 1, 0}, 1.0}, .material = 0},
                  {.name = "box", .shape = scene::Box{{-2.4, 0, 0.2}, {-1.6, 1.2, 1.0}}, .material = 1},
-                 {.name = "ground", .shape = scene::Quad{.center = {0, 0, 0}, .normal = {0, 1, 0}, .size = {20, 20}},
+                 {.name = "ground",
+                  .shape = scene::Quad{.center = {0, 0, 0}, .normal = {0, 1, 0}, .size = {20, 20}},
                   .material = 2}};
     return s;
 }
@@ -448,7 +470,8 @@ void benchTransmittance(int repeats) {
     std::printf("\n=== transmittance: %s shadow maps of %d, 640x360, median of %d frames, ms (min-max) ===\n",
                 cases[0].frame.attributes.at("shadow_maps").c_str(), kShadowMapSize, repeats);
     std::printf("  %-16s %22s %22s %9s\n", "stage", "glass", "opaque", "ratio");
-    for (const char* stage : {"shadow_pass", "gpu_shadow_pass", "cpu_shadow_pass", "lit_pass", "per_frame", "cpu_per_frame"}) {
+    for (const char* stage :
+         {"shadow_pass", "gpu_shadow_pass", "cpu_shadow_pass", "lit_pass", "per_frame", "cpu_per_frame"}) {
         auto cell = [&](const Series& x) {
             char buf[64];
             const auto [lo, hi] = x.range(stage);
@@ -458,9 +481,10 @@ void benchTransmittance(int repeats) {
         std::printf("  %-16s %22s %22s %9.2f\n", stage, cell(cases[0].series).c_str(), cell(cases[1].series).c_str(),
                     cases[0].series.med(stage) / cases[1].series.med(stage));
     }
-    std::printf("  first frame incl. setup (this process's shader cache): glass %.1f (shadow pass %.1f), opaque %.1f "
-                "(shadow pass %.1f)\n",
-                cases[0].firstMs, cases[0].firstShadowMs, cases[1].firstMs, cases[1].firstShadowMs);
+    std::printf(
+        "  first frame incl. setup (this process's shader cache): glass %.1f (shadow pass %.1f), opaque %.1f "
+        "(shadow pass %.1f)\n",
+        cases[0].firstMs, cases[0].firstShadowMs, cases[1].firstMs, cases[1].firstShadowMs);
     std::printf("TRANSMIT | %s | %.1f | %.1f | %.2f | %.1f | %.1f | %.2f | %.2f |\n", std::getenv("LP_NUM_THREADS"),
                 cases[0].series.med("shadow_pass"), cases[1].series.med("shadow_pass"),
                 cases[0].series.med("shadow_pass") / cases[1].series.med("shadow_pass"),
@@ -478,8 +502,8 @@ int main(int argc, char** argv) {
         // Both thread counts, each in its own process.
         int rc = 0;
         for (const char* threads : {"2", "1"}) {
-            const std::string command = std::string("LP_NUM_THREADS=") + threads + " '" + argv[0] + "' " +
-                                        std::to_string(repeats);
+            const std::string command =
+                std::string("LP_NUM_THREADS=") + threads + " '" + argv[0] + "' " + std::to_string(repeats);
             std::printf("\n##### %s\n", command.c_str());
             std::fflush(stdout);
             rc |= std::system(command.c_str());
@@ -515,11 +539,11 @@ int main(int argc, char** argv) {
     std::vector<fs::path> caches;
     int rc = 0;
     if (wantScene("seed")) try {
-        benchScene("seed", scene::findScene("seed"), repeats, caches);
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "seed scene failed: %s\n", e.what());
-        rc = 1;
-    }
+            benchScene("seed", scene::findScene("seed"), repeats, caches);
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "seed scene failed: %s\n", e.what());
+            rc = 1;
+        }
     if (!wantScene("Sponza")) {
     } else if (!fs::exists(kSponzaPath)) {
         std::printf("\n=== Sponza: SKIPPED, file absent: %s ===\n", kSponzaPath);

@@ -85,8 +85,7 @@ scene::Scene terrainScene(int cells = kTerrainCells) {
         }
     for (int j = 0; j < cells; ++j)
         for (int i = 0; i < cells; ++i) {
-            const std::uint32_t a = std::uint32_t(j * n + i), b = a + 1, c = a + std::uint32_t(n),
-                                d = c + 1;
+            const std::uint32_t a = std::uint32_t(j * n + i), b = a + 1, c = a + std::uint32_t(n), d = c + 1;
             for (std::uint32_t v : {a, c, b, b, c, d}) mesh->indices.push_back(v);
         }
     scene::Scene s;
@@ -137,8 +136,7 @@ void makeRays(Workload& w) {
     const scene::CameraBasis basis = scene::cameraBasis(cam);
     const V eye(basis.position);
     for (int y = 0; y < kHeight; ++y)
-        for (int x = 0; x < kWidth; ++x)
-            w.primary.emplace_back(eye, V(scene::pixelDirection(basis, x, y)));
+        for (int x = 0; x < kWidth; ++x) w.primary.emplace_back(eye, V(scene::pixelDirection(basis, x, y)));
     scene::RaytraceSettings robust;
     robust.robustOffset = true;
     const scene::Vec3 toLight = -w.scene.lights.at(0).direction;
@@ -155,13 +153,12 @@ void makeRays(Workload& w) {
 #ifdef SHADOWLAB_HAVE_EMBREE
 void addEmbreeQuads(RTCDevice device, RTCScene scene, const std::vector<scene::Vec3>& corners) {
     RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_QUAD);
-    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0,
-                                                          RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                                          corners.size()));
+    auto* v = static_cast<float*>(
+        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), corners.size()));
     for (std::size_t i = 0; i < corners.size(); ++i)
         for (int k = 0; k < 3; ++k) v[3 * i + k] = float(corners[i][k]);
-    auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-        g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT4, 4 * sizeof(unsigned), corners.size() / 4));
+    auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT4,
+                                                               4 * sizeof(unsigned), corners.size() / 4));
     for (std::size_t i = 0; i < corners.size(); ++i) idx[i] = unsigned(i);
     rtcCommitGeometry(g);
     rtcAttachGeometry(scene, g);
@@ -192,8 +189,8 @@ EmbreeScene embreeBuild(const scene::Scene& sc) {
     for (const scene::Object& o : sc.objects) {
         if (const auto* s = std::get_if<scene::Sphere>(&o.shape)) {
             RTCGeometry g = rtcNewGeometry(w.device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
-            auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
-                g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), 1));
+            auto* v = static_cast<float*>(
+                rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), 1));
             v[0] = float(s->center.x), v[1] = float(s->center.y), v[2] = float(s->center.z);
             v[3] = float(s->radius);
             rtcCommitGeometry(g);
@@ -202,13 +199,10 @@ EmbreeScene embreeBuild(const scene::Scene& sc) {
         } else if (const auto* q = std::get_if<scene::Quad>(&o.shape)) {
             const scene::Vec3 du = 0.5 * q->size.x * q->uAxis, dv = 0.5 * q->size.y * q->vAxis;
             addEmbreeQuads(w.device, w.scene,
-                           {q->center - du - dv, q->center + du - dv, q->center + du + dv,
-                            q->center - du + dv});
+                           {q->center - du - dv, q->center + du - dv, q->center + du + dv, q->center - du + dv});
         } else if (const auto* b = std::get_if<scene::Box>(&o.shape)) {
             const scene::Vec3 lo = b->min, hi = b->max;
-            auto c = [&](int i) {
-                return scene::Vec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
-            };
+            auto c = [&](int i) { return scene::Vec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z); };
             const int faces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1},
                                      {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
             std::vector<scene::Vec3> corners;
@@ -218,12 +212,12 @@ EmbreeScene embreeBuild(const scene::Scene& sc) {
         } else if (const auto* m = std::get_if<scene::Mesh>(&o.shape)) {
             const scene::TriangleMesh tm = scene::flattenInstances(m->instances);
             RTCGeometry g = rtcNewGeometry(w.device, RTC_GEOMETRY_TYPE_TRIANGLE);
-            auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
-                g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), tm.positions.size()));
+            auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                                  3 * sizeof(float), tm.positions.size()));
             for (std::size_t i = 0; i < tm.positions.size(); ++i)
                 for (int k = 0; k < 3; ++k) v[3 * i + k] = float(tm.positions[i][k]);
-            auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-                g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), tm.triangleCount()));
+            auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                       3 * sizeof(unsigned), tm.triangleCount()));
             for (std::size_t i = 0; i < tm.indices.size(); ++i) idx[i] = tm.indices[i];
             rtcCommitGeometry(g);
             rtcAttachGeometry(w.scene, g);
@@ -482,11 +476,12 @@ void countTies(const Workload& w) {
         for (const auto& c : same) std::printf(" %d -> %d", c.prim, answerOf(c));
         std::printf(" (reported %d; the double reference: triangle %d -> %d)\n", h.prim, hd.prim, refAnswer);
     }
-    std::printf("%-8s exact closest-hit ties: %zu of %zu primary hits (%zu reported the lowest index; at most "
-                "%zu triangles at one t); the shadow answer (-1 faces away, 0 lit, 1 blocked) differs between "
-                "the tied triangles on %zu (the facing test on %zu); the double reference agrees with the "
-                "reported triangle on %zu of those\n",
-                w.name.c_str(), tied, hits, idFromLowest, most, maskDiffers, facingDiffers, refAgrees);
+    std::printf(
+        "%-8s exact closest-hit ties: %zu of %zu primary hits (%zu reported the lowest index; at most "
+        "%zu triangles at one t); the shadow answer (-1 faces away, 0 lit, 1 blocked) differs between "
+        "the tied triangles on %zu (the facing test on %zu); the double reference agrees with the "
+        "reported triangle on %zu of those\n",
+        w.name.c_str(), tied, hits, idFromLowest, most, maskDiffers, facingDiffers, refAgrees);
 }
 
 // Collects items/s of every repetition per benchmark name while printing the usual table, so
@@ -562,8 +557,10 @@ int main(int argc, char** argv) {
         s.objects.push_back(o);
         add("sponza", std::move(s));
     } else {
-        std::printf("Sponza: %s is absent (set SHADOWLAB_SPONZA to its .gltf); only the seed "
-                    "scene is measured.\n", kSponzaPath);
+        std::printf(
+            "Sponza: %s is absent (set SHADOWLAB_SPONZA to its .gltf); only the seed "
+            "scene is measured.\n",
+            kSponzaPath);
     }
     if (wanted("terrain")) {
         const int tris = envInt("SHADOWLAB_BENCH_TERRAIN_TRIS", 2 * kTerrainCells * kTerrainCells);
@@ -576,20 +573,30 @@ int main(int argc, char** argv) {
     for (const auto& wp : workloads) {
         const Workload* w = wp.get();
         auto reg = [&](const std::string& n, std::size_t count, auto fn) {
-            benchmark::RegisterBenchmark((w->name + "/" + n).c_str(), [w, count, fn](benchmark::State& st) {
-                for (auto _ : st) benchmark::DoNotOptimize(fn(*w));
-                st.SetItemsProcessed(std::int64_t(st.iterations()) * std::int64_t(count));
-            })->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->MinTime(0.5);
+            benchmark::RegisterBenchmark((w->name + "/" + n).c_str(),
+                                         [w, count, fn](benchmark::State& st) {
+                                             for (auto _ : st) benchmark::DoNotOptimize(fn(*w));
+                                             st.SetItemsProcessed(std::int64_t(st.iterations()) * std::int64_t(count));
+                                         })
+                ->Unit(benchmark::kMillisecond)
+                ->MeasureProcessCPUTime()
+                ->MinTime(0.5);
         };
         reg("primary/ours", w->primary.size(), [](const Workload& x) { return ourPrimary(x); });
         reg("shadow/ours", w->shadow.size(), [](const Workload& x) { return ourShadow(x, false); });
         reg("shadow/ours_conservative", w->shadow.size(), [](const Workload& x) { return ourShadow(x, true); });
         // The same walk without the AVX box test and/or the occluder cache, for the record.
-        reg("primary/ours_sse", w->primary.size(), [](const Workload& x) { return variant(false, true, [&] { return ourPrimary(x); }); });
-        reg("shadow/ours_nocache", w->shadow.size(), [](const Workload& x) { return variant(true, false, [&] { return ourShadow(x, false); }); });
-        reg("primary/ours_reftree", w->primary.size(), [](const Workload& x) { return ourPrimary(x, x.refTree.get()); });
-        reg("shadow/ours_nocache_reftree", w->shadow.size(), [](const Workload& x) { return variant(true, false, [&] { return ourShadow(x, false, x.refTree.get()); }); });
-        reg("shadow/ours_sse_nocache", w->shadow.size(), [](const Workload& x) { return variant(false, false, [&] { return ourShadow(x, false); }); });
+        reg("primary/ours_sse", w->primary.size(),
+            [](const Workload& x) { return variant(false, true, [&] { return ourPrimary(x); }); });
+        reg("shadow/ours_nocache", w->shadow.size(),
+            [](const Workload& x) { return variant(true, false, [&] { return ourShadow(x, false); }); });
+        reg("primary/ours_reftree", w->primary.size(),
+            [](const Workload& x) { return ourPrimary(x, x.refTree.get()); });
+        reg("shadow/ours_nocache_reftree", w->shadow.size(), [](const Workload& x) {
+            return variant(true, false, [&] { return ourShadow(x, false, x.refTree.get()); });
+        });
+        reg("shadow/ours_sse_nocache", w->shadow.size(),
+            [](const Workload& x) { return variant(false, false, [&] { return ourShadow(x, false); }); });
 #ifdef SHADOWLAB_HAVE_EMBREE
         reg("primary/embree", w->primary.size(), [](const Workload& x) { return embreePrimary(x); });
         reg("shadow/embree", w->shadow.size(), [](const Workload& x) { return embreeShadow(x); });
@@ -600,16 +607,20 @@ int main(int argc, char** argv) {
     RatioReporter reporter;
     benchmark::RunSpecifiedBenchmarks(&reporter);
 
-    std::printf("\nMrays/s: median (min-max) over the repetitions; ratio = ours / Embree medians "
-                "(embree: rtcIntersect1/rtcOccluded1, embree8: rtcIntersect8/rtcOccluded8)\n");
-    std::printf("%-8s %-22s %8s %20s %20s %7s %20s %7s %s\n", "scene", "rays", "count", "ours", "embree",
-                "ratio", "embree8", "ratio8", "agreement");
+    std::printf(
+        "\nMrays/s: median (min-max) over the repetitions; ratio = ours / Embree medians "
+        "(embree: rtcIntersect1/rtcOccluded1, embree8: rtcIntersect8/rtcOccluded8)\n");
+    std::printf("%-8s %-22s %8s %20s %20s %7s %20s %7s %s\n", "scene", "rays", "count", "ours", "embree", "ratio",
+                "embree8", "ratio8", "agreement");
     for (const auto& wp : workloads) {
         const Workload& w = *wp;
-        const std::vector<std::pair<const char*, const char*>> rows = {
-            {"primary", "ours"}, {"primary", "ours_sse"}, {"shadow", "ours"},
-            {"shadow", "ours_nocache"}, {"shadow", "ours_sse_nocache"}, {"primary", "ours_reftree"},
-            {"shadow", "ours_nocache_reftree"}};
+        const std::vector<std::pair<const char*, const char*>> rows = {{"primary", "ours"},
+                                                                       {"primary", "ours_sse"},
+                                                                       {"shadow", "ours"},
+                                                                       {"shadow", "ours_nocache"},
+                                                                       {"shadow", "ours_sse_nocache"},
+                                                                       {"primary", "ours_reftree"},
+                                                                       {"shadow", "ours_nocache_reftree"}};
         for (const auto& [kind, who] : rows) {
             const bool prim = std::string(kind) == "primary";
             const std::size_t count = prim ? w.primary.size() : w.shadow.size();
@@ -620,7 +631,8 @@ int main(int argc, char** argv) {
             const bool cache = std::string(who).find("nocache") == std::string::npos;
             const raytrace::Tracer<Real>* tr =
                 std::string(who).find("reftree") != std::string::npos ? w.refTree.get() : w.tracer.get();
-            const std::size_t a = variant(avx, cache, [&] { return prim ? ourPrimary(w, tr) : ourShadow(w, false, tr); });
+            const std::size_t a =
+                variant(avx, cache, [&] { return prim ? ourPrimary(w, tr) : ourShadow(w, false, tr); });
             const std::string label = std::string(kind) + "/" + who;
 #ifdef SHADOWLAB_HAVE_EMBREE
             const auto emb = reporter.stats(w.name + "/" + kind + "/embree");
@@ -632,12 +644,11 @@ int main(int argc, char** argv) {
             const std::size_t b = prim ? embreePrimary(w) : embreeShadow(w);
             const std::size_t b8 = prim ? embreePrimary8(w) : embreeShadow8(w);
             std::printf("%-8s %-22s %8zu %20s %20s %7.3f %20s %7.3f hits ours %zu, embree %zu, embree8 %zu\n",
-                        w.name.c_str(), label.c_str(), count, oursText, embText,
-                        emb[0] > 0 ? ours[0] / emb[0] : 0.0, emb8Text, emb8[0] > 0 ? ours[0] / emb8[0] : 0.0,
-                        a, b, b8);
+                        w.name.c_str(), label.c_str(), count, oursText, embText, emb[0] > 0 ? ours[0] / emb[0] : 0.0,
+                        emb8Text, emb8[0] > 0 ? ours[0] / emb8[0] : 0.0, a, b, b8);
 #else
-            std::printf("%-8s %-22s %8zu %20s %20s %7s hits ours %zu\n", w.name.c_str(), label.c_str(), count,
-                        oursText, "-", "-", a);
+            std::printf("%-8s %-22s %8zu %20s %20s %7s hits ours %zu\n", w.name.c_str(), label.c_str(), count, oursText,
+                        "-", "-", a);
 #endif
         }
         // Our setup (conversion, BVH build, collapse, packets) and Embree's (flattening,
@@ -678,15 +689,17 @@ int main(int argc, char** argv) {
         embBpt = tris > 0 ? double(w.embreeBytes) / double(tris) : 0.0;
 #endif
         if (!oursCpu.empty()) {
-            std::printf("%-8s setup, %d alternating builds, CPU ms median (min-max): ours %.1f (%.1f-%.1f), "
-                        "embree %.1f (%.1f-%.1f), ratio %.2f; wall ms: ours %.1f (%.1f-%.1f), embree %.1f "
-                        "(%.1f-%.1f), ratio %.2f\n",
-                        w.name.c_str(), reps, oc[0], oc[1], oc[2], ec[0], ec[1], ec[2],
-                        ec[0] > 0 ? oc[0] / ec[0] : 0.0, ow[0], ow[1], ow[2], ew[0], ew[1], ew[2],
-                        ew[0] > 0 ? ow[0] / ew[0] : 0.0);
+            std::printf(
+                "%-8s setup, %d alternating builds, CPU ms median (min-max): ours %.1f (%.1f-%.1f), "
+                "embree %.1f (%.1f-%.1f), ratio %.2f; wall ms: ours %.1f (%.1f-%.1f), embree %.1f "
+                "(%.1f-%.1f), ratio %.2f\n",
+                w.name.c_str(), reps, oc[0], oc[1], oc[2], ec[0], ec[1], ec[2], ec[0] > 0 ? oc[0] / ec[0] : 0.0, ow[0],
+                ow[1], ow[2], ew[0], ew[1], ew[2], ew[0] > 0 ? ow[0] / ew[0] : 0.0);
         }
-        std::printf("%-8s %zu triangles: BVH + mesh %.1f bytes/triangle ours, %.1f embree (device bytes after "
-                    "the build)\n", w.name.c_str(), tris, oursBpt, embBpt);
+        std::printf(
+            "%-8s %zu triangles: BVH + mesh %.1f bytes/triangle ours, %.1f embree (device bytes after "
+            "the build)\n",
+            w.name.c_str(), tris, oursBpt, embBpt);
         // A fingerprint of every answer (primary: object, triangle, t and barycentric bits;
         // shadow: blocked or not), to show that two builds of the bench give the same hits.
         auto fingerprint = [&](const raytrace::Tracer<Real>& tracer) {
@@ -715,15 +728,15 @@ int main(int argc, char** argv) {
         std::printf("%-8s hits fingerprint %016llx, on the reference's trees %016llx\n", w.name.c_str(),
                     (unsigned long long)fingerprint(*w.tracer), (unsigned long long)fingerprint(*w.refTree));
         if (std::getenv("SHADOWLAB_BENCH_TIES")) countTies(w);
-        std::printf("SCALE | %s | %zu | setup cpu ms ours %.1f embree %.1f | bytes/tri ours %.1f embree %.1f | "
-                    "primary Mrays/s ours %.2f embree %.2f embree8 %.2f reftree %.2f | shadow(no cache) ours %.2f embree %.2f "
-                    "embree8 %.2f reftree %.2f | setup cpu ms reftree %.1f\n",
-                    w.name.c_str(), tris, oc[0], ec[0], oursBpt, embBpt,
-                    reporter.stats(w.name + "/primary/ours")[0], reporter.stats(w.name + "/primary/embree")[0],
-                    reporter.stats(w.name + "/primary/embree8")[0], reporter.stats(w.name + "/primary/ours_reftree")[0],
-                    reporter.stats(w.name + "/shadow/ours_nocache")[0], reporter.stats(w.name + "/shadow/embree")[0],
-                    reporter.stats(w.name + "/shadow/embree8")[0], reporter.stats(w.name + "/shadow/ours_nocache_reftree")[0],
-                    rc[0]);
+        std::printf(
+            "SCALE | %s | %zu | setup cpu ms ours %.1f embree %.1f | bytes/tri ours %.1f embree %.1f | "
+            "primary Mrays/s ours %.2f embree %.2f embree8 %.2f reftree %.2f | shadow(no cache) ours %.2f embree %.2f "
+            "embree8 %.2f reftree %.2f | setup cpu ms reftree %.1f\n",
+            w.name.c_str(), tris, oc[0], ec[0], oursBpt, embBpt, reporter.stats(w.name + "/primary/ours")[0],
+            reporter.stats(w.name + "/primary/embree")[0], reporter.stats(w.name + "/primary/embree8")[0],
+            reporter.stats(w.name + "/primary/ours_reftree")[0], reporter.stats(w.name + "/shadow/ours_nocache")[0],
+            reporter.stats(w.name + "/shadow/embree")[0], reporter.stats(w.name + "/shadow/embree8")[0],
+            reporter.stats(w.name + "/shadow/ours_nocache_reftree")[0], rc[0]);
     }
 #ifdef SHADOWLAB_HAVE_EMBREE
     for (auto& wp : workloads) {

@@ -50,12 +50,14 @@ int main(int argc, char** argv) try {
     std::vector<fs::path> models;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
-        if (a == "--repeats" && i + 1 < argc) repeats = std::max(1, std::stoi(argv[++i]));
-        else models.emplace_back(a);
+        if (a == "--repeats" && i + 1 < argc)
+            repeats = std::max(1, std::stoi(argv[++i]));
+        else
+            models.emplace_back(a);
     }
     if (models.empty())
-        for (const char* m : {"Sponza/Sponza.gltf", "SciFiHelmet/SciFiHelmet.gltf", "IntelSponzaCurtains/sponza_curtains.gltf",
-                              "AlphaBlendModeTest/AlphaBlendModeTest.gltf"})
+        for (const char* m : {"Sponza/Sponza.gltf", "SciFiHelmet/SciFiHelmet.gltf",
+                              "IntelSponzaCurtains/sponza_curtains.gltf", "AlphaBlendModeTest/AlphaBlendModeTest.gltf"})
             models.push_back(fs::path(SHADOWLAB_SHARED_SCENES) / m);
     std::printf("view search, %d interleaved runs each; seconds, median (min-max)\n", repeats);
     std::printf("%-44s %-22s %-22s %-22s %-22s %s\n", "model", "cpu refine=0", "cpu refine=8", "wall refine=0",
@@ -82,9 +84,9 @@ int main(int argc, char** argv) try {
                 into.wall.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count());
                 if (result.best.score < 0) throw std::runtime_error("no candidate scored");
             }
-        std::printf("%-44s %-22s %-22s %-22s %-22s %.2f\n", file.filename().string().c_str(), plain.text(plain.cpu).c_str(),
-                    refined.text(refined.cpu).c_str(), plain.text(plain.wall).c_str(), refined.text(refined.wall).c_str(),
-                    Series::median(refined.cpu) / Series::median(plain.cpu));
+        std::printf("%-44s %-22s %-22s %-22s %-22s %.2f\n", file.filename().string().c_str(),
+                    plain.text(plain.cpu).c_str(), refined.text(refined.cpu).c_str(), plain.text(plain.wall).c_str(),
+                    refined.text(refined.wall).c_str(), Series::median(refined.cpu) / Series::median(plain.cpu));
     }
     return 0;
 } catch (const std::exception& e) {

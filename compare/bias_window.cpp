@@ -23,8 +23,7 @@ double worst(const BiasSample& s) {
 BiasWindow findBiasWindow(std::vector<BiasSample> samples, double threshold) {
     if (samples.empty()) throw scene::InputError("bias window: no bias samples");
     if (!std::isfinite(threshold) || threshold < 0.0)
-        throw scene::InputError("bias window: threshold must be a finite rate >= 0, got " +
-                                formatShort(threshold));
+        throw scene::InputError("bias window: threshold must be a finite rate >= 0, got " + formatShort(threshold));
     std::stable_sort(samples.begin(), samples.end(),
                      [](const BiasSample& a, const BiasSample& b) { return a.bias < b.bias; });
     BiasWindow w;
@@ -72,8 +71,7 @@ std::string BiasWindow::describe() const {
                                    formatPercent(bestMissedShadowRate) + " missed";
     if (stiff) return "stiff: no sampled bias keeps both " + limit + "; " + compromise;
     return "bias window " + formatShort(lo) + " .. " + formatShort(hi) + " (" + limit + ", " +
-           std::to_string(acceptableSamples) + " sample" + (acceptableSamples == 1 ? "" : "s") + "); " +
-           compromise;
+           std::to_string(acceptableSamples) + " sample" + (acceptableSamples == 1 ? "" : "s") + "); " + compromise;
 }
 
 }  // namespace shadowlab::compare

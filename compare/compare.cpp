@@ -25,8 +25,10 @@ using scene::Frame;
 using scene::InputError;
 
 void countValue(NonFinite& n, float v) {
-    if (std::isnan(v)) ++n.nan;
-    else if (std::isinf(v)) ++n.inf;
+    if (std::isnan(v))
+        ++n.nan;
+    else if (std::isinf(v))
+        ++n.inf;
 }
 
 NonFinite countChannel(const std::vector<float>& values) {
@@ -35,19 +37,17 @@ NonFinite countChannel(const std::vector<float>& values) {
     return n;
 }
 
-void checkChannel(const std::string& which, const char* channel, std::size_t actual,
-                  std::size_t expected, bool optional) {
+void checkChannel(const std::string& which, const char* channel, std::size_t actual, std::size_t expected,
+                  bool optional) {
     if (optional && actual == 0) return;
     if (actual != expected)
         throw InputError(which + " frame: channel '" + channel + "' has " + std::to_string(actual) +
-                         " values, expected " + std::to_string(expected) +
-                         (actual == 0 ? " (missing)" : ""));
+                         " values, expected " + std::to_string(expected) + (actual == 0 ? " (missing)" : ""));
 }
 
 void checkFrame(const std::string& which, const Frame& f) {
     if (f.width <= 0 || f.height <= 0)
-        throw InputError(which + " frame is empty (" + std::to_string(f.width) + "x" +
-                         std::to_string(f.height) + ")");
+        throw InputError(which + " frame is empty (" + std::to_string(f.width) + "x" + std::to_string(f.height) + ")");
     const std::size_t n = f.pixelCount();
     checkChannel(which, "beauty", f.beauty.size(), 3 * n, which == "method");
     checkChannel(which, "visibility", f.visibility.size(), n, false);
@@ -183,8 +183,10 @@ Contact contactOf(const Frame& method, const CompareOptions& o) {
         c.bias = *o.contactBias;
     } else {
         const std::string ray = attribute(method, "ray_bias");
-        if (ray == "robust") c.bias = 0.0;
-        else if (!ray.empty()) c.bias = kContactRayBiasFactor * largestNumber(ray);
+        if (ray == "robust")
+            c.bias = 0.0;
+        else if (!ray.empty())
+            c.bias = kContactRayBiasFactor * largestNumber(ray);
     }
     return c;
 }
@@ -273,19 +275,16 @@ std::vector<unsigned char> shadowEdges(const Frame& r, const std::vector<signed 
         for (int x = 0; x < w; ++x) {
             const std::size_t i = std::size_t(y) * w + x;
             if (state[i] < 0) continue;
-            auto differs = [&](std::size_t j) {
-                return state[j] >= 0 && state[j] != state[i] && idAt(j) == idAt(i);
-            };
-            if ((x > 0 && differs(i - 1)) || (x + 1 < w && differs(i + 1)) ||
-                (y > 0 && differs(i - w)) || (y + 1 < h && differs(i + w)))
+            auto differs = [&](std::size_t j) { return state[j] >= 0 && state[j] != state[i] && idAt(j) == idAt(i); };
+            if ((x > 0 && differs(i - 1)) || (x + 1 < w && differs(i + 1)) || (y > 0 && differs(i - w)) ||
+                (y + 1 < h && differs(i + w)))
                 edge[i] = 1;
         }
     return edge;
 }
 
 // Square (Chebyshev) dilation by `radius`, separable: rows, then columns.
-std::vector<unsigned char> dilate(const std::vector<unsigned char>& mask, int w, int h,
-                                  int radius) {
+std::vector<unsigned char> dilate(const std::vector<unsigned char>& mask, int w, int h, int radius) {
     if (radius <= 0) return mask;
     std::vector<unsigned char> rows(mask.size(), 0), out(mask.size(), 0);
     for (int y = 0; y < h; ++y) {
@@ -351,9 +350,12 @@ double rate(std::size_t part, std::size_t whole) {
 nlohmann::json toJson(const NonFinite& n) { return {{"nan", n.nan}, {"inf", n.inf}}; }
 
 nlohmann::json toJson(const FrameHealth& h) {
-    return {{"beauty", toJson(h.beauty)},     {"visibility", toJson(h.visibility)},
-            {"object_id", toJson(h.objectId)}, {"ndotl", toJson(h.ndotl)},
-            {"Z", toJson(h.depth)},            {"blocker_id", toJson(h.blockerId)},
+    return {{"beauty", toJson(h.beauty)},
+            {"visibility", toJson(h.visibility)},
+            {"object_id", toJson(h.objectId)},
+            {"ndotl", toJson(h.ndotl)},
+            {"Z", toJson(h.depth)},
+            {"blocker_id", toJson(h.blockerId)},
             {"total", h.total()}};
 }
 
@@ -378,8 +380,7 @@ const char* toString(PixelClass c) {
 }
 
 std::size_t FrameHealth::total() const {
-    return beauty.total() + visibility.total() + objectId.total() + ndotl.total() + depth.total() +
-           blockerId.total();
+    return beauty.total() + visibility.total() + objectId.total() + ndotl.total() + depth.total() + blockerId.total();
 }
 
 FrameHealth measureHealth(const Frame& f) {
@@ -422,16 +423,14 @@ std::array<float, 3> diffColor(PixelClass c, float refR, float refG, float refB)
     return C::kInvalid;
 }
 
-Comparison compareFrames(const Frame& method, const Frame& reference,
-                         const CompareOptions& options) {
+Comparison compareFrames(const Frame& method, const Frame& reference, const CompareOptions& options) {
     checkFrame("method", method);
     checkFrame("reference", reference);
     if (method.width != reference.width || method.height != reference.height)
         throw InputError("frame sizes differ: method is " + std::to_string(method.width) + "x" +
-                         std::to_string(method.height) + ", reference is " +
-                         std::to_string(reference.width) + "x" + std::to_string(reference.height));
-    if (options.edgeRadius < 0)
-        throw InputError("edge radius must be >= 0, got " + std::to_string(options.edgeRadius));
+                         std::to_string(method.height) + ", reference is " + std::to_string(reference.width) + "x" +
+                         std::to_string(reference.height));
+    if (options.edgeRadius < 0) throw InputError("edge radius must be >= 0, got " + std::to_string(options.edgeRadius));
 
     const int w = reference.width, h = reference.height;
     const std::size_t n = reference.pixelCount();
@@ -491,8 +490,7 @@ Comparison compareFrames(const Frame& method, const Frame& reference,
         const bool idsFinite = std::isfinite(idm) && std::isfinite(idr);
         if (idsFinite && roundId(idm) != roundId(idr)) ++m.silhouetteMismatch;
 
-        if (!idsFinite || !std::isfinite(vm) || !std::isfinite(vr) || !std::isfinite(nm) ||
-            !std::isfinite(nr)) {
+        if (!idsFinite || !std::isfinite(vm) || !std::isfinite(vr) || !std::isfinite(nm) || !std::isfinite(nr)) {
             c = PixelClass::Invalid;
         } else if (roundId(idm) != roundId(idr) || roundId(idr) == 0) {
             c = PixelClass::NotCounted;
@@ -572,8 +570,8 @@ Comparison compareFrames(const Frame& method, const Frame& reference,
         if (c == PixelClass::NotCounted) ++m.notCounted;
         if (c == PixelClass::Invalid) ++m.invalid;
         out.classes[i] = c;
-        const auto rgb = diffColor(c, reference.beauty[3 * i], reference.beauty[3 * i + 1],
-                                   reference.beauty[3 * i + 2]);
+        const auto rgb =
+            diffColor(c, reference.beauty[3 * i], reference.beauty[3 * i + 1], reference.beauty[3 * i + 2]);
         std::copy(rgb.begin(), rgb.end(), out.diffRgb.begin() + 3 * std::ptrdiff_t(i));
     }
 
@@ -661,8 +659,8 @@ nlohmann::json toJson(const Metrics& m) {
         {"aliasing_rate", m.aliasingRate},
         {"bias_error_rate", m.biasErrorRate},
         {"per_object", perObject},
-        {"hotspot", {{"x", m.hotspot.x}, {"y", m.hotspot.y}, {"size", m.hotspot.size},
-                     {"wrong_pixels", m.hotspot.wrongPixels}}},
+        {"hotspot",
+         {{"x", m.hotspot.x}, {"y", m.hotspot.y}, {"size", m.hotspot.size}, {"wrong_pixels", m.hotspot.wrongPixels}}},
         {"method_backend", m.methodBackend},
         {"reference_backend", m.referenceBackend},
         {"method_timing", toJson(m.methodTiming)},
@@ -687,7 +685,8 @@ nlohmann::json toJson(const Metrics& m) {
         j["self_shadow_acne_rate"] = nullptr;
     }
     // Without the reference's blocker distances (older frames) bleeding is unknown, not zero.
-    for (const char* k : {"bleeding", "bias_leak", "bias_leak_near_edge", "bleeding_rate", "bias_leak_rate", "contact_distance"})
+    for (const char* k :
+         {"bleeding", "bias_leak", "bias_leak_near_edge", "bleeding_rate", "bias_leak_rate", "contact_distance"})
         j[k] = nullptr;
     if (m.hasBlockerDistance) {
         j["bleeding"] = m.bleeding;
@@ -701,15 +700,13 @@ nlohmann::json toJson(const Metrics& m) {
 }
 
 std::string summaryLine(const Metrics& m) {
-    std::string s = "counted " + formatCount(m.counted) + " px: false shadow " +
-                    formatPercent(m.falseShadowRate);
+    std::string s = "counted " + formatCount(m.counted) + " px: false shadow " + formatPercent(m.falseShadowRate);
     if (m.hasBlockerIds) s += " (self acne " + formatPercent(m.selfShadowAcneRate) + ")";
-    s += ", missed " + formatPercent(m.missedShadowRate) + ", mismatch " +
-         formatPercent(m.mismatchRate) + ", IoU " + formatFixed(m.shadowIoU, 3) + ", mean |dV| " +
-         formatFixed(m.meanAbsVisibilityError, 4) + " (penumbra " + formatFixed(m.meanAbsVisibilityErrorPenumbra, 3) +
-         " over " + formatCount(m.penumbraPixels) + " px), off by > " + formatFixed(kSoftErrorTolerance, 2) +
-         " within tau " + formatCount(m.softErrorPixels) + " px, silhouette " +
-         formatPercent(m.silhouetteMismatchRate) + ", " + formatDuration(m.methodTiming.totalMs) +
+    s += ", missed " + formatPercent(m.missedShadowRate) + ", mismatch " + formatPercent(m.mismatchRate) + ", IoU " +
+         formatFixed(m.shadowIoU, 3) + ", mean |dV| " + formatFixed(m.meanAbsVisibilityError, 4) + " (penumbra " +
+         formatFixed(m.meanAbsVisibilityErrorPenumbra, 3) + " over " + formatCount(m.penumbraPixels) +
+         " px), off by > " + formatFixed(kSoftErrorTolerance, 2) + " within tau " + formatCount(m.softErrorPixels) +
+         " px, silhouette " + formatPercent(m.silhouetteMismatchRate) + ", " + formatDuration(m.methodTiming.totalMs) +
          " (reference " + formatDuration(m.referenceTiming.totalMs) + ")";
     const std::size_t bad = m.methodHealth.total() + m.referenceHealth.total();
     if (bad > 0)

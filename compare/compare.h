@@ -156,7 +156,7 @@ struct Metrics {
     bool pointSampled = false;
     // falseShadowNearEdge + missedShadowNearEdge − biasLeakNearEdge; 0 when pointSampled.
     std::size_t aliasingPixels = 0;
-    std::size_t biasErrorPixels = 0;  // the other wrong pixels
+    std::size_t biasErrorPixels = 0;                 // the other wrong pixels
     double aliasingRate = 0.0, biasErrorRate = 0.0;  // over counted
 
     std::vector<ObjectErrors> perObject;  // objects with any counted pixel, by id
@@ -164,12 +164,12 @@ struct Metrics {
 
     // Continuous error |V_M − V_R| beside the classes, which τ = 0.5 makes blind to a penumbra
     // that is wrong by less than half the range (docs/compare.md "Continuous error").
-    double maxAbsVisibilityError = 0.0;      // over counted pixels
-    std::size_t penumbraPixels = 0;          // counted with 0 < V_R < 1 (kPenumbraMargin)
+    double maxAbsVisibilityError = 0.0;           // over counted pixels
+    std::size_t penumbraPixels = 0;               // counted with 0 < V_R < 1 (kPenumbraMargin)
     double meanAbsVisibilityErrorPenumbra = 0.0;  // mean |V_M − V_R| over them; 0 when none
     // Counted pixels with kSoftErrorTolerance < |V_M − V_R| ≤ τ: wrong, but agreeing in class.
     std::size_t softErrorPixels = 0;
-    double softErrorRate = 0.0;  // over counted
+    double softErrorRate = 0.0;        // over counted
     std::vector<LightError> perLight;  // one per light when both frames have per-light channels
 
     std::string methodBackend, referenceBackend;  // Frame attribute "backend", if any
@@ -191,9 +191,9 @@ struct CompareOptions {
 struct Comparison {
     Metrics metrics;
     int width = 0, height = 0;
-    std::vector<float> diffRgb;               // display-encoded 0..1, 3 per pixel, row 0 on top
-    std::vector<PixelClass> classes;          // one per pixel
-    std::vector<float> heatRgb;               // the error heat map (heatColor), 3 per pixel
+    std::vector<float> diffRgb;                    // display-encoded 0..1, 3 per pixel, row 0 on top
+    std::vector<PixelClass> classes;               // one per pixel
+    std::vector<float> heatRgb;                    // the error heat map (heatColor), 3 per pixel
     std::vector<std::vector<float>> lightHeatRgb;  // one heat map per light, with perLight
 };
 
@@ -215,8 +215,7 @@ std::array<float, 3> heatColor(float absError);
 
 // Throws scene::InputError when the sizes differ or a channel has the wrong length (naming
 // which frame and which channel).
-Comparison compareFrames(const scene::Frame& method, const scene::Frame& reference,
-                         const CompareOptions& options = {});
+Comparison compareFrames(const scene::Frame& method, const scene::Frame& reference, const CompareOptions& options = {});
 
 nlohmann::json toJson(const Metrics& metrics);
 // One line for a terminal, e.g.

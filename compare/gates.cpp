@@ -36,12 +36,14 @@ std::vector<BudgetCheck> checkBudgets(const Metrics& m, const scene::Budgets& bu
     std::vector<BudgetCheck> out;
     if (budgets.empty()) return out;
     if (budgets[BudgetKind::MaxSelfAcne] && !m.hasBlockerIds)
-        throw scene::InputError("--max-self-acne: the method frame has no blocker_id channel, so its self-shadow "
-                                "acne cannot be told from other false shadows (use --max-false-shadow)");
+        throw scene::InputError(
+            "--max-self-acne: the method frame has no blocker_id channel, so its self-shadow "
+            "acne cannot be told from other false shadows (use --max-false-shadow)");
     if (budgets[BudgetKind::MaxBleeding] && !m.hasBlockerDistance)
-        throw scene::InputError("--max-bleeding: the reference frame has no blocker_distance channel (rendered before "
-                                "it was written?) or the method frame no bias and texel size, so light bleeding cannot "
-                                "be told from bias leaks (render the reference again, or use --max-missed-shadow)");
+        throw scene::InputError(
+            "--max-bleeding: the reference frame has no blocker_distance channel (rendered before "
+            "it was written?) or the method frame no bias and texel size, so light bleeding cannot "
+            "be told from bias leaks (render the reference again, or use --max-missed-shadow)");
     if (m.counted == 0) {
         BudgetCheck c;
         c.kind = BudgetKind::MaxMismatch;
@@ -61,8 +63,8 @@ std::vector<BudgetCheck> checkBudgets(const Metrics& m, const scene::Budgets& bu
         const bool pixels = c.limit.unit == BudgetLimit::Unit::Pixels;
         c.measured = pixels ? double(v.pixels) : v.rate;
         c.broken = scene::budgetInfo(kind).isMinimum ? c.measured < c.limit.value : c.measured > c.limit.value;
-        c.measuredText = v.isRate ? formatPercent(v.rate) + " (" + formatCount(v.pixels) + " px)"
-                                  : formatFixed(v.rate, 4);
+        c.measuredText =
+            v.isRate ? formatPercent(v.rate) + " (" + formatCount(v.pixels) + " px)" : formatFixed(v.rate, 4);
         out.push_back(c);
     }
     return out;

@@ -15,8 +15,8 @@ namespace shadowlab::compare {
 struct BudgetCheck {
     scene::BudgetKind kind = scene::BudgetKind::MaxMismatch;
     scene::BudgetLimit limit;
-    double measured = 0.0;       // a rate, a pixel count or a ratio, in the limit's unit
-    std::string measuredText;    // "38.2% (12,034 px)", "0.981"
+    double measured = 0.0;     // a rate, a pixel count or a ratio, in the limit's unit
+    std::string measuredText;  // "38.2% (12,034 px)", "0.981"
     bool broken = false;
     bool nothingCounted = false;  // the "counted" check: no pixel counted at all
 };

@@ -21,8 +21,7 @@ std::vector<std::size_t> paretoFront(const std::vector<TimeErrorPoint>& points) 
     for (const std::size_t i : order) {
         if (front.empty() || points[i].error < points[front.back()].error) {
             front.push_back(i);
-        } else if (points[i].error == points[front.back()].error &&
-                   points[i].timeMs == points[front.back()].timeMs) {
+        } else if (points[i].error == points[front.back()].error && points[i].timeMs == points[front.back()].timeMs) {
             front.push_back(i);  // an exact duplicate of a front point
         }
         // Otherwise an earlier (no slower) point is at least as accurate: dominated.

@@ -84,17 +84,21 @@ std::string describeContinuous(const Metrics& m) {
     s += ".";
     const std::size_t wrong = m.falseShadow + m.missedShadow;
     if (m.softErrorPixels > 0) {
-        s += " " + formatCount(m.softErrorPixels) + " px (" + formatPercent(m.softErrorRate) + ") are off by more than " +
-             formatShort(kSoftErrorTolerance) + " without crossing τ";
-        if (m.softErrorRate <= kNotableSoftErrorRate) s += ".";
-        else s += m.softErrorPixels > wrong ? ": soft-shadow error dominates, and the mismatch rate does not show it."
-                                            : ": soft-shadow error beside the wrong pixels.";
+        s += " " + formatCount(m.softErrorPixels) + " px (" + formatPercent(m.softErrorRate) +
+             ") are off by more than " + formatShort(kSoftErrorTolerance) + " without crossing τ";
+        if (m.softErrorRate <= kNotableSoftErrorRate)
+            s += ".";
+        else
+            s += m.softErrorPixels > wrong ? ": soft-shadow error dominates, and the mismatch rate does not show it."
+                                           : ": soft-shadow error beside the wrong pixels.";
     }
     for (const LightError& l : m.perLight)
         if (l.softErrorPixels > 0 || l.meanAbsVisibilityErrorPenumbra > kSoftErrorTolerance)
             s += " Light " + std::to_string(l.light) + ": mean |ΔV| " + formatFixed(l.meanAbsVisibilityError, 4) +
-                 (l.penumbraPixels ? ", " + formatFixed(l.meanAbsVisibilityErrorPenumbra, 3) + " over its penumbra" : "") +
-                 ", " + formatCount(l.softErrorPixels) + " px off by more than " + formatShort(kSoftErrorTolerance) + ".";
+                 (l.penumbraPixels ? ", " + formatFixed(l.meanAbsVisibilityErrorPenumbra, 3) + " over its penumbra"
+                                   : "") +
+                 ", " + formatCount(l.softErrorPixels) + " px off by more than " + formatShort(kSoftErrorTolerance) +
+                 ".";
     return s;
 }
 
@@ -117,11 +121,12 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
     const std::string who = methodTitle(rm.label);
     std::string s;
     if (m.counted == 0) {
-        s = who + " has no pixel to compare: no visible point faces the light in both frames "
-                  "on the same object.";
+        s = who +
+            " has no pixel to compare: no visible point faces the light in both frames "
+            "on the same object.";
     } else if (m.falseShadow + m.missedShadow == 0 && m.softErrorRate <= kNotableSoftErrorRate) {
-        s = who + " matches the reference on all " + formatCount(m.counted) +
-            " counted pixels (mean |ΔV| " + formatFixed(m.meanAbsVisibilityError, 4) + ").";
+        s = who + " matches the reference on all " + formatCount(m.counted) + " counted pixels (mean |ΔV| " +
+            formatFixed(m.meanAbsVisibilityError, 4) + ").";
     } else if (m.falseShadow + m.missedShadow == 0) {
         s = who + " has no pixel wrong by more than τ = " + formatShort(kVisibilityTolerance) + " among the " +
             formatCount(m.counted) + " counted pixels, so the classes call it agreement, but it does not match.";
@@ -133,15 +138,15 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
             std::string f = formatPercent(m.falseShadowRate) + " false shadow";
             if (m.hasBlockerIds && double(m.selfShadowAcne) > kMostlyShare * double(m.falseShadow)) {
                 f += ", mostly self-shadow acne";
-                const std::string on = dominantObject(in, m, m.selfShadowAcne,
-                                                      [](const ObjectErrors& o) { return o.selfShadowAcne; });
+                const std::string on =
+                    dominantObject(in, m, m.selfShadowAcne, [](const ObjectErrors& o) { return o.selfShadowAcne; });
                 if (!on.empty()) f += " on " + on;
             } else {
                 if (m.hasBlockerIds && m.selfShadowAcne > 0)
                     f += " (" + formatPercent(double(m.selfShadowAcne) / double(m.falseShadow)) +
                          " of it self-shadow acne)";
-                const std::string on = dominantObject(in, m, m.falseShadow,
-                                                      [](const ObjectErrors& o) { return o.falseShadow; });
+                const std::string on =
+                    dominantObject(in, m, m.falseShadow, [](const ObjectErrors& o) { return o.falseShadow; });
                 if (!on.empty()) f += ", mostly on " + on;
             }
             parts.push_back(f);
@@ -150,8 +155,8 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
         }
         if (m.missedShadow > 0) {
             std::string f = formatPercent(m.missedShadowRate) + " missed shadow (light leaking or peter-panning";
-            const std::string on = dominantObject(in, m, m.missedShadow,
-                                                  [](const ObjectErrors& o) { return o.missedShadow; });
+            const std::string on =
+                dominantObject(in, m, m.missedShadow, [](const ObjectErrors& o) { return o.missedShadow; });
             f += on.empty() ? ")" : ", mostly on " + on + ")";
             // Near its blocker, a missed shadow is the bias's and the texel grid's; far from it, the
             // filter's (light bleeding).
@@ -159,13 +164,15 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
                 f += ", " + formatPercent(double(m.biasLeak) / double(m.missedShadow)) +
                      " of it within the contact distance of its blocker (" + formatShort(m.contactDistance) +
                      " with the light head-on, more at grazing light): a caster that close to its receiver is lost "
-                     "to the bias and the map's texels" + cappedMapText(rm.frame);
+                     "to the bias and the map's texels" +
+                     cappedMapText(rm.frame);
             else if (m.hasBlockerDistance && m.bleeding > 0)
                 f += double(m.bleeding) > kMostlyShare * double(m.missedShadow)
                          ? ", mostly light bleeding (" + formatPercent(double(m.bleeding) / double(m.missedShadow)) +
                                " of it farther than " + formatShort(m.contactDistance) + " from its blocker)"
                          : " (" + formatPercent(double(m.bleeding) / double(m.missedShadow)) +
-                               " of it light bleeding, farther than " + formatShort(m.contactDistance) + " from its blocker)";
+                               " of it light bleeding, farther than " + formatShort(m.contactDistance) +
+                               " from its blocker)";
             parts.push_back(f);
         } else {
             parts.push_back("no missed shadow");
@@ -198,8 +205,7 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
     }
     if (m.counted > 0) s += " " + describeContinuous(m);
     if (m.silhouetteMismatchRate > kNotableSilhouetteRate)
-        s += " Silhouettes differ on " + formatPercent(m.silhouetteMismatchRate) +
-             " of the image (not counted).";
+        s += " Silhouettes differ on " + formatPercent(m.silhouetteMismatchRate) + " of the image (not counted).";
     const double t = m.methodTiming.totalMs, tr = m.referenceTiming.totalMs;
     if (t > 0.0) {
         s += " It took " + formatDuration(t);
@@ -269,8 +275,8 @@ a { color: #1864ab; }
 
 std::string swatch(const std::array<float, 3>& c) {
     char buf[64];
-    std::snprintf(buf, sizeof buf, "#%02x%02x%02x", int(std::lround(c[0] * 255)),
-                  int(std::lround(c[1] * 255)), int(std::lround(c[2] * 255)));
+    std::snprintf(buf, sizeof buf, "#%02x%02x%02x", int(std::lround(c[0] * 255)), int(std::lround(c[1] * 255)),
+                  int(std::lround(c[2] * 255)));
     return buf;
 }
 
@@ -279,24 +285,23 @@ std::string swatchGradient(float base, float scale) {
     return "background: linear-gradient(90deg," + swatch({lo, lo, lo}) + "," + swatch({hi, hi, hi}) + ")";
 }
 
-std::string figure(const std::string& caption, const std::string& note, const std::string& png,
-                   const FrameInfo& f, const ErrorHotspot* hot) {
+std::string figure(const std::string& caption, const std::string& note, const std::string& png, const FrameInfo& f,
+                   const ErrorHotspot* hot) {
     std::ostringstream o;
     // Small frames are magnified with hard pixel edges; large ones scale down smoothly so a
     // single red pixel still tints its neighbourhood instead of vanishing.
     const bool upscale = f.width > 0 && f.width <= 440;
     o << "<figure><figcaption>" << escapeHtml(caption);
     if (!note.empty()) o << " <span>" << escapeHtml(note) << "</span>";
-    o << "</figcaption><div class=\"imgwrap\"><a href=\"" << escapeHtml(png) << "\"><img src=\""
-      << escapeHtml(png) << "\" alt=\"" << escapeHtml(caption) << "\""
-      << (upscale ? " class=\"upscale\"" : "");
+    o << "</figcaption><div class=\"imgwrap\"><a href=\"" << escapeHtml(png) << "\"><img src=\"" << escapeHtml(png)
+      << "\" alt=\"" << escapeHtml(caption) << "\"" << (upscale ? " class=\"upscale\"" : "");
     if (f.width > 0) o << " width=\"" << f.width << "\" height=\"" << f.height << "\"";
     o << "></a>";
     if (hot && hot->wrongPixels > 0 && f.width > 0 && f.height > 0) {
         o << "<div class=\"hot\" title=\"zoomed below\" style=\"left:" << formatFixed(100.0 * hot->x / f.width, 3)
-          << "%;top:" << formatFixed(100.0 * hot->y / f.height, 3) << "%;width:"
-          << formatFixed(100.0 * hot->size / f.width, 3) << "%;height:"
-          << formatFixed(100.0 * hot->size / f.height, 3) << "%\"></div>";
+          << "%;top:" << formatFixed(100.0 * hot->y / f.height, 3)
+          << "%;width:" << formatFixed(100.0 * hot->size / f.width, 3)
+          << "%;height:" << formatFixed(100.0 * hot->size / f.height, 3) << "%\"></div>";
     }
     o << "</div></figure>\n";
     return o.str();
@@ -320,9 +325,8 @@ std::string crop(const std::string& png, const FrameInfo& f, const ErrorHotspot&
     std::ostringstream o;
     const double s = hot.size;
     o << "<div class=\"crop\"><img src=\"" << escapeHtml(png) << "\" alt=\"" << escapeHtml(alt)
-      << "\" style=\"width:" << formatFixed(100.0 * f.width / s, 3) << "%;left:"
-      << formatFixed(-100.0 * hot.x / s, 3) << "%;top:" << formatFixed(-100.0 * hot.y / s, 3)
-      << "%\"></div>";
+      << "\" style=\"width:" << formatFixed(100.0 * f.width / s, 3) << "%;left:" << formatFixed(-100.0 * hot.x / s, 3)
+      << "%;top:" << formatFixed(-100.0 * hot.y / s, 3) << "%\"></div>";
     return o.str();
 }
 
@@ -354,7 +358,8 @@ std::string legendHtml() {
       << "</ul><p class=\"small\">A pixel counts when both frames see the same object there and "
          "it faces the light (N·L &gt; 0) in both. Visibilities V disagree when |V<sub>method</sub> − "
          "V<sub>reference</sub>| &gt; "
-      << formatShort(kVisibilityTolerance) << ". The yellow square marks the region with the most "
+      << formatShort(kVisibilityTolerance)
+      << ". The yellow square marks the region with the most "
          "errors, zoomed under each difference image.</p>";
     return o.str();
 }
@@ -365,12 +370,16 @@ std::string heatLegendHtml() {
         stops << ',' << swatch(HeatScale::kStops[k]) << ' ' << formatShort(100.0 * double(k) / 4.0) << '%';
     std::ostringstream o;
     o << "<div class=\"heatbar\" style=\"background:linear-gradient(90deg" << stops.str() << ")\"></div>"
-      << "<div class=\"heatticks\"><span>0</span><span>0.25</span><span>0.5 (τ)</span><span>0.75</span><span>1</span></div>"
+      << "<div class=\"heatticks\"><span>0</span><span>0.25</span><span>0.5 "
+         "(τ)</span><span>0.75</span><span>1</span></div>"
       << "<p class=\"small\">|V<sub>method</sub> − V<sub>reference</sub>| per counted pixel: dark where the two agree, "
          "brighter the further apart. Between 0.25 and 0.5 (purple to red) a pixel is wrong but still agrees in class; "
-         "above 0.5 it is a false or missed shadow. <span class=\"sw\" style=\"display:inline-block;vertical-align:middle;background:"
-      << swatch(DiffColors::kNotCounted) << "\"></span> not counted, <span class=\"sw\" style=\"display:inline-block;"
-         "vertical-align:middle;background:" << swatch(DiffColors::kInvalid) << "\"></span> invalid.</p>";
+         "above 0.5 it is a false or missed shadow. <span class=\"sw\" "
+         "style=\"display:inline-block;vertical-align:middle;background:"
+      << swatch(DiffColors::kNotCounted)
+      << "\"></span> not counted, <span class=\"sw\" style=\"display:inline-block;"
+         "vertical-align:middle;background:"
+      << swatch(DiffColors::kInvalid) << "\"></span> invalid.</p>";
     return o.str();
 }
 
@@ -385,29 +394,40 @@ std::string metricsTable(const ReportInput& in) {
         o << "</tr>\n";
     };
     auto plain = [](const std::string& s) { return "<td>" + s + "</td>"; };
-    row("counted pixels", [&](const Metrics& m) { return countCell(m.counted, double(m.counted) / std::max<double>(1, m.totalPixels)); });
-    row("mismatch", [&](const Metrics& m) { return countCell(m.falseShadow + m.missedShadow, m.mismatchRate); }, "key");
-    row("<span style=\"color:var(--false)\">■</span> false shadow", [&](const Metrics& m) { return countCell(m.falseShadow, m.falseShadowRate); });
+    row("counted pixels",
+        [&](const Metrics& m) { return countCell(m.counted, double(m.counted) / std::max<double>(1, m.totalPixels)); });
+    row(
+        "mismatch", [&](const Metrics& m) { return countCell(m.falseShadow + m.missedShadow, m.mismatchRate); }, "key");
+    row("<span style=\"color:var(--false)\">■</span> false shadow",
+        [&](const Metrics& m) { return countCell(m.falseShadow, m.falseShadowRate); });
     row("&nbsp;&nbsp;of which self-shadow acne", [&](const Metrics& m) {
         return m.hasBlockerIds ? countCell(m.selfShadowAcne, m.selfShadowAcneRate) : plain("n/a");
     });
-    row("<span style=\"color:var(--missed)\">■</span> missed shadow", [&](const Metrics& m) { return countCell(m.missedShadow, m.missedShadowRate); });
-    row("&nbsp;&nbsp;of which light bleeding (blocker far)", [&](const Metrics& m) {
-        return m.hasBlockerDistance ? countCell(m.bleeding, m.bleedingRate) : plain("n/a");
+    row("<span style=\"color:var(--missed)\">■</span> missed shadow",
+        [&](const Metrics& m) { return countCell(m.missedShadow, m.missedShadowRate); });
+    row("&nbsp;&nbsp;of which light bleeding (blocker far)",
+        [&](const Metrics& m) { return m.hasBlockerDistance ? countCell(m.bleeding, m.bleedingRate) : plain("n/a"); });
+    row("&nbsp;&nbsp;of which bias leak (blocker within the contact distance)",
+        [&](const Metrics& m) { return m.hasBlockerDistance ? countCell(m.biasLeak, m.biasLeakRate) : plain("n/a"); });
+    row("agree, lit",
+        [&](const Metrics& m) { return countCell(m.agreeLit, double(m.agreeLit) / std::max<double>(1, m.counted)); });
+    row("agree, shadow", [&](const Metrics& m) {
+        return countCell(m.agreeShadow, double(m.agreeShadow) / std::max<double>(1, m.counted));
     });
-    row("&nbsp;&nbsp;of which bias leak (blocker within the contact distance)", [&](const Metrics& m) {
-        return m.hasBlockerDistance ? countCell(m.biasLeak, m.biasLeakRate) : plain("n/a");
-    });
-    row("agree, lit", [&](const Metrics& m) { return countCell(m.agreeLit, double(m.agreeLit) / std::max<double>(1, m.counted)); });
-    row("agree, shadow", [&](const Metrics& m) { return countCell(m.agreeShadow, double(m.agreeShadow) / std::max<double>(1, m.counted)); });
-    row("mean |V<sub>M</sub> − V<sub>R</sub>|", [&](const Metrics& m) { return plain(formatFixed(m.meanAbsVisibilityError, 4)); });
-    row("mean |V<sub>M</sub> − V<sub>R</sub>| over the reference's penumbra", [&](const Metrics& m) {
-        return m.penumbraPixels ? "<td>" + formatFixed(m.meanAbsVisibilityErrorPenumbra, 4) + "<span class=\"rate\">" +
-                                      formatCount(m.penumbraPixels) + " px</span></td>"
-                                : plain("no penumbra");
-    }, "key");
-    row("off by &gt; " + formatShort(kSoftErrorTolerance) + ", ≤ τ (soft error)", [&](const Metrics& m) { return countCell(m.softErrorPixels, m.softErrorRate); });
-    row("max |V<sub>M</sub> − V<sub>R</sub>|", [&](const Metrics& m) { return plain(formatFixed(m.maxAbsVisibilityError, 3)); });
+    row("mean |V<sub>M</sub> − V<sub>R</sub>|",
+        [&](const Metrics& m) { return plain(formatFixed(m.meanAbsVisibilityError, 4)); });
+    row(
+        "mean |V<sub>M</sub> − V<sub>R</sub>| over the reference's penumbra",
+        [&](const Metrics& m) {
+            return m.penumbraPixels ? "<td>" + formatFixed(m.meanAbsVisibilityErrorPenumbra, 4) +
+                                          "<span class=\"rate\">" + formatCount(m.penumbraPixels) + " px</span></td>"
+                                    : plain("no penumbra");
+        },
+        "key");
+    row("off by &gt; " + formatShort(kSoftErrorTolerance) + ", ≤ τ (soft error)",
+        [&](const Metrics& m) { return countCell(m.softErrorPixels, m.softErrorRate); });
+    row("max |V<sub>M</sub> − V<sub>R</sub>|",
+        [&](const Metrics& m) { return plain(formatFixed(m.maxAbsVisibilityError, 3)); });
     std::size_t lights = 0;
     for (const auto& rm : in.methods) lights = std::max(lights, rm.metrics.perLight.size());
     for (std::size_t l = 0; l < lights; ++l)
@@ -417,16 +437,21 @@ std::string metricsTable(const ReportInput& in) {
             return plain(formatFixed(e.meanAbsVisibilityError, 4) + " / " +
                          (e.penumbraPixels ? formatFixed(e.meanAbsVisibilityErrorPenumbra, 4) : std::string("–")));
         });
-    row("IoU of shadowed areas", [&](const Metrics& m) { return plain(formatFixed(m.shadowIoU, 4)); }, "key");
-    row("wrong near a shadow edge (aliasing)", [&](const Metrics& m) { return countCell(m.aliasingPixels, m.aliasingRate); });
-    row("wrong away from edges (bias)", [&](const Metrics& m) { return countCell(m.biasErrorPixels, m.biasErrorRate); });
-    row("silhouette mismatch <span class=\"small\">(of all pixels)</span>", [&](const Metrics& m) { return countCell(m.silhouetteMismatch, m.silhouetteMismatchRate); });
+    row(
+        "IoU of shadowed areas", [&](const Metrics& m) { return plain(formatFixed(m.shadowIoU, 4)); }, "key");
+    row("wrong near a shadow edge (aliasing)",
+        [&](const Metrics& m) { return countCell(m.aliasingPixels, m.aliasingRate); });
+    row("wrong away from edges (bias)",
+        [&](const Metrics& m) { return countCell(m.biasErrorPixels, m.biasErrorRate); });
+    row("silhouette mismatch <span class=\"small\">(of all pixels)</span>",
+        [&](const Metrics& m) { return countCell(m.silhouetteMismatch, m.silhouetteMismatchRate); });
     row("N·L sign differs", [&](const Metrics& m) { return countCell(m.ndotlSignMismatch, 0, false); });
     row("non-finite values", [&](const Metrics& m) {
         const std::string t = healthText(m.methodHealth);
         return plain(t.empty() ? "0" : "<b style=\"color:#c92a2a\">" + escapeHtml(t) + "</b>");
     });
-    row("run time", [&](const Metrics& m) { return plain(formatDuration(m.methodTiming.totalMs)); }, "key");
+    row(
+        "run time", [&](const Metrics& m) { return plain(formatDuration(m.methodTiming.totalMs)); }, "key");
     o << "</tbody></table>\n";
     return o.str();
 }
@@ -486,7 +511,8 @@ std::string sweepSection(const SweepSummary& sw) {
         o << "<p>Recommended <code>\"shadow\"</code> block for the scene file:</p><pre>"
           << escapeHtml(sw.shadowBlockJson) << "</pre>";
     if (!sw.href.empty())
-        o << "<p><a href=\"" << escapeHtml(sw.href) << "\">The sweep's own report</a>: every configuration, "
+        o << "<p><a href=\"" << escapeHtml(sw.href)
+          << "\">The sweep's own report</a>: every configuration, "
              "best and worst images, bias plots.</p>";
     o << "</div></div>\n";
     return o.str();
@@ -511,9 +537,9 @@ std::string perObjectTable(const ReportInput& in) {
                 o << "<td>–</td><td>–</td><td>–</td><td>–</td>";
                 continue;
             }
-            o << "<td>" << formatCount(it->counted) << "</td><td>" << formatCount(it->falseShadow)
-              << "</td><td>" << (rm.metrics.hasBlockerIds ? formatCount(it->selfShadowAcne) : "n/a")
-              << "</td><td>" << formatCount(it->missedShadow) << "</td>";
+            o << "<td>" << formatCount(it->counted) << "</td><td>" << formatCount(it->falseShadow) << "</td><td>"
+              << (rm.metrics.hasBlockerIds ? formatCount(it->selfShadowAcne) : "n/a") << "</td><td>"
+              << formatCount(it->missedShadow) << "</td>";
         }
         o << "</tr>\n";
     }
@@ -535,8 +561,7 @@ std::string attributesHtml(const std::string& label, const FrameInfo& f) {
 }  // namespace
 
 FrameInfo::FrameInfo(const scene::Frame& frame)
-    : width(frame.width), height(frame.height), attributes(frame.attributes),
-      timingsMs(frame.timingsMs) {}
+    : width(frame.width), height(frame.height), attributes(frame.attributes), timingsMs(frame.timingsMs) {}
 
 double FrameInfo::totalTimeMs() const {
     double total = 0.0;
@@ -564,8 +589,7 @@ std::string describeFindings(const ReportInput& in) {
             lines.push_back(t + ".");
         }
     }
-    for (const auto& f : in.failures)
-        lines.push_back("The " + f.label + " backend failed: " + f.message);
+    for (const auto& f : in.failures) lines.push_back("The " + f.label + " backend failed: " + f.message);
     for (const auto& w : in.warnings) lines.push_back("Warning: " + w);
     if (in.reference.frame.width > 0) {
         // Reference health is checked once here rather than per method.
@@ -607,7 +631,8 @@ std::string renderReportHtml(const ReportInput& in) {
     for (std::string line; std::getline(lines, line);) o << "<p>" << escapeHtml(line) << "</p>";
     o << "</div>\n";
     for (const auto& f : in.failures)
-        o << "<div class=\"failure\"><b>" << escapeHtml(f.label) << " failed:</b> " << escapeHtml(f.message) << "</div>\n";
+        o << "<div class=\"failure\"><b>" << escapeHtml(f.label) << " failed:</b> " << escapeHtml(f.message)
+          << "</div>\n";
     for (const auto& w : in.warnings) o << "<div class=\"warning\"><b>Warning:</b> " << escapeHtml(w) << "</div>\n";
 
     // Images over difference images, one column per frame.
@@ -615,8 +640,8 @@ std::string renderReportHtml(const ReportInput& in) {
     const std::string gridStyle = "grid-template-columns: repeat(" + std::to_string(cols) + ", minmax(0, 1fr))";
     o << "<h2>Images</h2>\n<div class=\"grid\" style=\"" << gridStyle << "\">\n";
     o << "<div>"
-      << figure(in.reference.label.empty() ? "reference" : in.reference.label,
-                formatDuration(ref.totalTimeMs()), in.reference.png, ref, nullptr)
+      << figure(in.reference.label.empty() ? "reference" : in.reference.label, formatDuration(ref.totalTimeMs()),
+                in.reference.png, ref, nullptr)
       << settingsLine(ref) << "</div>\n";
     for (const auto& rm : in.methods)
         o << "<div>" << figure(rm.label, formatDuration(rm.frame.totalTimeMs()), rm.png, rm.frame, nullptr)
@@ -634,15 +659,16 @@ std::string renderReportHtml(const ReportInput& in) {
         if (m.hotspot.wrongPixels > 0 && m.hotspot.size > 0 && rm.frame.width > 0) {
             o << "<div class=\"crops\">" << crop(rm.png, rm.frame, m.hotspot, rm.label + " zoom")
               << crop(rm.diffPng, rm.frame, m.hotspot, rm.label + " difference zoom") << "</div>"
-              << "<div class=\"small\">Zoom into the " << m.hotspot.size << "×" << m.hotspot.size << " px region at (" << m.hotspot.x
-              << ", " << m.hotspot.y << ") with the most errors (" << formatCount(m.hotspot.wrongPixels)
+              << "<div class=\"small\">Zoom into the " << m.hotspot.size << "×" << m.hotspot.size << " px region at ("
+              << m.hotspot.x << ", " << m.hotspot.y << ") with the most errors (" << formatCount(m.hotspot.wrongPixels)
               << " px): " << escapeHtml(rm.label) << " image, then its difference.</div>";
         }
         o << "</div>\n";
     }
     o << "</div>\n";
 
-    const bool anyHeat = std::any_of(in.methods.begin(), in.methods.end(), [](const ReportMethod& rm) { return !rm.heatPng.empty(); });
+    const bool anyHeat =
+        std::any_of(in.methods.begin(), in.methods.end(), [](const ReportMethod& rm) { return !rm.heatPng.empty(); });
     if (anyHeat) {
         o << "<h2>Continuous error |V<sub>method</sub> − V<sub>reference</sub>|</h2>\n<div class=\"grid\" style=\""
           << gridStyle << "\">\n<div>" << heatLegendHtml() << "</div>\n";
@@ -673,8 +699,8 @@ std::string renderReportHtml(const ReportInput& in) {
             FrameInfo size;
             size.width = v.width;
             size.height = v.height;
-            o << "<div>" << figure(v.title, "", v.png, size, nullptr) << "<div class=\"small\">" << escapeHtml(v.caption)
-              << "</div></div>\n";
+            o << "<div>" << figure(v.title, "", v.png, size, nullptr) << "<div class=\"small\">"
+              << escapeHtml(v.caption) << "</div></div>\n";
         }
         o << "</div>\n";
     }
@@ -686,8 +712,8 @@ std::string renderReportHtml(const ReportInput& in) {
           << " px of a shadow edge in the reference; bias error counts the rest.</p>\n";
     }
 
-    o << "<h2>Error against run time</h2>\n<div class=\"plotrow\"><div>" << errorTimeSvg(in)
-      << "</div><div>" << timingTable(in)
+    o << "<h2>Error against run time</h2>\n<div class=\"plotrow\"><div>" << errorTimeSvg(in) << "</div><div>"
+      << timingTable(in)
       << "<p class=\"small\">Stage timings in milliseconds as each backend recorded them.</p></div></div>\n";
 
     if (in.sweep) o << sweepSection(*in.sweep);
@@ -714,8 +740,8 @@ namespace html {
 
 const char* css() { return kCss; }
 
-std::string figure(const std::string& caption, const std::string& note, const std::string& png,
-                   const FrameInfo& frame, const ErrorHotspot* hotspot) {
+std::string figure(const std::string& caption, const std::string& note, const std::string& png, const FrameInfo& frame,
+                   const ErrorHotspot* hotspot) {
     return compare::figure(caption, note, png, frame, hotspot);
 }
 

@@ -63,13 +63,13 @@ struct SweepSummary {
     std::string shadowBlockJson;     // the recommended scene-file "shadow" block, pretty-printed
     std::size_t configurations = 0;  // rows in the sweep, failed ones included
     std::size_t failed = 0;
-    std::string resolution;          // "640x360", the sweep's render size
+    std::string resolution;  // "640x360", the sweep's render size
 };
 
 struct ReportInput {
     std::string sceneName;  // shown as the title
     std::string scenePath;
-    std::string planText;   // RenderPlan::explain(), shown verbatim
+    std::string planText;  // RenderPlan::explain(), shown verbatim
     ReportImage reference;
     std::vector<ReportMethod> methods;
     std::vector<ReportFailure> failures;
@@ -97,8 +97,8 @@ namespace html {
 // The page's stylesheet (inline in <style>).
 const char* css();
 // An image with a caption; with a hotspot, the yellow square that marks the zoomed region.
-std::string figure(const std::string& caption, const std::string& note, const std::string& png,
-                   const FrameInfo& frame, const ErrorHotspot* hotspot);
+std::string figure(const std::string& caption, const std::string& note, const std::string& png, const FrameInfo& frame,
+                   const ErrorHotspot* hotspot);
 // A square crop of `png` around the hotspot, magnified with hard pixel edges (pure CSS).
 std::string zoomCrop(const std::string& png, const FrameInfo& frame, const ErrorHotspot& hotspot,
                      const std::string& alt);

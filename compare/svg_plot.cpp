@@ -69,7 +69,10 @@ Range fitRange(const PlotAxis& axis, const std::vector<double>& values) {
         hi = std::pow(10.0, std::ceil(std::log10(hi)));
         if (hi <= lo) hi = lo * 10.0;
     } else {
-        if (!(lo <= hi)) { lo = 0.0; hi = axis.percent ? 0.01 : 1.0; }
+        if (!(lo <= hi)) {
+            lo = 0.0;
+            hi = axis.percent ? 0.01 : 1.0;
+        }
         // Rates and other non-negative data read best from zero.
         if (lo >= 0.0 && (axis.percent || lo < 0.5 * hi)) lo = 0.0;
         if (hi == lo) hi = lo + (lo == 0.0 ? (axis.percent ? 0.01 : 1.0) : std::fabs(lo) * 0.2);
@@ -91,7 +94,6 @@ Range fitRange(const PlotAxis& axis, const std::vector<double>& values) {
     return r;
 }
 
-
 // The opening tag of a marker of `shape` centred on (x, y), without its ">" or "/>" (a tooltip
 // may go inside). Shapes other than the circle are paths of equal area, so none looks heavier.
 std::string markerShape(int shape, double x, double y, double r, const std::string& color, double stroke) {
@@ -111,13 +113,15 @@ std::string markerShape(int shape, double x, double y, double r, const std::stri
         pts = {{0, -a}, {a, 0}, {0, a}, {-a, 0}};
     } else if (k == 3) {  // plus
         const double a = r * 1.15, b = r * 0.42;
-        pts = {{-b, -a}, {b, -a}, {b, -b}, {a, -b}, {a, b}, {b, b}, {b, a}, {-b, a}, {-b, b}, {-a, b}, {-a, -b}, {-b, -b}};
+        pts = {{-b, -a}, {b, -a}, {b, -b}, {a, -b}, {a, b},   {b, b},
+               {b, a},   {-b, a}, {-b, b}, {-a, b}, {-a, -b}, {-b, -b}};
     } else {  // hexagon
         for (int i = 0; i < 6; ++i)
             pts.push_back({r * 1.1 * std::cos(i * 1.0471975512), r * 1.1 * std::sin(i * 1.0471975512)});
     }
     o << "<path d=\"";
-    for (std::size_t i = 0; i < pts.size(); ++i) o << (i ? " L" : "M") << num(x + pts[i].first) << "," << num(y + pts[i].second);
+    for (std::size_t i = 0; i < pts.size(); ++i)
+        o << (i ? " L" : "M") << num(x + pts[i].first) << "," << num(y + pts[i].second);
     o << " Z" << paint;
     return o.str();
 }
@@ -133,7 +137,7 @@ std::vector<double> axisTicks(double lo, double hi, bool log) {
         if (!(lo > 0.0)) return ticks;
         const int d0 = static_cast<int>(std::floor(std::log10(lo) + 1e-9));
         const int d1 = static_cast<int>(std::ceil(std::log10(hi) - 1e-9));
-        const bool fine = hi / lo < 999.999;  // fewer than three decades
+        const bool fine = hi / lo < 999.999;               // fewer than three decades
         const int every = std::max(1, (d1 - d0 + 7) / 8);  // at most ~8 decade labels
         for (int d = d0; d <= d1; ++d) {
             if ((d - d0) % every != 0) continue;
@@ -179,12 +183,10 @@ std::string renderSvg(const ScatterPlot& plot) {
     auto offLow = [](const Range& r, double v) { return r.t(v) < -1e-9; };
 
     std::ostringstream o;
-    o << "<svg xmlns=\"http://www.w3.org/2000/svg\" class=\"plot\" width=\"" << plot.width
-      << "\" height=\"" << plot.height << "\" viewBox=\"0 0 " << plot.width << " " << plot.height
-      << "\" role=\"img\" aria-label=\"" << escapeHtml(plot.title) << "\" " << kFont
-      << " font-size=\"12\">\n";
-    o << "<rect x=\"0\" y=\"0\" width=\"" << plot.width << "\" height=\"" << plot.height
-      << "\" fill=\"#ffffff\"/>\n";
+    o << "<svg xmlns=\"http://www.w3.org/2000/svg\" class=\"plot\" width=\"" << plot.width << "\" height=\""
+      << plot.height << "\" viewBox=\"0 0 " << plot.width << " " << plot.height << "\" role=\"img\" aria-label=\""
+      << escapeHtml(plot.title) << "\" " << kFont << " font-size=\"12\">\n";
+    o << "<rect x=\"0\" y=\"0\" width=\"" << plot.width << "\" height=\"" << plot.height << "\" fill=\"#ffffff\"/>\n";
     o << "<text x=\"" << num(x0) << "\" y=\"22\" font-size=\"14\" font-weight=\"600\" fill=\"#1f2933\">"
       << escapeHtml(plot.title) << "</text>\n";
 
@@ -194,27 +196,23 @@ std::string renderSvg(const ScatterPlot& plot) {
         if (s.name.empty()) continue;
         o << "<g class=\"legend\">";
         if (s.connect)
-            o << "<line x1=\"" << num(lx) << "\" y1=\"40\" x2=\"" << num(lx + 18)
-              << "\" y2=\"40\" stroke=\"" << escapeHtml(s.color) << "\" stroke-width=\"2\""
-              << (s.dashed ? " stroke-dasharray=\"5 3\"" : "") << "/>";
-        if (s.markers)
-            o << markerShape(s.shape, lx + 9, 40, 4.5, escapeHtml(s.color), 1.0) << "/>";
-        o << "<text x=\"" << num(lx + 24) << "\" y=\"44\" fill=\"#3e4c59\">" << escapeHtml(s.name)
-          << "</text></g>\n";
+            o << "<line x1=\"" << num(lx) << "\" y1=\"40\" x2=\"" << num(lx + 18) << "\" y2=\"40\" stroke=\""
+              << escapeHtml(s.color) << "\" stroke-width=\"2\"" << (s.dashed ? " stroke-dasharray=\"5 3\"" : "")
+              << "/>";
+        if (s.markers) o << markerShape(s.shape, lx + 9, 40, 4.5, escapeHtml(s.color), 1.0) << "/>";
+        o << "<text x=\"" << num(lx + 24) << "\" y=\"44\" fill=\"#3e4c59\">" << escapeHtml(s.name) << "</text></g>\n";
         lx += 24 + 7.0 * static_cast<double>(s.name.size()) + 18;
     }
 
     // Bands under everything else.
     for (const auto& b : plot.bands) {
         const double a = px(std::min(b.x0, b.x1)), c = px(std::max(b.x0, b.x1));
-        o << "<rect class=\"band\" x=\"" << num(a) << "\" y=\"" << num(y1) << "\" width=\""
-          << num(std::max(c - a, 1.5)) << "\" height=\"" << num(y0 - y1) << "\" fill=\""
-          << escapeHtml(b.color) << "\" fill-opacity=\"0.14\" stroke=\"" << escapeHtml(b.color)
-          << "\" stroke-opacity=\"0.5\"/>\n";
+        o << "<rect class=\"band\" x=\"" << num(a) << "\" y=\"" << num(y1) << "\" width=\"" << num(std::max(c - a, 1.5))
+          << "\" height=\"" << num(y0 - y1) << "\" fill=\"" << escapeHtml(b.color)
+          << "\" fill-opacity=\"0.14\" stroke=\"" << escapeHtml(b.color) << "\" stroke-opacity=\"0.5\"/>\n";
         if (!b.label.empty())
-            o << "<text x=\"" << num(0.5 * (a + c)) << "\" y=\"" << num(y1 + 14)
-              << "\" text-anchor=\"middle\" fill=\"" << escapeHtml(b.color) << "\">"
-              << escapeHtml(b.label) << "</text>\n";
+            o << "<text x=\"" << num(0.5 * (a + c)) << "\" y=\"" << num(y1 + 14) << "\" text-anchor=\"middle\" fill=\""
+              << escapeHtml(b.color) << "\">" << escapeHtml(b.label) << "</text>\n";
     }
 
     // Grid, ticks and tick labels.
@@ -233,23 +231,23 @@ std::string renderSvg(const ScatterPlot& plot) {
     };
     for (const double t : ticksOf(rx.lo, rx.hi, rx.log, plot.x.integer)) {
         const double x = px(t);
-        o << "<line x1=\"" << num(x) << "\" y1=\"" << num(y1) << "\" x2=\"" << num(x) << "\" y2=\""
-          << num(y0) << "\" stroke=\"#e4e7eb\"/>";
+        o << "<line x1=\"" << num(x) << "\" y1=\"" << num(y1) << "\" x2=\"" << num(x) << "\" y2=\"" << num(y0)
+          << "\" stroke=\"#e4e7eb\"/>";
         o << "<text x=\"" << num(x) << "\" y=\"" << num(y0 + 17) << "\" text-anchor=\"middle\">"
           << tickLabel(t, plot.x.percent) << "</text>\n";
     }
     for (const double t : ticksOf(ry.lo, ry.hi, ry.log, plot.y.integer)) {
         const double y = py(t);
-        o << "<line x1=\"" << num(x0) << "\" y1=\"" << num(y) << "\" x2=\"" << num(x1) << "\" y2=\""
-          << num(y) << "\" stroke=\"#e4e7eb\"/>";
+        o << "<line x1=\"" << num(x0) << "\" y1=\"" << num(y) << "\" x2=\"" << num(x1) << "\" y2=\"" << num(y)
+          << "\" stroke=\"#e4e7eb\"/>";
         o << "<text x=\"" << num(x0 - 8) << "\" y=\"" << num(y + 4) << "\" text-anchor=\"end\">"
           << tickLabel(t, plot.y.percent) << "</text>\n";
     }
-    o << "<rect x=\"" << num(x0) << "\" y=\"" << num(y1) << "\" width=\"" << num(x1 - x0)
-      << "\" height=\"" << num(y0 - y1) << "\" fill=\"none\" stroke=\"#9aa5b1\"/>\n";
+    o << "<rect x=\"" << num(x0) << "\" y=\"" << num(y1) << "\" width=\"" << num(x1 - x0) << "\" height=\""
+      << num(y0 - y1) << "\" fill=\"none\" stroke=\"#9aa5b1\"/>\n";
     o << "<text x=\"" << num(0.5 * (x0 + x1)) << "\" y=\"" << num(H - 12)
-      << "\" text-anchor=\"middle\" fill=\"#3e4c59\">" << escapeHtml(plot.x.title)
-      << (plot.x.log ? " (log scale)" : "") << "</text>\n";
+      << "\" text-anchor=\"middle\" fill=\"#3e4c59\">" << escapeHtml(plot.x.title) << (plot.x.log ? " (log scale)" : "")
+      << "</text>\n";
     o << "<text transform=\"translate(16 " << num(0.5 * (y0 + y1))
       << ") rotate(-90)\" text-anchor=\"middle\" fill=\"#3e4c59\">" << escapeHtml(plot.y.title)
       << (plot.y.log ? " (log scale)" : "") << "</text>\n";
@@ -257,11 +255,11 @@ std::string renderSvg(const ScatterPlot& plot) {
 
     for (const auto& m : plot.markers) {
         const double x = px(m.x);
-        o << "<g class=\"marker\"><line x1=\"" << num(x) << "\" y1=\"" << num(y1) << "\" x2=\""
-          << num(x) << "\" y2=\"" << num(y0) << "\" stroke=\"#616e7c\" stroke-dasharray=\"4 4\"/>";
+        o << "<g class=\"marker\"><line x1=\"" << num(x) << "\" y1=\"" << num(y1) << "\" x2=\"" << num(x) << "\" y2=\""
+          << num(y0) << "\" stroke=\"#616e7c\" stroke-dasharray=\"4 4\"/>";
         if (!m.label.empty())
-            o << "<text x=\"" << num(x - 5) << "\" y=\"" << num(y1 + 14)
-              << "\" text-anchor=\"end\" fill=\"#616e7c\">" << escapeHtml(m.label) << "</text>";
+            o << "<text x=\"" << num(x - 5) << "\" y=\"" << num(y1 + 14) << "\" text-anchor=\"end\" fill=\"#616e7c\">"
+              << escapeHtml(m.label) << "</text>";
         o << "</g>\n";
     }
 
@@ -284,8 +282,8 @@ std::string renderSvg(const ScatterPlot& plot) {
                 o << "<g class=\"point\">";
                 if (offLow(rx, p.x) || offLow(ry, p.y)) {
                     // Below a log axis: a triangle pointing off the plot, at its edge.
-                    o << "<path d=\"M" << num(x - 5) << "," << num(y - 7) << " L" << num(x + 5) << ","
-                      << num(y - 7) << " L" << num(x) << "," << num(y) << " Z\" fill=\"" << color
+                    o << "<path d=\"M" << num(x - 5) << "," << num(y - 7) << " L" << num(x + 5) << "," << num(y - 7)
+                      << " L" << num(x) << "," << num(y) << " Z\" fill=\"" << color
                       << "\" stroke=\"#fff\" stroke-width=\"1\">";
                 } else {
                     o << markerShape(s.shape, x, y, 5, color, 1.2) << ">";
@@ -296,16 +294,16 @@ std::string renderSvg(const ScatterPlot& plot) {
             }
             if (s.showLabels && !p.label.empty()) {
                 const bool right = x < x1 - 120;
-                o << "<text x=\"" << num(right ? x + 8 : x - 8) << "\" y=\"" << num(y - 8)
-                  << "\" text-anchor=\"" << (right ? "start" : "end") << "\" fill=\"" << color
-                  << "\" font-weight=\"600\">" << escapeHtml(p.label) << "</text>\n";
+                o << "<text x=\"" << num(right ? x + 8 : x - 8) << "\" y=\"" << num(y - 8) << "\" text-anchor=\""
+                  << (right ? "start" : "end") << "\" fill=\"" << color << "\" font-weight=\"600\">"
+                  << escapeHtml(p.label) << "</text>\n";
             }
         }
     }
     if (!plot.note.empty())  // inside the plot, top right: a verdict, not a footnote
         o << "<text x=\"" << num(x1 - 8) << "\" y=\"" << num(y1 + 18)
-          << "\" text-anchor=\"end\" font-size=\"13\" font-weight=\"600\" fill=\"#d9480f\">"
-          << escapeHtml(plot.note) << "</text>\n";
+          << "\" text-anchor=\"end\" font-size=\"13\" font-weight=\"600\" fill=\"#d9480f\">" << escapeHtml(plot.note)
+          << "</text>\n";
     o << "</svg>\n";
     return o.str();
 }
@@ -325,8 +323,7 @@ ScatterPlot errorTimePlot(const std::vector<SweepPoint>& points, double referenc
     p.y = {options.errorName, options.logError, true, {}, {}};
     std::vector<std::string> backends;
     for (const auto& pt : points)
-        if (std::find(backends.begin(), backends.end(), pt.backend) == backends.end())
-            backends.push_back(pt.backend);
+        if (std::find(backends.begin(), backends.end(), pt.backend) == backends.end()) backends.push_back(pt.backend);
     std::vector<std::string> machines;
     for (const auto& pt : points)
         if (std::find(machines.begin(), machines.end(), pt.machine) == machines.end()) machines.push_back(pt.machine);
@@ -340,13 +337,14 @@ ScatterPlot errorTimePlot(const std::vector<SweepPoint>& points, double referenc
         std::vector<PlotSeries> byMachine(perMachine ? machines.size() : 0, s);
         for (const auto& pt : points) {
             if (pt.backend != backends[b]) continue;
-            const std::string tip = pt.backend + (pt.label.empty() || pt.label == pt.backend ? "" : " " + pt.label) + ": " +
-                                    formatDuration(pt.timeMs) + ", " + formatPercent(pt.error) +
+            const std::string tip = pt.backend + (pt.label.empty() || pt.label == pt.backend ? "" : " " + pt.label) +
+                                    ": " + formatDuration(pt.timeMs) + ", " + formatPercent(pt.error) +
                                     (perMachine ? " (timed on " + pt.machine + ")" : "");
             s.points.push_back({pt.timeMs, pt.error, pt.label, tip});
             te.push_back({pt.timeMs, pt.error});
             if (perMachine) {
-                const std::size_t m = std::size_t(std::find(machines.begin(), machines.end(), pt.machine) - machines.begin());
+                const std::size_t m =
+                    std::size_t(std::find(machines.begin(), machines.end(), pt.machine) - machines.begin());
                 byMachine[m].points.push_back(s.points.back());
             }
         }
@@ -373,8 +371,8 @@ ScatterPlot errorTimePlot(const std::vector<SweepPoint>& points, double referenc
     return p;
 }
 
-ScatterPlot biasPlot(const std::vector<BiasSample>& samples, const BiasWindow& window,
-                     const std::string& biasName, bool logBias) {
+ScatterPlot biasPlot(const std::vector<BiasSample>& samples, const BiasWindow& window, const std::string& biasName,
+                     bool logBias) {
     ScatterPlot p;
     p.title = "False and missed shadow against " + biasName;
     p.x = {biasName, logBias, false, {}, {}};

@@ -35,8 +35,8 @@ struct PlotSeries {
 struct PlotAxis {
     std::string title;
     bool log = false;
-    bool percent = false;  // values are 0..1 rates, ticks read "1%"
-    bool integer = false;  // values are counts or indices (frame pairs): ticks only at whole numbers
+    bool percent = false;            // values are 0..1 rates, ticks read "1%"
+    bool integer = false;            // values are counts or indices (frame pairs): ticks only at whole numbers
     std::optional<double> min, max;  // fixed range; otherwise fitted to the data with a margin
 };
 
@@ -88,9 +88,9 @@ struct SweepPoint {
 struct ErrorTimeOptions {
     std::string title = "Shadow error against run time";
     std::string errorName = "mismatch rate";
-    bool logError = true;   // sweeps: log-log; the two-point run report uses a linear error axis
-    bool fronts = true;     // join each backend's Pareto front
-    bool labels = false;    // write each point's label beside it
+    bool logError = true;  // sweeps: log-log; the two-point run report uses a linear error axis
+    bool fronts = true;    // join each backend's Pareto front
+    bool labels = false;   // write each point's label beside it
 };
 
 // Error against time, one series per backend (in first-seen order), each backend's Pareto
@@ -100,7 +100,7 @@ ScatterPlot errorTimePlot(const std::vector<SweepPoint>& points, double referenc
                           const ErrorTimeOptions& options = {});
 // False- (red) and missed- (blue) shadow rates (log axis) against bias, the threshold as a dashed line and
 // the bias window shaded green, or a "stiff" note when there is none.
-ScatterPlot biasPlot(const std::vector<BiasSample>& samples, const BiasWindow& window,
-                     const std::string& biasName, bool logBias);
+ScatterPlot biasPlot(const std::vector<BiasSample>& samples, const BiasWindow& window, const std::string& biasName,
+                     bool logBias);
 
 }  // namespace shadowlab::compare

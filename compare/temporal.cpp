@@ -29,8 +29,8 @@ struct Crossing {
 // Crossings per line: rows first (index y), then columns (index height + x).
 using Lines = std::vector<std::vector<Crossing>>;
 
-Lines crossings(const std::vector<float>& v, const std::vector<PixelClass>& cls, const std::vector<float>& ids,
-                int w, int h) {
+Lines crossings(const std::vector<float>& v, const std::vector<PixelClass>& cls, const std::vector<float>& ids, int w,
+                int h) {
     Lines lines(std::size_t(w + h));
     auto scan = [&](std::size_t line, std::size_t a, std::size_t b, double at) {
         if (!counts(cls[a]) || !counts(cls[b]) || ids[a] != ids[b]) return;  // not across silhouettes
@@ -40,11 +40,9 @@ Lines crossings(const std::vector<float>& v, const std::vector<PixelClass>& cls,
         lines[line].push_back({at + 0.5 + t, litA ? 1 : -1});
     };
     for (int y = 0; y < h; ++y)
-        for (int x = 0; x + 1 < w; ++x)
-            scan(std::size_t(y), std::size_t(y) * w + x, std::size_t(y) * w + x + 1, x);
+        for (int x = 0; x + 1 < w; ++x) scan(std::size_t(y), std::size_t(y) * w + x, std::size_t(y) * w + x + 1, x);
     for (int x = 0; x < w; ++x)
-        for (int y = 0; y + 1 < h; ++y)
-            scan(std::size_t(h + x), std::size_t(y) * w + x, std::size_t(y + 1) * w + x, y);
+        for (int y = 0; y + 1 < h; ++y) scan(std::size_t(h + x), std::size_t(y) * w + x, std::size_t(y + 1) * w + x, y);
     return lines;
 }
 

@@ -24,8 +24,8 @@ inline constexpr double kEdgeTrackPixels = 1.5;
 
 // One consecutive pair of frames (t, t + 1), compared at the same image position.
 struct PairStability {
-    int first = 0;               // t
-    std::size_t comparable = 0;  // pixels counted (compare's rule) in both frames
+    int first = 0;                     // t
+    std::size_t comparable = 0;        // pixels counted (compare's rule) in both frames
     std::size_t methodChanges = 0;     // comparable pixels whose method state (V ≤ τ: shadow) changes
     std::size_t referenceChanges = 0;  // ... whose reference state changes
     std::size_t flicker = 0;           // method changes while the reference does not
@@ -78,7 +78,8 @@ TemporalSummary measureTemporal(const std::vector<const scene::Frame*>& method,
 // reference's does not), else 0: what PairStability::flicker counts.
 std::vector<unsigned char> flickerMask(const scene::Frame& method0, const scene::Frame& method1,
                                        const scene::Frame& reference0, const scene::Frame& reference1,
-                                       const std::vector<PixelClass>& classes0, const std::vector<PixelClass>& classes1);
+                                       const std::vector<PixelClass>& classes0,
+                                       const std::vector<PixelClass>& classes1);
 
 nlohmann::json toJson(const TemporalSummary& summary);
 nlohmann::json toJson(const PairStability& pair);

@@ -20,10 +20,31 @@ using Json = nlohmann::json;
 
 // Numbers that break size arithmetic and value checks: zero, negatives, the edges of 8, 16, 32
 // and 64 bits, doubles that overflow when multiplied, NaN-producing extremes.
-const double kInteresting[] = {0,    -1,         1,          2,          3,          4,          12,
-                               255,  256,        65535,      65536,      2147483647, 2147483648, 4294967295,
-                               4294967296, 9007199254740993.0, 9.2233720368547758e18, 1.8446744073709552e19,
-                               1e15, 1e16, 1e300,      -1e300,     1e308,      5e-324,     0.5};
+const double kInteresting[] = {0,
+                               -1,
+                               1,
+                               2,
+                               3,
+                               4,
+                               12,
+                               255,
+                               256,
+                               65535,
+                               65536,
+                               2147483647,
+                               2147483648,
+                               4294967295,
+                               4294967296,
+                               9007199254740993.0,
+                               9.2233720368547758e18,
+                               1.8446744073709552e19,
+                               1e15,
+                               1e16,
+                               1e300,
+                               -1e300,
+                               1e308,
+                               5e-324,
+                               0.5};
 
 // Every value of the tree, depth first (the tree is bounded: inputs deeper than
 // kMaxJsonDepth are not parsed).
@@ -62,7 +83,7 @@ bool mutateTree(Json& doc, std::mt19937& rng) {
             v[std::string(1000 + rng() % 1000, 'k')] = v.begin().value();
             return true;
         default: {
-            static const char* kNames[] = {"pipe.bin", "zero.bin", "dir.bin", "tri.bin", "pipe.obj", "zero.obj",
+            static const char* kNames[] = {"pipe.bin", "zero.bin", "dir.bin",  "tri.bin",  "pipe.obj",  "zero.obj",
                                            "dir.obj",  "tri.obj",  "pipe.png", "zero.png", "pipe.gltf", "tri.mtl"};
             if (!v.is_string()) return false;
             v = kNames[rng() % std::size(kNames)];

@@ -3,12 +3,12 @@
 // files); its name decides how it is read.
 #pragma once
 
+#include <sys/stat.h>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <sys/stat.h>
 #include <string>
 #include <string_view>
 

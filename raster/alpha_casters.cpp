@@ -12,7 +12,7 @@ namespace {
 // shaders/alpha.glsl's AlphaRecord (std430: two 16-byte vectors).
 struct AlphaRecord {
     glm::vec4 params{0.0f, 0.0f, 1.0f, 1.0f};  // mode, the camera's cutoff, factor, opacity
-    glm::uvec4 texture{0u};                     // first texel, width, height, wrapS + 4·wrapT
+    glm::uvec4 texture{0u};                    // first texel, width, height, wrapS + 4·wrapT
 };
 static_assert(sizeof(AlphaRecord) == 32, "AlphaRecord must match shaders/alpha.glsl (std430)");
 
@@ -44,19 +44,24 @@ AlphaCasters createAlphaCasters(const Context& ctx, const scene::Scene& scene, c
     a.records = uploadBuffer(ctx, records, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     a.texels = uploadBuffer(ctx, texels, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
 
-    const VkDescriptorSetLayoutBinding bindings[2] = {
-        {.binding = 0, .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, .descriptorCount = 1,
-         .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
-        {.binding = 1, .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, .descriptorCount = 1,
-         .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT}};
+    const VkDescriptorSetLayoutBinding bindings[2] = {{.binding = 0,
+                                                       .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                                       .descriptorCount = 1,
+                                                       .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
+                                                      {.binding = 1,
+                                                       .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                                       .descriptorCount = 1,
+                                                       .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT}};
     const VkDescriptorSetLayoutCreateInfo setInfo{
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 2, .pBindings = bindings};
     VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
     VK_CHECK(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &setLayout));
     a.setLayout = DescriptorSetLayoutHandle(device, setLayout);
     const VkDescriptorPoolSize poolSize{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2};
-    const VkDescriptorPoolCreateInfo poolInfo{
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1, .poolSizeCount = 1, .pPoolSizes = &poolSize};
+    const VkDescriptorPoolCreateInfo poolInfo{.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
+                                              .maxSets = 1,
+                                              .poolSizeCount = 1,
+                                              .pPoolSizes = &poolSize};
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VK_CHECK(vkCreateDescriptorPool(device, &poolInfo, nullptr, &pool));
     a.pool = DescriptorPoolHandle(device, pool);
@@ -67,11 +72,18 @@ AlphaCasters createAlphaCasters(const Context& ctx, const scene::Scene& scene, c
     VK_CHECK(vkAllocateDescriptorSets(device, &allocInfo, &a.set));
     const VkDescriptorBufferInfo recordInfo{a.records.buffer.get(), 0, VK_WHOLE_SIZE};
     const VkDescriptorBufferInfo texelInfo{a.texels.buffer.get(), 0, VK_WHOLE_SIZE};
-    const VkWriteDescriptorSet writes[2] = {
-        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = a.set, .dstBinding = 0, .descriptorCount = 1,
-         .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, .pBufferInfo = &recordInfo},
-        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = a.set, .dstBinding = 1, .descriptorCount = 1,
-         .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, .pBufferInfo = &texelInfo}};
+    const VkWriteDescriptorSet writes[2] = {{.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+                                             .dstSet = a.set,
+                                             .dstBinding = 0,
+                                             .descriptorCount = 1,
+                                             .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                             .pBufferInfo = &recordInfo},
+                                            {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+                                             .dstSet = a.set,
+                                             .dstBinding = 1,
+                                             .descriptorCount = 1,
+                                             .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                             .pBufferInfo = &texelInfo}};
     vkUpdateDescriptorSets(device, 2, writes, 0, nullptr);
     return a;
 }

@@ -182,13 +182,17 @@ CascadeChoice chooseCascades(const scene::Scene& scene, const scene::RasterSetti
         return {1, "1 (default: one map keeps its texel within 2 pixels; " + what + ")"};
     for (int n = 2; n <= scene::kMaxCascades; ++n)
         if (ratios[n] <= kCascadeTexelsPerPixel)
-            return {n, std::to_string(n) + " (default: the fewest cascades that keep every slice's texel within 2 "
-                                           "pixels; " + what + ")"};
+            return {n, std::to_string(n) +
+                           " (default: the fewest cascades that keep every slice's texel within 2 "
+                           "pixels; " +
+                           what + ")"};
     int best = 1;
     for (int n = 2; n <= scene::kMaxCascades; ++n)
         if (ratios[n] * kCascadeGainTolerance < ratios[best]) best = n;
-    return {best, std::to_string(best) + " (default: no count keeps the texel within 2 pixels; the finest worst "
-                                         "slice" + (best == 1 ? ", cascades gain nothing" : "") + "; " + what + ")"};
+    return {best, std::to_string(best) +
+                      " (default: no count keeps the texel within 2 pixels; the finest worst "
+                      "slice" +
+                      (best == 1 ? ", cascades gain nothing" : "") + "; " + what + ")"};
 }
 
 scene::RasterSettings resolveAutomaticChoices(const scene::Scene& scene, const scene::RasterSettings& settingsIn,

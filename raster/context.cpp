@@ -7,10 +7,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <iterator>
-#include <iomanip>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
+#include <iterator>
 #include <sstream>
 
 #include "raster/vulkan_error.h"
@@ -46,8 +46,7 @@ void setShaderCacheDir() {
 
 VKAPI_ATTR VkBool32 VKAPI_CALL onDebugMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                               VkDebugUtilsMessageTypeFlagsEXT types,
-                                              const VkDebugUtilsMessengerCallbackDataEXT* data,
-                                              void* userData) {
+                                              const VkDebugUtilsMessengerCallbackDataEXT* data, void* userData) {
     const bool counted = severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT ||
                          (severity == VK_DEBUG_UTILS_MESSAGE_SEVERITY_INFO_BIT_EXT &&
                           (types & VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT));
@@ -63,8 +62,8 @@ VKAPI_ATTR VkBool32 VKAPI_CALL onDebugMessage(VkDebugUtilsMessageSeverityFlagBit
     const char* level = severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT     ? "error"
                         : severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT ? "warning"
                                                                                       : "info";
-    const std::string text = std::string("vulkan validation ") + level + ": " +
-                             (data && data->pMessage ? data->pMessage : "(no message)");
+    const std::string text =
+        std::string("vulkan validation ") + level + ": " + (data && data->pMessage ? data->pMessage : "(no message)");
     log->count.fetch_add(1);
     const std::lock_guard lock(log->mutex);
     log->messages.push_back(text);
@@ -129,8 +128,7 @@ VkDebugUtilsMessengerCreateInfoEXT messengerCreateInfo(ValidationLog* log) {
         .messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_INFO_BIT_EXT |
                            VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
                            VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT,
-        .messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
-                       VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+        .messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                        VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT,
         .pfnUserCallback = onDebugMessage,
         .pUserData = log,
@@ -176,8 +174,9 @@ InstanceHandle createInstance(bool validate, const VkDebugUtilsMessengerCreateIn
     VkInstance instance = VK_NULL_HANDLE;
     const VkResult r = vkCreateInstance(&info, nullptr, &instance);
     if (r == VK_ERROR_INCOMPATIBLE_DRIVER)
-        throw RasterError("no Vulkan driver (ICD) is installed; install the Debian package mesa-vulkan-drivers "
-                          "for lavapipe, Mesa's CPU Vulkan driver");
+        throw RasterError(
+            "no Vulkan driver (ICD) is installed; install the Debian package mesa-vulkan-drivers "
+            "for lavapipe, Mesa's CPU Vulkan driver");
     if (r == VK_ERROR_LAYER_NOT_PRESENT)
         throw RasterError(std::string("the Vulkan layer ") + kValidationLayer +
                           " failed to load; reinstall the Debian package vulkan-validationlayers");
@@ -194,8 +193,9 @@ std::vector<DeviceReport> describePhysicalDevices(VkInstance instance, std::vect
     if (count > 0) VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, devices.data()));
     devices.resize(count);
     if (devices.empty())
-        throw RasterError("the Vulkan loader found no device; install the Debian package mesa-vulkan-drivers "
-                          "for lavapipe, Mesa's CPU Vulkan driver");
+        throw RasterError(
+            "the Vulkan loader found no device; install the Debian package mesa-vulkan-drivers "
+            "for lavapipe, Mesa's CPU Vulkan driver");
     std::vector<DeviceReport> reports;
     for (std::size_t i = 0; i < devices.size(); ++i) {
         VkPhysicalDeviceDriverProperties driver{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
@@ -209,8 +209,8 @@ std::vector<DeviceReport> describePhysicalDevices(VkInstance instance, std::vect
         r.driverInfo = driver.driverInfo;
         r.apiVersion = props.properties.apiVersion;
         r.apiVersionText = versionText(r.apiVersion);
-        r.lavapipe = driver.driverID == VK_DRIVER_ID_MESA_LLVMPIPE ||
-                     props.properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+        r.lavapipe =
+            driver.driverID == VK_DRIVER_ID_MESA_LLVMPIPE || props.properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
         if (r.apiVersion < VK_API_VERSION_1_3) {
             r.unusableReason = "Vulkan " + r.apiVersionText + " < 1.3";
         } else if (graphicsQueueFamily(devices[i]) < 0) {
@@ -238,9 +238,10 @@ std::size_t selectDevice(const std::vector<DeviceReport>& devices, const std::st
         for (std::size_t i = 0; i < devices.size() && chosen == devices.size(); ++i)
             if (devices[i].usable) chosen = i;
         if (chosen == devices.size())
-            throw RasterError("no usable Vulkan 1.3 device (needs a graphics queue, dynamic rendering and "
-                              "synchronization2); devices:" + listDevices(devices) +
-                              "\ninstall the Debian package mesa-vulkan-drivers for lavapipe");
+            throw RasterError(
+                "no usable Vulkan 1.3 device (needs a graphics queue, dynamic rendering and "
+                "synchronization2); devices:" +
+                listDevices(devices) + "\ninstall the Debian package mesa-vulkan-drivers for lavapipe");
         return chosen;
     }
     const bool isIndex = std::all_of(selector.begin(), selector.end(),
@@ -254,8 +255,10 @@ std::size_t selectDevice(const std::vector<DeviceReport>& devices, const std::st
             if (lower(devices[i].name).find(needle) != std::string::npos) chosen = i;
     }
     if (chosen == devices.size())
-        throw RasterError("--device '" + selector + "' matches no Vulkan device (give an index or part of a name); "
-                          "devices:" + listDevices(devices));
+        throw RasterError("--device '" + selector +
+                          "' matches no Vulkan device (give an index or part of a name); "
+                          "devices:" +
+                          listDevices(devices));
     if (!devices[chosen].usable)
         throw RasterError("--device '" + selector + "' selects " + devices[chosen].name +
                           ", which the raster backend cannot use: " + devices[chosen].unusableReason +

@@ -4,8 +4,8 @@
 #pragma once
 
 #include <atomic>
-#include <filesystem>
 #include <cstdint>
+#include <filesystem>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -26,9 +26,9 @@ struct ValidationLog {
 };
 
 struct ContextOptions {
-    std::string device;                // selector, see selectDevice()
-    bool validate = false;             // enable VK_LAYER_KHRONOS_validation + debug messenger
-    ValidationLog* log = nullptr;      // required when validate
+    std::string device;            // selector, see selectDevice()
+    bool validate = false;         // enable VK_LAYER_KHRONOS_validation + debug messenger
+    ValidationLog* log = nullptr;  // required when validate
 };
 
 // Members are declared in creation order; the destructor runs in reverse.

@@ -29,7 +29,9 @@ constexpr Glyph kGlyphs[] = {
 void fill(DisplayImage& img, int x0, int y0, int w, int h, const std::array<float, 3>& color) {
     for (int y = std::max(y0, 0); y < std::min(y0 + h, img.height); ++y)
         for (int x = std::max(x0, 0); x < std::min(x0 + w, img.width); ++x)
-            for (int k = 0; k < 3; ++k) img.rgb[3 * (std::size_t(y) * std::size_t(img.width) + std::size_t(x)) + std::size_t(k)] = color[std::size_t(k)];
+            for (int k = 0; k < 3; ++k)
+                img.rgb[3 * (std::size_t(y) * std::size_t(img.width) + std::size_t(x)) + std::size_t(k)] =
+                    color[std::size_t(k)];
 }
 
 // White text on a black box at (x0, y0), each font pixel `scale` image pixels.
@@ -131,7 +133,8 @@ DisplayImage cascadeView(const scene::Frame& frame, const RenderDebug& debug) {
     for (std::size_t i = 0; i < index.size(); ++i) {
         const float* b = &frame.beauty[3 * i];
         if (index[i] < 0) {
-            for (int k = 0; k < 3; ++k) img.rgb[3 * i + std::size_t(k)] = scene::linearToSrgb(std::clamp(b[k], 0.0f, 1.0f));
+            for (int k = 0; k < 3; ++k)
+                img.rgb[3 * i + std::size_t(k)] = scene::linearToSrgb(std::clamp(b[k], 0.0f, 1.0f));
             continue;
         }
         const std::array<float, 3> t = cascadeTint(index[i]);
@@ -163,10 +166,11 @@ std::vector<double> texelToPixelRatios(const scene::Frame& frame, const scene::S
             const scene::Vec3 p = cam.position + z * scene::pixelDirection(cam, x, y);
             double texel = 0.0;
             if (l.type == scene::LightType::Directional) {
-                texel = cascaded ? texels[std::size_t(std::max(cascade[i], 0))]
-                                 : debug.layers[0].frustum.texelWorldSize();
+                texel =
+                    cascaded ? texels[std::size_t(std::max(cascade[i], 0))] : debug.layers[0].frustum.texelWorldSize();
             } else if (l.type == scene::LightType::Spot) {
-                texel = debug.layers[0].frustum.texelWorldSize() * glm::dot(p - l.position, debug.layers[0].frustum.direction);
+                texel = debug.layers[0].frustum.texelWorldSize() *
+                        glm::dot(p - l.position, debug.layers[0].frustum.direction);
             } else {
                 const scene::Vec3 d = glm::abs(p - l.position);
                 texel = debug.layers[0].frustum.texelWorldSize() * std::max(d.x, std::max(d.y, d.z));
@@ -263,8 +267,7 @@ struct LightLayers {
 std::vector<LightLayers> shadowedLights(const RenderDebug& debug) {
     std::vector<LightLayers> out;
     for (std::size_t k = 0; k < debug.layers.size(); ++k) {
-        if (out.empty() || out.back().light != debug.layers[k].light)
-            out.push_back({debug.layers[k].light, int(k), 0});
+        if (out.empty() || out.back().light != debug.layers[k].light) out.push_back({debug.layers[k].light, int(k), 0});
         ++out.back().count;
     }
     return out;
@@ -361,8 +364,8 @@ struct Stroke {
 
 // One stroke of the projected segment: in front of the surface solid, behind it dashed (3 px on,
 // 3 off) and mixed half way into what is under it.
-void drawSegment(DisplayImage& img, const DepthBuffer& depth, const ScreenSegment& s,
-                 const std::array<float, 3>& color, int width, Stroke stroke) {
+void drawSegment(DisplayImage& img, const DepthBuffer& depth, const ScreenSegment& s, const std::array<float, 3>& color,
+                 int width, Stroke stroke) {
     // Liang–Barsky against the image rectangle, in the screen parameter t (0 at a, 1 at b).
     const double dx = s.b.x - s.a.x, dy = s.b.y - s.a.y;
     double t0 = 0.0, t1 = 1.0;
@@ -374,8 +377,10 @@ void drawSegment(DisplayImage& img, const DepthBuffer& depth, const ScreenSegmen
             continue;
         }
         const double r = q[k] / p[k];
-        if (p[k] < 0.0) t0 = std::max(t0, r);
-        else t1 = std::min(t1, r);
+        if (p[k] < 0.0)
+            t0 = std::max(t0, r);
+        else
+            t1 = std::min(t1, r);
     }
     if (!(t0 <= t1)) return;
     const double length = std::hypot(dx, dy) * (t1 - t0);
@@ -429,7 +434,8 @@ void legendRow(DisplayImage& img, int x0, int y0, int scale, const std::array<fl
     fill(img, x0, y0, side, side, {0.0f, 0.0f, 0.0f});
     for (int y = 0; y < side - 2 * scale; ++y)
         for (int x = 0; x < side - 2 * scale; ++x)
-            if (!stripes || ((x + y) / kLeakStripeWidth) % 2 == 0) fill(img, x0 + scale + x, y0 + scale + y, 1, 1, color);
+            if (!stripes || ((x + y) / kLeakStripeWidth) % 2 == 0)
+                fill(img, x0 + scale + x, y0 + scale + y, 1, 1, color);
     drawLabel(img, x0 + side, y0, label, scale);
 }
 
@@ -479,7 +485,8 @@ DisplayImage lightFrustumView(const scene::Frame& frame, const scene::Scene& sce
             const bool cascaded = light.type == scene::LightType::Directional && ll.count > 1;
             for (int k = 0; k < ll.count; ++k) {
                 const std::array<float, 3> color = cascaded ? cascadeTint(k) : lightTint(light);
-                const std::array<scene::Vec3, 8> corners = frustumCorners(debug.layers[std::size_t(ll.first + k)].frustum);
+                const std::array<scene::Vec3, 8> corners =
+                    frustumCorners(debug.layers[std::size_t(ll.first + k)].frustum);
                 for (const auto& e : kFrustumEdges)
                     if (const auto s = projectSegment(cam, scene.camera.near, corners[std::size_t(e[0])],
                                                       corners[std::size_t(e[1])]))

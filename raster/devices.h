@@ -10,10 +10,10 @@
 namespace shadowlab::raster {
 
 struct DeviceReport {
-    int index = 0;               // position in vkEnumeratePhysicalDevices; what --device N selects
-    std::string name;            // VkPhysicalDeviceProperties::deviceName
-    std::string type;            // "cpu", "integrated-gpu", "discrete-gpu", "virtual-gpu", "other"
-    std::string driverName;      // VkPhysicalDeviceDriverProperties
+    int index = 0;           // position in vkEnumeratePhysicalDevices; what --device N selects
+    std::string name;        // VkPhysicalDeviceProperties::deviceName
+    std::string type;        // "cpu", "integrated-gpu", "discrete-gpu", "virtual-gpu", "other"
+    std::string driverName;  // VkPhysicalDeviceDriverProperties
     std::string driverInfo;
     std::uint32_t apiVersion = 0;
     std::string apiVersionText;  // "1.3.230"

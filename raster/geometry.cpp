@@ -66,8 +66,10 @@ void addSphere(Builder& b, const scene::Sphere& s, int segments) {
 void addQuad(Builder& b, const scene::Quad& q) {
     const Vec3 du = 0.5 * q.size.x * q.uAxis;
     const Vec3 dv = 0.5 * q.size.y * q.vAxis;
-    b.quad(b.vertex(q.center - du - dv, q.normal, q.uvMin), b.vertex(q.center + du - dv, q.normal, {q.uvMax.x, q.uvMin.y}),
-           b.vertex(q.center + du + dv, q.normal, q.uvMax), b.vertex(q.center - du + dv, q.normal, {q.uvMin.x, q.uvMax.y}));
+    b.quad(b.vertex(q.center - du - dv, q.normal, q.uvMin),
+           b.vertex(q.center + du - dv, q.normal, {q.uvMax.x, q.uvMin.y}),
+           b.vertex(q.center + du + dv, q.normal, q.uvMax),
+           b.vertex(q.center - du + dv, q.normal, {q.uvMin.x, q.uvMax.y}));
 }
 
 void addBox(Builder& b, const scene::Box& box) {
@@ -93,8 +95,7 @@ void addBox(Builder& b, const scene::Box& box) {
 // vertex buffer, and its cost is per placed triangle anyway.
 void addMesh(Builder& b, const scene::Object& o, const scene::Mesh& m) {
     for (const scene::MeshInstance& inst : m.instances) {
-        if (!inst.geometry)
-            throw RasterError(o.name + ": mesh " + m.file.string() + " has no loaded geometry");
+        if (!inst.geometry) throw RasterError(o.name + ": mesh " + m.file.string() + " has no loaded geometry");
         const scene::TriangleMesh& g = *inst.geometry;
         const glm::dmat3 nm = scene::normalMatrix(inst.transform);
         std::uint32_t base = 0;
@@ -107,8 +108,7 @@ void addMesh(Builder& b, const scene::Object& o, const scene::Mesh& m) {
         for (std::size_t t = 0; t + 2 < g.indices.size(); t += 3)
             b.triangle(base + g.indices[t], base + g.indices[t + 1], base + g.indices[t + 2]);
     }
-    if (m.instances.empty())
-        throw RasterError(o.name + ": mesh " + m.file.string() + " has no loaded geometry");
+    if (m.instances.empty()) throw RasterError(o.name + ": mesh " + m.file.string() + " has no loaded geometry");
 }
 
 }  // namespace

@@ -13,8 +13,8 @@
 namespace shadowlab::raster {
 
 struct Vertex {
-    glm::vec3 position{0.0f};  // world position minus the origin (camera-relative)
-    glm::vec3 normal{0.0f};    // unit; flat per face for boxes, per vertex for spheres and meshes
+    glm::vec3 position{0.0f};    // world position minus the origin (camera-relative)
+    glm::vec3 normal{0.0f};      // unit; flat per face for boxes, per vertex for spheres and meshes
     std::uint32_t objectId = 0;  // object index + 1
 };
 static_assert(sizeof(Vertex) == 28, "vertex layout is declared to the pipelines with this stride");

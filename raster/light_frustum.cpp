@@ -65,8 +65,8 @@ MapExtent orthographicExtent(std::span<const Vec3> points, const LightFrustum& f
 }
 
 struct Plane {
-    Vec3 n;      // inward normal
-    double d;    // inside: dot(n, p) + d >= 0
+    Vec3 n;    // inward normal
+    double d;  // inside: dot(n, p) + d >= 0
 };
 
 // Sutherland–Hodgman: the part of convex polygon `poly` on the inner side of `plane`.
@@ -245,8 +245,8 @@ LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const Vec
     return f;
 }
 
-LightFrustum fitSpotLight(const scene::Bounds& bounds, const Vec3& position, const Vec3& direction,
-                          double coneDegrees, int mapSize) {
+LightFrustum fitSpotLight(const scene::Bounds& bounds, const Vec3& position, const Vec3& direction, double coneDegrees,
+                          int mapSize) {
     LightFrustum f;
     f.perspective = true;
     setBasis(f, direction);
@@ -352,10 +352,11 @@ glm::dmat4 LightFrustum::toTexture(const Vec3& origin) const {
 std::string LightFrustum::describe() const {
     char buf[400];
     if (perspective && windowU == 0.0 && windowV == 0.0)
-        std::snprintf(buf, sizeof buf,
-                      "perspective position=(%.9g,%.9g,%.9g) direction=(%.9g,%.9g,%.9g) half_fov_deg=%.9g near=%.9g far=%.9g",
-                      position.x, position.y, position.z, direction.x, direction.y, direction.z,
-                      std::atan(tanHalfFov) * 180.0 / kPi, near, far);
+        std::snprintf(
+            buf, sizeof buf,
+            "perspective position=(%.9g,%.9g,%.9g) direction=(%.9g,%.9g,%.9g) half_fov_deg=%.9g near=%.9g far=%.9g",
+            position.x, position.y, position.z, direction.x, direction.y, direction.z,
+            std::atan(tanHalfFov) * 180.0 / kPi, near, far);
     else if (perspective)  // an off-center window: its tangent ranges across the axis
         std::snprintf(buf, sizeof buf,
                       "perspective position=(%.9g,%.9g,%.9g) direction=(%.9g,%.9g,%.9g) half_fov_deg=%.9g "
@@ -364,10 +365,10 @@ std::string LightFrustum::describe() const {
                       std::atan(tanHalfFov) * 180.0 / kPi, windowU - tanHalfFov, windowU + tanHalfFov,
                       windowV - tanHalfFov, windowV + tanHalfFov, near, far);
     else
-        std::snprintf(buf, sizeof buf,
-                      "orthographic center=(%.9g,%.9g,%.9g) half_width=%.9g direction=(%.9g,%.9g,%.9g) depth=%.9g..%.9g",
-                      center.x, center.y, center.z, halfWidth, direction.x, direction.y, direction.z, nearDepth,
-                      farDepth);
+        std::snprintf(
+            buf, sizeof buf,
+            "orthographic center=(%.9g,%.9g,%.9g) half_width=%.9g direction=(%.9g,%.9g,%.9g) depth=%.9g..%.9g",
+            center.x, center.y, center.z, halfWidth, direction.x, direction.y, direction.z, nearDepth, farDepth);
     return buf;
 }
 
@@ -418,7 +419,9 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
             if (std::size_t(lp.light) == i) return lp.needsShadowTest;
         return false;
     };
-    auto keep = [&](const std::string& why) { return ShadowMapSizeChoice{size, std::to_string(size) + " (" + why + ")"}; };
+    auto keep = [&](const std::string& why) {
+        return ShadowMapSizeChoice{size, std::to_string(size) + " (" + why + ")"};
+    };
     // A size set after resolveSettings() (a test, the sweep) is forced too.
     if (!settings.shadowMapSizeIsDefault || size != scene::kDefaultShadowMapSize)
         return keep("set by --shadow-map-size or the scene");
@@ -439,7 +442,9 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
     // pixelWorldSize); tilted receivers have larger footprints, so this is the finest detail the
     // image can show.
     auto pixelAt = [&](double zc) { return 2.0 * cam.tanHalfFovY * zc / std::max(scene.camera.height, 1); };
-    auto viewDepth = [&](const Vec3& p) { return std::max(glm::dot(p - cam.position, cam.forward), scene.camera.near); };
+    auto viewDepth = [&](const Vec3& p) {
+        return std::max(glm::dot(p - cam.position, cam.forward), scene.camera.near);
+    };
     // The largest distance(p) / view depth over the visible polytopes' vertices (and 0).
     auto maxOverViewDepth = [&](auto distance) {
         double ratio = 0.0;
@@ -457,7 +462,7 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
     };
     double needed = 0.0;  // texels, rounded up to a power of two below
     double asked = 0.0;   // the same before a fitted spot's own size bounds it: what the cap cuts
-    int neededSize = 0;     // a size some light needs as it is (fitted spot windows)
+    int neededSize = 0;   // a size some light needs as it is (fitted spot windows)
     std::string why;
     char buf[320];
     if (directional) {
@@ -480,8 +485,9 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
         double widest = 0.0;
         for (const LightFrustum& f : maps) widest = std::max(widest, 2.0 * f.halfWidth);
         needed = widest / pixel;
-        std::snprintf(buf, sizeof buf, "map width %.4g / smallest pixel footprint %.4g at view depth %.4g = %.0f texels",
-                      widest, pixel, zMin, needed);
+        std::snprintf(buf, sizeof buf,
+                      "map width %.4g / smallest pixel footprint %.4g at view depth %.4g = %.0f texels", widest, pixel,
+                      zMin, needed);
         why = buf;
         // The casters' detail: k texels across the smallest feature of any object that can shade a
         // visible receiver, in the widest map.
@@ -510,10 +516,11 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
             spotNeeded = window * ratio / pixelAt(1.0);
             if (spotNeeded <= n || n >= size) break;
         }
-        std::snprintf(buf, sizeof buf,
-                      "%sspot %zu: 2·tan(half %s) %.4g x (distance / view depth) %.4g / pixel %.4g at view depth 1 = %.0f texels",
-                      why.empty() ? "" : "; ", i, settings.fitLightFrustum ? "window" : "fov", window, ratio,
-                      pixelAt(1.0), spotNeeded);
+        std::snprintf(
+            buf, sizeof buf,
+            "%sspot %zu: 2·tan(half %s) %.4g x (distance / view depth) %.4g / pixel %.4g at view depth 1 = %.0f texels",
+            why.empty() ? "" : "; ", i, settings.fitLightFrustum ? "window" : "fov", window, ratio, pixelAt(1.0),
+            spotNeeded);
         why += buf;
         needed = std::max(needed, std::min(spotNeeded, double(n)));
         asked = std::max(asked, spotNeeded);
@@ -581,7 +588,6 @@ ShadowMapSizeChoice chooseShadowMapSize(const scene::Scene& scene, const scene::
 
 namespace {
 
-
 // The receivers' extent in a perspective map: of their hull's part in front of the light (d > 0).
 // The hull's vertices with d > 0 project to finite (u, v); the rest of that part lies near where
 // an edge from such a vertex a to one behind, b, crosses the plane d = 0, at c. Along that edge
@@ -623,7 +629,6 @@ MapExtent perspectiveReceiverExtent(const std::vector<Vec3>& receivers, const Li
     e.maxV = std::clamp(e.maxV, f.windowV - t, f.windowV + t);
     return e;
 }
-
 
 }  // namespace
 
@@ -794,7 +799,7 @@ LightFrustum fitSpotLightToReceivers(const scene::Scene& scene, const scene::Lig
     const std::vector<Vec3> receivers = visibleReceiverPoints(scene);
     if (receivers.empty()) return f;
     const MapExtent r = perspectiveReceiverExtent(receivers, f);  // clamped to the cone's square
-    if (r.empty()) return f;  // no receiver in front of the light
+    if (r.empty()) return f;                                      // no receiver in front of the light
     bool inFront = true;
     for (const Vec3& p : receivers) inFront = inFront && glm::dot(p - f.position, f.direction) > 0.0;
     // The window: half-size h with the receivers' half-extent e, margin m texels and half a texel
@@ -823,7 +828,8 @@ LightFrustum spotLightFrustum(const scene::Scene& scene, const scene::RasterSett
     if (!settings.fitLightFrustum) return cone;
     // The fitted window's center lies in the cone's square and its half-size is below the cone's,
     // so no direction it holds has a tangent beyond 2·t.
-    return fitSpotLightToReceivers(scene, light, mapSize, fitMarginTexels(settings, light, mapSize, 2.0 * cone.tanHalfFov));
+    return fitSpotLightToReceivers(scene, light, mapSize,
+                                   fitMarginTexels(settings, light, mapSize, 2.0 * cone.tanHalfFov));
 }
 
 LightFrustum fitPointLightFaceToReceivers(const scene::Scene& scene, const scene::Light& light, int face, int mapSize,

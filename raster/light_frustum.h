@@ -16,11 +16,11 @@
 namespace shadowlab::raster {
 
 struct LightFrustum {
-    bool perspective = false;  // spot light
+    bool perspective = false;         // spot light
     scene::Vec3 direction{0, -1, 0};  // unit, the way the light travels (the map looks along it)
     scene::Vec3 right{1, 0, 0};       // unit, the map's +u axis
     scene::Vec3 up{0, 0, 1};          // unit, the map's +v axis (v grows with framebuffer rows)
-    int mapSize = 1;           // texels per side
+    int mapSize = 1;                  // texels per side
     // Orthographic: the map spans center ± halfWidth across, and depth 0..1 runs from
     // center − halfWidth·direction to center + halfWidth·direction... unless fitted, where
     // nearDepth/farDepth (along direction, relative to center) bound it.
@@ -152,7 +152,6 @@ LightFrustum fitPointLightFaceToReceivers(const scene::Scene& scene, const scene
 // Face `face` of `light`'s cube map: fitted when settings.fitLightFrustum.
 LightFrustum pointLightFaceFrustum(const scene::Scene& scene, const scene::RasterSettings& settings,
                                    const scene::Light& light, int face, int mapSize);
-
 
 // Caster culling: which objects can shadow a receiver that reads map f. An object is
 // left out of f's depth pass when it cannot write a depth any visible receiver's shadow test reads

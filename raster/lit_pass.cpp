@@ -41,33 +41,55 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkD
     requireFormat(ctx, kLitDepthFormat, VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT, "the camera depth buffer");
     VkDevice device = ctx.device.get();
     const VkDescriptorSetLayoutBinding bindings[] = {
-        {.binding = 0, .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .descriptorCount = 1,
+        {.binding = 0,
+         .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+         .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT},
         // Per-object albedo, read by lit.vert (and passed on flat).
-        {.binding = 1, .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, .descriptorCount = 1,
+        {.binding = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+         .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_VERTEX_BIT},
-        {.binding = 2, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
+        {.binding = 2,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+         .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
-        {.binding = 3, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
+        {.binding = 3,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+         .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
         // The shadow maps' raw depths (no compare), for the PCSS blocker search.
-        {.binding = 4, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
+        {.binding = 4,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+         .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
         // The transmittance maps: the product of 1 − opacity, and the nearest transparent depth.
-        {.binding = 5, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
+        {.binding = 5,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+         .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
-        {.binding = 6, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
+        {.binding = 6,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+         .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
         // Behind the nearest transparent layer: the product of the rest, and their nearest depth.
-        {.binding = 7, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
+        {.binding = 7,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+         .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
-        {.binding = 8, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
+        {.binding = 8,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+         .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
         // The filterable maps' blurred moments (raster/moment_maps.h), linearly filtered.
-        {.binding = 9, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
+        {.binding = 9,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+         .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
         // Each layer's transmittance window (shaders::TransmitWindows).
-        {.binding = 10, .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .descriptorCount = 1,
+        {.binding = 10,
+         .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+         .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
     };
     const VkDescriptorSetLayoutCreateInfo setInfo{
@@ -98,14 +120,23 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkD
     // stages get them all.
     constexpr std::uint32_t kConstants = 17;
     const scene::MomentSettings& m = variant.moments;
-    const std::int32_t constants[kConstants] = {
-        std::int32_t(variant.filter),     variant.blockerIds ? 1 : 0,       std::int32_t(variant.lightCount),
-        std::int32_t(variant.lightKinds), std::int32_t(variant.cascades),   variant.transmittance ? 1 : 0,
-        variant.receiverPlane ? 1 : 0,    variant.cascadeBlend ? 1 : 0,     variant.displayTarget ? 0 : 1,
-        variant.normalOffset ? 1 : 0,     variant.vertexLightConstants ? 1 : 0,
-        std::bit_cast<std::int32_t>(float(m.minVariance)), std::bit_cast<std::int32_t>(float(m.bleedReduction)),
-        std::bit_cast<std::int32_t>(float(m.evsmPositive)), std::bit_cast<std::int32_t>(float(m.evsmNegative)),
-        std::bit_cast<std::int32_t>(float(m.esmExponent)), std::bit_cast<std::int32_t>(float(m.momentBias))};
+    const std::int32_t constants[kConstants] = {std::int32_t(variant.filter),
+                                                variant.blockerIds ? 1 : 0,
+                                                std::int32_t(variant.lightCount),
+                                                std::int32_t(variant.lightKinds),
+                                                std::int32_t(variant.cascades),
+                                                variant.transmittance ? 1 : 0,
+                                                variant.receiverPlane ? 1 : 0,
+                                                variant.cascadeBlend ? 1 : 0,
+                                                variant.displayTarget ? 0 : 1,
+                                                variant.normalOffset ? 1 : 0,
+                                                variant.vertexLightConstants ? 1 : 0,
+                                                std::bit_cast<std::int32_t>(float(m.minVariance)),
+                                                std::bit_cast<std::int32_t>(float(m.bleedReduction)),
+                                                std::bit_cast<std::int32_t>(float(m.evsmPositive)),
+                                                std::bit_cast<std::int32_t>(float(m.evsmNegative)),
+                                                std::bit_cast<std::int32_t>(float(m.esmExponent)),
+                                                std::bit_cast<std::int32_t>(float(m.momentBias))};
     VkSpecializationMapEntry entries[kConstants];
     for (std::uint32_t i = 0; i < kConstants; ++i) entries[i] = {i, 4 * i, 4};
     const VkSpecializationInfo specialization{
@@ -115,19 +146,19 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkD
         colorFormats.insert(colorFormats.end(), kLitPlanes - 1, kLitPlaneFormat);
         colorFormats.insert(colorFormats.end(), variant.lightTargets, kLitLightsFormat);
     }
-    p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{
-                                                 .vertexShader = p.alpha ? shaders::litVertAlphaSpirv()
-                                                                         : shaders::litVertSpirv(),
-                                                 .fragmentShader = litFragment(variant, p.alpha),
-                                                 .fragmentSpecialization = &specialization,
-                                                 .vertexSpecialization = &specialization,
-                                                 .layout = layout,
-                                                 .usesUv = p.alpha,
-                                                 .colorFormats = colorFormats,
-                                                 .depthFormat = kLitDepthFormat,
-                                                 // Reversed Z: nearer is larger.
-                                                 .depthCompare = VK_COMPARE_OP_GREATER,
-                                             });
+    p.pipeline = createGraphicsPipeline(
+        ctx, PipelineDesc{
+                 .vertexShader = p.alpha ? shaders::litVertAlphaSpirv() : shaders::litVertSpirv(),
+                 .fragmentShader = litFragment(variant, p.alpha),
+                 .fragmentSpecialization = &specialization,
+                 .vertexSpecialization = &specialization,
+                 .layout = layout,
+                 .usesUv = p.alpha,
+                 .colorFormats = colorFormats,
+                 .depthFormat = kLitDepthFormat,
+                 // Reversed Z: nearer is larger.
+                 .depthCompare = VK_COMPARE_OP_GREATER,
+             });
     if (!variant.displayTarget) {
         // The background: where the depth is still the cleared far plane (0), which no fragment
         // of the scene can leave there (GREATER than 0 to be drawn). Its color as specialization
@@ -140,20 +171,20 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkD
         const VkSpecializationMapEntry colorEntries[3] = {{0, 0, 4}, {1, 4, 4}, {2, 8, 4}};
         const VkSpecializationInfo colorInfo{
             .mapEntryCount = 3, .pMapEntries = colorEntries, .dataSize = sizeof color, .pData = color};
-        p.background = createGraphicsPipeline(ctx, PipelineDesc{
-                                                       .vertexShader = shaders::backgroundVertSpirv(),
-                                                       .fragmentShader = !variant.aovTarget ? shaders::backgroundFragBeautySpirv()
-                                                                         : variant.lightTargets > 0
-                                                                             ? shaders::backgroundFragLightsSpirv()
-                                                                             : shaders::backgroundFragSpirv(),
-                                                       .fragmentSpecialization = &colorInfo,
-                                                       .layout = backgroundLayout,
-                                                       .vertexBuffer = false,
-                                                       .colorFormats = colorFormats,
-                                                       .depthFormat = kLitDepthFormat,
-                                                       .depthCompare = VK_COMPARE_OP_EQUAL,
-                                                       .depthWrite = false,
-                                                   });
+        p.background = createGraphicsPipeline(
+            ctx, PipelineDesc{
+                     .vertexShader = shaders::backgroundVertSpirv(),
+                     .fragmentShader = !variant.aovTarget         ? shaders::backgroundFragBeautySpirv()
+                                       : variant.lightTargets > 0 ? shaders::backgroundFragLightsSpirv()
+                                                                  : shaders::backgroundFragSpirv(),
+                     .fragmentSpecialization = &colorInfo,
+                     .layout = backgroundLayout,
+                     .vertexBuffer = false,
+                     .colorFormats = colorFormats,
+                     .depthFormat = kLitDepthFormat,
+                     .depthCompare = VK_COMPARE_OP_EQUAL,
+                     .depthWrite = false,
+                 });
     }
     return p;
 }
@@ -162,8 +193,8 @@ std::size_t litPlaneTexelBytes(const LitTargets& targets, LitPlane plane) {
     return plane == LitPlane::kBeauty ? targets.beautyTexelBytes : 4;
 }
 
-LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32_t height,
-                            std::uint32_t lightTargets, bool readInPlace) {
+LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32_t height, std::uint32_t lightTargets,
+                            bool readInPlace) {
     const std::uint32_t limit = ctx.properties.limits.maxImageDimension2D;
     if (width > limit || height > limit)
         throw RasterError("image " + std::to_string(width) + "x" + std::to_string(height) +
@@ -172,10 +203,10 @@ LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32
     // A target per channel, and two for eight lights' visibility: 6 + 2 attachments.
     const std::uint32_t attachments = kLitPlanes + lightTargets;
     if (ctx.properties.limits.maxColorAttachments < attachments)
-        throw RasterError("the lit pass renders into " + std::to_string(attachments) + " color targets (one per Frame " +
-                          "channel" + (lightTargets ? ", and the per-light visibility" : "") + "), and " +
-                          ctx.deviceReport.name + " allows " +
-                          std::to_string(ctx.properties.limits.maxColorAttachments) + "; choose another device with --device");
+        throw RasterError(
+            "the lit pass renders into " + std::to_string(attachments) + " color targets (one per Frame " + "channel" +
+            (lightTargets ? ", and the per-light visibility" : "") + "), and " + ctx.deviceReport.name + " allows " +
+            std::to_string(ctx.properties.limits.maxColorAttachments) + "; choose another device with --device");
     LitTargets t;
     t.width = width;
     t.height = height;
@@ -194,8 +225,7 @@ LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32
     requireFormat(ctx, kLitDepthFormat, VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT, "the camera depth buffer");
     // The planes (the beauty and five floats), the light targets, D32 depth, as many readback
     // buffers, and the RGBA8 display target.
-    requireDeviceMemory(ctx,
-                        VkDeviceSize(width) * height * ((t.beautyTexelBytes + 20 + lightTargets * 16) * 2 + 4 + 4),
+    requireDeviceMemory(ctx, VkDeviceSize(width) * height * ((t.beautyTexelBytes + 20 + lightTargets * 16) * 2 + 4 + 4),
                         "a " + std::to_string(width) + "x" + std::to_string(height) + " image");
     for (std::uint32_t p = 0; p < kLitPlanes; ++p) {
         const VkFormat format = p == 0 ? t.beautyFormat : kLitPlaneFormat;
@@ -204,8 +234,8 @@ LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32
         // Rendering into a Frame's memory needs the Frame's layout: the host-readable path, RGB
         // beauty, rows without padding.
         if (t.hostReadable && (p > 0 || rgbTarget))
-            t.frameImageBytes[p] = hostImageBytes(ctx, format, width, height, kLitTargetUsage,
-                                                  litPlaneTexelBytes(t, LitPlane(p)));
+            t.frameImageBytes[p] =
+                hostImageBytes(ctx, format, width, height, kLitTargetUsage, litPlaneTexelBytes(t, LitPlane(p)));
     }
     t.depth = createImage(ctx, kLitDepthFormat, width, height, 1, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
                           VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_VIEW_TYPE_2D);
@@ -222,7 +252,8 @@ LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32
 
 LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, const shaders::LitUniforms& uniforms,
                               const shaders::TransmitWindows& windows, const std::vector<glm::vec4>& albedos,
-                              const ShadowMaps& maps, const TransmittanceMaps& transmittance, const MomentMaps& moments) {
+                              const ShadowMaps& maps, const TransmittanceMaps& transmittance,
+                              const MomentMaps& moments) {
     VkDevice device = ctx.device.get();
     LitBindings b;
     // A depth-compare sampler: result = (ref <= stored), i.e. "receiver depth - bias <= stored
@@ -304,7 +335,8 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
     const VkDescriptorBufferInfo windowInfo{b.transmitWindows.buffer.get(), 0, VK_WHOLE_SIZE};
     const VkDescriptorImageInfo imageInfo{sampler, maps.depth.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkDescriptorImageInfo idInfo{idSampler, maps.ids.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-    const VkDescriptorImageInfo depthInfo{depthSampler, maps.depth.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    const VkDescriptorImageInfo depthInfo{depthSampler, maps.depth.view.get(),
+                                          VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     // The transmittance maps use the raw-depth sampler: NEAREST, border 1 (all light, nothing near).
     const VkDescriptorImageInfo transmittanceInfo{depthSampler, transmittance.transmittance.view.get(),
                                                   VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
@@ -317,28 +349,72 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
     const VkDescriptorImageInfo momentInfo{momentSampler, moments.moments.view.get(),
                                            VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkWriteDescriptorSet writes[] = {
-        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 0, .descriptorCount = 1,
-         .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .pBufferInfo = &uniformInfo},
-        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 1, .descriptorCount = 1,
-         .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, .pBufferInfo = &albedoInfo},
-        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 2, .descriptorCount = 1,
-         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &imageInfo},
-        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 3, .descriptorCount = 1,
-         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &idInfo},
-        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 4, .descriptorCount = 1,
-         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &depthInfo},
-        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 5, .descriptorCount = 1,
-         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &transmittanceInfo},
-        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 6, .descriptorCount = 1,
-         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &nearInfo},
-        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 7, .descriptorCount = 1,
-         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &restInfo},
-        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 8, .descriptorCount = 1,
-         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &secondInfo},
-        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 9, .descriptorCount = 1,
-         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &momentInfo},
-        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = b.set, .dstBinding = 10, .descriptorCount = 1,
-         .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .pBufferInfo = &windowInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+         .dstSet = b.set,
+         .dstBinding = 0,
+         .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+         .pBufferInfo = &uniformInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+         .dstSet = b.set,
+         .dstBinding = 1,
+         .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+         .pBufferInfo = &albedoInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+         .dstSet = b.set,
+         .dstBinding = 2,
+         .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+         .pImageInfo = &imageInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+         .dstSet = b.set,
+         .dstBinding = 3,
+         .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+         .pImageInfo = &idInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+         .dstSet = b.set,
+         .dstBinding = 4,
+         .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+         .pImageInfo = &depthInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+         .dstSet = b.set,
+         .dstBinding = 5,
+         .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+         .pImageInfo = &transmittanceInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+         .dstSet = b.set,
+         .dstBinding = 6,
+         .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+         .pImageInfo = &nearInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+         .dstSet = b.set,
+         .dstBinding = 7,
+         .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+         .pImageInfo = &restInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+         .dstSet = b.set,
+         .dstBinding = 8,
+         .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+         .pImageInfo = &secondInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+         .dstSet = b.set,
+         .dstBinding = 9,
+         .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+         .pImageInfo = &momentInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+         .dstSet = b.set,
+         .dstBinding = 10,
+         .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+         .pBufferInfo = &windowInfo},
     };
     vkUpdateDescriptorSets(device, 11, writes, 0, nullptr);
     return b;
@@ -362,14 +438,14 @@ void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const 
                           targets.hostReadable ? VK_PIPELINE_STAGE_2_HOST_BIT : VK_PIPELINE_STAGE_2_COPY_BIT,
                           VK_ACCESS_2_NONE, colorStage, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT});
         const bool isBeauty = i == 0;  // (the sRGB target encodes the linear clear color)
-        colors.push_back({.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
-                          .imageView = attachments.views[i],
-                          .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                          .loadOp = clear ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_DONT_CARE,
-                          .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
-                          .clearValue = {.color = {.float32 = {isBeauty ? background.r : 0.0f,
-                                                               isBeauty ? background.g : 0.0f,
-                                                               isBeauty ? background.b : 0.0f, 0.0f}}}});
+        colors.push_back(
+            {.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+             .imageView = attachments.views[i],
+             .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+             .loadOp = clear ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+             .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+             .clearValue = {.color = {.float32 = {isBeauty ? background.r : 0.0f, isBeauty ? background.g : 0.0f,
+                                                  isBeauty ? background.b : 0.0f, 0.0f}}}});
     }
     before.push_back({targets.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
                       VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, depthStages,
@@ -452,7 +528,9 @@ Readback createReadback(const Context& ctx, const LitTargets& targets) {
 void recordReadback(VkCommandBuffer commands, const LitTargets& targets, const Readback& readback,
                     const ReadbackSelection& selection) {
     const VkBufferImageCopy region{
-        .imageSubresource = {.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT, .mipLevel = 0, .baseArrayLayer = 0,
+        .imageSubresource = {.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT,
+                             .mipLevel = 0,
+                             .baseArrayLayer = 0,
                              .layerCount = 1},
         .imageExtent = {targets.width, targets.height, 1},
     };

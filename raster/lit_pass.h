@@ -36,18 +36,18 @@ inline constexpr VkFormat kLitDisplayFormat = VK_FORMAT_R8G8B8A8_SRGB;
 // the work they skip.
 struct LitVariant {
     scene::ShadowFilter filter = scene::ShadowFilter::Pcf2x2;  // of every light
-    bool blockerIds = true;         // look up blocker ids (the blocker-id maps must be rendered)
-    bool aovTarget = true;          // false: the beauty target only (no AOVs, no per-light targets)
-    bool displayTarget = false;     // the beauty target is kLitDisplayFormat (implies !aovTarget)
-    bool normalOffset = true;       // a normal offset is set (false: its code is left out)
+    bool blockerIds = true;                    // look up blocker ids (the blocker-id maps must be rendered)
+    bool aovTarget = true;                     // false: the beauty target only (no AOVs, no per-light targets)
+    bool displayTarget = false;                // the beauty target is kLitDisplayFormat (implies !aovTarget)
+    bool normalOffset = true;                  // a normal offset is set (false: its code is left out)
     VkFormat beautyFormat = kLitBeautyFormat;  // the float beauty target's (LitTargets::beautyFormat)
-    std::uint32_t lightTargets = 0;  // 0, or kLightTargets: per-light visibility targets
-    std::uint32_t lightCount = 1;    // = LitUniforms::lightCount
-    std::uint32_t lightKinds = 7;    // bit (1 << SHADOWLAB_LIGHT_*) for each kind in the scene
-    std::uint32_t cascades = 1;      // cascades of the cascaded directional lights (1: none cascaded)
-    bool transmittance = false;      // semi-transparent casters: read the transmittance maps
-    bool receiverPlane = false;      // receiver-plane depth bias in every filter tap
-    bool cascadeBlend = false;       // blend bands before the cascade splits (LitUniforms::cascadeBlendBand)
+    std::uint32_t lightTargets = 0;            // 0, or kLightTargets: per-light visibility targets
+    std::uint32_t lightCount = 1;              // = LitUniforms::lightCount
+    std::uint32_t lightKinds = 7;              // bit (1 << SHADOWLAB_LIGHT_*) for each kind in the scene
+    std::uint32_t cascades = 1;                // cascades of the cascaded directional lights (1: none cascaded)
+    bool transmittance = false;                // semi-transparent casters: read the transmittance maps
+    bool receiverPlane = false;                // receiver-plane depth bias in every filter tap
+    bool cascadeBlend = false;                 // blend bands before the cascade splits (LitUniforms::cascadeBlendBand)
     // Light 0's constants reach lit.frag as flat outputs of lit.vert instead of uniform reads
     // (shaders/lit_constants.glsl kVertexLightConstants); takes effect only where
     // usesVertexLightCoordinates().
@@ -91,7 +91,7 @@ struct LitTargets {
     std::size_t beautyTexelBytes = 12;         // 12 or 16
     // Per plane, hostImageBytes() for an image over a Frame's vector (0: not possible here).
     std::array<std::size_t, kLitPlanes> frameImageBytes{};
-    Image depth;   // reversed Z (cleared to 0 = far)
+    Image depth;  // reversed Z (cleared to 0 = far)
     // With lightTargets: light i's visibility in component i % 4 of lights[i / 4].
     std::vector<Image> lights;
     // The 8-bit sRGB beauty (kLitDisplayFormat), host-readable; only where the float targets are
@@ -108,7 +108,8 @@ struct LitTargets {
 LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32_t height,
                             std::uint32_t lightTargets = 0, bool readInPlace = true);
 // The usage of every float color target (the Renderer's and those over a Frame).
-inline constexpr VkImageUsageFlags kLitTargetUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+inline constexpr VkImageUsageFlags kLitTargetUsage =
+    VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
 // Bytes a texel of `plane` (the beauty: targets.beautyTexelBytes).
 std::size_t litPlaneTexelBytes(const LitTargets& targets, LitPlane plane);
 
@@ -116,9 +117,9 @@ std::size_t litPlaneTexelBytes(const LitTargets& targets, LitPlane plane);
 // depth-compare sampler (lit.frag builds the filters from its taps), blocker ids, and the
 // transmittance maps (placeholders in scenes without semi-transparent casters).
 struct LitBindings {
-    SamplerHandle sampler;    // depth compare, for the shadow maps
-    SamplerHandle idSampler;  // plain NEAREST, for the blocker ids
-    SamplerHandle depthSampler;  // plain NEAREST, the maps' raw depths (PCSS blocker search)
+    SamplerHandle sampler;        // depth compare, for the shadow maps
+    SamplerHandle idSampler;      // plain NEAREST, for the blocker ids
+    SamplerHandle depthSampler;   // plain NEAREST, the maps' raw depths (PCSS blocker search)
     SamplerHandle momentSampler;  // LINEAR, clamp to edge: the filterable maps' moments
     Buffer uniforms;
     Buffer transmitWindows;  // shaders::TransmitWindows
@@ -128,7 +129,8 @@ struct LitBindings {
 };
 LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, const shaders::LitUniforms& uniforms,
                               const shaders::TransmitWindows& windows, const std::vector<glm::vec4>& albedos,
-                              const ShadowMaps& maps, const TransmittanceMaps& transmittance, const MomentMaps& moments);
+                              const ShadowMaps& maps, const TransmittanceMaps& transmittance,
+                              const MomentMaps& moments);
 
 // Which targets a frame renders into, as its pipeline was made: every target, the float beauty
 // only (a pipeline without aovTarget), or the 8-bit display beauty only (displayTarget).

@@ -63,9 +63,8 @@ std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::Render
                 : 0) +
            // Alpha-tested casters: a UV per vertex (every vertex of the scene gets a slot in the
            // UV buffer, 3 · 8 bytes a triangle), the texels and one record per object.
-           (scene.hasAlphaCasters()
-                ? triangles * 24 + scene::alphaTextureBytes(scene) + scene.objects.size() * 32
-                : 0) +
+           (scene.hasAlphaCasters() ? triangles * 24 + scene::alphaTextureBytes(scene) + scene.objects.size() * 32
+                                    : 0) +
            scene.objects.size() * scene::kBackendBytesPerObject;
 }
 

@@ -27,9 +27,9 @@ void requireMomentFormat(const Context& ctx) {
 
 MomentMaps createMomentMaps(const Context& ctx, std::uint32_t size, std::uint32_t layers) {
     if (size > 1) requireMomentFormat(ctx);
-    requireDeviceMemory(ctx, VkDeviceSize(size) * size * layers * kMomentBytesPerTexel * kMomentArrays,
-                        std::to_string(layers) + " moment map(s) of " + std::to_string(size) + "x" +
-                            std::to_string(size));
+    requireDeviceMemory(
+        ctx, VkDeviceSize(size) * size * layers * kMomentBytesPerTexel * kMomentArrays,
+        std::to_string(layers) + " moment map(s) of " + std::to_string(size) + "x" + std::to_string(size));
     MomentMaps m;
     m.size = size;
     m.layers = layers;
@@ -53,11 +53,17 @@ MomentPipeline createMomentPipeline(const Context& ctx, const ShadowMaps& maps, 
     VkDevice device = ctx.device.get();
     MomentPipeline p;
     const VkDescriptorSetLayoutBinding bindings[] = {
-        {.binding = 0, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .descriptorCount = 1,
+        {.binding = 0,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+         .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_COMPUTE_BIT},
-        {.binding = 1, .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, .descriptorCount = 1,
+        {.binding = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+         .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_COMPUTE_BIT},
-        {.binding = 2, .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, .descriptorCount = 1,
+        {.binding = 2,
+         .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+         .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_COMPUTE_BIT},
     };
     const VkDescriptorSetLayoutCreateInfo setInfo{
@@ -104,10 +110,8 @@ MomentPipeline createMomentPipeline(const Context& ctx, const ShadowMaps& maps, 
 
     const VkDescriptorPoolSize sizes[] = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1},
                                           {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 2}};
-    const VkDescriptorPoolCreateInfo poolInfo{.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
-                                              .maxSets = 1,
-                                              .poolSizeCount = 2,
-                                              .pPoolSizes = sizes};
+    const VkDescriptorPoolCreateInfo poolInfo{
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1, .poolSizeCount = 2, .pPoolSizes = sizes};
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VK_CHECK(vkCreateDescriptorPool(device, &poolInfo, nullptr, &pool));
     p.pool = DescriptorPoolHandle(device, pool);
@@ -120,12 +124,24 @@ MomentPipeline createMomentPipeline(const Context& ctx, const ShadowMaps& maps, 
     const VkDescriptorImageInfo xInfo{VK_NULL_HANDLE, moments.blurredX.view.get(), VK_IMAGE_LAYOUT_GENERAL};
     const VkDescriptorImageInfo outInfo{VK_NULL_HANDLE, moments.moments.view.get(), VK_IMAGE_LAYOUT_GENERAL};
     const VkWriteDescriptorSet writes[] = {
-        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = p.set, .dstBinding = 0, .descriptorCount = 1,
-         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = &depthInfo},
-        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = p.set, .dstBinding = 1, .descriptorCount = 1,
-         .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, .pImageInfo = &xInfo},
-        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = p.set, .dstBinding = 2, .descriptorCount = 1,
-         .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, .pImageInfo = &outInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+         .dstSet = p.set,
+         .dstBinding = 0,
+         .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+         .pImageInfo = &depthInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+         .dstSet = p.set,
+         .dstBinding = 1,
+         .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+         .pImageInfo = &xInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+         .dstSet = p.set,
+         .dstBinding = 2,
+         .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+         .pImageInfo = &outInfo},
     };
     vkUpdateDescriptorSets(device, 3, writes, 0, nullptr);
     return p;
@@ -142,8 +158,8 @@ void recordMomentPasses(VkCommandBuffer commands, const MomentPipeline& pipeline
     // only) before the x pass's reads; both arrays' previous contents are not needed (UNDEFINED),
     // but the previous frame's lit pass may still read the moments (a reused Renderer).
     transition(commands,
-               {{maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, maps.layers, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+               {{maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, maps.layers,
+                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                  VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
                  VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                  VK_ACCESS_2_SHADER_SAMPLED_READ_BIT},
@@ -172,10 +188,10 @@ void recordMomentPasses(VkCommandBuffer commands, const MomentPipeline& pipeline
         }
     };
     dispatch(0);
-    transition(commands, {{moments.blurredX.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layerCount, VK_IMAGE_LAYOUT_GENERAL,
-                           VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                           VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                           VK_ACCESS_2_SHADER_STORAGE_READ_BIT}});
+    transition(commands,
+               {{moments.blurredX.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layerCount, VK_IMAGE_LAYOUT_GENERAL,
+                 VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT}});
     dispatch(1);
     transition(commands, {{moments.moments.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layerCount, VK_IMAGE_LAYOUT_GENERAL,
                            VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,

@@ -54,7 +54,9 @@ PipelineHandle createGraphicsPipeline(const Context& ctx, const PipelineDesc& de
         attributes.push_back({.location = 3, .binding = 1, .format = VK_FORMAT_R32G32_SFLOAT, .offset = 0});
     const VkPipelineVertexInputStateCreateInfo vertexInput{
         .sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
-        .vertexBindingDescriptionCount = !desc.vertexBuffer ? 0u : desc.usesUv ? 2u : 1u,
+        .vertexBindingDescriptionCount = !desc.vertexBuffer ? 0u
+                                         : desc.usesUv      ? 2u
+                                                            : 1u,
         .pVertexBindingDescriptions = bindings,
         .vertexAttributeDescriptionCount = desc.vertexBuffer ? std::uint32_t(attributes.size()) : 0u,
         .pVertexAttributeDescriptions = attributes.data(),
@@ -89,12 +91,11 @@ PipelineHandle createGraphicsPipeline(const Context& ctx, const PipelineDesc& de
         .maxDepthBounds = 1.0f,
     };
     std::vector<VkPipelineColorBlendAttachmentState> blend(
-        desc.colorFormats.size(),
-        VkPipelineColorBlendAttachmentState{
-            .blendEnable = VK_FALSE,
-            .colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
-                              VK_COLOR_COMPONENT_A_BIT,
-        });
+        desc.colorFormats.size(), VkPipelineColorBlendAttachmentState{
+                                      .blendEnable = VK_FALSE,
+                                      .colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
+                                                        VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT,
+                                  });
     if (desc.transmittanceBlend && blend.size() == 2) {
         // dst · src: result = src·0 + dst·src.
         blend[0].blendEnable = VK_TRUE;
@@ -156,13 +157,13 @@ void requireFormat(const Context& ctx, VkFormat format, VkFormatFeatureFlags fea
     vkGetPhysicalDeviceFormatProperties(ctx.physicalDevice, format, &props);
     if ((props.optimalTilingFeatures & features) != features)
         throw RasterError("the Vulkan device " + ctx.deviceReport.name + " does not support format " +
-                          std::to_string(int(format)) + " for " + purpose + " (features 0x" +
-                          std::to_string(features) + " missing); choose another device with --device");
+                          std::to_string(int(format)) + " for " + purpose + " (features 0x" + std::to_string(features) +
+                          " missing); choose another device with --device");
 }
 
 void setViewport(VkCommandBuffer commands, std::uint32_t width, std::uint32_t height) {
-    const VkViewport viewport{.x = 0, .y = 0, .width = float(width), .height = float(height),
-                              .minDepth = 0.0f, .maxDepth = 1.0f};
+    const VkViewport viewport{
+        .x = 0, .y = 0, .width = float(width), .height = float(height), .minDepth = 0.0f, .maxDepth = 1.0f};
     const VkRect2D scissor{.offset = {0, 0}, .extent = {width, height}};
     vkCmdSetViewport(commands, 0, 1, &viewport);
     vkCmdSetScissor(commands, 0, 1, &scissor);

@@ -14,11 +14,11 @@ ShaderModuleHandle createShaderModule(const Context& ctx, std::span<const std::u
 
 struct PipelineDesc {
     std::span<const std::uint32_t> vertexShader;
-    std::span<const std::uint32_t> fragmentShader;  // empty: depth only
+    std::span<const std::uint32_t> fragmentShader;                 // empty: depth only
     const VkSpecializationInfo* fragmentSpecialization = nullptr;  // the fragment stage's constants
     const VkSpecializationInfo* vertexSpecialization = nullptr;    // the vertex stage's
     VkPipelineLayout layout = VK_NULL_HANDLE;
-    bool usesNormal = true;  // declare vertex location 1; the validation layer warns about unused inputs
+    bool usesNormal = true;    // declare vertex location 1; the validation layer warns about unused inputs
     bool usesObjectId = true;  // declare vertex location 2 (the same warning)
     // Declare vertex location 3, the texture coordinates (vec2) of vertex binding 1 (alpha-tested
     // casters, raster/alpha_casters.h).

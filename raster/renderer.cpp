@@ -16,9 +16,9 @@
 #include <tuple>
 #include <variant>
 
+#include "raster/alpha_casters.h"
 #include "raster/cascades.h"
 #include "raster/context.h"
-#include "raster/alpha_casters.h"
 #include "raster/geometry.h"
 #include "raster/light_data.h"
 #include "raster/light_frustum.h"
@@ -89,7 +89,8 @@ bool isClosed(const SceneGeometry& g, std::size_t first, std::size_t count) {
         return std::array<float, 6>{p.x, p.y, p.z, q.x, q.y, q.z};
     };
     for (std::size_t t = first; t < first + count; t += 3)
-        for (int e = 0; e < 3; ++e) ++edges[key(g.indices[t + std::size_t(e)], g.indices[t + std::size_t((e + 1) % 3)])];
+        for (int e = 0; e < 3; ++e)
+            ++edges[key(g.indices[t + std::size_t(e)], g.indices[t + std::size_t((e + 1) % 3)])];
     for (const auto& [edge, uses] : edges)
         if (uses != 2) return false;
     return !edges.empty();
@@ -128,7 +129,7 @@ std::vector<TransparentDraw> separateTransparent(const scene::Scene& scene, Scen
         // Quads are open (one surface: every crossing counts); spheres and boxes closed; a mesh
         // by its edges.
         const scene::Shape& shape = scene.objects[o].shape;
-        d.closed = std::holds_alternative<scene::Quad>(shape)  ? false
+        d.closed = std::holds_alternative<scene::Quad>(shape)   ? false
                    : std::holds_alternative<scene::Mesh>(shape) ? isClosed(g, d.firstIndex, d.indexCount)
                                                                 : true;
         draws.push_back(d);
@@ -171,13 +172,14 @@ struct Renderer::Impl {
     // The Frame's vectors for `channels` sized (the others emptied), and where each plane of the
     // frame's pipeline is rendered: `frameImages` over the Frame's vectors where possible (their
     // planes set in `intoFrame`), the Renderer's own targets for the rest.
-    void prepareFrame(scene::Frame& frame, scene::ChannelMask channels, LitOutputs outputs,
-                      LitAttachments& attachments, std::vector<Image>& frameImages,
-                      std::array<bool, kLitPlanes>& intoFrame) const;
-    void readPixels(scene::Frame& frame, scene::ChannelMask channels, const std::array<bool, kLitPlanes>& intoFrame) const;
+    void prepareFrame(scene::Frame& frame, scene::ChannelMask channels, LitOutputs outputs, LitAttachments& attachments,
+                      std::vector<Image>& frameImages, std::array<bool, kLitPlanes>& intoFrame) const;
+    void readPixels(scene::Frame& frame, scene::ChannelMask channels,
+                    const std::array<bool, kLitPlanes>& intoFrame) const;
     void readDisplayPixels(scene::Frame& frame) const;
     void invalidateMemory(VkDeviceMemory memory) const {
-        const VkMappedMemoryRange range{.sType = VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE, .memory = memory, .size = VK_WHOLE_SIZE};
+        const VkMappedMemoryRange range{
+            .sType = VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE, .memory = memory, .size = VK_WHOLE_SIZE};
         VK_CHECK(vkInvalidateMappedMemoryRanges(ctx.device.get(), 1, &range));
     }
 
@@ -207,7 +209,7 @@ struct Renderer::Impl {
     Context ctx;
     Buffer vertexBuffer;
     Buffer indexBuffer;
-    AlphaCasters alpha;  // MASK or BLEND materials only (set == VK_NULL_HANDLE otherwise)
+    AlphaCasters alpha;        // MASK or BLEND materials only (set == VK_NULL_HANDLE otherwise)
     bool shadowAlpha = false;  // the shadow passes test alpha too (scene::Scene::hasAlphaCasters)
     DrawGeometry draw;
     ShadowMaps maps;
@@ -229,10 +231,10 @@ struct Renderer::Impl {
     // their compute passes, made with the first frame's pipelines.
     MomentMaps momentMaps;
     MomentPipeline momentPipeline;
-    std::vector<glm::vec4> layerLights;       // per layer, its light (TransmittancePass)
-    std::vector<TexelRect> transmitWindows;   // per layer, its window (TransmittancePass)
+    std::vector<glm::vec4> layerLights;             // per layer, its light (TransmittancePass)
+    std::vector<TexelRect> transmitWindows;         // per layer, its window (TransmittancePass)
     shaders::TransmitWindows transmitWindowData{};  // the same for lit.frag (LitBindings)
-    std::vector<DepthBiasFactors> layerBias;  // per layer, recordShadowPass's input (settings.hardwareBias)
+    std::vector<DepthBiasFactors> layerBias;        // per layer, recordShadowPass's input (settings.hardwareBias)
     LitPipeline litPipelines[4][2];
     LitBindings bindings;  // allocated with the first lit pipeline's (identical) set layout
     shaders::LitUniforms uniforms{};
@@ -265,13 +267,13 @@ struct Renderer::Impl {
     void setLayerLights(const scene::Scene& scene);  // layerLights from layers
     // The rest of the constructor: shadow maps, targets, readback, queries, attributes.
     void createTargets(const scene::Scene& scene, const RendererOptions& options);
-    void describeLayers();  // the attributes that follow the frusta
+    void describeLayers();           // the attributes that follow the frusta
     void describeTransmitWindows();  // transmittance_windows: each layer's window (x0,y0,x1,y1 or none)
     void update(const scene::Scene& scene, const scene::Camera& view);
 };
 
-Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn, const scene::RasterSettings& settingsIn,
-                     const RendererOptions& options, ValidationLog& log)
+Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
+                     const scene::RasterSettings& settingsIn, const RendererOptions& options, ValidationLog& log)
     : settings(settingsIn),
       ctx((checkSupported(scene, settingsIn),
            ContextOptions{.device = settingsIn.device, .validate = settingsIn.validate, .log = &log})) {
@@ -322,7 +324,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
                      .cameraAlpha = m.alphaMode != scene::AlphaMode::Opaque,
                      .depthPass = true};
         if (planIn.needsTransmittanceMap && !m.opaque()) {
-            if (d.count == 0) continue;  // (separateTransparent makes no draw for it)
+            if (d.count == 0) continue;                                // (separateTransparent makes no draw for it)
             d.first = transparentDraws[nextTransparent++].firstIndex;  // (in object order)
             d.depthPass = false;
             transparentObjects.push_back(d);
@@ -379,8 +381,7 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
     }
     splits = cascadeSplits(layers);
 
-    const glm::dmat4 viewProj = scene::projectionMatrix(cam, view.near, view.far) *
-                                scene::viewMatrix(cam, origin);
+    const glm::dmat4 viewProj = scene::projectionMatrix(cam, view.near, view.far) * scene::viewMatrix(cam, origin);
     uniforms.viewProj = glm::mat4(viewProj);
     uniforms.forward = glm::vec3(fitCam.forward);
     uniforms.ambient = float(scene.ambient);
@@ -470,7 +471,8 @@ void Renderer::Impl::createTargets(const scene::Scene& scene, const RendererOpti
     const bool moments = scene::isFilterable(settings.filter) && !layers.empty();
     momentMaps = createMomentMaps(ctx, moments ? mapSize : 1, moments ? arrayLayers : 1);
     if (moments)
-        attributes["moment_maps"] = describeMomentCost(settings.filter, mapSize, arrayLayers, settings.moments.blurWidth);
+        attributes["moment_maps"] =
+            describeMomentCost(settings.filter, mapSize, arrayLayers, settings.moments.blurWidth);
     targets = createLitTargets(ctx, width, height, lightCount > 1 ? kLightTargets : 0, options.readTargetsInPlace);
     renderIntoFrame = options.renderIntoFrame;
     if (!targets.hostReadable) readback = createReadback(ctx, targets);
@@ -541,11 +543,11 @@ void Renderer::Impl::describeLayers() {
     std::vector<double> usedDepthBias;
     for (const ShadowLayer& layer : layers)
         if (layer.reason != LayerReason::kCubeFace) usedDepthBias.push_back(layer.depthBias);
-    const bool oneBias = std::all_of(usedDepthBias.begin(), usedDepthBias.end(),
-                                     [&](double b) { return b == usedDepthBias[0]; });
+    const bool oneBias =
+        std::all_of(usedDepthBias.begin(), usedDepthBias.end(), [&](double b) { return b == usedDepthBias[0]; });
     attributes["depth_bias"] = usedDepthBias.empty() ? formatNumber(settings.depthBias)
-                               : oneBias            ? formatNumber(usedDepthBias[0])
-                                                    : joinedNumbers(usedDepthBias);
+                               : oneBias             ? formatNumber(usedDepthBias[0])
+                                                     : joinedNumbers(usedDepthBias);
     attributes["depth_bias_default"] = settings.depthBiasIsDefault ? "true" : "false";
     attributes["slope_bias"] = formatNumber(settings.slopeBias);
     // The slope bias that lit.frag continues along the normal past max_slope_tan (texels; its lift
@@ -553,8 +555,7 @@ void Renderer::Impl::describeLayers() {
     // whose slope bias the rasterizer applies. One value, or one per layer where they differ.
     std::vector<double> grazing;
     for (const ShadowLayer& layer : layers) grazing.push_back(layer.shaderSlopeBias);
-    const bool oneGrazing =
-        std::all_of(grazing.begin(), grazing.end(), [&](double g) { return g == grazing[0]; });
+    const bool oneGrazing = std::all_of(grazing.begin(), grazing.end(), [&](double g) { return g == grazing[0]; });
     attributes["grazing_normal_offset"] = grazing.empty() ? "0"
                                           : oneGrazing    ? formatNumber(grazing[0])
                                                           : joinedNumbers(grazing);
@@ -580,7 +581,8 @@ void Renderer::Impl::describeLayers() {
         attributes["texel_world_size"] = joined(layers, [](const ShadowLayer& l) {
             return formatNumber(l.frustum.texelWorldSize()) + (l.frustum.perspective ? "*d" : "");
         });
-        attributes["light_frustum"] = joined(layers, [](const ShadowLayer& l) { return l.frustum.describe(); }, "; ");
+        attributes["light_frustum"] = joined(
+            layers, [](const ShadowLayer& l) { return l.frustum.describe(); }, "; ");
         // Where a perspective map's texel grows from: its apex and unit axis in world coordinates,
         // "x,y,z,dx,dy,dz", so that compare takes the texel at a pixel's distance (p − apex)·axis
         // (docs/compare.md, contact distance); "-" for an orthographic map.
@@ -603,8 +605,9 @@ void Renderer::Impl::describeLayers() {
 void Renderer::Impl::update(const scene::Scene& scene, const scene::Camera& view) {
     if (scene.lights.size() != lightCount || scene.objects.size() + 1 != objectFirstIndex.size() ||
         std::uint32_t(view.width) != width || std::uint32_t(view.height) != height)
-        throw RasterError("Renderer::update: the scene must keep the objects, the number of lights and the "
-                          "resolution the Renderer was made for");
+        throw RasterError(
+            "Renderer::update: the scene must keep the objects, the number of lights and the "
+            "resolution the Renderer was made for");
     const auto updateStart = Clock::now();
     const std::size_t layerCount = lightMatrices.size();
     const int cascadeCount = cascadesUsed;
@@ -626,10 +629,12 @@ void Renderer::Impl::update(const scene::Scene& scene, const scene::Camera& view
     describeTransmitWindows();
     // The descriptor set's uniform buffers are device-local: refill them through a staging buffer.
     if (bindings.uniforms.buffer) {
-        Buffer staging = createBuffer(ctx, sizeof uniforms + sizeof transmitWindowData, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
-                                      VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+        Buffer staging =
+            createBuffer(ctx, sizeof uniforms + sizeof transmitWindowData, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                         VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
         std::memcpy(staging.mapped, &uniforms, sizeof uniforms);
-        std::memcpy(static_cast<char*>(staging.mapped) + sizeof uniforms, &transmitWindowData, sizeof transmitWindowData);
+        std::memcpy(static_cast<char*>(staging.mapped) + sizeof uniforms, &transmitWindowData,
+                    sizeof transmitWindowData);
         VkCommandBuffer commands = ctx.beginCommands();
         const VkBufferCopy region{.size = sizeof uniforms};
         vkCmdCopyBuffer(commands, staging.buffer.get(), bindings.uniforms.buffer.get(), 1, &region);
@@ -682,21 +687,22 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
             transmitRestPipeline = createTransmittanceRestPipeline(ctx, transmittanceMaps, alphaLayout);
         for (int a = 0; a < 2; ++a)
             if ((a ? litAlpha : needLitPlain) && !litPipeline[a].pipeline)
-                litPipeline[a] = createLitPipeline(ctx, LitVariant{.filter = settings.filter,
-                                                                   .blockerIds = wantIds,
-                                                                   .aovTarget = !beautyOnly,
-                                                                   .displayTarget = display,
-                                                                   .normalOffset = normalOffsetUsed(settings, layers),
-                                                                   .beautyFormat = targets.beautyFormat,
-                                                                   .lightTargets = std::uint32_t(targets.lights.size()),
-                                                                   .lightCount = std::uint32_t(lightCount),
-                                                                   .lightKinds = lightKinds,
-                                                                   .cascades = std::uint32_t(cascadesUsed),
-                                                                   .transmittance = transmit,
-                                                                   .receiverPlane = settings.receiverPlaneBias,
-                                                                   .cascadeBlend = cascadeBlendUsed > 0.0,
-                                                                   .vertexLightConstants = vertexLightConstants,
-                                                                   .moments = settings.moments},
+                litPipeline[a] = createLitPipeline(ctx,
+                                                   LitVariant{.filter = settings.filter,
+                                                              .blockerIds = wantIds,
+                                                              .aovTarget = !beautyOnly,
+                                                              .displayTarget = display,
+                                                              .normalOffset = normalOffsetUsed(settings, layers),
+                                                              .beautyFormat = targets.beautyFormat,
+                                                              .lightTargets = std::uint32_t(targets.lights.size()),
+                                                              .lightCount = std::uint32_t(lightCount),
+                                                              .lightKinds = lightKinds,
+                                                              .cascades = std::uint32_t(cascadesUsed),
+                                                              .transmittance = transmit,
+                                                              .receiverPlane = settings.receiverPlaneBias,
+                                                              .cascadeBlend = cascadeBlendUsed > 0.0,
+                                                              .vertexLightConstants = vertexLightConstants,
+                                                              .moments = settings.moments},
                                                    a ? alpha.setLayout.get() : VK_NULL_HANDLE, background);
         if (bindings.set == VK_NULL_HANDLE)
             bindings = createLitBindings(ctx, litPipeline[litPipeline[0].pipeline ? 0 : 1], uniforms,
@@ -722,7 +728,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                                               transmit ? &transmitRestPipeline : nullptr, transmitWindows};
     recordShadowPass(commands, shadowPipeline[shadowPipeline[0].pipeline ? 0 : 1], maps, draw, lightMatrices, wantIds,
                      &transmittancePass, &layerBias, shadowPipeline[1].pipeline ? &shadowPipeline[1] : nullptr);
-    if (momentPipeline.pipeline) recordMomentPasses(commands, momentPipeline, maps, momentMaps, layers, settings.filter, settings.moments);
+    if (momentPipeline.pipeline)
+        recordMomentPasses(commands, momentPipeline, maps, momentMaps, layers, settings.filter, settings.moments);
     stamp(commands, 1);
     ctx.submitAndWait(commands);
     frame.timingsMs.emplace_back("shadow_pass", msSince(shadowStart));
@@ -767,12 +774,12 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     } else {
         std::array<bool, kLitPlanes> copy{};
         const ChannelMask planeChannels[kLitPlanes] = {kChannelBeauty, kChannelVisibility, kChannelObjectId,
-                                                       kChannelNdotL, kChannelDepth, kChannelBlockerId};
+                                                       kChannelNdotL,  kChannelDepth,      kChannelBlockerId};
         for (std::uint32_t p = 0; p < kLitPlanes; ++p)
             // Z needs the object ids (the background's Z gets no offset) when it is offset.
-            copy[p] = !intoFrame[p] && ((channels & planeChannels[p]) ||
-                                        (p == std::uint32_t(LitPlane::kObjectId) && (channels & kChannelDepth) &&
-                                         viewDepthOffset != 0.0));
+            copy[p] = !intoFrame[p] &&
+                      ((channels & planeChannels[p]) || (p == std::uint32_t(LitPlane::kObjectId) &&
+                                                         (channels & kChannelDepth) && viewDepthOffset != 0.0));
         if (targets.hostReadable) {
             // The lit pass's barrier made the writes visible to the host; coherent memory needs no
             // invalidation, the rest does.
@@ -791,7 +798,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
         }
         readPixels(frame, channels, intoFrame);
         bool allIntoFrame = true;
-        for (std::uint32_t p = 0; p < kLitPlanes; ++p) allIntoFrame = allIntoFrame && (!(channels & planeChannels[p]) || intoFrame[p]);
+        for (std::uint32_t p = 0; p < kLitPlanes; ++p)
+            allIntoFrame = allIntoFrame && (!(channels & planeChannels[p]) || intoFrame[p]);
         frame.attributes["readback"] = !targets.hostReadable ? "copy" : allIntoFrame ? "into-frame" : "in-place";
     }
     frameImages.clear();  // the images over the Frame's memory go before anything can free it
@@ -849,9 +857,9 @@ void Renderer::Impl::prepareFrame(scene::Frame& frame, scene::ChannelMask channe
         const bool direct = wanted && p < planes && renderIntoFrame && targets.frameImageBytes[p] > 0;
         float* data = framePlane(*vectors[p], wanted, n, p == 0 ? 3 : 1, direct ? targets.frameImageBytes[p] : 0);
         if (!direct) continue;
-        Image image = importHostImage(ctx, p == 0 ? targets.beautyFormat : kLitPlaneFormat, width, height,
-                                      kLitTargetUsage, litPlaneTexelBytes(targets, LitPlane(p)), data,
-                                      vectors[p]->capacity() * sizeof(float));
+        Image image =
+            importHostImage(ctx, p == 0 ? targets.beautyFormat : kLitPlaneFormat, width, height, kLitTargetUsage,
+                            litPlaneTexelBytes(targets, LitPlane(p)), data, vectors[p]->capacity() * sizeof(float));
         if (!image.image) continue;  // a pointer the device cannot import: the Renderer's target
         intoFrame[p] = true;
         frameImages.push_back(std::move(image));
@@ -912,8 +920,8 @@ void Renderer::Impl::readPixels(scene::Frame& frame, scene::ChannelMask channels
             }
             if (offsetDepth) {
                 float* z = frame.depth.data() + y * w;
-                const float* id = idsInFrame ? frame.objectId.data() + y * w
-                                             : source[std::size_t(LitPlane::kObjectId)].row(y);
+                const float* id =
+                    idsInFrame ? frame.objectId.data() + y * w : source[std::size_t(LitPlane::kObjectId)].row(y);
                 for (std::size_t x = 0; x < w; ++x)
                     if (id[x] != 0.0f) z[x] += depthOffset;
             }

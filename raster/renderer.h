@@ -115,11 +115,10 @@ private:
 // function pointers it loads are shared by the process.
 // One frame from a Renderer made for it (setup included in the "setup" timing); with `debug`,
 // as Renderer::render.
-scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan,
-                    const scene::RasterSettings& settings, scene::ChannelMask channels = scene::kAllChannels,
-                    RenderDebug* debug = nullptr);
+scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settings,
+                    scene::ChannelMask channels = scene::kAllChannels, RenderDebug* debug = nullptr);
 // All channels, with `debug` (the debug views).
-scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan,
-                    const scene::RasterSettings& settings, RenderDebug* debug);
+scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RasterSettings& settings,
+                    RenderDebug* debug);
 
 }  // namespace shadowlab::raster

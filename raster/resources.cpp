@@ -14,13 +14,13 @@ void requireDeviceMemory(const Context& ctx, VkDeviceSize bytes, const std::stri
             largest = std::max(largest, ctx.memoryProperties.memoryHeaps[i].size);
     constexpr VkDeviceSize kMiB = 1024 * 1024;
     if (bytes > largest)
-        throw RasterError(what + " needs " + std::to_string(bytes / kMiB) + " MiB of device memory, but the largest heap of " +
-                          ctx.deviceReport.name + " has " + std::to_string(largest / kMiB) +
-                          " MiB; use a smaller resolution or --shadow-map-size");
+        throw RasterError(what + " needs " + std::to_string(bytes / kMiB) +
+                          " MiB of device memory, but the largest heap of " + ctx.deviceReport.name + " has " +
+                          std::to_string(largest / kMiB) + " MiB; use a smaller resolution or --shadow-map-size");
 }
 
-Buffer createBuffer(const Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage,
-                    VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred) {
+Buffer createBuffer(const Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, VkMemoryPropertyFlags required,
+                    VkMemoryPropertyFlags preferred) {
     VkDevice device = ctx.device.get();
     const VkBufferCreateInfo info{
         .sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO,
@@ -54,8 +54,7 @@ Buffer uploadBuffer(const Context& ctx, const void* bytes, std::size_t size, VkB
     Buffer staging = createBuffer(ctx, n, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                                   VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
     if (size > 0) std::memcpy(staging.mapped, bytes, size);
-    Buffer target = createBuffer(ctx, n, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                 VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    Buffer target = createBuffer(ctx, n, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
     VkCommandBuffer commands = ctx.beginCommands();
     const VkBufferCopy region{.size = n};
     vkCmdCopyBuffer(commands, staging.buffer.get(), target.buffer.get(), 1, &region);
@@ -87,8 +86,11 @@ ImageViewHandle createView(const Context& ctx, VkImage image, VkFormat format, V
         .image = image,
         .viewType = viewType,
         .format = format,
-        .subresourceRange = {.aspectMask = aspect, .baseMipLevel = 0, .levelCount = 1,
-                             .baseArrayLayer = firstLayer, .layerCount = layerCount},
+        .subresourceRange = {.aspectMask = aspect,
+                             .baseMipLevel = 0,
+                             .levelCount = 1,
+                             .baseArrayLayer = firstLayer,
+                             .layerCount = layerCount},
     };
     VkImageView view = VK_NULL_HANDLE;
     VK_CHECK(vkCreateImageView(ctx.device.get(), &info, nullptr, &view));
@@ -105,9 +107,8 @@ bool canReadImagesOnHost(const Context& ctx, VkFormat format, VkImageUsageFlags 
     return (props.linearTilingFeatures & needed) == needed;
 }
 
-Image createImage(const Context& ctx, VkFormat format, std::uint32_t width, std::uint32_t height,
-                  std::uint32_t layers, VkImageUsageFlags usage, VkImageAspectFlags aspect,
-                  VkImageViewType viewType, bool hostReadable) {
+Image createImage(const Context& ctx, VkFormat format, std::uint32_t width, std::uint32_t height, std::uint32_t layers,
+                  VkImageUsageFlags usage, VkImageAspectFlags aspect, VkImageViewType viewType, bool hostReadable) {
     VkDevice device = ctx.device.get();
     const VkImageCreateInfo info{
         .sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO,
@@ -131,10 +132,11 @@ Image createImage(const Context& ctx, VkFormat format, std::uint32_t width, std:
     const VkMemoryAllocateInfo alloc{
         .sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
         .allocationSize = req.size,
-        .memoryTypeIndex = hostReadable ? ctx.memoryType(req.memoryTypeBits,
-                                                         VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT,
-                                                         VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
-                                        : ctx.memoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT),
+        .memoryTypeIndex =
+            hostReadable ? ctx.memoryType(req.memoryTypeBits,
+                                          VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT,
+                                          VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
+                         : ctx.memoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT),
     };
     VkDeviceMemory memory = VK_NULL_HANDLE;
     VK_CHECK(vkAllocateMemory(device, &alloc, nullptr, &memory));
@@ -160,8 +162,8 @@ constexpr VkExternalMemoryHandleTypeFlagBits kHostAllocation = VK_EXTERNAL_MEMOR
 // A linear image that may be bound to imported host memory (its memory not yet bound).
 ImageHandle createHostImportImage(const Context& ctx, VkFormat format, std::uint32_t width, std::uint32_t height,
                                   VkImageUsageFlags usage) {
-    const VkExternalMemoryImageCreateInfo external{
-        .sType = VK_STRUCTURE_TYPE_EXTERNAL_MEMORY_IMAGE_CREATE_INFO, .handleTypes = kHostAllocation};
+    const VkExternalMemoryImageCreateInfo external{.sType = VK_STRUCTURE_TYPE_EXTERNAL_MEMORY_IMAGE_CREATE_INFO,
+                                                   .handleTypes = kHostAllocation};
     const VkImageCreateInfo info{
         .sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO,
         .pNext = &external,
@@ -254,8 +256,10 @@ Image importHostImage(const Context& ctx, VkFormat format, std::uint32_t width, 
         .handleType = kHostAllocation,
         .pHostPointer = reinterpret_cast<void*>(base),
     };
-    const VkMemoryAllocateInfo alloc{
-        .sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO, .pNext = &import, .allocationSize = size, .memoryTypeIndex = type};
+    const VkMemoryAllocateInfo alloc{.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
+                                     .pNext = &import,
+                                     .allocationSize = size,
+                                     .memoryTypeIndex = type};
     VkDeviceMemory memory = VK_NULL_HANDLE;
     if (vkAllocateMemory(device, &alloc, nullptr, &memory) != VK_SUCCESS) return img;
     MemoryHandle memoryHandle(device, memory);
@@ -282,8 +286,11 @@ void transition(VkCommandBuffer commands, const std::vector<ImageTransition>& tr
             .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
             .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
             .image = t.image,
-            .subresourceRange = {.aspectMask = t.aspect, .baseMipLevel = 0, .levelCount = 1,
-                                 .baseArrayLayer = 0, .layerCount = t.layers},
+            .subresourceRange = {.aspectMask = t.aspect,
+                                 .baseMipLevel = 0,
+                                 .levelCount = 1,
+                                 .baseArrayLayer = 0,
+                                 .layerCount = t.layers},
         });
     const VkDependencyInfo dependency{
         .sType = VK_STRUCTURE_TYPE_DEPENDENCY_INFO,

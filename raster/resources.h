@@ -35,8 +35,8 @@ struct Image {
 // `what` and both sizes, instead of a bare VK_ERROR_OUT_OF_DEVICE_MEMORY later.
 void requireDeviceMemory(const Context& ctx, VkDeviceSize bytes, const std::string& what);
 
-Buffer createBuffer(const Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage,
-                    VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred = 0);
+Buffer createBuffer(const Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, VkMemoryPropertyFlags required,
+                    VkMemoryPropertyFlags preferred = 0);
 
 // A device-local buffer holding `bytes`, filled through a host-visible staging buffer (one
 // submit, waited for). `usage` gets TRANSFER_DST added.
@@ -54,9 +54,9 @@ void invalidate(const Context& ctx, const Buffer& buffer);
 
 // With hostReadable: linear tiling in host-visible memory, mapped (one layer, color only; see
 // canReadImagesOnHost()).
-Image createImage(const Context& ctx, VkFormat format, std::uint32_t width, std::uint32_t height,
-                  std::uint32_t layers, VkImageUsageFlags usage, VkImageAspectFlags aspect,
-                  VkImageViewType viewType, bool hostReadable = false);
+Image createImage(const Context& ctx, VkFormat format, std::uint32_t width, std::uint32_t height, std::uint32_t layers,
+                  VkImageUsageFlags usage, VkImageAspectFlags aspect, VkImageViewType viewType,
+                  bool hostReadable = false);
 // Whether `format` can be a color attachment with linear tiling and live in host-visible memory
 // that is the device's own: true on lavapipe, whose "device memory" is host memory, so the host
 // can read rendered targets in place instead of copying them into a buffer first.

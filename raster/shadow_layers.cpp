@@ -83,16 +83,17 @@ std::vector<ShadowLayer> planShadowLayers(const scene::Scene& scene, const scene
             layer.shaderSlopeBias = settings.slopeBias;
             continue;
         }
-        const CascadeSet cascades =
-            settings.cascades > 1 ? fitCascades(scene, light.direction, settings.cascades, settings.shadowMapSize,
-                                                cascadeBandCover(settings), settings.snapLightFrustum)
-                                  : CascadeSet{};
+        const CascadeSet cascades = settings.cascades > 1
+                                        ? fitCascades(scene, light.direction, settings.cascades, settings.shadowMapSize,
+                                                      cascadeBandCover(settings), settings.snapLightFrustum)
+                                        : CascadeSet{};
         // With the hardware bias a directional map's depth pass applies both terms, and the lit
         // shader none.
         auto setBias = [&](ShadowLayer& layer, double depthBias) {
             layer.depthBias = depthBias;
             layer.biasInDepthPass = settings.hardwareBias;
-            layer.hardwareBias = settings.hardwareBias ? hardwareDepthBias(depthBias, layer.frustum) : DepthBiasFactors{};
+            layer.hardwareBias =
+                settings.hardwareBias ? hardwareDepthBias(depthBias, layer.frustum) : DepthBiasFactors{};
             layer.shaderDepthBias = settings.hardwareBias ? 0.0 : depthBias;
             layer.shaderSlopeBias = settings.hardwareBias ? 0.0 : settings.slopeBias;
         };
@@ -104,10 +105,9 @@ std::vector<ShadowLayer> planShadowLayers(const scene::Scene& scene, const scene
             const int count = int(cascades.frusta.size());
             for (std::size_t c = 0; c < cascades.frusta.size(); ++c) {
                 const LightFrustum& cf = cascades.frusta[c];
-                ShadowLayer& layer =
-                    add(i, LayerReason::kCascade, int(c), count, name + " C" + std::to_string(c), cf,
-                        cull ? cascadeReceivers(scene, cascades.splits, c, cascadeBandCover(settings))
-                             : std::vector<scene::Vec3>{});
+                ShadowLayer& layer = add(i, LayerReason::kCascade, int(c), count, name + " C" + std::to_string(c), cf,
+                                         cull ? cascadeReceivers(scene, cascades.splits, c, cascadeBandCover(settings))
+                                              : std::vector<scene::Vec3>{});
                 setBias(layer, settings.depthBiasIsDefault ? 0.5 * cf.texelWorldSize() : settings.depthBias);
                 layer.sliceNear = cascades.splits[c];
                 layer.sliceFar = cascades.splits[c + 1];
@@ -115,13 +115,12 @@ std::vector<ShadowLayer> planShadowLayers(const scene::Scene& scene, const scene
             continue;
         }
         // Objects that cannot cast onto the visible receivers stay out of this map.
-        ShadowLayer& layer =
-            add(i, LayerReason::kDirectional, 0, 1, name,
-                settings.fitLightFrustum
-                    ? fitDirectionalLightToReceivers(scene, light.direction, settings.shadowMapSize,
-                                                     settings.snapLightFrustum)
-                    : fitDirectionalLight(bounds, light.direction, settings.shadowMapSize),
-                receivers);
+        ShadowLayer& layer = add(i, LayerReason::kDirectional, 0, 1, name,
+                                 settings.fitLightFrustum
+                                     ? fitDirectionalLightToReceivers(scene, light.direction, settings.shadowMapSize,
+                                                                      settings.snapLightFrustum)
+                                     : fitDirectionalLight(bounds, light.direction, settings.shadowMapSize),
+                                 receivers);
         // The default constant bias is half a texel of the bounding-sphere map
         // (scene::defaultDepthBias); a fitted map's texel is smaller, so the default becomes half
         // of *its* texel. A bias the user gave is kept as given.
@@ -199,9 +198,9 @@ std::string explainShadowLayers(const std::vector<ShadowLayer>& layers, std::siz
         else
             out += formatNumber(l.shaderDepthBias) + " world, slope " + formatNumber(l.shaderSlopeBias) +
                    " texels in the lit shader";
-        out += l.casters.empty() ? "; every caster drawn"
-                                 : "; " + std::to_string(l.culled) + " of " + std::to_string(objectCount) +
-                                       " objects culled";
+        out += l.casters.empty()
+                   ? "; every caster drawn"
+                   : "; " + std::to_string(l.culled) + " of " + std::to_string(objectCount) + " objects culled";
         out += "\n";
     }
     return out;

@@ -34,8 +34,8 @@ enum class LayerReason { kDirectional, kCascade, kSpot, kCubeFace };
 struct ShadowLayer {
     int light = -1;  // index into Scene::lights
     LayerReason reason = LayerReason::kDirectional;
-    int index = 0;  // kCascade: the cascade; kCubeFace: the face (+X −X +Y −Y +Z −Z); else 0
-    int count = 1;  // kCascade: the light's cascades; kCubeFace: 6; else 1
+    int index = 0;      // kCascade: the cascade; kCubeFace: the face (+X −X +Y −Y +Z −Z); else 0
+    int count = 1;      // kCascade: the light's cascades; kCubeFace: 6; else 1
     std::string label;  // "L0", "L0 C2" (cascade 2), "L1 +X" (a point light's face)
     LightFrustum frustum;
     glm::mat4 matrix{1.0f};  // frustum.toClip(origin): what the depth pass draws this layer with

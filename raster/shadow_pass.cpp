@@ -36,22 +36,21 @@ ShadowPipeline createShadowPipeline(const Context& ctx, bool blockerIds, bool ha
     VkPipelineLayout layout = VK_NULL_HANDLE;
     VK_CHECK(vkCreatePipelineLayout(ctx.device.get(), &layoutInfo, nullptr, &layout));
     p.layout = PipelineLayoutHandle(ctx.device.get(), layout);
-    p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{
-                                                 .vertexShader = alpha ? shaders::shadowVertAlphaSpirv()
-                                                                       : shaders::shadowVertSpirv(),
-                                                 .fragmentShader = alpha ? (blockerIds ? shaders::shadowFragAlphaSpirv()
-                                                                                       : shaders::shadowFragAlphaDepthSpirv())
-                                                                   : blockerIds ? shaders::shadowFragSpirv()
-                                                                                : std::span<const std::uint32_t>(),
-                                                 .layout = layout,
-                                                 .usesNormal = false,
-                                                 .usesUv = alpha,
-                                                 .colorFormats = blockerIds ? std::vector<VkFormat>{kBlockerIdFormat}
-                                                                            : std::vector<VkFormat>{},
-                                                 .depthFormat = kShadowMapFormat,
-                                                 .depthCompare = VK_COMPARE_OP_LESS,
-                                                 .dynamicDepthBias = hardwareBias,
-                                             });
+    p.pipeline = createGraphicsPipeline(
+        ctx, PipelineDesc{
+                 .vertexShader = alpha ? shaders::shadowVertAlphaSpirv() : shaders::shadowVertSpirv(),
+                 .fragmentShader =
+                     alpha ? (blockerIds ? shaders::shadowFragAlphaSpirv() : shaders::shadowFragAlphaDepthSpirv())
+                     : blockerIds ? shaders::shadowFragSpirv()
+                                  : std::span<const std::uint32_t>(),
+                 .layout = layout,
+                 .usesNormal = false,
+                 .usesUv = alpha,
+                 .colorFormats = blockerIds ? std::vector<VkFormat>{kBlockerIdFormat} : std::vector<VkFormat>{},
+                 .depthFormat = kShadowMapFormat,
+                 .depthCompare = VK_COMPARE_OP_LESS,
+                 .dynamicDepthBias = hardwareBias,
+             });
     p.hardwareBias = hardwareBias;
     return p;
 }
@@ -59,21 +58,23 @@ ShadowPipeline createShadowPipeline(const Context& ctx, bool blockerIds, bool ha
 ShadowMaps createShadowMaps(const Context& ctx, std::uint32_t size, std::uint32_t layers) {
     if (size > ctx.properties.limits.maxImageDimension2D)
         throw RasterError("shadow map size " + std::to_string(size) + " exceeds the device's limit of " +
-                          std::to_string(ctx.properties.limits.maxImageDimension2D) + " (" +
-                          ctx.deviceReport.name + ")");
+                          std::to_string(ctx.properties.limits.maxImageDimension2D) + " (" + ctx.deviceReport.name +
+                          ")");
     // D32 depth and R32 ids per texel and layer.
-    requireDeviceMemory(ctx, VkDeviceSize(size) * size * layers * 8,
-                        std::to_string(layers) + " shadow map(s) of " + std::to_string(size) + "x" + std::to_string(size));
+    requireDeviceMemory(
+        ctx, VkDeviceSize(size) * size * layers * 8,
+        std::to_string(layers) + " shadow map(s) of " + std::to_string(size) + "x" + std::to_string(size));
     ShadowMaps m;
     m.size = size;
     m.layers = layers;
-    m.depth = createImage(ctx, kShadowMapFormat, size, size, layers,
-                          VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
-                              VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                          VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_VIEW_TYPE_2D_ARRAY);
-    m.ids = createImage(ctx, kBlockerIdFormat, size, size, layers,
-                        VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                        VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D_ARRAY);
+    m.depth = createImage(
+        ctx, kShadowMapFormat, size, size, layers,
+        VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+        VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_VIEW_TYPE_2D_ARRAY);
+    m.ids =
+        createImage(ctx, kBlockerIdFormat, size, size, layers,
+                    VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                    VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D_ARRAY);
     for (std::uint32_t i = 0; i < layers; ++i) {
         m.layerViews.push_back(createView(ctx, m.depth.image.get(), kShadowMapFormat, VK_IMAGE_ASPECT_DEPTH_BIT,
                                           VK_IMAGE_VIEW_TYPE_2D, i, 1));
@@ -89,9 +90,9 @@ TransmittanceMaps createTransmittanceMaps(const Context& ctx, std::uint32_t size
                       VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT,
                   "the transmittance map");
     // Four R32F arrays: T_all, D1, T_rest, D2.
-    requireDeviceMemory(ctx, VkDeviceSize(size) * size * layers * 16,
-                        std::to_string(layers) + " transmittance map(s) of " + std::to_string(size) + "x" +
-                            std::to_string(size));
+    requireDeviceMemory(
+        ctx, VkDeviceSize(size) * size * layers * 16,
+        std::to_string(layers) + " transmittance map(s) of " + std::to_string(size) + "x" + std::to_string(size));
     TransmittanceMaps m;
     m.size = size;
     m.layers = layers;
@@ -101,8 +102,8 @@ TransmittanceMaps createTransmittanceMaps(const Context& ctx, std::uint32_t size
                                   VK_IMAGE_VIEW_TYPE_2D_ARRAY);
     m.nearDepth = createImage(ctx, kTransmittanceFormat, size, size, layers, usage, VK_IMAGE_ASPECT_COLOR_BIT,
                               VK_IMAGE_VIEW_TYPE_2D_ARRAY);
-    m.restTransmittance = createImage(ctx, kTransmittanceFormat, size, size, layers, usage,
-                                      VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D_ARRAY);
+    m.restTransmittance = createImage(ctx, kTransmittanceFormat, size, size, layers, usage, VK_IMAGE_ASPECT_COLOR_BIT,
+                                      VK_IMAGE_VIEW_TYPE_2D_ARRAY);
     m.secondDepth = createImage(ctx, kTransmittanceFormat, size, size, layers, usage, VK_IMAGE_ASPECT_COLOR_BIT,
                                 VK_IMAGE_VIEW_TYPE_2D_ARRAY);
     for (std::uint32_t i = 0; i < layers; ++i) {
@@ -124,20 +125,20 @@ namespace {
 // opaque map (not written), into the two R32F targets, blended as transmit.frag says.
 PipelineHandle createTransmitPipeline(const Context& ctx, VkPipelineLayout layout,
                                       std::span<const std::uint32_t> fragmentShader, bool alpha) {
-    return createGraphicsPipeline(ctx, PipelineDesc{
-                                           .vertexShader = alpha ? shaders::transmitVertAlphaSpirv()
-                                                                 : shaders::transmitVertSpirv(),
-                                           .fragmentShader = fragmentShader,
-                                           .layout = layout,
-                                           .usesNormal = true,
-                                           .usesObjectId = alpha,
-                                           .usesUv = alpha,
-                                           .colorFormats = {kTransmittanceFormat, kTransmittanceFormat},
-                                           .depthFormat = kShadowMapFormat,
-                                           .depthCompare = VK_COMPARE_OP_LESS,
-                                           .depthWrite = false,
-                                           .transmittanceBlend = true,
-                                       });
+    return createGraphicsPipeline(
+        ctx, PipelineDesc{
+                 .vertexShader = alpha ? shaders::transmitVertAlphaSpirv() : shaders::transmitVertSpirv(),
+                 .fragmentShader = fragmentShader,
+                 .layout = layout,
+                 .usesNormal = true,
+                 .usesObjectId = alpha,
+                 .usesUv = alpha,
+                 .colorFormats = {kTransmittanceFormat, kTransmittanceFormat},
+                 .depthFormat = kShadowMapFormat,
+                 .depthCompare = VK_COMPARE_OP_LESS,
+                 .depthWrite = false,
+                 .transmittanceBlend = true,
+             });
 }
 
 // Both passes' layout: the transmit push constants, and the set that holds D1 (the second pass).
@@ -171,8 +172,8 @@ ShadowPipeline createTransmittancePipeline(const Context& ctx, VkDescriptorSetLa
     ShadowPipeline p;
     p.alpha = alphaSetLayout != VK_NULL_HANDLE;
     p.layout = createTransmitLayout(ctx, VK_NULL_HANDLE, alphaSetLayout);
-    p.pipeline = createTransmitPipeline(ctx, p.layout.get(),
-                                        p.alpha ? shaders::transmitFragAlphaSpirv() : shaders::transmitFragSpirv(), p.alpha);
+    p.pipeline = createTransmitPipeline(
+        ctx, p.layout.get(), p.alpha ? shaders::transmitFragAlphaSpirv() : shaders::transmitFragSpirv(), p.alpha);
     return p;
 }
 
@@ -204,8 +205,10 @@ TransmittanceRestPipeline createTransmittanceRestPipeline(const Context& ctx, co
     VK_CHECK(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &setLayout));
     p.setLayout = DescriptorSetLayoutHandle(device, setLayout);
     const VkDescriptorPoolSize poolSize{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1};
-    const VkDescriptorPoolCreateInfo poolInfo{
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1, .poolSizeCount = 1, .pPoolSizes = &poolSize};
+    const VkDescriptorPoolCreateInfo poolInfo{.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
+                                              .maxSets = 1,
+                                              .poolSizeCount = 1,
+                                              .pPoolSizes = &poolSize};
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VK_CHECK(vkCreateDescriptorPool(device, &poolInfo, nullptr, &pool));
     p.pool = DescriptorPoolHandle(device, pool);
@@ -224,9 +227,9 @@ TransmittanceRestPipeline createTransmittanceRestPipeline(const Context& ctx, co
     vkUpdateDescriptorSets(device, 1, &write, 0, nullptr);
     p.alpha = alphaSetLayout != VK_NULL_HANDLE;
     p.layout = createTransmitLayout(ctx, setLayout, alphaSetLayout);
-    p.pipeline = createTransmitPipeline(ctx, p.layout.get(),
-                                        p.alpha ? shaders::transmitFragRestAlphaSpirv() : shaders::transmitFragRestSpirv(),
-                                        p.alpha);
+    p.pipeline = createTransmitPipeline(
+        ctx, p.layout.get(), p.alpha ? shaders::transmitFragRestAlphaSpirv() : shaders::transmitFragRestSpirv(),
+        p.alpha);
     return p;
 }
 
@@ -248,14 +251,18 @@ TexelRect transmittanceWindow(const glm::mat4& lightMatrix, const std::vector<Tr
     bool unbounded = false;
     auto corner = [&](const glm::dvec4& p) {
         if (p.z < 0.0) return;
-        if (!(p.w > 0.0)) unbounded = true;  // (not a projection we know)
-        else add(p);
+        if (!(p.w > 0.0))
+            unbounded = true;  // (not a projection we know)
+        else
+            add(p);
     };
     auto edge = [&](const glm::dvec4& a, const glm::dvec4& b) {
         if ((a.z < 0.0) == (b.z < 0.0)) return;
         const glm::dvec4 p = a + (b - a) * (a.z / (a.z - b.z));
-        if (!(p.w > 0.0)) unbounded = true;
-        else add(p);
+        if (!(p.w > 0.0))
+            unbounded = true;
+        else
+            add(p);
     };
     for (const TransparentDraw& c : casters) {
         if (!c.triangles.empty()) {
@@ -352,13 +359,11 @@ void drawTransmittanceLayers(VkCommandBuffer commands, const TransmittancePass& 
             if (alpha) vkCmdBindVertexBuffers(commands, 1, 1, &geometry.uvs, &offset);
             vkCmdBindIndexBuffer(commands, geometry.indices, 0, VK_INDEX_TYPE_UINT32);
             for (const TransparentDraw& object : geometry.transparent) {
-                const shaders::TransmitPush push{
-                    .lightMatrix = lightMatrices[layer],
-                    .light = pass.layerLights[layer],
-                    .params = glm::vec4(object.transmittance, object.closed ? 1.0f : 0.0f, float(layer),
-                                        kTransmittanceLayerSeparation)};
-                vkCmdPushConstants(commands, layout, VK_SHADER_STAGE_VERTEX_BIT, 0,
-                                   sizeof push, &push);
+                const shaders::TransmitPush push{.lightMatrix = lightMatrices[layer],
+                                                 .light = pass.layerLights[layer],
+                                                 .params = glm::vec4(object.transmittance, object.closed ? 1.0f : 0.0f,
+                                                                     float(layer), kTransmittanceLayerSeparation)};
+                vkCmdPushConstants(commands, layout, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof push, &push);
                 vkCmdDrawIndexed(commands, object.indexCount, 1, object.firstIndex, 0, 0);
             }
         }
@@ -376,12 +381,12 @@ void recordTransmittance(VkCommandBuffer commands, const TransmittancePass& pass
     std::vector<ImageTransition> before;
     for (VkImage image : {maps.transmittance.image.get(), maps.nearDepth.image.get(),
                           maps.restTransmittance.image.get(), maps.secondDepth.image.get()})
-        before.push_back({image, VK_IMAGE_ASPECT_COLOR_BIT, maps.layers, VK_IMAGE_LAYOUT_UNDEFINED,
-                          draw ? VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                          VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_NONE,
-                          draw ? VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT : VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                          draw ? VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT
-                               : VK_ACCESS_2_NONE});
+        before.push_back(
+            {image, VK_IMAGE_ASPECT_COLOR_BIT, maps.layers, VK_IMAGE_LAYOUT_UNDEFINED,
+             draw ? VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+             VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_NONE,
+             draw ? VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT : VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+             draw ? VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT : VK_ACCESS_2_NONE});
     if (draw)  // the depth pass's writes before this pass's depth tests (same layout)
         before.push_back({shadow.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, shadow.layers,
                           VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
@@ -416,21 +421,20 @@ void recordTransmittance(VkCommandBuffer commands, const TransmittancePass& pass
 }  // namespace
 
 void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, const ShadowMaps& maps,
-                      const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices,
-                      bool blockerIds, const TransmittancePass* transmittance,
-                      const std::vector<DepthBiasFactors>* layerBias, const ShadowPipeline* alphaPipeline) {
+                      const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices, bool blockerIds,
+                      const TransmittancePass* transmittance, const std::vector<DepthBiasFactors>* layerBias,
+                      const ShadowPipeline* alphaPipeline) {
     // Source stage: the previous frame's lit pass sampled both arrays (a reused Renderer).
-    transition(commands, {{maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, maps.layers,
-                           VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                           VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_NONE,
-                           VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                           VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
-                               VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT},
-                          {maps.ids.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, maps.layers, VK_IMAGE_LAYOUT_UNDEFINED,
-                           blockerIds ? VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                           VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_NONE,
-                           blockerIds ? VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT : VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                           blockerIds ? VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT : VK_ACCESS_2_NONE}});
+    transition(commands,
+               {{maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, maps.layers, VK_IMAGE_LAYOUT_UNDEFINED,
+                 VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_NONE,
+                 VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT},
+                {maps.ids.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, maps.layers, VK_IMAGE_LAYOUT_UNDEFINED,
+                 blockerIds ? VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                 VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_NONE,
+                 blockerIds ? VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT : VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                 blockerIds ? VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT : VK_ACCESS_2_NONE}});
     for (std::uint32_t layer = 0; layer < maps.layers; ++layer) {
         const VkRenderingAttachmentInfo depth{
             .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
@@ -493,12 +497,13 @@ void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, 
         vkCmdEndRendering(commands);
     }
     if (transmittance) recordTransmittance(commands, *transmittance, maps, geometry, lightMatrices);
-    std::vector<ImageTransition> after{{maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, maps.layers,
-                           VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                           VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                           VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                           VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT,
-                           VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT}};
+    std::vector<ImageTransition> after{
+        {maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, maps.layers, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+         VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+         VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+         VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COPY_BIT,
+         VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT}};
     if (blockerIds)
         after.push_back({maps.ids.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, maps.layers,
                          VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,

@@ -33,9 +33,9 @@ ShadowPipeline createShadowPipeline(const Context& ctx, bool blockerIds = true, 
 // DepthBiasFactors, kShadowDepthUnitR: raster/shadow_layers.h.
 
 struct ShadowMaps {
-    Image depth;                             // size x size x layers; view: 2D array for sampling
+    Image depth;                              // size x size x layers; view: 2D array for sampling
     std::vector<ImageViewHandle> layerViews;  // one 2D view per layer, for rendering
-    Image ids;                               // object id nearest the light per texel, 0 = none
+    Image ids;                                // object id nearest the light per texel, 0 = none
     std::vector<ImageViewHandle> idLayerViews;
     std::uint32_t size = 0;
     std::uint32_t layers = 0;
@@ -46,8 +46,8 @@ ShadowMaps createShadowMaps(const Context& ctx, std::uint32_t size, std::uint32_
 struct TransparentDraw {
     std::uint32_t firstIndex = 0;
     std::uint32_t indexCount = 0;
-    float transmittance = 1.0f;  // 1 − opacity
-    bool closed = true;          // count only its surfaces facing the light (transmit.frag)
+    float transmittance = 1.0f;                  // 1 − opacity
+    bool closed = true;                          // count only its surfaces facing the light (transmit.frag)
     glm::vec3 boundsMin{0.0f}, boundsMax{0.0f};  // its vertices' box (camera-relative, as uploaded)
     // Its triangles' corners, three a triangle, as uploaded (transmittanceWindow projects them);
     // empty for a caster of more than kTransmittanceWindowTriangles triangles (its box is used).
@@ -174,8 +174,8 @@ struct TransmittancePass {
 // alphaPipeline: the SHADOWLAB_ALPHA variant of `pipeline`, for ranges with IndexRange::alpha
 // (null: `pipeline` draws them).
 void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, const ShadowMaps& maps,
-                      const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices,
-                      bool blockerIds = true, const TransmittancePass* transmittance = nullptr,
+                      const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices, bool blockerIds = true,
+                      const TransmittancePass* transmittance = nullptr,
                       const std::vector<DepthBiasFactors>* layerBias = nullptr,
                       const ShadowPipeline* alphaPipeline = nullptr);
 // Diagnostics and tests: the depths of one layer after recordShadowPass() has run, row 0 first.

@@ -52,9 +52,8 @@ std::string explain(VkResult result) {
 }
 
 VulkanError::VulkanError(VkResult result, const char* call, const char* file, int line)
-    : RasterError((explain(result).empty() ? "" : explain(result) + " (") + call + " failed with " +
-                  toString(result) + " at " + file + ":" + std::to_string(line) +
-                  (explain(result).empty() ? "" : ")")),
+    : RasterError((explain(result).empty() ? "" : explain(result) + " (") + call + " failed with " + toString(result) +
+                  " at " + file + ":" + std::to_string(line) + (explain(result).empty() ? "" : ")")),
       result_(result) {}
 
 }  // namespace shadowlab::raster

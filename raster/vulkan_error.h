@@ -35,8 +35,8 @@ std::string explain(VkResult result);
 
 }  // namespace shadowlab::raster
 
-#define VK_CHECK(call)                                                                 \
-    do {                                                                               \
-        if (const VkResult r_ = (call); r_ != VK_SUCCESS)                              \
-            throw ::shadowlab::raster::VulkanError(r_, #call, __FILE__, __LINE__);     \
+#define VK_CHECK(call)                                                             \
+    do {                                                                           \
+        if (const VkResult r_ = (call); r_ != VK_SUCCESS)                          \
+            throw ::shadowlab::raster::VulkanError(r_, #call, __FILE__, __LINE__); \
     } while (0)

@@ -38,8 +38,9 @@ void loadVulkanLoader() {
     auto getProc = reinterpret_cast<PFN_vkGetInstanceProcAddr>(dlsym(library, "vkGetInstanceProcAddr"));
     if (!getProc) {
         dlclose(library);
-        throw RasterError("libvulkan.so.1 has no vkGetInstanceProcAddr: the Vulkan loader is broken; "
-                          "reinstall the Debian package libvulkan1");
+        throw RasterError(
+            "libvulkan.so.1 has no vkGetInstanceProcAddr: the Vulkan loader is broken; "
+            "reinstall the Debian package libvulkan1");
     }
     vkGetInstanceProcAddr = getProc;
 #define SHADOWLAB_VK_LOAD_GLOBAL(name) \
@@ -60,10 +61,10 @@ void loadInstanceFunctions(VkInstance instance) {
     // (debug utils without validation) keeps the pointer an earlier instance loaded, which a
     // still-living messenger of that instance needs to be destroyed. The host-pointer import
     // (VK_EXT_external_memory_host) is optional too: without it the lit pass's targets are copied.
-#define SHADOWLAB_VK_LOAD_INSTANCE(name)                                                    \
+#define SHADOWLAB_VK_LOAD_INSTANCE(name)                                                                 \
     if (const auto p_ = reinterpret_cast<PFN_##name>(vkGetInstanceProcAddr(instance, #name))) name = p_; \
-    if (!name && !missing && std::string_view(#name).find("DebugUtils") == std::string_view::npos && \
-        std::string_view(#name).find("HostPointer") == std::string_view::npos)                        \
+    if (!name && !missing && std::string_view(#name).find("DebugUtils") == std::string_view::npos &&     \
+        std::string_view(#name).find("HostPointer") == std::string_view::npos)                           \
         missing = #name;
     SHADOWLAB_VK_INSTANCE_FUNCTIONS(SHADOWLAB_VK_LOAD_INSTANCE)
 #undef SHADOWLAB_VK_LOAD_INSTANCE

@@ -5,8 +5,8 @@
 
 #include <algorithm>
 #include <array>
-#include <limits>
 #include <cstring>
+#include <limits>
 #include <numeric>
 
 // SSE2 intrinsics: baseline on x86-64, the only target the builders are written for.
@@ -116,7 +116,9 @@ struct Builder {
         if (end - begin < kBvhParallelCount) return body(begin, end, {});
         return tbb::parallel_reduce(
             tbb::blocked_range<std::uint32_t>(begin, end, kBvhParallelGrain), scene::Bounds{},
-            [&](const tbb::blocked_range<std::uint32_t>& r, scene::Bounds acc) { return body(r.begin(), r.end(), acc); },
+            [&](const tbb::blocked_range<std::uint32_t>& r, scene::Bounds acc) {
+                return body(r.begin(), r.end(), acc);
+            },
             [](scene::Bounds x, const scene::Bounds& y) {
                 x.extend(y);
                 return x;
@@ -198,9 +200,7 @@ struct Builder {
                             scene::Bounds& right) {
         PrimRef* first = refs.data() + begin;
         PrimRef* last = refs.data() + end;
-        auto centroid = [](const PrimRef& r) {
-            return scene::Vec3(r.centroid(0), r.centroid(1), r.centroid(2));
-        };
+        auto centroid = [](const PrimRef& r) { return scene::Vec3(r.centroid(0), r.centroid(1), r.centroid(2)); };
         for (;;) {
             for (;;) {
                 if (first == last) return std::uint32_t(first - refs.data());
@@ -288,8 +288,7 @@ struct Builder {
                     left.extend(binBounds[b]);
                     nl += binCount[b];
                     if (nl == 0 || rightCount[b + 1] == 0) continue;
-                    const double cost =
-                        left.area() * blocks(nl) + rightArea[b + 1] * blocks(rightCount[b + 1]);
+                    const double cost = left.area() * blocks(nl) + rightArea[b + 1] * blocks(rightCount[b + 1]);
                     if (cost < bestCost) {
                         bestCost = cost;
                         bestAxis = axis;
@@ -315,9 +314,10 @@ struct Builder {
             axis = bestAxis;
             // The same std::partition with the same predicate on the same sequence as over
             // indices: the same swaps, so the same order of primitives.
-            mid = partition(begin, end, [&](const PrimRef& r) {
-                return binOf(r.centroid(axis), cb.min[axis], ext[axis]) <= bestBin;
-            }, leftCentroids, rightCentroids);
+            mid = partition(
+                begin, end,
+                [&](const PrimRef& r) { return binOf(r.centroid(axis), cb.min[axis], ext[axis]) <= bestBin; },
+                leftCentroids, rightCentroids);
             Box4 l, r;
             for (int b = 0; b <= bestBin; ++b) l.extend(bins.bounds[axis][b]);
             for (int b = bestBin + 1; b < kBvhBins; ++b) r.extend(bins.bounds[axis][b]);
@@ -330,9 +330,7 @@ struct Builder {
             axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
             mid = begin + count / 2;
             std::nth_element(refs.data() + begin, refs.data() + mid, refs.data() + end,
-                             [&](const PrimRef& a, const PrimRef& b) {
-                                 return a.centroid(axis) < b.centroid(axis);
-                             });
+                             [&](const PrimRef& a, const PrimRef& b) { return a.centroid(axis) < b.centroid(axis); });
         }
         int deepest;
         std::uint32_t second;
@@ -341,11 +339,12 @@ struct Builder {
             // with its node indices shifted, so the layout is exactly the sequential one.
             std::vector<BvhNode> right;
             int dl = 0, dr = 0;
-            tbb::parallel_invoke([&] { dl = build(nodes, begin, mid, depth + 1, childBounds ? &leftAll : nullptr, &leftCentroids); },
-                                 [&] {
-                                     right.reserve(2 * std::size_t(end - mid));
-                                     dr = build(right, mid, end, depth + 1, childBounds ? &rightAll : nullptr, &rightCentroids);
-                                 });
+            tbb::parallel_invoke(
+                [&] { dl = build(nodes, begin, mid, depth + 1, childBounds ? &leftAll : nullptr, &leftCentroids); },
+                [&] {
+                    right.reserve(2 * std::size_t(end - mid));
+                    dr = build(right, mid, end, depth + 1, childBounds ? &rightAll : nullptr, &rightCentroids);
+                });
             second = std::uint32_t(nodes.size());
             for (BvhNode& n : right)
                 if (n.count == 0) n.offset += second;
@@ -354,7 +353,8 @@ struct Builder {
         } else {
             const int dl = build(nodes, begin, mid, depth + 1, childBounds ? &leftAll : nullptr, &leftCentroids);
             second = std::uint32_t(nodes.size());
-            deepest = std::max(dl, build(nodes, mid, end, depth + 1, childBounds ? &rightAll : nullptr, &rightCentroids));
+            deepest =
+                std::max(dl, build(nodes, mid, end, depth + 1, childBounds ? &rightAll : nullptr, &rightCentroids));
         }
         nodes[node].offset = second;
         nodes[node].count = 0;
@@ -363,16 +363,13 @@ struct Builder {
     }
     // Leaves are tested kBvhLeafBlock triangles at a time (triangle4.h), so a leaf of n costs
     // ⌈n / block⌉ tests: Embree's SAH counts primitives in blocks the same way.
-    static double blocks(std::uint32_t n) {
-        return double((n + kBvhLeafBlock - 1) / kBvhLeafBlock);
-    }
+    static double blocks(std::uint32_t n) { return double((n + kBvhLeafBlock - 1) / kBvhLeafBlock); }
 
     static int binOf(double c, double lo, double extent) {
         const int b = int(kBvhBins * ((c - lo) / extent));
         return std::clamp(b, 0, kBvhBins - 1);
     }
 };
-
 
 // The float builder for the float tracer: the same SAH, leaf rules and layout as Builder, on
 // 32-byte float references (the double bounds rounded outward, so every box still contains its
@@ -427,8 +424,7 @@ struct FastBuilder {
             lo = cb.lo;
             alignas(16) float e[4], sc[4];
             _mm_store_ps(e, _mm_sub_ps(cb.hi, cb.lo));
-            for (int k = 0; k < 4; ++k)
-                sc[k] = k < 3 && e[k] > 0 ? float(kBvhBins) * (1.0f - 0x1.0p-20f) / e[k] : 0.0f;
+            for (int k = 0; k < 4; ++k) sc[k] = k < 3 && e[k] > 0 ? float(kBvhBins) * (1.0f - 0x1.0p-20f) / e[k] : 0.0f;
             scale = _mm_load_ps(sc);
         }
         __m128i operator()(__m128 c) const {
@@ -476,8 +472,8 @@ struct FastBuilder {
         }
     }
 
-    int build(std::vector<BvhNode>& nodes, std::uint32_t begin, std::uint32_t end, int depth,
-              const BoxF& all, const BoxF& cb) {
+    int build(std::vector<BvhNode>& nodes, std::uint32_t begin, std::uint32_t end, int depth, const BoxF& all,
+              const BoxF& cb) {
         const std::uint32_t node = std::uint32_t(nodes.size());
         nodes.emplace_back();
         alignas(16) float l[4], h[4];
@@ -532,8 +528,8 @@ struct FastBuilder {
             }
         }
         const float area = all.area();
-        const double splitCost = area > 0 ? kBvhTraversalCost + double(bestCost) / double(area)
-                                          : std::numeric_limits<double>::infinity();
+        const double splitCost =
+            area > 0 ? kBvhTraversalCost + double(bestCost) / double(area) : std::numeric_limits<double>::infinity();
         if (count <= kBvhMaxLeafCount && (bestAxis < 0 || splitCost >= Builder::blocks(count))) {
             Builder::makeLeaf(nodes, node, begin, end);
             return depth;
@@ -567,7 +563,8 @@ struct FastBuilder {
                     ++first;
                 }
                 // else *last stays right; *first is reclassified next round (same answer)
-                else rightC.extend(d, d);
+                else
+                    rightC.extend(d, d);
             }
             mid = std::uint32_t(first - refs.data());
             for (int b = 0; b <= bestBin; ++b) leftAll.extend(bins.bounds[axis][b]);
@@ -620,14 +617,13 @@ Bvh Bvh::build(const std::vector<scene::Bounds>& primitiveBounds) {
     const std::size_t n = primitiveBounds.size();
     if (n == 0) return bvh;
     std::vector<PrimRef> refs(n);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kBvhParallelGrain),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                          for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                              const scene::Bounds& b = primitiveBounds[i];
-                              refs[i] = PrimRef{{b.min.x, b.min.y, b.min.z, double(i)},
-                                                {b.max.x, b.max.y, b.max.z, 0.0}};
-                          }
-                      });
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, n, kBvhParallelGrain), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                const scene::Bounds& b = primitiveBounds[i];
+                refs[i] = PrimRef{{b.min.x, b.min.y, b.min.z, double(i)}, {b.max.x, b.max.y, b.max.z, 0.0}};
+            }
+        });
     bvh.nodes_.reserve(2 * n);
     Builder b{refs};
     bvh.depth_ = b.build(bvh.nodes_, 0, std::uint32_t(n), 0, nullptr, nullptr);
@@ -646,19 +642,19 @@ Bvh Bvh::buildFast(const std::vector<scene::Bounds>& primitiveBounds) {
     const std::size_t n = primitiveBounds.size();
     if (n == 0) return bvh;
     std::vector<PrimRefF> refs(n);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kBvhParallelGrain),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-                          for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                              const scene::Bounds& b = primitiveBounds[i];
-                              const std::uint32_t index = std::uint32_t(i);
-                              float idx;
-                              std::memcpy(&idx, &index, sizeof idx);
-                              refs[i].lo = _mm_setr_ps(roundDown<float>(b.min.x), roundDown<float>(b.min.y),
-                                                       roundDown<float>(b.min.z), idx);
-                              refs[i].hi = _mm_setr_ps(roundUp<float>(b.max.x), roundUp<float>(b.max.y),
-                                                       roundUp<float>(b.max.z), 0.0f);
-                          }
-                      });
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, n, kBvhParallelGrain), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                const scene::Bounds& b = primitiveBounds[i];
+                const std::uint32_t index = std::uint32_t(i);
+                float idx;
+                std::memcpy(&idx, &index, sizeof idx);
+                refs[i].lo =
+                    _mm_setr_ps(roundDown<float>(b.min.x), roundDown<float>(b.min.y), roundDown<float>(b.min.z), idx);
+                refs[i].hi =
+                    _mm_setr_ps(roundUp<float>(b.max.x), roundUp<float>(b.max.y), roundUp<float>(b.max.z), 0.0f);
+            }
+        });
     FastBuilder b{refs};
     BoxF all, cb;
     b.rangeBounds(0, std::uint32_t(n), all, cb);

@@ -46,10 +46,8 @@ struct Ray {
 // N is Real (plain mode) or Interval<Real> (conservative mode: pbrt-v4's Sphere::BasicIntersect
 // uses intervals the same way, src/pbrt/shapes.h).
 template <typename N, typename Real>
-inline bool intersectSphereT(const Ray<Real>& ray, const Vec3T<Real>& center, Real radius,
-                             Real tMax, Real& tHit) {
-    const N fx = N(ray.o.x) - N(center.x), fy = N(ray.o.y) - N(center.y),
-            fz = N(ray.o.z) - N(center.z);
+inline bool intersectSphereT(const Ray<Real>& ray, const Vec3T<Real>& center, Real radius, Real tMax, Real& tHit) {
+    const N fx = N(ray.o.x) - N(center.x), fy = N(ray.o.y) - N(center.y), fz = N(ray.o.z) - N(center.z);
     const N dx(ray.d.x), dy(ray.d.y), dz(ray.d.z);
     const N r(radius);
     const N a = sqrOf(dx) + sqrOf(dy) + sqrOf(dz);
@@ -75,8 +73,8 @@ inline bool intersectSphereT(const Ray<Real>& ray, const Vec3T<Real>& center, Re
 }
 
 template <typename Real>
-inline bool intersectSphere(const Ray<Real>& ray, const Vec3T<Real>& center, Real radius,
-                            Real tMax, bool conservative, Real& tHit) {
+inline bool intersectSphere(const Ray<Real>& ray, const Vec3T<Real>& center, Real radius, Real tMax, bool conservative,
+                            Real& tHit) {
     // Conservative = the plain test and the interval test agree on a hit. Most shadow rays
     // miss in the plain test, so the slower interval arithmetic runs only for candidates.
     if (!intersectSphereT<Real>(ray, center, radius, tMax, tHit)) return false;
@@ -88,10 +86,8 @@ inline bool intersectSphere(const Ray<Real>& ray, const Vec3T<Real>& center, Rea
 // every t the rounding allows is positive, so a ray leaving the plane from a point truly on
 // its far side is never taken back (a grazing ray whose n·d may be 0 is rejected outright).
 template <typename N, typename Real>
-inline bool intersectPlaneT(const Ray<Real>& ray, const Vec3T<Real>& c, const Vec3T<Real>& n,
-                            Real tMax, Real& tHit) {
-    const N num = N(n.x) * (N(c.x) - N(ray.o.x)) + N(n.y) * (N(c.y) - N(ray.o.y)) +
-                  N(n.z) * (N(c.z) - N(ray.o.z));
+inline bool intersectPlaneT(const Ray<Real>& ray, const Vec3T<Real>& c, const Vec3T<Real>& n, Real tMax, Real& tHit) {
+    const N num = N(n.x) * (N(c.x) - N(ray.o.x)) + N(n.y) * (N(c.y) - N(ray.o.y)) + N(n.z) * (N(c.z) - N(ray.o.z));
     const N den = N(n.x) * N(ray.d.x) + N(n.y) * N(ray.d.y) + N(n.z) * N(ray.d.z);
     if constexpr (std::is_floating_point_v<N>) {
         if (den == 0) return false;
@@ -103,8 +99,8 @@ inline bool intersectPlaneT(const Ray<Real>& ray, const Vec3T<Real>& c, const Ve
 }
 
 template <typename Real>
-inline bool intersectPlane(const Ray<Real>& ray, const Vec3T<Real>& c, const Vec3T<Real>& n,
-                           Real tMax, bool conservative, Real& tHit) {
+inline bool intersectPlane(const Ray<Real>& ray, const Vec3T<Real>& c, const Vec3T<Real>& n, Real tMax,
+                           bool conservative, Real& tHit) {
     if (!intersectPlaneT<Real>(ray, c, n, tMax, tHit)) return false;
     return !conservative || intersectPlaneT<Interval<Real>>(ray, c, n, tMax, tHit);
 }
@@ -118,9 +114,8 @@ inline bool intersectPlane(const Ray<Real>& ray, const Vec3T<Real>& c, const Vec
 // rounding error of t (derived in pbrt-v3 §3.9.6); it was derived for that algebra, so the code
 // below keeps the same sequence of operations.
 template <typename Real>
-inline bool intersectTriangle(const Ray<Real>& ray, const Vec3T<Real>& p0, const Vec3T<Real>& p1,
-                              const Vec3T<Real>& p2, Real tMax, bool conservative, Real& tHit,
-                              Real& b0, Real& b1, Real& b2) {
+inline bool intersectTriangle(const Ray<Real>& ray, const Vec3T<Real>& p0, const Vec3T<Real>& p1, const Vec3T<Real>& p2,
+                              Real tMax, bool conservative, Real& tHit, Real& b0, Real& b1, Real& b2) {
     using Vec = Vec3T<Real>;
     const Vec a = p0 - ray.o, b = p1 - ray.o, c = p2 - ray.o;
     Real ax = a[ray.kx], ay = a[ray.ky], az = a[ray.kz];
@@ -163,11 +158,9 @@ inline bool intersectTriangle(const Ray<Real>& ray, const Vec3T<Real>& p0, const
         const Real deltaZ = gamma<Real>(3) * maxZt;
         const Real deltaX = gamma<Real>(5) * (maxXt + maxZt);
         const Real deltaY = gamma<Real>(5) * (maxYt + maxZt);
-        const Real deltaE =
-            2 * (gamma<Real>(2) * maxXt * maxYt + deltaY * maxXt + deltaX * maxYt);
+        const Real deltaE = 2 * (gamma<Real>(2) * maxXt * maxYt + deltaY * maxXt + deltaX * maxYt);
         const Real maxE = std::max({std::abs(e0), std::abs(e1), std::abs(e2)});
-        const Real deltaT =
-            3 * (gamma<Real>(3) * maxE * maxZt + deltaE * maxZt + deltaZ * maxE) * std::abs(invDet);
+        const Real deltaT = 3 * (gamma<Real>(3) * maxE * maxZt + deltaE * maxZt + deltaZ * maxE) * std::abs(invDet);
         if (t <= deltaT) return false;
     }
     tHit = t;
@@ -182,8 +175,8 @@ inline bool intersectTriangle(const Ray<Real>& ray, const Vec3T<Real>& p0, const
 // an origin strictly outside that face's plane gets t < 0 on that slab and cannot hit the box
 // again: the box needs no conservative variant. `face` is axis + 3·(max side ? 1 : 0).
 template <typename Real>
-inline bool intersectBox(const Ray<Real>& ray, const Vec3T<Real>& lo, const Vec3T<Real>& hi,
-                         Real tMax, Real& tHit, int& face) {
+inline bool intersectBox(const Ray<Real>& ray, const Vec3T<Real>& lo, const Vec3T<Real>& hi, Real tMax, Real& tHit,
+                         int& face) {
     Real tNear = -std::numeric_limits<Real>::infinity();
     Real tFar = std::numeric_limits<Real>::infinity();
     int nearFace = -1, farFace = -1;

@@ -13,7 +13,7 @@ std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::Render
         for (const scene::Object& o : scene.objects)
             if (const auto* m = std::get_if<scene::Mesh>(&o.shape)) triangles += m->triangleCount();
     constexpr std::uint64_t kAllowance = 64 * scene::kMiB;  // threads' stacks, tiles, the program
-    std::uint64_t placements = 0;  // one BVH entry per object, and per mesh instance
+    std::uint64_t placements = 0;                           // one BVH entry per object, and per mesh instance
     for (const scene::Object& o : scene.objects)
         if (const auto* m = std::get_if<scene::Mesh>(&o.shape)) placements += m->instances.size();
     // Texture coordinates: three per alpha-textured triangle, two Reals each (double: 48 bytes).

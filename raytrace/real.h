@@ -81,24 +81,18 @@ struct Interval {
     Real lower() const { return lo; }
     Real upper() const { return hi; }
 
-    friend Interval operator+(Interval a, Interval b) {
-        return {nextDown(a.lo + b.lo), nextUp(a.hi + b.hi)};
-    }
-    friend Interval operator-(Interval a, Interval b) {
-        return {nextDown(a.lo - b.hi), nextUp(a.hi - b.lo)};
-    }
+    friend Interval operator+(Interval a, Interval b) { return {nextDown(a.lo + b.lo), nextUp(a.hi + b.hi)}; }
+    friend Interval operator-(Interval a, Interval b) { return {nextDown(a.lo - b.hi), nextUp(a.hi - b.lo)}; }
     friend Interval operator-(Interval a) { return {-a.hi, -a.lo}; }
     friend Interval operator*(Interval a, Interval b) {
         const Real p[4] = {a.lo * b.lo, a.lo * b.hi, a.hi * b.lo, a.hi * b.hi};
-        return {nextDown(std::min({p[0], p[1], p[2], p[3]})),
-                nextUp(std::max({p[0], p[1], p[2], p[3]}))};
+        return {nextDown(std::min({p[0], p[1], p[2], p[3]})), nextUp(std::max({p[0], p[1], p[2], p[3]}))};
     }
     friend Interval operator/(Interval a, Interval b) {
         if (b.lo <= 0 && b.hi >= 0)
             return {-std::numeric_limits<Real>::infinity(), std::numeric_limits<Real>::infinity()};
         const Real q[4] = {a.lo / b.lo, a.lo / b.hi, a.hi / b.lo, a.hi / b.hi};
-        return {nextDown(std::min({q[0], q[1], q[2], q[3]})),
-                nextUp(std::max({q[0], q[1], q[2], q[3]}))};
+        return {nextDown(std::min({q[0], q[1], q[2], q[3]})), nextUp(std::max({q[0], q[1], q[2], q[3]}))};
     }
 };
 
@@ -127,11 +121,17 @@ inline double upperOf(double v) { return v; }
 inline float midOf(float v) { return v; }
 inline double midOf(double v) { return v; }
 template <typename Real>
-inline Real lowerOf(const Interval<Real>& v) { return v.lo; }
+inline Real lowerOf(const Interval<Real>& v) {
+    return v.lo;
+}
 template <typename Real>
-inline Real upperOf(const Interval<Real>& v) { return v.hi; }
+inline Real upperOf(const Interval<Real>& v) {
+    return v.hi;
+}
 template <typename Real>
-inline Real midOf(const Interval<Real>& v) { return v.mid(); }
+inline Real midOf(const Interval<Real>& v) {
+    return v.mid();
+}
 
 // Deterministic per-pixel random numbers (SplitMix64, Steele et al. 2014): renders are
 // reproducible and independent of the thread schedule.

@@ -45,15 +45,13 @@ std::string formatNumber(double v) {
 }
 
 std::uint64_t sampleSeed(std::size_t pixel, int light) {
-    return kSampleSeed ^ (std::uint64_t(pixel) * 0x9E3779B97F4A7C15ull) ^
-           (std::uint64_t(light + 1) << 48);
+    return kSampleSeed ^ (std::uint64_t(pixel) * 0x9E3779B97F4A7C15ull) ^ (std::uint64_t(light + 1) << 48);
 }
 
 // With `prebuilt`, its acceleration structures are used and "setup" is 0 (Renderer).
 template <typename Real>
-scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan,
-                     const scene::RaytraceSettings& settings, scene::Backend backend,
-                     const Tracer<Real>* prebuilt = nullptr) {
+scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RaytraceSettings& settings,
+                     scene::Backend backend, const Tracer<Real>* prebuilt = nullptr) {
     const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
     const int width = cam.width, height = cam.height;
     scene::Frame frame = scene::Frame::allocate(width, height, true);
@@ -64,8 +62,7 @@ scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan,
     // Per-light visibility only when it adds something: with one light it is `visibility`.
     if (scene.lights.size() > 1)
         frame.lightVisibility.assign(scene.lights.size(), std::vector<float>(frame.pixelCount(), 0.0f));
-    tbb::task_arena arena(settings.threads > 0 ? settings.threads
-                                               : tbb::task_arena::automatic);
+    tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
     const bool robust = settings.robustOffset;
     // Semi-transparent objects need the whole segment; the plan allows any-hit otherwise.
     const bool anyHit = plan.anyHitShadowRays && scene.allOpaque();
@@ -84,17 +81,16 @@ scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan,
     const int tilesY = (height + kTileSize - 1) / kTileSize;
     auto forEachPixel = [&](auto&& body) {
         arena.execute([&] {
-            tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY),
-                              [&](const tbb::blocked_range<int>& r) {
-                                  for (int tile = r.begin(); tile != r.end(); ++tile) {
-                                      const int x0 = (tile % tilesX) * kTileSize;
-                                      const int y0 = (tile / tilesX) * kTileSize;
-                                      const int x1 = std::min(x0 + kTileSize, width);
-                                      const int y1 = std::min(y0 + kTileSize, height);
-                                      for (int y = y0; y < y1; ++y)
-                                          for (int x = x0; x < x1; ++x) body(x, y);
-                                  }
-                              });
+            tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY), [&](const tbb::blocked_range<int>& r) {
+                for (int tile = r.begin(); tile != r.end(); ++tile) {
+                    const int x0 = (tile % tilesX) * kTileSize;
+                    const int y0 = (tile / tilesX) * kTileSize;
+                    const int x1 = std::min(x0 + kTileSize, width);
+                    const int y1 = std::min(y0 + kTileSize, height);
+                    for (int y = y0; y < y1; ++y)
+                        for (int x = x0; x < x1; ++x) body(x, y);
+                }
+            });
         });
     };
 
@@ -183,15 +179,13 @@ scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan,
 
 scene::Frame renderWith(const scene::Scene& scene, const scene::RenderPlan& plan,
                         const scene::RaytraceSettings& settings, scene::Backend backend) {
-    if (settings.precision == scene::Precision::Double)
-        return renderT<double>(scene, plan, settings, backend);
+    if (settings.precision == scene::Precision::Double) return renderT<double>(scene, plan, settings, backend);
     return renderT<float>(scene, plan, settings, backend);
 }
 
 }  // namespace
 
-scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan,
-                    const scene::RaytraceSettings& settings) {
+scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RaytraceSettings& settings) {
     return renderWith(scene, plan, settings, scene::Backend::Raytrace);
 }
 
@@ -230,8 +224,8 @@ scene::Frame Renderer::render(const scene::Scene& scene, const scene::RenderPlan
 double Renderer::setupMs() const { return impl_->setupMs; }
 
 template <typename Real>
-double visibilityAt(const scene::Scene& scene, const scene::Vec3& p, const scene::Vec3& n,
-                    int light, const scene::RaytraceSettings& settings) {
+double visibilityAt(const scene::Scene& scene, const scene::Vec3& p, const scene::Vec3& n, int light,
+                    const scene::RaytraceSettings& settings) {
     if (light < 0 || std::size_t(light) >= scene.lights.size())
         throw std::out_of_range("visibilityAt: light " + std::to_string(light) + " of " +
                                 std::to_string(scene.lights.size()));
@@ -249,13 +243,12 @@ double visibilityAt(const scene::Scene& scene, const scene::Vec3& p, const scene
         sp.errorAlongNormal = glm::dot(glm::abs(sp.ng), sp.pError);
     }
     Rng rng(kSampleSeed);
-    return lightVisibility(tracer, scene.lights[light], sp, settings, scene.allOpaque(), rng)
-        .transmittance;
+    return lightVisibility(tracer, scene.lights[light], sp, settings, scene.allOpaque(), rng).transmittance;
 }
 
-template double visibilityAt<float>(const scene::Scene&, const scene::Vec3&, const scene::Vec3&,
-                                    int, const scene::RaytraceSettings&);
-template double visibilityAt<double>(const scene::Scene&, const scene::Vec3&, const scene::Vec3&,
-                                     int, const scene::RaytraceSettings&);
+template double visibilityAt<float>(const scene::Scene&, const scene::Vec3&, const scene::Vec3&, int,
+                                    const scene::RaytraceSettings&);
+template double visibilityAt<double>(const scene::Scene&, const scene::Vec3&, const scene::Vec3&, int,
+                                     const scene::RaytraceSettings&);
 
 }  // namespace shadowlab::raytrace

@@ -16,8 +16,7 @@ namespace shadowlab::raytrace {
 // timings "setup", "primary", "shadow" and the attributes backend="raytrace", precision,
 // ray_bias (value or "robust"), samples, threads, shadow_rays. Throws std::invalid_argument
 // for a scene it cannot trace (a mesh without loaded geometry).
-scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan,
-                    const scene::RaytraceSettings& settings);
+scene::Frame render(const scene::Scene& scene, const scene::RenderPlan& plan, const scene::RaytraceSettings& settings);
 
 // The reference: render() with scene::referenceSettings(base) (double precision, robust
 // offsets, no tunable bias, many area-light samples); backend attribute "reference".
@@ -48,13 +47,12 @@ private:
 // Returns 0 when n·L <= 0, else the visibility in 0..1. Builds the tracer on every call: for
 // many queries use Tracer and lightVisibility directly (raytrace/shadow_ray.h).
 template <typename Real>
-double visibilityAt(const scene::Scene& scene, const scene::Vec3& p, const scene::Vec3& n,
-                    int light, const scene::RaytraceSettings& settings);
+double visibilityAt(const scene::Scene& scene, const scene::Vec3& p, const scene::Vec3& n, int light,
+                    const scene::RaytraceSettings& settings);
 
-extern template double visibilityAt<float>(const scene::Scene&, const scene::Vec3&,
-                                           const scene::Vec3&, int, const scene::RaytraceSettings&);
-extern template double visibilityAt<double>(const scene::Scene&, const scene::Vec3&,
-                                            const scene::Vec3&, int,
+extern template double visibilityAt<float>(const scene::Scene&, const scene::Vec3&, const scene::Vec3&, int,
+                                           const scene::RaytraceSettings&);
+extern template double visibilityAt<double>(const scene::Scene&, const scene::Vec3&, const scene::Vec3&, int,
                                             const scene::RaytraceSettings&);
 
 }  // namespace shadowlab::raytrace

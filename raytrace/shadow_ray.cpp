@@ -31,8 +31,8 @@ void orthonormalBasis(const scene::Vec3& w, scene::Vec3& t1, scene::Vec3& t2) {
 }  // namespace
 
 template <typename Real>
-ShadowResult traceShadowRay(const Tracer<Real>& tracer, const Ray<Real>& ray, Real tMax,
-                            bool anyHit, bool conservative, bool nearestDistance) {
+ShadowResult traceShadowRay(const Tracer<Real>& tracer, const Ray<Real>& ray, Real tMax, bool anyHit, bool conservative,
+                            bool nearestDistance) {
     ShadowResult r;
     const double length = glm::length(scene::Vec3(ray.d));
     if (anyHit) {
@@ -73,16 +73,15 @@ ShadowResult traceShadowRay(const Tracer<Real>& tracer, const Ray<Real>& ray, Re
 }
 
 template <typename Real>
-ShadowResult lightVisibility(const Tracer<Real>& tracer, const scene::Light& light,
-                             const SurfacePoint<Real>& sp, const scene::RaytraceSettings& settings,
-                             bool anyHit, Rng& rng, bool nearestDistance) {
+ShadowResult lightVisibility(const Tracer<Real>& tracer, const scene::Light& light, const SurfacePoint<Real>& sp,
+                             const scene::RaytraceSettings& settings, bool anyHit, Rng& rng, bool nearestDistance) {
     using Vec = Vec3T<Real>;
     const bool conservative = settings.robustOffset;
     if (light.type == scene::LightType::Directional) {
         const Vec w(Real(-light.direction.x), Real(-light.direction.y), Real(-light.direction.z));
         const Ray<Real> ray(shadowOrigin(sp, w, settings), w);
-        return traceShadowRay(tracer, ray, std::numeric_limits<Real>::infinity(), anyHit,
-                              conservative, nearestDistance);
+        return traceShadowRay(tracer, ray, std::numeric_limits<Real>::infinity(), anyHit, conservative,
+                              nearestDistance);
     }
     const Vec lightPos(Real(light.position.x), Real(light.position.y), Real(light.position.z));
     if (!(light.radius > 0)) {
@@ -116,13 +115,11 @@ ShadowResult lightVisibility(const Tracer<Real>& tracer, const scene::Light& lig
             const double cosT = 1.0 - u1 * (1.0 - cosMax);
             const double sinT = std::sqrt(std::max(0.0, 1.0 - cosT * cosT));
             const double phi = 2.0 * kPi * u2;
-            const scene::Vec3 w =
-                sinT * std::cos(phi) * t1 + sinT * std::sin(phi) * t2 + cosT * wc;
+            const scene::Vec3 w = sinT * std::cos(phi) * t1 + sinT * std::sin(phi) * t2 + cosT * wc;
             // Below the receiver's horizon the surface itself hides that part of the light.
             if (glm::dot(w, ns) <= 0) continue;
             // Distance to the near side of the light sphere along w.
-            const double disc =
-                light.radius * light.radius - dc * dc * std::max(0.0, 1.0 - cosT * cosT);
+            const double disc = light.radius * light.radius - dc * dc * std::max(0.0, 1.0 - cosT * cosT);
             const double tl = dc * cosT - std::sqrt(std::max(0.0, disc));
             const scene::Vec3 q = p + tl * w;
             const Vec target(Real(q.x), Real(q.y), Real(q.z));
@@ -140,15 +137,11 @@ ShadowResult lightVisibility(const Tracer<Real>& tracer, const scene::Light& lig
     return result;
 }
 
-template ShadowResult traceShadowRay<float>(const Tracer<float>&, const Ray<float>&, float, bool,
-                                            bool, bool);
-template ShadowResult traceShadowRay<double>(const Tracer<double>&, const Ray<double>&, double,
-                                             bool, bool, bool);
-template ShadowResult lightVisibility<float>(const Tracer<float>&, const scene::Light&,
-                                             const SurfacePoint<float>&,
+template ShadowResult traceShadowRay<float>(const Tracer<float>&, const Ray<float>&, float, bool, bool, bool);
+template ShadowResult traceShadowRay<double>(const Tracer<double>&, const Ray<double>&, double, bool, bool, bool);
+template ShadowResult lightVisibility<float>(const Tracer<float>&, const scene::Light&, const SurfacePoint<float>&,
                                              const scene::RaytraceSettings&, bool, Rng&, bool);
-template ShadowResult lightVisibility<double>(const Tracer<double>&, const scene::Light&,
-                                              const SurfacePoint<double>&,
+template ShadowResult lightVisibility<double>(const Tracer<double>&, const scene::Light&, const SurfacePoint<double>&,
                                               const scene::RaytraceSettings&, bool, Rng&, bool);
 
 }  // namespace shadowlab::raytrace

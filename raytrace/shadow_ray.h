@@ -46,15 +46,15 @@ Vec3T<Real> shadowOrigin(const SurfacePoint<Real>& sp, const Vec3T<Real>& toward
 // a blocked any-hit ray traces once more for the nearest hit (the reference does, for
 // ShadowResult::distance).
 template <typename Real>
-ShadowResult traceShadowRay(const Tracer<Real>& tracer, const Ray<Real>& ray, Real tMax,
-                            bool anyHit, bool conservative, bool nearestDistance = false);
+ShadowResult traceShadowRay(const Tracer<Real>& tracer, const Ray<Real>& ray, Real tMax, bool anyHit, bool conservative,
+                            bool nearestDistance = false);
 
 // Visibility of `light` from a surface point (N·L > 0 is the caller's business): one ray for
 // directional and point lights; settings.samples stratified rays toward a spherical light
 // (radius > 0), uniform over the cone the sphere subtends (its visible cap), averaged.
 template <typename Real>
-ShadowResult lightVisibility(const Tracer<Real>& tracer, const scene::Light& light,
-                             const SurfacePoint<Real>& sp, const scene::RaytraceSettings& settings,
-                             bool anyHit, Rng& rng, bool nearestDistance = false);
+ShadowResult lightVisibility(const Tracer<Real>& tracer, const scene::Light& light, const SurfacePoint<Real>& sp,
+                             const scene::RaytraceSettings& settings, bool anyHit, Rng& rng,
+                             bool nearestDistance = false);
 
 }  // namespace shadowlab::raytrace

@@ -74,9 +74,8 @@ struct MaskFilter {
 // conservative mode, or a bound lowered by a hit earlier in the packet) go to the scalar test.
 // Lanes are decided in slot order, as the scalar loop always did. Fills the last hit.
 template <bool kAnyHit, typename BoxTest>
-inline bool traverseFloat(const Bvh8& bvh, const std::vector<TrianglePacket>& packets,
-                          const Ray<float>& ray, float& tBest, bool conservative, SlotHit& out,
-                          const MaskFilter<float>& mask) {
+inline bool traverseFloat(const Bvh8& bvh, const std::vector<TrianglePacket>& packets, const Ray<float>& ray,
+                          float& tBest, bool conservative, SlotHit& out, const MaskFilter<float>& mask) {
     const Triangle4Ray r4(ray);
     const BoxTest boxes(ray);
     const std::uint32_t* prims = bvh.primitives().data();
@@ -131,9 +130,8 @@ inline bool traverseFloat(const Bvh8& bvh, const std::vector<TrianglePacket>& pa
 }
 
 template <typename BoxTest>
-inline bool traverseFloat(const Bvh8& bvh, const std::vector<TrianglePacket>& packets,
-                          const Ray<float>& ray, float& tBest, bool conservative, bool anyHit,
-                          SlotHit& out, const MaskFilter<float>& mask) {
+inline bool traverseFloat(const Bvh8& bvh, const std::vector<TrianglePacket>& packets, const Ray<float>& ray,
+                          float& tBest, bool conservative, bool anyHit, SlotHit& out, const MaskFilter<float>& mask) {
     return anyHit ? traverseFloat<true, BoxTest>(bvh, packets, ray, tBest, conservative, out, mask)
                   : traverseFloat<false, BoxTest>(bvh, packets, ray, tBest, conservative, out, mask);
 }
@@ -144,37 +142,57 @@ inline bool traverseFloat(const Bvh8& bvh, const std::vector<TrianglePacket>& pa
 // scalar triangle test) into this one function, so the AVX code exists only here and runs only
 // after detail::useAvx() said the CPU has AVX. Target "avx" enables no FMA, so the float
 // results are the SSE path's, bit for bit.
-__attribute__((target("avx"), flatten)) bool traverseFloatAvx(
-    const Bvh8& bvh, const std::vector<TrianglePacket>& packets, const Ray<float>& ray,
-    float& tBest, bool conservative, bool anyHit, SlotHit& out, const MaskFilter<float>& mask) {
+__attribute__((target("avx"), flatten)) bool traverseFloatAvx(const Bvh8& bvh,
+                                                              const std::vector<TrianglePacket>& packets,
+                                                              const Ray<float>& ray, float& tBest, bool conservative,
+                                                              bool anyHit, SlotHit& out,
+                                                              const MaskFilter<float>& mask) {
     using detail::ChildBoxTestAvx8Octant;
     switch (detail::octantOf(ray)) {
-        case 0: return traverseFloat<ChildBoxTestAvx8Octant<0>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 1: return traverseFloat<ChildBoxTestAvx8Octant<1>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 2: return traverseFloat<ChildBoxTestAvx8Octant<2>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 3: return traverseFloat<ChildBoxTestAvx8Octant<3>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 4: return traverseFloat<ChildBoxTestAvx8Octant<4>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 5: return traverseFloat<ChildBoxTestAvx8Octant<5>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 6: return traverseFloat<ChildBoxTestAvx8Octant<6>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        default: return traverseFloat<ChildBoxTestAvx8Octant<7>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 0:
+            return traverseFloat<ChildBoxTestAvx8Octant<0>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 1:
+            return traverseFloat<ChildBoxTestAvx8Octant<1>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 2:
+            return traverseFloat<ChildBoxTestAvx8Octant<2>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 3:
+            return traverseFloat<ChildBoxTestAvx8Octant<3>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 4:
+            return traverseFloat<ChildBoxTestAvx8Octant<4>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 5:
+            return traverseFloat<ChildBoxTestAvx8Octant<5>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 6:
+            return traverseFloat<ChildBoxTestAvx8Octant<6>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        default:
+            return traverseFloat<ChildBoxTestAvx8Octant<7>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
     }
 }
 
 // The walk with the AVX2 box test (ChildBoxTestAvx2Octant) for rays whose inverse direction is
 // finite; the others take traverseFloatAvx. Target "avx2" enables no FMA either.
-__attribute__((target("avx2"), flatten)) bool traverseFloatAvx2(
-    const Bvh8& bvh, const std::vector<TrianglePacket>& packets, const Ray<float>& ray,
-    float& tBest, bool conservative, bool anyHit, SlotHit& out, const MaskFilter<float>& mask) {
+__attribute__((target("avx2"), flatten)) bool traverseFloatAvx2(const Bvh8& bvh,
+                                                                const std::vector<TrianglePacket>& packets,
+                                                                const Ray<float>& ray, float& tBest, bool conservative,
+                                                                bool anyHit, SlotHit& out,
+                                                                const MaskFilter<float>& mask) {
     using detail::ChildBoxTestAvx2Octant;
     switch (detail::octantOf(ray)) {
-        case 0: return traverseFloat<ChildBoxTestAvx2Octant<0>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 1: return traverseFloat<ChildBoxTestAvx2Octant<1>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 2: return traverseFloat<ChildBoxTestAvx2Octant<2>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 3: return traverseFloat<ChildBoxTestAvx2Octant<3>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 4: return traverseFloat<ChildBoxTestAvx2Octant<4>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 5: return traverseFloat<ChildBoxTestAvx2Octant<5>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 6: return traverseFloat<ChildBoxTestAvx2Octant<6>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        default: return traverseFloat<ChildBoxTestAvx2Octant<7>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 0:
+            return traverseFloat<ChildBoxTestAvx2Octant<0>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 1:
+            return traverseFloat<ChildBoxTestAvx2Octant<1>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 2:
+            return traverseFloat<ChildBoxTestAvx2Octant<2>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 3:
+            return traverseFloat<ChildBoxTestAvx2Octant<3>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 4:
+            return traverseFloat<ChildBoxTestAvx2Octant<4>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 5:
+            return traverseFloat<ChildBoxTestAvx2Octant<5>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 6:
+            return traverseFloat<ChildBoxTestAvx2Octant<6>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        default:
+            return traverseFloat<ChildBoxTestAvx2Octant<7>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
     }
 }
 #endif
@@ -183,8 +201,8 @@ __attribute__((target("avx2"), flatten)) bool traverseFloatAvx2(
 // The double walk with the AVX box test (ChildBoxTestAvx8Double): the same walk (traverseWith)
 // and leaf, so the same visits in the same order as the scalar test's.
 template <typename LeafFn>
-__attribute__((target("avx"), flatten)) bool traverseDoubleAvx(const Bvh8& bvh, const Ray<double>& ray,
-                                                               double& tBest, bool anyHit, LeafFn& leaf) {
+__attribute__((target("avx"), flatten)) bool traverseDoubleAvx(const Bvh8& bvh, const Ray<double>& ray, double& tBest,
+                                                               bool anyHit, LeafFn& leaf) {
     return bvh.traverseWith<detail::ChildBoxTestAvx8Double>(ray, tBest, anyHit, leaf);
 }
 #endif
@@ -294,8 +312,7 @@ double Tracer<Real>::transmittance(const Ray<Real>& ray, const Hit<Real>& hit) c
 
 template <typename Real>
 typename Tracer<Real>::MeshObjectData Tracer<Real>::buildMeshObject(
-    const scene::Object& obj, const scene::Mesh& m,
-    const std::map<const scene::TriangleMesh*, int>& uses,
+    const scene::Object& obj, const scene::Mesh& m, const std::map<const scene::TriangleMesh*, int>& uses,
     std::map<const scene::TriangleMesh*, int>& blasOf) {
     if (m.instances.empty())
         throw std::invalid_argument(obj.name + ": mesh '" + m.file.string() + "' has no geometry loaded");
@@ -342,7 +359,8 @@ typename Tracer<Real>::MeshObjectData Tracer<Real>::buildMeshObject(
         // (products of two floats are exact; of two doubles nearly so), plus γ(4) of the
         // magnitudes in long double as the bound on that evaluation's own rounding.
         using L = long double;
-        const L gammaL4 = 4 * (std::numeric_limits<L>::epsilon() / 2) / (1 - 4 * (std::numeric_limits<L>::epsilon() / 2));
+        const L gammaL4 =
+            4 * (std::numeric_limits<L>::epsilon() / 2) / (1 - 4 * (std::numeric_limits<L>::epsilon() / 2));
         for (int c = 0; c < 4; ++c)
             for (int r = 0; r < 3; ++r) {
                 L sum = c == 3 ? L(in.toObject[3][r]) : 0, mag = c == 3 ? std::abs(L(in.toObject[3][r])) : 0;
@@ -352,16 +370,17 @@ typename Tracer<Real>::MeshObjectData Tracer<Real>::buildMeshObject(
                     mag += std::abs(prod);
                 }
                 if (c == r) sum -= 1;
-                in.inverseError[c][r] = roundUp<Real>(double((std::abs(sum) + gammaL4 * (mag + 1)) * (1 + 4 * gammaL4)));
+                in.inverseError[c][r] =
+                    roundUp<Real>(double((std::abs(sum) + gammaL4 * (mag + 1)) * (1 + 4 * gammaL4)));
             }
         // World box of the placed mesh, padded so that rounding in the ray's transform never
         // culls an instance at its silhouette (the object-space test decides; tolerances.h).
         scene::Bounds local, world;
         for (const scene::Vec3& p : g.positions) local.extend(p);
         for (int k = 0; k < 8; ++k)
-            world.extend(scene::transformPoint(inst.transform, scene::Vec3((k & 1) ? local.max.x : local.min.x,
-                                                                           (k & 2) ? local.max.y : local.min.y,
-                                                                           (k & 4) ? local.max.z : local.min.z)));
+            world.extend(scene::transformPoint(
+                inst.transform, scene::Vec3((k & 1) ? local.max.x : local.min.x, (k & 2) ? local.max.y : local.min.y,
+                                            (k & 4) ? local.max.z : local.min.z)));
         const double pad = kInstanceBoxPad * (world.maxAbsCoordinate() + world.diagonal());
         world.min -= scene::Vec3(pad);
         world.max += scene::Vec3(pad);
@@ -378,8 +397,7 @@ typename Tracer<Real>::MeshObjectData Tracer<Real>::buildMeshObject(
 }
 
 template <typename Real>
-int Tracer<Real>::buildMesh(const std::vector<scene::Vec3>& positions,
-                            const std::vector<scene::Vec3>& normals,
+int Tracer<Real>::buildMesh(const std::vector<scene::Vec3>& positions, const std::vector<scene::Vec3>& normals,
                             const std::vector<std::uint32_t>& indices, const std::vector<scene::Vec2>& uvs) {
     MeshData d;
     if (uvs.size() == positions.size()) {
@@ -398,8 +416,8 @@ int Tracer<Real>::buildMesh(const std::vector<scene::Vec3>& positions,
         for (int k = 0; k < 3; ++k) triBounds[t].extend(positions[indices[3 * t + k]]);
     // The reference keeps the double build's tree; the float tracer takes the float build's
     // (closest-hit ties go to the lowest triangle index, so the hits do not depend on the tree).
-    d.bvh = std::is_same_v<Real, float> && detail::fastFloatBuild() ? Bvh8::buildFast(triBounds)
-                                                                    : Bvh8::build(triBounds);
+    d.bvh =
+        std::is_same_v<Real, float> && detail::fastFloatBuild() ? Bvh8::buildFast(triBounds) : Bvh8::build(triBounds);
     const std::vector<std::uint32_t>& slots = d.bvh.primitives();
     if constexpr (std::is_same_v<Real, float>) {
         d.packets.resize(slots.size() / WideRef::kLeafAlign);
@@ -407,18 +425,16 @@ int Tracer<Real>::buildMesh(const std::vector<scene::Vec3>& positions,
             TrianglePacket& pk = d.packets[s / 4];
             for (int k = 0; k < 3; ++k)
                 for (int a = 0; a < 3; ++a)
-                    pk.v[3 * k + a][s % 4] =
-                        slots[s] == WideRef::kEmpty
-                            ? std::numeric_limits<float>::quiet_NaN()
-                            : d.positions[d.indices[3 * std::size_t(slots[s]) + k]][a];
+                    pk.v[3 * k + a][s % 4] = slots[s] == WideRef::kEmpty
+                                                 ? std::numeric_limits<float>::quiet_NaN()
+                                                 : d.positions[d.indices[3 * std::size_t(slots[s]) + k]][a];
         }
     } else {
         d.slotVertices.reserve(3 * slots.size());
         for (std::uint32_t tri : slots)
             for (int k = 0; k < 3; ++k)
-                d.slotVertices.push_back(tri == WideRef::kEmpty
-                                             ? Vec(0)
-                                             : d.positions[d.indices[3 * std::size_t(tri) + k]]);
+                d.slotVertices.push_back(tri == WideRef::kEmpty ? Vec(0)
+                                                                : d.positions[d.indices[3 * std::size_t(tri) + k]]);
     }
     uniqueTriangles_ += triBounds.size();
     meshes_.push_back(std::move(d));
@@ -426,9 +442,8 @@ int Tracer<Real>::buildMesh(const std::vector<scene::Vec3>& positions,
 }
 
 template <typename Real>
-bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& tBest,
-                                 bool conservative, bool anyHit, Hit<Real>& hit, const AlphaData* alpha,
-                                 Real cutoff) const {
+bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& tBest, bool conservative, bool anyHit,
+                                 Hit<Real>& hit, const AlphaData* alpha, Real cutoff) const {
     MaskFilter<Real> mask;
     if (alpha) {
         mask.on = true;
@@ -469,8 +484,8 @@ bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& 
                     const int l = __builtin_ctz(unsigned(cand));
                     cand &= cand - 1;
                     float t, b0, b1, b2;
-                    if (!intersectTriangle(ray, pk.vertex(l, 0), pk.vertex(l, 1), pk.vertex(l, 2), tBest,
-                                           conservative, t, b0, b1, b2))
+                    if (!intersectTriangle(ray, pk.vertex(l, 0), pk.vertex(l, 1), pk.vertex(l, 2), tBest, conservative,
+                                           t, b0, b1, b2))
                         continue;
                     tBest = t;
                     record(4 * cached->packet + std::uint32_t(l), t, b0, b1, b2);
@@ -485,10 +500,10 @@ bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& 
                            : detail::useAvx()
                                ? traverseFloatAvx(m.bvh, m.packets, ray, tBest, conservative, anyHit, sh, mask)
                                : traverseFloat<detail::ChildBoxTest<float, 8>>(m.bvh, m.packets, ray, tBest,
-                                                                              conservative, anyHit, sh, mask);
+                                                                               conservative, anyHit, sh, mask);
 #else
-        const bool found = traverseFloat<detail::ChildBoxTest<float, 8>>(m.bvh, m.packets, ray, tBest,
-                                                                        conservative, anyHit, sh, mask);
+        const bool found =
+            traverseFloat<detail::ChildBoxTest<float, 8>>(m.bvh, m.packets, ray, tBest, conservative, anyHit, sh, mask);
 #endif
         if (found) record(sh.slot, sh.t, sh.b0, sh.b1, sh.b2);
         if (cached) {
@@ -504,8 +519,7 @@ bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& 
             for (std::uint32_t slot = first; slot < first + count; ++slot) {
                 const Vec* v = &m.slotVertices[3 * std::size_t(slot)];
                 Real t, b0, b1, b2;
-                if (!intersectTriangle(ray, v[0], v[1], v[2], tm, conservative, t, b0, b1, b2))
-                    continue;
+                if (!intersectTriangle(ray, v[0], v[1], v[2], tm, conservative, t, b0, b1, b2)) continue;
                 if (mask.rejects(slot, b0, b1, b2)) continue;
                 tm = t;
                 record(slot, t, b0, b1, b2);
@@ -522,8 +536,8 @@ bool Tracer<Real>::intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& 
 }
 
 template <typename Real>
-bool Tracer<Real>::intersectObject(int object, const Ray<Real>& ray, Real tMax, bool conservative,
-                                   bool anyHit, Hit<Real>& hit, scene::AlphaTest alphaTest) const {
+bool Tracer<Real>::intersectObject(int object, const Ray<Real>& ray, Real tMax, bool conservative, bool anyHit,
+                                   Hit<Real>& hit, scene::AlphaTest alphaTest) const {
     const ObjectData& od = objects_[object];
     // Shadow rays drop MASK texels below the cutoff (BLEND attenuates: transmittance()); camera
     // rays drop those and BLEND texels below scene::kBlendVisibleAlpha (cameraCutoff).
@@ -559,8 +573,7 @@ bool Tracer<Real>::intersectObject(int object, const Ray<Real>& ray, Real tMax, 
             if (!intersectPlane(ray, q.center, q.normal, tMax, conservative, t)) return false;
             // The rectangle's edges need no robustness: only the plane decides self-hits.
             const Vec rel = ray.o + t * ray.d - q.center;
-            if (!(std::abs(glm::dot(rel, q.uAxis)) <= q.halfU &&
-                  std::abs(glm::dot(rel, q.vAxis)) <= q.halfV))
+            if (!(std::abs(glm::dot(rel, q.uAxis)) <= q.halfU && std::abs(glm::dot(rel, q.vAxis)) <= q.halfV))
                 return false;
             hit.t = t;
             hit.object = object;
@@ -589,8 +602,7 @@ bool Tracer<Real>::intersectObject(int object, const Ray<Real>& ray, Real tMax, 
             }
             if (mo.instances.empty()) return found;
             const std::vector<std::uint32_t>& slots = mo.top.primitives();
-            return mo.top.traverse(ray, tBest, anyHit,
-                                   [&](std::uint32_t first, std::uint32_t count, Real& tm) {
+            return mo.top.traverse(ray, tBest, anyHit, [&](std::uint32_t first, std::uint32_t count, Real& tm) {
                 bool any = false;
                 for (std::uint32_t slot = first; slot < first + count; ++slot) {
                     const InstanceData& in = mo.instances[slots[slot]];
@@ -610,8 +622,7 @@ bool Tracer<Real>::intersectObject(int object, const Ray<Real>& ray, Real tMax, 
 }
 
 template <typename Real>
-bool Tracer<Real>::closestHit(const Ray<Real>& ray, Real tMax, bool conservative,
-                              Hit<Real>& hit) const {
+bool Tracer<Real>::closestHit(const Ray<Real>& ray, Real tMax, bool conservative, Hit<Real>& hit) const {
     bool found = false;
     for (int i = 0; i < objectCount(); ++i) {
         Hit<Real> h;
@@ -637,8 +648,7 @@ bool Tracer<Real>::anyHit(const Ray<Real>& ray, Real tMax, bool conservative, in
 }
 
 template <typename Real>
-SurfacePoint<Real> Tracer<Real>::surfacePoint(const Ray<Real>& ray, const Hit<Real>& hit,
-                                              bool robust) const {
+SurfacePoint<Real> Tracer<Real>::surfacePoint(const Ray<Real>& ray, const Hit<Real>& hit, bool robust) const {
     SurfacePoint<Real> sp;
     sp.object = hit.object;
     sp.p = ray.o + hit.t * ray.d;  // the lesson's hit point
@@ -713,8 +723,7 @@ SurfacePoint<Real> Tracer<Real>::surfacePoint(const Ray<Real>& ray, const Hit<Re
                 // Barycentric interpolation: error ≤ γ(7)·Σ|b_i·p_i| (pbrt-v4
                 // Triangle::InteractionFromIntersection, derived in pbrt-v3 §3.9.4).
                 po = hit.b0 * p0 + hit.b1 * p1 + hit.b2 * p2;
-                poError = gamma<Real>(7) * (glm::abs(hit.b0 * p0) + glm::abs(hit.b1 * p1) +
-                                            glm::abs(hit.b2 * p2));
+                poError = gamma<Real>(7) * (glm::abs(hit.b0 * p0) + glm::abs(hit.b1 * p1) + glm::abs(hit.b2 * p2));
                 sp.p = po;
                 sp.pError = poError;
                 if (in) {
@@ -723,8 +732,7 @@ SurfacePoint<Real> Tracer<Real>::surfacePoint(const Ray<Real>& ray, const Hit<Re
                     // γ(3)·(|M|·|p| + |t|). The exact surface is the stored M applied exactly.
                     sp.p = applyPoint(in->toWorld, po);
                     const Vec mErr = applyVector(in->absToWorld, poError);
-                    sp.pError = (1 + gamma<Real>(3)) * mErr +
-                                gamma<Real>(3) * applyPoint(in->absToWorld, glm::abs(po));
+                    sp.pError = (1 + gamma<Real>(3)) * mErr + gamma<Real>(3) * applyPoint(in->absToWorld, glm::abs(po));
                 }
             }
             Vec ng = glm::cross(p1 - p0, p2 - p0);
@@ -774,8 +782,7 @@ std::size_t Tracer<Real>::meshBytes() const {
              m.indices.capacity() * sizeof(std::uint32_t) + m.bvh.bytes() +
              m.packets.capacity() * sizeof(TrianglePacket) + m.slotVertices.capacity() * sizeof(Vec) +
              m.uvs.capacity() * sizeof(m.uvs[0]);
-    for (const MeshObjectData& mo : meshObjects_)
-        n += mo.instances.capacity() * sizeof(InstanceData) + mo.top.bytes();
+    for (const MeshObjectData& mo : meshObjects_) n += mo.instances.capacity() * sizeof(InstanceData) + mo.top.bytes();
     return n;
 }
 

@@ -10,10 +10,10 @@
 #include <memory>
 #include <vector>
 
-#include "raytrace/wide_bvh.h"
 #include "raytrace/intersect.h"
 #include "raytrace/real.h"
 #include "raytrace/triangle4.h"
+#include "raytrace/wide_bvh.h"
 #include "scene/scene.h"
 
 namespace shadowlab::raytrace {
@@ -21,9 +21,9 @@ namespace shadowlab::raytrace {
 template <typename Real>
 struct Hit {
     Real t = std::numeric_limits<Real>::infinity();
-    int object = -1;  // index into Scene::objects
-    int prim = 0;     // mesh: triangle index; box: face (axis + 3 on the max side)
-    int instance = -1;  // mesh: the instance hit (index in its object), -1 for world-space triangles
+    int object = -1;              // index into Scene::objects
+    int prim = 0;                 // mesh: triangle index; box: face (axis + 3 on the max side)
+    int instance = -1;            // mesh: the instance hit (index in its object), -1 for world-space triangles
     Real b0 = 0, b1 = 0, b2 = 0;  // mesh: barycentrics
 };
 
@@ -62,8 +62,8 @@ public:
     bool anyHit(const Ray<Real>& ray, Real tMax, bool conservative, int& blocker) const;
     // Hits on one object only. With anyHit, the first hit found rather than the nearest.
     // alpha: which hits the alpha test of scene::Material drops (scene::AlphaTest).
-    bool intersectObject(int object, const Ray<Real>& ray, Real tMax, bool conservative,
-                         bool anyHit, Hit<Real>& hit, scene::AlphaTest alpha = scene::AlphaTest::Shadow) const;
+    bool intersectObject(int object, const Ray<Real>& ray, Real tMax, bool conservative, bool anyHit, Hit<Real>& hit,
+                         scene::AlphaTest alpha = scene::AlphaTest::Shadow) const;
     // The light a hit on a non-opaque object lets through: 1 − opacity, or for BLEND
     // 1 − opacity·alpha(uv) with the alpha at the hit (scene::Material::transmittance).
     double transmittance(const Ray<Real>& ray, const Hit<Real>& hit) const;
@@ -96,15 +96,17 @@ private:
         bool opaque = true;  // scene::Material::opaque()
         int alpha = -1;      // into alphas_: a MASK or BLEND material
     };
+
 public:
     // An object's alpha (MASK or BLEND); the texture is shared with the scene's material.
     struct AlphaData {
         scene::AlphaMode mode = scene::AlphaMode::Opaque;
         Real cutoff = 0, factor = 1;
         std::shared_ptr<const scene::AlphaTexture> texture;  // may be null (constant alpha)
-        Real cameraCutoff = 0;  // the camera's: the cutoff (MASK) or scene::kBlendVisibleAlpha (BLEND)
+        Real cameraCutoff = 0;     // the camera's: the cutoff (MASK) or scene::kBlendVisibleAlpha (BLEND)
         scene::Material material;  // for transmittance(): the same formula as the scene's
     };
+
 private:
     struct SphereData {
         Vec center;
@@ -157,8 +159,8 @@ private:
     MeshObjectData buildMeshObject(const scene::Object& obj, const scene::Mesh& m,
                                    const std::map<const scene::TriangleMesh*, int>& uses,
                                    std::map<const scene::TriangleMesh*, int>& blasOf);
-    bool intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& tMax, bool conservative,
-                       bool anyHit, Hit<Real>& hit, const AlphaData* mask = nullptr, Real cutoff = 0) const;
+    bool intersectMesh(const MeshData& m, const Ray<Real>& ray, Real& tMax, bool conservative, bool anyHit,
+                       Hit<Real>& hit, const AlphaData* mask = nullptr, Real cutoff = 0) const;
     int buildMesh(const std::vector<scene::Vec3>& positions, const std::vector<scene::Vec3>& normals,
                   const std::vector<std::uint32_t>& indices, const std::vector<scene::Vec2>& uvs = {});
     // The texture's alpha at a hit (1 without a texture).

@@ -18,9 +18,7 @@ namespace shadowlab::raytrace {
 struct alignas(16) TrianglePacket {
     float v[9][4];
 
-    Vec3T<float> vertex(int lane, int k) const {
-        return {v[3 * k][lane], v[3 * k + 1][lane], v[3 * k + 2][lane]};
-    }
+    Vec3T<float> vertex(int lane, int k) const { return {v[3 * k][lane], v[3 * k + 1][lane], v[3 * k + 2][lane]}; }
 };
 static_assert(sizeof(TrianglePacket) == 144, "TrianglePacket: 36 bytes per triangle");
 
@@ -59,8 +57,7 @@ struct Triangle4Result {
     alignas(16) float invDet[4];
 };
 
-inline void triangle4Test(const Triangle4Ray& r, const TrianglePacket& p, float tMax, int valid,
-                          Triangle4Result& out) {
+inline void triangle4Test(const Triangle4Ray& r, const TrianglePacket& p, float tMax, int valid, Triangle4Result& out) {
 #if defined(__SSE2__)
     auto load = [&](int vertex, int k) { return _mm_load_ps(p.v[3 * vertex + r.row[k]]); };
     // a = p0 − o, b = p1 − o, c = p2 − o, permuted, then sheared: x += sx·z, y += sy·z.
@@ -77,24 +74,21 @@ inline void triangle4Test(const Triangle4Ray& r, const TrianglePacket& p, float 
     const __m128 e1 = _mm_sub_ps(_mm_mul_ps(cx, ay), _mm_mul_ps(cy, ax));
     const __m128 e2 = _mm_sub_ps(_mm_mul_ps(ax, by), _mm_mul_ps(ay, bx));
     const __m128 zero = _mm_setzero_ps();
-    const int zeroEdge = _mm_movemask_ps(_mm_or_ps(
-        _mm_or_ps(_mm_cmpeq_ps(e0, zero), _mm_cmpeq_ps(e1, zero)), _mm_cmpeq_ps(e2, zero)));
-    const __m128 anyNeg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(e0, zero), _mm_cmplt_ps(e1, zero)),
-                                    _mm_cmplt_ps(e2, zero));
-    const __m128 anyPos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(e0, zero), _mm_cmpgt_ps(e1, zero)),
-                                    _mm_cmpgt_ps(e2, zero));
+    const int zeroEdge =
+        _mm_movemask_ps(_mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(e0, zero), _mm_cmpeq_ps(e1, zero)), _mm_cmpeq_ps(e2, zero)));
+    const __m128 anyNeg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(e0, zero), _mm_cmplt_ps(e1, zero)), _mm_cmplt_ps(e2, zero));
+    const __m128 anyPos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(e0, zero), _mm_cmpgt_ps(e1, zero)), _mm_cmpgt_ps(e2, zero));
     const __m128 det = _mm_add_ps(_mm_add_ps(e0, e1), e2);
     az = _mm_mul_ps(az, r.sz);
     bz = _mm_mul_ps(bz, r.sz);
     cz = _mm_mul_ps(cz, r.sz);
-    const __m128 tScaled =
-        _mm_add_ps(_mm_add_ps(_mm_mul_ps(e0, az), _mm_mul_ps(e1, bz)), _mm_mul_ps(e2, cz));
+    const __m128 tScaled = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e0, az), _mm_mul_ps(e1, bz)), _mm_mul_ps(e2, cz));
     const __m128 tMaxDet = _mm_mul_ps(_mm_set1_ps(tMax), det);
     // det < 0: need tScaled < 0 and tScaled >= tMax·det; det > 0: tScaled > 0, <= tMax·det.
-    const __m128 okNeg = _mm_and_ps(_mm_cmplt_ps(det, zero),
-                                    _mm_and_ps(_mm_cmplt_ps(tScaled, zero), _mm_cmpge_ps(tScaled, tMaxDet)));
-    const __m128 okPos = _mm_and_ps(_mm_cmpgt_ps(det, zero),
-                                    _mm_and_ps(_mm_cmpgt_ps(tScaled, zero), _mm_cmple_ps(tScaled, tMaxDet)));
+    const __m128 okNeg =
+        _mm_and_ps(_mm_cmplt_ps(det, zero), _mm_and_ps(_mm_cmplt_ps(tScaled, zero), _mm_cmpge_ps(tScaled, tMaxDet)));
+    const __m128 okPos =
+        _mm_and_ps(_mm_cmpgt_ps(det, zero), _mm_and_ps(_mm_cmpgt_ps(tScaled, zero), _mm_cmple_ps(tScaled, tMaxDet)));
     const __m128 inside = _mm_andnot_ps(_mm_and_ps(anyNeg, anyPos), _mm_or_ps(okNeg, okPos));
     out.zeroEdge = zeroEdge & valid;
     out.pass = _mm_movemask_ps(inside) & valid & ~zeroEdge;
@@ -122,8 +116,7 @@ inline void triangle4Test(const Triangle4Ray& r, const TrianglePacket& p, float 
 // Returns the lanes of `valid` the scalar intersectTriangle must still decide: those that pass
 // the packet test (triangle4Test) plus those with an edge function exactly 0. Every lane the
 // scalar test accepts is therefore returned; most misses are rejected here, four at a time.
-inline int triangle4Candidates(const Triangle4Ray& r, const TrianglePacket& p, float tMax,
-                               int valid) {
+inline int triangle4Candidates(const Triangle4Ray& r, const TrianglePacket& p, float tMax, int valid) {
     Triangle4Result res;
     triangle4Test(r, p, tMax, valid, res);
     return res.pass | res.zeroEdge;

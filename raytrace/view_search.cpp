@@ -164,15 +164,18 @@ Shading shadowClasses(const Tracer<float>& tracer, const Thumbnail& t, const sce
             Vec3 toLight = -light.direction;
             if (light.type != scene::LightType::Directional) toLight = glm::normalize(light.position - p);
             bool reached = glm::dot(n, toLight) > 0;
-            if (light.type == scene::LightType::Spot) reached = reached && glm::dot(-toLight, light.direction) >= cosCone;
+            if (light.type == scene::LightType::Spot)
+                reached = reached && glm::dot(-toLight, light.direction) >= cosCone;
             if (!reached) {
                 out.cls[i] = 0;
                 continue;
             }
             const ShadowResult r = lightVisibility(tracer, light, sp, settings, anyHit, rng);
             out.cls[i] = r.transmittance < 0.5 ? 2 : 1;
-            if (out.cls[i] == 2) out.blocker[i] = r.blocker;
-            else if (!seeThrough.empty() && litThrough(tracer, light, sp, settings, seeThrough)) out.cls[i] = 3;
+            if (out.cls[i] == 2)
+                out.blocker[i] = r.blocker;
+            else if (!seeThrough.empty() && litThrough(tracer, light, sp, settings, seeThrough))
+                out.cls[i] = 3;
         }
     });
     return out;
@@ -232,8 +235,8 @@ ViewScore score(const Thumbnail& t, const Shading& shading, const Vec3& forward,
     }
     s.casters = sumSquares > 0 ? sum * sum / sumSquares : 0.0;
     // Shadows a quarter to a third of the lit-facing surface read best; more is a dark picture.
-    const double fShare = s.shadowedShare <= 0.35 ? s.shadowedShare / 0.35
-                                                  : std::max(0.2, 1.0 - (s.shadowedShare - 0.35) / 0.4);
+    const double fShare =
+        s.shadowedShare <= 0.35 ? s.shadowedShare / 0.35 : std::max(0.2, 1.0 - (s.shadowedShare - 0.35) / 0.4);
     const double fEdge = std::min(1.0, 0.5 * s.edgeLength);  // two image sides of edge: a pattern, not one line
     const double fCover = std::min(1.0, s.coverage / 0.5);
     // Most of what is seen should face the light, the model itself included: a model seen from
@@ -270,7 +273,8 @@ void probeInterior(const Tracer<float>& tracer, const scene::Bounds& b, ViewSear
     for (double h : {0.2, 0.4})
         for (int iz = 0; iz < 5; ++iz)
             for (int ix = 0; ix < 5; ++ix)
-                probes.push_back({b.min.x + e.x * (0.1 + 0.2 * ix), b.min.y + e.y * h, b.min.z + e.z * (0.1 + 0.2 * iz)});
+                probes.push_back(
+                    {b.min.x + e.x * (0.1 + 0.2 * ix), b.min.y + e.y * h, b.min.z + e.z * (0.1 + 0.2 * iz)});
     std::vector<int> state(probes.size(), 0);  // 0 open, 1 enclosed, 2 inside a solid
     std::vector<int> sky(probes.size(), 0);    // upward rays (45° and 70°) that meet nothing
     tbb::parallel_for(std::size_t(0), probes.size(), [&](std::size_t k) {
@@ -280,7 +284,8 @@ void probeInterior(const Tracer<float>& tracer, const scene::Bounds& b, ViewSear
                 const Vec3 d(std::cos(el * kDegrees) * std::sin(az), std::sin(el * kDegrees),
                              std::cos(el * kDegrees) * std::cos(az));
                 Hit<float> hit;
-                if (!tracer.closestHit(Ray<float>(V(probes[k]), V(d)), std::numeric_limits<float>::infinity(), false, hit))
+                if (!tracer.closestHit(Ray<float>(V(probes[k]), V(d)), std::numeric_limits<float>::infinity(), false,
+                                       hit))
                     ++sky[k];
             }
         int front = 0, back = 0, total = 0;
@@ -295,8 +300,10 @@ void probeInterior(const Tracer<float>& tracer, const scene::Bounds& b, ViewSear
                 if (!tracer.closestHit(ray, std::numeric_limits<float>::infinity(), false, hit)) continue;
                 const SurfacePoint<float> sp = tracer.surfacePoint(ray, hit, false);
                 // Quads are two-sided walls: a back hit on one says nothing about solids.
-                if (sp.backFacing && tracer.kind(hit.object) != ShapeKind::Quad) ++back;
-                else ++front;
+                if (sp.backFacing && tracer.kind(hit.object) != ShapeKind::Quad)
+                    ++back;
+                else
+                    ++front;
             }
         state[k] = back * 3 >= front + back && back > 0 ? 2 : front >= kEnclosedShare * total ? 1 : 0;
     });
@@ -347,7 +354,8 @@ std::vector<Candidate> viewCandidates(const scene::Scene& scene, const scene::Bo
         return out;
     }
     // Inside: the enclosed probe points that see the most sky (probeInterior's order).
-    const std::vector<Vec3> eyes(enclosed.begin(), enclosed.begin() + std::min<std::size_t>(enclosed.size(), kInsideEyes));
+    const std::vector<Vec3> eyes(enclosed.begin(),
+                                 enclosed.begin() + std::min<std::size_t>(enclosed.size(), kInsideEyes));
     const double diag = b.diagonal();
     for (const Vec3& eye : eyes)
         for (int h = 0; h < kInsideHeadings; ++h) {
@@ -362,8 +370,8 @@ std::vector<Candidate> viewCandidates(const scene::Scene& scene, const scene::Bo
             c.fovYDegrees = 60.0;
             c.near = 1e-3 * diag;
             c.far = 2.0 * diag;
-            out.push_back({c, "from inside at (" + fmt(eye.x) + ", " + fmt(eye.y) + ", " + fmt(eye.z) +
-                                  "), heading " + fmt(az) + " degrees, 10 degrees down"});
+            out.push_back({c, "from inside at (" + fmt(eye.x) + ", " + fmt(eye.y) + ", " + fmt(eye.z) + "), heading " +
+                                  fmt(az) + " degrees, 10 degrees down"});
         }
     addFileCameras(scene, out);
     return out;
@@ -378,9 +386,7 @@ int groundIndex(const scene::Scene& scene) {
 }
 
 // Objects that can cast a shadow the score counts: all but the added ground.
-int casterCount(const scene::Scene& scene) {
-    return int(scene.objects.size()) - (groundIndex(scene) >= 0 ? 1 : 0);
-}
+int casterCount(const scene::Scene& scene) { return int(scene.objects.size()) - (groundIndex(scene) >= 0 ? 1 : 0); }
 
 int thumbnailHeight(const scene::Camera& c, int width) {
     return std::clamp(int(std::lround(double(width) * c.height / std::max(1, c.width))), 16, 4 * width);
@@ -415,8 +421,10 @@ ViewSearchResult searchViewAndSun(const scene::Scene& scene, const ViewSearchOpt
         std::vector<Vec3> enclosed;
         probeInterior(tracer, b, r, enclosed);
         std::vector<Candidate> views;
-        if (options.chooseView) views = viewCandidates(scene, b, r.interior, enclosed);
-        else views.push_back({scene.camera, "the scene's camera"});
+        if (options.chooseView)
+            views = viewCandidates(scene, b, r.interior, enclosed);
+        else
+            views.push_back({scene.camera, "the scene's camera"});
         std::vector<std::pair<scene::Light, std::string>> suns;
         if (options.chooseSun) {
             for (double el : kSunElevations)
@@ -454,8 +462,9 @@ ViewSearchResult searchViewAndSun(const scene::Scene& scene, const ViewSearchOpt
             const Thumbnail t = primaryHits(tracer, views[v].camera, r.width, r.height);
             const Vec3 forward = scene::cameraBasis(views[v].camera).forward;
             for (std::size_t s = 0; s < suns.size(); ++s) {
-                const ViewScore sc = score(t, shadowClasses(tracer, t, suns[s].first, rayBias, scene.allOpaque(), seeThrough),
-                                           forward, suns[s].first, nearWall, ground, casters);
+                const ViewScore sc =
+                    score(t, shadowClasses(tracer, t, suns[s].first, rayBias, scene.allOpaque(), seeThrough), forward,
+                          suns[s].first, nearWall, ground, casters);
                 scored.push_back({sc, v, s});
             }
         }
@@ -483,8 +492,9 @@ ViewSearchResult searchViewAndSun(const scene::Scene& scene, const ViewSearchOpt
                     thumbnailView = c.view;
                 }
                 const Vec3 forward = scene::cameraBasis(views[c.view].camera).forward;
-                c.score = score(fine, shadowClasses(tracer, fine, suns[c.sun].first, rayBias, scene.allOpaque(), seeThrough),
-                                forward, suns[c.sun].first, nearWall, ground, casters);
+                c.score =
+                    score(fine, shadowClasses(tracer, fine, suns[c.sun].first, rayBias, scene.allOpaque(), seeThrough),
+                          forward, suns[c.sun].first, nearWall, ground, casters);
             }
             weighByHoles(scored, r.holes);
         }
@@ -508,22 +518,23 @@ ViewSearchResult searchViewAndSun(const scene::Scene& scene, const ViewSearchOpt
             widened = c.position != r.camera.position || c.lookAt != r.camera.lookAt;
             r.camera = c;
         }
-        const std::string refinedText = refined > 0 ? ", the best " + std::to_string(refined) + " again at " +
-                                                          std::to_string(r.fineWidth) + "x" + std::to_string(r.fineHeight)
-                                                    : "";
-        const std::string why = " (the best of " + std::to_string(r.views * r.suns) + " view x sun pairs at " +
-                                std::to_string(r.width) + "x" + std::to_string(r.height) + refinedText + ", score " +
-                                fmt(best.score, "%.2f") + ": " +
-                                fmt(100 * best.shadowedShare, "%.0f") + "% of the lit-facing surface in shadow, " +
-                                fmt(best.edgeLength, "%.2f") + " shadow edge per image side, the outlines of " +
-                                fmt(best.casters, "%.1f") + " caster(s), " +
-                                (r.holes ? fmt(best.holeEdgeLength, "%.2f") + " of it around holes (light through cut-outs), " : "") +
-                                fmt(100 * best.coverage, "%.0f") + "% of the image on the model)";
+        const std::string refinedText = refined > 0
+                                            ? ", the best " + std::to_string(refined) + " again at " +
+                                                  std::to_string(r.fineWidth) + "x" + std::to_string(r.fineHeight)
+                                            : "";
+        const std::string why =
+            " (the best of " + std::to_string(r.views * r.suns) + " view x sun pairs at " + std::to_string(r.width) +
+            "x" + std::to_string(r.height) + refinedText + ", score " + fmt(best.score, "%.2f") + ": " +
+            fmt(100 * best.shadowedShare, "%.0f") + "% of the lit-facing surface in shadow, " +
+            fmt(best.edgeLength, "%.2f") + " shadow edge per image side, the outlines of " + fmt(best.casters, "%.1f") +
+            " caster(s), " +
+            (r.holes ? fmt(best.holeEdgeLength, "%.2f") + " of it around holes (light through cut-outs), " : "") +
+            fmt(100 * best.coverage, "%.0f") + "% of the image on the model)";
         r.viewText = (options.chooseView ? "searched, " + views[bestView].text : views[bestView].text) +
                      (r.interior ? "; the model encloses its space (" + std::to_string(r.enclosedPoints) + " of " +
                                        std::to_string(r.probePoints) + " probe points walled in)"
-                                 : "") + why +
-                     (widened ? ", then moved back to hold the model's whole shadow under that sun" : "");
+                                 : "") +
+                     why + (widened ? ", then moved back to hold the model's whole shadow under that sun" : "");
         r.sunText = options.chooseSun ? "searched, " + suns[bestSun].second : suns[bestSun].second;
     });
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -44,16 +44,16 @@ struct ViewScore {
 };
 
 struct ViewSearchResult {
-    bool interior = false;      // the model encloses its space: views from inside
-    int enclosedPoints = 0;     // probe points with walls around them (see interior)
-    int probePoints = 0;        // probe points not inside a solid
-    int views = 0, suns = 0;    // candidates scored (views × suns pairs)
-    int width = 0, height = 0;  // thumbnail size
-    int refined = 0;            // the best pairs scored again (ViewSearchOptions::refine) ...
-    int fineWidth = 0, fineHeight = 0;  // ... at this size
-    bool holes = false;         // some candidate shows light through cut-outs: scores are weighed by it
-    double seconds = 0;         // the whole search, tracer build included
-    scene::Camera camera;       // the chosen view (the scene's image size)
+    bool interior = false;               // the model encloses its space: views from inside
+    int enclosedPoints = 0;              // probe points with walls around them (see interior)
+    int probePoints = 0;                 // probe points not inside a solid
+    int views = 0, suns = 0;             // candidates scored (views × suns pairs)
+    int width = 0, height = 0;           // thumbnail size
+    int refined = 0;                     // the best pairs scored again (ViewSearchOptions::refine) ...
+    int fineWidth = 0, fineHeight = 0;   // ... at this size
+    bool holes = false;                  // some candidate shows light through cut-outs: scores are weighed by it
+    double seconds = 0;                  // the whole search, tracer build included
+    scene::Camera camera;                // the chosen view (the scene's image size)
     scene::Vec3 sunDirection{0, -1, 0};  // the chosen sun (when chosen)
     ViewScore best;
     std::string viewText, sunText;  // what was chosen and why, in words

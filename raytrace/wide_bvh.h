@@ -42,9 +42,7 @@ struct WideRef {
     // Every leaf starts on a multiple of four slots (padding slots hold kEmpty), so the
     // triangles of a leaf fill whole SSE packets (triangle4.h).
     static constexpr std::uint32_t kLeafAlign = 4;
-    static constexpr std::uint32_t leafRef(std::uint32_t first, std::uint32_t count) {
-        return (count << 28) | first;
-    }
+    static constexpr std::uint32_t leafRef(std::uint32_t first, std::uint32_t count) { return (count << 28) | first; }
     static constexpr bool isLeaf(std::uint32_t ref) { return (ref >> 28) != 0; }
     static constexpr std::uint32_t leafCount(std::uint32_t ref) { return ref >> 28; }
     static constexpr std::uint32_t leafFirst(std::uint32_t ref) { return ref & (kMaxSlots - 1); }
@@ -163,10 +161,9 @@ struct ChildBoxTest<float, N> {
         for (int q = 0; q < N; q += 4) {
             __m128 tn = _mm_setzero_ps(), tf = _mm_set1_ps(tMax);
             for (int i = 0; i < 3; ++i) {
-                const __m128 a =
-                    _mm_mul_ps(_mm_sub_ps(_mm_load_ps(&n.bounds[nearRow[i]][q]), o[i]), inv[i]);
-                const __m128 b = _mm_mul_ps(
-                    _mm_mul_ps(_mm_sub_ps(_mm_load_ps(&n.bounds[farRow[i]][q]), o[i]), inv[i]), widen);
+                const __m128 a = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(&n.bounds[nearRow[i]][q]), o[i]), inv[i]);
+                const __m128 b =
+                    _mm_mul_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(&n.bounds[farRow[i]][q]), o[i]), inv[i]), widen);
                 tn = _mm_max_ps(a, tn);
                 tf = _mm_min_ps(b, tf);
             }
@@ -198,10 +195,9 @@ struct ChildBoxTestAvx8 {
     __attribute__((target("avx"))) int operator()(const WideNode<8>& n, float tMax, float tNear[8]) const {
         __m256 tn = _mm256_setzero_ps(), tf = _mm256_set1_ps(tMax);
         for (int i = 0; i < 3; ++i) {
-            const __m256 a =
-                _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[nearRow[i]]), o[i]), inv[i]);
-            const __m256 b = _mm256_mul_ps(
-                _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[farRow[i]]), o[i]), inv[i]), widen);
+            const __m256 a = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[nearRow[i]]), o[i]), inv[i]);
+            const __m256 b =
+                _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[farRow[i]]), o[i]), inv[i]), widen);
             tn = _mm256_max_ps(a, tn);
             tf = _mm256_min_ps(b, tf);
         }
@@ -230,12 +226,12 @@ struct ChildBoxTestAvx8Octant {
         const __m256 ax = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[nearRow(0)]), o[0]), inv[0]);
         const __m256 ay = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[nearRow(1)]), o[1]), inv[1]);
         const __m256 az = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[nearRow(2)]), o[2]), inv[2]);
-        const __m256 bx = _mm256_mul_ps(
-            _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[farRow(0)]), o[0]), inv[0]), widen);
-        const __m256 by = _mm256_mul_ps(
-            _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[farRow(1)]), o[1]), inv[1]), widen);
-        const __m256 bz = _mm256_mul_ps(
-            _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[farRow(2)]), o[2]), inv[2]), widen);
+        const __m256 bx =
+            _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[farRow(0)]), o[0]), inv[0]), widen);
+        const __m256 by =
+            _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[farRow(1)]), o[1]), inv[1]), widen);
+        const __m256 bz =
+            _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(n.bounds[farRow(2)]), o[2]), inv[2]), widen);
         tn = _mm256_max_ps(ax, tn);
         tf = _mm256_min_ps(bx, tf);
         tn = _mm256_max_ps(ay, tn);
@@ -269,8 +265,8 @@ struct ChildBoxTestAvx8Double {
         for (int q = 0; q < 8; q += 4) {
             __m256d tn = _mm256_setzero_pd(), tf = _mm256_set1_pd(tMax);
             for (int i = 0; i < 3; ++i) {
-                const __m256d a = _mm256_mul_pd(
-                    _mm256_sub_pd(_mm256_cvtps_pd(_mm_load_ps(&n.bounds[nearRow[i]][q])), o[i]), inv[i]);
+                const __m256d a =
+                    _mm256_mul_pd(_mm256_sub_pd(_mm256_cvtps_pd(_mm_load_ps(&n.bounds[nearRow[i]][q])), o[i]), inv[i]);
                 const __m256d b = _mm256_mul_pd(
                     _mm256_mul_pd(_mm256_sub_pd(_mm256_cvtps_pd(_mm_load_ps(&n.bounds[farRow[i]][q])), o[i]), inv[i]),
                     widen);
@@ -316,8 +312,8 @@ struct ChildBoxTestAvx2Octant {
                       bz = SHADOWLAB_SLAB(farRow(2), 2, invFar[2]);
 #undef SHADOWLAB_SLAB
         const __m256i tn = _mm256_max_epi32(_mm256_max_epi32(ax, ay), _mm256_max_epi32(az, _mm256_setzero_si256()));
-        const __m256i tf = _mm256_min_epi32(_mm256_min_epi32(bx, by),
-                                            _mm256_min_epi32(bz, _mm256_castps_si256(_mm256_set1_ps(tMax))));
+        const __m256i tf =
+            _mm256_min_epi32(_mm256_min_epi32(bx, by), _mm256_min_epi32(bz, _mm256_castps_si256(_mm256_set1_ps(tMax))));
         _mm256_store_si256(reinterpret_cast<__m256i*>(tNear), tn);
         return ~_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(tn, tf))) & 0xFF;
     }
@@ -329,8 +325,7 @@ struct ChildBoxTestAvx2Octant {
 // widening factor, finite in all three components, so that no slab value can be NaN (0·inf).
 inline bool avx2BoxTestApplies(const Ray<float>& r) {
     const float widen = 1 + 2 * gamma<float>(3);
-    return std::isfinite(r.invDir.x * widen) && std::isfinite(r.invDir.y * widen) &&
-           std::isfinite(r.invDir.z * widen);
+    return std::isfinite(r.invDir.x * widen) && std::isfinite(r.invDir.y * widen) && std::isfinite(r.invDir.z * widen);
 }
 
 // The octant of a ray's direction: bit i set when its component i is negative (dirIsNeg).
@@ -492,8 +487,7 @@ bool WideBvh<N>::walk(const BoxTest& boxes, float& tMax, LeafFn&& leaf) const {
 #if defined(__SSE2__)
                     if (!isLeaf(node.ref[c])) {
                         const char* p = reinterpret_cast<const char*>(&nodes[node.ref[c]]);
-                        for (std::size_t line = 0; line < sizeof(Node); line += 64)
-                            _mm_prefetch(p + line, _MM_HINT_T0);
+                        for (std::size_t line = 0; line < sizeof(Node); line += 64) _mm_prefetch(p + line, _MM_HINT_T0);
                     }
 #endif
                 } while (mask != 0);

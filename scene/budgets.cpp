@@ -96,8 +96,8 @@ Budgets readBudgets(const std::filesystem::path& file, const nlohmann::json& nod
         } else if (value.is_number()) {
             text = value.dump();
         } else {
-            throw SceneError(file, path / key, "expected a number or a string such as \"0.5%\" or \"120px\", got " +
-                                                   value.dump());
+            throw SceneError(file, path / key,
+                             "expected a number or a string such as \"0.5%\" or \"120px\", got " + value.dump());
         }
         try {
             b[info->kind] = parseBudgetLimit(text, info->kind, "budget");

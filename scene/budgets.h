@@ -24,14 +24,22 @@ struct BudgetLimit {
 };
 
 // The budgets, by their option and JSON names. Each is absent unless set.
-enum class BudgetKind { MaxMismatch, MaxFalseShadow, MaxMissedShadow, MaxSelfAcne, MaxMeanAbsDiff, MinIoU, MaxBleeding };
+enum class BudgetKind {
+    MaxMismatch,
+    MaxFalseShadow,
+    MaxMissedShadow,
+    MaxSelfAcne,
+    MaxMeanAbsDiff,
+    MinIoU,
+    MaxBleeding
+};
 inline constexpr int kBudgetKindCount = 7;
 struct BudgetInfo {
     BudgetKind kind;
-    const char* option;    // "--max-mismatch"
-    const char* jsonKey;   // "max_mismatch"
-    bool allowsPixels;     // false for the mean and the IoU, which are not pixel counts
-    bool isMinimum;        // min_iou: broken when the value is below the limit
+    const char* option;   // "--max-mismatch"
+    const char* jsonKey;  // "max_mismatch"
+    bool allowsPixels;    // false for the mean and the IoU, which are not pixel counts
+    bool isMinimum;       // min_iou: broken when the value is below the limit
 };
 const BudgetInfo& budgetInfo(BudgetKind kind);
 

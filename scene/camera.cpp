@@ -27,9 +27,15 @@ CameraBasis cameraBasis(const Camera& camera) {
 glm::dmat4 viewMatrix(const CameraBasis& c, const Vec3& origin) {
     // Camera space: x right, y up, looking down −z (right-handed).
     glm::dmat4 m(1.0);
-    m[0][0] = c.right.x;    m[1][0] = c.right.y;    m[2][0] = c.right.z;
-    m[0][1] = c.up.x;       m[1][1] = c.up.y;       m[2][1] = c.up.z;
-    m[0][2] = -c.forward.x; m[1][2] = -c.forward.y; m[2][2] = -c.forward.z;
+    m[0][0] = c.right.x;
+    m[1][0] = c.right.y;
+    m[2][0] = c.right.z;
+    m[0][1] = c.up.x;
+    m[1][1] = c.up.y;
+    m[2][1] = c.up.z;
+    m[0][2] = -c.forward.x;
+    m[1][2] = -c.forward.y;
+    m[2][2] = -c.forward.z;
     const Vec3 eye = c.position - origin;
     m[3][0] = -glm::dot(c.right, eye);
     m[3][1] = -glm::dot(c.up, eye);

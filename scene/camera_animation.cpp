@@ -43,8 +43,8 @@ glm::dvec4 sampleCurve(const AnimationCurve& c, double time, bool rotation) {
             const double s2 = s * s, s3 = s2 * s;
             const glm::dvec4 p0 = value(k), m0 = dt * c.values[3 * k + 2];
             const glm::dvec4 p1 = value(k + 1), m1 = dt * c.values[3 * (k + 1)];
-            const glm::dvec4 v = (2 * s3 - 3 * s2 + 1) * p0 + (s3 - 2 * s2 + s) * m0 + (-2 * s3 + 3 * s2) * p1 +
-                                 (s3 - s2) * m1;
+            const glm::dvec4 v =
+                (2 * s3 - 3 * s2 + 1) * p0 + (s3 - 2 * s2 + s) * m0 + (-2 * s3 + 3 * s2) * p1 + (s3 - s2) * m1;
             return rotation ? vec(glm::normalize(quat(v))) : v;
         }
     }

@@ -51,7 +51,8 @@ bool convertAll(const draco::PointAttribute& att, std::uint32_t points, int comp
             badPoint = p;
             return false;
         }
-        std::memcpy(out + std::size_t(p) * sizeof(T) * std::size_t(components), value, sizeof(T) * std::size_t(components));
+        std::memcpy(out + std::size_t(p) * sizeof(T) * std::size_t(components), value,
+                    sizeof(T) * std::size_t(components));
     }
     return true;
 }

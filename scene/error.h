@@ -51,7 +51,8 @@ public:
     SceneError(const std::filesystem::path& file, const JsonPath& path, const std::string& what)
         : std::runtime_error(file.string() + ": " + (path.empty() ? "" : path.str() + ": ") +
                              excerpt(what, kMaxErrorMessage)),
-          file_(file), path_(path.str()) {}
+          file_(file),
+          path_(path.str()) {}
     const std::filesystem::path& file() const { return file_; }
     const std::string& jsonPath() const { return path_; }
 

@@ -1,14 +1,14 @@
 // scene/folder_lock.cpp: the output folder's lock and its set replacement (see folder_lock.h).
 #include "scene/folder_lock.h"
 
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
 #include <fcntl.h>
 #include <sys/file.h>
 #include <sys/stat.h>
-#include <system_error>
 #include <unistd.h>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <system_error>
 
 #include "scene/error.h"
 
@@ -19,8 +19,7 @@ namespace fs = std::filesystem;
 FolderLock::FolderLock(const fs::path& dir, const std::string& what) : file_(dir / kLockFileName) {
     for (int attempt = 0; attempt < 100; ++attempt) {
         const int fd = ::open(file_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
-        if (fd < 0)
-            throw InputError(dir.string() + ": cannot lock the folder (" + std::strerror(errno) + ")");
+        if (fd < 0) throw InputError(dir.string() + ": cannot lock the folder (" + std::strerror(errno) + ")");
         if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
             const int error = errno;
             char holder[256] = {};
@@ -35,7 +34,8 @@ FolderLock::FolderLock(const fs::path& dir, const std::string& what) : file_(dir
         }
         // The holder before us may have removed the file between our open and our lock: then
         // we locked a file nobody else will see, and try again.
-        struct stat held {}, named {};
+        struct stat held {
+        }, named{};
         if (::fstat(fd, &held) == 0 && ::lstat(file_.c_str(), &named) == 0 && held.st_ino == named.st_ino &&
             held.st_dev == named.st_dev) {
             const std::string text = std::to_string(::getpid()) + " " + what + "\n";
@@ -52,7 +52,8 @@ FolderLock::FolderLock(const fs::path& dir, const std::string& what) : file_(dir
 
 FolderLock::~FolderLock() {
     if (fd_ < 0) return;
-    struct stat held {}, named {};
+    struct stat held {
+    }, named{};
     if (::fstat(fd_, &held) == 0 && ::lstat(file_.c_str(), &named) == 0 && held.st_ino == named.st_ino)
         ::unlink(file_.c_str());
     ::close(fd_);
@@ -77,8 +78,10 @@ bool sameFile(const fs::path& a, const fs::path& b) {
 }
 
 bool isMountPoint(const fs::path& dir) {
-    struct stat self {}, parent {};
-    return ::stat(dir.c_str(), &self) == 0 && ::stat((dir / "..").c_str(), &parent) == 0 && self.st_dev != parent.st_dev;
+    struct stat self {
+    }, parent{};
+    return ::stat(dir.c_str(), &self) == 0 && ::stat((dir / "..").c_str(), &parent) == 0 &&
+           self.st_dev != parent.st_dev;
 }
 
 }  // namespace

@@ -70,7 +70,7 @@ struct Frame {
     static Frame allocate(int width, int height, bool withBlockerId);
     std::size_t pixelCount() const { return std::size_t(width) * std::size_t(height); }
     double timing(const std::string& stage) const;  // 0 when absent
-    double totalTimeMs() const;                      // sum of all stages
+    double totalTimeMs() const;                     // sum of all stages
 };
 
 }  // namespace shadowlab::scene

@@ -2,23 +2,23 @@
 // and a rename so an interrupted write never leaves a torn file behind.
 #include "scene/frame_io.h"
 
+#include <fcntl.h>
+#include <unistd.h>
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <cstdint>
-#include <fstream>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <map>
 #include <optional>
 #include <sstream>
-#include <cerrno>
-#include <csignal>
-#include <cstdio>
-#include <cstdlib>
-#include <fcntl.h>
 #include <system_error>
-#include <unistd.h>
 
 #include <OpenImageIO/imageio.h>
 
@@ -56,9 +56,10 @@ void checkExrHeader(const fs::path& file) {
     };
     std::uint32_t magic = 0, version = 0;
     if (!readU32(magic) || magic != 20000630u)
-        throw InputError(file.string() + ": not an OpenEXR file, so it has no 'visibility' channel "
-                                         "(missing channel 'visibility': is this a Frame written by "
-                                         "`shadowlab render -o X.exr`?)");
+        throw InputError(file.string() +
+                         ": not an OpenEXR file, so it has no 'visibility' channel "
+                         "(missing channel 'visibility': is this a Frame written by "
+                         "`shadowlab render -o X.exr`?)");
     auto bad = [&](const std::string& what) { return InputError(file.string() + ": damaged OpenEXR header: " + what); };
     if (!readU32(version)) throw bad("truncated");
     if (version & 0x1800u)
@@ -70,13 +71,15 @@ void checkExrHeader(const fs::path& file) {
         name.clear();
         for (char c; in.get(c);) {
             if (c == '\0') return true;
-            if (name.size() == maxName) throw bad("an attribute name is longer than " + std::to_string(maxName) + " bytes");
+            if (name.size() == maxName)
+                throw bad("an attribute name is longer than " + std::to_string(maxName) + " bytes");
             name.push_back(c);
         }
         throw bad("truncated");
     };
     auto printable = [](std::string t) {  // a damaged name may hold any byte
-        for (char& ch : t) if (ch < 0x20 || ch > 0x7e) ch = '?';
+        for (char& ch : t)
+            if (ch < 0x20 || ch > 0x7e) ch = '?';
         return t;
     };
     constexpr int kMaxChannels = 32;
@@ -98,15 +101,20 @@ void checkExrHeader(const fs::path& file) {
         // contents must agree with it (a channel name longer than allowed misaligned the rest
         // of a fuzzed header into another 1.8 GB attribute).
         auto mismatch = [&] {
-            return bad("attribute '" + printable(name) + "' (" + printable(type) + ") does not match its declared size");
+            return bad("attribute '" + printable(name) + "' (" + printable(type) +
+                       ") does not match its declared size");
         };
         // Types of a fixed size, which OpenEXR reads whatever size is declared (a v2f declared as
         // 12 bytes misaligned a fuzzed header). Sizes from OpenEXR's attribute types.
         static const std::map<std::string, std::uint32_t> kFixedSize = {
-            {"box2i", 16}, {"box2f", 16}, {"chromaticities", 32}, {"compression", 1}, {"double", 8},
-            {"envmap", 1}, {"float", 4}, {"int", 4}, {"keycode", 28}, {"lineOrder", 1}, {"m33f", 36},
-            {"m33d", 72}, {"m44f", 64}, {"m44d", 128}, {"rational", 8}, {"tiledesc", 9}, {"timecode", 8},
-            {"v2i", 8}, {"v2f", 8}, {"v2d", 16}, {"v3i", 12}, {"v3f", 12}, {"v3d", 24}, {"deepImageState", 1}};
+            {"box2i", 16},      {"box2f", 16},   {"chromaticities", 32},
+            {"compression", 1}, {"double", 8},   {"envmap", 1},
+            {"float", 4},       {"int", 4},      {"keycode", 28},
+            {"lineOrder", 1},   {"m33f", 36},    {"m33d", 72},
+            {"m44f", 64},       {"m44d", 128},   {"rational", 8},
+            {"tiledesc", 9},    {"timecode", 8}, {"v2i", 8},
+            {"v2f", 8},         {"v2d", 16},     {"v3i", 12},
+            {"v3f", 12},        {"v3d", 24},     {"deepImageState", 1}};
         if (const auto fixed = kFixedSize.find(type); fixed != kFixedSize.end() && fixed->second != size)
             throw mismatch();
         if (type == "chlist") {
@@ -183,13 +191,10 @@ void writeAtomically(const fs::path& file, WriteFn&& write) {
 
 void writeImage(const fs::path& file, const ImageSpec& spec, const void* pixels, TypeDesc type) {
     auto out = ImageOutput::create(file.string());
-    if (!out)
-        throw InputError(file.string() + ": cannot write this image format (" +
-                         OIIO::geterror() + ")");
+    if (!out) throw InputError(file.string() + ": cannot write this image format (" + OIIO::geterror() + ")");
     if (!out->open(file.string(), spec))
         throw InputError(file.string() + ": cannot open for writing: " + out->geterror());
-    if (!out->write_image(type, pixels))
-        throw InputError(file.string() + ": write failed: " + out->geterror());
+    if (!out->write_image(type, pixels)) throw InputError(file.string() + ": write failed: " + out->geterror());
     if (!out->close()) throw InputError(file.string() + ": close failed: " + out->geterror());
 }
 
@@ -217,20 +222,18 @@ std::vector<std::pair<std::string, double>> decodeTimings(const std::string& tex
     return out;
 }
 
-void writePng8(const fs::path& file, int width, int height, const std::vector<float>& rgb,
-               bool encodeSrgb) {
+void writePng8(const fs::path& file, int width, int height, const std::vector<float>& rgb, bool encodeSrgb) {
     if (rgb.size() != std::size_t(width) * std::size_t(height) * 3)
         throw std::invalid_argument("writePng: pixel count does not match the size");
     std::vector<unsigned char> bytes(rgb.size());
     for (std::size_t i = 0; i < rgb.size(); ++i) {
         float v = rgb[i];
         if (!std::isfinite(v)) v = 0.0f;
-        bytes[i] = encodeSrgb ? linearToSrgbCode(v) : static_cast<unsigned char>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
+        bytes[i] = encodeSrgb ? linearToSrgbCode(v)
+                              : static_cast<unsigned char>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
     }
     ImageSpec spec(width, height, 3, TypeDesc::UINT8);
-    writeAtomically(file, [&](const fs::path& tmp) {
-        writeImage(tmp, spec, bytes.data(), TypeDesc::UINT8);
-    });
+    writeAtomically(file, [&](const fs::path& tmp) { writeImage(tmp, spec, bytes.data(), TypeDesc::UINT8); });
 }
 
 }  // namespace
@@ -325,8 +328,7 @@ void writeFrame(const Frame& frame, const fs::path& file) {
         writePngLinear(file, frame.width, frame.height, frame.beauty);
         return;
     }
-    if (ext != ".exr")
-        throw InputError(file.string() + ": unknown output type '" + ext + "' (use .exr or .png)");
+    if (ext != ".exr") throw InputError(file.string() + ": unknown output type '" + ext + "' (use .exr or .png)");
 
     const bool withBlocker = !frame.blockerId.empty();
     const std::size_t n = frame.pixelCount();
@@ -353,11 +355,15 @@ void writeFrame(const Frame& frame, const fs::path& file) {
     spec.attribute(kTimingsAttr, encodeTimings(frame.timingsMs));
     for (const auto& [key, value] : frame.typedAttributes) {
         const std::string name = exrStandardToOiio(key).value_or(kAttrPrefix + key);
-        if (const int* i = std::get_if<int>(&value)) spec.attribute(name, TypeDesc::INT, i);
-        else if (const float* f = std::get_if<float>(&value)) spec.attribute(name, TypeDesc::FLOAT, f);
-        else if (const glm::vec3* v = std::get_if<glm::vec3>(&value)) spec.attribute(name, OIIO::TypeVector, v);
+        if (const int* i = std::get_if<int>(&value))
+            spec.attribute(name, TypeDesc::INT, i);
+        else if (const float* f = std::get_if<float>(&value))
+            spec.attribute(name, TypeDesc::FLOAT, f);
+        else if (const glm::vec3* v = std::get_if<glm::vec3>(&value))
+            spec.attribute(name, OIIO::TypeVector, v);
         // GLM's memory order is the transpose of the matrix it means: the row-vector m44f EXR wants.
-        else spec.attribute(name, OIIO::TypeMatrix44, &std::get<glm::mat4>(value));
+        else
+            spec.attribute(name, OIIO::TypeMatrix44, &std::get<glm::mat4>(value));
     }
 
     const int firstLight = withBlocker ? 8 : 7;
@@ -375,9 +381,7 @@ void writeFrame(const Frame& frame, const fs::path& file) {
         for (std::size_t l = 0; l < lights; ++l) p[firstLight + l] = frame.lightVisibility[l][i];
         if (withDistance) p[channels - 1] = frame.blockerDistance[i];
     }
-    writeAtomically(file, [&](const fs::path& tmp) {
-        writeImage(tmp, spec, pixels.data(), TypeDesc::FLOAT);
-    });
+    writeAtomically(file, [&](const fs::path& tmp) { writeImage(tmp, spec, pixels.data(), TypeDesc::FLOAT); });
 }
 
 Frame readFrame(const fs::path& file) {
@@ -385,16 +389,15 @@ Frame readFrame(const fs::path& file) {
     auto in = ImageInput::open(file.string());
     if (!in) throw InputError(file.string() + ": not a readable image: " + OIIO::geterror());
     const ImageSpec spec = in->spec();
-    if (spec.width <= 0 || spec.height <= 0 || spec.depth > 1)
-        throw InputError(file.string() + ": not a 2D image");
+    if (spec.width <= 0 || spec.height <= 0 || spec.depth > 1) throw InputError(file.string() + ": not a 2D image");
     // The same bound as a render's (kMaxPixels), and reading by bands of rows below, keep the
     // memory a Frame file can make us allocate to the Frame itself plus one band.
     if (spec.width > kMaxResolution || spec.height > kMaxResolution ||
         std::int64_t(spec.width) * spec.height > kMaxPixels || spec.nchannels > 32)
         throw InputError(file.string() + ": image too large for a Frame (" + std::to_string(spec.width) + "x" +
-                         std::to_string(spec.height) + ", " + std::to_string(spec.nchannels) +
-                         " channels; at most " + std::to_string(kMaxResolution) + " a side, " +
-                         std::to_string(kMaxPixels) + " pixels and 32 channels)");
+                         std::to_string(spec.height) + ", " + std::to_string(spec.nchannels) + " channels; at most " +
+                         std::to_string(kMaxResolution) + " a side, " + std::to_string(kMaxPixels) +
+                         " pixels and 32 channels)");
 
     auto channelIndex = [&](const std::string& name, bool required) {
         const auto it = std::find(spec.channelnames.begin(), spec.channelnames.end(), name);
@@ -405,10 +408,9 @@ Frame readFrame(const fs::path& file) {
         }
         return int(it - spec.channelnames.begin());
     };
-    const int iR = channelIndex("R", true), iG = channelIndex("G", true),
-              iB = channelIndex("B", true), iV = channelIndex("visibility", true),
-              iId = channelIndex("object_id", true), iN = channelIndex("ndotl", true),
-              iZ = channelIndex("Z", true), iBl = channelIndex("blocker_id", false),
+    const int iR = channelIndex("R", true), iG = channelIndex("G", true), iB = channelIndex("B", true),
+              iV = channelIndex("visibility", true), iId = channelIndex("object_id", true),
+              iN = channelIndex("ndotl", true), iZ = channelIndex("Z", true), iBl = channelIndex("blocker_id", false),
               iBd = channelIndex("blocker_distance", false);
 
     // visibility.0, visibility.1, ... up to the first index that is missing.
@@ -432,8 +434,8 @@ Frame readFrame(const fs::path& file) {
     for (int y0 = 0; y0 < spec.height; y0 += bandRows) {
         const int y1 = std::min(spec.height, y0 + bandRows);
         const bool read =
-            tiled ? in->read_tiles(0, 0, spec.x, spec.x + spec.width, spec.y + y0, spec.y + y1, spec.z, spec.z + 1, 0, c,
-                                   TypeDesc::FLOAT, band.data())
+            tiled ? in->read_tiles(0, 0, spec.x, spec.x + spec.width, spec.y + y0, spec.y + y1, spec.z, spec.z + 1, 0,
+                                   c, TypeDesc::FLOAT, band.data())
                   : in->read_scanlines(0, 0, spec.y + y0, spec.y + y1, 0, 0, c, TypeDesc::FLOAT, band.data());
         if (!read) throw InputError(file.string() + ": read failed: " + excerpt(in->geterror(), 300));
         if (y0 == 0) {
@@ -470,7 +472,8 @@ Frame readFrame(const fs::path& file) {
             f.typedAttributes[standard.value_or(name.substr(prefix.size()))] = attr.get_int();
         } else if ((ours || standard) && t == TypeDesc::FLOAT) {
             f.typedAttributes[standard.value_or(name.substr(prefix.size()))] = attr.get_float();
-        } else if ((ours || standard) && t.basetype == TypeDesc::FLOAT && t.aggregate == TypeDesc::VEC3 && !t.arraylen) {
+        } else if ((ours || standard) && t.basetype == TypeDesc::FLOAT && t.aggregate == TypeDesc::VEC3 &&
+                   !t.arraylen) {
             glm::vec3 v;
             std::memcpy(&v, attr.data(), sizeof v);
             f.typedAttributes[standard.value_or(name.substr(prefix.size()))] = v;

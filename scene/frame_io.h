@@ -21,11 +21,9 @@ std::string lightVisibilityChannel(std::size_t light);
 Frame readFrame(const std::filesystem::path& file);
 
 // An 8-bit sRGB PNG from linear RGB floats (3 per pixel), written atomically.
-void writePngLinear(const std::filesystem::path& file, int width, int height,
-                    const std::vector<float>& linearRgb);
+void writePngLinear(const std::filesystem::path& file, int width, int height, const std::vector<float>& linearRgb);
 // An 8-bit PNG from already display-encoded RGB floats in 0..1 (diff images, plots).
-void writePngDisplay(const std::filesystem::path& file, int width, int height,
-                     const std::vector<float>& rgb);
+void writePngDisplay(const std::filesystem::path& file, int width, int height, const std::vector<float>& rgb);
 
 // Writes `text` to `file` through a temporary name and a rename.
 void writeTextAtomic(const std::filesystem::path& file, const std::string& text);

@@ -68,7 +68,8 @@ void uvCell(int r, int rings, Emit&& emit) {
     const int a = 0, b = 1, c = 2, d = 3;  // (r, s), (r+1, s), (r+1, s+1), (r, s+1)
     if (r != 0) emit(a, b, d);
     if (r != rings - 1) emit(b, c, d);
-    (void)a; (void)c;
+    (void)a;
+    (void)c;
 }
 
 Geometry sphereGeometry(const Sphere& sp, int segments, int rings) {
@@ -92,7 +93,8 @@ Geometry quadGeometry(const Quad& q) {
     Geometry g;
     const glm::dvec3 hu = 0.5 * q.size.x * q.uAxis, hv = 0.5 * q.size.y * q.vAxis;
     const glm::dvec3 corner[4] = {-hu - hv, hu - hv, hu + hv, -hu + hv};
-    const glm::dvec2 uv[4] = {{q.uvMin.x, q.uvMin.y}, {q.uvMax.x, q.uvMin.y}, {q.uvMax.x, q.uvMax.y}, {q.uvMin.x, q.uvMax.y}};
+    const glm::dvec2 uv[4] = {
+        {q.uvMin.x, q.uvMin.y}, {q.uvMax.x, q.uvMin.y}, {q.uvMax.x, q.uvMax.y}, {q.uvMin.x, q.uvMax.y}};
     for (int i = 0; i < 4; ++i) {
         g.positions.emplace_back(glm::vec3(corner[i]));
         g.normals.emplace_back(glm::vec3(q.normal));
@@ -194,7 +196,9 @@ std::string base64(const std::vector<unsigned char>& in) {
     return out;
 }
 
-int wrapCode(TextureWrap w) { return w == TextureWrap::ClampToEdge ? 33071 : w == TextureWrap::MirroredRepeat ? 33648 : 10497; }
+int wrapCode(TextureWrap w) {
+    return w == TextureWrap::ClampToEdge ? 33071 : w == TextureWrap::MirroredRepeat ? 33648 : 10497;
+}
 
 std::string lower(std::string s) {
     std::transform(s.begin(), s.end(), s.begin(), ::tolower);
@@ -264,9 +268,12 @@ ExportResult exportGltf(const Scene& scene, const fs::path& file, const ExportOp
         const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
         if (!in && !in.eof()) throw InputError(t->file.string() + ": cannot read the alpha texture to embed it");
         doc["images"].push_back({{"bufferView", buffer.view(bytes.data(), bytes.size())}, {"mimeType", mime}});
-        doc["samplers"].push_back({{"wrapS", wrapCode(t->wrapS)}, {"wrapT", wrapCode(t->wrapT)},
-                                   {"magFilter", 9728}, {"minFilter", 9728}});  // nearest, as shadowlab samples
-        doc["textures"].push_back({{"source", int(doc["images"].size()) - 1}, {"sampler", int(doc["samplers"].size()) - 1}});
+        doc["samplers"].push_back({{"wrapS", wrapCode(t->wrapS)},
+                                   {"wrapT", wrapCode(t->wrapT)},
+                                   {"magFilter", 9728},
+                                   {"minFilter", 9728}});  // nearest, as shadowlab samples
+        doc["textures"].push_back(
+            {{"source", int(doc["images"].size()) - 1}, {"sampler", int(doc["samplers"].size()) - 1}});
         return textureIndex[key] = int(doc["textures"].size()) - 1;
     };
 
@@ -295,7 +302,8 @@ ExportResult exportGltf(const Scene& scene, const fs::path& file, const ExportOp
         const bool blend = m.alphaMode == AlphaMode::Blend || (m.opacity < 1.0 && m.alphaMode != AlphaMode::Mask);
         const double alpha = blend ? m.opacity * m.alphaFactor : m.alphaFactor;
         mat["pbrMetallicRoughness"] = {{"baseColorFactor", {m.albedo.x, m.albedo.y, m.albedo.z, alpha}},
-                                       {"metallicFactor", 0.0}, {"roughnessFactor", 1.0}};
+                                       {"metallicFactor", 0.0},
+                                       {"roughnessFactor", 1.0}};
         if (m.alphaMode == AlphaMode::Mask) {
             if (m.opacity < 1.0)
                 throw InputError(scene.file.string() + ": material '" + m.name +
@@ -322,12 +330,15 @@ ExportResult exportGltf(const Scene& scene, const fs::path& file, const ExportOp
         attributes["NORMAL"] =
             buffer.accessor(g.normals.data(), g.normals.size() * 12, g.normals.size(), 5126, "VEC3", 34962);
         if (!g.uvs.empty())
-            attributes["TEXCOORD_0"] = buffer.accessor(g.uvs.data(), g.uvs.size() * 8, g.uvs.size(), 5126, "VEC2", 34962);
+            attributes["TEXCOORD_0"] =
+                buffer.accessor(g.uvs.data(), g.uvs.size() * 8, g.uvs.size(), 5126, "VEC2", 34962);
         const int indices =
             buffer.accessor(g.indices.data(), g.indices.size() * 4, g.indices.size(), 5125, "SCALAR", 34963);
-        doc["meshes"].push_back({{"name", o.name},
-                                 {"primitives", Json::array({{{"attributes", attributes}, {"indices", indices},
-                                                              {"material", materialIndex}, {"mode", 4}}})}});
+        doc["meshes"].push_back(
+            {{"name", o.name},
+             {"primitives",
+              Json::array(
+                  {{{"attributes", attributes}, {"indices", indices}, {"material", materialIndex}, {"mode", 4}}})}});
         addNode({{"name", o.name}, {"mesh", int(doc["meshes"].size()) - 1}, {"translation", vecJson(translation)}});
         result.triangles += g.indices.size() / 3;
     }
@@ -336,11 +347,15 @@ ExportResult exportGltf(const Scene& scene, const fs::path& file, const ExportOp
     // would give the height only up to rounding at another width).
     const Camera& c = scene.camera;
     doc["cameras"] = Json::array({{{"type", "perspective"},
-                                   {"perspective", {{"yfov", c.fovYDegrees * kPi / 180.0},
-                                                    {"aspectRatio", double(c.width) / double(c.height)},
-                                                    {"znear", c.near}, {"zfar", c.far}}},
+                                   {"perspective",
+                                    {{"yfov", c.fovYDegrees * kPi / 180.0},
+                                     {"aspectRatio", double(c.width) / double(c.height)},
+                                     {"znear", c.near},
+                                     {"zfar", c.far}}},
                                    {"extras", {{"shadowlab", {{"resolution", {c.width, c.height}}}}}}}});
-    addNode({{"name", "camera"}, {"camera", 0}, {"translation", vecJson(c.position)},
+    addNode({{"name", "camera"},
+             {"camera", 0},
+             {"translation", vecJson(c.position)},
              {"rotation", quatJson(orientation(c.lookAt - c.position, c.up))}});
 
     // Lights: the inverse of the glTF loader's conversions (scene/loader.cpp, loadModelScene).
@@ -364,8 +379,7 @@ ExportResult exportGltf(const Scene& scene, const fs::path& file, const ExportOp
             }
         }
         if (l.radius > 0) gl["extras"] = {{"shadowlab", {{"radius", l.radius}}}};
-        if (l.type != LightType::Point)
-            node["rotation"] = quatJson(orientation(l.direction, glm::dvec3(0, 1, 0)));
+        if (l.type != LightType::Point) node["rotation"] = quatJson(orientation(l.direction, glm::dvec3(0, 1, 0)));
         node["extensions"] = {{"KHR_lights_punctual", {{"light", int(i)}}}};
         lights.push_back(gl);
         addNode(node);

@@ -31,9 +31,9 @@ bool mulChecked(std::uint64_t a, std::uint64_t b, std::uint64_t& out) { return !
 // specular-glossiness, whose diffuse alpha replaces the base colour's, and the transmissive
 // ones, whose surfaces pass light that shadowlab would block), texture image formats (an alpha
 // texture stored only in one shadowlab cannot decode is refused where it is read) and metadata.
-const std::set<std::string, std::less<>> kRead = {
-    "KHR_mesh_quantization", "KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_meshopt_compression",
-    "KHR_texture_transform", "KHR_lights_punctual"};
+const std::set<std::string, std::less<>> kRead = {"KHR_mesh_quantization",   "KHR_draco_mesh_compression",
+                                                  "EXT_meshopt_compression", "KHR_meshopt_compression",
+                                                  "KHR_texture_transform",   "KHR_lights_punctual"};
 const std::set<std::string, std::less<>> kHarmless = {"KHR_texture_basisu", "EXT_texture_webp", "EXT_texture_avif",
                                                       "KHR_xmp_json_ld", "KHR_xmp"};
 const std::set<std::string, std::less<>> kTransmissive = {"KHR_materials_transmission", "KHR_materials_volume",
@@ -47,8 +47,7 @@ bool harmless(const std::string& name) {
 std::string refusal(const std::string& name) {
     if (name == "KHR_materials_pbrSpecularGlossiness")
         return "its diffuse alpha, not the base colour's, decides what MASK and BLEND materials cut out";
-    if (kTransmissive.count(name))
-        return "its surfaces let light through, where shadowlab's would cast a full shadow";
+    if (kTransmissive.count(name)) return "its surfaces let light through, where shadowlab's would cast a full shadow";
     if (name == "EXT_mesh_gpu_instancing") return "it places a mesh many times, which shadowlab would draw once";
     if (name == "KHR_node_visibility") return "it hides nodes, which shadowlab would draw";
     return "it may change the geometry or alpha that shadows depend on";
@@ -71,8 +70,7 @@ std::uint64_t wholeNumber(const tinygltf::Value& ext, const char* key, const std
     }
     const tinygltf::Value& v = ext.Get(key);
     const double d = v.IsNumber() || v.IsInt() ? v.GetNumberAsDouble() : -1.0;
-    if (!(d >= 0 && d <= 9007199254740992.0 && d == std::floor(d)))
-        bad(at + "." + key, "must be a whole number >= 0");
+    if (!(d >= 0 && d <= 9007199254740992.0 && d == std::floor(d))) bad(at + "." + key, "must be a whole number >= 0");
     return std::uint64_t(d);
 }
 
@@ -142,7 +140,8 @@ void decodeMeshoptView(tinygltf::Model& model, std::size_t viewIndex, const std:
         bad(at + ".byteStride", "must be a multiple of 4 in 4..256 for ATTRIBUTES, got " + std::to_string(stride));
     if (!attributes && stride != 2 && stride != 4)
         bad(at + ".byteStride", "must be 2 or 4 for " + mode + ", got " + std::to_string(stride));
-    if (triangles && count % 3 != 0) bad(at + ".count", "must be a multiple of 3 for TRIANGLES, got " + std::to_string(count));
+    if (triangles && count % 3 != 0)
+        bad(at + ".count", "must be a multiple of 3 for TRIANGLES, got " + std::to_string(count));
     if (filter != "NONE" && !attributes) bad(at + ".filter", "must be NONE for " + mode);
     if (filter == "OCTAHEDRAL" && stride != 4 && stride != 8) bad(at + ".filter", "OCTAHEDRAL needs byteStride 4 or 8");
     if (filter == "QUATERNION" && stride != 8) bad(at + ".filter", "QUATERNION needs byteStride 8");
@@ -178,9 +177,12 @@ void decodeMeshoptView(tinygltf::Model& model, std::size_t viewIndex, const std:
     std::vector<unsigned char> out(std::max<std::uint64_t>(decoded, 1));
     int rc = 0;
     if (count > 0) {
-        if (attributes) rc = meshopt_decodeVertexBuffer(out.data(), count, stride, data, length);
-        else if (triangles) rc = meshopt_decodeIndexBuffer(out.data(), count, stride, data, length);
-        else rc = meshopt_decodeIndexSequence(out.data(), count, stride, data, length);
+        if (attributes)
+            rc = meshopt_decodeVertexBuffer(out.data(), count, stride, data, length);
+        else if (triangles)
+            rc = meshopt_decodeIndexBuffer(out.data(), count, stride, data, length);
+        else
+            rc = meshopt_decodeIndexSequence(out.data(), count, stride, data, length);
     }
     if (rc != 0)
         bad(at, "the compressed data does not decode to " + std::to_string(count) + " elements of " +
@@ -210,7 +212,8 @@ struct DracoSource {
 void decodeDracoPrimitive(tinygltf::Model& model, std::size_t meshIndex, std::size_t primIndex,
                           std::map<int, DracoSource>& decodedAccessors, std::uint64_t& total) {
     tinygltf::Primitive& prim = model.meshes[meshIndex].primitives[primIndex];
-    const std::string primAt = "meshes[" + std::to_string(meshIndex) + "].primitives[" + std::to_string(primIndex) + "]";
+    const std::string primAt =
+        "meshes[" + std::to_string(meshIndex) + "].primitives[" + std::to_string(primIndex) + "]";
     const std::string at = primAt + ".extensions.KHR_draco_mesh_compression";
     const tinygltf::Value& ext = prim.extensions.at("KHR_draco_mesh_compression");
     if (!ext.IsObject()) bad(at, "must be an object");
@@ -233,7 +236,8 @@ void decodeDracoPrimitive(tinygltf::Model& model, std::size_t meshIndex, std::si
         const std::uint64_t id = wholeNumber(ids, name.c_str(), at + ".attributes", true);
         if (id > std::uint64_t(INT32_MAX)) bad(at + ".attributes." + name, "is too large");
         if (accessor < 0 || std::size_t(accessor) >= model.accessors.size())
-            bad(primAt + ".attributes." + name, "names accessor " + std::to_string(accessor) + ", which does not exist");
+            bad(primAt + ".attributes." + name,
+                "names accessor " + std::to_string(accessor) + ", which does not exist");
         const auto& acc = model.accessors[std::size_t(accessor)];
         const int comp = tinygltf::GetComponentSizeInBytes(acc.componentType);
         const int nComp = tinygltf::GetNumComponentsInType(acc.type);
@@ -262,9 +266,9 @@ void decodeDracoPrimitive(tinygltf::Model& model, std::size_t meshIndex, std::si
     const auto& source = model.buffers[std::size_t(view.buffer)].data;
     std::uint64_t end = 0;
     if (!addChecked(view.byteOffset, view.byteLength, end) || end > source.size())
-        bad(viewAt, "byteOffset " + std::to_string(view.byteOffset) + " + byteLength " + std::to_string(view.byteLength) +
-                        " reaches past the end of buffer " + std::to_string(view.buffer) + " (" +
-                        std::to_string(source.size()) + " bytes)");
+        bad(viewAt, "byteOffset " + std::to_string(view.byteOffset) + " + byteLength " +
+                        std::to_string(view.byteLength) + " reaches past the end of buffer " +
+                        std::to_string(view.buffer) + " (" + std::to_string(source.size()) + " bytes)");
 
     std::unique_ptr<DracoMesh> mesh;
     std::string error;
@@ -286,10 +290,12 @@ void decodeDracoPrimitive(tinygltf::Model& model, std::size_t meshIndex, std::si
         const DracoSource src{int(viewIndex), w.id};
         if (const auto it = decodedAccessors.find(w.accessor); it != decodedAccessors.end()) {
             if (it->second == src) continue;  // the same data, already decoded for another primitive
-            bad(primAt + ".attributes." + w.name, "names " + accAt + ", which another compressed primitive decodes differently");
+            bad(primAt + ".attributes." + w.name,
+                "names " + accAt + ", which another compressed primitive decodes differently");
         }
         if (!mesh->hasAttribute(w.id))
-            bad(at + ".attributes." + w.name, "Draco attribute " + std::to_string(w.id) + " is not in the data of " + viewAt);
+            bad(at + ".attributes." + w.name,
+                "Draco attribute " + std::to_string(w.id) + " is not in the data of " + viewAt);
         if (acc.count != points)
             bad(accAt + ".count", std::to_string(acc.count) + " elements, but the Draco data of " + w.name + " holds " +
                                       std::to_string(points) + " points");
@@ -315,8 +321,8 @@ void decodeDracoPrimitive(tinygltf::Model& model, std::size_t meshIndex, std::si
         if (prim.indices >= 0 && model.accessors[std::size_t(prim.indices)].count != std::uint64_t(faces) * 3)
             bad("accessors[" + std::to_string(prim.indices) + "].count",
                 std::to_string(model.accessors[std::size_t(prim.indices)].count) + " indices, but the Draco data of " +
-                    primAt + " holds " + std::to_string(faces) + " triangles (" + std::to_string(std::uint64_t(faces) * 3) +
-                    " indices)");
+                    primAt + " holds " + std::to_string(faces) + " triangles (" +
+                    std::to_string(std::uint64_t(faces) * 3) + " indices)");
         indexOffset = out.size();
         std::vector<std::uint32_t> indices(std::size_t(faces) * 3);
         mesh->readIndices(indices.data());
@@ -378,12 +384,15 @@ std::string glbLayoutProblem(const std::string& bytes) {
     // Chunk by chunk: length (4 bytes), type (4), data; the JSON chunk first, then BIN.
     std::uint64_t at = 12;
     for (int chunk = 0; at < declared; ++chunk) {
-        const std::string name = "GLB chunk " + std::to_string(chunk) + (chunk == 0 ? " (JSON)" : chunk == 1 ? " (BIN)" : "");
+        const std::string name = "GLB chunk " + std::to_string(chunk) +
+                                 (chunk == 0   ? " (JSON)"
+                                  : chunk == 1 ? " (BIN)"
+                                               : "");
         if (declared - at < 8) return name + ": its 8-byte header is cut short at byte " + std::to_string(at);
         const std::uint64_t length = readU32(bytes, std::size_t(at));
         if (length > declared - at - 8)
-            return name + ": declares " + std::to_string(length) + " bytes, but only " + std::to_string(declared - at - 8) +
-                   " follow its header";
+            return name + ": declares " + std::to_string(length) + " bytes, but only " +
+                   std::to_string(declared - at - 8) + " follow its header";
         at += 8 + length;
     }
     return {};
@@ -415,7 +424,8 @@ GltfPrepared prepareGltf(const std::string& bytes, bool binary) {
             const std::string name = used.get<std::string>();
             meshopt = meshopt || name == "EXT_meshopt_compression" || name == "KHR_meshopt_compression";
             if (!kRead.count(name) && !harmless(name) && !required.count(name) && out.notes.size() < 16)
-                out.notes.push_back("extensionsUsed: " + excerpt(name) + " is not read; the model is read as if it were absent");
+                out.notes.push_back("extensionsUsed: " + excerpt(name) +
+                                    " is not read; the model is read as if it were absent");
         }
     }
     // tinygltf keeps an extension's whole numbers as int (2^32 + 5 would read as 5): the
@@ -424,8 +434,10 @@ GltfPrepared prepareGltf(const std::string& bytes, bool binary) {
         if (object.is_object() || object.is_array()) {
             std::size_t i = 0;
             for (auto it = object.begin(); it != object.end(); ++it, ++i)
-                self(*it, at + (object.is_object() ? "." + excerpt(it.key(), 40) : "[" + std::to_string(i) + "]"), self);
-        } else if ((object.is_number_integer() && (object.get<std::int64_t>() < 0 || object.get<std::int64_t>() > INT32_MAX)) ||
+                self(*it, at + (object.is_object() ? "." + excerpt(it.key(), 40) : "[" + std::to_string(i) + "]"),
+                     self);
+        } else if ((object.is_number_integer() &&
+                    (object.get<std::int64_t>() < 0 || object.get<std::int64_t>() > INT32_MAX)) ||
                    (object.is_number_unsigned() && object.get<std::uint64_t>() > std::uint64_t(INT32_MAX))) {
             bad(at, object.dump() + " is out of the range shadowlab reads (0..2147483647)");
         }
@@ -434,10 +446,10 @@ GltfPrepared prepareGltf(const std::string& bytes, bool binary) {
     if (const auto views = j.find("bufferViews"); views != j.end() && views->is_array())
         for (std::size_t v = 0; v < views->size(); ++v)
             for (const char* name : {"EXT_meshopt_compression", "KHR_meshopt_compression"})
-                if ((*views)[v].is_object() && (*views)[v].contains("extensions") && (*views)[v]["extensions"].is_object() &&
-                    (*views)[v]["extensions"].contains(name))
-                    checkInts((*views)[v]["extensions"][name], "bufferViews[" + std::to_string(v) + "].extensions." + name,
-                              checkInts);
+                if ((*views)[v].is_object() && (*views)[v].contains("extensions") &&
+                    (*views)[v]["extensions"].is_object() && (*views)[v]["extensions"].contains(name))
+                    checkInts((*views)[v]["extensions"][name],
+                              "bufferViews[" + std::to_string(v) + "].extensions." + name, checkInts);
     const auto accessors = j.find("accessors");
     if (const auto meshes = j.find("meshes"); meshes != j.end() && meshes->is_array())
         for (std::size_t m = 0; m < meshes->size(); ++m) {
@@ -449,8 +461,10 @@ GltfPrepared prepareGltf(const std::string& bytes, bool binary) {
                     !prim["extensions"].contains("KHR_draco_mesh_compression"))
                     continue;
                 const nlohmann::json& ext = prim["extensions"]["KHR_draco_mesh_compression"];
-                checkInts(ext, "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(p) +
-                                   "].extensions.KHR_draco_mesh_compression", checkInts);
+                checkInts(ext,
+                          "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(p) +
+                              "].extensions.KHR_draco_mesh_compression",
+                          checkInts);
                 if (!prim.contains("indices") || !prim["indices"].is_number_unsigned() || !ext.is_object() ||
                     !ext.contains("bufferView") || !ext["bufferView"].is_number_unsigned() || accessors == j.end() ||
                     !accessors->is_array() || prim["indices"].get<std::uint64_t>() >= accessors->size())
@@ -511,7 +525,8 @@ std::uint64_t decodeCompressedGeometry(tinygltf::Model& model, const GltfPrepare
             bad("bufferViews[" + std::to_string(v) + "].extensions",
                 "has both EXT_meshopt_compression and KHR_meshopt_compression, which exclude each other");
         if (ext1 || khr)
-            decodeMeshoptView(model, v, ext1 ? "EXT_meshopt_compression" : "KHR_meshopt_compression", placeholders, total);
+            decodeMeshoptView(model, v, ext1 ? "EXT_meshopt_compression" : "KHR_meshopt_compression", placeholders,
+                              total);
     }
     // Every view left on a fallback buffer would read the placeholder's one byte.
     for (std::size_t v = 0; v < model.bufferViews.size(); ++v)

@@ -36,7 +36,7 @@ struct GltfPrepared {
     // Index accessors of Draco primitives, which have no buffer view; tinygltf 2.7 refuses
     // those, so each borrows its primitive's compressed view until tinygltf has parsed the file.
     std::vector<int> borrowedViews;
-    std::string rewritten;  // the file with its placeholder buffers swapped; empty: read it as it is
+    std::string rewritten;           // the file with its placeholder buffers swapped; empty: read it as it is
     std::vector<std::string> notes;  // extensions used but not read, for the user to see
 };
 GltfPrepared prepareGltf(const std::string& bytes, bool binary);

@@ -1,11 +1,11 @@
 // scene/input_file.cpp: regular files only, of a known and bounded size (see input_file.h).
 #include "scene/input_file.h"
 
-#include <cerrno>
-#include <cstring>
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <cerrno>
+#include <cstring>
 
 #include "scene/memory.h"
 
@@ -41,12 +41,12 @@ void checkStat(const fs::path& file, const struct stat& st, std::uint64_t maxByt
     if (!S_ISREG(st.st_mode)) throw InputFileError(file, notRegular(st.st_mode));
     const auto size = std::uint64_t(st.st_size);
     if (size > maxBytes)
-        throw InputFileError(file, "is " + mib(size) + ", more than the " + mib(maxBytes) +
-                                       " an input of this kind may be");
+        throw InputFileError(file,
+                             "is " + mib(size) + ", more than the " + mib(maxBytes) + " an input of this kind may be");
     // Reading it must fit beside what the program already holds (0: unknown, not checked).
     if (const std::uint64_t available = availableMemoryBytes(); available != 0 && size > available)
-        throw InputFileError(file, "is " + mib(size) + ", more than the " + mib(available) +
-                                       " of memory available to read it");
+        throw InputFileError(
+            file, "is " + mib(size) + ", more than the " + mib(available) + " of memory available to read it");
 }
 
 class Descriptor {

@@ -16,7 +16,10 @@ void describeInto(const nlohmann::json& v, std::size_t max, std::string& out, in
         const std::string& s = v.get_ref<const std::string&>();
         out += nlohmann::json(s.substr(0, max + 1)).dump();
     } else if (v.is_array() || v.is_object()) {
-        if (depth > kMaxJsonDepth) { out += "..."; return; }
+        if (depth > kMaxJsonDepth) {
+            out += "...";
+            return;
+        }
         out += v.is_array() ? '[' : '{';
         bool first = true;
         for (auto it = v.begin(); it != v.end(); ++it) {
@@ -44,7 +47,12 @@ std::string parserMessage(const std::exception& e) {
 std::string lineColumn(std::string_view text, std::size_t byte) {
     std::size_t line = 1, column = 1;
     for (std::size_t i = 0; i < byte && i < text.size(); ++i) {
-        if (text[i] == '\n') { ++line; column = 1; } else { ++column; }
+        if (text[i] == '\n') {
+            ++line;
+            column = 1;
+        } else {
+            ++column;
+        }
     }
     return "line " + std::to_string(line) + ", column " + std::to_string(column);
 }
@@ -55,16 +63,18 @@ std::string jsonNestingProblem(std::string_view text) {
     for (std::size_t i = 0; i < text.size(); ++i) {
         const char c = text[i];
         if (inString) {
-            if (c == '\\') ++i;
-            else if (c == '"') inString = false;
+            if (c == '\\')
+                ++i;
+            else if (c == '"')
+                inString = false;
             continue;
         }
         if (c == '"') {
             inString = true;
         } else if (c == '[' || c == '{') {
             if (++depth > kMaxJsonDepth)
-                return "arrays and objects are nested deeper than " + std::to_string(kMaxJsonDepth) +
-                       " levels near " + lineColumn(text, i);
+                return "arrays and objects are nested deeper than " + std::to_string(kMaxJsonDepth) + " levels near " +
+                       lineColumn(text, i);
         } else if ((c == ']' || c == '}') && depth > 0) {
             --depth;
         }
@@ -83,8 +93,10 @@ std::uint64_t jsonTreeBytes(std::string_view text) {
         const char c = text[i];
         if (inString) {
             ++stringBytes;
-            if (c == '\\') ++i;
-            else if (c == '"') inString = false;
+            if (c == '\\')
+                ++i;
+            else if (c == '"')
+                inString = false;
             continue;
         }
         const bool scalarChar = (c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') || c == '-' || c == '+' || c == '.' ||
@@ -107,14 +119,16 @@ std::uint64_t jsonTreeBytes(std::string_view text) {
 
 nlohmann::json parseJsonText(const std::filesystem::path& file, std::string_view text) {
     checkJsonNesting(file, text);
-    if (const std::uint64_t tree = jsonTreeBytes(text), available = availableMemoryBytes(); available != 0 && tree > available)
-        throw SceneError(file, {}, "parsing it needs about " + std::to_string(tree >> 20) + " MiB, more than the " +
-                                       std::to_string(available >> 20) + " MiB available");
+    if (const std::uint64_t tree = jsonTreeBytes(text), available = availableMemoryBytes();
+        available != 0 && tree > available)
+        throw SceneError(file, {},
+                         "parsing it needs about " + std::to_string(tree >> 20) + " MiB, more than the " +
+                             std::to_string(available >> 20) + " MiB available");
     try {
         return nlohmann::json::parse(text.begin(), text.end());
     } catch (const nlohmann::json::parse_error& e) {
-        throw SceneError(file, {}, "invalid JSON near " + lineColumn(text, e.byte == 0 ? 0 : e.byte - 1) + ": " +
-                                       parserMessage(e));
+        throw SceneError(
+            file, {}, "invalid JSON near " + lineColumn(text, e.byte == 0 ? 0 : e.byte - 1) + ": " + parserMessage(e));
     } catch (const nlohmann::json::exception& e) {
         throw SceneError(file, {}, "invalid JSON: " + parserMessage(e) + " (numbers must be finite)");
     }

@@ -64,9 +64,7 @@ class Reader {
 public:
     explicit Reader(fs::path file) : file_(std::move(file)) {}
 
-    [[noreturn]] void fail(const JsonPath& path, const std::string& what) const {
-        throw SceneError(file_, path, what);
-    }
+    [[noreturn]] void fail(const JsonPath& path, const std::string& what) const { throw SceneError(file_, path, what); }
 
     void expectObject(const Json& node, const JsonPath& path) const {
         if (!node.is_object()) fail(path, std::string("expected an object, got ") + typeName(node));
@@ -77,8 +75,7 @@ public:
         expectObject(node, path);
         for (const auto& item : node.items()) {
             const std::string& key = item.key();  // (a named variable: lambdas may capture it)
-            if (std::any_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; }))
-                continue;
+            if (std::any_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) continue;
             std::string best;
             std::size_t bestDistance = 3;  // suggest only close matches
             std::string list;
@@ -92,8 +89,8 @@ public:
                     best = a;
                 }
             }
-            fail(path / key, "unknown key" + (best.empty() ? "" : " (did you mean '" + best + "'?)") +
-                                 "; allowed here: " + list);
+            fail(path / key,
+                 "unknown key" + (best.empty() ? "" : " (did you mean '" + best + "'?)") + "; allowed here: " + list);
         }
     }
 
@@ -163,7 +160,8 @@ public:
     }
     Vec3 color(const Json& node, const JsonPath& path, const char* key, const Vec3& fallback) const {
         const Vec3 c = vec3(node, path, key, fallback);
-        if (c.x < 0 || c.y < 0 || c.z < 0) fail(path / key, "color components must be >= 0, got " + describe(node[key]));
+        if (c.x < 0 || c.y < 0 || c.z < 0)
+            fail(path / key, "color components must be >= 0, got " + describe(node[key]));
         return c;
     }
 
@@ -178,14 +176,17 @@ private:
 void readAlpha(const Reader& r, const Json& node, const JsonPath& path, Material& m, TextureCache& textures) {
     if (node.contains("alpha_mode")) {
         const std::string mode = r.string(node["alpha_mode"], path / "alpha_mode");
-        if (mode == "opaque") m.alphaMode = AlphaMode::Opaque;
-        else if (mode == "mask") m.alphaMode = AlphaMode::Mask;
-        else if (mode == "blend") m.alphaMode = AlphaMode::Blend;
-        else r.fail(path / "alpha_mode", "unknown alpha mode '" + excerpt(mode) + "' (expected opaque, mask or blend)");
+        if (mode == "opaque")
+            m.alphaMode = AlphaMode::Opaque;
+        else if (mode == "mask")
+            m.alphaMode = AlphaMode::Mask;
+        else if (mode == "blend")
+            m.alphaMode = AlphaMode::Blend;
+        else
+            r.fail(path / "alpha_mode", "unknown alpha mode '" + excerpt(mode) + "' (expected opaque, mask or blend)");
     }
     if (node.contains("alpha_cutoff")) {
-        if (m.alphaMode != AlphaMode::Mask)
-            r.fail(path / "alpha_cutoff", "applies only with \"alpha_mode\": \"mask\"");
+        if (m.alphaMode != AlphaMode::Mask) r.fail(path / "alpha_cutoff", "applies only with \"alpha_mode\": \"mask\"");
         m.alphaCutoff = r.unitInterval(node["alpha_cutoff"], path / "alpha_cutoff");
     }
     if (node.contains("alpha")) m.alphaFactor = r.unitInterval(node["alpha"], path / "alpha");
@@ -201,7 +202,8 @@ void readAlpha(const Reader& r, const Json& node, const JsonPath& path, Material
         if (!node.contains(key)) continue;
         const std::string w = r.string(node[key], path / key);
         if (!textureWrapFromName(w, wrap[k]))
-            r.fail(path / key, "unknown wrap mode '" + excerpt(w) + "' (expected repeat, clamp_to_edge or mirrored_repeat)");
+            r.fail(path / key,
+                   "unknown wrap mode '" + excerpt(w) + "' (expected repeat, clamp_to_edge or mirrored_repeat)");
     }
     if (node.contains("texcoord")) m.texCoord = r.integer(node["texcoord"], path / "texcoord", 0, 64);
     const fs::path base = r.file().has_parent_path() ? r.file().parent_path() : fs::path(".");
@@ -218,8 +220,7 @@ Camera readCamera(const Reader& r, const Json& node, const JsonPath& path) {
     Camera c;
     c.position = r.vector<3>(r.require(node, path, "position"), path / "position");
     c.lookAt = r.vector<3>(r.require(node, path, "look_at"), path / "look_at");
-    if (glm::length(c.lookAt - c.position) == 0.0)
-        r.fail(path / "look_at", "must differ from camera.position");
+    if (glm::length(c.lookAt - c.position) == 0.0) r.fail(path / "look_at", "must differ from camera.position");
     if (node.contains("up")) c.up = r.direction(node["up"], path / "up");
     c.fovYDegrees = r.number(node, path, "fov_y", c.fovYDegrees);
     if (!(c.fovYDegrees > 0.0 && c.fovYDegrees < 180.0))
@@ -235,8 +236,10 @@ Camera readCamera(const Reader& r, const Json& node, const JsonPath& path) {
                                             " is more than " + std::to_string(kMaxPixels) + " pixels");
     }
     if (node.contains("near")) c.near = r.positive(node["near"], path / "near");
-    if (node.contains("far")) c.far = r.positive(node["far"], path / "far");
-    else c.far = std::max(c.far, 2.0 * c.near);  // a placeholder: fitted to the scene's bounds once it is read
+    if (node.contains("far"))
+        c.far = r.positive(node["far"], path / "far");
+    else
+        c.far = std::max(c.far, 2.0 * c.near);  // a placeholder: fitted to the scene's bounds once it is read
     if (!(c.far > c.near)) r.fail(path / "far", "must be greater than near");
     return c;
 }
@@ -261,7 +264,8 @@ Light readLight(const Reader& r, const Json& node, const JsonPath& path) {
             l.direction = r.direction(r.require(node, path, "direction"), path / "direction");
             l.coneAngleDegrees = r.number(r.require(node, path, "cone_angle"), path / "cone_angle");
             if (!(l.coneAngleDegrees > 0.0 && l.coneAngleDegrees < 90.0))
-                r.fail(path / "cone_angle", "must be in (0, 90) degrees (half-angle), got " + describe(node["cone_angle"]));
+                r.fail(path / "cone_angle",
+                       "must be in (0, 90) degrees (half-angle), got " + describe(node["cone_angle"]));
         } else {
             for (const char* key : {"direction", "cone_angle"})
                 if (node.contains(key)) r.fail(path / key, "does not apply to a point light");
@@ -287,9 +291,9 @@ struct PendingCameras {
     JsonPath pickPath;
 };
 
-Object readObject(const Reader& r, const Json& node, const JsonPath& path,
-                  const std::map<std::string, int>& materials, const std::vector<Material>& sceneMaterials,
-                  MeshCache& meshCache, PendingCameras* pending = nullptr) {
+Object readObject(const Reader& r, const Json& node, const JsonPath& path, const std::map<std::string, int>& materials,
+                  const std::vector<Material>& sceneMaterials, MeshCache& meshCache,
+                  PendingCameras* pending = nullptr) {
     r.expectObject(node, path);
     Object o;
     const std::string type = r.string(r.require(node, path, "type"), path / "type");
@@ -299,8 +303,8 @@ Object readObject(const Reader& r, const Json& node, const JsonPath& path,
         if (it == materials.end()) {
             std::string known;
             for (const auto& [name, index] : materials) known += (known.empty() ? "" : ", ") + name;
-            r.fail(path / "material", "no material named '" + material + "' (defined: " +
-                                          (known.empty() ? "none" : known) + ")");
+            r.fail(path / "material",
+                   "no material named '" + material + "' (defined: " + (known.empty() ? "none" : known) + ")");
         }
         return it->second;
     };
@@ -342,8 +346,7 @@ Object readObject(const Reader& r, const Json& node, const JsonPath& path,
         if (node.contains("scale")) {
             const Json& s = node["scale"];
             scale = s.is_array() ? r.vector<3>(s, path / "scale") : Vec3(r.number(s, path / "scale"));
-            if (!(scale.x > 0 && scale.y > 0 && scale.z > 0))
-                r.fail(path / "scale", "must be > 0, got " + describe(s));
+            if (!(scale.x > 0 && scale.y > 0 && scale.z > 0)) r.fail(path / "scale", "must be > 0, got " + describe(s));
         }
         Mesh m;
         const fs::path base = r.file().has_parent_path() ? r.file().parent_path() : fs::path(".");
@@ -353,8 +356,8 @@ Object readObject(const Reader& r, const Json& node, const JsonPath& path,
         const Material& mat = sceneMaterials[std::size_t(lookupMaterial())];
         MeshRequest request;
         if (mat.alphaTextured()) request.uvSet = mat.texCoord;
-        m.instances = loadMeshInstances(m.file, objectTransform(translate, rotate, scale), r.file(),
-                                        path / "file", pending ? &extras : nullptr, &meshCache, request);
+        m.instances = loadMeshInstances(m.file, objectTransform(translate, rotate, scale), r.file(), path / "file",
+                                        pending ? &extras : nullptr, &meshCache, request);
         if (pending) {
             pending->cameras = extras.cameras;
             pending->transform = objectTransform(translate, rotate, scale);
@@ -362,8 +365,10 @@ Object readObject(const Reader& r, const Json& node, const JsonPath& path,
             if (node.contains("camera")) {
                 const Json& c = node["camera"];
                 pending->pickPath = path / "camera";
-                if (c.is_string()) pending->pick = c.get<std::string>();
-                else pending->pick = std::to_string(r.integer(c, path / "camera", 0, 1 << 20));
+                if (c.is_string())
+                    pending->pick = c.get<std::string>();
+                else
+                    pending->pick = std::to_string(r.integer(c, path / "camera", 0, 1 << 20));
             }
         }
         o.shape = m;
@@ -388,10 +393,28 @@ std::string numberText(double v) {
 }
 
 ShadowDefaults readShadow(const Reader& r, const Json& node, const JsonPath& path) {
-    r.checkKeys(node, path, {"shadow_map_size", "depth_bias", "slope_bias", "filter", "pcf_size", "normal_offset",
-                             "receiver_plane_bias", "hardware_bias", "fit_light_frustum", "cascades", "cascade_blend", "ray_bias", "precision", "samples",
-                             "min_variance", "light_bleeding_reduction", "evsm_positive_exponent",
-                             "evsm_negative_exponent", "esm_exponent", "moment_bias", "blur_width"});
+    r.checkKeys(node, path,
+                {"shadow_map_size",
+                 "depth_bias",
+                 "slope_bias",
+                 "filter",
+                 "pcf_size",
+                 "normal_offset",
+                 "receiver_plane_bias",
+                 "hardware_bias",
+                 "fit_light_frustum",
+                 "cascades",
+                 "cascade_blend",
+                 "ray_bias",
+                 "precision",
+                 "samples",
+                 "min_variance",
+                 "light_bleeding_reduction",
+                 "evsm_positive_exponent",
+                 "evsm_negative_exponent",
+                 "esm_exponent",
+                 "moment_bias",
+                 "blur_width"});
     ShadowDefaults d;
     if (node.contains("shadow_map_size"))
         d.shadowMapSize = r.integer(node["shadow_map_size"], path / "shadow_map_size", 16, 16384);
@@ -408,8 +431,8 @@ ShadowDefaults readShadow(const Reader& r, const Json& node, const JsonPath& pat
         if (*d.filter != "none" && *d.filter != "pcf2x2" && *d.filter != "pcf" && *d.filter != "poisson" &&
             *d.filter != "pcss" && *d.filter != "vsm" && *d.filter != "evsm2" && *d.filter != "evsm4" &&
             *d.filter != "esm" && *d.filter != "msm")
-            r.fail(path / "filter", "expected none, pcf2x2, pcf, poisson, pcss, vsm, evsm2, evsm4, esm or msm, got '" +
-                                        *d.filter + "'");
+            r.fail(path / "filter",
+                   "expected none, pcf2x2, pcf, poisson, pcss, vsm, evsm2, evsm4, esm or msm, got '" + *d.filter + "'");
     }
     if (node.contains("pcf_size")) d.pcfSize = r.integer(node["pcf_size"], path / "pcf_size", 1, 15);
     // The filterable maps' parameters (scene::MomentSettings, with its ranges).
@@ -427,7 +450,8 @@ ShadowDefaults readShadow(const Reader& r, const Json& node, const JsonPath& pat
     ranged(d.momentBias, "moment_bias", 0.0, 1.0, "fraction");
     if (node.contains("blur_width")) {
         d.blurWidth = r.integer(node["blur_width"], path / "blur_width", 1, kMaxBlurWidth);
-        if (*d.blurWidth % 2 == 0) r.fail(path / "blur_width", "must be odd (texels), got " + std::to_string(*d.blurWidth));
+        if (*d.blurWidth % 2 == 0)
+            r.fail(path / "blur_width", "must be odd (texels), got " + std::to_string(*d.blurWidth));
     }
     if (node.contains("normal_offset")) {
         d.normalOffset = r.number(node["normal_offset"], path / "normal_offset");
@@ -486,14 +510,13 @@ void addFileCameras(const Reader& r, Scene& scene, const std::vector<PendingCame
                 scene.camera.near = keep.near;
                 scene.camera.far = keep.far;
             }
-            scene.origin.choices.emplace_back(
-                "view", "file camera " + std::to_string(scene.origin.cameras.size() + std::size_t(i)) + " (" +
-                            p.pickPath.str() + ")");
+            scene.origin.choices.emplace_back("view", "file camera " +
+                                                          std::to_string(scene.origin.cameras.size() + std::size_t(i)) +
+                                                          " (" + p.pickPath.str() + ")");
         }
         scene.origin.cameras.insert(scene.origin.cameras.end(), own.begin(), own.end());
     }
 }
-
 
 }  // namespace
 
@@ -505,28 +528,33 @@ PathBlock readPath(const Reader& r, const Json& node, const JsonPath& path, cons
     r.checkKeys(node, path, {"kind", "frames", "amount", "light", "animation"});
     PathBlock b;
     b.kind = r.string(r.require(node, path, "kind"), path / "kind");
-    static const char* kKinds[] = {"orbit", "dolly", "pan", "subtexel", "sun-azimuth", "sun-elevation", "light-move",
-                                   "gltf-animation"};
+    static const char* kKinds[] = {"orbit",       "dolly",         "pan",        "subtexel",
+                                   "sun-azimuth", "sun-elevation", "light-move", "gltf-animation"};
     if (std::none_of(std::begin(kKinds), std::end(kKinds), [&](const char* k) { return b.kind == k; }))
-        r.fail(path / "kind", "expected orbit, dolly, pan, subtexel, sun-azimuth, sun-elevation, light-move or "
-                              "gltf-animation, got " + describe(node["kind"]));
+        r.fail(path / "kind",
+               "expected orbit, dolly, pan, subtexel, sun-azimuth, sun-elevation, light-move or "
+               "gltf-animation, got " +
+                   describe(node["kind"]));
     if (node.contains("frames")) b.frames = r.integer(node["frames"], path / "frames", 2, 10000);
     if (node.contains("amount")) {
-        if (b.kind == "gltf-animation") r.fail(path / "amount", "a glTF animation has no amount (its keys set the motion)");
+        if (b.kind == "gltf-animation")
+            r.fail(path / "amount", "a glTF animation has no amount (its keys set the motion)");
         b.amount = r.number(node["amount"], path / "amount");
         if (b.kind == "dolly" && !(*b.amount < 1.0))
             r.fail(path / "amount", "a dolly covers a fraction < 1 of the distance, got " + describe(node["amount"]));
     }
     const bool lightPath = b.kind == "sun-azimuth" || b.kind == "sun-elevation" || b.kind == "light-move";
     if (node.contains("light")) {
-        if (!lightPath) r.fail(path / "light", "only a light path (sun-azimuth, sun-elevation, light-move) moves a light");
+        if (!lightPath)
+            r.fail(path / "light", "only a light path (sun-azimuth, sun-elevation, light-move) moves a light");
         b.light = r.integer(node["light"], path / "light", 0, (long long)(scene.lights.size()) - 1);
     }
     if (lightPath) {
         const Light& l = scene.lights[std::size_t(b.light.value_or(0))];
         const JsonPath at = node.contains("light") ? path / "light" : path / "kind";
         if (b.kind != "light-move" && l.type != LightType::Directional)
-            r.fail(at, b.kind + " turns a directional light; light " + std::to_string(b.light.value_or(0)) + " is not one");
+            r.fail(at,
+                   b.kind + " turns a directional light; light " + std::to_string(b.light.value_or(0)) + " is not one");
         if (b.kind == "light-move" && l.type == LightType::Directional)
             r.fail(at, "light-move moves a spot or point light; light " + std::to_string(b.light.value_or(0)) +
                            " is directional (use sun-azimuth or sun-elevation)");
@@ -534,12 +562,15 @@ PathBlock readPath(const Reader& r, const Json& node, const JsonPath& path, cons
     if (node.contains("animation")) {
         if (b.kind != "gltf-animation") r.fail(path / "animation", "only a gltf-animation path names an animation");
         const Json& a = node["animation"];
-        if (a.is_string()) b.animation = a.get<std::string>();
-        else b.animation = std::to_string(r.integer(a, path / "animation", 0, 1000000));
+        if (a.is_string())
+            b.animation = a.get<std::string>();
+        else
+            b.animation = std::to_string(r.integer(a, path / "animation", 0, 1000000));
     }
     if (b.kind == "gltf-animation")
-        r.fail(path / "kind", "camera animations are read from a .gltf/.glb given as the scene "
-                              "(`shadowlab path MODEL.gltf --camera-animation`); a JSON scene has none");
+        r.fail(path / "kind",
+               "camera animations are read from a .gltf/.glb given as the scene "
+               "(`shadowlab path MODEL.gltf --camera-animation`); a JSON scene has none");
     return b;
 }
 
@@ -555,7 +586,12 @@ namespace {
 std::string lineColumn(const std::string& text, std::size_t byte) {
     std::size_t line = 1, column = 1;
     for (std::size_t i = 0; i < byte && i < text.size(); ++i) {
-        if (text[i] == '\n') { ++line; column = 1; } else { ++column; }
+        if (text[i] == '\n') {
+            ++line;
+            column = 1;
+        } else {
+            ++column;
+        }
     }
     return "line " + std::to_string(line) + ", column " + std::to_string(column);
 }
@@ -568,23 +604,26 @@ Scene parseScene(const fs::path& file, const std::string& text) {
     // The parsed tree takes several times the text: refused before it is built when it cannot fit.
     const std::uint64_t treeBytes = std::uint64_t(text.size()) + jsonTreeBytes(text);
     if (const std::uint64_t available = availableMemoryBytes(); available != 0 && treeBytes > available)
-        throw SceneError(file, root, "parsing it needs about " + std::to_string(treeBytes / kMiB) + " MiB, more than the " +
-                                         std::to_string(available / kMiB) + " MiB available");
+        throw SceneError(file, root,
+                         "parsing it needs about " + std::to_string(treeBytes / kMiB) + " MiB, more than the " +
+                             std::to_string(available / kMiB) + " MiB available");
     try {
         doc = Json::parse(text);
     } catch (const Json::parse_error& e) {
         std::string what = e.what();
         // nlohmann's message starts "[json.exception.parse_error.101] parse error at line..."
         if (const auto pos = what.find("] "); pos != std::string::npos) what = what.substr(pos + 2);
-        throw SceneError(file, root, "invalid JSON near " + lineColumn(text, e.byte == 0 ? 0 : e.byte - 1) + ": " + what);
+        throw SceneError(file, root,
+                         "invalid JSON near " + lineColumn(text, e.byte == 0 ? 0 : e.byte - 1) + ": " + what);
     } catch (const Json::exception& e) {
         // Number overflow (1e999) and the like: nlohmann reports no position for these.
         std::string what = e.what();
         if (const auto pos = what.find("] "); pos != std::string::npos) what = what.substr(pos + 2);
         throw SceneError(file, root, "invalid JSON: " + what + " (numbers must be finite)");
     }
-    r.checkKeys(doc, root, {"camera", "background", "ambient", "materials", "lights", "objects", "shadow", "budgets",
-                            "description", "ground", "$schema", "path"});
+    r.checkKeys(doc, root,
+                {"camera", "background", "ambient", "materials", "lights", "objects", "shadow", "budgets",
+                 "description", "ground", "$schema", "path"});
 
     Scene scene;
     scene.file = file;
@@ -593,15 +632,17 @@ Scene parseScene(const fs::path& file, const std::string& text) {
     bool viewFromModel = false;
     if (const auto it = doc.find("objects"); it != doc.end() && it->is_array())
         for (const Json& o : *it)
-            viewFromModel = viewFromModel || (o.is_object() && o.contains("camera") && o.value("type", Json()) == "mesh");
+            viewFromModel =
+                viewFromModel || (o.is_object() && o.contains("camera") && o.value("type", Json()) == "mesh");
     bool nearFarGiven = false;
     if (viewFromModel) {
         if (doc.contains("camera")) {
             const Json& node = doc["camera"];
             for (const char* key : {"position", "look_at", "up", "fov_y"})
                 if (node.is_object() && node.contains(key))
-                    r.fail(root / "camera" / key, "a mesh object's \"camera\" key sets the view; give only "
-                                                  "resolution, near and far here");
+                    r.fail(root / "camera" / key,
+                           "a mesh object's \"camera\" key sets the view; give only "
+                           "resolution, near and far here");
             r.checkKeys(node, root / "camera", {"resolution", "near", "far"});
             Json full = node;
             full["position"] = Json::array({0, 0, 1});
@@ -627,8 +668,9 @@ Scene parseScene(const fs::path& file, const std::string& text) {
     if (materials.empty()) r.fail(root / "materials", "must define at least one material");
     for (const auto& [name, node] : materials.items()) {
         const JsonPath path = root / "materials" / name;
-        r.checkKeys(node, path, {"albedo", "opacity", "alpha_mode", "alpha_cutoff", "alpha", "texture", "wrap_s",
-                                 "wrap_t", "texcoord"});
+        r.checkKeys(
+            node, path,
+            {"albedo", "opacity", "alpha_mode", "alpha_cutoff", "alpha", "texture", "wrap_s", "wrap_t", "texcoord"});
         Material m;
         m.name = name;
         m.albedo = r.color(node, path, "albedo", m.albedo);
@@ -691,8 +733,10 @@ Scene loadModelScene(const fs::path& file) {
         if (std::find(order.begin(), order.end(), inst.fileMaterial) == order.end()) order.push_back(inst.fileMaterial);
     for (const int fileMaterial : order) {
         Material m;
-        if (fileMaterial >= 0 && std::size_t(fileMaterial) < extras.materials.size()) m = extras.materials[std::size_t(fileMaterial)];
-        else m.name = "model";
+        if (fileMaterial >= 0 && std::size_t(fileMaterial) < extras.materials.size())
+            m = extras.materials[std::size_t(fileMaterial)];
+        else
+            m.name = "model";
         m.albedo = {0.8, 0.8, 0.8};  // shadows are the point: every part the same grey
         m.opacity = 1.0;
         Mesh mesh;
@@ -708,8 +752,8 @@ Scene loadModelScene(const fs::path& file) {
     scene.origin.modelScene = true;
     scene.origin.modelBounds = b;
     for (const GltfCamera& c : extras.cameras) {
-        Camera camera = cameraFromGltf(c.position, c.forward, c.up, c.yfovRadians, c.znear, c.zfar, c.aspect, b,
-                                       scene.camera);
+        Camera camera =
+            cameraFromGltf(c.position, c.forward, c.up, c.yfovRadians, c.znear, c.zfar, c.aspect, b, scene.camera);
         if (c.width > 0 && c.height > 0 && static_cast<long long>(c.width) * c.height <= kMaxPixels) {
             camera.width = c.width;  // a shadowlab export's image size (scene/gltf_export.h)
             camera.height = c.height;
@@ -720,8 +764,8 @@ Scene loadModelScene(const fs::path& file) {
     // objects, so none is added.
     if (extras.shadowlabExport) {
         scene.origin.ground = false;
-        scene.origin.choices.emplace_back("export", "a shadowlab export (" + file.filename().string() +
-                                                        "): its image size kept, no ground added");
+        scene.origin.choices.emplace_back(
+            "export", "a shadowlab export (" + file.filename().string() + "): its image size kept, no ground added");
     }
     scene.origin.cameraAnimations = extras.cameraAnimations;
     if (!scene.origin.cameras.empty()) {
@@ -737,7 +781,8 @@ Scene loadModelScene(const fs::path& file) {
     for (const GltfLight& l : extras.lights) {
         const JsonPath lightPath = JsonPath() / "extensions" / "KHR_lights_punctual" / "lights" / std::size_t(l.index);
         if (!(l.intensity >= 0))  // in the file's units, before the conversion below
-            throw SceneError(file, lightPath / "intensity", "must be finite and >= 0, got " + describeJson(l.intensity));
+            throw SceneError(file, lightPath / "intensity",
+                             "must be finite and >= 0, got " + describeJson(l.intensity));
         Light light;
         light.color = l.color;
         if (l.type == "directional") {
@@ -757,10 +802,11 @@ Scene loadModelScene(const fs::path& file) {
         // The checks a JSON light gets, at the glTF light's path (its position and direction
         // come from its node).
         if (const ValueProblem problem = lightProblem(light))
-            throw SceneError(file, lightPath / (problem.key == "cone_angle" ? std::string("spot.outerConeAngle") : problem.key),
-                             problem.what + (problem.key == "position" || problem.key == "direction"
-                                                 ? " (from the transform of the node that holds the light)"
-                                                 : ""));
+            throw SceneError(
+                file, lightPath / (problem.key == "cone_angle" ? std::string("spot.outerConeAngle") : problem.key),
+                problem.what + (problem.key == "position" || problem.key == "direction"
+                                    ? " (from the transform of the node that holds the light)"
+                                    : ""));
         scene.lights.push_back(light);
     }
     if (scene.lights.empty()) {
@@ -781,15 +827,13 @@ Scene loadModelScene(const fs::path& file) {
 
 // Mesh files that can be the whole scene: glTF with its cameras and lights where it has them;
 // OBJ and PLY, which have neither, with a searched view and sun over a ground like a bare glTF.
-bool isModelFormat(const std::string& ext) {
-    return ext == ".gltf" || ext == ".glb" || ext == ".obj" || ext == ".ply";
-}
+bool isModelFormat(const std::string& ext) { return ext == ".gltf" || ext == ".glb" || ext == ".obj" || ext == ".ply"; }
 
 // Model formats people try first that shadowlab does not read: named as such rather than
 // parsed as JSON (which would report a syntax error at byte 1).
 bool isOtherModelFormat(const std::string& ext) {
-    for (const char* e : {".stl", ".fbx", ".dae", ".3ds", ".blend", ".usd", ".usda", ".usdc", ".usdz",
-                          ".off", ".x3d", ".wrl", ".abc"})
+    for (const char* e :
+         {".stl", ".fbx", ".dae", ".3ds", ".blend", ".usd", ".usda", ".usdc", ".usdz", ".off", ".x3d", ".wrl", ".abc"})
         if (ext == e) return true;
     return false;
 }
@@ -801,12 +845,16 @@ Scene loadScene(const fs::path& file) {
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
     // Told by its name before any byte is read: a .ply read as JSON would be a parse error.
     if (isOtherModelFormat(ext))
-        throw SceneError(file, {}, "unsupported format '" + excerpt(ext) + "': a scene is a .json file or a .gltf, .glb, "
-                                   ".obj or .ply model (convert the model, e.g. to .obj or .glb)");
+        throw SceneError(file, {},
+                         "unsupported format '" + excerpt(ext) +
+                             "': a scene is a .json file or a .gltf, .glb, "
+                             ".obj or .ply model (convert the model, e.g. to .obj or .glb)");
     std::string text;
     try {
-        if (isModelFormat(ext)) checkInputFile(file, kMaxMeshFileBytes);
-        else text = readInputFile(file, kMaxJsonFileBytes);
+        if (isModelFormat(ext))
+            checkInputFile(file, kMaxMeshFileBytes);
+        else
+            text = readInputFile(file, kMaxJsonFileBytes);
     } catch (const InputFileError& e) {
         throw SceneError(file, {}, e.problem());
     }
@@ -827,8 +875,10 @@ fs::path findScene(const std::string& nameOrPath) {
     for (const fs::path& candidate : {dir / nameOrPath, dir / (nameOrPath + ".json")})
         if (fs::is_regular_file(candidate, ec)) return candidate;
     std::set<std::string> names;
-    for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
-        if (it->path().extension() == ".json" && !it->path().stem().string().ends_with(".schema"))  // not scene.schema.json
+    for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator();
+         it.increment(ec))
+        if (it->path().extension() == ".json" &&
+            !it->path().stem().string().ends_with(".schema"))  // not scene.schema.json
             names.insert(fs::relative(it->path(), dir, ec).replace_extension().string());
     std::string list;
     for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;

@@ -1,12 +1,12 @@
 // scene/memory.cpp: measured and available memory (Linux: getrusage, /proc/meminfo).
 #include "scene/memory.h"
 
-#include <cstdlib>
-#include <set>
-#include <variant>
-#include <fstream>
-#include <sstream>
 #include <sys/resource.h>
+#include <cstdlib>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <variant>
 
 #include "scene/error.h"
 #include "scene/scene.h"
@@ -58,8 +58,10 @@ std::uint64_t alphaTexturedTriangles(const Scene& scene) {
     std::uint64_t n = 0;
     for (const Object& o : scene.objects)
         if (scene.materialOf(o).alphaTextured()) {
-            if (const auto* m = std::get_if<Mesh>(&o.shape)) n += m->triangleCount();
-            else n += 2;  // a quad
+            if (const auto* m = std::get_if<Mesh>(&o.shape))
+                n += m->triangleCount();
+            else
+                n += 2;  // a quad
         }
     return n;
 }

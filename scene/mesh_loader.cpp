@@ -13,10 +13,10 @@
 #include <map>
 #include <sstream>
 
-#include <glm/gtc/matrix_transform.hpp>
-#include <glm/gtc/quaternion.hpp>
 #include <tiny_gltf.h>
 #include <tiny_obj_loader.h>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
 
 #include "scene/gltf_extensions.h"
 #include "scene/input_file.h"
@@ -31,8 +31,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-[[noreturn]] void fail(const fs::path& sceneFile, const JsonPath& path, const fs::path& mesh,
-                       const std::string& what) {
+[[noreturn]] void fail(const fs::path& sceneFile, const JsonPath& path, const fs::path& mesh, const std::string& what) {
     // (a glTF given as the scene is both: named once)
     throw SceneError(sceneFile, path, mesh == sceneFile ? what : mesh.string() + ": " + what);
 }
@@ -66,8 +65,12 @@ void checkObjText(const std::string& text, const fs::path& file, const fs::path&
                 char* stop = nullptr;
                 const double v = std::strtod(token.c_str(), &stop);
                 if (stop == token.c_str() || *stop != '\0' || !std::isfinite(v))
-                    fail(sceneFile, path, file, at() + (keyword == "v" ? "vertex" : keyword == "vn" ? "normal" : "texture") +
-                                                    " coordinate '" + excerpt(token) + "' is not a finite number");
+                    fail(sceneFile, path, file,
+                         at() +
+                             (keyword == "v"    ? "vertex"
+                              : keyword == "vn" ? "normal"
+                                                : "texture") +
+                             " coordinate '" + excerpt(token) + "' is not a finite number");
             }
         } else if (keyword == "f" || keyword == "l" || keyword == "p") {
             while (fields >> token) {
@@ -85,11 +88,13 @@ void checkObjText(const std::string& text, const fs::path& file, const fs::path&
                     const std::size_t defined = part == 0 ? vertices : part == 1 ? texcoords : normals;
                     const char* what = part == 0 ? "vertices" : part == 1 ? "texture coordinates" : "normals";
                     if (stop == number.c_str() || *stop != '\0')
-                        fail(sceneFile, path, file, at() + "face index '" + excerpt(number) + "' is not a whole number");
+                        fail(sceneFile, path, file,
+                             at() + "face index '" + excerpt(number) + "' is not a whole number");
                     if (index == 0 || errno == ERANGE || index > std::int64_t(INT32_MAX) ||
                         (index < 0 && std::uint64_t(-(index + 1)) >= defined))
-                        fail(sceneFile, path, file, at() + "face index " + excerpt(number) + " is out of range (" +
-                                                        std::to_string(defined) + " " + what + " defined so far)");
+                        fail(sceneFile, path, file,
+                             at() + "face index " + excerpt(number) + " is out of range (" + std::to_string(defined) +
+                                 " " + what + " defined so far)");
                 }
             }
         }
@@ -130,7 +135,8 @@ void loadObj(const fs::path& file, const std::string& text, TriangleMesh& mesh, 
     std::string warn, err;
     std::istringstream stream(text);
     MaterialCheck materialCheck(file.has_parent_path() ? file.parent_path() : fs::path("."));
-    const bool ok = tinyobj::LoadObj(&attribStorage, &shapes, &materials, &warn, &err, &stream, &materialCheck, true, false);
+    const bool ok =
+        tinyobj::LoadObj(&attribStorage, &shapes, &materials, &warn, &err, &stream, &materialCheck, true, false);
     if (!materialCheck.problem().empty()) fail(sceneFile, path, file, materialCheck.problem());
     if (!ok) fail(sceneFile, path, file, "not a readable OBJ file: " + excerpt(err, 200));
     const auto& attrib = attribStorage;
@@ -144,8 +150,7 @@ void loadObj(const fs::path& file, const std::string& text, TriangleMesh& mesh, 
                 fail(sceneFile, path, file,
                      "face index " + std::to_string(std::int64_t(idx.vertex_index) + 1) + " is out of range (" +
                          std::to_string(vertexCount) + " vertices)");
-            if (idx.normal_index < 0 || std::size_t(idx.normal_index) >= normalCount)
-                allHaveNormals = false;
+            if (idx.normal_index < 0 || std::size_t(idx.normal_index) >= normalCount) allHaveNormals = false;
         }
         faces += shape.mesh.num_face_vertices.size();
     }
@@ -157,16 +162,19 @@ void loadObj(const fs::path& file, const std::string& text, TriangleMesh& mesh, 
         fail(sceneFile, path, file, "has " + std::to_string(corners) + " face corners, more than 32-bit indices hold");
     for (const auto& shape : shapes) {
         for (const auto& idx : shape.mesh.indices) {
-            const Vec3 p(attrib.vertices[3 * std::size_t(idx.vertex_index)], attrib.vertices[3 * std::size_t(idx.vertex_index) + 1],
+            const Vec3 p(attrib.vertices[3 * std::size_t(idx.vertex_index)],
+                         attrib.vertices[3 * std::size_t(idx.vertex_index) + 1],
                          attrib.vertices[3 * std::size_t(idx.vertex_index) + 2]);
-            if (!finite(p)) fail(sceneFile, path, file, "vertex " + std::to_string(idx.vertex_index + 1) + " is not finite");
+            if (!finite(p))
+                fail(sceneFile, path, file, "vertex " + std::to_string(idx.vertex_index + 1) + " is not finite");
             mesh.indices.push_back(std::uint32_t(mesh.positions.size()));
             mesh.positions.push_back(p);
             if (wantUvs) {
                 // OBJ's vt has v up from the image's bottom; glTF's (and ours) runs down from its top.
                 if (idx.texcoord_index < 0 || 2 * std::size_t(idx.texcoord_index) + 1 >= attrib.texcoords.size())
-                    fail(sceneFile, path, file, "a face corner has no texture coordinate (vt), which the object's "
-                                                "alpha texture needs");
+                    fail(sceneFile, path, file,
+                         "a face corner has no texture coordinate (vt), which the object's "
+                         "alpha texture needs");
                 mesh.uvs.emplace_back(attrib.texcoords[2 * std::size_t(idx.texcoord_index)],
                                       1.0 - attrib.texcoords[2 * std::size_t(idx.texcoord_index) + 1]);
             }
@@ -206,13 +214,13 @@ std::vector<double> readElements(const tinygltf::Model& model, int viewIndex, st
     const std::uint64_t element = std::uint64_t(compSize) * std::uint64_t(nComp);
     const std::uint64_t stride = !packed && view.byteStride ? std::uint64_t(view.byteStride) : element;
     if (stride < element)
-        bad(viewAt + ".byteStride", std::to_string(stride) + " is smaller than one element (" + std::to_string(element) +
-                                        " bytes)");
+        bad(viewAt + ".byteStride",
+            std::to_string(stride) + " is smaller than one element (" + std::to_string(element) + " bytes)");
     std::uint64_t viewEnd = 0;
     if (!addChecked(view.byteOffset, view.byteLength, viewEnd) || viewEnd > buffer.data.size())
-        bad(viewAt, "byteOffset " + std::to_string(view.byteOffset) + " + byteLength " + std::to_string(view.byteLength) +
-                        " reaches past the end of buffer " + std::to_string(view.buffer) + " (" +
-                        std::to_string(buffer.data.size()) + " bytes)");
+        bad(viewAt, "byteOffset " + std::to_string(view.byteOffset) + " + byteLength " +
+                        std::to_string(view.byteLength) + " reaches past the end of buffer " +
+                        std::to_string(view.buffer) + " (" + std::to_string(buffer.data.size()) + " bytes)");
     std::uint64_t span = 0, last = 0, end = 0;
     if (count > 0 && (!mulChecked(stride, count - 1, span) || !addChecked(span, element, last) ||
                       !addChecked(last, byteOffset, end) || end > view.byteLength))
@@ -235,12 +243,32 @@ std::vector<double> readElements(const tinygltf::Model& model, int viewIndex, st
             const unsigned char* p = base + i * stride + std::size_t(c) * compSize;
             double v = 0;
             switch (componentType) {
-                case TINYGLTF_COMPONENT_TYPE_FLOAT: { float f; std::memcpy(&f, p, 4); v = f; break; }
-                case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { std::uint32_t u; std::memcpy(&u, p, 4); v = u; break; }
-                case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { std::uint16_t u; std::memcpy(&u, p, 2); v = u; break; }
+                case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+                    float f;
+                    std::memcpy(&f, p, 4);
+                    v = f;
+                    break;
+                }
+                case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+                    std::uint32_t u;
+                    std::memcpy(&u, p, 4);
+                    v = u;
+                    break;
+                }
+                case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+                    std::uint16_t u;
+                    std::memcpy(&u, p, 2);
+                    v = u;
+                    break;
+                }
                 case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: v = *p; break;
                 // Signed types: KHR_mesh_quantization's positions, normals and texture coordinates.
-                case TINYGLTF_COMPONENT_TYPE_SHORT: { std::int16_t u; std::memcpy(&u, p, 2); v = u; break; }
+                case TINYGLTF_COMPONENT_TYPE_SHORT: {
+                    std::int16_t u;
+                    std::memcpy(&u, p, 2);
+                    v = u;
+                    break;
+                }
                 case TINYGLTF_COMPONENT_TYPE_BYTE: v = double(std::int8_t(*p)); break;
                 default: bad(where + ".componentType", "unsupported component type " + std::to_string(componentType));
             }
@@ -256,13 +284,20 @@ void normalize(std::vector<double>& values, int componentType, const std::string
                const fs::path& sceneFile, const JsonPath& path) {
     double scale = 0, lowest = 0;
     switch (componentType) {
-        case TINYGLTF_COMPONENT_TYPE_BYTE: scale = 127.0; lowest = -1.0; break;
+        case TINYGLTF_COMPONENT_TYPE_BYTE:
+            scale = 127.0;
+            lowest = -1.0;
+            break;
         case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: scale = 255.0; break;
-        case TINYGLTF_COMPONENT_TYPE_SHORT: scale = 32767.0; lowest = -1.0; break;
+        case TINYGLTF_COMPONENT_TYPE_SHORT:
+            scale = 32767.0;
+            lowest = -1.0;
+            break;
         case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: scale = 65535.0; break;
         default:
-            fail(sceneFile, path, file, at + ".normalized: must not be true for component type " +
-                                            std::to_string(componentType) + " (only bytes and shorts are normalized)");
+            fail(sceneFile, path, file,
+                 at + ".normalized: must not be true for component type " + std::to_string(componentType) +
+                     " (only bytes and shorts are normalized)");
     }
     for (double& v : values) v = std::max(v / scale, lowest);
 }
@@ -271,15 +306,16 @@ void normalize(std::vector<double>& values, int componentType, const std::string
 // zeros where it has none, with a sparse accessor's replacements applied (glTF 2.0, 3.6.2.3:
 // `count` strictly increasing indices into the accessor, and as many packed values), and
 // normalized integers mapped to -1..1 or 0..1.
-std::vector<double> readAccessor(const tinygltf::Model& model, int accessorIndex, int components,
-                                 const fs::path& file, const fs::path& sceneFile, const JsonPath& path) {
+std::vector<double> readAccessor(const tinygltf::Model& model, int accessorIndex, int components, const fs::path& file,
+                                 const fs::path& sceneFile, const JsonPath& path) {
     const std::string at = "accessors[" + std::to_string(accessorIndex) + "]";
     auto bad = [&](const std::string& where, const std::string& what) {
         fail(sceneFile, path, file, where + ": " + what);
     };
     if (accessorIndex < 0 || std::size_t(accessorIndex) >= model.accessors.size())
-        fail(sceneFile, path, file, "accessor " + std::to_string(accessorIndex) + " does not exist (" +
-                                        std::to_string(model.accessors.size()) + " accessors)");
+        fail(sceneFile, path, file,
+             "accessor " + std::to_string(accessorIndex) + " does not exist (" +
+                 std::to_string(model.accessors.size()) + " accessors)");
     const auto& acc = model.accessors[std::size_t(accessorIndex)];
     const int nComp = tinygltf::GetNumComponentsInType(acc.type);
     if (tinygltf::GetComponentSizeInBytes(acc.componentType) <= 0 || nComp != components)
@@ -291,7 +327,8 @@ std::vector<double> readAccessor(const tinygltf::Model& model, int accessorIndex
     } else {
         // No buffer view: zeros (bounded like any read: by the memory there is).
         const std::uint64_t values = std::uint64_t(acc.count) * std::uint64_t(nComp);
-        if (const std::uint64_t available = availableMemoryBytes(); available != 0 && values * sizeof(double) > available)
+        if (const std::uint64_t available = availableMemoryBytes();
+            available != 0 && values * sizeof(double) > available)
             bad(at + ".count", std::to_string(acc.count) + " elements need more than the " +
                                    std::to_string(available / kMiB) + " MiB available");
         out.assign(values, 0.0);
@@ -301,28 +338,30 @@ std::vector<double> readAccessor(const tinygltf::Model& model, int accessorIndex
     const auto& sparse = acc.sparse;
     const std::string sparseAt = at + ".sparse";
     if (sparse.count < 1 || std::uint64_t(sparse.count) > acc.count)
-        bad(sparseAt + ".count", "must be in 1.." + std::to_string(acc.count) + ", got " + std::to_string(sparse.count));
+        bad(sparseAt + ".count",
+            "must be in 1.." + std::to_string(acc.count) + ", got " + std::to_string(sparse.count));
     const int indexType = sparse.indices.componentType;
     if (indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
         indexType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
-        bad(sparseAt + ".indices.componentType", "must be an unsigned byte, short or int, got " + std::to_string(indexType));
-    if (sparse.indices.byteOffset < 0 || sparse.values.byteOffset < 0)
-        bad(sparseAt, "a byteOffset is negative");
+        bad(sparseAt + ".indices.componentType",
+            "must be an unsigned byte, short or int, got " + std::to_string(indexType));
+    if (sparse.indices.byteOffset < 0 || sparse.values.byteOffset < 0) bad(sparseAt, "a byteOffset is negative");
     const std::vector<double> indices =
-        readElements(model, sparse.indices.bufferView, std::uint64_t(sparse.indices.byteOffset), std::uint64_t(sparse.count),
-                     indexType, 1, true, sparseAt + ".indices", file, sceneFile, path);
-    std::vector<double> values =
-        readElements(model, sparse.values.bufferView, std::uint64_t(sparse.values.byteOffset), std::uint64_t(sparse.count),
-                     acc.componentType, nComp, true, sparseAt + ".values", file, sceneFile, path);
+        readElements(model, sparse.indices.bufferView, std::uint64_t(sparse.indices.byteOffset),
+                     std::uint64_t(sparse.count), indexType, 1, true, sparseAt + ".indices", file, sceneFile, path);
+    std::vector<double> values = readElements(model, sparse.values.bufferView, std::uint64_t(sparse.values.byteOffset),
+                                              std::uint64_t(sparse.count), acc.componentType, nComp, true,
+                                              sparseAt + ".values", file, sceneFile, path);
     if (acc.normalized) normalize(values, acc.componentType, at, file, sceneFile, path);
     for (std::size_t k = 0; k < indices.size(); ++k) {
         const double index = indices[k];
         if (index >= double(acc.count) || (k > 0 && !(index > indices[k - 1])))
-            bad(sparseAt + ".indices", "index " + std::to_string(std::uint64_t(index)) + " (element " + std::to_string(k) +
-                                           ") is out of range or not increasing (" + std::to_string(acc.count) +
-                                           " elements)");
+            bad(sparseAt + ".indices", "index " + std::to_string(std::uint64_t(index)) + " (element " +
+                                           std::to_string(k) + ") is out of range or not increasing (" +
+                                           std::to_string(acc.count) + " elements)");
         for (int c = 0; c < nComp; ++c)
-            out[std::size_t(index) * std::size_t(nComp) + std::size_t(c)] = values[k * std::size_t(nComp) + std::size_t(c)];
+            out[std::size_t(index) * std::size_t(nComp) + std::size_t(c)] =
+                values[k * std::size_t(nComp) + std::size_t(c)];
     }
     return out;
 }
@@ -355,34 +394,41 @@ void collectCameraAnimations(const tinygltf::Model& model, const std::map<int, s
         for (std::size_t c = 0; c < anim.channels.size(); ++c) {
             const tinygltf::AnimationChannel& ch = anim.channels[c];
             const auto node = cameraNodes.find(ch.target_node);
-            if (node == cameraNodes.end() || (ch.target_path != "translation" && ch.target_path != "rotation")) continue;
+            if (node == cameraNodes.end() || (ch.target_path != "translation" && ch.target_path != "rotation"))
+                continue;
             const std::string at = "animations[" + std::to_string(a) + "].channels[" + std::to_string(c) + "]";
             if (ch.sampler < 0 || std::size_t(ch.sampler) >= anim.samplers.size())
-                fail(sceneFile, path, file, at + ".sampler: names no sampler (" + std::to_string(anim.samplers.size()) + ")");
+                fail(sceneFile, path, file,
+                     at + ".sampler: names no sampler (" + std::to_string(anim.samplers.size()) + ")");
             const tinygltf::AnimationSampler& sampler = anim.samplers[std::size_t(ch.sampler)];
-            const std::string sat = "animations[" + std::to_string(a) + "].samplers[" + std::to_string(ch.sampler) + "]";
+            const std::string sat =
+                "animations[" + std::to_string(a) + "].samplers[" + std::to_string(ch.sampler) + "]";
             AnimationCurve curve;
             if (sampler.interpolation == "LINEAR" || sampler.interpolation.empty())
                 curve.interpolation = AnimationCurve::Interpolation::Linear;
-            else if (sampler.interpolation == "STEP") curve.interpolation = AnimationCurve::Interpolation::Step;
-            else if (sampler.interpolation == "CUBICSPLINE") curve.interpolation = AnimationCurve::Interpolation::CubicSpline;
+            else if (sampler.interpolation == "STEP")
+                curve.interpolation = AnimationCurve::Interpolation::Step;
+            else if (sampler.interpolation == "CUBICSPLINE")
+                curve.interpolation = AnimationCurve::Interpolation::CubicSpline;
             else
-                fail(sceneFile, path, file, sat + ".interpolation: expected LINEAR, STEP or CUBICSPLINE, got '" +
-                                                excerpt(sampler.interpolation) + "'");
+                fail(sceneFile, path, file,
+                     sat + ".interpolation: expected LINEAR, STEP or CUBICSPLINE, got '" +
+                         excerpt(sampler.interpolation) + "'");
             curve.times = readAccessor(model, sampler.input, 1, file, sceneFile, path);
             if (curve.times.empty()) fail(sceneFile, path, file, sat + ".input: has no keys");
             for (std::size_t k = 0; k < curve.times.size(); ++k)
                 if (!std::isfinite(curve.times[k]) || (k > 0 && !(curve.times[k] > curve.times[k - 1])))
-                    fail(sceneFile, path, file, sat + ".input: key times must be finite and increasing (key " +
-                                                    std::to_string(k) + ")");
+                    fail(sceneFile, path, file,
+                         sat + ".input: key times must be finite and increasing (key " + std::to_string(k) + ")");
             const bool rotation = ch.target_path == "rotation";
             const int components = rotation ? 4 : 3;
             const std::vector<double> v = readAccessor(model, sampler.output, components, file, sceneFile, path);
             const std::size_t perKey = curve.interpolation == AnimationCurve::Interpolation::CubicSpline ? 3 : 1;
             if (v.size() != curve.times.size() * perKey * std::size_t(components))
-                fail(sceneFile, path, file, sat + ".output: holds " + std::to_string(v.size() / std::size_t(components)) +
-                                                " values for " + std::to_string(curve.times.size()) + " keys (expected " +
-                                                std::to_string(curve.times.size() * perKey) + ")");
+                fail(sceneFile, path, file,
+                     sat + ".output: holds " + std::to_string(v.size() / std::size_t(components)) + " values for " +
+                         std::to_string(curve.times.size()) + " keys (expected " +
+                         std::to_string(curve.times.size() * perKey) + ")");
             for (std::size_t i = 0; i < v.size(); i += std::size_t(components)) {
                 glm::dvec4 value(v[i], v[i + 1], v[i + 2], rotation ? v[i + 3] : 0.0);
                 for (int k = 0; k < 4; ++k)
@@ -395,13 +441,15 @@ void collectCameraAnimations(const tinygltf::Model& model, const std::map<int, s
         for (auto& [nodeIndex, ca] : byNode) {
             const tinygltf::Node& node = model.nodes[std::size_t(nodeIndex)];
             if (node.matrix.size() == 16)
-                fail(sceneFile, path, file, "nodes[" + std::to_string(nodeIndex) +
-                                                "]: an animated node must have translation/rotation/scale, not a matrix");
+                fail(sceneFile, path, file,
+                     "nodes[" + std::to_string(nodeIndex) +
+                         "]: an animated node must have translation/rotation/scale, not a matrix");
             ca.name = anim.name;
             ca.index = int(a);
             ca.camera = cameraNodes.at(nodeIndex).first;
             ca.parent = cameraNodes.at(nodeIndex).second;
-            if (node.translation.size() == 3) ca.translation = Vec3(node.translation[0], node.translation[1], node.translation[2]);
+            if (node.translation.size() == 3)
+                ca.translation = Vec3(node.translation[0], node.translation[1], node.translation[2]);
             if (node.rotation.size() == 4)
                 ca.rotation = glm::dvec4(node.rotation[0], node.rotation[1], node.rotation[2], node.rotation[3]);
             if (node.scale.size() == 3) ca.scale = Vec3(node.scale[0], node.scale[1], node.scale[2]);
@@ -420,14 +468,16 @@ void collectCameraAnimations(const tinygltf::Model& model, const std::map<int, s
 // Images are decoded only where a MASK or BLEND material needs one's alpha (readMaterials), so
 // any image is accepted here, even a missing one; with `user` (a GltfImages) the bytes are kept.
 using GltfImages = std::map<int, std::vector<unsigned char>>;
-bool ignoreImage(tinygltf::Image*, const int index, std::string*, std::string*, int, int,
-                 const unsigned char* bytes, int size, void* user) {
+bool ignoreImage(tinygltf::Image*, const int index, std::string*, std::string*, int, int, const unsigned char* bytes,
+                 int size, void* user) {
     if (user && bytes && size > 0) (*static_cast<GltfImages*>(user))[index].assign(bytes, bytes + size);
     return true;
 }
 
 TextureWrap wrapOf(int glWrap) {
-    return glWrap == 33071 ? TextureWrap::ClampToEdge : glWrap == 33648 ? TextureWrap::MirroredRepeat : TextureWrap::Repeat;
+    return glWrap == 33071   ? TextureWrap::ClampToEdge
+           : glWrap == 33648 ? TextureWrap::MirroredRepeat
+                             : TextureWrap::Repeat;
 }
 
 // The file's materials as scene materials (grey albedo: shadows do not need its colours), with the
@@ -444,10 +494,12 @@ std::vector<Material> readMaterials(const tinygltf::Model& model, const GltfImag
         const std::string at = "materials[" + std::to_string(i) + "]";
         Material m;
         m.name = gm.name.empty() ? at : gm.name;
-        m.alphaMode = gm.alphaMode == "MASK" ? AlphaMode::Mask : gm.alphaMode == "BLEND" ? AlphaMode::Blend : AlphaMode::Opaque;
+        m.alphaMode = gm.alphaMode == "MASK"    ? AlphaMode::Mask
+                      : gm.alphaMode == "BLEND" ? AlphaMode::Blend
+                                                : AlphaMode::Opaque;
         if (gm.alphaMode != "OPAQUE" && gm.alphaMode != "MASK" && gm.alphaMode != "BLEND")
-            fail(sceneFile, path, file, at + ".alphaMode: unknown mode '" + excerpt(gm.alphaMode) +
-                                            "' (expected OPAQUE, MASK or BLEND)");
+            fail(sceneFile, path, file,
+                 at + ".alphaMode: unknown mode '" + excerpt(gm.alphaMode) + "' (expected OPAQUE, MASK or BLEND)");
         m.alphaCutoff = gm.alphaCutoff;
         if (!(m.alphaCutoff >= 0.0))
             fail(sceneFile, path, file, at + ".alphaCutoff: must be >= 0, got " + describeJson(gm.alphaCutoff));
@@ -459,8 +511,8 @@ std::vector<Material> readMaterials(const tinygltf::Model& model, const GltfImag
         if (m.alphaMode != AlphaMode::Opaque && info.index >= 0) {
             const std::string texAt = at + ".pbrMetallicRoughness.baseColorTexture";
             if (std::size_t(info.index) >= model.textures.size())
-                fail(sceneFile, path, file, texAt + ".index: names texture " + std::to_string(info.index) +
-                                                ", which does not exist");
+                fail(sceneFile, path, file,
+                     texAt + ".index: names texture " + std::to_string(info.index) + ", which does not exist");
             const tinygltf::Texture& tex = model.textures[std::size_t(info.index)];
             int source = tex.source;
             const std::string texturesAt = "textures[" + std::to_string(info.index) + "]";
@@ -471,11 +523,11 @@ std::vector<Material> readMaterials(const tinygltf::Model& model, const GltfImag
                 const auto it = tex.extensions.find(format);
                 if (source >= 0 || it == tex.extensions.end() || !it->second.Has("source")) continue;
                 if (std::string(format) != "EXT_texture_webp")
-                    fail(sceneFile, path, file, texturesAt + ".extensions." + format + ": the alpha of " + m.name +
-                                                    " (" + gm.alphaMode + ") is only in a" +
-                                                    (std::string(format) == "EXT_texture_avif" ? "n AVIF" : " KTX2") +
-                                                    " image, which shadowlab does not decode "
-                                                    "(give the texture a PNG or JPEG source)");
+                    fail(sceneFile, path, file,
+                         texturesAt + ".extensions." + format + ": the alpha of " + m.name + " (" + gm.alphaMode +
+                             ") is only in a" + (std::string(format) == "EXT_texture_avif" ? "n AVIF" : " KTX2") +
+                             " image, which shadowlab does not decode "
+                             "(give the texture a PNG or JPEG source)");
                 const tinygltf::Value& v = it->second.Get("source");
                 const double d = v.IsNumber() || v.IsInt() ? v.GetNumberAsDouble() : -1.0;
                 source = d >= 0 && d < double(model.images.size()) && d == std::floor(d) ? int(d) : -1;
@@ -488,8 +540,9 @@ std::vector<Material> readMaterials(const tinygltf::Model& model, const GltfImag
                 t = wrapOf(model.samplers[std::size_t(tex.sampler)].wrapT);
             }
             const tinygltf::Image& image = model.images[std::size_t(source)];
-            const std::string imageAt = "images[" + std::to_string(source) + "]" +
-                                        (image.uri.empty() || image.uri.rfind("data:", 0) == 0 ? "" : " (" + excerpt(image.uri) + ")");
+            const std::string imageAt =
+                "images[" + std::to_string(source) + "]" +
+                (image.uri.empty() || image.uri.rfind("data:", 0) == 0 ? "" : " (" + excerpt(image.uri) + ")");
             const auto key = std::make_tuple(source, int(s), int(t));
             const auto bytes = images.find(source);
             if (!decoded.count(key) && bytes == images.end()) {
@@ -497,14 +550,16 @@ std::vector<Material> readMaterials(const tinygltf::Model& model, const GltfImag
                 // rest of it is still worth grading): the material keeps its factor's alpha,
                 // and the user is told. An image that is there but broken is still an error.
                 notes.push_back(imageAt + " of " + file.filename().string() + " is missing, so " + m.name + " (" +
-                                gm.alphaMode + ") casts with its baseColorFactor alpha " +
-                                describeJson(m.alphaFactor) + " alone, without its texture's alpha");
+                                gm.alphaMode + ") casts with its baseColorFactor alpha " + describeJson(m.alphaFactor) +
+                                " alone, without its texture's alpha");
                 out.push_back(std::move(m));
                 continue;
             }
             if (!decoded.count(key)) {
-                std::string ext = image.mimeType == "image/jpeg" ? ".jpg" : image.mimeType == "image/png" ? ".png"
-                                  : image.mimeType == "image/webp" ? ".webp" : "";
+                std::string ext = image.mimeType == "image/jpeg"   ? ".jpg"
+                                  : image.mimeType == "image/png"  ? ".png"
+                                  : image.mimeType == "image/webp" ? ".webp"
+                                                                   : "";
                 if (ext.empty()) ext = fs::path(image.uri).extension().string();
                 try {
                     decoded[key] = loadAlphaTextureFromMemory(file.string() + "#" + imageAt, ext, bytes->second, s, t);
@@ -529,9 +584,9 @@ std::vector<Material> readMaterials(const tinygltf::Model& model, const GltfImag
 // One glTF mesh's triangle primitives in the mesh's own space: all of them (material -2), or
 // those of one material; with TEXCOORD_`uvSet` per vertex when uvSet >= 0, moved by
 // `uvTransform` (the material's alpha texture's KHR_texture_transform).
-void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& out,
-                    const fs::path& file, const fs::path& sceneFile, const JsonPath& path,
-                    int material = -2, int uvSet = -1, const UvTransform& uvTransform = {}) {
+void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& out, const fs::path& file,
+                    const fs::path& sceneFile, const JsonPath& path, int material = -2, int uvSet = -1,
+                    const UvTransform& uvTransform = {}) {
     if (meshIndex < 0 || std::size_t(meshIndex) >= model.meshes.size())
         fail(sceneFile, path, file, "node names mesh " + std::to_string(meshIndex) + ", which does not exist");
     for (std::size_t primIndex = 0; primIndex < model.meshes[meshIndex].primitives.size(); ++primIndex) {
@@ -551,11 +606,13 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
         if (uvSet >= 0) {
             const std::string name = "TEXCOORD_" + std::to_string(uvSet);
             const auto it = prim.attributes.find(name);
-            const std::string at = "meshes[" + std::to_string(meshIndex) + "].primitives[" + std::to_string(primIndex) + "]";
+            const std::string at =
+                "meshes[" + std::to_string(meshIndex) + "].primitives[" + std::to_string(primIndex) + "]";
             if (it == prim.attributes.end())
                 fail(sceneFile, path, file, at + ": has no " + name + ", which its material's alpha texture needs");
             uv = readAccessor(model, it->second, 2, file, sceneFile, path);
-            if (uv.size() != 2 * count) fail(sceneFile, path, file, at + ": " + name + " has not one element per vertex");
+            if (uv.size() != 2 * count)
+                fail(sceneFile, path, file, at + ": " + name + " has not one element per vertex");
             for (std::size_t i = 0; i < uv.size(); i += 2) {
                 // KHR_texture_transform moves where the alpha is sampled; both backends
                 // interpolate these per-vertex coordinates, and the transform is affine.
@@ -576,8 +633,9 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
                 if (ia.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
                     ia.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
                     ia.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
-                    fail(sceneFile, path, file, iaAt + ".componentType: indices must be an unsigned byte, short or int, got " +
-                                                    std::to_string(ia.componentType));
+                    fail(sceneFile, path, file,
+                         iaAt + ".componentType: indices must be an unsigned byte, short or int, got " +
+                             std::to_string(ia.componentType));
                 if (ia.normalized) fail(sceneFile, path, file, iaAt + ".normalized: indices must not be normalized");
             }
             idx = readAccessor(model, prim.indices, 1, file, sceneFile, path);
@@ -586,7 +644,8 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
             for (std::size_t i = 0; i < count; ++i) idx[i] = double(i);
         }
         if (out.positions.size() + count > std::size_t(UINT32_MAX))
-            fail(sceneFile, path, file, "mesh " + std::to_string(meshIndex) + " has more vertices than 32-bit indices hold");
+            fail(sceneFile, path, file,
+                 "mesh " + std::to_string(meshIndex) + " has more vertices than 32-bit indices hold");
         const std::uint32_t base = std::uint32_t(out.positions.size());
         const bool keepNormals = !n.empty() && (out.positions.empty() || !out.normals.empty());
         if (!keepNormals) out.normals.clear();
@@ -600,11 +659,11 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
         for (std::size_t i = 0; i + 2 < idx.size(); i += 3) {
             for (int k = 0; k < 3; ++k) {
                 if (idx[i + k] >= double(count))
-                    fail(sceneFile, path, file, "meshes[" + std::to_string(meshIndex) + "].primitives[" +
-                                                    std::to_string(primIndex) + "].indices (accessors[" +
-                                                    std::to_string(prim.indices) + "]): index " +
-                                                    std::to_string(std::uint64_t(idx[i + k])) + " is out of range (" +
-                                                    std::to_string(count) + " vertices)");
+                    fail(sceneFile, path, file,
+                         "meshes[" + std::to_string(meshIndex) + "].primitives[" + std::to_string(primIndex) +
+                             "].indices (accessors[" + std::to_string(prim.indices) + "]): index " +
+                             std::to_string(std::uint64_t(idx[i + k])) + " is out of range (" + std::to_string(count) +
+                             " vertices)");
                 out.indices.push_back(base + std::uint32_t(idx[i + k]));
             }
         }
@@ -653,15 +712,15 @@ void collectCameraAndLight(const tinygltf::Model& model, const tinygltf::Node& n
     const tinygltf::Value& v = ext->second.Get("light");
     const double number = v.IsNumber() || v.IsInt() ? v.GetNumberAsDouble() : -1.0;
     if (!(number >= 0 && number < double(model.lights.size()) && number == std::floor(number)))
-        fail(sceneFile, path, file, "nodes[" + std::to_string(nodeIndex) +
-                                        "].extensions.KHR_lights_punctual.light: names no light (" +
-                                        std::to_string(model.lights.size()) + " lights)");
+        fail(sceneFile, path, file,
+             "nodes[" + std::to_string(nodeIndex) + "].extensions.KHR_lights_punctual.light: names no light (" +
+                 std::to_string(model.lights.size()) + " lights)");
     const int index = int(number);
     const tinygltf::Light& l = model.lights[std::size_t(index)];
     if (l.type != "directional" && l.type != "point" && l.type != "spot")
-        fail(sceneFile, path, file, "extensions.KHR_lights_punctual.lights[" + std::to_string(index) +
-                                        "].type: unknown light type '" + excerpt(l.type) +
-                                        "' (expected directional, point or spot)");
+        fail(sceneFile, path, file,
+             "extensions.KHR_lights_punctual.lights[" + std::to_string(index) + "].type: unknown light type '" +
+                 excerpt(l.type) + "' (expected directional, point or spot)");
     GltfLight light;
     light.index = index;
     light.type = l.type;
@@ -716,14 +775,16 @@ bool gltfWriteFile(std::string* err, const std::string&, const std::vector<unsig
 }
 
 // `decodedBytes`: what decoding compressed geometry added to the file's buffers.
-void loadGltf(const fs::path& file, const std::string& fileBytes, std::vector<RawInstance>& out, const fs::path& sceneFile,
-              const JsonPath& path, GltfExtras* extras, const MeshRequest& request, std::uint64_t& decodedBytes) {
+void loadGltf(const fs::path& file, const std::string& fileBytes, std::vector<RawInstance>& out,
+              const fs::path& sceneFile, const JsonPath& path, GltfExtras* extras, const MeshRequest& request,
+              std::uint64_t& decodedBytes) {
     std::string ext = file.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
     const bool binary = ext == ".glb";
     // tinygltf parses extras and extensions recursively: nesting is bounded before it sees them.
     if (binary)
-        if (const std::string problem = glbLayoutProblem(fileBytes); !problem.empty()) fail(sceneFile, path, file, problem);
+        if (const std::string problem = glbLayoutProblem(fileBytes); !problem.empty())
+            fail(sceneFile, path, file, problem);
     if (const std::string problem = jsonNestingProblem(gltfJsonChunk(fileBytes, binary)); !problem.empty())
         fail(sceneFile, path, file, problem);
     GltfPrepared prepared;
@@ -766,8 +827,10 @@ void loadGltf(const fs::path& file, const std::string& fileBytes, std::vector<Ra
     // uses a mesh places it once; a mesh used by several nodes is read once and shared.
     std::vector<int> roots;
     const int sceneIndex = model.defaultScene >= 0 ? model.defaultScene : 0;
-    if (std::size_t(sceneIndex) < model.scenes.size()) roots = model.scenes[sceneIndex].nodes;
-    else for (std::size_t i = 0; i < model.nodes.size(); ++i) roots.push_back(int(i));
+    if (std::size_t(sceneIndex) < model.scenes.size())
+        roots = model.scenes[sceneIndex].nodes;
+    else
+        for (std::size_t i = 0; i < model.nodes.size(); ++i) roots.push_back(int(i));
     std::vector<std::shared_ptr<TriangleMesh>> meshes(model.meshes.size());
     std::map<std::pair<int, int>, std::shared_ptr<TriangleMesh>> perMaterial;  // (mesh, material)
     std::vector<std::pair<int, glm::dmat4>> stack;
@@ -781,22 +844,24 @@ void loadGltf(const fs::path& file, const std::string& fileBytes, std::vector<Ra
         auto [nodeIndex, parent] = stack.back();
         stack.pop_back();
         if (nodeIndex < 0 || std::size_t(nodeIndex) >= model.nodes.size())
-            fail(sceneFile, path, file, "the node hierarchy names node " + std::to_string(nodeIndex) +
-                                            ", which does not exist (" + std::to_string(model.nodes.size()) +
-                                            " nodes)");
+            fail(sceneFile, path, file,
+                 "the node hierarchy names node " + std::to_string(nodeIndex) + ", which does not exist (" +
+                     std::to_string(model.nodes.size()) + " nodes)");
         if (visited[nodeIndex]++)
-            fail(sceneFile, path, file, "node " + std::to_string(nodeIndex) +
-                                            " is reached twice in the node hierarchy (a cycle, or a node "
-                                            "with two parents); glTF nodes must form trees");
+            fail(sceneFile, path, file,
+                 "node " + std::to_string(nodeIndex) +
+                     " is reached twice in the node hierarchy (a cycle, or a node "
+                     "with two parents); glTF nodes must form trees");
         const auto& node = model.nodes[nodeIndex];
         const glm::dmat4 world = parent * nodeMatrix(node);
         // A scale of 0 hides a mesh (dropped below), but one that overflows is not a placement.
         for (int c = 0; c < 4; ++c)
             for (int r = 0; r < 4; ++r)
                 if (!std::isfinite(world[c][r]))
-                    fail(sceneFile, path, file, "nodes[" + std::to_string(nodeIndex) +
-                                                    "]: its transform, applied after its parents', is not finite "
-                                                    "(a scale or translation overflows)");
+                    fail(sceneFile, path, file,
+                         "nodes[" + std::to_string(nodeIndex) +
+                             "]: its transform, applied after its parents', is not finite "
+                             "(a scale or translation overflows)");
         if (node.mesh >= 0) {
             if (std::size_t(node.mesh) >= model.meshes.size())
                 fail(sceneFile, path, file, "node names mesh " + std::to_string(node.mesh) + ", which does not exist");
@@ -814,9 +879,9 @@ void loadGltf(const fs::path& file, const std::string& fileBytes, std::vector<Ra
                     if (std::find(used.begin(), used.end(), prim.material) == used.end()) used.push_back(prim.material);
                 for (const int material : used) {
                     if (material >= int(materials.size()))
-                        fail(sceneFile, path, file, "a primitive of mesh " + std::to_string(node.mesh) +
-                                                        " names material " + std::to_string(material) +
-                                                        ", which does not exist");
+                        fail(sceneFile, path, file,
+                             "a primitive of mesh " + std::to_string(node.mesh) + " names material " +
+                                 std::to_string(material) + ", which does not exist");
                     auto& geometry = perMaterial[{node.mesh, material}];
                     if (!geometry) {
                         geometry = std::make_shared<TriangleMesh>();
@@ -854,9 +919,8 @@ bool invertible(const glm::dmat4& m) {
 // `loadBytes`: an upper estimate of what reading the file held at its peak beside the result:
 // its bytes, tinyobjloader's arrays (about three times an OBJ's text), or tinygltf's JSON tree
 // (twice: its parse tree and the model's copies), buffers and the accessors read as doubles.
-std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path& sceneFile,
-                                       const JsonPath& path, GltfExtras* extras, std::uint64_t& loadBytes,
-                                       const MeshRequest& request) {
+std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path& sceneFile, const JsonPath& path,
+                                       GltfExtras* extras, std::uint64_t& loadBytes, const MeshRequest& request) {
     std::string bytes;
     try {
         bytes = readInputFile(meshFile, kMaxMeshFileBytes);
@@ -867,11 +931,13 @@ std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path&
     std::vector<RawInstance> raw;
     std::string ext = meshFile.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-    loadBytes = ext == ".obj" || ext == ".ply" ? 4 * std::uint64_t(bytes.size())
-                              : 5 * std::uint64_t(bytes.size()) + 2 * jsonTreeBytes(gltfJsonChunk(bytes, ext == ".glb"));
+    loadBytes = ext == ".obj" || ext == ".ply"
+                    ? 4 * std::uint64_t(bytes.size())
+                    : 5 * std::uint64_t(bytes.size()) + 2 * jsonTreeBytes(gltfJsonChunk(bytes, ext == ".glb"));
     if (const std::uint64_t available = availableMemoryBytes(); available != 0 && loadBytes > available)
-        fail(sceneFile, path, meshFile, "reading it needs about " + std::to_string(loadBytes / kMiB) + " MiB, more than the " +
-                                            std::to_string(available / kMiB) + " MiB available");
+        fail(sceneFile, path, meshFile,
+             "reading it needs about " + std::to_string(loadBytes / kMiB) + " MiB, more than the " +
+                 std::to_string(available / kMiB) + " MiB available");
     if (ext == ".obj") {
         raw.push_back({std::make_shared<TriangleMesh>(), glm::dmat4(1.0)});
         loadObj(meshFile, bytes, *raw.back().geometry, sceneFile, path, request.uvSet >= 0);
@@ -883,7 +949,8 @@ std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path&
         loadBytes += 9 * decodedBytes;
     } else if (ext == ".ply") {
         if (request.uvSet >= 0)
-            fail(sceneFile, path, meshFile, "a PLY mesh has no texture coordinates, which the object's alpha texture needs");
+            fail(sceneFile, path, meshFile,
+                 "a PLY mesh has no texture coordinates, which the object's alpha texture needs");
         raw.push_back({std::make_shared<TriangleMesh>(), glm::dmat4(1.0)});
         try {
             loadPly(bytes, *raw.back().geometry);
@@ -891,7 +958,9 @@ std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path&
             fail(sceneFile, path, meshFile, e.what());
         }
     } else {
-        fail(sceneFile, path, meshFile, "unsupported format '" + excerpt(ext) + "': a mesh is .obj, .ply, .gltf or .glb (convert the model, e.g. to .obj or .glb)");
+        fail(sceneFile, path, meshFile,
+             "unsupported format '" + excerpt(ext) +
+                 "': a mesh is .obj, .ply, .gltf or .glb (convert the model, e.g. to .obj or .glb)");
     }
     // Degenerate triangles are judged in object space: an invertible affine map keeps a
     // triangle's area zero or non-zero.
@@ -914,8 +983,8 @@ std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path&
     }
     if (triangles == 0 && dropped == 0) fail(sceneFile, path, meshFile, "has no triangles");
     if (out.empty())
-        fail(sceneFile, path, meshFile, "has no triangles left after dropping " +
-                                            std::to_string(dropped) + " degenerate ones");
+        fail(sceneFile, path, meshFile,
+             "has no triangles left after dropping " + std::to_string(dropped) + " degenerate ones");
     return out;
 }
 
@@ -950,7 +1019,10 @@ void finalizeMesh(TriangleMesh& mesh) {
     if (normalsOk)
         for (Vec3& n : mesh.normals) {
             const double len = glm::length(n);
-            if (!(len > 0.0) || !std::isfinite(len)) { normalsOk = false; break; }
+            if (!(len > 0.0) || !std::isfinite(len)) {
+                normalsOk = false;
+                break;
+            }
             n /= len;
         }
     if (!normalsOk) {
@@ -958,9 +1030,11 @@ void finalizeMesh(TriangleMesh& mesh) {
         mesh.normals.assign(mesh.positions.size(), Vec3(0.0));
         for (std::size_t t = 0; t < mesh.indices.size(); t += 3) {
             const auto i0 = mesh.indices[t], i1 = mesh.indices[t + 1], i2 = mesh.indices[t + 2];
-            const Vec3 fn = glm::cross(mesh.positions[i1] - mesh.positions[i0],
-                                       mesh.positions[i2] - mesh.positions[i0]);
-            mesh.normals[i0] += fn; mesh.normals[i1] += fn; mesh.normals[i2] += fn;
+            const Vec3 fn =
+                glm::cross(mesh.positions[i1] - mesh.positions[i0], mesh.positions[i2] - mesh.positions[i0]);
+            mesh.normals[i0] += fn;
+            mesh.normals[i1] += fn;
+            mesh.normals[i2] += fn;
         }
         for (Vec3& n : mesh.normals) {
             const double len = glm::length(n);
@@ -970,8 +1044,8 @@ void finalizeMesh(TriangleMesh& mesh) {
 }
 
 std::vector<MeshInstance> loadMeshInstances(const fs::path& meshFile, const glm::dmat4& transform,
-                                            const fs::path& sceneFile, const JsonPath& path,
-                                            GltfExtras* extras, MeshCache* cache, const MeshRequest& request) {
+                                            const fs::path& sceneFile, const JsonPath& path, GltfExtras* extras,
+                                            MeshCache* cache, const MeshRequest& request) {
     std::vector<MeshInstance> instances;
     std::string key;
     if (cache) {
@@ -989,8 +1063,8 @@ std::vector<MeshInstance> loadMeshInstances(const fs::path& meshFile, const glm:
     if (instances.empty()) {
         GltfExtras own;
         std::uint64_t loadBytes = 0;
-        instances = readMeshFile(meshFile, sceneFile, path, extras ? extras : (cache ? &own : nullptr), loadBytes,
-                                 request);
+        instances =
+            readMeshFile(meshFile, sceneFile, path, extras ? extras : (cache ? &own : nullptr), loadBytes, request);
         if (cache) {
             cache->files.emplace(key, instances);
             cache->extras[key] = extras ? *extras : own;
@@ -1019,9 +1093,10 @@ std::vector<MeshInstance> loadMeshInstances(const fs::path& meshFile, const glm:
         out.push_back({inst.geometry, affineOf(m), inst.fileMaterial});
     }
     if (out.empty())
-        fail(sceneFile, path, meshFile, overflowed ? "the object's transform overflows (its scale is too large for "
-                                                     "double precision)"
-                                                   : "the object's transform is not invertible");
+        fail(sceneFile, path, meshFile,
+             overflowed ? "the object's transform overflows (its scale is too large for "
+                          "double precision)"
+                        : "the object's transform is not invertible");
     return out;
 }
 
@@ -1030,7 +1105,8 @@ TriangleMesh flattenInstances(const std::vector<MeshInstance>& instances) {
     bool normals = true;
     bool uvs = true;
     for (const MeshInstance& inst : instances) normals = normals && !inst.geometry->normals.empty();
-    for (const MeshInstance& inst : instances) uvs = uvs && inst.geometry->uvs.size() == inst.geometry->positions.size();
+    for (const MeshInstance& inst : instances)
+        uvs = uvs && inst.geometry->uvs.size() == inst.geometry->positions.size();
     for (const MeshInstance& inst : instances) {
         const TriangleMesh& g = *inst.geometry;
         const glm::dmat3 nm = normalMatrix(inst.transform);
@@ -1046,8 +1122,7 @@ TriangleMesh flattenInstances(const std::vector<MeshInstance>& instances) {
 }
 
 std::shared_ptr<const TriangleMesh> loadMesh(const fs::path& meshFile, const glm::dmat4& transform,
-                                             const fs::path& sceneFile, const JsonPath& path,
-                                             GltfExtras* extras) {
+                                             const fs::path& sceneFile, const JsonPath& path, GltfExtras* extras) {
     return std::make_shared<TriangleMesh>(
         flattenInstances(loadMeshInstances(meshFile, transform, sceneFile, path, extras)));
 }

@@ -4,8 +4,8 @@
 // triangles are dropped and counted; missing normals are computed (area-weighted).
 #pragma once
 
-#include <filesystem>
 #include <cstdint>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <string>
@@ -66,7 +66,7 @@ struct MeshRequest {
 struct MeshCache {
     std::map<std::string, std::vector<MeshInstance>> files;
     std::map<std::string, GltfExtras> extras;  // each glTF file's cameras and lights
-    std::uint64_t peakLoadBytes = 0;  // the largest file's temporaries while it was read
+    std::uint64_t peakLoadBytes = 0;           // the largest file's temporaries while it was read
 };
 
 // Reads `meshFile`: one instance for an OBJ file, one per node that uses a mesh for glTF (the
@@ -74,21 +74,19 @@ struct MeshCache {
 // placed by `transform` (object to world). Errors name `sceneFile` and `path` (the JSON path of
 // the object's "file" key) as well as the mesh file. For glTF files, `extras` (when given)
 // receives the file's cameras and lights, also when the file was read earlier into `cache`.
-std::vector<MeshInstance> loadMeshInstances(const std::filesystem::path& meshFile,
-                                            const glm::dmat4& transform,
-                                            const std::filesystem::path& sceneFile,
-                                            const JsonPath& path, GltfExtras* extras = nullptr,
-                                            MeshCache* cache = nullptr, const MeshRequest& request = {});
+std::vector<MeshInstance> loadMeshInstances(const std::filesystem::path& meshFile, const glm::dmat4& transform,
+                                            const std::filesystem::path& sceneFile, const JsonPath& path,
+                                            GltfExtras* extras = nullptr, MeshCache* cache = nullptr,
+                                            const MeshRequest& request = {});
 
 // Copies every instance into one world-space mesh (positions transformed, normals by the
 // inverse transpose): for tools and tests that want one flat triangle list.
 TriangleMesh flattenInstances(const std::vector<MeshInstance>& instances);
 
 // loadMeshInstances, flattened.
-std::shared_ptr<const TriangleMesh> loadMesh(const std::filesystem::path& meshFile,
-                                             const glm::dmat4& transform,
-                                             const std::filesystem::path& sceneFile,
-                                             const JsonPath& path, GltfExtras* extras = nullptr);
+std::shared_ptr<const TriangleMesh> loadMesh(const std::filesystem::path& meshFile, const glm::dmat4& transform,
+                                             const std::filesystem::path& sceneFile, const JsonPath& path,
+                                             GltfExtras* extras = nullptr);
 
 // translate · Rz · Ry · Rx · scale, angles in degrees (a rotation about X is applied first).
 glm::dmat4 objectTransform(const Vec3& translate, const Vec3& rotateDegrees, const Vec3& scale);

@@ -133,9 +133,8 @@ Camera framedWithShadow(const Camera& framed, const Bounds& bounds, const Vec3& 
     double distance = framedDistance, radius = 0.5 * bounds.diagonal();
     for (const Vec3& p : points) {
         const Vec3 q = p - target;
-        distance = std::max(distance, -glm::dot(q, cam.forward) +
-                                          std::max(std::abs(glm::dot(q, cam.right)) / tanH,
-                                                   std::abs(glm::dot(q, cam.up)) / tanV));
+        distance = std::max(distance, -glm::dot(q, cam.forward) + std::max(std::abs(glm::dot(q, cam.right)) / tanH,
+                                                                           std::abs(glm::dot(q, cam.up)) / tanV));
         radius = std::max(radius, glm::length(q));
     }
     Camera c = framed;
@@ -183,7 +182,8 @@ bool hasOwnGround(const Scene& scene) {
     double area = 0;  // projected onto the ground plane
     for (const Object& o : scene.objects) {
         if (const Quad* q = std::get_if<Quad>(&o.shape)) {
-            if (std::abs(q->normal.y) > 0.7 && q->center.y <= top) area += q->size.x * q->size.y * std::abs(q->normal.y);
+            if (std::abs(q->normal.y) > 0.7 && q->center.y <= top)
+                area += q->size.x * q->size.y * std::abs(q->normal.y);
         } else if (const Mesh* m = std::get_if<Mesh>(&o.shape)) {
             for (const MeshInstance& in : m->instances) {
                 if (!in.geometry) continue;
@@ -250,7 +250,8 @@ void applyGround(Scene& scene, std::optional<bool> option) {
         addGround(scene);
         fitFarToBounds(scene);
         const Quad& q = std::get<Quad>(scene.objects.back().shape);
-        why = "a " + fmt(q.size.x) + " x " + fmt(q.size.y) + " quad at y = " + fmt(q.center.y, "%.4g") + " (" + why + ")";
+        why =
+            "a " + fmt(q.size.x) + " x " + fmt(q.size.y) + " quad at y = " + fmt(q.center.y, "%.4g") + " (" + why + ")";
     } else if (option || scene.origin.ground) {
         why = "none (" + why + ")";
     }
@@ -274,8 +275,8 @@ glm::dvec2 sunAngles(const Vec3& direction) {
 void applySunOption(Scene& scene, const std::string& text) {
     double az = 0, el = 0;
     char comma = 0, extra = 0;
-    if (std::sscanf(text.c_str(), "%lf%c%lf%c", &az, &comma, &el, &extra) != 3 || comma != ',' ||
-        !std::isfinite(az) || !std::isfinite(el))
+    if (std::sscanf(text.c_str(), "%lf%c%lf%c", &az, &comma, &el, &extra) != 3 || comma != ',' || !std::isfinite(az) ||
+        !std::isfinite(el))
         throw InputError("--sun: expected AZIMUTH,ELEVATION in degrees (e.g. 135,40), got '" + text + "'");
     if (el < -90.0 || el > 90.0)
         throw InputError("--sun " + text + ": the elevation must be in -90..90 degrees, got " + fmt(el));

@@ -39,7 +39,7 @@ std::optional<Type> typeNamed(const std::string& name) {
 
 struct Property {
     std::string name;
-    Type type;               // the value's (a list's entries')
+    Type type;                  // the value's (a list's entries')
     std::optional<Type> count;  // a list: the type of its length
 };
 
@@ -77,7 +77,8 @@ public:
         }
         std::uint64_t u = 0;
         for (int i = t.size - 1; i >= 0; --i) u = (u << 8) | raw[i];  // raw is little-endian now
-        if (t.isSigned && (u >> (8 * t.size - 1)) & 1u) return double(std::int64_t(u) - (std::int64_t(1) << (8 * t.size)));
+        if (t.isSigned && (u >> (8 * t.size - 1)) & 1u)
+            return double(std::int64_t(u) - (std::int64_t(1) << (8 * t.size)));
         return double(u);
     }
 
@@ -147,10 +148,14 @@ void loadPly(const std::string& bytes, TriangleMesh& mesh) {
         if (w[0] == "format") {
             if (w.size() != 3 || w[2].rfind("1.", 0) != 0)
                 throw PlyError(at + ": expected 'format ascii|binary_little_endian|binary_big_endian 1.0'");
-            if (w[1] == "ascii") format = Format::Ascii;
-            else if (w[1] == "binary_little_endian") format = Format::BinaryLittle;
-            else if (w[1] == "binary_big_endian") format = Format::BinaryBig;
-            else throw PlyError(at + ": unknown format '" + w[1].substr(0, 40) + "'");
+            if (w[1] == "ascii")
+                format = Format::Ascii;
+            else if (w[1] == "binary_little_endian")
+                format = Format::BinaryLittle;
+            else if (w[1] == "binary_big_endian")
+                format = Format::BinaryBig;
+            else
+                throw PlyError(at + ": unknown format '" + w[1].substr(0, 40) + "'");
         } else if (w[0] == "element") {
             if (w.size() != 3) throw PlyError(at + ": expected 'element NAME COUNT'");
             Element e;
@@ -173,7 +178,8 @@ void loadPly(const std::string& bytes, TriangleMesh& mesh) {
             if (list) {
                 p.count = typeNamed(w[2]);
                 if (!p.count || !p.count->integer)
-                    throw PlyError(at + ": a list's count type must be an integer type, got '" + w[2].substr(0, 40) + "'");
+                    throw PlyError(at + ": a list's count type must be an integer type, got '" + w[2].substr(0, 40) +
+                                   "'");
             }
             p.name = w.back().substr(0, 40);
             elements.back().properties.push_back(std::move(p));
@@ -220,8 +226,8 @@ void loadPly(const std::string& bytes, TriangleMesh& mesh) {
             // A binary element is at least a byte a property: a count past the data fails here
             // instead of looping over nothing.
             if (*format != Format::Ascii && body.remaining() < e.properties.size())
-                throw PlyError("the data ends at " + e.name + " " + std::to_string(i) + " of " + std::to_string(e.count) +
-                               " (the header promises more)");
+                throw PlyError("the data ends at " + e.name + " " + std::to_string(i) + " of " +
+                               std::to_string(e.count) + " (the header promises more)");
             double v[6] = {0, 0, 0, 0, 0, 0};
             for (std::size_t k = 0; k < e.properties.size(); ++k) {
                 const Property& p = e.properties[k];
@@ -229,12 +235,18 @@ void loadPly(const std::string& bytes, TriangleMesh& mesh) {
                 if (!p.count) {
                     const double value = body.read(p.type, where);
                     const int ki = int(k);
-                    if (ki == x) v[0] = value;
-                    else if (ki == y) v[1] = value;
-                    else if (ki == z) v[2] = value;
-                    else if (ki == nx) v[3] = value;
-                    else if (ki == ny) v[4] = value;
-                    else if (ki == nz) v[5] = value;
+                    if (ki == x)
+                        v[0] = value;
+                    else if (ki == y)
+                        v[1] = value;
+                    else if (ki == z)
+                        v[2] = value;
+                    else if (ki == nx)
+                        v[3] = value;
+                    else if (ki == ny)
+                        v[4] = value;
+                    else if (ki == nz)
+                        v[5] = value;
                     continue;
                 }
                 const double n = body.read(*p.count, where + " (its length)");
@@ -249,10 +261,12 @@ void loadPly(const std::string& bytes, TriangleMesh& mesh) {
                     throw PlyError(where + ": a face of " + std::to_string(corners.size()) + " corners (at least 3)");
                 for (double c : corners)
                     if (c < 0 || c > double(std::numeric_limits<std::uint32_t>::max()))
-                        throw PlyError(where + ": vertex index " + std::to_string(std::int64_t(c)) + " is out of range");
+                        throw PlyError(where + ": vertex index " + std::to_string(std::int64_t(c)) +
+                                       " is out of range");
                 // A convex polygon as a fan from its first corner.
                 for (std::size_t c = 1; c + 1 < corners.size(); ++c)
-                    for (double index : {corners[0], corners[c], corners[c + 1]}) indices.push_back(std::uint32_t(index));
+                    for (double index : {corners[0], corners[c], corners[c + 1]})
+                        indices.push_back(std::uint32_t(index));
                 if (indices.size() > std::size_t(std::numeric_limits<std::uint32_t>::max()))
                     throw PlyError("has more face corners than 32-bit indices hold");
             }

@@ -43,8 +43,7 @@ RenderPlan makeRenderPlan(const Scene& scene, const RenderSettings& settings) {
 
     // A convex object never shadows its own lit points (a ray leaving a convex surface with
     // N·L > 0 cannot re-enter it), so a scene of one convex object needs no shadow test at all.
-    const bool canShadow =
-        scene.objects.size() > 1 || (scene.objects.size() == 1 && !isConvex(scene.objects[0].shape));
+    const bool canShadow = scene.objects.size() > 1 || (scene.objects.size() == 1 && !isConvex(scene.objects[0].shape));
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {
         const Light& light = scene.lights[i];
         LightPlan lp;
@@ -92,8 +91,8 @@ RenderPlan makeRenderPlan(const Scene& scene, const RenderSettings& settings) {
                               " ignored: no shadowed directional light (only directional maps are split)";
     } else {
         plan.cascades = asked;
-        plan.cascadesReason = std::to_string(asked) +
-                              " per directional light, split along the view depth of the visible receivers";
+        plan.cascadesReason =
+            std::to_string(asked) + " per directional light, split along the view depth of the visible receivers";
     }
     const double blend = settings.raster.cascadeBlend;
     std::ostringstream band;
@@ -101,14 +100,14 @@ RenderPlan makeRenderPlan(const Scene& scene, const RenderSettings& settings) {
     if (blend <= 0.0) {
         plan.cascadeBlendReason = "off: each split switches cascades abruptly (cascade_blend = 0)";
     } else if (plan.cascades <= 1 && settings.raster.cascadesIsDefault && shadowedDirectional) {
-        plan.cascadeBlendReason = "cascade_blend = " + band.str() +
-                                  " applies if the raster backend splits the view (see 'raster cascades')";
+        plan.cascadeBlendReason =
+            "cascade_blend = " + band.str() + " applies if the raster backend splits the view (see 'raster cascades')";
     } else if (plan.cascades <= 1) {
         plan.cascadeBlendReason = "cascade_blend = " + band.str() + " ignored: no cascades";
     } else {
         plan.cascadeBlend = blend;
-        plan.cascadeBlendReason = "the last " + band.str() +
-                                  " of each slice but the last mixes its cascade's visibility with the next's";
+        plan.cascadeBlendReason =
+            "the last " + band.str() + " of each slice but the last mixes its cascade's visibility with the next's";
     }
     return plan;
 }
@@ -123,18 +122,15 @@ std::string RenderPlan::explain() const {
       << (needsTriangleBvh ? "built (the scene has meshes)"
                            : "not built (spheres, quads and boxes are intersected analytically)")
       << "\n";
-    s << "point-light cube map: " << (needsCubeMap ? "needed" : "not needed (no shadowed point light)")
-      << "\n";
+    s << "point-light cube map: " << (needsCubeMap ? "needed" : "not needed (no shadowed point light)") << "\n";
     s << "transmittance map: "
-      << (needsTransmittanceMap ? "needed (semi-transparent casters)" : "not needed (all casters opaque)")
-      << "\n";
-    s << "area lights: " << (hasAreaLights ? "yes, soft shadows are sampled" : "none, shadows are hard")
-      << "\n";
+      << (needsTransmittanceMap ? "needed (semi-transparent casters)" : "not needed (all casters opaque)") << "\n";
+    s << "area lights: " << (hasAreaLights ? "yes, soft shadows are sampled" : "none, shadows are hard") << "\n";
     s << "cascades: " << cascades << " (" << cascadesReason << ")\n";
     s << "cascade blend: " << cascadeBlend << " (" << cascadeBlendReason << ")\n";
     for (const LightPlan& lp : lights)
-        s << "light " << lp.light << ": shadow pass "
-          << (lp.needsShadowTest ? "rendered" : "skipped") << " (" << lp.reason << ")\n";
+        s << "light " << lp.light << ": shadow pass " << (lp.needsShadowTest ? "rendered" : "skipped") << " ("
+          << lp.reason << ")\n";
     return s.str();
 }
 

@@ -11,9 +11,9 @@
 namespace shadowlab::scene {
 
 struct LightPlan {
-    int light = 0;              // index into Scene::lights
+    int light = 0;                // index into Scene::lights
     bool needsShadowTest = true;  // false: no object can cast onto a lit receiver for this light
-    std::string reason;         // why, in words
+    std::string reason;           // why, in words
 };
 
 struct RenderPlan {
@@ -21,8 +21,8 @@ struct RenderPlan {
     bool anyHitShadowRays = true;
     // A triangle BVH is built only when the scene has meshes; spheres, quads, boxes stay analytic.
     bool needsTriangleBvh = false;
-    bool needsCubeMap = false;            // a point light is shadowed (raster)
-    bool needsTransmittanceMap = false;   // semi-transparent casters (raster)
+    bool needsCubeMap = false;           // a point light is shadowed (raster)
+    bool needsTransmittanceMap = false;  // semi-transparent casters (raster)
     bool hasAreaLights = false;
     // Cascaded shadow maps per shadowed directional light (raster): settings.raster.cascades, or 1
     // when more were asked for but no directional light is shadowed; cascadesReason says which.

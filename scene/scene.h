@@ -111,7 +111,9 @@ struct Material {
     double cameraCutoff() const {
         return alphaMode == AlphaMode::Mask ? alphaCutoff : alphaMode == AlphaMode::Blend ? kBlendVisibleAlpha : -1.0;
     }
-    bool cameraSkips(double texAlpha) const { return alphaMode != AlphaMode::Opaque && alphaAt(texAlpha) < cameraCutoff(); }
+    bool cameraSkips(double texAlpha) const {
+        return alphaMode != AlphaMode::Opaque && alphaAt(texAlpha) < cameraCutoff();
+    }
     // The light a hit lets through: 1 − opacity, and for BLEND 1 − opacity·alpha(uv).
     double transmittance(double texAlpha) const {
         return alphaMode == AlphaMode::Blend ? 1.0 - opacity * alphaAt(texAlpha) : 1.0 - opacity;
@@ -126,8 +128,8 @@ struct Light {
     Vec3 position{0, 0, 0};    // point and spot
     Vec3 color{1, 1, 1};
     double intensity = 1.0;
-    double radius = 0.0;           // point/spot: > 0 makes a spherical area light (soft shadows)
-    double coneAngleDegrees = 0.0; // spot: half-angle of the cone
+    double radius = 0.0;            // point/spot: > 0 makes a spherical area light (soft shadows)
+    double coneAngleDegrees = 0.0;  // spot: half-angle of the cone
 };
 
 struct Sphere {
@@ -164,7 +166,7 @@ struct TriangleMesh {
     std::vector<std::uint32_t> indices;  // three per triangle
     // Per vertex, only where a material reads an alpha texture (glTF TEXCOORD_n, OBJ vt); else empty.
     std::vector<Vec2> uvs;
-    std::size_t droppedDegenerate = 0;   // triangles removed on load (zero area / non-finite)
+    std::size_t droppedDegenerate = 0;  // triangles removed on load (zero area / non-finite)
     std::size_t triangleCount() const { return indices.size() / 3; }
 };
 
@@ -213,10 +215,10 @@ struct Object {
 // optional: absent means "use the program's scene-scaled default".
 struct ShadowDefaults {
     std::optional<int> shadowMapSize;
-    std::optional<double> depthBias;     // world units
-    std::optional<double> slopeBias;     // shadow-map texels
-    std::optional<std::string> filter;   // "none" | "pcf2x2" | "pcf" | "poisson"
-    std::optional<int> pcfSize;          // texels
+    std::optional<double> depthBias;    // world units
+    std::optional<double> slopeBias;    // shadow-map texels
+    std::optional<std::string> filter;  // "none" | "pcf2x2" | "pcf" | "poisson"
+    std::optional<int> pcfSize;         // texels
     // Filterable maps (MomentSettings): min_variance, light_bleeding_reduction,
     // evsm_positive_exponent, evsm_negative_exponent, esm_exponent, moment_bias, blur_width.
     std::optional<double> minVariance, bleedReduction, evsmPositive, evsmNegative, esmExponent, momentBias;
@@ -225,10 +227,10 @@ struct ShadowDefaults {
     std::optional<bool> receiverPlaneBias;
     std::optional<bool> hardwareBias;
     std::optional<bool> fitLightFrustum;
-    std::optional<int> cascades;         // directional lights: cascaded shadow maps, 1..kMaxCascades
-    std::optional<double> cascadeBlend;  // fraction of each slice blended into the next, 0..0.5
-    std::optional<double> rayBias;       // world units; absent: scene-scaled
-    std::optional<bool> robustRayOffset; // "ray_bias": "robust"
+    std::optional<int> cascades;          // directional lights: cascaded shadow maps, 1..kMaxCascades
+    std::optional<double> cascadeBlend;   // fraction of each slice blended into the next, 0..0.5
+    std::optional<double> rayBias;        // world units; absent: scene-scaled
+    std::optional<bool> robustRayOffset;  // "ray_bias": "robust"
     std::optional<std::string> precision;
     std::optional<int> samples;
 };
@@ -237,8 +239,16 @@ struct Bounds {
     Vec3 min{std::numeric_limits<double>::infinity()};
     Vec3 max{-std::numeric_limits<double>::infinity()};
     bool empty() const { return !(min.x <= max.x); }
-    void extend(const Vec3& p) { min = glm::min(min, p); max = glm::max(max, p); }
-    void extend(const Bounds& b) { if (!b.empty()) { extend(b.min); extend(b.max); } }
+    void extend(const Vec3& p) {
+        min = glm::min(min, p);
+        max = glm::max(max, p);
+    }
+    void extend(const Bounds& b) {
+        if (!b.empty()) {
+            extend(b.min);
+            extend(b.max);
+        }
+    }
     Vec3 center() const { return 0.5 * (min + max); }
     Vec3 extent() const { return max - min; }
     double diagonal() const { return empty() ? 0.0 : glm::length(max - min); }
@@ -267,9 +277,9 @@ struct AnimationCurve {
 // A glTF animation's channels that move the node of one of the file's cameras, kept so a path study
 // can sample the camera along it (scene/camera_animation.h). The node's parents are not animated.
 struct CameraAnimation {
-    std::string name;  // the animation's "name" ("" when unnamed)
-    int index = -1;    // in the file's animations
-    int camera = -1;   // into SceneOrigin::cameras
+    std::string name;        // the animation's "name" ("" when unnamed)
+    int index = -1;          // in the file's animations
+    int camera = -1;         // into SceneOrigin::cameras
     glm::dmat4 parent{1.0};  // the node's parents' transform
     Vec3 translation{0, 0, 0};
     glm::dvec4 rotation{0, 0, 0, 1};  // xyzw
@@ -285,14 +295,14 @@ struct SceneOrigin {
     std::vector<FileCamera> cameras;
     // Animations of those cameras' nodes (a .gltf/.glb given as the scene; `path --camera-animation`).
     std::vector<CameraAnimation> cameraAnimations;
-    bool modelScene = false;   // a .gltf/.glb given directly as the scene
-    bool chooseView = false;   // the camera is a placeholder: a view search replaces it
-    bool chooseSun = false;    // lights[0] is a placeholder sun: a view search replaces its direction
+    bool modelScene = false;     // a .gltf/.glb given directly as the scene
+    bool chooseView = false;     // the camera is a placeholder: a view search replaces it
+    bool chooseSun = false;      // lights[0] is a placeholder sun: a view search replaces its direction
     std::optional<bool> ground;  // the scene file's "ground" key
     // The JSON camera gives no "far": it reaches the farthest corner of the scene's bounds,
     // refitted when a ground is added (fitFarToBounds, scene/model_view.h).
     bool farFromBounds = false;
-    Bounds modelBounds;        // the objects without an added ground (what a view frames)
+    Bounds modelBounds;  // the objects without an added ground (what a view frames)
     // ("view", "searched: ..."), ("sun", ...), ("ground", ...): printed by --explain, recorded
     // in every Frame as attributes "choice.view", "choice.sun", ...
     std::vector<std::pair<std::string, std::string>> choices;

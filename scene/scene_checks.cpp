@@ -36,8 +36,8 @@ ValueProblem lightProblem(const Light& l) {
     }
     if (l.type != LightType::Directional) {
         if (!finite(l.position) || largest(l.position) > kMaxSceneCoordinate)
-            return {"position", "must be finite and within +-" + number(kMaxSceneCoordinate) + ", got a coordinate of " +
-                                    number(largest(l.position))};
+            return {"position", "must be finite and within +-" + number(kMaxSceneCoordinate) +
+                                    ", got a coordinate of " + number(largest(l.position))};
         if (!std::isfinite(l.radius) || l.radius < 0 || l.radius > kMaxSceneCoordinate)
             return {"radius", "must be in 0.." + number(kMaxSceneCoordinate) + ", got " + number(l.radius)};
     }

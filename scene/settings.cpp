@@ -64,19 +64,17 @@ RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& o) {
     s.raster.shadowMapSize = o.shadowMapSize.value_or(d.shadowMapSize.value_or(kDefaultShadowMapSize));
     s.raster.shadowMapSizeIsDefault = !o.shadowMapSize && !d.shadowMapSize;
     if (s.raster.shadowMapSize < 16 || s.raster.shadowMapSize > 16384)
-        throw InputError("--shadow-map-size: must be in 16..16384, got " +
-                         std::to_string(s.raster.shadowMapSize));
+        throw InputError("--shadow-map-size: must be in 16..16384, got " + std::to_string(s.raster.shadowMapSize));
     // Default bias: half a texel of constant bias and one texel of slope bias.
-    s.raster.depthBias =
-        o.depthBias.value_or(d.depthBias.value_or(defaultDepthBias(scene, s.raster.shadowMapSize)));
+    s.raster.depthBias = o.depthBias.value_or(d.depthBias.value_or(defaultDepthBias(scene, s.raster.shadowMapSize)));
     s.raster.depthBiasIsDefault = !o.depthBias && !d.depthBias;
     s.raster.slopeBias = o.slopeBias.value_or(d.slopeBias.value_or(1.0));
     if (!std::isfinite(s.raster.depthBias) || s.raster.depthBias < 0.0)
         throw InputError("--depth-bias: must be a finite value >= 0 (world units)");
     if (!std::isfinite(s.raster.slopeBias) || s.raster.slopeBias < 0.0)
         throw InputError("--slope-bias: must be a finite value >= 0 (texels)");
-    s.raster.filter = o.filter ? parseFilter(*o.filter, "--filter")
-                               : parseFilter(d.filter.value_or("pcf2x2"), "shadow.filter");
+    s.raster.filter =
+        o.filter ? parseFilter(*o.filter, "--filter") : parseFilter(d.filter.value_or("pcf2x2"), "shadow.filter");
     s.raster.pcfSize = o.pcfSize.value_or(d.pcfSize.value_or(3));
     if (s.raster.pcfSize < 1 || s.raster.pcfSize > 15)
         throw InputError("--pcf-size: must be in 1..15 texels, got " + std::to_string(s.raster.pcfSize));
@@ -85,8 +83,8 @@ RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& o) {
                    const char* name, double lo, double hi) {
         into = option.value_or(fromScene.value_or(into));
         if (!(into >= lo && into <= hi))  // also rejects NaN
-            throw InputError(std::string(name) + ": must be in " + formatBlend(lo) + ".." + formatBlend(hi) +
-                             ", got " + formatBlend(into));
+            throw InputError(std::string(name) + ": must be in " + formatBlend(lo) + ".." + formatBlend(hi) + ", got " +
+                             formatBlend(into));
     };
     take(m.minVariance, o.minVariance, d.minVariance, "--min-variance", 0.0, 1.0);
     take(m.bleedReduction, o.bleedReduction, d.bleedReduction, "--bleeding-reduction", 0.0, 0.99);
@@ -132,8 +130,7 @@ RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& o) {
                 used = 0;
             }
             if (used != o.rayBias->size() || !std::isfinite(v) || v < 0.0)
-                throw InputError("--ray-bias: expected a number >= 0 or 'robust', got '" +
-                                 *o.rayBias + "'");
+                throw InputError("--ray-bias: expected a number >= 0 or 'robust', got '" + *o.rayBias + "'");
             s.raytrace.rayBias = v;
         }
     } else if (d.robustRayOffset.value_or(false)) {
@@ -148,8 +145,7 @@ RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& o) {
         throw InputError("--samples: must be in 1..65536, got " + std::to_string(s.raytrace.samples));
     s.raytrace.threads = o.threads.value_or(0);
     if (s.raytrace.threads < 0 || s.raytrace.threads > 1024)
-        throw InputError("--threads: must be in 0..1024 (0 = all), got " +
-                         std::to_string(s.raytrace.threads));
+        throw InputError("--threads: must be in 0..1024 (0 = all), got " + std::to_string(s.raytrace.threads));
     return s;
 }
 

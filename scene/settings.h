@@ -26,13 +26,13 @@ inline bool isFilterable(ShadowFilter f) { return f >= ShadowFilter::Vsm; }
 // The filterable maps' parameters. Depths are the maps' normalized depths 0..1 (each map spans its
 // light's fitted depth range), so the defaults scale with the scene. See docs/raster.md.
 struct MomentSettings {
-    double minVariance = 1e-6;     // vsm, evsm: variance floor (normalized depth², warped for evsm)
-    double bleedReduction = 0.2;   // vsm, evsm: linstep(amount, 1, p) cuts this much of the tail
-    double evsmPositive = 40.0;    // evsm: exp(c·(2z−1)); ≤ kMaxEvsmExponent (float overflow of the square)
-    double evsmNegative = 5.0;     // evsm4: −exp(−c·(2z−1)); ≤ kMaxEvsmExponent
-    double esmExponent = 80.0;     // esm: exp(c·z) stored; ≤ kMaxEsmExponent
-    double momentBias = 3e-5;      // msm: moments pulled toward (0.5, 0.5, 0.5, 0.5) by this
-    int blurWidth = 5;             // box blur width in texels (odd, 1 = none), both directions
+    double minVariance = 1e-6;    // vsm, evsm: variance floor (normalized depth², warped for evsm)
+    double bleedReduction = 0.2;  // vsm, evsm: linstep(amount, 1, p) cuts this much of the tail
+    double evsmPositive = 40.0;   // evsm: exp(c·(2z−1)); ≤ kMaxEvsmExponent (float overflow of the square)
+    double evsmNegative = 5.0;    // evsm4: −exp(−c·(2z−1)); ≤ kMaxEvsmExponent
+    double esmExponent = 80.0;    // esm: exp(c·z) stored; ≤ kMaxEsmExponent
+    double momentBias = 3e-5;     // msm: moments pulled toward (0.5, 0.5, 0.5, 0.5) by this
+    int blurWidth = 5;            // box blur width in texels (odd, 1 = none), both directions
 };
 // float32 holds up to 3.4e38 = e^88.7: EVSM stores exp(2c) (the square at z = 1), so c ≤ 44, less
 // a margin for the blur's sums: 42. ESM stores exp(c) at z = 1: c ≤ 88, margin: 85.
@@ -57,7 +57,7 @@ struct RasterSettings {
     // True when shadowMapSize is the default (no option, no scene value): the raster backend may
     // then lower it to what the receivers' detail on screen needs (raster::chooseShadowMapSize).
     bool shadowMapSizeIsDefault = false;
-    double depthBias = 0.0;     // world units along the light direction 
+    double depthBias = 0.0;  // world units along the light direction
     // True when depthBias is defaultDepthBias() (no option, no scene value): the raster backend
     // then re-derives it as half a texel of each fitted map (fitLightFrustum), see docs/raster.md.
     bool depthBiasIsDefault = false;
@@ -65,9 +65,10 @@ struct RasterSettings {
     // raster shader lifts the lookup along the normal by slopeBias * texel * (sin - 10 cos)
     double slopeBias = 0.0;
     ShadowFilter filter = ShadowFilter::Pcf2x2;
-    int pcfSize = 3;            // pcf: taps per side; poisson: kernel diameter in texels (1..15)
-    MomentSettings moments;     // vsm, evsm2, evsm4, esm, msm
-    double normalOffset = 0.0;  // texels: the receiver moves along its normal by this x texel world size (plus the lift above)
+    int pcfSize = 3;         // pcf: taps per side; poisson: kernel diameter in texels (1..15)
+    MomentSettings moments;  // vsm, evsm2, evsm4, esm, msm
+    double normalOffset =
+        0.0;  // texels: the receiver moves along its normal by this x texel world size (plus the lift above)
     // Receiver-plane depth bias (Isidoro 2006): each filter tap compares against the receiver's
     // plane extrapolated to the texel it reads, instead of the slope bias (see docs/raster.md).
     bool receiverPlaneBias = false;
@@ -98,16 +99,16 @@ struct RasterSettings {
     // Leave objects that cannot cast onto the receivers a map serves out of its depth pass (every
     // map: raster castsOnto); tests and benchmarks turn it off to compare.
     bool cullCasters = true;
-    std::string device;         // "" = lavapipe if present, else the first device; index or name substring
-    bool validate = false;      // enable VK_LAYER_KHRONOS_validation and count its messages
+    std::string device;     // "" = lavapipe if present, else the first device; index or name substring
+    bool validate = false;  // enable VK_LAYER_KHRONOS_validation and count its messages
 };
 
 struct RaytraceSettings {
     double rayBias = 0.0;       // world units along the normal (the lesson's bias)
     bool robustOffset = false;  // offset by a bound on the hit point's rounding error instead
     Precision precision = Precision::Float;
-    int samples = 1;            // shadow samples per pixel for area lights
-    int threads = 0;            // 0 = all hardware threads
+    int samples = 1;  // shadow samples per pixel for area lights
+    int threads = 0;  // 0 = all hardware threads
 };
 
 struct RenderSettings {
@@ -122,22 +123,22 @@ struct SettingsOverrides {
     std::optional<double> depthBias;
     std::optional<double> slopeBias;
     std::optional<std::string> filter;
-    std::optional<int> pcfSize;          // --pcf-size
-    std::optional<double> minVariance;     // --min-variance
-    std::optional<double> bleedReduction;  // --bleeding-reduction
-    std::optional<double> evsmPositive;    // --evsm-positive
-    std::optional<double> evsmNegative;    // --evsm-negative
-    std::optional<double> esmExponent;     // --esm-exponent
-    std::optional<double> momentBias;      // --moment-bias
-    std::optional<int> blurWidth;          // --blur-width
-    std::optional<double> normalOffset;  // --normal-offset (texels)
+    std::optional<int> pcfSize;             // --pcf-size
+    std::optional<double> minVariance;      // --min-variance
+    std::optional<double> bleedReduction;   // --bleeding-reduction
+    std::optional<double> evsmPositive;     // --evsm-positive
+    std::optional<double> evsmNegative;     // --evsm-negative
+    std::optional<double> esmExponent;      // --esm-exponent
+    std::optional<double> momentBias;       // --moment-bias
+    std::optional<int> blurWidth;           // --blur-width
+    std::optional<double> normalOffset;     // --normal-offset (texels)
     std::optional<bool> receiverPlaneBias;  // --receiver-plane-bias
     std::optional<bool> hardwareBias;       // --hardware-bias
-    std::optional<bool> fitLightFrustum; // --fit-light-frustum on|off (--no-fit-light-frustum)
-    std::optional<bool> snapLightFrustum;  // --no-snap sets false (the temporal study)
-    std::optional<int> cascades;         // --cascades (1..kMaxCascades)
-    std::optional<double> cascadeBlend;  // --cascade-blend (0..kMaxCascadeBlend)
-    std::optional<std::string> rayBias;  // a number or "robust"
+    std::optional<bool> fitLightFrustum;    // --fit-light-frustum on|off (--no-fit-light-frustum)
+    std::optional<bool> snapLightFrustum;   // --no-snap sets false (the temporal study)
+    std::optional<int> cascades;            // --cascades (1..kMaxCascades)
+    std::optional<double> cascadeBlend;     // --cascade-blend (0..kMaxCascadeBlend)
+    std::optional<std::string> rayBias;     // a number or "robust"
     std::optional<std::string> precision;
     std::optional<int> samples;
     std::optional<int> threads;

@@ -71,10 +71,14 @@ std::shared_ptr<const AlphaTexture> loadAlphaTextureFromMemory(const std::string
 }
 
 bool textureWrapFromName(const std::string& name, TextureWrap& out) {
-    if (name == "repeat") out = TextureWrap::Repeat;
-    else if (name == "clamp_to_edge") out = TextureWrap::ClampToEdge;
-    else if (name == "mirrored_repeat") out = TextureWrap::MirroredRepeat;
-    else return false;
+    if (name == "repeat")
+        out = TextureWrap::Repeat;
+    else if (name == "clamp_to_edge")
+        out = TextureWrap::ClampToEdge;
+    else if (name == "mirrored_repeat")
+        out = TextureWrap::MirroredRepeat;
+    else
+        return false;
     return true;
 }
 

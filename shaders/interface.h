@@ -94,31 +94,31 @@ struct LightData {
     // cascaded light: cascade 0's (CascadeData has every cascade's). Spot: perspective, w the
     // distance along its axis. Point: unused (lit.frag builds each face's projection).
     mat4 toShadow;
-    vec3 position;     // spot, point: camera-relative position
+    vec3 position;  // spot, point: camera-relative position
     // The light's first shadow-map layer, -1 = no shadow test. Point: its +X face's, the six faces
     // +X −X +Y −Y +Z −Z follow; cascaded: cascade 0's, the others follow.
     float layer;
-    vec3 towardLight;  // directional: unit vector toward the light
-    int cascadeCount;  // directional: number of cascades (0 or 1: one map, described by this struct)
-    vec3 spotDirection;  // spot: unit vector the light travels along, its map's axis
-    float spotCosCone;   // spot: cosine of the cone's half-angle
-    vec3 radiance;           // color · intensity
-    float visibilityWeight;  // intensity · mean of color: the light's weight in the visibility AOV
-    float depthBiasWorld;   // constant depth bias, world units
-    float slopeBiasTexels;  // slope-scaled bias, texels per unit of tan(θ)
-    float texelWorldSize;   // a map texel's world size (spot, point: per unit of distance along the axis)
-    float depthPerWorld;    // directional: shadow-map depth per world unit (1 / depth range)
-    float maxSlopeTan;      // cap on tan(θ) in the slope bias
-    int filterCode;         // SHADOWLAB_FILTER_* (lit.frag uses kFilter, the same code)
+    vec3 towardLight;          // directional: unit vector toward the light
+    int cascadeCount;          // directional: number of cascades (0 or 1: one map, described by this struct)
+    vec3 spotDirection;        // spot: unit vector the light travels along, its map's axis
+    float spotCosCone;         // spot: cosine of the cone's half-angle
+    vec3 radiance;             // color · intensity
+    float visibilityWeight;    // intensity · mean of color: the light's weight in the visibility AOV
+    float depthBiasWorld;      // constant depth bias, world units
+    float slopeBiasTexels;     // slope-scaled bias, texels per unit of tan(θ)
+    float texelWorldSize;      // a map texel's world size (spot, point: per unit of distance along the axis)
+    float depthPerWorld;       // directional: shadow-map depth per world unit (1 / depth range)
+    float maxSlopeTan;         // cap on tan(θ) in the slope bias
+    int filterCode;            // SHADOWLAB_FILTER_* (lit.frag uses kFilter, the same code)
     float normalOffsetTexels;  // receivers move this many texels along their normal before the lookup
-    int pcfSize;            // pcf: taps per side; poisson: kernel diameter in texels
-    int kind;               // SHADOWLAB_LIGHT_*
-    float lightSize;        // spot, point: diameter (world units; 0 = a point), for PCSS
+    int pcfSize;               // pcf: taps per side; poisson: kernel diameter in texels
+    int kind;                  // SHADOWLAB_LIGHT_*
+    float lightSize;           // spot, point: diameter (world units; 0 = a point), for PCSS
     // The near and far distance, along its axis, of the perspective map being read: a spot's
     // one map. Point: zero here; lit.frag sets them to the face it reads (pointFaces).
     float mapNear;
     float mapFar;
-    float pointFaceTan;  // point: tan of each cube face's half field of view (> 1: the faces overlap)
+    float pointFaceTan;       // point: tan of each cube face's half field of view (> 1: the faces overlap)
     PointFace pointFaces[6];  // point: face k = 0..5, +X −X +Y −Y +Z −Z (layer + k)
 };
 
@@ -126,8 +126,8 @@ struct LightData {
 // (LightData::layer) plus the cascade's index. The last three replace the light's members of the
 // same names.
 struct CascadeData {
-    mat4 toShadow;         // as LightData::toShadow, for this cascade's map
-    float sliceFar;        // view depth where the cascade's slice ends
+    mat4 toShadow;   // as LightData::toShadow, for this cascade's map
+    float sliceFar;  // view depth where the cascade's slice ends
     float texelWorldSize;
     float depthPerWorld;
     float depthBiasWorld;
@@ -135,12 +135,12 @@ struct CascadeData {
 
 // The lit pass's uniform buffer.
 struct LitUniforms {
-    mat4 viewProj;     // camera-relative world position -> clip (reversed Z)
-    vec3 forward;      // camera forward (view depth = dot(position, forward))
+    mat4 viewProj;  // camera-relative world position -> clip (reversed Z)
+    vec3 forward;   // camera forward (view depth = dot(position, forward))
     float ambient;
-    vec3 background;   // background color
-    int lightCount;    // number of lights (lit.frag uses kLightCount, the same number)
-    float mapSize;     // the shadow maps' side in texels (every layer)
+    vec3 background;         // background color
+    int lightCount;          // number of lights (lit.frag uses kLightCount, the same number)
+    float mapSize;           // the shadow maps' side in texels (every layer)
     float cascadeBlendBand;  // cascade blend band, a fraction of a slice (0 = off)
     float cascadeStart;      // view depth where cascade 0's slice starts
     LightData lights[SHADOWLAB_MAX_LIGHTS];

@@ -32,11 +32,11 @@ constexpr Real kInf = std::numeric_limits<Real>::infinity();
 // for double inputs of similar magnitude, which is what keeps the 1e7 cases exact).
 struct Shape {
     enum Kind { Sphere, Quad, Box } kind = Sphere;
-    V3 c;            // sphere center / quad center
-    Real r = 0;      // sphere radius
-    V3 n, u, v;      // quad normal and edge axes (unit)
+    V3 c;                 // sphere center / quad center
+    Real r = 0;           // sphere radius
+    V3 n, u, v;           // quad normal and edge axes (unit)
     Real hu = 0, hv = 0;  // quad half sizes
-    V3 lo, hi;       // box
+    V3 lo, hi;            // box
 };
 
 // A ray-shape intersection: t of the first crossing with t > tMin, the outward normal there,
@@ -55,9 +55,9 @@ Crossing intersect(const Shape& s, V3 o, V3 d, Real tMin, Real margin) {
     Crossing x;
     if (s.kind == Shape::Sphere) {
         const V3 oc = s.c - o;
-        const Real t0 = dot(oc, d);                // closest approach along the ray
+        const Real t0 = dot(oc, d);  // closest approach along the ray
         const V3 perp = oc - t0 * d;
-        const Real dist = length(perp);            // distance of the center to the line
+        const Real dist = length(perp);               // distance of the center to the line
         const Real h2 = (s.r - dist) * (s.r + dist);  // half chord², cancellation-free
         if (std::fabs(dist - s.r) <= margin) x.knife = true;
         if (h2 < 0) return x;
@@ -101,13 +101,19 @@ Crossing intersect(const Shape& s, V3 o, V3 d, Real tMin, Real margin) {
         const Real lo = comp(s.lo, k), hi = comp(s.hi, k);
         if (dk == 0) {
             if (ok < lo - margin || ok > hi + margin) return x;
-            if (ok < lo || ok > hi) { x.knife = true; return x; }
+            if (ok < lo || ok > hi) {
+                x.knife = true;
+                return x;
+            }
             if (ok - lo <= margin || hi - ok <= margin) x.knife = true;
             continue;
         }
         Real t1 = (lo - ok) / dk, t2 = (hi - ok) / dk;
         if (t1 > t2) std::swap(t1, t2);
-        if (t1 > tNear) { tNear = t1; nearAxis = k; }
+        if (t1 > tNear) {
+            tNear = t1;
+            nearAxis = k;
+        }
         tFar = std::min(tFar, t2);
     }
     if (std::fabs(tFar - tNear) <= margin) x.knife = true;  // grazing an edge or corner
@@ -178,8 +184,7 @@ std::optional<AnalyticFrame> analyticAnswer(const scene::Scene& scene) {
     }
     const scene::Bounds bounds = scene.bounds();
     const Real margin = kKnifeRelative * Real(std::max(bounds.diagonal(), 1e-300)) +
-                        kKnifeCoordinateUlps *
-                            Real(std::max(bounds.maxAbsCoordinate(), glm::length(cam.position)));
+                        kKnifeCoordinateUlps * Real(std::max(bounds.maxAbsCoordinate(), glm::length(cam.position)));
 
     struct DirLight {
         V3 toLight;
@@ -187,8 +192,8 @@ std::optional<AnalyticFrame> analyticAnswer(const scene::Scene& scene) {
     };
     std::vector<DirLight> lights;
     for (const scene::Light& l : scene.lights)
-        lights.push_back({normalize(-1.0L * fromD(l.direction)),
-                          Real(l.intensity) * Real(l.color.r + l.color.g + l.color.b) / 3});
+        lights.push_back(
+            {normalize(-1.0L * fromD(l.direction)), Real(l.intensity) * Real(l.color.r + l.color.g + l.color.b) / 3});
 
     AnalyticFrame f;
     f.width = cam.width;
@@ -212,7 +217,10 @@ std::optional<AnalyticFrame> analyticAnswer(const scene::Scene& scene) {
             std::vector<Crossing> all(shapes.size());
             for (std::size_t k = 0; k < shapes.size(); ++k) {
                 all[k] = intersect(shapes[k], V3{}, d, 0, margin);
-                if (all[k].t < hit.t) { hit = all[k]; best = int(k); }
+                if (all[k].t < hit.t) {
+                    hit = all[k];
+                    best = int(k);
+                }
             }
             for (std::size_t k = 0; k < shapes.size(); ++k) {
                 if (all[k].knife && all[k].t <= hit.t + margin) knife = true;
@@ -255,9 +263,9 @@ std::optional<AnalyticFrame> analyticAnswer(const scene::Scene& scene) {
 
 std::string AnalyticCheck::summary() const {
     std::ostringstream s;
-    s << (passed() ? "matches" : "MISSES") << " the analytic answer: " << objectIdMismatches
-      << " object-id and " << visibilityMismatches << " visibility mismatches of "
-      << visibilityCompared << " judged pixels, " << knifeEdgePixels << " knife-edge pixels skipped";
+    s << (passed() ? "matches" : "MISSES") << " the analytic answer: " << objectIdMismatches << " object-id and "
+      << visibilityMismatches << " visibility mismatches of " << visibilityCompared << " judged pixels, "
+      << knifeEdgePixels << " knife-edge pixels skipped";
     if (nonFinite) s << ", " << nonFinite << " non-finite";
     if (firstX >= 0) s << ", first at (" << firstX << ", " << firstY << ")";
     return s.str();
@@ -274,7 +282,10 @@ AnalyticCheck checkAgainstAnalytic(const scene::Frame& reference, const Analytic
     AnalyticCheck c;
     c.pixels = n;
     for (std::size_t i = 0; i < n; ++i) {
-        if (answer.knifeEdge[i]) { ++c.knifeEdgePixels; continue; }
+        if (answer.knifeEdge[i]) {
+            ++c.knifeEdgePixels;
+            continue;
+        }
         const float id = reference.objectId[i], v = reference.visibility[i];
         bool wrong = false;
         if (!std::isfinite(id) || (answer.lit[i] && !std::isfinite(v))) {

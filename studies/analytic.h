@@ -29,11 +29,11 @@ inline constexpr long double kKnifeNdotL = 1e-9L;
 
 struct AnalyticFrame {
     int width = 0, height = 0;
-    std::vector<int> objectId;        // 0 = background, else object index + 1
+    std::vector<int> objectId;  // 0 = background, else object index + 1
     // Weighted visibility as raytrace/ defines the AOV: Σ w·v / Σ w with w = irradiance·N·L
     // over the lights with N·L > 0; 0 where no light faces the point. Exactly 0 or 1 for one light.
     std::vector<float> visibility;
-    std::vector<float> ndotl;         // max over lights, 0 on background
+    std::vector<float> ndotl;  // max over lights, 0 on background
     // True where the visibility is meaningful (a hit with N·L > kKnifeNdotL for some light).
     std::vector<std::uint8_t> lit;
     // True where the primary hit or a shadow test is within the margin of flipping.

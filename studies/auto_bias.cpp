@@ -200,16 +200,18 @@ std::string BiasSeries::describe() const {
     s += "): ";
     const std::string limit = "both rates <= " + compare::formatPercent(window.threshold);
     if (!window.stiff) {
-        s += std::string(momentKind(kind) ? "parameter window " : "bias window ") + compare::formatShort(window.lo) + " .. " + compare::formatShort(window.hi) + " (" + limit + ", " +
-             std::to_string(window.acceptableSamples) + " sample" + (window.acceptableSamples == 1 ? "" : "s") +
-             "); recommended " + compare::formatShort(recommended);
+        s += std::string(momentKind(kind) ? "parameter window " : "bias window ") + compare::formatShort(window.lo) +
+             " .. " + compare::formatShort(window.hi) + " (" + limit + ", " + std::to_string(window.acceptableSamples) +
+             " sample" + (window.acceptableSamples == 1 ? "" : "s") + "); recommended " +
+             compare::formatShort(recommended);
         if (window.lo != window.hi)
             s += std::string(" (") + (logSpaced && window.lo > 0.0 ? "geometric" : "arithmetic") + " middle)";
         return s + ".";
     }
-    return s + "stiff: no sampled value keeps " + limit + ". At the best compromise, " + compare::formatShort(window.bestBias) +
-           ", " + artifactName(dominant, kind) + " dominates (" + compare::formatPercent(window.bestFalseShadowRate) +
-           " false, " + compare::formatPercent(window.bestMissedShadowRate) + " missed).";
+    return s + "stiff: no sampled value keeps " + limit + ". At the best compromise, " +
+           compare::formatShort(window.bestBias) + ", " + artifactName(dominant, kind) + " dominates (" +
+           compare::formatPercent(window.bestFalseShadowRate) + " false, " +
+           compare::formatPercent(window.bestMissedShadowRate) + " missed).";
 }
 
 const BiasSeries* AutoBias::primary(const std::string& kind) const {
@@ -228,7 +230,8 @@ const RobustResult* AutoBias::robustPick() const {
 
 AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
     if (!std::isfinite(threshold) || threshold < 0.0)
-        throw scene::InputError("automatic bias: threshold must be a finite rate >= 0, got " + compare::formatShort(threshold));
+        throw scene::InputError("automatic bias: threshold must be a finite rate >= 0, got " +
+                                compare::formatShort(threshold));
     AutoBias out;
     out.threshold = threshold;
 
@@ -264,12 +267,14 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
             const auto it = index.find({r.config.backend, contextOf(r.config, kindKey(kind)).dump()});
             if (it == index.end()) continue;
             auto& samples = found[it->second].samples;
-            if (std::none_of(samples.begin(), samples.end(), [&](const compare::BiasSample& b) { return b.bias == *bias; }))
+            if (std::none_of(samples.begin(), samples.end(),
+                             [&](const compare::BiasSample& b) { return b.bias == *bias; }))
                 samples.push_back({*bias, f, m});
         }
         for (BiasSeries& s : found) {
-            std::stable_sort(s.samples.begin(), s.samples.end(),
-                             [](const compare::BiasSample& a, const compare::BiasSample& b) { return a.bias < b.bias; });
+            std::stable_sort(
+                s.samples.begin(), s.samples.end(),
+                [](const compare::BiasSample& a, const compare::BiasSample& b) { return a.bias < b.bias; });
             s.window = compare::findBiasWindow(s.samples, threshold);
             std::vector<double> biases;
             for (const auto& b : s.samples) biases.push_back(b.bias);
@@ -285,12 +290,13 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
     }
 
     for (const SweepRow& r : rows) {
-        if (r.config.backend != scene::Backend::Raytrace || r.config.overrides.rayBias != std::optional<std::string>("robust") ||
-            !r.error.empty())
+        if (r.config.backend != scene::Backend::Raytrace ||
+            r.config.overrides.rayBias != std::optional<std::string>("robust") || !r.error.empty())
             continue;
         const double f = r.rate("false_shadow_rate"), m = r.rate("missed_shadow_rate");
         if (!std::isfinite(f) || !std::isfinite(m)) continue;
-        out.robust.push_back({r.config.overrides.precision.value_or(""), f, m, r.frameMs, f <= threshold && m <= threshold});
+        out.robust.push_back(
+            {r.config.overrides.precision.value_or(""), f, m, r.frameMs, f <= threshold && m <= threshold});
     }
 
     // One sentence per primary series; others (the same kind at other settings) are mentioned.
@@ -330,20 +336,22 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
         std::string why;
         if (raster->window.stiff) {
             why = "On the probe slice the shadow map is stiff for this scene: no " +
-                  std::string(other ? "depth or slope bias" : raster->name()) + " keeps both rates <= " +
-                  compare::formatPercent(threshold) + ". Its best compromise is " +
+                  std::string(other ? "depth or slope bias" : raster->name()) +
+                  " keeps both rates <= " + compare::formatPercent(threshold) + ". Its best compromise is " +
                   raster->name() + " " + compare::formatShort(raster->recommended) + ", where " +
                   artifactName(raster->dominant, raster->kind) + " dominates.";
         } else if (other) {
-            why = "On the probe slice the " + raster->name() + " is the pick (" + compare::formatShort(raster->recommended) +
-                  " " + raster->unit() + "): ";
-            why += other->window.stiff ? "the " + other->name() + " has no window."
-                                       : "its window holds " + std::to_string(raster->window.acceptableSamples) +
-                                             " sampled values against " + std::to_string(other->window.acceptableSamples) +
-                                             " for the " + other->name() + ".";
+            why = "On the probe slice the " + raster->name() + " is the pick (" +
+                  compare::formatShort(raster->recommended) + " " + raster->unit() + "): ";
+            why += other->window.stiff
+                       ? "the " + other->name() + " has no window."
+                       : "its window holds " + std::to_string(raster->window.acceptableSamples) +
+                             " sampled values against " + std::to_string(other->window.acceptableSamples) +
+                             " for the " + other->name() + ".";
             why += " Each was measured with the other held fixed.";
         } else {
-            why = "On the probe slice: " + raster->name() + " " + compare::formatShort(raster->recommended) + " " + raster->unit() + ".";
+            why = "On the probe slice: " + raster->name() + " " + compare::formatShort(raster->recommended) + " " +
+                  raster->unit() + ".";
         }
         out.notes.push_back(why);
     }
@@ -357,11 +365,11 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
         if (out.shadowBlock.value("filter", std::string()) == filter) {
             out.shadowBlock[m.key] = p->recommended;
         } else {
-            out.notes.push_back(std::string("The ") + m.name + " window was measured with filter " +
-                                (filter.empty() ? std::string("(scene default)") : filter) +
-                                "; the block's shadow map uses " + out.shadowBlock.value("filter", std::string("its default")) +
-                                ", so it does not carry \"" + m.key + "\": " + m.key + " " + compare::formatShort(p->recommended) +
-                                " goes with that filter.");
+            out.notes.push_back(
+                std::string("The ") + m.name + " window was measured with filter " +
+                (filter.empty() ? std::string("(scene default)") : filter) + "; the block's shadow map uses " +
+                out.shadowBlock.value("filter", std::string("its default")) + ", so it does not carry \"" + m.key +
+                "\": " + m.key + " " + compare::formatShort(p->recommended) + " goes with that filter.");
         }
     }
 
@@ -372,20 +380,24 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
         out.shadowBlock["ray_bias"] = "robust";
         if (!pick->precision.empty()) out.shadowBlock["precision"] = pick->precision;
         out.notes.push_back("Robust ray offsets" + precisionText(pick->precision) + " keep both rates <= " +
-                            compare::formatPercent(threshold) + " (" + compare::formatPercent(pick->falseShadowRate) + " false, " +
-                            compare::formatPercent(pick->missedShadowRate) + " missed) with no bias to tune: the ray tracer "
+                            compare::formatPercent(threshold) + " (" + compare::formatPercent(pick->falseShadowRate) +
+                            " false, " + compare::formatPercent(pick->missedShadowRate) +
+                            " missed) with no bias to tune: the ray tracer "
                             "should use \"ray_bias\": \"robust\".");
     } else {
         for (const RobustResult& r : out.robust)
-            out.notes.push_back("Robust ray offsets" + precisionText(r.precision) + " do not pass: " +
-                                compare::formatPercent(r.falseShadowRate) + " false, " + compare::formatPercent(r.missedShadowRate) + " missed.");
+            out.notes.push_back("Robust ray offsets" + precisionText(r.precision) +
+                                " do not pass: " + compare::formatPercent(r.falseShadowRate) + " false, " +
+                                compare::formatPercent(r.missedShadowRate) + " missed.");
         if (ray) {
             for (const auto& [key, value] : ray->context.items()) out.shadowBlock[key] = value;
             out.shadowBlock["ray_bias"] = ray->recommended;
             if (ray->window.stiff)
-                out.notes.push_back("The ray tracer is stiff for this scene with a constant ray bias; the block uses the "
-                                    "best compromise, " + compare::formatShort(ray->recommended) + " world units, where " +
-                                    artifactName(ray->dominant, "ray") + " dominates.");
+                out.notes.push_back(
+                    "The ray tracer is stiff for this scene with a constant ray bias; the block uses the "
+                    "best compromise, " +
+                    compare::formatShort(ray->recommended) + " world units, where " +
+                    artifactName(ray->dominant, "ray") + " dominates.");
         } else if (!out.robust.empty()) {
             const auto best = std::min_element(out.robust.begin(), out.robust.end(), [](const auto& a, const auto& b) {
                 return worstOf(a.falseShadowRate, a.missedShadowRate) < worstOf(b.falseShadowRate, b.missedShadowRate);

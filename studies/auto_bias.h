@@ -11,8 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "compare/bias_window.h"
-#include "studies/sweep.h"
 #include "compare/thresholds.h"
+#include "studies/sweep.h"
 
 namespace shadowlab::studies {
 
@@ -54,8 +54,8 @@ struct RobustResult {
 
 struct AutoBias {
     double threshold = compare::kBiasWindowMaxRate;
-    std::vector<BiasSeries> series;     // every series found, kinds in seriesKinds() order
-    std::vector<RobustResult> robust;   // every robust-offset row that rendered
+    std::vector<BiasSeries> series;    // every series found, kinds in seriesKinds() order
+    std::vector<RobustResult> robust;  // every robust-offset row that rendered
     // A valid scene-file "shadow" block (scene/loader.cpp readShadow accepts every key it holds):
     // the raster's chosen bias kind at its recommended value with the other kind at 0 (each was
     // measured alone), the shadow-map size and filter the series ran at, and the ray tracer's

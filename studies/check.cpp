@@ -7,11 +7,11 @@
 #include <fstream>
 #include <set>
 
-#include "studies/sweep.h"
 #include "scene/backend.h"
 #include "scene/error.h"
 #include "scene/loader.h"
 #include "scene/settings.h"
+#include "studies/sweep.h"
 
 namespace shadowlab::studies {
 
@@ -34,7 +34,8 @@ Json parseFile(const fs::path& file) {
     }
 }
 
-void checkKeys(const fs::path& file, const Json& node, const JsonPath& path, std::initializer_list<const char*> allowed) {
+void checkKeys(const fs::path& file, const Json& node, const JsonPath& path,
+               std::initializer_list<const char*> allowed) {
     if (!node.is_object()) throw SceneError(file, path, "expected an object, got " + node.dump().substr(0, 40));
     for (const auto& item : node.items()) {
         bool ok = false;
@@ -60,8 +61,9 @@ std::pair<int, int> parseResolution(const fs::path& file, const Json& node, cons
     if (!node.is_string() || std::sscanf(node.get<std::string>().c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 ||
         x != 'x' || w < 1 || h < 1 || w > scene::kMaxResolution || h > scene::kMaxResolution ||
         static_cast<long long>(w) * h > scene::kMaxPixels)
-        throw SceneError(file, path, "expected \"WxH\" with sides in 1.." + std::to_string(scene::kMaxResolution) +
-                                         ", got " + node.dump().substr(0, 40));
+        throw SceneError(file, path,
+                         "expected \"WxH\" with sides in 1.." + std::to_string(scene::kMaxResolution) + ", got " +
+                             node.dump().substr(0, 40));
     return {w, h};
 }
 
@@ -124,14 +126,16 @@ CheckSuite loadSuite(const fs::path& file) {
         const JsonPath p = root / "tolerance";
         checkKeys(file, t, p, {"rate", "mean_abs_diff", "iou"});
         if (t.contains("rate")) suite.tolerance.rate = nonNegative(file, t["rate"], p / "rate");
-        if (t.contains("mean_abs_diff")) suite.tolerance.meanAbsDiff = nonNegative(file, t["mean_abs_diff"], p / "mean_abs_diff");
+        if (t.contains("mean_abs_diff"))
+            suite.tolerance.meanAbsDiff = nonNegative(file, t["mean_abs_diff"], p / "mean_abs_diff");
         if (t.contains("iou")) suite.tolerance.iou = nonNegative(file, t["iou"], p / "iou");
     }
     scene::Budgets suiteBudgets;
     if (doc.contains("budgets")) suiteBudgets = scene::readBudgets(file, doc["budgets"], root / "budgets");
     if (!doc.contains("cases")) throw SceneError(file, root / "cases", "is required");
     const Json& cases = doc["cases"];
-    if (!cases.is_array() || cases.empty()) throw SceneError(file, root / "cases", "expected a non-empty array of cases");
+    if (!cases.is_array() || cases.empty())
+        throw SceneError(file, root / "cases", "expected a non-empty array of cases");
     std::set<std::string> names;
     for (std::size_t i = 0; i < cases.size(); ++i) {
         const Json& c = cases[i];
@@ -141,8 +145,10 @@ CheckSuite loadSuite(const fs::path& file) {
         if (!c.contains("name")) throw SceneError(file, p / "name", "is required");
         k.name = stringAt(file, c["name"], p / "name");
         if (!validName(k.name))
-            throw SceneError(file, p / "name", "'" + k.name + "': use letters, digits, '.', '_' and '-' (it names files)");
-        if (!names.insert(k.name).second) throw SceneError(file, p / "name", "'" + k.name + "' names an earlier case too");
+            throw SceneError(file, p / "name",
+                             "'" + k.name + "': use letters, digits, '.', '_' and '-' (it names files)");
+        if (!names.insert(k.name).second)
+            throw SceneError(file, p / "name", "'" + k.name + "' names an earlier case too");
         if (!c.contains("scene")) throw SceneError(file, p / "scene", "is required");
         const std::string sceneName = stringAt(file, c["scene"], p / "scene");
         // A path beside the suite, or a shipped scene's name.
@@ -164,9 +170,12 @@ CheckSuite loadSuite(const fs::path& file) {
         }
         if (c.contains("device")) k.device = stringAt(file, c["device"], p / "device");
         k.scene = scene::loadScene(k.sceneFile);
-        const Json* res = c.contains("resolution") ? &c["resolution"] : defaultResolution ? &*defaultResolution : nullptr;
+        const Json* res = c.contains("resolution") ? &c["resolution"]
+                          : defaultResolution      ? &*defaultResolution
+                                                   : nullptr;
         if (res) {
-            const auto [w, h] = parseResolution(file, *res, c.contains("resolution") ? p / "resolution" : root / "resolution");
+            const auto [w, h] =
+                parseResolution(file, *res, c.contains("resolution") ? p / "resolution" : root / "resolution");
             k.scene.camera.width = w;
             k.scene.camera.height = h;
         }
@@ -195,7 +204,7 @@ CheckSuite loadSuite(const fs::path& file) {
 
 const std::vector<TrackedMetric>& trackedMetrics() {
     static const std::vector<TrackedMetric> kMetrics = {
-        {"mismatch_rate", false},      {"false_shadow_rate", false},         {"missed_shadow_rate", false},
+        {"mismatch_rate", false},         {"false_shadow_rate", false},         {"missed_shadow_rate", false},
         {"self_shadow_acne_rate", false}, {"mean_abs_visibility_error", false}, {"shadow_iou", true},
     };
     return kMetrics;
@@ -228,9 +237,11 @@ Baseline loadBaseline(const fs::path& file) {
         for (const auto& [metric, value] : entry.items()) {
             bool known = false;
             for (const TrackedMetric& t : trackedMetrics()) known = known || metric == t.name;
-            if (!known) throw SceneError(file, p / metric, "not a tracked metric (mismatch_rate, false_shadow_rate, "
-                                                           "missed_shadow_rate, self_shadow_acne_rate, "
-                                                           "mean_abs_visibility_error, shadow_iou)");
+            if (!known)
+                throw SceneError(file, p / metric,
+                                 "not a tracked metric (mismatch_rate, false_shadow_rate, "
+                                 "missed_shadow_rate, self_shadow_acne_rate, "
+                                 "mean_abs_visibility_error, shadow_iou)");
             if (!value.is_number() || !std::isfinite(value.get<double>()) || value.get<double>() < 0.0 ||
                 value.get<double>() > 1.0)
                 throw SceneError(file, p / metric, "expected a number in 0..1, got " + value.dump().substr(0, 40));
@@ -258,7 +269,8 @@ CheckSuite shardSuite(const CheckSuite& suite, const Shard& shard) {
     return s;
 }
 
-std::vector<MetricDrift> compareWithBaseline(const compare::Metrics& m, const BaselineEntry& entry, const CheckTolerance& t) {
+std::vector<MetricDrift> compareWithBaseline(const compare::Metrics& m, const BaselineEntry& entry,
+                                             const CheckTolerance& t) {
     const BaselineEntry now = baselineEntry(m);
     std::vector<MetricDrift> out;
     for (const TrackedMetric& tm : trackedMetrics()) {
@@ -271,7 +283,7 @@ std::vector<MetricDrift> compareWithBaseline(const compare::Metrics& m, const Ba
         d.current = c->second;
         d.tolerance = std::string(tm.name) == "shadow_iou"                  ? t.iou
                       : std::string(tm.name) == "mean_abs_visibility_error" ? t.meanAbsDiff
-                                                                              : t.rate;
+                                                                            : t.rate;
         const double worse = tm.higherIsBetter ? d.baseline - d.current : d.current - d.baseline;
         d.regressed = worse > d.tolerance;
         d.improved = -worse > d.tolerance;

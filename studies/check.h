@@ -15,9 +15,9 @@
 
 #include "compare/compare.h"
 #include "compare/gates.h"
-#include "studies/shard.h"
 #include "scene/budgets.h"
 #include "scene/scene.h"
+#include "studies/shard.h"
 
 namespace shadowlab::studies {
 
@@ -31,14 +31,14 @@ struct CheckTolerance {
 };
 
 struct CheckCase {
-    std::string name;          // the case's key: unique in the suite, [A-Za-z0-9._-]
+    std::string name;  // the case's key: unique in the suite, [A-Za-z0-9._-]
     std::filesystem::path sceneFile;
     scene::Backend backend = scene::Backend::Raster;  // Raster or Raytrace; Raster when the suite names none
-    scene::Scene scene;        // loaded, resolution applied, case settings merged into its "shadow"
-    std::string resolution;    // "WxH"
-    std::string device;        // raster: Vulkan device ("" = the default)
-    scene::Budgets budgets;    // scene's, then suite's, then case's
-    nlohmann::json settings;   // the case's "settings" block as written (reports)
+    scene::Scene scene;       // loaded, resolution applied, case settings merged into its "shadow"
+    std::string resolution;   // "WxH"
+    std::string device;       // raster: Vulkan device ("" = the default)
+    scene::Budgets budgets;   // scene's, then suite's, then case's
+    nlohmann::json settings;  // the case's "settings" block as written (reports)
 };
 
 struct CheckSuite {
@@ -83,16 +83,16 @@ const char* toString(CaseVerdict v);
 struct CaseResult {
     std::string name;
     CaseVerdict verdict = CaseVerdict::Passed;
-    std::string error;                    // Error: what went wrong
-    std::vector<std::string> failures;    // Failed: one line per broken budget or regression
+    std::string error;                  // Error: what went wrong
+    std::vector<std::string> failures;  // Failed: one line per broken budget or regression
     std::optional<compare::Metrics> metrics;
     std::vector<compare::BudgetCheck> budgets;
     bool hasBaseline = false;
     std::vector<MetricDrift> drift;
-    double seconds = 0.0;                 // rendering and comparing (the reference excluded)
-    std::vector<float> diffRgb;           // the difference image (kept for failing cases only)
+    double seconds = 0.0;        // rendering and comparing (the reference excluded)
+    std::vector<float> diffRgb;  // the difference image (kept for failing cases only)
     int width = 0, height = 0;
-    nlohmann::json attributes;            // the method frame's settings as applied
+    nlohmann::json attributes;  // the method frame's settings as applied
 };
 
 // Renders every case in order, calling `progress` after each; a case that fails to render is an

@@ -49,8 +49,10 @@ std::string escapeXml(const std::string& text) {
             case '\'': out += "&apos;"; break;
             default:
                 // XML 1.0 allows no control characters but tab, newline and carriage return.
-                if (static_cast<unsigned char>(c) < 0x20 && c != '\t' && c != '\n' && c != '\r') out += '?';
-                else out += c;
+                if (static_cast<unsigned char>(c) < 0x20 && c != '\t' && c != '\n' && c != '\r')
+                    out += '?';
+                else
+                    out += c;
         }
     }
     return out;
@@ -71,32 +73,40 @@ CasePart casePart(const CheckSuite& suite, const CheckCase& c, const CaseResult&
         std::string text;
         for (const std::string& f : r.failures) text += f + "\n";
         x << "      <failure message=\"" << escapeXml(r.failures.front())
-          << (r.failures.size() > 1 ? " (+" + std::to_string(r.failures.size() - 1) + " more)" : "")
-          << "\" type=\"" << (r.failures.front().rfind("budget", 0) == 0 ? "budget" : "regression") << "\">"
-          << escapeXml(text) << "</failure>\n";
+          << (r.failures.size() > 1 ? " (+" + std::to_string(r.failures.size() - 1) + " more)" : "") << "\" type=\""
+          << (r.failures.front().rfind("budget", 0) == 0 ? "budget" : "regression") << "\">" << escapeXml(text)
+          << "</failure>\n";
     }
     if (r.metrics)
-        x << "      <system-out>" << escapeXml(c.sceneFile.filename().string() + " " + scene::toString(c.backend) + " " +
-                                               c.resolution + ": " + compare::summaryLine(*r.metrics))
+        x << "      <system-out>"
+          << escapeXml(c.sceneFile.filename().string() + " " + scene::toString(c.backend) + " " + c.resolution + ": " +
+                       compare::summaryLine(*r.metrics))
           << "</system-out>\n";
     x << "    </testcase>\n";
     p.junit = x.str();
 
     std::ostringstream m;
-    m << "| " << cell(r.name) << " | " << cell(c.sceneFile.stem().string()) << " | " << scene::toString(c.backend) << " | "
-      << (r.verdict == CaseVerdict::Passed ? "passed" : r.verdict == CaseVerdict::Failed ? "**FAILED**" : "**ERROR**")
+    m << "| " << cell(r.name) << " | " << cell(c.sceneFile.stem().string()) << " | " << scene::toString(c.backend)
+      << " | "
+      << (r.verdict == CaseVerdict::Passed   ? "passed"
+          : r.verdict == CaseVerdict::Failed ? "**FAILED**"
+                                             : "**ERROR**")
       << " | ";
     if (r.metrics) {
         const compare::Metrics& v = *r.metrics;
         m << compare::formatPercent(v.mismatchRate) << " | " << compare::formatPercent(v.falseShadowRate) << " | "
           << compare::formatPercent(v.missedShadowRate) << " | "
-          << (v.hasBlockerIds ? compare::formatPercent(v.selfShadowAcneRate) : "n/a") << " | " << compare::formatFixed(v.shadowIoU, 3)
-          << " | " << compare::formatFixed(v.meanAbsVisibilityError, 4) << " | ";
+          << (v.hasBlockerIds ? compare::formatPercent(v.selfShadowAcneRate) : "n/a") << " | "
+          << compare::formatFixed(v.shadowIoU, 3) << " | " << compare::formatFixed(v.meanAbsVisibilityError, 4)
+          << " | ";
         std::string drift;
         for (const MetricDrift& d : r.drift)
-            if (d.regressed || d.improved) drift += (drift.empty() ? "" : ", ") + d.metric + (d.regressed ? " worse" : " better");
-        m << (!r.hasBaseline ? "no baseline" : drift.empty() ? "within tolerance" : drift) << " | "
-          << compare::formatDuration(1000.0 * r.seconds) << " |\n";
+            if (d.regressed || d.improved)
+                drift += (drift.empty() ? "" : ", ") + d.metric + (d.regressed ? " worse" : " better");
+        m << (!r.hasBaseline  ? "no baseline"
+              : drift.empty() ? "within tolerance"
+                              : drift)
+          << " | " << compare::formatDuration(1000.0 * r.seconds) << " |\n";
     } else {
         m << "| | | | | | " << cell(r.error.substr(0, 120)) << " | |\n";
     }
@@ -104,7 +114,8 @@ CasePart casePart(const CheckSuite& suite, const CheckCase& c, const CaseResult&
 
     std::ostringstream w;
     if (r.verdict == CaseVerdict::Error) w << "- `" << r.name << "`: error: " << cell(r.error) << "\n";
-    for (const std::string& f : r.failures) w << "- `" << r.name << "`: " << cell(f) << " (cases/" << r.name << "-diff.png)\n";
+    for (const std::string& f : r.failures)
+        w << "- `" << r.name << "`: " << cell(f) << " (cases/" << r.name << "-diff.png)\n";
     p.why = w.str();
     return p;
 }
@@ -124,8 +135,8 @@ std::string junitXml(const std::string& suiteName, const std::vector<CasePart>& 
     std::ostringstream x;
     x << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
     x << "<testsuites name=\"shadowlab check\" " << counts << " time=\"" << seconds(total) << "\">\n";
-    x << "  <testsuite name=\"" << escapeXml(suiteName) << "\" " << counts << " skipped=\"0\" time=\""
-      << seconds(total) << "\">\n";
+    x << "  <testsuite name=\"" << escapeXml(suiteName) << "\" " << counts << " skipped=\"0\" time=\"" << seconds(total)
+      << "\">\n";
     for (const CasePart& p : parts) x << p.junit;
     x << "  </testsuite>\n</testsuites>\n";
     return x.str();
@@ -140,8 +151,8 @@ std::string markdownSummary(const std::string& suiteName, const std::vector<Case
     const std::size_t failed = count(parts, CaseVerdict::Failed), errors = count(parts, CaseVerdict::Error);
     m << "### shadowlab check: " << suiteName << "\n\n";
     m << (failed + errors == 0 ? "All " + std::to_string(parts.size()) + " cases passed."
-                               : std::to_string(parts.size() - failed - errors) + " passed, " +
-                                     std::to_string(failed) + " failed, " + std::to_string(errors) + " errors.")
+                               : std::to_string(parts.size() - failed - errors) + " passed, " + std::to_string(failed) +
+                                     " failed, " + std::to_string(errors) + " errors.")
       << (baselineUpdated ? " The baseline was written from this run." : "") << "\n\n";
     m << "| case | scene | backend | verdict | mismatch | false shadow | missed | self acne | IoU | mean \\|ΔV\\| | "
          "vs baseline | time |\n";
@@ -205,24 +216,33 @@ std::string htmlSummary(const std::string& suiteName, const std::vector<CasePart
       << " td.passed{color:#1b5e20} td.failed,td.error{color:#a51111;font-weight:600}"
          " .diffs{grid-template-columns:repeat(auto-fill,minmax(300px,1fr))} .why li{margin-bottom:4px}"
          " .scroll{overflow-x:auto} table.cases td{white-space:nowrap} table.cases :is(td,th){padding:6px 8px}"
-         " table.cases :is(td,th):is(:nth-child(-n+4),:nth-child(11)){text-align:left}</style>\n</head>\n<body>\n<main>\n";
+         " table.cases "
+         ":is(td,th):is(:nth-child(-n+4),:nth-child(11)){text-align:left}</style>\n</head>\n<body>\n<main>\n";
     h << "<header><h1>shadowlab check: " << compare::escapeHtml(suiteName) << "</h1><div class=\"sub\">"
       << (failed + errors == 0 ? "All " + std::to_string(parts.size()) + " cases passed."
-                               : std::to_string(parts.size() - failed - errors) + " passed, " +
-                                     std::to_string(failed) + " failed, " + std::to_string(errors) + " errors.")
+                               : std::to_string(parts.size() - failed - errors) + " passed, " + std::to_string(failed) +
+                                     " failed, " + std::to_string(errors) + " errors.")
       << (baselineUpdated ? " The baseline was written from this run." : "")
-      << " JUnit: <a href=\"junit.xml\">junit.xml</a>; Markdown: <a href=\"summary.md\">summary.md</a>.</div></header>\n";
-    h << "<h2>Cases</h2>\n<div class=\"scroll\"><table class=\"cases\"><thead><tr><th>case</th><th>scene</th><th>backend</th>"
+      << " JUnit: <a href=\"junit.xml\">junit.xml</a>; Markdown: <a "
+         "href=\"summary.md\">summary.md</a>.</div></header>\n";
+    h << "<h2>Cases</h2>\n<div class=\"scroll\"><table "
+         "class=\"cases\"><thead><tr><th>case</th><th>scene</th><th>backend</th>"
          "<th>verdict</th><th>mismatch</th><th>false shadow</th><th>missed</th><th>self acne</th><th>IoU</th>"
          "<th>mean |ΔV|</th><th>vs baseline</th><th>time</th></tr></thead><tbody>\n";
     for (const CasePart& p : parts) {
         const std::vector<std::string> cells = rowCells(p.row);
-        const char* verdict = p.verdict == CaseVerdict::Passed ? "passed" : p.verdict == CaseVerdict::Failed ? "failed" : "error";
+        const char* verdict = p.verdict == CaseVerdict::Passed   ? "passed"
+                              : p.verdict == CaseVerdict::Failed ? "failed"
+                                                                 : "error";
         h << "<tr>";
         for (std::size_t i = 0; i < cells.size(); ++i) {
-            if (i == 0) h << "<td><a href=\"cases/" << compare::escapeHtml(p.name) << ".json\">" << compare::escapeHtml(p.name) << "</a></td>";
-            else if (i == 3) h << "<td class=\"" << verdict << "\">" << verdict << "</td>";
-            else h << "<td>" << inlineHtml(cells[i]) << "</td>";
+            if (i == 0)
+                h << "<td><a href=\"cases/" << compare::escapeHtml(p.name) << ".json\">" << compare::escapeHtml(p.name)
+                  << "</a></td>";
+            else if (i == 3)
+                h << "<td class=\"" << verdict << "\">" << verdict << "</td>";
+            else
+                h << "<td>" << inlineHtml(cells[i]) << "</td>";
         }
         h << "</tr>\n";
     }
@@ -248,8 +268,9 @@ std::string htmlSummary(const std::string& suiteName, const std::vector<CasePart
         }
         any = true;
         const std::string png = "cases/" + p.name + "-diff.png";
-        h << "<figure><figcaption>" << compare::escapeHtml(p.name) << "</figcaption><a href=\"" << compare::escapeHtml(png)
-          << "\"><img src=\"" << compare::escapeHtml(png) << "\" alt=\"" << compare::escapeHtml(p.name) << " difference\" class=\"upscale\"></a></figure>\n";
+        h << "<figure><figcaption>" << compare::escapeHtml(p.name) << "</figcaption><a href=\""
+          << compare::escapeHtml(png) << "\"><img src=\"" << compare::escapeHtml(png) << "\" alt=\""
+          << compare::escapeHtml(p.name) << " difference\" class=\"upscale\"></a></figure>\n";
     }
     if (any) h << "</div>\n";
     h << "</main>\n</body>\n</html>\n";
@@ -261,18 +282,23 @@ std::string markdownSummary(const CheckSuite& suite, const std::vector<CaseResul
 }
 
 nlohmann::json toJson(const CasePart& p) {
-    return {{"name", p.name}, {"verdict", toString(p.verdict)}, {"seconds", p.seconds},
-            {"junit", p.junit}, {"row", p.row}, {"why", p.why}};
+    return {{"name", p.name},       {"verdict", toString(p.verdict)},
+            {"seconds", p.seconds}, {"junit", p.junit},
+            {"row", p.row},         {"why", p.why}};
 }
 
 CasePart casePartFromJson(const nlohmann::json& j) {
     CasePart p;
     p.name = j.at("name").get<std::string>();
     const std::string v = j.at("verdict").get<std::string>();
-    if (v == "passed") p.verdict = CaseVerdict::Passed;
-    else if (v == "failed") p.verdict = CaseVerdict::Failed;
-    else if (v == "error") p.verdict = CaseVerdict::Error;
-    else throw std::runtime_error("verdict '" + v + "' is not passed, failed or error");
+    if (v == "passed")
+        p.verdict = CaseVerdict::Passed;
+    else if (v == "failed")
+        p.verdict = CaseVerdict::Failed;
+    else if (v == "error")
+        p.verdict = CaseVerdict::Error;
+    else
+        throw std::runtime_error("verdict '" + v + "' is not passed, failed or error");
     p.seconds = j.at("seconds").get<double>();
     p.junit = j.at("junit").get<std::string>();
     p.row = j.at("row").get<std::string>();
@@ -283,8 +309,12 @@ CasePart casePartFromJson(const nlohmann::json& j) {
 nlohmann::json caseJson(const CheckCase& c, const CaseResult& r) {
     nlohmann::json drift = nlohmann::json::array();
     for (const MetricDrift& d : r.drift)
-        drift.push_back({{"metric", d.metric}, {"baseline", d.baseline}, {"current", d.current},
-                         {"tolerance", d.tolerance}, {"regressed", d.regressed}, {"improved", d.improved}});
+        drift.push_back({{"metric", d.metric},
+                         {"baseline", d.baseline},
+                         {"current", d.current},
+                         {"tolerance", d.tolerance},
+                         {"regressed", d.regressed},
+                         {"improved", d.improved}});
     nlohmann::json j = {{"name", c.name},
                         {"scene", c.sceneFile.string()},
                         {"backend", scene::toString(c.backend)},
@@ -415,14 +445,16 @@ MergedCheck readCheckShards(const std::vector<fs::path>& inputs) {
             } else {
                 const CheckShardManifest& a = merged.identity;
                 std::string diff;
-                if (m.version != a.version) diff = "program version " + m.version + " vs " + a.version;
+                if (m.version != a.version)
+                    diff = "program version " + m.version + " vs " + a.version;
                 else if (m.suiteHash != a.suiteHash || m.suiteCases != a.suiteCases)
                     diff = "suite hash " + m.suiteHash + " (" + m.suite + ") vs " + a.suiteHash + " (" + a.suite +
                            ") (another suite file)";
                 else if (m.baselineHash != a.baselineHash)
                     diff = "baseline hash " + m.baselineHash + " vs " + a.baselineHash + " (another baseline)";
                 else if (m.shard.count != a.shard.count)
-                    diff = "split into " + std::to_string(m.shard.count) + " shards vs " + std::to_string(a.shard.count);
+                    diff =
+                        "split into " + std::to_string(m.shard.count) + " shards vs " + std::to_string(a.shard.count);
                 if (!diff.empty())
                     throw scene::InputError(d.string() + ": a shard of another check than " + firstDir.string() + " (" +
                                             diff + "); merge the shards of one run");
@@ -456,8 +488,8 @@ MergedCheck readCheckShards(const std::vector<fs::path>& inputs) {
         for (std::size_t i = 0; i < id.suiteCases.size(); ++i)
             if (of[i] == k) expected.push_back(id.suiteCases[i]);
         if (m.cases != expected)
-            throw scene::InputError((dir / "shard.json").string() + ": cases: not the cases shard " + std::to_string(k) +
-                                    "/" + std::to_string(id.shard.count) + " of this suite holds");
+            throw scene::InputError((dir / "shard.json").string() + ": cases: not the cases shard " +
+                                    std::to_string(k) + "/" + std::to_string(id.shard.count) + " of this suite holds");
         const fs::path file = dir / "shard-parts.json";
         const nlohmann::json j = readJson(file, "check shard's results");
         if (!j.is_array() || j.size() != expected.size())

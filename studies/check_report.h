@@ -50,7 +50,7 @@ std::string escapeXml(const std::string& text);
 // a sweep shard's manifest.
 struct CheckShardManifest {
     std::string version;
-    std::string suite;      // the suite file, as given on the machine that wrote it (messages only)
+    std::string suite;  // the suite file, as given on the machine that wrote it (messages only)
     std::string suiteName;
     std::string suiteHash;
     std::string baselineHash;  // "none": no regression check

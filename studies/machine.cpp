@@ -1,10 +1,10 @@
 // studies/machine.cpp: reads the host name, CPU model, usable cores and load average.
 #include "studies/machine.h"
 
-#include <cstdlib>
-#include <fstream>
 #include <sched.h>
 #include <unistd.h>
+#include <cstdlib>
+#include <fstream>
 
 namespace shadowlab::studies {
 
@@ -36,8 +36,9 @@ std::string MachineInfo::id() const { return host + "|" + cpu + "|" + std::to_st
 
 std::string MachineInfo::describe() const {
     std::string s = (host.empty() ? std::string("unknown host") : host) + " (" + cpu + ", ";
-    s += onlineCores > 0 && onlineCores != cores ? std::to_string(cores) + " of " + std::to_string(onlineCores) + " cores"
-                                                 : std::to_string(cores) + " cores";
+    s += onlineCores > 0 && onlineCores != cores
+             ? std::to_string(cores) + " of " + std::to_string(onlineCores) + " cores"
+             : std::to_string(cores) + " cores";
     return s + ")";
 }
 

@@ -9,11 +9,11 @@
 namespace shadowlab::studies {
 
 struct MachineInfo {
-    std::string host;       // gethostname()
-    std::string cpu;        // /proc/cpuinfo "model name" (or the closest field the CPU has)
-    int cores = 0;          // CPUs this process may run on (its affinity mask: a Slurm allocation)
-    int onlineCores = 0;    // CPUs the machine has online
-    double load = 0.0;      // 1-minute load average when the row finished
+    std::string host;     // gethostname()
+    std::string cpu;      // /proc/cpuinfo "model name" (or the closest field the CPU has)
+    int cores = 0;        // CPUs this process may run on (its affinity mask: a Slurm allocation)
+    int onlineCores = 0;  // CPUs the machine has online
+    double load = 0.0;    // 1-minute load average when the row finished
 
     // What makes two rows' times comparable: host, CPU model and usable cores (not the load).
     std::string id() const;

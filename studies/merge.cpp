@@ -9,11 +9,11 @@
 #include <set>
 #include <sstream>
 
-#include "studies/auto_bias.h"
-#include "studies/machine.h"
 #include "scene/append_line.h"
 #include "scene/error.h"
 #include "scene/frame_io.h"
+#include "studies/auto_bias.h"
+#include "studies/machine.h"
 
 namespace shadowlab::studies {
 
@@ -124,8 +124,13 @@ Json comparable(const SweepRow& r) {
 // A bias verdict as compared: the window or "stiff", the recommended value and the dominant artifact.
 Json verdictOf(const BiasSeries& s) {
     auto num = [](double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); };  // NaN ≠ NaN
-    return {{"kind", s.kind}, {"backend", scene::toString(s.backend)}, {"context", s.context}, {"stiff", s.window.stiff},
-            {"lo", num(s.window.lo)}, {"hi", num(s.window.hi)}, {"recommended", num(s.recommended)},
+    return {{"kind", s.kind},
+            {"backend", scene::toString(s.backend)},
+            {"context", s.context},
+            {"stiff", s.window.stiff},
+            {"lo", num(s.window.lo)},
+            {"hi", num(s.window.hi)},
+            {"recommended", num(s.recommended)},
             {"dominant", s.dominant}};
 }
 
@@ -193,13 +198,14 @@ MergedSweep readShards(const std::vector<fs::path>& inputs) {
         const std::string name = std::to_string(k) + "/" + std::to_string(m.shardCount);
         if (!present.count(k)) {
             problems.push_back("shard " + name + " is missing (no " + shardFolderName({k, m.shardCount}) +
-                               " among the inputs; " + std::to_string(total) + " rows): render it with `shadowlab sweep " +
-                               scene + " -o " + quoteArg(base.string()) + " --shard " + name +
-                               "` and the same grid options");
+                               " among the inputs; " + std::to_string(total) +
+                               " rows): render it with `shadowlab sweep " + scene + " -o " + quoteArg(base.string()) +
+                               " --shard " + name + "` and the same grid options");
         } else if (missing > 0) {
             problems.push_back("shard " + name + " is unfinished (" + std::to_string(missing) + " of " +
                                std::to_string(total) + " rows missing): finish it with `shadowlab sweep " + scene +
-                               " -o " + quoteArg(base.string()) + " --shard " + name + " --resume` and the same grid options");
+                               " -o " + quoteArg(base.string()) + " --shard " + name +
+                               " --resume` and the same grid options");
         }
     }
     if (!problems.empty()) {
@@ -233,7 +239,8 @@ MergedSweep readShards(const std::vector<fs::path>& inputs) {
 void writeMerged(const MergedSweep& m, const fs::path& out) {
     std::error_code ec;
     if (fs::exists(out / "shard.json", ec))
-        throw scene::InputError(out.string() + ": is a shard folder (shard.json), whose journal the merge would "
+        throw scene::InputError(out.string() +
+                                ": is a shard folder (shard.json), whose journal the merge would "
                                 "overwrite; merge into the folder above it or another one");
     if (fs::exists(out / "sweep.json", ec) && !fs::exists(out / "merge.json", ec))
         throw scene::InputError(out.string() + ": holds an unsharded sweep (sweep.json); merge into another folder");
@@ -241,7 +248,8 @@ void writeMerged(const MergedSweep& m, const fs::path& out) {
     std::vector<SweepRow> rows = m.rows;
     for (std::size_t i = 0; i < rows.size(); ++i)
         for (const std::string* image : {&rows[i].image, &rows[i].diffImage})
-            if (!image->empty() && fs::exists(m.rowSource[i] / *image, ec)) placeFile(m.rowSource[i] / *image, out / *image);
+            if (!image->empty() && fs::exists(m.rowSource[i] / *image, ec))
+                placeFile(m.rowSource[i] / *image, out / *image);
     if (!m.reference.empty()) {
         placeFile(m.reference, out / "reference.exr");
         if (fs::exists(m.reference.parent_path() / "reference.png", ec))
@@ -306,7 +314,8 @@ std::vector<std::string> rowDifferences(const std::vector<SweepRow>& a, const st
         if (x == y) continue;
         std::string what = "row " + std::to_string(i + 1) + " (" + a[i].key + "):";
         for (const auto& [k, v] : x.items())
-            if (!y.contains(k) || y[k] != v) what += " " + k + " " + v.dump() + " vs " + (y.contains(k) ? y[k].dump() : "absent") + ";";
+            if (!y.contains(k) || y[k] != v)
+                what += " " + k + " " + v.dump() + " vs " + (y.contains(k) ? y[k].dump() : "absent") + ";";
         for (const auto& [k, v] : y.items())
             if (!x.contains(k)) what += " " + k + " absent vs " + v.dump() + ";";
         d.push_back(what);

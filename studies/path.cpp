@@ -16,7 +16,6 @@
 
 #include <OpenImageIO/imageio.h>
 
-#include "studies/shard.h"
 #include "compare/svg_plot.h"
 #include "compare/text.h"
 #include "raster/light_frustum.h"
@@ -27,6 +26,7 @@
 #include "scene/frame_io.h"
 #include "scene/render_plan.h"
 #include "studies/backend.h"
+#include "studies/shard.h"
 
 namespace shadowlab::studies {
 
@@ -157,8 +157,9 @@ compare::ErrorHotspot densestWindow(const std::vector<unsigned char>& mask, int 
     std::vector<std::size_t> sat(std::size_t(w + 1) * (h + 1), 0);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
-            sat[std::size_t(y + 1) * (w + 1) + x + 1] = mask[std::size_t(y) * w + x] + sat[std::size_t(y) * (w + 1) + x + 1] +
-                                                       sat[std::size_t(y + 1) * (w + 1) + x] - sat[std::size_t(y) * (w + 1) + x];
+            sat[std::size_t(y + 1) * (w + 1) + x + 1] =
+                mask[std::size_t(y) * w + x] + sat[std::size_t(y) * (w + 1) + x + 1] +
+                sat[std::size_t(y + 1) * (w + 1) + x] - sat[std::size_t(y) * (w + 1) + x];
     for (int y = 0; y + size <= h; ++y)
         for (int x = 0; x + size <= w; ++x) {
             const auto at = [&](int xx, int yy) { return sat[std::size_t(yy) * (w + 1) + xx]; };
@@ -197,7 +198,8 @@ PathKind parsePathKind(const std::string& text) {
                        PathKind::SunElevation, PathKind::LightMove, PathKind::GltfAnimation})
         if (text == toString(k)) return k;
     throw scene::InputError(
-        "--kind: expected orbit|dolly|pan|subtexel|sun-azimuth|sun-elevation|light-move|gltf-animation, got '" + text + "'");
+        "--kind: expected orbit|dolly|pan|subtexel|sun-azimuth|sun-elevation|light-move|gltf-animation, got '" + text +
+        "'");
 }
 
 bool isCameraPath(PathKind kind) {
@@ -262,8 +264,8 @@ std::vector<scene::Scene> pathScenes(const scene::Scene& base, const scene::Rend
                                 std::to_string(spec.light));
     if ((spec.kind == PathKind::SunAzimuth || spec.kind == PathKind::SunElevation) &&
         base.lights[std::size_t(spec.light)].type != scene::LightType::Directional)
-        throw scene::InputError("--kind " + std::string(toString(spec.kind)) + ": light " +
-                                std::to_string(spec.light) + " is not directional");
+        throw scene::InputError("--kind " + std::string(toString(spec.kind)) + ": light " + std::to_string(spec.light) +
+                                " is not directional");
     if (spec.kind == PathKind::LightMove && base.lights[std::size_t(spec.light)].type == scene::LightType::Directional)
         throw scene::InputError("--kind light-move: light " + std::to_string(spec.light) +
                                 " is directional (use sun-azimuth or sun-elevation)");
@@ -275,7 +277,8 @@ std::vector<scene::Scene> pathScenes(const scene::Scene& base, const scene::Rend
         throw scene::InputError("--camera-animation: animation " + std::to_string(animation->index) +
                                 " has one key time: nothing moves");
     if (spec.kind == PathKind::Dolly && !(amount < 1.0))
-        throw scene::InputError("--amount: a dolly covers a fraction < 1 of the distance, got " + std::to_string(amount));
+        throw scene::InputError("--amount: a dolly covers a fraction < 1 of the distance, got " +
+                                std::to_string(amount));
 
     const scene::CameraBasis cam = scene::cameraBasis(base.camera);
     const scene::Vec3 yAxis(0, 1, 0);
@@ -291,9 +294,7 @@ std::vector<scene::Scene> pathScenes(const scene::Scene& base, const scene::Rend
                 c.position = c.lookAt + rotate(base.camera.position - c.lookAt, yAxis, amount * u);
                 c.up = rotate(base.camera.up, yAxis, amount * u);
                 break;
-            case PathKind::Dolly:
-                c.position = c.lookAt + (base.camera.position - c.lookAt) * (1.0 - amount * u);
-                break;
+            case PathKind::Dolly: c.position = c.lookAt + (base.camera.position - c.lookAt) * (1.0 - amount * u); break;
             case PathKind::Pan: {
                 const scene::Vec3 d = cam.right * (amount * u * glm::length(base.camera.lookAt - base.camera.position));
                 c.position += d;
@@ -318,9 +319,7 @@ std::vector<scene::Scene> pathScenes(const scene::Scene& base, const scene::Rend
                 l.direction = glm::normalize(rotate(l.direction, glm::normalize(axis), amount * u));
                 break;
             }
-            case PathKind::LightMove:
-                s.lights[std::size_t(spec.light)].position.x += amount * u * diagonal;
-                break;
+            case PathKind::LightMove: s.lights[std::size_t(spec.light)].position.x += amount * u * diagonal; break;
             case PathKind::GltfAnimation:
                 c = scene::animatedCamera(base, *animation, animation->start + u * (animation->end - animation->start));
                 break;
@@ -421,7 +420,8 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
         std::vector<std::vector<unsigned char>> gifFrames;
         int gw = 0;
         for (int t = 0; t < result.frames; ++t) {
-            const std::vector<float> a = displayBeauty(frames[std::size_t(t)]), b = displayBeauty(*heldRefs[std::size_t(t)]);
+            const std::vector<float> a = displayBeauty(frames[std::size_t(t)]),
+                                     b = displayBeauty(*heldRefs[std::size_t(t)]);
             gifFrames.push_back(sideBySide({&a, &b, &comparisons[std::size_t(t)].diffRgb}, w, h, gw));
         }
         writeGif(dir / (name + ".gif"), gw, h, gifFrames, fps);
@@ -438,8 +438,8 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
             const scene::Frame& f1 = frames[std::size_t(t) + 1];
             const scene::Frame& r0 = *heldRefs[std::size_t(t)];
             const scene::Frame& r1 = *heldRefs[std::size_t(t) + 1];
-            const std::vector<unsigned char> mask = compare::flickerMask(f0, f1, r0, r1, comparisons[std::size_t(t)].classes,
-                                                                comparisons[std::size_t(t) + 1].classes);
+            const std::vector<unsigned char> mask = compare::flickerMask(
+                f0, f1, r0, r1, comparisons[std::size_t(t)].classes, comparisons[std::size_t(t) + 1].classes);
             std::vector<float> map = displayBeauty(f0);
             for (std::size_t i = 0; i < mask.size(); ++i)
                 if (mask[i]) map[3 * i] = 1.0f, map[3 * i + 1] = 0.08f, map[3 * i + 2] = 0.05f;
@@ -462,12 +462,13 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
             for (std::size_t i = 0; i < zoom.size(); ++i) zoomFloat[i] = zoom[i] / 255.0f;
             const std::string zoomName = name + "-worst-pair.png";
             scene::writePngDisplay(dir / zoomName, zw, side, zoomFloat);
-            zooms += "<figure><img src=\"" + zoomName + "\" alt=\"worst pair of " + name +
-                     "\"><figcaption><b>" + compare::escapeHtml(name) + "</b>, worst pair (" + std::to_string(t) + ", " +
+            zooms += "<figure><img src=\"" + zoomName + "\" alt=\"worst pair of " + name + "\"><figcaption><b>" +
+                     compare::escapeHtml(name) + "</b>, worst pair (" + std::to_string(t) + ", " +
                      std::to_string(t + 1) + "): frame t | frame t+1 | flicker pixels in red; window " +
                      std::to_string(win.size) + " px at (" + std::to_string(win.x) + ", " + std::to_string(win.y) +
                      "), " + compare::formatCount(win.wrongPixels) + " of the pair's " +
-                     compare::formatCount(m.temporal.pairs[std::size_t(t)].flicker) + " flicker pixels</figcaption></figure>\n";
+                     compare::formatCount(m.temporal.pairs[std::size_t(t)].flicker) +
+                     " flicker pixels</figcaption></figure>\n";
         }
 
         compare::PlotSeries series;
@@ -477,8 +478,9 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
         series.connect = true;
         series.dashed = heldView;
         for (const compare::PairStability& p : m.temporal.pairs)
-            series.points.push_back({double(p.first), p.flickerRate, "",
-                                     name + " pair " + std::to_string(p.first) + ": " + compare::formatCount(p.flicker) + " px"});
+            series.points.push_back(
+                {double(p.first), p.flickerRate, "",
+                 name + " pair " + std::to_string(p.first) + ": " + compare::formatCount(p.flicker) + " px"});
         plot.series.push_back(series);
         result.methods.push_back(std::move(m));
     }
@@ -488,29 +490,34 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
 
     // The report.
     std::ostringstream html;
-    html << "<!doctype html><html><head><meta charset=\"utf-8\"><title>shadowlab path: " << compare::escapeHtml(toString(spec.kind))
+    html << "<!doctype html><html><head><meta charset=\"utf-8\"><title>shadowlab path: "
+         << compare::escapeHtml(toString(spec.kind))
          << "</title><style>body{font-family:sans-serif;margin:1.5em;max-width:1300px}table{border-collapse:collapse}"
             "td,th{border:1px solid #ccc;padding:3px 8px;text-align:right}th{background:#eee}"
             "td,tr th:first-child{white-space:nowrap}figure{margin:1em 0}"
             "</style></head><body>\n";
     html << "<h1>Temporal stability: " << compare::escapeHtml(toString(spec.kind)) << " path</h1>\n<p>Scene <code>"
          << compare::escapeHtml(sceneFile) << "</code>, " << result.frames << " frames at " << w << "x" << h
-         << ", amount " << compare::formatShort(result.amount) << ". Pixels are compared between frames at the same image "
+         << ", amount " << compare::formatShort(result.amount)
+         << ". Pixels are compared between frames at the same image "
          << "position; flicker counts the counted pixels whose lit/shadow state changes while the reference's does "
          << "not (docs/temporal.md).</p>\n";
     html << "<table><tr><th>method</th><th>setup</th><th>median per frame</th><th>mean flicker</th><th>max flicker</th>"
             "<th>flicker px</th><th>error variation</th><th>swim (px)</th><th>edge offset (px)</th>"
             "<th>mean mismatch</th></tr>\n";
-    auto row = [&](const std::string& name, double setup, const std::vector<double>& ms, const compare::TemporalSummary& tsum,
-                   double mismatch) {
+    auto row = [&](const std::string& name, double setup, const std::vector<double>& ms,
+                   const compare::TemporalSummary& tsum, double mismatch) {
         html << "<tr><th>" << compare::escapeHtml(name) << "</th><td>" << compare::formatDuration(setup) << "</td><td>"
-             << compare::formatDuration(median(ms)) << "</td><td>" << compare::formatPercent(tsum.meanFlickerRate) << "</td><td>"
-             << compare::formatPercent(tsum.maxFlickerRate) << "</td><td>" << compare::formatCount(tsum.totalFlicker) << "</td><td>"
-             << compare::formatFixed(tsum.meanErrorVariation, 5) << "</td><td>" << compare::formatFixed(tsum.meanSwimPixels, 3)
-             << "</td><td>" << compare::formatFixed(tsum.meanEdgeOffset, 3) << "</td><td>"
+             << compare::formatDuration(median(ms)) << "</td><td>" << compare::formatPercent(tsum.meanFlickerRate)
+             << "</td><td>" << compare::formatPercent(tsum.maxFlickerRate) << "</td><td>"
+             << compare::formatCount(tsum.totalFlicker) << "</td><td>"
+             << compare::formatFixed(tsum.meanErrorVariation, 5) << "</td><td>"
+             << compare::formatFixed(tsum.meanSwimPixels, 3) << "</td><td>"
+             << compare::formatFixed(tsum.meanEdgeOffset, 3) << "</td><td>"
              << (mismatch < 0 ? std::string("-") : compare::formatPercent(mismatch)) << "</td></tr>\n";
     };
-    row(nameOf(scene::Backend::Reference), result.referenceSetupMs, result.referenceFrameMs, result.referenceTemporal, -1.0);
+    row(nameOf(scene::Backend::Reference), result.referenceSetupMs, result.referenceFrameMs, result.referenceTemporal,
+        -1.0);
     for (const PathMethod& m : result.methods) {
         double mismatch = 0.0;
         for (const compare::Metrics& x : m.metrics) mismatch += x.mismatchRate;
@@ -525,7 +532,6 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
             "</body></html>\n";
     scene::writeTextAtomic(dir / "report.html", html.str());
 }
-
 
 }  // namespace
 
@@ -569,7 +575,8 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
     scene::removeStaleTemporaries(framesDir);
     scene::writeTextAtomic(manifestFile, manifest.dump(2) + "\n");
     if (sharded)
-        scene::writeTextAtomic(dir / "shard.json", pathShardManifest(base, manifest, shard, result.frames).dump(2) + "\n");
+        scene::writeTextAtomic(dir / "shard.json",
+                               pathShardManifest(base, manifest, shard, result.frames).dump(2) + "\n");
 
     // Finished frames: the journal's lines (a torn last line is dropped and the journal rewritten).
     std::map<int, Json> done;
@@ -644,8 +651,7 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
         for (const auto& [name, ms] : line["setup_ms"].items())
             if (ms.get<double>() > 0.0 || !setupMs.count(name)) setupMs[name] = ms.get<double>();
         appendLine(journal, line.dump());
-        if (options.progress)
-            options.progress("frame " + std::to_string(t + 1) + "/" + std::to_string(result.frames));
+        if (options.progress) options.progress("frame " + std::to_string(t + 1) + "/" + std::to_string(result.frames));
     }
     if (sharded) return result;  // measured by mergePathShards, from every shard's frames
     measurePath(result, dir, base.file.string(), names, setupMs, times);
@@ -673,10 +679,11 @@ Json toJson(const PathResult& r) {
             {"amount", r.amount},
             {"light", r.spec.light},
             {"resumed_frames", r.resumedFrames},
-            {nameOf(scene::Backend::Reference), {{"setup_ms", r.referenceSetupMs},
-                           {"median_frame_ms", median(r.referenceFrameMs)},
-                           {"frame_ms", r.referenceFrameMs},
-                           {"temporal", toJson(r.referenceTemporal)}}},
+            {nameOf(scene::Backend::Reference),
+             {{"setup_ms", r.referenceSetupMs},
+              {"median_frame_ms", median(r.referenceFrameMs)},
+              {"frame_ms", r.referenceFrameMs},
+              {"temporal", toJson(r.referenceTemporal)}}},
             {"methods", methods}};
 }
 
@@ -694,7 +701,8 @@ std::vector<fs::path> pathShardFolders(const fs::path& input) {
     std::vector<fs::path> dirs;
     if (fs::exists(input / "shard.json", ec)) return {input};
     for (const auto& e : fs::directory_iterator(input, ec))
-        if (e.is_directory() && e.path().filename().string().rfind("shard-", 0) == 0 && fs::exists(e.path() / "shard.json"))
+        if (e.is_directory() && e.path().filename().string().rfind("shard-", 0) == 0 &&
+            fs::exists(e.path() / "shard.json"))
             dirs.push_back(e.path());
     std::sort(dirs.begin(), dirs.end());
     return dirs;
@@ -766,8 +774,8 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
     std::string sceneFile;
     fs::path firstDir, base;
     int frames = 0;
-    std::map<int, fs::path> shardOf;                          // shard index → its first folder
-    std::map<int, std::pair<fs::path, Json>> lines;           // frame → (folder, journal line)
+    std::map<int, fs::path> shardOf;                 // shard index → its first folder
+    std::map<int, std::pair<fs::path, Json>> lines;  // frame → (folder, journal line)
     std::error_code ec;
     for (const fs::path& input : inputs) {
         if (!fs::is_directory(input, ec)) throw scene::InputError(input.string() + ": no such folder");
@@ -779,7 +787,8 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
             const Json j = readJsonFile(file);
             if (!j.is_object() || j.value("study", "") != "path" || !j.contains("identity") || !j.contains("shard") ||
                 !j.contains("frames"))
-                throw scene::InputError(file.string() + ": not the manifest of a path shard (a sweep's or a check's "
+                throw scene::InputError(file.string() +
+                                        ": not the manifest of a path shard (a sweep's or a check's "
                                         "shards are merged on their own)");
             const int index = j["shard"].value("index", -1), count = j["shard"].value("count", 0);
             if (identity.is_null()) {
@@ -793,8 +802,8 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
                 throw scene::InputError(d.string() + ": a shard of another path than " + firstDir.string() + " (" +
                                         diff + ")");
             } else if (count != merged.shardCount) {
-                throw scene::InputError(d.string() + ": a shard of a split into " + std::to_string(count) +
-                                        ", not " + std::to_string(merged.shardCount) + " as " + firstDir.string());
+                throw scene::InputError(d.string() + ": a shard of a split into " + std::to_string(count) + ", not " +
+                                        std::to_string(merged.shardCount) + " as " + firstDir.string());
             }
             if (!(index >= 0 && index < count)) throw scene::InputError(file.string() + ": shard index out of range");
             merged.shardDirs.push_back(d);
@@ -839,8 +848,9 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
                                " --shard " + name + "` and the same path options");
         else
             problems.push_back("shard " + name + " is unfinished (" + std::to_string(missing) + " of " +
-                               std::to_string(want.size()) + " frames missing): finish it with `shadowlab path " + scene +
-                               " -o " + quoted(base.string()) + " --shard " + name + " --resume` and the same path options");
+                               std::to_string(want.size()) + " frames missing): finish it with `shadowlab path " +
+                               scene + " -o " + quoted(base.string()) + " --shard " + name +
+                               " --resume` and the same path options");
     }
     if (!problems.empty()) {
         std::string what = "merge: the path is incomplete:";
@@ -855,7 +865,8 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
             if (!fs::exists(entry.first / "frames" / frameName(t, name), ec))
                 throw scene::InputError((entry.first / "frames" / frameName(t, name)).string() +
                                         ": missing, though the journal lists frame " + std::to_string(t));
-    if (fs::exists(out / "shard.json", ec)) throw scene::InputError(out.string() + ": is a shard folder; merge into another");
+    if (fs::exists(out / "shard.json", ec))
+        throw scene::InputError(out.string() + ": is a shard folder; merge into another");
     if (fs::exists(out / "frames.jsonl", ec) && !fs::exists(out / "merge.json", ec))
         throw scene::InputError(out.string() + ": holds an unsharded path; merge into another folder");
 
@@ -865,7 +876,8 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
     std::map<std::string, std::vector<double>> times;
     std::string journal;
     for (const auto& [t, entry] : lines) {
-        for (const std::string& name : all) placeFile(entry.first / "frames" / frameName(t, name), out / "frames" / frameName(t, name));
+        for (const std::string& name : all)
+            placeFile(entry.first / "frames" / frameName(t, name), out / "frames" / frameName(t, name));
         journal += entry.second.dump() + "\n";
         for (const auto& [name, ms] : entry.second.at("frame_ms").items()) times[name].push_back(ms.get<double>());
         const Json setups = entry.second.value("setup_ms", Json::object());
@@ -876,8 +888,9 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
     scene::writeTextAtomic(out / "path.json", manifest.dump(2) + "\n");
     Json dirs = Json::array();
     for (const fs::path& d : merged.shardDirs) dirs.push_back(d.string());
-    scene::writeTextAtomic(out / "merge.json",
-                           Json{{"shards", merged.shardCount}, {"folders", dirs}, {"duplicates", merged.duplicates}}.dump(2) + "\n");
+    scene::writeTextAtomic(
+        out / "merge.json",
+        Json{{"shards", merged.shardCount}, {"folders", dirs}, {"duplicates", merged.duplicates}}.dump(2) + "\n");
 
     PathResult& result = merged.result;
     result.spec.kind = parsePathKind(manifest.at("kind").get<std::string>());
@@ -896,8 +909,8 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
 std::vector<std::string> pathDifferences(const fs::path& a, const fs::path& b) {
     const std::function<void(Json&)> strip = [&](Json& j) {
         if (j.is_object()) {
-            for (const char* k : {"setup_ms", "median_frame_ms", "frame_ms", "method_timing", "reference_timing",
-                                  "resumed_frames"})
+            for (const char* k :
+                 {"setup_ms", "median_frame_ms", "frame_ms", "method_timing", "reference_timing", "resumed_frames"})
                 j.erase(k);
             for (auto& [key, value] : j.items()) strip(value);
         } else if (j.is_array()) {

@@ -39,7 +39,7 @@ struct PathSpec {
     // fraction of that distance moved (0.1); subtexel: the step per frame as a fraction of
     // min(texel, pixel footprint) (0.1); light-move: the fraction of the scene's diagonal (0.1).
     std::optional<double> amount;
-    int light = 0;  // the light a light path moves
+    int light = 0;          // the light a light path moves
     std::string animation;  // gltf-animation: its name or index; empty: the first camera animation
 };
 // The scene's "path" block as a PathSpec (the loader has checked its values).
@@ -76,10 +76,10 @@ struct PathRunOptions {
 
 // One method along the path.
 struct PathMethod {
-    std::string name;  // raster | raster-held | raytrace
-    double setupMs = 0.0;                // the one-time setup (Renderer, acceleration structure)
-    std::vector<double> frameMs;         // per frame, setup excluded (update included)
-    std::vector<compare::Metrics> metrics;        // per frame, against that frame's reference
+    std::string name;                       // raster | raster-held | raytrace
+    double setupMs = 0.0;                   // the one-time setup (Renderer, acceleration structure)
+    std::vector<double> frameMs;            // per frame, setup excluded (update included)
+    std::vector<compare::Metrics> metrics;  // per frame, against that frame's reference
     compare::TemporalSummary temporal;
 };
 

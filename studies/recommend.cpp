@@ -80,9 +80,12 @@ Measured measureRender(const RecommendOptions& o, const scene::Scene& s, const s
 
 Json measuredJson(const Measured& m) {
     if (!m.ok) return {{"error", m.error}};
-    return {{"mismatch_rate", m.mismatchRate},         {"false_shadow_rate", m.falseShadowRate},
-            {"missed_shadow_rate", m.missedShadowRate}, {"shadow_iou", m.shadowIoU},
-            {"mean_abs_visibility_error", m.meanAbsVisibilityError}, {"soft_error_rate", m.softErrorRate}};
+    return {{"mismatch_rate", m.mismatchRate},
+            {"false_shadow_rate", m.falseShadowRate},
+            {"missed_shadow_rate", m.missedShadowRate},
+            {"shadow_iou", m.shadowIoU},
+            {"mean_abs_visibility_error", m.meanAbsVisibilityError},
+            {"soft_error_rate", m.softErrorRate}};
 }
 
 // The scene-file keys of the user's own settings (everything but the biases this file chooses),
@@ -131,14 +134,17 @@ std::vector<double> around(const std::vector<double>& axis, double v) {
     std::vector<double> out{v};
     const auto it = std::lower_bound(axis.begin(), axis.end(), v);
     if (it != axis.begin()) out.push_back(midpoint(*(it - 1), v));
-    if (it != axis.end() && it + 1 != axis.end()) out.push_back(midpoint(v, *(it + 1)));
-    else if (v > 0.0) out.push_back(2.0 * v);
+    if (it != axis.end() && it + 1 != axis.end())
+        out.push_back(midpoint(v, *(it + 1)));
+    else if (v > 0.0)
+        out.push_back(2.0 * v);
     return out;
 }
 
 std::string percentPair(const Measured& a, const Measured& b) {
-    return compare::formatPercent(a.mismatchRate) + " mismatch (IoU " + compare::formatFixed(a.shadowIoU, 3) + ") against the defaults' " +
-           compare::formatPercent(b.mismatchRate) + " (IoU " + compare::formatFixed(b.shadowIoU, 3) + ")";
+    return compare::formatPercent(a.mismatchRate) + " mismatch (IoU " + compare::formatFixed(a.shadowIoU, 3) +
+           ") against the defaults' " + compare::formatPercent(b.mismatchRate) + " (IoU " +
+           compare::formatFixed(b.shadowIoU, 3) + ")";
 }
 
 }  // namespace
@@ -297,16 +303,16 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
             v.beatsDefaults = beats(v.tried, v.defaults);
         }
         v.recommended = v.beatsDefaults ? v.tried : v.defaults;
-        const std::string config = "filter " + attribute(defaultsFrame, "filter") + ", map " +
-                                   attribute(defaultsFrame, "shadow_map_size") + ", " +
-                                   (resolved.raster.cascades > 1 ? std::to_string(resolved.raster.cascades) + " cascades, " : "") +
-                                   (attribute(defaultsFrame, "light_frustum_fit") == "receivers" ? "fitted to the view"
-                                                                                                  : "bounding-sphere fit");
-        r.notes.push_back("The shadow map's biases were searched in the configuration you run (" + config + "): " +
-                          std::to_string(r.points.size()) + " renders at " + r.searchResolution +
+        const std::string config =
+            "filter " + attribute(defaultsFrame, "filter") + ", map " + attribute(defaultsFrame, "shadow_map_size") +
+            ", " + (resolved.raster.cascades > 1 ? std::to_string(resolved.raster.cascades) + " cascades, " : "") +
+            (attribute(defaultsFrame, "light_frustum_fit") == "receivers" ? "fitted to the view"
+                                                                          : "bounding-sphere fit");
+        r.notes.push_back("The shadow map's biases were searched in the configuration you run (" + config +
+                          "): " + std::to_string(r.points.size()) + " renders at " + r.searchResolution +
                           ", constant bias 0 .. " + compare::formatShort(o.depthSteps.back() * b0) +
-                          " world units together with slope bias 0 .. " + compare::formatShort(o.slopeSteps.back() * s0) +
-                          " texels, refined around the best point.");
+                          " world units together with slope bias 0 .. " +
+                          compare::formatShort(o.slopeSteps.back() * s0) + " texels, refined around the best point.");
         if (scene::isFilterable(resolved.raster.filter))
             r.notes.push_back(std::string("Filter ") + scene::toString(resolved.raster.filter) +
                               " biases the receiver's depth before its moment test as `none` does, so the same "
@@ -316,8 +322,9 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
         if (v.beatsDefaults) {
             block["depth_bias"] = best.depthBias;
             block["slope_bias"] = best.slopeBias;
-            r.notes.push_back("At " + r.resolution + ", " + v.candidate + " gives " + percentPair(v.recommended, v.defaults) +
-                              ": " + compare::formatPercent(v.defaults.mismatchRate - v.recommended.mismatchRate) +
+            r.notes.push_back("At " + r.resolution + ", " + v.candidate + " gives " +
+                              percentPair(v.recommended, v.defaults) + ": " +
+                              compare::formatPercent(v.defaults.mismatchRate - v.recommended.mismatchRate) +
                               " of the counted pixels fewer wrong. The block recommends it.");
         } else {
             if (user.depthBias) block["depth_bias"] = *user.depthBias;
@@ -326,11 +333,12 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
             if (!v.defaults.ok)
                 why = "the defaults did not render (" + v.defaults.error + "), so no bias is recommended.";
             else if (!v.searched)
-                why = "no searched bias beats the defaults (" + compare::formatPercent(v.defaults.mismatchRate) + " mismatch, IoU " +
-                      compare::formatFixed(v.defaults.shadowIoU, 3) + " at " + r.resolution + "): the block keeps them.";
+                why = "no searched bias beats the defaults (" + compare::formatPercent(v.defaults.mismatchRate) +
+                      " mismatch, IoU " + compare::formatFixed(v.defaults.shadowIoU, 3) + " at " + r.resolution +
+                      "): the block keeps them.";
             else if (!v.tried.ok)
-                why = "the best searched point (" + v.candidate + ") failed at " + r.resolution + " (" +
-                      v.tried.error + "): the block keeps the defaults.";
+                why = "the best searched point (" + v.candidate + ") failed at " + r.resolution + " (" + v.tried.error +
+                      "): the block keeps the defaults.";
             else
                 why = "the best searched point (" + v.candidate + ") gives " + percentPair(v.tried, v.defaults) +
                       " and mean |dV| " + compare::formatFixed(v.tried.meanAbsVisibilityError, 4) + " against " +
@@ -362,8 +370,9 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
         if (v.beatsDefaults) {
             setRayBias(block, *ov.rayBias);
             if (ov.precision) block["precision"] = *ov.precision;
-            r.notes.push_back("For the ray tracer, " + v.candidate + " gives " + percentPair(v.recommended, v.defaults) +
-                              " at " + r.resolution + ". The block recommends it.");
+            r.notes.push_back("For the ray tracer, " + v.candidate + " gives " +
+                              percentPair(v.recommended, v.defaults) + " at " + r.resolution +
+                              ". The block recommends it.");
         } else {
             if (user.rayBias) setRayBias(block, *user.rayBias);
             if (user.precision) block["precision"] = *user.precision;

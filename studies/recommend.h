@@ -11,11 +11,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "studies/auto_bias.h"
-#include "studies/sweep.h"
 #include "scene/frame.h"
 #include "scene/scene.h"
 #include "scene/settings.h"
+#include "studies/auto_bias.h"
+#include "studies/sweep.h"
 
 namespace shadowlab::studies {
 
@@ -48,12 +48,12 @@ struct BiasPoint {
 
 // The verdict of one backend at the requested resolution.
 struct Verified {
-    bool searched = false;      // a candidate other than the defaults was found and rendered
+    bool searched = false;  // a candidate other than the defaults was found and rendered
     bool beatsDefaults = false;
-    Measured defaults;               // the user's configuration
-    Measured tried;                  // the candidate (when searched)
-    Measured recommended;            // what the block gives: tried when it beats the defaults, else defaults
-    std::string candidate;           // "depth bias 0.01 world units, slope bias 2 texels", "ray bias robust (float)"
+    Measured defaults;      // the user's configuration
+    Measured tried;         // the candidate (when searched)
+    Measured recommended;   // what the block gives: tried when it beats the defaults, else defaults
+    std::string candidate;  // "depth bias 0.01 world units, slope bias 2 texels", "ray bias robust (float)"
 };
 
 struct RecommendOptions {

@@ -2,26 +2,26 @@
 // shared by the shards of one output folder through an O_EXCL lock file.
 #include "studies/shard.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
-#include <fcntl.h>
 #include <fstream>
 #include <numeric>
 #include <set>
 #include <sstream>
-#include <sys/stat.h>
 #include <thread>
-#include <unistd.h>
 #include <variant>
 
-#include "studies/machine.h"
 #include "scene/error.h"
 #include "scene/frame_io.h"
 #include "scene/settings.h"
+#include "studies/machine.h"
 
 namespace shadowlab::studies {
 
@@ -238,8 +238,8 @@ long long stamp(const fs::path& lock) {
 
 }  // namespace
 
-scene::Frame sharedReference(const fs::path& dir, const scene::Scene& scene, const std::function<scene::Frame()>& render,
-                             const SharedReferenceOptions& options) {
+scene::Frame sharedReference(const fs::path& dir, const scene::Scene& scene,
+                             const std::function<scene::Frame()>& render, const SharedReferenceOptions& options) {
     using Clock = std::chrono::steady_clock;
     const fs::path file = dir / "reference.exr";
     const fs::path lock = dir / "reference.exr.lock";
@@ -332,11 +332,13 @@ SweepResult runShard(const scene::Scene& baseScene, const SweepGrid& grid, const
         Shard oldShard;
         readShardManifest(manifest, old, oldShard);
         if (const std::string d = identityDifference(old, id); !d.empty())
-            throw scene::InputError(dir.string() + ": holds a shard of another sweep (" + d + "); choose another folder");
+            throw scene::InputError(dir.string() + ": holds a shard of another sweep (" + d +
+                                    "); choose another folder");
     }
     // Refused before anything is written, as runSweep would refuse it.
     if (fs::exists(dir / "results.jsonl", ec) && !options.resume)
-        throw scene::InputError(dir.string() + ": already holds this shard (results.jsonl); use --resume to "
+        throw scene::InputError(dir.string() +
+                                ": already holds this shard (results.jsonl); use --resume to "
                                 "continue it, or choose another folder");
     fs::create_directories(dir);
     scene::writeTextAtomic(manifest, shardManifest(id, shard).dump(1) + "\n");
@@ -352,12 +354,15 @@ SweepResult runShard(const scene::Scene& baseScene, const SweepGrid& grid, const
     const RenderFn render = options.render;
     const fs::path shared = options.outputDir;
     o.reference = [render, shared, referenceOptions](const scene::Scene& sc) {
-        return sharedReference(shared, sc, [&] {
-            const scene::RenderSettings settings = scene::resolveSettings(sc, {});
-            scene::Frame f = render(sc, settings, scene::Backend::Reference);
-            f.attributes["scene"] = sc.file.string();
-            return f;
-        }, referenceOptions);
+        return sharedReference(
+            shared, sc,
+            [&] {
+                const scene::RenderSettings settings = scene::resolveSettings(sc, {});
+                scene::Frame f = render(sc, settings, scene::Backend::Reference);
+                f.attributes["scene"] = sc.file.string();
+                return f;
+            },
+            referenceOptions);
     };
     return runSweep(scene, mine, o);
 }

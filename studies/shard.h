@@ -44,7 +44,7 @@ struct SweepIdentity {
     std::string sceneHash;  // 16 hex digits
     int width = 0, height = 0;
     int repetitions = 0;
-    std::string gridHash;   // 16 hex digits over keys (in grid order) and repetitions
+    std::string gridHash;           // 16 hex digits over keys (in grid order) and repetitions
     std::vector<std::string> keys;  // the whole grid's row keys, in grid order
 };
 

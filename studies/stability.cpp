@@ -9,7 +9,6 @@
 #include <map>
 #include <sstream>
 
-#include "studies/auto_bias.h"
 #include "compare/report.h"
 #include "compare/text.h"
 #include "scene/error.h"
@@ -18,6 +17,7 @@
 #include "scene/json_input.h"
 #include "scene/loader.h"
 #include "scene/settings.h"
+#include "studies/auto_bias.h"
 
 namespace shadowlab::studies {
 namespace fs = std::filesystem;
@@ -72,9 +72,8 @@ std::string describeOverrides(const Json& block, scene::Backend backend) {
 }
 
 BackendRun renderRun(const scene::Scene& scene, const scene::Frame& reference,
-                     const scene::SettingsOverrides& overrides, const StabilityOptions& options,
-                     scene::Backend backend, const std::string& variant, const std::string& label,
-                     scene::Frame* keep = nullptr) {
+                     const scene::SettingsOverrides& overrides, const StabilityOptions& options, scene::Backend backend,
+                     const std::string& variant, const std::string& label, scene::Frame* keep = nullptr) {
     BackendRun run;
     run.backend = backend;
     run.variant = variant;
@@ -108,16 +107,17 @@ BackendRun renderRun(const scene::Scene& scene, const scene::Frame& reference,
 
 // The bias search: each grid point rendered once and measured (the sweep's warm-up, repeated
 // timing and journal are not needed to find a window), then recommendBias.
-AutoBias searchBias(const scene::Scene& scene, const scene::Frame& reference,
-                    const StabilityOptions& options) {
+AutoBias searchBias(const scene::Scene& scene, const scene::Frame& reference, const StabilityOptions& options) {
     SweepGrid grid = defaultGrid(scene, options.quick);
     std::vector<SweepRow> rows;
     for (SweepConfig config : grid.configs) {
         if (std::find(options.backends.begin(), options.backends.end(), config.backend) == options.backends.end())
             continue;
-        const bool isSeries = !config.biasKind.empty() || config.overrides.rayBias == std::optional<std::string>("robust");
+        const bool isSeries =
+            !config.biasKind.empty() || config.overrides.rayBias == std::optional<std::string>("robust");
         if (options.biasSeriesOnly && !isSeries) continue;
-        if (options.searchMapSize > 0 && config.backend == scene::Backend::Raster) config.overrides.shadowMapSize = options.searchMapSize;
+        if (options.searchMapSize > 0 && config.backend == scene::Backend::Raster)
+            config.overrides.shadowMapSize = options.searchMapSize;
         SweepRow row;
         row.config = config;
         row.key = config.key();
@@ -168,8 +168,8 @@ std::string readDescription(const fs::path& sceneFile) {
     }
 }
 
-StabilityCase runStabilityCase(const scene::Scene& sceneIn, const StabilityOptions& options,
-                               const std::string& name, const std::string& description) {
+StabilityCase runStabilityCase(const scene::Scene& sceneIn, const StabilityOptions& options, const std::string& name,
+                               const std::string& description) {
     if (options.width < 1 || options.height < 1 || options.width > scene::kMaxResolution ||
         options.height > scene::kMaxResolution)
         throw scene::InputError("stability: resolution " + std::to_string(options.width) + "x" +
@@ -216,8 +216,8 @@ StabilityCase runStabilityCase(const scene::Scene& sceneIn, const StabilityOptio
     // Backends at their defaults (kept: the recommendation is checked against them).
     std::map<scene::Backend, scene::Frame> defaultsFrames;
     for (const scene::Backend backend : options.backends)
-        c.runs.push_back(renderRun(scene, c.reference, {}, options, backend, "defaults", "defaults",
-                                   &defaultsFrames[backend]));
+        c.runs.push_back(
+            renderRun(scene, c.reference, {}, options, backend, "defaults", "defaults", &defaultsFrames[backend]));
     auto defaultsOf = [&](scene::Backend backend) -> const scene::Frame* {
         const auto it = defaultsFrames.find(backend);
         return it == defaultsFrames.end() || it->second.pixelCount() == 0 ? nullptr : &it->second;
@@ -278,9 +278,11 @@ StabilityCase runStabilityCase(const scene::Scene& sceneIn, const StabilityOptio
 
     for (const BackendRun& r : c.runs) {
         const std::string who = std::string(scene::toString(r.backend)) + " (" + r.variant + ")";
-        if (!r.ok) c.failures.push_back(who + " failed: " + r.error);
+        if (!r.ok)
+            c.failures.push_back(who + " failed: " + r.error);
         else {
-            if (r.health.total() > 0) c.failures.push_back(who + " has " + std::to_string(r.health.total()) + " NaN/Inf values");
+            if (r.health.total() > 0)
+                c.failures.push_back(who + " has " + std::to_string(r.health.total()) + " NaN/Inf values");
             if (r.blackFrame) c.failures.push_back(who + " rendered a black frame");
             if (r.validationMessages > 0)
                 c.failures.push_back(who + ": " + std::to_string(r.validationMessages) + " validation messages");
@@ -329,13 +331,14 @@ std::string StabilityCase::referenceVerdict() const {
 BackendState stateOf(const BackendRun* r, bool atBest) {
     if (!r) return {"not run", "not run"};
     if (r->failed()) {
-        std::string why = !r->ok ? r->error
-                          : r->blackFrame ? "black frame"
+        std::string why = !r->ok                  ? r->error
+                          : r->blackFrame         ? "black frame"
                           : r->health.total() > 0 ? std::to_string(r->health.total()) + " NaN/Inf"
                                                   : std::to_string(r->validationMessages) + " validation messages";
         return {"failed", "failed: " + why};
     }
-    const bool acne = r->falseShadowRate > compare::kBiasWindowMaxRate, leaks = r->missedShadowRate > compare::kBiasWindowMaxRate;
+    const bool acne = r->falseShadowRate > compare::kBiasWindowMaxRate,
+               leaks = r->missedShadowRate > compare::kBiasWindowMaxRate;
     if (!acne && !leaks) return {"clean", "clean"};
     std::string text;
     if (acne) text = "acne " + compare::formatPercent(r->falseShadowRate);
@@ -359,39 +362,55 @@ Json toJson(const StabilityCase& c) {
     j["states"] = Json::object();
     for (const BackendRun& r : c.runs) {
         const BackendState st = stateOf(&r, r.variant == "best");
-        j["states"][scene::toString(r.backend)][r.variant] = {{"state", st.state}, {"text", st.text},
-                                             {"false_shadow_rate", r.falseShadowRate},
-                                             {"missed_shadow_rate", r.missedShadowRate}};
+        j["states"][scene::toString(r.backend)][r.variant] = {{"state", st.state},
+                                                              {"text", st.text},
+                                                              {"false_shadow_rate", r.falseShadowRate},
+                                                              {"missed_shadow_rate", r.missedShadowRate}};
     }
     j["best_notes"] = c.bestNotes;
     j["failures"] = c.failures;
     j["resolution"] = std::to_string(c.width) + "x" + std::to_string(c.height);
-    j[scene::toString(scene::Backend::Reference)] = {{"ok", c.referenceOk}, {"error", c.referenceError}, {"time_ms", c.referenceMs},
-                      {"non_finite", c.referenceHealth.total()}};
+    j[scene::toString(scene::Backend::Reference)] = {{"ok", c.referenceOk},
+                                                     {"error", c.referenceError},
+                                                     {"time_ms", c.referenceMs},
+                                                     {"non_finite", c.referenceHealth.total()}};
     if (c.analytic) {
         const AnalyticCheck& a = *c.analytic;
-        j["analytic"] = {{"passed", a.passed()}, {"object_id_mismatches", a.objectIdMismatches},
+        j["analytic"] = {{"passed", a.passed()},
+                         {"object_id_mismatches", a.objectIdMismatches},
                          {"visibility_mismatches", a.visibilityMismatches},
                          {"visibility_compared", a.visibilityCompared},
-                         {"knife_edge_pixels", a.knifeEdgePixels}, {"summary", a.summary()}};
+                         {"knife_edge_pixels", a.knifeEdgePixels},
+                         {"summary", a.summary()}};
     } else {
         j["analytic"] = nullptr;
         j["not_analytic"] = c.notAnalytic;
     }
     j["runs"] = Json::array();
     for (const BackendRun& r : c.runs)
-        j["runs"].push_back({{"backend", scene::toString(r.backend)}, {"variant", r.variant}, {"settings", r.settings},
-                             {"ok", r.ok}, {"error", r.error}, {"black_frame", r.blackFrame},
+        j["runs"].push_back({{"backend", scene::toString(r.backend)},
+                             {"variant", r.variant},
+                             {"settings", r.settings},
+                             {"ok", r.ok},
+                             {"error", r.error},
+                             {"black_frame", r.blackFrame},
                              {"nan", r.health.beauty.nan + r.health.visibility.nan + r.health.objectId.nan +
                                          r.health.ndotl.nan + r.health.depth.nan + r.health.blockerId.nan},
-                             {"non_finite", r.health.total()}, {"validation_messages", r.validationMessages},
-                             {"time_ms", r.timeMs}, {"counted", r.counted},
+                             {"non_finite", r.health.total()},
+                             {"validation_messages", r.validationMessages},
+                             {"time_ms", r.timeMs},
+                             {"counted", r.counted},
                              {"false_shadow_rate", r.falseShadowRate},
                              {"missed_shadow_rate", r.missedShadowRate}});
     j["bias"] = Json::array();
     for (const MethodBias& b : c.bias)
-        j["bias"].push_back({{"backend", scene::toString(b.backend)}, {"stiff", b.stiff}, {"kind", b.kind}, {"lo", b.lo},
-                             {"hi", b.hi}, {"recommended", b.recommended}, {"dominant", b.dominant},
+        j["bias"].push_back({{"backend", scene::toString(b.backend)},
+                             {"stiff", b.stiff},
+                             {"kind", b.kind},
+                             {"lo", b.lo},
+                             {"hi", b.hi},
+                             {"recommended", b.recommended},
+                             {"dominant", b.dominant},
                              {"text", b.text}});
     j["best_shadow_block"] = c.bestShadowBlock;
     return j;
@@ -419,14 +438,14 @@ std::string stabilityCsv(const std::vector<StabilityCase>& cases) {
     for (const StabilityCase& c : cases) {
         const std::string analytic = c.analytic ? (c.analytic->passed() ? "exact" : "MISSED") : "n/a";
         for (const BackendRun& r : c.runs)
-            s << c.name << ',' << (c.failed() ? "failed" : "ok") << ',' << c.referenceVerdict() << ',' << analytic << ','
-              << c.referenceMs << ',' << scene::toString(r.backend) << ',' << r.variant << ',' << csvField(stateOf(&r, r.variant == "best").text)
-              << ',' << csvField(r.settings) << ',' << r.ok << ',' << r.blackFrame
-              << ',' << r.health.total() << ',' << r.falseShadowRate << ',' << r.missedShadowRate << ','
+            s << c.name << ',' << (c.failed() ? "failed" : "ok") << ',' << c.referenceVerdict() << ',' << analytic
+              << ',' << c.referenceMs << ',' << scene::toString(r.backend) << ',' << r.variant << ','
+              << csvField(stateOf(&r, r.variant == "best").text) << ',' << csvField(r.settings) << ',' << r.ok << ','
+              << r.blackFrame << ',' << r.health.total() << ',' << r.falseShadowRate << ',' << r.missedShadowRate << ','
               << r.timeMs << ',' << csvField(windowText(c.biasOf(r.backend))) << '\n';
         if (c.runs.empty())
-            s << c.name << ',' << (c.failed() ? "failed" : "ok") << ',' << c.referenceVerdict() << ',' << analytic << ','
-              << c.referenceMs << ",,,,,,,,,,,\n";
+            s << c.name << ',' << (c.failed() ? "failed" : "ok") << ',' << c.referenceVerdict() << ',' << analytic
+              << ',' << c.referenceMs << ",,,,,,,,,,,\n";
     }
     return s.str();
 }
@@ -462,21 +481,30 @@ void writeStabilityReport(const fs::path& dir, const std::vector<StabilityCase>&
          " .fail{color:#b00;font-weight:bold} .pass{color:#070;font-weight:bold}"
          " .st-clean,.ref-exact{background:#d3f9d8;color:#1b5e20} .st-acne{background:#ffe3e3;color:#a51111}"
          " .st-leaks{background:#dbe4ff;color:#1c3faa} .st-acne-leaks{background:#f3d9fa;color:#6b1e80}"
-         " .st-stiff{background:#fff0d4;color:#8a4b00;font-weight:600} .st-failed,.ref-wrong{background:#c92a2a;color:#fff;font-weight:600}"
-         " .st-not-run,.ref-unchecked{background:#f1f3f5;color:#495057} .figs{display:flex;flex-wrap:wrap;gap:10px;margin:12px 0} .figs figure{width:320px}</style></head><body><main>"
+         " .st-stiff{background:#fff0d4;color:#8a4b00;font-weight:600} "
+         ".st-failed,.ref-wrong{background:#c92a2a;color:#fff;font-weight:600}"
+         " .st-not-run,.ref-unchecked{background:#f1f3f5;color:#495057} "
+         ".figs{display:flex;flex-wrap:wrap;gap:10px;margin:12px 0} .figs "
+         "figure{width:320px}</style></head><body><main>"
       << "<h1>Stability suite</h1><p>" << cases.size() << " cases. Reference: <span class=pass>" << exact
-      << " exact</span> against the analytic answer, " << (cases.size() - exact - wrong) << " unchecked (no analytic answer), "
-      << (wrong ? "<span class=fail>" : "") << wrong << " wrong" << (wrong ? "</span>" : "") << ". Runs: "
-      << (failedCases ? "<span class=fail>" + std::to_string(failedCases) + " with a crash, NaN/Inf, black frame or validation message</span>"
-                      : std::string("<span class=pass>none crashed, produced NaN/Inf, a black frame or a validation message</span>"))
+      << " exact</span> against the analytic answer, " << (cases.size() - exact - wrong)
+      << " unchecked (no analytic answer), " << (wrong ? "<span class=fail>" : "") << wrong << " wrong"
+      << (wrong ? "</span>" : "") << ". Runs: "
+      << (failedCases
+              ? "<span class=fail>" + std::to_string(failedCases) +
+                    " with a crash, NaN/Inf, black frame or validation message</span>"
+              : std::string(
+                    "<span class=pass>none crashed, produced NaN/Inf, a black frame or a validation message</span>"))
       << ".</p><p>Each case runs through the double reference, the analytic oracle (where the scene is"
          " spheres, quads and boxes under directional lights), and each backend at its defaults and at"
          " its best bias (searched in its own configuration over depth × slope, never worse than the defaults)."
          " A backend's state: <span class=st-clean>clean</span> (false and missed shadow both ≤ "
-      << compare::formatPercent(compare::kBiasWindowMaxRate) << " of the counted pixels), <span class=st-acne>acne x%</span> (false shadow),"
+      << compare::formatPercent(compare::kBiasWindowMaxRate)
+      << " of the counted pixels), <span class=st-acne>acne x%</span> (false shadow),"
          " <span class=st-leaks>leaks y%</span> (missed shadow: light leaking, peter-panning),"
          " <span class=st-acne-leaks>both</span>, and at the best bias <span class=st-stiff>stiff</span>: no searched"
-         " bias makes it clean. <span class=st-failed>failed</span>: crash, NaN/Inf, black frame or validation messages."
+         " bias makes it clean. <span class=st-failed>failed</span>: crash, NaN/Inf, black frame or validation "
+         "messages."
          "</p><table class=st><tr><th>case</th><th>reference</th><th>raster at defaults</th><th>raster at best</th>"
          "<th>raytrace at defaults</th><th>raytrace at best</th><th>raster window</th><th>raytrace window</th></tr>";
     for (const StabilityCase& c : cases) {
@@ -490,9 +518,11 @@ void writeStabilityReport(const fs::path& dir, const std::vector<StabilityCase>&
     }
     h << "</table>" << compare::html::diffLegend();
     for (const StabilityCase& c : cases) {
-        h << "<section id=\"" << compare::escapeHtml(c.name) << "\"><h2>" << compare::escapeHtml(c.name) << "</h2><table class=st><tr>"
+        h << "<section id=\"" << compare::escapeHtml(c.name) << "\"><h2>" << compare::escapeHtml(c.name)
+          << "</h2><table class=st><tr>"
           << "<th>reference</th><th>raster at defaults</th><th>raster at best</th><th>raytrace at defaults</th>"
-             "<th>raytrace at best</th></tr><tr>" << referenceCell(c.referenceVerdict());
+             "<th>raytrace at best</th></tr><tr>"
+          << referenceCell(c.referenceVerdict());
         for (const scene::Backend backend : {scene::Backend::Raster, scene::Backend::Raytrace})
             for (const char* variant : {"defaults", "best"})
                 h << stateCell(stateOf(c.run(backend, variant), std::string(variant) == "best"));
@@ -500,22 +530,26 @@ void writeStabilityReport(const fs::path& dir, const std::vector<StabilityCase>&
         if (!c.description.empty()) h << "<p>" << compare::escapeHtml(c.description) << "</p>";
         for (const std::string& f : c.failures) h << "<p class=fail>" << compare::escapeHtml(f) << "</p>";
         h << "<p>Reference: " << fmt(c.referenceMs) << " ms, " << c.referenceHealth.total() << " NaN/Inf. Analytic: "
-          << compare::escapeHtml(c.analytic ? c.analytic->summary() : "not analytic (" + c.notAnalytic + ")") << ".</p>";
+          << compare::escapeHtml(c.analytic ? c.analytic->summary() : "not analytic (" + c.notAnalytic + ")")
+          << ".</p>";
         h << "<table class=st><tr><th>backend</th><th>settings</th><th>state</th><th>NaN/Inf</th><th>acne</th>"
              "<th>leak</th><th>time ms</th></tr>";
         for (const BackendRun& r : c.runs)
-            h << "<tr><td>" << scene::toString(r.backend) << "</td><td>" << compare::escapeHtml(r.variant + ": " + r.settings) << "</td>"
-              << stateCell(stateOf(&r, r.variant == "best")) << "<td>"
-              << r.health.total() << "</td><td>" << fmt(100 * r.falseShadowRate, 3) << "%</td><td>"
-              << fmt(100 * r.missedShadowRate, 3) << "%</td><td>" << fmt(r.timeMs) << "</td></tr>";
+            h << "<tr><td>" << scene::toString(r.backend) << "</td><td>"
+              << compare::escapeHtml(r.variant + ": " + r.settings) << "</td>"
+              << stateCell(stateOf(&r, r.variant == "best")) << "<td>" << r.health.total() << "</td><td>"
+              << fmt(100 * r.falseShadowRate, 3) << "%</td><td>" << fmt(100 * r.missedShadowRate, 3) << "%</td><td>"
+              << fmt(r.timeMs) << "</td></tr>";
         h << "</table>";
         for (const MethodBias& b : c.bias)
-            h << "<p><b>" << scene::toString(b.backend) << "</b> (probe slice): " << compare::escapeHtml(windowText(&b)) << ". " << compare::escapeHtml(b.text) << "</p>";
+            h << "<p><b>" << scene::toString(b.backend) << "</b> (probe slice): " << compare::escapeHtml(windowText(&b))
+              << ". " << compare::escapeHtml(b.text) << "</p>";
         for (const std::string& note : c.bestNotes) h << "<p>" << compare::escapeHtml(note) << "</p>";
         h << "<div class=figs>";
         // Every image at one width (figures in a flex row would shrink to their captions), small
         // renders magnified with crisp pixels so their shadows can be seen.
-        const std::string size = "width=320 height=" + std::to_string(std::max(1, 320 * c.height / std::max(1, c.width)));
+        const std::string size =
+            "width=320 height=" + std::to_string(std::max(1, 320 * c.height / std::max(1, c.width)));
         if (c.referenceOk && !c.reference.beauty.empty()) {
             const std::string png = "stability/" + c.name + "-reference.png";
             scene::writePngLinear(dir / png, c.width, c.height, c.reference.beauty);
@@ -524,11 +558,12 @@ void writeStabilityReport(const fs::path& dir, const std::vector<StabilityCase>&
         }
         for (const BackendRun& r : c.runs) {
             if (r.diffRgb.empty()) continue;
-            const std::string png =
-                "stability/" + c.name + "-" + scene::toString(r.backend) + (r.variant == "defaults" ? "" : "-" + r.variant) + "-diff.png";
+            const std::string png = "stability/" + c.name + "-" + scene::toString(r.backend) +
+                                    (r.variant == "defaults" ? "" : "-" + r.variant) + "-diff.png";
             scene::writePngDisplay(dir / png, c.width, c.height, r.diffRgb);
-            h << "<figure><img src=\"" << png << "\" " << size << " class=upscale alt=\"" << scene::toString(r.backend) << " difference\"><figcaption>"
-              << scene::toString(r.backend) << " at " << r.variant << " vs reference</figcaption></figure>";
+            h << "<figure><img src=\"" << png << "\" " << size << " class=upscale alt=\"" << scene::toString(r.backend)
+              << " difference\"><figcaption>" << scene::toString(r.backend) << " at " << r.variant
+              << " vs reference</figcaption></figure>";
         }
         h << "</div></section>";
     }
@@ -537,8 +572,7 @@ void writeStabilityReport(const fs::path& dir, const std::vector<StabilityCase>&
     scene::writeTextAtomic(dir / "stability.csv", stabilityCsv(cases));
     Json all = Json::array();
     for (const StabilityCase& c : cases) all.push_back(toJson(c));
-    scene::writeTextAtomic(dir / "stability.json",
-                           Json{{"passed", suitePassed(cases)}, {"cases", all}}.dump(2) + "\n");
+    scene::writeTextAtomic(dir / "stability.json", Json{{"passed", suitePassed(cases)}, {"cases", all}}.dump(2) + "\n");
 }
 
 }  // namespace shadowlab::studies

@@ -14,12 +14,12 @@
 
 #include <nlohmann/json.hpp>
 
-#include "studies/analytic.h"
 #include "compare/compare.h"
-#include "studies/recommend.h"
-#include "studies/sweep.h"
 #include "scene/frame.h"
 #include "scene/scene.h"
+#include "studies/analytic.h"
+#include "studies/recommend.h"
+#include "studies/sweep.h"
 
 namespace shadowlab::studies {
 
@@ -28,30 +28,30 @@ namespace shadowlab::studies {
 inline constexpr float kBlackFrameMax = 1e-4f;
 
 struct StabilityOptions {
-    int width = 160, height = 90;          // every render of the case
-    std::optional<int> shadowMapSize;      // overrides the default settings' map size (tests: 512)
-    bool search = true;                    // run the bias search and the best-settings renders
-    bool quick = true;                     // defaultGrid(scene, quick)
+    int width = 160, height = 90;      // every render of the case
+    std::optional<int> shadowMapSize;  // overrides the default settings' map size (tests: 512)
+    bool search = true;                // run the bias search and the best-settings renders
+    bool quick = true;                 // defaultGrid(scene, quick)
     // Keep only the bias series and robust rows of the grid (drop the map-size × filter block),
     // and use this map size for the raster series (0: the grid's own): the tests' small search.
     bool biasSeriesOnly = false;
     int searchMapSize = 0;
-    bool validate = false;                 // Vulkan validation on every raster render
+    bool validate = false;  // Vulkan validation on every raster render
     // The "best" renders use the recommendation searched in the case's own configuration
     // (studies/recommend.h: depth × slope, never worse than the defaults); these are its grids.
     std::vector<double> bestDepthSteps = RecommendOptions{}.depthSteps;
     std::vector<double> bestSlopeSteps = RecommendOptions{}.slopeSteps;
     std::vector<scene::Backend> backends{scene::Backend::Raster, scene::Backend::Raytrace};
-    RenderFn render = renderWithBackend;   // tests may pass a fake
+    RenderFn render = renderWithBackend;  // tests may pass a fake
 };
 
 // One backend render of the case and what it measured.
 struct BackendRun {
     scene::Backend backend = scene::Backend::Raster;  // Raster or Raytrace
-    std::string variant;     // "defaults" | "best"
-    std::string settings;    // short text of the overrides applied
-    bool ok = false;         // rendered without throwing
-    std::string error;       // the exception's message when !ok
+    std::string variant;                              // "defaults" | "best"
+    std::string settings;                             // short text of the overrides applied
+    bool ok = false;                                  // rendered without throwing
+    std::string error;                                // the exception's message when !ok
     bool blackFrame = false;
     compare::FrameHealth health;
     int validationMessages = -1;  // -1 when the frame does not say
@@ -65,11 +65,11 @@ struct BackendRun {
 // The bias search's verdict for one method: a window, or "stiff" with what dominates.
 struct MethodBias {
     scene::Backend backend = scene::Backend::Raster;  // Raster or Raytrace
-    bool stiff = true;       // no series of this backend has a window
-    std::string kind;        // the series the verdict comes from ("depth", "slope", "ray")
+    bool stiff = true;                                // no series of this backend has a window
+    std::string kind;                                 // the series the verdict comes from ("depth", "slope", "ray")
     double lo = 0.0, hi = 0.0, recommended = 0.0;
-    std::string dominant;    // when stiff: "false" (acne) or "missed" (leaks)
-    std::string text;        // BiasSeries::describe() of each series, joined
+    std::string dominant;  // when stiff: "false" (acne) or "missed" (leaks)
+    std::string text;      // BiasSeries::describe() of each series, joined
 };
 
 // What a backend's shadows look like in one run, for the page's colored columns: "clean" (both
@@ -94,11 +94,11 @@ struct StabilityCase {
     scene::Frame reference;   // kept for the report's images
     std::string notAnalytic;  // why there is no analytic answer; empty when there is one
     std::optional<AnalyticCheck> analytic;
-    std::vector<BackendRun> runs;       // defaults first, then best
-    std::vector<MethodBias> bias;       // one per backend when searched
+    std::vector<BackendRun> runs;  // defaults first, then best
+    std::vector<MethodBias> bias;  // one per backend when searched
     nlohmann::json bestShadowBlock = nlohmann::json::object();
     std::vector<std::string> bestNotes;  // the recommendation's sentences (what it searched and measured)
-    std::vector<std::string> failures;  // why the case FAILs; empty: PASS
+    std::vector<std::string> failures;   // why the case FAILs; empty: PASS
 
     bool failed() const { return !failures.empty(); }
     // The reference's verdict: "exact" (matches the analytic answer), "wrong" (misses it, failed,
@@ -110,8 +110,8 @@ struct StabilityCase {
 
 // Never throws for a render failure (recorded in the case); throws scene::InputError for bad
 // options. `description` is shown in the report.
-StabilityCase runStabilityCase(const scene::Scene& scene, const StabilityOptions& options,
-                               const std::string& name = "", const std::string& description = "");
+StabilityCase runStabilityCase(const scene::Scene& scene, const StabilityOptions& options, const std::string& name = "",
+                               const std::string& description = "");
 
 // Every scenes/extreme/*.json under scene::scenesDirectory(), sorted by name.
 std::vector<std::filesystem::path> extremeSceneFiles();

@@ -1,23 +1,21 @@
 // studies/sweep.cpp: the sweep runner: grid, timing, the append-only journal and resume.
 #include "studies/sweep.h"
 
+#include <fcntl.h>
+#include <unistd.h>
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cerrno>
 #include <csignal>
-#include <fcntl.h>
+#include <cstdio>
 #include <fstream>
 #include <memory>
 #include <set>
 #include <sstream>
 #include <stdexcept>
-#include <unistd.h>
 
 #include "compare/compare.h"
-#include "studies/backend.h"
-#include "studies/machine.h"
 #include "scene/append_line.h"
 #include "scene/backend.h"
 #include "scene/error.h"
@@ -26,6 +24,8 @@
 #include "scene/input_file.h"
 #include "scene/json_input.h"
 #include "scene/render_plan.h"
+#include "studies/backend.h"
+#include "studies/machine.h"
 
 namespace shadowlab::studies {
 
@@ -341,7 +341,8 @@ SweepGrid defaultGrid(const scene::Scene& scene, bool quick) {
     // The filterable maps, one row each at their default parameters beside pcf2x2 of the largest
     // size (the same map), so the error-vs-time plot shows which technique buys the most per
     // millisecond; their parameter windows are a grid file's axes (docs/sweep.md).
-    for (const char* filter : {"vsm", "evsm2", "evsm4", "esm", "msm"}) g.configs.push_back(raster(sizes.back(), filter));
+    for (const char* filter : {"vsm", "evsm2", "evsm4", "esm", "msm"})
+        g.configs.push_back(raster(sizes.back(), filter));
     // The map fitted to what the camera sees (the default fitting, one cascade) against the
     // bounding-sphere maps above, at each size: what the fitted frustum gains on this view.
     for (int size : sizes) {
@@ -363,8 +364,8 @@ SweepGrid defaultGrid(const scene::Scene& scene, bool quick) {
         g.configs.push_back(c);
     }
     // No zero here: depth 0 + slope 0 is the first point of the depth series, shared by both.
-    const std::vector<double> slopes = quick ? std::vector<double>{0.5, 2, 8}
-                                             : std::vector<double>{0.25, 0.5, 1, 2, 4, 8, 16};
+    const std::vector<double> slopes =
+        quick ? std::vector<double>{0.5, 2, 8} : std::vector<double>{0.25, 0.5, 1, 2, 4, 8, 16};
     for (double s : slopes) {
         SweepConfig c = raster(biasMapSize, "none");
         c.overrides.depthBias = 0.0;
@@ -375,7 +376,8 @@ SweepGrid defaultGrid(const scene::Scene& scene, bool quick) {
     }
 
     // The lesson's constant ray bias in float, from none to a tenth of the scene.
-    const std::vector<int> decades = quick ? std::vector<int>{-8, -6, -4, -2} : std::vector<int>{-9, -8, -7, -6, -5, -4, -3, -2, -1};
+    const std::vector<int> decades =
+        quick ? std::vector<int>{-8, -6, -4, -2} : std::vector<int>{-9, -8, -7, -6, -5, -4, -3, -2, -1};
     std::vector<double> rayBiases{0.0};
     for (int d : decades) rayBiases.push_back(extent * std::pow(10.0, d));
     for (double b : rayBiases) {
@@ -419,8 +421,9 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
     for (const auto& [key, value] : doc.items()) {
         if (key != "repetitions" && key != "resolution" && !backendBlock(key) && key != "include_default" &&
             key != "flicker")
-            throw SceneError(file, root / key,
-                             "unknown key; allowed: repetitions, resolution, raster, raytrace, include_default, flicker");
+            throw SceneError(
+                file, root / key,
+                "unknown key; allowed: repetitions, resolution, raster, raytrace, include_default, flicker");
     }
     if (doc.contains("repetitions")) {
         const Json& r = doc["repetitions"];
@@ -435,7 +438,8 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
         const Json& res = doc["resolution"];
         if (!res.is_string() || std::sscanf(res.get<std::string>().c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 ||
             x != 'x' || w < 1 || h < 1 || w > 16384 || h > 16384)
-            throw SceneError(file, root / "resolution", "expected \"WxH\" with sides in 1..16384, got " + scene::describeJson(res));
+            throw SceneError(file, root / "resolution",
+                             "expected \"WxH\" with sides in 1..16384, got " + scene::describeJson(res));
         g.resolution = res.get<std::string>();
     }
     if (doc.contains("flicker")) {
@@ -448,7 +452,8 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
             PathSpec p = defaultFlickerPath();
             for (const auto& [k, v] : f.items()) {
                 if (k == "kind") {
-                    if (!v.is_string()) throw SceneError(file, at / k, "expected a path kind, got " + scene::describeJson(v));
+                    if (!v.is_string())
+                        throw SceneError(file, at / k, "expected a path kind, got " + scene::describeJson(v));
                     try {
                         p.kind = parsePathKind(v.get<std::string>());
                     } catch (const scene::InputError& e) {
@@ -456,8 +461,9 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
                     }
                 } else if (k == "frames") {
                     if (!v.is_number_integer() || v.get<long long>() < 2 || v.get<long long>() > 64)
-                        throw SceneError(file, at / k, "expected an integer in 2..64 (every row renders them), got " +
-                                                           scene::describeJson(v));
+                        throw SceneError(
+                            file, at / k,
+                            "expected an integer in 2..64 (every row renders them), got " + scene::describeJson(v));
                     p.frames = v.get<int>();
                 } else if (k == "amount") {
                     if (!v.is_number() || !std::isfinite(v.get<double>()))
@@ -476,8 +482,9 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
             }
             g.flicker = p;
         } else {
-            throw SceneError(file, at, "expected true, false or an object {kind, frames, amount, light}, got " +
-                                           scene::describeJson(f));
+            throw SceneError(
+                file, at,
+                "expected true, false or an object {kind, frames, amount, light}, got " + scene::describeJson(f));
         }
         if (g.flicker) {
             try {
@@ -488,7 +495,8 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
         }
     }
     if (doc.contains("include_default") && !doc["include_default"].is_boolean())
-        throw SceneError(file, root / "include_default", "expected true or false, got " + scene::describeJson(doc["include_default"]));
+        throw SceneError(file, root / "include_default",
+                         "expected true or false, got " + scene::describeJson(doc["include_default"]));
     if (doc.value("include_default", false)) g.configs = defaultGrid(scene, false).configs;
 
     // Each backend block holds axes (arrays); the grid is their cartesian product.
@@ -508,12 +516,24 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
         const JsonPath path = root / section;
         if (!block.is_object()) throw SceneError(file, path, "expected an object of axes");
         const bool isRaster = backend == scene::Backend::Raster;
-        const std::vector<const char*> names = isRaster
-            ? std::vector<const char*>{"shadow_map_size", "filter", "cascades", "cascade_blend", "fit_light_frustum",
-                                       "snap_light_frustum", "receiver_plane_bias", "hardware_bias", "depth_bias",
-                                       "slope_bias", "min_variance", "bleeding_reduction", "evsm_positive",
-                                       "evsm_negative", "esm_exponent", "moment_bias", "blur_width"}
-            : std::vector<const char*>{"ray_bias", "precision", "samples"};
+        const std::vector<const char*> names = isRaster ? std::vector<const char*>{"shadow_map_size",
+                                                                                   "filter",
+                                                                                   "cascades",
+                                                                                   "cascade_blend",
+                                                                                   "fit_light_frustum",
+                                                                                   "snap_light_frustum",
+                                                                                   "receiver_plane_bias",
+                                                                                   "hardware_bias",
+                                                                                   "depth_bias",
+                                                                                   "slope_bias",
+                                                                                   "min_variance",
+                                                                                   "bleeding_reduction",
+                                                                                   "evsm_positive",
+                                                                                   "evsm_negative",
+                                                                                   "esm_exponent",
+                                                                                   "moment_bias",
+                                                                                   "blur_width"}
+                                                        : std::vector<const char*>{"ray_bias", "precision", "samples"};
         for (const auto& [key, value] : block.items())
             if (std::none_of(names.begin(), names.end(), [&](const char* n) { return key == n; }))
                 throw SceneError(file, path / key, "unknown axis for " + section);
@@ -540,44 +560,56 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
                     const std::string n = name;
                     auto num = [&](double lo) {
                         if (!v.is_number() || !std::isfinite(v.get<double>()) || v.get<double>() < lo)
-                            throw SceneError(file, at, "expected a number >= " + number(lo) + ", got " + scene::describeJson(v));
+                            throw SceneError(file, at,
+                                             "expected a number >= " + number(lo) + ", got " + scene::describeJson(v));
                         return v.get<double>();
                     };
                     if (n == "shadow_map_size") {
                         if (!v.is_number_integer() || v.get<long long>() < 16 || v.get<long long>() > 16384)
-                            throw SceneError(file, at, "expected an integer in 16..16384, got " + scene::describeJson(v));
+                            throw SceneError(file, at,
+                                             "expected an integer in 16..16384, got " + scene::describeJson(v));
                         c.overrides.shadowMapSize = v.get<int>();
                     } else if (n == "filter") {
                         const std::string f = v.is_string() ? v.get<std::string>() : std::string();
-                        static const char* kFilters[] = {"none", "pcf2x2", "pcf", "poisson", "pcss", "vsm",
-                                                         "evsm2", "evsm4", "esm", "msm"};
-                        if (std::none_of(std::begin(kFilters), std::end(kFilters), [&](const char* k) { return f == k; }))
-                            throw SceneError(file, at, "expected \"none\", \"pcf2x2\", \"pcf\", \"poisson\", \"pcss\", "
-                                                       "\"vsm\", \"evsm2\", \"evsm4\", \"esm\" or \"msm\", got " +
-                                                           scene::describeJson(v));
+                        static const char* kFilters[] = {"none", "pcf2x2", "pcf",   "poisson", "pcss",
+                                                         "vsm",  "evsm2",  "evsm4", "esm",     "msm"};
+                        if (std::none_of(std::begin(kFilters), std::end(kFilters),
+                                         [&](const char* k) { return f == k; }))
+                            throw SceneError(file, at,
+                                             "expected \"none\", \"pcf2x2\", \"pcf\", \"poisson\", \"pcss\", "
+                                             "\"vsm\", \"evsm2\", \"evsm4\", \"esm\" or \"msm\", got " +
+                                                 scene::describeJson(v));
                         c.overrides.filter = f;
                     } else if (n == "cascade_blend") {
                         const double b = num(0.0);
                         if (b > scene::kMaxCascadeBlend)
-                            throw SceneError(file, at, "expected a number in 0..0.5 (a fraction of a slice), got " +
-                                                           scene::describeJson(v));
+                            throw SceneError(
+                                file, at,
+                                "expected a number in 0..0.5 (a fraction of a slice), got " + scene::describeJson(v));
                         c.overrides.cascadeBlend = b;
                     } else if (n == "fit_light_frustum") {
-                        if (!v.is_boolean()) throw SceneError(file, at, "expected true or false, got " + scene::describeJson(v));
+                        if (!v.is_boolean())
+                            throw SceneError(file, at, "expected true or false, got " + scene::describeJson(v));
                         c.overrides.fitLightFrustum = v.get<bool>();
                     } else if (n == "snap_light_frustum") {
-                        if (!v.is_boolean()) throw SceneError(file, at, "expected true or false, got " + scene::describeJson(v));
+                        if (!v.is_boolean())
+                            throw SceneError(file, at, "expected true or false, got " + scene::describeJson(v));
                         c.overrides.snapLightFrustum = v.get<bool>();
                     } else if (n == "cascades") {
-                        if (!v.is_number_integer() || v.get<long long>() < 1 || v.get<long long>() > scene::kMaxCascades)
-                            throw SceneError(file, at, "expected an integer in 1.." + std::to_string(scene::kMaxCascades) +
-                                                           " (cascaded shadow maps per directional light), got " + scene::describeJson(v));
+                        if (!v.is_number_integer() || v.get<long long>() < 1 ||
+                            v.get<long long>() > scene::kMaxCascades)
+                            throw SceneError(file, at,
+                                             "expected an integer in 1.." + std::to_string(scene::kMaxCascades) +
+                                                 " (cascaded shadow maps per directional light), got " +
+                                                 scene::describeJson(v));
                         c.overrides.cascades = v.get<int>();
                     } else if (n == "receiver_plane_bias") {
-                        if (!v.is_boolean()) throw SceneError(file, at, "expected true or false, got " + scene::describeJson(v));
+                        if (!v.is_boolean())
+                            throw SceneError(file, at, "expected true or false, got " + scene::describeJson(v));
                         c.overrides.receiverPlaneBias = v.get<bool>();
                     } else if (n == "hardware_bias") {
-                        if (!v.is_boolean()) throw SceneError(file, at, "expected true or false, got " + scene::describeJson(v));
+                        if (!v.is_boolean())
+                            throw SceneError(file, at, "expected true or false, got " + scene::describeJson(v));
                         c.overrides.hardwareBias = v.get<bool>();
                     } else if (n == "depth_bias") {
                         c.overrides.depthBias = num(0.0);
@@ -593,24 +625,28 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
                         // A filterable map's own parameter: ranges as resolveSettings checks them
                         // (below); an axis of several values is the series its window is read from.
                         if (n == "blur_width") {
-                            if (!v.is_number_integer() || v.get<long long>() < 1 || v.get<long long>() > scene::kMaxBlurWidth ||
-                                v.get<long long>() % 2 == 0)
-                                throw SceneError(file, at, "expected an odd integer in 1.." + std::to_string(scene::kMaxBlurWidth) +
-                                                               " (texels), got " + scene::describeJson(v));
+                            if (!v.is_number_integer() || v.get<long long>() < 1 ||
+                                v.get<long long>() > scene::kMaxBlurWidth || v.get<long long>() % 2 == 0)
+                                throw SceneError(file, at,
+                                                 "expected an odd integer in 1.." +
+                                                     std::to_string(scene::kMaxBlurWidth) + " (texels), got " +
+                                                     scene::describeJson(v));
                             c.overrides.blurWidth = v.get<int>();
                         } else {
                             // The ranges resolveSettings() accepts (scene/settings.cpp), checked
                             // here so a bad value is named with its JSON path.
                             const double hi = n == "min_variance" || n == "moment_bias" ? 1.0
-                                              : n == "bleeding_reduction"              ? 0.99
-                                              : n == "esm_exponent"                    ? scene::kMaxEsmExponent
-                                                                                       : scene::kMaxEvsmExponent;
+                                              : n == "bleeding_reduction"               ? 0.99
+                                              : n == "esm_exponent"                     ? scene::kMaxEsmExponent
+                                                                                        : scene::kMaxEvsmExponent;
                             const double x = num(0.0);
                             if (x > hi)
-                                throw SceneError(file, at, "expected a number in 0.." + number(hi) + ", got " +
-                                                               scene::describeJson(v));
+                                throw SceneError(
+                                    file, at,
+                                    "expected a number in 0.." + number(hi) + ", got " + scene::describeJson(v));
                             momentOverride(c.overrides, n) = x;
-                            if (values.size() > 1 && (c.biasKind.empty() || isFilterableName(c.overrides.filter.value_or("")))) {
+                            if (values.size() > 1 &&
+                                (c.biasKind.empty() || isFilterableName(c.overrides.filter.value_or("")))) {
                                 c.biasKind = n;
                                 c.biasValue = x;
                             }
@@ -625,11 +661,13 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
                         }
                     } else if (n == "precision") {
                         if (!v.is_string() || (v.get<std::string>() != "float" && v.get<std::string>() != "double"))
-                            throw SceneError(file, at, "expected \"float\" or \"double\", got " + scene::describeJson(v));
+                            throw SceneError(file, at,
+                                             "expected \"float\" or \"double\", got " + scene::describeJson(v));
                         c.overrides.precision = v.get<std::string>();
                     } else if (n == "samples") {
                         if (!v.is_number_integer() || v.get<long long>() < 1 || v.get<long long>() > 65536)
-                            throw SceneError(file, at, "expected an integer in 1..65536, got " + scene::describeJson(v));
+                            throw SceneError(file, at,
+                                             "expected an integer in 1..65536, got " + scene::describeJson(v));
                         c.overrides.samples = v.get<int>();
                     }
                     next.push_back(c);
@@ -637,8 +675,9 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
             configs = std::move(next);
         }
         if (g.configs.size() + configs.size() > kMaxGridConfigurations)
-            throw SceneError(file, path, "the grid would have more than " + std::to_string(kMaxGridConfigurations) +
-                                             " configurations");
+            throw SceneError(
+                file, path,
+                "the grid would have more than " + std::to_string(kMaxGridConfigurations) + " configurations");
         g.configs.insert(g.configs.end(), configs.begin(), configs.end());
     }
     if (g.configs.empty()) throw SceneError(file, root, "the grid is empty: give a \"raster\" or \"raytrace\" block");
@@ -647,7 +686,8 @@ SweepGrid loadGrid(const fs::path& file, const scene::Scene& scene) {
         try {
             scene::resolveSettings(scene, g.configs[i].overrides);
         } catch (const scene::InputError& e) {
-            throw SceneError(file, root / scene::toString(g.configs[i].backend), std::string("configuration ") + g.configs[i].label() + ": " + e.what());
+            throw SceneError(file, root / scene::toString(g.configs[i].backend),
+                             std::string("configuration ") + g.configs[i].label() + ": " + e.what());
         }
     }
     return g;
@@ -691,9 +731,12 @@ std::vector<const scene::Frame*> pointersTo(const std::vector<scene::Frame>& fra
 Json temporalFigures(const compare::TemporalSummary& t) {
     Json pairs = Json::array();
     for (const compare::PairStability& p : t.pairs) pairs.push_back(p.flicker);
-    return {{"flicker_rate", t.meanFlickerRate},     {"max_flicker_rate", t.maxFlickerRate},
-            {"flicker_px", t.totalFlicker},          {"error_variation", t.meanErrorVariation},
-            {"swim_px", t.meanSwimPixels},           {"edge_offset_px", t.meanEdgeOffset},
+    return {{"flicker_rate", t.meanFlickerRate},
+            {"max_flicker_rate", t.maxFlickerRate},
+            {"flicker_px", t.totalFlicker},
+            {"error_variation", t.meanErrorVariation},
+            {"swim_px", t.meanSwimPixels},
+            {"edge_offset_px", t.meanEdgeOffset},
             {"pairs", pairs}};
 }
 
@@ -755,10 +798,21 @@ std::vector<SweepRow> readJournal(const fs::path& file) {
 }
 
 std::string rowsToCsv(const std::vector<SweepRow>& rows) {
-    static const char* kMetrics[] = {"counted", "false_shadow", "missed_shadow", "false_shadow_rate",
-                                     "missed_shadow_rate", "mismatch_rate", "mean_abs_visibility_error",
-                                     "mean_abs_visibility_error_penumbra", "soft_error_rate", "shadow_iou", "self_shadow_acne_rate", "aliasing_rate", "bias_error_rate",
-                                     "silhouette_mismatch_rate", "invalid"};
+    static const char* kMetrics[] = {"counted",
+                                     "false_shadow",
+                                     "missed_shadow",
+                                     "false_shadow_rate",
+                                     "missed_shadow_rate",
+                                     "mismatch_rate",
+                                     "mean_abs_visibility_error",
+                                     "mean_abs_visibility_error_penumbra",
+                                     "soft_error_rate",
+                                     "shadow_iou",
+                                     "self_shadow_acne_rate",
+                                     "aliasing_rate",
+                                     "bias_error_rate",
+                                     "silhouette_mismatch_rate",
+                                     "invalid"};
     std::ostringstream s;
     s << "key,backend,label,shadow_map_size,filter,cascades,depth_bias,slope_bias,ray_bias,precision,samples,"
          "bias_kind,bias_value,repetitions,setup_ms,frame_ms,frame_ms_min,frame_ms_max";
@@ -766,7 +820,8 @@ std::string rowsToCsv(const std::vector<SweepRow>& rows) {
     s << ",error,machine";
     // The flicker axis's columns, only when a row has them: a sweep without it writes what it did.
     static const char* kTemporal[] = {"flicker_rate", "flicker_px", "error_variation", "swim_px", "edge_offset_px"};
-    const bool temporal = std::any_of(rows.begin(), rows.end(), [](const SweepRow& r) { return !r.temporal.is_null(); });
+    const bool temporal =
+        std::any_of(rows.begin(), rows.end(), [](const SweepRow& r) { return !r.temporal.is_null(); });
     if (temporal) {
         s << ",flicker_path";
         for (const char* t : kTemporal) s << "," << t;
@@ -777,12 +832,11 @@ std::string rowsToCsv(const std::vector<SweepRow>& rows) {
         const auto& o = r.config.overrides;
         s << csvField(r.key) << "," << scene::toString(r.config.backend) << "," << csvField(r.config.label()) << ","
           << (o.shadowMapSize ? std::to_string(*o.shadowMapSize) : "") << "," << o.filter.value_or("") << ","
-          << (o.cascades ? std::to_string(*o.cascades) : "") << ","
-          << (o.depthBias ? number(*o.depthBias) : "") << "," << (o.slopeBias ? number(*o.slopeBias) : "") << ","
-          << o.rayBias.value_or("") << "," << o.precision.value_or("") << ","
-          << (o.samples ? std::to_string(*o.samples) : "") << "," << r.config.biasKind << ","
-          << (std::isfinite(r.config.biasValue) ? number(r.config.biasValue) : "") << "," << r.repetitions << ","
-          << number(r.setupMs) << "," << number(r.frameMs) << "," << number(r.frameMsMin) << ","
+          << (o.cascades ? std::to_string(*o.cascades) : "") << "," << (o.depthBias ? number(*o.depthBias) : "") << ","
+          << (o.slopeBias ? number(*o.slopeBias) : "") << "," << o.rayBias.value_or("") << ","
+          << o.precision.value_or("") << "," << (o.samples ? std::to_string(*o.samples) : "") << ","
+          << r.config.biasKind << "," << (std::isfinite(r.config.biasValue) ? number(r.config.biasValue) : "") << ","
+          << r.repetitions << "," << number(r.setupMs) << "," << number(r.frameMs) << "," << number(r.frameMsMin) << ","
           << number(r.frameMsMax);
         for (const char* m : kMetrics) s << "," << jsonNumber(r.metrics, m);
         s << "," << csvField(r.error) << "," << csvField(machineFromJson(r.machine).host);
@@ -836,19 +890,26 @@ SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const
 
     std::error_code ec;
     if (fs::exists(journal, ec) && !options.resume)
-        throw scene::InputError(dir.string() + ": already holds a sweep (results.jsonl); use --resume to "
+        throw scene::InputError(dir.string() +
+                                ": already holds a sweep (results.jsonl); use --resume to "
                                 "continue it, or choose another folder");
     std::vector<SweepRow> done;
     if (options.resume && fs::exists(journal, ec) && !fs::exists(manifest, ec))
-        throw scene::InputError(dir.string() + ": has results.jsonl but no sweep.json, so the scene it belongs "
+        throw scene::InputError(dir.string() +
+                                ": has results.jsonl but no sweep.json, so the scene it belongs "
                                 "to is unknown; choose another folder");
     if (options.resume && fs::exists(manifest, ec)) {
         const std::string manifestText = scene::readInputFile(manifest, scene::kMaxJsonFileBytes);
         Json old;
-        try { old = scene::parseJsonText(manifest, manifestText); } catch (const std::exception&) { old = nullptr; }
+        try {
+            old = scene::parseJsonText(manifest, manifestText);
+        } catch (const std::exception&) {
+            old = nullptr;
+        }
         if (old != identity)
-            throw scene::InputError(dir.string() + ": holds a sweep of another scene or resolution (" +
-                                    (old.is_null() ? std::string("unreadable sweep.json") : scene::describeJson(old, 200)) + ")");
+            throw scene::InputError(
+                dir.string() + ": holds a sweep of another scene or resolution (" +
+                (old.is_null() ? std::string("unreadable sweep.json") : scene::describeJson(old, 200)) + ")");
         scene::removeStaleTemporaries(dir);
         scene::removeStaleTemporaries(dir / "images");
         done = readJournal(journal);
@@ -870,8 +931,8 @@ SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const
     if (options.resume && fs::exists(refFile, ec)) {
         try {
             result.reference = scene::readFrame(refFile);
-            haveReference = result.reference.width == scene.camera.width &&
-                            result.reference.height == scene.camera.height;
+            haveReference =
+                result.reference.width == scene.camera.width && result.reference.height == scene.camera.height;
         } catch (const std::exception&) {
             haveReference = false;
         }
@@ -965,7 +1026,8 @@ SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const
             const compare::Comparison c = compare::compareFrames(frame, result.reference);
             row.metrics = toJson(c.metrics);
             if (grid.flicker)
-                row.temporal = rowTemporal(options, *grid.flicker, pathFrames, pathReferencesReady(), settings, config.backend);
+                row.temporal =
+                    rowTemporal(options, *grid.flicker, pathFrames, pathReferencesReady(), settings, config.backend);
             row.settings = frame.attributes;
             if (options.writeImages) {
                 const std::string name = std::string(scene::toString(config.backend)) + "-" + shortHash(key);

@@ -13,11 +13,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include "studies/path.h"
 #include "scene/backend.h"
 #include "scene/frame.h"
 #include "scene/scene.h"
 #include "scene/settings.h"
+#include "studies/path.h"
 
 namespace shadowlab::studies {
 
@@ -83,28 +83,27 @@ struct SweepRow {
     SweepConfig config;
     std::string key;
     int repetitions = 0;
-    double setupMs = 0.0;                  // median over the runs
-    double frameMs = 0.0;                  // median per-frame time (total − setup)
+    double setupMs = 0.0;  // median over the runs
+    double frameMs = 0.0;  // median per-frame time (total − setup)
     double frameMsMin = 0.0, frameMsMax = 0.0;
-    nlohmann::json metrics;                // compare::toJson of the last run, or null on error
-    nlohmann::json settings;               // the settings applied (Frame attributes)
-    std::string error;                     // non-empty when the configuration failed
-    std::string image, diffImage;          // file names under DIR/images/
-    nlohmann::json machine;                // toJson(MachineInfo) it was timed on; null in old journals
+    nlohmann::json metrics;        // compare::toJson of the last run, or null on error
+    nlohmann::json settings;       // the settings applied (Frame attributes)
+    std::string error;             // non-empty when the configuration failed
+    std::string image, diffImage;  // file names under DIR/images/
+    nlohmann::json machine;        // toJson(MachineInfo) it was timed on; null in old journals
     // With a flicker axis: the row along the path (flicker_rate, flicker_px, error_variation,
     // swim_px, edge_offset_px, pairs; "held": the same for the raster held view on camera paths).
     // Null without one.
     nlohmann::json temporal;
 
-    double rate(const char* name) const;   // a metrics rate, NaN when absent
+    double rate(const char* name) const;  // a metrics rate, NaN when absent
     // A temporal figure (`held`: of the raster held view), NaN when absent.
     double temporalValue(const char* name, bool held = false) const;
 };
 
 // Renders one configuration (or the reference); tests pass fakes. The default renders through
 // the backend seam (studies/backend.h) and records the scene's identity in the Frame.
-using RenderFn =
-    std::function<scene::Frame(const scene::Scene&, const scene::RenderSettings&, scene::Backend backend)>;
+using RenderFn = std::function<scene::Frame(const scene::Scene&, const scene::RenderSettings&, scene::Backend backend)>;
 scene::Frame renderWithBackend(const scene::Scene& scene, const scene::RenderSettings& settings,
                                scene::Backend backend);
 

@@ -8,11 +8,11 @@
 #include <map>
 #include <sstream>
 
-#include "studies/machine.h"
 #include "compare/pareto.h"
 #include "compare/svg_plot.h"
 #include "compare/text.h"
 #include "scene/frame_io.h"
+#include "studies/machine.h"
 
 namespace shadowlab::studies {
 
@@ -20,7 +20,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
-
 
 // A row that rendered and was measured: it is plotted and ranked; the others are listed.
 bool usable(const SweepRow& r) {
@@ -55,7 +54,7 @@ std::string settingsOf(const SweepRow& r) {
         const double v = std::strtod(o.rayBias->c_str(), &end);
         parts.push_back(*o.rayBias == "robust" ? std::string("robust offset")
                         : end && *end == '\0'  ? "ray bias " + num(v)
-                                                : "ray bias " + *o.rayBias);
+                                               : "ray bias " + *o.rayBias);
     }
     if (o.precision) parts.push_back(*o.precision);
     if (o.samples) parts.push_back(std::to_string(*o.samples) + " samples");
@@ -193,13 +192,12 @@ compare::ScatterPlot biasSeriesPlot(const BiasSeries& s) {
     return p;
 }
 
-std::string rowTitle(const SweepRow& r) {
-    return settingsOf(r).empty() ? "defaults" : settingsOf(r);
-}
+std::string rowTitle(const SweepRow& r) { return settingsOf(r).empty() ? "defaults" : settingsOf(r); }
 
 std::string ratesNote(const SweepRow& r) {
-    return compare::formatPercent(r.rate("false_shadow_rate")) + " false, " + compare::formatPercent(r.rate("missed_shadow_rate")) +
-           " missed · " + compare::formatDuration(r.frameMs) + " per frame";
+    return compare::formatPercent(r.rate("false_shadow_rate")) + " false, " +
+           compare::formatPercent(r.rate("missed_shadow_rate")) + " missed · " + compare::formatDuration(r.frameMs) +
+           " per frame";
 }
 
 // One configuration: caption, its image and difference image side by side, and the zooms.
@@ -208,17 +206,21 @@ std::string configCard(const SweepRow& r, const std::string& tag, const SweepRep
     const compare::ErrorHotspot hot = hotspotOf(r);
     std::ostringstream o;
     o << "<div class=\"cfg\"><div class=\"cfghead\"><span class=\"tag " << tag << "\">" << tag << "</span> <b>"
-      << compare::escapeHtml(rowTitle(r)) << "</b><div class=\"small\">" << compare::escapeHtml(ratesNote(r)) << "</div></div>"
+      << compare::escapeHtml(rowTitle(r)) << "</b><div class=\"small\">" << compare::escapeHtml(ratesNote(r))
+      << "</div></div>"
       << "<div class=\"pair\">";
     if (!r.image.empty()) o << compare::html::figure("image", "", r.image, f, nullptr);
     if (!r.diffImage.empty())
-        o << compare::html::figure("difference", compare::formatPercent(r.rate("mismatch_rate")) + " wrong", r.diffImage, f, &hot);
+        o << compare::html::figure("difference", compare::formatPercent(r.rate("mismatch_rate")) + " wrong",
+                                   r.diffImage, f, &hot);
     o << "</div>";
-    if (hot.wrongPixels > 0 && hot.size > 0 && f.width > 0 && f.height > 0 && !r.image.empty() && !r.diffImage.empty()) {
+    if (hot.wrongPixels > 0 && hot.size > 0 && f.width > 0 && f.height > 0 && !r.image.empty() &&
+        !r.diffImage.empty()) {
         o << "<div class=\"crops\">" << compare::html::zoomCrop(r.image, f, hot, rowTitle(r) + " zoom")
           << compare::html::zoomCrop(r.diffImage, f, hot, rowTitle(r) + " difference zoom")
           << "<div class=\"small\">Zoom into the " << hot.size << "×" << hot.size << " px region at (" << hot.x << ", "
-          << hot.y << ") with the most errors (" << compare::formatCount(hot.wrongPixels) << " px), marked yellow above: "
+          << hot.y << ") with the most errors (" << compare::formatCount(hot.wrongPixels)
+          << " px), marked yellow above: "
           << "the image, then its difference.</div></div>";
     } else if (hot.wrongPixels == 0) {
         o << "<div class=\"small\">No wrong pixel: nothing to zoom into.</div>";
@@ -228,7 +230,8 @@ std::string configCard(const SweepRow& r, const std::string& tag, const SweepRep
 }
 
 bool hasFlicker(const SweepReportInput& in) {
-    return std::any_of(in.rows.begin(), in.rows.end(), [](const SweepRow& r) { return usable(r) && r.temporal.is_object(); });
+    return std::any_of(in.rows.begin(), in.rows.end(),
+                       [](const SweepRow& r) { return usable(r) && r.temporal.is_object(); });
 }
 
 std::string rowsTable(const SweepReportInput& in, const std::vector<bool>& front) {
@@ -253,21 +256,24 @@ std::string rowsTable(const SweepReportInput& in, const std::vector<bool>& front
         if (front[i]) o << " <span class=\"tag front\" title=\"on the Pareto front\">front</span>";
         if (std::ptrdiff_t(i) == e.best) o << " <span class=\"tag best\">best</span>";
         if (std::ptrdiff_t(i) == e.worst && e.worst != e.best) o << " <span class=\"tag worst\">worst</span>";
-        o << "</td><td>" << ms(r.setupMs) << "</td><td>" << ms(r.frameMs) << " <span class=\"small\">[" << ms(r.frameMsMin)
-          << "–" << ms(r.frameMsMax) << "]</span></td><td>";
+        o << "</td><td>" << ms(r.setupMs) << "</td><td>" << ms(r.frameMs) << " <span class=\"small\">["
+          << ms(r.frameMsMin) << "–" << ms(r.frameMsMax) << "]</span></td><td>";
         if (perMachine) {
-            o << compare::escapeHtml(machines.label(machines.ofRow[i])) << " <span class=\"small\">load " << compare::formatFixed(machineFromJson(r.machine).load, 1)
-              << "</span></td><td>";
+            o << compare::escapeHtml(machines.label(machines.ofRow[i])) << " <span class=\"small\">load "
+              << compare::formatFixed(machineFromJson(r.machine).load, 1) << "</span></td><td>";
         }
         o << compare::formatPercent(r.rate("false_shadow_rate")) << "</td><td>"
-          << compare::formatPercent(r.rate("missed_shadow_rate")) << "</td><td><b>" << compare::formatPercent(r.rate("mismatch_rate"))
-          << "</b></td><td>" << compare::formatFixed(r.rate("shadow_iou"), 3) << "</td><td>";
+          << compare::formatPercent(r.rate("missed_shadow_rate")) << "</td><td><b>"
+          << compare::formatPercent(r.rate("mismatch_rate")) << "</b></td><td>"
+          << compare::formatFixed(r.rate("shadow_iou"), 3) << "</td><td>";
         if (temporal) {
             auto cell = [&](double v, bool percent) {
-                return std::isfinite(v) ? (percent ? compare::formatPercent(v) : compare::formatFixed(v, 3)) : std::string("–");
+                return std::isfinite(v) ? (percent ? compare::formatPercent(v) : compare::formatFixed(v, 3))
+                                        : std::string("–");
             };
-            o << cell(r.temporalValue("flicker_rate"), true) << "</td><td>" << cell(r.temporalValue("flicker_rate", true), true)
-              << "</td><td>" << cell(r.temporalValue("swim_px"), false) << "</td><td>";
+            o << cell(r.temporalValue("flicker_rate"), true) << "</td><td>"
+              << cell(r.temporalValue("flicker_rate", true), true) << "</td><td>"
+              << cell(r.temporalValue("swim_px"), false) << "</td><td>";
         }
         if (!r.image.empty()) o << "<a href=\"" << compare::escapeHtml(r.image) << "\">image</a>";
         if (!r.image.empty() && !r.diffImage.empty()) o << " · ";
@@ -307,7 +313,6 @@ tr.front td { background: #f8f5ff; }
 
 std::string svgName(const std::string& kind) { return "bias-" + kind + ".svg"; }
 
-
 }  // namespace
 
 SweepReportInput makeSweepReportInput(const std::string& sceneName, const std::string& scenePath,
@@ -342,8 +347,8 @@ std::string sweepFlickerSvg(const SweepReportInput& in) {
     compare::ScatterPlot plot;
     std::string path;
     for (const SweepRow& r : in.rows)
-        if (usable(r) && r.temporal.is_object()) path = r.temporal.value("path", "") + " path, " +
-                                                        std::to_string(r.temporal.value("frames", 0)) + " frames";
+        if (usable(r) && r.temporal.is_object())
+            path = r.temporal.value("path", "") + " path, " + std::to_string(r.temporal.value("frames", 0)) + " frames";
     plot.title = "Flicker against error (" + path + ")";
     plot.x.title = "mismatch rate (false + missed)";
     plot.x.log = true;
@@ -363,14 +368,15 @@ std::string sweepFlickerSvg(const SweepReportInput& in) {
             if (!series.count(name)) {
                 names.push_back(name);
                 series[name].name = name;
-                series[name].color = compare::backendColor(held ? name : scene::toString(r.config.backend), names.size() - 1);
+                series[name].color =
+                    compare::backendColor(held ? name : scene::toString(r.config.backend), names.size() - 1);
                 series[name].shape = held ? 1 : 0;
             }
-            series[name].points.push_back(
-                {r.rate("mismatch_rate"), f, "",
-                 rowTitle(r) + ": " + compare::formatPercent(f) + " flicker, " + compare::formatFixed(r.temporalValue("swim_px", held), 3) +
-                     " px swim, " + compare::formatPercent(r.rate("mismatch_rate")) + " wrong, " + compare::formatDuration(r.frameMs) +
-                     " per frame"});
+            series[name].points.push_back({r.rate("mismatch_rate"), f, "",
+                                           rowTitle(r) + ": " + compare::formatPercent(f) + " flicker, " +
+                                               compare::formatFixed(r.temporalValue("swim_px", held), 3) +
+                                               " px swim, " + compare::formatPercent(r.rate("mismatch_rate")) +
+                                               " wrong, " + compare::formatDuration(r.frameMs) + " per frame"});
         }
     }
     for (const std::string& n : names) plot.series.push_back(series[n]);
@@ -382,7 +388,8 @@ std::vector<std::string> describeSweep(const SweepReportInput& in, const AutoBia
     for (const scene::Backend backend : backendsOf(in.rows)) {
         const SweepRow* fastest = nullptr;
         for (const SweepRow& r : in.rows)
-            if (r.config.backend == backend && usable(r) && r.rate("mismatch_rate") <= compare::kSweepGoodMismatchRate &&
+            if (r.config.backend == backend && usable(r) &&
+                r.rate("mismatch_rate") <= compare::kSweepGoodMismatchRate &&
                 (!fastest || r.frameMs < fastest->frameMs))
                 fastest = &r;
         const Extremes e = extremesOf(in.rows, backend);
@@ -390,18 +397,19 @@ std::vector<std::string> describeSweep(const SweepReportInput& in, const AutoBia
         if (e.best < 0) {
             s += "no configuration rendered.";
         } else if (fastest) {
-            s += "the fastest configuration under " + compare::formatPercent(compare::kSweepGoodMismatchRate) + " mismatch is " +
-                 rowTitle(*fastest) + ": " + compare::formatDuration(fastest->frameMs) + " per frame, " +
-                 compare::formatPercent(fastest->rate("mismatch_rate")) + " wrong.";
+            s += "the fastest configuration under " + compare::formatPercent(compare::kSweepGoodMismatchRate) +
+                 " mismatch is " + rowTitle(*fastest) + ": " + compare::formatDuration(fastest->frameMs) +
+                 " per frame, " + compare::formatPercent(fastest->rate("mismatch_rate")) + " wrong.";
             const SweepRow& b = in.rows[e.best];
             if (&b != fastest)
-                s += " The most accurate, " + rowTitle(b) + ", has " + compare::formatPercent(b.rate("mismatch_rate")) + " at " +
-                     compare::formatDuration(b.frameMs) + ".";
+                s += " The most accurate, " + rowTitle(b) + ", has " + compare::formatPercent(b.rate("mismatch_rate")) +
+                     " at " + compare::formatDuration(b.frameMs) + ".";
         } else {
             const SweepRow& b = in.rows[e.best];
             s += "no configuration stays under " + compare::formatPercent(compare::kSweepGoodMismatchRate) +
-                 " mismatch; the most accurate, " + rowTitle(b) + ", has " + compare::formatPercent(b.rate("mismatch_rate")) +
-                 " at " + compare::formatDuration(b.frameMs) + " per frame.";
+                 " mismatch; the most accurate, " + rowTitle(b) + ", has " +
+                 compare::formatPercent(b.rate("mismatch_rate")) + " at " + compare::formatDuration(b.frameMs) +
+                 " per frame.";
         }
         lines.push_back(s);
     }
@@ -421,8 +429,8 @@ std::vector<std::string> describeSweep(const SweepReportInput& in, const AutoBia
     std::size_t failed = 0;
     for (const SweepRow& r : in.rows) failed += usable(r) ? 0 : 1;
     if (failed > 0)
-        lines.push_back(std::to_string(failed) + " configuration" + (failed == 1 ? "" : "s") +
-                        " failed and " + (failed == 1 ? "is" : "are") + " listed at the end, not plotted.");
+        lines.push_back(std::to_string(failed) + " configuration" + (failed == 1 ? "" : "s") + " failed and " +
+                        (failed == 1 ? "is" : "are") + " listed at the end, not plotted.");
     if (in.rows.empty()) lines.push_back("The sweep holds no configuration yet.");
     return lines;
 }
@@ -468,8 +476,9 @@ std::string renderSweepReportHtml(const SweepReportInput& in) {
         compare::FrameInfo ref;
         ref.width = width;
         ref.height = height;
-        o << compare::html::figure(scene::toString(scene::Backend::Reference), in.referenceMs > 0.0 ? compare::formatDuration(in.referenceMs) : "", in.referencePng, ref,
-                          nullptr);
+        o << compare::html::figure(scene::toString(scene::Backend::Reference),
+                                   in.referenceMs > 0.0 ? compare::formatDuration(in.referenceMs) : "", in.referencePng,
+                                   ref, nullptr);
     }
     o << "</div></div>\n";
 
@@ -477,13 +486,14 @@ std::string renderSweepReportHtml(const SweepReportInput& in) {
     for (const scene::Backend backend : backendsOf(in.rows)) {
         const Extremes e = extremesOf(in.rows, backend);
         if (e.best < 0) continue;
-        o << "<h2>" << compare::escapeHtml(backendTitle(backend)) << ": best and worst configuration</h2>\n<div class=\"backend\">"
-          << configCard(in.rows[e.best], "best", in);
+        o << "<h2>" << compare::escapeHtml(backendTitle(backend))
+          << ": best and worst configuration</h2>\n<div class=\"backend\">" << configCard(in.rows[e.best], "best", in);
         if (e.worst != e.best) o << configCard(in.rows[e.worst], "worst", in);
         o << "</div>\n";
     }
     if (!in.rows.empty())
-        o << "<details><summary>Colors of the difference images</summary>" << compare::html::diffLegend() << "</details>\n";
+        o << "<details><summary>Colors of the difference images</summary>" << compare::html::diffLegend()
+          << "</details>\n";
 
     // Plots.
     o << "<h2>Error against run time</h2>\n<div class=\"plots\"><div>" << sweepErrorTimeSvg(in)
@@ -509,16 +519,19 @@ std::string renderSweepReportHtml(const SweepReportInput& in) {
         for (const std::string& kind : seriesKinds()) {
             const BiasSeries* s = bias.primary(kind);
             if (!s) continue;
-            o << "<div>" << compare::renderSvg(biasSeriesPlot(*s)) << "<p>" << compare::escapeHtml(s->describe()) << "</p></div>";
+            o << "<div>" << compare::renderSvg(biasSeriesPlot(*s)) << "<p>" << compare::escapeHtml(s->describe())
+              << "</p></div>";
         }
         o << "</div>\n<p class=\"small\">Too little bias gives false shadow (acne, red); too much gives missed "
              "shadow (peter-panning and light leaks, blue). The green band is the bias window: the sampled "
              "values where both stay at or under "
-          << compare::formatPercent(bias.threshold) << " of the counted pixels. Without one, the scene is stiff for that "
+          << compare::formatPercent(bias.threshold)
+          << " of the counted pixels. Without one, the scene is stiff for that "
              "method.</p>\n";
     }
 
-    o << "<h2>All configurations</h2>\n" << rowsTable(in, front)
+    o << "<h2>All configurations</h2>\n"
+      << rowsTable(in, front)
       << "<p class=\"small\">Rates are over counted pixels. <span class=\"tag front\">front</span> marks the "
          "Pareto front of each backend. Setup is the one-time cost (Vulkan device and pipelines, the ray "
          "tracer's BVH).</p>\n";
@@ -528,7 +541,8 @@ std::string renderSweepReportHtml(const SweepReportInput& in) {
         for (std::size_t i = 0; i < in.rows.size(); ++i) {
             const SweepRow& r = in.rows[i];
             if (usable(r)) continue;
-            o << "<div class=\"failure\"><b>#" << i + 1 << " " << compare::escapeHtml(std::string(scene::toString(r.config.backend)) + ": " + rowTitle(r)) << ":</b> "
+            o << "<div class=\"failure\"><b>#" << i + 1 << " "
+              << compare::escapeHtml(std::string(scene::toString(r.config.backend)) + ": " + rowTitle(r)) << ":</b> "
               << compare::escapeHtml(r.error.empty() ? std::string("no metrics recorded") : r.error) << "</div>\n";
         }
     }

@@ -12,22 +12,22 @@
 
 #include <optional>
 
+#include "compare/report.h"
+#include "compare/thresholds.h"
 #include "studies/auto_bias.h"
 #include "studies/recommend.h"
-#include "compare/report.h"
 #include "studies/sweep.h"
-#include "compare/thresholds.h"
 
 namespace shadowlab::studies {
 
 struct SweepReportInput {
     std::string sceneName;  // the title
     std::string scenePath;
-    std::vector<SweepRow> rows;              // in grid order; image paths relative to the report's folder
-    std::string referencePng = "reference.png";  // relative to the report's folder; "" = none
-    double referenceMs = 0.0;                // the reference's render time (a marker on the plot)
-    int width = 0, height = 0;               // render size; 0 = read from the rows' metrics
-    double threshold = compare::kBiasWindowMaxRate;   // bias-window threshold
+    std::vector<SweepRow> rows;                      // in grid order; image paths relative to the report's folder
+    std::string referencePng = "reference.png";      // relative to the report's folder; "" = none
+    double referenceMs = 0.0;                        // the reference's render time (a marker on the plot)
+    int width = 0, height = 0;                       // render size; 0 = read from the rows' metrics
+    double threshold = compare::kBiasWindowMaxRate;  // bias-window threshold
     // The block searched in the user's configuration and verified against their defaults
     // (studies/recommend.h). Without it the page and recommended-shadow.json show the probe
     // slice's block, marked as not measured against the defaults.

@@ -1,10 +1,10 @@
 // tests/app/app_test.cpp: runs the `shadowlab` program as a user would: the main job on the
 // seed scene writes every output with sane metrics; bad input gets one clear error, a non-zero
 // exit and writes nothing.
+#include <sys/wait.h>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
-#include <sys/wait.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -37,11 +37,11 @@ std::pair<int, int> pngSize(const std::filesystem::path& file) {
 TEST(App, RunOnTheSeedSceneWritesEveryOutputWithSaneMetrics) {
     TempDir dir;
     const auto out = dir.path() / "seed";
-    const Result r = shadowlab({"run", "seed", "-o", out.string(), "--resolution", "192x108",
-                                "--shadow-map-size", "1024", "--validate"});
+    const Result r = shadowlab(
+        {"run", "seed", "-o", out.string(), "--resolution", "192x108", "--shadow-map-size", "1024", "--validate"});
     ASSERT_EQ(r.exitCode, 0) << r.err;
-    for (const char* f : {"raster.exr", "raytrace.exr", "reference.exr", "raster.png", "raytrace.png",
-                          "reference.png", "diff-raster.png", "diff-raytrace.png", "metrics.json", "report.html"})
+    for (const char* f : {"raster.exr", "raytrace.exr", "reference.exr", "raster.png", "raytrace.png", "reference.png",
+                          "diff-raster.png", "diff-raytrace.png", "metrics.json", "report.html"})
         EXPECT_TRUE(std::filesystem::is_regular_file(out / f)) << f;
 
     const auto metrics = nlohmann::json::parse(slurp(out / "metrics.json"));
@@ -60,9 +60,9 @@ TEST(App, RunOnTheSeedSceneWritesEveryOutputWithSaneMetrics) {
         EXPECT_NE(html.find(f), std::string::npos) << f;
     // The raster backend's debug views, in the report: one 1024² map shown as a 512² tile, the
     // others at the image's size; no cascades view without cascades.
-    const std::vector<std::pair<std::string, std::pair<int, int>>> views = {
-        {"raster-shadow-map.png", {512, 512}}, {"raster-light-frustum.png", {192, 108}},
-        {"raster-texel-density.png", {192, 108}}};
+    const std::vector<std::pair<std::string, std::pair<int, int>>> views = {{"raster-shadow-map.png", {512, 512}},
+                                                                            {"raster-light-frustum.png", {192, 108}},
+                                                                            {"raster-texel-density.png", {192, 108}}};
     for (const auto& [file, size] : views) {
         EXPECT_EQ(pngSize(out / file), size) << file;
         EXPECT_NE(html.find("src=\"" + file + "\""), std::string::npos) << file;
@@ -105,10 +105,12 @@ TEST(App, RunWarnsWhenALightWithARadiusGetsAHardFilter) {
 TEST(App, RenderWritesTheRequestedFrame) {
     TempDir dir;
     const auto exr = dir.path() / "rt.exr";
-    const Result r = shadowlab({"render", "seed", "--backend", "raytrace", "--resolution", "32x18", "-o", exr.string()});
+    const Result r =
+        shadowlab({"render", "seed", "--backend", "raytrace", "--resolution", "32x18", "-o", exr.string()});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_TRUE(std::filesystem::is_regular_file(exr));
-    const Result c = shadowlab({"compare", exr.string(), exr.string(), "-o", (dir.path() / "d.png").string(), "--json"});
+    const Result c =
+        shadowlab({"compare", exr.string(), exr.string(), "-o", (dir.path() / "d.png").string(), "--json"});
     ASSERT_EQ(c.exitCode, 0) << c.err;
     const auto j = nlohmann::json::parse(c.out);
     EXPECT_EQ(j.at("false_shadow").get<double>(), 0.0);  // a frame agrees with itself
@@ -148,7 +150,8 @@ TEST(App, MemoryIsEstimatedBeforeRenderingAndBoundsThePeak) {
     ::setenv("SHADOWLAB_MEMORY_LIMIT_MB", "lots", 1);
     const Result bad = shadowlab({"render", "seed", "--resolution", "16x9", "-o", (dir.path() / "x.exr").string()});
     EXPECT_EQ(bad.exitCode, 2);
-    EXPECT_NE(bad.err.find("SHADOWLAB_MEMORY_LIMIT_MB: expected a positive whole number"), std::string::npos) << bad.err;
+    EXPECT_NE(bad.err.find("SHADOWLAB_MEMORY_LIMIT_MB: expected a positive whole number"), std::string::npos)
+        << bad.err;
     ::unsetenv("SHADOWLAB_MEMORY_LIMIT_MB");
 }
 
@@ -167,10 +170,11 @@ TEST_P(BadInput, OneClearErrorNonZeroExitNothingWritten) {
         "objects": [{"type": "sphere", "center": [0,1,0], "radius": 1, "material": "m"}]})");
     std::vector<std::string> args;
     for (const auto& a : GetParam().args)
-        args.push_back(a == "OUT" ? (dir.path() / "out" / "x.exr").string()
+        args.push_back(a == "OUT"      ? (dir.path() / "out" / "x.exr").string()
                        : a == "OUTPNG" ? (dir.path() / "out" / "x.png").string()
                        : a == "OUTDIR" ? (dir.path() / "out").string()
-                       : a == "BAD" ? scene.string() : a);
+                       : a == "BAD"    ? scene.string()
+                                       : a);
     const std::size_t before = dir.fileCount();
     const Result r = shadowlab(args);
     EXPECT_NE(r.exitCode, 0);
@@ -191,47 +195,54 @@ INSTANTIATE_TEST_SUITE_P(
         BadRun{"bad_ray_bias", {"run", "seed", "--ray-bias", "lots", "-o", "OUTDIR"}, "--ray-bias"},
         BadRun{"bad_backend", {"render", "seed", "--backend", "magic", "-o", "OUT"}, "--backend"},
         BadRun{"bad_extension", {"render", "seed", "-o", "frame.tiff"}, "unknown output type"},
-        BadRun{"view_needs_raster", {"render", "seed", "--backend", "raytrace", "--view", "cascades", "-o", "OUTPNG"},
+        BadRun{"view_needs_raster",
+               {"render", "seed", "--backend", "raytrace", "--view", "cascades", "-o", "OUTPNG"},
                "needs --backend raster and a .png output"},
-        BadRun{"view_needs_png", {"render", "seed", "--backend", "raster", "--view", "shadow-map", "-o", "OUT"},
+        BadRun{"view_needs_png",
+               {"render", "seed", "--backend", "raster", "--view", "shadow-map", "-o", "OUT"},
                "needs --backend raster and a .png output"},
-        BadRun{"unknown_view", {"render", "seed", "--backend", "raster", "--view", "normals", "-o", "OUTPNG"},
+        BadRun{"unknown_view",
+               {"render", "seed", "--backend", "raster", "--view", "normals", "-o", "OUTPNG"},
                "--view: normals not in {shadow-map,cascades,texel-density,light-frustum}"},
         BadRun{"bad_cascades", {"render", "seed", "--backend", "raster", "--cascades", "9", "-o", "OUT"}, "--cascades"},
-        BadRun{"bad_cascade_blend", {"render", "seed", "--backend", "raster", "--cascades", "3", "--cascade-blend", "0.7",
-                                     "-o", "OUT"},
+        BadRun{"bad_cascade_blend",
+               {"render", "seed", "--backend", "raster", "--cascades", "3", "--cascade-blend", "0.7", "-o", "OUT"},
                "--cascade-blend: must be in 0..0.5"},
         BadRun{"missing_frames", {"compare", "a.exr", "b.exr", "-o", "OUT.png"}, "no such file"},
         BadRun{"bad_path_kind", {"path", "seed", "--kind", "spiral", "-o", "OUTDIR"}, "--kind: expected orbit|"},
         BadRun{"path_one_frame", {"path", "seed", "--frames", "1", "-o", "OUTDIR"}, "--frames: must be in 2.."},
-        BadRun{"path_no_such_light", {"path", "seed", "--kind", "sun-azimuth", "--light", "2", "-o", "OUTDIR"},
+        BadRun{"path_no_such_light",
+               {"path", "seed", "--kind", "sun-azimuth", "--light", "2", "-o", "OUTDIR"},
                "--light: the scene has 1 light(s)"},
         BadRun{"path_bad_scene", {"path", "BAD", "-o", "OUTDIR"}, "lights[0].direction"},
-        BadRun{"path_no_camera_animation", {"path", "seed", "--camera-animation", "-o", "OUTDIR"},
+        BadRun{"path_no_camera_animation",
+               {"path", "seed", "--camera-animation", "-o", "OUTDIR"},
                "has no animation that moves a camera"},
         BadRun{"path_bad_shard", {"path", "seed", "--shard", "2/2", "-o", "OUTDIR"}, "--shard"},
-        BadRun{"sweep_bad_flicker_kind", {"sweep", "seed", "--quick", "--flicker", "spiral", "-o", "OUTDIR"},
+        BadRun{"sweep_bad_flicker_kind",
+               {"sweep", "seed", "--quick", "--flicker", "spiral", "-o", "OUTDIR"},
                "--kind: expected orbit|"}),
     [](const ::testing::TestParamInfo<BadRun>& testParam) { return std::string(testParam.param.name); });
 
 TEST(App, RenderViewsWriteImagesOfTheDocumentedSizes) {
     TempDir dir;
     // 4 cascades at map 128: 2 x 2 tiles of 128 pixels, 4 apart; the other views: the image size.
-    const std::vector<std::pair<std::string, std::pair<int, int>>> views = {
-        {"shadow-map", {2 * 128 + 4, 2 * 128 + 4}}, {"cascades", {96, 54}}, {"texel-density", {96, 54}},
-        {"light-frustum", {96, 54}}};
+    const std::vector<std::pair<std::string, std::pair<int, int>>> views = {{"shadow-map", {2 * 128 + 4, 2 * 128 + 4}},
+                                                                            {"cascades", {96, 54}},
+                                                                            {"texel-density", {96, 54}},
+                                                                            {"light-frustum", {96, 54}}};
     for (const auto& [view, size] : views) {
         const auto out = dir.path() / (view + ".png");
-        const Result r = shadowlab({"render", "seed", "--backend", "raster", "--view", view, "--cascades", "4",
-                                    "--shadow-map-size", "128", "--resolution", "96x54", "--validate", "-o",
-                                    out.string()});
+        const Result r =
+            shadowlab({"render", "seed", "--backend", "raster", "--view", view, "--cascades", "4", "--shadow-map-size",
+                       "128", "--resolution", "96x54", "--validate", "-o", out.string()});
         ASSERT_EQ(r.exitCode, 0) << view << ": " << r.err;
         EXPECT_EQ(pngSize(out), size) << view;
     }
     // --view without --backend: the views are of the shadow maps, so it renders with raster.
     const auto out = dir.path() / "implied.png";
-    const Result r = shadowlab({"render", "seed", "--view", "light-frustum", "--resolution", "96x54", "--validate",
-                                "-o", out.string()});
+    const Result r = shadowlab(
+        {"render", "seed", "--view", "light-frustum", "--resolution", "96x54", "--validate", "-o", out.string()});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_EQ(pngSize(out), std::make_pair(96, 54));
 }
@@ -243,11 +254,13 @@ std::string culledScene(const std::string& light, const std::string& far, const 
     return R"({"camera": {"position": [0, 2, 6], "look_at": [0, 0.7, 0], "up": [0, 1, 0], "fov_y": 40,
                           "resolution": [96, 54], "near": 0.1, "far": 100},
                "materials": {"m": {"albedo": [0.8, 0.8, 0.8]}},
-               "lights": [)" + light + R"(],
+               "lights": [)" +
+           light + R"(],
                "objects": [
                  {"type": "sphere", "center": [0, 1, 0], "radius": 1, "material": "m"},
                  {"type": "quad", "center": [0, 0, 0], "normal": [0, 1, 0], "size": [20, 20], "material": "m"},
-                 )" + far + ",\n" + kept + "]}";
+                 )" +
+           far + ",\n" + kept + "]}";
 }
 
 TEST(App, ExplainSaysHowManyCastersEachMapLeavesOut) {
@@ -255,9 +268,11 @@ TEST(App, ExplainSaysHowManyCastersEachMapLeavesOut) {
     // Spot straight down, cone 60°: the sphere at (0, 1, 12) lies in its cone but can shadow no
     // visible receiver: 1 of 4 objects left out.
     const auto spot = dir.write(
-        "spot.json", culledScene(R"({"type": "spot", "position": [0, 8, 0], "direction": [0, -1, 0], "cone_angle": 60, "intensity": 800})",
-                                 R"({"type": "sphere", "center": [0, 1, 12], "radius": 1, "material": "m"})",
-                                 R"({"type": "sphere", "center": [2, 6, -2], "radius": 0.5, "material": "m"})"));
+        "spot.json",
+        culledScene(
+            R"({"type": "spot", "position": [0, 8, 0], "direction": [0, -1, 0], "cone_angle": 60, "intensity": 800})",
+            R"({"type": "sphere", "center": [0, 1, 12], "radius": 1, "material": "m"})",
+            R"({"type": "sphere", "center": [2, 6, -2], "radius": 0.5, "material": "m"})"));
     Result r = shadowlab({"render", spot.string(), "--backend", "raster", "--explain", "--validate", "-o",
                           (dir.path() / "spot.png").string()});
     ASSERT_EQ(r.exitCode, 0) << r.err;
@@ -277,8 +292,8 @@ TEST(App, ExplainSaysHowManyCastersEachMapLeavesOut) {
 TEST(App, ExplainSaysWhereTheBiasIsApplied) {
     TempDir dir;
     const std::string out = (dir.path() / "seed.png").string();
-    Result r = shadowlab({"render", "seed", "--backend", "raster", "--explain", "--resolution", "96x54",
-                          "--depth-bias", "0.02", "--slope-bias", "1.5", "-o", out});
+    Result r = shadowlab({"render", "seed", "--backend", "raster", "--explain", "--resolution", "96x54", "--depth-bias",
+                          "0.02", "--slope-bias", "1.5", "-o", out});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.err.find("raster bias: constant 0.02 world units, slope 1.5 texels x tan(angle to light), in the "
                          "lit shader; past tan 10 (84.3 deg between normal and light) the slope term goes on as a "
@@ -313,8 +328,8 @@ TEST(App, ExplainGivesEveryAutomaticRasterChoiceAndEachCanBeForced) {
     EXPECT_NE(r.err.find("raster shadow-map size: "), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("casters: 4 texels across the smallest feature"), std::string::npos) << r.err;
     for (const char* off : {"--no-fit-light-frustum", "--fit-light-frustum=off"}) {
-        r = shadowlab({"render", "seed", "--backend", "raster", "--explain", "--resolution", "96x54", off,
-                       "--cascades", "2", "--shadow-map-size", "1024", "-o", out});
+        r = shadowlab({"render", "seed", "--backend", "raster", "--explain", "--resolution", "96x54", off, "--cascades",
+                       "2", "--shadow-map-size", "1024", "-o", out});
         ASSERT_EQ(r.exitCode, 0) << r.err;
         EXPECT_NE(r.err.find("raster light frustum: the scene's bounding sphere (set by"), std::string::npos) << r.err;
         EXPECT_NE(r.err.find("raster cascades: 2 (set by --cascades or the scene)"), std::string::npos) << r.err;
@@ -341,9 +356,12 @@ TEST(App, StabilityRunsTheNamedCasesAndWritesItsReport) {
 }
 
 TEST(App, HelpOnEverySubcommandNamesItsOptions) {
-    for (const auto& [cmd, option] : std::vector<std::pair<std::string, std::string>>{
-             {"run", "--output"}, {"render", "--backend"}, {"compare", "--json"}, {"info", "--validate"},
-             {"sweep", "--resume"}, {"stability", "--no-search"}}) {
+    for (const auto& [cmd, option] : std::vector<std::pair<std::string, std::string>>{{"run", "--output"},
+                                                                                      {"render", "--backend"},
+                                                                                      {"compare", "--json"},
+                                                                                      {"info", "--validate"},
+                                                                                      {"sweep", "--resume"},
+                                                                                      {"stability", "--no-search"}}) {
         const Result r = shadowlab({cmd, "--help"});
         EXPECT_EQ(r.exitCode, 0) << cmd;
         EXPECT_NE(r.out.find(option), std::string::npos) << cmd << ": " << r.out;

@@ -2,6 +2,7 @@
 // tools/browser-check.sh (console errors, missing images and links, empty SVG plots, overflowing
 // text), and hand-written bad pages that prove each of its checks fails when it should. The pages
 // and their screenshots stay in BUILD/browser-check/ for CI to keep (docs/ci.md).
+#include <sys/wait.h>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -10,7 +11,6 @@
 #include <set>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -89,7 +89,8 @@ TEST(BrowserCheck, EachKindOfBadPageFailsWithItsOwnProblem) {
         {"overflowing-text.html", {": overflow: div.label", "text \"a caption that does not fit", "sticks out"}},
         {"overflowing-height.html", {": overflow: div.note", "div > p \"Second line, below the box.\" sticks out by"}},
         {"clipped-text.html", {": overflow: div.cap", "text \"a caption cut off", "is clipped by"}},
-        {"svg-text-outside.html", {": overflow: svg > text \"a label running off the plot\"", "sticks out of its plot"}},
+        {"svg-text-outside.html",
+         {": overflow: svg > text \"a label running off the plot\"", "sticks out of its plot"}},
         {"console-error.html", {": console: error: plot data missing"}},
         {"page-error.html", {": console: page error: undefinedFunctionOfThePlot is not defined"}},
     };
@@ -142,8 +143,8 @@ TEST(BrowserCheck, EveryPageShadowlabWritesLoadsRendersAndFits) {
     run({"sweep", "seed", "-o", (pages / "sweep").string(), "--quick", "--resolution", "64x36", "--repetitions", "1"});
     run({"stability", "extreme/straight-down", "extreme/grazing-1deg", "-o", (pages / "stability").string(),
          "--resolution", "48x27", "--no-search"});
-    run({"path", "seed", "-o", (pages / "path").string(), "--frames", "3", "--resolution", "64x36",
-         "--shadow-map-size", "512"});
+    run({"path", "seed", "-o", (pages / "path").string(), "--frames", "3", "--resolution", "64x36", "--shadow-map-size",
+         "512"});
     // `check`: summary.html, with the difference image of the case that fails (no ray bias: acne).
     const fs::path suite = pages / "suite.json";
     {
@@ -166,9 +167,9 @@ TEST(BrowserCheck, EveryPageShadowlabWritesLoadsRendersAndFits) {
     std::set<std::string> html;
     for (const auto& e : fs::recursive_directory_iterator(pages))
         if (e.path().extension() == ".html") html.insert(fs::relative(e.path(), pages).string());
-    for (const char* p : {"run/report.html", "run/sweep/report.html", "sweep/report.html",
-                          "stability/stability.html", "path/report.html", "check/summary.html", "demo-run/report.html",
-                          "demo-sweep/report.html", "demo-sweep/sweep/report.html"})
+    for (const char* p : {"run/report.html", "run/sweep/report.html", "sweep/report.html", "stability/stability.html",
+                          "path/report.html", "check/summary.html", "demo-run/report.html", "demo-sweep/report.html",
+                          "demo-sweep/sweep/report.html"})
         EXPECT_TRUE(html.count(p)) << p << " was not written";
 
     const char* env = std::getenv("SHADOWLAB_BROWSER_SCREENSHOTS");

@@ -60,8 +60,8 @@ void expectMergedEqualsUnsharded(const std::string& suiteJson, int expectedExit,
     for (int n : counts) {
         const fs::path out = dir.path() / ("sharded-" + std::to_string(n));
         for (int k = 0; k < n; ++k) {
-            const auto r = runShadowlab({"check", suite.string(), "--shard", std::to_string(k) + "/" + std::to_string(n),
-                                         "-o", out.string()});
+            const auto r = runShadowlab(
+                {"check", suite.string(), "--shard", std::to_string(k) + "/" + std::to_string(n), "-o", out.string()});
             ASSERT_TRUE(r.exitCode == 0 || r.exitCode == 1 || r.exitCode == 3) << r.err;
             const std::string name = "shard-" + std::to_string(k) + "-of-" + std::to_string(n);
             ASSERT_TRUE(fs::exists(out / name / "shard.json")) << r.err;
@@ -74,7 +74,8 @@ void expectMergedEqualsUnsharded(const std::string& suiteJson, int expectedExit,
         const std::string a = slurpFile(dir.path() / "full" / "junit.xml"), b = slurpFile(out / "junit.xml");
         EXPECT_FALSE(b.empty());
         EXPECT_EQ(withoutTimes(a), withoutTimes(b)) << "N=" << n;
-        EXPECT_EQ(withoutTimes(slurpFile(dir.path() / "full" / "summary.md")), withoutTimes(slurpFile(out / "summary.md")))
+        EXPECT_EQ(withoutTimes(slurpFile(dir.path() / "full" / "summary.md")),
+                  withoutTimes(slurpFile(out / "summary.md")))
             << "N=" << n;
         EXPECT_EQ(withoutTimes(slurpFile(dir.path() / "full" / "summary.html")),
                   withoutTimes(slurpFile(out / "summary.html")))
@@ -83,7 +84,8 @@ void expectMergedEqualsUnsharded(const std::string& suiteJson, int expectedExit,
         ASSERT_EQ(filesIn(dir.path() / "full" / "cases"), filesIn(out / "cases")) << "N=" << n;
         for (const std::string& f : filesIn(out / "cases")) {
             if (f.size() > 5 && f.substr(f.size() - 5) == ".json") {
-                EXPECT_EQ(caseWithoutTimes(dir.path() / "full" / "cases" / f), caseWithoutTimes(out / "cases" / f)) << f;
+                EXPECT_EQ(caseWithoutTimes(dir.path() / "full" / "cases" / f), caseWithoutTimes(out / "cases" / f))
+                    << f;
             }
         }
     }

@@ -2,12 +2,12 @@
 // stdout and stderr (for test files that need no process control; see subprocess.h for that).
 #pragma once
 
+#include <sys/wait.h>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
 #include <vector>
 
 #include "tests/scene/test_files.h"

@@ -103,8 +103,13 @@ TEST(ExportApp, TheReferenceOfAnExportAgreesWithTheSceneWithinTheTessellation) {
     TempDir dir;
     const fs::path glb = dir.path() / "seed.glb", a = dir.path() / "a.exr", b = dir.path() / "b.exr";
     ASSERT_EQ(runShadowlab({"export", "seed", "-o", glb.string()}).exitCode, 0);
-    ASSERT_EQ(runShadowlab({"render", "seed", "--backend", "reference", "--resolution", "320x180", "-o", a.string()}).exitCode, 0);
-    ASSERT_EQ(runShadowlab({"render", glb.string(), "--backend", "reference", "--resolution", "320x180", "-o", b.string()}).exitCode, 0);
+    ASSERT_EQ(runShadowlab({"render", "seed", "--backend", "reference", "--resolution", "320x180", "-o", a.string()})
+                  .exitCode,
+              0);
+    ASSERT_EQ(
+        runShadowlab({"render", glb.string(), "--backend", "reference", "--resolution", "320x180", "-o", b.string()})
+            .exitCode,
+        0);
     const auto r = runShadowlab({"compare", b.string(), a.string(), "-o", (dir.path() / "d.png").string(), "--json",
                                  "--allow-different-scene"});
     ASSERT_EQ(r.exitCode, 0) << r.err;

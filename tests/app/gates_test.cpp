@@ -16,8 +16,8 @@ namespace shadowlab {
 namespace {
 
 namespace fs = std::filesystem;
-using test::slurpFile;
 using test::runShadowlab;
+using test::slurpFile;
 using test::TempDir;
 
 std::size_t occurrences(const std::string& text, const std::string& what) {
@@ -32,19 +32,23 @@ struct SeedFrames {
     TempDir dir;
     fs::path reference = dir.path() / "ref.exr", acne = dir.path() / "acne.exr";
     SeedFrames() {
-        EXPECT_EQ(runShadowlab({"render", "seed", "--backend", "reference", "--resolution", "160x90", "-o",
-                                reference.string()}).exitCode, 0);
-        EXPECT_EQ(runShadowlab({"render", "seed", "--backend", "raytrace", "--ray-bias", "0", "--resolution",
-                                "160x90", "-o", acne.string()}).exitCode, 0);
+        EXPECT_EQ(runShadowlab(
+                      {"render", "seed", "--backend", "reference", "--resolution", "160x90", "-o", reference.string()})
+                      .exitCode,
+                  0);
+        EXPECT_EQ(runShadowlab({"render", "seed", "--backend", "raytrace", "--ray-bias", "0", "--resolution", "160x90",
+                                "-o", acne.string()})
+                      .exitCode,
+                  0);
     }
 };
 
 TEST(AppGates, CompareExitsThreeAndPrintsEveryBrokenBudgetWithValueAndLimit) {
     SeedFrames f;
     const auto diff = (f.dir.path() / "d.png").string();
-    const auto broken = runShadowlab({"compare", f.acne.string(), f.reference.string(), "-o", diff, "--json",
-                                      "--max-false-shadow", "1%", "--max-self-acne", "10px", "--min-iou", "0.99",
-                                      "--max-missed-shadow", "0.5%"});
+    const auto broken =
+        runShadowlab({"compare", f.acne.string(), f.reference.string(), "-o", diff, "--json", "--max-false-shadow",
+                      "1%", "--max-self-acne", "10px", "--min-iou", "0.99", "--max-missed-shadow", "0.5%"});
     EXPECT_EQ(broken.exitCode, 3) << broken.err;
     const auto j = nlohmann::json::parse(broken.out);
     const double rate = j["false_shadow_rate"];
@@ -59,19 +63,21 @@ TEST(AppGates, CompareExitsThreeAndPrintsEveryBrokenBudgetWithValueAndLimit) {
     EXPECT_EQ(j["budgets"][1]["budget"], "max_missed_shadow");
     EXPECT_EQ(j["budgets"][1]["broken"], false);
     // The same frames pass a budget above what they measure; no budget: exit 0 as before.
-    EXPECT_EQ(runShadowlab({"compare", f.acne.string(), f.reference.string(), "-o", diff, "--max-mismatch", "50%"})
-                  .exitCode, 0);
+    EXPECT_EQ(
+        runShadowlab({"compare", f.acne.string(), f.reference.string(), "-o", diff, "--max-mismatch", "50%"}).exitCode,
+        0);
     EXPECT_EQ(runShadowlab({"compare", f.acne.string(), f.reference.string(), "-o", diff}).exitCode, 0);
     // Bad budgets are bad input and write nothing.
     fs::remove(diff);
     for (const char* bad : {"12", "5px%", "-1%"}) {
-        const auto r = runShadowlab({"compare", f.acne.string(), f.reference.string(), "-o", diff, "--max-mismatch", bad});
+        const auto r =
+            runShadowlab({"compare", f.acne.string(), f.reference.string(), "-o", diff, "--max-mismatch", bad});
         EXPECT_EQ(r.exitCode, 2) << bad;
         EXPECT_NE(r.err.find("--max-mismatch: "), std::string::npos) << r.err;
         EXPECT_FALSE(fs::exists(diff));
     }
-    EXPECT_EQ(runShadowlab({"compare", f.acne.string(), f.reference.string(), "-o", diff, "--min-iou", "3px"})
-                  .exitCode, 2);
+    EXPECT_EQ(runShadowlab({"compare", f.acne.string(), f.reference.string(), "-o", diff, "--min-iou", "3px"}).exitCode,
+              2);
 }
 
 TEST(AppGates, CompareRefusesFramesOfAnotherSceneCameraOrSize) {
@@ -79,8 +85,10 @@ TEST(AppGates, CompareRefusesFramesOfAnotherSceneCameraOrSize) {
     TempDir dir;
     const auto diff = (dir.path() / "d.png").string();
     const auto other = (dir.path() / "glass.exr").string();
-    ASSERT_EQ(runShadowlab({"render", "lesson/semi-transparent", "--backend", "raytrace", "--resolution", "160x90",
-                            "-o", other}).exitCode, 0);
+    ASSERT_EQ(runShadowlab(
+                  {"render", "lesson/semi-transparent", "--backend", "raytrace", "--resolution", "160x90", "-o", other})
+                  .exitCode,
+              0);
     auto r = runShadowlab({"compare", other, f.reference.string(), "-o", diff});
     EXPECT_EQ(r.exitCode, 2);
     EXPECT_NE(r.err.find("different scenes (scene_hash "), std::string::npos) << r.err;
@@ -91,7 +99,8 @@ TEST(AppGates, CompareRefusesFramesOfAnotherSceneCameraOrSize) {
 
     // The seed from another camera position: same scene hash, different worldToCamera.
     const std::string seed = slurpFile(fs::path(SHADOWLAB_SOURCE_DIR) / "scenes" / "seed.json");
-    const auto moved = std::regex_replace(seed, std::regex("\"position\": \\[[^\\]]*\\]"), "\"position\": [0.5, 2, 6]", std::regex_constants::format_first_only);
+    const auto moved = std::regex_replace(seed, std::regex("\"position\": \\[[^\\]]*\\]"), "\"position\": [0.5, 2, 6]",
+                                          std::regex_constants::format_first_only);
     ASSERT_NE(moved, seed);
     const auto movedScene = dir.write("moved.json", moved);
     const auto movedFrame = (dir.path() / "moved.exr").string();
@@ -120,8 +129,8 @@ TEST(AppGates, AnotherEnginesMaskIsGradedWithTheReferencesIdsAndNdotL) {
     }
     const auto png = dir.path() / "mask.png";
     scene::writePngDisplay(png, acne.width, acne.height, rgb);
-    const auto full = runShadowlab({"compare", f.acne.string(), f.reference.string(), "-o",
-                                    (dir.path() / "a.png").string(), "--json"});
+    const auto full = runShadowlab(
+        {"compare", f.acne.string(), f.reference.string(), "-o", (dir.path() / "a.png").string(), "--json"});
     ASSERT_EQ(full.exitCode, 0) << full.err;
     const auto fromMask = runShadowlab({"compare", png.string(), f.reference.string(), "-o",
                                         (dir.path() / "b.png").string(), "--json", "--mask-channel", "R"});
@@ -135,8 +144,8 @@ TEST(AppGates, AnotherEnginesMaskIsGradedWithTheReferencesIdsAndNdotL) {
     EXPECT_EQ(b["silhouette_mismatch"], 0);
     EXPECT_EQ(b["false_shadow"], a["false_shadow"]);
     EXPECT_EQ(b["method_backend"], "mask");
-    const auto inv = runShadowlab({"compare", png.string(), f.reference.string(), "-o",
-                                   (dir.path() / "c.png").string(), "--json", "--mask-channel", "G", "--mask-invert"});
+    const auto inv = runShadowlab({"compare", png.string(), f.reference.string(), "-o", (dir.path() / "c.png").string(),
+                                   "--json", "--mask-channel", "G", "--mask-invert"});
     ASSERT_EQ(inv.exitCode, 0) << inv.err;
     EXPECT_EQ(nlohmann::json::parse(inv.out)["false_shadow"], a["false_shadow"]);
     // A mask of several channels needs one chosen; a wrong name lists the channels.
@@ -153,8 +162,8 @@ TEST(AppGates, AnotherEnginesMaskIsGradedWithTheReferencesIdsAndNdotL) {
 TEST(AppGates, RunHoldsEveryMethodToTheBudgetsAndRecordsThem) {
     TempDir dir;
     const auto out = dir.path() / "run";
-    const auto r = runShadowlab({"run", "seed", "-o", out.string(), "--resolution", "96x54", "--no-sweep",
-                                 "--ray-bias", "0", "--max-false-shadow", "1%"});
+    const auto r = runShadowlab({"run", "seed", "-o", out.string(), "--resolution", "96x54", "--no-sweep", "--ray-bias",
+                                 "0", "--max-false-shadow", "1%"});
     EXPECT_EQ(r.exitCode, 3) << r.err;
     EXPECT_NE(r.err.find("budget: raytrace: --max-false-shadow: "), std::string::npos) << r.err;
     const auto metrics = nlohmann::json::parse(slurpFile(out / "metrics.json"));

@@ -2,14 +2,14 @@
 // written fail before any work with exit 2, results that cannot reach stdout are an error, a
 // second writer of a folder is refused naming the first, a run replaces the previous run's
 // files as a set and keeps the user's, and unforeseen standard exceptions on inputs are bad input.
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <csignal>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
-#include <sys/stat.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -132,8 +132,8 @@ TEST(HostileApp, TheMemoryEstimateCountsTheSceneItself) {
     std::ofstream(file) << gltf;
     const std::string frame = (dir.path() / "n.exr").string();
     TempDir io;
-    const Outcome r = run("render " + file.string() + " --resolution 16x9 --json -o " + frame,
-                          (io.path() / "out.json").string());
+    const Outcome r =
+        run("render " + file.string() + " --resolution 16x9 --json -o " + frame, (io.path() / "out.json").string());
     ASSERT_EQ(r.exitCode, 0) << r.err;
     std::ifstream out(io.path() / "out.json");
     const auto memory = nlohmann::json::parse(out).at("memory");

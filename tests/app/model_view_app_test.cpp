@@ -12,16 +12,14 @@ namespace {
 using test::runShadowlab;
 using test::TempDir;
 
-nlohmann::json attributes(const test::CliResult& r) {
-    return nlohmann::json::parse(r.out).at("attributes");
-}
+nlohmann::json attributes(const test::CliResult& r) { return nlohmann::json::parse(r.out).at("attributes"); }
 
 TEST(ModelViewApp, ExplainListsTheFilesCamerasAndCameraPicksOneByName) {
     TempDir dir;
     const auto model = dir.write("box.gltf", test::cameraBoxGltf());
     const auto out = dir.path() / "x.exr";
-    const auto r = runShadowlab({"render", model.string(), "--camera", "Side", "--explain", "--json",
-                                 "--resolution", "64x36", "-o", out.string()});
+    const auto r = runShadowlab({"render", model.string(), "--camera", "Side", "--explain", "--json", "--resolution",
+                                 "64x36", "-o", out.string()});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_NE(r.err.find("0 'Front'"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("1 'Side'"), std::string::npos) << r.err;
@@ -55,8 +53,8 @@ TEST(ModelViewApp, AModelWithoutCameraOrLightGetsASearchedViewSunAndGroundRecord
 TEST(ModelViewApp, SunAndNoGroundOverrideTheDefaults) {
     TempDir dir;
     const auto model = dir.write("box.gltf", test::cameraBoxGltf(false));
-    const auto r = runShadowlab({"render", model.string(), "--sun", "90,30", "--no-ground", "--json",
-                                 "--resolution", "64x36", "-o", (dir.path() / "x.exr").string()});
+    const auto r = runShadowlab({"render", model.string(), "--sun", "90,30", "--no-ground", "--json", "--resolution",
+                                 "64x36", "-o", (dir.path() / "x.exr").string()});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     const auto a = attributes(r);
     EXPECT_EQ(a.at("choice.sun").get<std::string>(), "azimuth 90, elevation 30 degrees (--sun)");
@@ -80,8 +78,8 @@ TEST(ModelViewApp, HelpNamesTheViewOptions) {
 
 TEST(ModelViewApp, GroundOnAJsonSceneAddsOne) {
     TempDir dir;
-    const auto s = runShadowlab({"render", "seed", "--ground", "--explain", "--resolution", "32x18", "-o",
-                                 (dir.path() / "x.png").string()});
+    const auto s = runShadowlab(
+        {"render", "seed", "--ground", "--explain", "--resolution", "32x18", "-o", (dir.path() / "x.png").string()});
     ASSERT_EQ(s.exitCode, 0) << s.err;
     EXPECT_NE(s.err.find("ground: a "), std::string::npos) << s.err;
 }

@@ -39,7 +39,8 @@ TEST(Outputs, RenderUnderAFileOrOntoAFolderIsBadInput) {
     EXPECT_EQ(under.exitCode, 2);
     EXPECT_NE(under.err.find("is a file, not a folder"), std::string::npos) << under.err;
     fs::create_directories(dir.path() / "folder.png");
-    const auto onto = runShadowlab({"render", "seed", "--resolution", "32x18", "-o", (dir.path() / "folder.png").string()});
+    const auto onto =
+        runShadowlab({"render", "seed", "--resolution", "32x18", "-o", (dir.path() / "folder.png").string()});
     EXPECT_EQ(onto.exitCode, 2);
     EXPECT_NE(onto.err.find("is a folder"), std::string::npos) << onto.err;
 }
@@ -64,8 +65,9 @@ TEST(Outputs, AnStlModelIsAnUnsupportedFormatNotAJsonError) {
 
 TEST(Outputs, APlyPointCloudIsRefusedAsAModelWithNoFaces) {
     TempDir dir;
-    const auto ply = dir.write("cloud.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
-                                            "property float y\nproperty float z\nend_header\n0 0 0\n");
+    const auto ply = dir.write("cloud.ply",
+                               "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"
+                               "property float y\nproperty float z\nend_header\n0 0 0\n");
     const auto r = runShadowlab({"render", ply.string(), "-o", (dir.path() / "x.png").string()});
     EXPECT_EQ(r.exitCode, 2);
     EXPECT_NE(r.err.find(ply.string()), std::string::npos) << r.err;
@@ -87,7 +89,8 @@ TEST(Outputs, ARunRemovesWhatTheEarlierRunWroteAndThisOneDoesNotButNothingElse) 
     dir.write("run/.shadowlab-run.json",
               R"({"files": ["raster.exr", "diff-raster.png", "sweep/", "reference.exr", "../outside.txt"]})");
     dir.write("outside.txt", "mine too");
-    const auto r = runShadowlab({"run", "seed", "-o", out.string(), "--no-raster", "--no-sweep", "--resolution", "32x18"});
+    const auto r =
+        runShadowlab({"run", "seed", "-o", out.string(), "--no-raster", "--no-sweep", "--resolution", "32x18"});
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_FALSE(fs::exists(out / "raster.exr"));
     EXPECT_FALSE(fs::exists(out / "diff-raster.png"));

@@ -75,9 +75,14 @@ TEST(RunKill, KilledAtRandomMomentsEveryOutputIsTheOldOrACompleteNewFile) {
     test::TempDir dir;
     const fs::path out = dir.path() / "run";
     auto args = [&](int width) {
-        return std::vector<std::string>{"run", "seed", "-o", out.string(), "--resolution",
+        return std::vector<std::string>{"run",
+                                        "seed",
+                                        "-o",
+                                        out.string(),
+                                        "--resolution",
                                         std::to_string(width) + "x" + std::to_string(width * 9 / 16),
-                                        "--shadow-map-size", "256"};
+                                        "--shadow-map-size",
+                                        "256"};
     };
     // A complete run first: these are the "old" files, and its duration spaces the kills.
     const auto start = std::chrono::steady_clock::now();

@@ -26,8 +26,8 @@ using Json = nlohmann::json;
 // biases and ray offsets, and one per filterable map: vsm, evsm2, evsm4, esm, msm).
 constexpr std::size_t kQuickRows = 29;
 std::vector<std::string> sweepArgs(const fs::path& out) {
-    return {"sweep", "seed", "-o", out.string(), "--quick", "--resolution", "48x27", "--repetitions", "1",
-            "--shadow-map-size", "256"};
+    return {"sweep", "seed",          "-o", out.string(),        "--quick", "--resolution",
+            "48x27", "--repetitions", "1",  "--shadow-map-size", "256"};
 }
 
 std::vector<std::string> with(std::vector<std::string> a, const std::vector<std::string>& more) {

@@ -4,8 +4,8 @@
 
 #include <fcntl.h>
 #include <spawn.h>
-#include <string>
 #include <sys/wait.h>
+#include <string>
 #include <vector>
 
 extern char** environ;

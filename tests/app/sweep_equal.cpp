@@ -7,9 +7,9 @@
 #include <filesystem>
 #include <iostream>
 
-#include "studies/path.h"
-#include "studies/merge.h"
 #include "scene/error.h"
+#include "studies/merge.h"
+#include "studies/path.h"
 
 int main(int argc, char** argv) {
     if (argc != 3) {

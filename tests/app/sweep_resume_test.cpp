@@ -37,8 +37,9 @@ std::vector<Json> journalRows(const std::filesystem::path& file) {
 TEST(SweepResume, KilledSweepResumesWithEveryRowExactlyOnce) {
     TempDir dir;
     const auto out = dir.path() / "sweep";
-    const std::vector<std::string> args = {"sweep", "seed", "-o", out.string(), "--quick", "--resolution", "48x27",
-                                           "--repetitions", "1", "--shadow-map-size", "256"};
+    const std::vector<std::string> args = {
+        "sweep", "seed",          "-o", out.string(),        "--quick", "--resolution",
+        "48x27", "--repetitions", "1",  "--shadow-map-size", "256"};
     const auto journal = out / "results.jsonl";
 
     // Kill twice, at different points: once after two rows, once a little later still.
@@ -57,7 +58,11 @@ TEST(SweepResume, KilledSweepResumesWithEveryRowExactlyOnce) {
         ASSERT_GE(beforeKill.size(), killAfter) << "the sweep did not get far enough before the deadline";
     }
 
-    const pid_t pid = test::spawnShadowlab([&] { auto a = args; a.push_back("--resume"); return a; }());
+    const pid_t pid = test::spawnShadowlab([&] {
+        auto a = args;
+        a.push_back("--resume");
+        return a;
+    }());
     ASSERT_GT(pid, 0);
     ASSERT_EQ(test::waitFor(pid), 0);
 

@@ -8,11 +8,11 @@
 // (tan θ = 0.707). Its shadow camera (tools/browser/threejs-grade.html) is a box fitted to the
 // meshes' bounding sphere, radius R = 14.18 (the 20 x 20 ground), with a 2048² map: a texel is
 // 2R / 2048 = 0.01384 wide and the depth range far - near is 2R = 28.35.
+#include <sys/wait.h>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <sys/wait.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -37,8 +37,8 @@ struct ScriptRun {
 
 ScriptRun runScript(const fs::path& script, const std::string& args) {
     test::TempDir io;
-    const std::string cmd = "SHADOWLAB_BUILD_DIR=" + shellQuote(kBuild.string()) + " SHADOWLAB_EXE=" +
-                            shellQuote(SHADOWLAB_EXE) + " SHADOWLAB_BROWSER_SCREENSHOTS=" +
+    const std::string cmd = "SHADOWLAB_BUILD_DIR=" + shellQuote(kBuild.string()) +
+                            " SHADOWLAB_EXE=" + shellQuote(SHADOWLAB_EXE) + " SHADOWLAB_BROWSER_SCREENSHOTS=" +
                             shellQuote((kBuild / "browser-check" / "screenshots" / "threejs-grade").string()) + " " +
                             shellQuote(script.string()) + " " + args + " >" + shellQuote((io.path() / "out").string()) +
                             " 2>" + shellQuote((io.path() / "err").string());
@@ -166,17 +166,30 @@ Json grades(double falseShadow, double falseNearEdge, double missed, double miss
 TEST(ThreejsGrade, ThePageSaysWhatWentWrongAndWhatTheBiasIsInWorldUnits) {
     test::TempDir dir;
     const fs::path out = dir.path();
-    ASSERT_EQ(std::system((shellQuote(SHADOWLAB_EXE) + " export lesson/spot-light -o " + shellQuote((out / "scene.glb").string()) +
-                           " >/dev/null 2>&1").c_str()), 0);
+    ASSERT_EQ(std::system((shellQuote(SHADOWLAB_EXE) + " export lesson/spot-light -o " +
+                           shellQuote((out / "scene.glb").string()) + " >/dev/null 2>&1")
+                              .c_str()),
+              0);
     // A spot's map holds perspective depth far (d - near) / (d (far - near)): at distance d a
     // bias b spans b (far - near) d^2 / (far near) in world units, 0.001 * 16 * 64 / 80 = 0.0128.
-    const Json three = {{"width", 64}, {"height", 36}, {"three", "181"}, {"webgl", "test"}, {"mapSize", 1024},
-                        {"bias", -0.001}, {"normalBias", 0},
-                        {"lights", Json::array({{{"type", "SpotLight"}, {"near", 4}, {"far", 20}, {"fov", 64},
-                                                 {"distance", 8}, {"bias", -0.001}, {"normalBias", 0}}})}};
+    const Json three = {{"width", 64},
+                        {"height", 36},
+                        {"three", "181"},
+                        {"webgl", "test"},
+                        {"mapSize", 1024},
+                        {"bias", -0.001},
+                        {"normalBias", 0},
+                        {"lights", Json::array({{{"type", "SpotLight"},
+                                                 {"near", 4},
+                                                 {"far", 20},
+                                                 {"fov", 64},
+                                                 {"distance", 8},
+                                                 {"bias", -0.001},
+                                                 {"normalBias", 0}}})}};
     std::ofstream(out / "threejs.json") << three.dump();
     std::ofstream(out / "silhouette.json") << R"({"differ": 0, "total": 2304})";
-    const Json acne = grades(3000, 0, 0, 0, Json::array({{{"object_id", 3}, {"false_shadow", 3000}, {"missed_shadow", 0}}}));
+    const Json acne =
+        grades(3000, 0, 0, 0, Json::array({{{"object_id", 3}, {"false_shadow", 3000}, {"missed_shadow", 0}}}));
     std::ofstream(out / "PCFShadowMap.json") << acne.dump();
     std::ofstream(out / "PCFSoftShadowMap.json") << acne.dump();
     std::ofstream(out / "VSMShadowMap.json")
@@ -184,11 +197,13 @@ TEST(ThreejsGrade, ThePageSaysWhatWentWrongAndWhatTheBiasIsInWorldUnits) {
                   Json::array({{{"object_id", 1}, {"false_shadow", 0}, {"missed_shadow", 400}},
                                {{"object_id", 3}, {"false_shadow", 0}, {"missed_shadow", 100}}}))
                .dump();
-    std::ofstream(out / "raster.json")
-        << grades(10, 10, 10, 10, Json::array({{{"object_id", 3}, {"false_shadow", 10}, {"missed_shadow", 10}}})).dump();
+    std::ofstream(out / "raster.json") << grades(10, 10, 10, 10,
+                                                 Json::array(
+                                                     {{{"object_id", 3}, {"false_shadow", 10}, {"missed_shadow", 10}}}))
+                                              .dump();
 
-    const ScriptRun r = runScript("node", shellQuote((kSource / "tools" / "browser" / "threejs-report.mjs").string()) + " " +
-                                              shellQuote(out.string()) + " --scene spot");
+    const ScriptRun r = runScript("node", shellQuote((kSource / "tools" / "browser" / "threejs-report.mjs").string()) +
+                                              " " + shellQuote(out.string()) + " --scene spot");
     ASSERT_EQ(r.exitCode, 0) << r.err;
     const std::string page = test::slurpFile(out / "report.html");
     EXPECT_NE(page.find("bias -0.001, normalBias 0"), std::string::npos);
@@ -198,7 +213,8 @@ TEST(ThreejsGrade, ThePageSaysWhatWentWrongAndWhatTheBiasIsInWorldUnits) {
               std::string::npos);
     // 400 of the 500 missed pixels away from the edges (4%), 400 of 500 on the sphere: VSM's bleeding.
     const std::string vsm = sectionOf(page, "VSMShadowMap");
-    EXPECT_NE(vsm.find("Missed shadow away from the edges (4.00%, 80% of it on “sphere”): light bleeding"), std::string::npos);
+    EXPECT_NE(vsm.find("Missed shadow away from the edges (4.00%, 80% of it on “sphere”): light bleeding"),
+              std::string::npos);
     EXPECT_EQ(vsm.find("acne"), std::string::npos);
     EXPECT_NE(sectionOf(page, "raster").find("Close to the reference: 0.20%"), std::string::npos);
 }

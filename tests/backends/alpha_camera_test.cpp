@@ -33,8 +33,12 @@ scene::Object quad(const Vec3& center, double side, int material) {
 
 scene::Scene stage(const scene::Material& card) {
     scene::Scene s;
-    s.camera = {.position = Vec3(0, 10, 0), .lookAt = Vec3(0), .up = Vec3(0, 0, -1), .fovYDegrees = 30.0,
-                .width = kPixels, .height = kPixels};  // near 0.1, far 100
+    s.camera = {.position = Vec3(0, 10, 0),
+                .lookAt = Vec3(0),
+                .up = Vec3(0, 0, -1),
+                .fovYDegrees = 30.0,
+                .width = kPixels,
+                .height = kPixels};  // near 0.1, far 100
     scene::Material ground;
     ground.name = "ground";
     s.materials = {ground, card};
@@ -70,7 +74,7 @@ float expectedId(const scene::Scene& s, int x, int y, int n, OpaqueCell opaqueCe
     const double footprint = (c.position.y - kHeight) * 2.0 * c.tanHalfFovY / kPixels;
     const double u = p.x / 2.0 + 0.5, v = -p.z / 2.0 + 0.5;
     edge = false;
-    const double f = footprint / 2.0;  // in (u, v)
+    const double f = footprint / 2.0;                                 // in (u, v)
     if (u < -f || u > 1.0 + f || v < -f || v > 1.0 + f) return 1.0f;  // well past the quad: the ground
     for (double t : {u, v}) {
         const double cell = t * n;  // the borders are at the integers 0..n, in cells
@@ -126,8 +130,10 @@ TEST(AlphaCamera, TheCameraSeesTheGroundThroughAMaskedCheckerboard) {
         for (int x = 0; x < kPixels; ++x) {
             const std::size_t px = std::size_t(y) * kPixels + std::size_t(x);
             bool edge = false;
-            expectedId(s, x, y, 4, [](int i, int j) { return (i + j) % 2 == 0; }, edge);
-            if (f.raster.objectId[px] != f.reference.objectId[px] || f.raytrace.objectId[px] != f.reference.objectId[px]) {
+            expectedId(
+                s, x, y, 4, [](int i, int j) { return (i + j) % 2 == 0; }, edge);
+            if (f.raster.objectId[px] != f.reference.objectId[px] ||
+                f.raytrace.objectId[px] != f.reference.objectId[px]) {
                 EXPECT_TRUE(edge) << "the backends disagree off the border band at pixel " << x << "," << y;
             }
         }

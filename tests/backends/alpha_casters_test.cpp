@@ -44,8 +44,12 @@ scene::Object quad(const Vec3& center, double side, int material, Vec2 uvMin = V
 // Ground (material 0) and the caster material `caster` (index 1) on the 2×2 quad at height 3.
 scene::Scene stage(const scene::Material& caster, Vec2 uvMin = Vec2(0), Vec2 uvMax = Vec2(1)) {
     scene::Scene s;
-    s.camera = {.position = Vec3(3, 10, 0), .lookAt = Vec3(3, 0, 0), .up = Vec3(0, 0, -1), .fovYDegrees = 30.0,
-                .width = 160, .height = 160};  // near 0.1, far 100
+    s.camera = {.position = Vec3(3, 10, 0),
+                .lookAt = Vec3(3, 0, 0),
+                .up = Vec3(0, 0, -1),
+                .fovYDegrees = 30.0,
+                .width = 160,
+                .height = 160};  // near 0.1, far 100
     scene::Material ground;
     ground.name = "ground";
     s.materials = {ground, caster};
@@ -88,7 +92,8 @@ void expectCells(const scene::Scene& s, const Frames& f, int n, int m, Expected 
         }
 }
 
-scene::Material alphaMaterial(scene::AlphaMode mode, std::shared_ptr<const scene::AlphaTexture> tex, double cutoff = 0.5) {
+scene::Material alphaMaterial(scene::AlphaMode mode, std::shared_ptr<const scene::AlphaTexture> tex,
+                              double cutoff = 0.5) {
     return test::alphaMaterial("caster", mode, std::move(tex), cutoff);
 }
 
@@ -229,7 +234,8 @@ TEST(AlphaCasters, AlphaBlendModeTestCastsWhatTheGltfAlphaRulesSay) {
             bool crossed = false;
             for (const int c : cards) {
                 const scene::Material& m = s.materialOf(s.objects[std::size_t(c)]);
-                for (const scene::MeshInstance& inst : std::get<scene::Mesh>(s.objects[std::size_t(c)].shape).instances) {
+                for (const scene::MeshInstance& inst :
+                     std::get<scene::Mesh>(s.objects[std::size_t(c)].shape).instances) {
                     const scene::TriangleMesh& g = *inst.geometry;
                     for (std::size_t t = 0; t + 2 < g.indices.size(); t += 3) {
                         const std::uint32_t* ix = &g.indices[t];
@@ -247,10 +253,14 @@ TEST(AlphaCasters, AlphaBlendModeTestCastsWhatTheGltfAlphaRulesSay) {
                             const int ty = std::clamp(int(std::floor(uv.y * h)), 0, h - 1);
                             alpha = m.alphaTexture->alpha[std::size_t(ty) * std::size_t(w) + std::size_t(tx)];
                         }
-                        if (m.alphaMode == scene::AlphaMode::Opaque) want = 0.0;
-                        else if (m.alphaMode == scene::AlphaMode::Blend) want *= 1.0 - alpha, ++blended;
-                        else if (alpha >= m.alphaCutoff) want = 0.0, ++cast;
-                        else ++cut;
+                        if (m.alphaMode == scene::AlphaMode::Opaque)
+                            want = 0.0;
+                        else if (m.alphaMode == scene::AlphaMode::Blend)
+                            want *= 1.0 - alpha, ++blended;
+                        else if (alpha >= m.alphaCutoff)
+                            want = 0.0, ++cast;
+                        else
+                            ++cut;
                     }
                 }
             }

@@ -31,8 +31,12 @@ using scene::Vec3;
 
 scene::Scene leaningNormals(bool reversedWinding) {
     scene::Scene s;
-    s.camera = {.position = Vec3(0, 2, 2 * std::sqrt(3.0)), .lookAt = Vec3(0), .up = Vec3(0, 1, 0), .fovYDegrees = 40.0,
-                .width = 160, .height = 90};
+    s.camera = {.position = Vec3(0, 2, 2 * std::sqrt(3.0)),
+                .lookAt = Vec3(0),
+                .up = Vec3(0, 1, 0),
+                .fovYDegrees = 40.0,
+                .width = 160,
+                .height = 90};
     scene::Material m;
     m.name = "matte";
     s.materials = {m};
@@ -42,8 +46,8 @@ scene::Scene leaningNormals(bool reversedWinding) {
     const Vec3 n = glm::normalize(Vec3(0, 0.3, -1));
     mesh->normals = {n, n, n, n};
     // (0, 2, 1), (0, 3, 2): cross(p1 − p0, p2 − p0) = (0, 4, 0), the facet normal +y; reversed, −y.
-    mesh->indices = reversedWinding ? std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3}
-                                    : std::vector<std::uint32_t>{0, 2, 1, 0, 3, 2};
+    mesh->indices =
+        reversedWinding ? std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3} : std::vector<std::uint32_t>{0, 2, 1, 0, 3, 2};
     test::addMesh(s, mesh);
     return s;
 }
@@ -73,8 +77,9 @@ TEST_P(TwoSidedNormal, AShadingNormalLeaningAwayFromTheViewerKeepsItsFacetsSide)
     EXPECT_GE(m.counted + 2 * 160, onSquare);  // up to a silhouette row of pixels either way
 }
 
-INSTANTIATE_TEST_SUITE_P(BothWindings, TwoSidedNormal, ::testing::Bool(),
-                         [](const ::testing::TestParamInfo<bool>& p) { return p.param ? "Reversed" : "Counterclockwise"; });
+INSTANTIATE_TEST_SUITE_P(BothWindings, TwoSidedNormal, ::testing::Bool(), [](const ::testing::TestParamInfo<bool>& p) {
+    return p.param ? "Reversed" : "Counterclockwise";
+});
 
 }  // namespace
 }  // namespace shadowlab

@@ -263,10 +263,11 @@ TEST(BleedingAgainstReference, ALowCurbsThinShadowLostToTheDefaultBiasIsABiasLea
             ++elsewhere;
         }
     }
-    std::printf("curb h %.3f, texel %.4f: strip %zu px (%zu missed); missed %zu (%zu near an edge), bias leak %zu "
-                "(%zu near an edge), aliasing %zu, D %.4f\n",
-                h, r.texel, strip, stripMissed, m.missedShadow, m.missedShadowNearEdge, m.biasLeak, m.biasLeakNearEdge,
-                m.aliasingPixels, m.contactDistance);
+    std::printf(
+        "curb h %.3f, texel %.4f: strip %zu px (%zu missed); missed %zu (%zu near an edge), bias leak %zu "
+        "(%zu near an edge), aliasing %zu, D %.4f\n",
+        h, r.texel, strip, stripMissed, m.missedShadow, m.missedShadowNearEdge, m.biasLeak, m.biasLeakNearEdge,
+        m.aliasingPixels, m.contactDistance);
     EXPECT_GT(strip, 100u) << "the camera must see the strip";
     EXPECT_EQ(elsewhere, 0u) << "the reference shadows the strip and nothing else";
     EXPECT_GE(double(stripMissed), 0.9 * double(strip)) << "the bias loses the strip";

@@ -49,11 +49,11 @@ float srgb(float c) { return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c,
 TEST(ClassifyCounted, FollowsTheTableOnBothSidesOfTau) {
     // τ = 0.5; all values are binary fractions, so the differences are exact.
     EXPECT_EQ(classifyCounted(1.0f, 1.0f), PixelClass::AgreeLit);
-    EXPECT_EQ(classifyCounted(0.25f, 0.75f), PixelClass::AgreeLit);      // V_R − V_M = τ: agree
+    EXPECT_EQ(classifyCounted(0.25f, 0.75f), PixelClass::AgreeLit);          // V_R − V_M = τ: agree
     EXPECT_EQ(classifyCounted(0.2421875f, 0.75f), PixelClass::FalseShadow);  // τ + 1/128
     EXPECT_EQ(classifyCounted(0.0f, 1.0f), PixelClass::FalseShadow);
     EXPECT_EQ(classifyCounted(0.0f, 0.0f), PixelClass::AgreeShadow);
-    EXPECT_EQ(classifyCounted(0.75f, 0.25f), PixelClass::AgreeShadow);    // V_M − V_R = τ: agree
+    EXPECT_EQ(classifyCounted(0.75f, 0.25f), PixelClass::AgreeShadow);        // V_M − V_R = τ: agree
     EXPECT_EQ(classifyCounted(0.7578125f, 0.25f), PixelClass::MissedShadow);  // τ + 1/128
     EXPECT_EQ(classifyCounted(1.0f, 0.0f), PixelClass::MissedShadow);
     // V_R = τ exactly is shadowed (V ≤ τ), V_R just above τ is lit.
@@ -63,27 +63,26 @@ TEST(ClassifyCounted, FollowsTheTableOnBothSidesOfTau) {
 
 TEST(CompareFrames, CountsOnlySameObjectFacingTheLightInBothFrames) {
     const auto [m, r] = framesFrom({
-        {1, 1, 0.5f, 0.5f, 1, 1},       // 0 counted
-        {1, 2, 0.5f, 0.5f, 1, 1},       // 1 ids differ: silhouette
-        {0, 0, 0, 0, 1, 1},             // 2 background in both
-        {0, 3, 0, 0.5f, 1, 1},          // 3 method sees background: silhouette
-        {1, 1, 0.0f, 0.5f, 0, 1},       // 4 method N·L = 0: not counted, sign differs
-        {1, 1, 0.5f, -0.2f, 0, 1},      // 5 reference faces away: not counted, sign differs
-        {1, 1, -0.1f, -0.2f, 0, 1},     // 6 both face away: not counted, signs agree
-        {2.4f, 2.0f, 0.5f, 0.5f, 1, 1}, // 7 ids round to 2 and 2: counted
-        {2.6f, 2.0f, 0.5f, 0.5f, 1, 1}, // 8 ids round to 3 and 2: silhouette
+        {1, 1, 0.5f, 0.5f, 1, 1},        // 0 counted
+        {1, 2, 0.5f, 0.5f, 1, 1},        // 1 ids differ: silhouette
+        {0, 0, 0, 0, 1, 1},              // 2 background in both
+        {0, 3, 0, 0.5f, 1, 1},           // 3 method sees background: silhouette
+        {1, 1, 0.0f, 0.5f, 0, 1},        // 4 method N·L = 0: not counted, sign differs
+        {1, 1, 0.5f, -0.2f, 0, 1},       // 5 reference faces away: not counted, sign differs
+        {1, 1, -0.1f, -0.2f, 0, 1},      // 6 both face away: not counted, signs agree
+        {2.4f, 2.0f, 0.5f, 0.5f, 1, 1},  // 7 ids round to 2 and 2: counted
+        {2.6f, 2.0f, 0.5f, 0.5f, 1, 1},  // 8 ids round to 3 and 2: silhouette
     });
     const Comparison c = compareFrames(m, r);
-    const std::vector<PixelClass> expected = {
-        PixelClass::AgreeLit,   PixelClass::NotCounted, PixelClass::NotCounted,
-        PixelClass::NotCounted, PixelClass::NotCounted, PixelClass::NotCounted,
-        PixelClass::NotCounted, PixelClass::AgreeLit,   PixelClass::NotCounted};
+    const std::vector<PixelClass> expected = {PixelClass::AgreeLit,   PixelClass::NotCounted, PixelClass::NotCounted,
+                                              PixelClass::NotCounted, PixelClass::NotCounted, PixelClass::NotCounted,
+                                              PixelClass::NotCounted, PixelClass::AgreeLit,   PixelClass::NotCounted};
     EXPECT_EQ(c.classes, expected);
     EXPECT_EQ(c.metrics.counted, 2u);
     EXPECT_EQ(c.metrics.notCounted, 7u);
     EXPECT_EQ(c.metrics.silhouetteMismatch, 3u);  // pixels 1, 3, 8
     EXPECT_DOUBLE_EQ(c.metrics.silhouetteMismatchRate, 3.0 / 9.0);
-    EXPECT_EQ(c.metrics.ndotlSignMismatch, 2u);   // pixels 4, 5
+    EXPECT_EQ(c.metrics.ndotlSignMismatch, 2u);  // pixels 4, 5
 }
 
 TEST(CompareFrames, NonFiniteValuesAreInvalidAndCountedPerChannel) {
@@ -115,16 +114,16 @@ TEST(CompareFrames, NonFiniteValuesAreInvalidAndCountedPerChannel) {
 
 TEST(CompareFrames, MetricsOfAHandBuiltRowEqualHandCounts) {
     const auto [m, r] = framesFrom({
-        {1, 1, 0.5f, 0.5f, 1, 1},           // p0 agree lit
-        {1, 1, 0.5f, 0.5f, 0, 0},           // p1 agree shadow
-        {1, 1, 0.5f, 0.5f, 0, 1, 1},        // p2 false shadow, blocked by itself: acne
-        {1, 1, 0.5f, 0.5f, 0, 1, 2},        // p3 false shadow, blocked by object 2
-        {2, 2, 0.5f, 0.5f, 1, 0},           // p4 missed shadow
-        {2, 2, 0.5f, 0.5f, 0.25f, 0},       // p5 agree shadow, |ΔV| = 0.25
-        {1, 2, 0.5f, 0.5f, 1, 1},           // p6 silhouette
-        {0, 0, 0, 0, 1, 1},                 // p7 background
-        {0, 1, 0, 0.5f, 1, 1},              // p8 silhouette
-        {2, 2, -0.1f, 0.3f, 0, 1},          // p9 N·L sign differs
+        {1, 1, 0.5f, 0.5f, 1, 1},      // p0 agree lit
+        {1, 1, 0.5f, 0.5f, 0, 0},      // p1 agree shadow
+        {1, 1, 0.5f, 0.5f, 0, 1, 1},   // p2 false shadow, blocked by itself: acne
+        {1, 1, 0.5f, 0.5f, 0, 1, 2},   // p3 false shadow, blocked by object 2
+        {2, 2, 0.5f, 0.5f, 1, 0},      // p4 missed shadow
+        {2, 2, 0.5f, 0.5f, 0.25f, 0},  // p5 agree shadow, |ΔV| = 0.25
+        {1, 2, 0.5f, 0.5f, 1, 1},      // p6 silhouette
+        {0, 0, 0, 0, 1, 1},            // p7 background
+        {0, 1, 0, 0.5f, 1, 1},         // p8 silhouette
+        {2, 2, -0.1f, 0.3f, 0, 1},     // p9 N·L sign differs
     });
     const Metrics k = compareFrames(m, r).metrics;
     EXPECT_EQ(k.totalPixels, 10u);
@@ -183,17 +182,15 @@ TEST(CompareFrames, NothingCountedGivesZeroRatesAndUnitIoU) {
 
 TEST(DiffColors, EachClassHasItsDocumentedColor) {
     const auto [m, r] = framesFrom({
-        {1, 1, 0.5f, 0.5f, 1, 1},  // agree lit
-        {1, 1, 0.5f, 0.5f, 0, 0},  // agree shadow
-        {1, 1, 0.5f, 0.5f, 0, 1},  // false
-        {1, 1, 0.5f, 0.5f, 1, 0},  // missed
-        {0, 0, 0, 0, 1, 1},        // not counted
+        {1, 1, 0.5f, 0.5f, 1, 1},                                        // agree lit
+        {1, 1, 0.5f, 0.5f, 0, 0},                                        // agree shadow
+        {1, 1, 0.5f, 0.5f, 0, 1},                                        // false
+        {1, 1, 0.5f, 0.5f, 1, 0},                                        // missed
+        {0, 0, 0, 0, 1, 1},                                              // not counted
         {1, 1, 0.5f, 0.5f, std::numeric_limits<float>::quiet_NaN(), 1},  // invalid
     });
     const Comparison c = compareFrames(m, r);
-    auto px = [&](int i) {
-        return std::array<float, 3>{c.diffRgb[3 * i], c.diffRgb[3 * i + 1], c.diffRgb[3 * i + 2]};
-    };
+    auto px = [&](int i) { return std::array<float, 3>{c.diffRgb[3 * i], c.diffRgb[3 * i + 1], c.diffRgb[3 * i + 2]}; };
     // Reference beauty is linear gray 0.2: luminance 0.2 (709 weights sum to 1), sRGB ≈ 0.484.
     const float y = srgb(0.2f);
     EXPECT_NEAR(px(0)[0], DiffColors::kLitBase + DiffColors::kLitScale * y, 1e-5);
@@ -232,8 +229,7 @@ TEST(CompareFrames, SizeMismatchThrowsNamingBothSizes) {
 
 TEST(CompareFrames, MissingChannelThrowsNamingFrameAndChannel) {
     const Frame good = test::uniformFrame(3, 2, 1, 0.5f, 1);
-    auto expectThrow = [&](const Frame& m, const Frame& r, const std::string& which,
-                           const std::string& channel) {
+    auto expectThrow = [&](const Frame& m, const Frame& r, const std::string& which, const std::string& channel) {
         try {
             compareFrames(m, r);
             ADD_FAILURE() << "expected InputError for " << which << " " << channel;
@@ -270,8 +266,7 @@ TEST(CompareFrames, IdenticalFramesAgreeEverywhere) {
     const Frame f = test::syntheticFrame(o);
     const Metrics k = compareFrames(f, f).metrics;
     std::size_t expectedCounted = 0;
-    for (std::size_t i = 0; i < f.pixelCount(); ++i)
-        expectedCounted += f.objectId[i] > 0 && f.ndotl[i] > 0;
+    for (std::size_t i = 0; i < f.pixelCount(); ++i) expectedCounted += f.objectId[i] > 0 && f.ndotl[i] > 0;
     EXPECT_EQ(k.counted, expectedCounted);
     EXPECT_GT(k.counted, 0u);
     EXPECT_EQ(k.falseShadow + k.missedShadow, 0u);
@@ -293,7 +288,7 @@ std::pair<Frame, Frame> halfShadow(int methodShadowColumns) {
 }
 
 TEST(EdgeAwareError, WrongPixelsNextToAReferenceShadowEdgeAreAliasing) {
-    auto [m, r] = halfShadow(12);  // columns 10 and 11 falsely shadowed
+    auto [m, r] = halfShadow(12);      // columns 10 and 11 falsely shadowed
     m.visibility[5 * 20 + 18] = 0.0f;  // a false speckle 8 columns from the edge
     m.visibility[0] = 1.0f;            // a missed pixel 9 columns from the edge
     // Reference edge pixels: columns 9 and 10 (neighbours differ), 20 rows each.
@@ -304,7 +299,7 @@ TEST(EdgeAwareError, WrongPixelsNextToAReferenceShadowEdgeAreAliasing) {
     EXPECT_EQ(k0.falseShadow, 41u);
     EXPECT_EQ(k0.falseShadowNearEdge, 20u);  // only column 10 is itself an edge pixel
     EXPECT_EQ(k0.aliasingPixels, 20u);
-    EXPECT_EQ(k0.biasErrorPixels, 22u);      // column 11 + speckle + missed pixel
+    EXPECT_EQ(k0.biasErrorPixels, 22u);  // column 11 + speckle + missed pixel
     CompareOptions radius1;
     radius1.edgeRadius = 1;
     const Metrics k1 = compareFrames(m, r, radius1).metrics;

@@ -110,8 +110,8 @@ TEST(HeatMap, PixelsHoldTheScaleColorOfTheirErrorAndNotCountedIsGray) {
     ASSERT_EQ(c.heatRgb.size(), 3u * 32u);
     const auto pen = heatColor(0.375f), exact = heatColor(0.0f);
     for (int ch = 0; ch < 3; ++ch) {
-        EXPECT_FLOAT_EQ(c.heatRgb[3 * 0 + ch], pen[ch]);          // (0, 0): penumbra
-        EXPECT_FLOAT_EQ(c.heatRgb[3 * 5 + ch], exact[ch]);        // (5, 0): hard, exact
+        EXPECT_FLOAT_EQ(c.heatRgb[3 * 0 + ch], pen[ch]);    // (0, 0): penumbra
+        EXPECT_FLOAT_EQ(c.heatRgb[3 * 5 + ch], exact[ch]);  // (5, 0): hard, exact
         EXPECT_FLOAT_EQ(c.heatRgb[3 * 7 + ch], DiffColors::kNotCounted[ch]);
     }
 }
@@ -128,7 +128,7 @@ TEST(ContinuousError, PerLightChannelsGiveEachLightsOwnError) {
         m.lightVisibility[0][i] = r.lightVisibility[0][i] = 1.0f;
         r.lightVisibility[1][i] = 0.5f;
         m.lightVisibility[1][i] = 0.875f;
-        r.visibility[i] = 0.75f;     // the mean of both
+        r.visibility[i] = 0.75f;  // the mean of both
         m.visibility[i] = 0.9375f;
         for (int ch = 0; ch < 3; ++ch) r.beauty[3 * i + ch] = 0.3f;
     }

@@ -13,16 +13,16 @@ namespace {
 
 TEST(ParetoFront, KeepsExactlyTheNonDominatedPointsInTimeOrder) {
     const std::vector<TimeErrorPoint> p = {
-        {10, 0.5},       // 0 front
-        {20, 0.2},       // 1 front
-        {15, 0.6},       // 2 dominated by 0 (faster and more accurate)
-        {40, 0.2},       // 3 dominated by 1 (same error, slower)
-        {50, 0.05},      // 4 front
-        {20, 0.2},       // 5 duplicate of 1: kept, neither dominates
-        {5, 0.9},        // 6 front: the fastest
-        {NAN, 0.0},      // 7 failed row: never on the front
-        {60, 0.05},      // 8 dominated by 4
-        {30, 0.1},       // 9 front
+        {10, 0.5},   // 0 front
+        {20, 0.2},   // 1 front
+        {15, 0.6},   // 2 dominated by 0 (faster and more accurate)
+        {40, 0.2},   // 3 dominated by 1 (same error, slower)
+        {50, 0.05},  // 4 front
+        {20, 0.2},   // 5 duplicate of 1: kept, neither dominates
+        {5, 0.9},    // 6 front: the fastest
+        {NAN, 0.0},  // 7 failed row: never on the front
+        {60, 0.05},  // 8 dominated by 4
+        {30, 0.1},   // 9 front
     };
     EXPECT_EQ(paretoFront(p), (std::vector<std::size_t>{6, 0, 1, 5, 9, 4}));
     EXPECT_TRUE(paretoFront({}).empty());

@@ -29,13 +29,15 @@ int main(int argc, char** argv) {
         o.height = std::stoi(argv[3]);
     }
     auto reference = sc::test::syntheticFrame(o);
-    reference.attributes = {{"backend", "reference"}, {"precision", "double"}, {"ray_bias", "robust"}, {"version", "0.1.0"}};
+    reference.attributes = {
+        {"backend", "reference"}, {"precision", "double"}, {"ray_bias", "robust"}, {"version", "0.1.0"}};
     reference.timingsMs = {{"setup", 2.1}, {"render", 912.0}};
 
     sc::test::SyntheticOptions ro = o;
     ro.acne = ro.shiftShadow = ro.jaggies = true;
     auto raster = sc::test::syntheticFrame(ro);
-    raster.attributes = {{"backend", "raster"}, {"shadow_map_size", "2048"}, {"depth_bias", "0.002"}, {"filter", "none"}};
+    raster.attributes = {
+        {"backend", "raster"}, {"shadow_map_size", "2048"}, {"depth_bias", "0.002"}, {"filter", "none"}};
     raster.timingsMs = {{"setup", 41.0}, {"shadow_pass", 3.2}, {"lit_pass", 5.1}, {"readback", 1.9}};
 
     sc::test::SyntheticOptions to = o;
@@ -78,12 +80,14 @@ int main(int argc, char** argv) {
     for (int spp : {1, 4, 16})
         sweep.push_back({"raytrace", 110.0 * spp, spp == 16 ? 0.0 : 0.001 / spp, std::to_string(spp) + " spp"});
     const sc::BiasWindow window = sc::findBiasWindow(bias);
-    shadowlab::scene::writeTextAtomic(dir / "bias.svg", sc::renderSvg(sc::biasPlot(bias, window, "depth bias (world units)", true)));
+    shadowlab::scene::writeTextAtomic(dir / "bias.svg",
+                                      sc::renderSvg(sc::biasPlot(bias, window, "depth bias (world units)", true)));
     shadowlab::scene::writeTextAtomic(dir / "error-time.svg", sc::renderSvg(sc::errorTimePlot(sweep, 912.0)));
     std::cout << window.describe() << "\n";
     for (auto& b : bias) b.missedShadowRate *= 0.02;  // leaks start later: a window opens
     const sc::BiasWindow open = sc::findBiasWindow(bias);
-    shadowlab::scene::writeTextAtomic(dir / "bias-window.svg", sc::renderSvg(sc::biasPlot(bias, open, "depth bias (world units)", true)));
+    shadowlab::scene::writeTextAtomic(dir / "bias-window.svg",
+                                      sc::renderSvg(sc::biasPlot(bias, open, "depth bias (world units)", true)));
     std::cout << open.describe() << "\n";
     std::cout << "wrote " << (dir / "report.html").string() << "\n";
     return 0;

@@ -58,8 +58,8 @@ ReportInput syntheticRun() {
 TEST(Report, NamesOnlyTheGivenImageFilesAndNothingRemote) {
     const ReportInput in = syntheticRun();
     const std::string html = renderReportHtml(in);
-    const std::set<std::string> given = {"reference.png", "raytrace.png", "diff-raytrace.png",
-                                         "raster.png", "diff-raster.png"};
+    const std::set<std::string> given = {"reference.png", "raytrace.png", "diff-raytrace.png", "raster.png",
+                                         "diff-raster.png"};
     std::set<std::string> seen;
     const std::regex ref(R"((src|href)="([^"]*)\")");
     for (auto it = std::sregex_iterator(html.begin(), html.end(), ref); it != std::sregex_iterator(); ++it) {
@@ -76,7 +76,8 @@ TEST(Report, NamesOnlyTheGivenImageFilesAndNothingRemote) {
 TEST(Report, IsBalancedEnoughToParse) {
     const std::string html = renderReportHtml(syntheticRun());
     EXPECT_EQ(html.rfind("<!DOCTYPE html>", 0), 0u);
-    for (const std::string tag : {"div", "table", "tr", "figure", "svg", "section", "details", "p", "ul", "li", "g", "text"})
+    for (const std::string tag :
+         {"div", "table", "tr", "figure", "svg", "section", "details", "p", "ul", "li", "g", "text"})
         EXPECT_EQ(count(html, "<" + tag + ">") + count(html, "<" + tag + " "), count(html, "</" + tag + ">")) << tag;
     EXPECT_NE(html.find("</html>"), std::string::npos);
     // The scene name is escaped, not markup.
@@ -95,8 +96,8 @@ TEST(Report, ShowsEachMethodsMetricsAndTimings) {
         EXPECT_NE(html.find(formatPercent(k.missedShadowRate)), std::string::npos) << m.label;
         EXPECT_NE(html.find(formatFixed(k.shadowIoU, 4)), std::string::npos) << m.label;
     }
-    EXPECT_NE(html.find("shadow_pass"), std::string::npos);  // a stage timing row
-    EXPECT_NE(html.find(formatDuration(43.0)), std::string::npos);  // raster total 40 + 3
+    EXPECT_NE(html.find("shadow_pass"), std::string::npos);          // a stage timing row
+    EXPECT_NE(html.find(formatDuration(43.0)), std::string::npos);   // raster total 40 + 3
     EXPECT_NE(html.find("reference 900 ms"), std::string::npos);     // the plot's marker
     EXPECT_NE(html.find("any-hit shadow rays"), std::string::npos);  // the plan
     EXPECT_EQ(count(html, "<svg"), 1u);
@@ -138,8 +139,8 @@ TEST(Report, FindingsSayAThinShadowLostToTheBiasIsBiasAndARayTracerDoesNotAlias)
             ref.blockerDistance[std::size_t(y) * 20 + x] = 0.01f;
         }
     scene::Frame map = test::uniformFrame(20, 20, 1, 0.5f, 1), ray = map;
-    map.attributes = {{"backend", "raster"},       {"texel_world_size", "0.01"},   {"depth_bias", "0.005"},
-                      {"slope_bias", "1"},         {"shadow_map_size", "2048"},    {"shadow_map_size_needed", "4096"}};
+    map.attributes = {{"backend", "raster"}, {"texel_world_size", "0.01"}, {"depth_bias", "0.005"},
+                      {"slope_bias", "1"},   {"shadow_map_size", "2048"},  {"shadow_map_size_needed", "4096"}};
     ray.attributes = {{"backend", "raytrace"}, {"ray_bias", "0.001"}};
     ReportInput in;
     in.sceneName = "strip";

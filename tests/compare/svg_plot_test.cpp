@@ -134,9 +134,11 @@ namespace shadowlab::compare {
 namespace {
 
 TEST(ErrorTimePlot, OneSeriesAndOneFrontPerBackendAndTheReferenceMarker) {
-    const std::vector<SweepPoint> pts = {
-        {"raster", 10, 0.05, "1024"}, {"raster", 20, 0.01, "2048"}, {"raster", 30, 0.02, "4096"},
-        {"raytrace", 100, 0.001, "float"}, {"raytrace", 200, 0.0, "double"}};
+    const std::vector<SweepPoint> pts = {{"raster", 10, 0.05, "1024"},
+                                         {"raster", 20, 0.01, "2048"},
+                                         {"raster", 30, 0.02, "4096"},
+                                         {"raytrace", 100, 0.001, "float"},
+                                         {"raytrace", 200, 0.0, "double"}};
     const ScatterPlot p = errorTimePlot(pts, 900.0);
     ASSERT_EQ(p.series.size(), 4u);  // raster, raster front, raytrace, raytrace front
     EXPECT_EQ(p.series[0].name, "raster");
@@ -167,8 +169,8 @@ TEST(BiasPlot, ShadesTheWindowOrSaysStiff) {
     ASSERT_EQ(p.bands.size(), 1u);
     EXPECT_EQ(p.bands[0].x0, 0.002);
     EXPECT_EQ(p.bands[0].x1, 0.002);
-    EXPECT_EQ(p.series[0].points.size(), 3u);  // false shadow
-    EXPECT_EQ(p.series[1].points.size(), 3u);  // missed shadow
+    EXPECT_EQ(p.series[0].points.size(), 3u);   // false shadow
+    EXPECT_EQ(p.series[1].points.size(), 3u);   // missed shadow
     EXPECT_EQ(p.series[2].points[0].y, 0.001);  // threshold line
     EXPECT_TRUE(p.note.empty());
     BiasWindow stiff = w;

@@ -12,8 +12,7 @@
 namespace shadowlab::compare::test {
 
 // A frame of w×h with every AOV set to `id`, `ndotl`, `visibility`; beauty follows the shading.
-inline scene::Frame uniformFrame(int w, int h, float id, float ndotl, float visibility,
-                                 bool withBlocker = false) {
+inline scene::Frame uniformFrame(int w, int h, float id, float ndotl, float visibility, bool withBlocker = false) {
     scene::Frame f = scene::Frame::allocate(w, h, withBlocker);
     for (std::size_t i = 0; i < f.pixelCount(); ++i) {
         f.objectId[i] = id;
@@ -28,10 +27,10 @@ inline scene::Frame uniformFrame(int w, int h, float id, float ndotl, float visi
 
 struct SyntheticOptions {
     int width = 320, height = 180;
-    bool acne = false;          // speckled self-shadow on the lit floor and the disk's terminator
-    bool shiftShadow = false;   // the cast shadow detaches (peter-panning): false + missed
-    bool jaggies = false;       // the floor's shadow test snaps to texelPx-sized texels
-    bool rayAcne = false;       // a few self-shadowed pixels at the disk's grazing terminator
+    bool acne = false;              // speckled self-shadow on the lit floor and the disk's terminator
+    bool shiftShadow = false;       // the cast shadow detaches (peter-panning): false + missed
+    bool jaggies = false;           // the floor's shadow test snaps to texelPx-sized texels
+    bool rayAcne = false;           // a few self-shadowed pixels at the disk's grazing terminator
     double acneProbability = 0.08;  // share of lit plane pixels turned into acne speckles
     int shadowShiftPx = 6;          // peter-panning: the cast shadow moves right by this much
     int texelPx = 4;                // shadow-map texel size on screen for jagged edges
@@ -56,7 +55,7 @@ inline scene::Frame syntheticFrame(const SyntheticOptions& o) {
     const double horizon = 0.35 * h;
     const double cx = 0.42 * w, cy = 0.45 * h, r = 0.2 * h;
     const double sx = 0.56 * w, sy = 0.8 * h, sa = 0.24 * w, sb = 0.1 * h;  // shadow ellipse
-    const double lx = -0.55, ly = 0.6, lz = 0.58;                            // toward the light
+    const double lx = -0.55, ly = 0.6, lz = 0.58;                           // toward the light
     for (int y = 0; y < o.height; ++y)
         for (int x = 0; x < o.width; ++x) {
             const std::size_t i = std::size_t(y) * o.width + x;
@@ -68,8 +67,7 @@ inline scene::Frame syntheticFrame(const SyntheticOptions& o) {
                 const double nz = std::sqrt(1.0 - dx * dx - dy * dy);
                 ndotl = float(dx * lx - dy * ly + nz * lz);
                 albedo = 0.75f;
-                if (o.acne && ndotl > 0 && ndotl < 0.25 &&
-                    hashNoise(x, y) < 3 * o.acneProbability) {
+                if (o.acne && ndotl > 0 && ndotl < 0.25 && hashNoise(x, y) < 3 * o.acneProbability) {
                     vis = 0;
                     blocker = 2;
                 }

@@ -37,7 +37,8 @@ scene::Frame renderChecked(const scene::Scene& s, scene::RenderSettings settings
 }
 
 scene::Frame renderReference(const scene::Scene& s, const scene::RenderSettings& settings) {
-    return raytrace::renderReference(s, scene::makeRenderPlan(s, settings), scene::referenceSettings(settings.raytrace));
+    return raytrace::renderReference(s, scene::makeRenderPlan(s, settings),
+                                     scene::referenceSettings(settings.raytrace));
 }
 
 scene::Frame renderReference(const scene::Scene& s) { return renderReference(s, scene::resolveSettings(s, {})); }

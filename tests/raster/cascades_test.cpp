@@ -322,7 +322,8 @@ TEST(RasterCascades, AttributesRecordTheSplitsAndEachCascadesTexel) {
     const std::vector<double> splits = parseList(f.attributes.at("cascade_splits"));
     ASSERT_EQ(splits.size(), 4u);
     for (int i = 1; i < 3; ++i)
-        EXPECT_NEAR(splits[std::size_t(i)], zhangSplit(splits[0], splits[3], i, 3, kCascadeSplitLambda), 1e-7 * splits[3]);
+        EXPECT_NEAR(splits[std::size_t(i)], zhangSplit(splits[0], splits[3], i, 3, kCascadeSplitLambda),
+                    1e-7 * splits[3]);
     const std::vector<double> texels = parseList(f.attributes.at("cascade_texel_world_size"));
     const CascadeSet set = fitCascades(s, s.lights[0].direction, 3, 512);
     ASSERT_EQ(texels.size(), 3u);
@@ -568,7 +569,8 @@ TEST(RasterCascadeBlend, OutsideTheBandsUnchangedInsideTheLinearMixOfTheTwoCasca
         if (bh.kind == BandPosition::Outside) {
             ++outside;
             ASSERT_EQ(half.visibility[i], vc) << "pixel " << i;
-            for (std::size_t k = 0; k < 3; ++k) ASSERT_EQ(half.beauty[3 * i + k], plain.beauty[3 * i + k]) << "pixel " << i;
+            for (std::size_t k = 0; k < 3; ++k)
+                ASSERT_EQ(half.beauty[3 * i + k], plain.beauty[3 * i + k]) << "pixel " << i;
             continue;
         }
         const int x = int(i % std::size_t(plain.width)), y = int(i / std::size_t(plain.width));

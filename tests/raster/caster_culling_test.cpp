@@ -34,9 +34,7 @@ scene::Frame rasterRender(const scene::Scene& s, bool cull, int cascades = 1) {
     return test::renderChecked(s, settings);
 }
 
-int countOf(const std::vector<float>& ids, int id) {
-    return int(std::count(ids.begin(), ids.end(), float(id)));
-}
+int countOf(const std::vector<float>& ids, int id) { return int(std::count(ids.begin(), ids.end(), float(id))); }
 
 TEST(RasterCasterCulling, AFarObjectThatCannotShadowTheViewIsCulledAndTheImageIsUnchanged) {
     // A sphere at (60, 1, 60), behind and far to the side of the camera at (0, 2, 6) looking at
@@ -142,7 +140,7 @@ TEST(RasterCasterCulling, EachCubeFaceDrawsOnlyItsOwnCastersAndTheImageIsUnchang
         SCOPED_TRACE(face);
         const LightFrustum f = fitPointLightFace(s.bounds(), s.lights[0].position, face, settings.shadowMapSize);
         const std::vector<bool> casts = layerCasters(s, settings, s.lights[0], f, receivers);
-        EXPECT_FALSE(casts[2]);                // `far`
+        EXPECT_FALSE(casts[2]);  // `far`
         if (face == 3) {
             EXPECT_TRUE(casts[3]);  // `kept` in −Y
         }
@@ -176,8 +174,9 @@ TEST(RasterCasterCulling, PcssOfAnAreaPointLightReachesFartherAndStillLeavesTheI
     // Equal frames say something only where they hold soft shadows: `kept` (id 4) shadows the
     // visible ground, and the light's radius gives its shadow a penumbra.
     EXPECT_GT(countOf(culled.blockerId, 4), 0);
-    EXPECT_GT(std::count_if(culled.visibility.begin(), culled.visibility.end(), [](float v) { return v > 0.0f && v < 1.0f; }),
-              0);
+    EXPECT_GT(
+        std::count_if(culled.visibility.begin(), culled.visibility.end(), [](float v) { return v > 0.0f && v < 1.0f; }),
+        0);
 }
 
 TEST(RasterCasterCulling, EachCascadeDrawsOnlyTheCastersOfItsOwnSlice) {
@@ -193,8 +192,10 @@ TEST(RasterCasterCulling, EachCascadeDrawsOnlyTheCastersOfItsOwnSlice) {
     const scene::RasterSettings settings = scene::resolveSettings(s, o).raster;
     const CascadeSet cs = fitCascades(s, s.lights[0].direction, 3, settings.shadowMapSize);
     ASSERT_EQ(cs.frusta.size(), 3u);
-    const std::vector<bool> first = layerCasters(s, settings, s.lights[0], cs.frusta[0], cascadeReceivers(s, cs.splits, 0));
-    const std::vector<bool> last = layerCasters(s, settings, s.lights[0], cs.frusta[2], cascadeReceivers(s, cs.splits, 2));
+    const std::vector<bool> first =
+        layerCasters(s, settings, s.lights[0], cs.frusta[0], cascadeReceivers(s, cs.splits, 0));
+    const std::vector<bool> last =
+        layerCasters(s, settings, s.lights[0], cs.frusta[2], cascadeReceivers(s, cs.splits, 2));
     EXPECT_FALSE(first[2]);
     EXPECT_TRUE(last[2]);
     const std::vector<LightCulling> c = culledCasters(s, settings);
@@ -273,9 +274,9 @@ TEST(RasterCasterCulling, ReceiversPartlyBehindTheLightReachTheMapsEdgeOnlyOnThe
         for (const double y : {-1.0, 1.0})
             for (const double z : {-5.0, 5.0}) receivers.push_back({x, y, z});
     const scene::Scene s = boxes({
-        {{2, 3, -3}, {2.5, 4, -2}},    // u in [0.67, 1.25], v in [1, 2]: overlaps (v from 1 = t): kept
-        {{4, -0.1, -3}, {5, 0.1, -2}},  // u ≥ 4/3, past the clamped edge 1 + 0.02: culled
-        {{-3, -0.1, -3}, {-2, 0.1, -2}},  // u ≤ −2/3: on the side away from the crossing: culled
+        {{2, 3, -3}, {2.5, 4, -2}},         // u in [0.67, 1.25], v in [1, 2]: overlaps (v from 1 = t): kept
+        {{4, -0.1, -3}, {5, 0.1, -2}},      // u ≥ 4/3, past the clamped edge 1 + 0.02: culled
+        {{-3, -0.1, -3}, {-2, 0.1, -2}},    // u ≤ −2/3: on the side away from the crossing: culled
         {{0.5, -0.1, -3}, {0.6, 0.1, -2}},  // u in [0.17, 0.3]: kept
     });
     EXPECT_EQ(castsOnto(s, f, receivers, kCullMarginTexels, 0.0), (std::vector<bool>{true, false, false, true}));
@@ -301,7 +302,8 @@ scene::Scene spotFromAbove(int height) {
 
 int expectedSpotSize(int height) {
     using test::kPi;
-    const double needed = 2.0 * std::tan(30.6 * kPi / 180.0) * (10.0 / 8.0) / (2.0 * std::tan(20.0 * kPi / 180.0) / height);
+    const double needed =
+        2.0 * std::tan(30.6 * kPi / 180.0) * (10.0 / 8.0) / (2.0 * std::tan(20.0 * kPi / 180.0) / height);
     int size = 256;
     while (size < needed && size < 2048) size *= 2;
     return size;

@@ -2,10 +2,10 @@
 // real device list of this machine (lavapipe, with the validation layer).
 #include "raster/context.h"
 
+#include <unistd.h>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
 #include <optional>
 
 #include <gtest/gtest.h>
@@ -81,8 +81,10 @@ public:
         setenv(name, value, 1);
     }
     ~ScopedEnv() {
-        if (old_) setenv(name_, old_->c_str(), 1);
-        else unsetenv(name_);
+        if (old_)
+            setenv(name_, old_->c_str(), 1);
+        else
+            unsetenv(name_);
     }
 
 private:
@@ -189,7 +191,8 @@ TEST(Devices, AnUnvalidatedInstanceDoesNotBreakALivingValidatedOne) {
 TEST(Devices, SelectingByIndexAndByNameGivesTheSameDevice) {
     ValidationLog log;
     const Context byIndex(ContextOptions{.device = "0", .validate = true, .log = &log});
-    const Context byName(ContextOptions{.device = byIndex.deviceReport.name.substr(0, 5), .validate = true, .log = &log});
+    const Context byName(
+        ContextOptions{.device = byIndex.deviceReport.name.substr(0, 5), .validate = true, .log = &log});
     EXPECT_EQ(byIndex.deviceReport.name, byName.deviceReport.name);
     EXPECT_EQ(log.count.load(), 0);
 }
@@ -201,17 +204,19 @@ TEST(RasterContext, MemoryTypeIsTheFirstWithTheRequiredFlagsPreferringOneWithThe
     test::ValidatedContext vc;
     Context& ctx = vc.get();
     const VkPhysicalDeviceMemoryProperties real = ctx.memoryProperties;
-    constexpr VkMemoryPropertyFlags local = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, visible = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT,
-                                    coherent = VK_MEMORY_PROPERTY_HOST_COHERENT_BIT, cached = VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
+    constexpr VkMemoryPropertyFlags local = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT,
+                                    visible = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT,
+                                    coherent = VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+                                    cached = VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
     ctx.memoryProperties.memoryTypeCount = 4;
     const VkMemoryPropertyFlags types[4] = {local, visible | coherent, visible | coherent | cached, local | visible};
     for (int i = 0; i < 4; ++i) ctx.memoryProperties.memoryTypes[i] = {types[i], 0};
     EXPECT_EQ(ctx.memoryType(0b1111, local), 0u);
-    EXPECT_EQ(ctx.memoryType(0b1111, visible), 1u);                      // the first that has it
-    EXPECT_EQ(ctx.memoryType(0b1111, visible, cached), 2u);              // one with the preferred too
-    EXPECT_EQ(ctx.memoryType(0b1011, visible, cached), 1u);              // type 2 not allowed: the first
-    EXPECT_EQ(ctx.memoryType(0b1110, local), 3u);                        // type 0 not allowed
-    EXPECT_EQ(ctx.memoryType(0b1111, visible | coherent, local), 1u);    // no type has both: the first
+    EXPECT_EQ(ctx.memoryType(0b1111, visible), 1u);                    // the first that has it
+    EXPECT_EQ(ctx.memoryType(0b1111, visible, cached), 2u);            // one with the preferred too
+    EXPECT_EQ(ctx.memoryType(0b1011, visible, cached), 1u);            // type 2 not allowed: the first
+    EXPECT_EQ(ctx.memoryType(0b1110, local), 3u);                      // type 0 not allowed
+    EXPECT_EQ(ctx.memoryType(0b1111, visible | coherent, local), 1u);  // no type has both: the first
     try {
         ctx.memoryType(0b0111, local | visible);
         ADD_FAILURE() << "expected RasterError";

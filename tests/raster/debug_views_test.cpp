@@ -200,7 +200,8 @@ TEST(FrustumView, InsideLightMapOnEachFaceOfASpotPyramidAndAPointFace) {
     face.tanHalfFov = 1.05;
     face.near = 0.5;
     face.far = 10.0;
-    for (const double d : {0.5 + e, 3.0, 10.0 - e}) EXPECT_TRUE(insideLightMap(face, Vec3(d, 0.99 * d, -0.99 * d))) << d;
+    for (const double d : {0.5 + e, 3.0, 10.0 - e})
+        EXPECT_TRUE(insideLightMap(face, Vec3(d, 0.99 * d, -0.99 * d))) << d;
     for (const double d : {0.5 - e, 10.0 + e}) EXPECT_FALSE(insideLightMap(face, Vec3(d, 0.99 * d, -0.99 * d))) << d;
 }
 

@@ -70,8 +70,7 @@ scene::Frame renderDefaults(const scene::Scene& s, const scene::SettingsOverride
 struct ShadowCount {
     int inside = 0, insideShadowed = 0, outside = 0, outsideShadowed = 0;
 };
-ShadowCount countSphereShadow(const scene::Scene& s, const scene::Frame& f, const Vec3& c, double r,
-                              double margin) {
+ShadowCount countSphereShadow(const scene::Scene& s, const scene::Frame& f, const Vec3& c, double r, double margin) {
     const Vec3 L = s.lights[0].direction;
     ShadowCount n;
     for (int y = 0; y < f.height; ++y)
@@ -217,7 +216,8 @@ TEST(RasterDefaults, CascadesAreChosenWhenOneMapsTexelExceedsTwoPixels) {
     const double across = std::max(std::abs(glm::dot(*a - *b, basis.right)), std::abs(glm::dot(*a - *b, basis.up)));
     const double zNear = std::min(glm::dot(*a - cam.position, cam.forward), glm::dot(*b - cam.position, cam.forward));
     const double pixel = 2.0 * std::tan(20.0 * kPi / 180.0) * zNear / s.camera.height;
-    ASSERT_GT(across / 2048.0 / pixel, 2.0) << across << " across, nearest " << zNear;  // one map's texels per pixel, at least
+    ASSERT_GT(across / 2048.0 / pixel, 2.0)
+        << across << " across, nearest " << zNear;  // one map's texels per pixel, at least
     const CascadeChoice chosen = chooseCascades(s, settings.raster);
     EXPECT_GE(chosen.count, 2) << chosen.reason;
     EXPECT_LE(chosen.count, scene::kMaxCascades);

@@ -29,8 +29,13 @@ double deg(double d) { return d * kPi / 180.0; }
 
 // makeScene's sphere (r = 0.5) at `center` over a 20 x 20 ground, seen from `eye` toward `lookAt`.
 scene::Scene sphereOnTheGround(const Vec3& center, const Vec3& eye, const Vec3& lookAt, int width, int height) {
-    return test::makeScene(test::SphereOverPlane{
-        .center = center, .radius = 0.5, .planeSize = 20.0, .eye = eye, .lookAt = lookAt, .width = width, .height = height});
+    return test::makeScene(test::SphereOverPlane{.center = center,
+                                                 .radius = 0.5,
+                                                 .planeSize = 20.0,
+                                                 .eye = eye,
+                                                 .lookAt = lookAt,
+                                                 .width = width,
+                                                 .height = height});
 }
 
 // Spot at (0, 8, 0) straight down, cone 60° (the cone map's half-angle 61.2°, t0 = tan 61.2°),
@@ -239,7 +244,6 @@ TEST(RasterSpotFit, FarFromTheOriginTheFittedMapIsTheSame) {
     EXPECT_EQ(fm.near, fa.near);
     EXPECT_EQ(fm.far, fa.far);
 }
-
 
 TEST(RasterSpotFit, MovingTheCameraByAFractionOfATexelKeepsTheSizeAndMovesTheCenterByWholeTexels) {
     // A texel of the fitted map at the ground is 8·2h/N = 0.0055 units; the camera moves along x

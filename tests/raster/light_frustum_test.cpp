@@ -44,9 +44,9 @@ TEST(LightFrustum, DepthGrowsAlongTheLightAndSpansTheDiameter) {
     EXPECT_NEAR(f.halfWidth, h, 1e-12);
     EXPECT_NEAR(f.texelWorldSize(), 2.0 * h / 512, 1e-12);
     const glm::dmat4 m = f.toClip(Vec3(0));
-    EXPECT_NEAR(apply(m, Vec3(0)).z, 0.5, 1e-12);           // the center is mid-depth
-    EXPECT_NEAR(apply(m, -h * dir).z, 0.0, 1e-12);          // toward the light: depth 0
-    EXPECT_NEAR(apply(m, h * dir).z, 1.0, 1e-12);           // away from it: depth 1
+    EXPECT_NEAR(apply(m, Vec3(0)).z, 0.5, 1e-12);                    // the center is mid-depth
+    EXPECT_NEAR(apply(m, -h * dir).z, 0.0, 1e-12);                   // toward the light: depth 0
+    EXPECT_NEAR(apply(m, h * dir).z, 1.0, 1e-12);                    // away from it: depth 1
     EXPECT_NEAR(apply(m, 0.3 * dir).z - 0.5, 0.3 / (2 * h), 1e-12);  // 1 / depthRange per world unit
     // Moving across the light does not change depth.
     EXPECT_NEAR(apply(m, f.right + f.up).z, 0.5, 1e-12);
@@ -222,7 +222,8 @@ TEST(LightFrustum, FittedFallsBackToTheBoundingSphereWhenTheCameraSeesNothing) {
     s.camera.lookAt = Vec3(0, 10, 6);  // straight up, away from everything
     s.camera.up = Vec3(0, 0, -1);
     const Vec3 dir(0, -1, 0);
-    EXPECT_EQ(fitDirectionalLightToReceivers(s, dir, 256).halfWidth, fitDirectionalLight(s.bounds(), dir, 256).halfWidth);
+    EXPECT_EQ(fitDirectionalLightToReceivers(s, dir, 256).halfWidth,
+              fitDirectionalLight(s.bounds(), dir, 256).halfWidth);
 }
 
 TEST(CubeFaces, EachFaceReachesTheMarginPastItsEdgeAndLooksAlongItsAxis) {
@@ -249,7 +250,8 @@ TEST(CubeFaces, EachFaceReachesTheMarginPastItsEdgeAndLooksAlongItsAxis) {
         }
         // The six axes are distinct: +X −X +Y −Y +Z −Z.
         for (int a = 0; a < kCubeFaces; ++a)
-            for (int b = a + 1; b < kCubeFaces; ++b) EXPECT_LT(glm::dot(cubeFaceDirection(a), cubeFaceDirection(b)), 0.5);
+            for (int b = a + 1; b < kCubeFaces; ++b)
+                EXPECT_LT(glm::dot(cubeFaceDirection(a), cubeFaceDirection(b)), 0.5);
     }
 }
 

@@ -6,9 +6,9 @@
 // limit and where lit.vert hands lit.frag the light's map coordinates.
 #include "raster/lit_pass.h"
 
+#include <array>
 #include <cmath>
 #include <string>
-#include <array>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -67,7 +67,8 @@ Pixels litPass(const Context& ctx, const scene::Scene& s, bool readInPlace, bool
     geometry.indexCount = draw ? std::uint32_t(g.indices.size()) : 0u;
 
     shaders::LitUniforms u{};
-    u.viewProj = glm::mat4(scene::projectionMatrix(cam, s.camera.near, s.camera.far) * scene::viewMatrix(cam, cam.position));
+    u.viewProj =
+        glm::mat4(scene::projectionMatrix(cam, s.camera.near, s.camera.far) * scene::viewMatrix(cam, cam.position));
     u.forward = glm::vec3(cam.forward);
     u.ambient = float(s.ambient);
     u.background = glm::vec3(s.background);
@@ -85,11 +86,11 @@ Pixels litPass(const Context& ctx, const scene::Scene& s, bool readInPlace, bool
     l.kind = SHADOWLAB_LIGHT_DIRECTIONAL;
     const std::vector<glm::vec4> albedos = {glm::vec4(glm::vec3(kAlbedo), 1.0f)};
 
-    const LitPipeline pipeline =
-        createLitPipeline(ctx,
-                          LitVariant{.filter = scene::ShadowFilter::None, .normalOffset = false,
-                                     .lightKinds = 1u << SHADOWLAB_LIGHT_DIRECTIONAL},
-                          VK_NULL_HANDLE, glm::vec3(s.background));
+    const LitPipeline pipeline = createLitPipeline(ctx,
+                                                   LitVariant{.filter = scene::ShadowFilter::None,
+                                                              .normalOffset = false,
+                                                              .lightKinds = 1u << SHADOWLAB_LIGHT_DIRECTIONAL},
+                                                   VK_NULL_HANDLE, glm::vec3(s.background));
     // Placeholders, moved to SHADER_READ_ONLY_OPTIMAL by a shadow pass of no layers.
     const ShadowPipeline shadowPipeline = createShadowPipeline(ctx);
     const ShadowMaps maps = createShadowMaps(ctx, 1, 1);
@@ -165,12 +166,13 @@ TEST(RasterLitPass, DrawsTheQuadTheCameraSeesWithItsShadingAndAovs) {
                                     blocker == 0.0f && v == 1.0f && std::abs(b.r - color.r) < 1e-5 &&
                                     std::abs(b.g - color.g) < 1e-5 && std::abs(b.b - color.b) < 1e-5;
                     if (!ok && ++wrong <= 3)
-                        ADD_FAILURE() << "quad pixel " << x << "," << y << ": beauty " << b.r << " " << b.g << " " << b.b
-                                      << ", visibility " << v << ", aovs " << id << " " << nl << " " << z << " " << blocker;
+                        ADD_FAILURE() << "quad pixel " << x << "," << y << ": beauty " << b.r << " " << b.g << " "
+                                      << b.b << ", visibility " << v << ", aovs " << id << " " << nl << " " << z << " "
+                                      << blocker;
                 } else if (!down || edge > 1.6) {
                     ++off;
-                    const bool ok = b == glm::vec3(kBackground) && v == 0.0f && id == 0.0f && nl == 0.0f &&
-                                    z == 0.0f && blocker == 0.0f;
+                    const bool ok = b == glm::vec3(kBackground) && v == 0.0f && id == 0.0f && nl == 0.0f && z == 0.0f &&
+                                    blocker == 0.0f;
                     if (!ok && ++wrong <= 3) ADD_FAILURE() << "background pixel " << x << "," << y;
                 }
             }

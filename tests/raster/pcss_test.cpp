@@ -26,7 +26,8 @@ constexpr double kH = 10.0, kSize = 1.0;
 
 scene::Scene edgeScene(double hb) {
     scene::Scene s;
-    s.camera = {.position = Vec3(2.5, 3.0, 0.0), .lookAt = Vec3(0.0), .width = 320, .height = 180};  // fov 40°, near 0.1
+    s.camera = {
+        .position = Vec3(2.5, 3.0, 0.0), .lookAt = Vec3(0.0), .width = 320, .height = 180};  // fov 40°, near 0.1
     scene::Material m;
     m.name = "matte";
     s.materials.push_back(m);
@@ -42,7 +43,6 @@ scene::Scene edgeScene(double hb) {
     s.objects.push_back(test::horizontalQuad("blocker", Vec3(-3, hb, 0), 6.0, 6.0));
     return s;
 }
-
 
 // The 10%–90% width of the visibility ramp across the edge, on the floor near z = 0: floor pixels
 // (found by the test's own ray–plane intersection) are binned by x, each bin's mean visibility
@@ -220,8 +220,8 @@ TEST(RasterPcss, APointLightPenumbraCrossesACubeFaceSeamWithoutACut) {
     ASSERT_GT(count[1], 500);
     for (int side = 0; side < 2; ++side) {
         const double mean = err[side] / count[side];
-        std::printf("side %d (%s the seam): %d pixels, mean |V - V_disk| = %.4f\n", side, side ? "+X face," : "-Y face,",
-                    count[side], mean);
+        std::printf("side %d (%s the seam): %d pixels, mean |V - V_disk| = %.4f\n", side,
+                    side ? "+X face," : "-Y face,", count[side], mean);
         EXPECT_LT(mean, 0.04) << (side ? "+X" : "-Y") << " side of the seam";
     }
     EXPECT_LT(std::abs(err[0] / count[0] - err[1] / count[1]), 0.03);

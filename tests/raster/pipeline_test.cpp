@@ -70,9 +70,12 @@ TEST(RasterPipeline, EveryPipelineARenderAsksForIsCreatedWithoutValidationMessag
     using F = scene::ShadowFilter;
     const LitVariant variants[] = {
         {},  // the default: pcf2x2, one directional light, every target
-        {.filter = F::None, .blockerIds = false, .aovTarget = false},  // beauty and visibility only
+        {.filter = F::None, .blockerIds = false, .aovTarget = false},   // beauty and visibility only
         {.filter = F::Pcf, .aovTarget = false, .displayTarget = true},  // the 8-bit display target
-        {.filter = F::Poisson, .lightTargets = kLightTargets, .lightCount = 3, .lightKinds = kDirectional | kSpot | kPoint},
+        {.filter = F::Poisson,
+         .lightTargets = kLightTargets,
+         .lightCount = 3,
+         .lightKinds = kDirectional | kSpot | kPoint},
         {.filter = F::Pcss, .lightKinds = kSpot, .receiverPlane = true},
         {.filter = F::Vsm, .cascades = 3, .cascadeBlend = true},
         {.filter = F::Evsm2, .transmittance = true},
@@ -132,9 +135,12 @@ TEST(RasterPipeline, TheDynamicDepthBiasAddsTheConstantFactorInUnitsOfR) {
     int quad = 0, top = 0, other = 0, wrong = 0;
     for (std::size_t i = 0; i < plain.size(); ++i) {
         double expected = 0.0;
-        if (std::abs(plain[i] - zQuad) < 1e-6) ++quad, expected = std::ldexp(1.0, -16);
-        else if (std::abs(plain[i] - zTop) < 1e-6) ++top, expected = std::ldexp(1.0, -18);
-        else ++other;  // empty (1, unbiased: nothing drawn) or the box's sides at the outline
+        if (std::abs(plain[i] - zQuad) < 1e-6)
+            ++quad, expected = std::ldexp(1.0, -16);
+        else if (std::abs(plain[i] - zTop) < 1e-6)
+            ++top, expected = std::ldexp(1.0, -18);
+        else
+            ++other;  // empty (1, unbiased: nothing drawn) or the box's sides at the outline
         if (expected > 0.0 && std::abs(double(biased[i]) - double(plain[i]) - expected) > 1e-3 * expected) ++wrong;
         if (expected == 0.0 && plain[i] == 1.0f && biased[i] != 1.0f) ++wrong;
     }

@@ -22,8 +22,8 @@ namespace {
 scene::Scene grazingSeed(double elevationDegrees) {
     scene::Scene s = test::loadSeed(160, 90);
     const double e = elevationDegrees * test::kPi / 180.0;
-    s.lights[0].direction = glm::normalize(scene::Vec3(-std::cos(e) / std::sqrt(2.0), -std::sin(e),
-                                                       -std::cos(e) / std::sqrt(2.0)));
+    s.lights[0].direction =
+        glm::normalize(scene::Vec3(-std::cos(e) / std::sqrt(2.0), -std::sin(e), -std::cos(e) / std::sqrt(2.0)));
     return s;
 }
 
@@ -57,10 +57,11 @@ TEST(RasterReceiverPlane, RemovesThePcfAcneThatTheSameConstantBiasShowsAtGrazing
     const scene::Frame ref = test::renderReference(s);
     const compare::Metrics off = compare::compareFrames(rasterRender(s, pcf5(s, false), "rpb-off"), ref).metrics;
     const compare::Metrics on = compare::compareFrames(rasterRender(s, pcf5(s, true), "rpb-on"), ref).metrics;
-    std::printf("counted %zu, reference shadowed %zu; off: false %zu (self acne %zu) missed %zu; "
-                "on: false %zu (self acne %zu) missed %zu\n",
-                off.counted, off.shadowedReference, off.falseShadow, off.selfShadowAcne, off.missedShadow,
-                on.falseShadow, on.selfShadowAcne, on.missedShadow);
+    std::printf(
+        "counted %zu, reference shadowed %zu; off: false %zu (self acne %zu) missed %zu; "
+        "on: false %zu (self acne %zu) missed %zu\n",
+        off.counted, off.shadowedReference, off.falseShadow, off.selfShadowAcne, off.missedShadow, on.falseShadow,
+        on.selfShadowAcne, on.missedShadow);
     ASSERT_TRUE(off.hasBlockerIds && on.hasBlockerIds);
     ASSERT_GT(off.counted, 5000u);
     ASSERT_GT(off.shadowedReference, 300u);
@@ -169,9 +170,10 @@ TEST(RasterReceiverPlane, PcssBlockerSearchDoesNotCountTheReceiverItself) {
                 umbraDark += f.visibility[i] < 0.5f;
             }
         }
-    std::printf("floor in front of the quad: %d pixels, reference lit %d, pcss darkened %d (worst %.3f); "
-                "umbra %d, dark there %d\n",
-                front, refLit, darkened, worst, umbra, umbraDark);
+    std::printf(
+        "floor in front of the quad: %d pixels, reference lit %d, pcss darkened %d (worst %.3f); "
+        "umbra %d, dark there %d\n",
+        front, refLit, darkened, worst, umbra, umbraDark);
     ASSERT_GT(front, 10000);
     EXPECT_EQ(refLit, front);
     EXPECT_EQ(darkened, 0);
@@ -213,9 +215,10 @@ TEST(RasterReceiverPlane, PcssOfAPointLightKeepsTheReceiverPlaneInItsOwnFace) {
                 umbraSum += f.visibility[i];
             }
         }
-    std::printf("floor beside the quad: %d pixels, reference lit %d, pcss darkened %d (worst %.3f); "
-                "umbra %d, mean visibility there %.3f\n",
-                beside, refLit, darkened, worst, umbra, umbraSum / std::max(umbra, 1));
+    std::printf(
+        "floor beside the quad: %d pixels, reference lit %d, pcss darkened %d (worst %.3f); "
+        "umbra %d, mean visibility there %.3f\n",
+        beside, refLit, darkened, worst, umbra, umbraSum / std::max(umbra, 1));
     ASSERT_GT(beside, 2000);
     EXPECT_EQ(refLit, beside);
     EXPECT_EQ(darkened, 0) << "before: 1465 of 6268 darkened, down to 0";

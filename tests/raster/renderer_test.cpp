@@ -447,8 +447,7 @@ TEST(RasterRender, ObjectIdsMatchClosedFormPrimaryVisibilityExceptOnSilhouettes)
     const scene::Frame f = renderValidated(s, validatedSettings(256, 0.01, 1.0, ShadowFilter::None), "ids");
     int differ = 0;
     for (int y = 0; y < f.height; ++y)
-        for (int x = 0; x < f.width; ++x)
-            differ += f.objectId[at(f, x, y)] != float(primaryHit(p, cam, x, y).id);
+        for (int x = 0; x < f.width; ++x) differ += f.objectId[at(f, x, y)] != float(primaryHit(p, cam, x, y).id);
     EXPECT_LT(differ, int(f.pixelCount() / 100)) << differ << " of " << f.pixelCount() << " pixels differ";
 }
 
@@ -467,8 +466,7 @@ TEST(RasterRender, FarFromOriginSceneKeepsItsPrecision) {
     const scene::Frame f = renderValidated(s, validatedSettings(256, 0.01, 1.0, ShadowFilter::None), "far");
     int differ = 0;
     for (int y = 0; y < f.height; ++y)
-        for (int x = 0; x < f.width; ++x)
-            differ += f.objectId[at(f, x, y)] != float(primaryHit(p, cam, x, y).id);
+        for (int x = 0; x < f.width; ++x) differ += f.objectId[at(f, x, y)] != float(primaryHit(p, cam, x, y).id);
     EXPECT_LT(differ, int(f.pixelCount() / 100));
 }
 
@@ -554,8 +552,9 @@ TEST(RasterFilters, FiltersSoftenOnlyABandAroundTheShadowOutline) {
     int previousFractional = -1;
     for (const Case c : {Case{ShadowFilter::Pcf2x2, 2, 1.0}, Case{ShadowFilter::Pcf, 3, 1.5},
                          Case{ShadowFilter::Pcf, 5, 2.5}, Case{ShadowFilter::Poisson, 7, 3.5}}) {
-        const scene::Frame f = renderValidated(s, filterSettings(c.filter, c.size),
-                                               std::string("filter-") + scene::toString(c.filter) + std::to_string(c.size));
+        const scene::Frame f =
+            renderValidated(s, filterSettings(c.filter, c.size),
+                            std::string("filter-") + scene::toString(c.filter) + std::to_string(c.size));
         const EdgeStats e = edgeStats(p, s, f, (c.reach + 1.5) * texel);
         EXPECT_GT(e.farFromEdge, 10000);
         EXPECT_EQ(e.exactWrong, 0) << f.attributes.at("filter") << " " << c.size;
@@ -575,7 +574,8 @@ TEST(RasterFilters, Pcf2x2LiesBetweenTheHardResultsOfTheNeighbouringTexels) {
     const SphereOverPlane p = litFrom(40.0);
     const scene::Scene s = makeScene(p);
     const scene::Frame hard = renderValidated(s, validatedSettings(256, 0.02, 0.0, ShadowFilter::None), "between-hard");
-    const scene::Frame soft = renderValidated(s, validatedSettings(256, 0.02, 0.0, ShadowFilter::Pcf2x2), "between-pcf");
+    const scene::Frame soft =
+        renderValidated(s, validatedSettings(256, 0.02, 0.0, ShadowFilter::Pcf2x2), "between-pcf");
     int outside = 0, fractional = 0, shadowed = 0;
     for (std::size_t i = 0; i < hard.pixelCount(); ++i) {
         if (hard.objectId[i] != 2.0f || hard.ndotl[i] <= 0.0f) continue;
@@ -853,7 +853,7 @@ struct LightZeroAgreement {
 // The scene `one` rendered alone and with `dim` added (a second light takes lit.frag off the
 // interpolated map-coordinate path, onto the per-fragment product), normal offset 1.5 texels.
 std::pair<scene::Frame, scene::Frame> aloneAndWithADimLight(const scene::Scene& one, const scene::Light& dim,
-                                                           scene::RasterSettings settings) {
+                                                            scene::RasterSettings settings) {
     settings.normalOffset = 1.5;
     scene::Scene two = one;
     two.lights.push_back(dim);
@@ -954,8 +954,8 @@ TEST(RasterRender, InterpolatedSpotLightCoordinatesMatchThePerFragmentProduct) {
                     lit += a.visibility[i] > 0.99f;
                     const PrimaryHit h = primaryHit(base, cam, x, y);
                     const Vec3 toLight = spotPosition - h.p;
-                    if (h.id == 2 && glm::dot(-glm::normalize(toLight), spotDirection) >
-                                         std::cos(cone * kPi / 180.0) + 0.01) {
+                    if (h.id == 2 &&
+                        glm::dot(-glm::normalize(toLight), spotDirection) > std::cos(cone * kPi / 180.0) + 0.01) {
                         const auto t = raySphere(h.p, toLight, base.center, base.radius);
                         shadowedInCone += t && *t < 1.0;
                     }
@@ -1002,8 +1002,8 @@ TEST(RasterRenderer, ChannelsNotAskedForAreLeftOutAndTheRestIsUnchanged) {
         Renderer renderer(s, planFor(s, settings), settings);
         const scene::Frame all = renderer.render(scene::kAllChannels);
         const scene::Frame beauty = renderer.render(scene::kChannelBeauty);
-        const scene::Frame noIds = renderer.render(scene::kChannelVisibility | scene::kChannelObjectId |
-                                                   scene::kChannelLightVisibility);
+        const scene::Frame noIds =
+            renderer.render(scene::kChannelVisibility | scene::kChannelObjectId | scene::kChannelLightVisibility);
         ASSERT_EQ(all.beauty.size(), 3 * all.pixelCount());
         EXPECT_EQ(beauty.beauty, all.beauty) << "filter " << int(filter);
         EXPECT_TRUE(beauty.visibility.empty() && beauty.objectId.empty() && beauty.ndotl.empty() &&
@@ -1069,7 +1069,8 @@ TEST(RasterRenderer, DisplayFramesGiveThePngCodesOfTheFloatBeautyWithinOne) {
     EXPECT_EQ(c.beauty, copied.render(scene::kAllChannels).beauty);
     // Asking for visibility as well keeps the float target (the sRGB target has no room for it).
     Renderer renderer(s, planFor(s, settings), settings);
-    const scene::Frame v = renderer.render(scene::kChannelBeauty | scene::kChannelVisibility | scene::kBeautyForDisplay);
+    const scene::Frame v =
+        renderer.render(scene::kChannelBeauty | scene::kChannelVisibility | scene::kBeautyForDisplay);
     EXPECT_EQ(v.attributes.count("beauty_precision"), 0u);
     EXPECT_EQ(v.visibility.size(), v.pixelCount());
     EXPECT_EQ(renderer.validationMessages(), 0);
@@ -1090,9 +1091,9 @@ TEST(RasterRenderer, RenderingIntoTheFrameReadingTheTargetsInPlaceAndCopyingThem
     Renderer inPlace(s, planFor(s, settings), settings, RendererOptions{.renderIntoFrame = false});
     Renderer copied(s, planFor(s, settings), settings, RendererOptions{.readTargetsInPlace = false});
     scene::Frame reused;
-    for (scene::ChannelMask channels : {scene::kAllChannels, scene::kChannelBeauty,
-                                        scene::kChannelVisibility | scene::kChannelDepth, scene::kAllChannels,
-                                        scene::kChannelObjectId | scene::kChannelBlockerId}) {
+    for (scene::ChannelMask channels :
+         {scene::kAllChannels, scene::kChannelBeauty, scene::kChannelVisibility | scene::kChannelDepth,
+          scene::kAllChannels, scene::kChannelObjectId | scene::kChannelBlockerId}) {
         const scene::Frame f = intoFrame.render(channels);
         intoFrame.render(reused, channels);
         const scene::Frame a = inPlace.render(channels);
@@ -1151,8 +1152,10 @@ TEST(RasterRenderer, RenderingIntoTheFrameReadingTheTargetsInPlaceAndCopyingThem
 std::pair<scene::Frame, scene::Frame> withBothLightConstantSources(const scene::Scene& s,
                                                                    const scene::RasterSettings& settings,
                                                                    scene::ChannelMask channels) {
-    Renderer buffer(s, planFor(s, settings), settings, RendererOptions{.lightConstants = LightConstants::kUniformBuffer});
-    Renderer vertex(s, planFor(s, settings), settings, RendererOptions{.lightConstants = LightConstants::kVertexOutputs});
+    Renderer buffer(s, planFor(s, settings), settings,
+                    RendererOptions{.lightConstants = LightConstants::kUniformBuffer});
+    Renderer vertex(s, planFor(s, settings), settings,
+                    RendererOptions{.lightConstants = LightConstants::kVertexOutputs});
     std::pair<scene::Frame, scene::Frame> frames{buffer.render(channels), vertex.render(channels)};
     EXPECT_EQ(buffer.validationMessages(), 0);
     EXPECT_EQ(vertex.validationMessages(), 0);
@@ -1194,7 +1197,8 @@ TEST(RasterRenderer, LightConstantsFromTheVertexShaderGiveTheSameFrameBitForBit)
                 std::size_t shadowed = 0;
                 for (std::size_t i = 0; i < a.pixelCount(); ++i)
                     shadowed += a.objectId[i] == 2.0f && a.visibility[i] < 0.5f;  // plane pixels (id 2) only
-                EXPECT_GT(shadowed, 500u) << what << ": the sphere shadows the plane (a spot: or its cone leaves it dark)";
+                EXPECT_GT(shadowed, 500u)
+                    << what << ": the sphere shadows the plane (a spot: or its cone leaves it dark)";
                 EXPECT_TRUE(a.beauty == b.beauty) << what;
                 EXPECT_TRUE(a.visibility == b.visibility) << what;
                 EXPECT_TRUE(a.ndotl == b.ndotl) << what;
@@ -1294,8 +1298,7 @@ TEST(RasterPointLight, SphereCastsTheTangentConeShadow) {
         if (!shadowed && f.visibility[i] == 1.0f) {
             const Vec3 toLight = s.lights[0].position - q;
             const double d2 = glm::dot(toLight, toLight);
-            EXPECT_NEAR(f.beauty[3 * i], 0.8 * 300.0 / (4 * kPi * d2) * (toLight.y / std::sqrt(d2)) + 0.05 * 0.8,
-                        2e-4);
+            EXPECT_NEAR(f.beauty[3 * i], 0.8 * 300.0 / (4 * kPi * d2) * (toLight.y / std::sqrt(d2)) + 0.05 * 0.8, 2e-4);
         }
     });
     EXPECT_GT(inside, 500);
@@ -1349,7 +1352,8 @@ TEST(RasterPointLight, CubeMapSeamsMakeNoFalseShadows) {
     // four side faces at |x| = h or |z| = h, the side faces meet each other on |x| = |z|).
     // Nothing casts, so every pixel the light reaches must be fully lit, with every filter.
     for (const double side : {1.0, -1.0}) {
-        for (const ShadowFilter filter : {ShadowFilter::None, ShadowFilter::Pcf2x2, ShadowFilter::Pcf, ShadowFilter::Poisson}) {
+        for (const ShadowFilter filter :
+             {ShadowFilter::None, ShadowFilter::Pcf2x2, ShadowFilter::Pcf, ShadowFilter::Poisson}) {
             SphereOverPlane p;
             p.center = Vec3(0, -100, 0);  // keeps primaryHit() off the sphere we remove
             p.eye = Vec3(0, 4 * side, 6);
@@ -1362,19 +1366,23 @@ TEST(RasterPointLight, CubeMapSeamsMakeNoFalseShadows) {
             s.lights[0].intensity = 50.0;
             scene::RasterSettings settings = validatedSettings(512, 0.01, 1.0, filter);
             settings.pcfSize = 5;
-            const std::string name = std::string("point_seams_") + (side > 0 ? "floor_" : "ceiling_") + scene::toString(filter);
+            const std::string name =
+                std::string("point_seams_") + (side > 0 ? "floor_" : "ceiling_") + scene::toString(filter);
             const scene::Frame f = renderValidated(s, settings, name);
             int counted = 0, falseShadow = 0, nearSeam = 0;
-            forEachPlanePixel(p, s, f, [&](std::size_t i, const Vec3& q) {
-                ++counted;
-                const Vec3 d = q - s.lights[0].position;
-                // Within 0.1 of a boundary between faces (where two axes are equally major).
-                const double ax = std::abs(d.x), ay = std::abs(d.y), az = std::abs(d.z);
-                const double m = std::max({ax, ay, az});
-                const double second = ax + ay + az - m - std::min({ax, ay, az});
-                if (m - second < 0.1) ++nearSeam;
-                if (f.visibility[i] != 1.0f) ++falseShadow;
-            }, 1.0f);  // the plane is object 1 here
+            forEachPlanePixel(
+                p, s, f,
+                [&](std::size_t i, const Vec3& q) {
+                    ++counted;
+                    const Vec3 d = q - s.lights[0].position;
+                    // Within 0.1 of a boundary between faces (where two axes are equally major).
+                    const double ax = std::abs(d.x), ay = std::abs(d.y), az = std::abs(d.z);
+                    const double m = std::max({ax, ay, az});
+                    const double second = ax + ay + az - m - std::min({ax, ay, az});
+                    if (m - second < 0.1) ++nearSeam;
+                    if (f.visibility[i] != 1.0f) ++falseShadow;
+                },
+                1.0f);  // the plane is object 1 here
             EXPECT_GT(counted, 5000) << name;
             EXPECT_GT(nearSeam, 300) << name << ": the view should cross the face boundaries";
             EXPECT_EQ(falseShadow, 0) << name << ": " << falseShadow << " of " << counted << " pixels falsely shadowed";

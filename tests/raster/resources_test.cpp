@@ -46,7 +46,8 @@ TEST(RasterResources, BuffersHaveTheAskedSizeAndHostVisibleOnesAreMapped) {
     const Context& ctx = vc.get();
     const Buffer host = createBuffer(ctx, 1000, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                      VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
-    const Buffer device = createBuffer(ctx, 1000, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    const Buffer device =
+        createBuffer(ctx, 1000, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
     const Buffer readback = createReadbackBuffer(ctx, 64);
     EXPECT_EQ(host.size, 1000u);
     EXPECT_EQ(device.size, 1000u);
@@ -67,7 +68,8 @@ TEST(RasterResources, AnUploadArrivesByteForByteInADeviceLocalBuffer) {
     // 1000 words of a pattern no two neighbours share (Knuth's multiplicative hash of the index).
     std::vector<std::uint32_t> data(1000);
     for (std::uint32_t i = 0; i < data.size(); ++i) data[i] = i * 2654435761u;
-    const Buffer uploaded = uploadBuffer(ctx, data, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    const Buffer uploaded =
+        uploadBuffer(ctx, data, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
     EXPECT_EQ(uploaded.size, data.size() * 4);
     EXPECT_EQ(uploaded.mapped, nullptr) << "the target is device-local, filled through a staging buffer";
     const Buffer back = createReadbackBuffer(ctx, uploaded.size);
@@ -114,18 +116,24 @@ TEST(RasterResources, EachLayerOfAnImageHoldsWhatWasRenderedThroughItsView) {
     const std::uint32_t uint0 = 123456789u, uint1 = 42u;
     const std::uint8_t unorm0[4] = {51, 255, 0, 255}, unorm1[4] = {0, 0, 255, 51};
     const FormatCase cases[] = {
-        {VK_FORMAT_R32G32B32A32_SFLOAT, 16, {{.float32 = {1.5f, -2.25f, 3.0f, 0.125f}}, {.float32 = {7, 8, 9, 10}}},
+        {VK_FORMAT_R32G32B32A32_SFLOAT,
+         16,
+         {{.float32 = {1.5f, -2.25f, 3.0f, 0.125f}}, {.float32 = {7, 8, 9, 10}}},
          {bytesOf(rgba0, 16), bytesOf(rgba1, 16)}},
-        {VK_FORMAT_R8G8B8A8_UNORM, 4, {{.float32 = {0.2f, 1.0f, 0.0f, 1.0f}}, {.float32 = {0.0f, 0.0f, 1.0f, 0.2f}}},
+        {VK_FORMAT_R8G8B8A8_UNORM,
+         4,
+         {{.float32 = {0.2f, 1.0f, 0.0f, 1.0f}}, {.float32 = {0.0f, 0.0f, 1.0f, 0.2f}}},
          {bytesOf(unorm0, 4), bytesOf(unorm1, 4)}},
-        {VK_FORMAT_R32_UINT, 4, {{.uint32 = {uint0, 0, 0, 0}}, {.uint32 = {uint1, 0, 0, 0}}},
+        {VK_FORMAT_R32_UINT,
+         4,
+         {{.uint32 = {uint0, 0, 0, 0}}, {.uint32 = {uint1, 0, 0, 0}}},
          {bytesOf(&uint0, 4), bytesOf(&uint1, 4)}},
     };
     for (const FormatCase& c : cases) {
         SCOPED_TRACE(int(c.format));
-        const Image image = createImage(ctx, c.format, w, h, 2,
-                                        VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                                        VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D_ARRAY);
+        const Image image =
+            createImage(ctx, c.format, w, h, 2, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                        VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D_ARRAY);
         EXPECT_TRUE(image.view);
         EXPECT_EQ(image.mapped, nullptr);
         const ImageViewHandle views[2] = {
@@ -134,16 +142,19 @@ TEST(RasterResources, EachLayerOfAnImageHoldsWhatWasRenderedThroughItsView) {
         const VkDeviceSize bytes = VkDeviceSize(w) * h * 2 * c.texelBytes;
         const Buffer back = createReadbackBuffer(ctx, bytes);
         VkCommandBuffer commands = ctx.beginCommands();
-        transition(commands, {{image.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 2, VK_IMAGE_LAYOUT_UNDEFINED,
-                               VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
-                               VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT}});
+        transition(commands,
+                   {{image.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 2, VK_IMAGE_LAYOUT_UNDEFINED,
+                     VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
+                     VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT}});
         for (int k = 0; k < 2; ++k) clearThroughView(commands, views[k].get(), w, h, c.layer[k]);
-        transition(commands, {{image.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 2, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                               VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                               VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
-                               VK_ACCESS_2_TRANSFER_READ_BIT}});
+        transition(commands, {{image.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 2,
+                               VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                               VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                               VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT}});
         const VkBufferImageCopy region{
-            .imageSubresource = {.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT, .mipLevel = 0, .baseArrayLayer = 0,
+            .imageSubresource = {.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT,
+                                 .mipLevel = 0,
+                                 .baseArrayLayer = 0,
                                  .layerCount = 2},
             .imageExtent = {w, h, 1},
         };
@@ -187,16 +198,17 @@ TEST(RasterResources, AHostReadableImageIsMappedAtItsFirstTexelWithItsRowPitch) 
                            VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT}});
     clearThroughView(commands, image.view.get(), w, h, {.float32 = {0.25f, 0.5f, 4.0f, -1.0f}});
     // Host access to a linear image needs GENERAL.
-    transition(commands, {{image.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                           VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                           VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT,
-                           VK_ACCESS_2_HOST_READ_BIT}});
+    transition(commands,
+               {{image.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                 VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT}});
     ctx.submitAndWait(commands);
     int wrong = 0;
     for (std::uint32_t y = 0; y < h; ++y) {
         const auto* row = reinterpret_cast<const float*>(static_cast<const char*>(image.mapped) + y * image.rowPitch);
         for (std::uint32_t x = 0; x < w; ++x)
-            wrong += !(row[4 * x] == 0.25f && row[4 * x + 1] == 0.5f && row[4 * x + 2] == 4.0f && row[4 * x + 3] == -1.0f);
+            wrong +=
+                !(row[4 * x] == 0.25f && row[4 * x + 1] == 0.5f && row[4 * x + 2] == 4.0f && row[4 * x + 3] == -1.0f);
     }
     EXPECT_EQ(wrong, 0);
 }

@@ -202,7 +202,8 @@ TEST(ShadowLayers, ALightThePlanGivesNoShadowTestHasNoLayer) {
     ASSERT_FALSE(plan.lights.empty());
     plan.lights[0].needsShadowTest = false;
     EXPECT_TRUE(planShadowLayers(s, plan, r).empty());
-    EXPECT_EQ(explainShadowLayers({}, s.objects.size()), "raster shadow-map layers: none (no light needs a shadow test)\n");
+    EXPECT_EQ(explainShadowLayers({}, s.objects.size()),
+              "raster shadow-map layers: none (no light needs a shadow test)\n");
 }
 
 TEST(ShadowLayers, LayersOfTwoLightsFollowTheLightOrder) {

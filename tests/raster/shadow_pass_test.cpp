@@ -3,8 +3,8 @@
 // blocker-id map the id of that surface's object.
 #include "raster/shadow_pass.h"
 
-#include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "raster/geometry.h"
 #include "raster/light_frustum.h"
@@ -118,8 +118,8 @@ TEST(TransmittanceWindow, HoldsTheCastersProjectionWithItsMarginAndNoMore) {
     EXPECT_EQ(w.y1, 43u);
     // Two casters: the window of both; none: empty; off the map: empty; past its edge: clamped.
     const TexelRect both = transmittanceWindow(
-        identity, {boxCaster({-0.5f, -0.25f, 0.2f}, {0.5f, 0.25f, 0.3f}), boxCaster({0.6f, 0.6f, 0.5f}, {0.7f, 0.7f, 0.6f})},
-        64);
+        identity,
+        {boxCaster({-0.5f, -0.25f, 0.2f}, {0.5f, 0.25f, 0.3f}), boxCaster({0.6f, 0.6f, 0.5f}, {0.7f, 0.7f, 0.6f})}, 64);
     // The second projects to x, y in [51.2, 54.4]: floor + 3 = 57, floor(51.2) − 2 = 49.
     EXPECT_EQ(both.x0, 14u);
     EXPECT_EQ(both.y0, 22u);

@@ -26,7 +26,8 @@ scene::Object quad(const Vec3& center, double side, int material) {
 // floor, the lower pane half-shadowed by the upper one.
 scene::Scene glassScene() {
     scene::Scene s;
-    s.camera = {.position = Vec3(5, 6, 7), .lookAt = Vec3(0, 0.5, 0), .width = 192, .height = 108};  // fov 40°, near 0.1
+    s.camera = {
+        .position = Vec3(5, 6, 7), .lookAt = Vec3(0, 0.5, 0), .width = 192, .height = 108};  // fov 40°, near 0.1
     test::addMaterial(s, "matte");
     test::addMaterial(s, "glass", 0.5);
     test::addMaterial(s, "tinted", 0.6);
@@ -60,8 +61,8 @@ TEST(TransmittanceAgainstReference, RasterVisibilityMatchesTheReferenceAwayFromE
         if (vr > 0.05f && vr < 0.95f) ++intermediate;
         if (std::abs(raster.visibility[i] - vr) > 0.02f) ++far;
     }
-    std::printf("counted %zu, with partial light %zu, off by > 0.02: %zu; mean |dV| %.5f\n", counted, intermediate,
-                far, m.meanAbsVisibilityError);
+    std::printf("counted %zu, with partial light %zu, off by > 0.02: %zu; mean |dV| %.5f\n", counted, intermediate, far,
+                m.meanAbsVisibilityError);
     ASSERT_GT(intermediate, 500u);  // the glass shadows are in view
     EXPECT_LT(double(far), 0.02 * double(counted));
     EXPECT_LT(m.meanAbsVisibilityError, 0.005);

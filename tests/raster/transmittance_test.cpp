@@ -65,14 +65,18 @@ TEST(RasterTransmittance, TwoHalfOpaquePanesLeaveAQuarterBehindBothAndAHalfBehin
         constexpr double m = 0.15;
         int counted[3] = {0, 0, 0}, wrong = 0;
         test::forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
-            const bool inZ = std::abs(q.z) < 1.5 - m, outZ = std::abs(q.z) > 1.5 + m;
+            const bool inZ = std::abs(q.z)<1.5 - m, outZ = std::abs(q.z)> 1.5 + m;
             const bool underA = inZ && q.x > -2 + m && q.x < 1 - m, underB = inZ && q.x > -1 + m && q.x < 2 - m;
             const bool clearA = outZ || q.x < -2 - m || q.x > 1 + m, clearB = outZ || q.x < -1 - m || q.x > 2 + m;
             double expected;
-            if (underA && underB) expected = 0.25;
-            else if ((underA && clearB) || (underB && clearA)) expected = 0.5;
-            else if (clearA && clearB) expected = 1.0;
-            else return;  // near an outline
+            if (underA && underB)
+                expected = 0.25;
+            else if ((underA && clearB) || (underB && clearA))
+                expected = 0.5;
+            else if (clearA && clearB)
+                expected = 1.0;
+            else
+                return;  // near an outline
             ++counted[expected == 0.25 ? 0 : expected == 0.5 ? 1 : 2];
             if (std::abs(v - expected) > 1e-5) ++wrong;
         });
@@ -97,12 +101,15 @@ TEST(RasterTransmittance, ALowerPaneGetsTheUpperPanesShadowNotItsOwn) {
             for (int x = 0; x < f.width; ++x) {
                 const std::size_t i = std::size_t(y) * std::size_t(f.width) + std::size_t(x);
                 if (f.objectId[i] != 3.0f || f.ndotl[i] <= 0.0f) continue;  // pane B's top
-                const Vec3 q = test::floorPoint(cam, x, y, 1.0);  // on pane B's plane
+                const Vec3 q = test::floorPoint(cam, x, y, 1.0);            // on pane B's plane
                 if (std::abs(q.z) > 1.35) continue;
                 double expected;
-                if (q.x > -0.85 && q.x < 0.85) expected = 0.5;
-                else if (q.x > 1.15 && q.x < 1.85) expected = 1.0;
-                else continue;
+                if (q.x > -0.85 && q.x < 0.85)
+                    expected = 0.5;
+                else if (q.x > 1.15 && q.x < 1.85)
+                    expected = 1.0;
+                else
+                    continue;
                 ++(expected == 0.5 ? under : beyond);
                 if (std::abs(f.visibility[i] - expected) > 1e-5) ++wrong;
             }
@@ -145,9 +152,12 @@ TEST(RasterTransmittance, AClosedSphereAttenuatesOnceNotOncePerSurface) {
                 const Vec3 q = test::floorPoint(cam, x, y);
                 const double rho = std::hypot(q.x, q.z);  // the shadow is the disk of radius 0.8
                 double expected;
-                if (rho < 0.6) expected = 0.5;  // (the tessellated outline lies inside the circle)
-                else if (rho > 1.0) expected = 1.0;
-                else continue;
+                if (rho < 0.6)
+                    expected = 0.5;  // (the tessellated outline lies inside the circle)
+                else if (rho > 1.0)
+                    expected = 1.0;
+                else
+                    continue;
                 ++(expected == 0.5 ? inside : outside);
                 if (std::abs(f.visibility[i] - expected) > 1e-5) {
                     ++wrong;
@@ -175,8 +185,8 @@ TEST(RasterTransmittance, OpaqueAndSemiTransparentCastersCombine) {
     int dark = 0, half = 0, wrong = 0;
     test::forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
         const bool underBox = std::abs(q.x) < 0.3 && std::abs(q.z) < 0.3;
-        const bool underPaneOnly = std::abs(q.z) < 1.3 && q.x > -1.8 && q.x < 0.8 &&
-                                   (std::abs(q.x) > 0.55 || std::abs(q.z) > 0.55);
+        const bool underPaneOnly =
+            std::abs(q.z) < 1.3 && q.x > -1.8 && q.x < 0.8 && (std::abs(q.x) > 0.55 || std::abs(q.z) > 0.55);
         if (underBox) {
             ++dark;
             if (v > 1e-5) ++wrong;
@@ -230,9 +240,12 @@ TEST(RasterTransmittance, APointLightsCubeFacesCarryTheTransmittanceToo) {
         test::forEachFloorPixel(s, f, [&](const Vec3& q, double v) {
             const double m = std::max(std::abs(q.x), std::abs(q.z));
             double expected;
-            if (m < 1.8) expected = 0.5;
-            else if (m > 2.2 && m < 6.0) expected = 1.0;
-            else return;
+            if (m < 1.8)
+                expected = 0.5;
+            else if (m > 2.2 && m < 6.0)
+                expected = 1.0;
+            else
+                return;
             ++(expected == 0.5 ? inside : outside);
             if (std::abs(v - expected) > 1e-5) ++wrong;
         });
@@ -303,10 +316,14 @@ TEST(RasterTransmittance, TheFloorUnderPaneSpherePaneGetsEveryFactorOnce) {
             const double rho = std::hypot(q.x, q.z);
             const double box = std::max(std::abs(q.x), std::abs(q.z));
             double expected;
-            if (rho < 0.8) expected = 0.125;
-            else if (rho > 1.0 + m && box < 1.5 - m) expected = 0.25;
-            else if (box > 1.5 + m) expected = 1.0;
-            else return;
+            if (rho < 0.8)
+                expected = 0.125;
+            else if (rho > 1.0 + m && box < 1.5 - m)
+                expected = 0.25;
+            else if (box > 1.5 + m)
+                expected = 1.0;
+            else
+                return;
             ++counted[expected == 0.125 ? 0 : expected == 0.25 ? 1 : 2];
             if (std::abs(v - expected) > 1e-5) ++wrong;
         });
@@ -327,7 +344,8 @@ scene::Scene fourPanes() {
         m.name = std::string("glass ") + char('A' + k);
         m.opacity = opacities[k];
         s.materials.push_back(m);
-        s.objects.push_back(quadObject(std::string(1, char('A' + k)), Vec3(0, 4 - k, 0), 3.0, int(s.materials.size()) - 1));
+        s.objects.push_back(
+            quadObject(std::string(1, char('A' + k)), Vec3(0, 4 - k, 0), 3.0, int(s.materials.size()) - 1));
     }
     return s;
 }
@@ -419,8 +437,8 @@ TEST(RasterTransmittance, MapsDrawnOnlyInTheCastersWindowsGiveTheFramesOfWholeMa
             EXPECT_EQ(a.lightVisibility, b.lightVisibility) << "filter " << int(filter) << " frame " << frame;
             EXPECT_EQ(a.blockerId, b.blockerId) << "filter " << int(filter) << " frame " << frame;
             // The glass does shadow: some floor pixel gets a factor strictly between 0 and 1.
-            EXPECT_TRUE(std::any_of(a.visibility.begin(), a.visibility.end(),
-                                    [](float v) { return v > 0.05f && v < 0.95f; }));
+            EXPECT_TRUE(
+                std::any_of(a.visibility.begin(), a.visibility.end(), [](float v) { return v > 0.05f && v < 0.95f; }));
         }
         EXPECT_EQ(windowed.validationMessages(), 0);
         EXPECT_EQ(whole.validationMessages(), 0);

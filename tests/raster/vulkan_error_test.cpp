@@ -23,9 +23,7 @@ TEST(VulkanError, VkCheckNamesTheCallTheResultAndTheLine) {
     }
 }
 
-TEST(VulkanError, VkCheckPassesSuccessThrough) {
-    EXPECT_NO_THROW(VK_CHECK(failWith(VK_SUCCESS)));
-}
+TEST(VulkanError, VkCheckPassesSuccessThrough) { EXPECT_NO_THROW(VK_CHECK(failWith(VK_SUCCESS))); }
 
 TEST(VulkanError, UnknownResultsPrintTheirNumber) {
     EXPECT_EQ(toString(VkResult(-123456)), "VkResult(-123456)");
@@ -45,7 +43,8 @@ TEST(VulkanError, FailuresAUserCanMeetLeadWithWhatHappenedAndWhatToDo) {
     EXPECT_EQ(lost.rfind("the Vulkan device was lost during the render", 0), 0u) << lost;
     EXPECT_NE(lost.find("--backend raytrace"), std::string::npos) << lost;
     EXPECT_NE(lost.find("failed with VK_ERROR_DEVICE_LOST"), std::string::npos) << lost;
-    EXPECT_NE(message(VK_ERROR_OUT_OF_DEVICE_MEMORY).find("lower --resolution or --shadow-map-size"), std::string::npos);
+    EXPECT_NE(message(VK_ERROR_OUT_OF_DEVICE_MEMORY).find("lower --resolution or --shadow-map-size"),
+              std::string::npos);
     EXPECT_NE(message(VK_TIMEOUT).find("did not finish in time"), std::string::npos);
     // Programming errors keep the plain form: the call, the result, the place.
     EXPECT_EQ(message(VK_ERROR_FORMAT_NOT_SUPPORTED).rfind("failWith(", 0), 0u);

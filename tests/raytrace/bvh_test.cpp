@@ -79,8 +79,8 @@ TEST(Bvh, NodesAre32BytesAndBoundEverythingBelowThem) {
 // Möller–Trumbore with strict inside tests, in Real: the common non-watertight test, used only
 // to show that the rays below do run along edges where a test can leak.
 template <typename Real>
-bool naiveHit(const Vec3T<Real>& o, const Vec3T<Real>& d, const Vec3T<Real>& a,
-              const Vec3T<Real>& b, const Vec3T<Real>& c) {
+bool naiveHit(const Vec3T<Real>& o, const Vec3T<Real>& d, const Vec3T<Real>& a, const Vec3T<Real>& b,
+              const Vec3T<Real>& c) {
     const Vec3T<Real> e1 = b - a, e2 = c - a, pv = glm::cross(d, e2);
     const Real det = glm::dot(e1, pv);
     if (det == 0) return false;
@@ -173,8 +173,8 @@ TYPED_TEST(BvhTraversal, RaysThroughSharedEdgesAndVerticesOfAClosedMeshNeverMiss
         }
         bool naive = false;
         for (std::size_t t = 0; t < sphere->indices.size() && !naive; t += 3)
-            naive = naiveHit(ray.o, ray.d, pr[sphere->indices[t]], pr[sphere->indices[t + 1]],
-                             pr[sphere->indices[t + 2]]);
+            naive =
+                naiveHit(ray.o, ray.d, pr[sphere->indices[t]], pr[sphere->indices[t + 1]], pr[sphere->indices[t + 2]]);
         if (!naive) ++naiveMisses;
     };
     for (const Vec3& target : targets) {

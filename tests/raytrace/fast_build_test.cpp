@@ -60,8 +60,7 @@ TEST(FastBuild, HoldsEveryPrimitiveOnceInsideItsNodesBoxes) {
         ASSERT_GT(n.offset, i + 1);
         // A parent's box contains its children's.
         for (std::uint32_t c : {i + 1, n.offset})
-            for (int k = 0; k < 3; ++k)
-                EXPECT_TRUE(n.lo[k] <= bvh.nodes()[c].lo[k] && bvh.nodes()[c].hi[k] <= n.hi[k]);
+            for (int k = 0; k < 3; ++k) EXPECT_TRUE(n.lo[k] <= bvh.nodes()[c].lo[k] && bvh.nodes()[c].hi[k] <= n.hi[k]);
         stack.push_back(n.offset);
         stack.push_back(i + 1);
     }
@@ -130,7 +129,7 @@ TEST(FastBuild, FloatTracerHitsAreTheSameOnItsTreeAndOnTheReferenceTree) {
             const bool fb = reference.closestHit(ray, std::numeric_limits<float>::infinity(), conservative, b);
             hits += fa;
             differ += fa != fb || (fa && (std::memcmp(&a.t, &b.t, sizeof(float)) != 0 || a.prim != b.prim ||
-                                         std::memcmp(&a.b1, &b.b1, sizeof(float)) != 0));
+                                          std::memcmp(&a.b1, &b.b1, sizeof(float)) != 0));
             int x = -1, y = -1;
             differ += fast.anyHit(ray, std::numeric_limits<float>::infinity(), conservative, x) !=
                       reference.anyHit(ray, std::numeric_limits<float>::infinity(), conservative, y);
@@ -155,12 +154,14 @@ TEST(FastBuild, AnExactTieGoesToTheLowestTriangleIndexOnEitherTree) {
         for (std::size_t t = 17; t < 6000; t += 500) {
             const std::size_t lowest = 17 + 500 * ((t / 500) % 6);  // the group's first copy
             const Vec3 a = mesh->positions[mesh->indices[3 * t]];
-            const Vec3 m = (a + mesh->positions[mesh->indices[3 * t + 1]] + mesh->positions[mesh->indices[3 * t + 2]]) / 3.0;
+            const Vec3 m =
+                (a + mesh->positions[mesh->indices[3 * t + 1]] + mesh->positions[mesh->indices[3 * t + 2]]) / 3.0;
             const Ray<float> ray(Vec3T<float>(m + Vec3(0, 0, -40)), Vec3T<float>(0, 0, 1));
             Hit<float> h;
             ASSERT_TRUE(tracer.closestHit(ray, std::numeric_limits<float>::infinity(), false, h));
             if (!(mesh->positions[mesh->indices[3 * std::size_t(h.prim)]] == a)) continue;  // a soup triangle in front
-            EXPECT_EQ(std::size_t(h.prim), lowest) << "triangle " << t << (fastTree ? " (fast tree)" : " (reference tree)");
+            EXPECT_EQ(std::size_t(h.prim), lowest)
+                << "triangle " << t << (fastTree ? " (fast tree)" : " (reference tree)");
             ++checked;
         }
         EXPECT_GE(checked, 8);  // 10 of the 12 copies are not behind a soup triangle

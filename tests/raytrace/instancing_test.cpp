@@ -31,10 +31,10 @@ const char* kNodes = R"([{"mesh": 0, "translation": [-1.5, 0, 0]},
 // node 0 = T(−1.5, 0, 0); node 1 = T(0.3, 0, 0.2)·R_y(45°); node 2 = node 1·T(0, 0.5, 0)·S.
 std::vector<glm::dmat4> handTransforms() {
     const glm::dmat4 n0 = glm::translate(glm::dmat4(1.0), Vec3(-1.5, 0, 0));
-    const glm::dmat4 n1 = glm::translate(glm::dmat4(1.0), Vec3(0.3, 0, 0.2)) *
-                          glm::dmat4(test::rotation(Vec3(0, 1, 0), 45.0));
-    const glm::dmat4 n2 = n1 * glm::translate(glm::dmat4(1.0), Vec3(0, 0.5, 0)) *
-                          glm::scale(glm::dmat4(1.0), Vec3(0.6, 1.5, 0.8));
+    const glm::dmat4 n1 =
+        glm::translate(glm::dmat4(1.0), Vec3(0.3, 0, 0.2)) * glm::dmat4(test::rotation(Vec3(0, 1, 0), 45.0));
+    const glm::dmat4 n2 =
+        n1 * glm::translate(glm::dmat4(1.0), Vec3(0, 0.5, 0)) * glm::scale(glm::dmat4(1.0), Vec3(0.6, 1.5, 0.8));
     return {n0, n1, n2};
 }
 
@@ -64,7 +64,8 @@ TwoScenes loadBoth(const shadowlab::test::TempDir& dir) {
         const std::uint32_t base = std::uint32_t(flat->positions.size());
         const glm::dmat3 nm = glm::transpose(glm::inverse(glm::dmat3(m)));
         for (std::size_t k = 0; k < 8; ++k) {
-            const Vec3 corner(shadowlab::test::boxCorners()[3 * k], shadowlab::test::boxCorners()[3 * k + 1], shadowlab::test::boxCorners()[3 * k + 2]);
+            const Vec3 corner(shadowlab::test::boxCorners()[3 * k], shadowlab::test::boxCorners()[3 * k + 1],
+                              shadowlab::test::boxCorners()[3 * k + 2]);
             flat->positions.push_back(Vec3(m * glm::dvec4(corner, 1.0)));
             flat->normals.push_back(glm::normalize(nm * g.normals.at(k)));
         }

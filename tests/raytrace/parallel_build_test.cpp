@@ -26,8 +26,7 @@ Bvh buildWith(int threads, const std::vector<scene::Bounds>& boxes) {
 }
 
 bool sameTree(const Bvh& a, const Bvh& b) {
-    return a.nodes().size() == b.nodes().size() && a.primitives() == b.primitives() &&
-           a.depth() == b.depth() &&
+    return a.nodes().size() == b.nodes().size() && a.primitives() == b.primitives() && a.depth() == b.depth() &&
            std::memcmp(a.nodes().data(), b.nodes().data(), a.nodes().size() * sizeof(BvhNode)) == 0;
 }
 

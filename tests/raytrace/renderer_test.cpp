@@ -36,8 +36,8 @@ TEST(ReferenceRender, SeedSceneVisibilityEqualsClosedFormAwayFromShadowEdge) {
             const float expected = a.lit ? 1.0f : 0.0f;
             if (f.visibility[i] != expected) {
                 ++wrong;
-                ADD_FAILURE() << "pixel " << x << "," << y << " visibility " << f.visibility[i]
-                              << " expected " << expected;
+                ADD_FAILURE() << "pixel " << x << "," << y << " visibility " << f.visibility[i] << " expected "
+                              << expected;
                 if (wrong > 10) return;
             }
         }
@@ -88,8 +88,7 @@ TEST(ReferenceRender, TwoLightsKeepEachLightsVisibilityAndCombineThem) {
 }
 
 // Counts plane pixels that are lit in closed form but have visibility 0 in the frame.
-int falseShadowsOnPlane(const scene::Scene& s, const test::Placement& at, const scene::Frame& f,
-                        int& litPlanePixels) {
+int falseShadowsOnPlane(const scene::Scene& s, const test::Placement& at, const scene::Frame& f, int& litPlanePixels) {
     int acne = 0;
     litPlanePixels = 0;
     for (int y = 0; y < f.height; ++y)
@@ -148,7 +147,8 @@ TEST(MethodRender, ATinyBiasIsEnoughInDoubleButNotInFloat) {
     const scene::Scene s = test::seedScene(at);
     const scene::RenderPlan plan = test::planFor(s);
     int lit = 0;
-    const int floatAcne = falseShadowsOnPlane(s, at, render(s, plan, test::biasSettings(1e-8, scene::Precision::Float)), lit);
+    const int floatAcne =
+        falseShadowsOnPlane(s, at, render(s, plan, test::biasSettings(1e-8, scene::Precision::Float)), lit);
     ASSERT_GT(lit, 5000);
     EXPECT_GT(floatAcne, lit / 10) << floatAcne << " of " << lit;
     EXPECT_EQ(falseShadowsOnPlane(s, at, render(s, plan, test::biasSettings(1e-8, scene::Precision::Double)), lit), 0);
@@ -324,17 +324,18 @@ TEST(RaytraceRender, TheCameraSeesOnlyBetweenItsNearAndFarPlanesAsTheRasterPipel
     s.camera.height = 8;
     test::addMaterial(s, "m");
     test::addDirectional(s, Vec3(0, 0, -1));
-    test::addQuad(s, Vec3(0, 0, -0.05), Vec3(0, 0, 1), 0.01, 0.01);    // id 1: pixels 7..8 across
-    test::addQuad(s, Vec3(-50, 0, -10), Vec3(0, 0, 1), 100, 100);       // id 2: x < 0
-    test::addQuad(s, Vec3(0, 0, -30), Vec3(0, 0, 1), 1000, 1000);       // id 3
+    test::addQuad(s, Vec3(0, 0, -0.05), Vec3(0, 0, 1), 0.01, 0.01);  // id 1: pixels 7..8 across
+    test::addQuad(s, Vec3(-50, 0, -10), Vec3(0, 0, 1), 100, 100);    // id 2: x < 0
+    test::addQuad(s, Vec3(0, 0, -30), Vec3(0, 0, 1), 1000, 1000);    // id 3
     const auto idAt = [](const scene::Frame& f, int x, int y) { return int(f.objectId[std::size_t(y) * f.width + x]); };
     for (const auto& [near, far] : {std::pair{0.1, 20.0}, std::pair{0.1, 40.0}, std::pair{0.01, 20.0}}) {
         s.camera.near = near;
         s.camera.far = far;
         SCOPED_TRACE("near " + std::to_string(near) + ", far " + std::to_string(far));
         for (const bool reference : {false, true}) {
-            const scene::Frame f = reference ? renderReference(s, test::planFor(s), test::biasSettings(0, scene::Precision::Double))
-                                             : render(s, test::planFor(s), test::biasSettings(1e-4, scene::Precision::Float));
+            const scene::Frame f =
+                reference ? renderReference(s, test::planFor(s), test::biasSettings(0, scene::Precision::Double))
+                          : render(s, test::planFor(s), test::biasSettings(1e-4, scene::Precision::Float));
             // Pixels 7 and 8 of rows 3 and 4 look through the small quad: its half-width 0.005 at
             // depth 0.05 covers directions within ±0.1, and their centres are ±0.046 off the axis
             // (a pixel is 2·tan 20°/8 = 0.091 across); pixel 7 leans left, onto the near wall.

@@ -25,12 +25,10 @@ scene::RaytraceSettings robustSettings(scene::Precision precision) {
 
 std::vector<scene::RaytraceSettings> allModes() {
     return {robustSettings(scene::Precision::Double), robustSettings(scene::Precision::Float),
-            test::biasSettings(1e-4, scene::Precision::Double),
-            test::biasSettings(1e-4, scene::Precision::Float)};
+            test::biasSettings(1e-4, scene::Precision::Double), test::biasSettings(1e-4, scene::Precision::Float)};
 }
 
-double visibility(const scene::Scene& s, const Vec3& p, const Vec3& n,
-                  const scene::RaytraceSettings& rs) {
+double visibility(const scene::Scene& s, const Vec3& p, const Vec3& n, const scene::RaytraceSettings& rs) {
     return rs.precision == scene::Precision::Double ? visibilityAt<double>(s, p, n, 0, rs)
                                                     : visibilityAt<float>(s, p, n, 0, rs);
 }
@@ -154,9 +152,9 @@ TEST(AreaLight, OnAxisPenumbraEqualsTheUnblockedFractionOfTheLightsSolidAngle) {
         double H, R, h, rho;
     };
     const int samples = 4096;  // 64 x 64 strata
-    for (const Config& c : {Config{10, 2, 4, 0.1}, Config{10, 2, 4, 0.3}, Config{10, 2, 4, 0.5},
-                            Config{10, 2, 4, 0.79}, Config{10, 2, 4, 0.9}, Config{4, 2.5, 1, 0.25},
-                            Config{4, 2.5, 1, 0.5}, Config{4, 2.5, 1.2, 0.3}}) {
+    for (const Config& c :
+         {Config{10, 2, 4, 0.1}, Config{10, 2, 4, 0.3}, Config{10, 2, 4, 0.5}, Config{10, 2, 4, 0.79},
+          Config{10, 2, 4, 0.9}, Config{4, 2.5, 1, 0.25}, Config{4, 2.5, 1, 0.5}, Config{4, 2.5, 1.2, 0.3}}) {
         const double H = c.H, R = c.R, h = c.h, rho = c.rho;
         scene::Scene s;
         test::addMaterial(s, "matte");
@@ -253,11 +251,10 @@ void countSelfHits(int kind, double scale, double distance, std::mt19937_64& g, 
                 const Vec3T<Real> wr(w);
                 int blocker = -1;
                 ++out.rays;
-                if (tracer.anyHit(Ray<Real>(shadowOrigin(spr, wr, robust), wr),
-                                  std::numeric_limits<Real>::infinity(), true, blocker))
+                if (tracer.anyHit(Ray<Real>(shadowOrigin(spr, wr, robust), wr), std::numeric_limits<Real>::infinity(),
+                                  true, blocker))
                     ++out.robust;
-                if (tracer.anyHit(Ray<Real>(spp.p, wr), std::numeric_limits<Real>::infinity(),
-                                  false, blocker))
+                if (tracer.anyHit(Ray<Real>(spp.p, wr), std::numeric_limits<Real>::infinity(), false, blocker))
                     ++out.plain;
             }
         }
@@ -275,8 +272,8 @@ void expectNoRobustSelfHits(int firstKind = 0, int lastKind = 3,
             for (double distance : {1.0, 1000.0}) {
                 SelfHits h;
                 countSelfHits<Real>(kind, scale, distance, g, h);
-                EXPECT_EQ(h.robust, 0) << names[kind] << " scale " << scale << " distance "
-                                       << distance << ": " << h.robust << " of " << h.rays;
+                EXPECT_EQ(h.robust, 0) << names[kind] << " scale " << scale << " distance " << distance << ": "
+                                       << h.robust << " of " << h.rays;
                 total.rays += h.rays;
                 total.plain += h.plain;
             }
@@ -287,13 +284,9 @@ void expectNoRobustSelfHits(int firstKind = 0, int lastKind = 3,
     }
 }
 
-TEST(RobustOffset, NoSelfHitsOnSpheresQuadsBoxesMeshesFrom1eMinus8To1e8InDouble) {
-    expectNoRobustSelfHits<double>();
-}
+TEST(RobustOffset, NoSelfHitsOnSpheresQuadsBoxesMeshesFrom1eMinus8To1e8InDouble) { expectNoRobustSelfHits<double>(); }
 
-TEST(RobustOffset, NoSelfHitsOnSpheresQuadsBoxesMeshesFrom1eMinus8To1e8InFloat) {
-    expectNoRobustSelfHits<float>();
-}
+TEST(RobustOffset, NoSelfHitsOnSpheresQuadsBoxesMeshesFrom1eMinus8To1e8InFloat) { expectNoRobustSelfHits<float>(); }
 
 // The instance transform is part of the error bound (docs/raytrace.md, "Instances"): scale
 // 1e-3 and 1e4 (non-uniform within 0.1..2 of that), any rotation, placed 1x and 1000x its size

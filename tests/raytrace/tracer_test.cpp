@@ -20,9 +20,9 @@ TYPED_TEST(TracerTest, ClosestHitFindsTheNearestOfSphereQuadAndBox) {
     using V = Vec3T<Real>;
     scene::Scene s;
     test::addMaterial(s, "matte");
-    test::addSphere(s, Vec3(0, 0, -10), 2.0);                 // front at z = -8
-    test::addQuad(s, Vec3(0, 0, -5), Vec3(0, 0, 1), 1, 1);     // z = -5, |x|,|y| <= 0.5
-    test::addBox(s, Vec3(2, -1, -7), Vec3(4, 1, -6));          // front face z = -6
+    test::addSphere(s, Vec3(0, 0, -10), 2.0);               // front at z = -8
+    test::addQuad(s, Vec3(0, 0, -5), Vec3(0, 0, 1), 1, 1);  // z = -5, |x|,|y| <= 0.5
+    test::addBox(s, Vec3(2, -1, -7), Vec3(4, 1, -6));       // front face z = -6
     const Tracer<Real> tracer(s);
     for (bool robust : {false, true}) {
         Hit<Real> h;

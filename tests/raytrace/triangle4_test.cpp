@@ -24,9 +24,8 @@ TEST(Triangle4, FilterKeepsEveryScalarHitAndRejectsMostMisses) {
     for (std::size_t t = 0; t < packets.size() * 4; ++t)
         for (int k = 0; k < 3; ++k)
             for (int a = 0; a < 3; ++a)
-                packets[t / 4].v[3 * k + a][t % 4] =
-                    t < tris ? float(mesh->positions[mesh->indices[3 * t + k]][a])
-                             : std::numeric_limits<float>::quiet_NaN();
+                packets[t / 4].v[3 * k + a][t % 4] = t < tris ? float(mesh->positions[mesh->indices[3 * t + k]][a])
+                                                              : std::numeric_limits<float>::quiet_NaN();
     std::vector<V> targets;
     for (const auto& p : mesh->positions) targets.emplace_back(p);
     for (std::size_t t = 0; t < tris; ++t) {
@@ -54,8 +53,8 @@ TEST(Triangle4, FilterKeepsEveryScalarHitAndRejectsMostMisses) {
                     float t, b0, b1, b2;
                     const TrianglePacket& p = packets[pk];
                     for (bool conservative : {false, true}) {
-                        if (!intersectTriangle(ray, p.vertex(l, 0), p.vertex(l, 1), p.vertex(l, 2), tMax,
-                                               conservative, t, b0, b1, b2))
+                        if (!intersectTriangle(ray, p.vertex(l, 0), p.vertex(l, 1), p.vertex(l, 2), tMax, conservative,
+                                               t, b0, b1, b2))
                             continue;
                         ++scalarHits;
                         dropped += !((cand >> l) & 1);

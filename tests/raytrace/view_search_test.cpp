@@ -90,7 +90,8 @@ TEST(ViewSearch, AModelOutsideIsSeenFromOutsideUnderASunAboveTheHorizonWithItsSh
         EXPECT_EQ(cut, 0u) << "the box's shadow runs off the image";
     }
     bool recorded = false;
-    for (const auto& [key, text] : s.origin.choices) recorded = recorded || (key == "view" && text.find("searched") == 0);
+    for (const auto& [key, text] : s.origin.choices)
+        recorded = recorded || (key == "view" && text.find("searched") == 0);
     EXPECT_TRUE(recorded);
 }
 
@@ -216,8 +217,8 @@ TEST(ViewSearch, CasterVarietyCountsTheShadowsWhoseOutlinesShowNotThoseSwallowed
     // ground in front of each card, whose nearest blocker is the card, would count for it.)
     scene::Scene s = cardsBeforeAWall(true);
     const double a = 330.0 * kDegreesToRadians, e = 20.0 * kDegreesToRadians;
-    s.camera = scene::framedCamera(s.origin.modelBounds, {std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a)},
-                                   40.0, s.camera);
+    s.camera = scene::framedCamera(s.origin.modelBounds,
+                                   {std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a)}, 40.0, s.camera);
     s.lights[0].direction = scene::sunDirection(45.0, 35.0);
     const ViewScore front = scoreScene(s, 192);
     s.lights[0].direction = scene::sunDirection(180.0, 35.0);
@@ -295,8 +296,10 @@ TEST(ViewSearch, ShadowEdgesSeenNearEdgeOnCountByTheirLegibility) {
             }
         ASSERT_GT(pairs, 100.0) << offNormal << "°: the stripes' edges are in view";
         EXPECT_NEAR(v.edgeLength, weighted / 300.0, 0.05 * weighted / 300.0) << offNormal << "° off the normal";
-        if (offNormal < 60.0) EXPECT_DOUBLE_EQ(weighted, pairs);  // within 60°: every pair counts whole
-        else EXPECT_LT(weighted, 0.6 * pairs);                     // squeezed: about half
+        if (offNormal < 60.0)
+            EXPECT_DOUBLE_EQ(weighted, pairs);  // within 60°: every pair counts whole
+        else
+            EXPECT_LT(weighted, 0.6 * pairs);  // squeezed: about half
         if (offNormal < 0.0) {
             std::size_t screenPixels = 0;
             for (std::size_t i = 0; i < f.pixelCount(); ++i) screenPixels += f.objectId[i] == 2.0f;

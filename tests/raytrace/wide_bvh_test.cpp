@@ -3,8 +3,8 @@
 #include "raytrace/wide_bvh.h"
 
 #include <cmath>
-#include <limits>
 #include <cstring>
+#include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -215,9 +215,8 @@ TYPED_TEST(WideBvhTraversal, ClosestAndAnyHitEqualTheBinaryTreeAndBruteForce) {
         for (std::uint32_t t = 0; t < soup.bounds.size(); ++t) test(t, tBrute, brute);
         Real tBin = tMax;
         int bin = -1;
-        binary.traverse(ray, tBin, false, [&](std::uint32_t slot, Real& tm) {
-            return test(binary.primitives()[slot], tm, bin);
-        });
+        binary.traverse(ray, tBin, false,
+                        [&](std::uint32_t slot, Real& tm) { return test(binary.primitives()[slot], tm, bin); });
         auto walk = [&](const auto& tree, bool anyHit, Real& tm, int& best) {
             return tree.traverse(ray, tm, anyHit, [&](std::uint32_t first, std::uint32_t count, Real& t) {
                 bool any = false;
@@ -265,14 +264,12 @@ TEST(WideBvh, FloatTracerHoldsUnder100BytesPerTriangle) {
 
 #if defined(SHADOWLAB_AVX_BOX_TEST)
 // Runs the AVX test from a function compiled for AVX (only called when the CPU has it).
-__attribute__((target("avx"))) int avxBoxTest(const Ray<float>& ray, const Bvh8Node& n, float tMax,
-                                              float tn[8]) {
+__attribute__((target("avx"))) int avxBoxTest(const Ray<float>& ray, const Bvh8Node& n, float tMax, float tn[8]) {
     return detail::ChildBoxTestAvx8(ray)(n, tMax, tn);
 }
 // The per-octant copy the tracer's walk runs, for the ray's own octant.
 template <int kOctant>
-__attribute__((target("avx"))) int avxOctantBoxTest(const Ray<float>& ray, const Bvh8Node& n, float tMax,
-                                                    float tn[8]) {
+__attribute__((target("avx"))) int avxOctantBoxTest(const Ray<float>& ray, const Bvh8Node& n, float tMax, float tn[8]) {
     alignas(32) float t[8];
     const int mask = detail::ChildBoxTestAvx8Octant<kOctant>(ray)(n, tMax, t);
     std::memcpy(tn, t, sizeof t);
@@ -502,7 +499,8 @@ TEST(WideBvh, TracerAnswersAreTheSameWithAvx2AvxOrSseAndWithOrWithoutTheOccluder
     }
     for (int y = 0; y < 100; ++y)
         for (int x = 0; x < 100; ++x)
-            rays.emplace_back(Vec3T<float>(-12.0f + 0.05f * x, -12.0f + 0.05f * y, -14.0f), Vec3T<float>(0.3f, 0.4f, 1.0f));
+            rays.emplace_back(Vec3T<float>(-12.0f + 0.05f * x, -12.0f + 0.05f * y, -14.0f),
+                              Vec3T<float>(0.3f, 0.4f, 1.0f));
     // Axis-parallel rays (an infinite inverse direction: the AVX2 walk hands them to the AVX one),
     // and rays with a component so small that its inverse is finite but times the widening
     // factor is not (also the AVX walk's) or just finite (the AVX2 walk's).
@@ -534,9 +532,9 @@ TEST(WideBvh, TracerAnswersAreTheSameWithAvx2AvxOrSseAndWithOrWithoutTheOccluder
         }
         hits += found[0];
         for (int config = 1; config < 8; ++config)
-            differ += found[0] != found[config] || any[0] != any[config] ||
-                      (found[0] && (std::memcmp(&h[0].t, &h[config].t, sizeof(float)) != 0 ||
-                                    h[0].prim != h[config].prim));
+            differ +=
+                found[0] != found[config] || any[0] != any[config] ||
+                (found[0] && (std::memcmp(&h[0].t, &h[config].t, sizeof(float)) != 0 || h[0].prim != h[config].prim));
         differ += any[0] != found[0];  // any hit exactly when a closest hit exists
     }
     detail::setUseAvx(true);

@@ -31,10 +31,12 @@ std::filesystem::path writeAlphaPng(const TempDir& dir, const std::string& name)
 
 std::string sceneWith(const std::string& material, const std::string& object) {
     return R"({"camera": {"position": [0, 5, 5], "look_at": [0, 0, 0]},
-               "materials": {"ground": {}, "leaf": )" + material + R"(},
+               "materials": {"ground": {}, "leaf": )" +
+           material + R"(},
                "lights": [{"type": "directional", "direction": [0, -1, 0]}],
                "objects": [{"type": "quad", "center": [0, 0, 0], "normal": [0, 1, 0], "size": [4, 4], "material": "ground"},
-                           )" + object + "]}";
+                           )" +
+           object + "]}";
 }
 
 const std::string kLeafQuad =
@@ -54,7 +56,8 @@ TEST(AlphaLoader, AJsonMaterialCarriesItsModeCutoffFactorTextureAndWraps) {
     TempDir dir;
     writeAlphaPng(dir, "leaf.png");
     const Scene s = loadScene(dir.write("s.json", sceneWith(R"({"alpha_mode": "mask", "alpha_cutoff": 0.3, "alpha": 0.9,
-        "texture": "leaf.png", "wrap_s": "clamp_to_edge", "wrap_t": "mirrored_repeat"})", kLeafQuad)));
+        "texture": "leaf.png", "wrap_s": "clamp_to_edge", "wrap_t": "mirrored_repeat"})",
+                                                            kLeafQuad)));
     const Material& m = s.materials[1];
     EXPECT_EQ(m.alphaMode, AlphaMode::Mask);
     EXPECT_DOUBLE_EQ(m.alphaCutoff, 0.3);
@@ -134,9 +137,15 @@ TEST(AlphaLoader, AGltfModelSceneKeepsEachMaterialAsItsOwnObject) {
         const auto& mesh = std::get<Mesh>(o.shape);
         for (const MeshInstance& inst : mesh.instances)
             EXPECT_EQ(inst.geometry->uvs.empty(), !m.alphaTextured()) << m.name << ": UVs only where alpha is read";
-        if (m.name == "MatCutoff25") { EXPECT_DOUBLE_EQ(m.alphaCutoff, 0.25); }
-        if (m.name == "MatCutoff75") { EXPECT_DOUBLE_EQ(m.alphaCutoff, 0.75); }
-        if (m.name == "MatCutoffDefault") { EXPECT_DOUBLE_EQ(m.alphaCutoff, 0.5); }
+        if (m.name == "MatCutoff25") {
+            EXPECT_DOUBLE_EQ(m.alphaCutoff, 0.25);
+        }
+        if (m.name == "MatCutoff75") {
+            EXPECT_DOUBLE_EQ(m.alphaCutoff, 0.75);
+        }
+        if (m.name == "MatCutoffDefault") {
+            EXPECT_DOUBLE_EQ(m.alphaCutoff, 0.5);
+        }
         if (m.name.rfind("MatCutoff", 0) == 0) {
             EXPECT_EQ(m.alphaMode, AlphaMode::Mask);
             ASSERT_TRUE(m.alphaTexture);
@@ -145,7 +154,9 @@ TEST(AlphaLoader, AGltfModelSceneKeepsEachMaterialAsItsOwnObject) {
             EXPECT_EQ(m.alphaTexture.get(), labels);
             EXPECT_EQ(m.alphaTexture->width, 1024);
         }
-        if (m.name == "MatBlend") { EXPECT_EQ(m.alphaMode, AlphaMode::Blend); }
+        if (m.name == "MatBlend") {
+            EXPECT_EQ(m.alphaMode, AlphaMode::Blend);
+        }
         if (m.name == "MatOpaque" || m.name == "MatBed") {
             EXPECT_EQ(m.alphaMode, AlphaMode::Opaque);
             EXPECT_FALSE(m.alphaTexture) << "OPAQUE reads no texture";
@@ -160,11 +171,14 @@ TEST(AlphaLoader, AGltfModelSceneKeepsEachMaterialAsItsOwnObject) {
 std::string blendBoxGltf(const std::string& imageUri) {
     std::string g = test::boxGltf(R"([{"mesh": 0}])", "[0]");
     const std::string prim = R"("primitives": [{"attributes": {"POSITION": 0}, "indices": 1}])";
-    g.replace(g.find(prim), prim.size(), R"("primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}])");
+    g.replace(g.find(prim), prim.size(),
+              R"("primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}])");
     const std::string asset = R"({"asset": {"version": "2.0"},)";
-    g.replace(g.find(asset), asset.size(), asset + R"( "materials": [{"name": "Lens", "alphaMode": "BLEND",
+    g.replace(g.find(asset), asset.size(),
+              asset + R"( "materials": [{"name": "Lens", "alphaMode": "BLEND",
         "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.6], "baseColorTexture": {"index": 0}}}],
-        "textures": [{"source": 0}], "images": [{"uri": ")" + imageUri + R"("}],)");
+        "textures": [{"source": 0}], "images": [{"uri": ")" +
+                  imageUri + R"("}],)");
     return g;
 }
 

@@ -50,7 +50,8 @@ struct GltfBuffer {
         bytes.resize(offset + v.size() * 2);
         std::memcpy(bytes.data() + offset, v.data(), v.size() * 2);
         views.push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", v.size() * 2}});
-        accessors.push_back({{"bufferView", views.size() - 1}, {"componentType", 5123}, {"count", v.size()}, {"type", "SCALAR"}});
+        accessors.push_back(
+            {{"bufferView", views.size() - 1}, {"componentType", 5123}, {"count", v.size()}, {"type", "SCALAR"}});
         return int(accessors.size()) - 1;
     }
 };
@@ -75,26 +76,30 @@ inline std::filesystem::path writeAnimatedGltf(const TempDir& dir, const std::st
     const int stepValues = b.add({0, 1, 5, 0, 3, 5}, "VEC3", 2);
     const int cubicValues = b.add({0, 0, 0, 0, 1, 5, 0, 0, 0, 0, 0, 0, 0, 1, 3, 0, 0, 0}, "VEC3", 6);
     const std::filesystem::path bin = dir.path() / "anim.bin";
-    std::ofstream(bin, std::ios::binary).write(reinterpret_cast<const char*>(b.bytes.data()), std::streamsize(b.bytes.size()));
+    std::ofstream(bin, std::ios::binary)
+        .write(reinterpret_cast<const char*>(b.bytes.data()), std::streamsize(b.bytes.size()));
     const Json gltf = {
         {"asset", {{"version", "2.0"}}},
         {"scene", 0},
         {"scenes", {{{"nodes", {0, 1}}}}},
-        {"nodes", {{{"mesh", 0}, {"name", "ground"}},
-                   {{"name", "rig"}, {"translation", {10, 0, 0}}, {"children", {2}}},
-                   {{"name", "eye"}, {"camera", 0}, {"translation", {0, 1, 5}}}}},
-        {"cameras", {{{"type", "perspective"}, {"name", "cam"},
-                      {"perspective", {{"yfov", 0.7}, {"znear", 0.1}, {"zfar", 100}}}}}},
+        {"nodes",
+         {{{"mesh", 0}, {"name", "ground"}},
+          {{"name", "rig"}, {"translation", {10, 0, 0}}, {"children", {2}}},
+          {{"name", "eye"}, {"camera", 0}, {"translation", {0, 1, 5}}}}},
+        {"cameras",
+         {{{"type", "perspective"}, {"name", "cam"}, {"perspective", {{"yfov", 0.7}, {"znear", 0.1}, {"zfar", 100}}}}}},
         {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", pos}}}, {"indices", idx}}}}}}},
         {"buffers", {{{"uri", "anim.bin"}, {"byteLength", b.bytes.size()}}}},
         {"bufferViews", b.views},
         {"accessors", b.accessors},
         {"animations",
          {{{"name", "Fly"},
-           {"samplers", {{{"input", t3}, {"output", tr3}, {"interpolation", interpolationOfFly}},
-                         {{"input", t2}, {"output", rot2}, {"interpolation", "LINEAR"}}}},
-           {"channels", {{{"sampler", 0}, {"target", {{"node", 2}, {"path", "translation"}}}},
-                         {{"sampler", 1}, {"target", {{"node", 2}, {"path", "rotation"}}}}}}},
+           {"samplers",
+            {{{"input", t3}, {"output", tr3}, {"interpolation", interpolationOfFly}},
+             {{"input", t2}, {"output", rot2}, {"interpolation", "LINEAR"}}}},
+           {"channels",
+            {{{"sampler", 0}, {"target", {{"node", 2}, {"path", "translation"}}}},
+             {{"sampler", 1}, {"target", {{"node", 2}, {"path", "rotation"}}}}}}},
           {{"name", "Hop"},
            {"samplers", {{{"input", ts}, {"output", stepValues}, {"interpolation", "STEP"}}}},
            {"channels", {{{"sampler", 0}, {"target", {{"node", 2}, {"path", "translation"}}}}}}},

@@ -78,15 +78,17 @@ TEST(CameraAnimation, AnUnknownInterpolationIsAnErrorNamingTheSampler) {
     }
 }
 
-const char* kSceneHead = R"({"camera": {"position": [0, 2, 6], "look_at": [0, 0.7, 0], "fov_y": 40, "resolution": [64, 36]},
+const char* kSceneHead =
+    R"({"camera": {"position": [0, 2, 6], "look_at": [0, 0.7, 0], "fov_y": 40, "resolution": [64, 36]},
   "materials": {"matte": {"albedo": [0.8, 0.8, 0.8]}},
   "lights": [{"type": "directional", "direction": [-1, -2, -1]}],
   "objects": [{"type": "sphere", "center": [0, 1, 0], "radius": 1, "material": "matte"}])";
 
 TEST(ScenePathBlock, IsReadWithEveryValue) {
     TempDir dir;
-    const Scene s = loadScene(
-        dir.write("p.json", std::string(kSceneHead) + R"(, "path": {"kind": "sun-azimuth", "frames": 6, "amount": 15, "light": 0}})"));
+    const Scene s = loadScene(dir.write(
+        "p.json",
+        std::string(kSceneHead) + R"(, "path": {"kind": "sun-azimuth", "frames": 6, "amount": 15, "light": 0}})"));
     ASSERT_TRUE(s.path.has_value());
     EXPECT_EQ(s.path->kind, "sun-azimuth");
     EXPECT_EQ(s.path->frames, std::optional<int>(6));

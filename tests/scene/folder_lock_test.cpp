@@ -2,11 +2,11 @@
 // the first's PID, a killed writer's lock is taken over) and a folder's files replaced as a set.
 #include "scene/folder_lock.h"
 
+#include <sys/wait.h>
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <gtest/gtest.h>
 

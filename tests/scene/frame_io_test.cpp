@@ -164,7 +164,8 @@ TEST(FrameIo, AnExrHeaderThatDeclaresMoreThanTheFileHoldsIsRefusedBeforeOpenExrR
         ADD_FAILURE() << "accepted";
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("damaged OpenEXR header: an attribute name is longer than 31 bytes"),
-                  std::string::npos) << e.what();
+                  std::string::npos)
+            << e.what();
     }
     // Multi-part files (version bit 12) are not Frames.
     std::string multipart = bytes;

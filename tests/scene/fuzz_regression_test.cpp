@@ -28,8 +28,8 @@ std::vector<Replay> replays() {
     std::vector<Replay> all;
     for (const char* target : {"scene_json", "obj", "ply", "gltf", "exr"})
         for (const bool finding : {true, false}) {
-            const fs::path root = fs::path(SHADOWLAB_SOURCE_DIR) /
-                                  (finding ? "tests/scene/fuzz_regressions" : "fuzz/corpus") / target;
+            const fs::path root =
+                fs::path(SHADOWLAB_SOURCE_DIR) / (finding ? "tests/scene/fuzz_regressions" : "fuzz/corpus") / target;
             if (fs::is_directory(root))
                 for (const auto& entry : fs::directory_iterator(root))
                     if (entry.is_regular_file()) all.push_back({target, entry.path(), finding});

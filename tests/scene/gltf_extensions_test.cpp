@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <meshoptimizer.h>
 #include <nlohmann/json.hpp>
-#include <OpenImageIO/imageio.h>
 
 #include "scene/draco_codec.h"
 #include "scene/loader.h"
@@ -197,8 +197,11 @@ TEST(GltfQuantization, NormalizedIntegersFollowTheSpecsRules) {
         {"asset", {{"version", "2.0"}}},
         {"scenes", {{{"nodes", {0}}}}},
         {"nodes", {{{"mesh", 0}, {"scale", {2, 2, 2}}}}},
-        {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}}, {{"attributes", {{"POSITION", 1}}}},
-                                     {{"attributes", {{"POSITION", 2}}}}}}}}},
+        {"meshes",
+         {{{"primitives",
+            {{{"attributes", {{"POSITION", 0}}}},
+             {{"attributes", {{"POSITION", 1}}}},
+             {{"attributes", {{"POSITION", 2}}}}}}}}},
         {"accessors",
          {{{"bufferView", 0}, {"componentType", 5120}, {"normalized", true}, {"count", 3}, {"type", "VEC3"}},
           {{"bufferView", 1}, {"componentType", 5122}, {"normalized", true}, {"count", 3}, {"type", "VEC3"}},
@@ -211,11 +214,11 @@ TEST(GltfQuantization, NormalizedIntegersFollowTheSpecsRules) {
     TempDir dir;
     const TriangleMesh m = loaded(dir.write("n.gltf", doc.dump()));
     ASSERT_EQ(m.positions.size(), 9u);
-    EXPECT_EQ(m.positions[0], Vec3(-2, 0, 0));                    // -128 clamps to -1
-    EXPECT_EQ(m.positions[1], Vec3(-2, 2, 0));                    // -127 is -1 too
-    EXPECT_EQ(m.positions[3], Vec3(-2, 0, 0));                    // -32768 clamps to -1
-    EXPECT_EQ(m.positions[4], Vec3(2, 2, 0));                     // 32767 is 1
-    EXPECT_EQ(m.positions[7], Vec3(2, 0, 0));                     // 65535 is 1
+    EXPECT_EQ(m.positions[0], Vec3(-2, 0, 0));  // -128 clamps to -1
+    EXPECT_EQ(m.positions[1], Vec3(-2, 2, 0));  // -127 is -1 too
+    EXPECT_EQ(m.positions[3], Vec3(-2, 0, 0));  // -32768 clamps to -1
+    EXPECT_EQ(m.positions[4], Vec3(2, 2, 0));   // 32767 is 1
+    EXPECT_EQ(m.positions[7], Vec3(2, 0, 0));   // 65535 is 1
     EXPECT_DOUBLE_EQ(m.positions[8].y, 2.0);
 }
 
@@ -235,7 +238,8 @@ TEST(GltfQuantization, NormalizedFloatsAndSignedOrNormalizedIndicesAreRefused) {
     signedIndices.replace(signedIndices.find(R"("componentType": 5123,)"), 22, R"("componentType": 5122,)");
     e = errorOf([&] { loaded(dir.write("s.gltf", signedIndices)); });
     EXPECT_NE(e.find("accessors[1].componentType: indices must be an unsigned byte, short or int, got 5122"),
-              std::string::npos) << e;
+              std::string::npos)
+        << e;
 }
 
 // ---- EXT_meshopt_compression / KHR_meshopt_compression ------------------------------------
@@ -257,11 +261,12 @@ MeshoptFile meshoptTetra(const Grid& g, const std::string& extension, const std:
     const std::vector<std::uint32_t> indices(tetraIndices().begin(), tetraIndices().end());
     std::vector<unsigned char> encoded(indexMode == "TRIANGLES" ? meshopt_encodeIndexBufferBound(12, 4)
                                                                 : meshopt_encodeIndexSequenceBound(12, 4));
-    encoded.resize(indexMode == "TRIANGLES" ? meshopt_encodeIndexBuffer(encoded.data(), encoded.size(), indices.data(), 12)
-                                            : meshopt_encodeIndexSequence(encoded.data(), encoded.size(), indices.data(), 12));
+    encoded.resize(indexMode == "TRIANGLES"
+                       ? meshopt_encodeIndexBuffer(encoded.data(), encoded.size(), indices.data(), 12)
+                       : meshopt_encodeIndexSequence(encoded.data(), encoded.size(), indices.data(), 12));
     bin.insert(bin.end(), encoded.begin(), encoded.end());
-    const json vertexExt = {{"buffer", 0}, {"byteOffset", 0}, {"byteLength", vertexBytes}, {"byteStride", 8},
-                            {"count", 4}, {"mode", "ATTRIBUTES"}};
+    const json vertexExt = {{"buffer", 0},     {"byteOffset", 0}, {"byteLength", vertexBytes},
+                            {"byteStride", 8}, {"count", 4},      {"mode", "ATTRIBUTES"}};
     const json indexExt = {{"buffer", 0}, {"byteOffset", indicesAt}, {"byteLength", encoded.size()}, {"byteStride", 4},
                            {"count", 12}, {"mode", indexMode}};
     MeshoptFile f;
@@ -277,9 +282,14 @@ MeshoptFile meshoptTetra(const Grid& g, const std::string& extension, const std:
          {{{"bufferView", 0}, {"componentType", 5123}, {"count", 4}, {"type", "VEC3"}},
           {{"bufferView", 1}, {"componentType", 5125}, {"count", 12}, {"type", "SCALAR"}}}},
         {"bufferViews",
-         {{{"buffer", 1}, {"byteOffset", 0}, {"byteLength", 32}, {"byteStride", 8}, {"extensions", {{extension, vertexExt}}}},
+         {{{"buffer", 1},
+           {"byteOffset", 0},
+           {"byteLength", 32},
+           {"byteStride", 8},
+           {"extensions", {{extension, vertexExt}}}},
           {{"buffer", 1}, {"byteOffset", 32}, {"byteLength", 48}, {"extensions", {{extension, indexExt}}}}}},
-        {"buffers", {{{"byteLength", bin.size()}}, {{"byteLength", 80}, {"extensions", {{extension, {{"fallback", true}}}}}}}}};
+        {"buffers",
+         {{{"byteLength", bin.size()}}, {{"byteLength", 80}, {"extensions", {{extension, {{"fallback", true}}}}}}}}};
     return f;
 }
 
@@ -327,7 +337,8 @@ TEST(GltfMeshopt, ExponentialAndOctahedralFiltersDecodeWithinTheirPrecision) {
     for (const Vec3& p : tetra()) {
         positions.insert(positions.end(), {float(p.x), float(p.y), float(p.z)});
         normals.push_back(glm::normalize(p - Vec3(0.5, 0.45, 0.55)));
-        normals4.insert(normals4.end(), {float(normals.back().x), float(normals.back().y), float(normals.back().z), 0.0f});
+        normals4.insert(normals4.end(),
+                        {float(normals.back().x), float(normals.back().y), float(normals.back().z), 0.0f});
     }
     std::vector<unsigned char> expPositions(4 * 12), octNormals(4 * 4);
     meshopt_encodeFilterExp(expPositions.data(), 4, 12, kMantissa, positions.data());
@@ -337,10 +348,18 @@ TEST(GltfMeshopt, ExponentialAndOctahedralFiltersDecodeWithinTheirPrecision) {
     auto compress = [&](const std::vector<unsigned char>& raw, std::size_t stride, const char* filter) {
         std::vector<unsigned char> encoded(meshopt_encodeVertexBufferBound(4, stride));
         encoded.resize(meshopt_encodeVertexBuffer(encoded.data(), encoded.size(), raw.data(), 4, stride));
-        const json ext = {{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", encoded.size()}, {"byteStride", stride},
-                          {"count", 4}, {"mode", "ATTRIBUTES"}, {"filter", filter}};
-        views.push_back({{"buffer", 1}, {"byteOffset", views.size() * 48}, {"byteLength", 4 * stride},
-                         {"byteStride", stride}, {"extensions", {{"EXT_meshopt_compression", ext}}}});
+        const json ext = {{"buffer", 0},
+                          {"byteOffset", bin.size()},
+                          {"byteLength", encoded.size()},
+                          {"byteStride", stride},
+                          {"count", 4},
+                          {"mode", "ATTRIBUTES"},
+                          {"filter", filter}};
+        views.push_back({{"buffer", 1},
+                         {"byteOffset", views.size() * 48},
+                         {"byteLength", 4 * stride},
+                         {"byteStride", stride},
+                         {"extensions", {{"EXT_meshopt_compression", ext}}}});
         bin.insert(bin.end(), encoded.begin(), encoded.end());
         while (bin.size() % 4) bin.push_back(0);
     };
@@ -361,7 +380,9 @@ TEST(GltfMeshopt, ExponentialAndOctahedralFiltersDecodeWithinTheirPrecision) {
           {{"bufferView", 1}, {"componentType", 5120}, {"normalized", true}, {"count", 4}, {"type", "VEC3"}},
           {{"bufferView", 2}, {"componentType", 5121}, {"count", 12}, {"type", "SCALAR"}}}},
         {"bufferViews", views},
-        {"buffers", {{{"byteLength", bin.size()}}, {{"byteLength", 96}, {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}}}}};
+        {"buffers",
+         {{{"byteLength", bin.size()}},
+          {{"byteLength", 96}, {"extensions", {{"EXT_meshopt_compression", {{"fallback", true}}}}}}}}};
     TempDir dir;
     const TriangleMesh m = loaded(dir.write("filters.glb", glb(doc, bin)));
     ASSERT_EQ(m.positions.size(), 4u);
@@ -393,7 +414,8 @@ TEST(GltfMeshopt, BrokenStreamsAreErrorsNamingTheView) {
         const std::string e = errorOf([&] { loaded(file); });
         EXPECT_NE(e.find(file.string()), std::string::npos) << e;
         EXPECT_NE(e.find("bufferViews[0].extensions.EXT_meshopt_compression: the compressed data does not decode"),
-                  std::string::npos) << e;
+                  std::string::npos)
+            << e;
     }
     {
         // A wrong count, with the view's byteLength made to agree: the stream holds 4 triangles,
@@ -414,7 +436,8 @@ TEST(GltfMeshopt, BrokenStreamsAreErrorsNamingTheView) {
         f.doc["bufferViews"][0]["extensions"]["EXT_meshopt_compression"]["count"] = 5;
         const std::string e = errorOf([&] { loaded(dir.write("five.glb", glb(f.doc, f.bin))); });
         EXPECT_NE(e.find("bufferViews[0].extensions.EXT_meshopt_compression: byteStride 8 x count 5 must equal"),
-                  std::string::npos) << e;
+                  std::string::npos)
+            << e;
     }
     {
         // A count past 32 bits, which tinygltf would wrap (2^32 + 4 to 4): refused by its path.
@@ -422,7 +445,8 @@ TEST(GltfMeshopt, BrokenStreamsAreErrorsNamingTheView) {
         f.doc["bufferViews"][0]["extensions"]["EXT_meshopt_compression"]["count"] = 4294967300LL;
         const std::string e = errorOf([&] { loaded(dir.write("wrap.glb", glb(f.doc, f.bin))); });
         EXPECT_NE(e.find("bufferViews[0].extensions.EXT_meshopt_compression.count: 4294967300 is out of the range"),
-                  std::string::npos) << e;
+                  std::string::npos)
+            << e;
     }
     {
         // A huge count with a byteLength to match: refused as too short to hold it, before any
@@ -432,7 +456,8 @@ TEST(GltfMeshopt, BrokenStreamsAreErrorsNamingTheView) {
         f.doc["bufferViews"][0]["byteLength"] = 4000000000LL;
         f.doc["buffers"][1]["byteLength"] = 4000000048LL;
         const std::string e = errorOf([&] { loaded(dir.write("huge.glb", glb(f.doc, f.bin))); });
-        EXPECT_NE(e.find("is too short to hold 500000000 elements of 8 bytes (at least 62500000 bytes)"), std::string::npos)
+        EXPECT_NE(e.find("is too short to hold 500000000 elements of 8 bytes (at least 62500000 bytes)"),
+                  std::string::npos)
             << e;
     }
     {
@@ -490,8 +515,11 @@ json dracoDoc(const DracoData& d, std::size_t byteLength) {
             {"extensionsRequired", {"KHR_draco_mesh_compression"}},
             {"scenes", {{{"nodes", {0}}}}},
             {"nodes", {{{"mesh", 0}}}},
-            {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}, {"indices", 1},
-                                          {"extensions", {{"KHR_draco_mesh_compression", ext}}}}}}}}},
+            {"meshes",
+             {{{"primitives",
+                {{{"attributes", {{"POSITION", 0}}},
+                  {"indices", 1},
+                  {"extensions", {{"KHR_draco_mesh_compression", ext}}}}}}}}},
             {"accessors",
              {{{"componentType", 5126}, {"count", d.points}, {"type", "VEC3"}},
               {{"componentType", 5125}, {"count", d.faces * 3}, {"type", "SCALAR"}}}},
@@ -524,13 +552,15 @@ TEST(GltfDraco, CutOrMismatchedDataIsAnErrorNamingThePrimitive) {
     EXPECT_NE(e.find(cut.string()), std::string::npos) << e;
     EXPECT_NE(e.find("meshes[0].primitives[0].extensions.KHR_draco_mesh_compression: the Draco data in bufferViews[0] "
                      "does not decode"),
-              std::string::npos) << e;
+              std::string::npos)
+        << e;
     // An accessor count that is not the decoded one.
     json doc = dracoDoc(d, d.bytes.size());
     doc["accessors"][0]["count"] = d.points + 1;
     e = errorOf([&] { loaded(dir.write("count.glb", glb(doc, d.bytes))); });
     EXPECT_NE(e.find("accessors[0].count: " + std::to_string(d.points + 1) + " elements, but the Draco data"),
-              std::string::npos) << e;
+              std::string::npos)
+        << e;
     // An attribute id the data does not hold.
     doc = dracoDoc(d, d.bytes.size());
     doc["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"]["attributes"]["POSITION"] = 7;
@@ -556,7 +586,8 @@ TEST(GltfContainer, ChunksThatReachPastTheFileAreRefusedBeforeTinygltfReadsThem)
         const std::string e = errorOf([&] { loaded(file); });
         EXPECT_NE(e.find(file.string() + ": GLB chunk 1 (BIN): declares " + std::to_string(f.bin.size()) +
                          " bytes, but only " + std::to_string(f.bin.size() - 4) + " follow its header"),
-                  std::string::npos) << e;
+                  std::string::npos)
+            << e;
     }
     {
         // The header's length is past the file's end.
@@ -565,7 +596,8 @@ TEST(GltfContainer, ChunksThatReachPastTheFileAreRefusedBeforeTinygltfReadsThem)
         const std::string e = errorOf([&] { loaded(dir.write("length.glb", longer)); });
         EXPECT_NE(e.find("GLB header: declares " + std::to_string(good.size() + 8) + " bytes, but the file has only " +
                          std::to_string(good.size())),
-                  std::string::npos) << e;
+                  std::string::npos)
+            << e;
     }
     {
         // A JSON chunk longer than the file.
@@ -592,20 +624,27 @@ TEST(GltfExtensions, ARequiredExtensionShadowlabDoesNotReadIsRefusedByName) {
     const std::string e = errorOf([&] { loadScene(file); });
     EXPECT_NE(e.find(file.string() + ": extensionsRequired[1]: the file requires EXT_mesh_gpu_instancing, which "
                                      "shadowlab does not read"),
-              std::string::npos) << e;
+              std::string::npos)
+        << e;
     // An unknown name is refused the same way.
-    const std::string u = errorOf([&] { loadScene(dir.write("u.gltf", boxWith(R"("extensionsRequired": ["VENDOR_new_geometry"])"))); });
+    const std::string u =
+        errorOf([&] { loadScene(dir.write("u.gltf", boxWith(R"("extensionsRequired": ["VENDOR_new_geometry"])"))); });
     EXPECT_NE(u.find("extensionsRequired[0]: the file requires VENDOR_new_geometry"), std::string::npos) << u;
     // Specular-glossiness takes MASK/BLEND alpha from elsewhere: refused when required.
-    const std::string sg = errorOf(
-        [&] { loadScene(dir.write("sg.gltf", boxWith(R"("extensionsRequired": ["KHR_materials_pbrSpecularGlossiness"])"))); });
+    const std::string sg = errorOf([&] {
+        loadScene(dir.write("sg.gltf", boxWith(R"("extensionsRequired": ["KHR_materials_pbrSpecularGlossiness"])")));
+    });
     EXPECT_NE(sg.find("KHR_materials_pbrSpecularGlossiness"), std::string::npos) << sg;
     // Transmission lets light through surfaces that shadowlab would cast as opaque.
-    for (const std::string name : {"KHR_materials_transmission", "KHR_materials_volume", "KHR_materials_diffuse_transmission"}) {
-        const std::string t = errorOf([&] { loadScene(dir.write("t.gltf", boxWith(R"("extensionsRequired": [")" + name + R"("])"))); });
-        EXPECT_NE(t.find("extensionsRequired[0]: the file requires " + name + ", which shadowlab does not read (its "
+    for (const std::string name :
+         {"KHR_materials_transmission", "KHR_materials_volume", "KHR_materials_diffuse_transmission"}) {
+        const std::string t =
+            errorOf([&] { loadScene(dir.write("t.gltf", boxWith(R"("extensionsRequired": [")" + name + R"("])"))); });
+        EXPECT_NE(t.find("extensionsRequired[0]: the file requires " + name +
+                         ", which shadowlab does not read (its "
                          "surfaces let light through"),
-                  std::string::npos) << t;
+                  std::string::npos)
+            << t;
     }
 }
 
@@ -645,15 +684,19 @@ TEST(GltfTextureTransform, MovesTheCoordinatesTheAlphaIsSampledAt) {
                   reinterpret_cast<const unsigned char*>(positions) + 36);
     const std::uint16_t decoy[6] = {1, 1, 1, 1, 1, 1};
     const std::uint16_t uv[6] = {0, 0, 65535, 0, 13107, 65535};
-    buffer.insert(buffer.end(), reinterpret_cast<const unsigned char*>(decoy), reinterpret_cast<const unsigned char*>(decoy) + 12);
-    buffer.insert(buffer.end(), reinterpret_cast<const unsigned char*>(uv), reinterpret_cast<const unsigned char*>(uv) + 12);
+    buffer.insert(buffer.end(), reinterpret_cast<const unsigned char*>(decoy),
+                  reinterpret_cast<const unsigned char*>(decoy) + 12);
+    buffer.insert(buffer.end(), reinterpret_cast<const unsigned char*>(uv),
+                  reinterpret_cast<const unsigned char*>(uv) + 12);
     const double quarter = 1.5707963267948966;
     const json doc = {
         {"asset", {{"version", "2.0"}}},
         {"extensionsUsed", {"KHR_texture_transform"}},
         {"scenes", {{{"nodes", {0}}}}},
         {"nodes", {{{"mesh", 0}}}},
-        {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}, {"TEXCOORD_0", 1}, {"TEXCOORD_1", 2}}}, {"material", 0}}}}}}},
+        {"meshes",
+         {{{"primitives",
+            {{{"attributes", {{"POSITION", 0}, {"TEXCOORD_0", 1}, {"TEXCOORD_1", 2}}}, {"material", 0}}}}}}},
         {"materials",
          {{{"name", "Leaf"},
            {"alphaMode", "MASK"},
@@ -701,7 +744,8 @@ std::string alphaTriangle(const json& texture, const json& images) {
         {"scenes", {{{"nodes", {0}}}}},
         {"nodes", {{{"mesh", 0}}}},
         {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}, {"TEXCOORD_0", 1}}}, {"material", 0}}}}}}},
-        {"materials", {{{"name", "Leaf"}, {"alphaMode", "MASK"}, {"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}}},
+        {"materials",
+         {{{"name", "Leaf"}, {"alphaMode", "MASK"}, {"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}}},
         {"textures", {texture}},
         {"images", images},
         {"accessors",
@@ -732,11 +776,13 @@ TEST(GltfTextureFormats, AWebpOnlyAlphaIsDecodedAndAvifOrKtx2OnlyAreRefusedByNam
     ASSERT_TRUE(s.materials[0].alphaTexture);
     EXPECT_EQ(s.materials[0].alphaTexture->alpha, (std::vector<float>{0.0f, 1.0f, 128.0f / 255.0f, 1.0f}));
     for (const std::string format : {"EXT_texture_avif", "KHR_texture_basisu"}) {
-        const fs::path file = dir.write("other.gltf", alphaTriangle({{"extensions", {{format, {{"source", 0}}}}}},
-                                                                    {{{"uri", "a.webp"}}}));
+        const fs::path file = dir.write(
+            "other.gltf", alphaTriangle({{"extensions", {{format, {{"source", 0}}}}}}, {{{"uri", "a.webp"}}}));
         const std::string e = errorOf([&] { loadScene(file); });
-        EXPECT_NE(e.find(file.string() + ": textures[0].extensions." + format + ": the alpha of Leaf (MASK) is only in"),
-                  std::string::npos) << e;
+        EXPECT_NE(
+            e.find(file.string() + ": textures[0].extensions." + format + ": the alpha of Leaf (MASK) is only in"),
+            std::string::npos)
+            << e;
     }
 }
 
@@ -793,7 +839,8 @@ TEST(GltfToolOutput, KhrMeshoptVersion1StreamsAreRefusedWithWhatToDo) {
     const fs::path file = fs::path(SHADOWLAB_SOURCE_DIR) / "tests" / "scene" / "data" / "Box.gltfpack-khr.glb";
     const std::string e = errorOf([&] { loaded(file); });
     EXPECT_NE(e.find("bufferViews[0].extensions.KHR_meshopt_compression: the attribute stream is of version 1"),
-              std::string::npos) << e;
+              std::string::npos)
+        << e;
     EXPECT_NE(e.find("gltfpack -ce ext"), std::string::npos) << e;
 }
 

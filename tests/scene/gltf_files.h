@@ -40,8 +40,8 @@ inline const std::vector<float>& boxCorners() {
     return c;
 }
 inline const std::vector<std::uint16_t>& boxIndices() {
-    static const std::vector<std::uint16_t> i = {0, 2, 3, 0, 3, 1,  4, 5, 7, 4, 7, 6,  0, 1, 5, 0, 5, 4,
-                                                 2, 6, 7, 2, 7, 3,  0, 4, 6, 0, 6, 2,  1, 3, 7, 1, 7, 5};
+    static const std::vector<std::uint16_t> i = {0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4,
+                                                 2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5};
     return i;
 }
 
@@ -54,17 +54,20 @@ inline std::string boxGltf(const std::string& nodesJson, const std::string& root
     std::memcpy(buffer.data() + boxCorners().size() * 4, boxIndices().data(), boxIndices().size() * 2);
     const std::string posBytes = std::to_string(boxCorners().size() * 4);
     const std::string idxBytes = std::to_string(boxIndices().size() * 2);
-    return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": )" + rootsJson +
-           R"(}], "nodes": )" + nodesJson +
+    return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": )" + rootsJson + R"(}], "nodes": )" +
+           nodesJson +
            R"(, "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
   "accessors": [
     {"bufferView": 0, "componentType": 5126, "count": 8, "type": "VEC3", "min": [0, 0, 0], "max": [1, 0.5, 0.25]},
     {"bufferView": 1, "componentType": 5123, "count": 36, "type": "SCALAR"}],
   "bufferViews": [
-    {"buffer": 0, "byteOffset": 0, "byteLength": )" + posBytes + R"(},
-    {"buffer": 0, "byteOffset": )" + posBytes + R"(, "byteLength": )" + idxBytes + R"(}],
-  "buffers": [{"byteLength": )" + std::to_string(buffer.size()) +
-           R"(, "uri": "data:application/octet-stream;base64,)" + base64(buffer) + R"("}]})";
+    {"buffer": 0, "byteOffset": 0, "byteLength": )" +
+           posBytes + R"(},
+    {"buffer": 0, "byteOffset": )" +
+           posBytes + R"(, "byteLength": )" + idxBytes + R"(}],
+  "buffers": [{"byteLength": )" +
+           std::to_string(buffer.size()) + R"(, "uri": "data:application/octet-stream;base64,)" + base64(buffer) +
+           R"("}]})";
 }
 
 }  // namespace shadowlab::test

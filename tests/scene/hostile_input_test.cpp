@@ -2,14 +2,14 @@
 // folders, links to /dev/zero, deep nesting, glTF accessors whose sums wrap, values that
 // overflow): every one must end in one SceneError/InputError naming the file, quickly, without
 // a crash, a hang or a large allocation.
+#include <sys/stat.h>
+#include <unistd.h>
 #include <cmath>
 #include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <functional>
 #include <string>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -52,7 +52,9 @@ std::string errorOf(F&& f) {
 const char* kSceneHead = R"({"camera": {"position": [0, 2, 6], "look_at": [0, 0, 0]},
   "materials": {"m": {}}, "lights": [{"type": "directional", "direction": [0, -1, 0]}], )";
 
-std::string sceneWithObjects(const std::string& objects) { return std::string(kSceneHead) + "\"objects\": " + objects + "}"; }
+std::string sceneWithObjects(const std::string& objects) {
+    return std::string(kSceneHead) + "\"objects\": " + objects + "}";
+}
 
 std::string meshScene(const std::string& file) {
     return sceneWithObjects(R"([{"type": "mesh", "file": ")" + file + R"(", "material": "m"}])");
@@ -247,14 +249,13 @@ Json sparseTriangle(std::uint32_t index, const float moved[3]) {
     std::string bytes = triangleBytes();
     bytes.append(reinterpret_cast<const char*>(&index), 4);
     bytes.append(reinterpret_cast<const char*>(moved), 12);
-    g["buffers"][0]["uri"] = "data:application/octet-stream;base64," +
-                             test::base64(std::vector<unsigned char>(bytes.begin(), bytes.end()));
+    g["buffers"][0]["uri"] =
+        "data:application/octet-stream;base64," + test::base64(std::vector<unsigned char>(bytes.begin(), bytes.end()));
     g["bufferViews"] = {{{"buffer", 0}, {"byteLength", 36}},
                         {{"buffer", 0}, {"byteOffset", 36}, {"byteLength", 4}},
                         {{"buffer", 0}, {"byteOffset", 40}, {"byteLength", 12}}};
-    g["accessors"][0]["sparse"] = {{"count", 1},
-                                   {"indices", {{"bufferView", 1}, {"componentType", 5125}}},
-                                   {"values", {{"bufferView", 2}}}};
+    g["accessors"][0]["sparse"] = {
+        {"count", 1}, {"indices", {{"bufferView", 1}, {"componentType", 5125}}}, {"values", {{"bufferView", 2}}}};
     return g;
 }
 
@@ -326,7 +327,8 @@ TEST(Values, GltfLightsGetTheChecksJsonLightsGet) {
     EXPECT_NE(e.find("lights[0].color"), std::string::npos) << e;
     // And the JSON ones: finite in double, infinite once shaded in float.
     TempDir dir;
-    const fs::path file = dir.write("bright.json", std::string(R"({"camera": {"position": [0, 2, 6], "look_at": [0, 0, 0]},
+    const fs::path file =
+        dir.write("bright.json", std::string(R"({"camera": {"position": [0, 2, 6], "look_at": [0, 0, 0]},
         "materials": {"m": {}}, "lights": [{"type": "directional", "direction": [0, -1, 0], "intensity": 1e308}],
         "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}]})"));
     e = errorOf([&] { scene::loadScene(file); });

@@ -28,11 +28,36 @@ public:
 
 private:
     static const std::set<std::string>& keywords() {
-        static const std::set<std::string> k = {
-            "$schema", "$id", "$defs", "$ref", "title", "description", "default", "examples",
-            "type", "properties", "required", "additionalProperties", "minProperties", "items", "minItems",
-            "maxItems", "enum", "const", "minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum",
-            "minLength", "allOf", "anyOf", "oneOf", "not", "if", "then", "else"};
+        static const std::set<std::string> k = {"$schema",
+                                                "$id",
+                                                "$defs",
+                                                "$ref",
+                                                "title",
+                                                "description",
+                                                "default",
+                                                "examples",
+                                                "type",
+                                                "properties",
+                                                "required",
+                                                "additionalProperties",
+                                                "minProperties",
+                                                "items",
+                                                "minItems",
+                                                "maxItems",
+                                                "enum",
+                                                "const",
+                                                "minimum",
+                                                "maximum",
+                                                "exclusiveMinimum",
+                                                "exclusiveMaximum",
+                                                "minLength",
+                                                "allOf",
+                                                "anyOf",
+                                                "oneOf",
+                                                "not",
+                                                "if",
+                                                "then",
+                                                "else"};
         return k;
     }
 
@@ -98,8 +123,10 @@ private:
         if (s.contains("type")) {
             const Json& t = s["type"];
             bool ok = false;
-            if (t.is_string()) ok = hasType(v, t.get<std::string>());
-            else for (const Json& one : t) ok = ok || hasType(v, one.get<std::string>());
+            if (t.is_string())
+                ok = hasType(v, t.get<std::string>());
+            else
+                for (const Json& one : t) ok = ok || hasType(v, one.get<std::string>());
             if (!ok) {
                 errors.push_back(where(path) + ": expected type " + t.dump() + ", got " + v.dump());
                 return;
@@ -119,9 +146,11 @@ private:
             if (s.contains("maximum") && !(d <= s["maximum"].get<double>()))
                 errors.push_back(where(path) + ": " + v.dump() + " > maximum " + s["maximum"].dump());
             if (s.contains("exclusiveMinimum") && !(d > s["exclusiveMinimum"].get<double>()))
-                errors.push_back(where(path) + ": " + v.dump() + " <= exclusive minimum " + s["exclusiveMinimum"].dump());
+                errors.push_back(where(path) + ": " + v.dump() + " <= exclusive minimum " +
+                                 s["exclusiveMinimum"].dump());
             if (s.contains("exclusiveMaximum") && !(d < s["exclusiveMaximum"].get<double>()))
-                errors.push_back(where(path) + ": " + v.dump() + " >= exclusive maximum " + s["exclusiveMaximum"].dump());
+                errors.push_back(where(path) + ": " + v.dump() + " >= exclusive maximum " +
+                                 s["exclusiveMaximum"].dump());
         }
         if (v.is_string() && s.contains("minLength") && v.get<std::string>().size() < s["minLength"].get<std::size_t>())
             errors.push_back(where(path) + ": shorter than " + s["minLength"].dump());
@@ -143,8 +172,10 @@ private:
                         errors.push_back(at(path, key.get<std::string>()) + ": is required");
             const Json* props = s.contains("properties") ? &s["properties"] : nullptr;
             for (const auto& [key, value] : v.items()) {
-                if (props && props->contains(key)) check((*props)[key], value, at(path, key), errors);
-                else if (s.contains("additionalProperties")) check(s["additionalProperties"], value, at(path, key), errors);
+                if (props && props->contains(key))
+                    check((*props)[key], value, at(path, key), errors);
+                else if (s.contains("additionalProperties"))
+                    check(s["additionalProperties"], value, at(path, key), errors);
             }
         }
         if (s.contains("allOf"))

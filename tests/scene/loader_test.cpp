@@ -84,8 +84,9 @@ class BadScene : public ::testing::TestWithParam<BadCase> {};
 
 TEST(SceneLoader, ShadowBlockReadsTheCascadeBlendAndTheHardwareBias) {
     TempDir dir;
-    const auto file = dir.write("blend.json", sceneText(kCamera, kMaterials, kLights, kObjects,
-                                                          R"(, "shadow": {"cascades": 3, "cascade_blend": 0.2, "hardware_bias": true})"));
+    const auto file = dir.write(
+        "blend.json", sceneText(kCamera, kMaterials, kLights, kObjects,
+                                R"(, "shadow": {"cascades": 3, "cascade_blend": 0.2, "hardware_bias": true})"));
     const Scene s = loadScene(file);
     ASSERT_TRUE(s.shadow.cascadeBlend.has_value());
     EXPECT_EQ(*s.shadow.cascadeBlend, 0.2);
@@ -107,7 +108,9 @@ TEST_P(BadScene, GivesOneErrorNamingFileAndPath) {
     }
 }
 
-std::string withObjects(const std::string& objects) { return sceneText(kCamera, kMaterials, kLights, "\"objects\": " + objects); }
+std::string withObjects(const std::string& objects) {
+    return sceneText(kCamera, kMaterials, kLights, "\"objects\": " + objects);
+}
 std::string withLights(const std::string& lights) { return sceneText(kCamera, kMaterials, lights, kObjects); }
 std::string withCamera(const std::string& camera) { return sceneText(camera, kMaterials, kLights, kObjects); }
 
@@ -117,34 +120,46 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"syntax", R"({"camera": {"position": [0, 2, 6],, }})", "", "invalid JSON near line 1"},
         BadCase{"truncated", sceneText().substr(0, 80), "", "invalid JSON"},
         BadCase{"not_an_object", "[1, 2, 3]", "", "expected an object"},
-        BadCase{"unknown_top_key", sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "lightz": [])"),
-                "lightz", "unknown key"},
-        BadCase{"unknown_key_suggests", withObjects(R"([{"type": "sphere", "center": [0,1,0], "radus": 1, "material": "matte"}])"),
+        BadCase{"unknown_top_key", sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "lightz": [])"), "lightz",
+                "unknown key"},
+        BadCase{"unknown_key_suggests",
+                withObjects(R"([{"type": "sphere", "center": [0,1,0], "radus": 1, "material": "matte"}])"),
                 "objects[0].radus", "did you mean 'radius'"},
-        BadCase{"wrong_type", withObjects(R"([{"type": "sphere", "center": [0,1,0], "radius": "one", "material": "matte"}])"),
+        BadCase{"wrong_type",
+                withObjects(R"([{"type": "sphere", "center": [0,1,0], "radius": "one", "material": "matte"}])"),
                 "objects[0].radius", "expected a number, got a string"},
-        BadCase{"infinite", withObjects(R"([{"type": "sphere", "center": [0,1e999,0], "radius": 1, "material": "matte"}])"),
-                "", "number overflow parsing '1e999'"},
-        BadCase{"nan_token", withObjects(R"([{"type": "sphere", "center": [0,NaN,0], "radius": 1, "material": "matte"}])"),
-                "", "invalid JSON"},
+        BadCase{"infinite",
+                withObjects(R"([{"type": "sphere", "center": [0,1e999,0], "radius": 1, "material": "matte"}])"), "",
+                "number overflow parsing '1e999'"},
+        BadCase{"nan_token",
+                withObjects(R"([{"type": "sphere", "center": [0,NaN,0], "radius": 1, "material": "matte"}])"), "",
+                "invalid JSON"},
         BadCase{"zero_direction", withLights(R"("lights": [{"type": "directional", "direction": [0, 0, 0]}])"),
                 "lights[0].direction", "non-zero direction"},
-        BadCase{"negative_radius", withObjects(R"([{"type": "sphere", "center": [0,1,0], "radius": -1, "material": "matte"}])"),
+        BadCase{"negative_radius",
+                withObjects(R"([{"type": "sphere", "center": [0,1,0], "radius": -1, "material": "matte"}])"),
                 "objects[0].radius", "must be > 0"},
-        BadCase{"zero_quad_size", withObjects(R"([{"type": "quad", "center": [0,0,0], "normal": [0,1,0], "size": [20, 0], "material": "matte"}])"),
-                "objects[0].size[1]", "must be > 0"},
-        BadCase{"inverted_box", withObjects(R"([{"type": "box", "min": [0,0,0], "max": [1,-1,1], "material": "matte"}])"),
+        BadCase{
+            "zero_quad_size",
+            withObjects(
+                R"([{"type": "quad", "center": [0,0,0], "normal": [0,1,0], "size": [20, 0], "material": "matte"}])"),
+            "objects[0].size[1]", "must be > 0"},
+        BadCase{"inverted_box",
+                withObjects(R"([{"type": "box", "min": [0,0,0], "max": [1,-1,1], "material": "matte"}])"),
                 "objects[0].max", "greater than min"},
-        BadCase{"missing_material", withObjects(R"([{"type": "sphere", "center": [0,1,0], "radius": 1, "material": "gold"}])"),
+        BadCase{"missing_material",
+                withObjects(R"([{"type": "sphere", "center": [0,1,0], "radius": 1, "material": "gold"}])"),
                 "objects[0].material", "no material named 'gold'"},
-        BadCase{"absurd_resolution", withCamera(R"("camera": {"position": [0,2,6], "look_at": [0,0,0], "resolution": [100000, 100000]})"),
+        BadCase{"absurd_resolution",
+                withCamera(R"("camera": {"position": [0,2,6], "look_at": [0,0,0], "resolution": [100000, 100000]})"),
                 "camera.resolution[0]", "must be in 1..16384"},
-        BadCase{"zero_resolution", withCamera(R"("camera": {"position": [0,2,6], "look_at": [0,0,0], "resolution": [0, 10]})"),
+        BadCase{"zero_resolution",
+                withCamera(R"("camera": {"position": [0,2,6], "look_at": [0,0,0], "resolution": [0, 10]})"),
                 "camera.resolution[0]", "must be in 1..16384"},
         BadCase{"missing_mesh_file", withObjects(R"([{"type": "mesh", "file": "nowhere.obj", "material": "matte"}])"),
                 "objects[0].file", "no such file"},
-        BadCase{"unknown_object_type", withObjects(R"([{"type": "torus", "material": "matte"}])"),
-                "objects[0].type", "unknown object type 'torus'"},
+        BadCase{"unknown_object_type", withObjects(R"([{"type": "torus", "material": "matte"}])"), "objects[0].type",
+                "unknown object type 'torus'"},
         BadCase{"unknown_light_type", withLights(R"("lights": [{"type": "laser", "direction": [0, -1, 0]}])"),
                 "lights[0].type", "unknown light type"},
         BadCase{"no_lights", withLights(R"("lights": [])"), "lights", "at least one light"},
@@ -153,14 +168,17 @@ INSTANTIATE_TEST_SUITE_P(
                 "camera.look_at", "must differ"},
         BadCase{"fov_out_of_range", withCamera(R"("camera": {"position": [0,2,6], "look_at": [0,0,0], "fov_y": 180})"),
                 "camera.fov_y", "(0, 180)"},
-        BadCase{"far_before_near", withCamera(R"("camera": {"position": [0,2,6], "look_at": [0,0,0], "near": 5, "far": 1})"),
-                "camera.far", "greater than near"},
+        BadCase{"far_before_near",
+                withCamera(R"("camera": {"position": [0,2,6], "look_at": [0,0,0], "near": 5, "far": 1})"), "camera.far",
+                "greater than near"},
         BadCase{"opacity_out_of_range", sceneText(kCamera, R"("materials": {"matte": {"opacity": 1.5}})"),
                 "materials.matte.opacity", "must be in 0..1"},
-        BadCase{"spot_without_cone", withLights(R"("lights": [{"type": "spot", "position": [0,5,0], "direction": [0,-1,0]}])"),
+        BadCase{"spot_without_cone",
+                withLights(R"("lights": [{"type": "spot", "position": [0,5,0], "direction": [0,-1,0]}])"),
                 "lights[0].cone_angle", "is required"},
-        BadCase{"bad_shadow_filter", sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"filter": "blur"})"),
-                "shadow.filter", "expected none, pcf2x2, pcf, poisson, pcss, vsm, evsm2, evsm4, esm or msm"},
+        BadCase{"bad_shadow_filter",
+                sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"filter": "blur"})"), "shadow.filter",
+                "expected none, pcf2x2, pcf, poisson, pcss, vsm, evsm2, evsm4, esm or msm"},
         BadCase{"evsm_exponent_overflows_float",
                 sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"evsm_positive_exponent": 43})"),
                 "shadow.evsm_positive_exponent", "must be in 0..42"},
@@ -173,13 +191,15 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"bleeding_reduction_of_one",
                 sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"light_bleeding_reduction": 1})"),
                 "shadow.light_bleeding_reduction", "must be in 0..0.99"},
-        BadCase{"even_blur_width", sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"blur_width": 4})"),
+        BadCase{"even_blur_width",
+                sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"blur_width": 4})"),
                 "shadow.blur_width", "must be odd"},
         BadCase{"moment_bias_not_a_number",
                 sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"moment_bias": "small"})"),
                 "shadow.moment_bias", "expected"},
-        BadCase{"too_many_cascades", sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"cascades": 5})"),
-                "shadow.cascades", "must be in 1..4"},
+        BadCase{"too_many_cascades",
+                sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"cascades": 5})"), "shadow.cascades",
+                "must be in 1..4"},
         BadCase{"cascade_blend_too_wide",
                 sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"cascade_blend": 0.6})"),
                 "shadow.cascade_blend", "must be in 0..0.5"},
@@ -192,7 +212,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"receiver_plane_bias_not_bool",
                 sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"receiver_plane_bias": 1})"),
                 "shadow.receiver_plane_bias", "expected"},
-        BadCase{"fractional_cascades", sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"cascades": 2.5})"),
+        BadCase{"fractional_cascades",
+                sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"cascades": 2.5})"),
                 "shadow.cascades", "expected an integer"}),
     [](const ::testing::TestParamInfo<BadCase>& testParam) { return std::string(testParam.param.name); });
 
@@ -232,7 +253,8 @@ TEST(SceneLoader, GltfCamerasAndPunctualLightsAreUsed) {
       "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
                      "min": [0, 0, 0], "max": [1, 1, 0]}],
       "bufferViews": [{"buffer": 0, "byteLength": 36}],
-      "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64,)" + buffer + R"("}]})");
+      "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64,)" +
+                            buffer + R"("}]})");
     const Scene s = loadScene(dir.path() / "t.gltf");
     EXPECT_NEAR(s.camera.position.z, 5.0, 1e-12);
     EXPECT_NEAR(glm::normalize(s.camera.lookAt - s.camera.position).z, -1.0, 1e-12);

@@ -80,8 +80,8 @@ TEST(MeshLoader, BadMeshesGiveClearErrors) {
 
 // One triangle in an embedded buffer, placed by the node hierarchy `nodes` (a JSON array).
 std::string oneTriangleGltf(const std::string& nodes, const std::string& sceneRoots) {
-    return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": )" + sceneRoots +
-           R"(}], "nodes": )" + nodes + R"(,
+    return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": )" + sceneRoots + R"(}], "nodes": )" +
+           nodes + R"(,
       "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
       "buffers": [{"byteLength": 44, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAA="}],
       "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
@@ -92,8 +92,8 @@ std::string oneTriangleGltf(const std::string& nodes, const std::string& sceneRo
 TEST(MeshLoader, GltfNodeHierarchyMustBeAForest) {
     test::TempDir dir;
     // A tree: the mesh node under a translated parent is placed once, moved by its parent.
-    const auto tree = load(dir.write("tree.gltf", oneTriangleGltf(
-        R"([{"children": [1], "translation": [5, 0, 0]}, {"mesh": 0}])", "[0]")));
+    const auto tree = load(dir.write(
+        "tree.gltf", oneTriangleGltf(R"([{"children": [1], "translation": [5, 0, 0]}, {"mesh": 0}])", "[0]")));
     ASSERT_EQ(tree->triangleCount(), 1u);
     for (const Vec3& p : tree->positions) EXPECT_GE(p.x, 5.0);
     // A cycle (found by fuzzing: it used to loop until a million visits) and a node with two
@@ -179,8 +179,8 @@ TEST(MeshInstancing, ObjectsNamingTheSameFileShareItsGeometryAndKeepOneIdEach) {
     // (−1, 0, 0) by the node, then ·0.5 → (−0.5, 0, 0), R_y(30°) → (−0.5·cos30, 0, 0.5·sin30),
     // + (0, 0, 4).
     const double c = std::cos(glm::radians(30.0)), sn = std::sin(glm::radians(30.0));
-    EXPECT_LT(glm::length(transformPoint(b.instances[0].transform, Vec3(1, 0, 0)) -
-                          Vec3(-0.5 * c, 0, 4 + 0.5 * sn)), 1e-12);
+    EXPECT_LT(glm::length(transformPoint(b.instances[0].transform, Vec3(1, 0, 0)) - Vec3(-0.5 * c, 0, 4 + 0.5 * sn)),
+              1e-12);
     // The same OBJ named two ways is read once.
     EXPECT_EQ(std::get<Mesh>(s.objects[3].shape).instances[0].geometry.get(),
               std::get<Mesh>(s.objects[4].shape).instances[0].geometry.get());
@@ -188,7 +188,8 @@ TEST(MeshInstancing, ObjectsNamingTheSameFileShareItsGeometryAndKeepOneIdEach) {
 
 TEST(MeshInstancing, ANodeScaledToZeroIsDroppedAndAllDroppedIsAnError) {
     TempDir dir;
-    const auto some = dir.write("some.gltf", test::boxGltf(R"([{"mesh": 0}, {"mesh": 0, "scale": [0, 1, 1]}])", "[0, 1]"));
+    const auto some =
+        dir.write("some.gltf", test::boxGltf(R"([{"mesh": 0}, {"mesh": 0, "scale": [0, 1, 1]}])", "[0, 1]"));
     EXPECT_EQ(loadMeshInstances(some, glm::dmat4(1.0), "scene.json", JsonPath()).size(), 1u);
     const auto none = dir.write("none.gltf", test::boxGltf(R"([{"mesh": 0, "scale": [0, 0, 0]}])", "[0]"));
     try {

@@ -78,13 +78,15 @@ TEST(ModelView, AModelWithoutCameraOrLightAsksForASearch) {
 std::string jsonWithModel(const std::string& objectExtra, const std::string& camera) {
     return R"({"camera": )" + camera + R"(, "materials": {"m": {}},
         "lights": [{"type": "directional", "direction": [0, -1, 0]}],
-        "objects": [{"type": "mesh", "file": "box.gltf", "translate": [10, 0, 0], "material": "m")" + objectExtra + "}]}";
+        "objects": [{"type": "mesh", "file": "box.gltf", "translate": [10, 0, 0], "material": "m")" +
+           objectExtra + "}]}";
 }
 
 TEST(ModelView, AMeshObjectsCameraKeyTakesTheViewFromItsFileMovedWithTheObject) {
     test::TempDir dir;
     dir.write("box.gltf", test::cameraBoxGltf());
-    const Scene s = loadScene(dir.write("a.json", jsonWithModel(R"(, "camera": "Side")", R"({"resolution": [320, 180]})")));
+    const Scene s =
+        loadScene(dir.write("a.json", jsonWithModel(R"(, "camera": "Side")", R"({"resolution": [320, 180]})")));
     expectNear(s.camera.position, {14, 0.25, 0.125});  // the node's position, translated with the object
     expectNear(glm::normalize(s.camera.lookAt - s.camera.position), {-1, 0, 0}, 1e-9);
     EXPECT_EQ(s.camera.width, 320);
@@ -258,7 +260,8 @@ TEST(ModelView, AFramedViewMovesBackJustEnoughToHoldTheModelsShadow) {
     base.width = 1280;
     base.height = 720;
     const double a = 30 * kPi / 180, e = 20 * kPi / 180;
-    const Camera framed = framedCamera(b, {std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a)}, 40.0, base);
+    const Camera framed =
+        framedCamera(b, {std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a)}, 40.0, base);
     const Camera overhead = framedWithShadow(framed, b, sunDirection(300, 90));
     EXPECT_EQ(overhead.position, framed.position);
     EXPECT_EQ(overhead.lookAt, framed.lookAt);

@@ -71,10 +71,11 @@ TEST(PlyLoader, AsciiAndBothBinaryOrdersSpellTheSameSquare) {
 }
 
 TEST(PlyLoader, NormalsAreKeptWhenTheFileHasAllThree) {
-    const std::string ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                            "property float z\nproperty float nx\nproperty float ny\nproperty float nz\n"
-                            "element face 1\nproperty list uchar uint vertex_index\nend_header\n"
-                            "0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0.6 0.8\n3 2 1 0\n";
+    const std::string ply =
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nproperty float nx\nproperty float ny\nproperty float nz\n"
+        "element face 1\nproperty list uchar uint vertex_index\nend_header\n"
+        "0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0.6 0.8\n3 2 1 0\n";
     TriangleMesh m;
     loadPly(ply, m);
     ASSERT_EQ(m.normals.size(), 3u);
@@ -83,8 +84,9 @@ TEST(PlyLoader, NormalsAreKeptWhenTheFileHasAllThree) {
 }
 
 TEST(PlyLoader, BadFilesNameTheirProblem) {
-    const std::string head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                             "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    const std::string head =
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
     struct Case {
         std::string bytes, what;
     };

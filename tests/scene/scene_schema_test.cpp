@@ -47,8 +47,8 @@ TEST(SchemaValidator, TypesRequiredAndClosedObjects) {
     EXPECT_FALSE(validates(v, Json::parse(R"({"a": 2.5})")));
     EXPECT_FALSE(validates(v, Json::parse(R"({"a": 0})")));
     EXPECT_FALSE(validates(v, Json::parse(R"({"a": 4})")));
-    EXPECT_FALSE(validates(v, Json::parse(R"({"b": "x"})")));          // a missing
-    EXPECT_FALSE(validates(v, Json::parse(R"({"a": 1, "c": 1})")));    // c not allowed
+    EXPECT_FALSE(validates(v, Json::parse(R"({"b": "x"})")));        // a missing
+    EXPECT_FALSE(validates(v, Json::parse(R"({"a": 1, "c": 1})")));  // c not allowed
     EXPECT_FALSE(validates(v, Json::parse(R"({"a": 1, "b": 3})")));
     EXPECT_FALSE(validates(v, Json::parse(R"([1])")));
     const auto errors = v.validate(Json::parse(R"({"a": 1, "c": 1})"));
@@ -62,10 +62,11 @@ TEST(SchemaValidator, ExclusiveBoundsArraysEnumsConstAndStrings) {
         "v": {"type": "array", "items": {"type": "number"}, "minItems": 3, "maxItems": 3},
         "e": {"enum": ["p", "q"]}, "c": {"const": "k"}, "s": {"type": "string", "minLength": 1},
         "m": {"type": "object", "minProperties": 1, "additionalProperties": {"type": "boolean"}}}})"));
-    EXPECT_TRUE(validates(v, Json::parse(R"({"x": 45, "v": [1, 2, 3], "e": "q", "c": "k", "s": "a", "m": {"z": true}})")));
-    for (const char* bad : {R"({"x": 0})", R"({"x": 90})", R"({"v": [1, 2]})", R"({"v": [1, 2, 3, 4]})",
-                            R"({"v": [1, "2", 3]})", R"({"e": "r"})", R"({"c": "j"})", R"({"s": ""})",
-                            R"({"m": {}})", R"({"m": {"z": 1}})"})
+    EXPECT_TRUE(
+        validates(v, Json::parse(R"({"x": 45, "v": [1, 2, 3], "e": "q", "c": "k", "s": "a", "m": {"z": true}})")));
+    for (const char* bad :
+         {R"({"x": 0})", R"({"x": 90})", R"({"v": [1, 2]})", R"({"v": [1, 2, 3, 4]})", R"({"v": [1, "2", 3]})",
+          R"({"e": "r"})", R"({"c": "j"})", R"({"s": ""})", R"({"m": {}})", R"({"m": {"z": 1}})"})
         EXPECT_FALSE(validates(v, Json::parse(bad))) << bad;
 }
 
@@ -92,7 +93,8 @@ TEST(SchemaValidator, CombinatorsConditionalsAndReferences) {
 
 TEST(SchemaValidator, RefusesKeywordsItDoesNotImplement) {
     EXPECT_THROW(SchemaValidator(Json::parse(R"({"type": "string", "pattern": "^a"})")), std::invalid_argument);
-    EXPECT_THROW(SchemaValidator(Json::parse(R"({"properties": {"a": {"uniqueItems": true}}})")), std::invalid_argument);
+    EXPECT_THROW(SchemaValidator(Json::parse(R"({"properties": {"a": {"uniqueItems": true}}})")),
+                 std::invalid_argument);
 }
 
 // --- the scene schema ----------------------------------------------------------------------
@@ -100,7 +102,8 @@ TEST(SchemaValidator, RefusesKeywordsItDoesNotImplement) {
 std::vector<fs::path> shippedScenes() {
     std::vector<fs::path> files;
     for (const auto& e : fs::recursive_directory_iterator(fs::path(SHADOWLAB_SOURCE_DIR) / "scenes"))
-        if (e.path().extension() == ".json" && !e.path().stem().string().ends_with(".schema")) files.push_back(e.path());
+        if (e.path().extension() == ".json" && !e.path().stem().string().ends_with(".schema"))
+            files.push_back(e.path());
     std::sort(files.begin(), files.end());
     return files;
 }
@@ -203,7 +206,8 @@ TEST(SceneSchema, NamesExactlyTheKeysTheLoaderAcceptsInEachPlace) {
     EXPECT_EQ(loaderKeys(s), lightKeys);
     const std::map<std::string, Json> objects = {
         {"sphere", Json::parse(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"})")},
-        {"quad", Json::parse(R"({"type": "quad", "center": [0, 0, 0], "normal": [0, 1, 0], "size": [1, 1], "material": "m"})")},
+        {"quad",
+         Json::parse(R"({"type": "quad", "center": [0, 0, 0], "normal": [0, 1, 0], "size": [1, 1], "material": "m"})")},
         {"box", Json::parse(R"({"type": "box", "min": [0, 0, 0], "max": [1, 1, 1], "material": "m"})")},
         {"mesh", Json::parse(R"({"type": "mesh", "file": "x.obj", "material": "m"})")}};
     for (const auto& [type, object] : objects) {
@@ -219,23 +223,44 @@ TEST(SceneSchema, RejectsWhatTheLoaderRejects) {
     const std::vector<std::pair<std::string, std::function<void(Json&)>>> edits = {
         {"negative radius", [](Json& s) { s["objects"][0]["radius"] = -1; }},
         {"fov 180", [](Json& s) { s["camera"]["fov_y"] = 180; }},
-        {"resolution 0", [](Json& s) { s["camera"]["resolution"] = {0, 10}; }},
-        {"albedo above 1", [](Json& s) { s["materials"]["m"]["albedo"] = {1.5, 0, 0}; }},
+        {"resolution 0",
+         [](Json& s) {
+             s["camera"]["resolution"] = {0, 10};
+         }},
+        {"albedo above 1",
+         [](Json& s) {
+             s["materials"]["m"]["albedo"] = {1.5, 0, 0};
+         }},
         {"opacity above 1", [](Json& s) { s["materials"]["m"]["opacity"] = 2; }},
         {"no lights", [](Json& s) { s["lights"] = Json::array(); }},
         {"directional without direction", [](Json& s) { s["lights"][0].erase("direction"); }},
-        {"directional with a position", [](Json& s) { s["lights"][0]["position"] = {0, 1, 0}; }},
-        {"spot cone 90", [](Json& s) {
-             s["lights"][0] = Json::parse(R"({"type": "spot", "position": [0, 3, 0], "direction": [0, -1, 0], "cone_angle": 90})");
+        {"directional with a position",
+         [](Json& s) {
+             s["lights"][0]["position"] = {0, 1, 0};
          }},
-        {"point with a cone", [](Json& s) {
+        {"spot cone 90",
+         [](Json& s) {
+             s["lights"][0] =
+                 Json::parse(R"({"type": "spot", "position": [0, 3, 0], "direction": [0, -1, 0], "cone_angle": 90})");
+         }},
+        {"point with a cone",
+         [](Json& s) {
              s["lights"][0] = Json::parse(R"({"type": "point", "position": [0, 3, 0], "cone_angle": 30})");
          }},
         {"unknown light type", [](Json& s) { s["lights"][0]["type"] = "area"; }},
         {"unknown object type", [](Json& s) { s["objects"][0]["type"] = "torus"; }},
-        {"filter name", [](Json& s) { s["shadow"] = {{"filter", "pcf4"}}; }},
-        {"cascades 5", [](Json& s) { s["shadow"] = {{"cascades", 5}}; }},
-        {"ray bias word", [](Json& s) { s["shadow"] = {{"ray_bias", "tiny"}}; }},
+        {"filter name",
+         [](Json& s) {
+             s["shadow"] = {{"filter", "pcf4"}};
+         }},
+        {"cascades 5",
+         [](Json& s) {
+             s["shadow"] = {{"cascades", 5}};
+         }},
+        {"ray bias word",
+         [](Json& s) {
+             s["shadow"] = {{"ray_bias", "tiny"}};
+         }},
         {"ground not a boolean", [](Json& s) { s["ground"] = "yes"; }},
     };
     ASSERT_TRUE(validates(sceneSchema(), minimalScene()));

@@ -131,29 +131,74 @@ TEST(Settings, BadValuesNameTheOption) {
         }
     };
     SettingsOverrides o;
-    o.shadowMapSize = -4; expectError(o, "--shadow-map-size"); o = {};
-    o.shadowMapSize = 1 << 20; expectError(o, "--shadow-map-size"); o = {};
-    o.rayBias = "tiny"; expectError(o, "--ray-bias"); o = {};
-    o.rayBias = "-1"; expectError(o, "--ray-bias"); o = {};
-    o.rayBias = "1e-3x"; expectError(o, "--ray-bias"); o = {};
-    o.filter = "gauss"; expectError(o, "--filter"); o = {};
-    o.precision = "half"; expectError(o, "--precision"); o = {};
-    o.depthBias = -1.0; expectError(o, "--depth-bias"); o = {};
-    o.samples = 0; expectError(o, "--samples"); o = {};
-    o.threads = -2; expectError(o, "--threads"); o = {};
-    o.cascades = 0; expectError(o, "--cascades"); o = {};
-    o.cascades = kMaxCascades + 1; expectError(o, "--cascades"); o = {};
-    o.cascadeBlend = -0.01; expectError(o, "--cascade-blend"); o = {};
-    o.cascadeBlend = 0.51; expectError(o, "--cascade-blend"); o = {};
-    o.cascadeBlend = std::nan(""); expectError(o, "--cascade-blend"); o = {};
-    o.minVariance = -1e-9; expectError(o, "--min-variance"); o = {};
-    o.bleedReduction = 1.0; expectError(o, "--bleeding-reduction"); o = {};
-    o.evsmPositive = kMaxEvsmExponent + 1; expectError(o, "--evsm-positive"); o = {};
-    o.evsmNegative = std::nan(""); expectError(o, "--evsm-negative"); o = {};
-    o.esmExponent = kMaxEsmExponent + 1; expectError(o, "--esm-exponent"); o = {};
-    o.momentBias = -0.1; expectError(o, "--moment-bias"); o = {};
-    o.blurWidth = 6; expectError(o, "--blur-width"); o = {};
-    o.blurWidth = kMaxBlurWidth + 2; expectError(o, "--blur-width");
+    o.shadowMapSize = -4;
+    expectError(o, "--shadow-map-size");
+    o = {};
+    o.shadowMapSize = 1 << 20;
+    expectError(o, "--shadow-map-size");
+    o = {};
+    o.rayBias = "tiny";
+    expectError(o, "--ray-bias");
+    o = {};
+    o.rayBias = "-1";
+    expectError(o, "--ray-bias");
+    o = {};
+    o.rayBias = "1e-3x";
+    expectError(o, "--ray-bias");
+    o = {};
+    o.filter = "gauss";
+    expectError(o, "--filter");
+    o = {};
+    o.precision = "half";
+    expectError(o, "--precision");
+    o = {};
+    o.depthBias = -1.0;
+    expectError(o, "--depth-bias");
+    o = {};
+    o.samples = 0;
+    expectError(o, "--samples");
+    o = {};
+    o.threads = -2;
+    expectError(o, "--threads");
+    o = {};
+    o.cascades = 0;
+    expectError(o, "--cascades");
+    o = {};
+    o.cascades = kMaxCascades + 1;
+    expectError(o, "--cascades");
+    o = {};
+    o.cascadeBlend = -0.01;
+    expectError(o, "--cascade-blend");
+    o = {};
+    o.cascadeBlend = 0.51;
+    expectError(o, "--cascade-blend");
+    o = {};
+    o.cascadeBlend = std::nan("");
+    expectError(o, "--cascade-blend");
+    o = {};
+    o.minVariance = -1e-9;
+    expectError(o, "--min-variance");
+    o = {};
+    o.bleedReduction = 1.0;
+    expectError(o, "--bleeding-reduction");
+    o = {};
+    o.evsmPositive = kMaxEvsmExponent + 1;
+    expectError(o, "--evsm-positive");
+    o = {};
+    o.evsmNegative = std::nan("");
+    expectError(o, "--evsm-negative");
+    o = {};
+    o.esmExponent = kMaxEsmExponent + 1;
+    expectError(o, "--esm-exponent");
+    o = {};
+    o.momentBias = -0.1;
+    expectError(o, "--moment-bias");
+    o = {};
+    o.blurWidth = 6;
+    expectError(o, "--blur-width");
+    o = {};
+    o.blurWidth = kMaxBlurWidth + 2;
+    expectError(o, "--blur-width");
 }
 
 TEST(Settings, FilterableMapParametersComeFromTheCommandLineThenTheSceneThenTheDefaults) {
@@ -167,8 +212,8 @@ TEST(Settings, FilterableMapParametersComeFromTheCommandLineThenTheSceneThenTheD
     EXPECT_EQ(r.filter, ShadowFilter::Evsm4);
     EXPECT_TRUE(isFilterable(r.filter));
     EXPECT_FALSE(isFilterable(ShadowFilter::Pcss));
-    EXPECT_EQ(r.moments.evsmPositive, 30.0);  // the scene's
-    EXPECT_EQ(r.moments.blurWidth, 3);        // the command line's
+    EXPECT_EQ(r.moments.evsmPositive, 30.0);                           // the scene's
+    EXPECT_EQ(r.moments.blurWidth, 3);                                 // the command line's
     EXPECT_EQ(r.moments.evsmNegative, MomentSettings{}.evsmNegative);  // the default
     for (const char* name : {"vsm", "evsm2", "evsm4", "esm", "msm"}) {
         o.filter = name;

@@ -57,7 +57,10 @@ TEST(AnalyticTest, UnitSphereUnderVerticalLightShadowsTheUnitDisk) {
     for (int y = 0; y < a->height; ++y)
         for (int x = 0; x < a->width; ++x) {
             const std::size_t i = std::size_t(y) * a->width + x;
-            if (a->knifeEdge[i]) { ++knife; continue; }
+            if (a->knifeEdge[i]) {
+                ++knife;
+                continue;
+            }
             if (a->objectId[i] != 1) continue;
             const Vec3 p = groundPoint(s, x, y);
             const bool inDisk = p.x * p.x + p.z * p.z < 1.0;
@@ -85,7 +88,10 @@ TEST(AnalyticTest, SpherePixelsAreTheSphereAndLitOnTheUpperHalf) {
             const Vec3 d = glm::normalize(scene::pixelDirection(cam, x, y));
             const Vec3 oc = cam.position - Vec3(0, 1, 0);
             const double b = glm::dot(oc, d), disc = b * b - (glm::dot(oc, oc) - 1.0);
-            if (disc < 0) { EXPECT_NE(a->objectId[i], 2); continue; }
+            if (disc < 0) {
+                EXPECT_NE(a->objectId[i], 2);
+                continue;
+            }
             EXPECT_EQ(a->objectId[i], 2);
             ++spherePixels;
             const Vec3 p = cam.position + (-b - std::sqrt(disc)) * d;
@@ -170,9 +176,15 @@ TEST(AnalyticTest, CheckCountsMismatchesOutsideKnifeEdges) {
     // Flip one judged lit pixel's visibility and another judged pixel's id.
     std::size_t flipV = 0, flipId = 0;
     for (std::size_t i = 0; i < a->pixelCount(); ++i)
-        if (!a->knifeEdge[i] && a->lit[i]) { flipV = i; break; }
+        if (!a->knifeEdge[i] && a->lit[i]) {
+            flipV = i;
+            break;
+        }
     for (std::size_t i = a->pixelCount(); i-- > 0;)
-        if (!a->knifeEdge[i] && i != flipV) { flipId = i; break; }
+        if (!a->knifeEdge[i] && i != flipV) {
+            flipId = i;
+            break;
+        }
     f.visibility[flipV] = 1.0f - f.visibility[flipV];
     f.objectId[flipId] += 1.0f;
     const AnalyticCheck c = checkAgainstAnalytic(f, *a);

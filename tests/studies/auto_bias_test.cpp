@@ -29,24 +29,24 @@ constexpr double kBad = 0.02;     // a rate well over it
 // A depth series at 0, ¼, 1, 4, 16, 64 texels (defaultGrid's quick series) where 1..16 texels
 // are clean: acne below, leaks above.
 std::vector<SweepRow> depthSeriesWithWindow() {
-    return {depthRow(0, 0.3, 0), depthRow(0.25 * kTexel, kBad, 0), depthRow(1 * kTexel, kOk, 0),
-            depthRow(4 * kTexel, 0, 0), depthRow(16 * kTexel, 0, kOk), depthRow(64 * kTexel, 0, kBad)};
+    return {depthRow(0, 0.3, 0),        depthRow(0.25 * kTexel, kBad, 0), depthRow(1 * kTexel, kOk, 0),
+            depthRow(4 * kTexel, 0, 0), depthRow(16 * kTexel, 0, kOk),    depthRow(64 * kTexel, 0, kBad)};
 }
 
 TEST(IsLogSpaced, TellsGeometricFromArithmeticSeries) {
-    EXPECT_TRUE(isLogSpaced({0, 0.25, 1, 4, 16, 64}));        // ratio 4, zero ignored
+    EXPECT_TRUE(isLogSpaced({0, 0.25, 1, 4, 16, 64}));  // ratio 4, zero ignored
     EXPECT_TRUE(isLogSpaced({1e-8, 1e-6, 1e-4, 1e-2}));
-    EXPECT_FALSE(isLogSpaced({0, 1, 2, 3, 4, 5}));            // step 1
+    EXPECT_FALSE(isLogSpaced({0, 1, 2, 3, 4, 5}));  // step 1
     EXPECT_FALSE(isLogSpaced({0.1, 0.2, 0.3, 0.4}));
-    EXPECT_TRUE(isLogSpaced({0.001, 0.01}));                   // two values a decade apart
+    EXPECT_TRUE(isLogSpaced({0.001, 0.01}));  // two values a decade apart
     EXPECT_FALSE(isLogSpaced({0.001, 0.002}));
-    EXPECT_FALSE(isLogSpaced({0, 0.5}));                       // one positive value
+    EXPECT_FALSE(isLogSpaced({0, 0.5}));  // one positive value
 }
 
 TEST(WindowMiddle, GeometricForLogSpacedPositiveWindowsElseArithmetic) {
-    EXPECT_DOUBLE_EQ(windowMiddle(1e-4, 1e-2, true), 1e-3);   // sqrt(1e-4 · 1e-2)
+    EXPECT_DOUBLE_EQ(windowMiddle(1e-4, 1e-2, true), 1e-3);  // sqrt(1e-4 · 1e-2)
     EXPECT_DOUBLE_EQ(windowMiddle(1e-4, 1e-2, false), 0.00505);
-    EXPECT_DOUBLE_EQ(windowMiddle(0.0, 1e-2, true), 0.005);   // lo = 0: no geometric middle
+    EXPECT_DOUBLE_EQ(windowMiddle(0.0, 1e-2, true), 0.005);  // lo = 0: no geometric middle
 }
 
 TEST(AutoBias, RecommendsTheGeometricMiddleOfALogSpacedWindow) {
@@ -83,8 +83,8 @@ TEST(AutoBias, RecommendsTheArithmeticMiddleOfAnEvenlySpacedWindow) {
 
 TEST(AutoBias, AWindowStartingAtZeroUsesTheArithmeticMiddle) {
     // Ray bias 0, 1e-6 .. 1e-3 (log-spaced), clean from 0 to 1e-4: (0 + 1e-4) / 2.
-    const AutoBias a = recommendBias({rayRow(0, 0, 0), rayRow(1e-6, 0, 0), rayRow(1e-5, 0, 0), rayRow(1e-4, 0, kOk),
-                                      rayRow(1e-3, 0, kBad)});
+    const AutoBias a = recommendBias(
+        {rayRow(0, 0, 0), rayRow(1e-6, 0, 0), rayRow(1e-5, 0, 0), rayRow(1e-4, 0, kOk), rayRow(1e-3, 0, kBad)});
     const BiasSeries* r = a.primary("ray");
     ASSERT_NE(r, nullptr);
     EXPECT_TRUE(r->logSpaced);
@@ -126,14 +126,14 @@ TEST(AutoBias, PrefersTheRasterBiasKindWithTheWiderWindow) {
     // Depth: one clean sample; slope: three. The slope bias wins, the depth bias stays at 0
     // as it was when the slope series was measured.
     std::vector<SweepRow> rows = {depthRow(0, kBad, 0), depthRow(kTexel, 0, 0), depthRow(4 * kTexel, 0, kBad),
-                                  slopeRow(0, kBad, 0), slopeRow(0.5, 0, 0), slopeRow(2, 0, 0),
+                                  slopeRow(0, kBad, 0), slopeRow(0.5, 0, 0),    slopeRow(2, 0, 0),
                                   slopeRow(8, 0, 0),    slopeRow(32, 0, kBad)};
     const AutoBias a = recommendBias(rows);
     EXPECT_DOUBLE_EQ(a.shadowBlock.at("slope_bias").get<double>(), 2.0);  // sqrt(0.5 · 8)
     EXPECT_EQ(a.shadowBlock.at("depth_bias").get<double>(), 0.0);
     // Reversed: depth has the wider window.
-    rows = {depthRow(0, kBad, 0),  depthRow(kTexel, 0, 0), depthRow(4 * kTexel, 0, 0), depthRow(16 * kTexel, 0, kBad),
-            slopeRow(0, kBad, 0), slopeRow(2, 0, 0),       slopeRow(8, 0, kBad)};
+    rows = {depthRow(0, kBad, 0), depthRow(kTexel, 0, 0), depthRow(4 * kTexel, 0, 0), depthRow(16 * kTexel, 0, kBad),
+            slopeRow(0, kBad, 0), slopeRow(2, 0, 0),      slopeRow(8, 0, kBad)};
     const AutoBias b = recommendBias(rows);
     EXPECT_DOUBLE_EQ(b.shadowBlock.at("depth_bias").get<double>(), 2 * kTexel);  // sqrt(1 · 4) texels
     EXPECT_EQ(b.shadowBlock.at("slope_bias").get<double>(), 0.0);
@@ -211,8 +211,14 @@ TEST(AutoBias, TheShadowBlockIsAcceptedByTheSceneLoader) {
     rows.push_back(robustRow("double", 0, 0));
     const AutoBias a = recommendBias(rows);
     const nlohmann::json scene = {
-        {"camera", {{"position", {0, 2, 6}}, {"look_at", {0, 0.7, 0}}, {"up", {0, 1, 0}}, {"fov_y", 40},
-                    {"resolution", {64, 36}}, {"near", 0.1}, {"far", 100}}},
+        {"camera",
+         {{"position", {0, 2, 6}},
+          {"look_at", {0, 0.7, 0}},
+          {"up", {0, 1, 0}},
+          {"fov_y", 40},
+          {"resolution", {64, 36}},
+          {"near", 0.1},
+          {"far", 100}}},
         {"materials", {{"matte", {{"albedo", {0.8, 0.8, 0.8}}}}}},
         {"lights", {{{"type", "directional"}, {"direction", {-1, -2, -1}}, {"color", {1, 1, 1}}, {"intensity", 3}}}},
         {"objects", {{{"type", "sphere"}, {"center", {0, 1, 0}}, {"radius", 1}, {"material", "matte"}}}},
@@ -235,7 +241,7 @@ std::vector<SweepRow> minVarianceSeries() {
     using test::momentRow;
     return {momentRow("vsm", "min_variance", 1e-7, kBad, 0), momentRow("vsm", "min_variance", 1e-6, kOk, 0),
             momentRow("vsm", "min_variance", 1e-5, 0, 0),    momentRow("vsm", "min_variance", 1e-4, 0, 0),
-            momentRow("vsm", "min_variance", 1e-3, 0, kOk), momentRow("vsm", "min_variance", 1e-2, 0, kBad)};
+            momentRow("vsm", "min_variance", 1e-3, 0, kOk),  momentRow("vsm", "min_variance", 1e-2, 0, kBad)};
 }
 
 TEST(AutoBias, AFilterableMapsParameterSeriesHasItsOwnWindow) {
@@ -251,12 +257,15 @@ TEST(AutoBias, AFilterableMapsParameterSeriesHasItsOwnWindow) {
     EXPECT_DOUBLE_EQ(m->recommended, 3.16e-5);
     EXPECT_EQ(m->name(), "min variance");
     const std::string d = m->describe();
-    EXPECT_NE(d.find("min variance (normalized depth squared; filter vsm, map 1024): parameter window"), std::string::npos) << d;
+    EXPECT_NE(d.find("min variance (normalized depth squared; filter vsm, map 1024): parameter window"),
+              std::string::npos)
+        << d;
     // No depth or slope series chose the block's filter: the parameter is not put in it, and a
     // sentence says with which filter it goes.
     EXPECT_FALSE(a.shadowBlock.contains("min_variance"));
     bool said = false;
-    for (const std::string& n : a.notes) said = said || (n.find("\"min_variance\"") != std::string::npos && n.find("vsm") != std::string::npos);
+    for (const std::string& n : a.notes)
+        said = said || (n.find("\"min_variance\"") != std::string::npos && n.find("vsm") != std::string::npos);
     EXPECT_TRUE(said);
 }
 
@@ -288,8 +297,14 @@ TEST(AutoBias, TheBlockCarriesTheParameterWhenItsSeriesRanWithTheBlocksFilter) {
     EXPECT_EQ(a.shadowBlock.at("filter").get<std::string>(), "vsm");
     EXPECT_DOUBLE_EQ(a.shadowBlock.at("min_variance").get<double>(), 3.16e-5);
     const nlohmann::json scene = {
-        {"camera", {{"position", {0, 2, 6}}, {"look_at", {0, 0.7, 0}}, {"up", {0, 1, 0}}, {"fov_y", 40},
-                    {"resolution", {64, 36}}, {"near", 0.1}, {"far", 100}}},
+        {"camera",
+         {{"position", {0, 2, 6}},
+          {"look_at", {0, 0.7, 0}},
+          {"up", {0, 1, 0}},
+          {"fov_y", 40},
+          {"resolution", {64, 36}},
+          {"near", 0.1},
+          {"far", 100}}},
         {"materials", {{"matte", {{"albedo", {0.8, 0.8, 0.8}}}}}},
         {"lights", {{{"type", "directional"}, {"direction", {-1, -2, -1}}, {"color", {1, 1, 1}}, {"intensity", 3}}}},
         {"objects", {{{"type", "sphere"}, {"center", {0, 1, 0}}, {"radius", 1}, {"material", "matte"}}}},

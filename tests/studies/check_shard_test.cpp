@@ -76,11 +76,25 @@ TEST(CheckShard, TheSplitDoesNotDependOnTheFileOrder) {
 }
 
 TEST(CheckSummaryHtml, OneRowPerCaseWithItsVerdictReasonsAndOnlyTheNamedDifferenceImages) {
-    CasePart pass{"a.pass", CaseVerdict::Passed, 0.1, "", "| a.pass | seed | raster | passed | 0% | 0% | 0% | 0% | 1.000 | 0.0000 | within tolerance | 100 ms |\n", ""};
-    CasePart fail{"b<fail>", CaseVerdict::Failed, 0.2, "",
-                  "| b<fail> | seed | raytrace | **FAILED** | 6.7% | 6.7% | 0% | 6.7% | 0.279 | 0.0673 | no baseline | 0.3 ms |\n",
+    CasePart pass{
+        "a.pass",
+        CaseVerdict::Passed,
+        0.1,
+        "",
+        "| a.pass | seed | raster | passed | 0% | 0% | 0% | 0% | 1.000 | 0.0000 | within tolerance | 100 ms |\n",
+        ""};
+    CasePart fail{"b<fail>",
+                  CaseVerdict::Failed,
+                  0.2,
+                  "",
+                  "| b<fail> | seed | raytrace | **FAILED** | 6.7% | 6.7% | 0% | 6.7% | 0.279 | 0.0673 | no baseline | "
+                  "0.3 ms |\n",
                   "- `b<fail>`: budget --max-false-shadow: 6.7% > limit 0px: BROKEN (cases/b<fail>-diff.png)\n"};
-    CasePart error{"c.error", CaseVerdict::Error, 0.0, "", "| c.error | seed | raster | **ERROR** | | | | | | | no device | |\n",
+    CasePart error{"c.error",
+                   CaseVerdict::Error,
+                   0.0,
+                   "",
+                   "| c.error | seed | raster | **ERROR** | | | | | | | no device | |\n",
                    "- `c.error`: error: no device\n"};
     const std::string h = htmlSummary("t", {pass, fail, error}, false, {"b<fail>"});
     auto count = [&](const std::string& what) {

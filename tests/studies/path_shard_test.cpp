@@ -12,12 +12,12 @@
 
 #include <gtest/gtest.h>
 
-#include "studies/path.h"
-#include "studies/sweep.h"
 #include "raster/light_frustum.h"
 #include "scene/camera.h"
 #include "scene/error.h"
 #include "scene/loader.h"
+#include "studies/path.h"
+#include "studies/sweep.h"
 #include "tests/kit/render_checked.h"
 #include "tests/kit/test_scenes.h"
 #include "tests/scene/animated_gltf.h"
@@ -73,8 +73,11 @@ Json measured(const PathResult& r) {
         }
         methods.push_back({{"name", m.name}, {"temporal", toJson(m.temporal)}, {"frames", frames}});
     }
-    return {{"kind", toString(r.spec.kind)}, {"frames", r.frames}, {"amount", r.amount},
-            {"reference", toJson(r.referenceTemporal)}, {"methods", methods}};
+    return {{"kind", toString(r.spec.kind)},
+            {"frames", r.frames},
+            {"amount", r.amount},
+            {"reference", toJson(r.referenceTemporal)},
+            {"methods", methods}};
 }
 
 TEST(PathShards, EveryFrameIsInExactlyOneShardForOneToEightShards) {
@@ -171,7 +174,8 @@ TEST(PathShards, AShardOfAnotherPathIsRefusedAndAMissingOrUnfinishedShardIsNamed
     const TempFolder foreign("path-foreign");
     runPath(base, settings, other, shardOptions(foreign.path, 1, 3));
     try {
-        mergePathShards({dir.path / "shard-0-of-3", dir.path / "shard-2-of-3", foreign.path / "shard-1-of-3"}, dir.path);
+        mergePathShards({dir.path / "shard-0-of-3", dir.path / "shard-2-of-3", foreign.path / "shard-1-of-3"},
+                        dir.path);
         FAIL() << "merged a shard of another path";
     } catch (const scene::InputError& e) {
         EXPECT_NE(std::string(e.what()).find("another path"), std::string::npos) << e.what();
@@ -221,7 +225,8 @@ TEST(ScenePathBlock, BecomesThePathSpecWithTheKindsDefaultsForWhatItLeavesOut) {
     EXPECT_FALSE(s.amount.has_value());
     EXPECT_EQ(s.light, 0);
     // Every kind the loader accepts is one compare knows (the names are the same list).
-    for (const char* k : {"orbit", "dolly", "pan", "subtexel", "sun-azimuth", "sun-elevation", "light-move", "gltf-animation"})
+    for (const char* k :
+         {"orbit", "dolly", "pan", "subtexel", "sun-azimuth", "sun-elevation", "light-move", "gltf-animation"})
         EXPECT_STREQ(toString(parsePathKind(k)), k);
 }
 
@@ -252,7 +257,8 @@ TEST(SweepFlickerAxis, SnappedFittedMapsHoldStillInTheHeldViewWhereUnsnappedOnes
             raster::fitDirectionalLightToReceivers(frames[0], frames[0].lights[0].direction, kMap, true);
         bool still = true;
         for (const scene::Scene& f : frames) {
-            const raster::LightFrustum fi = raster::fitDirectionalLightToReceivers(f, f.lights[0].direction, kMap, true);
+            const raster::LightFrustum fi =
+                raster::fitDirectionalLightToReceivers(f, f.lights[0].direction, kMap, true);
             still = still && fi.center == f0.center && fi.halfWidth == f0.halfWidth && fi.nearDepth == f0.nearDepth &&
                     fi.farDepth == f0.farDepth;
         }
@@ -285,11 +291,12 @@ TEST(SweepFlickerAxis, SnappedFittedMapsHoldStillInTheHeldViewWhereUnsnappedOnes
     for (const SweepRow& r : result.rows) ASSERT_TRUE(r.error.empty()) << r.error;
     const SweepRow& snapped = result.rows[0];
     const SweepRow& unsnapped = result.rows[1];
-    std::printf("flicker axis, held view: snapped %g px, unsnapped %g px (swim %g px); moving view %g / %g px; "
-                "raytrace %g px\n",
-                snapped.temporalValue("flicker_px", true), unsnapped.temporalValue("flicker_px", true),
-                unsnapped.temporalValue("swim_px", true), snapped.temporalValue("flicker_px"),
-                unsnapped.temporalValue("flicker_px"), result.rows[2].temporalValue("flicker_px"));
+    std::printf(
+        "flicker axis, held view: snapped %g px, unsnapped %g px (swim %g px); moving view %g / %g px; "
+        "raytrace %g px\n",
+        snapped.temporalValue("flicker_px", true), unsnapped.temporalValue("flicker_px", true),
+        unsnapped.temporalValue("swim_px", true), snapped.temporalValue("flicker_px"),
+        unsnapped.temporalValue("flicker_px"), result.rows[2].temporalValue("flicker_px"));
     EXPECT_EQ(snapped.temporalValue("flicker_px", true), 0.0);
     EXPECT_EQ(snapped.temporalValue("error_variation", true), 0.0);
     EXPECT_EQ(snapped.temporalValue("swim_px", true), 0.0);

@@ -13,12 +13,12 @@
 #include <gtest/gtest.h>
 
 #include "compare/compare.h"
-#include "studies/path.h"
 #include "compare/temporal.h"
 #include "raster/light_frustum.h"
 #include "raster/renderer.h"
 #include "raytrace/renderer.h"
 #include "scene/error.h"
+#include "studies/path.h"
 #include "tests/kit/render_checked.h"
 #include "tests/kit/test_scenes.h"
 
@@ -26,8 +26,8 @@ namespace shadowlab::studies {
 namespace {
 
 namespace fs = std::filesystem;
-using shadowlab::test::SphereOverPlane;
 using scene::Vec3;
+using shadowlab::test::SphereOverPlane;
 
 scene::RenderSettings settingsFor(const scene::Scene& s, int mapSize) {
     scene::RenderSettings settings = scene::resolveSettings(s, {});
@@ -82,7 +82,8 @@ void expectSameImage(const scene::Frame& moved, const scene::Frame& fresh, float
         if (fresh.objectId[i] == 0) continue;
         ++both;
         agree += std::abs(moved.visibility[i] - fresh.visibility[i]) <= 0.5f;
-        if (fresh.objectId[i] == planeId) depthErrors.push_back(std::abs(double(moved.depth[i]) - fresh.depth[i]) / fresh.depth[i]);
+        if (fresh.objectId[i] == planeId)
+            depthErrors.push_back(std::abs(double(moved.depth[i]) - fresh.depth[i]) / fresh.depth[i]);
     }
     EXPECT_GE(double(sameId), 0.998 * double(moved.pixelCount()));
     EXPECT_GE(double(agree), 0.998 * double(both));
@@ -199,7 +200,9 @@ double startInsideOneSnapStep(const scene::RenderSettings& settings) {
         const raster::LightFrustum f0 =
             raster::fitDirectionalLightToReceivers(scenes[0], scenes[0].lights[0].direction, kHeldMapSize, true);
         for (const scene::Scene& s : scenes)
-            still = still && sameFrustum(raster::fitDirectionalLightToReceivers(s, s.lights[0].direction, kHeldMapSize, true), f0);
+            still =
+                still &&
+                sameFrustum(raster::fitDirectionalLightToReceivers(s, s.lights[0].direction, kHeldMapSize, true), f0);
         if (still) return 0.05 * k * texel;
     }
     ADD_FAILURE() << "no start within two texels keeps the snapped frustum over the path";
@@ -245,10 +248,11 @@ TEST(PathStability, SnappedFittedMapsHoldStillUnderSubTexelMovesWhereUnsnappedOn
     for (std::size_t t = 1; t < unsnapped.frusta.size(); ++t)
         EXPECT_NE(unsnapped.frusta[t].center, unsnapped.frusta[t - 1].center) << "frame " << t;
     EXPECT_NE(unsnapped.maps.back(), unsnapped.maps[0]);
-    std::printf("held view, 5 sub-texel steps: snapped flicker %zu px; unsnapped %zu px (mean rate %.4f%%), "
-                "swim %.4f px, error variation %.2e\n",
-                snapped.temporal.totalFlicker, unsnapped.temporal.totalFlicker, 100 * unsnapped.temporal.meanFlickerRate,
-                unsnapped.temporal.meanSwimPixels, unsnapped.temporal.meanErrorVariation);
+    std::printf(
+        "held view, 5 sub-texel steps: snapped flicker %zu px; unsnapped %zu px (mean rate %.4f%%), "
+        "swim %.4f px, error variation %.2e\n",
+        snapped.temporal.totalFlicker, unsnapped.temporal.totalFlicker, 100 * unsnapped.temporal.meanFlickerRate,
+        unsnapped.temporal.meanSwimPixels, unsnapped.temporal.meanErrorVariation);
     EXPECT_GT(unsnapped.temporal.totalFlicker, 0u);
     EXPECT_GT(unsnapped.temporal.meanSwimPixels, 0.0);
     EXPECT_GT(unsnapped.temporal.meanErrorVariation, 0.0);
@@ -269,7 +273,9 @@ Seam seamFlicker(const scene::Frame& m0, const scene::Frame& m1, const scene::Fr
     std::stringstream in(m0.attributes.at("cascade_splits"));
     for (std::string item; std::getline(in, item, ';');) splits.push_back(std::stod(item));
     Seam seam;
-    const auto counted = [](compare::PixelClass c) { return c != compare::PixelClass::NotCounted && c != compare::PixelClass::Invalid; };
+    const auto counted = [](compare::PixelClass c) {
+        return c != compare::PixelClass::NotCounted && c != compare::PixelClass::Invalid;
+    };
     for (std::size_t i = 0; i < mask.size(); ++i) {
         if (!counted(c0.classes[i]) || !counted(c1.classes[i])) continue;
         for (std::size_t k = 1; k + 1 < splits.size(); ++k)
@@ -309,8 +315,10 @@ TEST(PathStability, CascadeSeamFlickerUnderADollyWithAndWithoutBlending) {
         raster::Renderer r(scenes[0], scene::makeRenderPlan(scenes[0], b), b.raster);
         std::vector<scene::Frame> frames;
         for (const scene::Scene& s : scenes) {
-            if (held) r.update(s, scenes[0].camera);
-            else r.update(s);
+            if (held)
+                r.update(s, scenes[0].camera);
+            else
+                r.update(s);
             frames.push_back(r.render());
         }
         const std::vector<scene::Frame> refs = held ? std::vector<scene::Frame>(scenes.size(), moving[0]) : moving;
@@ -322,10 +330,11 @@ TEST(PathStability, CascadeSeamFlickerUnderADollyWithAndWithoutBlending) {
             seam.variation += s.variation;
         }
         const compare::TemporalSummary all = compare::measureTemporal(pointers(frames), pointers(refs));
-        std::printf("dolly, 3 cascades, %s view, blend %.2f: seam flicker %zu px, seam error variation %.3f; all flicker %zu "
-                    "px (mean rate %.3f%%), swim %.3f px\n",
-                    held ? "held" : "moving", blend, seam.flicker, seam.variation, all.totalFlicker, 100 * all.meanFlickerRate,
-                    all.meanSwimPixels);
+        std::printf(
+            "dolly, 3 cascades, %s view, blend %.2f: seam flicker %zu px, seam error variation %.3f; all flicker %zu "
+            "px (mean rate %.3f%%), swim %.3f px\n",
+            held ? "held" : "moving", blend, seam.flicker, seam.variation, all.totalFlicker, 100 * all.meanFlickerRate,
+            all.meanSwimPixels);
         return seam;
     };
     const Seam hard = run(0.0, true), blended = run(band, true);

@@ -46,7 +46,9 @@ scene::Frame row(int width, int wrong) {
 }
 
 // The fake's error: 10 pixels per octave away from (depth*, slope*), 200 when a bias is 0.
-int octaves(double v, double target) { return v > 0.0 ? int(std::lround(10.0 * std::fabs(std::log2(v / target)))) : 200; }
+int octaves(double v, double target) {
+    return v > 0.0 ? int(std::lround(10.0 * std::fabs(std::log2(v / target)))) : 200;
+}
 
 struct Fake {
     double depthTarget = 0.0, slopeTarget = 2.0;
@@ -82,7 +84,9 @@ TEST(Recommend, RefinementFindsTheOptimumBetweenCoarsePointsAndTheBlockHoldsIt) 
     // coarse best is (b0, 1) or (4b0, 4) at 20 px; its geometric midpoints reach (2b0, 2): 0 px.
     fake->depthTarget = 2.0 * b0;
     RecommendOptions o;
-    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) { return (*fake)(sc, st, b); };
+    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) {
+        return (*fake)(sc, st, b);
+    };
     const scene::Frame ref = row(1000, 0);
     const Recommendation r = recommendShadow(s, ref, s, ref, nullptr, nullptr, Json{{"ray_bias", "robust"}}, o);
     ASSERT_GE(r.best, 0);
@@ -119,10 +123,12 @@ TEST(Recommend, KeepsTheDefaultsWhenNothingSearchedBeatsThem) {
     const scene::Scene s = fakeScene(1000);
     const double b0 = scene::resolveSettings(s, {}).raster.depthBias;
     auto fake = std::make_shared<Fake>();
-    fake->depthTarget = b0;   // the defaults (b0, 1) are the optimum: 0 px
+    fake->depthTarget = b0;  // the defaults (b0, 1) are the optimum: 0 px
     fake->slopeTarget = 1.0;
     RecommendOptions o;
-    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) { return (*fake)(sc, st, b); };
+    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) {
+        return (*fake)(sc, st, b);
+    };
     o.raytrace = false;
     const scene::Frame ref = row(1000, 0);
     const Recommendation r = recommendShadow(s, ref, s, ref, nullptr, nullptr, Json::object(), o);
@@ -140,9 +146,12 @@ TEST(Recommend, ACandidateThatLosesAtTheRequestedResolutionIsNotRecommended) {
     fake->depthTarget = 2.0 * b0;
     fake->loseAtWidth = 2000;  // at 2000 px every explicit bias darkens everything
     RecommendOptions o;
-    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) { return (*fake)(sc, st, b); };
+    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) {
+        return (*fake)(sc, st, b);
+    };
     o.raytrace = false;
-    const Recommendation r = recommendShadow(search, row(1000, 0), full, row(2000, 0), nullptr, nullptr, Json::object(), o);
+    const Recommendation r =
+        recommendShadow(search, row(1000, 0), full, row(2000, 0), nullptr, nullptr, Json::object(), o);
     EXPECT_TRUE(r.raster.searched);
     EXPECT_DOUBLE_EQ(r.raster.tried.mismatchRate, 1.0);
     EXPECT_DOUBLE_EQ(r.raster.defaults.mismatchRate, 0.01);  // 20 px of 2000
@@ -156,7 +165,9 @@ TEST(Recommend, KeepsTheUsersOwnSettingsInTheBlock) {
     auto fake = std::make_shared<Fake>();
     fake->depthTarget = 1e-3;
     RecommendOptions o;
-    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) { return (*fake)(sc, st, b); };
+    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) {
+        return (*fake)(sc, st, b);
+    };
     o.user.filter = "pcf";
     o.user.shadowMapSize = 1024;
     o.user.fitLightFrustum = false;  // a flag not given: not the user's choice
@@ -195,7 +206,8 @@ void checkNeverLoses(const std::string& name) {
     search.camera.width = 80;
     search.camera.height = 45;
     const scene::Frame ref = renderWithBackend(full, scene::resolveSettings(full, {}), scene::Backend::Reference);
-    const scene::Frame searchRef = renderWithBackend(search, scene::resolveSettings(search, {}), scene::Backend::Reference);
+    const scene::Frame searchRef =
+        renderWithBackend(search, scene::resolveSettings(search, {}), scene::Backend::Reference);
     RecommendOptions o;
     o.user.validate = true;
     o.raytrace = false;
@@ -203,7 +215,8 @@ void checkNeverLoses(const std::string& name) {
     ASSERT_TRUE(r.raster.defaults.ok) << r.raster.defaults.error;
     scene::SettingsOverrides v;
     v.validate = true;
-    const Measured defaults = measure(shadowlab::test::renderChecked(full, scene::resolveSettings(full, v).raster), ref);
+    const Measured defaults =
+        measure(shadowlab::test::renderChecked(full, scene::resolveSettings(full, v).raster), ref);
     const Measured block = pasted(file, r.shadowBlock, 160, 90, ref);
     std::printf("%s: %zu points, defaults %.4f%% (IoU %.3f), block %.4f%% (IoU %.3f), block %s\n", name.c_str(),
                 r.points.size(), 100 * defaults.mismatchRate, defaults.shadowIoU, 100 * block.mismatchRate,

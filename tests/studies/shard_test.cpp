@@ -14,13 +14,13 @@
 
 #include <gtest/gtest.h>
 
-#include "studies/auto_bias.h"
-#include "studies/machine.h"
-#include "studies/sweep_report.h"
-#include "studies/shard.h"
 #include "scene/error.h"
 #include "scene/frame_io.h"
 #include "scene/loader.h"
+#include "studies/auto_bias.h"
+#include "studies/machine.h"
+#include "studies/shard.h"
+#include "studies/sweep_report.h"
 #include "tests/compare/synthetic.h"
 
 namespace shadowlab::studies {
@@ -53,8 +53,8 @@ struct FakeRenderer {
     RenderFn fn() {
         return [this](const scene::Scene& sc, const scene::RenderSettings& s, scene::Backend backend) {
             if (backend == scene::Backend::Reference) ++referenceCalls;
-            const std::string what = scene::toString(backend) + std::to_string(s.raster.shadowMapSize) + std::to_string(s.raster.depthBias) +
-                                     std::to_string(s.raytrace.rayBias);
+            const std::string what = scene::toString(backend) + std::to_string(s.raster.shadowMapSize) +
+                                     std::to_string(s.raster.depthBias) + std::to_string(s.raytrace.rayBias);
             const int n = calls[what]++;
             const float v = backend == scene::Backend::Raster && s.raster.shadowMapSize == 512 ? 0.0f : 1.0f;
             scene::Frame f = compare::test::uniformFrame(sc.camera.width, sc.camera.height, 1.0f, 0.6f, v);
@@ -67,13 +67,23 @@ struct FakeRenderer {
 fs::path writeScene(const fs::path& dir, double radius = 1.0) {
     fs::create_directories(dir);
     const Json scene = {
-        {"camera", {{"position", {0, 2, 6}}, {"look_at", {0, 0.7, 0}}, {"up", {0, 1, 0}}, {"fov_y", 40},
-                    {"resolution", {24, 16}}, {"near", 0.1}, {"far", 100}}},
+        {"camera",
+         {{"position", {0, 2, 6}},
+          {"look_at", {0, 0.7, 0}},
+          {"up", {0, 1, 0}},
+          {"fov_y", 40},
+          {"resolution", {24, 16}},
+          {"near", 0.1},
+          {"far", 100}}},
         {"materials", {{"matte", {{"albedo", {0.8, 0.8, 0.8}}}}}},
         {"lights", {{{"type", "directional"}, {"direction", {-1, -2, -1}}, {"color", {1, 1, 1}}, {"intensity", 3}}}},
         {"objects",
          {{{"type", "sphere"}, {"center", {0, 1, 0}}, {"radius", radius}, {"material", "matte"}},
-          {{"type", "quad"}, {"center", {0, 0, 0}}, {"normal", {0, 1, 0}}, {"size", {20, 20}}, {"material", "matte"}}}}};
+          {{"type", "quad"},
+           {"center", {0, 0, 0}},
+           {"normal", {0, 1, 0}},
+           {"size", {20, 20}},
+           {"material", "matte"}}}}};
     std::ofstream(dir / "scene.json") << scene.dump(2);
     return dir / "scene.json";
 }
@@ -199,7 +209,8 @@ TEST(ShardMerge, EqualsTheUnshardedRunAndRendersTheReferenceOnce) {
     EXPECT_EQ(verdictDifferences(unsharded.rows, merged.rows), std::vector<std::string>{});
     // The fake's times are the same in both runs and both ran here: the CSVs are equal byte for byte.
     EXPECT_EQ(readText(f.path / "whole" / "results.csv"), readText(f.path / "sharded" / "results.csv"));
-    EXPECT_EQ(rowDifferences(readResults(f.path / "whole"), readResults(f.path / "sharded")), std::vector<std::string>{});
+    EXPECT_EQ(rowDifferences(readResults(f.path / "whole"), readResults(f.path / "sharded")),
+              std::vector<std::string>{});
     // Every row's images are in the merged folder under the names the unsharded run gives them.
     for (const SweepRow& r : merged.rows) {
         EXPECT_TRUE(fs::exists(f.path / "sharded" / r.image)) << r.image;
@@ -384,7 +395,9 @@ TEST(SharedReference, ASecondShardWaitsForTheFirstAndReusesItsReference) {
 TEST(SharedReference, TheLockOfAStoppedShardIsTakenOver) {
     Folder f;
     const scene::Scene scene = scene::loadScene(writeScene(f.path / "scene"));
-    auto render = [&] { return compare::test::uniformFrame(scene.camera.width, scene.camera.height, 1.0f, 0.6f, 1.0f); };
+    auto render = [&] {
+        return compare::test::uniformFrame(scene.camera.width, scene.camera.height, 1.0f, 0.6f, 1.0f);
+    };
     SharedReferenceOptions o;
     o.pollSeconds = 0.02;
     o.staleSeconds = 0.3;

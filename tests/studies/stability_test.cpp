@@ -5,8 +5,8 @@
 #include "studies/stability.h"
 
 #include <algorithm>
-#include <filesystem>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <stdexcept>
@@ -44,14 +44,14 @@ StabilityOptions smallOptions() {
 const std::set<std::string> kRasterStiff = {"grazing-1deg", "tiny-and-huge"};
 // A bias window for the raster: moderate slopes at sensible scale, or scale-invariant defaults
 // (far-*, scale-*, near-far only move or scale the seed scene; the raster is camera-relative).
-const std::set<std::string> kRasterWindow = {"far-1e5", "far-1e7", "grazing-0deg", "near-far-1e-5",
+const std::set<std::string> kRasterWindow = {"far-1e5",    "far-1e7",   "grazing-0deg", "near-far-1e-5",
                                              "scale-1e-3", "scale-1e4", "straight-down"};
 // Stiff for the float ray tracer with the lesson's constant ray bias: at 1e7 the float spacing
 // (1.0) is the sphere's radius, so primary and shadow hit points are off by whole units and no
 // bias can separate acne from leaks; robust offsets in float cannot fix that either (only double).
 const std::set<std::string> kRaytraceStiff = {"far-1e7"};
-const std::set<std::string> kRaytraceWindow = {"contact-box", "coplanar-quads", "grazing-0deg", "near-far-1e-5",
-                                               "scale-1e-3", "scale-1e4", "straight-down", "slivers",
+const std::set<std::string> kRaytraceWindow = {"contact-box",   "coplanar-quads", "grazing-0deg",  "near-far-1e-5",
+                                               "scale-1e-3",    "scale-1e4",      "straight-down", "slivers",
                                                "thin-occluder", "tiny-and-huge"};
 
 std::vector<std::string> extremeCases() {
@@ -147,10 +147,11 @@ TEST(StabilityTest, DISABLED_WriteReport) {
         cases.push_back(runStabilityCase(scene::loadScene(file), o, name, readDescription(file)));
         const StabilityCase& c = cases.back();
         std::cout << name << ": reference " << c.referenceVerdict() << "; raster "
-                  << stateOf(c.run(scene::Backend::Raster, "defaults"), false).text << " / " << stateOf(c.run(scene::Backend::Raster, "best"), true).text
-                  << "; raytrace " << stateOf(c.run(scene::Backend::Raytrace, "defaults"), false).text << " / "
-                  << stateOf(c.run(scene::Backend::Raytrace, "best"), true).text << (c.failed() ? "; FAILED to run cleanly" : "")
-                  << std::endl;
+                  << stateOf(c.run(scene::Backend::Raster, "defaults"), false).text << " / "
+                  << stateOf(c.run(scene::Backend::Raster, "best"), true).text << "; raytrace "
+                  << stateOf(c.run(scene::Backend::Raytrace, "defaults"), false).text << " / "
+                  << stateOf(c.run(scene::Backend::Raytrace, "best"), true).text
+                  << (c.failed() ? "; FAILED to run cleanly" : "") << std::endl;
     }
     writeStabilityReport(out, cases);
 }
@@ -277,7 +278,7 @@ TEST(StabilityVerdicts, InjectedAcneAtDefaultsShowsTheAcneStateNotAPass) {
     StabilityOptions o = acneOptions(1e30);  // never clean
     o.search = false;
     const StabilityCase c = runStabilityCase(tinyScene(), o, "acne");
-    EXPECT_FALSE(c.failed());  // nothing crashed: the run is healthy, the shadows are not
+    EXPECT_FALSE(c.failed());                      // nothing crashed: the run is healthy, the shadows are not
     EXPECT_EQ(c.referenceVerdict(), "unchecked");  // a point light: no analytic answer
     const BackendState raster = stateOf(c.run(scene::Backend::Raster, "defaults"), false);
     EXPECT_EQ(raster.state, "acne");

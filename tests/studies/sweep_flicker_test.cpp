@@ -12,9 +12,9 @@
 
 #include <gtest/gtest.h>
 
-#include "studies/sweep_report.h"
 #include "scene/error.h"
 #include "scene/loader.h"
+#include "studies/sweep_report.h"
 #include "tests/compare/synthetic.h"
 
 namespace shadowlab::studies {
@@ -28,8 +28,12 @@ constexpr int kW = 24, kH = 16, kStripe = 4;  // the stripe: the kStripe leftmos
 fs::path writeScene(const fs::path& dir) {
     fs::create_directories(dir);
     const Json scene = {
-        {"camera", {{"position", {0, 2, 6}}, {"look_at", {0, 0.7, 0}}, {"up", {0, 1, 0}}, {"fov_y", 40},
-                    {"resolution", {kW, kH}}}},
+        {"camera",
+         {{"position", {0, 2, 6}},
+          {"look_at", {0, 0.7, 0}},
+          {"up", {0, 1, 0}},
+          {"fov_y", 40},
+          {"resolution", {kW, kH}}}},
         {"materials", {{"matte", {{"albedo", {0.8, 0.8, 0.8}}}}}},
         {"lights", {{{"type", "directional"}, {"direction", {-1, -2, -1}}}}},
         {"objects", {{{"type", "sphere"}, {"center", {0, 1, 0}}, {"radius", 1}, {"material", "matte"}}}}};
@@ -55,8 +59,9 @@ struct PanFake {
             scene::Frame f = compare::test::uniformFrame(s.camera.width, s.camera.height, 1.0f, 0.6f, 1.0f);
             f.timingsMs = {{"setup", 1.0}, {"render", 2.0}};
             // raster map 512: the stripe in every frame (a fixed wrong offset); map 1024: in odd frames.
-            const bool stripe = backend == scene::Backend::Raster && (settings.raster.shadowMapSize == 512 ||
-                                                        (settings.raster.shadowMapSize == 1024 && frameOf(s) % 2 == 1));
+            const bool stripe =
+                backend == scene::Backend::Raster && (settings.raster.shadowMapSize == 512 ||
+                                                      (settings.raster.shadowMapSize == 1024 && frameOf(s) % 2 == 1));
             if (stripe)
                 for (int y = 0; y < f.height; ++y)
                     for (int x = 0; x < kStripe; ++x) f.visibility[std::size_t(y) * f.width + x] = 0.0f;
@@ -129,8 +134,9 @@ TEST_F(SweepFlicker, RowsCarryFlickerThatIsZeroForTheReferenceAndAFixedOffsetAnd
     std::ifstream csv(root / "out" / "results.csv");
     std::string header;
     std::getline(csv, header);
-    EXPECT_NE(header.find(",flicker_path,flicker_rate,flicker_px,error_variation,swim_px,edge_offset_px,held_flicker_rate"),
-              std::string::npos)
+    EXPECT_NE(
+        header.find(",flicker_path,flicker_rate,flicker_px,error_variation,swim_px,edge_offset_px,held_flicker_rate"),
+        std::string::npos)
         << header;
     SweepReportInput in = makeSweepReportInput("a", "a.json", r);
     const std::string html = renderSweepReportHtml(in);
@@ -210,7 +216,8 @@ TEST_F(FlickerGridFile, BadValuesAreRejectedWithTheirJsonPath) {
         {R"({"flicker": {"frames": 1}, "raytrace": {"precision": ["float"]}})", "flicker.frames"},
         {R"({"flicker": {"frames": 500}, "raytrace": {"precision": ["float"]}})", "flicker.frames"},
         {R"({"flicker": {"speed": 1}, "raytrace": {"precision": ["float"]}})", "flicker.speed"},
-        {R"({"flicker": {"kind": "light-move"}, "raytrace": {"precision": ["float"]}})", "flicker"},  // directional light
+        {R"({"flicker": {"kind": "light-move"}, "raytrace": {"precision": ["float"]}})",
+         "flicker"},  // directional light
         {R"({"raster": {"cascade_blend": [0.1, 0.7]}})", "raster.cascade_blend[1]"},
         {R"({"raster": {"snap_light_frustum": ["yes"]}})", "raster.snap_light_frustum[0]"},
         {R"({"raster": {"fit_light_frustum": [1]}})", "raster.fit_light_frustum[0]"},

@@ -15,11 +15,11 @@
 
 #include "compare/compare.h"
 #include "compare/report.h"
-#include "studies/sweep.h"
-#include "studies/sweep_report.h"
 #include "scene/frame_io.h"
 #include "scene/loader.h"
 #include "scene/settings.h"
+#include "studies/sweep.h"
+#include "studies/sweep_report.h"
 #include "tests/compare/synthetic.h"
 
 namespace studies = shadowlab::studies;
@@ -59,7 +59,7 @@ scene::Frame fakeRender(const scene::Scene& s, const scene::RenderSettings& sett
         if (r.shadowMapSize >= 4096 && r.filter == scene::ShadowFilter::Pcf2x2)
             throw std::runtime_error("VK_ERROR_OUT_OF_DEVICE_MEMORY: vkAllocateMemory for the 4096² shadow map (fake)");
         const double texel = 2.0 * scene::defaultDepthBias(s, r.shadowMapSize);  // world size of a texel
-        const double k = r.depthBias / texel;                                     // constant bias in texels
+        const double k = r.depthBias / texel;                                    // constant bias in texels
         const double bias = k + 0.5 * r.slopeBias;  // what reaches the lit floor, in texels
         const double acne = 0.35 * std::exp(-bias / 0.3);
         o.acne = acne > 1e-5;
@@ -73,8 +73,10 @@ scene::Frame fakeRender(const scene::Scene& s, const scene::RenderSettings& sett
         f = compare::test::syntheticFrame(o);
         const double size = r.shadowMapSize;
         const double shadow = 0.4 + size * size * 1.1e-6 * (r.filter == scene::ShadowFilter::Pcf2x2 ? 1.5 : 1.0);
-        f.timingsMs = {{"setup", 38.0 * jitter(call)}, {"shadow_pass", shadow * jitter(call + 1)},
-                       {"lit_pass", 2.6 * jitter(call + 2)}, {"readback", 0.9}};
+        f.timingsMs = {{"setup", 38.0 * jitter(call)},
+                       {"shadow_pass", shadow * jitter(call + 1)},
+                       {"lit_pass", 2.6 * jitter(call + 2)},
+                       {"readback", 0.9}};
     } else {
         const auto& t = settings.raytrace;
         const double extent = s.bounds().diagonal();
@@ -92,7 +94,8 @@ scene::Frame fakeRender(const scene::Scene& s, const scene::RenderSettings& sett
         }
         f = compare::test::syntheticFrame(o);
         const double scale = t.precision == scene::Precision::Double ? 1.7 : 1.0;
-        f.timingsMs = {{"setup", 2.8 * jitter(call)}, {"primary", 30.0 * scale * jitter(call + 1)},
+        f.timingsMs = {{"setup", 2.8 * jitter(call)},
+                       {"primary", 30.0 * scale * jitter(call + 1)},
                        {"shadow", (t.robustOffset ? 68.0 : 62.0) * scale * jitter(call + 2)}};
     }
     f.attributes["backend"] = scene::toString(backend);
@@ -113,11 +116,13 @@ int main(int argc, char** argv) {
             result.rows = studies::readJournal(dir / "results.jsonl");
             result.reference = scene::readFrame(dir / "reference.exr");
             result.referenceMs = result.reference.totalTimeMs();
-            const auto scenePath = result.reference.attributes.count("scene") ? result.reference.attributes.at("scene") : "";
+            const auto scenePath =
+                result.reference.attributes.count("scene") ? result.reference.attributes.at("scene") : "";
             const studies::SweepReportInput input =
                 studies::makeSweepReportInput(fs::path(scenePath).stem().string(), scenePath, result);
             studies::writeSweepReport(dir, input);
-            for (const auto& line : studies::describeSweep(input, studies::recommendBias(input.rows))) std::cout << line << "\n";
+            for (const auto& line : studies::describeSweep(input, studies::recommendBias(input.rows)))
+                std::cout << line << "\n";
             std::cout << "wrote " << (dir / "report.html").string() << "\n";
             return 0;
         }
@@ -134,9 +139,11 @@ int main(int argc, char** argv) {
         options.resume = true;  // a second run of the demo reuses the rows
         options.render = fakeRender;
         const studies::SweepResult result = studies::runSweep(s, grid, options);
-        const studies::SweepReportInput input = studies::makeSweepReportInput("demo", (dir / "scene.json").string(), result);
+        const studies::SweepReportInput input =
+            studies::makeSweepReportInput("demo", (dir / "scene.json").string(), result);
         studies::writeSweepReport(dir / "sweep", input);
-        for (const auto& line : studies::describeSweep(input, studies::recommendBias(input.rows))) std::cout << line << "\n";
+        for (const auto& line : studies::describeSweep(input, studies::recommendBias(input.rows)))
+            std::cout << line << "\n";
 
         // The run report at full resolution, with the sweep's summary.
         compare::ReportInput report;

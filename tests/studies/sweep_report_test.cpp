@@ -72,7 +72,8 @@ TEST(SweepReport, WritesThePagePlotsAndTheShadowBlock) {
     std::ofstream(dir / "bias-slope.svg") << "<svg>stale</svg>";  // from an older report: no slope rows now
     const SweepReportInput in = syntheticSweep();
     writeSweepReport(dir, in);
-    for (const char* name : {"report.html", "error-time.svg", "bias-depth.svg", "bias-ray.svg", "recommended-shadow.json"})
+    for (const char* name :
+         {"report.html", "error-time.svg", "bias-depth.svg", "bias-ray.svg", "recommended-shadow.json"})
         EXPECT_TRUE(fs::exists(dir / name)) << name;
     EXPECT_FALSE(fs::exists(dir / "bias-slope.svg"));
     for (const auto& e : fs::directory_iterator(dir))
@@ -111,7 +112,8 @@ TEST(SweepReport, NamesOnlyItsOwnImagesAndNothingRemote) {
 TEST(SweepReport, IsBalancedEnoughToParse) {
     const std::string html = renderSweepReportHtml(syntheticSweep());
     EXPECT_EQ(html.rfind("<!DOCTYPE html>", 0), 0u);
-    for (const std::string tag : {"div", "table", "tr", "figure", "svg", "details", "p", "ul", "li", "g", "text", "pre"})
+    for (const std::string tag :
+         {"div", "table", "tr", "figure", "svg", "details", "p", "ul", "li", "g", "text", "pre"})
         EXPECT_EQ(count(html, "<" + tag + ">") + count(html, "<" + tag + " "), count(html, "</" + tag + ">")) << tag;
     EXPECT_NE(html.find("synthetic &lt;sweep&gt;"), std::string::npos);
     EXPECT_EQ(html.find("<sweep>"), std::string::npos);
@@ -152,7 +154,8 @@ TEST(SweepReport, SummarySaysTheFastestUnderOnePercentAndTheBiasVerdicts) {
     std::string text;
     for (const auto& l : lines) text += l + "\n";
     // Raster: 512 is faster but 3% wrong; 1024 (4 ms, 0.5%) is the fastest under 1%.
-    const std::string under = "the fastest configuration under " + compare::formatPercent(compare::kSweepGoodMismatchRate) + " mismatch is ";
+    const std::string under =
+        "the fastest configuration under " + compare::formatPercent(compare::kSweepGoodMismatchRate) + " mismatch is ";
     EXPECT_NE(text.find(under + "map 1024, none"), std::string::npos) << text;
     EXPECT_NE(text.find("most accurate, map 4096, pcf2x2"), std::string::npos) << text;
     // Raytrace: only the robust row (0.02%) is under 1%.
@@ -174,8 +177,9 @@ TEST(SweepReport, RowsThatDifferOnlyInCascadesFitOrHardwareBiasReadDifferently) 
     in.rows[2].config.overrides.hardwareBias = true;
     in.rows[2].config.overrides.pcfSize = 5;
     const std::string html = renderSweepReportHtml(in);
-    for (const char* s : {">map 2048, pcf2x2, bounds frustum, 1 cascade", ">map 2048, pcf2x2, bounds frustum, 3 cascades",
-                          ">map 2048, pcf2x2, pcf size 5, hardware bias, bounds frustum, 1 cascade"})
+    for (const char* s :
+         {">map 2048, pcf2x2, bounds frustum, 1 cascade", ">map 2048, pcf2x2, bounds frustum, 3 cascades",
+          ">map 2048, pcf2x2, pcf size 5, hardware bias, bounds frustum, 1 cascade"})
         EXPECT_NE(html.find(s), std::string::npos) << s;
 }
 
@@ -205,7 +209,8 @@ TEST(SweepReport, TheRunReportShowsTheSweepSummary) {
     EXPECT_NE(html.find("href=\"sweep/report.html\""), std::string::npos);
     EXPECT_NE(html.find(compare::escapeHtml(recommendBias(in.rows).shadowBlock.dump(2))), std::string::npos);
     EXPECT_NE(html.find("Shadow error against per-frame time"), std::string::npos);  // the inline plot
-    for (const auto& line : run.sweep->lines) EXPECT_NE(html.find(compare::escapeHtml(line)), std::string::npos) << line;
+    for (const auto& line : run.sweep->lines)
+        EXPECT_NE(html.find(compare::escapeHtml(line)), std::string::npos) << line;
 }
 
 TEST(SweepReport, AnEmptySweepStillWritesAPage) {

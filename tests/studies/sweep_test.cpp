@@ -3,6 +3,7 @@
 // refusal of another scene's folder, grid files, and timings as medians without the warm-up.
 #include "studies/sweep.h"
 
+#include <sys/stat.h>
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
@@ -11,7 +12,6 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
-#include <sys/stat.h>
 
 #include <gtest/gtest.h>
 
@@ -45,7 +45,7 @@ std::string describe(const scene::RenderSettings& s, scene::Backend backend) {
 struct FakeRenderer {
     std::map<std::string, int> calls;  // by describe(); the reference included
     int referenceCalls = 0, methodCalls = 0;
-    double failDepthBias = -1.0;       // a raster render with this depth bias throws
+    double failDepthBias = -1.0;  // a raster render with this depth bias throws
 
     RenderFn fn() {
         return [this](const scene::Scene& sc, const scene::RenderSettings& s, scene::Backend backend) {
@@ -72,13 +72,23 @@ struct FakeRenderer {
 fs::path writeSceneFile(const fs::path& dir, const std::string& name) {
     fs::create_directories(dir);
     const Json scene = {
-        {"camera", {{"position", {0, 2, 6}}, {"look_at", {0, 0.7, 0}}, {"up", {0, 1, 0}}, {"fov_y", 40},
-                    {"resolution", {48, 32}}, {"near", 0.1}, {"far", 100}}},
+        {"camera",
+         {{"position", {0, 2, 6}},
+          {"look_at", {0, 0.7, 0}},
+          {"up", {0, 1, 0}},
+          {"fov_y", 40},
+          {"resolution", {48, 32}},
+          {"near", 0.1},
+          {"far", 100}}},
         {"materials", {{"matte", {{"albedo", {0.8, 0.8, 0.8}}}}}},
         {"lights", {{{"type", "directional"}, {"direction", {-1, -2, -1}}, {"color", {1, 1, 1}}, {"intensity", 3}}}},
         {"objects",
          {{{"type", "sphere"}, {"center", {0, 1, 0}}, {"radius", 1}, {"material", "matte"}},
-          {{"type", "quad"}, {"center", {0, 0, 0}}, {"normal", {0, 1, 0}}, {"size", {20, 20}}, {"material", "matte"}}}}};
+          {{"type", "quad"},
+           {"center", {0, 0, 0}},
+           {"normal", {0, 1, 0}},
+           {"size", {20, 20}},
+           {"material", "matte"}}}}};
     std::ofstream(dir / name) << scene.dump(2);
     return dir / name;
 }
@@ -502,7 +512,8 @@ TEST_F(GridFile, ReceiverPlaneBiasAxisVariesTheRasterRowsAndIsRecorded) {
 }
 
 TEST_F(GridFile, HardwareBiasAxisVariesTheRasterRowsAndRoundTrips) {
-    const SweepGrid g = loadGrid(write(R"({ "raster": { "hardware_bias": [false, true], "depth_bias": [0, 0.01] } })"), scene);
+    const SweepGrid g =
+        loadGrid(write(R"({ "raster": { "hardware_bias": [false, true], "depth_bias": [0, 0.01] } })"), scene);
     ASSERT_EQ(g.configs.size(), 4u);
     EXPECT_EQ(g.configs[0].overrides.hardwareBias, std::optional<bool>(false));
     EXPECT_EQ(g.configs[2].overrides.hardwareBias, std::optional<bool>(true));
@@ -580,13 +591,15 @@ TEST_F(GridFile, KeysOfRowsWithoutMomentParametersAreUnchanged) {
     c.overrides.slopeBias = 0.0;
     c.overrides.fitLightFrustum = false;
     c.overrides.cascades = 1;
-    EXPECT_EQ(c.key(), "backend=raster;map=1024;filter=pcf2x2;depth_bias=0.01;slope_bias=0;fit_light_frustum=0;cascades=1");
+    EXPECT_EQ(c.key(),
+              "backend=raster;map=1024;filter=pcf2x2;depth_bias=0.01;slope_bias=0;fit_light_frustum=0;cascades=1");
     EXPECT_EQ(c.label(), "raster: map 1024, pcf2x2, depth bias 0.01, slope bias 0, bounds frustum, 1 cascade");
     c.overrides.filter = "vsm";
     c.overrides.minVariance = 1e-5;
     c.overrides.blurWidth = 7;
-    EXPECT_EQ(c.key(), "backend=raster;map=1024;filter=vsm;depth_bias=0.01;slope_bias=0;fit_light_frustum=0;cascades=1;"
-                       "min_variance=1e-05;blur_width=7");
+    EXPECT_EQ(c.key(),
+              "backend=raster;map=1024;filter=vsm;depth_bias=0.01;slope_bias=0;fit_light_frustum=0;cascades=1;"
+              "min_variance=1e-05;blur_width=7");
     EXPECT_NE(c.label().find("min variance 1e-05, blur 7"), std::string::npos) << c.label();
 }
 
@@ -618,13 +631,15 @@ TEST_F(GridFile, MomentParameterAxesAreSeriesAndRoundTrip) {
     EXPECT_EQ(keys.size(), 6u);
     // Each filterable filter is a grid value; a one-valued parameter axis is no series.
     const SweepGrid filters = loadGrid(write(R"({ "raster": { "filter": ["vsm", "evsm2", "evsm4", "esm", "msm"],
-        "esm_exponent": [40] } })"), scene);
+        "esm_exponent": [40] } })"),
+                                       scene);
     ASSERT_EQ(filters.configs.size(), 5u);
     for (const SweepConfig& c : filters.configs) EXPECT_EQ(c.biasKind, "") << c.label();
     // With a depth series beside it, a swept parameter of a filterable filter is the series;
     // a non-filterable one keeps the depth series (the parameter does nothing there).
     const SweepGrid both = loadGrid(write(R"({ "raster": { "filter": ["pcf2x2", "vsm"], "depth_bias": [0, 0.01],
-        "bleeding_reduction": [0.1, 0.5] } })"), scene);
+        "bleeding_reduction": [0.1, 0.5] } })"),
+                                    scene);
     for (const SweepConfig& c : both.configs)
         EXPECT_EQ(c.biasKind, *c.overrides.filter == "vsm" ? "bleeding_reduction" : "depth") << c.label();
 }
