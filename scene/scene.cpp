@@ -73,4 +73,36 @@ Bounds Scene::bounds() const {
     return b;
 }
 
+ShadowDefaults ShadowDefaults::overriddenBy(const ShadowDefaults& over) const {
+    ShadowDefaults out = *this;
+    auto take = [](auto& into, const auto& from) {
+        if (from) into = from;
+    };
+    take(out.shadowMapSize, over.shadowMapSize);
+    take(out.depthBias, over.depthBias);
+    take(out.slopeBias, over.slopeBias);
+    take(out.filter, over.filter);
+    take(out.pcfSize, over.pcfSize);
+    take(out.minVariance, over.minVariance);
+    take(out.bleedReduction, over.bleedReduction);
+    take(out.evsmPositive, over.evsmPositive);
+    take(out.evsmNegative, over.evsmNegative);
+    take(out.esmExponent, over.esmExponent);
+    take(out.momentBias, over.momentBias);
+    take(out.blurWidth, over.blurWidth);
+    take(out.normalOffset, over.normalOffset);
+    take(out.receiverPlaneBias, over.receiverPlaneBias);
+    take(out.hardwareBias, over.hardwareBias);
+    take(out.fitLightFrustum, over.fitLightFrustum);
+    take(out.cascades, over.cascades);
+    take(out.cascadeBlend, over.cascadeBlend);
+    if (over.rayBias || over.robustRayOffset) {
+        out.rayBias = over.rayBias;
+        out.robustRayOffset = over.robustRayOffset;
+    }
+    take(out.precision, over.precision);
+    take(out.samples, over.samples);
+    return out;
+}
+
 }  // namespace shadowlab::scene

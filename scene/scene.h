@@ -233,6 +233,11 @@ struct ShadowDefaults {
     std::optional<bool> robustRayOffset;  // "ray_bias": "robust"
     std::optional<std::string> precision;
     std::optional<int> samples;
+
+    // These defaults with every key that `over` sets taken from it (a check case's "settings" over
+    // its scene's "shadow" block). "ray_bias" is one key: a number or "robust" replaces both fields.
+    ShadowDefaults overriddenBy(const ShadowDefaults& over) const;
+    bool operator==(const ShadowDefaults&) const = default;
 };
 
 struct Bounds {

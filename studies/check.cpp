@@ -74,29 +74,6 @@ double nonNegative(const fs::path& file, const Json& node, const JsonPath& path)
 }
 
 // Every setting the case names replaces the scene's "shadow" block value.
-void mergeShadow(scene::ShadowDefaults& into, const scene::ShadowDefaults& from) {
-    auto take = [](auto& a, const auto& b) {
-        if (b) a = b;
-    };
-    take(into.shadowMapSize, from.shadowMapSize);
-    take(into.depthBias, from.depthBias);
-    take(into.slopeBias, from.slopeBias);
-    take(into.filter, from.filter);
-    take(into.pcfSize, from.pcfSize);
-    take(into.normalOffset, from.normalOffset);
-    take(into.receiverPlaneBias, from.receiverPlaneBias);
-    take(into.hardwareBias, from.hardwareBias);
-    take(into.fitLightFrustum, from.fitLightFrustum);
-    take(into.cascades, from.cascades);
-    take(into.cascadeBlend, from.cascadeBlend);
-    if (from.rayBias || from.robustRayOffset) {
-        into.rayBias = from.rayBias;
-        into.robustRayOffset = from.robustRayOffset;
-    }
-    take(into.precision, from.precision);
-    take(into.samples, from.samples);
-}
-
 bool validName(const std::string& s) {
     if (s.empty() || s.size() > 100) return false;
     for (char c : s)
@@ -182,7 +159,7 @@ CheckSuite loadSuite(const fs::path& file) {
         k.resolution = std::to_string(k.scene.camera.width) + "x" + std::to_string(k.scene.camera.height);
         if (c.contains("settings")) {
             k.settings = c["settings"];
-            mergeShadow(k.scene.shadow, scene::readShadowBlock(file, c["settings"], p / "settings"));
+            k.scene.shadow = k.scene.shadow.overriddenBy(scene::readShadowBlock(file, c["settings"], p / "settings"));
         } else {
             k.settings = Json::object();
         }

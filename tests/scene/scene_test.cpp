@@ -1,0 +1,68 @@
+// tests/scene/scene_test.cpp: small queries on the scene model (scene/scene.cpp).
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "scene/loader.h"
+#include "scene/scene.h"
+
+using namespace shadowlab;
+using Json = nlohmann::json;
+
+namespace {
+
+// Every key a "shadow" block accepts, each with a valid value; `second` picks another valid value
+// for each, so that every field of the two parsed blocks differs.
+Json everyShadowKey(bool second) {
+    return Json{{"shadow_map_size", second ? 1024 : 512},
+                {"depth_bias", second ? 0.02 : 0.01},
+                {"slope_bias", second ? 3.0 : 2.0},
+                {"filter", second ? "vsm" : "pcf"},
+                {"pcf_size", second ? 5 : 3},
+                {"min_variance", second ? 1e-4 : 1e-5},
+                {"light_bleeding_reduction", second ? 0.3 : 0.2},
+                {"evsm_positive_exponent", second ? 30.0 : 20.0},
+                {"evsm_negative_exponent", second ? 8.0 : 5.0},
+                {"esm_exponent", second ? 60.0 : 40.0},
+                {"moment_bias", second ? 3e-5 : 2e-5},
+                {"blur_width", second ? 9 : 5},
+                {"normal_offset", second ? 1.5 : 1.0},
+                {"receiver_plane_bias", second},
+                {"hardware_bias", second},
+                {"fit_light_frustum", second},
+                {"cascades", second ? 3 : 2},
+                {"cascade_blend", second ? 0.2 : 0.1},
+                {"ray_bias", second ? 0.002 : 0.001},
+                {"precision", second ? "double" : "float"},
+                {"samples", second ? 16 : 8}};
+}
+
+scene::ShadowDefaults parse(const Json& block) { return scene::readShadowBlock("test.json", block, scene::JsonPath()); }
+
+}  // namespace
+
+// A block that sets every key replaces every field: a field the merge forgot would keep the first
+// block's value, and the two would differ.
+TEST(ShadowDefaults, AnOverrideThatSetsEveryKeyReplacesEveryField) {
+    const scene::ShadowDefaults first = parse(everyShadowKey(false));
+    const scene::ShadowDefaults second = parse(everyShadowKey(true));
+    ASSERT_NE(first, second);
+    EXPECT_EQ(first.overriddenBy(second), second);
+}
+
+TEST(ShadowDefaults, AnEmptyOverrideKeepsEveryField) {
+    const scene::ShadowDefaults first = parse(everyShadowKey(false));
+    EXPECT_EQ(first.overriddenBy(scene::ShadowDefaults{}), first);
+}
+
+// "ray_bias" is one key with two forms: "robust" over a number drops the number, and back.
+TEST(ShadowDefaults, RayBiasIsOneKeyInEitherForm) {
+    const scene::ShadowDefaults number = parse(Json{{"ray_bias", 0.001}});
+    const scene::ShadowDefaults robust = parse(Json{{"ray_bias", "robust"}});
+    const scene::ShadowDefaults a = number.overriddenBy(robust);
+    EXPECT_FALSE(a.rayBias.has_value());
+    EXPECT_TRUE(a.robustRayOffset.value_or(false));
+    const scene::ShadowDefaults b = robust.overriddenBy(number);
+    EXPECT_EQ(b.rayBias, 0.001);
+    EXPECT_FALSE(b.robustRayOffset.value_or(false));
+}
