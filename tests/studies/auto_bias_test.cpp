@@ -26,6 +26,28 @@ constexpr double kTexel = 0.002;  // world size of a texel in these made-up seri
 constexpr double kOk = 0.0002;    // a rate well under the 0.1% threshold
 constexpr double kBad = 0.02;     // a rate well over it
 
+// A sphere over nothing under a sun, with `shadow` as its "shadow" block, written to a scene file
+// in the test's temporary folder `name` and loaded by the scene loader.
+scene::Scene loadWithShadowBlock(const nlohmann::json& shadow, const std::string& name) {
+    const nlohmann::json scene = {
+        {"camera",
+         {{"position", {0, 2, 6}},
+          {"look_at", {0, 0.7, 0}},
+          {"up", {0, 1, 0}},
+          {"fov_y", 40},
+          {"resolution", {64, 36}},
+          {"near", 0.1},
+          {"far", 100}}},
+        {"materials", {{"matte", {{"albedo", {0.8, 0.8, 0.8}}}}}},
+        {"lights", {{{"type", "directional"}, {"direction", {-1, -2, -1}}, {"color", {1, 1, 1}}, {"intensity", 3}}}},
+        {"objects", {{{"type", "sphere"}, {"center", {0, 1, 0}}, {"radius", 1}, {"material", "matte"}}}},
+        {"shadow", shadow}};
+    const fs::path dir = fs::path(::testing::TempDir()) / name;
+    fs::create_directories(dir);
+    std::ofstream(dir / "scene.json") << scene.dump(2);
+    return scene::loadScene(dir / "scene.json");
+}
+
 // A depth series at 0, ¼, 1, 4, 16, 64 texels (defaultGrid's quick series) where 1..16 texels
 // are clean: acne below, leaks above.
 std::vector<SweepRow> depthSeriesWithWindow() {
@@ -210,23 +232,7 @@ TEST(AutoBias, TheShadowBlockIsAcceptedByTheSceneLoader) {
     rows.push_back(rayRow(1e-4, 0, 0));
     rows.push_back(robustRow("double", 0, 0));
     const AutoBias a = recommendBias(rows);
-    const nlohmann::json scene = {
-        {"camera",
-         {{"position", {0, 2, 6}},
-          {"look_at", {0, 0.7, 0}},
-          {"up", {0, 1, 0}},
-          {"fov_y", 40},
-          {"resolution", {64, 36}},
-          {"near", 0.1},
-          {"far", 100}}},
-        {"materials", {{"matte", {{"albedo", {0.8, 0.8, 0.8}}}}}},
-        {"lights", {{{"type", "directional"}, {"direction", {-1, -2, -1}}, {"color", {1, 1, 1}}, {"intensity", 3}}}},
-        {"objects", {{{"type", "sphere"}, {"center", {0, 1, 0}}, {"radius", 1}, {"material", "matte"}}}},
-        {"shadow", a.shadowBlock}};
-    const fs::path dir = fs::path(::testing::TempDir()) / "auto_bias_scene";
-    fs::create_directories(dir);
-    std::ofstream(dir / "scene.json") << scene.dump(2);
-    const scene::Scene loaded = scene::loadScene(dir / "scene.json");
+    const scene::Scene loaded = loadWithShadowBlock(a.shadowBlock, "auto_bias_scene");
     ASSERT_TRUE(loaded.shadow.depthBias.has_value());
     EXPECT_NEAR(*loaded.shadow.depthBias, 4 * kTexel, 1e-12);
     ASSERT_TRUE(loaded.shadow.robustRayOffset.has_value());
@@ -296,23 +302,7 @@ TEST(AutoBias, TheBlockCarriesTheParameterWhenItsSeriesRanWithTheBlocksFilter) {
     ASSERT_NE(a.primary("depth"), nullptr);
     EXPECT_EQ(a.shadowBlock.at("filter").get<std::string>(), "vsm");
     EXPECT_DOUBLE_EQ(a.shadowBlock.at("min_variance").get<double>(), 3.16e-5);
-    const nlohmann::json scene = {
-        {"camera",
-         {{"position", {0, 2, 6}},
-          {"look_at", {0, 0.7, 0}},
-          {"up", {0, 1, 0}},
-          {"fov_y", 40},
-          {"resolution", {64, 36}},
-          {"near", 0.1},
-          {"far", 100}}},
-        {"materials", {{"matte", {{"albedo", {0.8, 0.8, 0.8}}}}}},
-        {"lights", {{{"type", "directional"}, {"direction", {-1, -2, -1}}, {"color", {1, 1, 1}}, {"intensity", 3}}}},
-        {"objects", {{{"type", "sphere"}, {"center", {0, 1, 0}}, {"radius", 1}, {"material", "matte"}}}},
-        {"shadow", a.shadowBlock}};
-    const fs::path dir = fs::path(::testing::TempDir()) / "auto_bias_moment_scene";
-    fs::create_directories(dir);
-    std::ofstream(dir / "scene.json") << scene.dump(2);
-    const scene::Scene loaded = scene::loadScene(dir / "scene.json");
+    const scene::Scene loaded = loadWithShadowBlock(a.shadowBlock, "auto_bias_moment_scene");
     EXPECT_EQ(loaded.shadow.filter, std::optional<std::string>("vsm"));
     ASSERT_TRUE(loaded.shadow.minVariance.has_value());
     EXPECT_DOUBLE_EQ(*loaded.shadow.minVariance, 3.16e-5);
