@@ -52,34 +52,17 @@ AlphaCasters createAlphaCasters(const Context& ctx, const scene::Scene& scene, c
                                                        .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                                        .descriptorCount = 1,
                                                        .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT}};
-    const VkDescriptorSetLayoutCreateInfo setInfo{
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 2, .pBindings = bindings};
-    VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
-    VK_CHECK(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &setLayout));
-    a.setLayout = DescriptorSetLayoutHandle(device, setLayout);
-    const VkDescriptorPoolSize poolSize{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2};
-    const VkDescriptorPoolCreateInfo poolInfo{.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
-                                              .maxSets = 1,
-                                              .poolSizeCount = 1,
-                                              .pPoolSizes = &poolSize};
-    VkDescriptorPool pool = VK_NULL_HANDLE;
-    VK_CHECK(vkCreateDescriptorPool(device, &poolInfo, nullptr, &pool));
-    a.pool = DescriptorPoolHandle(device, pool);
-    const VkDescriptorSetAllocateInfo allocInfo{.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
-                                                .descriptorPool = pool,
-                                                .descriptorSetCount = 1,
-                                                .pSetLayouts = &setLayout};
-    VK_CHECK(vkAllocateDescriptorSets(device, &allocInfo, &a.set));
+    a.descriptors = createDescriptorSet(ctx, bindings);
     const VkDescriptorBufferInfo recordInfo{a.records.buffer.get(), 0, VK_WHOLE_SIZE};
     const VkDescriptorBufferInfo texelInfo{a.texels.buffer.get(), 0, VK_WHOLE_SIZE};
     const VkWriteDescriptorSet writes[2] = {{.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
-                                             .dstSet = a.set,
+                                             .dstSet = a.descriptors.set,
                                              .dstBinding = 0,
                                              .descriptorCount = 1,
                                              .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                              .pBufferInfo = &recordInfo},
                                             {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
-                                             .dstSet = a.set,
+                                             .dstSet = a.descriptors.set,
                                              .dstBinding = 1,
                                              .descriptorCount = 1,
                                              .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,

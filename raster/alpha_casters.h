@@ -6,18 +6,17 @@
 #pragma once
 
 #include "raster/geometry.h"
+#include "raster/pipeline.h"
 #include "raster/resources.h"
 #include "scene/scene.h"
 
 namespace shadowlab::raster {
 
 struct AlphaCasters {
-    Buffer uvs;      // vertex binding 1, one vec2 per vertex of SceneGeometry
-    Buffer records;  // std430 AlphaRecord per object id (0: unused)
-    Buffer texels;   // every texture's alpha, one float a texel
-    DescriptorSetLayoutHandle setLayout;
-    DescriptorPoolHandle pool;
-    VkDescriptorSet set = VK_NULL_HANDLE;  // freed with the pool
+    Buffer uvs;                 // vertex binding 1, one vec2 per vertex of SceneGeometry
+    Buffer records;             // std430 AlphaRecord per object id (0: unused)
+    Buffer texels;              // every texture's alpha, one float a texel
+    DescriptorSet descriptors;  // records and texels, bound as set 1 of the passes that test alpha
     std::size_t textureTexels = 0;
 };
 

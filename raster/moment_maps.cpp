@@ -66,11 +66,8 @@ MomentPipeline createMomentPipeline(const Context& ctx, const ShadowMaps& maps, 
          .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_COMPUTE_BIT},
     };
-    const VkDescriptorSetLayoutCreateInfo setInfo{
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 3, .pBindings = bindings};
-    VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
-    VK_CHECK(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &setLayout));
-    p.setLayout = DescriptorSetLayoutHandle(device, setLayout);
+    p.descriptors = createDescriptorSet(ctx, bindings);
+    const VkDescriptorSetLayout setLayout = p.descriptors.layout.get();
     const VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(shaders::MomentPush)};
     const VkPipelineLayoutCreateInfo layoutInfo{.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
                                                 .setLayoutCount = 1,
@@ -94,50 +91,26 @@ MomentPipeline createMomentPipeline(const Context& ctx, const ShadowMaps& maps, 
     VK_CHECK(vkCreateComputePipelines(device, ctx.pipelineCache.get(), 1, &info, nullptr, &pipeline));
     p.pipeline = PipelineHandle(device, pipeline);
 
-    const VkSamplerCreateInfo samplerInfo{
-        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
-        .magFilter = VK_FILTER_NEAREST,
-        .minFilter = VK_FILTER_NEAREST,
-        .mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
-        .addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .maxLod = 0.0f,
-    };
-    VkSampler sampler = VK_NULL_HANDLE;
-    VK_CHECK(vkCreateSampler(device, &samplerInfo, nullptr, &sampler));
-    p.depthSampler = SamplerHandle(device, sampler);
-
-    const VkDescriptorPoolSize sizes[] = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1},
-                                          {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 2}};
-    const VkDescriptorPoolCreateInfo poolInfo{
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1, .poolSizeCount = 2, .pPoolSizes = sizes};
-    VkDescriptorPool pool = VK_NULL_HANDLE;
-    VK_CHECK(vkCreateDescriptorPool(device, &poolInfo, nullptr, &pool));
-    p.pool = DescriptorPoolHandle(device, pool);
-    const VkDescriptorSetAllocateInfo allocInfo{.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
-                                                .descriptorPool = pool,
-                                                .descriptorSetCount = 1,
-                                                .pSetLayouts = &setLayout};
-    VK_CHECK(vkAllocateDescriptorSets(device, &allocInfo, &p.set));
+    p.depthSampler = createNearestSampler(ctx);
+    const VkSampler sampler = p.depthSampler.get();
     const VkDescriptorImageInfo depthInfo{sampler, maps.depth.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkDescriptorImageInfo xInfo{VK_NULL_HANDLE, moments.blurredX.view.get(), VK_IMAGE_LAYOUT_GENERAL};
     const VkDescriptorImageInfo outInfo{VK_NULL_HANDLE, moments.moments.view.get(), VK_IMAGE_LAYOUT_GENERAL};
     const VkWriteDescriptorSet writes[] = {
         {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
-         .dstSet = p.set,
+         .dstSet = p.descriptors.set,
          .dstBinding = 0,
          .descriptorCount = 1,
          .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
          .pImageInfo = &depthInfo},
         {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
-         .dstSet = p.set,
+         .dstSet = p.descriptors.set,
          .dstBinding = 1,
          .descriptorCount = 1,
          .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
          .pImageInfo = &xInfo},
         {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
-         .dstSet = p.set,
+         .dstSet = p.descriptors.set,
          .dstBinding = 2,
          .descriptorCount = 1,
          .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
@@ -170,8 +143,8 @@ void recordMomentPasses(VkCommandBuffer commands, const MomentPipeline& pipeline
                  VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_NONE,
                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT}});
     vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline.get());
-    vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.layout.get(), 0, 1, &pipeline.set, 0,
-                            nullptr);
+    vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.layout.get(), 0, 1,
+                            &pipeline.descriptors.set, 0, nullptr);
     const std::uint32_t groups = (moments.size + kGroup - 1) / kGroup;
     // One dispatch per layer and pass: each layer's own near and far.
     auto dispatch = [&](int pass) {

@@ -38,12 +38,10 @@ struct MomentMaps {
 MomentMaps createMomentMaps(const Context& ctx, std::uint32_t size, std::uint32_t layers);
 
 struct MomentPipeline {
-    DescriptorSetLayoutHandle setLayout;
+    DescriptorSet descriptors;
     PipelineLayoutHandle layout;
     PipelineHandle pipeline;
     SamplerHandle depthSampler;  // NEAREST, for texelFetch of the depth array
-    DescriptorPoolHandle pool;
-    VkDescriptorSet set = VK_NULL_HANDLE;  // freed with the pool
 };
 // Throws RasterError naming kMomentFormat and the device when the format cannot be a storage
 // image or be filtered linearly.

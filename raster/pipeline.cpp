@@ -1,6 +1,8 @@
 // raster/pipeline.cpp: shader modules and the shared graphics-pipeline builder.
 #include "raster/pipeline.h"
 
+#include <algorithm>
+
 #include "raster/geometry.h"
 #include "raster/vulkan_error.h"
 
@@ -167,6 +169,55 @@ void setViewport(VkCommandBuffer commands, std::uint32_t width, std::uint32_t he
     const VkRect2D scissor{.offset = {0, 0}, .extent = {width, height}};
     vkCmdSetViewport(commands, 0, 1, &viewport);
     vkCmdSetScissor(commands, 0, 1, &scissor);
+}
+
+DescriptorSet createDescriptorSet(const Context& ctx, std::span<const VkDescriptorSetLayoutBinding> bindings) {
+    VkDevice device = ctx.device.get();
+    DescriptorSet d;
+    const VkDescriptorSetLayoutCreateInfo setInfo{.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
+                                                  .bindingCount = std::uint32_t(bindings.size()),
+                                                  .pBindings = bindings.data()};
+    VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &setLayout));
+    d.layout = DescriptorSetLayoutHandle(device, setLayout);
+    std::vector<VkDescriptorPoolSize> sizes;
+    for (const VkDescriptorSetLayoutBinding& b : bindings) {
+        auto same = std::find_if(sizes.begin(), sizes.end(),
+                                 [&](const VkDescriptorPoolSize& s) { return s.type == b.descriptorType; });
+        if (same == sizes.end())
+            sizes.push_back({b.descriptorType, b.descriptorCount});
+        else
+            same->descriptorCount += b.descriptorCount;
+    }
+    const VkDescriptorPoolCreateInfo poolInfo{.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
+                                              .maxSets = 1,
+                                              .poolSizeCount = std::uint32_t(sizes.size()),
+                                              .pPoolSizes = sizes.data()};
+    VkDescriptorPool pool = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateDescriptorPool(device, &poolInfo, nullptr, &pool));
+    d.pool = DescriptorPoolHandle(device, pool);
+    const VkDescriptorSetAllocateInfo allocInfo{.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
+                                                .descriptorPool = pool,
+                                                .descriptorSetCount = 1,
+                                                .pSetLayouts = &setLayout};
+    VK_CHECK(vkAllocateDescriptorSets(device, &allocInfo, &d.set));
+    return d;
+}
+
+SamplerHandle createNearestSampler(const Context& ctx) {
+    const VkSamplerCreateInfo info{
+        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
+        .magFilter = VK_FILTER_NEAREST,
+        .minFilter = VK_FILTER_NEAREST,
+        .mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
+        .addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .maxLod = 0.0f,
+    };
+    VkSampler sampler = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateSampler(ctx.device.get(), &info, nullptr, &sampler));
+    return SamplerHandle(ctx.device.get(), sampler);
 }
 
 }  // namespace shadowlab::raster

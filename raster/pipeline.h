@@ -40,6 +40,19 @@ struct PipelineDesc {
 // depth write and blending as desc says, viewport and scissor dynamic.
 PipelineHandle createGraphicsPipeline(const Context& ctx, const PipelineDesc& desc);
 
+// One descriptor set of `bindings`, with its layout and a pool sized for exactly it: what each pass
+// that binds one set of its own needs (the set is freed with the pool).
+struct DescriptorSet {
+    DescriptorSetLayoutHandle layout;
+    DescriptorPoolHandle pool;
+    VkDescriptorSet set = VK_NULL_HANDLE;
+};
+DescriptorSet createDescriptorSet(const Context& ctx, std::span<const VkDescriptorSetLayoutBinding> bindings);
+
+// A sampler that returns stored texels: nearest, clamped to the edge, one level (texelFetch and
+// exact taps on depth and moment maps).
+SamplerHandle createNearestSampler(const Context& ctx);
+
 // Throws RasterError naming the device and the format when it lacks `features` (optimal tiling).
 void requireFormat(const Context& ctx, VkFormat format, VkFormatFeatureFlags features, const char* purpose);
 

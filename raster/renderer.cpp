@@ -303,7 +303,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
     if (scene.hasCameraAlpha()) {
         alpha = createAlphaCasters(ctx, scene, geometry);
         draw.uvs = alpha.uvs.buffer.get();
-        draw.alphaSet = alpha.set;
+        draw.alphaSet = alpha.descriptors.set;
         shadowAlpha = scene.hasAlphaCasters();
         if (shadowAlpha) attributes["alpha_casters"] = "alpha-tested in the depth pass";  // only where there are some
     }
@@ -677,9 +677,9 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
         for (int a = 0; a < 2; ++a)
             if ((a ? depthAlpha : needDepthPlain) && !shadowPipeline[a].pipeline)
                 shadowPipeline[a] = createShadowPipeline(ctx, wantIds, settings.hardwareBias,
-                                                         a ? alpha.setLayout.get() : VK_NULL_HANDLE);
+                                                         a ? alpha.descriptors.layout.get() : VK_NULL_HANDLE);
         // The transmittance passes test alpha for every caster when the scene has alpha casters.
-        const VkDescriptorSetLayout alphaLayout = shadowAlpha ? alpha.setLayout.get() : VK_NULL_HANDLE;
+        const VkDescriptorSetLayout alphaLayout = shadowAlpha ? alpha.descriptors.layout.get() : VK_NULL_HANDLE;
         if (momentMaps.size > 1 && !momentPipeline.pipeline)
             momentPipeline = createMomentPipeline(ctx, maps, momentMaps);
         if (transmit && !transmitPipeline.pipeline) transmitPipeline = createTransmittancePipeline(ctx, alphaLayout);
@@ -703,7 +703,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                                                               .cascadeBlend = cascadeBlendUsed > 0.0,
                                                               .vertexLightConstants = vertexLightConstants,
                                                               .moments = settings.moments},
-                                                   a ? alpha.setLayout.get() : VK_NULL_HANDLE, background);
+                                                   a ? alpha.descriptors.layout.get() : VK_NULL_HANDLE, background);
         if (bindings.set == VK_NULL_HANDLE)
             bindings = createLitBindings(ctx, litPipeline[litPipeline[0].pipeline ? 0 : 1], uniforms,
                                          transmitWindowData, albedos, maps, transmittanceMaps, momentMaps);

@@ -182,44 +182,17 @@ TransmittanceRestPipeline createTransmittanceRestPipeline(const Context& ctx, co
     VkDevice device = ctx.device.get();
     TransmittanceRestPipeline p;
     // transmit.frag reads D1 with texelFetch at its own texel: no filtering, no addressing.
-    const VkSamplerCreateInfo samplerInfo{
-        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
-        .magFilter = VK_FILTER_NEAREST,
-        .minFilter = VK_FILTER_NEAREST,
-        .mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
-        .addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .maxLod = 0.0f,
-    };
-    VkSampler sampler = VK_NULL_HANDLE;
-    VK_CHECK(vkCreateSampler(device, &samplerInfo, nullptr, &sampler));
-    p.sampler = SamplerHandle(device, sampler);
+    p.sampler = createNearestSampler(ctx);
+    const VkSampler sampler = p.sampler.get();
     const VkDescriptorSetLayoutBinding binding{.binding = 0,
                                                .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                                                .descriptorCount = 1,
                                                .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT};
-    const VkDescriptorSetLayoutCreateInfo setInfo{
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 1, .pBindings = &binding};
-    VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
-    VK_CHECK(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &setLayout));
-    p.setLayout = DescriptorSetLayoutHandle(device, setLayout);
-    const VkDescriptorPoolSize poolSize{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1};
-    const VkDescriptorPoolCreateInfo poolInfo{.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
-                                              .maxSets = 1,
-                                              .poolSizeCount = 1,
-                                              .pPoolSizes = &poolSize};
-    VkDescriptorPool pool = VK_NULL_HANDLE;
-    VK_CHECK(vkCreateDescriptorPool(device, &poolInfo, nullptr, &pool));
-    p.pool = DescriptorPoolHandle(device, pool);
-    const VkDescriptorSetAllocateInfo allocInfo{.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
-                                                .descriptorPool = pool,
-                                                .descriptorSetCount = 1,
-                                                .pSetLayouts = &setLayout};
-    VK_CHECK(vkAllocateDescriptorSets(device, &allocInfo, &p.set));
+    p.descriptors = createDescriptorSet(ctx, std::span(&binding, 1));
+    const VkDescriptorSetLayout setLayout = p.descriptors.layout.get();
     const VkDescriptorImageInfo nearInfo{sampler, maps.nearDepth.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkWriteDescriptorSet write{.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
-                                     .dstSet = p.set,
+                                     .dstSet = p.descriptors.set,
                                      .dstBinding = 0,
                                      .descriptorCount = 1,
                                      .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
@@ -343,8 +316,8 @@ void drawTransmittanceLayers(VkCommandBuffer commands, const TransmittancePass& 
         if (layer < lightMatrices.size() && layer < pass.layerLights.size() && !geometry.transparent.empty()) {
             vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline);
             if (rest)
-                vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, layout, 0, 1, &rest->set, 0,
-                                        nullptr);
+                vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, layout, 0, 1, &rest->descriptors.set,
+                                        0, nullptr);
             const bool alpha = rest ? rest->alpha : pass.pipeline->alpha;
             if (alpha)
                 vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, layout, rest ? 1 : 0, 1,

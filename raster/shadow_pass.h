@@ -8,6 +8,7 @@
 
 #include <glm/glm.hpp>
 
+#include "raster/pipeline.h"
 #include "raster/resources.h"
 #include "raster/shadow_layers.h"
 
@@ -25,7 +26,7 @@ struct ShadowPipeline {
 };
 // Without blockerIds: depth only, no fragment shader (much cheaper on lavapipe). hardwareBias:
 // depth bias on with dynamic factors (recordShadowPass sets each layer's). alphaSetLayout
-// (AlphaCasters::setLayout): alpha-tested casters, whose MASK texels below the cutoff the
+// (AlphaCasters::descriptors): alpha-tested casters, whose MASK texels below the cutoff the
 // fragment shader discards (then always with a fragment shader, also without blockerIds).
 ShadowPipeline createShadowPipeline(const Context& ctx, bool blockerIds = true, bool hardwareBias = false,
                                     VkDescriptorSetLayout alphaSetLayout = VK_NULL_HANDLE);
@@ -134,9 +135,7 @@ ShadowPipeline createTransmittancePipeline(const Context& ctx, VkDescriptorSetLa
 // (`maps.nearDepth`, bound here once: the set belongs to these maps).
 struct TransmittanceRestPipeline {
     SamplerHandle sampler;
-    DescriptorSetLayoutHandle setLayout;
-    DescriptorPoolHandle pool;
-    VkDescriptorSet set = VK_NULL_HANDLE;  // freed with the pool
+    DescriptorSet descriptors;
     PipelineLayoutHandle layout;
     PipelineHandle pipeline;
     bool alpha = false;  // the alpha records' set at index 1

@@ -41,7 +41,7 @@ TEST(RasterPipeline, EveryPipelineARenderAsksForIsCreatedWithoutValidationMessag
     ASSERT_TRUE(s.hasAlphaCasters());
     const SceneGeometry g = tessellateScene(s, s.camera.position, true);
     const AlphaCasters alpha = createAlphaCasters(ctx, s, g);
-    const VkDescriptorSetLayout alphaLayout = alpha.setLayout.get();
+    const VkDescriptorSetLayout alphaLayout = alpha.descriptors.layout.get();
 
     // The depth pass: with and without blocker ids, the hardware bias, the alpha test.
     for (const bool ids : {false, true})
