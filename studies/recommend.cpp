@@ -181,6 +181,64 @@ Json rayCandidateOf(const AutoBias& bias) {
     return j;
 }
 
+namespace {
+
+double numberAttribute(const scene::Frame& f, const char* key) {
+    const std::string text = attribute(f, key);
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    return !text.empty() && end && *end == '\0' ? v : 0.0;
+}
+
+// The default map size caps what the receivers ask for (the raster frame's shadow_map_size_needed
+// above its shadow_map_size) and the user set no size: a larger map at the user's biases (the
+// default depth bias is half a texel of each map, so it shrinks with the texel) is rendered at the
+// requested resolution and replaces the block's choice when it beats what the block gives.
+void tryLargerMap(const RecommendOptions& o, const scene::Scene& scene, const scene::Frame& reference,
+                  const scene::Frame& defaults, Verified& v, Json& block, std::vector<std::string>& notes) {
+    const double needed = numberAttribute(defaults, "shadow_map_size_needed");
+    const int size = int(numberAttribute(defaults, "shadow_map_size"));
+    if (o.user.shadowMapSize || !v.defaults.ok || size <= 0 || !(needed > size) || size >= o.largestMapSize) return;
+    int larger = size;
+    while (larger < needed && larger < o.largestMapSize) larger *= 2;
+    larger = std::min(larger, o.largestMapSize);
+    scene::SettingsOverrides ov = o.user;
+    ov.shadowMapSize = larger;
+    v.largerMapSize = larger;
+    v.largerMap = measureRender(o, scene, ov, scene::Backend::Raster, reference);
+    const std::string asked = "the default caps the map at " + std::to_string(size) +
+                              " texels where the receivers and casters ask for " +
+                              std::to_string(int(std::ceil(needed))) + ": ";
+    const bool biasesWon = v.beatsDefaults;
+    if (v.largerMap.ok && beats(v.largerMap, v.recommended) && better(v.largerMap, v.recommended)) {
+        notes.push_back("For the shadow map, " + asked + "a " + std::to_string(larger) + " map gives " +
+                        percentPair(v.largerMap, v.defaults) +
+                        (biasesWon
+                             ? " and beats the searched biases' " + compare::formatPercent(v.recommended.mismatchRate)
+                             : std::string()) +
+                        " at " + sizeText(scene) +
+                        ", for four times the texels of each map and more render time. The block recommends "
+                        "shadow_map_size " +
+                        std::to_string(larger) + (biasesWon ? " in place of the biases." : "."));
+        v.largerMapRecommended = true;
+        v.beatsDefaults = true;
+        v.recommended = v.largerMap;
+        block.erase("depth_bias");
+        block.erase("slope_bias");
+        if (o.user.depthBias) block["depth_bias"] = *o.user.depthBias;
+        if (o.user.slopeBias) block["slope_bias"] = *o.user.slopeBias;
+        block["shadow_map_size"] = larger;
+    } else {
+        notes.push_back("For the shadow map, " + asked + "a " + std::to_string(larger) + " map " +
+                        (v.largerMap.ok ? "gives " + percentPair(v.largerMap, v.defaults) + ", no better than " +
+                                              (biasesWon ? "the searched biases" : "the defaults")
+                                        : "failed (" + v.largerMap.error + ")") +
+                        ": the block keeps the size.");
+    }
+}
+
+}  // namespace
+
 Json Recommendation::toJson() const {
     auto side = [&](const Verified& v, bool withPoints) {
         Json j = {{"beats_defaults", v.beatsDefaults},
@@ -192,7 +250,13 @@ Json Recommendation::toJson() const {
         j["mismatch_rate_gain"] = v.defaults.ok && v.recommended.ok
                                       ? Json(v.defaults.mismatchRate - v.recommended.mismatchRate)
                                       : Json(nullptr);
-        if (withPoints) j["searched_points"] = points.size();
+        if (withPoints) {
+            j["searched_points"] = points.size();
+            j["larger_map"] = v.largerMapSize > 0 ? Json{{"shadow_map_size", v.largerMapSize},
+                                                         {"measured", measuredJson(v.largerMap)},
+                                                         {"recommended", v.largerMapRecommended}}
+                                                  : Json(nullptr);
+        }
         return j;
     };
     return {{"shadow", shadowBlock},
@@ -346,6 +410,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
                       ", not better in every respect: the block keeps the defaults.";
             r.notes.push_back("For the shadow map, " + why);
         }
+        tryLargerMap(o, scene, reference, rasterDefaults ? *rasterDefaults : fullDefaults, v, block, r.notes);
     }
 
     if (o.raytrace && rayCandidate.contains("ray_bias")) {

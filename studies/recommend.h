@@ -52,9 +52,18 @@ struct Verified {
     bool beatsDefaults = false;
     Measured defaults;      // the user's configuration
     Measured tried;         // the candidate (when searched)
-    Measured recommended;   // what the block gives: tried when it beats the defaults, else defaults
+    Measured recommended;   // what the block gives: the best of defaults, tried and largerMap
     std::string candidate;  // "depth bias 0.01 world units, slope bias 2 texels", "ray bias robust (float)"
+    // Raster: the map size tried where the default size capped what the receivers ask for (0: not
+    // tried), at the user's biases, and what it measured.
+    int largerMapSize = 0;
+    Measured largerMap;
+    bool largerMapRecommended = false;
 };
+
+// Twice the default size: four times its texels and memory, about 1.7 times the raster frame's
+// time on lavapipe (docs/sweep.md "The recommendation"); larger maps are the user's call.
+inline constexpr int kLargestRecommendedMapSize = 2 * scene::kDefaultShadowMapSize;
 
 struct RecommendOptions {
     RenderFn render = renderWithBackend;
@@ -67,6 +76,9 @@ struct RecommendOptions {
     std::vector<double> depthSteps{0.0, 1.0, 4.0, 16.0};
     std::vector<double> slopeSteps{0.0, 1.0, 4.0};
     bool refine = true;
+    // Where the user set no map size and the default capped it below what the receivers ask for
+    // (the frame's shadow_map_size_needed), the next power of two up to this size is tried too.
+    int largestMapSize = kLargestRecommendedMapSize;
 };
 
 struct Recommendation {

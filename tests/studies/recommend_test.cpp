@@ -54,6 +54,10 @@ struct Fake {
     double depthTarget = 0.0, slopeTarget = 2.0;
     // Used at this width only: the candidate loses there (for the "never loses" case).
     int loseAtWidth = 0;
+    // The map-size cap: a frame at the default size reports this many texels needed (0: none),
+    // and a map of at most 2048 texels adds smallMapFloor wrong pixels (aliasing a larger one fixes).
+    double neededMap = 0.0;
+    int smallMapFloor = 0;
     int renders = 0;
     scene::Frame operator()(const scene::Scene& s, const scene::RenderSettings& settings, scene::Backend backend) {
         ++renders;
@@ -63,6 +67,7 @@ struct Fake {
         if (backend == scene::Backend::Raster) {
             wrong = octaves(settings.raster.depthBias, depthTarget) + octaves(settings.raster.slopeBias, slopeTarget);
             if (w == loseAtWidth && !settings.raster.depthBiasIsDefault) wrong = w;
+            if (settings.raster.shadowMapSize <= 2048) wrong += smallMapFloor;
         } else {
             wrong = settings.raytrace.robustOffset ? 0 : 3;
         }
@@ -72,6 +77,8 @@ struct Fake {
         f.attributes["depth_bias"] = buf;
         f.attributes["filter"] = "pcf2x2";
         f.attributes["shadow_map_size"] = std::to_string(settings.raster.shadowMapSize);
+        if (neededMap > 0.0 && settings.raster.shadowMapSizeIsDefault)
+            f.attributes["shadow_map_size_needed"] = std::to_string(int(neededMap));
         return f;
     }
 };
@@ -158,6 +165,83 @@ TEST(Recommend, ACandidateThatLosesAtTheRequestedResolutionIsNotRecommended) {
     EXPECT_FALSE(r.raster.beatsDefaults);
     EXPECT_FALSE(r.shadowBlock.contains("depth_bias"));
     EXPECT_DOUBLE_EQ(r.raster.recommended.mismatchRate, r.raster.defaults.mismatchRate);
+}
+
+// The defaults' biases are the fake's optimum (no bias beats them), but every map of at most 2048
+// texels loses 30 px to aliasing, and the receivers ask for 5000 texels: a 4096 map (the largest
+// tried) at the default biases, whose depth bias is half a 4096 texel, is rendered and wins.
+TEST(Recommend, ALargerMapIsRecommendedWhereTheDefaultSizeCapsWhatTheReceiversAskFor) {
+    const scene::Scene s = fakeScene(1000);
+    const double b0 = scene::resolveSettings(s, {}).raster.depthBias;
+    scene::SettingsOverrides at4096;
+    at4096.shadowMapSize = 4096;
+    const double b4096 = scene::resolveSettings(s, at4096).raster.depthBias;
+    auto fake = std::make_shared<Fake>();
+    fake->depthTarget = b0;
+    fake->slopeTarget = 1.0;
+    fake->neededMap = 5000;
+    fake->smallMapFloor = 30;
+    RecommendOptions o;
+    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) {
+        return (*fake)(sc, st, b);
+    };
+    o.raytrace = false;
+    const scene::Frame ref = row(1000, 0);
+    const Recommendation r = recommendShadow(s, ref, s, ref, nullptr, nullptr, Json::object(), o);
+    EXPECT_DOUBLE_EQ(r.raster.defaults.mismatchRate, 0.03);
+    ASSERT_EQ(r.raster.largerMapSize, 4096);
+    // The fake's own error at the 4096 map's default bias, slope 1 on target: no floor.
+    const double expected = octaves(b4096, b0) / 1000.0;
+    ASSERT_LT(expected, 0.03);
+    EXPECT_DOUBLE_EQ(r.raster.largerMap.mismatchRate, expected);
+    EXPECT_TRUE(r.raster.largerMapRecommended);
+    EXPECT_TRUE(r.raster.beatsDefaults);
+    EXPECT_DOUBLE_EQ(r.raster.recommended.mismatchRate, expected);
+    EXPECT_EQ(r.shadowBlock.at("shadow_map_size"), 4096);
+    EXPECT_FALSE(r.shadowBlock.contains("depth_bias"));
+    EXPECT_EQ(r.toJson()["measured"]["raster"]["larger_map"]["shadow_map_size"], 4096);
+}
+
+TEST(Recommend, ALargerMapIsNotTriedWhereNothingIsCappedOrTheUserSetTheSize) {
+    const scene::Scene s = fakeScene(1000);
+    const double b0 = scene::resolveSettings(s, {}).raster.depthBias;
+    for (const bool userSize : {false, true}) {
+        auto fake = std::make_shared<Fake>();
+        fake->depthTarget = b0;
+        fake->slopeTarget = 1.0;
+        fake->smallMapFloor = 30;
+        fake->neededMap = userSize ? 5000 : 0;  // with the user's size the frame reports no need anyway
+        RecommendOptions o;
+        o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) {
+            return (*fake)(sc, st, b);
+        };
+        o.raytrace = false;
+        if (userSize) o.user.shadowMapSize = 2048;
+        const Recommendation r = recommendShadow(s, row(1000, 0), s, row(1000, 0), nullptr, nullptr, Json::object(), o);
+        EXPECT_EQ(r.raster.largerMapSize, 0) << "user size " << userSize;
+        EXPECT_EQ(r.shadowBlock.value("shadow_map_size", 0), userSize ? 2048 : 0);
+    }
+}
+
+// A larger map whose default bias is off the optimum (10 px) loses to defaults at 0 px: kept out.
+TEST(Recommend, ALargerMapThatDoesNotHelpIsNotRecommended) {
+    const scene::Scene s = fakeScene(1000);
+    const double b0 = scene::resolveSettings(s, {}).raster.depthBias;
+    auto fake = std::make_shared<Fake>();
+    fake->depthTarget = b0;
+    fake->slopeTarget = 1.0;
+    fake->neededMap = 3000;
+    RecommendOptions o;
+    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) {
+        return (*fake)(sc, st, b);
+    };
+    o.raytrace = false;
+    const Recommendation r = recommendShadow(s, row(1000, 0), s, row(1000, 0), nullptr, nullptr, Json::object(), o);
+    EXPECT_EQ(r.raster.largerMapSize, 4096);
+    EXPECT_GT(r.raster.largerMap.mismatchRate, 0.0);
+    EXPECT_FALSE(r.raster.largerMapRecommended);
+    EXPECT_FALSE(r.shadowBlock.contains("shadow_map_size"));
+    EXPECT_EQ(r.raster.recommended.mismatchRate, 0.0);
 }
 
 TEST(Recommend, KeepsTheUsersOwnSettingsInTheBlock) {
