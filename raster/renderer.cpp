@@ -202,6 +202,7 @@ struct Renderer::Impl {
     bool vertexLightConstants = false;  // LitVariant::vertexLightConstants of every lit pipeline
     bool renderIntoFrame = true;        // RendererOptions::renderIntoFrame
     bool transmittanceWindows = true;   // RendererOptions::transmittanceWindows
+    bool sunModules = true;             // RendererOptions::sunModules
     double setupMs = 0.0;
     double pendingSetupMs = 0.0;  // setup not yet reported in a frame (the constructor's)
 
@@ -475,6 +476,7 @@ void Renderer::Impl::createTargets(const scene::Scene& scene, const RendererOpti
             describeMomentCost(settings.filter, mapSize, arrayLayers, settings.moments.blurWidth);
     targets = createLitTargets(ctx, width, height, lightCount > 1 ? kLightTargets : 0, options.readTargetsInPlace);
     renderIntoFrame = options.renderIntoFrame;
+    sunModules = options.sunModules;
     if (!targets.hostReadable) readback = createReadback(ctx, targets);
     // How the targets reach the Frame: read in place (lavapipe) or copied into buffers first.
     attributes["readback"] = targets.hostReadable ? "in-place" : "copy";
@@ -702,7 +704,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                                                               .receiverPlane = settings.receiverPlaneBias,
                                                               .cascadeBlend = cascadeBlendUsed > 0.0,
                                                               .vertexLightConstants = vertexLightConstants,
-                                                              .moments = settings.moments},
+                                                              .moments = settings.moments,
+                                                              .sunModules = sunModules},
                                                    a ? alpha.setLayout.get() : VK_NULL_HANDLE, background);
         if (bindings.set == VK_NULL_HANDLE)
             bindings = createLitBindings(ctx, litPipeline[litPipeline[0].pipeline ? 0 : 1], uniforms,
