@@ -30,6 +30,7 @@
 #include "scene/camera.h"
 #include "scene/frame_io.h"
 
+#include <sys/mman.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -829,7 +830,17 @@ float* framePlane(std::vector<float>& v, bool wanted, std::size_t pixels, std::s
         v.clear();
         return nullptr;
     }
+    const std::size_t capacity = v.capacity();
     v.reserve(std::max(perPixel * pixels, (reserveBytes + sizeof(float) - 1) / sizeof(float)));
+#ifdef MADV_POPULATE_WRITE
+    if (v.capacity() != capacity) {
+        // New memory: its pages in one call (Linux 5.14) instead of a fault each as resize()
+        // zeroes them. Nothing changes where the kernel refuses.
+        const auto begin = (reinterpret_cast<std::uintptr_t>(v.data()) + 4095) & ~std::uintptr_t(4095);
+        const auto end = reinterpret_cast<std::uintptr_t>(v.data() + v.capacity()) & ~std::uintptr_t(4095);
+        if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE);
+    }
+#endif
     v.resize(perPixel * pixels);
     return v.data();
 }
