@@ -18,10 +18,6 @@ bool usesVertexLightCoordinates(const LitVariant& variant) {
 
 namespace {
 
-// lit.frag's SPIR-V for the variant: its outputs (beauty only, the AOVs, the per-light targets),
-// the camera's alpha test, and for none and pcf2x2 the *_taps build without the other filters' code
-// (lavapipe turns all of a module into NIR before the specialization constants remove what a
-// pipeline does not run: the full module doubled the lit pipeline's creation).
 // Whether the variant has the constants SHADOWLAB_ONE_SUN fixes (lit_constants.glsl), with none
 // or pcf2x2: the *_taps_sun builds.
 bool sunVariant(const LitVariant& v) {
@@ -30,6 +26,11 @@ bool sunVariant(const LitVariant& v) {
            v.lightKinds == (1u << SHADOWLAB_LIGHT_DIRECTIONAL) && !v.transmittance && !v.receiverPlane;
 }
 
+// lit.frag's SPIR-V for the variant: its outputs (beauty only, the AOVs, the per-light targets),
+// the camera's alpha test, and for none and pcf2x2 the *_taps build without the other filters' code
+// (lavapipe turns all of a module into NIR before the specialization constants remove what a
+// pipeline does not run: the full module doubled the lit pipeline's creation); where sunVariant(),
+// the *_sun modules (*_sun_map with one map and no blend bands).
 std::span<const std::uint32_t> litFragment(const LitVariant& v, bool alpha) {
     const bool taps = v.filter == scene::ShadowFilter::None || v.filter == scene::ShadowFilter::Pcf2x2;
     const bool sun = sunVariant(v);
