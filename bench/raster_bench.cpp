@@ -118,6 +118,9 @@ raster::RendererOptions rendererOptions() {
         else
             throw std::runtime_error("SHADOWLAB_BENCH_LIGHT_CONSTANTS: expected uniform or vertex, got " + which);
     }
+    // SHADOWLAB_BENCH_SUN_MODULES=0: the general lit shader modules where the size-optimized ones
+    // would be used (raster::RendererOptions::sunModules), for comparing the pipelines' creation.
+    if (const char* v = std::getenv("SHADOWLAB_BENCH_SUN_MODULES"); v && std::string(v) == "0") o.sunModules = false;
     return o;
 }
 

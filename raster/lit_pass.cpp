@@ -18,12 +18,30 @@ bool usesVertexLightCoordinates(const LitVariant& variant) {
 
 namespace {
 
+// Whether the variant has the constants SHADOWLAB_ONE_SUN fixes (lit_constants.glsl), with none
+// or pcf2x2: the *_taps_sun builds.
+bool sunVariant(const LitVariant& v) {
+    const bool taps = v.filter == scene::ShadowFilter::None || v.filter == scene::ShadowFilter::Pcf2x2;
+    return v.sunModules && taps && v.lightTargets == 0 && v.lightCount == 1 &&
+           v.lightKinds == (1u << SHADOWLAB_LIGHT_DIRECTIONAL) && !v.transmittance && !v.receiverPlane;
+}
+
 // lit.frag's SPIR-V for the variant: its outputs (beauty only, the AOVs, the per-light targets),
 // the camera's alpha test, and for none and pcf2x2 the *_taps build without the other filters' code
 // (lavapipe turns all of a module into NIR before the specialization constants remove what a
-// pipeline does not run: the full module doubled the lit pipeline's creation).
+// pipeline does not run: the full module doubled the lit pipeline's creation); where sunVariant(),
+// the *_sun modules (*_sun_map with one map and no blend bands).
 std::span<const std::uint32_t> litFragment(const LitVariant& v, bool alpha) {
     const bool taps = v.filter == scene::ShadowFilter::None || v.filter == scene::ShadowFilter::Pcf2x2;
+    const bool sun = sunVariant(v);
+    if (sun && v.cascades == 1 && !v.cascadeBlend) {
+        if (!v.aovTarget)
+            return alpha ? shaders::litFragBeautyAlphaTapsSunMapSpirv() : shaders::litFragBeautyTapsSunMapSpirv();
+        return alpha ? shaders::litFragAlphaTapsSunMapSpirv() : shaders::litFragTapsSunMapSpirv();
+    }
+    if (sun && !v.aovTarget)
+        return alpha ? shaders::litFragBeautyAlphaTapsSunSpirv() : shaders::litFragBeautyTapsSunSpirv();
+    if (sun) return alpha ? shaders::litFragAlphaTapsSunSpirv() : shaders::litFragTapsSunSpirv();
     if (!v.aovTarget)
         return taps ? (alpha ? shaders::litFragBeautyAlphaTapsSpirv() : shaders::litFragBeautyTapsSpirv())
                     : (alpha ? shaders::litFragBeautyAlphaSpirv() : shaders::litFragBeautySpirv());
@@ -148,7 +166,9 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkD
     }
     p.pipeline = createGraphicsPipeline(
         ctx, PipelineDesc{
-                 .vertexShader = p.alpha ? shaders::litVertAlphaSpirv() : shaders::litVertSpirv(),
+                 .vertexShader = p.alpha                                     ? shaders::litVertAlphaSpirv()
+                                 : sunVariant(variant) && !variant.aovTarget ? shaders::litVertNoIdSpirv()
+                                                                             : shaders::litVertSpirv(),
                  .fragmentShader = litFragment(variant, p.alpha),
                  .fragmentSpecialization = &specialization,
                  .vertexSpecialization = &specialization,

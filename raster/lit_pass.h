@@ -54,6 +54,11 @@ struct LitVariant {
     bool vertexLightConstants = false;
     // The filterable filters' parameters (specialization constants 11..16; unused by the others).
     scene::MomentSettings moments;
+    // Where the variant allows (none or pcf2x2, one directional light, no semi-transparent casters,
+    // no receiver plane, no per-light targets): the *_sun modules, with those constants fixed in
+    // the source and the code they switch off left out, so that the pipeline is made several times
+    // faster (lavapipe turns the whole module into NIR); false: the general module (tests compare).
+    bool sunModules = true;
 };
 // Whether lit.frag takes light 0's map coordinates from lit.vert (lit_constants.glsl
 // kVertexLightCoordinates, the same condition): one light, directional with one map or a spot, and

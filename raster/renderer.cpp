@@ -30,6 +30,7 @@
 #include "scene/camera.h"
 #include "scene/frame_io.h"
 
+#include <sys/mman.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -202,6 +203,7 @@ struct Renderer::Impl {
     bool vertexLightConstants = false;  // LitVariant::vertexLightConstants of every lit pipeline
     bool renderIntoFrame = true;        // RendererOptions::renderIntoFrame
     bool transmittanceWindows = true;   // RendererOptions::transmittanceWindows
+    bool sunModules = true;             // RendererOptions::sunModules
     double setupMs = 0.0;
     double pendingSetupMs = 0.0;  // setup not yet reported in a frame (the constructor's)
 
@@ -475,6 +477,7 @@ void Renderer::Impl::createTargets(const scene::Scene& scene, const RendererOpti
             describeMomentCost(settings.filter, mapSize, arrayLayers, settings.moments.blurWidth);
     targets = createLitTargets(ctx, width, height, lightCount > 1 ? kLightTargets : 0, options.readTargetsInPlace);
     renderIntoFrame = options.renderIntoFrame;
+    sunModules = options.sunModules;
     if (!targets.hostReadable) readback = createReadback(ctx, targets);
     // How the targets reach the Frame: read in place (lavapipe) or copied into buffers first.
     attributes["readback"] = targets.hostReadable ? "in-place" : "copy";
@@ -702,7 +705,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                                                               .receiverPlane = settings.receiverPlaneBias,
                                                               .cascadeBlend = cascadeBlendUsed > 0.0,
                                                               .vertexLightConstants = vertexLightConstants,
-                                                              .moments = settings.moments},
+                                                              .moments = settings.moments,
+                                                              .sunModules = sunModules},
                                                    a ? alpha.descriptors.layout.get() : VK_NULL_HANDLE, background);
         if (bindings.set == VK_NULL_HANDLE)
             bindings = createLitBindings(ctx, litPipeline[litPipeline[0].pipeline ? 0 : 1], uniforms,
@@ -826,7 +830,17 @@ float* framePlane(std::vector<float>& v, bool wanted, std::size_t pixels, std::s
         v.clear();
         return nullptr;
     }
+    const std::size_t capacity = v.capacity();
     v.reserve(std::max(perPixel * pixels, (reserveBytes + sizeof(float) - 1) / sizeof(float)));
+#ifdef MADV_POPULATE_WRITE
+    if (v.capacity() != capacity) {
+        // New memory: its pages in one call (Linux 5.14) instead of a fault each as resize()
+        // zeroes them. Nothing changes where the kernel refuses.
+        const auto begin = (reinterpret_cast<std::uintptr_t>(v.data()) + 4095) & ~std::uintptr_t(4095);
+        const auto end = reinterpret_cast<std::uintptr_t>(v.data() + v.capacity()) & ~std::uintptr_t(4095);
+        if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE);
+    }
+#endif
     v.resize(perPixel * pixels);
     return v.data();
 }

@@ -52,6 +52,9 @@ struct RendererOptions {
     // without windows (tests compare the two).
     bool transmittanceWindows = true;
     LightConstants lightConstants = LightConstants::kVertexOutputs;
+    // The lit pass's size-optimized shader modules where the scene allows them
+    // (LitVariant::sunModules); false: the general ones (tests compare the two).
+    bool sunModules = true;
 };
 
 // A reusable raster renderer for one scene and its settings: the constructor does the setup

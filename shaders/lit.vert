@@ -15,7 +15,9 @@ layout(location = 2) in uint inObjectId;
 
 layout(location = 0) out vec3 outPosition;
 layout(location = 1) out vec3 outNormal;
+#ifndef SHADOWLAB_NO_OBJECT_ID
 layout(location = 2) flat out uint outObjectId;
+#endif
 // The first light's homogeneous map coordinates of the position (toShadow · (p, 1)) and of the
 // normal (toShadow · (n, 0)), which lit.frag interpolates instead of a matrix product per fragment
 // where that light is the only one and directional or a spot (kVertexLightCoordinates); unused
@@ -41,7 +43,11 @@ layout(location = 14) out vec2 outUv;
 void main() {
     outPosition = inPosition;
     outNormal = inNormal;
+#ifndef SHADOWLAB_NO_OBJECT_ID
+    // (The lit_vert_no_id variant: for the size-optimized beauty-only fragment shaders without the
+    // alpha test, from which spirv-opt removes the object id they do not read.)
     outObjectId = inObjectId;
+#endif
 #ifdef SHADOWLAB_ALPHA
     outUv = inUv;
 #endif

@@ -9,6 +9,22 @@ layout(constant_id = 1) const bool kBlockerIds = true;  // look up and write the
 // The number of lights (u.lightCount holds the same), so the light loop unrolls and each light's
 // uniforms are loaded from a constant index; and the light kinds present (bit 1 << kind), so
 // the spot and point-light paths are left out of scenes without such lights.
+#ifdef SHADOWLAB_ONE_SUN
+// (The *_sun variants: one directional light, no semi-transparent casters, no receiver plane;
+// *_sun_map also one map, no cascades. These constants are plain constants there, so spirv-opt
+// drops the code they switch off before lavapipe turns the module into NIR.)
+const int kLightCount = 1;
+const int kLightKinds = 1 << SHADOWLAB_LIGHT_DIRECTIONAL;
+#ifdef SHADOWLAB_ONE_MAP
+const int kCascades = 1;
+const bool kCascadeBlend = false;
+#else
+layout(constant_id = 4) const int kCascades = 1;
+layout(constant_id = 7) const bool kCascadeBlend = false;
+#endif
+const bool kTransmittance = false;
+const bool kReceiverPlane = false;
+#else
 layout(constant_id = 2) const int kLightCount = SHADOWLAB_MAX_LIGHTS;
 layout(constant_id = 3) const int kLightKinds = 7;
 // The cascades of the cascaded directional lights (1: none cascaded; every cascaded light has
@@ -24,6 +40,7 @@ layout(constant_id = 6) const bool kReceiverPlane = false;
 // (u.cascadeBlendBand, the band's fraction of the slice; see cascadeOf); off, the second shadow
 // test is compiled out.
 layout(constant_id = 7) const bool kCascadeBlend = false;
+#endif
 // The visibility AOV is computed (the AOV variants); off for the beauty-only variants (the float
 // beauty and the 8-bit display target), which leaves out the weighting and the division per pixel.
 layout(constant_id = 8) const bool kVisibility = true;

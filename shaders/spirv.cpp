@@ -10,17 +10,26 @@
 #include "lit_frag.spv.h"
 #include "lit_frag_alpha.spv.h"
 #include "lit_frag_alpha_taps.spv.h"
+#include "lit_frag_alpha_taps_sun.spv.h"
+#include "lit_frag_alpha_taps_sun_map.spv.h"
 #include "lit_frag_beauty.spv.h"
 #include "lit_frag_beauty_alpha.spv.h"
 #include "lit_frag_beauty_alpha_taps.spv.h"
+#include "lit_frag_beauty_alpha_taps_sun.spv.h"
+#include "lit_frag_beauty_alpha_taps_sun_map.spv.h"
 #include "lit_frag_beauty_taps.spv.h"
+#include "lit_frag_beauty_taps_sun.spv.h"
+#include "lit_frag_beauty_taps_sun_map.spv.h"
 #include "lit_frag_lights.spv.h"
 #include "lit_frag_lights_alpha.spv.h"
 #include "lit_frag_lights_alpha_taps.spv.h"
 #include "lit_frag_lights_taps.spv.h"
 #include "lit_frag_taps.spv.h"
+#include "lit_frag_taps_sun.spv.h"
+#include "lit_frag_taps_sun_map.spv.h"
 #include "lit_vert.spv.h"
 #include "lit_vert_alpha.spv.h"
+#include "lit_vert_no_id.spv.h"
 #include "moments_comp.spv.h"
 #include "shadow_frag.spv.h"
 #include "shadow_frag_alpha.spv.h"
@@ -62,6 +71,15 @@ std::span<const std::uint32_t> litFragLightsTapsSpirv() { return kLitFragLightsT
 std::span<const std::uint32_t> litFragLightsAlphaTapsSpirv() { return kLitFragLightsAlphaTapsSpv; }
 std::span<const std::uint32_t> litFragBeautyTapsSpirv() { return kLitFragBeautyTapsSpv; }
 std::span<const std::uint32_t> litFragBeautyAlphaTapsSpirv() { return kLitFragBeautyAlphaTapsSpv; }
+std::span<const std::uint32_t> litFragTapsSunSpirv() { return kLitFragTapsSunSpv; }
+std::span<const std::uint32_t> litFragAlphaTapsSunSpirv() { return kLitFragAlphaTapsSunSpv; }
+std::span<const std::uint32_t> litFragBeautyTapsSunSpirv() { return kLitFragBeautyTapsSunSpv; }
+std::span<const std::uint32_t> litFragBeautyAlphaTapsSunSpirv() { return kLitFragBeautyAlphaTapsSunSpv; }
+std::span<const std::uint32_t> litFragTapsSunMapSpirv() { return kLitFragTapsSunMapSpv; }
+std::span<const std::uint32_t> litFragAlphaTapsSunMapSpirv() { return kLitFragAlphaTapsSunMapSpv; }
+std::span<const std::uint32_t> litFragBeautyTapsSunMapSpirv() { return kLitFragBeautyTapsSunMapSpv; }
+std::span<const std::uint32_t> litFragBeautyAlphaTapsSunMapSpirv() { return kLitFragBeautyAlphaTapsSunMapSpv; }
+std::span<const std::uint32_t> litVertNoIdSpirv() { return kLitVertNoIdSpv; }
 std::span<const std::uint32_t> backgroundVertSpirv() { return kBackgroundVertSpv; }
 std::span<const std::uint32_t> backgroundFragSpirv() { return kBackgroundFragSpv; }
 std::span<const std::uint32_t> backgroundFragBeautySpirv() { return kBackgroundFragBeautySpv; }

@@ -42,6 +42,20 @@ std::span<const std::uint32_t> litFragLightsTapsSpirv();
 std::span<const std::uint32_t> litFragLightsAlphaTapsSpirv();
 std::span<const std::uint32_t> litFragBeautyTapsSpirv();
 std::span<const std::uint32_t> litFragBeautyAlphaTapsSpirv();
+// The *_taps variants without per-light targets again with SHADOWLAB_ONE_SUN (one directional
+// light, no semi-transparent casters, no receiver plane), and with SHADOWLAB_ONE_MAP too (no
+// cascades), optimized for size: the code those constants switch off is not in the module.
+std::span<const std::uint32_t> litFragTapsSunSpirv();
+std::span<const std::uint32_t> litFragAlphaTapsSunSpirv();
+std::span<const std::uint32_t> litFragBeautyTapsSunSpirv();
+std::span<const std::uint32_t> litFragBeautyAlphaTapsSunSpirv();
+std::span<const std::uint32_t> litFragTapsSunMapSpirv();
+std::span<const std::uint32_t> litFragAlphaTapsSunMapSpirv();
+std::span<const std::uint32_t> litFragBeautyTapsSunMapSpirv();
+std::span<const std::uint32_t> litFragBeautyAlphaTapsSunMapSpirv();
+// lit.vert without the object id output, for the *_sun beauty-only shaders without the alpha
+// test (which do not read it, and spirv-opt removes the input).
+std::span<const std::uint32_t> litVertNoIdSpirv();
 // The lit pass's background (pixels no object covers): a triangle over the image, and the values
 // for the float targets of the AOV, beauty-only and per-light variants.
 std::span<const std::uint32_t> backgroundVertSpirv();

@@ -1147,6 +1147,46 @@ TEST(RasterRenderer, RenderingIntoTheFrameReadingTheTargetsInPlaceAndCopyingThem
     EXPECT_EQ(copied.validationMessages(), 0);
 }
 
+TEST(RasterRenderer, SizeOptimizedSunModulesGiveTheGeneralModulesFramesBitForBit) {
+    // One directional light with none or pcf2x2 gets the *_sun modules (constants fixed in the
+    // source, spirv-opt's size passes); the general *_taps modules are the reference: every channel
+    // of the all-channel, float-beauty and display frames the same, bit for bit. One map (*_sun_map),
+    // three cascades with blend bands (*_sun), filter none, a normal offset, and an alpha-tested
+    // caster (the *_alpha_* modules, and the beauty-only module without the object id input).
+    scene::Scene cascaded = makeLongPlane();
+    scene::RasterSettings cascades = validatedSettings(512, 0.0, 1.0, ShadowFilter::Pcf2x2);
+    cascades.depthBias = scene::defaultDepthBias(cascaded, 512);
+    cascades.cascades = 3;
+    cascades.cascadeBlend = 0.3;
+    scene::Scene leaf = makeScene(SphereOverPlane{});
+    leaf.materials.push_back(alphaMaterial("leaf", scene::AlphaMode::Mask, checkerTexture(2, 1.0f, 0.0f)));
+    addQuad(leaf, Vec3(0, 2, 0), Vec3(0, 1, 0), 1, 1, 1);
+    scene::RasterSettings offset = validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2);
+    offset.normalOffset = 1.0;
+    const std::pair<scene::Scene, scene::RasterSettings> cases[] = {
+        {makeScene(SphereOverPlane{}), validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2)},
+        {makeScene(SphereOverPlane{}), validatedSettings(512, 0.01, 1.0, ShadowFilter::None)},
+        {makeScene(SphereOverPlane{}), offset},
+        {cascaded, cascades},
+        {leaf, validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2)}};
+    for (const auto& [s, settings] : cases) {
+        Renderer sun(s, planFor(s, settings), settings);
+        Renderer general(s, planFor(s, settings), settings, RendererOptions{.sunModules = false});
+        for (const scene::ChannelMask channels :
+             {scene::kAllChannels, scene::kChannelBeauty, scene::kChannelBeauty | scene::kBeautyForDisplay}) {
+            const scene::Frame a = sun.render(channels), b = general.render(channels);
+            EXPECT_EQ(a.beauty, b.beauty);
+            EXPECT_EQ(a.visibility, b.visibility);
+            EXPECT_EQ(a.objectId, b.objectId);
+            EXPECT_EQ(a.ndotl, b.ndotl);
+            EXPECT_EQ(a.depth, b.depth);
+            EXPECT_EQ(a.blockerId, b.blockerId);
+        }
+        EXPECT_EQ(sun.validationMessages(), 0);
+        EXPECT_EQ(general.validationMessages(), 0);
+    }
+}
+
 // The frames of two renderers, one reading light 0's constants from the uniform buffer and one
 // taking them as flat outputs of the vertex shader, for the same channels.
 std::pair<scene::Frame, scene::Frame> withBothLightConstantSources(const scene::Scene& s,
