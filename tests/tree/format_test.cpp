@@ -43,6 +43,10 @@ TEST(Format, EveryTrackedCppFilePassesClangFormat) {
     const std::string tool = clangFormat14();
     if (tool.empty()) GTEST_SKIP() << "clang-format 14 is not installed (tools/debian-packages.txt lists it)";
     if (!std::filesystem::exists(kSource + "/.git")) GTEST_SKIP() << "not a git checkout: no file list";
+    // A checkout git will not read (another owner without safe.directory, say) has no list either.
+    const Result files = run("git -C '" + kSource + "' ls-files '*.cpp' '*.h'");
+    if (files.status != 0) GTEST_SKIP() << "git ls-files failed: " << files.output;
+    ASSERT_NE(files.output.find(".cpp"), std::string::npos) << "no C++ file listed";
     const Result result = run("cd '" + kSource + "' && git ls-files -z '*.cpp' '*.h' | xargs -0 " + tool +
                               " --dry-run --Werror --style=file");
     EXPECT_EQ(result.status, 0) << "run `clang-format -i` on the files below:\n" << result.output;
