@@ -83,6 +83,15 @@ struct Fake {
     }
 };
 
+// Options whose renderer is `fake` (shared, so a test can read its render count afterwards).
+RecommendOptions fakeOptions(const std::shared_ptr<Fake>& fake) {
+    RecommendOptions o;
+    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) {
+        return (*fake)(sc, st, b);
+    };
+    return o;
+}
+
 TEST(Recommend, RefinementFindsTheOptimumBetweenCoarsePointsAndTheBlockHoldsIt) {
     const scene::Scene s = fakeScene(1000);
     const double b0 = scene::resolveSettings(s, {}).raster.depthBias;  // the default half texel
@@ -90,10 +99,7 @@ TEST(Recommend, RefinementFindsTheOptimumBetweenCoarsePointsAndTheBlockHoldsIt) 
     // Optimum at depth 2·b0, slope 2: off the coarse grid (b0 × {0,1,4,16}, slope {0,1,4}); the
     // coarse best is (b0, 1) or (4b0, 4) at 20 px; its geometric midpoints reach (2b0, 2): 0 px.
     fake->depthTarget = 2.0 * b0;
-    RecommendOptions o;
-    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) {
-        return (*fake)(sc, st, b);
-    };
+    RecommendOptions o = fakeOptions(fake);
     const scene::Frame ref = row(1000, 0);
     const Recommendation r = recommendShadow(s, ref, s, ref, nullptr, nullptr, Json{{"ray_bias", "robust"}}, o);
     ASSERT_GE(r.best, 0);
@@ -132,10 +138,7 @@ TEST(Recommend, KeepsTheDefaultsWhenNothingSearchedBeatsThem) {
     auto fake = std::make_shared<Fake>();
     fake->depthTarget = b0;  // the defaults (b0, 1) are the optimum: 0 px
     fake->slopeTarget = 1.0;
-    RecommendOptions o;
-    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) {
-        return (*fake)(sc, st, b);
-    };
+    RecommendOptions o = fakeOptions(fake);
     o.raytrace = false;
     const scene::Frame ref = row(1000, 0);
     const Recommendation r = recommendShadow(s, ref, s, ref, nullptr, nullptr, Json::object(), o);
@@ -152,10 +155,7 @@ TEST(Recommend, ACandidateThatLosesAtTheRequestedResolutionIsNotRecommended) {
     auto fake = std::make_shared<Fake>();
     fake->depthTarget = 2.0 * b0;
     fake->loseAtWidth = 2000;  // at 2000 px every explicit bias darkens everything
-    RecommendOptions o;
-    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) {
-        return (*fake)(sc, st, b);
-    };
+    RecommendOptions o = fakeOptions(fake);
     o.raytrace = false;
     const Recommendation r =
         recommendShadow(search, row(1000, 0), full, row(2000, 0), nullptr, nullptr, Json::object(), o);
@@ -181,10 +181,7 @@ TEST(Recommend, ALargerMapIsRecommendedWhereTheDefaultSizeCapsWhatTheReceiversAs
     fake->slopeTarget = 1.0;
     fake->neededMap = 5000;
     fake->smallMapFloor = 30;
-    RecommendOptions o;
-    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) {
-        return (*fake)(sc, st, b);
-    };
+    RecommendOptions o = fakeOptions(fake);
     o.raytrace = false;
     const scene::Frame ref = row(1000, 0);
     const Recommendation r = recommendShadow(s, ref, s, ref, nullptr, nullptr, Json::object(), o);
@@ -211,10 +208,7 @@ TEST(Recommend, ALargerMapIsNotTriedWhereNothingIsCappedOrTheUserSetTheSize) {
         fake->slopeTarget = 1.0;
         fake->smallMapFloor = 30;
         fake->neededMap = userSize ? 5000 : 0;  // with the user's size the frame reports no need anyway
-        RecommendOptions o;
-        o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) {
-            return (*fake)(sc, st, b);
-        };
+        RecommendOptions o = fakeOptions(fake);
         o.raytrace = false;
         if (userSize) o.user.shadowMapSize = 2048;
         const Recommendation r = recommendShadow(s, row(1000, 0), s, row(1000, 0), nullptr, nullptr, Json::object(), o);
@@ -231,10 +225,7 @@ TEST(Recommend, ALargerMapThatDoesNotHelpIsNotRecommended) {
     fake->depthTarget = b0;
     fake->slopeTarget = 1.0;
     fake->neededMap = 3000;
-    RecommendOptions o;
-    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) {
-        return (*fake)(sc, st, b);
-    };
+    RecommendOptions o = fakeOptions(fake);
     o.raytrace = false;
     const Recommendation r = recommendShadow(s, row(1000, 0), s, row(1000, 0), nullptr, nullptr, Json::object(), o);
     EXPECT_EQ(r.raster.largerMapSize, 4096);
@@ -248,10 +239,7 @@ TEST(Recommend, KeepsTheUsersOwnSettingsInTheBlock) {
     const scene::Scene s = fakeScene(500);
     auto fake = std::make_shared<Fake>();
     fake->depthTarget = 1e-3;
-    RecommendOptions o;
-    o.render = [fake](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) {
-        return (*fake)(sc, st, b);
-    };
+    RecommendOptions o = fakeOptions(fake);
     o.user.filter = "pcf";
     o.user.shadowMapSize = 1024;
     o.user.fitLightFrustum = false;  // a flag not given: not the user's choice
