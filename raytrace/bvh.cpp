@@ -640,13 +640,58 @@ namespace shadowlab::raytrace {
 
 namespace {
 
+// roundDown<float> / roundUp<float> (real.h) with the step to the neighbouring float taken on
+// the bits instead of by std::nextafter, a library call that was most of a reference's cost.
+// For every non-NaN float r: the next float down is bits − 1 above zero, bits + 1 below it, and
+// the smallest negative subnormal from ±0 (and the next up mirrors it).
+float floatDown(double x) {
+    float r = float(x);
+    if (double(r) > x) {
+        std::uint32_t bits;
+        std::memcpy(&bits, &r, sizeof bits);
+        bits = r > 0 ? bits - 1 : (r < 0 ? bits + 1 : 0x80000001u);
+        std::memcpy(&r, &bits, sizeof r);
+    }
+    return r;
+}
+float floatUp(double x) {
+    float r = float(x);
+    if (double(r) < x) {
+        std::uint32_t bits;
+        std::memcpy(&bits, &r, sizeof bits);
+        bits = r > 0 ? bits + 1 : (r < 0 ? bits - 1 : 0x00000001u);
+        std::memcpy(&r, &bits, sizeof r);
+    }
+    return r;
+}
+
 PrimRefF floatRef(const scene::Bounds& b, std::uint32_t index) {
     float idx;
     std::memcpy(&idx, &index, sizeof idx);
     PrimRefF r;
-    r.lo = _mm_setr_ps(roundDown<float>(b.min.x), roundDown<float>(b.min.y), roundDown<float>(b.min.z), idx);
-    r.hi = _mm_setr_ps(roundUp<float>(b.max.x), roundUp<float>(b.max.y), roundUp<float>(b.max.z), 0.0f);
+    r.lo = _mm_setr_ps(floatDown(b.min.x), floatDown(b.min.y), floatDown(b.min.z), idx);
+    r.hi = _mm_setr_ps(floatUp(b.max.x), floatUp(b.max.y), floatUp(b.max.z), 0.0f);
     return r;
+}
+
+// 2^-k for k in [0, 31], made on the exponent bits (exact).
+double levelWeight(int k) {
+    const std::uint64_t bits = std::uint64_t(1023 - k) << 52;
+    double w;
+    std::memcpy(&w, &bits, sizeof w);
+    return w;
+}
+
+// x^(1/3) within a few per cent for normal floats x > 0, 0 otherwise: the exponent divided by
+// three on the bits (Kahan's estimate, the constant re-biases it). A priority needs no more,
+// and std::cbrt was a twentieth of the float build.
+float cubeRootEstimate(float x) {
+    if (!(x >= std::numeric_limits<float>::min())) return 0.0f;
+    std::uint32_t bits;
+    std::memcpy(&bits, &x, sizeof bits);
+    bits = bits / 3 + 0x2a514067u;
+    std::memcpy(&x, &bits, sizeof x);
+    return x;
 }
 
 // Pre-splitting of triangles (Karras & Aila, "Fast Parallel Construction of High-Quality
@@ -658,8 +703,8 @@ PrimRefF floatRef(const scene::Bounds& b, std::uint32_t index) {
 struct Presplitter {
     const std::vector<Vec3T<float>>& positions;
     const std::vector<std::uint32_t>& indices;
-    double gridLo[3], gridExtent[3];
-    double pad;  // margin around a piece (see emit)
+    double gridLo[3], gridExtent[3], gridScale[3];  // scale: 2^31 / extent
+    double pad;                                     // margin around a piece (see emit)
 
     struct BoxD {
         double lo[3], hi[3];
@@ -704,36 +749,33 @@ struct Presplitter {
         }
     }
 
+    // [0, 2^31) fixed point of a coordinate over the mesh box on this axis.
+    std::uint32_t fixed(int axis, double x) const {
+        return std::uint32_t(std::clamp((x - gridLo[axis]) * gridScale[axis], 0.0, 0x1.0p31 - 2));
+    }
+
     // The level k (1: the middle plane) of the coarsest grid plane the box crosses, over its
-    // axes: with the box's ends in 31-bit fixed point, the highest bit in which they differ.
+    // axes: with the box's ends in fixed point, the highest bit in which they differ.
     int level(const scene::Bounds& b) const {
         int best = 31;
         for (int axis = 0; axis < 3; ++axis) {
-            const double e = gridExtent[axis];
-            if (!(e > 0)) continue;
-            auto fixed = [&](double x) {
-                return std::uint32_t(std::clamp((x - gridLo[axis]) / e, 0.0, 1.0) * 0x1.0p31 * (1 - 0x1.0p-30));
-            };
-            const std::uint32_t d = fixed(b.min[axis]) ^ fixed(b.max[axis]);
+            if (!(gridExtent[axis] > 0)) continue;
+            const std::uint32_t d = fixed(axis, b.min[axis]) ^ fixed(axis, b.max[axis]);
             if (d != 0) best = std::min(best, __builtin_clz(d));  // bit 30 differs: level 1
         }
         return best;
     }
 
-    // The coarsest grid plane strictly inside (lo, hi) on this axis, as a float; NaN if none.
+    // The coarsest grid plane inside (lo, hi) on this axis (the upper end's fixed point with the
+    // bits below the highest one that differs from the lower end's cleared), else the middle,
+    // as a float strictly inside; NaN if none.
     float plane(int axis, double lo, double hi) const {
-        const double e = gridExtent[axis];
-        if (!(e > 0) || !(hi > lo)) return std::numeric_limits<float>::quiet_NaN();
-        const double u0 = (lo - gridLo[axis]) / e, u1 = (hi - gridLo[axis]) / e;
-        for (int k = 1; k <= 40; ++k) {
-            const double cells = std::ldexp(1.0, k);
-            double m = std::floor(u1 * cells);
-            if (m == u1 * cells) m -= 1;
-            if (m > u0 * cells) {
-                const float s = float(gridLo[axis] + e * (m / cells));
-                if (double(s) > lo && double(s) < hi) return s;
-                break;
-            }
+        if (!(gridExtent[axis] > 0) || !(hi > lo)) return std::numeric_limits<float>::quiet_NaN();
+        const std::uint32_t a = fixed(axis, lo), b = fixed(axis, hi);
+        if (a != b) {
+            const int h = 31 - __builtin_clz(a ^ b);
+            const float s = float(gridLo[axis] + gridExtent[axis] * (double((b >> h) << h) * 0x1.0p-31));
+            if (double(s) > lo && double(s) < hi) return s;
         }
         const float s = float(0.5 * (lo + hi));
         return double(s) > lo && double(s) < hi ? s : std::numeric_limits<float>::quiet_NaN();
@@ -747,8 +789,8 @@ struct Presplitter {
         _mm_store_ps(wl, whole.lo);
         _mm_store_ps(wh, whole.hi);
         for (int k = 0; k < 3; ++k) {
-            l[k] = std::max(wl[k], roundDown<float>(box.lo[k] - pad));
-            h[k] = std::min(wh[k], roundUp<float>(box.hi[k] + pad));
+            l[k] = std::max(wl[k], floatDown(box.lo[k] - pad));
+            h[k] = std::min(wh[k], floatUp(box.hi[k] + pad));
         }
         l[3] = wl[3];
         h[3] = 0.0f;
@@ -814,10 +856,11 @@ Bvh Bvh::buildFast(const std::vector<scene::Bounds>& primitiveBounds, const std:
     if (n == 0) return Bvh{};
     scene::Bounds all;
     for (const scene::Bounds& b : primitiveBounds) all.extend(b);
-    Presplitter ps{positions, indices, {}, {}, 0.0};
+    Presplitter ps{positions, indices, {}, {}, {}, 0.0};
     for (int k = 0; k < 3; ++k) {
         ps.gridLo[k] = all.min[k];
         ps.gridExtent[k] = all.max[k] - all.min[k];
+        ps.gridScale[k] = ps.gridExtent[k] > 0 ? 0x1.0p31 / ps.gridExtent[k] : 0.0;
     }
     ps.pad = kPresplitPad * (all.maxAbsCoordinate() + all.diagonal());
     // Priority: Karras & Aila's, the cube root of the box's empty surface times the importance of
@@ -835,8 +878,8 @@ Bvh Bvh::buildFast(const std::vector<scene::Bounds>& primitiveBounds, const std:
                 // The box's surface not covered by the triangle's two sides, weighted by the
                 // coarsest grid plane the box crosses: halved per level below the middle one.
                 const double waste = (surfaceArea(primitiveBounds[i]) - std::sqrt(cx * cx + cy * cy + cz * cz)) *
-                                     std::ldexp(1.0, -ps.level(primitiveBounds[i]));
-                priority[i] = waste > 0 ? std::cbrt(float(waste)) : 0.0f;
+                                     levelWeight(ps.level(primitiveBounds[i]));
+                priority[i] = cubeRootEstimate(float(waste));
             }
         });
     // Summed in order, and the extras below are integers: the tree does not depend on the threads.
@@ -845,22 +888,18 @@ Bvh Bvh::buildFast(const std::vector<scene::Bounds>& primitiveBounds, const std:
     // Triangle i gets floor(scale · priority) extra pieces (at most kPresplitMaxPieces in all),
     // the scale found by bisection so that the extras come to the budget.
     const double budget = kPresplitBudget * double(n);
-    auto extras = [&](std::size_t i, double scale) {
-        return std::uint32_t(std::min(std::floor(scale * double(priority[i])), double(kPresplitMaxPieces - 1)));
+    auto extras = [&](std::size_t i, double scale) {  // (a truncation: scale · priority ≥ 0)
+        return std::uint32_t(std::min(scale * double(priority[i]), double(kPresplitMaxPieces - 1)));
     };
-    auto used = [&](double scale) {
-        return tbb::parallel_reduce(
-            tbb::blocked_range<std::size_t>(0, n, kBvhParallelGrain), 0.0,
-            [&](const tbb::blocked_range<std::size_t>& r, double acc) {
-                for (std::size_t i = r.begin(); i != r.end(); ++i) acc += extras(i, scale);
-                return acc;
-            },
-            [](double a, double b) { return a + b; });
+    auto used = [&](double scale) {  // (serial: a fraction of a ns per triangle, less than waking threads)
+        std::uint64_t sum = 0;
+        for (std::size_t i = 0; i < n; ++i) sum += extras(i, scale);
+        return double(sum);
     };
     // Σ⌊s·p⌋ lies in (s·Σp − n, s·Σp]: at budget / total it is within the budget, at
-    // (n + budget) / total beyond it. A few halvings find the scale to a few per cent.
+    // (n + budget) / total beyond it. Six halvings find the scale to a fraction of that range.
     double lo = total > 0 ? budget / total : 0.0, hi = total > 0 ? (double(n) + budget) / total : 0.0;
-    for (int it = 0; it < 8 && hi > 0; ++it) {
+    for (int it = 0; it < 6 && hi > 0; ++it) {
         const double mid = 0.5 * (lo + hi);
         (used(mid) > budget ? hi : lo) = mid;
     }

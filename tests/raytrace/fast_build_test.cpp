@@ -206,6 +206,23 @@ TEST(FastBuild, PresplitPiecesCoverTheirTriangles) {
     }
 }
 
+TEST(FastBuild, ThePresplitTreeDoesNotDependOnTheThreadCount) {
+    std::mt19937_64 g(49);
+    const auto mesh = largeAndSmall(g);
+    std::vector<scene::Bounds> boxes(mesh->indices.size() / 3);
+    std::vector<Vec3T<float>> positions;
+    for (const Vec3& p : mesh->positions) positions.emplace_back(p);
+    for (std::size_t t = 0; t < boxes.size(); ++t)
+        for (int k = 0; k < 3; ++k) boxes[t].extend(mesh->positions[mesh->indices[3 * t + k]]);
+    tbb::task_arena a1(1), a4(4);
+    Bvh t1, t4;
+    a1.execute([&] { t1 = Bvh::buildFast(boxes, positions, mesh->indices); });
+    a4.execute([&] { t4 = Bvh::buildFast(boxes, positions, mesh->indices); });
+    ASSERT_EQ(t1.nodes().size(), t4.nodes().size());
+    EXPECT_EQ(t1.primitives(), t4.primitives());
+    EXPECT_EQ(std::memcmp(t1.nodes().data(), t4.nodes().data(), t1.nodes().size() * sizeof(BvhNode)), 0);
+}
+
 // The float tracer finds the same hits with pre-split triangles as without: rays at random and
 // rays aimed at the large triangles' edges, where a piece's box is tightest.
 TEST(FastBuild, PresplitTreeGivesTheSameHitsAsTheReferenceTree) {
