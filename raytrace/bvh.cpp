@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <numeric>
@@ -637,24 +638,299 @@ Bvh Bvh::build(const std::vector<scene::Bounds>& primitiveBounds) {
 
 namespace shadowlab::raytrace {
 
+namespace {
+
+// roundDown<float> / roundUp<float> (real.h) with the step to the neighbouring float taken on
+// the bits instead of by std::nextafter, a library call that was most of a reference's cost.
+// For every non-NaN float r: the next float down is bits − 1 above zero, bits + 1 below it, and
+// the smallest negative subnormal from ±0 (and the next up mirrors it).
+float floatDown(double x) {
+    float r = float(x);
+    if (double(r) > x) {
+        std::uint32_t bits;
+        std::memcpy(&bits, &r, sizeof bits);
+        bits = r > 0 ? bits - 1 : (r < 0 ? bits + 1 : 0x80000001u);
+        std::memcpy(&r, &bits, sizeof r);
+    }
+    return r;
+}
+float floatUp(double x) {
+    float r = float(x);
+    if (double(r) < x) {
+        std::uint32_t bits;
+        std::memcpy(&bits, &r, sizeof bits);
+        bits = r > 0 ? bits + 1 : (r < 0 ? bits - 1 : 0x00000001u);
+        std::memcpy(&r, &bits, sizeof r);
+    }
+    return r;
+}
+
+PrimRefF floatRef(const scene::Bounds& b, std::uint32_t index) {
+    float idx;
+    std::memcpy(&idx, &index, sizeof idx);
+    PrimRefF r;
+    r.lo = _mm_setr_ps(floatDown(b.min.x), floatDown(b.min.y), floatDown(b.min.z), idx);
+    r.hi = _mm_setr_ps(floatUp(b.max.x), floatUp(b.max.y), floatUp(b.max.z), 0.0f);
+    return r;
+}
+
+// 2^-k for k in [0, 31], made on the exponent bits (exact).
+double levelWeight(int k) {
+    const std::uint64_t bits = std::uint64_t(1023 - k) << 52;
+    double w;
+    std::memcpy(&w, &bits, sizeof w);
+    return w;
+}
+
+// x^(1/3) within a few per cent for normal floats x > 0, 0 otherwise: the exponent divided by
+// three on the bits (Kahan's estimate, the constant re-biases it). A priority needs no more,
+// and std::cbrt was a twentieth of the float build.
+float cubeRootEstimate(float x) {
+    if (!(x >= std::numeric_limits<float>::min())) return 0.0f;
+    std::uint32_t bits;
+    std::memcpy(&bits, &x, sizeof bits);
+    bits = bits / 3 + 0x2a514067u;
+    std::memcpy(&x, &bits, sizeof x);
+    return x;
+}
+
+// Pre-splitting of triangles (Karras & Aila, "Fast Parallel Construction of High-Quality
+// Bounding Volume Hierarchies", HPG 2013, section 4.2): a budget of extra references goes to the
+// triangles whose box is largest and emptiest, each split recursively across its box's longest
+// axis at the coarsest plane of a power-of-two grid over the mesh (the planes the SAH splits
+// near the root most likely use). A piece's box is the box of the triangle clipped to one side,
+// within its parent's box.
+struct Presplitter {
+    const std::vector<Vec3T<float>>& positions;
+    const std::vector<std::uint32_t>& indices;
+    double gridLo[3], gridExtent[3], gridScale[3];  // scale: 2^31 / extent
+    double pad;                                     // margin around a piece (see emit)
+
+    struct BoxD {
+        double lo[3], hi[3];
+        void empty() {
+            for (int k = 0; k < 3; ++k) {
+                lo[k] = std::numeric_limits<double>::infinity();
+                hi[k] = -std::numeric_limits<double>::infinity();
+            }
+        }
+        void extend(const double p[3]) {
+            for (int k = 0; k < 3; ++k) {
+                lo[k] = std::min(lo[k], p[k]);
+                hi[k] = std::max(hi[k], p[k]);
+            }
+        }
+        bool isEmpty() const { return !(lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2]); }
+    };
+
+    void vertices(std::uint32_t tri, double v[3][3]) const {
+        for (int k = 0; k < 3; ++k) {
+            const Vec3T<float>& p = positions[indices[3 * std::size_t(tri) + k]];
+            for (int a = 0; a < 3; ++a) v[k][a] = double(p[a]);
+        }
+    }
+
+    // The box of the part of the triangle on one side of the plane x[axis] = s (both sides take
+    // points on the plane).
+    static void clipHalf(const double v[3][3], int axis, double s, bool below, BoxD& out) {
+        out.empty();
+        for (int i = 0; i < 3; ++i) {
+            const double* a = v[i];
+            const double* b = v[(i + 1) % 3];
+            const double da = a[axis] - s, db = b[axis] - s;
+            if (below ? da <= 0 : da >= 0) out.extend(a);
+            if ((da < 0 && db > 0) || (da > 0 && db < 0)) {
+                const double f = da / (da - db);
+                double p[3];
+                for (int k = 0; k < 3; ++k) p[k] = a[k] + f * (b[k] - a[k]);
+                p[axis] = s;
+                out.extend(p);
+            }
+        }
+    }
+
+    // [0, 2^31) fixed point of a coordinate over the mesh box on this axis.
+    std::uint32_t fixed(int axis, double x) const {
+        return std::uint32_t(std::clamp((x - gridLo[axis]) * gridScale[axis], 0.0, 0x1.0p31 - 2));
+    }
+
+    // The level k (1: the middle plane) of the coarsest grid plane the box crosses, over its
+    // axes: with the box's ends in fixed point, the highest bit in which they differ.
+    int level(const scene::Bounds& b) const {
+        int best = 31;
+        for (int axis = 0; axis < 3; ++axis) {
+            if (!(gridExtent[axis] > 0)) continue;
+            const std::uint32_t d = fixed(axis, b.min[axis]) ^ fixed(axis, b.max[axis]);
+            if (d != 0) best = std::min(best, __builtin_clz(d));  // bit 30 differs: level 1
+        }
+        return best;
+    }
+
+    // The coarsest grid plane inside (lo, hi) on this axis (the upper end's fixed point with the
+    // bits below the highest one that differs from the lower end's cleared), else the middle,
+    // as a float strictly inside; NaN if none.
+    float plane(int axis, double lo, double hi) const {
+        if (!(gridExtent[axis] > 0) || !(hi > lo)) return std::numeric_limits<float>::quiet_NaN();
+        const std::uint32_t a = fixed(axis, lo), b = fixed(axis, hi);
+        if (a != b) {
+            const int h = 31 - __builtin_clz(a ^ b);
+            const float s = float(gridLo[axis] + gridExtent[axis] * (double((b >> h) << h) * 0x1.0p-31));
+            if (double(s) > lo && double(s) < hi) return s;
+        }
+        const float s = float(0.5 * (lo + hi));
+        return double(s) > lo && double(s) < hi ? s : std::numeric_limits<float>::quiet_NaN();
+    }
+
+    // A piece's reference: its box widened by `pad` and rounded outward, but never beyond the
+    // whole triangle's box. The margin keeps inside the pieces every point the float triangle
+    // test may accept near the triangle (its rounding is far below it), as the whole box did.
+    static void emit(const BoxD& box, double pad, const PrimRefF& whole, PrimRefF*& out) {
+        alignas(16) float wl[4], wh[4], l[4], h[4];
+        _mm_store_ps(wl, whole.lo);
+        _mm_store_ps(wh, whole.hi);
+        for (int k = 0; k < 3; ++k) {
+            l[k] = std::max(wl[k], floatDown(box.lo[k] - pad));
+            h[k] = std::min(wh[k], floatUp(box.hi[k] + pad));
+        }
+        l[3] = wl[3];
+        h[3] = 0.0f;
+        out->lo = _mm_load_ps(l);
+        out->hi = _mm_load_ps(h);
+        ++out;
+    }
+
+    void split(const double v[3][3], const BoxD& box, int pieces, const PrimRefF& whole, PrimRefF*& out) const {
+        int axis = 0;
+        for (int k = 1; k < 3; ++k)
+            if (box.hi[k] - box.lo[k] > box.hi[axis] - box.lo[axis]) axis = k;
+        const float s = pieces > 1 ? plane(axis, box.lo[axis], box.hi[axis]) : 0.0f;
+        if (pieces <= 1 || std::isnan(s)) {
+            for (int i = 0; i < pieces; ++i) emit(box, pad, whole, out);  // (count kept exact)
+            return;
+        }
+        BoxD left, right;
+        clipHalf(v, axis, s, true, left);
+        clipHalf(v, axis, s, false, right);
+        for (int k = 0; k < 3; ++k) {
+            left.lo[k] = std::max(left.lo[k], box.lo[k]);
+            left.hi[k] = std::min(left.hi[k], box.hi[k]);
+            right.lo[k] = std::max(right.lo[k], box.lo[k]);
+            right.hi[k] = std::min(right.hi[k], box.hi[k]);
+        }
+        left.hi[axis] = std::min(left.hi[axis], double(s));
+        right.lo[axis] = std::max(right.lo[axis], double(s));
+        if (left.isEmpty() || right.isEmpty()) {
+            for (int i = 0; i < pieces; ++i) emit(box, pad, whole, out);
+            return;
+        }
+        const double el = left.hi[axis] - left.lo[axis], er = right.hi[axis] - right.lo[axis];
+        int nl = int(std::lround(pieces * (el / (el + er))));
+        nl = std::clamp(nl, 1, pieces - 1);
+        split(v, left, nl, whole, out);
+        split(v, right, pieces - nl, whole, out);
+    }
+};
+
+}  // namespace
+
+struct FastBuildAccess {
+    static Bvh build(std::vector<PrimRefF>& refs);
+};
+
 Bvh Bvh::buildFast(const std::vector<scene::Bounds>& primitiveBounds) {
     Bvh bvh;
     const std::size_t n = primitiveBounds.size();
     if (n == 0) return bvh;
     std::vector<PrimRefF> refs(n);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kBvhParallelGrain),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t i = r.begin(); i != r.end(); ++i)
+                              refs[i] = floatRef(primitiveBounds[i], std::uint32_t(i));
+                      });
+    return FastBuildAccess::build(refs);
+}
+
+Bvh Bvh::buildFast(const std::vector<scene::Bounds>& primitiveBounds, const std::vector<Vec3T<float>>& positions,
+                   const std::vector<std::uint32_t>& indices) {
+    const std::size_t n = primitiveBounds.size();
+    if (n == 0) return Bvh{};
+    scene::Bounds all;
+    for (const scene::Bounds& b : primitiveBounds) all.extend(b);
+    Presplitter ps{positions, indices, {}, {}, {}, 0.0};
+    for (int k = 0; k < 3; ++k) {
+        ps.gridLo[k] = all.min[k];
+        ps.gridExtent[k] = all.max[k] - all.min[k];
+        ps.gridScale[k] = ps.gridExtent[k] > 0 ? 0x1.0p31 / ps.gridExtent[k] : 0.0;
+    }
+    ps.pad = kPresplitPad * (all.maxAbsCoordinate() + all.diagonal());
+    // Priority: Karras & Aila's, the cube root of the box's empty surface times the importance of
+    // the planes it crosses; the budget is shared in proportion.
+    std::vector<float> priority(n);
     tbb::parallel_for(
         tbb::blocked_range<std::size_t>(0, n, kBvhParallelGrain), [&](const tbb::blocked_range<std::size_t>& r) {
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                const scene::Bounds& b = primitiveBounds[i];
-                const std::uint32_t index = std::uint32_t(i);
-                float idx;
-                std::memcpy(&idx, &index, sizeof idx);
-                refs[i].lo =
-                    _mm_setr_ps(roundDown<float>(b.min.x), roundDown<float>(b.min.y), roundDown<float>(b.min.z), idx);
-                refs[i].hi =
-                    _mm_setr_ps(roundUp<float>(b.max.x), roundUp<float>(b.max.y), roundUp<float>(b.max.z), 0.0f);
+                double v[3][3];
+                ps.vertices(std::uint32_t(i), v);
+                const double e1[3] = {v[1][0] - v[0][0], v[1][1] - v[0][1], v[1][2] - v[0][2]};
+                const double e2[3] = {v[2][0] - v[0][0], v[2][1] - v[0][1], v[2][2] - v[0][2]};
+                const double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2],
+                             cz = e1[0] * e2[1] - e1[1] * e2[0];
+                // The box's surface not covered by the triangle's two sides, weighted by the
+                // coarsest grid plane the box crosses: halved per level below the middle one.
+                const double waste = (surfaceArea(primitiveBounds[i]) - std::sqrt(cx * cx + cy * cy + cz * cz)) *
+                                     levelWeight(ps.level(primitiveBounds[i]));
+                priority[i] = cubeRootEstimate(float(waste));
             }
         });
+    // Summed in order, and the extras below are integers: the tree does not depend on the threads.
+    double total = 0;
+    for (float p : priority) total += p;
+    // Triangle i gets floor(scale · priority) extra pieces (at most kPresplitMaxPieces in all),
+    // the scale found by bisection so that the extras come to the budget.
+    const double budget = kPresplitBudget * double(n);
+    auto extras = [&](std::size_t i, double scale) {  // (a truncation: scale · priority ≥ 0)
+        return std::uint32_t(std::min(scale * double(priority[i]), double(kPresplitMaxPieces - 1)));
+    };
+    auto used = [&](double scale) {  // (serial: a fraction of a ns per triangle, less than waking threads)
+        std::uint64_t sum = 0;
+        for (std::size_t i = 0; i < n; ++i) sum += extras(i, scale);
+        return double(sum);
+    };
+    // Σ⌊s·p⌋ lies in (s·Σp − n, s·Σp]: at budget / total it is within the budget, at
+    // (n + budget) / total beyond it. Six halvings find the scale to a fraction of that range.
+    double lo = total > 0 ? budget / total : 0.0, hi = total > 0 ? (double(n) + budget) / total : 0.0;
+    for (int it = 0; it < 6 && hi > 0; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (used(mid) > budget ? hi : lo) = mid;
+    }
+    std::vector<std::uint32_t> first(n + 1);
+    first[0] = 0;
+    for (std::size_t i = 0; i < n; ++i) first[i + 1] = first[i] + 1 + extras(i, lo);
+    std::vector<PrimRefF> refs(first[n]);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, kBvhParallelGrain),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                              const PrimRefF whole = floatRef(primitiveBounds[i], std::uint32_t(i));
+                              PrimRefF* out = refs.data() + first[i];
+                              const int pieces = int(first[i + 1] - first[i]);
+                              if (pieces == 1) {
+                                  *out = whole;
+                                  continue;
+                              }
+                              double v[3][3];
+                              ps.vertices(std::uint32_t(i), v);
+                              Presplitter::BoxD box;
+                              box.empty();
+                              for (int k = 0; k < 3; ++k) box.extend(v[k]);
+                              ps.split(v, box, pieces, whole, out);
+                          }
+                      });
+    return FastBuildAccess::build(refs);
+}
+
+Bvh FastBuildAccess::build(std::vector<PrimRefF>& refs) {
+    Bvh bvh;
+    const std::size_t n = refs.size();
     FastBuilder b{refs};
     BoxF all, cb;
     b.rangeBounds(0, std::uint32_t(n), all, cb);

@@ -29,6 +29,12 @@ public:
     // The same SAH on float bounds (rounded outward), for the float tracer: about half the
     // build time, a slightly different tree (docs/performance.md, "Setup time").
     static Bvh buildFast(const std::vector<scene::Bounds>& primitiveBounds);
+    // buildFast over triangles (positions[indices[3i + k]], the float vertices the tracer tests)
+    // whose large, mostly empty boxes are first split into several tighter references
+    // (pre-splitting, Karras & Aila 2013): a triangle may then sit in several leaves.
+    // primitiveBounds[i] must contain triangle i.
+    static Bvh buildFast(const std::vector<scene::Bounds>& primitiveBounds, const std::vector<Vec3T<float>>& positions,
+                         const std::vector<std::uint32_t>& indices);
 
     const std::vector<BvhNode>& nodes() const { return nodes_; }
     const std::vector<std::uint32_t>& primitives() const { return primitives_; }
@@ -42,6 +48,7 @@ public:
     bool traverse(const Ray<Real>& ray, Real& tMax, bool anyHit, LeafFn&& leaf) const;
 
 private:
+    friend struct FastBuildAccess;  // bvh.cpp: buildFast's common end
     std::vector<BvhNode> nodes_;
     std::vector<std::uint32_t> primitives_;
     int depth_ = 0;

@@ -45,6 +45,22 @@ inline constexpr unsigned kBvhParallelGrain = 1024;
 // culling a hit the object-space test finds. The object-space trees decide every hit.
 inline constexpr double kInstanceBoxPad = 0x1.0p-16;
 
+// The float walk's closest-hit tie rule (docs/raytrace.md, "Ties") needs every triangle hit at
+// the best t tested, but a box's entry distance and a triangle's t are computed differently
+// and may round apart (a box entered at exactly the hit's t measures a float or two beyond
+// it). So the walk culls boxes beyond tMax·(1 + 2^-16): over 100 floats of slack, far more
+// than the few roundings either side carries for any but the most grazing hits.
+inline constexpr float kTieCullSlack = 1.0f + 0x1.0p-16f;
+
+// Pre-splitting of the float build (bvh.cpp, Presplitter): extra references, as a fraction of
+// the triangle count, and the most pieces one triangle is cut into.
+inline constexpr double kPresplitBudget = 0.1;
+inline constexpr int kPresplitMaxPieces = 64;
+// A piece's box is widened by this much of the mesh's scale (largest coordinate plus diagonal),
+// within its triangle's whole box: far above the float triangle test's rounding (a few 2^-24
+// of that scale), so every hit the test can accept lies in some piece's box.
+inline constexpr double kPresplitPad = 0x1.0p-16;
+
 // Seed of the per-pixel random streams for area-light samples, so renders are reproducible.
 inline constexpr unsigned long long kSampleSeed = 0x5eed5eedULL;
 

@@ -416,8 +416,10 @@ int Tracer<Real>::buildMesh(const std::vector<scene::Vec3>& positions, const std
         for (int k = 0; k < 3; ++k) triBounds[t].extend(positions[indices[3 * t + k]]);
     // The reference keeps the double build's tree; the float tracer takes the float build's
     // (closest-hit ties go to the lowest triangle index, so the hits do not depend on the tree).
-    d.bvh =
-        std::is_same_v<Real, float> && detail::fastFloatBuild() ? Bvh8::buildFast(triBounds) : Bvh8::build(triBounds);
+    if constexpr (std::is_same_v<Real, float>)
+        d.bvh = detail::fastFloatBuild() ? Bvh8::buildFast(triBounds, d.positions, d.indices) : Bvh8::build(triBounds);
+    else
+        d.bvh = Bvh8::build(triBounds);
     const std::vector<std::uint32_t>& slots = d.bvh.primitives();
     if constexpr (std::is_same_v<Real, float>) {
         d.packets.resize(slots.size() / WideRef::kLeafAlign);

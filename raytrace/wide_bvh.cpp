@@ -1,6 +1,7 @@
 // raytrace/wide_bvh.cpp: collapse of the binary SAH tree into N-wide nodes.
 #include "raytrace/wide_bvh.h"
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <limits>
@@ -31,10 +32,13 @@ struct Collapser {
         if (n.count == 0) return collapse(b);
         // Leaves are laid out in traversal order, each starting on a multiple of kLeafAlign
         // slots, so a leaf is whole packets of four triangles.
+        // A pre-split triangle (Bvh::buildFast) may have several pieces in one leaf: it is kept once.
         const std::uint32_t first = std::uint32_t(prims.size());
-        prims.insert(prims.end(), binPrims.begin() + n.offset, binPrims.begin() + n.offset + n.count);
+        for (std::uint32_t i = n.offset; i < n.offset + n.count; ++i)
+            if (std::find(prims.begin() + first, prims.end(), binPrims[i]) == prims.end()) prims.push_back(binPrims[i]);
+        const std::uint32_t count = std::uint32_t(prims.size()) - first;
         while (prims.size() % WideRef::kLeafAlign != 0) prims.push_back(WideRef::kEmpty);
-        return WideRef::leafRef(first, n.count);
+        return WideRef::leafRef(first, count);
     }
 
     // Makes the wide node for binary interior node b and returns its index.
@@ -109,6 +113,16 @@ WideBvh<N> WideBvh<N>::build(const std::vector<scene::Bounds>& primitiveBounds) 
 template <int N>
 WideBvh<N> WideBvh<N>::buildFast(const std::vector<scene::Bounds>& primitiveBounds) {
     return collapse(Bvh::buildFast(primitiveBounds));
+}
+
+template <int N>
+WideBvh<N> WideBvh<N>::buildFast(const std::vector<scene::Bounds>& primitiveBounds,
+                                 const std::vector<Vec3T<float>>& positions,
+                                 const std::vector<std::uint32_t>& indices) {
+    // Pre-split references count against the slot limit: a mesh near it is built unsplit.
+    if (double(primitiveBounds.size()) * (1 + kPresplitBudget) >= double(kMaxSlots / kLeafAlign))
+        return buildFast(primitiveBounds);
+    return collapse(Bvh::buildFast(primitiveBounds, positions, indices));
 }
 
 template class WideBvh<4>;

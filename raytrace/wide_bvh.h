@@ -20,6 +20,7 @@
 #endif
 
 #include "raytrace/bvh.h"
+#include "raytrace/tolerances.h"
 
 namespace shadowlab::raytrace {
 
@@ -61,6 +62,9 @@ public:
     static WideBvh build(const std::vector<scene::Bounds>& primitiveBounds);
     // Bvh::buildFast collapsed: the float tracer's tree.
     static WideBvh buildFast(const std::vector<scene::Bounds>& primitiveBounds);
+    // Bvh::buildFast with pre-split triangles, collapsed.
+    static WideBvh buildFast(const std::vector<scene::Bounds>& primitiveBounds,
+                             const std::vector<Vec3T<float>>& positions, const std::vector<std::uint32_t>& indices);
     // Collapses a binary tree: each wide node takes a binary node's children and keeps opening
     // its interior child of largest surface area until it has N (the usual collapse, as
     // Embree's BVHNBuilder does; pbrt-v4 stays binary). The binary leaves are kept as they are.
@@ -454,6 +458,9 @@ bool WideBvh<N>::walk(const BoxTest& boxes, float& tMax, LeafFn&& leaf) const {
     float stackNear[kStackSize];
     int top = 0;
     bool hit = false;
+    // Boxes are culled a little beyond the best hit (tolerances.h, kTieCullSlack): a box whose
+    // computed entry rounds just past a hit's computed t may hold a triangle tied with it.
+    float cull = tMax * kTieCullSlack;
     for (;;) {
         bool leafReached = true;
         while (!isLeaf(ref)) {
@@ -463,7 +470,7 @@ bool WideBvh<N>::walk(const BoxTest& boxes, float& tMax, LeafFn&& leaf) const {
             _mm_prefetch(reinterpret_cast<const char*>(node.ref), _MM_HINT_T0);
 #endif
             alignas(32) float tn[N];
-            unsigned mask = unsigned(boxes(node, tMax, tn));
+            unsigned mask = unsigned(boxes(node, cull, tn));
             if (mask == 0) {
                 leafReached = false;
                 break;
@@ -536,12 +543,13 @@ bool WideBvh<N>::walk(const BoxTest& boxes, float& tMax, LeafFn&& leaf) const {
         if (leafReached && leaf(leafFirst(ref), leafCount(ref), tMax)) {
             hit = true;
             if constexpr (kAnyHit) return true;
+            cull = tMax * kTieCullSlack;
         }
         // Pop, skipping entries that begin beyond the nearest hit so far.
         for (;;) {
             if (top == 0) return hit;
             --top;
-            if (stackNear[top] <= tMax) {
+            if (stackNear[top] <= cull) {
                 ref = stackRef[top];
                 break;
             }

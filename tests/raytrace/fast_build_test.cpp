@@ -139,6 +139,133 @@ TEST(FastBuild, FloatTracerHitsAreTheSameOnItsTreeAndOnTheReferenceTree) {
     EXPECT_GT(hits, 10000);
 }
 
+// Large triangles across the whole mesh box (slanted, and axis-aligned ones whose edges lie on
+// their boxes' faces) among small ones: the pre-split build cuts the large ones into pieces.
+std::shared_ptr<scene::TriangleMesh> largeAndSmall(std::mt19937_64& g) {
+    auto mesh = std::make_shared<scene::TriangleMesh>();
+    std::uniform_real_distribution<double> u(-10, 10), d(-1, 1);
+    auto tri = [&](Vec3 a, Vec3 b, Vec3 c) {
+        const std::uint32_t base = std::uint32_t(mesh->positions.size());
+        for (const Vec3& p : {a, b, c}) mesh->positions.push_back(p);
+        for (std::uint32_t k = 0; k < 3; ++k) mesh->indices.push_back(base + k);
+    };
+    for (int i = 0; i < 60; ++i) tri(Vec3(u(g), u(g), u(g)), Vec3(u(g), u(g), u(g)), Vec3(u(g), u(g), u(g)));
+    for (int i = 0; i < 20; ++i) {
+        const double z = u(g);
+        tri(Vec3(-10, -10, z), Vec3(10, -10 + i, z), Vec3(-10 + i, 10, z));
+    }
+    for (int i = 0; i < 3000; ++i) {
+        const Vec3 c(u(g), u(g), u(g));
+        tri(c + 0.3 * Vec3(d(g), d(g), d(g)), c + 0.3 * Vec3(d(g), d(g), d(g)), c + 0.3 * Vec3(d(g), d(g), d(g)));
+    }
+    return mesh;
+}
+
+// Every point of every triangle lies in the box of some leaf that holds the triangle: the pieces'
+// boxes cover their triangle, whatever the split planes.
+TEST(FastBuild, PresplitPiecesCoverTheirTriangles) {
+    std::mt19937_64 g(45);
+    const auto mesh = largeAndSmall(g);
+    const std::size_t n = mesh->indices.size() / 3;
+    std::vector<scene::Bounds> boxes(n);
+    std::vector<Vec3T<float>> positions;
+    for (const Vec3& p : mesh->positions) positions.emplace_back(p);
+    for (std::size_t t = 0; t < n; ++t)
+        for (int k = 0; k < 3; ++k) boxes[t].extend(mesh->positions[mesh->indices[3 * t + k]]);
+    const Bvh bvh = Bvh::buildFast(boxes, positions, mesh->indices);
+    EXPECT_GT(bvh.primitives().size(), n);  // some triangles were split
+    std::vector<std::vector<std::uint32_t>> leavesOf(n);
+    for (std::uint32_t i = 0; i < bvh.nodes().size(); ++i)
+        if (bvh.nodes()[i].count > 0)
+            for (std::uint32_t s = 0; s < bvh.nodes()[i].count; ++s)
+                leavesOf.at(bvh.primitives()[bvh.nodes()[i].offset + s]).push_back(i);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (std::size_t t = 0; t < n; ++t) {
+        ASSERT_FALSE(leavesOf[t].empty()) << t;
+        for (int sample = 0; sample < 200; ++sample) {
+            double a = u(g), b = u(g);
+            if (a + b > 1) a = 1 - a, b = 1 - b;
+            // Vertices and edge points exactly, the rest inside.
+            if (sample < 3) a = sample == 1, b = sample == 2;
+            Vec3T<double> p(0);
+            for (int k = 0; k < 3; ++k) {
+                const double w = k == 0 ? 1 - a - b : (k == 1 ? a : b);
+                p += w * Vec3T<double>(positions[mesh->indices[3 * t + k]]);
+            }
+            bool inside = false;
+            for (std::uint32_t leaf : leavesOf[t]) {
+                const BvhNode& nd = bvh.nodes()[leaf];
+                bool in = true;
+                // (1e-12: the sample's own rounding in double, far below any float box's step)
+                for (int k = 0; k < 3; ++k)
+                    in = in && double(nd.lo[k]) - 1e-12 <= p[k] && p[k] <= double(nd.hi[k]) + 1e-12;
+                inside = inside || in;
+            }
+            ASSERT_TRUE(inside) << "triangle " << t << " sample " << sample;
+        }
+    }
+}
+
+TEST(FastBuild, ThePresplitTreeDoesNotDependOnTheThreadCount) {
+    std::mt19937_64 g(49);
+    const auto mesh = largeAndSmall(g);
+    std::vector<scene::Bounds> boxes(mesh->indices.size() / 3);
+    std::vector<Vec3T<float>> positions;
+    for (const Vec3& p : mesh->positions) positions.emplace_back(p);
+    for (std::size_t t = 0; t < boxes.size(); ++t)
+        for (int k = 0; k < 3; ++k) boxes[t].extend(mesh->positions[mesh->indices[3 * t + k]]);
+    tbb::task_arena a1(1), a4(4);
+    Bvh t1, t4;
+    a1.execute([&] { t1 = Bvh::buildFast(boxes, positions, mesh->indices); });
+    a4.execute([&] { t4 = Bvh::buildFast(boxes, positions, mesh->indices); });
+    ASSERT_EQ(t1.nodes().size(), t4.nodes().size());
+    EXPECT_EQ(t1.primitives(), t4.primitives());
+    EXPECT_EQ(std::memcmp(t1.nodes().data(), t4.nodes().data(), t1.nodes().size() * sizeof(BvhNode)), 0);
+}
+
+// The float tracer finds the same hits with pre-split triangles as without: rays at random and
+// rays aimed at the large triangles' edges, where a piece's box is tightest.
+TEST(FastBuild, PresplitTreeGivesTheSameHitsAsTheReferenceTree) {
+    std::mt19937_64 g(47);
+    const auto mesh = largeAndSmall(g);
+    scene::Scene s;
+    test::addMaterial(s, "matte");
+    test::addMesh(s, mesh);
+    const Tracer<float> fast(s);
+    detail::setFastFloatBuild(false);
+    const Tracer<float> reference(s);
+    detail::setFastFloatBuild(true);
+    std::uniform_real_distribution<double> u(-12, 12), w(0, 1);
+    std::vector<Ray<float>> rays;
+    for (int r = 0; r < 10000; ++r) {
+        const Vec3 from(u(g), u(g), -30), to(u(g), u(g), u(g));
+        rays.emplace_back(Vec3T<float>(from), Vec3T<float>(to - from));
+    }
+    for (int t = 0; t < 80; ++t)  // the large triangles
+        for (int r = 0; r < 150; ++r) {
+            const int e = r % 3;
+            const Vec3 a = mesh->positions[mesh->indices[3 * t + e]];
+            const Vec3 b = mesh->positions[mesh->indices[3 * t + (e + 1) % 3]];
+            const Vec3 to = a + w(g) * (b - a);
+            const Vec3 from(u(g), u(g), r % 2 ? -30 : 30);
+            rays.emplace_back(Vec3T<float>(from), Vec3T<float>(to - from));
+        }
+    int differ = 0, hits = 0;
+    for (const Ray<float>& ray : rays) {
+        Hit<float> a, b;
+        const bool fa = fast.closestHit(ray, std::numeric_limits<float>::infinity(), false, a);
+        const bool fb = reference.closestHit(ray, std::numeric_limits<float>::infinity(), false, b);
+        hits += fa;
+        differ += fa != fb || (fa && (std::memcmp(&a.t, &b.t, sizeof(float)) != 0 || a.prim != b.prim ||
+                                      std::memcmp(&a.b1, &b.b1, sizeof(float)) != 0));
+        int x = -1, y = -1;
+        differ += fast.anyHit(ray, std::numeric_limits<float>::infinity(), false, x) !=
+                  reference.anyHit(ray, std::numeric_limits<float>::infinity(), false, y);
+    }
+    EXPECT_EQ(differ, 0);
+    EXPECT_GT(hits, 10000);
+}
+
 TEST(FastBuild, AnExactTieGoesToTheLowestTriangleIndexOnEitherTree) {
     std::mt19937_64 g(43);
     const auto mesh = soupWithTies(g);
