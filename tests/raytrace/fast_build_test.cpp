@@ -103,6 +103,23 @@ std::shared_ptr<scene::TriangleMesh> soupWithTies(std::mt19937_64& g) {
     return mesh;
 }
 
+// How many of the ray's two answers differ between two tracers of the same mesh (0, 1 or 2): the
+// closest hit bit for bit (t, triangle, barycentrics) and whether anything is hit at all.
+// `hits` counts the closest hits of `fast`.
+template <class T>
+int answersDiffer(const T& fast, const T& reference, const Ray<float>& ray, bool conservative, int& hits) {
+    constexpr float kFar = std::numeric_limits<float>::infinity();
+    Hit<float> a, b;
+    const bool fa = fast.closestHit(ray, kFar, conservative, a);
+    const bool fb = reference.closestHit(ray, kFar, conservative, b);
+    hits += fa;
+    const bool closest = fa != fb || (fa && (std::memcmp(&a.t, &b.t, sizeof(float)) != 0 || a.prim != b.prim ||
+                                             std::memcmp(&a.b1, &b.b1, sizeof(float)) != 0));
+    int x = -1, y = -1;
+    const bool any = fast.anyHit(ray, kFar, conservative, x) != reference.anyHit(ray, kFar, conservative, y);
+    return int(closest) + int(any);
+}
+
 TEST(FastBuild, FloatTracerHitsAreTheSameOnItsTreeAndOnTheReferenceTree) {
     std::mt19937_64 g(41);
     scene::Scene s;
@@ -122,19 +139,8 @@ TEST(FastBuild, FloatTracerHitsAreTheSameOnItsTreeAndOnTheReferenceTree) {
     for (int k = 0; k < 400; ++k)
         rays.emplace_back(Vec3T<float>(float(-10 + k % 20), float(-10 + 0.05 * k), -30.0f), Vec3T<float>(0, 0, 1));
     int differ = 0, hits = 0;
-    for (const Ray<float>& ray : rays) {
-        for (bool conservative : {false, true}) {
-            Hit<float> a, b;
-            const bool fa = fast.closestHit(ray, std::numeric_limits<float>::infinity(), conservative, a);
-            const bool fb = reference.closestHit(ray, std::numeric_limits<float>::infinity(), conservative, b);
-            hits += fa;
-            differ += fa != fb || (fa && (std::memcmp(&a.t, &b.t, sizeof(float)) != 0 || a.prim != b.prim ||
-                                          std::memcmp(&a.b1, &b.b1, sizeof(float)) != 0));
-            int x = -1, y = -1;
-            differ += fast.anyHit(ray, std::numeric_limits<float>::infinity(), conservative, x) !=
-                      reference.anyHit(ray, std::numeric_limits<float>::infinity(), conservative, y);
-        }
-    }
+    for (const Ray<float>& ray : rays)
+        for (bool conservative : {false, true}) differ += answersDiffer(fast, reference, ray, conservative, hits);
     EXPECT_EQ(differ, 0);
     EXPECT_GT(hits, 10000);
 }
@@ -251,17 +257,7 @@ TEST(FastBuild, PresplitTreeGivesTheSameHitsAsTheReferenceTree) {
             rays.emplace_back(Vec3T<float>(from), Vec3T<float>(to - from));
         }
     int differ = 0, hits = 0;
-    for (const Ray<float>& ray : rays) {
-        Hit<float> a, b;
-        const bool fa = fast.closestHit(ray, std::numeric_limits<float>::infinity(), false, a);
-        const bool fb = reference.closestHit(ray, std::numeric_limits<float>::infinity(), false, b);
-        hits += fa;
-        differ += fa != fb || (fa && (std::memcmp(&a.t, &b.t, sizeof(float)) != 0 || a.prim != b.prim ||
-                                      std::memcmp(&a.b1, &b.b1, sizeof(float)) != 0));
-        int x = -1, y = -1;
-        differ += fast.anyHit(ray, std::numeric_limits<float>::infinity(), false, x) !=
-                  reference.anyHit(ray, std::numeric_limits<float>::infinity(), false, y);
-    }
+    for (const Ray<float>& ray : rays) differ += answersDiffer(fast, reference, ray, false, hits);
     EXPECT_EQ(differ, 0);
     EXPECT_GT(hits, 10000);
 }
