@@ -137,6 +137,24 @@ inline bool traverseFloat(const Bvh8& bvh, const std::vector<TrianglePacket>& pa
 }
 
 #if defined(SHADOWLAB_AVX_BOX_TEST)
+// The walk with the box test of the ray's octant (OctantTest<0..7>: its rows are constants). Called
+// only from the `flatten` functions below, which inline it with their own target.
+template <template <int> class OctantTest>
+inline bool traverseFloatByOctant(const Bvh8& bvh, const std::vector<TrianglePacket>& packets, const Ray<float>& ray,
+                                  float& tBest, bool conservative, bool anyHit, SlotHit& out,
+                                  const MaskFilter<float>& mask) {
+    switch (detail::octantOf(ray)) {
+        case 0: return traverseFloat<OctantTest<0>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 1: return traverseFloat<OctantTest<1>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 2: return traverseFloat<OctantTest<2>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 3: return traverseFloat<OctantTest<3>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 4: return traverseFloat<OctantTest<4>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 5: return traverseFloat<OctantTest<5>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        case 6: return traverseFloat<OctantTest<6>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+        default: return traverseFloat<OctantTest<7>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
+    }
+}
+
 // The same walk compiled for AVX, one copy per ray octant (the box test's rows are constants):
 // `flatten` inlines everything it calls (the walk, the leaf test, the SSE packet filter, the
 // scalar triangle test) into this one function, so the AVX code exists only here and runs only
@@ -147,25 +165,8 @@ __attribute__((target("avx"), flatten)) bool traverseFloatAvx(const Bvh8& bvh,
                                                               const Ray<float>& ray, float& tBest, bool conservative,
                                                               bool anyHit, SlotHit& out,
                                                               const MaskFilter<float>& mask) {
-    using detail::ChildBoxTestAvx8Octant;
-    switch (detail::octantOf(ray)) {
-        case 0:
-            return traverseFloat<ChildBoxTestAvx8Octant<0>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 1:
-            return traverseFloat<ChildBoxTestAvx8Octant<1>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 2:
-            return traverseFloat<ChildBoxTestAvx8Octant<2>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 3:
-            return traverseFloat<ChildBoxTestAvx8Octant<3>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 4:
-            return traverseFloat<ChildBoxTestAvx8Octant<4>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 5:
-            return traverseFloat<ChildBoxTestAvx8Octant<5>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 6:
-            return traverseFloat<ChildBoxTestAvx8Octant<6>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        default:
-            return traverseFloat<ChildBoxTestAvx8Octant<7>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-    }
+    return traverseFloatByOctant<detail::ChildBoxTestAvx8Octant>(bvh, packets, ray, tBest, conservative, anyHit, out,
+                                                                 mask);
 }
 
 // The walk with the AVX2 box test (ChildBoxTestAvx2Octant) for rays whose inverse direction is
@@ -175,25 +176,8 @@ __attribute__((target("avx2"), flatten)) bool traverseFloatAvx2(const Bvh8& bvh,
                                                                 const Ray<float>& ray, float& tBest, bool conservative,
                                                                 bool anyHit, SlotHit& out,
                                                                 const MaskFilter<float>& mask) {
-    using detail::ChildBoxTestAvx2Octant;
-    switch (detail::octantOf(ray)) {
-        case 0:
-            return traverseFloat<ChildBoxTestAvx2Octant<0>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 1:
-            return traverseFloat<ChildBoxTestAvx2Octant<1>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 2:
-            return traverseFloat<ChildBoxTestAvx2Octant<2>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 3:
-            return traverseFloat<ChildBoxTestAvx2Octant<3>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 4:
-            return traverseFloat<ChildBoxTestAvx2Octant<4>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 5:
-            return traverseFloat<ChildBoxTestAvx2Octant<5>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        case 6:
-            return traverseFloat<ChildBoxTestAvx2Octant<6>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-        default:
-            return traverseFloat<ChildBoxTestAvx2Octant<7>>(bvh, packets, ray, tBest, conservative, anyHit, out, mask);
-    }
+    return traverseFloatByOctant<detail::ChildBoxTestAvx2Octant>(bvh, packets, ray, tBest, conservative, anyHit, out,
+                                                                 mask);
 }
 #endif
 

@@ -68,6 +68,13 @@ TEST(FastBuild, HoldsEveryPrimitiveOnceInsideItsNodesBoxes) {
     for (std::size_t p = 0; p < seen.size(); ++p) ASSERT_EQ(seen[p], 1) << p;
 }
 
+// Appends triangle (a, b, c) with three vertices of its own.
+void addTriangle(scene::TriangleMesh& mesh, const Vec3& a, const Vec3& b, const Vec3& c) {
+    const std::uint32_t base = std::uint32_t(mesh.positions.size());
+    for (const Vec3& p : {a, b, c}) mesh.positions.push_back(p);
+    for (std::uint32_t k = 0; k < 3; ++k) mesh.indices.push_back(base + k);
+}
+
 // A soup of random triangles plus, scattered through the index list, several exact copies of
 // a few triangles (so the trees put copies in different leaves, in different orders) and a grid
 // of coplanar squares sharing edges (rays through shared edges and vertices hit two or more
@@ -75,11 +82,7 @@ TEST(FastBuild, HoldsEveryPrimitiveOnceInsideItsNodesBoxes) {
 std::shared_ptr<scene::TriangleMesh> soupWithTies(std::mt19937_64& g) {
     auto mesh = std::make_shared<scene::TriangleMesh>();
     std::uniform_real_distribution<double> u(-10, 10), d(-1, 1);
-    auto tri = [&](Vec3 a, Vec3 b, Vec3 c) {
-        const std::uint32_t base = std::uint32_t(mesh->positions.size());
-        for (const Vec3& p : {a, b, c}) mesh->positions.push_back(p);
-        for (std::uint32_t k = 0; k < 3; ++k) mesh->indices.push_back(base + k);
-    };
+    auto tri = [&](Vec3 a, Vec3 b, Vec3 c) { addTriangle(*mesh, a, b, c); };
     std::vector<std::array<Vec3, 3>> copies;
     for (int i = 0; i < 6; ++i) {
         const Vec3 c(u(g), u(g), u(g));
@@ -150,11 +153,7 @@ TEST(FastBuild, FloatTracerHitsAreTheSameOnItsTreeAndOnTheReferenceTree) {
 std::shared_ptr<scene::TriangleMesh> largeAndSmall(std::mt19937_64& g) {
     auto mesh = std::make_shared<scene::TriangleMesh>();
     std::uniform_real_distribution<double> u(-10, 10), d(-1, 1);
-    auto tri = [&](Vec3 a, Vec3 b, Vec3 c) {
-        const std::uint32_t base = std::uint32_t(mesh->positions.size());
-        for (const Vec3& p : {a, b, c}) mesh->positions.push_back(p);
-        for (std::uint32_t k = 0; k < 3; ++k) mesh->indices.push_back(base + k);
-    };
+    auto tri = [&](Vec3 a, Vec3 b, Vec3 c) { addTriangle(*mesh, a, b, c); };
     for (int i = 0; i < 60; ++i) tri(Vec3(u(g), u(g), u(g)), Vec3(u(g), u(g), u(g)), Vec3(u(g), u(g), u(g)));
     for (int i = 0; i < 20; ++i) {
         const double z = u(g);
