@@ -210,7 +210,7 @@ void tryLargerMap(const RecommendOptions& o, const scene::Scene& scene, const sc
                               " texels where the receivers and casters ask for " +
                               std::to_string(int(std::ceil(needed))) + ": ";
     const bool biasesWon = v.beatsDefaults;
-    if (v.largerMap.ok && beats(v.largerMap, v.recommended) && better(v.largerMap, v.recommended)) {
+    if (beats(v.largerMap, v.recommended)) {
         notes.push_back("For the shadow map, " + asked + "a " + std::to_string(larger) + " map gives " +
                         percentPair(v.largerMap, v.defaults) +
                         (biasesWon

@@ -57,6 +57,7 @@ struct Fake {
     // The map-size cap: a frame at the default size reports this many texels needed (0: none),
     // and a map of at most 2048 texels adds smallMapFloor wrong pixels (aliasing a larger one fixes).
     double neededMap = 0.0;
+    bool neededEvenWhenSet = false;  // report it at a size the user set too (the guard is the caller's)
     int smallMapFloor = 0;
     int renders = 0;
     scene::Frame operator()(const scene::Scene& s, const scene::RenderSettings& settings, scene::Backend backend) {
@@ -77,7 +78,7 @@ struct Fake {
         f.attributes["depth_bias"] = buf;
         f.attributes["filter"] = "pcf2x2";
         f.attributes["shadow_map_size"] = std::to_string(settings.raster.shadowMapSize);
-        if (neededMap > 0.0 && settings.raster.shadowMapSizeIsDefault)
+        if (neededMap > 0.0 && (settings.raster.shadowMapSizeIsDefault || neededEvenWhenSet))
             f.attributes["shadow_map_size_needed"] = std::to_string(int(neededMap));
         return f;
     }
@@ -207,7 +208,9 @@ TEST(Recommend, ALargerMapIsNotTriedWhereNothingIsCappedOrTheUserSetTheSize) {
         fake->depthTarget = b0;
         fake->slopeTarget = 1.0;
         fake->smallMapFloor = 30;
-        fake->neededMap = userSize ? 5000 : 0;  // with the user's size the frame reports no need anyway
+        // With the user's size the frame still says the receivers ask for more: the size is theirs.
+        fake->neededMap = userSize ? 5000 : 0;
+        fake->neededEvenWhenSet = true;
         RecommendOptions o = fakeOptions(fake);
         o.raytrace = false;
         if (userSize) o.user.shadowMapSize = 2048;
