@@ -911,15 +911,15 @@ bool Renderer::Impl::prepareFrame(scene::Frame& frame, scene::ChannelMask channe
         transition(commands, toGeneral);
         ctx.submitAndWait(commands);
     }
-    for (std::uint32_t p = 0; p < planes; ++p)
+    const bool colored = fresh && background != glm::vec3(0.0f);
+    for (std::uint32_t p = colored ? 1 : 0; p < planes; ++p)
         if (intoFrame[p]) vectors[p]->resize((p == 0 ? 3 : 1) * n);
-    if (fresh && background != glm::vec3(0.0f)) {
-        float* rgb = frame.beauty.data();
-        for (std::size_t i = 0; i < n; ++i, rgb += 3) {
-            rgb[0] = background.r;
-            rgb[1] = background.g;
-            rgb[2] = background.b;
-        }
+    if (colored) {
+        // Row by row from one row of the color (each float written once; resize() would zero
+        // them first). The vector is empty and has the room: nothing is reallocated.
+        std::vector<float> row(3 * std::size_t(width));
+        for (std::size_t x = 0; x < width; ++x) std::memcpy(&row[3 * x], &background[0], 3 * sizeof(float));
+        for (std::uint32_t y = 0; y < height; ++y) frame.beauty.insert(frame.beauty.end(), row.begin(), row.end());
     }
     std::size_t next = 0;
     for (std::uint32_t p = 0; p < planes; ++p) attachments.add(intoFrame[p] ? frameImages[next++] : targets.planes[p]);
