@@ -442,18 +442,22 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
 
 void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const LitBindings& bindings,
                    const LitTargets& targets, const LitAttachments& attachments, const DrawGeometry& geometry,
-                   const glm::vec3& background, LitOutputs outputs, const LitPipeline* alphaPipeline) {
+                   const glm::vec3& background, LitOutputs outputs, const LitPipeline* alphaPipeline,
+                   bool backgroundInAttachments) {
     const VkPipelineStageFlags2 colorStage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
     const VkPipelineStageFlags2 depthStages =
         VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
     // The float targets are not cleared: the background pipeline writes every pixel the scene
-    // leaves uncovered (their old contents are discarded). The display target is cleared.
+    // leaves uncovered (their old contents are discarded), or they hold the background already
+    // (kept). The display target is cleared.
     const bool clear = outputs == LitOutputs::kDisplay || !pipeline.background;
+    const bool keep = !clear && backgroundInAttachments;
     // The previous frame's copy or host read read them: the barrier orders this frame's writes after it.
     std::vector<ImageTransition> before;
     std::vector<VkRenderingAttachmentInfo> colors;
     for (std::size_t i = 0; i < attachments.images.size(); ++i) {
-        before.push_back({attachments.images[i], VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+        before.push_back({attachments.images[i], VK_IMAGE_ASPECT_COLOR_BIT, 1,
+                          keep ? VK_IMAGE_LAYOUT_GENERAL : VK_IMAGE_LAYOUT_UNDEFINED,
                           VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
                           targets.hostReadable ? VK_PIPELINE_STAGE_2_HOST_BIT : VK_PIPELINE_STAGE_2_COPY_BIT,
                           VK_ACCESS_2_NONE, colorStage, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT});
@@ -462,7 +466,9 @@ void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const 
             {.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
              .imageView = attachments.views[i],
              .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-             .loadOp = clear ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+             .loadOp = clear  ? VK_ATTACHMENT_LOAD_OP_CLEAR
+                       : keep ? VK_ATTACHMENT_LOAD_OP_LOAD
+                              : VK_ATTACHMENT_LOAD_OP_DONT_CARE,
              .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
              .clearValue = {.color = {.float32 = {isBeauty ? background.r : 0.0f, isBeauty ? background.g : 0.0f,
                                                   isBeauty ? background.b : 0.0f, 0.0f}}}});
@@ -516,7 +522,7 @@ void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const 
             vkCmdDrawIndexed(commands, r.count, 1, r.first, 0, 0);
         }
     }
-    if (!clear) {
+    if (!clear && !keep) {
         vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.background.get());
         vkCmdDraw(commands, 3, 1, 0, 0);
     }

@@ -156,10 +156,13 @@ struct LitAttachments {
 // GENERAL and visible to host reads once the submission has finished.
 // alphaPipeline: the SHADOWLAB_ALPHA variant of `pipeline` for DrawGeometry::litRanges with
 // IndexRange::alpha (null: `pipeline` draws them).
+// backgroundInAttachments (float targets only): every attachment is in GENERAL and already holds
+// the background's values in every pixel (a new Frame's planes); they are loaded and the
+// background pipeline is not drawn.
 void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const LitBindings& bindings,
                    const LitTargets& targets, const LitAttachments& attachments, const DrawGeometry& geometry,
                    const glm::vec3& background, LitOutputs outputs = LitOutputs::kAll,
-                   const LitPipeline* alphaPipeline = nullptr);
+                   const LitPipeline* alphaPipeline = nullptr, bool backgroundInAttachments = false);
 
 struct Readback {
     std::array<Buffer, kLitPlanes> planes;

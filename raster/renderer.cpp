@@ -173,7 +173,9 @@ struct Renderer::Impl {
     // The Frame's vectors for `channels` sized (the others emptied), and where each plane of the
     // frame's pipeline is rendered: `frameImages` over the Frame's vectors where possible (their
     // planes set in `intoFrame`), the Renderer's own targets for the rest.
-    void prepareFrame(scene::Frame& frame, scene::ChannelMask channels, LitOutputs outputs, LitAttachments& attachments,
+    // Returns true where every attachment is a new plane of the Frame that already holds the
+    // background (see there): the lit pass then draws no background.
+    bool prepareFrame(scene::Frame& frame, scene::ChannelMask channels, LitOutputs outputs, LitAttachments& attachments,
                       std::vector<Image>& frameImages, std::array<bool, kLitPlanes>& intoFrame) const;
     void readPixels(scene::Frame& frame, scene::ChannelMask channels,
                     const std::array<bool, kLitPlanes>& intoFrame) const;
@@ -756,14 +758,15 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     LitAttachments attachments;
     std::vector<Image> frameImages;  // over the Frame's vectors, released after this frame
     std::array<bool, kLitPlanes> intoFrame{};
-    prepareFrame(frame, channels, outputs, attachments, frameImages, intoFrame);
+    const bool backgroundInFrame = prepareFrame(frame, channels, outputs, attachments, frameImages, intoFrame);
+    if (debug) debug->backgroundFromFrame = backgroundInFrame;
     const double prepareMs = msSince(prepareStart);
     const auto litStart = Clock::now();
     const double litCpuStart = processCpuMs();
     commands = ctx.beginCommands();
     stamp(commands, 2);
     recordLitPass(commands, litPipeline[litPipeline[0].pipeline ? 0 : 1], bindings, targets, attachments, draw,
-                  background, outputs, litPipeline[1].pipeline ? &litPipeline[1] : nullptr);
+                  background, outputs, litPipeline[1].pipeline ? &litPipeline[1] : nullptr, backgroundInFrame);
     stamp(commands, 3);
     ctx.submitAndWait(commands);
     frame.timingsMs.emplace_back("lit_pass", msSince(litStart));
@@ -821,17 +824,11 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
 
 namespace {
 
-// The Frame's vector for a plane: sized for `pixels` (`perPixel` floats each) when the channel is
-// asked for, with room for `reserveBytes` (a driver may want more behind an image than its rows),
-// else emptied; null when not asked for.
-float* framePlane(std::vector<float>& v, bool wanted, std::size_t pixels, std::size_t perPixel,
-                  std::size_t reserveBytes) {
-    if (!wanted) {
-        v.clear();
-        return nullptr;
-    }
+// Room in the Frame's vector for `values` floats, and for `reserveBytes` (a driver may want more
+// behind an image than its rows); new memory has its pages faulted in. Returns the data.
+float* reservePlane(std::vector<float>& v, std::size_t values, std::size_t reserveBytes) {
     const std::size_t capacity = v.capacity();
-    v.reserve(std::max(perPixel * pixels, (reserveBytes + sizeof(float) - 1) / sizeof(float)));
+    v.reserve(std::max(values, (reserveBytes + sizeof(float) - 1) / sizeof(float)));
 #ifdef MADV_POPULATE_WRITE
     if (v.capacity() != capacity) {
         // New memory: its pages in one call (Linux 5.14) instead of a fault each as resize()
@@ -841,13 +838,24 @@ float* framePlane(std::vector<float>& v, bool wanted, std::size_t pixels, std::s
         if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE);
     }
 #endif
+    return v.data();
+}
+
+// The Frame's vector for a plane: sized for `pixels` (`perPixel` floats each) when the channel is
+// asked for, else emptied; null when not asked for.
+float* framePlane(std::vector<float>& v, bool wanted, std::size_t pixels, std::size_t perPixel) {
+    if (!wanted) {
+        v.clear();
+        return nullptr;
+    }
+    reservePlane(v, perPixel * pixels, 0);
     v.resize(perPixel * pixels);
     return v.data();
 }
 
 }  // namespace
 
-void Renderer::Impl::prepareFrame(scene::Frame& frame, scene::ChannelMask channels, LitOutputs outputs,
+bool Renderer::Impl::prepareFrame(scene::Frame& frame, scene::ChannelMask channels, LitOutputs outputs,
                                   LitAttachments& attachments, std::vector<Image>& frameImages,
                                   std::array<bool, kLitPlanes>& intoFrame) const {
     using namespace scene;
@@ -857,7 +865,7 @@ void Renderer::Impl::prepareFrame(scene::Frame& frame, scene::ChannelMask channe
     intoFrame.fill(false);
     if (outputs == LitOutputs::kDisplay) {
         attachments.add(targets.display);
-        return;  // readDisplayPixels sizes the Frame
+        return false;  // readDisplayPixels sizes the Frame
     }
     // A reused frame keeps its vectors' memory: no new pages to fault in and zero (on a
     // 1920x1080 frame that cost more than rendering it).
@@ -866,24 +874,60 @@ void Renderer::Impl::prepareFrame(scene::Frame& frame, scene::ChannelMask channe
     const ChannelMask bits[kLitPlanes] = {kChannelBeauty, kChannelVisibility, kChannelObjectId,
                                           kChannelNdotL,  kChannelDepth,      kChannelBlockerId};
     const std::uint32_t planes = outputs == LitOutputs::kAll ? kLitPlanes : 1;
+    // An empty vector is value-initialized whole by resize(): all zeros, the background's AOVs.
+    bool fresh = outputs == LitOutputs::kBeauty || targets.lights.empty();
     for (std::uint32_t p = 0; p < kLitPlanes; ++p) {
         const bool wanted = (channels & bits[p]) != 0;
         const bool direct = wanted && p < planes && renderIntoFrame && targets.frameImageBytes[p] > 0;
-        float* data = framePlane(*vectors[p], wanted, n, p == 0 ? 3 : 1, direct ? targets.frameImageBytes[p] : 0);
-        if (!direct) continue;
+        const std::size_t perPixel = p == 0 ? 3 : 1;
+        if (!direct) {
+            framePlane(*vectors[p], wanted, n, perPixel);
+            fresh = fresh && p >= planes;
+            continue;
+        }
+        fresh = fresh && vectors[p]->empty();
+        float* data = reservePlane(*vectors[p], perPixel * n, targets.frameImageBytes[p]);
         Image image =
             importHostImage(ctx, p == 0 ? targets.beautyFormat : kLitPlaneFormat, width, height, kLitTargetUsage,
                             litPlaneTexelBytes(targets, LitPlane(p)), data, vectors[p]->capacity() * sizeof(float));
-        if (!image.image) continue;  // a pointer the device cannot import: the Renderer's target
+        if (!image.image) {
+            fresh = false;  // a pointer the device cannot import: the Renderer's target
+            continue;
+        }
         intoFrame[p] = true;
         frameImages.push_back(std::move(image));
+    }
+    if (fresh) {
+        // Every attachment is a new plane of the Frame: its zeros, with the beauty set to the
+        // background color, are the background, and the lit pass draws none (on a first frame its
+        // pipeline's shaders are not compiled then). The images go to GENERAL before the host
+        // writes them, so that the pass's transition (from GENERAL, load) keeps what is written.
+        std::vector<ImageTransition> toGeneral;
+        for (const Image& image : frameImages)
+            toGeneral.push_back({image.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+                                 VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
+                                 VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_NONE});
+        VkCommandBuffer commands = ctx.beginCommands();
+        transition(commands, toGeneral);
+        ctx.submitAndWait(commands);
+    }
+    const bool colored = fresh && background != glm::vec3(0.0f);
+    for (std::uint32_t p = colored ? 1 : 0; p < planes; ++p)
+        if (intoFrame[p]) vectors[p]->resize((p == 0 ? 3 : 1) * n);
+    if (colored) {
+        // Row by row from one row of the color (each float written once; resize() would zero
+        // them first). The vector is empty and has the room: nothing is reallocated.
+        std::vector<float> row(3 * std::size_t(width));
+        for (std::size_t x = 0; x < width; ++x) std::memcpy(&row[3 * x], &background[0], 3 * sizeof(float));
+        for (std::uint32_t y = 0; y < height; ++y) frame.beauty.insert(frame.beauty.end(), row.begin(), row.end());
     }
     std::size_t next = 0;
     for (std::uint32_t p = 0; p < planes; ++p) attachments.add(intoFrame[p] ? frameImages[next++] : targets.planes[p]);
     if (outputs == LitOutputs::kAll)
         for (const Image& l : targets.lights) attachments.add(l);
     frame.lightVisibility.resize((channels & kChannelLightVisibility) && !targets.lights.empty() ? lightCount : 0);
-    for (std::vector<float>& v : frame.lightVisibility) framePlane(v, true, n, 1, 0);
+    for (std::vector<float>& v : frame.lightVisibility) framePlane(v, true, n, 1);
+    return fresh;
 }
 
 // Copies the planes asked for that were not rendered into the Frame (from the targets in place,
@@ -919,6 +963,11 @@ void Renderer::Impl::readPixels(scene::Frame& frame, scene::ChannelMask channels
     const float depthOffset = float(viewDepthOffset);  // 0 for the camera the Renderer was made for
     const bool offsetDepth = (channels & kChannelDepth) && depthOffset != 0.0f;
     const bool idsInFrame = (channels & kChannelObjectId) != 0;
+    bool copies = offsetDepth || !frame.lightVisibility.empty();
+    for (std::uint32_t p = 0; p < kLitPlanes; ++p) copies = copies || ((channels & bits[p]) && !intoFrame[p]);
+    // Rendered into the Frame, nothing to do: no parallel loop (a process's first one starts
+    // the thread pool: a few ms of CPU on a first frame).
+    if (!copies) return;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, height, 16), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t y = r.begin(); y < r.end(); ++y) {
             for (std::uint32_t p = 0; p < kLitPlanes; ++p) {

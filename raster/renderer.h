@@ -29,6 +29,9 @@ struct RenderDebug {
     std::vector<ShadowLayer> layers;
     std::vector<std::vector<float>> layerDepths;
     std::uint32_t mapSize = 0;
+    // Out: the background came from the Frame (its planes were new: zeros and the background
+    // color) instead of the lit pass's background pipeline.
+    bool backgroundFromFrame = false;
 };
 
 // Where the lit pass's fragment shader reads the one light's constants, where it takes that

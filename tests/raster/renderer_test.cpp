@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <utility>
 
 #include <gtest/gtest.h>
@@ -1145,6 +1146,72 @@ TEST(RasterRenderer, RenderingIntoTheFrameReadingTheTargetsInPlaceAndCopyingThem
     EXPECT_EQ(intoFrame.validationMessages(), 0);
     EXPECT_EQ(inPlace.validationMessages(), 0);
     EXPECT_EQ(copied.validationMessages(), 0);
+}
+
+TEST(RasterRenderer, ANewFrameHoldsTheBackgroundAndAReusedOneGetsTheBackgroundPass) {
+    // Where every lit-pass attachment is a new plane of the Frame, the planes' zeros (resize()
+    // value-initializes) with the beauty set to the background color are the background, and the
+    // background pipeline is not drawn; into a reused Frame (here holding NaN everywhere, so that
+    // a pixel left unwritten shows) and into the Renderer's own targets it is. All give the same
+    // frame bit for bit, and the background pixels are the scene's color with zero AOVs (the
+    // background pass's values, docs/raster.md). Black (nothing to fill) and a color; all channels
+    // and the float beauty; two lights (per-light targets of the Renderer's own: the pass).
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    for (const scene::Vec3& color : {scene::Vec3(0.0, 0.0, 0.0), scene::Vec3(0.05, 0.1, 0.2)})
+        for (int lights : {1, 2}) {
+            scene::Scene s = withASecondLightFrom40Degrees(SphereOverPlane{});
+            s.lights.resize(std::size_t(lights));
+            s.background = color;
+            const scene::RasterSettings settings = validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2);
+            Renderer renderer(s, planFor(s, settings), settings);
+            Renderer copied(s, planFor(s, settings), settings, RendererOptions{.readTargetsInPlace = false});
+            for (scene::ChannelMask channels : {scene::kAllChannels, scene::kChannelBeauty}) {
+                RenderDebug fromNew, fromReused, fromCopied;
+                const scene::Frame fresh = renderer.render(channels, &fromNew);
+                EXPECT_EQ(fromNew.backgroundFromFrame, lights == 1 || channels == scene::kChannelBeauty);
+                scene::Frame reused;
+                for (std::vector<float>* v : {&reused.beauty, &reused.visibility, &reused.objectId, &reused.ndotl,
+                                              &reused.depth, &reused.blockerId})
+                    v->assign(fresh.pixelCount() * (v == &reused.beauty ? 3 : 1), nan);
+                renderer.render(reused, channels, &fromReused);
+                EXPECT_FALSE(fromReused.backgroundFromFrame);
+                const scene::Frame c = copied.render(channels, &fromCopied);
+                EXPECT_FALSE(fromCopied.backgroundFromFrame);
+                for (const scene::Frame* x : std::initializer_list<const scene::Frame*>{&reused, &c}) {
+                    EXPECT_EQ(x->beauty, fresh.beauty);
+                    EXPECT_EQ(x->visibility, fresh.visibility);
+                    EXPECT_EQ(x->objectId, fresh.objectId);
+                    EXPECT_EQ(x->ndotl, fresh.ndotl);
+                    EXPECT_EQ(x->depth, fresh.depth);
+                    EXPECT_EQ(x->blockerId, fresh.blockerId);
+                    EXPECT_EQ(x->lightVisibility, fresh.lightVisibility);
+                }
+                if (channels != scene::kAllChannels) continue;
+                std::size_t background = 0;
+                for (std::size_t i = 0; i < fresh.pixelCount(); ++i) {
+                    if (fresh.objectId[i] != 0.0f) continue;
+                    ++background;
+                    for (int k = 0; k < 3; ++k) ASSERT_EQ(fresh.beauty[3 * i + k], float(color[k])) << i;
+                    ASSERT_EQ(fresh.visibility[i], 0.0f) << i;
+                    ASSERT_EQ(fresh.ndotl[i], 0.0f) << i;
+                    ASSERT_EQ(fresh.depth[i], 0.0f) << i;
+                    ASSERT_EQ(fresh.blockerId[i], 0.0f) << i;
+                }
+                EXPECT_GT(background, 0u) << "the test would not see the background";
+                EXPECT_LT(background, fresh.pixelCount() / 2) << "nor the objects";
+            }
+            // A Frame with one plane from before and the others new: the pass draws the background.
+            scene::Frame mixed = renderer.render(scene::kChannelBeauty);
+            RenderDebug fromMixed;
+            renderer.render(mixed, scene::kAllChannels, &fromMixed);
+            EXPECT_FALSE(fromMixed.backgroundFromFrame);
+            const scene::Frame all = renderer.render(scene::kAllChannels);
+            EXPECT_EQ(mixed.beauty, all.beauty);
+            EXPECT_EQ(mixed.objectId, all.objectId);
+            EXPECT_EQ(mixed.depth, all.depth);
+            EXPECT_EQ(renderer.validationMessages(), 0);
+            EXPECT_EQ(copied.validationMessages(), 0);
+        }
 }
 
 TEST(RasterRenderer, SizeOptimizedSunModulesGiveTheGeneralModulesFramesBitForBit) {
