@@ -55,18 +55,18 @@ bool liftFree(std::uint32_t shared) {
 std::vector<float> pixelAreas(std::span<const glm::vec3> positions, std::span<const std::uint32_t> indices,
                               const glm::mat4& viewProj, std::uint32_t width, std::uint32_t height) {
     const float whole = float(width) * float(height);
-    std::vector<float> areas(indices.size() / 3, whole);
+    // Each vertex projected once (NDC x, y; NaN at or behind the camera's plane).
+    std::vector<glm::vec2> ndc(positions.size());
+    for (std::size_t v = 0; v < positions.size(); ++v) {
+        const glm::vec4 c = viewProj * glm::vec4(positions[v], 1.0f);
+        ndc[v] = c.w > 0.0f ? glm::vec2(c) / c.w : glm::vec2(NAN);
+    }
+    std::vector<float> areas(indices.size() / 3);
     for (std::size_t t = 0; t < areas.size(); ++t) {
-        glm::vec2 p[3];
-        bool behind = false;
-        for (int k = 0; k < 3; ++k) {
-            const glm::vec4 c = viewProj * glm::vec4(positions[indices[3 * t + std::size_t(k)]], 1.0f);
-            behind = behind || !(c.w > 0.0f);
-            p[k] = glm::vec2(c) / c.w;
-        }
-        if (behind) continue;
-        const glm::vec2 a = p[1] - p[0], b = p[2] - p[0];
-        areas[t] = 0.125f * std::fabs(a.x * b.y - a.y * b.x) * whole;  // NDC spans 2 x 2
+        const glm::vec2 p0 = ndc[indices[3 * t]];
+        const glm::vec2 a = ndc[indices[3 * t + 1]] - p0, b = ndc[indices[3 * t + 2]] - p0;
+        const float area = 0.125f * std::fabs(a.x * b.y - a.y * b.x) * whole;  // NDC spans 2 x 2
+        areas[t] = std::isnan(area) ? whole : area;
     }
     return areas;
 }

@@ -244,7 +244,7 @@ struct Renderer::Impl {
     LitPipeline liftFreePipelines[4];
     bool liftFreeDraws = true;  // RendererOptions::liftFreeDraws
     // The vertex normals, positions and the index buffer as uploaded, for the lift-free triangles (placeLights);
-    // kept only where they can be used (no normal offset asked for, liftFreeDraws).
+    // kept only where they can be used (liftFreeDraws).
     std::vector<glm::vec3> hostNormals;
     std::vector<glm::vec3> hostPositions;  // camera-relative, as the vertex buffer (the runs' pixel areas)
     std::vector<std::uint32_t> hostIndices;
@@ -310,8 +310,13 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
     plan = planIn;
     // Device-local, uploaded once for every frame of this Renderer.
     vertexBuffer = uploadBuffer(ctx, geometry.vertices, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
-    liftFreeDraws = options.liftFreeDraws;
-    if (liftFreeDraws && settings.normalOffset == 0.0) {
+    // Lift-free draws need the *_sun modules (one directional light, none or pcf2x2, no
+    // semi-transparent casters, no receiver plane) and no normal offset asked for.
+    liftFreeDraws = options.liftFreeDraws && options.sunModules && scene.lights.size() == 1 &&
+                    scene.lights[0].type == scene::LightType::Directional &&
+                    (settings.filter == scene::ShadowFilter::None || settings.filter == scene::ShadowFilter::Pcf2x2) &&
+                    !settings.receiverPlaneBias && !planIn.needsTransmittanceMap && settings.normalOffset == 0.0;
+    if (liftFreeDraws) {
         hostNormals.reserve(geometry.vertices.size());
         hostPositions.reserve(geometry.vertices.size());
         for (const Vertex& v : geometry.vertices) {
