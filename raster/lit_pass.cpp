@@ -16,24 +16,22 @@ bool usesVertexLightCoordinates(const LitVariant& variant) {
            variant.lightKinds == (1u << SHADOWLAB_LIGHT_SPOT);
 }
 
-namespace {
-
-// Whether the variant has the constants SHADOWLAB_ONE_SUN fixes (lit_constants.glsl), with none
-// or pcf2x2: the *_taps_sun builds.
-bool sunVariant(const LitVariant& v) {
+bool usesSunModules(const LitVariant& v) {
     const bool taps = v.filter == scene::ShadowFilter::None || v.filter == scene::ShadowFilter::Pcf2x2;
     return v.sunModules && taps && v.lightTargets == 0 && v.lightCount == 1 &&
            v.lightKinds == (1u << SHADOWLAB_LIGHT_DIRECTIONAL) && !v.transmittance && !v.receiverPlane;
 }
 
+namespace {
+
 // lit.frag's SPIR-V for the variant: its outputs (beauty only, the AOVs, the per-light targets),
 // the camera's alpha test, and for none and pcf2x2 the *_taps build without the other filters' code
 // (lavapipe turns all of a module into NIR before the specialization constants remove what a
-// pipeline does not run: the full module doubled the lit pipeline's creation); where sunVariant(),
+// pipeline does not run: the full module doubled the lit pipeline's creation); where usesSunModules(),
 // the *_sun modules (*_sun_map with one map and no blend bands).
 std::span<const std::uint32_t> litFragment(const LitVariant& v, bool alpha) {
     const bool taps = v.filter == scene::ShadowFilter::None || v.filter == scene::ShadowFilter::Pcf2x2;
-    const bool sun = sunVariant(v);
+    const bool sun = usesSunModules(v);
     if (sun && v.cascades == 1 && !v.cascadeBlend) {
         if (!v.aovTarget)
             return alpha ? shaders::litFragBeautyAlphaTapsSunMapSpirv() : shaders::litFragBeautyTapsSunMapSpirv();
@@ -166,9 +164,9 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkD
     }
     p.pipeline = createGraphicsPipeline(
         ctx, PipelineDesc{
-                 .vertexShader = p.alpha                                     ? shaders::litVertAlphaSpirv()
-                                 : sunVariant(variant) && !variant.aovTarget ? shaders::litVertNoIdSpirv()
-                                                                             : shaders::litVertSpirv(),
+                 .vertexShader = p.alpha                                         ? shaders::litVertAlphaSpirv()
+                                 : usesSunModules(variant) && !variant.aovTarget ? shaders::litVertNoIdSpirv()
+                                                                                 : shaders::litVertSpirv(),
                  .fragmentShader = litFragment(variant, p.alpha),
                  .fragmentSpecialization = &specialization,
                  .vertexSpecialization = &specialization,
@@ -443,7 +441,7 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
 void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const LitBindings& bindings,
                    const LitTargets& targets, const LitAttachments& attachments, const DrawGeometry& geometry,
                    const glm::vec3& background, LitOutputs outputs, const LitPipeline* alphaPipeline,
-                   bool backgroundInAttachments) {
+                   const LitPipeline* liftFreePipeline, bool backgroundInAttachments) {
     const VkPipelineStageFlags2 colorStage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
     const VkPipelineStageFlags2 depthStages =
         VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
@@ -512,13 +510,15 @@ void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const 
                 vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_GRAPHICS, p.layout.get(), 1, 1,
                                         &geometry.alphaSet, 0, nullptr);
         };
-        if (geometry.litRanges.empty()) {
+        const bool byLift = liftFreePipeline && !geometry.litRangesByLift.empty();
+        const std::vector<IndexRange>& ranges = byLift ? geometry.litRangesByLift : geometry.litRanges;
+        if (ranges.empty()) {
             use(pipeline);
             vkCmdDrawIndexed(commands, geometry.indexCount, 1, 0, 0, 0);
         }
-        for (const IndexRange& r : geometry.litRanges) {
+        for (const IndexRange& r : ranges) {
             if (r.count == 0) continue;
-            use(r.alpha && alphaPipeline ? *alphaPipeline : pipeline);
+            use(r.alpha && alphaPipeline ? *alphaPipeline : byLift && r.liftFree ? *liftFreePipeline : pipeline);
             vkCmdDrawIndexed(commands, r.count, 1, r.first, 0, 0);
         }
     }

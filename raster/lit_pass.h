@@ -64,6 +64,9 @@ struct LitVariant {
 // kVertexLightCoordinates, the same condition): one light, directional with one map or a spot, and
 // no receiver-plane bias.
 bool usesVertexLightCoordinates(const LitVariant& variant);
+// Whether the variant has the constants SHADOWLAB_ONE_SUN fixes (lit_constants.glsl), with none or
+// pcf2x2: the *_taps_sun modules (where LitVariant::sunModules asks for them).
+bool usesSunModules(const LitVariant& variant);
 // Per-light visibility targets: four lights in each RGBA32F target, SHADOWLAB_MAX_LIGHTS in all.
 inline constexpr std::uint32_t kLightTargets = (SHADOWLAB_MAX_LIGHTS + 3) / 4;
 
@@ -155,14 +158,17 @@ struct LitAttachments {
 // attachment in TRANSFER_SRC_OPTIMAL for recordReadback(), or, for host-readable targets, in
 // GENERAL and visible to host reads once the submission has finished.
 // alphaPipeline: the SHADOWLAB_ALPHA variant of `pipeline` for DrawGeometry::litRanges with
-// IndexRange::alpha (null: `pipeline` draws them).
+// IndexRange::alpha (null: `pipeline` draws them). liftFreePipeline: `pipeline` made without the
+// slope bias's lift (LitVariant::normalOffset false), which then draws the lift-free ranges of
+// DrawGeometry::litRangesByLift (null: litRanges, every one with the lift where `pipeline` has it).
 // backgroundInAttachments (float targets only): every attachment is in GENERAL and already holds
 // the background's values in every pixel (a new Frame's planes); they are loaded and the
 // background pipeline is not drawn.
 void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const LitBindings& bindings,
                    const LitTargets& targets, const LitAttachments& attachments, const DrawGeometry& geometry,
                    const glm::vec3& background, LitOutputs outputs = LitOutputs::kAll,
-                   const LitPipeline* alphaPipeline = nullptr, bool backgroundInAttachments = false);
+                   const LitPipeline* alphaPipeline = nullptr, const LitPipeline* liftFreePipeline = nullptr,
+                   bool backgroundInAttachments = false);
 
 struct Readback {
     std::array<Buffer, kLitPlanes> planes;

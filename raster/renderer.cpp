@@ -20,6 +20,7 @@
 #include "raster/cascades.h"
 #include "raster/context.h"
 #include "raster/geometry.h"
+#include "raster/lift_free.h"
 #include "raster/light_data.h"
 #include "raster/light_frustum.h"
 #include "raster/lit_pass.h"
@@ -240,6 +241,16 @@ struct Renderer::Impl {
     shaders::TransmitWindows transmitWindowData{};  // the same for lit.frag (LitBindings)
     std::vector<DepthBiasFactors> layerBias;        // per layer, recordShadowPass's input (settings.hardwareBias)
     LitPipeline litPipelines[4][2];
+    // The same four without the slope bias's lift past its cap (LitVariant::normalOffset false, no
+    // alpha test), for the lift-free triangles (draw.litRangesByLift), with the *_sun modules.
+    LitPipeline liftFreePipelines[4];
+    bool liftFreeDraws = true;  // RendererOptions::liftFreeDraws
+    // The vertex normals, positions and the index buffer as uploaded, for the lift-free triangles (placeLights);
+    // kept only where they can be used (liftFreeDraws).
+    std::vector<glm::vec3> hostNormals;
+    std::vector<glm::vec3> hostPositions;  // camera-relative, as the vertex buffer (the runs' pixel areas)
+    std::vector<std::uint32_t> hostIndices;
+    void splitByLift();    // draw.litRangesByLift for the current lights
     LitBindings bindings;  // allocated with the first lit pipeline's (identical) set layout
     shaders::LitUniforms uniforms{};
     std::vector<glm::vec4> albedos;
@@ -301,6 +312,21 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
     plan = planIn;
     // Device-local, uploaded once for every frame of this Renderer.
     vertexBuffer = uploadBuffer(ctx, geometry.vertices, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+    // Lift-free draws need the *_sun modules (one directional light, none or pcf2x2, no
+    // semi-transparent casters, no receiver plane) and no normal offset asked for.
+    liftFreeDraws = options.liftFreeDraws && options.sunModules && scene.lights.size() == 1 &&
+                    scene.lights[0].type == scene::LightType::Directional &&
+                    (settings.filter == scene::ShadowFilter::None || settings.filter == scene::ShadowFilter::Pcf2x2) &&
+                    !settings.receiverPlaneBias && !planIn.needsTransmittanceMap && settings.normalOffset == 0.0;
+    if (liftFreeDraws) {
+        hostNormals.reserve(geometry.vertices.size());
+        hostPositions.reserve(geometry.vertices.size());
+        for (const Vertex& v : geometry.vertices) {
+            hostNormals.push_back(v.normal);
+            hostPositions.push_back(v.position);
+        }
+        hostIndices = geometry.indices;
+    }
     indexBuffer = uploadBuffer(ctx, geometry.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
     draw = DrawGeometry{vertexBuffer.buffer.get(), indexBuffer.buffer.get(), std::uint32_t(geometry.indices.size()),
                         opaqueIndexCount, transparentDraws};
@@ -434,6 +460,28 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
     std::set<int> shadowed;
     for (const ShadowLayer& layer : layers) shadowed.insert(layer.light);
     if (layers.size() > shadowed.size()) attributes["culled_casters_per_layer"] = joined(culledPerLayer, count);
+    splitByLift();
+}
+
+void Renderer::Impl::splitByLift() {
+    draw.litRangesByLift.clear();
+    // Only directional lights (N·L constant over a triangle's plane of normals), and only where the
+    // lift is the one use of the normal-offset path.
+    if (hostNormals.empty() || lightKinds != (1u << SHADOWLAB_LIGHT_DIRECTIONAL) || settings.normalOffset != 0.0 ||
+        !normalOffsetUsed(settings, layers))
+        return;
+    std::vector<glm::vec3> towardLights;  // the lights whose shadow test applies the slope bias in the shader
+    for (std::size_t i = 0; i < lightCount; ++i) {
+        const shaders::LightData& l = uniforms.lights[i];
+        if (l.layer >= 0.0f && l.slopeBiasTexels > 0.0f) towardLights.push_back(l.towardLight);
+    }
+    const std::vector<std::uint32_t> bits =
+        liftFreeVertexBits(hostNormals, towardLights, liftFreeThreshold(double(uniforms.lights[0].maxSlopeTan)));
+    std::vector<IndexRange> ranges = raster::splitByLift(
+        bits, hostIndices, draw.litRanges, pixelAreas(hostPositions, hostIndices, uniforms.viewProj, width, height),
+        kLiftFreeMinPixels);
+    if (std::any_of(ranges.begin(), ranges.end(), [](const IndexRange& r) { return r.liftFree; }))
+        draw.litRangesByLift = std::move(ranges);
 }
 
 void Renderer::Impl::setLayerLights(const scene::Scene& scene) {
@@ -670,14 +718,41 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     // Only the beauty, only for an 8-bit sRGB image: the display target, where there is one.
     const bool display = beautyOnly && (channels & kBeautyForDisplay) && targets.display.image;
     const LitOutputs outputs = display ? LitOutputs::kDisplay : beautyOnly ? LitOutputs::kBeauty : LitOutputs::kAll;
-    LitPipeline* const litPipeline = litPipelines[display ? 3 : beautyOnly ? 0 : wantIds ? 2 : 1];
+    const int litIndex = display ? 3 : beautyOnly ? 0 : wantIds ? 2 : 1;
+    LitPipeline* const litPipeline = litPipelines[litIndex];
+    auto litVariant = [&](bool normalOffset) {
+        return LitVariant{.filter = settings.filter,
+                          .blockerIds = wantIds,
+                          .aovTarget = !beautyOnly,
+                          .displayTarget = display,
+                          .normalOffset = normalOffset,
+                          .beautyFormat = targets.beautyFormat,
+                          .lightTargets = std::uint32_t(targets.lights.size()),
+                          .lightCount = std::uint32_t(lightCount),
+                          .lightKinds = lightKinds,
+                          .cascades = std::uint32_t(cascadesUsed),
+                          .transmittance = transmit,
+                          .receiverPlane = settings.receiverPlaneBias,
+                          .cascadeBlend = cascadeBlendUsed > 0.0,
+                          .vertexLightConstants = vertexLightConstants,
+                          .moments = settings.moments,
+                          .sunModules = sunModules};
+    };
+    // The lift-free triangles' pipeline (docs/raster.md "Lift-free draws"): with the *_sun modules
+    // only, whose pipelines are made in about 5 ms of CPU, so that it is made with the frame's others.
+    // It draws from the frame after the one that made it: its shader is compiled at its first draw, so
+    // a one-frame render compiles one lit shader.
+    LitPipeline& liftFree = liftFreePipelines[litIndex];
+    const bool liftFreeWanted = !draw.litRangesByLift.empty() && usesSunModules(litVariant(false));
+    const bool byLift = liftFreeWanted && liftFree.pipeline;
     double setup = pendingSetupMs;  // 0 for a frame that creates nothing
     pendingSetupMs = 0.0;
     // (A scene without objects, or without any drawn by the depth pass, still gets each pass's
     // pipeline without the alpha test.)
     const bool needDepthPlain = depthPlain || !depthAlpha, needLitPlain = litPlain || !litAlpha;
     if ((needDepthPlain && !shadowPipeline[0].pipeline) || (depthAlpha && !shadowPipeline[1].pipeline) ||
-        (needLitPlain && !litPipeline[0].pipeline) || (litAlpha && !litPipeline[1].pipeline)) {
+        (needLitPlain && !litPipeline[0].pipeline) || (litAlpha && !litPipeline[1].pipeline) ||
+        (liftFreeWanted && !liftFree.pipeline)) {
         const auto pipelineStart = Clock::now();
         for (int a = 0; a < 2; ++a)
             if ((a ? depthAlpha : needDepthPlain) && !shadowPipeline[a].pipeline)
@@ -692,24 +767,10 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
             transmitRestPipeline = createTransmittanceRestPipeline(ctx, transmittanceMaps, alphaLayout);
         for (int a = 0; a < 2; ++a)
             if ((a ? litAlpha : needLitPlain) && !litPipeline[a].pipeline)
-                litPipeline[a] = createLitPipeline(ctx,
-                                                   LitVariant{.filter = settings.filter,
-                                                              .blockerIds = wantIds,
-                                                              .aovTarget = !beautyOnly,
-                                                              .displayTarget = display,
-                                                              .normalOffset = normalOffsetUsed(settings, layers),
-                                                              .beautyFormat = targets.beautyFormat,
-                                                              .lightTargets = std::uint32_t(targets.lights.size()),
-                                                              .lightCount = std::uint32_t(lightCount),
-                                                              .lightKinds = lightKinds,
-                                                              .cascades = std::uint32_t(cascadesUsed),
-                                                              .transmittance = transmit,
-                                                              .receiverPlane = settings.receiverPlaneBias,
-                                                              .cascadeBlend = cascadeBlendUsed > 0.0,
-                                                              .vertexLightConstants = vertexLightConstants,
-                                                              .moments = settings.moments,
-                                                              .sunModules = sunModules},
+                litPipeline[a] = createLitPipeline(ctx, litVariant(normalOffsetUsed(settings, layers)),
                                                    a ? alpha.descriptors.layout.get() : VK_NULL_HANDLE, background);
+        if (liftFreeWanted && !liftFree.pipeline)
+            liftFree = createLitPipeline(ctx, litVariant(false), VK_NULL_HANDLE, background);
         if (bindings.set == VK_NULL_HANDLE)
             bindings = createLitBindings(ctx, litPipeline[litPipeline[0].pipeline ? 0 : 1], uniforms,
                                          transmitWindowData, albedos, maps, transmittanceMaps, momentMaps);
@@ -766,7 +827,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     commands = ctx.beginCommands();
     stamp(commands, 2);
     recordLitPass(commands, litPipeline[litPipeline[0].pipeline ? 0 : 1], bindings, targets, attachments, draw,
-                  background, outputs, litPipeline[1].pipeline ? &litPipeline[1] : nullptr, backgroundInFrame);
+                  background, outputs, litPipeline[1].pipeline ? &litPipeline[1] : nullptr,
+                  byLift ? &liftFree : nullptr, backgroundInFrame);
     stamp(commands, 3);
     ctx.submitAndWait(commands);
     frame.timingsMs.emplace_back("lit_pass", msSince(litStart));
@@ -820,6 +882,11 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
         frame.attributes["gpu_lit_pass_ms"] = formatNumber(double(ticks[3] - ticks[2]) * msPerTick);
     }
     if (settings.validate) frame.attributes["validation_messages"] = std::to_string(log.count.load());
+    if (debug) {
+        debug->liftFreeTriangles = 0;
+        if (byLift)
+            for (const IndexRange& r : draw.litRangesByLift) debug->liftFreeTriangles += r.liftFree ? r.count / 3 : 0;
+    }
 }
 
 namespace {

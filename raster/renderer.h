@@ -32,6 +32,9 @@ struct RenderDebug {
     // Out: the background came from the Frame (its planes were new: zeros and the background
     // color) instead of the lit pass's background pipeline.
     bool backgroundFromFrame = false;
+    // Out: the triangles the lit pass drew with the pipeline without the slope bias's lift
+    // (RendererOptions::liftFreeDraws; 0 in the frame that made that pipeline, a Renderer's first).
+    std::size_t liftFreeTriangles = 0;
 };
 
 // Where the lit pass's fragment shader reads the one light's constants, where it takes that
@@ -58,6 +61,11 @@ struct RendererOptions {
     // The lit pass's size-optimized shader modules where the scene allows them
     // (LitVariant::sunModules); false: the general ones (tests compare the two).
     bool sunModules = true;
+    // With the size-optimized modules (sunModules), the lit pass draws the triangles on which no
+    // fragment takes the slope bias's lift past its cap (raster/lift_free.h) with a pipeline without
+    // that path, the rest with it, from the frame after the one that made that pipeline (its shader
+    // is compiled at its first draw); the same frames (tests compare). false: every triangle with it.
+    bool liftFreeDraws = true;
 };
 
 // A reusable raster renderer for one scene and its settings: the constructor does the setup

@@ -77,6 +77,9 @@ struct IndexRange {
     std::uint32_t first = 0;
     std::uint32_t count = 0;
     bool alpha = false;
+    // Lit pass: no fragment of these triangles takes the slope bias's lift past its cap
+    // (raster/lift_free.h), so the pipeline without that path may draw them.
+    bool liftFree = false;
 };
 
 // Index and vertex buffers of the whole scene (raster/geometry.h layout).
@@ -96,6 +99,9 @@ struct DrawGeometry {
     // Lit pass: every index in order, split where the camera's alpha test starts or stops (empty:
     // one draw of every index with the pass's pipeline).
     std::vector<IndexRange> litRanges;
+    // The same cut where triangles become lift-free or stop being so (IndexRange::liftFree;
+    // raster/lift_free.h): drawn instead of litRanges when the lit pass has a lift-free pipeline.
+    std::vector<IndexRange> litRangesByLift;
     // Alpha-tested casters (raster/alpha_casters.h): the UV buffer and the records' set, used by
     // pipelines made with an alpha set layout.
     VkBuffer uvs = VK_NULL_HANDLE;

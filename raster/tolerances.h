@@ -69,6 +69,15 @@ inline constexpr std::size_t kTransmittanceWindowTriangles = 1 << 16;
 // rest of the slope bias as a lift along the normal, which gives the receiver's own plane the same
 // margin without carrying the compare point along the light (docs/raster.md "Grazing light").
 inline constexpr double kMaxSlopeTan = 10.0;
+// The lit pass draws a triangle with the pipeline without that lift when every vertex normal has
+// |N·L| ≥ cos θ at the cap plus this margin (raster/lift_free.h): the interpolated, normalized normal
+// then has N·L past the cap by the margin, far more than the float error of lavapipe's
+// interpolation and normalization (a few ulp of the interpolation plane's values), so no fragment of
+// it takes the lift in the pipeline with it either. 0.05: light up to about 81° from the normal.
+inline constexpr double kLiftFreeMargin = 0.05;
+// A run of lift-free triangles covering fewer pixels than this (their areas on the image, unclipped)
+// stays with the lift: each run is a draw and a pipeline switch of its own.
+inline constexpr double kLiftFreeMinPixels = 1024.0;
 
 // Largest pcf kernel (taps per side; the Poisson diameter in texels): 15x15 = 225 taps per
 // pixel and light is already slow on lavapipe, and wider penumbrae want a different filter.

@@ -137,17 +137,19 @@ TEST(RasterDefaults, ALowSunOverALargeGroundKeepsTheSmallSpheresEllipse) {
 // the one texel diagonally toward the light can be that far. So every lit ground pixel keeps
 // V ≥ 1 − 0.086. (Without the part past the cap the margin is 20.5 texels of depth against 57.3:
 // stripes across the ground where V < 0.5, 13% of scenes/extreme/grazing-1deg.)
-TEST(RasterDefaults, ASunOneDegreeHighLeavesTheLitGroundLitAndKeepsTheShadow) {
-    const Vec3 c(0, 0.5, 0);
-    const double r = 0.5;
+const Vec3 kOneDegreeSphereCenter(0, 0.5, 0);
+const double kOneDegreeSphereRadius = 0.5;
+scene::Scene oneDegreeSun() {
     scene::Scene s = largeGround(1.0, Vec3(-4, 3, 6), Vec3(6, 0, 0));
     scene::Object sphere;
     sphere.name = "sphere";
-    sphere.shape = scene::Sphere{c, r};
+    sphere.shape = scene::Sphere{kOneDegreeSphereCenter, kOneDegreeSphereRadius};
     s.objects.insert(s.objects.begin(), sphere);
-    scene::RenderSettings settings = scene::resolveSettings(s, {});
-    settings.raster.validate = true;
-    const scene::Frame f = test::renderChecked(s, settings.raster);
+    return s;
+}
+void expectOneDegreeGroundLitAndShadowed(const scene::Scene& s, const scene::Frame& f) {
+    const Vec3 c = kOneDegreeSphereCenter;
+    const double r = kOneDegreeSphereRadius;
 
     // Pixels within three texels of the ellipse's edge (in distance from the light's axis through
     // the sphere's center, a distance across the map) are left out: pcf2x2 spreads an edge over a
@@ -186,6 +188,59 @@ TEST(RasterDefaults, ASunOneDegreeHighLeavesTheLitGroundLitAndKeepsTheShadow) {
     EXPECT_GE(insideShadowed, int(0.97 * inside)) << insideShadowed << " of " << inside;
     EXPECT_EQ(f.attributes.at("slope_bias"), "1");
     EXPECT_EQ(f.attributes.at("grazing_normal_offset"), "1");
+}
+TEST(RasterDefaults, ASunOneDegreeHighLeavesTheLitGroundLitAndKeepsTheShadow) {
+    const scene::Scene s = oneDegreeSun();
+    scene::RenderSettings settings = scene::resolveSettings(s, {});
+    settings.raster.validate = true;
+    expectOneDegreeGroundLitAndShadowed(s, test::renderChecked(s, settings.raster));
+}
+
+// The same scene with a wall, drawn from a Renderer's second frame on: the triangles whose every
+// vertex has N·L past the slope bias's cap by the margin go through the lit pipeline without the
+// lift (raster/lift_free.h), the ground (N·L = sin 1°, a receiver past tan θ = 10) through the one
+// with it. The ground keeps the bounds worked out above, and every channel of
+// every frame kind is a Renderer's without lift-free draws, bit for bit (its first frame too, drawn
+// all with the lift).
+TEST(RasterDefaults, LiftFreeDrawsFromTheSecondFrameKeepTheOneDegreeGroundAndEveryChannel) {
+    scene::Scene s = oneDegreeSun();
+    // A wall across the far end of the view, facing the sun (N·L = cos 1°): large lift-free faces
+    // beside the grazing ground. It is taller than the camera (3 above the ground), so the ground
+    // it shadows, all beyond it along the light (+x), is hidden behind it; the ground pixels the test
+    // judges are object 2 and unchanged.
+    scene::Object wall;
+    wall.name = "wall";
+    wall.shape = scene::Box{{30, 0, -100}, {31, 4, 100}};
+    s.objects.push_back(wall);
+    scene::RenderSettings settings = scene::resolveSettings(s, {});
+    settings.raster.validate = true;
+    const scene::RenderPlan plan = scene::makeRenderPlan(s, settings);
+    Renderer split(s, plan, settings.raster);
+    Renderer whole(s, plan, settings.raster, RendererOptions{.liftFreeDraws = false});
+    for (const scene::ChannelMask channels :
+         {scene::kAllChannels, scene::kChannelBeauty, scene::kChannelBeauty | scene::kBeautyForDisplay}) {
+        RenderDebug first, second, reference;
+        const scene::Frame a = split.render(channels, &first), b = split.render(channels, &second);
+        whole.render(channels);
+        const scene::Frame w = whole.render(channels, &reference);
+        EXPECT_GT(second.liftFreeTriangles, 0u) << "nothing was drawn without the lift";
+        EXPECT_EQ(reference.liftFreeTriangles, 0u);
+        if (channels == scene::kAllChannels) {
+            EXPECT_EQ(first.liftFreeTriangles, 0u);  // a Renderer's first frame: every triangle with the lift
+            expectOneDegreeGroundLitAndShadowed(s, b);
+            test::writePngToLookAt(b, "one-degree-lift-free");
+        }
+        for (const scene::Frame* f : {&a, &b}) {
+            EXPECT_EQ(f->beauty, w.beauty);
+            EXPECT_EQ(f->visibility, w.visibility);
+            EXPECT_EQ(f->objectId, w.objectId);
+            EXPECT_EQ(f->ndotl, w.ndotl);
+            EXPECT_EQ(f->depth, w.depth);
+            EXPECT_EQ(f->blockerId, w.blockerId);
+        }
+    }
+    EXPECT_EQ(split.validationMessages(), 0);
+    EXPECT_EQ(whole.validationMessages(), 0);
 }
 
 // The cascade rule: one map is kept while its texel is at most 2 pixels at the nearest visible
