@@ -45,11 +45,8 @@ std::vector<std::uint32_t> liftFreeVertexBits(std::span<const glm::vec3> normals
 }
 
 namespace {
-bool liftFree(std::uint32_t shared) {
-    for (int l = 0; l < 16; ++l)
-        if (((shared >> (2 * l)) & 3u) == 0) return false;
-    return true;
-}
+// Every light's pair of bits (2l, 2l+1) has at least one bit set.
+bool liftFree(std::uint32_t shared) { return ((shared | (shared >> 1)) & 0x55555555u) == 0x55555555u; }
 }  // namespace
 
 std::vector<float> pixelAreas(std::span<const glm::vec3> positions, std::span<const std::uint32_t> indices,
