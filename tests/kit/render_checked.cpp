@@ -54,6 +54,16 @@ Frames renderAll(const scene::Scene& s, const scene::RenderSettings& settings) {
     return f;
 }
 
+void expectSamePixels(const scene::Frame& actual, const scene::Frame& expected, const std::string& what) {
+    EXPECT_EQ(actual.beauty, expected.beauty) << what;
+    EXPECT_EQ(actual.visibility, expected.visibility) << what;
+    EXPECT_EQ(actual.objectId, expected.objectId) << what;
+    EXPECT_EQ(actual.ndotl, expected.ndotl) << what;
+    EXPECT_EQ(actual.depth, expected.depth) << what;
+    EXPECT_EQ(actual.blockerId, expected.blockerId) << what;
+    EXPECT_EQ(actual.lightVisibility, expected.lightVisibility) << what;
+}
+
 void writePngToLookAt(const scene::Frame& f, const std::string& name) {
     if (const char* dir = std::getenv("SHADOWLAB_TEST_PNG_DIR"))
         scene::writePngLinear(std::filesystem::path(dir) / (name + ".png"), f.width, f.height, f.beauty);

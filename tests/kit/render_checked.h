@@ -47,6 +47,10 @@ struct Frames {
 };
 Frames renderAll(const scene::Scene& s, const scene::RenderSettings& settings);
 
+// Every per-pixel channel of `actual` (beauty, visibility, object id, N·L, Z, blocker ids,
+// per-light visibility) equal to `expected`'s, bit for bit; `what` names the pair in a failure.
+void expectSamePixels(const scene::Frame& actual, const scene::Frame& expected, const std::string& what = "");
+
 // With SHADOWLAB_TEST_PNG_DIR set, writes the frame's beauty there as NAME.png, to look at.
 void writePngToLookAt(const scene::Frame& f, const std::string& name);
 

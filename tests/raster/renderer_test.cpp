@@ -1103,15 +1103,9 @@ TEST(RasterRenderer, RenderingIntoTheFrameReadingTheTargetsInPlaceAndCopyingThem
         EXPECT_EQ(reused.attributes.at("readback"), "into-frame");
         EXPECT_EQ(a.attributes.at("readback"), "in-place");
         EXPECT_EQ(c.attributes.at("readback"), "copy");
-        for (const scene::Frame* x : std::initializer_list<const scene::Frame*>{&f, &reused, &c}) {
-            EXPECT_EQ(x->beauty, a.beauty);
-            EXPECT_EQ(x->visibility, a.visibility);
-            EXPECT_EQ(x->objectId, a.objectId);
-            EXPECT_EQ(x->ndotl, a.ndotl);
-            EXPECT_EQ(x->depth, a.depth);
-            EXPECT_EQ(x->blockerId, a.blockerId);
-            EXPECT_EQ(x->lightVisibility, a.lightVisibility);
-        }
+        test::expectSamePixels(f, a, "into a new Frame");
+        test::expectSamePixels(reused, a, "into a reused Frame");
+        test::expectSamePixels(c, a, "copied");
         // What was asked for, and only that.
         EXPECT_EQ(a.beauty.size(), channels & scene::kChannelBeauty ? 3 * a.pixelCount() : 0u);
         EXPECT_EQ(a.depth.size(), channels & scene::kChannelDepth ? a.pixelCount() : 0u);
@@ -1177,15 +1171,8 @@ TEST(RasterRenderer, ANewFrameHoldsTheBackgroundAndAReusedOneGetsTheBackgroundPa
                 EXPECT_FALSE(fromReused.backgroundFromFrame);
                 const scene::Frame c = copied.render(channels, &fromCopied);
                 EXPECT_FALSE(fromCopied.backgroundFromFrame);
-                for (const scene::Frame* x : std::initializer_list<const scene::Frame*>{&reused, &c}) {
-                    EXPECT_EQ(x->beauty, fresh.beauty);
-                    EXPECT_EQ(x->visibility, fresh.visibility);
-                    EXPECT_EQ(x->objectId, fresh.objectId);
-                    EXPECT_EQ(x->ndotl, fresh.ndotl);
-                    EXPECT_EQ(x->depth, fresh.depth);
-                    EXPECT_EQ(x->blockerId, fresh.blockerId);
-                    EXPECT_EQ(x->lightVisibility, fresh.lightVisibility);
-                }
+                test::expectSamePixels(reused, fresh, "into a reused Frame");
+                test::expectSamePixels(c, fresh, "copied");
                 if (channels != scene::kAllChannels) continue;
                 std::size_t background = 0;
                 for (std::size_t i = 0; i < fresh.pixelCount(); ++i) {
@@ -1241,13 +1228,7 @@ TEST(RasterRenderer, SizeOptimizedSunModulesGiveTheGeneralModulesFramesBitForBit
         Renderer general(s, planFor(s, settings), settings, RendererOptions{.sunModules = false});
         for (const scene::ChannelMask channels :
              {scene::kAllChannels, scene::kChannelBeauty, scene::kChannelBeauty | scene::kBeautyForDisplay}) {
-            const scene::Frame a = sun.render(channels), b = general.render(channels);
-            EXPECT_EQ(a.beauty, b.beauty);
-            EXPECT_EQ(a.visibility, b.visibility);
-            EXPECT_EQ(a.objectId, b.objectId);
-            EXPECT_EQ(a.ndotl, b.ndotl);
-            EXPECT_EQ(a.depth, b.depth);
-            EXPECT_EQ(a.blockerId, b.blockerId);
+            test::expectSamePixels(sun.render(channels), general.render(channels), "sun against general modules");
         }
         EXPECT_EQ(sun.validationMessages(), 0);
         EXPECT_EQ(general.validationMessages(), 0);
