@@ -78,10 +78,14 @@ struct Collapser {
                 lo = std::min(lo, surfaceArea(bin[kids[i]]));
                 hi = std::max(hi, surfaceArea(bin[kids[i]]));
             }
-            if (hi > 2 * lo)
-                std::stable_sort(kids.begin(), kids.begin() + n, [&](std::uint32_t x, std::uint32_t y) {
-                    return surfaceArea(bin[x]) < surfaceArea(bin[y]);
-                });
+            if (hi > 2 * lo)  // insertion sort: stable, and no allocation per node
+                for (int i = 1; i < n; ++i) {
+                    const std::uint32_t k = kids[i];
+                    const float a = surfaceArea(bin[k]);
+                    int j = i;
+                    for (; j > 0 && surfaceArea(bin[kids[j - 1]]) > a; --j) kids[j] = kids[j - 1];
+                    kids[j] = k;
+                }
         }
         const std::uint32_t index = std::uint32_t(out.size());
         out.emplace_back();
