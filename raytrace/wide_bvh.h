@@ -1,6 +1,6 @@
 // raytrace/wide_bvh.h: an N-wide BVH (N = 4 or 8) collapsed from the binary SAH tree (bvh.h):
 // nodes hold N child boxes tested four at a time with SSE, traversed nearest child first for
-// closest hit with a stack that skips entries beyond the current hit, any order for any hit.
+// closest hit with a stack that skips entries beyond the current hit, stored order for any hit.
 #pragma once
 
 #include <cmath>
@@ -60,15 +60,19 @@ public:
     // Builds the binary SAH tree (Bvh::build) and collapses it. Throws std::length_error past
     // 2^26 primitives in one tree.
     static WideBvh build(const std::vector<scene::Bounds>& primitiveBounds);
-    // Bvh::buildFast collapsed: the float tracer's tree.
+    // Bvh::buildFast collapsed with smallFirst: the float tracer's tree.
     static WideBvh buildFast(const std::vector<scene::Bounds>& primitiveBounds);
-    // Bvh::buildFast with pre-split triangles, collapsed.
+    // Bvh::buildFast with pre-split triangles, collapsed with smallFirst.
     static WideBvh buildFast(const std::vector<scene::Bounds>& primitiveBounds,
                              const std::vector<Vec3T<float>>& positions, const std::vector<std::uint32_t>& indices);
     // Collapses a binary tree: each wide node takes a binary node's children and keeps opening
     // its interior child of largest surface area until it has N (the usual collapse, as
     // Embree's BVHNBuilder does; pbrt-v4 stays binary). The binary leaves are kept as they are.
-    static WideBvh collapse(const Bvh& binary);
+    // Children are stored in the binary tree's left-to-right order; with smallFirst, a node whose
+    // largest child box has over twice the surface area of its smallest stores them by increasing
+    // surface area instead (the any-hit walk's order, docs/raytrace.md "Traversal"; closest hit
+    // sorts by distance, so only its ties see the order, and those do not change its answers).
+    static WideBvh collapse(const Bvh& binary, bool smallFirst = false);
 
     const std::vector<Node>& nodes() const { return nodes_; }
     // primitives()[slot] = primitive index, or kEmpty for padding; the slots of a leaf are
@@ -93,10 +97,12 @@ public:
     template <typename BoxTest, typename Real, typename LeafFn>
     bool traverseWith(const Ray<Real>& ray, Real& tMax, bool anyHit, LeafFn&& leaf) const;
 
-    // The float tracer's walk (tracer.cpp), the same visits as traverseWith's with a leaner
-    // loop: closest hit (kAnyHit false) takes one entered child without touching the stack, two
-    // by one comparison, three or more by sorting them on the stack; any hit pushes in stored
-    // order. `boxes(node, tMax, tNear)` is a child-box test as above; `tNear` is 32-byte aligned.
+    // The float tracer's walk (tracer.cpp), the same closest-hit visits as traverseWith's with
+    // a leaner loop: closest hit (kAnyHit false) takes one entered child without touching the
+    // stack, two by one comparison, three or more by sorting them on the stack; any hit visits
+    // the entered children in stored order, pushed with the box test's `pushRefs(node, mask,
+    // out)` where it has one (one vector permute and store instead of a loop). `boxes(node,
+    // tMax, tNear)` is a child-box test as above; `tNear` is 32-byte aligned.
     template <bool kAnyHit, typename BoxTest, typename LeafFn>
     bool walk(const BoxTest& boxes, float& tMax, LeafFn&& leaf) const;
 
@@ -284,6 +290,32 @@ struct ChildBoxTestAvx8Double {
     }
 };
 
+// Byte b of kCompressLanes[mask] is the index of mask's b-th set bit counted from the highest
+// (bytes past its bit count 0): the permutation that packs a node's entered children to the
+// front, last stored child first, so that a stack popping from the top gives them in stored order.
+inline constexpr auto kCompressLanes = [] {
+    struct Table {
+        std::uint64_t lanes[256];
+    } t{};
+    for (unsigned m = 0; m < 256; ++m) {
+        int b = 0;
+        for (int c = 7; c >= 0; --c)
+            if (m >> c & 1) t.lanes[m] |= std::uint64_t(c) << (8 * b++);
+    }
+    return t;
+}();
+
+// The any-hit walk's push (WideBvh::walk): the refs of the children in `mask`, last stored first,
+// written to out[0 .. count) in one permute and one store, no loop or branch per child; the store
+// writes eight lanes, so `out` has room for eight. Returns the count.
+__attribute__((target("avx2"))) inline unsigned pushRefsAvx2(const WideNode<8>& n, unsigned mask, std::uint32_t* out) {
+    const __m256i lanes =
+        _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(&kCompressLanes.lanes[mask])));
+    const __m256i refs = _mm256_load_si256(reinterpret_cast<const __m256i*>(n.ref));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), _mm256_permutevar8x32_epi32(refs, lanes));
+    return unsigned(__builtin_popcount(mask));
+}
+
 // The box test of the float walk on CPUs with AVX2, for rays of one octant whose inverse
 // direction is finite in all three components, also times the widening factor
 // (avx2BoxTestApplies: no slab value can be NaN). The far distances use
@@ -320,6 +352,9 @@ struct ChildBoxTestAvx2Octant {
             _mm256_min_epi32(_mm256_min_epi32(bx, by), _mm256_min_epi32(bz, _mm256_castps_si256(_mm256_set1_ps(tMax))));
         _mm256_store_si256(reinterpret_cast<__m256i*>(tNear), tn);
         return ~_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(tn, tf))) & 0xFF;
+    }
+    __attribute__((target("avx2"))) unsigned pushRefs(const WideNode<8>& n, unsigned mask, std::uint32_t* out) const {
+        return pushRefsAvx2(n, mask, out);
     }
 };
 
@@ -453,7 +488,8 @@ bool WideBvh<N>::walk(const BoxTest& boxes, float& tMax, LeafFn&& leaf) const {
     if (ref == kEmpty) return false;
     const Node* nodes = nodes_.data();
     // As traverseWith: at most N − 1 entries per level of at most 80, plus a node's N at once.
-    constexpr int kStackSize = 82 * N;
+    // (Plus N: a box test's pushRefs stores N lanes at once.)
+    constexpr int kStackSize = 82 * N + N;
     std::uint32_t stackRef[kStackSize];
     float stackNear[kStackSize];
     int top = 0;
@@ -481,16 +517,21 @@ bool WideBvh<N>::walk(const BoxTest& boxes, float& tMax, LeafFn&& leaf) const {
                 ref = node.ref[c];
                 continue;
             }
+            if constexpr (kAnyHit && requires { boxes.pushRefs(node, mask, stackRef); }) {
+                // Any hit with a vector push: the first entered child in stored order next, the
+                // others pushed to be popped in stored order, without a loop over them.
+                top += int(boxes.pushRefs(node, mask, stackRef + top));
+                ref = node.ref[c];
+                continue;
+            }
             if constexpr (kAnyHit) {
-                // The first child in stored order, the others pushed; their node lines are
-                // prefetched, as they will be read soon.
+                // The first entered child in stored order next, the others pushed to be popped in
+                // stored order; their node lines are prefetched, as they will be read soon.
                 ref = node.ref[c];
                 do {
-                    c = __builtin_ctz(mask);
-                    mask &= mask - 1;
-                    stackRef[top] = node.ref[c];
-                    stackNear[top] = tn[c];
-                    ++top;
+                    c = 31 - __builtin_clz(mask);  // last stored first: popped in stored order
+                    mask &= ~(1u << c);
+                    stackRef[top++] = node.ref[c];
 #if defined(__SSE2__)
                     if (!isLeaf(node.ref[c])) {
                         const char* p = reinterpret_cast<const char*>(&nodes[node.ref[c]]);
@@ -544,6 +585,13 @@ bool WideBvh<N>::walk(const BoxTest& boxes, float& tMax, LeafFn&& leaf) const {
             hit = true;
             if constexpr (kAnyHit) return true;
             cull = tMax * kTieCullSlack;
+        }
+        if constexpr (kAnyHit) {
+            // Any hit stops at its first hit, so the cull distance never shrinks and every
+            // pushed child (entered: its entry ≤ its exit ≤ cull) is still to be visited.
+            if (top == 0) return false;
+            ref = stackRef[--top];
+            continue;
         }
         // Pop, skipping entries that begin beyond the nearest hit so far.
         for (;;) {

@@ -2,6 +2,7 @@
 // the binary tree and brute force, the SSE box test against the scalar one, memory per triangle.
 #include "raytrace/wide_bvh.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -183,6 +184,41 @@ TYPED_TEST(WideBvhTest, SseChildBoxTestEqualsTheScalarSlabTest) {
 template <typename Real>
 class WideBvhTraversal : public ::testing::Test {};
 using Reals = ::testing::Types<float, double>;
+// The float build's any-hit order (WideBvh::collapse with smallFirst): a node whose child boxes'
+// surface areas differ by more than a factor 2 stores its children by increasing area. Areas are
+// recomputed here in double from the stored boxes; nodes within 1% of the factor make no claim.
+TEST(WideBvh, FloatBuildStoresChildrenSmallestFirstWhereTheirAreasDiffer) {
+    std::mt19937_64 g(4);
+    Soup soup = triangleSoup(5000, g);
+    // Some large triangles among the small ones, as in real scenes (Sponza's floor and walls).
+    std::uniform_real_distribution<double> pos(-10, 10);
+    for (int i = 0; i < 200; ++i) {
+        scene::Bounds b;
+        b.extend(Vec3(pos(g), pos(g), pos(g)));
+        b.extend(Vec3(pos(g), pos(g), pos(g)));
+        soup.bounds.push_back(b);
+    }
+    const Bvh8 bvh = Bvh8::buildFast(soup.bounds);
+    int ordered = 0, unordered = 0;
+    for (const Bvh8Node& n : bvh.nodes()) {
+        std::vector<double> area;
+        for (int c = 0; c < 8 && n.ref[c] != Bvh8::kEmpty; ++c) {
+            const double x = double(n.bounds[3][c]) - n.bounds[0][c], y = double(n.bounds[4][c]) - n.bounds[1][c],
+                         z = double(n.bounds[5][c]) - n.bounds[2][c];
+            area.push_back(2 * (x * y + y * z + z * x));
+        }
+        const double lo = *std::min_element(area.begin(), area.end()), hi = *std::max_element(area.begin(), area.end());
+        if (hi > 2.02 * lo) {
+            ++ordered;
+            for (std::size_t c = 1; c < area.size(); ++c) EXPECT_LE(area[c - 1], area[c] * (1 + 1e-6));
+        } else if (hi < 1.98 * lo) {
+            ++unordered;
+        }
+    }
+    EXPECT_GT(ordered, 100);
+    EXPECT_GT(unordered, 10);
+}
+
 TYPED_TEST_SUITE(WideBvhTraversal, Reals);
 
 // Closest and any hit through the 8-wide tree (and closest through the 4-wide one) equal the binary tree's and brute force's: same
@@ -544,6 +580,68 @@ TEST(WideBvh, TracerAnswersAreTheSameWithAvx2AvxOrSseAndWithOrWithoutTheOccluder
     EXPECT_GT(hits, 3000);
     // The grid's blocked rays: most are answered by the previous ray's triangle packet.
     EXPECT_GT(cacheAnswers, 2000u);
+}
+
+// The float tracer's any-hit answer is brute force's: whether some triangle passes the scalar
+// watertight test (intersectTriangle) within (0, tMax), in plain and conservative mode, with the
+// AVX2, AVX or SSE walk. The any-hit walk takes each node's children in the float build's stored
+// order and pushes several at once (the AVX2 walk's vector push); neither may change the answer.
+// Rays: random segments and lines through a triangle soup, a grid of parallel rays (the
+// coherent shadow-ray case), and rays from just above the soup's triangles (shadow-ray origins).
+TEST(WideBvh, FloatTracerAnyHitIsBruteForcesAnswerWithEveryBoxTest) {
+    std::mt19937_64 g(33);
+    const Soup soup = triangleSoup(20000, g);
+    auto mesh = std::make_shared<scene::TriangleMesh>();
+    for (const Vec3& p : soup.p) mesh->positions.push_back(p);
+    for (std::uint32_t i = 0; i < soup.p.size(); ++i) mesh->indices.push_back(i);
+    scene::Scene s;
+    test::addMaterial(s, "matte");
+    test::addMesh(s, mesh);
+    const Tracer<float> tracer(s);
+    const std::vector<Vec3T<float>> p(soup.p.begin(), soup.p.end());  // the tracer's float vertices
+    std::uniform_real_distribution<double> u(-14, 14), unit(0, 1);
+    std::vector<Ray<float>> rays;
+    for (int r = 0; r < 3000; ++r) {
+        const Vec3 from(u(g), u(g), u(g)), to(u(g) / 2, u(g) / 2, u(g) / 2);
+        rays.emplace_back(Vec3T<float>(from), Vec3T<float>(to - from));
+    }
+    for (int y = 0; y < 40; ++y)
+        for (int x = 0; x < 40; ++x)
+            rays.emplace_back(Vec3T<float>(-12.0f + 0.6f * x, -12.0f + 0.6f * y, -14.0f),
+                              Vec3T<float>(0.3f, 0.4f, 1.0f));
+    for (int r = 0; r < 2000; ++r) {
+        // A point inside triangle r, lifted a little, towards a fixed "sun".
+        const Vec3 a = soup.p[3 * r], b = soup.p[3 * r + 1], c = soup.p[3 * r + 2];
+        const double s0 = unit(g), s1 = unit(g) * (1 - s0);
+        const Vec3 at = a + s0 * (b - a) + s1 * (c - a) + Vec3(0, 0.01, 0);
+        rays.emplace_back(Vec3T<float>(at), Vec3T<float>(0.2f, 1.0f, -0.35f));
+    }
+    int blocked = 0, differ = 0;
+    for (std::size_t r = 0; r < rays.size(); ++r) {
+        const Ray<float>& ray = rays[r];
+        const float tMax = r % 3 == 0 ? 0.6f : r % 3 == 1 ? 3.0f : std::numeric_limits<float>::infinity();
+        const bool conservative = r % 2 == 0;
+        bool brute = false;
+        for (std::size_t t = 0; t < soup.bounds.size() && !brute; ++t) {
+            float th, b0, b1, b2;
+            brute = intersectTriangle(ray, p[3 * t], p[3 * t + 1], p[3 * t + 2], tMax, conservative, th, b0, b1, b2);
+        }
+        blocked += brute;
+        for (int config = 0; config < 3; ++config) {
+            detail::setUseAvx(config < 2);
+            detail::setUseAvx2(config == 0);
+            setOccluderCache(false);
+            int blocker = -1;
+            differ += tracer.anyHit(ray, tMax, conservative, blocker) != brute;
+        }
+    }
+    detail::setUseAvx(true);
+    detail::setUseAvx2(true);
+    setOccluderCache(true);
+    EXPECT_EQ(differ, 0);
+    // Both answers are common, so a walk that always or never reports a hit fails.
+    EXPECT_GT(blocked, 1000);
+    EXPECT_LT(blocked, int(rays.size()) - 1000);
 }
 
 // The double tracer (the reference) gives the same closest hits (t, triangle, barycentrics, bit
