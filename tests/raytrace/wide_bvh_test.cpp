@@ -38,6 +38,17 @@ Soup triangleSoup(int count, std::mt19937_64& g) {
     return s;
 }
 
+// A scene of one matte mesh holding the soup's triangles in order.
+scene::Scene soupScene(const Soup& soup) {
+    auto mesh = std::make_shared<scene::TriangleMesh>();
+    for (const Vec3& p : soup.p) mesh->positions.push_back(p);
+    for (std::uint32_t i = 0; i < soup.p.size(); ++i) mesh->indices.push_back(i);
+    scene::Scene s;
+    test::addMaterial(s, "matte");
+    test::addMesh(s, mesh);
+    return s;
+}
+
 template <typename Node>
 bool boxContains(const Node& n, int c, const scene::Bounds& b) {
     for (int k = 0; k < 3; ++k)
@@ -520,12 +531,7 @@ TEST(WideBvh, Avx2ChildBoxTestIsItsScalarModelAndEntersEveryBoxTheSegmentMeets) 
 TEST(WideBvh, TracerAnswersAreTheSameWithAvx2AvxOrSseAndWithOrWithoutTheOccluderCache) {
     std::mt19937_64 g(31);
     const Soup soup = triangleSoup(20000, g);
-    auto mesh = std::make_shared<scene::TriangleMesh>();
-    for (const Vec3& p : soup.p) mesh->positions.push_back(p);
-    for (std::uint32_t i = 0; i < soup.p.size(); ++i) mesh->indices.push_back(i);
-    scene::Scene s;
-    test::addMaterial(s, "matte");
-    test::addMesh(s, mesh);
+    const scene::Scene s = soupScene(soup);
     const Tracer<float> tracer(s);
     std::uniform_real_distribution<double> u(-14, 14);
     std::vector<Ray<float>> rays;
@@ -591,12 +597,7 @@ TEST(WideBvh, TracerAnswersAreTheSameWithAvx2AvxOrSseAndWithOrWithoutTheOccluder
 TEST(WideBvh, FloatTracerAnyHitIsBruteForcesAnswerWithEveryBoxTest) {
     std::mt19937_64 g(33);
     const Soup soup = triangleSoup(20000, g);
-    auto mesh = std::make_shared<scene::TriangleMesh>();
-    for (const Vec3& p : soup.p) mesh->positions.push_back(p);
-    for (std::uint32_t i = 0; i < soup.p.size(); ++i) mesh->indices.push_back(i);
-    scene::Scene s;
-    test::addMaterial(s, "matte");
-    test::addMesh(s, mesh);
+    const scene::Scene s = soupScene(soup);
     const Tracer<float> tracer(s);
     const std::vector<Vec3T<float>> p(soup.p.begin(), soup.p.end());  // the tracer's float vertices
     std::uniform_real_distribution<double> u(-14, 14), unit(0, 1);
@@ -650,12 +651,7 @@ TEST(WideBvh, FloatTracerAnyHitIsBruteForcesAnswerWithEveryBoxTest) {
 TEST(WideBvh, DoubleTracerAnswersAreTheSameWithAvxOrScalarBoxTests) {
     std::mt19937_64 g(32);
     const Soup soup = triangleSoup(20000, g);
-    auto mesh = std::make_shared<scene::TriangleMesh>();
-    for (const Vec3& p : soup.p) mesh->positions.push_back(p);
-    for (std::uint32_t i = 0; i < soup.p.size(); ++i) mesh->indices.push_back(i);
-    scene::Scene s;
-    test::addMaterial(s, "matte");
-    test::addMesh(s, mesh);
+    const scene::Scene s = soupScene(soup);
     const Tracer<double> tracer(s);
     std::uniform_real_distribution<double> u(-14, 14);
     int hits = 0, differ = 0;
