@@ -958,7 +958,8 @@ bool Renderer::Impl::prepareFrame(scene::Frame& frame, scene::ChannelMask channe
             importHostImage(ctx, p == 0 ? targets.beautyFormat : kLitPlaneFormat, width, height, kLitTargetUsage,
                             litPlaneTexelBytes(targets, LitPlane(p)), data, vectors[p]->capacity() * sizeof(float));
         if (!image.image) {
-            fresh = false;  // a pointer the device cannot import: the Renderer's target
+            fresh = false;  // a pointer the device cannot import: the Renderer's target, copied
+            framePlane(*vectors[p], true, n, perPixel);
             continue;
         }
         intoFrame[p] = true;
@@ -978,7 +979,9 @@ bool Renderer::Impl::prepareFrame(scene::Frame& frame, scene::ChannelMask channe
         transition(commands, toGeneral);
         ctx.submitAndWait(commands);
     }
-    const bool colored = fresh && background != glm::vec3(0.0f);
+    // Bitwise: a background of −0.0 is written as the background pipeline would write it.
+    const glm::vec3 zero(0.0f);
+    const bool colored = fresh && std::memcmp(&background, &zero, sizeof zero) != 0;
     for (std::uint32_t p = colored ? 1 : 0; p < planes; ++p)
         if (intoFrame[p]) vectors[p]->resize((p == 0 ? 3 : 1) * n);
     if (colored) {

@@ -237,6 +237,33 @@ TEST(RasterDefaults, LiftFreeDrawsFromTheSecondFrameKeepTheOneDegreeGroundAndEve
     EXPECT_EQ(whole.validationMessages(), 0);
 }
 
+// update() finds the lift-free triangles again for the new light. A Renderer made under a sun 63°
+// high, where the ground (N·L = sin 63°) is lift-free, then moved to the 1° sun, where it is a
+// receiver past tan θ = 10, must draw the ground with the lift again: the 1° bounds above hold, and
+// every channel is that of a Renderer made for the 1° sun without lift-free draws. Keeping the high
+// sun's split would draw the ground without the lift, and its acne would fail both.
+TEST(RasterDefaults, LiftFreeDrawsFollowTheLightThroughUpdate) {
+    const scene::Scene low = oneDegreeSun();
+    scene::Scene high = low;
+    high.lights[0].direction = glm::normalize(Vec3(1.0, -2.0, 0.0));
+    scene::RenderSettings settings = scene::resolveSettings(low, {});
+    settings.raster.validate = true;
+    const scene::RenderPlan plan = scene::makeRenderPlan(low, settings);
+    Renderer moved(high, plan, settings.raster);
+    Renderer whole(low, plan, settings.raster, RendererOptions{.liftFreeDraws = false});
+    RenderDebug underHigh, underLow;
+    moved.render(scene::kAllChannels);
+    moved.render(scene::kAllChannels, &underHigh);
+    moved.update(low);
+    const scene::Frame f = moved.render(scene::kAllChannels, &underLow);
+    EXPECT_GT(underHigh.liftFreeTriangles, underLow.liftFreeTriangles)
+        << "the ground is lift-free only under the high sun";
+    expectOneDegreeGroundLitAndShadowed(low, f);
+    test::expectSamePixels(f, whole.render(scene::kAllChannels), "moved to the low sun against made for it");
+    EXPECT_EQ(moved.validationMessages(), 0);
+    EXPECT_EQ(whole.validationMessages(), 0);
+}
+
 // The cascade rule: one map is kept while its texel is at most 2 pixels at the nearest visible
 // receiver. On the low-sun ground the single fitted map is at least as wide, across the light, as
 // the distance across the light between two visible ground points, and the nearest receiver is no
