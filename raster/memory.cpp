@@ -28,6 +28,10 @@ std::uint64_t litBytesPerPixel(std::size_t lights) {
 // A tessellated sphere (raster/geometry.cpp) stays well under this many triangles.
 constexpr std::uint64_t kSphereTriangles = 1 << 16;
 constexpr std::uint64_t kBytesPerTriangle = 3 * 32 + 3 * 4;  // vertices (position, normal, id) + indices
+// Lift-free draws (one directional light, none or pcf2x2): the host keeps each vertex's position and
+// normal and the indices, and each split adds per vertex its light bits and projected point and per
+// triangle its area; counted with three vertices a triangle, an upper bound.
+constexpr std::uint64_t kLiftFreeBytesPerTriangle = 3 * (12 + 12) + 3 * 4 + 3 * (4 + 8) + 4;
 // Filterable maps (raster/moment_maps.h): two RGBA32F arrays the size of the shadow maps, and the
 // compute pipeline's compilation, measured on lavapipe (Mesa 22.3) as about 97 MiB above the
 // arrays on the seed scene at 1024² (the arrays alone: 32 bytes a texel, as measured at 4096²).
@@ -65,7 +69,11 @@ std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::Render
            // UV buffer, 3 · 8 bytes a triangle), the texels and one record per object.
            (scene.hasAlphaCasters() ? triangles * 24 + scene::alphaTextureBytes(scene) + scene.objects.size() * 32
                                     : 0) +
-           scene.objects.size() * scene::kBackendBytesPerObject;
+           scene.objects.size() * scene::kBackendBytesPerObject +
+           (scene.lights.size() == 1 && scene.lights[0].type == scene::LightType::Directional &&
+                    (settings.filter == scene::ShadowFilter::None || settings.filter == scene::ShadowFilter::Pcf2x2)
+                ? triangles * kLiftFreeBytesPerTriangle
+                : 0);
 }
 
 std::uint64_t shadowMapLayers(const scene::Scene& scene, const scene::RenderPlan& plan,
