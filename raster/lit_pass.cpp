@@ -53,7 +53,7 @@ std::span<const std::uint32_t> litFragment(const LitVariant& v, bool alpha) {
 }  // namespace
 
 LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkDescriptorSetLayout alphaSetLayout,
-                              const glm::vec3& background) {
+                              const glm::vec3& background, bool withBackground) {
     requireFormat(ctx, kLitDepthFormat, VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT, "the camera depth buffer");
     VkDevice device = ctx.device.get();
     const VkDescriptorSetLayoutBinding bindings[] = {
@@ -177,7 +177,7 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkD
                  // Reversed Z: nearer is larger.
                  .depthCompare = VK_COMPARE_OP_GREATER,
              });
-    if (!variant.displayTarget) {
+    if (!variant.displayTarget && withBackground) {
         // The background: where the depth is still the cleared far plane (0), which no fragment
         // of the scene can leave there (GREATER than 0 to be drawn). Its color as specialization
         // constants (the bits of the floats the clear used).

@@ -86,10 +86,11 @@ struct LitPipeline {
 };
 // alphaSetLayout (raster/alpha_casters.h; VK_NULL_HANDLE: none): scenes with MASK or BLEND
 // materials, whose texels the camera looks through as camera rays do (docs/raster.md).
-// background: the scene's background color (linear), for the background pipeline.
+// background: the scene's background color (linear), for the background pipeline; withBackground
+// false makes none (a pipeline that only draws triangles, e.g. the lift-free one).
 LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant = {},
                               VkDescriptorSetLayout alphaSetLayout = VK_NULL_HANDLE,
-                              const glm::vec3& background = glm::vec3(0.0f));
+                              const glm::vec3& background = glm::vec3(0.0f), bool withBackground = true);
 
 struct LitTargets {
     // The Renderer's own targets for each plane (LitPlane order): rendered into when a frame

@@ -770,7 +770,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                 litPipeline[a] = createLitPipeline(ctx, litVariant(normalOffsetUsed(settings, layers)),
                                                    a ? alpha.descriptors.layout.get() : VK_NULL_HANDLE, background);
         if (liftFreeWanted && !liftFree.pipeline)
-            liftFree = createLitPipeline(ctx, litVariant(false), VK_NULL_HANDLE, background);
+            liftFree = createLitPipeline(ctx, litVariant(false), VK_NULL_HANDLE, background, false);
         if (bindings.set == VK_NULL_HANDLE)
             bindings = createLitBindings(ctx, litPipeline[litPipeline[0].pipeline ? 0 : 1], uniforms,
                                          transmitWindowData, albedos, maps, transmittanceMaps, momentMaps);
