@@ -250,7 +250,11 @@ struct Renderer::Impl {
     std::vector<glm::vec3> hostNormals;
     std::vector<glm::vec3> hostPositions;  // camera-relative, as the vertex buffer (the runs' pixel areas)
     std::vector<std::uint32_t> hostIndices;
-    void splitByLift();    // draw.litRangesByLift for the current lights
+    void splitByLift();  // draw.litRangesByLift for the current lights
+    // The vertices' lift-free bits (liftFreeVertexBits) and the lights and threshold they were made for.
+    std::vector<std::uint32_t> liftBits;
+    std::vector<glm::vec3> liftBitsLights;
+    double liftBitsThreshold = -1.0;
     LitBindings bindings;  // allocated with the first lit pipeline's (identical) set layout
     shaders::LitUniforms uniforms{};
     std::vector<glm::vec4> albedos;
@@ -475,10 +479,15 @@ void Renderer::Impl::splitByLift() {
         const shaders::LightData& l = uniforms.lights[i];
         if (l.layer >= 0.0f && l.slopeBiasTexels > 0.0f) towardLights.push_back(l.towardLight);
     }
-    const std::vector<std::uint32_t> bits =
-        liftFreeVertexBits(hostNormals, towardLights, liftFreeThreshold(double(uniforms.lights[0].maxSlopeTan)));
+    // The vertices' bits depend on the lights alone: a camera that moves reuses them.
+    const double threshold = liftFreeThreshold(double(uniforms.lights[0].maxSlopeTan));
+    if (towardLights != liftBitsLights || threshold != liftBitsThreshold || liftBits.empty()) {
+        liftBits = liftFreeVertexBits(hostNormals, towardLights, threshold);
+        liftBitsLights = towardLights;
+        liftBitsThreshold = threshold;
+    }
     std::vector<IndexRange> ranges = raster::splitByLift(
-        bits, hostIndices, draw.litRanges, pixelAreas(hostPositions, hostIndices, uniforms.viewProj, width, height),
+        liftBits, hostIndices, draw.litRanges, pixelAreas(hostPositions, hostIndices, uniforms.viewProj, width, height),
         kLiftFreeMinPixels);
     if (std::any_of(ranges.begin(), ranges.end(), [](const IndexRange& r) { return r.liftFree; }))
         draw.litRangesByLift = std::move(ranges);
