@@ -95,6 +95,14 @@ inline void addMesh(scene::Scene& s, std::shared_ptr<const scene::TriangleMesh> 
     s.objects.push_back(o);
 }
 
+// A scene of one mesh with the one material "matte" (no lights, no camera): what a tracer test needs.
+inline scene::Scene matteMeshScene(std::shared_ptr<const scene::TriangleMesh> geometry) {
+    scene::Scene s;
+    addMaterial(s, "matte");
+    addMesh(s, std::move(geometry));
+    return s;
+}
+
 // An alpha texture w x h (row 0 at the top) with the given wrap modes.
 inline std::shared_ptr<scene::AlphaTexture> alphaTexture(int w, int h, std::vector<float> alpha,
                                                          scene::TextureWrap s = scene::TextureWrap::Repeat,

@@ -104,9 +104,7 @@ TYPED_TEST(BvhTraversal, ClosestAndAnyHitEqualBruteForceOnRandomRays) {
     using V = Vec3T<Real>;
     std::mt19937_64 g(11);
     const auto soup = triangleSoup(2000, g);
-    scene::Scene s;
-    test::addMaterial(s, "matte");
-    test::addMesh(s, soup);
+    scene::Scene s = test::matteMeshScene(soup);
     const Tracer<Real> tracer(s);
     std::vector<V> p(soup->positions.size());
     for (std::size_t i = 0; i < p.size(); ++i) p[i] = V(soup->positions[i]);
@@ -147,9 +145,7 @@ TYPED_TEST(BvhTraversal, RaysThroughSharedEdgesAndVerticesOfAClosedMeshNeverMiss
     using V = Vec3T<Real>;
     const Vec3 center(3.25, -1.5, 7.75);
     const auto sphere = test::icosphere(center, 2.0, 3);
-    scene::Scene s;
-    test::addMaterial(s, "matte");
-    test::addMesh(s, sphere);
+    scene::Scene s = test::matteMeshScene(sphere);
     const Tracer<Real> tracer(s);
     std::mt19937_64 g(5);
     std::uniform_real_distribution<double> u(-0.5, 0.5);

@@ -125,9 +125,7 @@ int answersDiffer(const T& fast, const T& reference, const Ray<float>& ray, bool
 
 TEST(FastBuild, FloatTracerHitsAreTheSameOnItsTreeAndOnTheReferenceTree) {
     std::mt19937_64 g(41);
-    scene::Scene s;
-    test::addMaterial(s, "matte");
-    test::addMesh(s, soupWithTies(g));
+    scene::Scene s = test::matteMeshScene(soupWithTies(g));
     const Tracer<float> fast(s);
     detail::setFastFloatBuild(false);
     const Tracer<float> reference(s);
@@ -233,9 +231,7 @@ TEST(FastBuild, ThePresplitTreeDoesNotDependOnTheThreadCount) {
 TEST(FastBuild, PresplitTreeGivesTheSameHitsAsTheReferenceTree) {
     std::mt19937_64 g(47);
     const auto mesh = largeAndSmall(g);
-    scene::Scene s;
-    test::addMaterial(s, "matte");
-    test::addMesh(s, mesh);
+    scene::Scene s = test::matteMeshScene(mesh);
     const Tracer<float> fast(s);
     detail::setFastFloatBuild(false);
     const Tracer<float> reference(s);
@@ -264,9 +260,7 @@ TEST(FastBuild, PresplitTreeGivesTheSameHitsAsTheReferenceTree) {
 TEST(FastBuild, AnExactTieGoesToTheLowestTriangleIndexOnEitherTree) {
     std::mt19937_64 g(43);
     const auto mesh = soupWithTies(g);
-    scene::Scene s;
-    test::addMaterial(s, "matte");
-    test::addMesh(s, mesh);
+    scene::Scene s = test::matteMeshScene(mesh);
     for (bool fastTree : {true, false}) {
         detail::setFastFloatBuild(fastTree);
         const Tracer<float> tracer(s);

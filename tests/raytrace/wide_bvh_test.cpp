@@ -43,10 +43,7 @@ scene::Scene soupScene(const Soup& soup) {
     auto mesh = std::make_shared<scene::TriangleMesh>();
     for (const Vec3& p : soup.p) mesh->positions.push_back(p);
     for (std::uint32_t i = 0; i < soup.p.size(); ++i) mesh->indices.push_back(i);
-    scene::Scene s;
-    test::addMaterial(s, "matte");
-    test::addMesh(s, mesh);
-    return s;
+    return test::matteMeshScene(mesh);
 }
 
 template <typename Node>
