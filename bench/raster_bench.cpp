@@ -1,8 +1,9 @@
 // bench/raster_bench.cpp: our raster frame (raster::Renderer) against a bare two-pass lavapipe
-// renderer (bench/bare_renderer.h) on the seed scene and Sponza at 1920x1080 with a 2048² map,
-// in one process: per-stage medians of interleaved repetitions, cold (empty Mesa shader cache)
-// and warm first frames, and, when LP_NUM_THREADS is not set, the whole run once with
-// LP_NUM_THREADS=2 and once with 1 (child processes: lavapipe reads it at device creation).
+// renderer (bench/bare_renderer.h) on the seed scene and Sponza (or the generated terrain of
+// bench/terrain_scene.h at a given size) at 1920x1080 with a 2048² map, in one process:
+// per-stage medians of interleaved repetitions, cold (empty Mesa shader cache) and warm first
+// frames, and, when LP_NUM_THREADS is not set, the whole run once with LP_NUM_THREADS=2 and once
+// with 1 (child processes: lavapipe reads it at device creation).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -12,9 +13,12 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include <sys/resource.h>
 
 #include "bare_renderer.h"
 #include "raster/renderer.h"
@@ -22,6 +26,7 @@
 #include "scene/loader.h"
 #include "scene/render_plan.h"
 #include "scene/settings.h"
+#include "terrain_scene.h"
 
 namespace {
 
@@ -48,6 +53,13 @@ double cpuMs() {
     timespec t{};
     clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
     return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
+}
+
+// The process's peak resident set so far, MiB (ru_maxrss is in KiB on Linux).
+double peakRssMiB() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return double(u.ru_maxrss) / 1024.0;
 }
 
 double median(std::vector<double> v) {
@@ -124,10 +136,13 @@ raster::RendererOptions rendererOptions() {
     return o;
 }
 
-void benchScene(const std::string& label, const fs::path& file, int repeats, std::vector<fs::path>& caches) {
+// `scaling`: the generated terrain, whose run grows with its size: only the series the scaling
+// table reads (ours all channels, ours float beauty, bare), so no png, sRGB or new-Frame series and
+// no second bare renderer holding another copy of the triangles.
+void benchScene(const std::string& label, scene::Scene s, int repeats, std::vector<fs::path>& caches,
+                bool scaling = false) {
     const char* noFresh = std::getenv("SHADOWLAB_BENCH_NO_FRESH");
-    const bool skipFresh = noFresh && std::string(noFresh) == "1";
-    scene::Scene s = scene::loadScene(file);
+    const bool skipFresh = scaling || (noFresh && std::string(noFresh) == "1");
     const auto [width, height] = benchResolution();
     s.camera.width = width;
     s.camera.height = height;
@@ -193,8 +208,11 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
     bare.render(rgba);
     // The same bare passes writing an sRGB target, as ours does for a PNG: what the device's
     // sRGB encoding on store costs (the headline ratios are against the UNORM one above).
-    bench::BareRenderer bareSrgb(s, settings.raster, true);
-    bareSrgb.render(rgba);
+    std::optional<bench::BareRenderer> bareSrgb;
+    if (!scaling) {
+        bareSrgb.emplace(s, settings.raster, true);
+        bareSrgb->render(rgba);
+    }
 
     std::printf(
         "\n=== %s: %s triangles, %dx%d, shadow map %d, filter %s, light constants: %s, bare PCF: "
@@ -225,8 +243,8 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
                 ours.render(into, scene::kChannelBeauty | scene::kBeautyForDisplay);
             else if (which == "bare")
                 bare.render(rgba);
-            else if (which == "bare-srgb")
-                bareSrgb.render(rgba);
+            else if (which == "bare-srgb" && bareSrgb)
+                bareSrgb->render(rgba);
             else
                 throw std::runtime_error(
                     "SHADOWLAB_BENCH_PROFILE: expected all, no-ids, beauty, png, bare or bare-srgb, got " + which);
@@ -249,26 +267,33 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
         ours.render(beautyFrame, scene::kChannelBeauty);
         beauty.add("cpu_per_frame", cpuMs() - c);
         addOurs(beauty, beautyFrame);
-        c = cpuMs();
-        ours.render(pngFrame, scene::kChannelBeauty | scene::kBeautyForDisplay);
-        png.add("cpu_per_frame", cpuMs() - c);
-        addOurs(png, pngFrame);
+        if (!scaling) {
+            c = cpuMs();
+            ours.render(pngFrame, scene::kChannelBeauty | scene::kBeautyForDisplay);
+            png.add("cpu_per_frame", cpuMs() - c);
+            addOurs(png, pngFrame);
+        }
         if (!skipFresh) addOurs(fresh, ours.render(scene::kAllChannels));  // a new Frame every time
         c = cpuMs();
         const bench::BareTimings t = bare.render(rgba);
         base.add("cpu_per_frame", cpuMs() - c);
         addBare(base, t);
-        c = cpuMs();
-        const bench::BareTimings ts = bareSrgb.render(rgba);
-        baseSrgb.add("cpu_per_frame", cpuMs() - c);
-        addBare(baseSrgb, ts);
+        if (bareSrgb) {
+            c = cpuMs();
+            const bench::BareTimings ts = bareSrgb->render(rgba);
+            baseSrgb.add("cpu_per_frame", cpuMs() - c);
+            addBare(baseSrgb, ts);
+        }
     }
 
-    // Warm first frames: a new renderer (new device) whose shaders are now in the cache.
+    // Warm first frames: a new renderer (new device) whose shaders are now in the cache; the
+    // construction's CPU time apart (the upload of the triangles: what grows with the scene).
     t0 = Clock::now();
     c0 = cpuMs();
+    double oursConstructCpu = 0, bareConstructCpu = 0;
     {
         raster::Renderer again(s, plan, settings.raster, rendererOptions());
+        oursConstructCpu = cpuMs() - c0;
         again.render();
     }
     const double oursWarmFirst = msSince(t0);
@@ -277,6 +302,7 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
     c0 = cpuMs();
     {
         bench::BareRenderer again(s, settings.raster);
+        bareConstructCpu = cpuMs() - c0;
         again.render(rgba);
     }
     const double bareWarmFirst = msSince(t0);
@@ -288,6 +314,7 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
     for (const char* stage :
          {"shadow_pass", "lit_pass", "readback", "per_frame", "cpu_shadow_pass", "cpu_lit_pass", "cpu_per_frame"}) {
         auto cell = [&](const Series& x) {
+            if (x.med(stage) < 0) return std::string("-");  // a series not run (the terrain's png)
             char buf[64];
             const auto [lo, hi] = x.range(stage);
             std::snprintf(buf, sizeof buf, "%.1f (%.1f-%.1f)", x.med(stage), lo, hi);
@@ -295,25 +322,39 @@ void benchScene(const std::string& label, const fs::path& file, int repeats, std
         };
         std::printf("  %-12s %22s %22s %22s %22s %9.2f %9.2f %9.2f\n", stage, cell(all).c_str(), cell(beauty).c_str(),
                     cell(png).c_str(), cell(base).c_str(), all.med(stage) / base.med(stage),
-                    beauty.med(stage) / base.med(stage), png.med(stage) / base.med(stage));
+                    beauty.med(stage) / base.med(stage), scaling ? 0.0 : png.med(stage) / base.med(stage));
     }
-    std::printf(
-        "  bare with an sRGB target: per_frame %.1f, lit_pass %.1f, cpu_per_frame %.1f; png / bare sRGB: "
-        "per_frame %.2f, cpu %.2f\n",
-        baseSrgb.med("per_frame"), baseSrgb.med("lit_pass"), baseSrgb.med("cpu_per_frame"),
-        png.med("per_frame") / baseSrgb.med("per_frame"), png.med("cpu_per_frame") / baseSrgb.med("cpu_per_frame"));
-    std::printf("  ours (all channels) into a new Frame each time: per_frame %.1f, readback %.1f\n",
-                fresh.med("per_frame"), fresh.med("readback"));
+    if (!scaling)
+        std::printf(
+            "  bare with an sRGB target: per_frame %.1f, lit_pass %.1f, cpu_per_frame %.1f; png / bare sRGB: "
+            "per_frame %.2f, cpu %.2f\n",
+            baseSrgb.med("per_frame"), baseSrgb.med("lit_pass"), baseSrgb.med("cpu_per_frame"),
+            png.med("per_frame") / baseSrgb.med("per_frame"), png.med("cpu_per_frame") / baseSrgb.med("cpu_per_frame"));
+    if (!skipFresh)
+        std::printf("  ours (all channels) into a new Frame each time: per_frame %.1f, readback %.1f\n",
+                    fresh.med("per_frame"), fresh.med("readback"));
     std::printf("  setup (construction): ours %.1f, bare %.1f\n", ours.setupMs(), bare.setupMs());
     std::printf("  first frame incl. setup: cold ours %.1f, bare %.1f; warm ours %.1f, bare %.1f (%s first)\n",
                 oursCold, bareCold, oursWarmFirst, bareWarmFirst, bareFirst ? "bare" : "ours");
     std::printf("  first frame, process CPU: cold ours %.1f, bare %.1f (%.2f); warm ours %.1f, bare %.1f (%.2f)\n",
                 oursColdCpu, bareColdCpu, oursColdCpu / bareColdCpu, oursWarmFirstCpu, bareWarmFirstCpu,
                 oursWarmFirstCpu / bareWarmFirstCpu);
+    std::printf("  warm construction alone (the triangles' upload), process CPU: ours %.1f, bare %.1f (%.2f)\n",
+                oursConstructCpu, bareConstructCpu, oursConstructCpu / bareConstructCpu);
     std::printf("  gpu timestamps: first frame shadow %s, lit %s; last warm frame (all channels) shadow %s, lit %s\n",
                 frame.attributes["gpu_shadow_pass_ms"].c_str(), frame.attributes["gpu_lit_pass_ms"].c_str(),
                 allFrame.attributes["gpu_shadow_pass_ms"].c_str(), allFrame.attributes["gpu_lit_pass_ms"].c_str());
     const char* threads = std::getenv("LP_NUM_THREADS");
+    // One line per scene for tools/scaling_plot.py: per-frame process CPU medians, the warm first
+    // frame's process CPU (construction + first frame, shaders cached), and the peak RSS so far.
+    std::printf(
+        "RSCALE | %s | %s | frame_cpu ours_all %.1f ours_beauty %.1f bare %.1f | frame_wall ours_all %.1f ours_beauty "
+        "%.1f bare %.1f | setup_cpu ours %.1f bare %.1f | construct_cpu ours %.1f bare %.1f | rss_mib %.0f | "
+        "lp_threads %s\n",
+        label.c_str(), frame.attributes["triangles"].c_str(), all.med("cpu_per_frame"), beauty.med("cpu_per_frame"),
+        base.med("cpu_per_frame"), all.med("per_frame"), beauty.med("per_frame"), base.med("per_frame"),
+        oursWarmFirstCpu, bareWarmFirstCpu, oursConstructCpu, bareConstructCpu, peakRssMiB(), threads ? threads : "?");
+    if (scaling) return;
     std::printf(
         "ROW | %s | %s | %.1f | %.1f | %.1f | %.1f | %.2f | %.2f | %.2f | %.2f | %.2f | %.1f | %.1f | %.1f / %.1f | "
         "%.1f / %.1f |\n",
@@ -541,8 +582,25 @@ int main(int argc, char** argv) {
     std::printf("driver loaded in %.1f ms (before any timing)\n", msSince(loadStart));
     std::vector<fs::path> caches;
     int rc = 0;
+    // SHADOWLAB_BENCH_TERRAIN_TRIS=N: only the generated terrain of about N triangles (bench/terrain_scene.h,
+    // raytrace_bench's camera and sun), for the scaling table.
+    if (const char* t = std::getenv("SHADOWLAB_BENCH_TERRAIN_TRIS"); t && *t) {
+        const long long tris = std::atoll(t);
+        if (tris <= 0) {
+            std::fprintf(stderr, "SHADOWLAB_BENCH_TERRAIN_TRIS: expected a positive count, got %s\n", t);
+            return 2;
+        }
+        try {
+            benchScene("terrain", bench::terrainScene(bench::terrainCellsFor(tris)), repeats, caches, true);
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "terrain failed: %s\n", e.what());
+            rc = 1;
+        }
+        for (const fs::path& dir : caches) fs::remove_all(dir);
+        return rc;
+    }
     if (wantScene("seed")) try {
-            benchScene("seed", scene::findScene("seed"), repeats, caches);
+            benchScene("seed", scene::loadScene(scene::findScene("seed")), repeats, caches);
         } catch (const std::exception& e) {
             std::fprintf(stderr, "seed scene failed: %s\n", e.what());
             rc = 1;
@@ -552,7 +610,7 @@ int main(int argc, char** argv) {
         std::printf("\n=== Sponza: SKIPPED, file absent: %s ===\n", kSponzaPath);
     } else {
         try {
-            benchScene("Sponza", kSponzaPath, repeats, caches);
+            benchScene("Sponza", scene::loadScene(kSponzaPath), repeats, caches);
         } catch (const std::exception& e) {
             std::fprintf(stderr, "Sponza failed: %s\n", e.what());
             rc = 1;

@@ -35,6 +35,7 @@
 #include "scene/camera.h"
 #include "scene/loader.h"
 #include "scene/mesh_loader.h"
+#include "terrain_scene.h"
 
 #ifdef SHADOWLAB_HAVE_EMBREE
 #include <embree3/rtcore.h>
@@ -67,42 +68,6 @@ struct Workload {
     long long embreeBytes = 0;  // held by the device after the build (memory monitor)
 #endif
 };
-
-// A height field of cells² quads (two triangles each) over [−50, 50]², with smooth
-// hills and sharp ridges so that shadow rays cross much of the terrain before they leave it.
-constexpr int kTerrainCells = 708;  // 2·708² = 1,002,528 triangles
-scene::Scene terrainScene(int cells = kTerrainCells) {
-    auto mesh = std::make_shared<scene::TriangleMesh>();
-    const int n = cells + 1;
-    auto height = [](double x, double z) {
-        return 3.0 * std::sin(0.11 * x) * std::cos(0.13 * z) + 1.5 * std::sin(0.37 * x + 0.5 * z) +
-               4.0 * std::abs(std::sin(0.05 * (x - 2 * z)));
-    };
-    for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i) {
-            const double x = -50 + 100.0 * i / cells, z = -50 + 100.0 * j / cells;
-            mesh->positions.emplace_back(x, height(x, z), z);
-        }
-    for (int j = 0; j < cells; ++j)
-        for (int i = 0; i < cells; ++i) {
-            const std::uint32_t a = std::uint32_t(j * n + i), b = a + 1, c = a + std::uint32_t(n), d = c + 1;
-            for (std::uint32_t v : {a, c, b, b, c, d}) mesh->indices.push_back(v);
-        }
-    scene::Scene s;
-    s.file = "generated-terrain";
-    s.camera.position = {-45, 14, -45};
-    s.camera.lookAt = {10, 0, 10};
-    s.camera.fovYDegrees = 60;
-    scene::Light sun;
-    sun.direction = glm::normalize(scene::Vec3(0.6, -0.25, 0.3));  // about 14° above the horizon
-    s.lights.push_back(sun);
-    s.materials.push_back(scene::Material{"matte"});
-    scene::Object o;
-    o.name = "terrain";
-    o.shape = scene::Mesh::single("generated-terrain", mesh);
-    s.objects.push_back(o);
-    return s;
-}
 
 int envInt(const char* name, int fallback) {
     const char* v = std::getenv(name);
@@ -563,8 +528,8 @@ int main(int argc, char** argv) {
             kSponzaPath);
     }
     if (wanted("terrain")) {
-        const int tris = envInt("SHADOWLAB_BENCH_TERRAIN_TRIS", 2 * kTerrainCells * kTerrainCells);
-        add("terrain", terrainScene(std::max(1, int(std::lround(std::sqrt(tris / 2.0))))));
+        const int tris = envInt("SHADOWLAB_BENCH_TERRAIN_TRIS", 2 * bench::kTerrainCells * bench::kTerrainCells);
+        add("terrain", bench::terrainScene(bench::terrainCellsFor(tris)));
     }
 #ifndef SHADOWLAB_HAVE_EMBREE
     std::printf("Embree 3 was not found at configure time: our tracer is measured alone.\n");
