@@ -98,11 +98,27 @@ void addMesh(Builder& b, const scene::Object& o, const scene::Mesh& m) {
         if (!inst.geometry) throw RasterError(o.name + ": mesh " + m.file.string() + " has no loaded geometry");
         const scene::TriangleMesh& g = *inst.geometry;
         const glm::dmat3 nm = scene::normalMatrix(inst.transform);
+        auto uv = [&](std::uint32_t i) { return i < g.uvs.size() ? g.uvs[i] : scene::Vec2(0.0); };
+        if (g.normals.size() != g.positions.size()) {
+            // No vertex normals (a mesh built in code; the loaders always compute them): flat
+            // triangles with the face normal, as the ray tracer shades such a mesh.
+            for (std::size_t t = 0; t + 2 < g.indices.size(); t += 3) {
+                const std::uint32_t i[3] = {g.indices[t], g.indices[t + 1], g.indices[t + 2]};
+                const Vec3 face =
+                    nm * glm::cross(g.positions[i[1]] - g.positions[i[0]], g.positions[i[2]] - g.positions[i[0]]);
+                const double len = glm::length(face);
+                const Vec3 n = len > 0.0 ? face / len : Vec3(0, 1, 0);  // degenerate: draws nothing
+                std::uint32_t v[3];
+                for (int k = 0; k < 3; ++k)
+                    v[k] = b.vertex(scene::transformPoint(inst.transform, g.positions[i[k]]), n, uv(i[k]));
+                b.triangle(v[0], v[1], v[2]);
+            }
+            continue;
+        }
         std::uint32_t base = 0;
         for (std::size_t i = 0; i < g.positions.size(); ++i) {
-            const Vec3 n = i < g.normals.size() ? glm::normalize(nm * g.normals[i]) : Vec3(0, 1, 0);
-            const std::uint32_t v = b.vertex(scene::transformPoint(inst.transform, g.positions[i]), n,
-                                             i < g.uvs.size() ? g.uvs[i] : scene::Vec2(0.0));
+            const std::uint32_t v = b.vertex(scene::transformPoint(inst.transform, g.positions[i]),
+                                             glm::normalize(nm * g.normals[i]), uv(std::uint32_t(i)));
             if (i == 0) base = v;
         }
         for (std::size_t t = 0; t + 2 < g.indices.size(); t += 3)

@@ -113,6 +113,31 @@ TEST(Tessellate, MeshIsTakenAsIsWithObjectIds) {
     EXPECT_EQ(g.indices[6], 4u);  // the second copy's indices point at its own vertices
 }
 
+TEST(Tessellate, MeshWithoutNormalsIsDrawnFlatWithEachFaceNormal) {
+    // A roof of two faces sharing the ridge, with no vertex normals, placed by a non-uniform scale
+    // and a move. Each triangle gets its own three vertices whose normal is the placed face's:
+    // the cross product of its placed edges (a shared vertex would blend the two faces).
+    auto mesh = std::make_shared<scene::TriangleMesh>();
+    mesh->positions = {Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, 1, 1), Vec3(1, 0, 0)};
+    mesh->indices = {0, 2, 1, 1, 2, 3};
+    scene::Affine m(1.0);
+    m[0][0] = 3.0;                 // x scaled by 3: the slopes flatten to 1:3
+    m[3] = scene::Vec3(5, 2, -1);  // moved
+    const SceneGeometry g = tessellateScene(oneObject(scene::Mesh::single("roof.obj", mesh, m)), Vec3(0));
+    ASSERT_EQ(g.triangleCount(), 2u);
+    ASSERT_EQ(g.vertices.size(), 6u);
+    const Vec3 expected[2] = {glm::normalize(Vec3(-1, 3, 0)), glm::normalize(Vec3(1, 3, 0))};
+    for (std::size_t t = 0; t < 2; ++t) {
+        const Vec3 a(g.vertices[g.indices[3 * t]].position), b(g.vertices[g.indices[3 * t + 1]].position),
+            c(g.vertices[g.indices[3 * t + 2]].position);
+        EXPECT_NEAR(glm::dot(glm::normalize(glm::cross(b - a, c - a)), expected[t]), 1.0, 1e-6);  // winding kept
+        for (int k = 0; k < 3; ++k) {
+            const Vec3 n(g.vertices[g.indices[3 * t + k]].normal);
+            EXPECT_NEAR(glm::dot(n, expected[t]), 1.0, 1e-6) << "triangle " << t << " vertex " << k;
+        }
+    }
+}
+
 TEST(Tessellate, MeshWithoutGeometryIsAnError) {
     EXPECT_THROW(tessellateScene(oneObject(scene::Mesh::single("missing.obj", nullptr)), Vec3(0)), std::runtime_error);
 }
