@@ -1,7 +1,8 @@
 // scene/mesh_loader.h: OBJ and glTF/GLB triangle meshes (double precision) in object space,
 // each placed by a transform; a mesh that several glTF nodes or objects use is read once.
 // Non-finite vertices, out-of-range indices and unreadable files are errors; degenerate
-// triangles are dropped and counted; missing normals are computed (area-weighted).
+// triangles are dropped and counted; missing normals are computed (glTF: flat, as its spec
+// requires; OBJ and PLY: area-weighted).
 #pragma once
 
 #include <cstdint>

@@ -159,7 +159,7 @@ struct Box {
 
 // A triangle mesh in its own object space (double precision), shared (shared_ptr<const>) by
 // every object and glTF node that places it. Loaded from OBJ/glTF by mesh_loader.h; `normals`
-// is per vertex, computed when the file has none.
+// is per vertex, computed when the file has none (flat for glTF, smooth for OBJ and PLY).
 struct TriangleMesh {
     std::vector<Vec3> positions;
     std::vector<Vec3> normals;

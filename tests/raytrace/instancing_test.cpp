@@ -63,13 +63,12 @@ TwoScenes loadBoth(const shadowlab::test::TempDir& dir) {
     for (const glm::dmat4& m : handTransforms()) {
         const std::uint32_t base = std::uint32_t(flat->positions.size());
         const glm::dmat3 nm = glm::transpose(glm::inverse(glm::dmat3(m)));
-        for (std::size_t k = 0; k < 8; ++k) {
-            const Vec3 corner(shadowlab::test::boxCorners()[3 * k], shadowlab::test::boxCorners()[3 * k + 1],
-                              shadowlab::test::boxCorners()[3 * k + 2]);
-            flat->positions.push_back(Vec3(m * glm::dvec4(corner, 1.0)));
+        // The file has no normals, so the loaded box is flat: three corners of its own per triangle.
+        for (std::size_t k = 0; k < g.positions.size(); ++k) {
+            flat->positions.push_back(Vec3(m * glm::dvec4(g.positions[k], 1.0)));
             flat->normals.push_back(glm::normalize(nm * g.normals.at(k)));
         }
-        for (std::uint16_t i : shadowlab::test::boxIndices()) flat->indices.push_back(base + i);
+        for (std::uint32_t i : g.indices) flat->indices.push_back(base + i);
     }
     t.flattened = t.instanced;
     t.flattened.objects[1].shape = scene::Mesh::single("by hand", flat);

@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "raytrace/memory.h"
 #include "raytrace/tracer.h"
 #include "tests/kit/test_scenes.h"
 
@@ -304,6 +305,28 @@ TEST(WideBvh, FloatTracerHoldsUnder100BytesPerTriangle) {
     const double bytes = double(tracer.meshBytes());
     EXPECT_GT(bytes, floor + 36.0 * 20480);  // plus at least one float copy per triangle
     EXPECT_LT(bytes / 20480.0, 100.0) << bytes / 20480.0 << " bytes per triangle";
+}
+
+TEST(WideBvh, TheMemoryEstimateCoversAFlatMesh) {
+    // A glTF without normals loads flat: three vertices a triangle, six times a shared mesh's
+    // share. The estimate's mesh part (what the scene with the mesh adds over the scene without
+    // it) must still hold what the tracer allocates.
+    scene::Scene empty;
+    test::addMaterial(empty, "matte");
+    const auto shared = test::icosphere(Vec3(0), 1.0, 4);  // 5,120 triangles
+    auto flat = std::make_shared<scene::TriangleMesh>();
+    for (const std::uint32_t i : shared->indices) {
+        flat->indices.push_back(std::uint32_t(flat->positions.size()));
+        flat->positions.push_back(shared->positions[i]);
+        flat->normals.push_back(shared->normals[i]);
+    }
+    scene::Scene s = empty;
+    test::addMesh(s, flat);
+    const Tracer<float> tracer(s);
+    ASSERT_EQ(tracer.triangleCount(), 5120u);
+    const std::uint64_t part =
+        raytrace::estimateMemoryBytes(s, test::planFor(s)) - raytrace::estimateMemoryBytes(empty, test::planFor(empty));
+    EXPECT_GE(part, tracer.meshBytes()) << double(tracer.meshBytes()) / 5120.0 << " bytes per triangle";
 }
 
 #if defined(SHADOWLAB_AVX_BOX_TEST)

@@ -129,6 +129,29 @@ const char* kThreeNodes = R"([{"mesh": 0, "translation": [-2, 0, 0]},
   {"mesh": 0, "translation": [1, 0, 0], "rotation": [0, 0.7071067811865476, 0, 0.7071067811865476], "children": [2]},
   {"mesh": 0, "translation": [0, 1, 0], "scale": [2, 2, 2]}])";
 
+TEST(MeshLoader, GltfWithoutNormalsGetsFlatFaceNormals) {
+    // glTF 2.0, 3.7.2.1: a primitive without NORMAL is shaded flat. The test box has none: each
+    // of its 12 triangles gets three vertices of its own whose normal is its face's, the
+    // axis-aligned outward normal of the box side it lies on (away from the box's centre).
+    TempDir dir;
+    const auto mesh = load(dir.write("box.gltf", test::boxGltf(R"([{"mesh": 0}])", "[0]")));
+    ASSERT_EQ(mesh->triangleCount(), 12u);
+    ASSERT_EQ(mesh->positions.size(), 36u);
+    ASSERT_EQ(mesh->normals.size(), 36u);
+    const Vec3 centre(0.5, 0.25, 0.125);
+    for (std::size_t t = 0; t < 36; t += 3) {
+        const Vec3& a = mesh->positions[mesh->indices[t]];
+        const Vec3& b = mesh->positions[mesh->indices[t + 1]];
+        const Vec3& c = mesh->positions[mesh->indices[t + 2]];
+        Vec3 side(0.0);  // the axis on which all three corners agree, signed away from the centre
+        for (int axis = 0; axis < 3; ++axis)
+            if (a[axis] == b[axis] && b[axis] == c[axis]) side[axis] = a[axis] > centre[axis] ? 1.0 : -1.0;
+        ASSERT_EQ(glm::length(side), 1.0) << "triangle " << t / 3;
+        for (std::size_t k = 0; k < 3; ++k)
+            EXPECT_EQ(mesh->normals[mesh->indices[t + k]], side) << "triangle " << t / 3 << " corner " << k;
+    }
+}
+
 TEST(MeshInstancing, AGltfMeshUsedByThreeNodesIsOneGeometryPlacedThreeTimes) {
     TempDir dir;
     const auto file = dir.write("three.gltf", test::boxGltf(kThreeNodes, "[0, 1]"));
@@ -140,8 +163,10 @@ TEST(MeshInstancing, AGltfMeshUsedByThreeNodesIsOneGeometryPlacedThreeTimes) {
     EXPECT_EQ(inst[1].geometry.get(), inst[2].geometry.get());
     EXPECT_EQ(inst[0].geometry.use_count(), 3);
     EXPECT_EQ(inst[0].geometry->triangleCount(), 12u);
-    // Object space: the box's own corners, untouched by any node.
-    EXPECT_EQ(inst[0].geometry->positions[7], Vec3(1, 0.5, 0.25));
+    // Object space: the box's own corners, untouched by any node (its third triangle's last
+    // corner is corner 7).
+    const TriangleMesh& box = *inst[0].geometry;
+    EXPECT_EQ(box.positions[box.indices[8]], Vec3(1, 0.5, 0.25));
     // Corner (1, 0, 0) by hand. Node 0: (−1, 0, 0). Node 1: R_y(90°) maps (x, y, z) to
     // (z, y, −x), so (0, 0, −1), then + (1, 0, 0): (1, 0, −1). Node 2 inside node 1: scale 2 and
     // lift: (2, 1, 0); rotate: (0, 1, −2); move: (1, 1, −2). Nodes come in document order.
