@@ -121,6 +121,8 @@ raster::RendererOptions rendererOptions() {
     // SHADOWLAB_BENCH_SUN_MODULES=0: the general lit shader modules where the size-optimized ones
     // would be used (raster::RendererOptions::sunModules), for comparing the pipelines' creation.
     if (const char* v = std::getenv("SHADOWLAB_BENCH_SUN_MODULES"); v && std::string(v) == "0") o.sunModules = false;
+    // SHADOWLAB_BENCH_VIEW_CULL=0: the lit pass draws every triangle (raster::RendererOptions::viewCull).
+    if (const char* v = std::getenv("SHADOWLAB_BENCH_VIEW_CULL"); v && std::string(v) == "0") o.viewCull = false;
     return o;
 }
 
@@ -541,6 +543,11 @@ int main(int argc, char** argv) {
     std::printf("driver loaded in %.1f ms (before any timing)\n", msSince(loadStart));
     std::vector<fs::path> caches;
     int rc = 0;
+    // SHADOWLAB_BENCH_SCENE_FILE=path: that scene (its own camera) instead of seed and Sponza.
+    if (const char* file = std::getenv("SHADOWLAB_BENCH_SCENE_FILE"); file && *file) {
+        benchScene(fs::path(file).stem().string(), file, repeats, caches);
+        return 0;
+    }
     if (wantScene("seed")) try {
             benchScene("seed", scene::findScene("seed"), repeats, caches);
         } catch (const std::exception& e) {
