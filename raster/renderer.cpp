@@ -337,7 +337,6 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
         hostIndices = geometry.indices;
     }
     indexBuffer = uploadBuffer(ctx, geometry.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
-    const bool viewCull = options.viewCull;
     draw = DrawGeometry{vertexBuffer.buffer.get(), indexBuffer.buffer.get(), std::uint32_t(geometry.indices.size()),
                         opaqueIndexCount, transparentDraws};
     if (scene.hasCameraAlpha()) {
@@ -384,7 +383,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
         else
             draw.litRanges.push_back(IndexRange{d.first, d.count, d.cameraAlpha});
     }
-    if (viewCull) {
+    if (options.viewCull) {
         std::vector<IndexRange> pieces;
         for (const DrawObject& d : drawObjects) pieces.push_back(IndexRange{d.first, d.count});
         viewClusters = indexClusters(geometry.vertices, geometry.indices, pieces, kViewCullClusterTriangles);
