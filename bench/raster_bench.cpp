@@ -133,6 +133,8 @@ raster::RendererOptions rendererOptions() {
     // SHADOWLAB_BENCH_SUN_MODULES=0: the general lit shader modules where the size-optimized ones
     // would be used (raster::RendererOptions::sunModules), for comparing the pipelines' creation.
     if (const char* v = std::getenv("SHADOWLAB_BENCH_SUN_MODULES"); v && std::string(v) == "0") o.sunModules = false;
+    // SHADOWLAB_BENCH_VIEW_CULL=0: the lit pass draws every triangle (raster::RendererOptions::viewCull).
+    if (const char* v = std::getenv("SHADOWLAB_BENCH_VIEW_CULL"); v && std::string(v) == "0") o.viewCull = false;
     return o;
 }
 
@@ -594,6 +596,17 @@ int main(int argc, char** argv) {
             benchScene("terrain", bench::terrainScene(bench::terrainCellsFor(tris)), repeats, caches, true);
         } catch (const std::exception& e) {
             std::fprintf(stderr, "terrain failed: %s\n", e.what());
+            rc = 1;
+        }
+        for (const fs::path& dir : caches) fs::remove_all(dir);
+        return rc;
+    }
+    // SHADOWLAB_BENCH_SCENE_FILE=path: that scene (its own camera) instead of seed and Sponza.
+    if (const char* file = std::getenv("SHADOWLAB_BENCH_SCENE_FILE"); file && *file) {
+        try {
+            benchScene(fs::path(file).stem().string(), scene::loadScene(file), repeats, caches);
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "%s failed: %s\n", file, e.what());
             rc = 1;
         }
         for (const fs::path& dir : caches) fs::remove_all(dir);

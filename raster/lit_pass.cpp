@@ -438,6 +438,20 @@ LitBindings createLitBindings(const Context& ctx, const LitPipeline& pipeline, c
     return b;
 }
 
+const std::vector<IndexRange>* litDrawRanges(const DrawGeometry& geometry, bool byLift) {
+    if (geometry.litCulled) return byLift ? &geometry.litRangesByLiftVisible : &geometry.litRangesVisible;
+    const std::vector<IndexRange>& ranges = byLift ? geometry.litRangesByLift : geometry.litRanges;
+    return ranges.empty() ? nullptr : &ranges;
+}
+
+std::size_t litTrianglesDrawn(const DrawGeometry& geometry, bool byLift) {
+    const std::vector<IndexRange>* ranges = litDrawRanges(geometry, byLift);
+    if (!ranges) return geometry.indexCount / 3;
+    std::size_t indices = 0;
+    for (const IndexRange& r : *ranges) indices += r.count;
+    return indices / 3;
+}
+
 void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const LitBindings& bindings,
                    const LitTargets& targets, const LitAttachments& attachments, const DrawGeometry& geometry,
                    const glm::vec3& background, LitOutputs outputs, const LitPipeline* alphaPipeline,
@@ -511,12 +525,13 @@ void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const 
                                         &geometry.alphaSet, 0, nullptr);
         };
         const bool byLift = liftFreePipeline && !geometry.litRangesByLift.empty();
-        const std::vector<IndexRange>& ranges = byLift ? geometry.litRangesByLift : geometry.litRanges;
-        if (ranges.empty()) {
+        const std::vector<IndexRange>* ranges = litDrawRanges(geometry, byLift);
+        if (!ranges) {
             use(pipeline);
             vkCmdDrawIndexed(commands, geometry.indexCount, 1, 0, 0, 0);
+            ranges = &geometry.litRanges;  // (empty)
         }
-        for (const IndexRange& r : ranges) {
+        for (const IndexRange& r : *ranges) {
             if (r.count == 0) continue;
             use(r.alpha && alphaPipeline ? *alphaPipeline : byLift && r.liftFree ? *liftFreePipeline : pipeline);
             vkCmdDrawIndexed(commands, r.count, 1, r.first, 0, 0);

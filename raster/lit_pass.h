@@ -154,6 +154,12 @@ struct LitAttachments {
         views.push_back(image.view.get());
     }
 };
+// The ranges the lit pass draws (litRanges or, with byLift, litRangesByLift; their camera-visible
+// parts when geometry.litCulled); null: one draw of every index.
+const std::vector<IndexRange>* litDrawRanges(const DrawGeometry& geometry, bool byLift);
+// The triangles those ranges hold.
+std::size_t litTrianglesDrawn(const DrawGeometry& geometry, bool byLift);
+
 // Records the pass; background pixels get `background` (rgb, visibility 0) and zero AOVs, from
 // the background pipeline (float targets) or a clear (the display target). Leaves every color
 // attachment in TRANSFER_SRC_OPTIMAL for recordReadback(), or, for host-readable targets, in

@@ -7,6 +7,7 @@
 #include "raster/cascades.h"
 #include "raster/geometry.h"
 #include "raster/moment_maps.h"
+#include "raster/tolerances.h"
 #include "scene/camera.h"
 #include "scene/memory.h"
 
@@ -32,6 +33,12 @@ constexpr std::uint64_t kBytesPerTriangle = 3 * 32 + 3 * 4;  // vertices (positi
 // normal and the indices, and each split adds per vertex its light bits and projected point and per
 // triangle its area; counted with three vertices a triangle, an upper bound.
 constexpr std::uint64_t kLiftFreeBytesPerTriangle = 3 * (12 + 12) + 3 * 4 + 3 * (4 + 8) + 4;
+// View culling (raster/view_cull.h): a 32-byte box per cluster of kViewCullClusterTriangles (a
+// cluster more per object, where one ends) and, per frame, up to two 12-byte cut ranges per cluster
+// in each of the visible runs and the two range lists.
+std::uint64_t viewCullBytes(std::uint64_t triangles, std::uint64_t objects) {
+    return (triangles / kViewCullClusterTriangles + objects) * (32 + 3 * 2 * 12);
+}
 // Filterable maps (raster/moment_maps.h): two RGBA32F arrays the size of the shadow maps, and the
 // compute pipeline's compilation, measured on lavapipe (Mesa 22.3) as about 97 MiB above the
 // arrays on the seed scene at 1024² (the arrays alone: 32 bytes a texel, as measured at 4096²).
@@ -69,7 +76,7 @@ std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::Render
            // UV buffer, 3 · 8 bytes a triangle), the texels and one record per object.
            (scene.hasAlphaCasters() ? triangles * 24 + scene::alphaTextureBytes(scene) + scene.objects.size() * 32
                                     : 0) +
-           scene.objects.size() * scene::kBackendBytesPerObject +
+           scene.objects.size() * scene::kBackendBytesPerObject + viewCullBytes(triangles, scene.objects.size()) +
            (scene.lights.size() == 1 && scene.lights[0].type == scene::LightType::Directional &&
                     (settings.filter == scene::ShadowFilter::None || settings.filter == scene::ShadowFilter::Pcf2x2)
                 ? triangles * kLiftFreeBytesPerTriangle

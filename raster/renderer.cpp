@@ -28,6 +28,7 @@
 #include "raster/shadow_layers.h"
 #include "raster/shadow_pass.h"
 #include "raster/tolerances.h"
+#include "raster/view_cull.h"
 #include "scene/camera.h"
 #include "scene/frame_io.h"
 
@@ -251,6 +252,10 @@ struct Renderer::Impl {
     std::vector<glm::vec3> hostPositions;  // camera-relative, as the vertex buffer (the runs' pixel areas)
     std::vector<std::uint32_t> hostIndices;
     void splitByLift();  // draw.litRangesByLift for the current lights
+    // RendererOptions::viewCull: the index buffer's clusters (raster/view_cull.h), made once, and
+    // the draw's camera-visible ranges from them for the current view.
+    std::vector<IndexCluster> viewClusters;
+    void cullToView();
     // The vertices' lift-free bits (liftFreeVertexBits) and the lights and threshold they were made for.
     std::vector<std::uint32_t> liftBits;
     std::vector<glm::vec3> liftBitsLights;
@@ -378,6 +383,11 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
         else
             draw.litRanges.push_back(IndexRange{d.first, d.count, d.cameraAlpha});
     }
+    if (options.viewCull) {
+        std::vector<IndexRange> pieces;
+        for (const DrawObject& d : drawObjects) pieces.push_back(IndexRange{d.first, d.count});
+        viewClusters = indexClusters(geometry.vertices, geometry.indices, pieces, kViewCullClusterTriangles);
+    }
 
     // The automatic choices: a default cascade count follows the view, then a default size follows
     // the receivers' and casters' detail, and a default constant bias follows the size.
@@ -465,6 +475,15 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
     for (const ShadowLayer& layer : layers) shadowed.insert(layer.light);
     if (layers.size() > shadowed.size()) attributes["culled_casters_per_layer"] = joined(culledPerLayer, count);
     splitByLift();
+    cullToView();
+}
+
+void Renderer::Impl::cullToView() {
+    draw.litCulled = !viewClusters.empty();
+    if (!draw.litCulled) return;
+    const std::vector<IndexRange> visible = visibleIndexRuns(viewClusters, uniforms.viewProj);
+    draw.litRangesVisible = intersectRanges(draw.litRanges, visible);
+    draw.litRangesByLiftVisible = intersectRanges(draw.litRangesByLift, visible);
 }
 
 void Renderer::Impl::splitByLift() {
@@ -894,7 +913,9 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     if (debug) {
         debug->liftFreeTriangles = 0;
         if (byLift)
-            for (const IndexRange& r : draw.litRangesByLift) debug->liftFreeTriangles += r.liftFree ? r.count / 3 : 0;
+            for (const IndexRange& r : *litDrawRanges(draw, true))
+                debug->liftFreeTriangles += r.liftFree ? r.count / 3 : 0;
+        debug->litTriangles = litTrianglesDrawn(draw, byLift);
     }
 }
 

@@ -35,6 +35,8 @@ struct RenderDebug {
     // Out: the triangles the lit pass drew with the pipeline without the slope bias's lift
     // (RendererOptions::liftFreeDraws; 0 in the frame that made that pipeline, a Renderer's first).
     std::size_t liftFreeTriangles = 0;
+    // Out: the triangles the lit pass drew (all but those RendererOptions::viewCull left out).
+    std::size_t litTriangles = 0;
 };
 
 // Where the lit pass's fragment shader reads the one light's constants, where it takes that
@@ -66,6 +68,9 @@ struct RendererOptions {
     // that path, the rest with it, from the frame after the one that made that pipeline (its shader
     // is compiled at its first draw); the same frames (tests compare). false: every triangle with it.
     bool liftFreeDraws = true;
+    // The lit pass leaves out runs of triangles whose box lies outside the camera's clip volume
+    // (raster/view_cull.h); the same frames (tests compare). false: it draws every triangle.
+    bool viewCull = true;
 };
 
 // A reusable raster renderer for one scene and its settings: the constructor does the setup

@@ -102,6 +102,12 @@ struct DrawGeometry {
     // The same cut where triangles become lift-free or stop being so (IndexRange::liftFree;
     // raster/lift_free.h): drawn instead of litRanges when the lit pass has a lift-free pipeline.
     std::vector<IndexRange> litRangesByLift;
+    // The camera's view culling (raster/view_cull.h): litRanges and litRangesByLift cut to the
+    // clusters the camera can see, drawn instead of them when litCulled (then an empty list draws
+    // nothing).
+    bool litCulled = false;
+    std::vector<IndexRange> litRangesVisible;
+    std::vector<IndexRange> litRangesByLiftVisible;
     // Alpha-tested casters (raster/alpha_casters.h): the UV buffer and the records' set, used by
     // pipelines made with an alpha set layout.
     VkBuffer uvs = VK_NULL_HANDLE;
