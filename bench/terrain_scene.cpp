@@ -29,8 +29,8 @@ scene::Scene terrainScene(int cells) {
             const std::uint32_t a = std::uint32_t(j * n + i), b = a + 1, c = a + std::uint32_t(n), d = c + 1;
             for (std::uint32_t v : {a, c, b, b, c, d}) mesh->indices.push_back(v);
         }
-    // Area-weighted vertex normals, as a mesh file without normals gets on load: the raster
-    // backend shades with them (without, it takes (0, 1, 0) everywhere: a flat N·L).
+    // Area-weighted vertex normals, as an OBJ without normals gets on load (without them both
+    // backends would shade each triangle flat).
     scene::finalizeMesh(*mesh);
     scene::Scene s;
     s.file = "generated-terrain";
