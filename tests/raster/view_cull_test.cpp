@@ -138,6 +138,17 @@ std::shared_ptr<scene::TriangleMesh> groundGrid(int cells, double half) {
 // bit for bit, twice each (the second frames with the lift-free draws); returns the lit pass's
 // triangles with culling (the last frame's) and the scene's, and checks that without culling every
 // triangle is drawn.
+// An empty scene with the material "matte" and a 160x90 camera at `position` looking at `lookAt`.
+scene::Scene smallView(const Vec3& position, const Vec3& lookAt) {
+    scene::Scene s;
+    s.camera.position = position;
+    s.camera.lookAt = lookAt;
+    s.camera.width = 160;
+    s.camera.height = 90;
+    addMaterial(s, "matte");
+    return s;
+}
+
 struct Drawn {
     std::size_t culled = 0, all = 0;
 };
@@ -163,12 +174,7 @@ Drawn expectSameFramesCulled(const scene::Scene& s, const scene::RasterSettings&
 TEST(ViewCull, CulledFramesAreTheSameBitForBit) {
     // A tessellated ground reaching 40 units behind and beside the camera, a sphere in view, boxes
     // behind the camera and beside the view (one of them casts into the view under the low sun).
-    scene::Scene s;
-    s.camera.position = Vec3(0, 2, 0);
-    s.camera.lookAt = Vec3(0, 0.5, -6);
-    s.camera.width = 160;
-    s.camera.height = 90;
-    addMaterial(s, "matte");
+    scene::Scene s = smallView(Vec3(0, 2, 0), Vec3(0, 0.5, -6));
     constexpr int kCells = 40;  // 2-unit cells, 80 triangles a row, rows along +z from z = −40
     addMesh(s, groundGrid(kCells, 40.0));
     addSphere(s, Vec3(0, 1, -6), 1.0);
@@ -201,12 +207,7 @@ TEST(ViewCull, DrawsTheQuadsInViewAndOnlyThose) {
     // (z = 5, 10, 15), one far left at depth 5, and one at depth 5 whose right edge reaches 0.1 into
     // the view past its left edge (half width 5 · tan 20° · 16/9 = 3.235). Each quad is an object of
     // two triangles and so a cluster of its own.
-    scene::Scene s;
-    s.camera.position = Vec3(0, 1, 0);
-    s.camera.lookAt = Vec3(0, 1, -1);
-    s.camera.width = 160;
-    s.camera.height = 90;
-    addMaterial(s, "matte");
+    scene::Scene s = smallView(Vec3(0, 1, 0), Vec3(0, 1, -1));
     for (int i = 1; i <= 4; ++i) addQuad(s, Vec3(0, 1, -5.0 * i), Vec3(0, 0, 1), 1, 1);
     for (int i = 1; i <= 3; ++i) addQuad(s, Vec3(0, 1, 5.0 * i), Vec3(0, 0, 1), 1, 1);
     addQuad(s, Vec3(-20, 1, -5), Vec3(0, 0, 1), 1, 1);
