@@ -132,6 +132,10 @@ scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan, c
         const scene::Vec3 p(sp.p);
         const scene::Vec3 ns(sp.ns);
         scene::Vec3 color = scene.ambient * mat.albedo;
+        scene::RaytraceSettings pixelSettings = settings;
+        if (!robust)
+            pixelSettings.rayBias =
+                scene::rayBiasAt(settings, double(frame.depth[i]), scene.camera.fovYDegrees, height);
         double weightSum = 0.0, weightedVisibility = 0.0;
         double maxNdotL = scene.lights.empty() ? 0.0 : -std::numeric_limits<double>::infinity();
         int blocker = 0;
@@ -145,7 +149,7 @@ scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan, c
             double v = 1.0;
             if (needsShadowTest[li]) {
                 Rng rng(sampleSeed(i, int(li)));
-                const ShadowResult r = lightVisibility(tracer, light, sp, settings, anyHit, rng, nearestDistance);
+                const ShadowResult r = lightVisibility(tracer, light, sp, pixelSettings, anyHit, rng, nearestDistance);
                 v = r.transmittance;
                 if (blocker == 0 && r.blocker >= 0) {
                     blocker = r.blocker + 1;
@@ -170,6 +174,11 @@ scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan, c
     frame.attributes["backend"] = scene::toString(backend);
     frame.attributes["precision"] = scene::toString(settings.precision);
     frame.attributes["ray_bias"] = robust ? "robust" : formatNumber(settings.rayBias);
+    if (!robust && settings.rayBiasPixels > 0) {
+        // The default's view scaling: ray_bias is then the largest offset used.
+        frame.attributes["ray_bias_pixels"] = formatNumber(settings.rayBiasPixels);
+        frame.attributes["ray_bias_floor"] = formatNumber(settings.rayBiasFloor);
+    }
     frame.attributes["samples"] = std::to_string(plan.hasAreaLights ? settings.samples : 1);
     frame.attributes["threads"] = std::to_string(arena.max_concurrency());
     frame.attributes["shadow_rays"] = anyHit ? "any-hit" : "closest-hit";

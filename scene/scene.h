@@ -229,7 +229,7 @@ struct ShadowDefaults {
     std::optional<bool> fitLightFrustum;
     std::optional<int> cascades;          // directional lights: cascaded shadow maps, 1..kMaxCascades
     std::optional<double> cascadeBlend;   // fraction of each slice blended into the next, 0..0.5
-    std::optional<double> rayBias;        // world units; absent: scene-scaled
+    std::optional<double> rayBias;        // world units; absent: the view-scaled default
     std::optional<bool> robustRayOffset;  // "ray_bias": "robust"
     std::optional<std::string> precision;
     std::optional<int> samples;

@@ -48,7 +48,18 @@ double defaultRayBias(const Scene& scene) {
     // a 16x margin for the arithmetic of a hit point).
     const Bounds b = scene.bounds();
     const double extent = std::max(b.diagonal(), 1e-30);
-    return std::max(1e-4 * extent, 16.0 * 1.1920929e-7 * b.maxAbsCoordinate());
+    return std::max(1e-4 * extent, rayBiasFloor(scene));
+}
+
+double rayBiasFloor(const Scene& scene) { return 16.0 * 1.1920929e-7 * scene.bounds().maxAbsCoordinate(); }
+
+double rayBiasAt(const RaytraceSettings& s, double z, double fovYDegrees, int height) {
+    if (!(s.rayBiasPixels > 0.0)) return s.rayBias;
+    const double footprint =
+        2.0 * z * std::tan(0.5 * fovYDegrees * 3.14159265358979323846 / 180.0) / std::max(height, 1);
+    const double scaled = s.rayBiasPixels * footprint;
+    // NaN (no depth) falls to the scene-scaled bias.
+    return std::isfinite(scaled) ? std::min(s.rayBias, std::max(s.rayBiasFloor, scaled)) : s.rayBias;
 }
 
 double defaultDepthBias(const Scene& scene, int shadowMapSize) {
@@ -135,8 +146,14 @@ RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& o) {
         }
     } else if (d.robustRayOffset.value_or(false)) {
         s.raytrace.robustOffset = true;
+    } else if (d.rayBias) {
+        s.raytrace.rayBias = *d.rayBias;
     } else {
-        s.raytrace.rayBias = d.rayBias.value_or(defaultRayBias(scene));
+        // The lesson's bias scaled to the scene, at most; less where a pixel covers less, so that
+        // a large ground does not set the offset of what stands near the camera.
+        s.raytrace.rayBias = defaultRayBias(scene);
+        s.raytrace.rayBiasPixels = kDefaultRayBiasPixels;
+        s.raytrace.rayBiasFloor = rayBiasFloor(scene);
     }
     s.raytrace.precision = o.precision ? parsePrecision(*o.precision, "--precision")
                                        : parsePrecision(d.precision.value_or("float"), "shadow.precision");
@@ -154,6 +171,7 @@ RaytraceSettings referenceSettings(const RaytraceSettings& base) {
     r.precision = Precision::Double;
     r.robustOffset = true;
     r.rayBias = 0.0;
+    r.rayBiasPixels = 0.0;
     // Area lights: enough samples that the reference's own noise stays below the error it
     // reports (see docs/decisions.md); point lights need one.
     r.samples = std::max(base.samples, 256);

@@ -104,7 +104,12 @@ struct RasterSettings {
 };
 
 struct RaytraceSettings {
-    double rayBias = 0.0;       // world units along the normal (the lesson's bias)
+    double rayBias = 0.0;  // world units along the normal (the lesson's bias)
+    // The default's view scaling (docs/decisions.md, "Bias defaults"): where rayBiasPixels > 0 the
+    // bias at a point is min(rayBias, max(rayBiasFloor, rayBiasPixels × the pixel's footprint at
+    // its view depth)); 0 = rayBias everywhere, as a bias given by the user is.
+    double rayBiasPixels = 0.0;
+    double rayBiasFloor = 0.0;
     bool robustOffset = false;  // offset by a bound on the hit point's rounding error instead
     Precision precision = Precision::Float;
     int samples = 1;  // shadow samples per pixel for area lights
@@ -149,6 +154,14 @@ struct SettingsOverrides {
 // Scene-scaled defaults (see docs/decisions.md): the lesson's constant ray bias, and half a
 // shadow-map texel of constant depth bias for a map fitted to the scene's bounding sphere.
 double defaultRayBias(const Scene& scene);
+// What float rounding of a hit point needs far from the origin: 16 float steps of the scene's
+// largest coordinate (the floor of the default ray bias).
+double rayBiasFloor(const Scene& scene);
+// The default ray bias at a view depth, in pixels of footprint (docs/decisions.md).
+inline constexpr double kDefaultRayBiasPixels = 0.5;
+// The bias a point gets under `s`: rayBias, or its view-scaled share at view depth z (world
+// units) for a camera of vertical field fovYDegrees over `height` pixels.
+double rayBiasAt(const RaytraceSettings& s, double z, double fovYDegrees, int height);
 double defaultDepthBias(const Scene& scene, int shadowMapSize);
 // Throws InputError naming the option (e.g. "--filter: expected none|pcf2x2, got 'x'").
 RenderSettings resolveSettings(const Scene& scene, const SettingsOverrides& overrides);

@@ -3,6 +3,9 @@
 // contact shadow, any-hit and closest-hit shadow rays agree, AOVs and metadata are filled.
 #include "raytrace/renderer.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "scene/settings.h"
@@ -184,6 +187,44 @@ TEST(MethodRender, HugeBiasLiftsTheContactShadowExactlyAsTheShiftedOriginPredict
         EXPECT_EQ(mismatches, 0);
         EXPECT_EQ(f.attributes.at("ray_bias"), "1.5");
     }
+}
+
+TEST(MethodRender, TheDefaultBiasFollowsThePixelNotTheSizeOfTheScene) {
+    // The seed's sphere and ground with a small box 3000 units behind the camera (out of view,
+    // its shadow far away): the scene-scaled bias becomes 1e-4 × a diagonal over 3000, about
+    // 0.3, which lifts the contact shadow visibly. The default offsets each point by half its
+    // pixel's footprint instead (2·z·tan 20° / 90 at view depth z: 0.03 to 0.13), capped there.
+    // Closed form: the shadow test from p + b(z)·n, with b computed here from the pixel.
+    scene::Scene s = test::seedScene();
+    test::addBox(s, Vec3(-0.5, 0, 2999.5), Vec3(0.5, 1, 3000.5));
+    const scene::RenderSettings settings = scene::resolveSettings(s, {});
+    const double cap = settings.raytrace.rayBias;
+    ASSERT_GT(cap, 0.3);
+    const scene::CameraBasis cam = scene::cameraBasis(s.camera);
+    auto viewScaled = [&](const Vec3& p) {
+        const double z = glm::dot(p - cam.position, cam.forward);
+        return std::min(cap, 0.5 * 2.0 * z * std::tan(20.0 * test::kPi / 180.0) / s.camera.height);
+    };
+    const scene::Frame f = render(s, test::planFor(s), settings.raytrace);
+    int shadowed = 0, liftedByCap = 0, mismatches = 0;
+    for (int y = 0; y < f.height; ++y)
+        for (int x = 0; x < f.width; ++x) {
+            const std::size_t i = std::size_t(y) * f.width + x;
+            const Analytic truth = test::analyticPixel(s, {}, x, y, 0.0, 1e-4);
+            if (truth.kind != Analytic::Plane || truth.nearEdge) continue;
+            const double b = viewScaled(truth.p);
+            ASSERT_LT(b, cap / 2);  // every plane pixel here gets less than the scene-scaled bias
+            const Analytic biased = test::analyticPixel(s, {}, x, y, b, 1e-4);
+            const Analytic capped = test::analyticPixel(s, {}, x, y, cap, 1e-4);
+            if (biased.nearEdge || capped.nearEdge) continue;
+            if (!truth.lit) ++shadowed;
+            if (!truth.lit && capped.lit) ++liftedByCap;
+            if (f.visibility[i] != (biased.lit ? 1.0f : 0.0f)) ++mismatches;
+        }
+    EXPECT_GT(shadowed, 200);
+    EXPECT_GT(liftedByCap, 20);  // what the scene-scaled bias alone would have lost
+    EXPECT_EQ(mismatches, 0);
+    EXPECT_EQ(f.attributes.at("ray_bias_pixels"), "0.5");
 }
 
 TEST(MeshRender, FlatConvexMeshIsAcneFreeInTheReferenceAndAcneRiddenInFloatWithoutBias) {

@@ -33,6 +33,33 @@ TEST(Settings, DefaultRayBiasCoversFloatRoundingFarFromTheOrigin) {
     EXPECT_GT(defaultRayBias(s), 1e7 * 1.1920929e-7);
 }
 
+TEST(Settings, TheDefaultRayBiasIsHalfAPixelsFootprintCappedByTheScenesAndFloored) {
+    Scene s = unitScene(1.0);
+    RenderSettings r = resolveSettings(s, {});
+    EXPECT_EQ(r.raytrace.rayBias, defaultRayBias(s));  // the cap
+    EXPECT_EQ(r.raytrace.rayBiasPixels, 0.5);
+    EXPECT_EQ(r.raytrace.rayBiasFloor, 16.0 * 1.1920929e-7 * 2.0);  // the sphere's top is at y = 2
+    // A 90° field over 100 rows: one pixel spans 2·z·tan 45° / 100 = z / 50 at view depth z.
+    RaytraceSettings t;
+    t.rayBias = 0.05;
+    t.rayBiasFloor = 0.001;
+    t.rayBiasPixels = 0.5;
+    EXPECT_NEAR(rayBiasAt(t, 2.0, 90.0, 100), 0.02, 1e-15);  // half of 2/50
+    EXPECT_EQ(rayBiasAt(t, 20.0, 90.0, 100), 0.05);          // the cap
+    EXPECT_EQ(rayBiasAt(t, 0.01, 90.0, 100), 0.001);         // the floor
+    EXPECT_EQ(rayBiasAt(t, std::nan(""), 90.0, 100), 0.05);  // no depth: the cap
+    t.rayBiasPixels = 0.0;
+    EXPECT_EQ(rayBiasAt(t, 2.0, 90.0, 100), 0.05);  // a bias given by the user holds everywhere
+    // Given on the command line or in the scene, the bias is the user's, not view-scaled.
+    SettingsOverrides o;
+    o.rayBias = "0.01";
+    EXPECT_EQ(resolveSettings(s, o).raytrace.rayBiasPixels, 0.0);
+    s.shadow.rayBias = 0.02;
+    r = resolveSettings(s, {});
+    EXPECT_EQ(r.raytrace.rayBias, 0.02);
+    EXPECT_EQ(r.raytrace.rayBiasPixels, 0.0);
+}
+
 TEST(Settings, CommandLineBeatsTheSceneWhichBeatsTheDefault) {
     Scene s = unitScene(1.0);
     s.shadow.shadowMapSize = 512;
