@@ -595,8 +595,8 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
         if (material != -2 && prim.material != material) continue;
         const auto pos = prim.attributes.find("POSITION");
         if (pos == prim.attributes.end()) fail(sceneFile, path, file, "a primitive has no POSITION");
-        std::vector<double> p = readAccessor(model, pos->second, 3, file, sceneFile, path);
-        std::size_t count = p.size() / 3;
+        const std::vector<double> p = readAccessor(model, pos->second, 3, file, sceneFile, path);
+        const std::size_t count = p.size() / 3;
         std::vector<double> n;
         if (const auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
             n = readAccessor(model, it->second, 3, file, sceneFile, path);
@@ -651,37 +651,37 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
                          "].indices (accessors[" + std::to_string(prim.indices) + "]): index " +
                          std::to_string(std::uint64_t(idx[i])) + " is out of range (" + std::to_string(count) +
                          " vertices)");
-        if (n.empty()) {
-            // glTF 2.0, 3.7.2.1: without NORMAL, "client implementations MUST calculate flat
-            // normals": each triangle gets its own three vertices with its face normal.
-            std::vector<double> fp(3 * corners), fn(3 * corners), fuv(uvSet >= 0 ? 2 * corners : 0), fidx(corners);
-            for (std::size_t t = 0; t < corners; t += 3) {
-                Vec3 c[3];
-                for (std::size_t k = 0; k < 3; ++k) {
-                    const std::size_t j = std::size_t(idx[t + k]);
-                    c[k] = Vec3(p[3 * j], p[3 * j + 1], p[3 * j + 2]);
-                    for (std::size_t a = 0; a < 3; ++a) fp[3 * (t + k) + a] = p[3 * j + a];
-                    if (uvSet >= 0) fuv[2 * (t + k)] = uv[2 * j], fuv[2 * (t + k) + 1] = uv[2 * j + 1];
-                    fidx[t + k] = double(t + k);
-                }
-                const Vec3 face = glm::cross(c[1] - c[0], c[2] - c[0]);
-                const double len = glm::length(face);
-                // A degenerate triangle is dropped later; its vertices need only a unit normal.
-                const Vec3 unit = len > 0.0 && std::isfinite(len) ? face / len : Vec3(0, 1, 0);
-                for (std::size_t k = 0; k < 3; ++k)
-                    for (std::size_t a = 0; a < 3; ++a) fn[3 * (t + k) + a] = unit[int(a)];
-            }
-            p = std::move(fp), n = std::move(fn), uv = std::move(fuv), idx = std::move(fidx);
-            count = corners;
-        }
-        if (out.positions.size() + count > std::size_t(UINT32_MAX))
+        for (std::size_t i = 0; i < count; ++i)
+            if (!finite(Vec3(p[3 * i], p[3 * i + 1], p[3 * i + 2])))
+                fail(sceneFile, path, file, "a vertex is not finite");
+        const bool flat = n.empty();
+        const std::size_t added = flat ? corners : count;
+        if (out.positions.size() + added > std::size_t(UINT32_MAX))
             fail(sceneFile, path, file,
                  "mesh " + std::to_string(meshIndex) + " has more vertices than 32-bit indices hold");
         const std::uint32_t base = std::uint32_t(out.positions.size());
+        auto at = [&](std::size_t j) { return Vec3(p[3 * j], p[3 * j + 1], p[3 * j + 2]); };
+        if (flat) {
+            // glTF 2.0, 3.7.2.1: without NORMAL, "client implementations MUST calculate flat
+            // normals": each triangle gets its own three vertices with its face normal, written
+            // straight into the mesh (no second copy of the corners beside it while loading).
+            for (std::size_t t = 0; t < corners; t += 3) {
+                const std::size_t j[3] = {std::size_t(idx[t]), std::size_t(idx[t + 1]), std::size_t(idx[t + 2])};
+                const Vec3 face = glm::cross(at(j[1]) - at(j[0]), at(j[2]) - at(j[0]));
+                const double len = glm::length(face);
+                // A degenerate triangle is dropped later; its vertices need only a unit normal.
+                const Vec3 unit = len > 0.0 && std::isfinite(len) ? face / len : Vec3(0, 1, 0);
+                for (std::size_t k = 0; k < 3; ++k) {
+                    out.positions.push_back(at(j[k]));
+                    out.normals.push_back(unit);
+                    if (uvSet >= 0) out.uvs.emplace_back(uv[2 * j[k]], uv[2 * j[k] + 1]);
+                    out.indices.push_back(base + std::uint32_t(t + k));
+                }
+            }
+            continue;
+        }
         for (std::size_t i = 0; i < count; ++i) {
-            const Vec3 v(p[3 * i], p[3 * i + 1], p[3 * i + 2]);
-            if (!finite(v)) fail(sceneFile, path, file, "a vertex is not finite");
-            out.positions.push_back(v);
+            out.positions.push_back(at(i));
             out.normals.emplace_back(n[3 * i], n[3 * i + 1], n[3 * i + 2]);
             if (uvSet >= 0) out.uvs.emplace_back(uv[2 * i], uv[2 * i + 1]);
         }
