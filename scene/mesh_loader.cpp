@@ -966,6 +966,17 @@ std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path&
         // Decoded geometry is held beside the file like its buffers, and read as doubles (at
         // most 8 a byte, for byte components).
         loadBytes += 9 * decodedBytes;
+        // The meshes grow primitive by primitive, and a vector that grows holds its old buffer
+        // beside the new one: at most the result's own size more (a flat primitive, without
+        // NORMAL, has three vertices a triangle, far more than its accessors).
+        std::vector<const TriangleMesh*> counted;
+        for (const RawInstance& r : raw)
+            if (std::find(counted.begin(), counted.end(), r.geometry.get()) == counted.end()) {
+                counted.push_back(r.geometry.get());
+                const TriangleMesh& g = *r.geometry;
+                loadBytes += (g.positions.capacity() + g.normals.capacity()) * sizeof(Vec3) +
+                             g.indices.capacity() * sizeof(std::uint32_t) + g.uvs.capacity() * sizeof(Vec2);
+            }
     } else if (ext == ".ply") {
         if (request.uvSet >= 0)
             fail(sceneFile, path, meshFile,
