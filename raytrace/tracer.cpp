@@ -306,7 +306,7 @@ typename Tracer<Real>::MeshObjectData Tracer<Real>::buildMeshObject(
     std::vector<scene::Vec3> positions, normals;
     std::vector<scene::Vec2> uvs;
     std::vector<std::uint32_t> indices;
-    bool allNormals = true, allUvs = true;
+    bool allUvs = true;
     std::vector<scene::Bounds> instanceBounds;
     for (const scene::MeshInstance& inst : m.instances) {
         if (!inst.geometry)
@@ -314,14 +314,30 @@ typename Tracer<Real>::MeshObjectData Tracer<Real>::buildMeshObject(
         const scene::TriangleMesh& g = *inst.geometry;
         triangles_ += g.triangleCount();
         if (uses.at(&g) == 1) {
+            const glm::dmat3 nm = scene::normalMatrix(inst.transform);
+            allUvs = allUvs && g.uvs.size() == g.positions.size();
+            if (g.normals.size() != g.positions.size()) {
+                // No vertex normals (a mesh built in code; the loaders always compute them): flat
+                // triangles with each face's normal, so the other meshes merged here keep theirs
+                // and the raster backend draws the same normals.
+                for (std::size_t t = 0; t + 2 < g.indices.size(); t += 3) {
+                    const std::uint32_t i[3] = {g.indices[t], g.indices[t + 1], g.indices[t + 2]};
+                    const scene::Vec3 face =
+                        nm * glm::cross(g.positions[i[1]] - g.positions[i[0]], g.positions[i[2]] - g.positions[i[0]]);
+                    const double len = glm::length(face);
+                    const scene::Vec3 n = len > 0.0 ? face / len : scene::Vec3(0, 1, 0);  // degenerate: never hit
+                    for (const std::uint32_t k : i) {
+                        indices.push_back(std::uint32_t(positions.size()));
+                        positions.push_back(scene::transformPoint(inst.transform, g.positions[k]));
+                        normals.push_back(n);
+                        if (allUvs) uvs.push_back(g.uvs[k]);
+                    }
+                }
+                continue;
+            }
             const std::uint32_t base = std::uint32_t(positions.size());
             for (const scene::Vec3& p : g.positions) positions.push_back(scene::transformPoint(inst.transform, p));
-            allNormals = allNormals && g.normals.size() == g.positions.size();
-            if (allNormals) {
-                const glm::dmat3 nm = scene::normalMatrix(inst.transform);
-                for (const scene::Vec3& n : g.normals) normals.push_back(glm::normalize(nm * n));
-            }
-            allUvs = allUvs && g.uvs.size() == g.positions.size();
+            for (const scene::Vec3& n : g.normals) normals.push_back(glm::normalize(nm * n));
             if (allUvs) uvs.insert(uvs.end(), g.uvs.begin(), g.uvs.end());
             for (std::uint32_t i : g.indices) indices.push_back(base + i);
             continue;
@@ -372,7 +388,6 @@ typename Tracer<Real>::MeshObjectData Tracer<Real>::buildMeshObject(
         mo.instances.push_back(in);
     }
     if (!indices.empty()) {
-        if (!allNormals) normals.clear();
         if (!allUvs) uvs.clear();
         mo.flat = buildMesh(positions, normals, indices, uvs);
     }

@@ -53,6 +53,41 @@ TYPED_TEST(TracerTest, ClosestHitFindsTheNearestOfSphereQuadAndBox) {
     }
 }
 
+TYPED_TEST(TracerTest, AMeshWithoutNormalsMergedWithOneWithNormalsLeavesTheirsAlone) {
+    // One object placing two geometries once each (merged into one world-space mesh): a unit
+    // square at y = 0 whose vertex normals all lean to (0, 1, 1)/sqrt 2, and a triangle at
+    // y = 0 beside it with no normals, turned by a placement that tilts it 45° about z. The
+    // square keeps its normals; the triangle is shaded with its placed face normal.
+    using Real = TypeParam;
+    using V = Vec3T<Real>;
+    auto square = std::make_shared<scene::TriangleMesh>();
+    square->positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 0, 1), Vec3(0, 0, 1)};
+    square->normals.assign(4, glm::normalize(Vec3(0, 1, 1)));
+    square->indices = {0, 2, 1, 0, 3, 2};
+    auto triangle = std::make_shared<scene::TriangleMesh>();
+    triangle->positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 0, 1)};
+    triangle->indices = {0, 2, 1};
+    const double c = std::sqrt(0.5);
+    scene::Affine tilt(1.0);  // x' = c·x − c·y + 5, y' = c·x + c·y: the plane y = 0 tilted 45° about z
+    tilt[0][0] = c, tilt[0][1] = c, tilt[1][0] = -c, tilt[1][1] = c, tilt[3] = Vec3(5, 0, 0);
+    scene::Scene s;
+    test::addMaterial(s, "matte");
+    scene::Object o;
+    o.name = "two";
+    o.shape = scene::Mesh{"generated", {{square, scene::Affine(1.0)}, {triangle, tilt}}};
+    s.objects.push_back(o);
+    const Tracer<Real> tracer(s);
+    Hit<Real> h;
+    const Ray<Real> onSquare(V(0.5, 5, 0.5), V(0, -1, 0));
+    ASSERT_TRUE(tracer.closestHit(onSquare, Real(1e30), false, h));
+    EXPECT_NEAR(glm::dot(Vec3(tracer.surfacePoint(onSquare, h, false).ns), glm::normalize(Vec3(0, 1, 1))), 1.0, 1e-6);
+    // The tilted triangle's point (0.2, 0, 0.2) lies at (5 + 0.2c, 0.2c, 0.2); its face normal
+    // is the tilt of (0, 1, 0): (−c, c, 0), turned toward the ray by the facing rule.
+    const Ray<Real> onTriangle(V(5 + 0.2 * c - c, 0.2 * c + c, 0.2), V(c, -c, 0));  // along the normal
+    ASSERT_TRUE(tracer.closestHit(onTriangle, Real(1e30), false, h));
+    EXPECT_NEAR(std::abs(glm::dot(Vec3(tracer.surfacePoint(onTriangle, h, false).ns), Vec3(-c, c, 0))), 1.0, 1e-6);
+}
+
 TYPED_TEST(TracerTest, QuadsAreTwoSidedAndFaceTheViewer) {
     using Real = TypeParam;
     using V = Vec3T<Real>;
