@@ -47,6 +47,22 @@ scene::Scene soupScene(const Soup& soup) {
     return test::matteMeshScene(mesh);
 }
 
+// Rays through the soup: `segments` random segments (from anywhere in it toward its middle) and a
+// grid × grid of parallel rays `step` apart from below it (the coherent shadow-ray case).
+std::vector<Ray<float>> soupRays(std::mt19937_64& g, int segments, int grid, float step) {
+    std::uniform_real_distribution<double> u(-14, 14);
+    std::vector<Ray<float>> rays;
+    for (int r = 0; r < segments; ++r) {
+        const Vec3 from(u(g), u(g), u(g)), to(u(g) / 2, u(g) / 2, u(g) / 2);
+        rays.emplace_back(Vec3T<float>(from), Vec3T<float>(to - from));
+    }
+    for (int y = 0; y < grid; ++y)
+        for (int x = 0; x < grid; ++x)
+            rays.emplace_back(Vec3T<float>(-12.0f + step * x, -12.0f + step * y, -14.0f),
+                              Vec3T<float>(0.3f, 0.4f, 1.0f));
+    return rays;
+}
+
 template <typename Node>
 bool boxContains(const Node& n, int c, const scene::Bounds& b) {
     for (int k = 0; k < 3; ++k)
@@ -553,16 +569,8 @@ TEST(WideBvh, TracerAnswersAreTheSameWithAvx2AvxOrSseAndWithOrWithoutTheOccluder
     const Soup soup = triangleSoup(20000, g);
     const scene::Scene s = soupScene(soup);
     const Tracer<float> tracer(s);
+    std::vector<Ray<float>> rays = soupRays(g, 10000, 100, 0.05f);
     std::uniform_real_distribution<double> u(-14, 14);
-    std::vector<Ray<float>> rays;
-    for (int r = 0; r < 10000; ++r) {
-        const Vec3 from(u(g), u(g), u(g)), to(u(g) / 2, u(g) / 2, u(g) / 2);
-        rays.emplace_back(Vec3T<float>(from), Vec3T<float>(to - from));
-    }
-    for (int y = 0; y < 100; ++y)
-        for (int x = 0; x < 100; ++x)
-            rays.emplace_back(Vec3T<float>(-12.0f + 0.05f * x, -12.0f + 0.05f * y, -14.0f),
-                              Vec3T<float>(0.3f, 0.4f, 1.0f));
     // Axis-parallel rays (an infinite inverse direction: the AVX2 walk hands them to the AVX one),
     // and rays with a component so small that its inverse is finite but times the widening
     // factor is not (also the AVX walk's) or just finite (the AVX2 walk's).
@@ -620,16 +628,8 @@ TEST(WideBvh, FloatTracerAnyHitIsBruteForcesAnswerWithEveryBoxTest) {
     const scene::Scene s = soupScene(soup);
     const Tracer<float> tracer(s);
     const std::vector<Vec3T<float>> p(soup.p.begin(), soup.p.end());  // the tracer's float vertices
-    std::uniform_real_distribution<double> u(-14, 14), unit(0, 1);
-    std::vector<Ray<float>> rays;
-    for (int r = 0; r < 3000; ++r) {
-        const Vec3 from(u(g), u(g), u(g)), to(u(g) / 2, u(g) / 2, u(g) / 2);
-        rays.emplace_back(Vec3T<float>(from), Vec3T<float>(to - from));
-    }
-    for (int y = 0; y < 40; ++y)
-        for (int x = 0; x < 40; ++x)
-            rays.emplace_back(Vec3T<float>(-12.0f + 0.6f * x, -12.0f + 0.6f * y, -14.0f),
-                              Vec3T<float>(0.3f, 0.4f, 1.0f));
+    std::uniform_real_distribution<double> unit(0, 1);
+    std::vector<Ray<float>> rays = soupRays(g, 3000, 40, 0.6f);
     for (int r = 0; r < 2000; ++r) {
         // A point inside triangle r, lifted a little, towards a fixed "sun".
         const Vec3 a = soup.p[3 * r], b = soup.p[3 * r + 1], c = soup.p[3 * r + 2];
