@@ -4,13 +4,19 @@
 #include <chrono>
 #include <cstring>
 #include <ctime>
+#include <vector>
 
+#include "bare_aov_frag.spv.h"
+#include "bare_aov_vert.spv.h"
 #include "bare_depth_vert.spv.h"
+#include "bare_ids_frag.spv.h"
+#include "bare_ids_vert.spv.h"
 #include "bare_lit_frag.spv.h"
 #include "bare_lit_vert.spv.h"
 #include "raster/context.h"
 #include "raster/geometry.h"
 #include "raster/light_frustum.h"
+#include "raster/lit_pass.h"
 #include "raster/pipeline.h"
 #include "raster/resources.h"
 #include "raster/vulkan_error.h"
@@ -44,10 +50,15 @@ struct BareRenderer::Impl {
     Context ctx{ContextOptions{}};
     std::uint32_t width = 0, height = 0, mapSize = 0, indexCount = 0;
     bool hardwarePcf = false;
+    bool aovs = false;
+    VkFormat beautyFormat = VK_FORMAT_UNDEFINED;
     glm::mat4 lightMatrix{1.0f};
     double setupMs = 0;
     Buffer vertices, indices, uniforms;
     Image map, color, depth;
+    Image ids;                       // BareTarget::Aovs: the blocker-id map
+    std::array<Image, 5> planes;     // BareTarget::Aovs: visibility, object id, N·L, depth, blocker id
+    SamplerHandle nearest;
     Buffer readback;
     SamplerHandle sampler;
     DescriptorSetLayoutHandle setLayout;
@@ -57,7 +68,7 @@ struct BareRenderer::Impl {
     VkDescriptorSet set = VK_NULL_HANDLE;
 };
 
-BareRenderer::BareRenderer(const scene::Scene& scene, const scene::RasterSettings& settings, bool srgbTarget)
+BareRenderer::BareRenderer(const scene::Scene& scene, const scene::RasterSettings& settings, BareTarget target)
     : impl_(std::make_unique<Impl>()) {
     const auto start = Clock::now();
     Impl& m = *impl_;
@@ -67,7 +78,16 @@ BareRenderer::BareRenderer(const scene::Scene& scene, const scene::RasterSetting
     m.width = std::uint32_t(scene.camera.width);
     m.height = std::uint32_t(scene.camera.height);
     m.mapSize = std::uint32_t(settings.shadowMapSize);
-    const VkFormat colorFormat = srgbTarget ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
+    m.aovs = target == BareTarget::Aovs;
+    VkFormat colorFormat = target == BareTarget::Srgb ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
+    if (m.aovs) {
+        // The beauty format ours renders into (RGB32F where the device renders to it).
+        VkFormatProperties rgb{};
+        vkGetPhysicalDeviceFormatProperties(ctx.physicalDevice, kLitBeautyFormat, &rgb);
+        colorFormat = (rgb.optimalTilingFeatures & VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT) ? kLitBeautyFormat
+                                                                                           : kLitBeautyFallbackFormat;
+    }
+    m.beautyFormat = colorFormat;
 
     const SceneGeometry geometry = tessellateScene(scene, cam.position);
     m.vertices = uploadBuffer(ctx, geometry.vertices, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
@@ -107,6 +127,15 @@ BareRenderer::BareRenderer(const scene::Scene& scene, const scene::RasterSetting
     m.depth = createImage(ctx, VK_FORMAT_D32_SFLOAT, m.width, m.height, 1, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
                           VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_VIEW_TYPE_2D);
     m.readback = createReadbackBuffer(ctx, VkDeviceSize(m.width) * m.height * 4);
+    if (m.aovs) {
+        m.ids = createImage(ctx, VK_FORMAT_R32_UINT, m.mapSize, m.mapSize, 1,
+                            VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, VK_IMAGE_ASPECT_COLOR_BIT,
+                            VK_IMAGE_VIEW_TYPE_2D);
+        for (Image& plane : m.planes)
+            plane = createImage(ctx, kLitPlaneFormat, m.width, m.height, 1, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT,
+                                VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D);
+        m.nearest = createNearestSampler(ctx);
+    }
 
     const VkFilter filter = m.hardwarePcf ? VK_FILTER_LINEAR : VK_FILTER_NEAREST;
     const VkSamplerCreateInfo samplerInfo{
@@ -133,9 +162,15 @@ BareRenderer::BareRenderer(const scene::Scene& scene, const scene::RasterSetting
          .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
          .descriptorCount = 1,
          .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
+        {.binding = 2,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+         .descriptorCount = 1,
+         .stageFlags = VK_SHADER_STAGE_FRAGMENT_BIT},
     };
-    const VkDescriptorSetLayoutCreateInfo setInfo{
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 2, .pBindings = bindings};
+    const std::uint32_t bindingCount = m.aovs ? 3 : 2;
+    const VkDescriptorSetLayoutCreateInfo setInfo{.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
+                                                  .bindingCount = bindingCount,
+                                                  .pBindings = bindings};
     VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
     VK_CHECK(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &setLayout));
     m.setLayout = DescriptorSetLayoutHandle(device, setLayout);
@@ -152,26 +187,39 @@ BareRenderer::BareRenderer(const scene::Scene& scene, const scene::RasterSetting
     VK_CHECK(vkCreatePipelineLayout(device, &litLayoutInfo, nullptr, &layout));
     m.litLayout = PipelineLayoutHandle(device, layout);
 
-    m.depthPipeline = createGraphicsPipeline(ctx, PipelineDesc{.vertexShader = kBareDepthVertSpv,
-                                                               .layout = m.depthLayout.get(),
-                                                               .usesNormal = false,
-                                                               .depthFormat = VK_FORMAT_D32_SFLOAT,
-                                                               .depthCompare = VK_COMPARE_OP_LESS});
+    if (m.aovs)
+        m.depthPipeline = createGraphicsPipeline(ctx, PipelineDesc{.vertexShader = kBareIdsVertSpv,
+                                                                   .fragmentShader = kBareIdsFragSpv,
+                                                                   .layout = m.depthLayout.get(),
+                                                                   .usesNormal = false,
+                                                                   .colorFormats = {VK_FORMAT_R32_UINT},
+                                                                   .depthFormat = VK_FORMAT_D32_SFLOAT,
+                                                                   .depthCompare = VK_COMPARE_OP_LESS});
+    else
+        m.depthPipeline = createGraphicsPipeline(ctx, PipelineDesc{.vertexShader = kBareDepthVertSpv,
+                                                                   .layout = m.depthLayout.get(),
+                                                                   .usesNormal = false,
+                                                                   .depthFormat = VK_FORMAT_D32_SFLOAT,
+                                                                   .depthCompare = VK_COMPARE_OP_LESS});
     const VkBool32 hardware = m.hardwarePcf ? VK_TRUE : VK_FALSE;
     const VkSpecializationMapEntry entry{0, 0, sizeof(VkBool32)};
     const VkSpecializationInfo specialization{
         .mapEntryCount = 1, .pMapEntries = &entry, .dataSize = sizeof hardware, .pData = &hardware};
-    m.litPipeline = createGraphicsPipeline(ctx, PipelineDesc{.vertexShader = kBareLitVertSpv,
-                                                             .fragmentShader = kBareLitFragSpv,
+    std::vector<VkFormat> colorFormats{colorFormat};
+    if (m.aovs) colorFormats.insert(colorFormats.end(), m.planes.size(), kLitPlaneFormat);
+    m.litPipeline = createGraphicsPipeline(ctx, PipelineDesc{.vertexShader = m.aovs ? std::span<const std::uint32_t>(kBareAovVertSpv)
+                                                                     : std::span<const std::uint32_t>(kBareLitVertSpv),
+                                                             .fragmentShader = m.aovs ? std::span<const std::uint32_t>(kBareAovFragSpv)
+                                                                       : std::span<const std::uint32_t>(kBareLitFragSpv),
                                                              .fragmentSpecialization = &specialization,
                                                              .layout = m.litLayout.get(),
-                                                             .colorFormats = {colorFormat},
+                                                             .colorFormats = colorFormats,
                                                              .depthFormat = VK_FORMAT_D32_SFLOAT,
                                                              // scene::projectionMatrix is reversed Z
                                                              .depthCompare = VK_COMPARE_OP_GREATER});
 
     const VkDescriptorPoolSize sizes[] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
-                                          {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1}};
+                                          {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 2}};
     const VkDescriptorPoolCreateInfo poolInfo{
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1, .poolSizeCount = 2, .pPoolSizes = sizes};
     VkDescriptorPool pool = VK_NULL_HANDLE;
@@ -184,6 +232,8 @@ BareRenderer::BareRenderer(const scene::Scene& scene, const scene::RasterSetting
     VK_CHECK(vkAllocateDescriptorSets(device, &allocInfo, &m.set));
     const VkDescriptorBufferInfo uniformInfo{m.uniforms.buffer.get(), 0, VK_WHOLE_SIZE};
     const VkDescriptorImageInfo imageInfo{sampler, m.map.view.get(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    const VkDescriptorImageInfo idsInfo{m.nearest.get(), m.aovs ? m.ids.view.get() : VK_NULL_HANDLE,
+                                        VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     const VkWriteDescriptorSet writes[] = {
         {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
          .dstSet = m.set,
@@ -197,8 +247,14 @@ BareRenderer::BareRenderer(const scene::Scene& scene, const scene::RasterSetting
          .descriptorCount = 1,
          .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
          .pImageInfo = &imageInfo},
+        {.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+         .dstSet = m.set,
+         .dstBinding = 2,
+         .descriptorCount = 1,
+         .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+         .pImageInfo = &idsInfo},
     };
-    vkUpdateDescriptorSets(device, 2, writes, 0, nullptr);
+    vkUpdateDescriptorSets(device, bindingCount, writes, 0, nullptr);
     m.setupMs = msSince(start);
 }
 
@@ -222,6 +278,17 @@ BareTimings BareRenderer::render(std::vector<std::uint8_t>& rgba) {
     transition(cb, {{m.map.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
                      VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
                      VK_ACCESS_2_NONE, depthStages, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT}});
+    if (m.aovs)
+        transition(cb, {{m.ids.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+                         VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                         VK_ACCESS_2_NONE, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                         VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT}});
+    const VkRenderingAttachmentInfo idsAttachment{.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+                                                  .imageView = m.aovs ? m.ids.view.get() : VK_NULL_HANDLE,
+                                                  .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                                                  .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+                                                  .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+                                                  .clearValue = {.color = {.uint32 = {0, 0, 0, 0}}}};
     const VkRenderingAttachmentInfo mapAttachment{.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
                                                   .imageView = m.map.view.get(),
                                                   .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
@@ -231,6 +298,8 @@ BareTimings BareRenderer::render(std::vector<std::uint8_t>& rgba) {
     const VkRenderingInfo mapRendering{.sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
                                        .renderArea = {{0, 0}, {m.mapSize, m.mapSize}},
                                        .layerCount = 1,
+                                       .colorAttachmentCount = m.aovs ? 1u : 0u,
+                                       .pColorAttachments = &idsAttachment,
                                        .pDepthAttachment = &mapAttachment};
     vkCmdBeginRendering(cb, &mapRendering);
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, m.depthPipeline.get());
@@ -245,6 +314,11 @@ BareTimings BareRenderer::render(std::vector<std::uint8_t>& rgba) {
                {{m.map.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, 1, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
                  VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, depthStages, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
                  VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT}});
+    if (m.aovs)
+        transition(cb, {{m.ids.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                         VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                         VK_ACCESS_2_SHADER_SAMPLED_READ_BIT}});
     ctx.submitAndWait(cb);
     t.shadowPass = msSince(start);
     t.cpuShadowPass = cpuMs() - cpuStart;
@@ -259,12 +333,27 @@ BareTimings BareRenderer::render(std::vector<std::uint8_t>& rgba) {
                      VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, depthStages,
                      VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, depthStages,
                      VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT}});
-    const VkRenderingAttachmentInfo colorAttachment{.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
-                                                    .imageView = m.color.view.get(),
-                                                    .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                                                    .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
-                                                    .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
-                                                    .clearValue = {.color = {.float32 = {0, 0, 0, 1}}}};
+    // The AOV floor clears no color target (ours clears none of its float targets either: its
+    // background pass writes them, which the floor leaves out).
+    std::vector<VkRenderingAttachmentInfo> colorAttachments{
+        {.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+         .imageView = m.color.view.get(),
+         .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+         .loadOp = m.aovs ? VK_ATTACHMENT_LOAD_OP_DONT_CARE : VK_ATTACHMENT_LOAD_OP_CLEAR,
+         .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+         .clearValue = {.color = {.float32 = {0, 0, 0, 1}}}}};
+    if (m.aovs)
+        for (const Image& plane : m.planes) {
+            transition(cb, {{plane.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+                             VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                             VK_ACCESS_2_NONE, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                             VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT}});
+            colorAttachments.push_back({.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
+                                        .imageView = plane.view.get(),
+                                        .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                                        .loadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+                                        .storeOp = VK_ATTACHMENT_STORE_OP_STORE});
+        }
     const VkRenderingAttachmentInfo depthAttachment{.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
                                                     .imageView = m.depth.view.get(),
                                                     .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
@@ -274,8 +363,8 @@ BareTimings BareRenderer::render(std::vector<std::uint8_t>& rgba) {
     const VkRenderingInfo litRendering{.sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
                                        .renderArea = {{0, 0}, {m.width, m.height}},
                                        .layerCount = 1,
-                                       .colorAttachmentCount = 1,
-                                       .pColorAttachments = &colorAttachment,
+                                       .colorAttachmentCount = std::uint32_t(colorAttachments.size()),
+                                       .pColorAttachments = colorAttachments.data(),
                                        .pDepthAttachment = &depthAttachment};
     vkCmdBeginRendering(cb, &litRendering);
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, m.litPipeline.get());
@@ -292,6 +381,7 @@ BareTimings BareRenderer::render(std::vector<std::uint8_t>& rgba) {
     ctx.submitAndWait(cb);
     t.litPass = msSince(start);
     t.cpuLitPass = cpuMs() - cpuStart;
+    if (m.aovs) return t;  // the floor's planes stay on the device (ours renders into the Frame)
 
     start = Clock::now();
     cb = ctx.beginCommands();

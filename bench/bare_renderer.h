@@ -25,14 +25,23 @@ struct BareTimings {
     double perFrame() const { return shadowPass + litPass + readback; }
 };
 
+enum class BareTarget {
+    Unorm,  // one R8G8B8A8_UNORM target
+    Srgb,   // one R8G8B8A8_SRGB target (the device encodes on store, as ours does for a PNG)
+    // A float RGB beauty and five R32F planes (visibility, object id, N·L, depth, blocker id), not
+    // cleared and not read back, and an R32_UINT blocker-id map in the depth pass: what any
+    // renderer filling a Frame's channels has to write.
+    Aovs,
+};
+
 class BareRenderer {
 public:
     // The first directional light of `scene` (else straight down) casts; others are ignored.
-    // srgbTarget: an R8G8B8A8_SRGB target (the device encodes on store, as ours does for a PNG)
-    // instead of R8G8B8A8_UNORM.
-    BareRenderer(const scene::Scene& scene, const scene::RasterSettings& settings, bool srgbTarget = false);
+    BareRenderer(const scene::Scene& scene, const scene::RasterSettings& settings,
+                 BareTarget target = BareTarget::Unorm);
     ~BareRenderer();
-    // One frame: both passes and the readback into an RGBA8 image (row 0 on top).
+    // One frame: both passes and the readback into an RGBA8 image (row 0 on top; BareTarget::Aovs
+    // reads nothing back and leaves `rgba` as it is).
     BareTimings render(std::vector<std::uint8_t>& rgba);
     double setupMs() const;
     std::string pcfKind() const;  // "hardware (LINEAR compare sampler)" or "gather"

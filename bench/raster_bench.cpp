@@ -211,9 +211,15 @@ void benchScene(const std::string& label, scene::Scene s, int repeats, std::vect
     // The same bare passes writing an sRGB target, as ours does for a PNG: what the device's
     // sRGB encoding on store costs (the headline ratios are against the UNORM one above).
     std::optional<bench::BareRenderer> bareSrgb;
+    // The bare passes writing every channel of a Frame (bench::BareTarget::Aovs): the floor under
+    // the all-channel frame, so that its ratio to the bare one splits into what the AOV contract
+    // costs any renderer and what our design adds on top.
+    std::optional<bench::BareRenderer> aovFloor;
     if (!scaling) {
-        bareSrgb.emplace(s, settings.raster, true);
+        bareSrgb.emplace(s, settings.raster, bench::BareTarget::Srgb);
         bareSrgb->render(rgba);
+        aovFloor.emplace(s, settings.raster, bench::BareTarget::Aovs);
+        aovFloor->render(rgba);
     }
 
     std::printf(
@@ -229,7 +235,7 @@ void benchScene(const std::string& label, scene::Scene s, int repeats, std::vect
         scene::writePngDisplay(fs::path(dir) / (label + "-bare.png"), width, height, rgb);
     }
 
-    // SHADOWLAB_BENCH_PROFILE=all|no-ids|beauty|png|bare|bare-srgb: only that series, `repeats` frames,
+    // SHADOWLAB_BENCH_PROFILE=all|no-ids|beauty|png|bare|bare-srgb|bare-aovs: only that series, `repeats` frames,
     // nothing printed: a process to run under `perf record` (docs/performance.md).
     if (const char* profile = std::getenv("SHADOWLAB_BENCH_PROFILE"); profile && *profile) {
         const std::string which = profile;
@@ -247,9 +253,12 @@ void benchScene(const std::string& label, scene::Scene s, int repeats, std::vect
                 bare.render(rgba);
             else if (which == "bare-srgb" && bareSrgb)
                 bareSrgb->render(rgba);
+            else if (which == "bare-aovs" && aovFloor)
+                aovFloor->render(rgba);
             else
                 throw std::runtime_error(
-                    "SHADOWLAB_BENCH_PROFILE: expected all, no-ids, beauty, png, bare or bare-srgb, got " + which);
+                    "SHADOWLAB_BENCH_PROFILE: expected all, no-ids, beauty, png, bare, bare-srgb or bare-aovs, got " +
+                    which);
         }
         return;
     }
@@ -258,7 +267,7 @@ void benchScene(const std::string& label, scene::Scene s, int repeats, std::vect
     // (what compare reads), ours with the float beauty only, ours for a PNG (`render -o x.png`:
     // the beauty into the 8-bit sRGB target), the bare renderer. Each keeps its frame between
     // repetitions, as the bare renderer keeps its image.
-    Series all, beauty, png, fresh, base, baseSrgb;
+    Series all, beauty, png, fresh, base, baseSrgb, baseAovs;
     scene::Frame allFrame, beautyFrame, pngFrame;
     for (int i = 0; i < repeats; ++i) {
         double c = cpuMs();
@@ -285,6 +294,12 @@ void benchScene(const std::string& label, scene::Scene s, int repeats, std::vect
             const bench::BareTimings ts = bareSrgb->render(rgba);
             baseSrgb.add("cpu_per_frame", cpuMs() - c);
             addBare(baseSrgb, ts);
+        }
+        if (aovFloor) {
+            c = cpuMs();
+            const bench::BareTimings ta = aovFloor->render(rgba);
+            baseAovs.add("cpu_per_frame", cpuMs() - c);
+            addBare(baseAovs, ta);
         }
     }
 
@@ -332,6 +347,21 @@ void benchScene(const std::string& label, scene::Scene s, int repeats, std::vect
             "per_frame %.2f, cpu %.2f\n",
             baseSrgb.med("per_frame"), baseSrgb.med("lit_pass"), baseSrgb.med("cpu_per_frame"),
             png.med("per_frame") / baseSrgb.med("per_frame"), png.med("cpu_per_frame") / baseSrgb.med("cpu_per_frame"));
+    if (!scaling) {
+        auto range = [](const Series& x, const char* stage) {
+            const auto [lo, hi] = x.range(stage);
+            char buf[64];
+            std::snprintf(buf, sizeof buf, "%.1f (%.1f-%.1f)", x.med(stage), lo, hi);
+            return std::string(buf);
+        };
+        std::printf(
+            "  bare writing every AOV (the floor): cpu_shadow_pass %s, cpu_lit_pass %s, cpu_per_frame %s; floor / "
+            "bare: cpu %.2f, wall %.2f; all / floor: cpu %.2f, wall %.2f\n",
+            range(baseAovs, "cpu_shadow_pass").c_str(), range(baseAovs, "cpu_lit_pass").c_str(),
+            range(baseAovs, "cpu_per_frame").c_str(), baseAovs.med("cpu_per_frame") / base.med("cpu_per_frame"),
+            baseAovs.med("per_frame") / base.med("per_frame"), all.med("cpu_per_frame") / baseAovs.med("cpu_per_frame"),
+            all.med("per_frame") / baseAovs.med("per_frame"));
+    }
     if (!skipFresh)
         std::printf("  ours (all channels) into a new Frame each time: per_frame %.1f, readback %.1f\n",
                     fresh.med("per_frame"), fresh.med("readback"));
