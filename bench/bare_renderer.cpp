@@ -56,8 +56,8 @@ struct BareRenderer::Impl {
     double setupMs = 0;
     Buffer vertices, indices, uniforms;
     Image map, color, depth;
-    Image ids;                       // BareTarget::Aovs: the blocker-id map
-    std::array<Image, 5> planes;     // BareTarget::Aovs: visibility, object id, N·L, depth, blocker id
+    Image ids;                    // BareTarget::Aovs: the blocker-id map
+    std::array<Image, 5> planes;  // BareTarget::Aovs: visibility, object id, N·L, depth, blocker id
     SamplerHandle nearest;
     Buffer readback;
     SamplerHandle sampler;
@@ -207,16 +207,17 @@ BareRenderer::BareRenderer(const scene::Scene& scene, const scene::RasterSetting
         .mapEntryCount = 1, .pMapEntries = &entry, .dataSize = sizeof hardware, .pData = &hardware};
     std::vector<VkFormat> colorFormats{colorFormat};
     if (m.aovs) colorFormats.insert(colorFormats.end(), m.planes.size(), kLitPlaneFormat);
-    m.litPipeline = createGraphicsPipeline(ctx, PipelineDesc{.vertexShader = m.aovs ? std::span<const std::uint32_t>(kBareAovVertSpv)
-                                                                     : std::span<const std::uint32_t>(kBareLitVertSpv),
-                                                             .fragmentShader = m.aovs ? std::span<const std::uint32_t>(kBareAovFragSpv)
-                                                                       : std::span<const std::uint32_t>(kBareLitFragSpv),
-                                                             .fragmentSpecialization = &specialization,
-                                                             .layout = m.litLayout.get(),
-                                                             .colorFormats = colorFormats,
-                                                             .depthFormat = VK_FORMAT_D32_SFLOAT,
-                                                             // scene::projectionMatrix is reversed Z
-                                                             .depthCompare = VK_COMPARE_OP_GREATER});
+    m.litPipeline = createGraphicsPipeline(
+        ctx, PipelineDesc{.vertexShader = m.aovs ? std::span<const std::uint32_t>(kBareAovVertSpv)
+                                                 : std::span<const std::uint32_t>(kBareLitVertSpv),
+                          .fragmentShader = m.aovs ? std::span<const std::uint32_t>(kBareAovFragSpv)
+                                                   : std::span<const std::uint32_t>(kBareLitFragSpv),
+                          .fragmentSpecialization = &specialization,
+                          .layout = m.litLayout.get(),
+                          .colorFormats = colorFormats,
+                          .depthFormat = VK_FORMAT_D32_SFLOAT,
+                          // scene::projectionMatrix is reversed Z
+                          .depthCompare = VK_COMPARE_OP_GREATER});
 
     const VkDescriptorPoolSize sizes[] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
                                           {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 2}};
@@ -279,10 +280,10 @@ BareTimings BareRenderer::render(std::vector<std::uint8_t>& rgba) {
                      VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
                      VK_ACCESS_2_NONE, depthStages, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT}});
     if (m.aovs)
-        transition(cb, {{m.ids.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-                         VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                         VK_ACCESS_2_NONE, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-                         VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT}});
+        transition(
+            cb, {{m.ids.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+                  VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_NONE,
+                  VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT}});
     const VkRenderingAttachmentInfo idsAttachment{.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
                                                   .imageView = m.aovs ? m.ids.view.get() : VK_NULL_HANDLE,
                                                   .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
