@@ -29,6 +29,20 @@ std::optional<std::array<double, 2>> visibleDepthRange(const scene::Scene& scene
     return std::array<double, 2>{lo, hi};
 }
 
+std::optional<std::array<double, 2>> shadowableDepthRange(const scene::Scene& scene, const Vec3& direction) {
+    const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
+    double lo = INFINITY, hi = -INFINITY;
+    for (const Vec3& p : visibleShadowableReceiverPoints(scene, direction)) {
+        const double z = glm::dot(p - cam.position, cam.forward);
+        lo = std::min(lo, z);
+        hi = std::max(hi, z);
+    }
+    lo = std::max(lo, scene.camera.near);
+    hi = std::min(hi, scene.camera.far);
+    if (!(hi > lo)) return std::nullopt;
+    return std::array<double, 2>{lo, hi};
+}
+
 std::vector<double> practicalSplits(double near, double far, int count, double lambda) {
     std::vector<double> s(std::size_t(count) + 1);
     for (int i = 0; i <= count; ++i) {
@@ -101,7 +115,8 @@ LightFrustum fitCascade(const scene::Scene& scene, const scene::CameraBasis& cam
 CascadeSet fitCascades(const scene::Scene& scene, const Vec3& direction, int count, int mapSize, double blend,
                        bool snap) {
     CascadeSet set;
-    const auto range = visibleDepthRange(scene);
+    auto range = shadowableDepthRange(scene, direction);
+    if (!range) range = visibleDepthRange(scene);  // nothing visible can be shaded: the old fit
     if (!range || count < 1) return set;
     set.splits = practicalSplits((*range)[0], (*range)[1], count);
     const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
@@ -142,8 +157,15 @@ CascadeChoice chooseCascades(const scene::Scene& scene, const scene::RasterSetti
         if (shadowed) lights.push_back(i);
     }
     if (lights.empty()) return {asked, std::to_string(asked) + " (default: no shadowed directional light)"};
-    const auto range = visibleDepthRange(scene);
-    if (!range) return {asked, std::to_string(asked) + " (default: the camera sees no receiver)"};
+    if (!visibleDepthRange(scene)) return {asked, std::to_string(asked) + " (default: the camera sees no receiver)"};
+    // The depths the maps must cover: those of the visible receivers some caster can shade, over
+    // every shadowed light; all visible receivers when none can be shaded.
+    std::optional<std::array<double, 2>> range;
+    for (const std::size_t i : lights)
+        if (const auto r = shadowableDepthRange(scene, scene.lights[i].direction))
+            range = range ? std::array<double, 2>{std::min((*range)[0], (*r)[0]), std::max((*range)[1], (*r)[1])} : *r;
+    const bool shadowable = range.has_value();
+    if (!shadowable) range = visibleDepthRange(scene);
     // The size as set: a default one is kDefaultShadowMapSize, the most chooseShadowMapSize keeps
     // (cascades keep it whole).
     const int size = settings.shadowMapSize;
@@ -170,13 +192,14 @@ CascadeChoice chooseCascades(const scene::Scene& scene, const scene::RasterSetti
     };
     double ratios[scene::kMaxCascades + 1] = {};
     std::string table;
-    char buf[96];
+    char buf[160];
     for (int n = 1; n <= scene::kMaxCascades; ++n) {
         ratios[n] = worst(n);
         std::snprintf(buf, sizeof buf, "%s%d: %.3g", n == 1 ? "" : ", ", n, ratios[n]);
         table += buf;
     }
-    std::snprintf(buf, sizeof buf, "; map %d, visible view depths %.4g..%.4g)", size, zMin, (*range)[1]);
+    std::snprintf(buf, sizeof buf, "; map %d, %s view depths %.4g..%.4g)", size,
+                  shadowable ? "shadowable" : "no visible receiver can be shaded: visible", zMin, (*range)[1]);
     const std::string what = "worst shadow texel / pixel footprint by cascade count (" + table + buf;
     if (ratios[1] <= kCascadeTexelsPerPixel)
         return {1, "1 (default: one map keeps its texel within 2 pixels; " + what + ")"};

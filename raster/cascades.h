@@ -31,6 +31,12 @@ inline constexpr double kCascadeMarginTexels = 8.0;
 // camera's near and far planes. None when the camera sees none of the scene.
 std::optional<std::array<double, 2>> visibleDepthRange(const scene::Scene& scene);
 
+// The same over the visible receivers some caster can shade under light along `direction`
+// (shadowableReceiverBoxes clipped to the camera frustum): past them nothing is shadowed, so the
+// cascades need not reach there (lit.frag lights what lies past the last split). None when no
+// visible receiver can be shaded.
+std::optional<std::array<double, 2>> shadowableDepthRange(const scene::Scene& scene, const scene::Vec3& direction);
+
 // count + 1 split depths from near to far (the first is near, the last far) by the practical
 // scheme with blend `lambda`. Requires 0 < near < far and count >= 1.
 std::vector<double> practicalSplits(double near, double far, int count, double lambda = kCascadeSplitLambda);
@@ -70,7 +76,8 @@ struct CascadeSet {
     std::vector<double> splits;        // count + 1 view depths, near to far
     std::vector<LightFrustum> frusta;  // one per slice; empty when the camera sees none of the scene
 };
-// The splits over visibleDepthRange() and fitCascade() of each slice, except that a cascade whose
+// The splits over shadowableDepthRange() (visibleDepthRange() when no visible receiver can be
+// shaded) and fitCascade() of each slice, except that a cascade whose
 // map would be wider than the scene's bounding-sphere map (fitDirectionalLight) uses that instead.
 // With a blend band (`blend` of each slice before its far split, lit.frag mixes the next cascade
 // in there), each cascade c > 0 covers the band of slice c − 1 too: its slice starts there.

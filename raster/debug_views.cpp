@@ -307,6 +307,23 @@ std::vector<PixelCoverage> coverage(const scene::Frame& frame, const scene::Scen
     const std::vector<LightLayers> lights = shadowedLights(debug);
     const std::vector<int> cascade = cascadeIndices(frame, debug);
     const bool hasNdotL = frame.ndotl.size() == frame.pixelCount();
+    // A directional map holds only the receivers some caster can shade (light_frustum.h,
+    // shadowableReceiverBoxes); lit.frag lights a point outside it, which no caster reaches. The
+    // boxes are padded by kCoverageBoxPad of the scene's size for the float depth p comes from.
+    const double pad = kCoverageBoxPad * scene.bounds().diagonal();
+    std::vector<std::vector<scene::Bounds>> shadowable(lights.size());
+    for (std::size_t k = 0; k < lights.size(); ++k) {
+        const scene::Light& light = scene.lights[std::size_t(lights[k].light)];
+        if (light.type != scene::LightType::Directional) continue;
+        for (scene::Bounds b : shadowableReceiverBoxes(scene, light.direction))
+            if (!b.empty()) shadowable[k].push_back({b.min - scene::Vec3(pad), b.max + scene::Vec3(pad)});
+    }
+    auto canBeShaded = [&](std::size_t k, const scene::Vec3& p) {
+        if (scene.lights[std::size_t(lights[k].light)].type != scene::LightType::Directional) return true;
+        for (const scene::Bounds& b : shadowable[k])
+            if (glm::all(glm::greaterThanEqual(p, b.min)) && glm::all(glm::lessThanEqual(p, b.max))) return true;
+        return false;
+    };
     for (int y = 0; y < frame.height; ++y)
         for (int x = 0; x < frame.width; ++x) {
             const std::size_t i = std::size_t(y) * std::size_t(frame.width) + std::size_t(x);
@@ -317,11 +334,12 @@ std::vector<PixelCoverage> coverage(const scene::Frame& frame, const scene::Scen
             const scene::Vec3 p = cam.position + double(frame.depth[i]) * scene::pixelDirection(cam, x, y);
             int inside = 0;
             bool uncovered = false;
-            for (const LightLayers& ll : lights) {
+            for (std::size_t li = 0; li < lights.size(); ++li) {
+                const LightLayers& ll = lights[li];
                 const scene::Light& light = scene.lights[std::size_t(ll.light)];
                 const int layer = layerAt(ll, light, p, cascade[i]);
                 if (!insideLightMap(debug.layers[std::size_t(layer)].frustum, p)) {
-                    uncovered = uncovered || (facing && reaches(light, p));
+                    uncovered = uncovered || (facing && reaches(light, p) && canBeShaded(li, p));
                     continue;
                 }
                 const bool cascaded = light.type == scene::LightType::Directional && ll.count > 1;

@@ -107,6 +107,9 @@ std::optional<ScreenSegment> projectSegment(const scene::CameraBasis& cam, doubl
 // (the largest over the lights) > 0 where the Frame has it, and for a spot, p within its cone.
 // A point inside a map but not reached (a spot map's corners past the cone, a surface facing
 // away) counts as Covered: the view shows what each map holds, not only what it needs to.
+// A directional light's map need not hold a point no caster can shade (outside every box of
+// shadowableReceiverBoxes, padded by this fraction of the scene's size): it stays Outside.
+inline constexpr double kCoverageBoxPad = 1e-5;
 enum class Coverage : int { Background = 0, Outside = 1, Covered = 2, Uncovered = 3 };
 std::vector<Coverage> lightMapCoverage(const scene::Frame& frame, const scene::Scene& scene, const RenderDebug& debug);
 

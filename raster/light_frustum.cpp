@@ -171,6 +171,81 @@ std::vector<Vec3> visibleReceiverPointsInSlice(const scene::Scene& scene, double
     return clipBoxToFrustum(sceneBounds, cam, nearD, farD);
 }
 
+bool shadesItself(const scene::Object& object) {
+    const scene::Mesh* mesh = std::get_if<scene::Mesh>(&object.shape);
+    if (!mesh) return false;  // convex: see the header
+    // The placed vertices, and the normal of the largest placed triangle as the candidate plane's.
+    std::vector<Vec3> points;
+    Vec3 normal(0.0), origin(0.0);
+    double largest = 0.0;
+    for (const scene::MeshInstance& inst : mesh->instances) {
+        const scene::TriangleMesh& g = *inst.geometry;
+        const std::size_t base = points.size();
+        for (const Vec3& p : g.positions) points.push_back(scene::transformPoint(inst.transform, p));
+        for (std::size_t t = 0; t + 2 < g.indices.size(); t += 3) {
+            const Vec3 a = points[base + g.indices[t]], b = points[base + g.indices[t + 1]],
+                       c = points[base + g.indices[t + 2]];
+            const Vec3 n = glm::cross(b - a, c - a);
+            if (glm::length(n) > largest) largest = glm::length(n), normal = n, origin = a;
+        }
+    }
+    if (!(largest > 0.0)) return false;  // no area: nothing to shade
+    normal /= largest;
+    scene::Bounds b;
+    for (const Vec3& p : points) b.extend(p);
+    const double tolerance = kPlanarMeshTolerance * b.diagonal();
+    for (const Vec3& p : points)
+        if (std::abs(glm::dot(p - origin, normal)) > tolerance) return true;
+    return false;  // planar: a plane cannot shade itself
+}
+
+std::vector<scene::Bounds> shadowableReceiverBoxes(const scene::Scene& scene, const Vec3& direction) {
+    const scene::Bounds sceneBounds = scene.bounds();
+    const std::size_t n = scene.objects.size();
+    std::vector<scene::Bounds> boxes(n);
+    if (sceneBounds.empty()) return boxes;
+    const Vec3 d = glm::normalize(direction);
+    const double pad = kShadowSweepPad * std::max(sceneBounds.diagonal(), sceneBounds.maxAbsCoordinate());
+    std::vector<scene::Bounds> bounds(n), swept(n);
+    for (std::size_t j = 0; j < n; ++j) {
+        const scene::Bounds b = scene::boundsOf(scene.objects[j].shape);
+        bounds[j] = b;
+        if (b.empty()) continue;
+        // The time at which the box has crossed the scene's far face on some axis: past it, the
+        // swept box lies wholly outside the scene, where nothing is to shade.
+        double t = INFINITY;
+        for (int k = 0; k < 3; ++k) {
+            if (d[k] > 0.0) t = std::min(t, (sceneBounds.max[k] - b.min[k]) / d[k]);
+            if (d[k] < 0.0) t = std::min(t, (sceneBounds.min[k] - b.max[k]) / d[k]);
+        }
+        t = std::max(t, 0.0);
+        scene::Bounds s = b;
+        s.extend(scene::Bounds{b.min + t * d, b.max + t * d});
+        s.min -= Vec3(pad);
+        s.max += Vec3(pad);
+        swept[j] = s;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+        if (bounds[i].empty()) continue;
+        for (std::size_t j = 0; j < n; ++j) {
+            if (swept[j].empty() || (j == i && !shadesItself(scene.objects[i]))) continue;
+            const scene::Bounds c{glm::max(bounds[i].min, swept[j].min), glm::min(bounds[i].max, swept[j].max)};
+            if (glm::all(glm::lessThanEqual(c.min, c.max))) boxes[i].extend(c);
+        }
+    }
+    return boxes;
+}
+
+std::vector<Vec3> visibleShadowableReceiverPoints(const scene::Scene& scene, const Vec3& direction) {
+    std::vector<Vec3> points;
+    for (const scene::Bounds& b : shadowableReceiverBoxes(scene, direction)) {
+        if (b.empty()) continue;
+        const std::vector<Vec3> v = visibleReceiverPoints(scene, b);
+        points.insert(points.end(), v.begin(), v.end());
+    }
+    return points;
+}
+
 double nearestCasterDepth(const scene::Scene& scene, const LightFrustum& f, double minU, double maxU, double minV,
                           double maxV) {
     double minDepth = INFINITY;
@@ -188,8 +263,9 @@ LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const Vec
     const scene::Bounds sceneBounds = scene.bounds();
     LightFrustum f = fitDirectionalLight(sceneBounds, direction, mapSize);
     if (sceneBounds.empty()) return f;
-    const std::vector<Vec3> receivers = visibleReceiverPoints(scene);
-    if (receivers.empty()) return f;  // the camera sees none of the scene
+    std::vector<Vec3> receivers = visibleShadowableReceiverPoints(scene, direction);
+    if (receivers.empty()) receivers = visibleReceiverPoints(scene);  // nothing visible can be shaded
+    if (receivers.empty()) return f;                                  // the camera sees none of the scene
 
     // Receivers' extent across the light and their farthest depth along it.
     double minU = INFINITY, maxU = -INFINITY, minV = INFINITY, maxV = -INFINITY, maxDepth = -INFINITY;

@@ -55,8 +55,10 @@ struct LightFrustum {
 // `direction`. An empty or point-like bounds gets a tiny but valid frustum.
 LightFrustum fitDirectionalLight(const scene::Bounds& bounds, const scene::Vec3& direction, int mapSize);
 
-// A map covering only what can shadow what the camera sees: the receivers are the scene's
-// bounds clipped to the camera frustum (its far plane pulled in to the scene); across the light
+// A map covering only what can shadow what the camera sees: the receivers are the visible ones
+// some caster can shade (visibleShadowableReceiverPoints; lit.frag lights a point past the map's
+// square or depth, where no caster reaches), or, when there are none, the scene's bounds clipped
+// to the camera frustum (its far plane pulled in to the scene); across the light
 // the map covers their extent, and in depth it reaches back toward the light to the nearest
 // object whose extent across the light overlaps theirs. Snapped so that it does not swim: the
 // half-width rounded up to 1/16 of its power of two, the center on the world-fixed texel grid,
@@ -79,6 +81,23 @@ std::vector<scene::Vec3> visibleReceiverPoints(const scene::Scene& scene, const 
 // The same (for the scene's bounds) with the view depths further limited to [minDepth, maxDepth]:
 // the receivers of one cascade's slice.
 std::vector<scene::Vec3> visibleReceiverPointsInSlice(const scene::Scene& scene, double minDepth, double maxDepth);
+
+// Whether an object can shade part of itself under a directional light: a mesh can, unless it is
+// planar (all vertices within kPlanarMeshTolerance of its size of one plane, like a glTF ground).
+// Spheres, boxes and quads cannot: a convex surface facing the light (N·L > 0) is not
+// self-shadowed, and where N·L ≤ 0 lit.frag gives no light without a shadow test.
+bool shadesItself(const scene::Object& object);
+inline constexpr double kPlanarMeshTolerance = 1e-7;
+// The receivers some caster can shade under light travelling along `direction`, one box per
+// object (empty where nothing can shade it): each caster's bounds swept along the light until it
+// has left the scene's bounds (padded by kShadowSweepPad of the scene's size, so that rounding
+// keeps a ground at the scene's edge), intersected with every other object's bounds (and its own
+// where shadesItself), and the object's box the bounding box of those intersections.
+std::vector<scene::Bounds> shadowableReceiverBoxes(const scene::Scene& scene, const scene::Vec3& direction);
+inline constexpr double kShadowSweepPad = 1e-9;
+// visibleReceiverPoints() of each of those boxes, together: the vertices of the visible receivers
+// some caster can shade. Empty when the camera sees none.
+std::vector<scene::Vec3> visibleShadowableReceiverPoints(const scene::Scene& scene, const scene::Vec3& direction);
 
 // The smallest depth along f.direction (relative to f.center) of any object whose bounding box's
 // extent across the light (f.right, f.up, relative to f.center) overlaps [minU, maxU] × [minV,

@@ -431,6 +431,9 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         r.uv = perspective ? s.xy / s.w : s.xy;
         r.axial = perspective ? dot(q - light.position, axis) : s.z;
     }
+    // An orthographic map's depth ends past the farthest receiver a caster can shade
+    // (fitDirectionalLightToReceivers): a point beyond it has nothing between it and the light.
+    if (!perspective && r.axial > 1.0) return 1.0;
     const int filterCode = kFilter;  // light.filterCode holds the same code
     const float size = mapSize();  // = textureSize(shadowMaps, 0).x, without a query per fragment
     r.plane = false;
@@ -652,7 +655,12 @@ LightData cascadeOf(LightData light, int lightIndex, vec3 p, out LightData next,
             next = withCascade(light, first, c + 1);
         }
     }
-    return withCascade(light, first, c);
+    LightData chosen = withCascade(light, first, c);
+    // Past the last split (with the slack raster/cascades.h kCascadeSplitSlack gives its receivers)
+    // lie only receivers no caster can shade (shadowableDepthRange): lit, with no shadow test.
+    const float last = u.cascades[first + count - 1].sliceFar;
+    if (z > last + 1e-4 * abs(last)) chosen.layer = -1.0;
+    return chosen;
 }
 
 void main() {

@@ -13,6 +13,7 @@
 #include <random>
 #include <string>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include "scene/camera.h"
@@ -134,6 +135,29 @@ inline scene::Material alphaMaterial(const std::string& name, scene::AlphaMode m
     m.alphaCutoff = cutoff;
     m.alphaTexture = std::move(tex);
     return m;
+}
+
+// Makes quad object `index` of `s` a mesh that can shade itself (raster/light_frustum.h
+// shadesItself), so that its whole visible part is a shadowable receiver and directional maps
+// and cascades are fitted over all of it: the quad's two triangles (the same plane, normal and
+// object id) plus a sliver hanging below its (−u, −v) corner, 1e-3 of its size deep, under the
+// quad where a camera above it does not see it. The bounds grow by that depth below it.
+inline void makeGroundShadeItself(scene::Scene& s, std::size_t index) {
+    const scene::Quad q = std::get<scene::Quad>(s.objects[index].shape);
+    const Vec3 hu = 0.5 * q.size.x * q.uAxis, hv = 0.5 * q.size.y * q.vAxis;
+    const double depth = 1e-3 * std::max(q.size.x, q.size.y);
+    auto mesh = std::make_shared<scene::TriangleMesh>();
+    const Vec3 corner = q.center - hu - hv;
+    mesh->positions = {corner,
+                       q.center + hu - hv,
+                       q.center + hu + hv,
+                       q.center - hu + hv,
+                       corner + 1e-3 * (q.center - corner),
+                       corner - depth * q.normal};
+    mesh->indices = {0, 1, 2, 0, 2, 3, 0, 4, 5};
+    const Vec3 side = glm::normalize(glm::cross(mesh->positions[4] - corner, mesh->positions[5] - corner));
+    mesh->normals = {q.normal, q.normal, q.normal, q.normal, side, side};
+    s.objects[index].shape = scene::Mesh::single("ground-shading-itself", std::move(mesh));
 }
 
 // A closed, convex triangle mesh: an icosahedron subdivided `levels` times and pushed onto the

@@ -493,9 +493,11 @@ BandPosition bandPosition(const scene::Frame& f, const std::vector<double>& spli
 // The long plane with two larger spheres whose shadows lie in the blend bands of both inner splits
 // (view depths ~24 and ~68; the splits are near 29 and 76), seen at 480x270 so that the far band
 // is more than a few rows tall, so that their edges, where the two
-// cascades' texels give different filtered visibilities, cross the bands.
+// cascades' texels give different filtered visibilities, cross the bands. The plane shades itself
+// (a mesh), so the cascades split all of its visible depths, not only those under the spheres.
 scene::Scene blendScene() {
     scene::Scene s = test::makeLongPlane(480, 270);
+    test::makeGroundShadeItself(s, 0);
     const std::pair<Vec3, double> extra[] = {{Vec3(4.0, 1.6, -22.0), 1.5}, {Vec3(-5.0, 3.2, -66.0), 3.0}};
     for (const auto& [center, radius] : extra) {
         scene::Object o;

@@ -341,8 +341,10 @@ TEST(FrustumView, SpotMapHoldsItsPyramidAndAForcedNarrowMapStripesLitPointsOutsi
 
 TEST(FrustumView, CascadesHoldEverySliceAndEachReceiverCarriesItsCascadesTint) {
     // The long plane with 3 cascades: each cascade's map is fitted to its slice, so every visible
-    // receiver lies in the map of the cascade its view depth picks (no stripes anywhere).
-    const scene::Scene s = test::makeLongPlane();
+    // receiver lies in the map of the cascade its view depth picks (no stripes anywhere). The plane
+    // shades itself (a mesh), so all of it is a receiver the cascades must hold.
+    scene::Scene s = test::makeLongPlane();
+    test::makeGroundShadeItself(s, 0);
     scene::RasterSettings settings = test::validatedSettings(256, 0.0, 1.0, scene::ShadowFilter::Pcf2x2);
     settings.depthBias = scene::defaultDepthBias(s, 256);
     settings.depthBiasIsDefault = true;
@@ -368,16 +370,18 @@ TEST(FrustumView, CascadesHoldEverySliceAndEachReceiverCarriesItsCascadesTint) {
     }
     EXPECT_EQ(seen.size(), 3u);
     EXPECT_GT(tinted, 0.9 * receivers);
-    // Shrinking cascade 1's map to a tenth of its width leaves most of its slice uncovered.
+    // Shrinking cascade 1's map to a tenth of its width leaves most of its slice of the plane (id 1)
+    // uncovered. (The spheres are convex: the parts of them no other object can shade stay Outside.)
     RenderDebug shrunk = debug;
     shrunk.layers[1].frustum.halfWidth *= 0.1;
     const std::vector<Coverage> after = lightMapCoverage(f, s, shrunk);
     int slice = 0, uncovered = 0;
     for (std::size_t i = 0; i < after.size(); ++i)
-        if (f.objectId[i] > 0.0f && cascade[i] == 1 && f.ndotl[i] > 0.0f) {
+        if (f.objectId[i] == 1.0f && cascade[i] == 1 && f.ndotl[i] > 0.0f) {
             ++slice;
             uncovered += after[i] == Coverage::Uncovered;
-            EXPECT_NE(after[i], Coverage::Outside);  // a directional light reaches every facing point
+            // The light reaches every facing point of the plane, and the plane shades itself.
+            EXPECT_NE(after[i], Coverage::Outside);
         }
     EXPECT_GT(uncovered, slice / 2);
 }

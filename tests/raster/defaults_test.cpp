@@ -273,8 +273,10 @@ TEST(RasterDefaults, LiftFreeDrawsFollowTheLightThroughUpdate) {
 // fitted one never exceeds) is already under 2 pixels a texel: one map.
 TEST(RasterDefaults, CascadesAreChosenWhenOneMapsTexelExceedsTwoPixels) {
     // The camera looks across the light (along −z), so the ground it sees spans hundreds of units
-    // across the map.
+    // across the map. The ground shades itself (a mesh), so all of it that the camera sees is a
+    // receiver the maps must cover.
     scene::Scene s = largeGround(2.0, Vec3(0, 3, 8), Vec3(0, 0, -10));
+    test::makeGroundShadeItself(s, 0);
     scene::Object caster;  // something to shadow the ground, so the light gets a map
     caster.shape = scene::Sphere{Vec3(0, 0.5, -5), 0.5};
     s.objects.push_back(caster);

@@ -119,13 +119,15 @@ TEST(LightFrustum, SpotNearPlaneStaysAFractionOfFarWhenTheLightIsInsideTheScene)
 }
 
 // A camera at (0, 2, 6) looking at the origin over a 200 x 200 plane with a small sphere (all of
-// it moved by `shift`).
+// it moved by `shift`). The plane is a mesh that can shade itself, so every visible point of it is
+// a receiver the fitted map must hold (a quad would leave only the part under the sphere).
 scene::Scene bigPlaneScene(const Vec3& shift = Vec3(0)) {
     test::SphereOverPlane p;
     p.planeSize = 200.0;
     p.eye = Vec3(0, 2, 6);
     p.lookAt = Vec3(0, 0, 0);
     scene::Scene s = test::makeScene(p, shift);
+    test::makeGroundShadeItself(s, 1);
     s.camera.far = 30.0;  // the visible part of the plane ends 30 units away
     return s;
 }

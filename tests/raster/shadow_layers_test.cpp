@@ -131,13 +131,15 @@ TEST(ShadowLayers, APointLightHasSixCubeFacesOfNinetyDegreesAlongTheAxes) {
 }
 
 TEST(ShadowLayers, CascadeSplitsFollowThePracticalSplitScheme) {
-    // C_i = λ n (f/n)^(i/N) + (1 − λ)(n + (f − n) i/N) over the visible depth range [n, f].
-    const scene::Scene s = test::makeLongPlane(64, 36);
+    // C_i = λ n (f/n)^(i/N) + (1 − λ)(n + (f − n) i/N) over the depth range [n, f] of the visible
+    // receivers some caster can shade (the plane shades itself here, so all of it counts).
+    scene::Scene s = test::makeLongPlane(64, 36);
+    test::makeGroundShadeItself(s, 0);
     scene::RasterSettings r = fixedSettings(1024);
     r.cascades = 3;
     const std::vector<ShadowLayer> layers = planShadowLayers(s, test::planFor(s, r), r);
     ASSERT_EQ(layers.size(), 3u);
-    const auto range = visibleDepthRange(s);
+    const auto range = shadowableDepthRange(s, s.lights[0].direction);
     ASSERT_TRUE(range.has_value());
     const double n = (*range)[0], f = (*range)[1];
     for (int c = 0; c < 3; ++c) {

@@ -50,6 +50,15 @@ scene::Scene slantedSphere(int width, int height) {
     return s;
 }
 
+// The same with a plane that shades itself (a mesh), so that every visible point of it is a receiver
+// the fitted map must hold, and the map follows the camera as it moves (over a quad it would hold
+// only the fixed region under the sphere, and not move at all).
+scene::Scene slantedSphereOverAShadingPlane(int width, int height) {
+    scene::Scene s = slantedSphere(width, height);
+    shadowlab::test::makeGroundShadeItself(s, 1);
+    return s;
+}
+
 struct TempFolder {
     fs::path path;
     explicit TempFolder(const std::string& name)
@@ -236,7 +245,7 @@ TEST(ScenePathBlock, BecomesThePathSpecWithTheKindsDefaultsForWhatItLeavesOut) {
 // the snapped row's held view must not flicker or vary at all, the unsnapped row's must flicker.
 TEST(SweepFlickerAxis, SnappedFittedMapsHoldStillInTheHeldViewWhereUnsnappedOnesFlicker) {
     constexpr int kMap = 128;
-    scene::Scene base = slantedSphere(128, 72);
+    scene::Scene base = slantedSphereOverAShadingPlane(128, 72);
     base.shadow.shadowMapSize = kMap;  // the path's texel is the scene's own map's (flickerScenes)
     base.shadow.fitLightFrustum = true;
     const scene::RenderSettings fitted = scene::resolveSettings(base, {});

@@ -47,6 +47,15 @@ scene::Scene slantedSphere(int width, int height) {
     return shadowlab::test::makeScene(p);
 }
 
+// The same with a plane that shades itself (a mesh), so that every visible point of it is a receiver
+// the fitted map must hold, and the map follows the camera as it moves (over a quad it would hold
+// only the fixed region under the sphere, and not move at all).
+scene::Scene slantedSphereOverAShadingPlane(int width, int height) {
+    scene::Scene s = slantedSphere(width, height);
+    shadowlab::test::makeGroundShadeItself(s, 1);
+    return s;
+}
+
 std::vector<const scene::Frame*> pointers(const std::vector<scene::Frame>& frames) {
     std::vector<const scene::Frame*> p;
     for (const scene::Frame& f : frames) p.push_back(&f);
@@ -172,7 +181,7 @@ struct HeldPath {
 constexpr int kHeldMapSize = 128;
 
 std::vector<scene::Scene> subTexelScenes(double startShift, const scene::RenderSettings& settings) {
-    scene::Scene base = slantedSphere(128, 72);
+    scene::Scene base = slantedSphereOverAShadingPlane(128, 72);
     const scene::CameraBasis cam = scene::cameraBasis(base.camera);
     const Vec3 along = glm::normalize(cam.right + cam.up);  // the path's own direction
     base.camera.position += startShift * along;
@@ -192,7 +201,7 @@ bool sameFrustum(const raster::LightFrustum& a, const raster::LightFrustum& b) {
 // one whole texel) or their size a size step: the start, moved along the path's direction in
 // twentieths of a texel, where the fitting rule keeps one frustum over the whole path.
 double startInsideOneSnapStep(const scene::RenderSettings& settings) {
-    const scene::Scene probe = slantedSphere(128, 72);
+    const scene::Scene probe = slantedSphereOverAShadingPlane(128, 72);
     const double texel = subTexelStep(probe, settings.raster, 1.0).texel;
     for (int k = 0; k < 40; ++k) {
         const std::vector<scene::Scene> scenes = subTexelScenes(0.05 * k * texel, settings);
@@ -210,7 +219,7 @@ double startInsideOneSnapStep(const scene::RenderSettings& settings) {
 }
 
 HeldPath heldSubTexelPath(bool snap, double startShift) {
-    scene::RenderSettings settings = settingsFor(slantedSphere(128, 72), kHeldMapSize);
+    scene::RenderSettings settings = settingsFor(slantedSphereOverAShadingPlane(128, 72), kHeldMapSize);
     settings.raster.fitLightFrustum = true;
     settings.raster.snapLightFrustum = snap;
     const std::vector<scene::Scene> scenes = subTexelScenes(startShift, settings);
@@ -234,7 +243,7 @@ HeldPath heldSubTexelPath(bool snap, double startShift) {
 }
 
 TEST(PathStability, SnappedFittedMapsHoldStillUnderSubTexelMovesWhereUnsnappedOnesFlicker) {
-    scene::RenderSettings fitted = settingsFor(slantedSphere(128, 72), kHeldMapSize);
+    scene::RenderSettings fitted = settingsFor(slantedSphereOverAShadingPlane(128, 72), kHeldMapSize);
     fitted.raster.fitLightFrustum = true;
     const double start = startInsideOneSnapStep(fitted);
     const HeldPath snapped = heldSubTexelPath(true, start);
