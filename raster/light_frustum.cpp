@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <span>
@@ -21,6 +22,83 @@ using scene::Vec3;
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+
+// A bounding-box tree over boxes, for the overlap queries of shadowableReceiverBoxes: a scene
+// may hold up to a million objects, and testing every receiver against every caster is n².
+class BoxTree {
+public:
+    explicit BoxTree(std::span<const scene::Bounds> boxes) : boxes_(boxes) {
+        for (std::uint32_t i = 0; i < boxes.size(); ++i)
+            if (!boxes[i].empty()) order_.push_back(i);
+        if (order_.empty()) return;
+        nodes_.resize(1);
+        build(0, 0, std::uint32_t(order_.size()));
+    }
+
+    // Calls visit(j) for each box j overlapping `query` (touching counts) until visit returns false.
+    template <class Visit>
+    void overlapping(const scene::Bounds& query, Visit&& visit) const {
+        if (nodes_.empty()) return;
+        std::uint32_t stack[64];
+        int top = 0;
+        stack[top++] = 0;
+        while (top > 0) {
+            const Node& node = nodes_[stack[--top]];
+            if (!overlaps(node.box, query)) continue;
+            if (node.count > 0) {
+                for (std::uint32_t k = node.first; k < node.first + node.count; ++k)
+                    if (overlaps(boxes_[order_[k]], query) && !visit(order_[k])) return;
+            } else {
+                stack[top++] = node.first;
+                stack[top++] = node.first + 1;
+            }
+        }
+    }
+
+private:
+    struct Node {
+        scene::Bounds box;
+        std::uint32_t first = 0;  // a leaf's first entry in order_, else its left child (right follows)
+        std::uint32_t count = 0;  // entries of a leaf; 0 for an inner node
+    };
+    static constexpr std::uint32_t kLeafSize = 4;
+
+    static bool overlaps(const scene::Bounds& a, const scene::Bounds& b) {
+        return glm::all(glm::lessThanEqual(a.min, b.max)) && glm::all(glm::lessThanEqual(b.min, a.max));
+    }
+
+    // Fills node `at` with order_[begin, end): a median split on the centres' widest axis, so the
+    // depth stays below log2(n) + 1, far under the query's stack. Children sit side by side.
+    void build(std::uint32_t at, std::uint32_t begin, std::uint32_t end) {
+        scene::Bounds box, centres;
+        for (std::uint32_t k = begin; k < end; ++k) {
+            box.extend(boxes_[order_[k]]);
+            centres.extend(boxes_[order_[k]].center());
+        }
+        nodes_[at].box = box;
+        if (end - begin <= kLeafSize) {
+            nodes_[at].first = begin;
+            nodes_[at].count = end - begin;
+            return;
+        }
+        const Vec3 e = centres.extent();
+        const int axis = e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
+        const std::uint32_t mid = begin + (end - begin) / 2;
+        std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
+                         [&](std::uint32_t l, std::uint32_t r) {
+                             return boxes_[l].center()[axis] < boxes_[r].center()[axis];
+                         });
+        const std::uint32_t left = std::uint32_t(nodes_.size());
+        nodes_.resize(nodes_.size() + 2);
+        nodes_[at].first = left;
+        build(left, begin, mid);
+        build(left + 1, mid, end);
+    }
+
+    std::span<const scene::Bounds> boxes_;
+    std::vector<std::uint32_t> order_;
+    std::vector<Node> nodes_;
+};
 
 }  // namespace
 
@@ -225,13 +303,15 @@ std::vector<scene::Bounds> shadowableReceiverBoxes(const scene::Scene& scene, co
         s.max += Vec3(pad);
         swept[j] = s;
     }
+    const BoxTree tree(swept);
     for (std::size_t i = 0; i < n; ++i) {
         if (bounds[i].empty()) continue;
-        for (std::size_t j = 0; j < n; ++j) {
-            if (swept[j].empty() || (j == i && !shadesItself(scene.objects[i]))) continue;
-            const scene::Bounds c{glm::max(bounds[i].min, swept[j].min), glm::min(bounds[i].max, swept[j].max)};
-            if (glm::all(glm::lessThanEqual(c.min, c.max))) boxes[i].extend(c);
-        }
+        tree.overlapping(bounds[i], [&](std::uint32_t j) {
+            if (j == i && !shadesItself(scene.objects[i])) return true;
+            boxes[i].extend(scene::Bounds{glm::max(bounds[i].min, swept[j].min), glm::min(bounds[i].max, swept[j].max)});
+            // Once the whole object can be shaded, no other caster adds to its box.
+            return !(boxes[i].min == bounds[i].min && boxes[i].max == bounds[i].max);
+        });
     }
     return boxes;
 }

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "raster/cascades.h"
 #include "raster/light_frustum.h"
@@ -79,6 +80,68 @@ TEST(ShadowableReceivers, AMeshShadesItselfButAConvexShapeOrAPlanarMeshDoesNot) 
     const scene::Bounds ico = scene::boundsOf(s.objects[0].shape);
     const std::vector<scene::Bounds> boxes = shadowableReceiverBoxes(s, kSeedLight);
     expectBox(boxes[0], ico.min, ico.max, 1e-9);
+}
+
+// The boxes as the header defines them, by testing every receiver against every caster: each
+// caster's box swept along the light until it lies past one of the scene's faces, padded, met
+// with each other box (its own where shadesItself).
+std::vector<scene::Bounds> boxesEveryPair(const scene::Scene& s, const Vec3& direction) {
+    const scene::Bounds scene = s.bounds();
+    const Vec3 d = glm::normalize(direction);
+    const double pad = kShadowSweepPad * std::max(scene.diagonal(), scene.maxAbsCoordinate());
+    const std::size_t n = s.objects.size();
+    std::vector<scene::Bounds> out(n);
+    for (std::size_t j = 0; j < n; ++j) {
+        const scene::Bounds b = scene::boundsOf(s.objects[j].shape);
+        double t = INFINITY;
+        for (int k = 0; k < 3; ++k)
+            if (d[k] != 0.0) t = std::min(t, ((d[k] > 0 ? scene.max[k] - b.min[k] : scene.min[k] - b.max[k])) / d[k]);
+        t = std::max(t, 0.0);
+        scene::Bounds swept{glm::min(b.min, b.min + t * d) - pad, glm::max(b.max, b.max + t * d) + pad};
+        for (std::size_t i = 0; i < n; ++i) {
+            if (i == j && !shadesItself(s.objects[i])) continue;
+            const scene::Bounds r = scene::boundsOf(s.objects[i].shape);
+            const scene::Bounds c{glm::max(r.min, swept.min), glm::min(r.max, swept.max)};
+            if (glm::all(glm::lessThanEqual(c.min, c.max))) out[i].extend(c);
+        }
+    }
+    return out;
+}
+
+// A thousand spheres, boxes and small meshes of sizes over three orders of magnitude, scattered
+// over a ground and in the air, under a high and a low light: the tree's query finds the same
+// boxes as every pair.
+TEST(ShadowableReceivers, ManyObjectsGiveTheSameBoxesAsTestingEveryPair) {
+    scene::Scene s = largeGroundSeed();
+    s.objects.resize(1);
+    s.objects[0].shape = test::quadShape(Vec3(0), Vec3(0, 1, 0), 200, 200);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> across(-100, 100), up(0, 30), size(-2, 1);
+    for (int i = 0; i < 1000; ++i) {
+        const Vec3 c(across(rng), up(rng), across(rng));
+        const double r = std::pow(10.0, size(rng));
+        if (i % 3 == 0)
+            s.objects.push_back(objectOf(scene::Sphere{c, r}));
+        else if (i % 3 == 1)
+            s.objects.push_back(objectOf(scene::Box{c - r, c + Vec3(r, 2 * r, r)}));
+        else
+            s.objects.push_back(objectOf(scene::Mesh::single("ico", test::icosphere(c, r, 0))));
+    }
+    for (const Vec3& light : {kSeedLight, Vec3(-1, -0.05, 0.3)}) {
+        const std::vector<scene::Bounds> got = shadowableReceiverBoxes(s, light);
+        const std::vector<scene::Bounds> want = boxesEveryPair(s, light);
+        ASSERT_EQ(got.size(), want.size());
+        int shadowable = 0;
+        for (std::size_t i = 0; i < got.size(); ++i) {
+            ASSERT_EQ(got[i].empty(), want[i].empty()) << "object " << i;
+            if (got[i].empty()) continue;
+            ++shadowable;
+            expectBox(got[i], want[i].min, want[i].max, 1e-12 * 200);
+        }
+        // Both outcomes occur: some objects are shaded, some stand alone.
+        EXPECT_GT(shadowable, 1);
+        EXPECT_LT(shadowable, int(got.size()));
+    }
 }
 
 // The cascades split the shadowable depths 5.31..8.242 (above): with λ = 0.75 the first split is
