@@ -26,10 +26,12 @@
 #include "raster/cascades.h"
 #include "raster/debug_views.h"
 #include "raster/devices.h"
+#include "raster/light_frustum.h"
 #include "raster/memory.h"
 #include "raster/renderer.h"
 #include "raster/shadow_layers.h"
 #include "raster/tolerances.h"
+#include "raster/vulkan_error.h"
 #include "raytrace/view_search.h"
 #include "scene/error.h"
 #include "scene/frame_identity.h"
@@ -80,6 +82,12 @@ void applyResolution(scene::Scene& s, const std::string& text) {
     s.camera.height = h;
 }
 
+std::string formatNumberShort(double v) {
+    std::ostringstream o;
+    o << v;
+    return o.str();
+}
+
 // The choices a scene file leaves open (scene/model_view.h): a file camera, a ground, the sun,
 // then a search for a view and a sun that show shadows where the file has no camera or light.
 void chooseView(scene::Scene& s, const SceneOptions* o) {
@@ -87,12 +95,26 @@ void chooseView(scene::Scene& s, const SceneOptions* o) {
     scene::applyGround(s, o ? o->ground : std::nullopt);
     if (o && o->sun) scene::applySunOption(s, *o->sun);
     raytrace::chooseViewAndSun(s, o && o->settings.threads ? *o->settings.threads : 0);
-}
-
-std::string formatNumberShort(double v) {
-    std::ostringstream o;
-    o << v;
-    return o.str();
+    // A camera that frames none of the objects renders only background, which would compare as
+    // a perfect agreement: say so.
+    bool seen = false;
+    for (const scene::Object& obj : s.objects)
+        if (!raster::visibleReceiverPoints(s, scene::boundsOf(obj.shape)).empty()) {
+            seen = true;
+            break;
+        }
+    if (!seen) {
+        const auto v = [](const scene::Vec3& p) {
+            std::ostringstream t;
+            t << "[" << p.x << ", " << p.y << ", " << p.z << "]";
+            return t.str();
+        };
+        const scene::Bounds b = s.bounds();
+        s.origin.notes.push_back("the camera at " + v(s.camera.position) + " looking at " + v(s.camera.lookAt) +
+                                 " (near " + formatNumberShort(s.camera.near) + ", far " +
+                                 formatNumberShort(s.camera.far) + ") frames none of the objects (bounds " + v(b.min) +
+                                 " to " + v(b.max) + "): every pixel is background and there is no shadow to judge");
+    }
 }
 
 // --explain's words for the slope bias past its cap (lit.frag; docs/raster.md "Grazing light").
@@ -109,7 +131,20 @@ std::string grazingLiftText(const scene::RasterSettings& r) {
     return o.str();
 }
 
+// A --device that names no usable device is bad usage: refused before anything is rendered or
+// written, as any other bad option is, rather than failing the raster backend midway through.
+void checkDeviceOption(const SceneOptions& o) {
+    if (!o.settings.device || o.settings.device->empty()) return;
+    try {
+        raster::selectDevice(raster::enumerateDevices(false), *o.settings.device);
+    } catch (const raster::RasterError& e) {
+        const std::string what = e.what();
+        throw scene::InputError(what.rfind("--device", 0) == 0 ? what : "--device " + *o.settings.device + ": " + what);
+    }
+}
+
 Prepared prepare(const SceneOptions& o) {
+    checkDeviceOption(o);
     Prepared p{readingInput(o.scene, [&] { return scene::loadScene(scene::findScene(o.scene)); }), {}, {}};
     if (o.resolution) applyResolution(p.scene, *o.resolution);
     chooseView(p.scene, &o);
@@ -278,8 +313,9 @@ private:
 
 }  // namespace
 
-// The scene as glTF for other engines (docs/export.md): the scene as its file says, no view
-// search or ground, since another engine renders it from the file alone.
+// The scene as glTF for other engines (docs/export.md): the scene run and render would draw,
+// with the view, sun and ground they would choose, since another engine renders it from the
+// file alone and its shadows are graded against this scene's reference.
 int exportScene(const ExportOptions& o) {
     std::string ext = o.output.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
@@ -290,7 +326,11 @@ int exportScene(const ExportOptions& o) {
         throw scene::InputError("--tolerance: must be in (0, 0.5) (a fraction of a sphere's radius), got " +
                                 std::to_string(o.tolerance));
     checkOutputFile(o.output);
-    const scene::Scene s = readingInput(o.scene, [&] { return scene::loadScene(scene::findScene(o.scene)); });
+    scene::Scene s = readingInput(o.common.scene, [&] { return scene::loadScene(scene::findScene(o.common.scene)); });
+    if (o.common.resolution) applyResolution(s, *o.common.resolution);
+    chooseView(s, &o.common);
+    for (const std::string& note : s.origin.notes) std::cerr << "shadowlab: note: " << note << "\n";
+    if (o.common.explain) std::cerr << scene::explainOrigin(s);
     createOutputFolder(o.output);
     Stage stage("exporting " + s.file.filename().string());
     const scene::ExportResult r = scene::exportGltf(s, o.output, {o.tolerance});

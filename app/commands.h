@@ -118,7 +118,9 @@ struct PathCommandOptions {
 };
 
 struct ExportOptions {
-    std::string scene;             // path or shipped name
+    // The scene and the view options run and render take (resolution, camera, ground, sun), so
+    // that the file holds the scene they render; render settings do not apply.
+    SceneOptions common;
     std::filesystem::path output;  // .glb or .gltf
     double tolerance = 1e-3;       // a sphere's largest sagitta / radius
 };

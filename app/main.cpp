@@ -19,13 +19,34 @@ namespace {
 
 using shadowlab::app::SceneOptions;
 
-void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
+// The scene and what decides the view: the image size, the camera, the ground, the sun.
+void addViewOptions(CLI::App& cmd, SceneOptions& o) {
     cmd.add_option("SCENE", o.scene, "Scene file, or the name of a shipped scene (e.g. seed)")->required();
     cmd.add_option("--resolution", o.resolution, "Image size WxH, overriding the scene's camera (e.g. 640x360)");
+    cmd.add_option("--camera", o.camera,
+                   "View: a camera of the scene's glTF file by index (0, 1, ...) or name, or 'auto' to search a view "
+                   "that shows shadows (default: the file's first camera; a search where it has none)");
+    cmd.add_flag_function(
+        "--ground", [&o](std::int64_t) { o.ground = true; },
+        "Put a ground under the model, sized from its bounds (default for a glTF scene without a floor of its own)");
+    cmd.add_flag_function(
+        "--no-ground", [&o](std::int64_t) { o.ground = false; }, "No added ground");
+    cmd.add_option("--sun", o.sun,
+                   "AZIMUTH,ELEVATION in degrees: the directional light's direction (azimuth in the ground plane from "
+                   "+Z toward +X, elevation above the horizon; default: the scene's, or a search)");
+    cmd.add_flag("--explain", o.explain, "Print what this scene needs (the render plan) before rendering");
+}
+
+void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
+    addViewOptions(cmd, o);
     auto& s = o.settings;
-    cmd.add_option("--shadow-map-size", s.shadowMapSize, "raster: shadow-map texels per side (default 2048)");
+    cmd.add_option("--shadow-map-size", s.shadowMapSize,
+                   "raster: shadow-map texels per side (default: chosen per view, the power of two in 256..2048 whose "
+                   "texel is no larger than a pixel on the visible receivers and gives the smallest caster 4 "
+                   "texels; 2048 with cascades; --explain says why)");
     cmd.add_option("--depth-bias", s.depthBias,
-                   "raster: constant depth bias in world units (default: half a shadow-map texel)");
+                   "raster: constant depth bias in world units (default: half a texel of each map as fitted or "
+                   "cascaded)");
     cmd.add_option("--slope-bias", s.slopeBias,
                    "raster: slope-scaled bias in texels, times tan(angle to light) up to tan 10; past that the rest "
                    "lifts the lookup along the normal, so a grazing plane keeps its margin (default 1)");
@@ -90,18 +111,6 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
     cmd.add_option("--threads", s.threads, "raytrace: worker threads, 0 = all cores (default 0)");
     cmd.add_flag("--validate", s.validate,
                  "raster: enable VK_LAYER_KHRONOS_validation; any message makes the command fail");
-    cmd.add_option("--camera", o.camera,
-                   "View: a camera of the scene's glTF file by index (0, 1, ...) or name, or 'auto' to search a view "
-                   "that shows shadows (default: the file's first camera; a search where it has none)");
-    cmd.add_flag_function(
-        "--ground", [&o](std::int64_t) { o.ground = true; },
-        "Put a ground under the model, sized from its bounds (default for a glTF scene without a floor of its own)");
-    cmd.add_flag_function(
-        "--no-ground", [&o](std::int64_t) { o.ground = false; }, "No added ground");
-    cmd.add_option("--sun", o.sun,
-                   "AZIMUTH,ELEVATION in degrees: the directional light's direction (azimuth in the ground plane from "
-                   "+Z toward +X, elevation above the horizon; default: the scene's, or a search)");
-    cmd.add_flag("--explain", o.explain, "Print what this scene needs (the render plan) before rendering");
     cmd.add_flag("--json", o.json, "Print machine-readable results on stdout");
 }
 
@@ -278,7 +287,7 @@ int main(int argc, char** argv) {
     auto* exportCmd = app.add_subcommand("export",
                                          "Write the scene as glTF 2.0 with KHR_lights_punctual (.glb or "
                                          ".gltf) for another engine (docs/export.md)");
-    exportCmd->add_option("SCENE", exportOptions.scene, "Scene file or shipped name")->required();
+    addViewOptions(*exportCmd, exportOptions.common);
     exportCmd->add_option("-o,--output", exportOptions.output, "The glTF file (.glb or .gltf)")->required();
     exportCmd->add_option("--tolerance", exportOptions.tolerance,
                           "Largest sagitta of a tessellated sphere, as a fraction of its radius (default 1e-3)");

@@ -706,8 +706,8 @@ std::string summaryLine(const Metrics& m) {
          formatFixed(m.shadowIoU, 3) + ", mean |dV| " + formatFixed(m.meanAbsVisibilityError, 4) + " (penumbra " +
          formatFixed(m.meanAbsVisibilityErrorPenumbra, 3) + " over " + formatCount(m.penumbraPixels) +
          " px), off by > " + formatFixed(kSoftErrorTolerance, 2) + " within tau " + formatCount(m.softErrorPixels) +
-         " px, silhouette " + formatPercent(m.silhouetteMismatchRate) + ", " + formatDuration(m.methodTiming.totalMs) +
-         " (reference " + formatDuration(m.referenceTiming.totalMs) + ")";
+         " px, silhouette " + formatPercent(m.silhouetteMismatchRate) + ", run time " +
+         formatRunTime(m.methodTiming.totalMs) + " (reference " + formatRunTime(m.referenceTiming.totalMs) + ")";
     const std::size_t bad = m.methodHealth.total() + m.referenceHealth.total();
     if (bad > 0)
         s += ", NON-FINITE values: method " + formatCount(m.methodHealth.total()) + ", reference " +

@@ -451,7 +451,7 @@ std::string metricsTable(const ReportInput& in) {
         return plain(t.empty() ? "0" : "<b style=\"color:#c92a2a\">" + escapeHtml(t) + "</b>");
     });
     row(
-        "run time", [&](const Metrics& m) { return plain(formatDuration(m.methodTiming.totalMs)); }, "key");
+        "run time", [&](const Metrics& m) { return plain(formatRunTime(m.methodTiming.totalMs)); }, "key");
     o << "</tbody></table>\n";
     return o.str();
 }
@@ -478,7 +478,7 @@ std::string timingTable(const ReportInput& in) {
         o << "</tr>\n";
     }
     o << "<tr class=\"key\"><td>total</td>";
-    for (const auto& c : cols) o << "<td>" << formatDuration(c.second->totalTimeMs()) << "</td>";
+    for (const auto& c : cols) o << "<td>" << formatRunTime(c.second->totalTimeMs()) << "</td>";
     o << "</tr></tbody></table>\n";
     return o.str();
 }

@@ -47,6 +47,8 @@ std::string formatDuration(double ms) {
     return printf1("%.3g ms", ms);
 }
 
+std::string formatRunTime(double ms) { return ms > 0.0 ? formatDuration(ms) : "not recorded"; }
+
 std::string formatFixed(double value, int decimals) {
     if (!std::isfinite(value)) return "n/a";
     char buf[64];

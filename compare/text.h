@@ -14,6 +14,8 @@ std::string formatCount(std::size_t n);
 std::string formatPercent(double rate);
 // Milliseconds with a unit that keeps 3 significant digits: "0.412 ms", "87.3 ms", "1.25 s".
 std::string formatDuration(double ms);
+// A method's run time: "not recorded" where the frame records none (a mask another renderer wrote).
+std::string formatRunTime(double ms);
 // Fixed decimals: formatFixed(0.98123, 3) -> "0.981". Non-finite -> "n/a".
 std::string formatFixed(double value, int decimals);
 // Short general form for axis labels: 3 significant digits, no trailing zeros ("0.5", "120", "1e-05").

@@ -84,10 +84,9 @@ private:
         const Vec3 e = centres.extent();
         const int axis = e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
         const std::uint32_t mid = begin + (end - begin) / 2;
-        std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
-                         [&](std::uint32_t l, std::uint32_t r) {
-                             return boxes_[l].center()[axis] < boxes_[r].center()[axis];
-                         });
+        std::nth_element(
+            order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
+            [&](std::uint32_t l, std::uint32_t r) { return boxes_[l].center()[axis] < boxes_[r].center()[axis]; });
         const std::uint32_t left = std::uint32_t(nodes_.size());
         nodes_.resize(nodes_.size() + 2);
         nodes_[at].first = left;
@@ -308,7 +307,8 @@ std::vector<scene::Bounds> shadowableReceiverBoxes(const scene::Scene& scene, co
         if (bounds[i].empty()) continue;
         tree.overlapping(bounds[i], [&](std::uint32_t j) {
             if (j == i && !shadesItself(scene.objects[i])) return true;
-            boxes[i].extend(scene::Bounds{glm::max(bounds[i].min, swept[j].min), glm::min(bounds[i].max, swept[j].max)});
+            boxes[i].extend(
+                scene::Bounds{glm::max(bounds[i].min, swept[j].min), glm::min(bounds[i].max, swept[j].max)});
             // Once the whole object can be shaded, no other caster adds to its box.
             return !(boxes[i].min == bounds[i].min && boxes[i].max == bounds[i].max);
         });

@@ -236,10 +236,14 @@ Camera readCamera(const Reader& r, const Json& node, const JsonPath& path) {
                                             " is more than " + std::to_string(kMaxPixels) + " pixels");
     }
     if (node.contains("near")) c.near = r.positive(node["near"], path / "near");
-    if (node.contains("far"))
+    if (node.contains("far")) {
         c.far = r.positive(node["far"], path / "far");
-    else
+        // Without a near plane, a thousandth of the far one when that is nearer than the default:
+        // a scene a few centimetres across is not clipped away.
+        if (!node.contains("near")) c.near = std::min(c.near, kNearPerFar * c.far);
+    } else {
         c.far = std::max(c.far, 2.0 * c.near);  // a placeholder: fitted to the scene's bounds once it is read
+    }
     if (!(c.far > c.near)) r.fail(path / "far", "must be greater than near");
     return c;
 }
@@ -654,6 +658,7 @@ Scene parseScene(const fs::path& file, const std::string& text) {
         const Json& camera = r.require(doc, root, "camera");
         scene.camera = readCamera(r, camera, root / "camera");
         scene.origin.farFromBounds = camera.is_object() && !camera.contains("far");
+        scene.origin.nearFromBounds = scene.origin.farFromBounds && !camera.contains("near");
     }
     if (doc.contains("ground")) scene.origin.ground = r.boolean(doc["ground"], root / "ground");
     if (doc.contains("$schema")) r.string(doc["$schema"], root / "$schema");
@@ -685,8 +690,19 @@ Scene parseScene(const fs::path& file, const std::string& text) {
     const Json& lights = r.require(doc, root, "lights");
     if (!lights.is_array()) r.fail(root / "lights", std::string("expected an array, got ") + typeName(lights));
     if (lights.empty()) r.fail(root / "lights", "must hold at least one light (a shadow needs a light)");
-    for (std::size_t i = 0; i < lights.size(); ++i)
+    for (std::size_t i = 0; i < lights.size(); ++i) {
         scene.lights.push_back(readLight(r, lights[i], root / "lights" / i));
+        // "direction" is the way the light travels; giving the way to the sun instead is the usual
+        // slip, and it puts the sun below the horizon: upward faces unlit, no shadow on a ground.
+        const Light& l = scene.lights.back();
+        if (l.type == LightType::Directional && glm::dot(l.direction, glm::normalize(scene.camera.up)) > 0.0)
+            scene.origin.notes.push_back(
+                file.string() + ": " + (root / "lights" / i / "direction").str() + " " +
+                describe(lights[i]["direction"]) +
+                " points up (against the camera's up): \"direction\" is the way the light travels, so this sun "
+                "is below the horizon and faces turned up get no light and show no shadow; a sun above "
+                "would be the opposite vector");
+    }
 
     const Json& objects = r.require(doc, root, "objects");
     if (!objects.is_array()) r.fail(root / "objects", std::string("expected an array, got ") + typeName(objects));
@@ -704,7 +720,7 @@ Scene parseScene(const fs::path& file, const std::string& text) {
         if (!p.cameras.empty() || p.pick) pending.push_back(std::move(p));
     }
     addFileCameras(r, scene, pending, nearFarGiven);
-    fitFarToBounds(scene);
+    fitNearFarToBounds(scene);
 
     if (doc.contains("shadow")) scene.shadow = readShadow(r, doc["shadow"], root / "shadow");
     if (doc.contains("budgets")) scene.budgets = readBudgets(file, doc["budgets"], root / "budgets");

@@ -216,7 +216,7 @@ void addGround(Scene& scene) {
     scene.objects.push_back({"ground", q, int(scene.materials.size()) - 1});
 }
 
-void fitFarToBounds(Scene& scene) {
+void fitNearFarToBounds(Scene& scene) {
     const Bounds b = scene.bounds();
     if (!scene.origin.farFromBounds || b.empty()) return;
     double farthest = 0.0;
@@ -225,6 +225,7 @@ void fitFarToBounds(Scene& scene) {
         farthest = std::max(farthest, glm::length(corner - scene.camera.position));
     }
     // A hundredth beyond, so the depth of the farthest point does not round past the plane.
+    if (scene.origin.nearFromBounds) scene.camera.near = std::min(kDefaultNear, kNearPerFar * 1.01 * farthest);
     scene.camera.far = std::max(1.01 * farthest, 2.0 * scene.camera.near);
 }
 
@@ -248,7 +249,7 @@ void applyGround(Scene& scene, std::optional<bool> option) {
     }
     if (on) {
         addGround(scene);
-        fitFarToBounds(scene);
+        fitNearFarToBounds(scene);
         const Quad& q = std::get<Quad>(scene.objects.back().shape);
         why =
             "a " + fmt(q.size.x) + " x " + fmt(q.size.y) + " quad at y = " + fmt(q.center.y, "%.4g") + " (" + why + ")";

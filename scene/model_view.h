@@ -50,8 +50,10 @@ bool hasOwnGround(const Scene& scene);
 void addGround(Scene& scene);
 
 // A JSON camera without "far" (SceneOrigin::farFromBounds) sees to the farthest corner of the
-// scene's bounds, so a large ground is never cut off by a guessed constant; no-op otherwise.
-void fitFarToBounds(Scene& scene);
+// scene's bounds, so a large ground is never cut off by a guessed constant; without "near" either
+// (nearFromBounds), its near plane is kNearPerFar of that far one when nearer than the default
+// 0.1, so a scene a few centimetres across is not clipped away. No-op otherwise.
+void fitNearFarToBounds(Scene& scene);
 
 // Whether a ground is added and why: `option` (--ground / --no-ground), else the file's "ground"
 // key, else on for a glTF given as the scene that has no ground of its own (hasOwnGround), off

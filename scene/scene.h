@@ -23,6 +23,11 @@ using Vec3 = glm::dvec3;
 
 // Pinhole camera, vertical field of view; pixel (x, y) is sampled at its center and row 0 is
 // the top of the image (see camera.h for the shared ray/projection math).
+// A JSON camera's near plane when it names none: kDefaultNear, or kNearPerFar of the far plane
+// when that is nearer (scene/loader.cpp, fitNearFarToBounds).
+inline constexpr double kDefaultNear = 0.1;
+inline constexpr double kNearPerFar = 1e-3;
+
 struct Camera {
     Vec3 position{0, 2, 6};
     Vec3 lookAt{0, 0.7, 0};
@@ -30,7 +35,7 @@ struct Camera {
     double fovYDegrees = 40.0;
     int width = 1280;
     int height = 720;
-    double near = 0.1;
+    double near = kDefaultNear;
     double far = 100.0;
 };
 
@@ -305,9 +310,10 @@ struct SceneOrigin {
     bool chooseSun = false;      // lights[0] is a placeholder sun: a view search replaces its direction
     std::optional<bool> ground;  // the scene file's "ground" key
     // The JSON camera gives no "far": it reaches the farthest corner of the scene's bounds,
-    // refitted when a ground is added (fitFarToBounds, scene/model_view.h).
+    // refitted when a ground is added (fitNearFarToBounds, scene/model_view.h).
     bool farFromBounds = false;
-    Bounds modelBounds;  // the objects without an added ground (what a view frames)
+    bool nearFromBounds = false;  // nor "near": fitted with far (fitNearFarToBounds)
+    Bounds modelBounds;           // the objects without an added ground (what a view frames)
     // ("view", "searched: ..."), ("sun", ...), ("ground", ...): printed by --explain, recorded
     // in every Frame as attributes "choice.view", "choice.sun", ...
     std::vector<std::pair<std::string, std::string>> choices;

@@ -102,6 +102,32 @@ TEST(App, RunWarnsWhenALightWithARadiusGetsAHardFilter) {
     EXPECT_EQ(pcss.err.find("warning: light"), std::string::npos) << pcss.err;
 }
 
+// Two slips a new scene file makes: the camera turned away from everything, and a sun given as
+// the way to the light rather than the way the light travels. Each renders (the scene is valid)
+// and each gets a note naming what is wrong.
+TEST(App, ACameraThatSeesNothingAndASunBelowTheHorizonGetANote) {
+    TempDir dir;
+    const std::string rest = R"("materials": {"m": {}},
+        "objects": [{"type": "sphere", "center": [0, 1, 0], "radius": 1, "material": "m"},
+                    {"type": "quad", "center": [0, 0, 0], "normal": [0, 1, 0], "size": [20, 20], "material": "m"}]})";
+    const auto away = dir.write("away.json", R"({"camera": {"position": [0, 2, 6], "look_at": [0, 2, 20]},
+        "lights": [{"type": "directional", "direction": [-1, -2, -1]}], )" +
+                                                 rest);
+    const Result a = shadowlab({"render", away.string(), "--backend", "raytrace", "--resolution", "32x18", "-o",
+                                (dir.path() / "a.png").string()});
+    ASSERT_EQ(a.exitCode, 0) << a.err;
+    EXPECT_NE(a.err.find("frames none of the objects"), std::string::npos) << a.err;
+    EXPECT_EQ(a.err.find("points up"), std::string::npos) << a.err;
+    const auto below = dir.write("below.json", R"({"camera": {"position": [0, 2, 6], "look_at": [0, 0.7, 0]},
+        "lights": [{"type": "directional", "direction": [1, 2, 1]}], )" +
+                                                   rest);
+    const Result b = shadowlab({"render", below.string(), "--backend", "raytrace", "--resolution", "32x18", "-o",
+                                (dir.path() / "b.png").string()});
+    ASSERT_EQ(b.exitCode, 0) << b.err;
+    EXPECT_NE(b.err.find("lights[0].direction [1,2,1] points up"), std::string::npos) << b.err;
+    EXPECT_EQ(b.err.find("frames none"), std::string::npos) << b.err;
+}
+
 TEST(App, RenderWritesTheRequestedFrame) {
     TempDir dir;
     const auto exr = dir.path() / "rt.exr";
@@ -194,6 +220,12 @@ INSTANTIATE_TEST_SUITE_P(
         BadRun{"negative_map", {"run", "seed", "--shadow-map-size", "-5", "-o", "OUTDIR"}, "--shadow-map-size"},
         BadRun{"bad_ray_bias", {"run", "seed", "--ray-bias", "lots", "-o", "OUTDIR"}, "--ray-bias"},
         BadRun{"bad_backend", {"render", "seed", "--backend", "magic", "-o", "OUT"}, "--backend"},
+        BadRun{"unknown_device_run",
+               {"run", "seed", "--resolution", "32x18", "--no-sweep", "--device", "no-such-gpu", "-o", "OUTDIR"},
+               "--device 'no-such-gpu' matches no Vulkan device"},
+        BadRun{"unknown_device_render",
+               {"render", "seed", "--backend", "raster", "--device", "99", "-o", "OUT"},
+               "--device '99' matches no"},
         BadRun{"bad_extension", {"render", "seed", "-o", "frame.tiff"}, "unknown output type"},
         BadRun{"view_needs_raster",
                {"render", "seed", "--backend", "raytrace", "--view", "cascades", "-o", "OUTPNG"},

@@ -148,6 +148,12 @@ TEST(AppGates, AnotherEnginesMaskIsGradedWithTheReferencesIdsAndNdotL) {
                                    "--json", "--mask-channel", "G", "--mask-invert"});
     ASSERT_EQ(inv.exitCode, 0) << inv.err;
     EXPECT_EQ(nlohmann::json::parse(inv.out)["false_shadow"], a["false_shadow"]);
+    // A mask records no run time: the summary says so rather than "0 ms".
+    const auto said = runShadowlab(
+        {"compare", png.string(), f.reference.string(), "-o", (dir.path() / "e.png").string(), "--mask-channel", "R"});
+    ASSERT_EQ(said.exitCode, 0) << said.err;
+    EXPECT_NE((said.out + said.err).find("run time not recorded (reference "), std::string::npos)
+        << said.out << said.err;
     // A mask of several channels needs one chosen; a wrong name lists the channels.
     auto r = runShadowlab({"compare", png.string(), f.reference.string(), "-o", (dir.path() / "d.png").string()});
     EXPECT_EQ(r.exitCode, 2);

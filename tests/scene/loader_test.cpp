@@ -2,6 +2,7 @@
 // error, with the JSON path, for each kind of bad input.
 #include "scene/loader.h"
 
+#include <cmath>
 #include <fstream>
 #include <iterator>
 
@@ -216,6 +217,37 @@ INSTANTIATE_TEST_SUITE_P(
                 sceneText(kCamera, kMaterials, kLights, kObjects, R"(, "shadow": {"cascades": 2.5})"),
                 "shadow.cascades", "expected an integer"}),
     [](const ::testing::TestParamInfo<BadCase>& testParam) { return std::string(testParam.param.name); });
+
+// A sphere 2 cm across seen from 5 cm: the default near plane 0.1 would clip all of it. Without
+// near and far, far is the farthest corner plus 1% and near a thousandth of it; with far alone,
+// near is a thousandth of that far; with near given it stays as written.
+TEST(SceneLoader, ACentimetreSceneWithoutANearPlaneIsNotClippedAway) {
+    TempDir dir;
+    const std::string objects =
+        R"("objects": [{"type": "sphere", "center": [0, 0.01, 0], "radius": 0.01, "material": "matte"}])";
+    const std::string view = R"("position": [0, 0.01, 0.05], "look_at": [0, 0.01, 0])";
+    // Farthest corner of [−0.01, 0.01] x [0, 0.02] x [−0.01, 0.01] from (0, 0.01, 0.05):
+    // √(0.01² + 0.01² + 0.06²).
+    const double far = 1.01 * std::sqrt(0.0001 + 0.0001 + 0.0036);
+    const Scene fitted =
+        loadScene(dir.write("a.json", sceneText(R"("camera": {)" + view + "}", kMaterials, kLights, objects)));
+    EXPECT_NEAR(fitted.camera.far, far, 1e-12);
+    EXPECT_NEAR(fitted.camera.near, 1e-3 * far, 1e-15);
+    EXPECT_LT(fitted.camera.near, 0.04);  // the sphere's nearest point
+    const Scene farOnly = loadScene(
+        dir.write("b.json", sceneText(R"("camera": {)" + view + R"(, "far": 0.5})", kMaterials, kLights, objects)));
+    EXPECT_DOUBLE_EQ(farOnly.camera.near, 5e-4);
+    const Scene given = loadScene(
+        dir.write("c.json", sceneText(R"("camera": {)" + view + R"(, "near": 0.02})", kMaterials, kLights, objects)));
+    EXPECT_DOUBLE_EQ(given.camera.near, 0.02);
+    // A scene whose far plane is beyond 100 keeps the default: a 200 x 200 ground reaches about
+    // 140 from the camera.
+    const std::string large = R"("objects": [{"type": "quad", "center": [0, 0, 0], "normal": [0, 1, 0],
+                                              "size": [200, 200], "material": "matte"}])";
+    const Scene big = loadScene(dir.write("d.json", sceneText(kCamera, kMaterials, kLights, large)));
+    EXPECT_GT(big.camera.far, 100.0);
+    EXPECT_DOUBLE_EQ(big.camera.near, 0.1);
+}
 
 TEST(SceneLoader, AGltfFileIsASceneWithAFramedCameraAndADefaultSun) {
     // The Khronos Box has no camera and no light: the loader frames its bounding sphere
