@@ -11,28 +11,13 @@ namespace shadowlab::raster {
 
 using scene::Vec3;
 
-std::optional<std::array<double, 2>> visibleDepthRange(const scene::Scene& scene) {
-    // Each object's bounds clipped to the camera frustum: tighter than the scene's box, which is
-    // mostly empty space in a scene of a floor and a few objects (its near corner is often at the
-    // camera's near plane, where no receiver is).
-    const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
-    double lo = INFINITY, hi = -INFINITY;
-    for (const scene::Object& o : scene.objects)
-        for (const Vec3& p : visibleReceiverPoints(scene, scene::boundsOf(o.shape))) {
-            const double z = glm::dot(p - cam.position, cam.forward);
-            lo = std::min(lo, z);
-            hi = std::max(hi, z);
-        }
-    lo = std::max(lo, scene.camera.near);
-    hi = std::min(hi, scene.camera.far);
-    if (!(hi > lo)) return std::nullopt;
-    return std::array<double, 2>{lo, hi};
-}
+namespace {
 
-std::optional<std::array<double, 2>> shadowableDepthRange(const scene::Scene& scene, const Vec3& direction) {
+// The view depths `points` span, clamped to the camera's near and far planes; none when empty.
+std::optional<std::array<double, 2>> viewDepthRange(const scene::Scene& scene, const std::vector<Vec3>& points) {
     const scene::CameraBasis cam = scene::cameraBasis(scene.camera);
     double lo = INFINITY, hi = -INFINITY;
-    for (const Vec3& p : visibleShadowableReceiverPoints(scene, direction)) {
+    for (const Vec3& p : points) {
         const double z = glm::dot(p - cam.position, cam.forward);
         lo = std::min(lo, z);
         hi = std::max(hi, z);
@@ -41,6 +26,24 @@ std::optional<std::array<double, 2>> shadowableDepthRange(const scene::Scene& sc
     hi = std::min(hi, scene.camera.far);
     if (!(hi > lo)) return std::nullopt;
     return std::array<double, 2>{lo, hi};
+}
+
+}  // namespace
+
+std::optional<std::array<double, 2>> visibleDepthRange(const scene::Scene& scene) {
+    // Each object's bounds clipped to the camera frustum: tighter than the scene's box, which is
+    // mostly empty space in a scene of a floor and a few objects (its near corner is often at the
+    // camera's near plane, where no receiver is).
+    std::vector<Vec3> points;
+    for (const scene::Object& o : scene.objects) {
+        const std::vector<Vec3> v = visibleReceiverPoints(scene, scene::boundsOf(o.shape));
+        points.insert(points.end(), v.begin(), v.end());
+    }
+    return viewDepthRange(scene, points);
+}
+
+std::optional<std::array<double, 2>> shadowableDepthRange(const scene::Scene& scene, const Vec3& direction) {
+    return viewDepthRange(scene, visibleShadowableReceiverPoints(scene, direction));
 }
 
 std::vector<double> practicalSplits(double near, double far, int count, double lambda) {

@@ -110,22 +110,22 @@ TEST(App, ACameraThatSeesNothingAndASunBelowTheHorizonGetANote) {
     const std::string rest = R"("materials": {"m": {}},
         "objects": [{"type": "sphere", "center": [0, 1, 0], "radius": 1, "material": "m"},
                     {"type": "quad", "center": [0, 0, 0], "normal": [0, 1, 0], "size": [20, 20], "material": "m"}]})";
-    const auto away = dir.write("away.json", R"({"camera": {"position": [0, 2, 6], "look_at": [0, 2, 20]},
-        "lights": [{"type": "directional", "direction": [-1, -2, -1]}], )" +
-                                                 rest);
-    const Result a = shadowlab({"render", away.string(), "--backend", "raytrace", "--resolution", "32x18", "-o",
-                                (dir.path() / "a.png").string()});
-    ASSERT_EQ(a.exitCode, 0) << a.err;
-    EXPECT_NE(a.err.find("frames none of the objects"), std::string::npos) << a.err;
-    EXPECT_EQ(a.err.find("points up"), std::string::npos) << a.err;
-    const auto below = dir.write("below.json", R"({"camera": {"position": [0, 2, 6], "look_at": [0, 0.7, 0]},
-        "lights": [{"type": "directional", "direction": [1, 2, 1]}], )" +
-                                                   rest);
-    const Result b = shadowlab({"render", below.string(), "--backend", "raytrace", "--resolution", "32x18", "-o",
-                                (dir.path() / "b.png").string()});
-    ASSERT_EQ(b.exitCode, 0) << b.err;
-    EXPECT_NE(b.err.find("lights[0].direction [1,2,1] points up"), std::string::npos) << b.err;
-    EXPECT_EQ(b.err.find("frames none"), std::string::npos) << b.err;
+    // The notes a scene with this look-at and light direction gets from `render`.
+    const auto notes = [&](const std::string& name, const std::string& lookAt, const std::string& direction) {
+        const auto file = dir.write(name + ".json", R"({"camera": {"position": [0, 2, 6], "look_at": )" + lookAt +
+                                                        R"(}, "lights": [{"type": "directional", "direction": )" +
+                                                        direction + "}], " + rest);
+        const Result r = shadowlab({"render", file.string(), "--backend", "raytrace", "--resolution", "32x18", "-o",
+                                    (dir.path() / (name + ".png")).string()});
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        return r.err;
+    };
+    const std::string away = notes("away", "[0, 2, 20]", "[-1, -2, -1]");
+    EXPECT_NE(away.find("frames none of the objects"), std::string::npos) << away;
+    EXPECT_EQ(away.find("points up"), std::string::npos) << away;
+    const std::string below = notes("below", "[0, 0.7, 0]", "[1, 2, 1]");
+    EXPECT_NE(below.find("lights[0].direction [1,2,1] points up"), std::string::npos) << below;
+    EXPECT_EQ(below.find("frames none"), std::string::npos) << below;
 }
 
 TEST(App, RenderWritesTheRequestedFrame) {
