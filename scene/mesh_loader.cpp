@@ -3,6 +3,7 @@
 #include "scene/ply_loader.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <climits>
 #include <cmath>
@@ -12,11 +13,13 @@
 #include <limits>
 #include <map>
 #include <sstream>
+#include <string_view>
 
 #include <tiny_gltf.h>
 #include <tiny_obj_loader.h>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
+#include <nlohmann/json.hpp>
 
 #include "scene/gltf_extensions.h"
 #include "scene/input_file.h"
@@ -793,6 +796,44 @@ bool gltfWriteFile(std::string* err, const std::string&, const std::vector<unsig
     return false;
 }
 
+// After a failed load: the first buffer whose file is missing, unreadable or shorter than its
+// byteLength, by its JSON path (tinygltf names the file but not which buffer wants it); "" when
+// the buffers are not the problem.
+std::string bufferFileProblem(std::string_view json, const std::string& baseDir) {
+    const nlohmann::json doc = nlohmann::json::parse(json, nullptr, false);
+    if (!doc.is_object() || !doc.contains("buffers") || !doc["buffers"].is_array()) return "";
+    const nlohmann::json& buffers = doc["buffers"];
+    for (std::size_t i = 0; i < buffers.size(); ++i) {
+        const nlohmann::json& b = buffers[i];
+        if (!b.is_object() || !b.contains("uri") || !b["uri"].is_string()) continue;
+        const std::string uri = b["uri"].get<std::string>();
+        if (uri.rfind("data:", 0) == 0) continue;
+        std::string name;  // a URI's %XX escapes decoded, as the loader reads them
+        for (std::size_t k = 0; k < uri.size(); ++k) {
+            if (uri[k] == '%' && k + 2 < uri.size() && std::isxdigit(static_cast<unsigned char>(uri[k + 1])) &&
+                std::isxdigit(static_cast<unsigned char>(uri[k + 2]))) {
+                name.push_back(char(std::stoi(uri.substr(k + 1, 2), nullptr, 16)));
+                k += 2;
+            } else {
+                name.push_back(uri[k]);
+            }
+        }
+        const fs::path at = baseDir.empty() ? fs::path(name) : fs::path(baseDir) / name;
+        const std::string where = "buffers[" + std::to_string(i) + "].uri \"" + excerpt(uri, 80) + "\"";
+        std::uint64_t size = 0;
+        try {
+            size = checkInputFile(at, kMaxMeshFileBytes);
+        } catch (const InputFileError& e) {
+            return where + ": " + e.problem() + " (" + excerpt(at.string(), 200) + ")";
+        }
+        const nlohmann::json length = b.value("byteLength", nlohmann::json());
+        if (length.is_number_unsigned() && size < length.get<std::uint64_t>())
+            return where + ": the file holds " + std::to_string(size) + " bytes, fewer than the buffer's byteLength " +
+                   std::to_string(length.get<std::uint64_t>()) + " (a truncated or different file)";
+    }
+    return "";
+}
+
 // `decodedBytes`: what decoding compressed geometry added to the file's buffers.
 void loadGltf(const fs::path& file, const std::string& fileBytes, std::vector<RawInstance>& out,
               const fs::path& sceneFile, const JsonPath& path, GltfExtras* extras, const MeshRequest& request,
@@ -825,7 +866,12 @@ void loadGltf(const fs::path& file, const std::string& fileBytes, std::vector<Ra
                                              unsigned(std::min<std::size_t>(bytes.size(), UINT_MAX)), files.baseDir)
                : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(),
                                             unsigned(std::min<std::size_t>(bytes.size(), UINT_MAX)), files.baseDir);
-    if (!ok) fail(sceneFile, path, file, "not a readable glTF file: " + excerpt(err.empty() ? warn : err, 400));
+    if (!ok) {
+        if (const std::string problem = bufferFileProblem(gltfJsonChunk(fileBytes, binary), files.baseDir);
+            !problem.empty())
+            fail(sceneFile, path, file, problem);
+        fail(sceneFile, path, file, "not a readable glTF file: " + excerpt(err.empty() ? warn : err, 400));
+    }
     prepared.rewritten.clear();
     prepared.rewritten.shrink_to_fit();
     try {

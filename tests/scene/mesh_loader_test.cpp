@@ -76,6 +76,19 @@ TEST(MeshLoader, BadMeshesGiveClearErrors) {
     expectError(dir.write("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"), "degenerate");
     expectError(dir.write("mesh.stl", "solid"), "unsupported format");
     expectError(dir.write("garbage.gltf", "\x01\x02 not json"), "not a readable glTF");
+    // A buffer file that is missing or shorter than its byteLength is named by its JSON path.
+    const std::string external = R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+      "nodes": [{"mesh": 0}], "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+      "buffers": [{"byteLength": 36, "uri": "tri%20angle.bin"}],
+      "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}],
+      "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0],
+                     "max": [1, 1, 0]}]})";
+    const auto gltf = dir.write("external.gltf", external);
+    expectError(gltf, "external.gltf: buffers[0].uri \"tri%20angle.bin\": no such file");
+    dir.write("tri angle.bin", std::string(20, '\0'));
+    expectError(gltf,
+                "buffers[0].uri \"tri%20angle.bin\": the file holds 20 bytes, fewer than the buffer's "
+                "byteLength 36");
 }
 
 // One triangle in an embedded buffer, placed by the node hierarchy `nodes` (a JSON array).
