@@ -514,7 +514,7 @@ ViewSearchResult searchViewAndSun(const scene::Scene& scene, const ViewSearchOpt
         // 1.4 heights long at 35°): the chosen view moves back until that shadow fits too.
         bool widened = false;
         if (views[bestView].framed && suns[bestSun].first.type == scene::LightType::Directional) {
-            const scene::Camera c = scene::framedWithShadow(r.camera, b, r.sunDirection);
+            const scene::Camera c = scene::framedWithShadow(r.camera, b, r.sunDirection, scene.bounds());
             widened = c.position != r.camera.position || c.lookAt != r.camera.lookAt;
             r.camera = c;
         }

@@ -100,16 +100,33 @@ Camera framedCamera(const Bounds& bounds, const Vec3& fromDirection, double fovY
     return cam;
 }
 
-Camera framedWithShadow(const Camera& framed, const Bounds& bounds, const Vec3& lightDirection) {
+Camera framedWithShadow(const Camera& framed, const Bounds& bounds, const Vec3& lightDirection,
+                        const Bounds& receivers) {
     // The shadow of the bounds' box on the plane of its base contains the model's shadow there.
     const Vec3 l = glm::normalize(lightDirection);
     if (bounds.empty() || !(l.y < -1e-9)) return framed;
-    std::vector<Vec3> points;
+    std::vector<Vec3> points, shadow;
     for (int k = 0; k < 8; ++k) {
         const Vec3 c((k & 1) ? bounds.max.x : bounds.min.x, (k & 2) ? bounds.max.y : bounds.min.y,
                      (k & 4) ? bounds.max.z : bounds.min.z);
         points.push_back(c);
-        points.push_back(c + ((bounds.min.y - c.y) / l.y) * l);
+        shadow.push_back(c + ((bounds.min.y - c.y) / l.y) * l);
+    }
+    const auto over = [&](const Vec3& p) {
+        return p.x >= receivers.min.x && p.x <= receivers.max.x && p.z >= receivers.min.z && p.z <= receivers.max.z;
+    };
+    if (receivers.empty() || std::all_of(shadow.begin(), shadow.end(), over)) {
+        points.insert(points.end(), shadow.begin(), shadow.end());
+    } else {
+        // Past the receivers: the shadow's rectangle on the base plane cut to theirs, which holds
+        // every part of the shadow that lands on them.
+        Bounds r;
+        for (const Vec3& p : shadow) r.extend(p);
+        r.min = glm::max(r.min, receivers.min);
+        r.max = glm::min(r.max, receivers.max);
+        if (r.min.x <= r.max.x && r.min.z <= r.max.z)
+            for (const double x : {r.min.x, r.max.x})
+                for (const double z : {r.min.z, r.max.z}) points.push_back(Vec3(x, bounds.min.y, z));
     }
     const CameraBasis cam = cameraBasis(framed);
     const double tanV = cam.tanHalfFovY / kShadowFrameMargin, tanH = tanV * cam.aspect;

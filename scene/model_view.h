@@ -33,8 +33,12 @@ Camera framedCamera(const Bounds& bounds, const Vec3& fromDirection, double fovY
 // light travelling along `lightDirection` (its corners projected along the light onto the plane
 // of its base, where the added ground lies) fits the image too, each point at least 1/1.1 of the
 // half-width and half-height from the center's edge. Unchanged when that shadow already fits, or
-// the light does not travel downward; never closer than `framed`.
-Camera framedWithShadow(const Camera& framed, const Bounds& bounds, const Vec3& lightDirection);
+// the light does not travel downward; never closer than `framed`. With `receivers` (the scene's
+// bounds, ground included), only the part of the shadow over them counts: under a low sun the
+// shadow runs far past the ground, where nothing receives it, and framing it all would leave the
+// model a speck.
+Camera framedWithShadow(const Camera& framed, const Bounds& bounds, const Vec3& lightDirection,
+                        const Bounds& receivers = {});
 
 // --camera N|NAME|auto: N or NAME puts that file camera in place of the view; auto asks for a
 // view search even where the file has cameras. Throws InputError listing the cameras there are.

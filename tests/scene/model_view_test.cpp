@@ -296,6 +296,50 @@ TEST(ModelView, AFramedViewMovesBackJustEnoughToHoldTheModelsShadow) {
     EXPECT_GT(framedReach, 1.0);
 }
 
+// The same cube on the ground addGround gives it (side 1 + 3·1 = 4, x and z in [−2, 2]) under a
+// sun 5° up at azimuth 300: the shadow runs 0.5 + 1/tan 5° ≈ 11.9 along h, far past the ground.
+// Only what lands on the ground counts: the shadow's rectangle on the base plane, x from −0.5 to
+// 0.5 + 11.43·0.866 and z from 0.5 − 11.43·0.5 to 0.5, cut to [−2, 2]², is [−0.5, 2] x [−2, 0.5];
+// the view holds its corners and the cube's on the margin, and stays far closer than the one that
+// holds the whole shadow.
+TEST(ModelView, AFramedViewHoldsOnlyTheShadowThatLandsOnTheGround) {
+    Bounds b;
+    b.extend(Vec3(-0.5, -0.5, -0.5));
+    b.extend(Vec3(0.5, 0.5, 0.5));
+    Bounds ground = b;
+    ground.extend(Vec3(-2, -0.5, -2));
+    ground.extend(Vec3(2, -0.5, 2));
+    Camera base;
+    base.width = 1280;
+    base.height = 720;
+    const double a = 30 * kPi / 180, e = 20 * kPi / 180;
+    const Camera framed =
+        framedCamera(b, {std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a)}, 40.0, base);
+    const Camera whole = framedWithShadow(framed, b, sunDirection(300, 5));
+    const Camera cut = framedWithShadow(framed, b, sunDirection(300, 5), ground);
+    const CameraBasis c = cameraBasis(cut);
+    auto reach = [](const CameraBasis& v, const Vec3& p) {
+        const Vec3 q = p - v.position;
+        const double z = glm::dot(q, v.forward);
+        return std::max(std::abs(glm::dot(q, v.right)) / (z * v.tanHalfFovY * v.aspect),
+                        std::abs(glm::dot(q, v.up)) / (z * v.tanHalfFovY));
+    };
+    double tightest = 0;
+    std::vector<Vec3> must;
+    for (int k = 0; k < 8; ++k) must.push_back({(k & 1) ? 0.5 : -0.5, (k & 2) ? 0.5 : -0.5, (k & 4) ? 0.5 : -0.5});
+    for (const double x : {-0.5, 2.0})
+        for (const double z : {-2.0, 0.5}) must.push_back({x, -0.5, z});
+    for (const Vec3& p : must) {
+        EXPECT_LE(reach(c, p), 1 / 1.1 + 1e-9) << p.x << " " << p.y << " " << p.z;
+        tightest = std::max(tightest, reach(c, p));
+    }
+    EXPECT_NEAR(tightest, 1 / 1.1, 1e-9);
+    EXPECT_LT(2.0 * glm::length(cut.lookAt - cut.position), glm::length(whole.lookAt - whole.position));
+    // A shadow that stays on the ground is framed exactly as without the receivers.
+    const Camera high = framedWithShadow(framed, b, sunDirection(300, 45), ground);
+    EXPECT_EQ(high.position, framedWithShadow(framed, b, sunDirection(300, 45)).position);
+}
+
 TEST(ModelView, SunOptionPointsTheDirectionalLightAndRefusesBadText) {
     test::TempDir dir;
     Scene s = loadScene(dir.write("box.gltf", test::cameraBoxGltf(false)));
