@@ -247,21 +247,36 @@ TEST(ModelView, SunAtAQuarterTurnTravelsExactlyInAnAxisPlane) {
         EXPECT_NEAR(glm::length(sunDirection(az, 35)), 1.0, 1e-15) << az;
 }
 
+// The unit cube [−0.5, 0.5]³ and the view search's framing of it from azimuth 30, 20° up, 16:9.
+Bounds unitCube() {
+    Bounds b;
+    b.extend(Vec3(-0.5, -0.5, -0.5));
+    b.extend(Vec3(0.5, 0.5, 0.5));
+    return b;
+}
+Camera framedUnitCube() {
+    Camera base;
+    base.width = 1280;
+    base.height = 720;
+    const double a = 30 * kPi / 180, e = 20 * kPi / 180;
+    return framedCamera(unitCube(), {std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a)}, 40.0, base);
+}
+// Where a point lies in a view: the larger of |x| and |y| over the image's half-extent at its depth.
+double reach(const CameraBasis& v, const Vec3& p) {
+    const Vec3 q = p - v.position;
+    const double z = glm::dot(q, v.forward);
+    return std::max(std::abs(glm::dot(q, v.right)) / (z * v.tanHalfFovY * v.aspect),
+                    std::abs(glm::dot(q, v.up)) / (z * v.tanHalfFovY));
+}
+
 TEST(ModelView, AFramedViewMovesBackJustEnoughToHoldTheModelsShadow) {
     // A unit cube [−0.5, 0.5]³ seen from azimuth 30, 20° up (the view search's framing, 16:9).
     // A sun 25° up at azimuth 300 sends its light along h = (−sin 300°, 0, −cos 300°) =
     // (0.866, 0, −0.5) and down: a corner Δ above the base y = −0.5 casts its shadow on that
     // plane Δ/tan 25° along h, up to 2.14 beyond the cube, off to the side of this view. Straight
     // overhead the cube casts under itself, and the framing stays as it was.
-    Bounds b;
-    b.extend(Vec3(-0.5, -0.5, -0.5));
-    b.extend(Vec3(0.5, 0.5, 0.5));
-    Camera base;
-    base.width = 1280;
-    base.height = 720;
-    const double a = 30 * kPi / 180, e = 20 * kPi / 180;
-    const Camera framed =
-        framedCamera(b, {std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a)}, 40.0, base);
+    const Bounds b = unitCube();
+    const Camera framed = framedUnitCube();
     const Camera overhead = framedWithShadow(framed, b, sunDirection(300, 90));
     EXPECT_EQ(overhead.position, framed.position);
     EXPECT_EQ(overhead.lookAt, framed.lookAt);
@@ -270,13 +285,6 @@ TEST(ModelView, AFramedViewMovesBackJustEnoughToHoldTheModelsShadow) {
     const CameraBasis f = cameraBasis(framed), c = cameraBasis(low);
     EXPECT_NEAR(glm::dot(f.forward, c.forward), 1.0, 1e-12) << "the same view direction";
     EXPECT_GE(glm::length(low.lookAt - low.position), glm::length(framed.lookAt - framed.position));
-    // Where a point lies in a view: the larger of |x| and |y| over the image's half-extent at its depth.
-    auto reach = [](const CameraBasis& v, const Vec3& p) {
-        const Vec3 q = p - v.position;
-        const double z = glm::dot(q, v.forward);
-        return std::max(std::abs(glm::dot(q, v.right)) / (z * v.tanHalfFovY * v.aspect),
-                        std::abs(glm::dot(q, v.up)) / (z * v.tanHalfFovY));
-    };
     // Every corner and every corner's shadow within 1/1.1 of the half-extents, the tightest of
     // them on that margin (no farther back than needed); in the framed view some shadow corner
     // lay outside the image.
@@ -303,27 +311,14 @@ TEST(ModelView, AFramedViewMovesBackJustEnoughToHoldTheModelsShadow) {
 // the view holds its corners and the cube's on the margin, and stays far closer than the one that
 // holds the whole shadow.
 TEST(ModelView, AFramedViewHoldsOnlyTheShadowThatLandsOnTheGround) {
-    Bounds b;
-    b.extend(Vec3(-0.5, -0.5, -0.5));
-    b.extend(Vec3(0.5, 0.5, 0.5));
+    const Bounds b = unitCube();
     Bounds ground = b;
     ground.extend(Vec3(-2, -0.5, -2));
     ground.extend(Vec3(2, -0.5, 2));
-    Camera base;
-    base.width = 1280;
-    base.height = 720;
-    const double a = 30 * kPi / 180, e = 20 * kPi / 180;
-    const Camera framed =
-        framedCamera(b, {std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a)}, 40.0, base);
+    const Camera framed = framedUnitCube();
     const Camera whole = framedWithShadow(framed, b, sunDirection(300, 5));
     const Camera cut = framedWithShadow(framed, b, sunDirection(300, 5), ground);
     const CameraBasis c = cameraBasis(cut);
-    auto reach = [](const CameraBasis& v, const Vec3& p) {
-        const Vec3 q = p - v.position;
-        const double z = glm::dot(q, v.forward);
-        return std::max(std::abs(glm::dot(q, v.right)) / (z * v.tanHalfFovY * v.aspect),
-                        std::abs(glm::dot(q, v.up)) / (z * v.tanHalfFovY));
-    };
     double tightest = 0;
     std::vector<Vec3> must;
     for (int k = 0; k < 8; ++k) must.push_back({(k & 1) ? 0.5 : -0.5, (k & 2) ? 0.5 : -0.5, (k & 4) ? 0.5 : -0.5});
