@@ -285,8 +285,9 @@ int main(int argc, char** argv) {
 
     shadowlab::app::ExportOptions exportOptions;
     auto* exportCmd = app.add_subcommand("export",
-                                         "Write the scene as glTF 2.0 with KHR_lights_punctual (.glb or "
-                                         ".gltf) for another engine (docs/export.md)");
+                                         "Write the scene run renders (its view, sun and ground) as glTF "
+                                         "2.0 with KHR_lights_punctual (.glb or .gltf) for another engine "
+                                         "(docs/export.md)");
     addViewOptions(*exportCmd, exportOptions.common);
     exportCmd->add_option("-o,--output", exportOptions.output, "The glTF file (.glb or .gltf)")->required();
     exportCmd->add_option("--tolerance", exportOptions.tolerance,
