@@ -116,9 +116,9 @@ LightFrustum fitCascade(const scene::Scene& scene, const scene::CameraBasis& cam
 }
 
 CascadeSet fitCascades(const scene::Scene& scene, const Vec3& direction, int count, int mapSize, double blend,
-                       bool snap) {
+                       bool snap, const std::vector<Vec3>* shadowable) {
     CascadeSet set;
-    auto range = shadowableDepthRange(scene, direction);
+    auto range = shadowable ? viewDepthRange(scene, *shadowable) : shadowableDepthRange(scene, direction);
     if (!range) range = visibleDepthRange(scene);  // nothing visible can be shaded: the old fit
     if (!range || count < 1) return set;
     set.splits = practicalSplits((*range)[0], (*range)[1], count);
@@ -162,11 +162,15 @@ CascadeChoice chooseCascades(const scene::Scene& scene, const scene::RasterSetti
     if (lights.empty()) return {asked, std::to_string(asked) + " (default: no shadowed directional light)"};
     if (!visibleDepthRange(scene)) return {asked, std::to_string(asked) + " (default: the camera sees no receiver)"};
     // The depths the maps must cover: those of the visible receivers some caster can shade, over
-    // every shadowed light; all visible receivers when none can be shaded.
+    // every shadowed light; all visible receivers when none can be shaded. Each light's receivers
+    // are found once, for every count tried below.
+    std::vector<std::vector<Vec3>> receivers(scene.lights.size());
     std::optional<std::array<double, 2>> range;
-    for (const std::size_t i : lights)
-        if (const auto r = shadowableDepthRange(scene, scene.lights[i].direction))
+    for (const std::size_t i : lights) {
+        receivers[i] = visibleShadowableReceiverPoints(scene, scene.lights[i].direction);
+        if (const auto r = viewDepthRange(scene, receivers[i]))
             range = range ? std::array<double, 2>{std::min((*range)[0], (*r)[0]), std::max((*range)[1], (*r)[1])} : *r;
+    }
     const bool shadowable = range.has_value();
     if (!shadowable) range = visibleDepthRange(scene);
     // The size as set: a default one is kDefaultShadowMapSize, the most chooseShadowMapSize keeps
@@ -182,12 +186,13 @@ CascadeChoice chooseCascades(const scene::Scene& scene, const scene::RasterSetti
         for (const std::size_t i : lights) {
             const scene::Vec3 dir = scene.lights[i].direction;
             if (count == 1) {
-                const LightFrustum f = settings.fitLightFrustum ? fitDirectionalLightToReceivers(scene, dir, size)
-                                                                : fitDirectionalLight(scene.bounds(), dir, size);
+                const LightFrustum f = settings.fitLightFrustum
+                                           ? fitDirectionalLightToReceivers(scene, dir, size, true, &receivers[i])
+                                           : fitDirectionalLight(scene.bounds(), dir, size);
                 ratio = std::max(ratio, f.texelWorldSize() / pixelAt(zMin));
                 continue;
             }
-            const CascadeSet cs = fitCascades(scene, dir, count, size, cascadeBandCover(settings));
+            const CascadeSet cs = fitCascades(scene, dir, count, size, cascadeBandCover(settings), true, &receivers[i]);
             for (std::size_t c = 0; c < cs.frusta.size(); ++c)
                 ratio = std::max(ratio, cs.frusta[c].texelWorldSize() / pixelAt(std::max(cs.splits[c], zMin)));
         }

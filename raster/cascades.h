@@ -81,8 +81,9 @@ struct CascadeSet {
 // map would be wider than the scene's bounding-sphere map (fitDirectionalLight) uses that instead.
 // With a blend band (`blend` of each slice before its far split, lit.frag mixes the next cascade
 // in there), each cascade c > 0 covers the band of slice c − 1 too: its slice starts there.
+// `shadowable` as for fitDirectionalLightToReceivers.
 CascadeSet fitCascades(const scene::Scene& scene, const scene::Vec3& direction, int count, int mapSize,
-                       double blend = 0.0, bool snap = true);
+                       double blend = 0.0, bool snap = true, const std::vector<scene::Vec3>* shadowable = nullptr);
 // The band the maps cover for these settings: the widest one (kMaxCascadeBlend) whenever blending
 // is on, so that the maps, and every pixel outside the bands, do not change with the band's width;
 // 0 when it is off (the maps of the plain slices).

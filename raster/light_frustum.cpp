@@ -339,11 +339,12 @@ double nearestCasterDepth(const scene::Scene& scene, const LightFrustum& f, doub
     return minDepth;
 }
 
-LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const Vec3& direction, int mapSize, bool snap) {
+LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const Vec3& direction, int mapSize, bool snap,
+                                            const std::vector<Vec3>* shadowable) {
     const scene::Bounds sceneBounds = scene.bounds();
     LightFrustum f = fitDirectionalLight(sceneBounds, direction, mapSize);
     if (sceneBounds.empty()) return f;
-    std::vector<Vec3> receivers = visibleShadowableReceiverPoints(scene, direction);
+    std::vector<Vec3> receivers = shadowable ? *shadowable : visibleShadowableReceiverPoints(scene, direction);
     if (receivers.empty()) receivers = visibleReceiverPoints(scene);  // nothing visible can be shaded
     if (receivers.empty()) return f;                                  // the camera sees none of the scene
 

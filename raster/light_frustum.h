@@ -65,8 +65,10 @@ LightFrustum fitDirectionalLight(const scene::Bounds& bounds, const scene::Vec3&
 // near and far rounded outward to 1/16 of their range's power of two. Falls back to
 // fitDirectionalLight() when the camera sees none of the scene.
 // snap = false leaves all three unsnapped (RasterSettings::snapLightFrustum, the temporal study).
+// `shadowable`, when given, is visibleShadowableReceiverPoints(scene, direction) already computed
+// (chooseCascades fits every count from one set).
 LightFrustum fitDirectionalLightToReceivers(const scene::Scene& scene, const scene::Vec3& direction, int mapSize,
-                                            bool snap = true);
+                                            bool snap = true, const std::vector<scene::Vec3>* shadowable = nullptr);
 
 // The map's basis for light travelling along `direction`: right = direction × (world Y, or X for
 // a vertical light), up = right × direction. Fixed in the world, so texel grids are too.
