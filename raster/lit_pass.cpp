@@ -211,6 +211,14 @@ std::size_t litPlaneTexelBytes(const LitTargets& targets, LitPlane plane) {
     return plane == LitPlane::kBeauty ? targets.beautyTexelBytes : 4;
 }
 
+VkFormat litBeautyFormat(const Context& ctx, bool hostReadable) {
+    VkFormatProperties rgb{};
+    vkGetPhysicalDeviceFormatProperties(ctx.physicalDevice, kLitBeautyFormat, &rgb);
+    const VkFormatFeatureFlags needed = VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_TRANSFER_SRC_BIT;
+    const VkFormatFeatureFlags features = hostReadable ? rgb.linearTilingFeatures : rgb.optimalTilingFeatures;
+    return (features & needed) == needed ? kLitBeautyFormat : kLitBeautyFallbackFormat;
+}
+
 LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32_t height, std::uint32_t lightTargets,
                             bool readInPlace) {
     const std::uint32_t limit = ctx.properties.limits.maxImageDimension2D;
@@ -228,15 +236,11 @@ LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32
     LitTargets t;
     t.width = width;
     t.height = height;
-    // The beauty as three floats where the device renders RGB32F (lavapipe), else four.
-    VkFormatProperties rgb{};
-    vkGetPhysicalDeviceFormatProperties(ctx.physicalDevice, kLitBeautyFormat, &rgb);
     const VkFormatFeatureFlags needed = VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_TRANSFER_SRC_BIT;
     t.hostReadable = readInPlace && canReadImagesOnHost(ctx, kLitPlaneFormat, kLitTargetUsage) &&
                      canReadImagesOnHost(ctx, kLitLightsFormat, kLitTargetUsage);
-    const bool rgbTarget = ((t.hostReadable ? rgb.linearTilingFeatures : rgb.optimalTilingFeatures) & needed) == needed;
-    t.beautyFormat = rgbTarget ? kLitBeautyFormat : kLitBeautyFallbackFormat;
-    t.beautyTexelBytes = rgbTarget ? 12 : 16;
+    t.beautyFormat = litBeautyFormat(ctx, t.hostReadable);
+    t.beautyTexelBytes = t.beautyFormat == kLitBeautyFormat ? 12 : 16;
     requireFormat(ctx, t.beautyFormat, needed, "the lit pass's beauty target");
     requireFormat(ctx, kLitPlaneFormat, needed, "the lit pass's AOV targets");
     requireFormat(ctx, kLitLightsFormat, needed, "the lit pass's per-light visibility targets");
@@ -251,7 +255,7 @@ LitTargets createLitTargets(const Context& ctx, std::uint32_t width, std::uint32
                                   VK_IMAGE_VIEW_TYPE_2D, t.hostReadable);
         // Rendering into a Frame's memory needs the Frame's layout: the host-readable path, RGB
         // beauty, rows without padding.
-        if (t.hostReadable && (p > 0 || rgbTarget))
+        if (t.hostReadable && (p > 0 || t.beautyFormat == kLitBeautyFormat))
             t.frameImageBytes[p] =
                 hostImageBytes(ctx, format, width, height, kLitTargetUsage, litPlaneTexelBytes(t, LitPlane(p)));
     }

@@ -92,6 +92,10 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant = {}
                               VkDescriptorSetLayout alphaSetLayout = VK_NULL_HANDLE,
                               const glm::vec3& background = glm::vec3(0.0f), bool withBackground = true);
 
+// The float beauty target's format on this device: RGB32F where it can render into it (lavapipe),
+// else RGBA32F. hostReadable: the target is a linear image read in place (LitTargets::hostReadable).
+VkFormat litBeautyFormat(const Context& ctx, bool hostReadable);
+
 struct LitTargets {
     // The Renderer's own targets for each plane (LitPlane order): rendered into when a frame
     // does not ask for that channel, or cannot render it into the Frame's memory.

@@ -86,9 +86,11 @@ Pixels litPass(const Context& ctx, const scene::Scene& s, bool readInPlace, bool
     l.kind = SHADOWLAB_LIGHT_DIRECTIONAL;
     const std::vector<glm::vec4> albedos = {glm::vec4(glm::vec3(kAlbedo), 1.0f)};
 
+    const LitTargets targets = createLitTargets(ctx, kWidth, kHeight, 0, readInPlace);
     const LitPipeline pipeline = createLitPipeline(ctx,
                                                    LitVariant{.filter = scene::ShadowFilter::None,
                                                               .normalOffset = false,
+                                                              .beautyFormat = targets.beautyFormat,
                                                               .lightKinds = 1u << SHADOWLAB_LIGHT_DIRECTIONAL},
                                                    VK_NULL_HANDLE, glm::vec3(s.background));
     // Placeholders, moved to SHADER_READ_ONLY_OPTIMAL by a shadow pass of no layers.
@@ -97,7 +99,6 @@ Pixels litPass(const Context& ctx, const scene::Scene& s, bool readInPlace, bool
     const TransmittanceMaps transmittance = createTransmittanceMaps(ctx, 1, 1);
     const MomentMaps moments = createMomentMaps(ctx, 1, 1);
     const TransmittancePass placeholders{nullptr, &transmittance, {}, nullptr, {}};
-    const LitTargets targets = createLitTargets(ctx, kWidth, kHeight, 0, readInPlace);
     EXPECT_EQ(targets.hostReadable, readInPlace) << "lavapipe reads its targets in place when asked";
     const LitBindings bindings =
         createLitBindings(ctx, pipeline, u, shaders::TransmitWindows{}, albedos, maps, transmittance, moments);

@@ -84,8 +84,9 @@ TEST(RasterPipeline, EveryPipelineARenderAsksForIsCreatedWithoutValidationMessag
         {.filter = F::Msm, .normalOffset = false},
         {.lightKinds = kSpot, .vertexLightConstants = true},
     };
-    for (const LitVariant& v : variants) {
+    for (LitVariant v : variants) {
         SCOPED_TRACE(scene::toString(v.filter));
+        v.beautyFormat = litBeautyFormat(ctx, false);  // as the renderer sets it from its targets
         const LitPipeline plain = createLitPipeline(ctx, v);
         EXPECT_TRUE(plain.pipeline);
         EXPECT_FALSE(plain.alpha);
