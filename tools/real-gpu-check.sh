@@ -17,16 +17,26 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 say() { echo "real-gpu check: $*" >&2; }
 [ $# -eq 2 ] || { say "usage: real-gpu-check.sh run|compare OUT"; exit 2; }
 mode=$1; out=$(realpath -m "$2")
+# Each a `render --backend raster` whose frame compare checks against lavapipe's: the default path,
+# the alpha-tested and blended casters, the transmittance map, the moment maps and PCSS, the
+# cascades of a large ground, and grazing light at far coordinates.
 renders=("seed-render:render seed" "alpha-render:render ../shared/scenes/AlphaBlendModeTest/AlphaBlendModeTest.gltf"
-         "helmet-render:render ../shared/scenes/FlightHelmet/FlightHelmet.gltf")
+         "helmet-render:render ../shared/scenes/FlightHelmet/FlightHelmet.gltf"
+         "panes-render:render stacked-panes" "foliage-render:render foliage"
+         "msm-render:render seed --filter msm" "evsm4-render:render seed --filter evsm4"
+         "pcss-render:render scenes/lesson/spot-light.json --filter pcss"
+         "ground-render:render scenes/extreme/large-ground-low-sun.json"
+         "far-render:render scenes/extreme/far-1e7.json")
 
 if [ "$mode" = compare ]; then
     root="$(cd "$here/.." && pwd)"; s="${SHADOWLAB_BUILD_DIR:-$root/build}/app/shadowlab"
     mkdir -p "$out/lavapipe"
     for r in "${renders[@]}" "sponza-run:render ../shared/scenes/Sponza/Sponza.gltf"; do
-        name=${r%%:*}; set -- ${r#*:}; [ "$name" = sponza-run ] && gpu=$out/sponza/raster.exr || gpu=$out/$name.exr
+        name=${r%%:*}; [ "$name" = sponza-run ] && gpu=$out/sponza/raster.exr || gpu=$out/$name.exr
         [ -f "$gpu" ] || { say "$gpu missing"; continue; }
-        (cd "$root" && "$s" "$1" "$2" --backend raster -o "$out/lavapipe/$name.exr" >/dev/null 2>&1) || { say "$name failed on lavapipe"; continue; }
+        # shellcheck disable=SC2086  # the render's words
+        (cd "$root" && "$s" ${r#*:} --backend raster -o "$out/lavapipe/$name.exr" >/dev/null 2>&1) ||
+            { say "$name failed on lavapipe"; continue; }
         read -r w h < <(oiiotool --info "$gpu" | awk '{gsub(",", ""); print $3, $5}')
         mean=$(oiiotool "$out/lavapipe/$name.exr" --ch visibility "$gpu" --ch visibility --absdiff --subc 0.25 \
                --clamp:min=0 --mulc 1e9 --clamp:max=1 --printstats 2>&1 | awk '/Stats Avg/ {print $3}')
@@ -64,7 +74,7 @@ step() {
     (cd "$src" && "$@") >"$out/logs/$name.log" 2>&1; local rc=$?
     echo "$name: exit $rc, $(( ($(date +%s%N) - t0) / 1000000 )) ms" | tee -a "$out/summary.txt"
 }
-step seed-run "$s" run seed --validate --no-sweep -o "$out/seed"
+step seed-run "$s" run seed --validate -o "$out/seed"  # with its default sweep: many renders, one device
 step sponza-run "$s" run ../shared/scenes/Sponza/Sponza.gltf --validate --no-sweep -o "$out/sponza"
 for r in "${renders[@]}"; do step "${r%%:*}" "$s" ${r#*:} --backend raster --validate -o "$out/${r%%:*}.exr"; done
 
