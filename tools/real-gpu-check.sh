@@ -10,8 +10,8 @@
 #     real-gpu-check.sh compare OUT renders the same frames on lavapipe and counts the pixels whose
 #                                   visibility differs from the GPU's by more than 0.25
 # The GPU's ICD is taken from VK_DRIVER_FILES, else the first NVIDIA, AMD or Intel manifest found,
-# so that lavapipe, where installed there too, is not chosen. Tests that assert this machine's
-# default is lavapipe fail there by design (docs/raster.md, "On a real GPU").
+# so that lavapipe, where installed there too, is not chosen. Devices.ThisMachineHasLavapipeAsTheDefault
+# fails there by design (docs/raster.md, "On a real GPU").
 set -uo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 say() { echo "real-gpu check: $*" >&2; }

@@ -178,11 +178,13 @@ TEST(RasterResources, EachLayerOfAnImageHoldsWhatWasRenderedThroughItsView) {
 TEST(RasterResources, AHostReadableImageIsMappedAtItsFirstTexelWithItsRowPitch) {
     // lavapipe's device memory is host memory, so linear RGBA32F targets can be read in place
     // (canReadImagesOnHost's doc); every other device copies them. Rendered (cleared) to a known
-    // value and read through `mapped` row by row with `rowPitch`, every texel has that value.
+    // value and read through `mapped` row by row with `rowPitch`, every texel has that value. (Skipped
+    // on other devices, where nothing is read in place.)
     test::ValidatedContext vc;
     Context& ctx = vc.get();
     const VkImageUsageFlags usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-    ASSERT_TRUE(ctx.deviceReport.lavapipe);
+    if (!ctx.deviceReport.lavapipe)
+        GTEST_SKIP() << ctx.deviceReport.name << " copies its targets: nothing is read in place";
     ASSERT_TRUE(canReadImagesOnHost(ctx, VK_FORMAT_R32G32B32A32_SFLOAT, usage));
     ctx.deviceReport.lavapipe = false;
     EXPECT_FALSE(canReadImagesOnHost(ctx, VK_FORMAT_R32G32B32A32_SFLOAT, usage)) << "only lavapipe reads in place";
