@@ -3,7 +3,7 @@
 # build/real-gpu), for a machine that has a GPU and its Vulkan driver but not Debian 12's packages
 # (a lent accelerator machine, a colleague's workstation): the shadowlab binary and the Vulkan test
 # binaries with every shared library they load (glibc's own excepted), Debian's Vulkan loader and
-# validation layer, and the models of ../shared/scenes the check renders. Libraries OpenImageIO
+# validation layer, glvnd's packages, and the models of ../shared/scenes the check renders. Libraries OpenImageIO
 # links for formats shadowlab never reads are replaced by stubs (tools/stub_library.py): the
 # whole set is about 380 MB, the stubbed one about 100 MB, 28 MB as xz.
 # Usage: tools/real-gpu-bundle.sh [DEST]    (after a build in build/)
@@ -36,6 +36,10 @@ cp -L /usr/lib/x86_64-linux-gnu/libvulkan.so.1 "$work/lib/"
 cp -L /usr/lib/x86_64-linux-gnu/libVkLayer_khronos_validation.so "$work/layer/"
 sed 's#"library_path": "libVkLayer_khronos_validation.so"#"library_path": "./libVkLayer_khronos_validation.so"#' \
     /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json >"$work/layer/VkLayer_khronos_validation.json"
+# glvnd, which NVIDIA's Vulkan driver loads through and a bare image may lack; real-gpu-check.sh
+# unpacks these into / only where the machine has none of its own.
+mkdir -p "$work/debs"
+(cd "$work/debs" && apt-get download libglvnd0 libglx0 libegl1 >/dev/null 2>&1) || say "glvnd packages not downloaded (apt-get download failed); the target must have its own"
 # The test binaries read scenes below the source folder they were built from.
 mkdir -p "$work/source"; cp -r "$root/scenes" "$work/source/"; echo "$root" >"$work/source_dir"
 for m in Sponza AlphaBlendModeTest FlightHelmet; do

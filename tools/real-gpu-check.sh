@@ -51,6 +51,10 @@ tar -C "$b" -xJf "$here/bundle.tar.xz" || { say "cannot unpack $here/bundle.tar.
 src=$(cat "$b/source_dir")
 if [ ! -e "$src" ]; then mkdir -p "$(dirname "$src")" && ln -s "$b/source" "$src"; fi
 if [ ! -e "$src/../shared/scenes" ]; then mkdir -p "$src/../shared" && ln -s "$b/scenes" "$src/../shared/scenes"; fi
+if ! ldconfig -p | grep -q libGLdispatch.so.0 && [ "$(id -u)" = 0 ]; then
+    for deb in "$b"/debs/*.deb; do [ -f "$deb" ] && dpkg -x "$deb" /; done
+    ldconfig
+fi
 export LD_LIBRARY_PATH="$b/lib" VK_LAYER_PATH="$b/layer" SHADOWLAB_SCENES="$src/scenes"
 s="$b/bin/shadowlab"
 if [ -z "${VK_DRIVER_FILES:-}" ]; then
