@@ -3,9 +3,9 @@
 # build/real-gpu), for a machine that has a GPU and its Vulkan driver but not Debian 12's packages
 # (a lent accelerator machine, a colleague's workstation): the shadowlab binary and the Vulkan test
 # binaries with every shared library they load (glibc's own excepted), Debian's Vulkan loader and
-# validation layer, glvnd's packages, and the models of ../shared/scenes the check renders. Libraries OpenImageIO
-# links for formats shadowlab never reads are replaced by stubs (tools/stub_library.py): the
-# whole set is about 380 MB, the stubbed one about 100 MB, 28 MB as xz.
+# validation layer, glvnd's packages, and the models of ../shared/scenes the check renders.
+# Libraries OpenImageIO links for formats shadowlab never reads are replaced by stubs
+# (tools/stub_library.py): the whole set is about 380 MB, the stubbed one about 100 MB, 28 MB as xz.
 # Usage: tools/real-gpu-bundle.sh [DEST]    (after a build in build/)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
