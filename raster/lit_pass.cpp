@@ -55,6 +55,9 @@ std::span<const std::uint32_t> litFragment(const LitVariant& v, bool alpha) {
 LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkDescriptorSetLayout alphaSetLayout,
                               const glm::vec3& background, bool withBackground) {
     requireFormat(ctx, kLitDepthFormat, VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT, "the camera depth buffer");
+    // A pipeline for a color format the device cannot render into is invalid usage, which a driver
+    // may answer by crashing (NVIDIA's did, given RGB32F): refused here, the format named.
+    requireFormat(ctx, variant.beautyFormat, VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT, "the lit pass's beauty target");
     VkDevice device = ctx.device.get();
     const VkDescriptorSetLayoutBinding bindings[] = {
         {.binding = 0,

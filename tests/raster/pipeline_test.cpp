@@ -169,5 +169,20 @@ TEST(RasterPipeline, AMissingFormatFeatureIsRefusedNamingTheDeviceTheFormatAndTh
     }
 }
 
+TEST(RasterPipeline, ALitPipelineForABeautyFormatTheDeviceCannotRenderIntoIsRefusedBeforeTheDriverSeesIt) {
+    // A block-compressed format is never a color attachment (VK_FORMAT_BC1_RGB_UNORM_BLOCK is 131);
+    // a pipeline for it would be invalid usage, and the validated context would count a message.
+    test::ValidatedContext vc;
+    const Context& ctx = vc.get();
+    try {
+        createLitPipeline(ctx, LitVariant{.beautyFormat = VK_FORMAT_BC1_RGB_UNORM_BLOCK});
+        FAIL() << "expected RasterError";
+    } catch (const RasterError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("format 131"), std::string::npos) << what;
+        EXPECT_NE(what.find("beauty target"), std::string::npos) << what;
+    }
+}
+
 }  // namespace
 }  // namespace shadowlab::raster
