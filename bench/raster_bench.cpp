@@ -117,7 +117,7 @@ bool wantScene(const char* label) {
     return !only || !*only || std::string(only) == label;
 }
 
-// SHADOWLAB_BENCH_LIGHT_CONSTANTS=uniform|vertex: force where our lit pass reads the light's
+// SHADOWLAB_BENCH_LIGHT_CONSTANTS=uniform|vertex|specialization: force where our lit pass reads the light's
 // constants (raster::RendererOptions::lightConstants; default: the renderer's own choice).
 raster::RendererOptions rendererOptions() {
     raster::RendererOptions o;
@@ -127,8 +127,11 @@ raster::RendererOptions rendererOptions() {
             o.lightConstants = raster::LightConstants::kUniformBuffer;
         else if (which == "vertex")
             o.lightConstants = raster::LightConstants::kVertexOutputs;
+        else if (which == "specialization")
+            o.lightConstants = raster::LightConstants::kSpecialization;
         else
-            throw std::runtime_error("SHADOWLAB_BENCH_LIGHT_CONSTANTS: expected uniform or vertex, got " + which);
+            throw std::runtime_error(
+                "SHADOWLAB_BENCH_LIGHT_CONSTANTS: expected uniform, vertex or specialization, got " + which);
     }
     // SHADOWLAB_BENCH_SUN_MODULES=0: the general lit shader modules where the size-optimized ones
     // would be used (raster::RendererOptions::sunModules), for comparing the pipelines' creation.

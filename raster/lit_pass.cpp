@@ -1,8 +1,10 @@
 // raster/lit_pass.cpp: the camera pass and the readback of its targets.
 #include "raster/lit_pass.h"
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
+#include <iterator>
 
 #include "raster/pipeline.h"
 #include "raster/vulkan_error.h"
@@ -20,6 +22,28 @@ bool usesSunModules(const LitVariant& v) {
     const bool taps = v.filter == scene::ShadowFilter::None || v.filter == scene::ShadowFilter::Pcf2x2;
     return v.sunModules && taps && v.lightTargets == 0 && v.lightCount == 1 &&
            v.lightKinds == (1u << SHADOWLAB_LIGHT_DIRECTIONAL) && !v.transmittance && !v.receiverPlane;
+}
+
+std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUniforms& u) {
+    const shaders::LightData& l = u.lights[0];
+    const bool spot = l.kind == SHADOWLAB_LIGHT_SPOT;
+    const glm::vec3 place = spot ? l.position : l.towardLight;
+    std::array<float, kPackedLightConstants> c{place.x,          place.y,
+                                               place.z,          l.layer,
+                                               l.radiance.x,     l.radiance.y,
+                                               l.radiance.z,     l.visibilityWeight,
+                                               l.depthBiasWorld, l.slopeBiasTexels,
+                                               l.texelWorldSize, l.depthPerWorld,
+                                               l.maxSlopeTan,    l.normalOffsetTexels,
+                                               float(l.pcfSize), 0.0f};
+    if (spot) {
+        const float spotSlots[8] = {l.spotDirection.x, l.spotDirection.y, l.spotDirection.z, l.spotCosCone,
+                                    l.mapNear,         l.mapFar,          l.lightSize,       0.0f};
+        std::copy(std::begin(spotSlots), std::end(spotSlots), c.begin() + 16);
+    }
+    const float frameSlots[8] = {u.forward.x, u.forward.y, u.forward.z, u.ambient, u.mapSize, 0.0f, 0.0f, 0.0f};
+    std::copy(std::begin(frameSlots), std::end(frameSlots), c.begin() + 24);
+    return c;
 }
 
 namespace {
@@ -137,25 +161,29 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkD
     // constants as flat vertex outputs (bool), 11..16: the filterable maps' parameters (float bits:
     // minimum variance, bleeding reduction, EVSM exponents, ESM exponent, MSM moment bias). Both
     // stages get them all.
-    constexpr std::uint32_t kConstants = 17;
+    // 17: light 0's constants baked in (bool), 18..49: their values (packLightConstants).
+    constexpr std::uint32_t kConstants = 18 + kPackedLightConstants;
     const scene::MomentSettings& m = variant.moments;
-    const std::int32_t constants[kConstants] = {std::int32_t(variant.filter),
-                                                variant.blockerIds ? 1 : 0,
-                                                std::int32_t(variant.lightCount),
-                                                std::int32_t(variant.lightKinds),
-                                                std::int32_t(variant.cascades),
-                                                variant.transmittance ? 1 : 0,
-                                                variant.receiverPlane ? 1 : 0,
-                                                variant.cascadeBlend ? 1 : 0,
-                                                variant.displayTarget ? 0 : 1,
-                                                variant.normalOffset ? 1 : 0,
-                                                variant.vertexLightConstants ? 1 : 0,
-                                                std::bit_cast<std::int32_t>(float(m.minVariance)),
-                                                std::bit_cast<std::int32_t>(float(m.bleedReduction)),
-                                                std::bit_cast<std::int32_t>(float(m.evsmPositive)),
-                                                std::bit_cast<std::int32_t>(float(m.evsmNegative)),
-                                                std::bit_cast<std::int32_t>(float(m.esmExponent)),
-                                                std::bit_cast<std::int32_t>(float(m.momentBias))};
+    std::int32_t constants[kConstants] = {std::int32_t(variant.filter),
+                                          variant.blockerIds ? 1 : 0,
+                                          std::int32_t(variant.lightCount),
+                                          std::int32_t(variant.lightKinds),
+                                          std::int32_t(variant.cascades),
+                                          variant.transmittance ? 1 : 0,
+                                          variant.receiverPlane ? 1 : 0,
+                                          variant.cascadeBlend ? 1 : 0,
+                                          variant.displayTarget ? 0 : 1,
+                                          variant.normalOffset ? 1 : 0,
+                                          variant.vertexLightConstants ? 1 : 0,
+                                          std::bit_cast<std::int32_t>(float(m.minVariance)),
+                                          std::bit_cast<std::int32_t>(float(m.bleedReduction)),
+                                          std::bit_cast<std::int32_t>(float(m.evsmPositive)),
+                                          std::bit_cast<std::int32_t>(float(m.evsmNegative)),
+                                          std::bit_cast<std::int32_t>(float(m.esmExponent)),
+                                          std::bit_cast<std::int32_t>(float(m.momentBias)),
+                                          variant.specializedLightConstants ? 1 : 0};
+    for (std::size_t i = 0; i < kPackedLightConstants; ++i)
+        constants[18 + i] = std::bit_cast<std::int32_t>(variant.lightConstants[i]);
     VkSpecializationMapEntry entries[kConstants];
     for (std::uint32_t i = 0; i < kConstants; ++i) entries[i] = {i, 4 * i, 4};
     const VkSpecializationInfo specialization{

@@ -31,6 +31,12 @@ inline constexpr VkFormat kLitDepthFormat = VK_FORMAT_D32_SFLOAT;
 // device encodes sRGB on store, 4 bytes a pixel instead of 12 (docs/raster.md "Display target").
 inline constexpr VkFormat kLitDisplayFormat = VK_FORMAT_R8G8B8A8_SRGB;
 
+// Light 0's constants as lit.vert packs them into its flat outputs outLight[0..5] and outFrame[0..1]
+// (the members of LightData that lit.frag reads for that light's kind, LitUniforms' forward, ambient
+// and map size), in that order: the values a pipeline with LitVariant::specializedLightConstants bakes.
+inline constexpr std::size_t kPackedLightConstants = 32;
+std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUniforms& uniforms);
+
 // What is fixed when the lit pipeline is created (lit.frag's specialization constants and
 // variant): lavapipe executes every branch of a shader, so run-time switches cost as much as
 // the work they skip.
@@ -52,6 +58,11 @@ struct LitVariant {
     // (shaders/lit_constants.glsl kVertexLightConstants); takes effect only where
     // usesVertexLightCoordinates().
     bool vertexLightConstants = false;
+    // With vertexLightConstants: the same values baked into the pipeline as specialization
+    // constants (shaders/lit_constants.glsl kSpecializedLightConstants), `lightConstants` from
+    // packLightConstants(); lit.vert then writes no flat outputs for them.
+    bool specializedLightConstants = false;
+    std::array<float, kPackedLightConstants> lightConstants{};
     // The filterable filters' parameters (specialization constants 11..16; unused by the others).
     scene::MomentSettings moments;
     // Where the variant allows (none or pcf2x2, one directional light, no semi-transparent casters,

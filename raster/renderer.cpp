@@ -205,9 +205,13 @@ struct Renderer::Impl {
     // lit.frag's blend code is compiled in (specialization constant) and reads it from cascadeBlendBand.
     double cascadeBlendUsed = 0.0;
     bool vertexLightConstants = false;  // LitVariant::vertexLightConstants of every lit pipeline
-    bool renderIntoFrame = true;        // RendererOptions::renderIntoFrame
-    bool transmittanceWindows = true;   // RendererOptions::transmittanceWindows
-    bool sunModules = true;             // RendererOptions::sunModules
+    // LitVariant::specializedLightConstants of the lit pipelines made from now on, and the values the
+    // existing ones baked in; update() turns it off when the values change (RendererOptions::lightConstants).
+    bool specializedLightConstants = false;
+    std::array<float, kPackedLightConstants> bakedLightConstants{};
+    bool renderIntoFrame = true;       // RendererOptions::renderIntoFrame
+    bool transmittanceWindows = true;  // RendererOptions::transmittanceWindows
+    bool sunModules = true;            // RendererOptions::sunModules
     double setupMs = 0.0;
     double pendingSetupMs = 0.0;  // setup not yet reported in a frame (the constructor's)
 
@@ -245,6 +249,9 @@ struct Renderer::Impl {
     // The same four without the slope bias's lift past its cap (LitVariant::normalOffset false, no
     // alpha test), for the lift-free triangles (draw.litRangesByLift), with the *_sun modules.
     LitPipeline liftFreePipelines[4];
+    // Lit pipelines with light constants baked in that update() replaced; kept until the Renderer
+    // goes, as the descriptor set was allocated with one of their (identical) set layouts.
+    std::vector<LitPipeline> retiredLitPipelines;
     bool liftFreeDraws = true;  // RendererOptions::liftFreeDraws
     // The vertex normals, positions and the index buffer as uploaded, for the lift-free triangles (placeLights);
     // kept only where they can be used (liftFreeDraws).
@@ -578,8 +585,12 @@ void Renderer::Impl::createTargets(const scene::Scene& scene, const RendererOpti
                                                                          .lightKinds = lightKinds,
                                                                          .cascades = std::uint32_t(cascadesUsed),
                                                                          .receiverPlane = settings.receiverPlaneBias});
-    vertexLightConstants = vertexCoordinates && options.lightConstants == LightConstants::kVertexOutputs;
-    attributes["light_constants"] = vertexLightConstants ? "vertex-outputs" : "uniform-buffer";
+    vertexLightConstants = vertexCoordinates && options.lightConstants != LightConstants::kUniformBuffer;
+    specializedLightConstants = vertexCoordinates && options.lightConstants == LightConstants::kSpecialization;
+    bakedLightConstants = packLightConstants(uniforms);
+    attributes["light_constants"] = specializedLightConstants ? "specialization"
+                                    : vertexLightConstants    ? "vertex-outputs"
+                                                              : "uniform-buffer";
     describeLayers();
 }
 
@@ -706,6 +717,18 @@ void Renderer::Impl::update(const scene::Scene& scene, const scene::Camera& view
         uniforms.cascadeStart = float(splits[0] - viewDepthOffset);
     }
     setLayerLights(scene);
+    const std::array<float, kPackedLightConstants> packed = packLightConstants(uniforms);
+    if (specializedLightConstants && std::memcmp(packed.data(), bakedLightConstants.data(), sizeof packed) != 0) {
+        // The values baked into the lit pipelines changed: from now on lit.vert passes them (a
+        // moving light or camera would otherwise compile new pipelines every frame).
+        specializedLightConstants = false;
+        attributes["light_constants"] = "vertex-outputs";
+        for (auto& pair : litPipelines)
+            for (LitPipeline& p : pair)
+                if (p.pipeline) retiredLitPipelines.push_back(std::move(p));
+        for (LitPipeline& p : liftFreePipelines)
+            if (p.pipeline) retiredLitPipelines.push_back(std::move(p));
+    }
     describeLayers();
     describeTransmitWindows();
     // The descriptor set's uniform buffers are device-local: refill them through a staging buffer.
@@ -763,6 +786,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                           .receiverPlane = settings.receiverPlaneBias,
                           .cascadeBlend = cascadeBlendUsed > 0.0,
                           .vertexLightConstants = vertexLightConstants,
+                          .specializedLightConstants = specializedLightConstants,
+                          .lightConstants = bakedLightConstants,
                           .moments = settings.moments,
                           .sunModules = sunModules};
     };

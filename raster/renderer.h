@@ -41,11 +41,16 @@ struct RenderDebug {
 
 // Where the lit pass's fragment shader reads the one light's constants, where it takes that
 // light's map coordinates from the vertex shader (one directional light with one map, or one
-// spot; shaders/lit_constants.glsl): as flat outputs of the vertex shader (the default: lavapipe
-// reads a uniform lane by lane for every eight pixels, a flat input once per triangle;
-// docs/performance.md), or from the uniform buffer. The frames are the same bit for bit (tests
-// render both).
-enum class LightConstants { kVertexOutputs, kUniformBuffer };
+// spot; shaders/lit_constants.glsl):
+// - kSpecialization (the default): baked into the lit pipelines as specialization constants, which
+//   cost nothing per triangle or pixel. A Renderer whose update() changes them (a moving light or
+//   camera) switches to kVertexOutputs for the rest of its life, compiling those pipelines once,
+//   instead of compiling new ones for every frame;
+// - kVertexOutputs: flat outputs of the vertex shader (lavapipe reads a uniform lane by lane for
+//   every eight pixels, a flat input once per triangle; docs/performance.md);
+// - kUniformBuffer: the uniform buffer.
+// The frames are the same bit for bit (tests render all three).
+enum class LightConstants { kSpecialization, kVertexOutputs, kUniformBuffer };
 
 struct RendererOptions {
     // Read the targets in place where the device's memory is the host's (lavapipe); false
@@ -59,7 +64,7 @@ struct RendererOptions {
     // window (raster/shadow_pass.h transmittanceWindow); false draws every layer whole, as a map
     // without windows (tests compare the two).
     bool transmittanceWindows = true;
-    LightConstants lightConstants = LightConstants::kVertexOutputs;
+    LightConstants lightConstants = LightConstants::kSpecialization;
     // The lit pass's size-optimized shader modules where the scene allows them
     // (LitVariant::sunModules); false: the general ones (tests compare the two).
     bool sunModules = true;

@@ -76,37 +76,54 @@ layout(location = 7) out vec4 outLights1;
 layout(location = 14) in vec2 inUv;
 #endif
 
-// Light i's constants: the uniform buffer's, or light 0's as flat inputs from lit.vert
-// (kVertexLightConstants: the one light), unpacked as lit.vert packs them. The members lit.vert does
-// not pass come from the buffer, and only where code reads them (none does).
+// Slot k of those constants: baked into the pipeline (kSpecializedLightConstants) or lit.vert's.
+vec4 lightSlot(int k) {
+    if (kSpecializedLightConstants) {
+        if (k == 0) return vec4(kL00, kL01, kL02, kL03);
+        if (k == 1) return vec4(kL10, kL11, kL12, kL13);
+        if (k == 2) return vec4(kL20, kL21, kL22, kL23);
+        if (k == 3) return vec4(kL30, kL31, kL32, kL33);
+        if (k == 4) return vec4(kL40, kL41, kL42, kL43);
+        return vec4(kL50, kL51, kL52, kL53);
+    }
+    return inLight[k];
+}
+vec4 frameSlot(int k) {
+    if (kSpecializedLightConstants) return k == 0 ? vec4(kF00, kF01, kF02, kF03) : vec4(kF10, kF11, kF12, kF13);
+    return inFrame[k];
+}
+// Light i's constants: the uniform buffer's, or (kVertexLightConstants: the one light) light 0's as
+// lit.vert packs them, its flat outputs or the same values baked in. The members lit.vert does not
+// pass come from the buffer, and only where code reads them (none does).
 LightData lightAt(int i) {
     if (!kVertexLightConstants) return u.lights[i];
     LightData light = u.lights[0];
-    if (kVertexSpot) light.position = inLight[0].xyz;
-    else light.towardLight = inLight[0].xyz;
-    light.layer = inLight[0].w;
-    light.radiance = inLight[1].rgb;
-    light.visibilityWeight = inLight[1].w;
-    light.depthBiasWorld = inLight[2].x;
-    light.slopeBiasTexels = inLight[2].y;
-    light.texelWorldSize = inLight[2].z;
-    light.depthPerWorld = inLight[2].w;
-    light.maxSlopeTan = inLight[3].x;
-    light.normalOffsetTexels = inLight[3].y;
-    light.pcfSize = int(inLight[3].z);
+    const vec4 slot[6] = vec4[](lightSlot(0), lightSlot(1), lightSlot(2), lightSlot(3), lightSlot(4), lightSlot(5));
+    if (kVertexSpot) light.position = slot[0].xyz;
+    else light.towardLight = slot[0].xyz;
+    light.layer = slot[0].w;
+    light.radiance = slot[1].rgb;
+    light.visibilityWeight = slot[1].w;
+    light.depthBiasWorld = slot[2].x;
+    light.slopeBiasTexels = slot[2].y;
+    light.texelWorldSize = slot[2].z;
+    light.depthPerWorld = slot[2].w;
+    light.maxSlopeTan = slot[3].x;
+    light.normalOffsetTexels = slot[3].y;
+    light.pcfSize = int(slot[3].z);
     if (kVertexSpot) {
-        light.spotDirection = inLight[4].xyz;
-        light.spotCosCone = inLight[4].w;
-        light.mapNear = inLight[5].x;
-        light.mapFar = inLight[5].y;
-        light.lightSize = inLight[5].z;
+        light.spotDirection = slot[4].xyz;
+        light.spotCosCone = slot[4].w;
+        light.mapNear = slot[5].x;
+        light.mapFar = slot[5].y;
+        light.lightSize = slot[5].z;
     }
     return light;
 }
 // LitUniforms' members that lit.vert passes with the light.
-vec3 viewForward() { return kVertexLightConstants ? inFrame[0].xyz : u.forward; }
-float ambient() { return kVertexLightConstants ? inFrame[0].w : u.ambient; }
-float mapSize() { return kVertexLightConstants ? inFrame[1].x : u.mapSize; }
+vec3 viewForward() { return kVertexLightConstants ? frameSlot(0).xyz : u.forward; }
+float ambient() { return kVertexLightConstants ? frameSlot(0).w : u.ambient; }
+float mapSize() { return kVertexLightConstants ? frameSlot(1).x : u.mapSize; }
 
 // Whether the light is of this kind: constant false for a kind the scene lacks, which removes its
 // code, and constant true where the scene has lights of that kind only, so the kind is not read

@@ -54,7 +54,7 @@ void main() {
     outAlbedo = albedo[inObjectId - 1u];
     outLightCoordinates = u.lights[0].toShadow * vec4(inPosition, 1.0);
     outLightNormal = u.lights[0].toShadow * vec4(inNormal, 0.0);
-    if (kVertexLightConstants) {
+    if (kVertexLightConstants && !kSpecializedLightConstants) {
         const LightData light = u.lights[0];
         outLight[0] = vec4(kVertexSpot ? light.position : light.towardLight, light.layer);
         outLight[1] = vec4(light.radiance, light.visibilityWeight);

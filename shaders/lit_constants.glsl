@@ -69,6 +69,44 @@ const bool kAnyPerspective =
 // per triangle). The values are the same floats either way (raster::LightConstants).
 layout(constant_id = 10) const bool kVertexLightConstantsAsked = false;
 const bool kVertexLightConstants = kVertexLightConstantsAsked && kVertexLightCoordinates;
+// The same values baked into the pipeline (raster::LightConstants::kSpecialization): lit.frag reads
+// them as constants 18..49, packed as lit.vert packs outLight[0..5] and outFrame[0..1], and lit.vert
+// writes neither. A flat input costs llvmpipe its setup and 48 bytes per triangle in every bin it
+// touches; a constant costs nothing per triangle, and folds into the arithmetic that reads it.
+layout(constant_id = 17) const bool kSpecializedLightConstantsAsked = false;
+const bool kSpecializedLightConstants = kSpecializedLightConstantsAsked && kVertexLightConstants;
+layout(constant_id = 18) const float kL00 = 0.0;
+layout(constant_id = 19) const float kL01 = 0.0;
+layout(constant_id = 20) const float kL02 = 0.0;
+layout(constant_id = 21) const float kL03 = 0.0;
+layout(constant_id = 22) const float kL10 = 0.0;
+layout(constant_id = 23) const float kL11 = 0.0;
+layout(constant_id = 24) const float kL12 = 0.0;
+layout(constant_id = 25) const float kL13 = 0.0;
+layout(constant_id = 26) const float kL20 = 0.0;
+layout(constant_id = 27) const float kL21 = 0.0;
+layout(constant_id = 28) const float kL22 = 0.0;
+layout(constant_id = 29) const float kL23 = 0.0;
+layout(constant_id = 30) const float kL30 = 0.0;
+layout(constant_id = 31) const float kL31 = 0.0;
+layout(constant_id = 32) const float kL32 = 0.0;
+layout(constant_id = 33) const float kL33 = 0.0;
+layout(constant_id = 34) const float kL40 = 0.0;
+layout(constant_id = 35) const float kL41 = 0.0;
+layout(constant_id = 36) const float kL42 = 0.0;
+layout(constant_id = 37) const float kL43 = 0.0;
+layout(constant_id = 38) const float kL50 = 0.0;
+layout(constant_id = 39) const float kL51 = 0.0;
+layout(constant_id = 40) const float kL52 = 0.0;
+layout(constant_id = 41) const float kL53 = 0.0;
+layout(constant_id = 42) const float kF00 = 0.0;
+layout(constant_id = 43) const float kF01 = 0.0;
+layout(constant_id = 44) const float kF02 = 0.0;
+layout(constant_id = 45) const float kF03 = 0.0;
+layout(constant_id = 46) const float kF10 = 0.0;
+layout(constant_id = 47) const float kF11 = 0.0;
+layout(constant_id = 48) const float kF12 = 0.0;
+layout(constant_id = 49) const float kF13 = 0.0;
 
 // The filterable maps' parameters (scene::MomentSettings, raster/moment_maps.h), read only by
 // the vsm, evsm2, evsm4, esm and msm filters.

@@ -1235,27 +1235,29 @@ TEST(RasterRenderer, SizeOptimizedSunModulesGiveTheGeneralModulesFramesBitForBit
     }
 }
 
-// The frames of two renderers, one reading light 0's constants from the uniform buffer and one
-// taking them as flat outputs of the vertex shader, for the same channels.
-std::pair<scene::Frame, scene::Frame> withBothLightConstantSources(const scene::Scene& s,
-                                                                   const scene::RasterSettings& settings,
-                                                                   scene::ChannelMask channels) {
-    Renderer buffer(s, planFor(s, settings), settings,
-                    RendererOptions{.lightConstants = LightConstants::kUniformBuffer});
-    Renderer vertex(s, planFor(s, settings), settings,
-                    RendererOptions{.lightConstants = LightConstants::kVertexOutputs});
-    std::pair<scene::Frame, scene::Frame> frames{buffer.render(channels), vertex.render(channels)};
-    EXPECT_EQ(buffer.validationMessages(), 0);
-    EXPECT_EQ(vertex.validationMessages(), 0);
+// The frames of three renderers for the same channels: one reading light 0's constants from the
+// uniform buffer, one taking them as flat outputs of the vertex shader, one with them baked into
+// its pipelines as specialization constants.
+std::array<scene::Frame, 3> withEveryLightConstantSource(const scene::Scene& s, const scene::RasterSettings& settings,
+                                                         scene::ChannelMask channels) {
+    std::array<scene::Frame, 3> frames;
+    const LightConstants sources[3] = {LightConstants::kUniformBuffer, LightConstants::kVertexOutputs,
+                                       LightConstants::kSpecialization};
+    for (int i = 0; i < 3; ++i) {
+        Renderer r(s, planFor(s, settings), settings, RendererOptions{.lightConstants = sources[i]});
+        frames[std::size_t(i)] = r.render(channels);
+        EXPECT_EQ(r.validationMessages(), 0);
+    }
     return frames;
 }
 
-TEST(RasterRenderer, LightConstantsFromTheVertexShaderGiveTheSameFrameBitForBit) {
+TEST(RasterRenderer, LightConstantsFromTheVertexShaderOrBakedInGiveTheSameFrameBitForBit) {
     // lit.frag can read the one light's constants (direction or position, radiance, biases,
     // filter parameters, a spot's cone and size), the ambient and the map side from the uniform
-    // buffer or as flat inputs from lit.vert (shaders/lit_constants.glsl). Flat inputs carry the
-    // same floats into the same arithmetic, so every channel must be the same bit for bit: a
-    // field passed wrongly or not at all (a zero) changes shadows, shading or both. One
+    // buffer, as flat inputs from lit.vert or as specialization constants (shaders/lit_constants.glsl).
+    // Each carries the same floats into the same arithmetic, so every channel must be the same bit
+    // for bit: a field passed wrongly or not at all (a zero) changes shadows, shading or both, and a
+    // compiler that folded the constants into the arithmetic in another order would change bits. One
     // directional light and one spot, the normal offset on (its code reads the most fields),
     // every filter the light kind has, near the origin and 10^7 units away; the PNG's display
     // target too.
@@ -1279,33 +1281,73 @@ TEST(RasterRenderer, LightConstantsFromTheVertexShaderGiveTheSameFrameBitForBit)
                 settings.normalOffset = 0.5;
                 const std::string what = std::string(spot ? "spot" : "directional") + ", filter " +
                                          std::to_string(int(filter)) + ", offset " + std::to_string(offset);
-                const auto [a, b] = withBothLightConstantSources(s, settings, scene::kAllChannels);
+                const auto frames = withEveryLightConstantSource(s, settings, scene::kAllChannels);
+                const scene::Frame& a = frames[0];
                 EXPECT_EQ(a.attributes.at("light_constants"), "uniform-buffer");
-                EXPECT_EQ(b.attributes.at("light_constants"), "vertex-outputs");
+                EXPECT_EQ(frames[1].attributes.at("light_constants"), "vertex-outputs");
+                EXPECT_EQ(frames[2].attributes.at("light_constants"), "specialization");
                 std::size_t shadowed = 0;
                 for (std::size_t i = 0; i < a.pixelCount(); ++i)
                     shadowed += a.objectId[i] == 2.0f && a.visibility[i] < 0.5f;  // plane pixels (id 2) only
                 EXPECT_GT(shadowed, 500u)
                     << what << ": the sphere shadows the plane (a spot: or its cone leaves it dark)";
-                EXPECT_TRUE(a.beauty == b.beauty) << what;
-                EXPECT_TRUE(a.visibility == b.visibility) << what;
-                EXPECT_TRUE(a.ndotl == b.ndotl) << what;
-                EXPECT_TRUE(a.depth == b.depth) << what;
-                EXPECT_TRUE(a.objectId == b.objectId) << what;
-                EXPECT_TRUE(a.blockerId == b.blockerId) << what;
+                for (int k = 1; k < 3; ++k) {
+                    const scene::Frame& b = frames[std::size_t(k)];
+                    const std::string which = what + (k == 1 ? ", flat inputs" : ", specialization constants");
+                    EXPECT_TRUE(a.beauty == b.beauty) << which;
+                    EXPECT_TRUE(a.visibility == b.visibility) << which;
+                    EXPECT_TRUE(a.ndotl == b.ndotl) << which;
+                    EXPECT_TRUE(a.depth == b.depth) << which;
+                    EXPECT_TRUE(a.objectId == b.objectId) << which;
+                    EXPECT_TRUE(a.blockerId == b.blockerId) << which;
+                }
                 if (offset == 0.0 && filter == ShadowFilter::Pcf2x2) {
-                    const auto [c, d] =
-                        withBothLightConstantSources(s, settings, scene::kChannelBeauty | scene::kBeautyForDisplay);
-                    ASSERT_EQ(c.attributes.count("beauty_precision"), 1u);
-                    EXPECT_TRUE(c.beauty == d.beauty) << what << ", display target";
+                    const auto display =
+                        withEveryLightConstantSource(s, settings, scene::kChannelBeauty | scene::kBeautyForDisplay);
+                    ASSERT_EQ(display[0].attributes.count("beauty_precision"), 1u);
+                    EXPECT_TRUE(display[0].beauty == display[1].beauty) << what << ", display target";
+                    EXPECT_TRUE(display[0].beauty == display[2].beauty) << what << ", display target, baked in";
                 }
             }
 }
 
-TEST(RasterRenderer, LightConstantsComeFromTheVertexShaderWhereItGivesTheLightsMapCoordinates) {
-    // By default lit.frag takes the one light's constants from lit.vert wherever it takes that
-    // light's map coordinates from there (one directional light with one map, or one spot; no
-    // receiver plane); a second light, cascades or the receiver-plane bias keep the uniform buffer.
+TEST(RasterRenderer, AnUpdateThatChangesTheBakedLightConstantsSwitchesToFlatInputsWithTheSameFrames) {
+    // A Renderer keeps its baked-in pipelines through an update() that leaves the light's constants
+    // as they are, and one that changes them (a moved sun, then a moved camera: the view axis is one
+    // of them) takes them from lit.vert from then on: each frame the same bit for bit as a Renderer
+    // that always did (updated the same way), with no validation message.
+    const scene::RasterSettings settings = validatedSettings(256, 0.01, 1.0, ShadowFilter::Pcf2x2);
+    const scene::Scene s = makeScene(SphereOverPlane{});
+    Renderer baked(s, planFor(s, settings), settings);
+    Renderer flat(s, planFor(s, settings), settings, RendererOptions{.lightConstants = LightConstants::kVertexOutputs});
+    auto expectSame = [&](const char* what, const char* source) {
+        const scene::Frame a = baked.render(), b = flat.render();
+        EXPECT_EQ(a.attributes.at("light_constants"), source) << what;
+        test::expectSamePixels(a, b, what);
+    };
+    expectSame("before any update", "specialization");
+    baked.update(s);
+    flat.update(s);
+    expectSame("after an update to the same scene", "specialization");
+    scene::Scene sun = s;
+    sun.lights[0].direction = lightFromElevation(35.0);
+    baked.update(sun);
+    flat.update(sun);
+    expectSame("after the sun moved", "vertex-outputs");
+    scene::Scene camera = sun;
+    camera.camera.position += scene::Vec3(0.4, 0.1, -0.3);
+    baked.update(camera);
+    flat.update(camera);
+    expectSame("after the camera moved", "vertex-outputs");
+    EXPECT_EQ(baked.validationMessages(), 0);
+    EXPECT_EQ(flat.validationMessages(), 0);
+}
+
+TEST(RasterRenderer, LightConstantsAreBakedInWhereTheVertexShaderGivesTheLightsMapCoordinates) {
+    // By default lit.frag takes the one light's constants as specialization constants wherever it
+    // takes that light's map coordinates from lit.vert (one directional light with one map, or one
+    // spot; no receiver plane); a second light, cascades or the receiver-plane bias keep the uniform
+    // buffer.
     const scene::RasterSettings settings = validatedSettings(256, 0.01, 1.0, ShadowFilter::Pcf2x2);
     const scene::Scene one = makeScene(SphereOverPlane{});
     auto source = [](const scene::Scene& s, const scene::RasterSettings& r) {
@@ -1314,13 +1356,13 @@ TEST(RasterRenderer, LightConstantsComeFromTheVertexShaderWhereItGivesTheLightsM
         EXPECT_EQ(renderer.validationMessages(), 0);
         return f.attributes.at("light_constants");
     };
-    EXPECT_EQ(source(one, settings), "vertex-outputs");
+    EXPECT_EQ(source(one, settings), "specialization");
     scene::Scene spot = one;
     spot.lights[0].type = scene::LightType::Spot;
     spot.lights[0].position = Vec3(2.5, 3.0, 1.5);
     spot.lights[0].direction = glm::normalize(Vec3(-2.5, -2.2, -1.5));
     spot.lights[0].coneAngleDegrees = 45.0;
-    EXPECT_EQ(source(spot, settings), "vertex-outputs");
+    EXPECT_EQ(source(spot, settings), "specialization");
     scene::Scene two = one;
     two.lights.push_back(two.lights[0]);
     two.lights[1].direction = lightFromElevation(40.0);
