@@ -154,8 +154,12 @@ void benchScene(const std::string& label, scene::Scene s, int repeats, std::vect
     scene::SettingsOverrides overrides;
     overrides.shadowMapSize = kShadowMapSize;
     // One map, as the bare two-pass baseline draws (the defaults would fit it and may cascade it).
+    // SHADOWLAB_BENCH_CASCADES=N: N cascades instead (the command line's default for a large view
+    // is 4), to compare two builds or light-constant sources of ours on that path; the bare
+    // baseline still draws one map, so the ratio to it is not like for like.
     overrides.fitLightFrustum = false;
     overrides.cascades = 1;
+    if (const char* v = std::getenv("SHADOWLAB_BENCH_CASCADES"); v && *v) overrides.cascades = std::atoi(v);
     const scene::RenderSettings settings = scene::resolveSettings(s, overrides);
     const scene::RenderPlan plan = scene::makeRenderPlan(s, settings);
 

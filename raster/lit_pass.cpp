@@ -18,6 +18,11 @@ bool usesVertexLightCoordinates(const LitVariant& variant) {
            variant.lightKinds == (1u << SHADOWLAB_LIGHT_SPOT);
 }
 
+bool bakesLightConstants(const LitVariant& v) {
+    return usesVertexLightCoordinates(v) || (v.lightCount == 1 && !v.receiverPlane && v.cascades > 1 &&
+                                             v.lightKinds == (1u << SHADOWLAB_LIGHT_DIRECTIONAL));
+}
+
 bool usesSunModules(const LitVariant& v) {
     const bool taps = v.filter == scene::ShadowFilter::None || v.filter == scene::ShadowFilter::Pcf2x2;
     return v.sunModules && taps && v.lightTargets == 0 && v.lightCount == 1 &&
@@ -43,6 +48,18 @@ std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUn
     }
     const float frameSlots[8] = {u.forward.x, u.forward.y, u.forward.z, u.ambient, u.mapSize, 0.0f, 0.0f, 0.0f};
     std::copy(std::begin(frameSlots), std::end(frameSlots), c.begin() + 24);
+    c[32] = u.cascadeStart;
+    c[33] = u.cascadeBlendBand;
+    for (std::size_t k = 0; k < SHADOWLAB_MAX_CASCADES; ++k) {
+        const shaders::CascadeData& d = u.cascades[k];
+        float* const at = c.data() + 34 + 16 * k;
+        for (int row = 0; row < 3; ++row)
+            for (int column = 0; column < 4; ++column) at[4 * row + column] = d.toShadow[column][row];
+        at[12] = d.sliceFar;
+        at[13] = d.texelWorldSize;
+        at[14] = d.depthPerWorld;
+        at[15] = d.depthBiasWorld;
+    }
     return c;
 }
 
@@ -161,7 +178,7 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkD
     // constants as flat vertex outputs (bool), 11..16: the filterable maps' parameters (float bits:
     // minimum variance, bleeding reduction, EVSM exponents, ESM exponent, MSM moment bias). Both
     // stages get them all.
-    // 17: light 0's constants baked in (bool), 18..49: their values (packLightConstants).
+    // 17: light 0's constants baked in (bool), 18..115: their values (packLightConstants).
     constexpr std::uint32_t kConstants = 18 + kPackedLightConstants;
     const scene::MomentSettings& m = variant.moments;
     std::int32_t constants[kConstants] = {std::int32_t(variant.filter),

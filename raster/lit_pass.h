@@ -33,8 +33,11 @@ inline constexpr VkFormat kLitDisplayFormat = VK_FORMAT_R8G8B8A8_SRGB;
 
 // Light 0's constants as lit.vert packs them into its flat outputs outLight[0..5] and outFrame[0..1]
 // (the members of LightData that lit.frag reads for that light's kind, LitUniforms' forward, ambient
-// and map size), in that order: the values a pipeline with LitVariant::specializedLightConstants bakes.
-inline constexpr std::size_t kPackedLightConstants = 32;
+// and map size), in that order; then LitUniforms' cascadeStart and cascadeBlendBand and, for each of
+// light 0's SHADOWLAB_MAX_CASCADES cascades, its toShadow's first three rows, sliceFar,
+// texelWorldSize, depthPerWorld and depthBiasWorld (zeros where it has none): the values a pipeline
+// with LitVariant::specializedLightConstants bakes (shaders/lit_constants.glsl, constants 18..115).
+inline constexpr std::size_t kPackedLightConstants = 32 + 2 + 16 * SHADOWLAB_MAX_CASCADES;
 std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUniforms& uniforms);
 
 // What is fixed when the lit pipeline is created (lit.frag's specialization constants and
@@ -58,9 +61,9 @@ struct LitVariant {
     // (shaders/lit_constants.glsl kVertexLightConstants); takes effect only where
     // usesVertexLightCoordinates().
     bool vertexLightConstants = false;
-    // With vertexLightConstants: the same values baked into the pipeline as specialization
-    // constants (shaders/lit_constants.glsl kSpecializedLightConstants), `lightConstants` from
-    // packLightConstants(); lit.vert then writes no flat outputs for them.
+    // The same values baked into the pipeline as specialization constants (shaders/lit_constants.glsl
+    // kSpecializedLightConstants), `lightConstants` from packLightConstants(); lit.vert then writes
+    // no flat outputs for them. Takes effect only where bakesLightConstants().
     bool specializedLightConstants = false;
     std::array<float, kPackedLightConstants> lightConstants{};
     // The filterable filters' parameters (specialization constants 11..16; unused by the others).
@@ -75,6 +78,9 @@ struct LitVariant {
 // kVertexLightCoordinates, the same condition): one light, directional with one map or a spot, and
 // no receiver-plane bias.
 bool usesVertexLightCoordinates(const LitVariant& variant);
+// Whether the variant can bake light 0's constants in: where usesVertexLightCoordinates(), or one
+// cascaded directional light without the receiver-plane bias.
+bool bakesLightConstants(const LitVariant& variant);
 // Whether the variant has the constants SHADOWLAB_ONE_SUN fixes (lit_constants.glsl), with none or
 // pcf2x2: the *_taps_sun modules (where LitVariant::sunModules asks for them).
 bool usesSunModules(const LitVariant& variant);

@@ -581,12 +581,14 @@ void Renderer::Impl::createTargets(const scene::Scene& scene, const RendererOpti
     }
 
     // Where lit.frag reads the light's constants (RendererOptions::lightConstants).
-    const bool vertexCoordinates = usesVertexLightCoordinates(LitVariant{.lightCount = std::uint32_t(lightCount),
-                                                                         .lightKinds = lightKinds,
-                                                                         .cascades = std::uint32_t(cascadesUsed),
-                                                                         .receiverPlane = settings.receiverPlaneBias});
-    vertexLightConstants = vertexCoordinates && options.lightConstants != LightConstants::kUniformBuffer;
-    specializedLightConstants = vertexCoordinates && options.lightConstants == LightConstants::kSpecialization;
+    const LitVariant lights{.lightCount = std::uint32_t(lightCount),
+                            .lightKinds = lightKinds,
+                            .cascades = std::uint32_t(cascadesUsed),
+                            .receiverPlane = settings.receiverPlaneBias};
+    vertexLightConstants =
+        usesVertexLightCoordinates(lights) && options.lightConstants != LightConstants::kUniformBuffer;
+    specializedLightConstants =
+        bakesLightConstants(lights) && options.lightConstants == LightConstants::kSpecialization;
     bakedLightConstants = packLightConstants(uniforms);
     attributes["light_constants"] = specializedLightConstants ? "specialization"
                                     : vertexLightConstants    ? "vertex-outputs"
@@ -719,10 +721,11 @@ void Renderer::Impl::update(const scene::Scene& scene, const scene::Camera& view
     setLayerLights(scene);
     const std::array<float, kPackedLightConstants> packed = packLightConstants(uniforms);
     if (specializedLightConstants && std::memcmp(packed.data(), bakedLightConstants.data(), sizeof packed) != 0) {
-        // The values baked into the lit pipelines changed: from now on lit.vert passes them (a
-        // moving light or camera would otherwise compile new pipelines every frame).
+        // The values baked into the lit pipelines changed: from now on lit.vert passes them, or
+        // (cascades) the uniform buffer (a moving light or camera would otherwise compile new
+        // pipelines every frame).
         specializedLightConstants = false;
-        attributes["light_constants"] = "vertex-outputs";
+        attributes["light_constants"] = vertexLightConstants ? "vertex-outputs" : "uniform-buffer";
         for (auto& pair : litPipelines)
             for (LitPipeline& p : pair)
                 if (p.pipeline) retiredLitPipelines.push_back(std::move(p));

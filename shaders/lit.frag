@@ -96,7 +96,7 @@ vec4 frameSlot(int k) {
 // lit.vert packs them, its flat outputs or the same values baked in. The members lit.vert does not
 // pass come from the buffer, and only where code reads them (none does).
 LightData lightAt(int i) {
-    if (!kVertexLightConstants) return u.lights[i];
+    if (!kLightFromSlots) return u.lights[i];
     LightData light = u.lights[0];
     const vec4 slot[6] = vec4[](lightSlot(0), lightSlot(1), lightSlot(2), lightSlot(3), lightSlot(4), lightSlot(5));
     if (kVertexSpot) light.position = slot[0].xyz;
@@ -121,9 +121,49 @@ LightData lightAt(int i) {
     return light;
 }
 // LitUniforms' members that lit.vert passes with the light.
-vec3 viewForward() { return kVertexLightConstants ? frameSlot(0).xyz : u.forward; }
-float ambient() { return kVertexLightConstants ? frameSlot(0).w : u.ambient; }
-float mapSize() { return kVertexLightConstants ? frameSlot(1).x : u.mapSize; }
+vec3 viewForward() { return kLightFromSlots ? frameSlot(0).xyz : u.forward; }
+float ambient() { return kLightFromSlots ? frameSlot(0).w : u.ambient; }
+float mapSize() { return kLightFromSlots ? frameSlot(1).x : u.mapSize; }
+
+// Cascade c of light `lightIndex`: the uniform buffer's, or (kSpecializedCascades: light 0 is the
+// only light) baked in. c varies per pixel, so the baked values are chosen by selects, where the
+// buffer's are loaded lane by lane.
+CascadeData cascadeAt(int lightIndex, int c) {
+    if (!kSpecializedCascades) return u.cascades[lightIndex * SHADOWLAB_MAX_CASCADES + c];
+    CascadeData d;
+    vec4 r0, r1, r2, rest;
+    if (c == 0) {
+        r0 = vec4(kC0_00, kC0_01, kC0_02, kC0_03);
+        r1 = vec4(kC0_04, kC0_05, kC0_06, kC0_07);
+        r2 = vec4(kC0_08, kC0_09, kC0_10, kC0_11);
+        rest = vec4(kC0_12, kC0_13, kC0_14, kC0_15);
+    } else if (c == 1) {
+        r0 = vec4(kC1_00, kC1_01, kC1_02, kC1_03);
+        r1 = vec4(kC1_04, kC1_05, kC1_06, kC1_07);
+        r2 = vec4(kC1_08, kC1_09, kC1_10, kC1_11);
+        rest = vec4(kC1_12, kC1_13, kC1_14, kC1_15);
+    } else if (c == 2) {
+        r0 = vec4(kC2_00, kC2_01, kC2_02, kC2_03);
+        r1 = vec4(kC2_04, kC2_05, kC2_06, kC2_07);
+        r2 = vec4(kC2_08, kC2_09, kC2_10, kC2_11);
+        rest = vec4(kC2_12, kC2_13, kC2_14, kC2_15);
+    } else {
+        r0 = vec4(kC3_00, kC3_01, kC3_02, kC3_03);
+        r1 = vec4(kC3_04, kC3_05, kC3_06, kC3_07);
+        r2 = vec4(kC3_08, kC3_09, kC3_10, kC3_11);
+        rest = vec4(kC3_12, kC3_13, kC3_14, kC3_15);
+    }
+    // (mat4 takes columns: column k is (r0[k], r1[k], r2[k], w row).)
+    d.toShadow = mat4(vec4(r0.x, r1.x, r2.x, 0.0), vec4(r0.y, r1.y, r2.y, 0.0), vec4(r0.z, r1.z, r2.z, 0.0),
+                      vec4(r0.w, r1.w, r2.w, 1.0));
+    d.sliceFar = rest.x;
+    d.texelWorldSize = rest.y;
+    d.depthPerWorld = rest.z;
+    d.depthBiasWorld = rest.w;
+    return d;
+}
+float cascadeStart() { return kSpecializedCascades ? kCascadeStart : u.cascadeStart; }
+float cascadeBlendBand() { return kSpecializedCascades ? kCascadeBlendBand : u.cascadeBlendBand; }
 
 // Whether the light is of this kind: constant false for a kind the scene lacks, which removes its
 // code, and constant true where the scene has lights of that kind only, so the kind is not read
@@ -638,8 +678,8 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
 
 // Cascade c's map, texel size, depth scale and constant bias in place of the light's; its layer
 // follows the light's first one.
-LightData withCascade(LightData light, int first, int c) {
-    const CascadeData cascade = u.cascades[first + c];
+LightData withCascade(LightData light, int lightIndex, int c) {
+    const CascadeData cascade = cascadeAt(lightIndex, c);
     light.toShadow = cascade.toShadow;
     light.layer += float(c);
     light.depthBiasWorld = cascade.depthBiasWorld;
@@ -655,27 +695,26 @@ LightData withCascade(LightData light, int first, int c) {
 // the band, 0 at its start to 1 at the split, so the visibility goes over linearly to the next
 // cascade's and is continuous across the split; elsewhere blend = 0.
 LightData cascadeOf(LightData light, int lightIndex, vec3 p, out LightData next, out float blend) {
-    const int first = lightIndex * SHADOWLAB_MAX_CASCADES;
     const int count = min(kCascades, SHADOWLAB_MAX_CASCADES);  // = light.cascadeCount
-    const float z = dot(p, u.forward);
+    const float z = dot(p, viewForward());
     int c = 0;
     [[unroll]] for (int k = 0; k + 1 < count; ++k)
-        if (z > u.cascades[first + k].sliceFar) c = k + 1;
+        if (z > cascadeAt(lightIndex, k).sliceFar) c = k + 1;
     blend = 0.0;
     next = light;
     if (kCascadeBlend && c + 1 < count) {
-        const float start = c == 0 ? u.cascadeStart : u.cascades[first + c - 1].sliceFar;  // split[c]
-        const float end = u.cascades[first + c].sliceFar;                            // split[c+1]
-        const float bandStart = end - u.cascadeBlendBand * (end - start);
+        const float start = c == 0 ? cascadeStart() : cascadeAt(lightIndex, c - 1).sliceFar;  // split[c]
+        const float end = cascadeAt(lightIndex, c).sliceFar;                                  // split[c+1]
+        const float bandStart = end - cascadeBlendBand() * (end - start);
         if (z > bandStart) {
             blend = clamp((z - bandStart) / (end - bandStart), 0.0, 1.0);
-            next = withCascade(light, first, c + 1);
+            next = withCascade(light, lightIndex, c + 1);
         }
     }
-    LightData chosen = withCascade(light, first, c);
+    LightData chosen = withCascade(light, lightIndex, c);
     // Past the last split (with the slack raster/cascades.h kCascadeSplitSlack gives its receivers)
     // lie only receivers no caster can shade (shadowableDepthRange): lit, with no shadow test.
-    const float last = u.cascades[first + count - 1].sliceFar;
+    const float last = cascadeAt(lightIndex, count - 1).sliceFar;
     if (z > last + 1e-4 * abs(last)) chosen.layer = -1.0;
     return chosen;
 }
@@ -724,7 +763,8 @@ void main() {
         // cascade's map. The code exists only in pipelines made for cascades (kCascades > 1).
         LightData nextCascade;
         float cascadeBlend = 0.0;  // > 0: in a blend band, mix with nextCascade's visibility
-        if (kCascades > 1 && isKind(light, SHADOWLAB_LIGHT_DIRECTIONAL) && light.cascadeCount > 1)
+        // (kSpecializedCascades: the one light is the cascaded one, its cascadeCount kCascades.)
+        if (kCascades > 1 && isKind(light, SHADOWLAB_LIGHT_DIRECTIONAL) && (kSpecializedCascades || light.cascadeCount > 1))
             light = cascadeOf(light, i, inPosition, nextCascade, cascadeBlend);
         vec3 l;
         float irradiance;  // relative to radiance: 1 for directional lights

@@ -73,8 +73,16 @@ const bool kVertexLightConstants = kVertexLightConstantsAsked && kVertexLightCoo
 // them as constants 18..49, packed as lit.vert packs outLight[0..5] and outFrame[0..1], and lit.vert
 // writes neither. A flat input costs llvmpipe its setup and 48 bytes per triangle in every bin it
 // touches; a constant costs nothing per triangle, and folds into the arithmetic that reads it.
+// One cascaded directional light, no receiver plane: the same 32 values (no map coordinates from
+// lit.vert then, so no flat inputs either), and the cascades' values below.
 layout(constant_id = 17) const bool kSpecializedLightConstantsAsked = false;
-const bool kSpecializedLightConstants = kSpecializedLightConstantsAsked && kVertexLightConstants;
+const bool kOneCascadedSun = kLightCount == 1 && kLightKinds == (1 << SHADOWLAB_LIGHT_DIRECTIONAL) && kCascades > 1 &&
+                             !kReceiverPlane;
+const bool kSpecializedCascades = kSpecializedLightConstantsAsked && kOneCascadedSun;
+const bool kSpecializedLightConstants =
+    !(!(kSpecializedLightConstantsAsked && kVertexLightCoordinates) && !kSpecializedCascades);
+// lightAt() unpacks the 32 values, from lit.vert or baked in.
+const bool kLightFromSlots = !(!kVertexLightConstants && !kSpecializedLightConstants);
 layout(constant_id = 18) const float kL00 = 0.0;
 layout(constant_id = 19) const float kL01 = 0.0;
 layout(constant_id = 20) const float kL02 = 0.0;
@@ -107,6 +115,75 @@ layout(constant_id = 46) const float kF10 = 0.0;
 layout(constant_id = 47) const float kF11 = 0.0;
 layout(constant_id = 48) const float kF12 = 0.0;
 layout(constant_id = 49) const float kF13 = 0.0;
+// kSpecializedCascades: LitUniforms' cascadeStart and cascadeBlendBand, then per cascade c of light 0
+// (constants 52 + 16c ..): toShadow's first three rows (an orthographic map's last row is 0 0 0 1),
+// then sliceFar, texelWorldSize, depthPerWorld and depthBiasWorld (raster::packLightConstants).
+layout(constant_id = 50) const float kCascadeStart = 0.0;
+layout(constant_id = 51) const float kCascadeBlendBand = 0.0;
+layout(constant_id = 52) const float kC0_00 = 0.0;
+layout(constant_id = 53) const float kC0_01 = 0.0;
+layout(constant_id = 54) const float kC0_02 = 0.0;
+layout(constant_id = 55) const float kC0_03 = 0.0;
+layout(constant_id = 56) const float kC0_04 = 0.0;
+layout(constant_id = 57) const float kC0_05 = 0.0;
+layout(constant_id = 58) const float kC0_06 = 0.0;
+layout(constant_id = 59) const float kC0_07 = 0.0;
+layout(constant_id = 60) const float kC0_08 = 0.0;
+layout(constant_id = 61) const float kC0_09 = 0.0;
+layout(constant_id = 62) const float kC0_10 = 0.0;
+layout(constant_id = 63) const float kC0_11 = 0.0;
+layout(constant_id = 64) const float kC0_12 = 0.0;
+layout(constant_id = 65) const float kC0_13 = 0.0;
+layout(constant_id = 66) const float kC0_14 = 0.0;
+layout(constant_id = 67) const float kC0_15 = 0.0;
+layout(constant_id = 68) const float kC1_00 = 0.0;
+layout(constant_id = 69) const float kC1_01 = 0.0;
+layout(constant_id = 70) const float kC1_02 = 0.0;
+layout(constant_id = 71) const float kC1_03 = 0.0;
+layout(constant_id = 72) const float kC1_04 = 0.0;
+layout(constant_id = 73) const float kC1_05 = 0.0;
+layout(constant_id = 74) const float kC1_06 = 0.0;
+layout(constant_id = 75) const float kC1_07 = 0.0;
+layout(constant_id = 76) const float kC1_08 = 0.0;
+layout(constant_id = 77) const float kC1_09 = 0.0;
+layout(constant_id = 78) const float kC1_10 = 0.0;
+layout(constant_id = 79) const float kC1_11 = 0.0;
+layout(constant_id = 80) const float kC1_12 = 0.0;
+layout(constant_id = 81) const float kC1_13 = 0.0;
+layout(constant_id = 82) const float kC1_14 = 0.0;
+layout(constant_id = 83) const float kC1_15 = 0.0;
+layout(constant_id = 84) const float kC2_00 = 0.0;
+layout(constant_id = 85) const float kC2_01 = 0.0;
+layout(constant_id = 86) const float kC2_02 = 0.0;
+layout(constant_id = 87) const float kC2_03 = 0.0;
+layout(constant_id = 88) const float kC2_04 = 0.0;
+layout(constant_id = 89) const float kC2_05 = 0.0;
+layout(constant_id = 90) const float kC2_06 = 0.0;
+layout(constant_id = 91) const float kC2_07 = 0.0;
+layout(constant_id = 92) const float kC2_08 = 0.0;
+layout(constant_id = 93) const float kC2_09 = 0.0;
+layout(constant_id = 94) const float kC2_10 = 0.0;
+layout(constant_id = 95) const float kC2_11 = 0.0;
+layout(constant_id = 96) const float kC2_12 = 0.0;
+layout(constant_id = 97) const float kC2_13 = 0.0;
+layout(constant_id = 98) const float kC2_14 = 0.0;
+layout(constant_id = 99) const float kC2_15 = 0.0;
+layout(constant_id = 100) const float kC3_00 = 0.0;
+layout(constant_id = 101) const float kC3_01 = 0.0;
+layout(constant_id = 102) const float kC3_02 = 0.0;
+layout(constant_id = 103) const float kC3_03 = 0.0;
+layout(constant_id = 104) const float kC3_04 = 0.0;
+layout(constant_id = 105) const float kC3_05 = 0.0;
+layout(constant_id = 106) const float kC3_06 = 0.0;
+layout(constant_id = 107) const float kC3_07 = 0.0;
+layout(constant_id = 108) const float kC3_08 = 0.0;
+layout(constant_id = 109) const float kC3_09 = 0.0;
+layout(constant_id = 110) const float kC3_10 = 0.0;
+layout(constant_id = 111) const float kC3_11 = 0.0;
+layout(constant_id = 112) const float kC3_12 = 0.0;
+layout(constant_id = 113) const float kC3_13 = 0.0;
+layout(constant_id = 114) const float kC3_14 = 0.0;
+layout(constant_id = 115) const float kC3_15 = 0.0;
 
 // The filterable maps' parameters (scene::MomentSettings, raster/moment_maps.h), read only by
 // the vsm, evsm2, evsm4, esm and msm filters.

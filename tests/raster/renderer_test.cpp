@@ -1311,6 +1311,57 @@ TEST(RasterRenderer, LightConstantsFromTheVertexShaderOrBakedInGiveTheSameFrameB
             }
 }
 
+TEST(RasterRenderer, CascadedLightConstantsBakedInGiveTheUniformBuffersFrameBitForBit) {
+    // One cascaded sun: its constants and every cascade's map, slice end, texel size, depth scale
+    // and bias baked into the lit pipelines (shaders/lit_constants.glsl kSpecializedCascades), which
+    // pick a pixel's cascade by selects instead of indexing the uniform buffer. The same floats in
+    // the same arithmetic: every channel the same bit for bit as the uniform buffer's frame. A
+    // cascade's value packed into another's place, or a row of its matrix into another's, moves the
+    // shadows of that slice. Three cascades with blend bands (two cascades read per pixel there),
+    // four without; pcf2x2 (the size-optimized *_sun modules) and poisson (the general modules).
+    // And without any bias: acne over every lit surface, whose pattern follows each cascade's texel
+    // grid and depths, so a slice end or a matrix entry off by a little changes many pixels.
+    const scene::Scene s = test::makeLongPlane(320, 180);
+    struct Case {
+        int cascades;
+        double blend;
+        ShadowFilter filter;
+        bool biased;
+    };
+    for (const Case c : {Case{3, 0.3, ShadowFilter::Pcf2x2, true}, Case{4, 0.0, ShadowFilter::Pcf2x2, true},
+                         Case{4, 0.2, ShadowFilter::Poisson, true}, Case{4, 0.2, ShadowFilter::None, false}}) {
+        scene::RasterSettings settings = validatedSettings(512, 0.0, c.biased ? 1.0 : 0.0, c.filter);
+        if (c.biased) settings.depthBias = scene::defaultDepthBias(s, 512);
+        settings.cascades = c.cascades;
+        settings.cascadeBlend = c.blend;
+        const std::string what = std::to_string(c.cascades) + " cascades, blend " + std::to_string(c.blend) +
+                                 ", filter " + std::to_string(int(c.filter)) + (c.biased ? "" : ", no bias");
+        Renderer buffer(s, planFor(s, settings), settings,
+                        RendererOptions{.lightConstants = LightConstants::kUniformBuffer});
+        Renderer baked(s, planFor(s, settings), settings);
+        const scene::Frame a = buffer.render(), b = baked.render();
+        EXPECT_EQ(a.attributes.at("light_constants"), "uniform-buffer") << what;
+        EXPECT_EQ(b.attributes.at("light_constants"), "specialization") << what;
+        EXPECT_EQ(b.attributes.at("cascades"), std::to_string(c.cascades)) << what;
+        // Shadows in the near and the far half of the view depths (different cascades).
+        float nearest = INFINITY, farthest = 0.0f;
+        for (std::size_t i = 0; i < a.pixelCount(); ++i)
+            if (a.objectId[i] > 0.0f) {
+                nearest = std::min(nearest, a.depth[i]);
+                farthest = std::max(farthest, a.depth[i]);
+            }
+        std::size_t nearShadow = 0, farShadow = 0;
+        const float middle = std::sqrt(nearest * farthest);
+        for (std::size_t i = 0; i < a.pixelCount(); ++i)
+            if (a.objectId[i] > 0.0f && a.visibility[i] < 0.5f) ++(a.depth[i] < middle ? nearShadow : farShadow);
+        EXPECT_GT(nearShadow, 200u) << what;
+        EXPECT_GT(farShadow, 20u) << what;
+        test::expectSamePixels(a, b, what.c_str());
+        EXPECT_EQ(buffer.validationMessages(), 0);
+        EXPECT_EQ(baked.validationMessages(), 0);
+    }
+}
+
 TEST(RasterRenderer, AnUpdateThatChangesTheBakedLightConstantsSwitchesToFlatInputsWithTheSameFrames) {
     // A Renderer keeps its baked-in pipelines through an update() that leaves the light's constants
     // as they are, and one that changes them (a moved sun, then a moved camera: the view axis is one
@@ -1343,11 +1394,39 @@ TEST(RasterRenderer, AnUpdateThatChangesTheBakedLightConstantsSwitchesToFlatInpu
     EXPECT_EQ(flat.validationMessages(), 0);
 }
 
-TEST(RasterRenderer, LightConstantsAreBakedInWhereTheVertexShaderGivesTheLightsMapCoordinates) {
-    // By default lit.frag takes the one light's constants as specialization constants wherever it
-    // takes that light's map coordinates from lit.vert (one directional light with one map, or one
-    // spot; no receiver plane); a second light, cascades or the receiver-plane bias keep the uniform
-    // buffer.
+TEST(RasterRenderer, AnUpdateThatMovesTheCascadesSwitchesToTheUniformBufferWithTheSameFrames) {
+    // Cascades follow the camera: a moved camera changes the baked cascades, and the Renderer reads
+    // them from the uniform buffer from then on, each frame the same bit for bit as a Renderer that
+    // always did.
+    const scene::Scene s = test::makeLongPlane(160, 90);
+    scene::RasterSettings settings = validatedSettings(512, 0.0, 1.0, ShadowFilter::Pcf2x2);
+    settings.depthBias = scene::defaultDepthBias(s, 512);
+    settings.cascades = 3;
+    Renderer baked(s, planFor(s, settings), settings);
+    Renderer buffer(s, planFor(s, settings), settings,
+                    RendererOptions{.lightConstants = LightConstants::kUniformBuffer});
+    auto expectSame = [&](const char* what, const char* source) {
+        const scene::Frame a = baked.render(), b = buffer.render();
+        EXPECT_EQ(a.attributes.at("light_constants"), source) << what;
+        test::expectSamePixels(a, b, what);
+    };
+    expectSame("before any update", "specialization");
+    baked.update(s);
+    buffer.update(s);
+    expectSame("after an update to the same scene", "specialization");
+    scene::Scene moved = s;
+    moved.camera.position += scene::Vec3(1.5, 0.2, -4.0);
+    baked.update(moved);
+    buffer.update(moved);
+    expectSame("after the camera moved", "uniform-buffer");
+    EXPECT_EQ(baked.validationMessages(), 0);
+    EXPECT_EQ(buffer.validationMessages(), 0);
+}
+
+TEST(RasterRenderer, LightConstantsAreBakedInForOneSunOrSpotWithoutTheReceiverPlane) {
+    // By default lit.frag takes the one light's constants as specialization constants where the
+    // scene has one directional light (one map or cascades) or one spot, and no receiver-plane bias;
+    // a second light or the receiver-plane bias keep the uniform buffer.
     const scene::RasterSettings settings = validatedSettings(256, 0.01, 1.0, ShadowFilter::Pcf2x2);
     const scene::Scene one = makeScene(SphereOverPlane{});
     auto source = [](const scene::Scene& s, const scene::RasterSettings& r) {
@@ -1372,6 +1451,8 @@ TEST(RasterRenderer, LightConstantsAreBakedInWhereTheVertexShaderGivesTheLightsM
     EXPECT_EQ(source(one, plane), "uniform-buffer");
     scene::RasterSettings cascades = settings;
     cascades.cascades = 3;
+    EXPECT_EQ(source(one, cascades), "specialization");
+    cascades.receiverPlaneBias = true;
     EXPECT_EQ(source(one, cascades), "uniform-buffer");
 }
 
