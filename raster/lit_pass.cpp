@@ -63,35 +63,53 @@ std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUn
     return c;
 }
 
-namespace {
-
-// lit.frag's SPIR-V for the variant: its outputs (beauty only, the AOVs, the per-light targets),
-// the camera's alpha test, and for none and pcf2x2 the *_taps build without the other filters' code
-// (lavapipe turns all of a module into NIR before the specialization constants remove what a
-// pipeline does not run: the full module doubled the lit pipeline's creation); where usesSunModules(),
-// the *_sun modules (*_sun_map with one map and no blend bands).
-std::span<const std::uint32_t> litFragment(const LitVariant& v, bool alpha) {
+// lit.frag: its outputs (beauty only, the AOVs, the per-light targets), the camera's alpha test,
+// and for none and pcf2x2 the *_taps build without the other filters' code (lavapipe turns all of a
+// module into NIR before the specialization constants remove what a pipeline does not run: the full
+// module doubled the lit pipeline's creation); where usesSunModules(), the *_sun modules (*_sun_map
+// with one map and no blend bands, *_baked of those for baked constants). lit.vert: the build whose
+// outputs are the fragment shader's inputs.
+LitStages litStages(const LitVariant& v, bool alpha) {
     const bool taps = v.filter == scene::ShadowFilter::None || v.filter == scene::ShadowFilter::Pcf2x2;
-    const bool sun = usesSunModules(v);
-    if (sun && v.cascades == 1 && !v.cascadeBlend) {
+    if (usesSunModules(v)) {
+        // The no-id lit.vert where the fragment shader reads no object id (spirv-opt removed it).
+        const bool noId = !alpha && !v.aovTarget;
+        if (v.cascades == 1 && !v.cascadeBlend && v.specializedLightConstants) {
+            const auto vertex = alpha  ? shaders::litVertAlphaBakedSpirv()
+                                : noId ? shaders::litVertNoIdBakedSpirv()
+                                       : shaders::litVertBakedSpirv();
+            if (!v.aovTarget)
+                return {vertex, alpha ? shaders::litFragBeautyAlphaTapsSunMapBakedSpirv()
+                                      : shaders::litFragBeautyTapsSunMapBakedSpirv()};
+            return {vertex,
+                    alpha ? shaders::litFragAlphaTapsSunMapBakedSpirv() : shaders::litFragTapsSunMapBakedSpirv()};
+        }
+        if (v.cascades == 1 && !v.cascadeBlend) {
+            const auto vertex = alpha  ? shaders::litVertAlphaSpirv()
+                                : noId ? shaders::litVertNoIdSpirv()
+                                       : shaders::litVertSpirv();
+            if (!v.aovTarget)
+                return {vertex,
+                        alpha ? shaders::litFragBeautyAlphaTapsSunMapSpirv() : shaders::litFragBeautyTapsSunMapSpirv()};
+            return {vertex, alpha ? shaders::litFragAlphaTapsSunMapSpirv() : shaders::litFragTapsSunMapSpirv()};
+        }
+        const auto vertex = alpha  ? shaders::litVertAlphaCascadesSpirv()
+                            : noId ? shaders::litVertNoIdCascadesSpirv()
+                                   : shaders::litVertCascadesSpirv();
         if (!v.aovTarget)
-            return alpha ? shaders::litFragBeautyAlphaTapsSunMapSpirv() : shaders::litFragBeautyTapsSunMapSpirv();
-        return alpha ? shaders::litFragAlphaTapsSunMapSpirv() : shaders::litFragTapsSunMapSpirv();
+            return {vertex, alpha ? shaders::litFragBeautyAlphaTapsSunSpirv() : shaders::litFragBeautyTapsSunSpirv()};
+        return {vertex, alpha ? shaders::litFragAlphaTapsSunSpirv() : shaders::litFragTapsSunSpirv()};
     }
-    if (sun && !v.aovTarget)
-        return alpha ? shaders::litFragBeautyAlphaTapsSunSpirv() : shaders::litFragBeautyTapsSunSpirv();
-    if (sun) return alpha ? shaders::litFragAlphaTapsSunSpirv() : shaders::litFragTapsSunSpirv();
+    const auto vertex = alpha ? shaders::litVertAlphaSpirv() : shaders::litVertSpirv();
     if (!v.aovTarget)
-        return taps ? (alpha ? shaders::litFragBeautyAlphaTapsSpirv() : shaders::litFragBeautyTapsSpirv())
-                    : (alpha ? shaders::litFragBeautyAlphaSpirv() : shaders::litFragBeautySpirv());
+        return {vertex, taps ? (alpha ? shaders::litFragBeautyAlphaTapsSpirv() : shaders::litFragBeautyTapsSpirv())
+                             : (alpha ? shaders::litFragBeautyAlphaSpirv() : shaders::litFragBeautySpirv())};
     if (v.lightTargets > 0)
-        return taps ? (alpha ? shaders::litFragLightsAlphaTapsSpirv() : shaders::litFragLightsTapsSpirv())
-                    : (alpha ? shaders::litFragLightsAlphaSpirv() : shaders::litFragLightsSpirv());
-    return taps ? (alpha ? shaders::litFragAlphaTapsSpirv() : shaders::litFragTapsSpirv())
-                : (alpha ? shaders::litFragAlphaSpirv() : shaders::litFragSpirv());
+        return {vertex, taps ? (alpha ? shaders::litFragLightsAlphaTapsSpirv() : shaders::litFragLightsTapsSpirv())
+                             : (alpha ? shaders::litFragLightsAlphaSpirv() : shaders::litFragLightsSpirv())};
+    return {vertex, taps ? (alpha ? shaders::litFragAlphaTapsSpirv() : shaders::litFragTapsSpirv())
+                         : (alpha ? shaders::litFragAlphaSpirv() : shaders::litFragSpirv())};
 }
-
-}  // namespace
 
 LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkDescriptorSetLayout alphaSetLayout,
                               const glm::vec3& background, bool withBackground) {
@@ -210,21 +228,19 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkD
         colorFormats.insert(colorFormats.end(), kLitPlanes - 1, kLitPlaneFormat);
         colorFormats.insert(colorFormats.end(), variant.lightTargets, kLitLightsFormat);
     }
-    p.pipeline = createGraphicsPipeline(
-        ctx, PipelineDesc{
-                 .vertexShader = p.alpha                                         ? shaders::litVertAlphaSpirv()
-                                 : usesSunModules(variant) && !variant.aovTarget ? shaders::litVertNoIdSpirv()
-                                                                                 : shaders::litVertSpirv(),
-                 .fragmentShader = litFragment(variant, p.alpha),
-                 .fragmentSpecialization = &specialization,
-                 .vertexSpecialization = &specialization,
-                 .layout = layout,
-                 .usesUv = p.alpha,
-                 .colorFormats = colorFormats,
-                 .depthFormat = kLitDepthFormat,
-                 // Reversed Z: nearer is larger.
-                 .depthCompare = VK_COMPARE_OP_GREATER,
-             });
+    const LitStages stages = litStages(variant, p.alpha);
+    p.pipeline = createGraphicsPipeline(ctx, PipelineDesc{
+                                                 .vertexShader = stages.vertex,
+                                                 .fragmentShader = stages.fragment,
+                                                 .fragmentSpecialization = &specialization,
+                                                 .vertexSpecialization = &specialization,
+                                                 .layout = layout,
+                                                 .usesUv = p.alpha,
+                                                 .colorFormats = colorFormats,
+                                                 .depthFormat = kLitDepthFormat,
+                                                 // Reversed Z: nearer is larger.
+                                                 .depthCompare = VK_COMPARE_OP_GREATER,
+                                             });
     if (!variant.displayTarget && withBackground) {
         // The background: where the depth is still the cleared far plane (0), which no fragment
         // of the scene can leave there (GREATER than 0 to be drawn). Its color as specialization

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -84,6 +85,15 @@ bool bakesLightConstants(const LitVariant& variant);
 // Whether the variant has the constants SHADOWLAB_ONE_SUN fixes (lit_constants.glsl), with none or
 // pcf2x2: the *_taps_sun modules (where LitVariant::sunModules asks for them).
 bool usesSunModules(const LitVariant& variant);
+// The SPIR-V of the lit pipeline's two stages for the variant (with the camera's alpha test or
+// not). Each pair's vertex outputs are exactly its fragment inputs: llvmpipe stores every declared
+// output per vertex and sets up every declared input per triangle, used or not, so the baked-constant
+// and cascaded-sun pairs declare no flat light interface (docs/raster.md).
+struct LitStages {
+    std::span<const std::uint32_t> vertex;
+    std::span<const std::uint32_t> fragment;
+};
+LitStages litStages(const LitVariant& variant, bool alpha);
 // Per-light visibility targets: four lights in each RGBA32F target, SHADOWLAB_MAX_LIGHTS in all.
 inline constexpr std::uint32_t kLightTargets = (SHADOWLAB_MAX_LIGHTS + 3) / 4;
 

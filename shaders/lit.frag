@@ -37,15 +37,21 @@ const float kPcssMaxFilterFraction = 1.0 / 8.0;
 layout(location = 0) in vec3 inPosition;  // camera-relative world position
 layout(location = 1) in vec3 inNormal;
 layout(location = 2) flat in uint inObjectId;
+#ifndef SHADOWLAB_NO_VERTEX_LIGHT
 layout(location = 3) in vec4 inLightCoordinates;  // lit.vert: light 0's toShadow · (p, 1)
 layout(location = 4) in vec4 inLightNormal;       // lit.vert: toShadow · (the unnormalized normal, 0)
+#endif
 // The object's albedo (rgb) and 1 − opacity (a), which lit.vert reads from the per-object buffer
 // (binding 1): flat, so the same value as a read here, without a buffer lookup per fragment.
 layout(location = 5) flat in vec4 inAlbedo;
 // kVertexLightConstants: light 0's constants, and LitUniforms' forward, ambient and map size, from
-// lit.vert (lightAt(), viewForward(), ambient(), mapSize()).
+// lit.vert (lightAt(), viewForward(), ambient(), mapSize()). Not declared in the modules for baked
+// constants (SHADOWLAB_BAKED_LIGHT, lit_constants.glsl): llvmpipe sets up every declared input
+// per triangle, read or not.
+#ifndef SHADOWLAB_BAKED_LIGHT
 layout(location = 6) flat in vec4 inLight[6];
 layout(location = 12) flat in vec4 inFrame[2];
+#endif
 
 // One color attachment per Frame channel (raster/lit_pass.h LitPlane), so that each is the
 // Frame's own layout and lavapipe can render into the Frame's memory (no readback copy).
@@ -86,11 +92,35 @@ vec4 lightSlot(int k) {
         if (k == 4) return vec4(kL40, kL41, kL42, kL43);
         return vec4(kL50, kL51, kL52, kL53);
     }
+#ifdef SHADOWLAB_BAKED_LIGHT
+    return vec4(0.0);  // not reached: kVertexLightConstants is false there
+#else
     return inLight[k];
+#endif
 }
 vec4 frameSlot(int k) {
     if (kSpecializedLightConstants) return k == 0 ? vec4(kF00, kF01, kF02, kF03) : vec4(kF10, kF11, kF12, kF13);
+#ifdef SHADOWLAB_BAKED_LIGHT
+    return vec4(0.0);
+#else
     return inFrame[k];
+#endif
+}
+// lit.vert's map coordinates of the point and of its normal (read only where
+// kVertexLightCoordinates; not declared in the modules that never read them).
+vec4 vertexMapPoint() {
+#ifdef SHADOWLAB_NO_VERTEX_LIGHT
+    return vec4(0.0);
+#else
+    return inLightCoordinates;
+#endif
+}
+vec4 vertexMapNormal() {
+#ifdef SHADOWLAB_NO_VERTEX_LIGHT
+    return vec4(0.0);
+#else
+    return inLightNormal;
+#endif
 }
 // Light i's constants: the uniform buffer's, or (kVertexLightConstants: the one light) light 0's as
 // lit.vert packs them, its flat outputs or the same values baked in. The members lit.vert does not
@@ -445,7 +475,7 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
     // World size of a texel at p: constant for an orthographic map, growing with distance
     // along the axis for a perspective one. (kVertexSpot: toShadow's w row is that distance,
     // (axis, −axis·L), so lit.vert's interpolated w is it.)
-    const float axialP = kVertexSpot ? inLightCoordinates.w : dot(p - light.position, axis);
+    const float axialP = kVertexSpot ? vertexMapPoint().w : dot(p - light.position, axis);
     const float texel = light.texelWorldSize * (perspective ? axialP : 1.0);
     // Normal offset: look the map up from a point moved off the surface along its normal, by the
     // user's k texels plus the slope bias beyond its cap: s·texel·(sin θ − maxTan·cos θ) puts the
@@ -477,8 +507,7 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         // offset point. Each component rounds at its own scale (x, y ≈ w·(u, v): ≈1e-7 of w, so
         // ≈1e-7 of the map after the divide; w ≈1e-7 of max(|p|, |L|) camera-relative, against a
         // bias of half a texel ≈ 1e-3·w at 2048²), as the per-fragment product does.
-        const vec4 s =
-            kNormalOffset ? inLightCoordinates + (offset * nScale) * inLightNormal : inLightCoordinates;
+        const vec4 s = kNormalOffset ? vertexMapPoint() + (offset * nScale) * vertexMapNormal() : vertexMapPoint();
         r.uv = kVertexSpot ? s.xy / s.w : s.xy;
         r.axial = kVertexSpot ? s.w : s.z;
     } else {

@@ -22,8 +22,10 @@ layout(location = 2) flat out uint outObjectId;
 // normal (toShadow · (n, 0)), which lit.frag interpolates instead of a matrix product per fragment
 // where that light is the only one and directional or a spot (kVertexLightCoordinates); unused
 // otherwise. The w row matters for a spot (its perspective divide and its distance along the axis).
+#ifndef SHADOWLAB_NO_VERTEX_LIGHT
 layout(location = 3) out vec4 outLightCoordinates;
 layout(location = 4) out vec4 outLightNormal;
+#endif
 // The object's albedo (lit.frag's), read here once per vertex instead of once per fragment.
 layout(location = 5) flat out vec4 outAlbedo;
 // kVertexLightConstants (lit_constants.glsl): the members of light 0's LightData that lit.frag reads
@@ -31,8 +33,12 @@ layout(location = 5) flat out vec4 outAlbedo;
 // lightAt() unpacks them, and LitUniforms' forward, ambient and map size; written only then.
 // (Locations 0..13, 56 components: within the 64 every Vulkan device must take,
 // maxVertexOutputComponents and maxFragmentInputComponents.)
+// Neither is declared in the variants for lit.frag's modules without them (SHADOWLAB_BAKED_LIGHT,
+// SHADOWLAB_NO_VERTEX_LIGHT: lit_constants.glsl), since llvmpipe stores every declared output.
+#ifndef SHADOWLAB_BAKED_LIGHT
 layout(location = 6) flat out vec4 outLight[6];
 layout(location = 12) flat out vec4 outFrame[2];
+#endif
 #ifdef SHADOWLAB_ALPHA
 // The lit_vert_alpha variant (scenes with MASK or BLEND materials): the texture coordinates of
 // vertex binding 1 for lit.frag's alpha test (58 components in all).
@@ -52,8 +58,11 @@ void main() {
     outUv = inUv;
 #endif
     outAlbedo = albedo[inObjectId - 1u];
+#ifndef SHADOWLAB_NO_VERTEX_LIGHT
     outLightCoordinates = u.lights[0].toShadow * vec4(inPosition, 1.0);
     outLightNormal = u.lights[0].toShadow * vec4(inNormal, 0.0);
+#endif
+#ifndef SHADOWLAB_BAKED_LIGHT
     if (kVertexLightConstants && !kSpecializedLightConstants) {
         const LightData light = u.lights[0];
         outLight[0] = vec4(kVertexSpot ? light.position : light.towardLight, light.layer);
@@ -67,5 +76,6 @@ void main() {
         outFrame[0] = vec4(u.forward, u.ambient);
         outFrame[1] = vec4(u.mapSize, 0.0, 0.0, 0.0);
     }
+#endif
     gl_Position = u.viewProj * vec4(inPosition, 1.0);
 }

@@ -53,9 +53,19 @@ layout(constant_id = 9) const bool kNormalOffset = true;
 // fragment.
 // (Written without ||: glslang turns || of specialization constants into a branch and an OpPhi
 // inside a function, which the constant's uses elsewhere cannot see.)
+// SHADOWLAB_NO_VERTEX_LIGHT (the cascaded *_sun modules and their lit.vert): never, so neither
+// stage declares the map coordinates (llvmpipe stores and sets up every declared varying).
+#ifdef SHADOWLAB_NO_VERTEX_LIGHT
+#ifndef SHADOWLAB_BAKED_LIGHT
+#error SHADOWLAB_NO_VERTEX_LIGHT goes with SHADOWLAB_BAKED_LIGHT (no flat light inputs either)
+#endif
+const bool kVertexSpot = false;
+const bool kVertexDirectional = false;
+#else
 const bool kVertexSpot = kLightCount == 1 && kLightKinds == (1 << SHADOWLAB_LIGHT_SPOT) && !kReceiverPlane;
 const bool kVertexDirectional = kLightCount == 1 && kLightKinds == (1 << SHADOWLAB_LIGHT_DIRECTIONAL) &&
                                 kCascades == 1 && !kReceiverPlane;
+#endif
 const bool kVertexLightCoordinates = !(!kVertexSpot && !kVertexDirectional);
 const bool kAnyPerspective =
     (kLightKinds & ((1 << SHADOWLAB_LIGHT_SPOT) | (1 << SHADOWLAB_LIGHT_POINT))) != 0;
@@ -67,8 +77,14 @@ const bool kAnyPerspective =
 // eight pixels; a flat input is set up once per triangle and then read as a constant
 // (docs/performance.md: less CPU per frame on the seed scene and on Sponza, down to half a pixel
 // per triangle). The values are the same floats either way (raster::LightConstants).
+// SHADOWLAB_BAKED_LIGHT (the modules raster/lit_pass.cpp picks for baked constants, below): never;
+// those modules declare no flat light inputs, which llvmpipe would set up per triangle unread.
 layout(constant_id = 10) const bool kVertexLightConstantsAsked = false;
+#ifdef SHADOWLAB_BAKED_LIGHT
+const bool kVertexLightConstants = false;
+#else
 const bool kVertexLightConstants = kVertexLightConstantsAsked && kVertexLightCoordinates;
+#endif
 // The same values baked into the pipeline (raster::LightConstants::kSpecialization): lit.frag reads
 // them as constants 18..49, packed as lit.vert packs outLight[0..5] and outFrame[0..1], and lit.vert
 // writes neither. A flat input costs llvmpipe its setup and 48 bytes per triangle in every bin it

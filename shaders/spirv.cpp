@@ -12,14 +12,17 @@
 #include "lit_frag_alpha_taps.spv.h"
 #include "lit_frag_alpha_taps_sun.spv.h"
 #include "lit_frag_alpha_taps_sun_map.spv.h"
+#include "lit_frag_alpha_taps_sun_map_baked.spv.h"
 #include "lit_frag_beauty.spv.h"
 #include "lit_frag_beauty_alpha.spv.h"
 #include "lit_frag_beauty_alpha_taps.spv.h"
 #include "lit_frag_beauty_alpha_taps_sun.spv.h"
 #include "lit_frag_beauty_alpha_taps_sun_map.spv.h"
+#include "lit_frag_beauty_alpha_taps_sun_map_baked.spv.h"
 #include "lit_frag_beauty_taps.spv.h"
 #include "lit_frag_beauty_taps_sun.spv.h"
 #include "lit_frag_beauty_taps_sun_map.spv.h"
+#include "lit_frag_beauty_taps_sun_map_baked.spv.h"
 #include "lit_frag_lights.spv.h"
 #include "lit_frag_lights_alpha.spv.h"
 #include "lit_frag_lights_alpha_taps.spv.h"
@@ -27,9 +30,16 @@
 #include "lit_frag_taps.spv.h"
 #include "lit_frag_taps_sun.spv.h"
 #include "lit_frag_taps_sun_map.spv.h"
+#include "lit_frag_taps_sun_map_baked.spv.h"
 #include "lit_vert.spv.h"
 #include "lit_vert_alpha.spv.h"
+#include "lit_vert_alpha_baked.spv.h"
+#include "lit_vert_alpha_cascades.spv.h"
+#include "lit_vert_baked.spv.h"
+#include "lit_vert_cascades.spv.h"
 #include "lit_vert_no_id.spv.h"
+#include "lit_vert_no_id_baked.spv.h"
+#include "lit_vert_no_id_cascades.spv.h"
 #include "moments_comp.spv.h"
 #include "shadow_frag.spv.h"
 #include "shadow_frag_alpha.spv.h"
@@ -80,6 +90,18 @@ std::span<const std::uint32_t> litFragAlphaTapsSunMapSpirv() { return kLitFragAl
 std::span<const std::uint32_t> litFragBeautyTapsSunMapSpirv() { return kLitFragBeautyTapsSunMapSpv; }
 std::span<const std::uint32_t> litFragBeautyAlphaTapsSunMapSpirv() { return kLitFragBeautyAlphaTapsSunMapSpv; }
 std::span<const std::uint32_t> litVertNoIdSpirv() { return kLitVertNoIdSpv; }
+std::span<const std::uint32_t> litFragTapsSunMapBakedSpirv() { return kLitFragTapsSunMapBakedSpv; }
+std::span<const std::uint32_t> litFragAlphaTapsSunMapBakedSpirv() { return kLitFragAlphaTapsSunMapBakedSpv; }
+std::span<const std::uint32_t> litFragBeautyTapsSunMapBakedSpirv() { return kLitFragBeautyTapsSunMapBakedSpv; }
+std::span<const std::uint32_t> litFragBeautyAlphaTapsSunMapBakedSpirv() {
+    return kLitFragBeautyAlphaTapsSunMapBakedSpv;
+}
+std::span<const std::uint32_t> litVertBakedSpirv() { return kLitVertBakedSpv; }
+std::span<const std::uint32_t> litVertAlphaBakedSpirv() { return kLitVertAlphaBakedSpv; }
+std::span<const std::uint32_t> litVertNoIdBakedSpirv() { return kLitVertNoIdBakedSpv; }
+std::span<const std::uint32_t> litVertCascadesSpirv() { return kLitVertCascadesSpv; }
+std::span<const std::uint32_t> litVertAlphaCascadesSpirv() { return kLitVertAlphaCascadesSpv; }
+std::span<const std::uint32_t> litVertNoIdCascadesSpirv() { return kLitVertNoIdCascadesSpv; }
 std::span<const std::uint32_t> backgroundVertSpirv() { return kBackgroundVertSpv; }
 std::span<const std::uint32_t> backgroundFragSpirv() { return kBackgroundFragSpv; }
 std::span<const std::uint32_t> backgroundFragBeautySpirv() { return kBackgroundFragBeautySpv; }

@@ -8,6 +8,9 @@
 
 #include <array>
 #include <cmath>
+#include <map>
+#include <set>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -226,6 +229,99 @@ TEST(RasterLitPass, TheLightsMapCoordinatesComeFromTheVertexShaderOnlyForOneDire
     EXPECT_FALSE(usesVertexLightCoordinates({.lightCount = 2, .lightKinds = dir}));
     EXPECT_FALSE(usesVertexLightCoordinates({.lightKinds = spot, .receiverPlane = true}));
     EXPECT_FALSE(usesVertexLightCoordinates({.lightKinds = dir | spot}));
+}
+
+// The locations of a SPIR-V module's Input (or Output) variables that carry a Location decoration
+// (built-ins have none), read from the instruction stream as the SPIR-V specification lays it out:
+// a five-word header, then instructions whose first word holds the word count (high 16 bits) and
+// the opcode (low 16): OpDecorate (71) target, decoration (Location = 30), value; OpVariable (59)
+// result type, result id, storage class (Input = 1, Output = 3).
+std::set<std::uint32_t> interfaceLocations(std::span<const std::uint32_t> spirv, std::uint32_t storageClass) {
+    constexpr std::uint32_t kOpDecorate = 71, kOpVariable = 59, kLocation = 30;
+    std::map<std::uint32_t, std::uint32_t> locationOf;
+    std::vector<std::uint32_t> variables;
+    for (std::size_t at = 5; at < spirv.size();) {
+        const std::uint32_t count = spirv[at] >> 16, opcode = spirv[at] & 0xffffu;
+        if (count == 0 || at + count > spirv.size()) {
+            ADD_FAILURE() << "malformed SPIR-V at word " << at;
+            return {};
+        }
+        if (opcode == kOpDecorate && count >= 4 && spirv[at + 2] == kLocation)
+            locationOf[spirv[at + 1]] = spirv[at + 3];
+        if (opcode == kOpVariable && count >= 4 && spirv[at + 3] == storageClass) variables.push_back(spirv[at + 2]);
+        at += count;
+    }
+    std::set<std::uint32_t> locations;
+    for (std::uint32_t id : variables)
+        if (const auto found = locationOf.find(id); found != locationOf.end()) locations.insert(found->second);
+    return locations;
+}
+
+TEST(RasterLitPass, EachVertexShaderWritesExactlyWhatItsFragmentShaderReads) {
+    // lit.frag's inputs must all be lit.vert's outputs (Vulkan's interface rule), and an output no
+    // input takes still costs llvmpipe a store per vertex, as a declared input costs it a setup per
+    // triangle: so the sets are equal, for every pair litStages() hands out.
+    constexpr std::uint32_t kInput = 1, kOutput = 3;
+    constexpr std::uint32_t dir = 1u << SHADOWLAB_LIGHT_DIRECTIONAL, spot = 1u << SHADOWLAB_LIGHT_SPOT;
+    int pairs = 0;
+    for (const scene::ShadowFilter filter : {scene::ShadowFilter::Pcf2x2, scene::ShadowFilter::Pcf})
+        for (const bool aov : {true, false})
+            for (const std::uint32_t lightTargets : {0u, kLightTargets})
+                for (const std::uint32_t kinds : {dir, spot, dir | spot})
+                    for (const std::uint32_t cascades : {1u, 4u})
+                        for (const bool blend : {false, true})
+                            for (const bool baked : {false, true})
+                                for (const bool sun : {true, false})
+                                    for (const bool alpha : {false, true}) {
+                                        if ((lightTargets > 0 && !aov) || (blend && cascades == 1)) continue;
+                                        LitVariant v{.filter = filter,
+                                                     .aovTarget = aov,
+                                                     .lightTargets = lightTargets,
+                                                     .lightCount = kinds == (dir | spot) ? 2u : 1u,
+                                                     .lightKinds = kinds,
+                                                     .cascades = cascades,
+                                                     .cascadeBlend = blend,
+                                                     .vertexLightConstants = true,
+                                                     .specializedLightConstants = baked,
+                                                     .sunModules = sun};
+                                        const LitStages stages = litStages(v, alpha);
+                                        EXPECT_EQ(interfaceLocations(stages.vertex, kOutput),
+                                                  interfaceLocations(stages.fragment, kInput))
+                                            << "filter " << int(filter) << " aov " << aov << " light targets "
+                                            << lightTargets << " kinds " << kinds << " cascades " << cascades
+                                            << " blend " << blend << " baked " << baked << " sun modules " << sun
+                                            << " alpha " << alpha;
+                                        ++pairs;
+                                    }
+    EXPECT_GT(pairs, 100);
+}
+
+TEST(RasterLitPass, OneSunWithBakedConstantsOrCascadesHasNoFlatLightInterface) {
+    // lit.vert's flat light constants sit at locations 6..13 (outLight[6], outFrame[2]) and light
+    // 0's map coordinates at 3 and 4. One sun with its constants baked in reads neither constant
+    // slot; a cascaded sun reads neither those nor the coordinates (a matrix per cascade). Neither
+    // stage may declare what the pipeline does not read.
+    constexpr std::uint32_t kInput = 1, kOutput = 3;
+    constexpr std::uint32_t dir = 1u << SHADOWLAB_LIGHT_DIRECTIONAL;
+    for (const bool alpha : {false, true})
+        for (const bool aov : {true, false}) {
+            const LitStages oneMap =
+                litStages({.aovTarget = aov, .lightKinds = dir, .specializedLightConstants = true}, alpha);
+            const LitStages cascaded = litStages({.aovTarget = aov, .lightKinds = dir, .cascades = 4}, alpha);
+            for (const std::uint32_t slot : {6u, 12u}) {
+                EXPECT_FALSE(interfaceLocations(oneMap.vertex, kOutput).contains(slot)) << slot;
+                EXPECT_FALSE(interfaceLocations(oneMap.fragment, kInput).contains(slot)) << slot;
+                EXPECT_FALSE(interfaceLocations(cascaded.fragment, kInput).contains(slot)) << slot;
+            }
+            EXPECT_TRUE(interfaceLocations(oneMap.fragment, kInput).contains(3u));  // the coordinates stay
+            for (const std::uint32_t slot : {3u, 4u})
+                EXPECT_FALSE(interfaceLocations(cascaded.fragment, kInput).contains(slot)) << slot;
+            // The flat-output path keeps them: lit.frag reads them there.
+            const LitStages flat =
+                litStages({.aovTarget = aov, .lightKinds = dir, .vertexLightConstants = true}, alpha);
+            EXPECT_TRUE(interfaceLocations(flat.fragment, kInput).contains(6u));
+            EXPECT_TRUE(interfaceLocations(flat.vertex, kOutput).contains(12u));
+        }
 }
 
 }  // namespace
