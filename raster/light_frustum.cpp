@@ -791,14 +791,22 @@ MapExtent perspectiveReceiverExtent(const std::vector<Vec3>& receivers, const Li
 
 std::vector<bool> castsOnto(const scene::Scene& scene, const LightFrustum& f, const std::vector<Vec3>& receivers,
                             double reachTexels, double normalOffsetTexels) {
-    std::vector<bool> casts(scene.objects.size(), true);
+    std::vector<scene::Bounds> boxes;
+    boxes.reserve(scene.objects.size());
+    for (const scene::Object& o : scene.objects) boxes.push_back(scene::boundsOf(o.shape));
+    return boxesCastOnto(boxes, f, receivers, reachTexels, normalOffsetTexels);
+}
+
+std::vector<bool> boxesCastOnto(std::span<const scene::Bounds> boxes, const LightFrustum& f,
+                                const std::vector<Vec3>& receivers, double reachTexels, double normalOffsetTexels) {
+    std::vector<bool> casts(boxes.size(), true);
     if (receivers.empty()) return casts;
     if (!f.perspective) {
         const MapExtent r = orthographicExtent(receivers, f);
         // The normal offset moves a receiver by that many texels in any direction.
         const double margin = (reachTexels + normalOffsetTexels) * f.texelWorldSize();
-        for (std::size_t i = 0; i < scene.objects.size(); ++i) {
-            const scene::Bounds b = scene::boundsOf(scene.objects[i].shape);
+        for (std::size_t i = 0; i < boxes.size(); ++i) {
+            const scene::Bounds& b = boxes[i];
             if (b.empty()) continue;
             const MapExtent o = orthographicExtent(corners(b), f);
             casts[i] = o.maxU >= r.minU - margin && o.minU <= r.maxU + margin && o.maxV >= r.minV - margin &&
@@ -817,10 +825,10 @@ std::vector<bool> castsOnto(const scene::Scene& scene, const LightFrustum& f, co
     const double t = std::max(std::abs(f.windowU), std::abs(f.windowV)) + f.tanHalfFov;
     const double margin = (reachTexels + 2.0 * normalOffsetTexels * std::sqrt(1.0 + t * t)) * texelAngle;
     const MapExtent r = perspectiveReceiverExtent(receivers, f);
-    if (r.empty()) return std::vector<bool>(scene.objects.size(), false);  // no receiver in front: none reads it
+    if (r.empty()) return std::vector<bool>(boxes.size(), false);  // no receiver in front: none reads it
     const double farthest = r.maxDepth * (1.0 + margin);
-    for (std::size_t i = 0; i < scene.objects.size(); ++i) {
-        const scene::Bounds b = scene::boundsOf(scene.objects[i].shape);
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+        const scene::Bounds& b = boxes[i];
         if (b.empty()) continue;
         MapExtent o;
         int behind = 0;

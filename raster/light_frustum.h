@@ -4,6 +4,7 @@
 // camera sees) and a point light's cube faces; and the texel size the biases scale with.
 #pragma once
 
+#include <span>
 #include <string>
 #include <vector>
 
@@ -194,6 +195,11 @@ LightFrustum pointLightFaceFrustum(const scene::Scene& scene, const scene::Raste
 // All true when there are no receivers.
 std::vector<bool> castsOnto(const scene::Scene& scene, const LightFrustum& f, const std::vector<scene::Vec3>& receivers,
                             double reachTexels, double normalOffsetTexels);
+// The same test for any boxes (world coordinates; an empty box is kept): the shadow pass's index
+// clusters, whose triangles lie in their boxes as an object's lie in its own.
+std::vector<bool> boxesCastOnto(std::span<const scene::Bounds> boxes, const LightFrustum& f,
+                                const std::vector<scene::Vec3>& receivers, double reachTexels,
+                                double normalOffsetTexels);
 // castsOnto() with every receiver the camera sees (visibleReceiverPoints(scene)).
 std::vector<bool> castsIntoView(const scene::Scene& scene, const LightFrustum& f, double reachTexels,
                                 double normalOffsetTexels = 0.0);

@@ -259,9 +259,12 @@ struct Renderer::Impl {
     std::vector<glm::vec3> hostPositions;  // camera-relative, as the vertex buffer (the runs' pixel areas)
     std::vector<std::uint32_t> hostIndices;
     void splitByLift();  // draw.litRangesByLift for the current lights
-    // RendererOptions::viewCull: the index buffer's clusters (raster/view_cull.h), made once, and
-    // the draw's camera-visible ranges from them for the current view.
-    std::vector<IndexCluster> viewClusters;
+    // The index buffer's clusters (raster/view_cull.h), made once, and their world boxes: the
+    // draw's camera-visible ranges from them for the current view (RendererOptions::viewCull), and
+    // each culled layer's casters cut to the clusters that can cast onto its receivers.
+    std::vector<IndexCluster> clusters;
+    std::vector<scene::Bounds> clusterBoxes;
+    bool viewCull = true;  // RendererOptions::viewCull
     void cullToView();
     // The vertices' lift-free bits (liftFreeVertexBits) and the lights and threshold they were made for.
     std::vector<std::uint32_t> liftBits;
@@ -390,10 +393,12 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
         else
             draw.litRanges.push_back(IndexRange{d.first, d.count, d.cameraAlpha});
     }
-    if (options.viewCull) {
+    viewCull = options.viewCull;
+    {
         std::vector<IndexRange> pieces;
         for (const DrawObject& d : drawObjects) pieces.push_back(IndexRange{d.first, d.count});
-        viewClusters = indexClusters(geometry.vertices, geometry.indices, pieces, kViewCullClusterTriangles);
+        clusters = indexClusters(geometry.vertices, geometry.indices, pieces, kViewCullClusterTriangles);
+        clusterBoxes = worldBoxes(clusters, origin);
     }
 
     // The automatic choices: a default cascade count follows the view, then a default size follows
@@ -455,7 +460,10 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
         albedos.emplace_back(glm::vec3(scene.materialOf(o).albedo),
                              scene.materialOf(o).opaque() ? 1.0f : float(scene.materialOf(o).transmittance(1.0)));
     // Each layer's index ranges: every object the depth pass draws, or the culled layer's casters,
-    // in index order, runs of them merged where they take the same pipeline.
+    // in index order, runs of them merged where they take the same pipeline; a culled layer's then
+    // cut to the clusters that can cast onto its receivers (an object's box can reach them while
+    // most of its triangles cannot: a large ground, a building's far wing).
+    std::vector<int> trianglesPerLayer;
     for (std::size_t k = 0; k < layers.size(); ++k) {
         std::vector<IndexRange> ranges;
         const std::vector<bool>& casters = layers[k].casters;
@@ -467,6 +475,11 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
             else
                 ranges.push_back(IndexRange{d.first, d.count, d.depthAlpha});
         }
+        if (!casters.empty() && !clusters.empty())
+            ranges = intersectRanges(ranges, keptIndexRuns(clusters, layerCastingBoxes(layers[k], clusterBoxes)));
+        std::uint64_t indices = 0;
+        for (const IndexRange& r : ranges) indices += r.count;
+        trianglesPerLayer.push_back(int(indices / 3));
         draw.layerRanges.push_back(std::move(ranges));
     }
     std::vector<int> culledPerLight(scene.lights.size(), 0), culledPerLayer;
@@ -481,14 +494,17 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
     std::set<int> shadowed;
     for (const ShadowLayer& layer : layers) shadowed.insert(layer.light);
     if (layers.size() > shadowed.size()) attributes["culled_casters_per_layer"] = joined(culledPerLayer, count);
+    // The triangles each layer's depth pass draws, in layer order (opaque casters; the
+    // transmittance pass draws the semi-transparent ones).
+    attributes["shadow_triangles_per_layer"] = joined(trianglesPerLayer, count);
     splitByLift();
     cullToView();
 }
 
 void Renderer::Impl::cullToView() {
-    draw.litCulled = !viewClusters.empty();
+    draw.litCulled = viewCull && !clusters.empty();
     if (!draw.litCulled) return;
-    const std::vector<IndexRange> visible = visibleIndexRuns(viewClusters, uniforms.viewProj);
+    const std::vector<IndexRange> visible = visibleIndexRuns(clusters, uniforms.viewProj);
     draw.litRangesVisible = intersectRanges(draw.litRanges, visible);
     draw.litRangesByLiftVisible = intersectRanges(draw.litRangesByLift, visible);
 }

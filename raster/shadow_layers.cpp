@@ -52,7 +52,10 @@ std::vector<ShadowLayer> planShadowLayers(const scene::Scene& scene, const scene
         layer.frustum = f;
         layer.matrix = glm::mat4(f.toClip(origin));
         if (cull) {
-            layer.casters = layerCasters(scene, settings, scene.lights[light], f, layerReceivers);
+            layer.receivers = layerReceivers;
+            layer.cullReachTexels = cullReachTexels(settings, scene.lights[light], f.mapSize);
+            layer.cullOffsetTexels = lookupOffsetTexels(settings);
+            layer.casters = castsOnto(scene, f, layer.receivers, layer.cullReachTexels, layer.cullOffsetTexels);
             for (const bool k : layer.casters) layer.culled += k ? 0 : 1;
         }
         return layer;
@@ -133,6 +136,11 @@ std::vector<ShadowLayer> planShadowLayers(const scene::Scene& scene, const scene
 std::vector<ShadowLayer> planShadowLayers(const scene::Scene& scene, const scene::RenderPlan& plan,
                                           const scene::RasterSettings& settings) {
     return planShadowLayers(scene, plan, settings, scene::cameraBasis(scene.camera).position);
+}
+
+std::vector<bool> layerCastingBoxes(const ShadowLayer& layer, std::span<const scene::Bounds> boxes) {
+    if (layer.casters.empty()) return std::vector<bool>(boxes.size(), true);
+    return boxesCastOnto(boxes, layer.frustum, layer.receivers, layer.cullReachTexels, layer.cullOffsetTexels);
 }
 
 std::vector<double> cascadeSplits(const std::vector<ShadowLayer>& layers) {

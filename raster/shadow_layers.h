@@ -4,6 +4,7 @@
 // the plan without a device.
 #pragma once
 
+#include <span>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,10 @@ struct ShadowLayer {
     // settings.cullCasters off, or a transmittance map, whose draw order is not per object).
     std::vector<bool> casters;
     int culled = 0;  // objects left out of this layer
+    // What the casters were tested against (culling on): the receivers that read this layer, the
+    // filter's reach and the normal offset in its texels, for layerCastingBoxes().
+    std::vector<scene::Vec3> receivers;
+    double cullReachTexels = 0.0, cullOffsetTexels = 0.0;
     // kCascade: the view-depth slice the cascade serves, [splits[index], splits[index + 1]].
     double sliceNear = 0.0, sliceFar = 0.0;
 };
@@ -66,6 +71,11 @@ std::vector<ShadowLayer> planShadowLayers(const scene::Scene& scene, const scene
 // The same relative to scene.camera's position.
 std::vector<ShadowLayer> planShadowLayers(const scene::Scene& scene, const scene::RenderPlan& plan,
                                           const scene::RasterSettings& settings);
+
+// Per box (world coordinates), whether what lies in it can cast onto a receiver of `layer`: the
+// objects' test (castsOnto) for parts of objects, such as the shadow pass's index clusters. All
+// true where the layer culls nothing (layer.casters empty).
+std::vector<bool> layerCastingBoxes(const ShadowLayer& layer, std::span<const scene::Bounds> boxes);
 
 // The cascades' count + 1 split depths along the view, and each cascade's texel world size, of
 // the last cascaded light (the splits are every cascaded light's: they depend on the camera

@@ -51,15 +51,37 @@ bool boxOutsideClipVolume(const glm::vec3& lo, const glm::vec3& hi, const glm::m
 }
 
 std::vector<IndexRange> visibleIndexRuns(std::span<const IndexCluster> clusters, const glm::mat4& viewProj) {
+    std::vector<bool> keep(clusters.size());
+    for (std::size_t i = 0; i < clusters.size(); ++i)
+        keep[i] = !boxOutsideClipVolume(clusters[i].lo, clusters[i].hi, viewProj);
+    return keptIndexRuns(clusters, keep);
+}
+
+std::vector<IndexRange> keptIndexRuns(std::span<const IndexCluster> clusters, const std::vector<bool>& keep) {
     std::vector<IndexRange> runs;
-    for (const IndexCluster& c : clusters) {
-        if (c.count == 0 || boxOutsideClipVolume(c.lo, c.hi, viewProj)) continue;
+    for (std::size_t i = 0; i < clusters.size(); ++i) {
+        const IndexCluster& c = clusters[i];
+        if (c.count == 0 || !keep[i]) continue;
         if (!runs.empty() && runs.back().first + runs.back().count == c.first)
             runs.back().count += c.count;
         else
             runs.push_back(IndexRange{c.first, c.count});
     }
     return runs;
+}
+
+std::vector<scene::Bounds> worldBoxes(std::span<const IndexCluster> clusters, const glm::dvec3& origin) {
+    std::vector<scene::Bounds> boxes;
+    boxes.reserve(clusters.size());
+    for (const IndexCluster& c : clusters) {
+        // The float box holds the float vertices exactly; in double, origin + a float is within an
+        // ulp of the double sum, which the culling margin (texels) dwarfs.
+        scene::Bounds b;
+        b.extend(origin + glm::dvec3(c.lo));
+        b.extend(origin + glm::dvec3(c.hi));
+        boxes.push_back(b);
+    }
+    return boxes;
 }
 
 std::vector<IndexRange> intersectRanges(std::span<const IndexRange> ranges, std::span<const IndexRange> visible) {

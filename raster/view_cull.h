@@ -1,6 +1,7 @@
 // raster/view_cull.h: which runs of the index buffer the camera cannot see, so that the lit pass
 // does not draw them. Exact: only triangles that produce no fragment are left out, and the rest
-// keep their order (draw order decides depth ties).
+// keep their order (draw order decides depth ties). The same clusters serve the shadow pass,
+// which leaves out those that cannot cast onto what the camera sees (docs/raster.md).
 #pragma once
 
 #include <cstdint>
@@ -12,6 +13,7 @@
 
 #include "raster/geometry.h"
 #include "raster/shadow_pass.h"
+#include "scene/scene.h"
 
 namespace shadowlab::raster {
 
@@ -37,6 +39,14 @@ bool boxOutsideClipVolume(const glm::vec3& lo, const glm::vec3& hi, const glm::m
 
 // The index runs of the clusters not outside the clip volume, adjacent ones merged, in order.
 std::vector<IndexRange> visibleIndexRuns(std::span<const IndexCluster> clusters, const glm::mat4& viewProj);
+
+// The index runs of the clusters with keep[i], adjacent ones merged, in order.
+std::vector<IndexRange> keptIndexRuns(std::span<const IndexCluster> clusters, const std::vector<bool>& keep);
+
+// The clusters' boxes in world coordinates (the vertex buffer's are relative to `origin`), for the
+// shadow pass's culling of clusters that cannot cast onto what the camera sees
+// (raster::layerCastingBoxes).
+std::vector<scene::Bounds> worldBoxes(std::span<const IndexCluster> clusters, const glm::dvec3& origin);
 
 // `ranges` (sorted, disjoint) cut to the parts inside `visible` (sorted, disjoint), each part
 // keeping its range's flags, in order; parts of one range that touch stay one.

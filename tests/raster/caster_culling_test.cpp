@@ -4,6 +4,8 @@
 // the image. Also the spot map's size from receiver detail (raster::chooseShadowMapSize).
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -211,6 +213,54 @@ TEST(RasterCasterCulling, EachCascadeDrawsOnlyTheCastersOfItsOwnSlice) {
     EXPECT_EQ(culled.beauty, all.beauty);
     EXPECT_EQ(culled.blockerId, all.blockerId);
     EXPECT_GT(countOf(culled.blockerId, 3), 0);  // the extra sphere's shadow is seen, from cascade 2
+}
+
+TEST(RasterCasterCulling, EachCascadeDrawsOnlyTheClustersOfALongMeshThatCanCastOntoItsSlice) {
+    // A shelf 0.6 high along x from −60 to 60 at z = −3..−2.7 (2,400 quads of 0.05, 4,800 triangles in
+    // the index buffer's order, so each cluster of 256 triangles spans 6.4 units of x), beside the
+    // seed, under its sun (light along (−1, −2, −1)/√6) with three cascades. Its box reaches every
+    // slice's receivers, so the object stays in every layer. Cascade 0 serves view depths up to
+    // ≈ 6.4 from the camera at (0, 2, 6): receivers within about 5 units of x = 0 (the view's half
+    // width there ≈ 4.1). Across the light a point x units along the shelf lies x·√(5/6) ≈ 0.91·x
+    // from x = 0's, so the shelf beyond |x| = 20 (two thirds of it, 3,200 triangles) is 18 units
+    // across the light from x = 0's point, at least 13 from any of those receivers, far past the 10-texel margin of a
+    // cascade texel: those clusters cannot shade the slice, and cascade 0 draws at least 2,400 of
+    // the shelf's triangles fewer than without culling (whole clusters at the cut). The image is
+    // the same bit for bit. Its shadow falls 0.3 toward −x and −z, on ground the camera sees under it.
+    scene::Scene s = test::loadSeed(160, 90);
+    auto shelf = std::make_shared<scene::TriangleMesh>();
+    constexpr int kQuads = 2400;
+    for (int i = 0; i < kQuads; ++i) {
+        const double x0 = -60.0 + 0.05 * i, x1 = x0 + 0.05;
+        const auto base = std::uint32_t(shelf->positions.size());
+        for (const scene::Vec3& p : {scene::Vec3(x0, 0.6, -2.7), scene::Vec3(x1, 0.6, -2.7), scene::Vec3(x1, 0.6, -3),
+                                     scene::Vec3(x0, 0.6, -3)}) {
+            shelf->positions.push_back(p);
+            shelf->normals.push_back({0, 1, 0});
+        }
+        for (const std::uint32_t k : {0u, 1u, 2u, 0u, 2u, 3u}) shelf->indices.push_back(base + k);
+    }
+    test::addMesh(s, shelf, s.objects[0].material);
+    const scene::Frame culled = rasterRender(s, true, 3);
+    const scene::Frame all = rasterRender(s, false, 3);
+    ASSERT_EQ(culled.attributes.at("cascades"), "3");
+    const auto perLayer = [](const scene::Frame& f) {
+        std::vector<int> n;
+        std::istringstream in(f.attributes.at("shadow_triangles_per_layer"));
+        for (std::string item; std::getline(in, item, ';');) n.push_back(std::stoi(item));
+        return n;
+    };
+    const std::vector<int> drawn = perLayer(culled), every = perLayer(all);
+    ASSERT_EQ(drawn.size(), 3u);
+    ASSERT_EQ(every.size(), 3u);
+    EXPECT_EQ(every[0], every[2]);  // without culling each layer draws every opaque triangle
+    EXPECT_GE(every[0], 2 * kQuads);
+    EXPECT_LE(drawn[0], every[0] - 2400);
+    for (std::size_t k = 0; k < 3; ++k) EXPECT_LE(drawn[k], every[k]) << k;
+    EXPECT_EQ(culled.visibility, all.visibility);
+    EXPECT_EQ(culled.beauty, all.beauty);
+    EXPECT_EQ(culled.blockerId, all.blockerId);
+    EXPECT_GT(countOf(culled.blockerId, int(s.objects.size())), 0);  // the shelf's shadow is seen
 }
 
 // castsOnto() for a perspective map at the origin looking down −z (basis right = +x, up = +y, so
