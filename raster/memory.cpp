@@ -33,11 +33,12 @@ constexpr std::uint64_t kBytesPerTriangle = 3 * 32 + 3 * 4;  // vertices (positi
 // normal and the indices, and each split adds per vertex its light bits and projected point and per
 // triangle its area; counted with three vertices a triangle, an upper bound.
 constexpr std::uint64_t kLiftFreeBytesPerTriangle = 3 * (12 + 12) + 3 * 4 + 3 * (4 + 8) + 4;
-// View culling (raster/view_cull.h): a 32-byte box per cluster of kViewCullClusterTriangles (a
-// cluster more per object, where one ends) and, per frame, up to two 12-byte cut ranges per cluster
-// in each of the visible runs and the two range lists.
+// View and caster culling by clusters (raster/view_cull.h): a 32-byte box per cluster of
+// kViewCullClusterTriangles (a cluster more per object, where one ends) and its 48-byte world box,
+// and per frame up to two 12-byte cut ranges per cluster in each of the visible runs and the two
+// range lists, and one more per shadow layer's casters (four cascades counted).
 std::uint64_t viewCullBytes(std::uint64_t triangles, std::uint64_t objects) {
-    return (triangles / kViewCullClusterTriangles + objects) * (32 + 3 * 2 * 12);
+    return (triangles / kViewCullClusterTriangles + objects) * (32 + 48 + 3 * 2 * 12 + 4 * 12);
 }
 // Filterable maps (raster/moment_maps.h): two RGBA32F arrays the size of the shadow maps, and the
 // compute pipeline's compilation, measured on lavapipe (Mesa 22.3) as about 97 MiB above the
