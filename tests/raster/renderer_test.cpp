@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <limits>
 #include <utility>
 
@@ -1362,6 +1363,28 @@ TEST(RasterRenderer, CascadedLightConstantsBakedInGiveTheUniformBuffersFrameBitF
     }
 }
 
+// One step of expectSameFramesThroughUpdates: both Renderers update() to `scene` (none for a null
+// one), then render; `baked` reads its light constants from `source`.
+struct UpdateStep {
+    const char* what;
+    const scene::Scene* scene;
+    const char* source;
+};
+// The same frames bit for bit from `baked` and `other` after each step, with no validation message.
+void expectSameFramesThroughUpdates(Renderer& baked, Renderer& other, std::initializer_list<UpdateStep> steps) {
+    for (const UpdateStep& step : steps) {
+        if (step.scene) {
+            baked.update(*step.scene);
+            other.update(*step.scene);
+        }
+        const scene::Frame a = baked.render(), b = other.render();
+        EXPECT_EQ(a.attributes.at("light_constants"), step.source) << step.what;
+        test::expectSamePixels(a, b, step.what);
+    }
+    EXPECT_EQ(baked.validationMessages(), 0);
+    EXPECT_EQ(other.validationMessages(), 0);
+}
+
 TEST(RasterRenderer, AnUpdateThatChangesTheBakedLightConstantsSwitchesToFlatInputsWithTheSameFrames) {
     // A Renderer keeps its baked-in pipelines through an update() that leaves the light's constants
     // as they are, and one that changes them (a moved sun, then a moved camera: the view axis is one
@@ -1371,27 +1394,15 @@ TEST(RasterRenderer, AnUpdateThatChangesTheBakedLightConstantsSwitchesToFlatInpu
     const scene::Scene s = makeScene(SphereOverPlane{});
     Renderer baked(s, planFor(s, settings), settings);
     Renderer flat(s, planFor(s, settings), settings, RendererOptions{.lightConstants = LightConstants::kVertexOutputs});
-    auto expectSame = [&](const char* what, const char* source) {
-        const scene::Frame a = baked.render(), b = flat.render();
-        EXPECT_EQ(a.attributes.at("light_constants"), source) << what;
-        test::expectSamePixels(a, b, what);
-    };
-    expectSame("before any update", "specialization");
-    baked.update(s);
-    flat.update(s);
-    expectSame("after an update to the same scene", "specialization");
     scene::Scene sun = s;
     sun.lights[0].direction = lightFromElevation(35.0);
-    baked.update(sun);
-    flat.update(sun);
-    expectSame("after the sun moved", "vertex-outputs");
     scene::Scene camera = sun;
     camera.camera.position += scene::Vec3(0.4, 0.1, -0.3);
-    baked.update(camera);
-    flat.update(camera);
-    expectSame("after the camera moved", "vertex-outputs");
-    EXPECT_EQ(baked.validationMessages(), 0);
-    EXPECT_EQ(flat.validationMessages(), 0);
+    expectSameFramesThroughUpdates(baked, flat,
+                                   {{"before any update", nullptr, "specialization"},
+                                    {"after an update to the same scene", &s, "specialization"},
+                                    {"after the sun moved", &sun, "vertex-outputs"},
+                                    {"after the camera moved", &camera, "vertex-outputs"}});
 }
 
 TEST(RasterRenderer, AnUpdateThatMovesTheCascadesSwitchesToTheUniformBufferWithTheSameFrames) {
@@ -1405,22 +1416,12 @@ TEST(RasterRenderer, AnUpdateThatMovesTheCascadesSwitchesToTheUniformBufferWithT
     Renderer baked(s, planFor(s, settings), settings);
     Renderer buffer(s, planFor(s, settings), settings,
                     RendererOptions{.lightConstants = LightConstants::kUniformBuffer});
-    auto expectSame = [&](const char* what, const char* source) {
-        const scene::Frame a = baked.render(), b = buffer.render();
-        EXPECT_EQ(a.attributes.at("light_constants"), source) << what;
-        test::expectSamePixels(a, b, what);
-    };
-    expectSame("before any update", "specialization");
-    baked.update(s);
-    buffer.update(s);
-    expectSame("after an update to the same scene", "specialization");
     scene::Scene moved = s;
     moved.camera.position += scene::Vec3(1.5, 0.2, -4.0);
-    baked.update(moved);
-    buffer.update(moved);
-    expectSame("after the camera moved", "uniform-buffer");
-    EXPECT_EQ(baked.validationMessages(), 0);
-    EXPECT_EQ(buffer.validationMessages(), 0);
+    expectSameFramesThroughUpdates(baked, buffer,
+                                   {{"before any update", nullptr, "specialization"},
+                                    {"after an update to the same scene", &s, "specialization"},
+                                    {"after the camera moved", &moved, "uniform-buffer"}});
 }
 
 TEST(RasterRenderer, LightConstantsAreBakedInForOneSunOrSpotWithoutTheReceiverPlane) {
