@@ -245,6 +245,8 @@ struct Renderer::Impl {
     std::vector<TexelRect> transmitWindows;         // per layer, its window (TransmittancePass)
     shaders::TransmitWindows transmitWindowData{};  // the same for lit.frag (LitBindings)
     std::vector<DepthBiasFactors> layerBias;        // per layer, recordShadowPass's input (settings.hardwareBias)
+    // Per layer, the texels its depth pass clears and draws (layerReadWindow); empty: whole layers.
+    std::vector<TexelRect> shadowWindows;
     LitPipeline litPipelines[4][2];
     // The same four without the slope bias's lift past its cap (LitVariant::normalOffset false, no
     // alpha test), for the lift-free triangles (draw.litRangesByLift), with the *_sun modules.
@@ -497,6 +499,23 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
     // The triangles each layer's depth pass draws, in layer order (opaque casters; the
     // transmittance pass draws the semi-transparent ones).
     attributes["shadow_triangles_per_layer"] = joined(trianglesPerLayer, count);
+    // Each layer's depth pass clears and draws only the texels its receivers can read. Not with
+    // filterable maps (their moment passes blur whole layers, so every texel is read), and not for
+    // a held view (update() with another view than scene.camera, whose receivers the layers were
+    // not planned for: it would read texels no pass drew).
+    const bool heldView = view.position != scene.camera.position || view.lookAt != scene.camera.lookAt ||
+                          view.up != scene.camera.up || view.fovYDegrees != scene.camera.fovYDegrees ||
+                          view.near != scene.camera.near || view.far != scene.camera.far;
+    const bool windowed = !scene::isFilterable(settings.filter) && !heldView;
+    shadowWindows.clear();
+    std::vector<std::uint64_t> texelsPerLayer;
+    for (const ShadowLayer& layer : layers) {
+        const auto size = std::uint32_t(layer.frustum.mapSize);
+        const TexelRect w = windowed ? layerReadWindow(layer) : TexelRect{0, 0, size, size};
+        shadowWindows.push_back(w);
+        texelsPerLayer.push_back(w.area());
+    }
+    attributes["shadow_texels_per_layer"] = joined(texelsPerLayer, [](std::uint64_t n) { return std::to_string(n); });
     splitByLift();
     cullToView();
 }
@@ -866,7 +885,9 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     const TransmittancePass transmittancePass{transmit ? &transmitPipeline : nullptr, &transmittanceMaps, layerLights,
                                               transmit ? &transmitRestPipeline : nullptr, transmitWindows};
     recordShadowPass(commands, shadowPipeline[shadowPipeline[0].pipeline ? 0 : 1], maps, draw, lightMatrices, wantIds,
-                     &transmittancePass, &layerBias, shadowPipeline[1].pipeline ? &shadowPipeline[1] : nullptr);
+                     &transmittancePass, &layerBias, shadowPipeline[1].pipeline ? &shadowPipeline[1] : nullptr,
+                     // A capture shows whole layers (the debug views draw them all).
+                     debug && debug->captureShadowMaps ? nullptr : &shadowWindows);
     if (momentPipeline.pipeline)
         recordMomentPasses(commands, momentPipeline, maps, momentMaps, layers, settings.filter, settings.moments);
     stamp(commands, 1);

@@ -2,6 +2,8 @@
 // frustum (fitted, cascaded, a spot cone, cube faces), its bias and the casters drawn into it.
 #include "raster/shadow_layers.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "raster/cascades.h"
@@ -138,6 +140,32 @@ std::vector<ShadowLayer> planShadowLayers(const scene::Scene& scene, const scene
     return planShadowLayers(scene, plan, settings, scene::cameraBasis(scene.camera).position);
 }
 
+TexelRect layerReadWindow(const ShadowLayer& layer) {
+    const auto size = std::uint32_t(std::max(layer.frustum.mapSize, 1));
+    const TexelRect whole{0, 0, size, size};
+    if (layer.casters.empty() || layer.receivers.empty() || layer.frustum.perspective) return whole;
+    const glm::dmat4 m = layer.frustum.toClip(scene::Vec3{0.0, 0.0, 0.0});
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    for (const scene::Vec3& p : layer.receivers) {
+        const glm::dvec4 c = m * glm::dvec4(p, 1.0);
+        for (int a = 0; a < 2; ++a) {
+            // Framebuffer texels: (ndc + 1) / 2 · size (the depth pass's viewport); w = 1.
+            const double t = (c[a] / c.w + 1.0) * 0.5 * double(size);
+            lo[a] = std::min(lo[a], t);
+            hi[a] = std::max(hi[a], t);
+        }
+    }
+    if (!(lo[0] <= hi[0] && lo[1] <= hi[1])) return whole;  // (NaN: not a projection we can bound)
+    // A lookup at u reads the texels whose centers lie within the margin of it: floor(u ± margin).
+    const double margin = layer.cullReachTexels + layer.cullOffsetTexels;
+    std::uint32_t r[4];
+    for (int a = 0; a < 2; ++a) {
+        r[a] = std::uint32_t(std::clamp(std::floor(lo[a] - margin), 0.0, double(size)));
+        r[a + 2] = std::uint32_t(std::clamp(std::floor(hi[a] + margin) + 1.0, 0.0, double(size)));
+    }
+    return TexelRect{r[0], r[1], r[2], r[3]};
+}
+
 std::vector<bool> layerCastingBoxes(const ShadowLayer& layer, std::span<const scene::Bounds> boxes) {
     if (layer.casters.empty()) return std::vector<bool>(boxes.size(), true);
     return boxesCastOnto(boxes, layer.frustum, layer.receivers, layer.cullReachTexels, layer.cullOffsetTexels);
@@ -209,6 +237,12 @@ std::string explainShadowLayers(const std::vector<ShadowLayer>& layers, std::siz
         out += l.casters.empty()
                    ? "; every caster drawn"
                    : "; " + std::to_string(l.culled) + " of " + std::to_string(objectCount) + " objects culled";
+        const TexelRect w = layerReadWindow(l);
+        const double mapArea = double(l.frustum.mapSize) * double(l.frustum.mapSize);
+        if (w.area() < std::uint64_t(mapArea))
+            out += "; drawn in texels [" + std::to_string(w.x0) + ", " + std::to_string(w.x1) + ") x [" +
+                   std::to_string(w.y0) + ", " + std::to_string(w.y1) + ") (" +
+                   formatNumber(std::round(1000.0 * double(w.area()) / mapArea) / 10.0) + "% of the map)";
         out += "\n";
     }
     return out;

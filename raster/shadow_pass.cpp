@@ -396,7 +396,7 @@ void recordTransmittance(VkCommandBuffer commands, const TransmittancePass& pass
 void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, const ShadowMaps& maps,
                       const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices, bool blockerIds,
                       const TransmittancePass* transmittance, const std::vector<DepthBiasFactors>* layerBias,
-                      const ShadowPipeline* alphaPipeline) {
+                      const ShadowPipeline* alphaPipeline, const std::vector<TexelRect>* windows) {
     // Source stage: the previous frame's lit pass sampled both arrays (a reused Renderer).
     transition(commands,
                {{maps.depth.image.get(), VK_IMAGE_ASPECT_DEPTH_BIT, maps.layers, VK_IMAGE_LAYOUT_UNDEFINED,
@@ -409,6 +409,11 @@ void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, 
                  blockerIds ? VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT : VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
                  blockerIds ? VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT : VK_ACCESS_2_NONE}});
     for (std::uint32_t layer = 0; layer < maps.layers; ++layer) {
+        const TexelRect window =
+            windows && layer < windows->size() ? (*windows)[layer] : TexelRect{0, 0, maps.size, maps.size};
+        if (window.empty()) continue;  // no receiver reads this layer: nothing to clear or draw
+        const VkRect2D area{{std::int32_t(window.x0), std::int32_t(window.y0)},
+                            {window.x1 - window.x0, window.y1 - window.y0}};
         const VkRenderingAttachmentInfo depth{
             .sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
             .imageView = maps.layerViews[layer].get(),
@@ -427,7 +432,7 @@ void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, 
         };
         const VkRenderingInfo rendering{
             .sType = VK_STRUCTURE_TYPE_RENDERING_INFO,
-            .renderArea = {{0, 0}, {maps.size, maps.size}},
+            .renderArea = area,
             .layerCount = 1,
             .colorAttachmentCount = blockerIds ? 1u : 0u,
             .pColorAttachments = blockerIds ? &ids : nullptr,
@@ -436,6 +441,7 @@ void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, 
         vkCmdBeginRendering(commands, &rendering);
         if (layer < lightMatrices.size() && geometry.depthPassIndexCount() > 0) {
             setViewport(commands, maps.size, maps.size);
+            vkCmdSetScissor(commands, 0, 1, &area);
             const VkDeviceSize offset = 0;
             vkCmdBindVertexBuffers(commands, 0, 1, &geometry.vertices, &offset);
             if (geometry.uvs != VK_NULL_HANDLE) vkCmdBindVertexBuffers(commands, 1, 1, &geometry.uvs, &offset);

@@ -55,11 +55,7 @@ struct TransparentDraw {
     std::vector<glm::vec3> triangles;
 };
 
-// Texels [x0, x1) × [y0, y1) of a shadow-map layer.
-struct TexelRect {
-    std::uint32_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-    bool empty() const { return x0 >= x1 || y0 >= y1; }
-};
+// TexelRect: raster/shadow_layers.h.
 // The window of a size² layer drawn with `lightMatrix` that holds every texel the semi-transparent
 // casters can cover (the part of their triangles, or of the boxes of casters with too many to
 // project each frame, on the light's side of the map's near plane, projected), with
@@ -170,8 +166,8 @@ struct TransmittancePass {
     std::vector<TexelRect> windows;
 };
 
-// Records: every layer cleared to depth 1 (far: lit) and id 0, and layer i drawn with
-// lightMatrices[i] (layers past the end of lightMatrices are only cleared), then both arrays
+// Records: every layer cleared to depth 1 (far: lit) and id 0 within its window (below), and
+// layer i drawn with lightMatrices[i] (layers past the end of lightMatrices are only cleared), then both arrays
 // made readable by fragment shaders (SHADER_READ_ONLY_OPTIMAL). Without blockerIds (the
 // pipeline made so) the id array is not rendered, only moved to SHADER_READ_ONLY_OPTIMAL with
 // undefined contents, for a lit pass that does not read it. The depth pass draws only
@@ -183,12 +179,14 @@ struct TransmittancePass {
 // `transmittance.pipeline` null, for a lit pass that does not read them).
 // layerBias: a pipeline made with hardwareBias needs each drawn layer's factors (missing ones: 0).
 // alphaPipeline: the SHADOWLAB_ALPHA variant of `pipeline`, for ranges with IndexRange::alpha
-// (null: `pipeline` draws them).
+// (null: `pipeline` draws them). windows: per layer, the texels its depth pass clears and draws
+// (layerReadWindow; the rest of the layer keeps what it held, undefined; an empty window: the
+// layer is left as it was); null or layers past its end: the whole layer.
 void recordShadowPass(VkCommandBuffer commands, const ShadowPipeline& pipeline, const ShadowMaps& maps,
                       const DrawGeometry& geometry, const std::vector<glm::mat4>& lightMatrices, bool blockerIds = true,
                       const TransmittancePass* transmittance = nullptr,
                       const std::vector<DepthBiasFactors>* layerBias = nullptr,
-                      const ShadowPipeline* alphaPipeline = nullptr);
+                      const ShadowPipeline* alphaPipeline = nullptr, const std::vector<TexelRect>* windows = nullptr);
 // Diagnostics and tests: the depths of one layer after recordShadowPass() has run, row 0 first.
 std::vector<float> readShadowMap(const Context& ctx, const ShadowMaps& maps, std::uint32_t layer);
 std::vector<std::uint32_t> readBlockerIds(const Context& ctx, const ShadowMaps& maps, std::uint32_t layer);

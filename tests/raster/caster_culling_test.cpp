@@ -257,10 +257,91 @@ TEST(RasterCasterCulling, EachCascadeDrawsOnlyTheClustersOfALongMeshThatCanCastO
     EXPECT_GE(every[0], 2 * kQuads);
     EXPECT_LE(drawn[0], every[0] - 2400);
     for (std::size_t k = 0; k < 3; ++k) EXPECT_LE(drawn[k], every[k]) << k;
+    // Each cascade's depth pass also clears and draws only the texels its slice's receivers can
+    // read (layerReadWindow): fewer than its map holds in all, the whole map without culling.
+    const auto texels = [](const scene::Frame& f) {
+        std::vector<long long> n;
+        std::istringstream in(f.attributes.at("shadow_texels_per_layer"));
+        for (std::string item; std::getline(in, item, ';');) n.push_back(std::stoll(item));
+        return n;
+    };
+    const long long mapArea =
+        std::stoll(culled.attributes.at("shadow_map_size")) * std::stoll(culled.attributes.at("shadow_map_size"));
+    const std::vector<long long> window = texels(culled), whole = texels(all);
+    ASSERT_EQ(window.size(), 3u);
+    ASSERT_EQ(whole.size(), 3u);
+    long long windowSum = 0;
+    for (std::size_t k = 0; k < 3; ++k) {
+        EXPECT_EQ(whole[k], mapArea) << k;
+        EXPECT_LE(window[k], mapArea) << k;
+        windowSum += window[k];
+    }
+    EXPECT_LT(windowSum, 3 * mapArea);
     EXPECT_EQ(culled.visibility, all.visibility);
     EXPECT_EQ(culled.beauty, all.beauty);
     EXPECT_EQ(culled.blockerId, all.blockerId);
     EXPECT_GT(countOf(culled.blockerId, int(s.objects.size())), 0);  // the shelf's shadow is seen
+}
+
+// A 60 x 60 ground with a sphere at (20, 1, 17) under light along (−1, −2, −1), its shadow around
+// (19.5, 0, 16.5), seen from close by: the camera sees a few units of the ground, the unfitted
+// map spans the ground's bounding sphere (radius ≈ 42, a texel ≈ 0.17 at 512).
+scene::Scene groundSeenFromCloseBy() {
+    test::SphereOverPlane p;
+    p.planeSize = 60.0;
+    p.center = {20, 1, 17};
+    p.radius = 0.8;
+    p.lightDirection = {-1, -2, -1};
+    p.eye = {20, 4, 23};
+    p.lookAt = {19, 0, 17};
+    return test::makeScene(p);
+}
+
+// The widest PCF kernel (15 taps: 7 texels each way) and a normal offset of 3 texels: the image's
+// border pixels read texels well past their own.
+scene::RasterSettings wideReachSettings() {
+    scene::RasterSettings r = test::fixedSettings(512);
+    r.fitLightFrustum = false;
+    r.filter = scene::ShadowFilter::Pcf;
+    r.pcfSize = 15;
+    r.normalOffset = 3.0;
+    r.cullCasters = true;
+    return r;
+}
+
+TEST(RasterCasterCulling, TheDepthPassDrawsOnlyTheTexelsTheViewCanReadAndTheImageIsUnchanged) {
+    // The window's margin must hold the border pixels' reads: the image is the same bit for bit as
+    // with whole layers, drawn into a tenth of the map or less.
+    const scene::Scene s = groundSeenFromCloseBy();
+    scene::RasterSettings r = wideReachSettings();
+    const scene::Frame windowed = test::renderChecked(s, r);
+    r.cullCasters = false;
+    const scene::Frame whole = test::renderChecked(s, r);
+    EXPECT_EQ(whole.attributes.at("shadow_texels_per_layer"), std::to_string(512 * 512));
+    EXPECT_LE(std::stoll(windowed.attributes.at("shadow_texels_per_layer")), 512 * 512 / 10);
+    EXPECT_EQ(windowed.visibility, whole.visibility);
+    EXPECT_EQ(windowed.beauty, whole.beauty);
+    EXPECT_EQ(windowed.blockerId, whole.blockerId);
+    EXPECT_GT(countOf(windowed.blockerId, 1), 100);  // the sphere's shadow is seen
+    EXPECT_GT(countOf(windowed.blockerId, 0), 100);  // and lit ground
+}
+
+TEST(RasterCasterCulling, AHeldViewDrawsWholeLayers) {
+    // update(scene, view) with another view than scene.camera draws the maps planned for
+    // scene.camera from `view`, which sees receivers the window was not made for: whole layers.
+    const scene::Scene s = groundSeenFromCloseBy();
+    const scene::RasterSettings r = wideReachSettings();
+    Renderer renderer(s, test::planFor(s, r), r);
+    const auto texels = [&] { return std::stoll(renderer.render().attributes.at("shadow_texels_per_layer")); };
+    EXPECT_LE(texels(), 512 * 512 / 10);
+    scene::Scene moved = s;
+    moved.camera.position.x += 4.0;
+    moved.camera.lookAt.x += 4.0;
+    renderer.update(moved, s.camera);  // the maps of the moved camera, seen from the first
+    EXPECT_EQ(texels(), 512 * 512);
+    renderer.update(moved);  // seen from the moved camera itself: windowed again
+    EXPECT_LE(texels(), 512 * 512 / 10);
+    EXPECT_EQ(renderer.validationMessages(), 0) << "validation messages were printed above";
 }
 
 // castsOnto() for a perspective map at the origin looking down −z (basis right = +x, up = +y, so

@@ -197,6 +197,58 @@ TEST(ShadowLayers, ACasterOutsideALayersFrustumIsCulledThere) {
     }
 }
 
+// layerReadWindow() by hand. An orthographic map along −z (setBasis: right = +x, up = +y) centered
+// on the origin, half-width 10, 1000 texels: texel x = 50·x + 500, y = 50·y + 500. Receivers
+// (1, 2, 0) and (3, −1, 5) project to x 550..650, y 450..600; a reach of 10 and a normal offset of
+// 2 texels widen that by 12: texels floor(538) .. floor(662) and floor(438) .. floor(612) inclusive.
+ShadowLayer handLayer() {
+    ShadowLayer l;
+    setBasis(l.frustum, {0, 0, -1});
+    l.frustum.center = {0, 0, 0};
+    l.frustum.halfWidth = 10.0;
+    l.frustum.nearDepth = -10.0;
+    l.frustum.farDepth = 10.0;
+    l.frustum.mapSize = 1000;
+    l.casters = {true};
+    l.receivers = {{1, 2, 0}, {3, -1, 5}};
+    l.cullReachTexels = 10.0;
+    l.cullOffsetTexels = 2.0;
+    return l;
+}
+
+TEST(ShadowLayers, TheReadWindowIsTheReceiversProjectionWidenedByTheReachInTexels) {
+    ASSERT_EQ(handLayer().frustum.right, Vec3(1, 0, 0));
+    ASSERT_EQ(handLayer().frustum.up, Vec3(0, 1, 0));
+    const TexelRect w = layerReadWindow(handLayer());
+    EXPECT_EQ(w.x0, 538u);
+    EXPECT_EQ(w.x1, 663u);
+    EXPECT_EQ(w.y0, 438u);
+    EXPECT_EQ(w.y1, 613u);
+    EXPECT_EQ(w.area(), 125u * 175u);
+    // Clamped to the map: a receiver at x = 9.9 (texel 995) reaches past its edge.
+    ShadowLayer edge = handLayer();
+    edge.receivers.push_back({9.9, 0, 0});
+    EXPECT_EQ(layerReadWindow(edge).x1, 1000u);
+    EXPECT_EQ(layerReadWindow(edge).x0, 538u);
+}
+
+TEST(ShadowLayers, TheReadWindowIsTheWholeMapWhereNothingBoundsTheReads) {
+    const TexelRect whole{0, 0, 1000, 1000};
+    auto same = [](const TexelRect& a, const TexelRect& b) {
+        return a.x0 == b.x0 && a.y0 == b.y0 && a.x1 == b.x1 && a.y1 == b.y1;
+    };
+    ShadowLayer noCulling = handLayer();
+    noCulling.casters.clear();  // culling off: the receivers were not recorded for this layer
+    EXPECT_TRUE(same(layerReadWindow(noCulling), whole));
+    ShadowLayer noReceivers = handLayer();
+    noReceivers.receivers.clear();  // the camera sees none of the scene
+    EXPECT_TRUE(same(layerReadWindow(noReceivers), whole));
+    ShadowLayer spot = handLayer();
+    spot.frustum.perspective = true;
+    spot.frustum.position = {0, 0, 20};
+    EXPECT_TRUE(same(layerReadWindow(spot), whole));
+}
+
 TEST(ShadowLayers, ALightThePlanGivesNoShadowTestHasNoLayer) {
     scene::Scene s = test::makeScene({});
     const scene::RasterSettings r = fixedSettings();
