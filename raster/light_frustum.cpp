@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <span>
 #include <variant>
 #include <vector>
@@ -797,14 +798,60 @@ std::vector<bool> castsOnto(const scene::Scene& scene, const LightFrustum& f, co
     return boxesCastOnto(boxes, f, receivers, reachTexels, normalOffsetTexels);
 }
 
+namespace {
+
+// How far across f's map (in its u, v: world units, or tangents for a perspective map) a receiver's
+// lookups reach from its own (u, v): the filter's reach and the normal offset. None where a
+// perspective map's normal offset turns the lookup too far to bound.
+std::optional<double> lookupReach(const LightFrustum& f, double reachTexels, double normalOffsetTexels) {
+    // The normal offset moves an orthographic map's receiver by that many texels in any direction.
+    if (!f.perspective) return (reachTexels + normalOffsetTexels) * f.texelWorldSize();
+    // Perspective. The normal offset moves a receiver at distance d by k·d, k = offset · texel
+    // angle: its direction turns by at most k·√(1 + u²)/(1 − k) in tangent units and its distance
+    // grows by at most k·d. For k < 0.1 and |u| ≤ ~1.13·t (beyond, the offset point stays off the
+    // map) that is under 2·k·√(1 + t²).
+    const double texelAngle = f.texelWorldSize();  // 2·t/N: tangent units per texel
+    const double k = normalOffsetTexels * texelAngle;
+    if (!(k < 0.1)) return std::nullopt;
+    // The widest tangent the map holds (an off-center fitted window reaches past its half-size).
+    const double t = std::max(std::abs(f.windowU), std::abs(f.windowV)) + f.tanHalfFov;
+    return (reachTexels + 2.0 * normalOffsetTexels * std::sqrt(1.0 + t * t)) * texelAngle;
+}
+
+}  // namespace
+
+std::optional<TexelRect> receiverTexels(const LightFrustum& f, const std::vector<Vec3>& receivers, double reachTexels,
+                                        double normalOffsetTexels) {
+    const std::optional<double> reach = lookupReach(f, reachTexels, normalOffsetTexels);
+    if (receivers.empty() || !reach) return std::nullopt;
+    const MapExtent r = f.perspective ? perspectiveReceiverExtent(receivers, f) : orthographicExtent(receivers, f);
+    // A perspective map with no receiver in front of the light: none reads it.
+    if (r.empty()) return f.perspective ? std::optional<TexelRect>(TexelRect{}) : std::nullopt;
+    // Framebuffer texels of u: (x + 1) / 2 · N with x = u / halfWidth (orthographic, u from the
+    // center) or (u − windowU) / tanHalfFov (perspective): the depth pass's viewport.
+    const double n = double(std::max(f.mapSize, 1));
+    const double scale = f.perspective ? f.tanHalfFov : f.halfWidth;
+    const double du = f.perspective ? f.windowU : 0.0, dv = f.perspective ? f.windowV : 0.0;
+    auto texel = [&](double u, double offset) { return ((u - offset) / scale + 1.0) * 0.5 * n; };
+    // A lookup at texel coordinate x reads the texels whose centers lie within the reach of it.
+    auto lo = [&](double u, double offset) {
+        return std::uint32_t(std::clamp(std::floor(texel(u - *reach, offset)), 0.0, n));
+    };
+    auto hi = [&](double u, double offset) {
+        return std::uint32_t(std::clamp(std::floor(texel(u + *reach, offset)) + 1.0, 0.0, n));
+    };
+    return TexelRect{lo(r.minU, du), lo(r.minV, dv), hi(r.maxU, du), hi(r.maxV, dv)};
+}
+
 std::vector<bool> boxesCastOnto(std::span<const scene::Bounds> boxes, const LightFrustum& f,
                                 const std::vector<Vec3>& receivers, double reachTexels, double normalOffsetTexels) {
     std::vector<bool> casts(boxes.size(), true);
     if (receivers.empty()) return casts;
+    const std::optional<double> reach = lookupReach(f, reachTexels, normalOffsetTexels);
+    if (!reach) return casts;
+    const double margin = *reach;
     if (!f.perspective) {
         const MapExtent r = orthographicExtent(receivers, f);
-        // The normal offset moves a receiver by that many texels in any direction.
-        const double margin = (reachTexels + normalOffsetTexels) * f.texelWorldSize();
         for (std::size_t i = 0; i < boxes.size(); ++i) {
             const scene::Bounds& b = boxes[i];
             if (b.empty()) continue;
@@ -814,16 +861,7 @@ std::vector<bool> boxesCastOnto(std::span<const scene::Bounds> boxes, const Ligh
         }
         return casts;
     }
-    // Perspective. The normal offset moves a receiver at distance d by k·d, k = offset · texel
-    // angle: its direction turns by at most k·√(1 + u²)/(1 − k) in tangent units and its distance
-    // grows by at most k·d. For k < 0.1 and |u| ≤ ~1.13·t (beyond, the offset point stays off the
-    // map) that is under 2·k·√(1 + t²).
-    const double texelAngle = f.texelWorldSize();  // 2·t/N: tangent units per texel
-    const double k = normalOffsetTexels * texelAngle;
-    if (!(k < 0.1)) return casts;
-    // The widest tangent the map holds (an off-center fitted window reaches past its half-size).
-    const double t = std::max(std::abs(f.windowU), std::abs(f.windowV)) + f.tanHalfFov;
-    const double margin = (reachTexels + 2.0 * normalOffsetTexels * std::sqrt(1.0 + t * t)) * texelAngle;
+    // Perspective (lookupReach has the normal offset's bound).
     const MapExtent r = perspectiveReceiverExtent(receivers, f);
     if (r.empty()) return std::vector<bool>(boxes.size(), false);  // no receiver in front: none reads it
     const double farthest = r.maxDepth * (1.0 + margin);

@@ -4,6 +4,8 @@
 // camera sees) and a point light's cube faces; and the texel size the biases scale with.
 #pragma once
 
+#include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -200,6 +202,17 @@ std::vector<bool> castsOnto(const scene::Scene& scene, const LightFrustum& f, co
 std::vector<bool> boxesCastOnto(std::span<const scene::Bounds> boxes, const LightFrustum& f,
                                 const std::vector<scene::Vec3>& receivers, double reachTexels,
                                 double normalOffsetTexels);
+// The texels of f's map that the shadow lookups of `receivers` can read, by the reach castsOnto
+// allows them: [x0, x1) × [y0, y1) of the depth pass's framebuffer, within the map. Empty where no
+// receiver lies in front of a perspective map (none reads it); none where nothing bounds the reads
+// (no receivers, or a perspective map's normal offset past castsOnto's bound).
+struct TexelRect {
+    std::uint32_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    bool empty() const { return x0 >= x1 || y0 >= y1; }
+    std::uint64_t area() const { return empty() ? 0 : std::uint64_t(x1 - x0) * (y1 - y0); }
+};
+std::optional<TexelRect> receiverTexels(const LightFrustum& f, const std::vector<scene::Vec3>& receivers,
+                                        double reachTexels, double normalOffsetTexels);
 // castsOnto() with every receiver the camera sees (visibleReceiverPoints(scene)).
 std::vector<bool> castsIntoView(const scene::Scene& scene, const LightFrustum& f, double reachTexels,
                                 double normalOffsetTexels = 0.0);

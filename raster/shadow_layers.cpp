@@ -142,28 +142,9 @@ std::vector<ShadowLayer> planShadowLayers(const scene::Scene& scene, const scene
 
 TexelRect layerReadWindow(const ShadowLayer& layer) {
     const auto size = std::uint32_t(std::max(layer.frustum.mapSize, 1));
-    const TexelRect whole{0, 0, size, size};
-    if (layer.casters.empty() || layer.receivers.empty() || layer.frustum.perspective) return whole;
-    const glm::dmat4 m = layer.frustum.toClip(scene::Vec3{0.0, 0.0, 0.0});
-    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
-    for (const scene::Vec3& p : layer.receivers) {
-        const glm::dvec4 c = m * glm::dvec4(p, 1.0);
-        for (int a = 0; a < 2; ++a) {
-            // Framebuffer texels: (ndc + 1) / 2 · size (the depth pass's viewport); w = 1.
-            const double t = (c[a] / c.w + 1.0) * 0.5 * double(size);
-            lo[a] = std::min(lo[a], t);
-            hi[a] = std::max(hi[a], t);
-        }
-    }
-    if (!(lo[0] <= hi[0] && lo[1] <= hi[1])) return whole;  // (NaN: not a projection we can bound)
-    // A lookup at u reads the texels whose centers lie within the margin of it: floor(u ± margin).
-    const double margin = layer.cullReachTexels + layer.cullOffsetTexels;
-    std::uint32_t r[4];
-    for (int a = 0; a < 2; ++a) {
-        r[a] = std::uint32_t(std::clamp(std::floor(lo[a] - margin), 0.0, double(size)));
-        r[a + 2] = std::uint32_t(std::clamp(std::floor(hi[a] + margin) + 1.0, 0.0, double(size)));
-    }
-    return TexelRect{r[0], r[1], r[2], r[3]};
+    if (layer.casters.empty()) return TexelRect{0, 0, size, size};
+    return receiverTexels(layer.frustum, layer.receivers, layer.cullReachTexels, layer.cullOffsetTexels)
+        .value_or(TexelRect{0, 0, size, size});
 }
 
 std::vector<bool> layerCastingBoxes(const ShadowLayer& layer, std::span<const scene::Bounds> boxes) {

@@ -4,7 +4,6 @@
 // the plan without a device.
 #pragma once
 
-#include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
@@ -62,20 +61,11 @@ struct ShadowLayer {
     double sliceNear = 0.0, sliceFar = 0.0;
 };
 
-// Texels [x0, x1) × [y0, y1) of a shadow-map layer.
-struct TexelRect {
-    std::uint32_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-    bool empty() const { return x0 >= x1 || y0 >= y1; }
-    std::uint64_t area() const { return empty() ? 0 : std::uint64_t(x1 - x0) * (y1 - y0); }
-};
-
-// The texels of `layer` that its receivers' shadow tests can read: the projection of its receivers
-// widened by the filter's reach and the normal offset (cullReachTexels + cullOffsetTexels, the
-// margin caster culling keeps), within the map. The depth pass clears and draws only these; no
-// lookup reads a texel outside. The whole map where nothing bounds the reads: a layer that
-// records no receivers (culling off, a transmittance map, a camera that sees none of the scene)
-// and a perspective map (spot light, cube face), whose window is fitted to its receivers already
-// or whose receivers may lie behind its plane.
+// The texels of `layer` that its receivers' shadow tests can read (receiverTexels with the reach
+// caster culling allows: cullReachTexels, cullOffsetTexels). The depth pass clears and draws only
+// these; no lookup reads a texel outside. Empty for a perspective map (spot, cube face) with no
+// receiver in front of it. The whole map where nothing bounds the reads: a layer that records no
+// receivers (culling off, a transmittance map, a camera that sees none of the scene).
 TexelRect layerReadWindow(const ShadowLayer& layer);
 
 // The layers for `settings` as resolved (resolveAutomaticChoices: cascade count, map size,

@@ -55,7 +55,7 @@ struct TransparentDraw {
     std::vector<glm::vec3> triangles;
 };
 
-// TexelRect: raster/shadow_layers.h.
+// TexelRect: raster/light_frustum.h.
 // The window of a size² layer drawn with `lightMatrix` that holds every texel the semi-transparent
 // casters can cover (the part of their triangles, or of the boxes of casters with too many to
 // project each frame, on the light's side of the map's near plane, projected), with

@@ -7,6 +7,8 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -309,21 +311,64 @@ scene::RasterSettings wideReachSettings() {
     return r;
 }
 
-TEST(RasterCasterCulling, TheDepthPassDrawsOnlyTheTexelsTheViewCanReadAndTheImageIsUnchanged) {
-    // The window's margin must hold the border pixels' reads: the image is the same bit for bit as
-    // with whole layers, drawn into a tenth of the map or less.
-    const scene::Scene s = groundSeenFromCloseBy();
-    scene::RasterSettings r = wideReachSettings();
+// Renders `s` with the depth pass in each layer's read window (culling on) and with whole layers
+// (culling off), expects the same frames bit for bit with the caster's shadow and lit ground in
+// view, and returns the texels each layer drew, windowed and whole.
+std::pair<std::vector<long long>, std::vector<long long>> windowedAndWhole(const scene::Scene& s,
+                                                                           scene::RasterSettings r) {
+    const auto texels = [](const scene::Frame& f) {
+        std::vector<long long> n;
+        std::istringstream in(f.attributes.at("shadow_texels_per_layer"));
+        for (std::string item; std::getline(in, item, ';');) n.push_back(std::stoll(item));
+        return n;
+    };
+    r.cullCasters = true;
     const scene::Frame windowed = test::renderChecked(s, r);
     r.cullCasters = false;
     const scene::Frame whole = test::renderChecked(s, r);
-    EXPECT_EQ(whole.attributes.at("shadow_texels_per_layer"), std::to_string(512 * 512));
-    EXPECT_LE(std::stoll(windowed.attributes.at("shadow_texels_per_layer")), 512 * 512 / 10);
     EXPECT_EQ(windowed.visibility, whole.visibility);
     EXPECT_EQ(windowed.beauty, whole.beauty);
     EXPECT_EQ(windowed.blockerId, whole.blockerId);
     EXPECT_GT(countOf(windowed.blockerId, 1), 100);  // the sphere's shadow is seen
     EXPECT_GT(countOf(windowed.blockerId, 0), 100);  // and lit ground
+    return {texels(windowed), texels(whole)};
+}
+
+TEST(RasterCasterCulling, TheDepthPassDrawsOnlyTheTexelsTheViewCanReadAndTheImageIsUnchanged) {
+    // The window's margin must hold the border pixels' reads: the image is the same bit for bit as
+    // with whole layers, drawn into a tenth of the map or less.
+    const scene::Scene s = groundSeenFromCloseBy();
+    const auto [windowed, whole] = windowedAndWhole(s, wideReachSettings());
+    EXPECT_EQ(whole, std::vector<long long>{512 * 512});
+    ASSERT_EQ(windowed.size(), 1u);
+    EXPECT_LE(windowed[0], 512 * 512 / 10);
+}
+
+TEST(RasterCasterCulling, SpotAndPointLightMapsAreDrawnOnlyWhereTheViewReads) {
+    // The same ground and sphere under a spot straight above the sphere (cone 60°, its unfitted map
+    // reaching ≈ 14 units across the ground, of which the camera sees the part in front of it and
+    // beside the sphere, not the ground behind the camera) and under a point light there (the +Y
+    // face looks away from everything: no receiver in front of it, nothing drawn).
+    scene::Scene spot = groundSeenFromCloseBy();
+    spot.lights[0] = test::spotDown();
+    spot.lights[0].position = {20, 8, 17};
+    const auto [spotWindowed, spotWhole] = windowedAndWhole(spot, wideReachSettings());
+    EXPECT_EQ(spotWhole, std::vector<long long>{512 * 512});
+    ASSERT_EQ(spotWindowed.size(), 1u);
+    EXPECT_LT(spotWindowed[0], 512 * 512);
+
+    scene::Scene point = groundSeenFromCloseBy();
+    point.lights[0].type = scene::LightType::Point;
+    point.lights[0].position = {20, 8, 17};
+    point.lights[0].intensity = 800;
+    const auto [pointWindowed, pointWhole] = windowedAndWhole(point, wideReachSettings());
+    ASSERT_EQ(pointWindowed.size(), 6u);
+    ASSERT_EQ(pointWhole.size(), 6u);
+    for (std::size_t face = 0; face < 6; ++face) {
+        EXPECT_EQ(pointWhole[face], 512 * 512) << face;
+        EXPECT_LE(pointWindowed[face], pointWhole[face]) << face;
+    }
+    EXPECT_EQ(pointWindowed[2], 0);  // +Y
 }
 
 TEST(RasterCasterCulling, AHeldViewDrawsWholeLayers) {

@@ -199,8 +199,8 @@ TEST(ShadowLayers, ACasterOutsideALayersFrustumIsCulledThere) {
 
 // layerReadWindow() by hand. An orthographic map along −z (setBasis: right = +x, up = +y) centered
 // on the origin, half-width 10, 1000 texels: texel x = 50·x + 500, y = 50·y + 500. Receivers
-// (1, 2, 0) and (3, −1, 5) project to x 550..650, y 450..600; a reach of 10 and a normal offset of
-// 2 texels widen that by 12: texels floor(538) .. floor(662) and floor(438) .. floor(612) inclusive.
+// (1, 2, 0) and (3, −1, 5) project to x 550..650, y 450..600; a reach of 10.5 and a normal offset
+// of 2 texels widen that by 12.5: texels 537..662 and 437..612 inclusive.
 ShadowLayer handLayer() {
     ShadowLayer l;
     setBasis(l.frustum, {0, 0, -1});
@@ -211,42 +211,74 @@ ShadowLayer handLayer() {
     l.frustum.mapSize = 1000;
     l.casters = {true};
     l.receivers = {{1, 2, 0}, {3, -1, 5}};
-    l.cullReachTexels = 10.0;
+    l.cullReachTexels = 10.5;
     l.cullOffsetTexels = 2.0;
     return l;
+}
+
+bool same(const TexelRect& a, const TexelRect& b) {
+    return a.x0 == b.x0 && a.y0 == b.y0 && a.x1 == b.x1 && a.y1 == b.y1;
 }
 
 TEST(ShadowLayers, TheReadWindowIsTheReceiversProjectionWidenedByTheReachInTexels) {
     ASSERT_EQ(handLayer().frustum.right, Vec3(1, 0, 0));
     ASSERT_EQ(handLayer().frustum.up, Vec3(0, 1, 0));
     const TexelRect w = layerReadWindow(handLayer());
-    EXPECT_EQ(w.x0, 538u);
-    EXPECT_EQ(w.x1, 663u);
-    EXPECT_EQ(w.y0, 438u);
-    EXPECT_EQ(w.y1, 613u);
-    EXPECT_EQ(w.area(), 125u * 175u);
+    EXPECT_TRUE(same(w, TexelRect{537, 437, 663, 613})) << w.x0 << " " << w.y0 << " " << w.x1 << " " << w.y1;
+    EXPECT_EQ(w.area(), 126u * 176u);
     // Clamped to the map: a receiver at x = 9.9 (texel 995) reaches past its edge.
     ShadowLayer edge = handLayer();
     edge.receivers.push_back({9.9, 0, 0});
     EXPECT_EQ(layerReadWindow(edge).x1, 1000u);
-    EXPECT_EQ(layerReadWindow(edge).x0, 538u);
+    EXPECT_EQ(layerReadWindow(edge).x0, 537u);
+}
+
+// A perspective map at the origin looking down −z (right = +x, up = +y: u = x/d, v = y/d with
+// d = −z), tan 1, 1000 texels: texel x = 500·(u + 1), a texel 0.002 of tangent. Receivers
+// (1, 2, −10) and (3, −1, −5): u 0.1..0.6, v −0.2..0.2; a reach of 10.3 texels is 0.0206 of
+// tangent: texels 539.7..810.3 and 389.7..610.3, so 539..810 and 389..610 inclusive.
+ShadowLayer handSpotLayer() {
+    ShadowLayer l;
+    l.frustum.perspective = true;
+    setBasis(l.frustum, {0, 0, -1});
+    l.frustum.position = {0, 0, 0};
+    l.frustum.tanHalfFov = 1.0;
+    l.frustum.mapSize = 1000;
+    l.frustum.near = 0.1;
+    l.frustum.far = 100.0;
+    l.casters = {true};
+    l.receivers = {{1, 2, -10}, {3, -1, -5}};
+    l.cullReachTexels = 10.3;
+    return l;
+}
+
+TEST(ShadowLayers, APerspectiveMapsReadWindowIsTheReceiversTangentsWidenedByTheReach) {
+    const TexelRect w = layerReadWindow(handSpotLayer());
+    EXPECT_TRUE(same(w, TexelRect{539, 389, 811, 611})) << w.x0 << " " << w.y0 << " " << w.x1 << " " << w.y1;
+    // No receiver in front of the light: nothing reads the map, nothing is drawn.
+    ShadowLayer behind = handSpotLayer();
+    behind.receivers = {{1, 2, 10}, {3, -1, 5}};
+    EXPECT_TRUE(layerReadWindow(behind).empty());
+    // Receivers across the light's plane: unbounded toward the side the crossing lies on (here
+    // x > 0 at the crossing: to the map's right edge).
+    ShadowLayer across = handSpotLayer();
+    across.receivers = {{1, 0, -10}, {3, 0, 5}};
+    EXPECT_EQ(layerReadWindow(across).x1, 1000u);
+    EXPECT_EQ(layerReadWindow(across).x0, 539u);
 }
 
 TEST(ShadowLayers, TheReadWindowIsTheWholeMapWhereNothingBoundsTheReads) {
     const TexelRect whole{0, 0, 1000, 1000};
-    auto same = [](const TexelRect& a, const TexelRect& b) {
-        return a.x0 == b.x0 && a.y0 == b.y0 && a.x1 == b.x1 && a.y1 == b.y1;
-    };
     ShadowLayer noCulling = handLayer();
     noCulling.casters.clear();  // culling off: the receivers were not recorded for this layer
     EXPECT_TRUE(same(layerReadWindow(noCulling), whole));
     ShadowLayer noReceivers = handLayer();
     noReceivers.receivers.clear();  // the camera sees none of the scene
     EXPECT_TRUE(same(layerReadWindow(noReceivers), whole));
-    ShadowLayer spot = handLayer();
-    spot.frustum.perspective = true;
-    spot.frustum.position = {0, 0, 20};
-    EXPECT_TRUE(same(layerReadWindow(spot), whole));
+    // A normal offset of 50 texels of 0.002 turns a perspective lookup by a tenth: not bounded.
+    ShadowLayer turned = handSpotLayer();
+    turned.cullOffsetTexels = 50.0;
+    EXPECT_TRUE(same(layerReadWindow(turned), whole));
 }
 
 TEST(ShadowLayers, ALightThePlanGivesNoShadowTestHasNoLayer) {
