@@ -36,7 +36,10 @@ std::vector<ShadowLayer> planShadowLayers(const scene::Scene& scene, const scene
     // behind it into the map, and a receiver between the two would get the nearer layer's factor
     // with one more rounding (T_all / T_rest), so the frame would not stay the same bit for bit.
     const bool cull = settings.cullCasters && !plan.needsTransmittanceMap;
-    const std::vector<scene::Vec3> receivers = cull ? visibleReceiverPoints(scene) : std::vector<scene::Vec3>{};
+    // The receivers also bound each layer's read window (layerReadWindow), which holds with a
+    // transmittance map too: it leaves out texels, not casters, so nothing read changes.
+    const bool window = settings.cullCasters;
+    const std::vector<scene::Vec3> receivers = window ? visibleReceiverPoints(scene) : std::vector<scene::Vec3>{};
     // The hardware bias of an orthographic map (settings.hardwareBias): the world constant bias
     // in units of r (its depth is linear: bias / depth range), the slope bias in texels as it is
     // (the rasterizer's slope is depth per texel, as the shader's slope term is per texel).
@@ -53,10 +56,12 @@ std::vector<ShadowLayer> planShadowLayers(const scene::Scene& scene, const scene
         layer.label = std::move(label);
         layer.frustum = f;
         layer.matrix = glm::mat4(f.toClip(origin));
-        if (cull) {
+        if (window) {
             layer.receivers = layerReceivers;
             layer.cullReachTexels = cullReachTexels(settings, scene.lights[light], f.mapSize);
             layer.cullOffsetTexels = lookupOffsetTexels(settings);
+        }
+        if (cull) {
             layer.casters = castsOnto(scene, f, layer.receivers, layer.cullReachTexels, layer.cullOffsetTexels);
             for (const bool k : layer.casters) layer.culled += k ? 0 : 1;
         }
@@ -110,9 +115,10 @@ std::vector<ShadowLayer> planShadowLayers(const scene::Scene& scene, const scene
             const int count = int(cascades.frusta.size());
             for (std::size_t c = 0; c < cascades.frusta.size(); ++c) {
                 const LightFrustum& cf = cascades.frusta[c];
-                ShadowLayer& layer = add(i, LayerReason::kCascade, int(c), count, name + " C" + std::to_string(c), cf,
-                                         cull ? cascadeReceivers(scene, cascades.splits, c, cascadeBandCover(settings))
-                                              : std::vector<scene::Vec3>{});
+                ShadowLayer& layer =
+                    add(i, LayerReason::kCascade, int(c), count, name + " C" + std::to_string(c), cf,
+                        window ? cascadeReceivers(scene, cascades.splits, c, cascadeBandCover(settings))
+                               : std::vector<scene::Vec3>{});
                 setBias(layer, settings.depthBiasIsDefault ? 0.5 * cf.texelWorldSize() : settings.depthBias);
                 layer.sliceNear = cascades.splits[c];
                 layer.sliceFar = cascades.splits[c + 1];
@@ -142,7 +148,6 @@ std::vector<ShadowLayer> planShadowLayers(const scene::Scene& scene, const scene
 
 TexelRect layerReadWindow(const ShadowLayer& layer) {
     const auto size = std::uint32_t(std::max(layer.frustum.mapSize, 1));
-    if (layer.casters.empty()) return TexelRect{0, 0, size, size};
     return receiverTexels(layer.frustum, layer.receivers, layer.cullReachTexels, layer.cullOffsetTexels)
         .value_or(TexelRect{0, 0, size, size});
 }

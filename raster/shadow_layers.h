@@ -53,8 +53,9 @@ struct ShadowLayer {
     // settings.cullCasters off, or a transmittance map, whose draw order is not per object).
     std::vector<bool> casters;
     int culled = 0;  // objects left out of this layer
-    // What the casters were tested against (culling on): the receivers that read this layer, the
-    // filter's reach and the normal offset in its texels, for layerCastingBoxes().
+    // What the casters were tested against (settings.cullCasters): the receivers that read this
+    // layer, the filter's reach and the normal offset in its texels, for layerCastingBoxes() and
+    // layerReadWindow(); recorded also with a transmittance map, which culls no caster.
     std::vector<scene::Vec3> receivers;
     double cullReachTexels = 0.0, cullOffsetTexels = 0.0;
     // kCascade: the view-depth slice the cascade serves, [splits[index], splits[index + 1]].
@@ -65,7 +66,7 @@ struct ShadowLayer {
 // caster culling allows: cullReachTexels, cullOffsetTexels). The depth pass clears and draws only
 // these; no lookup reads a texel outside. Empty for a perspective map (spot, cube face) with no
 // receiver in front of it. The whole map where nothing bounds the reads: a layer that records no
-// receivers (culling off, a transmittance map, a camera that sees none of the scene).
+// receivers (settings.cullCasters off, a camera that sees none of the scene).
 TexelRect layerReadWindow(const ShadowLayer& layer);
 
 // The layers for `settings` as resolved (resolveAutomaticChoices: cascade count, map size,

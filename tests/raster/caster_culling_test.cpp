@@ -4,10 +4,10 @@
 // the image. Also the spot map's size from receiver detail (raster::chooseShadowMapSize).
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -311,11 +311,17 @@ scene::RasterSettings wideReachSettings() {
     return r;
 }
 
+// The texels each layer drew, windowed and whole, and the windowed frame's attributes.
+struct Windows {
+    std::vector<long long> windowed, whole;
+    std::map<std::string, std::string> attributes;
+    std::vector<float> visibility;
+};
+
 // Renders `s` with the depth pass in each layer's read window (culling on) and with whole layers
 // (culling off), expects the same frames bit for bit with the caster's shadow and lit ground in
-// view, and returns the texels each layer drew, windowed and whole.
-std::pair<std::vector<long long>, std::vector<long long>> windowedAndWhole(const scene::Scene& s,
-                                                                           scene::RasterSettings r) {
+// view.
+Windows windowedAndWhole(const scene::Scene& s, scene::RasterSettings r) {
     const auto texels = [](const scene::Frame& f) {
         std::vector<long long> n;
         std::istringstream in(f.attributes.at("shadow_texels_per_layer"));
@@ -331,14 +337,14 @@ std::pair<std::vector<long long>, std::vector<long long>> windowedAndWhole(const
     EXPECT_EQ(windowed.blockerId, whole.blockerId);
     EXPECT_GT(countOf(windowed.blockerId, 1), 100);  // the sphere's shadow is seen
     EXPECT_GT(countOf(windowed.blockerId, 0), 100);  // and lit ground
-    return {texels(windowed), texels(whole)};
+    return {texels(windowed), texels(whole), windowed.attributes, windowed.visibility};
 }
 
 TEST(RasterCasterCulling, TheDepthPassDrawsOnlyTheTexelsTheViewCanReadAndTheImageIsUnchanged) {
     // The window's margin must hold the border pixels' reads: the image is the same bit for bit as
     // with whole layers, drawn into a tenth of the map or less.
     const scene::Scene s = groundSeenFromCloseBy();
-    const auto [windowed, whole] = windowedAndWhole(s, wideReachSettings());
+    const auto [windowed, whole, attributes, visibility] = windowedAndWhole(s, wideReachSettings());
     EXPECT_EQ(whole, std::vector<long long>{512 * 512});
     ASSERT_EQ(windowed.size(), 1u);
     EXPECT_LE(windowed[0], 512 * 512 / 10);
@@ -352,7 +358,7 @@ TEST(RasterCasterCulling, SpotAndPointLightMapsAreDrawnOnlyWhereTheViewReads) {
     scene::Scene spot = groundSeenFromCloseBy();
     spot.lights[0] = test::spotDown();
     spot.lights[0].position = {20, 8, 17};
-    const auto [spotWindowed, spotWhole] = windowedAndWhole(spot, wideReachSettings());
+    const auto [spotWindowed, spotWhole, spotAttributes, spotVisibility] = windowedAndWhole(spot, wideReachSettings());
     EXPECT_EQ(spotWhole, std::vector<long long>{512 * 512});
     ASSERT_EQ(spotWindowed.size(), 1u);
     EXPECT_LT(spotWindowed[0], 512 * 512);
@@ -361,7 +367,8 @@ TEST(RasterCasterCulling, SpotAndPointLightMapsAreDrawnOnlyWhereTheViewReads) {
     point.lights[0].type = scene::LightType::Point;
     point.lights[0].position = {20, 8, 17};
     point.lights[0].intensity = 800;
-    const auto [pointWindowed, pointWhole] = windowedAndWhole(point, wideReachSettings());
+    const auto [pointWindowed, pointWhole, pointAttributes, pointVisibility] =
+        windowedAndWhole(point, wideReachSettings());
     ASSERT_EQ(pointWindowed.size(), 6u);
     ASSERT_EQ(pointWhole.size(), 6u);
     for (std::size_t face = 0; face < 6; ++face) {
@@ -369,6 +376,23 @@ TEST(RasterCasterCulling, SpotAndPointLightMapsAreDrawnOnlyWhereTheViewReads) {
         EXPECT_LE(pointWindowed[face], pointWhole[face]) << face;
     }
     EXPECT_EQ(pointWindowed[2], 0);  // +Y
+}
+
+TEST(RasterCasterCulling, WithATransmittanceMapEveryCasterIsDrawnButOnlyWithinTheReadWindow) {
+    // The ground and sphere above with a glass sphere (opacity 0.5) beside the opaque one: the
+    // transmittance map culls no caster (an opaque one left out would let glass behind it into
+    // the map), but the window leaves out texels, not casters, and holds for every pass.
+    scene::Scene s = groundSeenFromCloseBy();
+    const int glass = test::addMaterial(s, "glass", 0.5);
+    test::addSphere(s, {21.8, 1, 17.5}, 0.6, glass);
+    const auto [windowed, whole, attributes, visibility] = windowedAndWhole(s, wideReachSettings());
+    EXPECT_EQ(attributes.at("transmittance_map"), "made");
+    // The glass's shadow is seen (the widest kernel spreads it over ≈ 2.6 units: no plateau at 0.5).
+    EXPECT_NE(visibility, test::renderChecked(groundSeenFromCloseBy(), wideReachSettings()).visibility);
+    EXPECT_EQ(attributes.at("culled_casters"), "0");
+    EXPECT_EQ(whole, std::vector<long long>{512 * 512});
+    ASSERT_EQ(windowed.size(), 1u);
+    EXPECT_LE(windowed[0], 512 * 512 / 10);
 }
 
 TEST(RasterCasterCulling, AHeldViewDrawsWholeLayers) {

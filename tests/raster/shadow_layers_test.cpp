@@ -269,12 +269,14 @@ TEST(ShadowLayers, APerspectiveMapsReadWindowIsTheReceiversTangentsWidenedByTheR
 
 TEST(ShadowLayers, TheReadWindowIsTheWholeMapWhereNothingBoundsTheReads) {
     const TexelRect whole{0, 0, 1000, 1000};
-    ShadowLayer noCulling = handLayer();
-    noCulling.casters.clear();  // culling off: the receivers were not recorded for this layer
-    EXPECT_TRUE(same(layerReadWindow(noCulling), whole));
+    // Culling off, or the camera sees none of the scene: no receivers recorded.
     ShadowLayer noReceivers = handLayer();
-    noReceivers.receivers.clear();  // the camera sees none of the scene
+    noReceivers.receivers.clear();
     EXPECT_TRUE(same(layerReadWindow(noReceivers), whole));
+    // A layer that culls no caster (a transmittance map) still has its window.
+    ShadowLayer everyCaster = handLayer();
+    everyCaster.casters.clear();
+    EXPECT_TRUE(same(layerReadWindow(everyCaster), layerReadWindow(handLayer())));
     // A normal offset of 50 texels of 0.002 turns a perspective lookup by a tenth: not bounded.
     ShadowLayer turned = handSpotLayer();
     turned.cullOffsetTexels = 50.0;
