@@ -505,7 +505,8 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
     // not planned for: it would read texels no pass drew).
     const bool heldView = view.position != scene.camera.position || view.lookAt != scene.camera.lookAt ||
                           view.up != scene.camera.up || view.fovYDegrees != scene.camera.fovYDegrees ||
-                          view.near != scene.camera.near || view.far != scene.camera.far;
+                          view.near != scene.camera.near || view.far != scene.camera.far ||
+                          view.width != scene.camera.width || view.height != scene.camera.height;
     const bool windowed = !scene::isFilterable(settings.filter) && !heldView;
     shadowWindows.clear();
     std::vector<std::uint64_t> texelsPerLayer;
