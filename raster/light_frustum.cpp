@@ -814,8 +814,10 @@ std::optional<double> lookupReach(const LightFrustum& f, double reachTexels, dou
     const double k = normalOffsetTexels * texelAngle;
     if (!(k < 0.1)) return std::nullopt;
     // The widest tangent the map holds (an off-center fitted window reaches past its half-size).
+    // The slope bias's first lifted texel (flat in reachTexels) is an offset along the normal too.
     const double t = std::max(std::abs(f.windowU), std::abs(f.windowV)) + f.tanHalfFov;
-    return (reachTexels + 2.0 * normalOffsetTexels * std::sqrt(1.0 + t * t)) * texelAngle;
+    const double offset = normalOffsetTexels + kCullLiftTexels;
+    return (reachTexels - kCullLiftTexels + 2.0 * offset * std::sqrt(1.0 + t * t)) * texelAngle;
 }
 
 }  // namespace

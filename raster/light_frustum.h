@@ -202,15 +202,16 @@ std::vector<bool> castsOnto(const scene::Scene& scene, const LightFrustum& f, co
 std::vector<bool> boxesCastOnto(std::span<const scene::Bounds> boxes, const LightFrustum& f,
                                 const std::vector<scene::Vec3>& receivers, double reachTexels,
                                 double normalOffsetTexels);
-// The texels of f's map that the shadow lookups of `receivers` can read, by the reach castsOnto
-// allows them: [x0, x1) × [y0, y1) of the depth pass's framebuffer, within the map. Empty where no
-// receiver lies in front of a perspective map (none reads it); none where nothing bounds the reads
-// (no receivers, or a perspective map's normal offset past castsOnto's bound).
+// Texels [x0, x1) × [y0, y1) of a shadow-map layer (the depth pass's framebuffer).
 struct TexelRect {
     std::uint32_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;
     bool empty() const { return x0 >= x1 || y0 >= y1; }
     std::uint64_t area() const { return empty() ? 0 : std::uint64_t(x1 - x0) * (y1 - y0); }
 };
+// The texels of f's map that the shadow lookups of `receivers` can read, by the reach castsOnto
+// allows them, within the map. Empty where no receiver lies in front of a perspective map (none
+// reads it); none where nothing bounds the reads (no receivers, or a perspective map's normal
+// offset past castsOnto's bound).
 std::optional<TexelRect> receiverTexels(const LightFrustum& f, const std::vector<scene::Vec3>& receivers,
                                         double reachTexels, double normalOffsetTexels);
 // castsOnto() with every receiver the camera sees (visibleReceiverPoints(scene)).
@@ -219,6 +220,9 @@ std::vector<bool> castsIntoView(const scene::Scene& scene, const LightFrustum& f
 // The widest filter reach in texels (a 15-tap kernel's half, pcf2x2's extra texel, rounding: 8.7)
 // and one texel of the slope bias's lift past its cap (lit.frag; the default slope bias's most).
 inline constexpr double kCullMarginTexels = 10.0;
+// That lift's part of kCullMarginTexels: it moves the lookup point along the normal, which a
+// perspective map magnifies as it does the normal offset (castsOnto).
+inline constexpr double kCullLiftTexels = 1.0;
 // PCSS of a spot or point light with a size looks up to this fraction of the map's side from the
 // point, in its blocker search and its widest kernel (shaders/lit.frag kPcssMaxSearchFraction,
 // half of kPcssMaxFilterFraction).

@@ -499,20 +499,18 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
     // The triangles each layer's depth pass draws, in layer order (opaque casters; the
     // transmittance pass draws the semi-transparent ones).
     attributes["shadow_triangles_per_layer"] = joined(trianglesPerLayer, count);
-    // Each layer's depth pass clears and draws only the texels its receivers can read. Not with
-    // filterable maps (their moment passes blur whole layers, so every texel is read), and not for
-    // a held view (update() with another view than scene.camera, whose receivers the layers were
-    // not planned for: it would read texels no pass drew).
+    // Each layer's depth pass clears and draws only the texels its receivers can read
+    // (layerReadWindow), but not for a held view (update() with another view than scene.camera,
+    // whose receivers the layers were not planned for: it would read texels no pass drew).
     const bool heldView = view.position != scene.camera.position || view.lookAt != scene.camera.lookAt ||
                           view.up != scene.camera.up || view.fovYDegrees != scene.camera.fovYDegrees ||
                           view.near != scene.camera.near || view.far != scene.camera.far ||
                           view.width != scene.camera.width || view.height != scene.camera.height;
-    const bool windowed = !scene::isFilterable(settings.filter) && !heldView;
     shadowWindows.clear();
     std::vector<std::uint64_t> texelsPerLayer;
     for (const ShadowLayer& layer : layers) {
         const auto size = std::uint32_t(layer.frustum.mapSize);
-        const TexelRect w = windowed ? layerReadWindow(layer) : TexelRect{0, 0, size, size};
+        const TexelRect w = heldView ? TexelRect{0, 0, size, size} : layerReadWindow(layer);
         shadowWindows.push_back(w);
         texelsPerLayer.push_back(w.area());
     }
@@ -870,6 +868,10 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     }
 
     frame.attributes = attributes;
+    if (debug && debug->captureShadowMaps && !layers.empty())  // a capture draws whole layers
+        frame.attributes["shadow_texels_per_layer"] = joined(layers, [](const ShadowLayer& l) {
+            return std::to_string(std::uint64_t(l.frustum.mapSize) * l.frustum.mapSize);
+        });
     frame.timingsMs.assign(1, {"setup", setup});
     if (pendingUpdateMs > 0.0) frame.timingsMs.emplace_back("update", pendingUpdateMs);
     pendingUpdateMs = 0.0;

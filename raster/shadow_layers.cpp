@@ -57,6 +57,7 @@ std::vector<ShadowLayer> planShadowLayers(const scene::Scene& scene, const scene
         layer.frustum = f;
         layer.matrix = glm::mat4(f.toClip(origin));
         if (window) {
+            layer.readWindow = !scene::isFilterable(settings.filter);
             layer.receivers = layerReceivers;
             layer.cullReachTexels = cullReachTexels(settings, scene.lights[light], f.mapSize);
             layer.cullOffsetTexels = lookupOffsetTexels(settings);
@@ -148,6 +149,7 @@ std::vector<ShadowLayer> planShadowLayers(const scene::Scene& scene, const scene
 
 TexelRect layerReadWindow(const ShadowLayer& layer) {
     const auto size = std::uint32_t(std::max(layer.frustum.mapSize, 1));
+    if (!layer.readWindow) return TexelRect{0, 0, size, size};
     return receiverTexels(layer.frustum, layer.receivers, layer.cullReachTexels, layer.cullOffsetTexels)
         .value_or(TexelRect{0, 0, size, size});
 }

@@ -58,6 +58,9 @@ struct ShadowLayer {
     // layerReadWindow(); recorded also with a transmittance map, which culls no caster.
     std::vector<scene::Vec3> receivers;
     double cullReachTexels = 0.0, cullOffsetTexels = 0.0;
+    // Whether the depth pass may leave out the texels outside layerReadWindow(): not for filterable
+    // maps, whose moment passes blur every texel of a layer.
+    bool readWindow = false;
     // kCascade: the view-depth slice the cascade serves, [splits[index], splits[index + 1]].
     double sliceNear = 0.0, sliceFar = 0.0;
 };
@@ -66,7 +69,7 @@ struct ShadowLayer {
 // caster culling allows: cullReachTexels, cullOffsetTexels). The depth pass clears and draws only
 // these; no lookup reads a texel outside. Empty for a perspective map (spot, cube face) with no
 // receiver in front of it. The whole map where nothing bounds the reads: a layer that records no
-// receivers (settings.cullCasters off, a camera that sees none of the scene).
+// receivers (settings.cullCasters off, a camera that sees none of the scene) or has no readWindow.
 TexelRect layerReadWindow(const ShadowLayer& layer);
 
 // The layers for `settings` as resolved (resolveAutomaticChoices: cascade count, map size,

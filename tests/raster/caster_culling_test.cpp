@@ -350,6 +350,22 @@ TEST(RasterCasterCulling, TheDepthPassDrawsOnlyTheTexelsTheViewCanReadAndTheImag
     EXPECT_LE(windowed[0], 512 * 512 / 10);
 }
 
+TEST(RasterCasterCulling, AnOverheadSunsWindowKeepsTheImage) {
+    // A sun straight down (the map's basis then takes world X as its reference: setBasis) over a
+    // low sphere: the window is the visible receivers' footprint widened by the margin, and the
+    // image is the same bit for bit as with the whole map.
+    test::SphereOverPlane p;
+    p.planeSize = 60.0;
+    p.center = {20, 0.35, 17};
+    p.radius = 0.3;
+    p.lightDirection = {0, -1, 0};
+    p.eye = {20, 4, 23};
+    p.lookAt = {19, 0, 17};
+    const auto [windowed, whole, attributes, visibility] = windowedAndWhole(test::makeScene(p), wideReachSettings());
+    ASSERT_EQ(windowed.size(), 1u);
+    EXPECT_LT(windowed[0], whole[0]);
+}
+
 TEST(RasterCasterCulling, SpotAndPointLightMapsAreDrawnOnlyWhereTheViewReads) {
     // The same ground and sphere under a spot straight above the sphere (cone 60°, its unfitted map
     // reaching ≈ 14 units across the ground, of which the camera sees the part in front of it and
@@ -410,6 +426,10 @@ TEST(RasterCasterCulling, AHeldViewDrawsWholeLayers) {
     EXPECT_EQ(texels(), 512 * 512);
     renderer.update(moved);  // seen from the moved camera itself: windowed again
     EXPECT_LE(texels(), 512 * 512 / 10);
+    RenderDebug capture;  // a capture of the maps draws (and reports) whole layers
+    capture.captureShadowMaps = true;
+    EXPECT_EQ(renderer.render(scene::kAllChannels, &capture).attributes.at("shadow_texels_per_layer"),
+              std::to_string(512 * 512));
     EXPECT_EQ(renderer.validationMessages(), 0) << "validation messages were printed above";
 }
 

@@ -210,6 +210,7 @@ ShadowLayer handLayer() {
     l.frustum.farDepth = 10.0;
     l.frustum.mapSize = 1000;
     l.casters = {true};
+    l.readWindow = true;
     l.receivers = {{1, 2, 0}, {3, -1, 5}};
     l.cullReachTexels = 10.5;
     l.cullOffsetTexels = 2.0;
@@ -235,8 +236,10 @@ TEST(ShadowLayers, TheReadWindowIsTheReceiversProjectionWidenedByTheReachInTexel
 
 // A perspective map at the origin looking down −z (right = +x, up = +y: u = x/d, v = y/d with
 // d = −z), tan 1, 1000 texels: texel x = 500·(u + 1), a texel 0.002 of tangent. Receivers
-// (1, 2, −10) and (3, −1, −5): u 0.1..0.6, v −0.2..0.2; a reach of 10.3 texels is 0.0206 of
-// tangent: texels 539.7..810.3 and 389.7..610.3, so 539..810 and 389..610 inclusive.
+// (1, 2, −10) and (3, −1, −5): u 0.1..0.6, v −0.2..0.2. A reach of 10.3 texels, the slope bias's
+// lifted texel in it counted as a normal offset (2·√(1 + t²) = 2√2 texels at t = 1): 9.3 + 2√2
+// = 12.1284 texels, 0.024257 of tangent: texels 537.87..812.13 and 387.87..612.13, so 537..812 and
+// 387..612 inclusive.
 ShadowLayer handSpotLayer() {
     ShadowLayer l;
     l.frustum.perspective = true;
@@ -247,6 +250,7 @@ ShadowLayer handSpotLayer() {
     l.frustum.near = 0.1;
     l.frustum.far = 100.0;
     l.casters = {true};
+    l.readWindow = true;
     l.receivers = {{1, 2, -10}, {3, -1, -5}};
     l.cullReachTexels = 10.3;
     return l;
@@ -254,7 +258,7 @@ ShadowLayer handSpotLayer() {
 
 TEST(ShadowLayers, APerspectiveMapsReadWindowIsTheReceiversTangentsWidenedByTheReach) {
     const TexelRect w = layerReadWindow(handSpotLayer());
-    EXPECT_TRUE(same(w, TexelRect{539, 389, 811, 611})) << w.x0 << " " << w.y0 << " " << w.x1 << " " << w.y1;
+    EXPECT_TRUE(same(w, TexelRect{537, 387, 813, 613})) << w.x0 << " " << w.y0 << " " << w.x1 << " " << w.y1;
     // No receiver in front of the light: nothing reads the map, nothing is drawn.
     ShadowLayer behind = handSpotLayer();
     behind.receivers = {{1, 2, 10}, {3, -1, 5}};
@@ -264,7 +268,7 @@ TEST(ShadowLayers, APerspectiveMapsReadWindowIsTheReceiversTangentsWidenedByTheR
     ShadowLayer across = handSpotLayer();
     across.receivers = {{1, 0, -10}, {3, 0, 5}};
     EXPECT_EQ(layerReadWindow(across).x1, 1000u);
-    EXPECT_EQ(layerReadWindow(across).x0, 539u);
+    EXPECT_EQ(layerReadWindow(across).x0, 537u);
 }
 
 TEST(ShadowLayers, TheReadWindowIsTheWholeMapWhereNothingBoundsTheReads) {
@@ -273,13 +277,17 @@ TEST(ShadowLayers, TheReadWindowIsTheWholeMapWhereNothingBoundsTheReads) {
     ShadowLayer noReceivers = handLayer();
     noReceivers.receivers.clear();
     EXPECT_TRUE(same(layerReadWindow(noReceivers), whole));
+    // A filterable map's moment passes blur every texel.
+    ShadowLayer filterable = handLayer();
+    filterable.readWindow = false;
+    EXPECT_TRUE(same(layerReadWindow(filterable), whole));
     // A layer that culls no caster (a transmittance map) still has its window.
     ShadowLayer everyCaster = handLayer();
     everyCaster.casters.clear();
     EXPECT_TRUE(same(layerReadWindow(everyCaster), layerReadWindow(handLayer())));
-    // A normal offset of 50 texels of 0.002 turns a perspective lookup by a tenth: not bounded.
+    // A normal offset of 60 texels of 0.002 turns a perspective lookup by more than a tenth: not bounded.
     ShadowLayer turned = handSpotLayer();
-    turned.cullOffsetTexels = 50.0;
+    turned.cullOffsetTexels = 60.0;
     EXPECT_TRUE(same(layerReadWindow(turned), whole));
 }
 
