@@ -366,6 +366,86 @@ TEST(RasterCasterCulling, AnOverheadSunsWindowKeepsTheImage) {
     EXPECT_LT(windowed[0], whole[0]);
 }
 
+// A camera 10 above the ground looking straight down (up −z): it sees the ground for
+// |x| ≤ 10·tan 20°·16/9 ≈ 6.47 and |z| ≤ 3.64, a rectangle whose sides run along the map's axes for
+// a light in the x-y plane, so the receivers' hull (the scene's box in the view) ends where the
+// image does on the right, and the window's edge is the image's right edge widened by the margin.
+// The image's right column reads texels past that edge with the widest kernel; a window narrower
+// than that reach leaves them as the depth pass found them (Vulkan: undefined outside the render
+// area). Whatever they hold, one of two scenes tells: one with a caster's shadow across the edge
+// (the whole map holds the caster there: a texel left far is lit), one with lit ground there (a
+// texel left near, as zeroed memory is, shadows). Without a normal offset: the offset moves a
+// lookup the way the light travels, inward for light from the right, and would hide a short margin.
+// Pixels of 0.02: the border pixel's center lies under a texel inside the edge (the spot's 0.012).
+constexpr int kEdgeWidth = 640, kEdgeHeight = 360;
+scene::Scene rightEdgeScene(const scene::Light& light, const scene::Vec3& sphere, double radius) {
+    scene::Scene s = test::matteScene({0, 10, 0}, {0, 0, 0}, kEdgeWidth, kEdgeHeight);
+    s.camera.up = {0, 0, -1};
+    s.lights.push_back(light);
+    test::addSphere(s, sphere, radius);
+    test::addQuad(s, {0, 0, 0}, {0, 1, 0}, 60, 60);
+    return s;
+}
+
+// The image's right column: how many of its pixels are mostly shadowed, and whether its middle
+// third (|z| < 1.2: inside the spot's cone too) is lit.
+int shadowedInTheRightColumn(const std::vector<float>& visibility) {
+    int n = 0;
+    for (std::size_t y = 0; y < kEdgeHeight; ++y) n += visibility[(y + 1) * kEdgeWidth - 1] < 0.5f;
+    return n;
+}
+bool rightColumnLit(const std::vector<float>& visibility) {
+    for (std::size_t y = kEdgeHeight / 3; y < 2 * kEdgeHeight / 3; ++y)
+        if (visibility[(y + 1) * kEdgeWidth - 1] != 1.0f) return false;
+    return true;
+}
+
+// The edge's two scenes for `light`: windowed and whole the same bit for bit.
+void expectTheEdgeHolds(const scene::Light& light, const scene::Vec3& across, double acrossRadius,
+                        const scene::Vec3& inside, double insideRadius) {
+    scene::RasterSettings r = wideReachSettings();
+    r.normalOffset = 0.0;
+    {
+        SCOPED_TRACE("a shadow across the edge");
+        const auto [windowed, whole, attributes, visibility] =
+            windowedAndWhole(rightEdgeScene(light, across, acrossRadius), r);
+        ASSERT_EQ(windowed.size(), 1u);
+        EXPECT_LT(windowed[0], whole[0]);
+        EXPECT_GT(shadowedInTheRightColumn(visibility), 20);
+    }
+    SCOPED_TRACE("lit ground across the edge");
+    const auto [windowed, whole, attributes, visibility] =
+        windowedAndWhole(rightEdgeScene(light, inside, insideRadius), r);
+    ASSERT_EQ(windowed.size(), 1u);
+    EXPECT_LT(windowed[0], whole[0]);
+    EXPECT_TRUE(rightColumnLit(visibility));
+}
+
+TEST(RasterCasterCulling, TheWindowsMarginHoldsTheWidestKernelAtTheImagesEdge) {
+    {
+        // Sun at 45° toward −x, texels of 0.17: the border's lookups reach 8 texels (7 taps, the
+        // bilinear one more) of the margin's 10.5. A sphere at (8.47, 2, 0), radius 1.6 (box
+        // x ≥ 6.87, y ≥ 0.4, where the frustum reaches x ≤ 6.21: no receiver of its own) shadows
+        // x = 6.47 ± 2.26, z = ±1.6, wide enough to stay dark under the 15-tap kernel; or at
+        // (0, 2, 0), x = −2 ± 2.26, inside the view.
+        SCOPED_TRACE("sun");
+        scene::Light sun;
+        sun.direction = glm::normalize(scene::Vec3(-1, -1, 0));
+        sun.intensity = 3.0;
+        expectTheEdgeHolds(sun, {8.47, 2, 0}, 1.6, {0, 2, 0}, 1.6);
+    }
+    // A spot right of the view aimed at the edge, half-angle 20° (≈ 0.012 units a texel there, its
+    // cone ≈ 3 units wide on the ground; a wider cone's margin counts more for the offset): a
+    // sphere on its axis at height 1.2 (box x ≥ 6.25 at y ≥ 0.6, the frustum x ≤ 6.08), or at
+    // height 5 (its shadow ≈ 1.4 left of the edge).
+    SCOPED_TRACE("spot");
+    scene::Light spot = test::spotDown();
+    spot.position = {9, 8, 0};
+    spot.direction = glm::normalize(scene::Vec3(-2.53, -8, 0));
+    spot.coneAngleDegrees = 20;
+    expectTheEdgeHolds(spot, {6.85, 1.2, 0}, 0.6, {8.05 - 1.0, 5, 0}, 0.6);
+}
+
 TEST(RasterCasterCulling, SpotAndPointLightMapsAreDrawnOnlyWhereTheViewReads) {
     // The same ground and sphere under a spot straight above the sphere (cone 60°, its unfitted map
     // reaching ≈ 14 units across the ground, of which the camera sees the part in front of it and
