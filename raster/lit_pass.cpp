@@ -67,8 +67,9 @@ std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUn
 // and for none and pcf2x2 the *_taps build without the other filters' code (lavapipe turns all of a
 // module into NIR before the specialization constants remove what a pipeline does not run: the full
 // module doubled the lit pipeline's creation); where usesSunModules(), the *_sun modules (*_sun_map
-// with one map and no blend bands, *_baked of those for baked constants). lit.vert: the build whose
-// outputs are the fragment shader's inputs.
+// with one map and no blend bands, *_baked of those for baked constants); elsewhere the general
+// ones, *_baked where the one light's constants are baked in. lit.vert: the build whose outputs
+// are the fragment shader's inputs.
 LitStages litStages(const LitVariant& v, bool alpha) {
     const bool taps = v.filter == scene::ShadowFilter::None || v.filter == scene::ShadowFilter::Pcf2x2;
     if (usesSunModules(v)) {
@@ -99,6 +100,18 @@ LitStages litStages(const LitVariant& v, bool alpha) {
         if (!v.aovTarget)
             return {vertex, alpha ? shaders::litFragBeautyAlphaTapsSunSpirv() : shaders::litFragBeautyTapsSunSpirv()};
         return {vertex, alpha ? shaders::litFragAlphaTapsSunSpirv() : shaders::litFragTapsSunSpirv()};
+    }
+    if (v.specializedLightConstants && bakesLightConstants(v) && v.lightTargets == 0) {
+        // One spot light, or one sun with another filter or a transmittance map: the general
+        // modules without the flat light inputs.
+        const auto vertex = alpha ? shaders::litVertAlphaBakedSpirv() : shaders::litVertBakedSpirv();
+        if (!v.aovTarget)
+            return {vertex,
+                    taps
+                        ? (alpha ? shaders::litFragBeautyAlphaTapsBakedSpirv() : shaders::litFragBeautyTapsBakedSpirv())
+                        : (alpha ? shaders::litFragBeautyAlphaBakedSpirv() : shaders::litFragBeautyBakedSpirv())};
+        return {vertex, taps ? (alpha ? shaders::litFragAlphaTapsBakedSpirv() : shaders::litFragTapsBakedSpirv())
+                             : (alpha ? shaders::litFragAlphaBakedSpirv() : shaders::litFragBakedSpirv())};
     }
     const auto vertex = alpha ? shaders::litVertAlphaSpirv() : shaders::litVertSpirv();
     if (!v.aovTarget)

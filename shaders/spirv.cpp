@@ -9,17 +9,24 @@
 #include "background_vert.spv.h"
 #include "lit_frag.spv.h"
 #include "lit_frag_alpha.spv.h"
+#include "lit_frag_alpha_baked.spv.h"
 #include "lit_frag_alpha_taps.spv.h"
+#include "lit_frag_alpha_taps_baked.spv.h"
 #include "lit_frag_alpha_taps_sun.spv.h"
 #include "lit_frag_alpha_taps_sun_map.spv.h"
 #include "lit_frag_alpha_taps_sun_map_baked.spv.h"
+#include "lit_frag_baked.spv.h"
 #include "lit_frag_beauty.spv.h"
 #include "lit_frag_beauty_alpha.spv.h"
+#include "lit_frag_beauty_alpha_baked.spv.h"
 #include "lit_frag_beauty_alpha_taps.spv.h"
+#include "lit_frag_beauty_alpha_taps_baked.spv.h"
 #include "lit_frag_beauty_alpha_taps_sun.spv.h"
 #include "lit_frag_beauty_alpha_taps_sun_map.spv.h"
 #include "lit_frag_beauty_alpha_taps_sun_map_baked.spv.h"
+#include "lit_frag_beauty_baked.spv.h"
 #include "lit_frag_beauty_taps.spv.h"
+#include "lit_frag_beauty_taps_baked.spv.h"
 #include "lit_frag_beauty_taps_sun.spv.h"
 #include "lit_frag_beauty_taps_sun_map.spv.h"
 #include "lit_frag_beauty_taps_sun_map_baked.spv.h"
@@ -28,6 +35,7 @@
 #include "lit_frag_lights_alpha_taps.spv.h"
 #include "lit_frag_lights_taps.spv.h"
 #include "lit_frag_taps.spv.h"
+#include "lit_frag_taps_baked.spv.h"
 #include "lit_frag_taps_sun.spv.h"
 #include "lit_frag_taps_sun_map.spv.h"
 #include "lit_frag_taps_sun_map_baked.spv.h"
@@ -96,6 +104,14 @@ std::span<const std::uint32_t> litFragBeautyTapsSunMapBakedSpirv() { return kLit
 std::span<const std::uint32_t> litFragBeautyAlphaTapsSunMapBakedSpirv() {
     return kLitFragBeautyAlphaTapsSunMapBakedSpv;
 }
+std::span<const std::uint32_t> litFragTapsBakedSpirv() { return kLitFragTapsBakedSpv; }
+std::span<const std::uint32_t> litFragAlphaTapsBakedSpirv() { return kLitFragAlphaTapsBakedSpv; }
+std::span<const std::uint32_t> litFragBeautyTapsBakedSpirv() { return kLitFragBeautyTapsBakedSpv; }
+std::span<const std::uint32_t> litFragBeautyAlphaTapsBakedSpirv() { return kLitFragBeautyAlphaTapsBakedSpv; }
+std::span<const std::uint32_t> litFragBakedSpirv() { return kLitFragBakedSpv; }
+std::span<const std::uint32_t> litFragAlphaBakedSpirv() { return kLitFragAlphaBakedSpv; }
+std::span<const std::uint32_t> litFragBeautyBakedSpirv() { return kLitFragBeautyBakedSpv; }
+std::span<const std::uint32_t> litFragBeautyAlphaBakedSpirv() { return kLitFragBeautyAlphaBakedSpv; }
 std::span<const std::uint32_t> litVertBakedSpirv() { return kLitVertBakedSpv; }
 std::span<const std::uint32_t> litVertAlphaBakedSpirv() { return kLitVertAlphaBakedSpv; }
 std::span<const std::uint32_t> litVertNoIdBakedSpirv() { return kLitVertNoIdBakedSpv; }

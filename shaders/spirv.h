@@ -56,13 +56,21 @@ std::span<const std::uint32_t> litFragBeautyAlphaTapsSunMapSpirv();
 // lit.vert without the object id output, for the *_sun beauty-only shaders without the alpha
 // test (which do not read it, and spirv-opt removes the input).
 std::span<const std::uint32_t> litVertNoIdSpirv();
-// The *_sun_map modules for the light's constants baked in (SHADOWLAB_BAKED_LIGHT: no flat light
-// inputs), and lit.vert without those outputs to go with them (*_baked); lit.vert without any
+// The *_sun_map and the general modules for the light's constants baked in (SHADOWLAB_BAKED_LIGHT:
+// no flat light inputs), and lit.vert without those outputs to go with them (*_baked); lit.vert without any
 // light output for the cascaded *_sun modules (*_cascades), which read none.
 std::span<const std::uint32_t> litFragTapsSunMapBakedSpirv();
 std::span<const std::uint32_t> litFragAlphaTapsSunMapBakedSpirv();
 std::span<const std::uint32_t> litFragBeautyTapsSunMapBakedSpirv();
 std::span<const std::uint32_t> litFragBeautyAlphaTapsSunMapBakedSpirv();
+std::span<const std::uint32_t> litFragTapsBakedSpirv();
+std::span<const std::uint32_t> litFragAlphaTapsBakedSpirv();
+std::span<const std::uint32_t> litFragBeautyTapsBakedSpirv();
+std::span<const std::uint32_t> litFragBeautyAlphaTapsBakedSpirv();
+std::span<const std::uint32_t> litFragBakedSpirv();
+std::span<const std::uint32_t> litFragAlphaBakedSpirv();
+std::span<const std::uint32_t> litFragBeautyBakedSpirv();
+std::span<const std::uint32_t> litFragBeautyAlphaBakedSpirv();
 std::span<const std::uint32_t> litVertBakedSpirv();
 std::span<const std::uint32_t> litVertAlphaBakedSpirv();
 std::span<const std::uint32_t> litVertNoIdBakedSpirv();

@@ -324,5 +324,43 @@ TEST(RasterLitPass, OneSunWithBakedConstantsOrCascadesHasNoFlatLightInterface) {
         }
 }
 
+TEST(RasterLitPass, OneSpotOrASunOutsideTheSunModulesWithBakedConstantsHasNoFlatLightInterface) {
+    // The general modules (a spot light; a sun with a wide kernel, a filterable map or a
+    // transmittance map) bake the one light's constants in too: then neither stage declares the
+    // flat slots (6..13), and the map coordinates (3, 4) stay. With the constants from the vertex
+    // shader both keep them.
+    constexpr std::uint32_t kInput = 1, kOutput = 3;
+    constexpr std::uint32_t dir = 1u << SHADOWLAB_LIGHT_DIRECTIONAL, spot = 1u << SHADOWLAB_LIGHT_SPOT;
+    struct Case {
+        std::uint32_t kinds;
+        scene::ShadowFilter filter;
+        bool transmittance;
+    };
+    const Case cases[] = {{spot, scene::ShadowFilter::Pcf2x2, false}, {spot, scene::ShadowFilter::Pcss, false},
+                          {spot, scene::ShadowFilter::Vsm, true},     {dir, scene::ShadowFilter::Pcf, false},
+                          {dir, scene::ShadowFilter::Evsm4, false},   {dir, scene::ShadowFilter::Pcf2x2, true}};
+    for (const Case& c : cases)
+        for (const bool alpha : {false, true})
+            for (const bool aov : {true, false}) {
+                const std::string what = "kinds " + std::to_string(c.kinds) + " filter " +
+                                         std::to_string(int(c.filter)) + " alpha " + std::to_string(alpha) + " aov " +
+                                         std::to_string(aov);
+                LitVariant v{.filter = c.filter,
+                             .aovTarget = aov,
+                             .lightKinds = c.kinds,
+                             .transmittance = c.transmittance,
+                             .specializedLightConstants = true};
+                const LitStages baked = litStages(v, alpha);
+                for (const std::uint32_t slot : {6u, 12u}) {
+                    EXPECT_FALSE(interfaceLocations(baked.vertex, kOutput).contains(slot)) << what;
+                    EXPECT_FALSE(interfaceLocations(baked.fragment, kInput).contains(slot)) << what;
+                }
+                EXPECT_TRUE(interfaceLocations(baked.fragment, kInput).contains(3u)) << what;
+                v.specializedLightConstants = false;
+                v.vertexLightConstants = true;
+                EXPECT_TRUE(interfaceLocations(litStages(v, alpha).fragment, kInput).contains(6u)) << what;
+            }
+}
+
 }  // namespace
 }  // namespace shadowlab::raster
