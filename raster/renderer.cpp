@@ -208,6 +208,7 @@ struct Renderer::Impl {
     // LitVariant::specializedLightConstants of the lit pipelines made from now on, and the values the
     // existing ones baked in; update() turns it off when the values change (RendererOptions::lightConstants).
     bool specializedLightConstants = false;
+    bool bakedAtConstruction = false;  // setBiases() bakes the new values in again
     std::array<float, kPackedLightConstants> bakedLightConstants{};
     bool renderIntoFrame = true;       // RendererOptions::renderIntoFrame
     bool transmittanceWindows = true;  // RendererOptions::transmittanceWindows
@@ -306,6 +307,8 @@ struct Renderer::Impl {
     void describeLayers();           // the attributes that follow the frusta
     void describeTransmitWindows();  // transmittance_windows: each layer's window (x0,y0,x1,y1 or none)
     void update(const scene::Scene& scene, const scene::Camera& view);
+    void setBiases(const scene::Scene& scene, double depthBias, double slopeBias);
+    void retireLitPipelines();  // into retiredLitPipelines: the next frame makes them again
 };
 
 Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
@@ -623,6 +626,7 @@ void Renderer::Impl::createTargets(const scene::Scene& scene, const RendererOpti
         usesVertexLightCoordinates(lights) && options.lightConstants != LightConstants::kUniformBuffer;
     specializedLightConstants =
         bakesLightConstants(lights) && options.lightConstants == LightConstants::kSpecialization;
+    bakedAtConstruction = specializedLightConstants;
     bakedLightConstants = packLightConstants(uniforms);
     attributes["light_constants"] = specializedLightConstants ? "specialization"
                                     : vertexLightConstants    ? "vertex-outputs"
@@ -760,11 +764,7 @@ void Renderer::Impl::update(const scene::Scene& scene, const scene::Camera& view
         // pipelines every frame).
         specializedLightConstants = false;
         attributes["light_constants"] = vertexLightConstants ? "vertex-outputs" : "uniform-buffer";
-        for (auto& pair : litPipelines)
-            for (LitPipeline& p : pair)
-                if (p.pipeline) retiredLitPipelines.push_back(std::move(p));
-        for (LitPipeline& p : liftFreePipelines)
-            if (p.pipeline) retiredLitPipelines.push_back(std::move(p));
+        retireLitPipelines();
     }
     describeLayers();
     describeTransmitWindows();
@@ -784,6 +784,31 @@ void Renderer::Impl::update(const scene::Scene& scene, const scene::Camera& view
         ctx.submitAndWait(commands);  // the fence makes the copy visible to the next submission
     }
     pendingUpdateMs = msSince(updateStart);
+}
+
+void Renderer::Impl::retireLitPipelines() {
+    for (auto& pair : litPipelines)
+        for (LitPipeline& p : pair)
+            if (p.pipeline) retiredLitPipelines.push_back(std::move(p));
+    for (LitPipeline& p : liftFreePipelines)
+        if (p.pipeline) retiredLitPipelines.push_back(std::move(p));
+}
+
+void Renderer::Impl::setBiases(const scene::Scene& scene, double depthBias, double slopeBias) {
+    // As resolveSettings() leaves a bias given explicitly; the map size and cascades do not follow
+    // the biases (resolveAutomaticChoices), so they stay the constructor's.
+    settings.depthBias = depthBias;
+    settings.depthBiasIsDefault = false;
+    settings.slopeBias = slopeBias;
+    update(scene, scene.camera);
+    // The lit pipelines are made again at the next frame, as a new Renderer's: with the new
+    // constants baked in, and with or without the normal-offset path, which the slope bias switches.
+    retireLitPipelines();
+    if (bakedAtConstruction) {
+        specializedLightConstants = true;
+        bakedLightConstants = packLightConstants(uniforms);
+        attributes["light_constants"] = "specialization";
+    }
 }
 
 void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, const ValidationLog& log,
@@ -1208,6 +1233,9 @@ void Renderer::render(scene::Frame& frame, scene::ChannelMask channels, RenderDe
 }
 void Renderer::update(const scene::Scene& scene) { impl_->update(scene, scene.camera); }
 void Renderer::update(const scene::Scene& scene, const scene::Camera& view) { impl_->update(scene, view); }
+void Renderer::setBiases(const scene::Scene& scene, double depthBias, double slopeBias) {
+    impl_->setBiases(scene, depthBias, slopeBias);
+}
 double Renderer::setupMs() const { return impl_->setupMs; }
 int Renderer::validationMessages() const { return log_->count.load(); }
 

@@ -113,6 +113,11 @@ public:
     // resolution): the held-view frames of a camera path (docs/temporal.md). Cascades are chosen,
     // and the Frame's Z measured, along scene.camera's view axis: the shadow setup is that camera's.
     void update(const scene::Scene& scene, const scene::Camera& view);
+    // The next frames with other shader biases (constant in world units, slope in texels) for
+    // `scene` (update()'s rules), as a new Renderer given them draws: the layers, caster culling
+    // and read windows are placed again (the culling margin counts the slope bias). A bias search
+    // renders its points with one Renderer instead of a device, upload and pipelines per point.
+    void setBiases(const scene::Scene& scene, double depthBias, double slopeBias);
     double setupMs() const;  // the constructor's time
     // Validation messages counted so far (settings.validate); messages raised when the Renderer
     // is destroyed are not in any frame: raster::render() adds them to its frame.

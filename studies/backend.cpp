@@ -17,6 +17,10 @@ namespace shadowlab::studies {
 // of MiB resident that no estimate counts (docs/reliability.md, "Memory").
 BackendRenderer::~BackendRenderer() { malloc_trim(0); }
 
+void BackendRenderer::setRasterBiases(const scene::Scene&, double, double) {
+    throw std::logic_error("setRasterBiases: only the raster backend has shadow-map biases");
+}
+
 namespace {
 
 class RasterRenderer final : public BackendRenderer {
@@ -25,6 +29,9 @@ public:
         : renderer_(scene, plan, settings) {}
     void update(const scene::Scene& scene) override { renderer_.update(scene); }
     void update(const scene::Scene& scene, const scene::Camera& view) override { renderer_.update(scene, view); }
+    void setRasterBiases(const scene::Scene& scene, double depthBias, double slopeBias) override {
+        renderer_.setBiases(scene, depthBias, slopeBias);
+    }
     scene::Frame render(scene::ChannelMask channels) override { return renderer_.render(channels); }
     double setupMs() const override { return renderer_.setupMs(); }
     int validationMessages() const override { return renderer_.validationMessages(); }

@@ -34,6 +34,10 @@ public:
     // held-view frames of a camera path). Only the raster backend has a shadow setup that differs
     // from the image's: the others throw std::logic_error.
     virtual void update(const scene::Scene& scene, const scene::Camera& view) = 0;
+    // The next frames with other shader biases (raster::Renderer::setBiases: the frames a new
+    // renderer given them draws). Only the raster backend has them: the others throw
+    // std::logic_error.
+    virtual void setRasterBiases(const scene::Scene& scene, double depthBias, double slopeBias);
     // The raster backend reads back only `channels` (scene/frame.h); the ray tracers fill every AOV.
     virtual scene::Frame render(scene::ChannelMask channels = scene::kAllChannels) = 0;
     virtual double setupMs() const = 0;  // the constructor's time

@@ -6,10 +6,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <set>
 
 #include "compare/compare.h"
 #include "compare/text.h"
+#include "scene/frame_identity.h"
+#include "studies/backend.h"
 
 namespace shadowlab::studies {
 
@@ -41,17 +44,24 @@ std::string attribute(const scene::Frame& f, const char* key) {
     return it == f.attributes.end() ? std::string() : it->second;
 }
 
+// What makes a rendered frame unusable (validation messages, non-finite values), or "".
+std::string frameError(const scene::Frame& f, const scene::RenderSettings& settings, scene::Backend backend) {
+    std::string error;
+    const std::string messages = attribute(f, "validation_messages");
+    if (settings.raster.validate && backend == scene::Backend::Raster && messages != "0")
+        error = "the Vulkan validation layer reported " + (messages.empty() ? "an unknown number of" : messages) +
+                " message(s)";
+    if (compare::measureHealth(f).total() > 0) error = "non-finite values";
+    return error;
+}
+
 // Renders one configuration; failures (exceptions, validation messages) are recorded in `error`.
 scene::Frame renderOne(const RecommendOptions& o, const scene::Scene& s, const scene::SettingsOverrides& overrides,
                        scene::Backend backend, std::string& error) {
     try {
         const scene::RenderSettings settings = scene::resolveSettings(s, overrides);
         scene::Frame f = o.render(s, settings, backend);
-        const std::string messages = attribute(f, "validation_messages");
-        if (settings.raster.validate && backend == scene::Backend::Raster && messages != "0")
-            error = "the Vulkan validation layer reported " + (messages.empty() ? "an unknown number of" : messages) +
-                    " message(s)";
-        if (compare::measureHealth(f).total() > 0) error = "non-finite values";
+        error = frameError(f, settings, backend);
         return f;
     } catch (const std::exception& e) {
         error = e.what();
@@ -59,10 +69,58 @@ scene::Frame renderOne(const RecommendOptions& o, const scene::Scene& s, const s
     }
 }
 
+Measured measured(scene::Frame f, const std::string& error, const scene::Frame& reference, scene::Frame* keep);
+
 Measured measureRender(const RecommendOptions& o, const scene::Scene& s, const scene::SettingsOverrides& overrides,
                        scene::Backend backend, const scene::Frame& reference, scene::Frame* keep = nullptr) {
     std::string error;
     scene::Frame f = renderOne(o, s, overrides, backend, error);
+    return measured(std::move(f), error, reference, keep);
+}
+
+// The search's points differ from one another only in the two biases: with the default render
+// function one raster renderer draws them all (BackendRenderer::setRasterBiases, the frames a new
+// renderer given those biases draws), not a device, an upload and pipelines per point. A fake
+// render function (tests) renders each point anew.
+class PointRenderer {
+public:
+    PointRenderer(const RecommendOptions& o, const scene::Scene& s) : o_(o), scene_(s) {
+        using Fn = scene::Frame (*)(const scene::Scene&, const scene::RenderSettings&, scene::Backend);
+        const Fn* fn = o.render.target<Fn>();
+        reuse_ = fn && *fn == &renderWithBackend;
+    }
+    Measured measure(const scene::SettingsOverrides& overrides, const scene::Frame& reference) {
+        if (!reuse_) return measureRender(o_, scene_, overrides, scene::Backend::Raster, reference);
+        std::string error;
+        scene::Frame f;
+        try {
+            const scene::RenderSettings settings = scene::resolveSettings(scene_, overrides);
+            if (renderer_)
+                renderer_->setRasterBiases(scene_, settings.raster.depthBias, settings.raster.slopeBias);
+            else
+                renderer_ =
+                    makeRenderer(scene::Backend::Raster, scene_, scene::makeRenderPlan(scene_, settings), settings);
+            f = renderer_->render();
+            scene::recordIdentity(f, scene_);
+            error = frameError(f, settings, scene::Backend::Raster);
+        } catch (const std::exception& e) {
+            renderer_.reset();  // the next point starts from a new renderer
+            error = e.what();
+        }
+        return measured(std::move(f), error, reference, nullptr);
+    }
+
+    // Its maps, geometry and pipelines go (and the heap is trimmed: ~BackendRenderer).
+    void release() { renderer_.reset(); }
+
+private:
+    const RecommendOptions& o_;
+    const scene::Scene& scene_;
+    bool reuse_ = false;
+    std::unique_ptr<BackendRenderer> renderer_;
+};
+
+Measured measured(scene::Frame f, const std::string& error, const scene::Frame& reference, scene::Frame* keep) {
     Measured m;
     if (!error.empty()) {
         m.error = error;
@@ -312,6 +370,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
         const bool oneBias = applied.find(';') == std::string::npos && resolved.raster.slopeBias == s0;
 
         std::set<std::pair<double, double>> done;
+        PointRenderer points(o, searchScene);
         auto tryPoint = [&](double depth, double slope, bool refined) {
             depth = tidy(depth);
             slope = tidy(slope);
@@ -324,7 +383,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
             scene::SettingsOverrides ov = searchUser;
             ov.depthBias = depth;
             ov.slopeBias = slope;
-            p.at = measureRender(o, searchScene, ov, scene::Backend::Raster, searchReference);
+            p.at = points.measure(ov, searchReference);
             r.points.push_back(p);
         };
         if (d.at.ok) {
@@ -354,6 +413,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
             r.best = 0;
         }
 
+        points.release();  // before the check's renderer at the requested resolution
         // At the requested resolution: the user's defaults against the best point.
         const BiasPoint& best = r.points[r.best];
         if (!best.defaults && best.at.ok) {

@@ -1236,6 +1236,68 @@ TEST(RasterRenderer, SizeOptimizedSunModulesGiveTheGeneralModulesFramesBitForBit
     }
 }
 
+TEST(RasterRenderer, SetBiasesDrawsWhatANewRendererGivenThoseBiasesDraws) {
+    // A bias search renders its points with one Renderer (setBiases): each frame must be the one a
+    // new Renderer made with those biases draws, bit for bit, although the layers' culling margin,
+    // the lit pipelines' baked constants and their normal-offset path (the slope bias's lift past
+    // its cap; none with slope 0) all follow the biases. One sun with one map (the *_sun modules,
+    // lift-free draws), three cascades (per-cascade biases), a spot with a wide kernel (the
+    // general modules), a sun 4° above the ground with its constants read from the uniform buffer
+    // and no slope bias at first (its pipelines are not baked and have no normal-offset path, which
+    // the ground needs once a slope bias lifts it past the cap: only setBiases() makes them
+    // again); each through a sequence that switches the slope bias off and on again.
+    scene::Scene spot = sunAt50Degrees(0.0);
+    spot.lights[0].type = scene::LightType::Spot;
+    spot.lights[0].position = Vec3(2.5, 3.0, 1.5);
+    spot.lights[0].direction = glm::normalize(Vec3(-2.5, -2.2, -1.5));
+    spot.lights[0].coneAngleDegrees = 45.0;
+    spot.lights[0].intensity = 300.0;
+    scene::RasterSettings cascades = validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2);
+    cascades.cascades = 3;
+    SphereOverPlane grazing;
+    grazing.lightDirection = Vec3(-1.0, -0.07, 0.0);  // 4° above the ground: past the slope cap
+    const scene::Scene lowSun = makeScene(grazing);
+    struct Case {
+        scene::Scene scene;
+        scene::RasterSettings settings;
+        LightConstants constants = LightConstants::kSpecialization;
+    };
+    const Case cases[] = {
+        {sunAt50Degrees(0.0), validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2)},
+        {lowSun, validatedSettings(512, 0.01, 0.0, ShadowFilter::Pcf2x2), LightConstants::kUniformBuffer},
+        {makeLongPlane(), cascades},
+        {spot, validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf)}};
+    const std::pair<double, double> biases[] = {{0.0, 0.0}, {0.05, 4.0}, {0.002, 0.0}, {0.01, 1.0}};
+    for (const auto& [s, first, constants] : cases) {
+        const RendererOptions options{.lightConstants = constants};
+        Renderer reused(s, planFor(s, first), first, options);
+        const scene::Frame before = reused.render();
+        bool anyDiffers = false;
+        for (const auto& [depth, slope] : biases) {
+            scene::RasterSettings settings = first;
+            settings.depthBias = depth;
+            settings.slopeBias = slope;
+            const std::string what = s.lights[0].type == scene::LightType::Spot ? "spot" : "sun";
+            reused.setBiases(s, depth, slope);
+            const scene::Frame f = reused.render();
+            Renderer fresh(s, planFor(s, settings), settings, options);
+            const scene::Frame expected = fresh.render();
+            const std::string at = what + ", depth " + std::to_string(depth) + ", slope " + std::to_string(slope);
+            test::expectSamePixels(f, expected, at);
+            const auto attribute = [](const scene::Frame& frame, const char* key) {
+                const auto it = frame.attributes.find(key);
+                return it == frame.attributes.end() ? std::string("(none)") : it->second;
+            };
+            for (const char* key : {"depth_bias", "slope_bias", "light_constants", "culled_casters"})
+                EXPECT_EQ(attribute(f, key), attribute(expected, key)) << at << ": " << key;
+            anyDiffers = anyDiffers || f.visibility != before.visibility;
+            EXPECT_EQ(fresh.validationMessages(), 0);
+        }
+        EXPECT_TRUE(anyDiffers) << "the biases change the shadows";
+        EXPECT_EQ(reused.validationMessages(), 0);
+    }
+}
+
 // The frames of three renderers for the same channels: one reading light 0's constants from the
 // uniform buffer, one taking them as flat outputs of the vertex shader, one with them baked into
 // its pipelines as specialization constants.

@@ -301,6 +301,39 @@ void checkNeverLoses(const std::string& name) {
     EXPECT_DOUBLE_EQ(r.raster.recommended.mismatchRate, block.mismatchRate);
 }
 
+TEST(RecommendOnLavapipe, OneRendererForEveryPointMeasuresWhatARendererPerPointMeasures) {
+    // With the default render function the search draws its points with one raster renderer,
+    // changing its biases between them; a wrapper around the same function (not recognised as
+    // the default) makes a renderer per point. Every point must measure the same.
+    const fs::path file = scene::findScene("extreme/grazing-1deg");
+    scene::Scene search = scene::loadScene(file);
+    search.camera.width = 80;
+    search.camera.height = 45;
+    const scene::Frame ref = renderWithBackend(search, scene::resolveSettings(search, {}), scene::Backend::Reference);
+    RecommendOptions reused;
+    reused.user.validate = true;
+    reused.raytrace = false;
+    RecommendOptions perPoint = reused;
+    perPoint.render = [](const scene::Scene& sc, const scene::RenderSettings& st, scene::Backend b) {
+        return renderWithBackend(sc, st, b);
+    };
+    const Recommendation a = recommendShadow(search, ref, search, ref, nullptr, nullptr, Json::object(), reused);
+    const Recommendation b = recommendShadow(search, ref, search, ref, nullptr, nullptr, Json::object(), perPoint);
+    ASSERT_EQ(a.points.size(), b.points.size());
+    ASSERT_GT(a.points.size(), 10u);
+    std::set<double> rates;
+    for (std::size_t i = 0; i < a.points.size(); ++i) {
+        ASSERT_TRUE(a.points[i].at.ok) << i << ": " << a.points[i].at.error;
+        EXPECT_EQ(a.points[i].depthBias, b.points[i].depthBias) << i;
+        EXPECT_EQ(a.points[i].slopeBias, b.points[i].slopeBias) << i;
+        EXPECT_EQ(a.points[i].at.mismatchRate, b.points[i].at.mismatchRate) << i;
+        EXPECT_EQ(a.points[i].at.meanAbsVisibilityError, b.points[i].at.meanAbsVisibilityError) << i;
+        rates.insert(a.points[i].at.mismatchRate);
+    }
+    EXPECT_GT(rates.size(), 3u);  // the biases change what the points measure
+    EXPECT_EQ(a.shadowBlock, b.shadowBlock);
+}
+
 TEST(RecommendOnLavapipe, TheSeedsBlockIsNoWorseThanItsDefaults) { checkNeverLoses("seed"); }
 
 TEST(RecommendOnLavapipe, AStiffCasesBlockIsNoWorseThanItsDefaults) { checkNeverLoses("extreme/grazing-1deg"); }
