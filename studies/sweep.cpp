@@ -702,19 +702,27 @@ scene::Frame renderWithBackend(const scene::Scene& scene, const scene::RenderSet
 
 namespace {
 
-// The frames of one configuration: with the default render function, a raster configuration
-// renders its warm-up and timed frames with one raster::Renderer, so the device, pipelines,
-// geometry and shadow maps are set up once (the warm-up frame's "setup"), as a program that
-// renders frames would; other backends (and fakes passed in by tests) render each frame anew.
+// The frames of one configuration: with the default render function, a raster or ray-traced
+// configuration renders its warm-up and timed frames with one renderer, so the device, pipelines,
+// geometry and shadow maps, or the acceleration structures, are set up once (the warm-up frame's
+// "setup"), as a program that renders frames would; fakes passed in by tests render each frame
+// anew.
 std::function<scene::Frame()> frameSource(const SweepOptions& options, const scene::Scene& scene,
                                           const scene::RenderSettings& settings, scene::Backend backend) {
     using Fn = scene::Frame (*)(const scene::Scene&, const scene::RenderSettings&, scene::Backend);
     const Fn* fn = options.render.target<Fn>();
-    if (backend == scene::Backend::Raster && fn && *fn == &renderWithBackend) {
+    if ((backend == scene::Backend::Raster || backend == scene::Backend::Raytrace) && fn && *fn == &renderWithBackend) {
         std::shared_ptr<BackendRenderer> renderer =
-            makeRenderer(scene::Backend::Raster, scene, scene::makeRenderPlan(scene, settings), settings);
-        return [renderer, &scene] {
+            makeRenderer(backend, scene, scene::makeRenderPlan(scene, settings), settings);
+        auto first = std::make_shared<bool>(true);
+        return [renderer, first, backend, &scene] {
             scene::Frame f = renderer->render();
+            // The ray tracer's frames report no setup of their own (its trees are built by the
+            // constructor): the first carries the constructor's, as the raster renderer's does.
+            if (backend == scene::Backend::Raytrace && *first)
+                for (auto& [stage, ms] : f.timingsMs)
+                    if (stage == "setup") ms = renderer->setupMs();
+            *first = false;
             scene::recordIdentity(f, scene);
             return f;
         };

@@ -752,5 +752,32 @@ TEST_F(GridFile, HostileFilesAreRefusedBeforeTheyAreReadOrExpanded) {
     EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
 }
 
+TEST_F(Sweep, EachRowRendersWithOneRendererAndMeasuresWhatARendererPerFrameMeasures) {
+    // With the default render function a raster or ray-traced row renders its warm-up and timed
+    // frames with one renderer; its setup (the device and upload, or the trees) is the warm-up's.
+    // A wrapper around the same function renders each frame anew: the same metrics on every row.
+    const SweepGrid grid = smallGrid();
+    SweepOptions reused;
+    reused.outputDir = dir;
+    reused.writeImages = false;
+    const SweepResult a = runSweep(scene, grid, reused);
+    SweepOptions perFrame = reused;
+    perFrame.outputDir = root / "per-frame";
+    perFrame.render = [](const scene::Scene& s, const scene::RenderSettings& st, scene::Backend b) {
+        return renderWithBackend(s, st, b);
+    };
+    const SweepResult b = runSweep(scene, grid, perFrame);
+    ASSERT_EQ(a.rows.size(), grid.configs.size());
+    ASSERT_EQ(b.rows.size(), grid.configs.size());
+    for (std::size_t i = 0; i < a.rows.size(); ++i) {
+        EXPECT_TRUE(a.rows[i].error.empty()) << a.rows[i].error;
+        for (const auto& [key, value] : a.rows[i].metrics.items())
+            if (key != "method_timing" && key != "reference_timing")  // times of their own
+                EXPECT_EQ(value, b.rows[i].metrics.value(key, Json())) << a.rows[i].config.label() << ": " << key;
+        EXPECT_GT(a.rows[i].setupMs, 0.0) << a.rows[i].config.label();  // the constructor's
+        EXPECT_GT(a.rows[i].frameMs, 0.0) << a.rows[i].config.label();
+    }
+}
+
 }  // namespace
 }  // namespace shadowlab::studies
