@@ -351,16 +351,21 @@ TEST(RasterHardwareBias, AConstantBiasInTheDepthPassComparesAsTheSameBiasInTheSh
     EXPECT_LT(std::abs(a.missedShadow - b.missedShadow), a.analyticShadowed / 20 + 1);
 }
 
+// `s` with its light a spot at `position` aimed along `direction` (half-angle 45°, intensity 300).
+scene::Scene withSpot(scene::Scene s, const Vec3& position, const Vec3& direction) {
+    s.lights[0].type = scene::LightType::Spot;
+    s.lights[0].position = position;
+    s.lights[0].direction = glm::normalize(direction);
+    s.lights[0].coneAngleDegrees = 45;
+    s.lights[0].intensity = 300;
+    return s;
+}
+
 TEST(RasterHardwareBias, SpotAndPointMapsKeepTheShaderBiasAndCascadesTakeTheirOwnFactors) {
     // Perspective depth is not linear in distance, so one constant factor cannot be one world bias:
     // spot and point layers keep the shader's bias (factors 0, the same pixels as without the
     // option). Cascades: each layer's factor is its own world bias over its own depth range.
-    scene::Scene s = makeScene(SphereOverPlane{});
-    s.lights[0].type = scene::LightType::Spot;
-    s.lights[0].position = Vec3(2, 5, 2);
-    s.lights[0].direction = glm::normalize(Vec3(-2, -5, -2));
-    s.lights[0].coneAngleDegrees = 45;
-    s.lights[0].intensity = 300;
+    scene::Scene s = withSpot(makeScene(SphereOverPlane{}), Vec3(2, 5, 2), Vec3(-2, -5, -2));
     scene::RasterSettings settings = validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2);
     const scene::Frame shader = renderValidated(s, settings, "spot-shader");
     settings.hardwareBias = true;
@@ -1246,12 +1251,7 @@ TEST(RasterRenderer, SetBiasesDrawsWhatANewRendererGivenThoseBiasesDraws) {
     // and no slope bias at first (its pipelines are not baked and have no normal-offset path, which
     // the ground needs once a slope bias lifts it past the cap: only setBiases() makes them
     // again); each through a sequence that switches the slope bias off and on again.
-    scene::Scene spot = sunAt50Degrees(0.0);
-    spot.lights[0].type = scene::LightType::Spot;
-    spot.lights[0].position = Vec3(2.5, 3.0, 1.5);
-    spot.lights[0].direction = glm::normalize(Vec3(-2.5, -2.2, -1.5));
-    spot.lights[0].coneAngleDegrees = 45.0;
-    spot.lights[0].intensity = 300.0;
+    const scene::Scene spot = withSpot(sunAt50Degrees(0.0), Vec3(2.5, 3.0, 1.5), Vec3(-2.5, -2.2, -1.5));
     scene::RasterSettings cascades = validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2);
     cascades.cascades = 3;
     SphereOverPlane grazing;
