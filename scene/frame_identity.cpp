@@ -6,7 +6,11 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <deque>
+#include <memory>
+#include <mutex>
 #include <type_traits>
+#include <vector>
 
 #include "scene/camera.h"
 
@@ -35,9 +39,10 @@ private:
 
 glm::mat4 toFloat(const glm::dmat4& m) { return glm::mat4(m); }
 
-}  // namespace
-
-std::string sceneHash(const Scene& scene) {
+// One pass over the scene. With `bulk`, the meshes' positions, normals, UVs and indices and the
+// alpha textures' texels are not hashed but their owners recorded there: the digest of the rest,
+// the cache's key (sceneHash).
+std::uint64_t digestOf(const Scene& scene, std::vector<std::shared_ptr<const void>>* bulk) {
     Hasher h;
     h.vec(scene.background);
     h.value(scene.ambient);
@@ -50,7 +55,10 @@ std::string sceneHash(const Scene& scene) {
             if (m.alphaTexture) {
                 h.value(m.alphaTexture->width), h.value(m.alphaTexture->height);
                 h.value(int(m.alphaTexture->wrapS)), h.value(int(m.alphaTexture->wrapT));
-                h.bytes(m.alphaTexture->alpha.data(), m.alphaTexture->alpha.size() * sizeof(float));
+                if (bulk)
+                    bulk->push_back(m.alphaTexture);
+                else
+                    h.bytes(m.alphaTexture->alpha.data(), m.alphaTexture->alpha.size() * sizeof(float));
             }
         }
     }
@@ -77,6 +85,11 @@ std::string sceneHash(const Scene& scene) {
                 for (int c = 0; c < 4; ++c) h.vec(inst.transform[c]);
                 const TriangleMesh& g = *inst.geometry;
                 h.value(g.positions.size());
+                if (bulk) {
+                    bulk->push_back(inst.geometry);
+                    h.value(g.indices.size());
+                    continue;
+                }
                 h.bytes(g.positions.data(), g.positions.size() * sizeof(Vec3));
                 h.bytes(g.normals.data(), g.normals.size() * sizeof(Vec3));
                 if (!g.uvs.empty()) h.bytes(g.uvs.data(), g.uvs.size() * sizeof(Vec2));
@@ -85,9 +98,51 @@ std::string sceneHash(const Scene& scene) {
             }
         }
     }
+    return h.digest();
+}
+
+std::string hex(std::uint64_t digest) {
     char text[17];
-    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h.digest()));
+    std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(digest));
     return text;
+}
+
+// The last scenes hashed: the digest of everything but the bulk, the bulk's owners (a Scene's meshes
+// and alpha textures are shared and never changed once loaded, so the same live one has the same
+// bytes), and the full hash. A sweep or a camera path records the identity of every frame of one
+// scene; hashing Sponza's 262k triangles each time cost a run about 2% of its CPU.
+struct CachedHash {
+    std::uint64_t key = 0;
+    std::vector<std::weak_ptr<const void>> bulk;
+    std::string hash;
+};
+std::mutex cacheMutex;
+std::deque<CachedHash> cache;  // newest first
+constexpr std::size_t kCachedScenes = 4;
+
+}  // namespace
+
+std::string sceneHash(const Scene& scene) {
+    std::vector<std::shared_ptr<const void>> bulk;
+    const std::uint64_t key = digestOf(scene, &bulk);
+    if (bulk.empty()) return hex(key);  // nothing was left out: the key is the hash
+    auto same = [&](const CachedHash& c) {
+        if (c.key != key || c.bulk.size() != bulk.size()) return false;
+        for (std::size_t i = 0; i < bulk.size(); ++i)
+            if (c.bulk[i].lock() != bulk[i]) return false;  // gone, or another one
+        return true;
+    };
+    {
+        const std::lock_guard<std::mutex> lock(cacheMutex);
+        for (const CachedHash& c : cache)
+            if (same(c)) return c.hash;
+    }
+    CachedHash entry{key, {bulk.begin(), bulk.end()}, hex(digestOf(scene, nullptr))};
+    const std::string hash = entry.hash;
+    const std::lock_guard<std::mutex> lock(cacheMutex);
+    cache.push_front(std::move(entry));
+    if (cache.size() > kCachedScenes) cache.pop_back();
+    return hash;
 }
 
 glm::dmat4 worldToCamera(const Camera& camera) {

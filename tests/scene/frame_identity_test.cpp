@@ -126,6 +126,48 @@ TEST(FrameIdentity, SceneHashFollowsTheContentNotTheCameraOrNames) {
     EXPECT_NE(sceneHash(e), sceneHash(e2));
 }
 
+TEST(FrameIdentity, TheHashOfAMeshSceneIsTheSameWhetherRecomputedOrRemembered) {
+    // sceneHash remembers the last scenes by everything but their meshes' and alpha textures'
+    // bulk and by which (shared, never changed) geometry they hold: a scene whose geometry is new
+    // objects with the same content hashes the same, other content or other lights differently,
+    // and asking again gives what the first call computed.
+    auto triangle = [](float x) {
+        auto mesh = std::make_shared<TriangleMesh>();
+        mesh->positions = {{0, 0, 0}, {x, 0, 0}, {0, 1, 0}};
+        mesh->normals = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}};
+        mesh->indices = {0, 1, 2};
+        return mesh;
+    };
+    Scene a = sphereScene();
+    a.objects.push_back({"tri", Mesh::single("t.obj", triangle(1.0f)), 0});
+    const std::string first = sceneHash(a);
+    EXPECT_EQ(sceneHash(a), first);
+    Scene copy = sphereScene();  // the same content in new objects
+    copy.objects.push_back({"tri", Mesh::single("t.obj", triangle(1.0f)), 0});
+    EXPECT_EQ(sceneHash(copy), first);
+    Scene other = sphereScene();
+    other.objects.push_back({"tri", Mesh::single("t.obj", triangle(2.0f)), 0});
+    EXPECT_NE(sceneHash(other), first);
+    EXPECT_EQ(sceneHash(a), first);  // still, after another scene
+    Scene lit = a;                   // the same geometry, another light
+    lit.lights[0].intensity = 2.0;
+    EXPECT_NE(sceneHash(lit), first);
+    // An alpha texture's texels count as a mesh's vertices do.
+    auto texture = [](float alpha) {
+        auto t = std::make_shared<AlphaTexture>();
+        t->width = t->height = 2;
+        t->alpha = {1, alpha, 1, 1};
+        return t;
+    };
+    Scene masked = a, masked2 = a;
+    masked.materials[0].alphaMode = masked2.materials[0].alphaMode = AlphaMode::Mask;
+    masked.materials[0].alphaTexture = texture(0.0f);
+    masked2.materials[0].alphaTexture = texture(0.5f);
+    const std::string m = sceneHash(masked);
+    EXPECT_NE(sceneHash(masked2), m);
+    EXPECT_EQ(sceneHash(masked), m);
+}
+
 TEST(FrameIdentity, DifferenceNamesSizeSceneOrCamera) {
     const Scene s = sphereScene();
     Frame a = Frame::allocate(64, 32, false);
