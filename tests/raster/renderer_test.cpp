@@ -1256,6 +1256,10 @@ TEST(RasterRenderer, SetBiasesDrawsWhatANewRendererGivenThoseBiasesDraws) {
     cascades.cascades = 3;
     SphereOverPlane grazing;
     grazing.lightDirection = Vec3(-1.0, -0.07, 0.0);  // 4° above the ground: past the slope cap
+    // A low sphere: its shadow begins in view, 0.7 past it, and the lift moves where it begins (a
+    // renderer that kept the pipelines without the lift draws it elsewhere).
+    grazing.center = Vec3(0, 0.3, 0);
+    grazing.radius = 0.25;
     const scene::Scene lowSun = makeScene(grazing);
     struct Case {
         scene::Scene scene;
