@@ -69,7 +69,22 @@ scene::Frame renderOne(const RecommendOptions& o, const scene::Scene& s, const s
     }
 }
 
-Measured measured(scene::Frame f, const std::string& error, const scene::Frame& reference, scene::Frame* keep);
+// The measurement of a rendered frame, or the error that kept it from one.
+Measured measured(scene::Frame f, const std::string& error, const scene::Frame& reference, scene::Frame* keep) {
+    Measured m;
+    if (!error.empty()) {
+        m.error = error;
+        return m;
+    }
+    try {
+        m = measure(f, reference);
+    } catch (const std::exception& e) {
+        m.ok = false;
+        m.error = e.what();
+    }
+    if (keep) *keep = std::move(f);
+    return m;
+}
 
 Measured measureRender(const RecommendOptions& o, const scene::Scene& s, const scene::SettingsOverrides& overrides,
                        scene::Backend backend, const scene::Frame& reference, scene::Frame* keep = nullptr) {
@@ -85,9 +100,7 @@ Measured measureRender(const RecommendOptions& o, const scene::Scene& s, const s
 class PointRenderer {
 public:
     PointRenderer(const RecommendOptions& o, const scene::Scene& s) : o_(o), scene_(s) {
-        using Fn = scene::Frame (*)(const scene::Scene&, const scene::RenderSettings&, scene::Backend);
-        const Fn* fn = o.render.target<Fn>();
-        reuse_ = fn && *fn == &renderWithBackend;
+        reuse_ = isRenderWithBackend(o.render);
     }
     Measured measure(const scene::SettingsOverrides& overrides, const scene::Frame& reference) {
         if (!reuse_) return measureRender(o_, scene_, overrides, scene::Backend::Raster, reference);
@@ -119,22 +132,6 @@ private:
     bool reuse_ = false;
     std::unique_ptr<BackendRenderer> renderer_;
 };
-
-Measured measured(scene::Frame f, const std::string& error, const scene::Frame& reference, scene::Frame* keep) {
-    Measured m;
-    if (!error.empty()) {
-        m.error = error;
-        return m;
-    }
-    try {
-        m = measure(f, reference);
-    } catch (const std::exception& e) {
-        m.ok = false;
-        m.error = e.what();
-    }
-    if (keep) *keep = std::move(f);
-    return m;
-}
 
 Json measuredJson(const Measured& m) {
     if (!m.ok) return {{"error", m.error}};

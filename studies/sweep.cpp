@@ -700,6 +700,12 @@ scene::Frame renderWithBackend(const scene::Scene& scene, const scene::RenderSet
     return f;
 }
 
+bool isRenderWithBackend(const RenderFn& render) {
+    using Fn = scene::Frame (*)(const scene::Scene&, const scene::RenderSettings&, scene::Backend);
+    const Fn* fn = render.target<Fn>();
+    return fn && *fn == &renderWithBackend;
+}
+
 namespace {
 
 // The frames of one configuration: with the default render function, a raster or ray-traced
@@ -709,9 +715,8 @@ namespace {
 // anew.
 std::function<scene::Frame()> frameSource(const SweepOptions& options, const scene::Scene& scene,
                                           const scene::RenderSettings& settings, scene::Backend backend) {
-    using Fn = scene::Frame (*)(const scene::Scene&, const scene::RenderSettings&, scene::Backend);
-    const Fn* fn = options.render.target<Fn>();
-    if ((backend == scene::Backend::Raster || backend == scene::Backend::Raytrace) && fn && *fn == &renderWithBackend) {
+    if ((backend == scene::Backend::Raster || backend == scene::Backend::Raytrace) &&
+        isRenderWithBackend(options.render)) {
         std::shared_ptr<BackendRenderer> renderer =
             makeRenderer(backend, scene, scene::makeRenderPlan(scene, settings), settings);
         auto first = std::make_shared<bool>(true);
@@ -755,9 +760,7 @@ Json temporalFigures(const compare::TemporalSummary& t) {
 // frame anew and have no held view.
 Json rowTemporal(const SweepOptions& options, const PathSpec& spec, const std::vector<scene::Scene>& scenes,
                  const std::vector<scene::Frame>& refs, const scene::RenderSettings& settings, scene::Backend backend) {
-    using Fn = scene::Frame (*)(const scene::Scene&, const scene::RenderSettings&, scene::Backend);
-    const Fn* fn = options.render.target<Fn>();
-    const bool real = fn && *fn == &renderWithBackend;
+    const bool real = isRenderWithBackend(options.render);
     std::vector<scene::Frame> frames, held;
     if (real && (backend == scene::Backend::Raster || backend == scene::Backend::Raytrace)) {
         const std::unique_ptr<BackendRenderer> r =

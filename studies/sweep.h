@@ -106,6 +106,10 @@ struct SweepRow {
 using RenderFn = std::function<scene::Frame(const scene::Scene&, const scene::RenderSettings&, scene::Backend backend)>;
 scene::Frame renderWithBackend(const scene::Scene& scene, const scene::RenderSettings& settings,
                                scene::Backend backend);
+// Whether `render` is renderWithBackend itself (not a wrapper or a test's fake): then a study may
+// keep one renderer across frames that differ only in what the renderer can change (a sweep row's
+// frames, the recommendation's bias points) and get the same frames.
+bool isRenderWithBackend(const RenderFn& render);
 
 struct SweepProgress {
     std::size_t done = 0, total = 0, skipped = 0;  // skipped: already in the journal (resume)
