@@ -116,6 +116,9 @@ public:
             f = renderer_->render();
             scene::recordIdentity(f, scene_);
             error = frameError(f, settings, scene::Backend::Raster);
+            // A renderer's validation count runs on from frame to frame: after a failed point the
+            // next one starts from a new renderer, so that it fails only on its own messages.
+            if (!error.empty()) renderer_.reset();
         } catch (const std::exception& e) {
             renderer_.reset();  // the next point starts from a new renderer
             error = e.what();
