@@ -1,7 +1,12 @@
-// scene/memory.cpp: measured and available memory (Linux: getrusage, /proc/meminfo).
+// scene/memory.cpp: measured and available memory, and the freed heap's release (Linux:
+// getrusage, /proc, glibc's malloc_trim).
 #include "scene/memory.h"
 
+#include <malloc.h>
 #include <sys/resource.h>
+#include <unistd.h>
+
+#include <atomic>
 #include <cstdlib>
 #include <fstream>
 #include <set>
@@ -70,6 +75,39 @@ std::uint64_t peakResidentBytes() {
     rusage usage{};
     if (::getrusage(RUSAGE_SELF, &usage) != 0) return 0;
     return std::uint64_t(usage.ru_maxrss) * 1024;  // Linux reports kilobytes
+}
+
+std::uint64_t residentBytes() {
+    std::ifstream statm("/proc/self/statm");
+    std::uint64_t size = 0, resident = 0;
+    if (!(statm >> size >> resident)) return 0;
+    return resident * std::uint64_t(::sysconf(_SC_PAGESIZE));
+}
+
+namespace {
+// The live FreedHeapBudget's figures (0: none). One at a time: studies do not nest.
+std::atomic<std::uint64_t> budgetEstimate{0};
+std::atomic<std::uint64_t> budgetHeadroom{0};
+}  // namespace
+
+FreedHeapBudget::FreedHeapBudget(std::uint64_t estimate, std::uint64_t headroom) {
+    budgetHeadroom = headroom;
+    budgetEstimate = estimate;
+}
+
+FreedHeapBudget::~FreedHeapBudget() {
+    budgetEstimate = 0;
+    budgetHeadroom = 0;
+}
+
+bool releaseFreedHeap() {
+    const std::uint64_t estimate = budgetEstimate;
+    if (estimate > 0) {
+        const std::uint64_t resident = residentBytes();
+        if (resident > 0 && resident + budgetHeadroom <= estimate) return false;
+    }
+    ::malloc_trim(0);
+    return true;
 }
 
 std::uint64_t availableMemoryBytes() {

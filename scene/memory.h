@@ -42,6 +42,29 @@ inline constexpr std::uint64_t kProgramBytes = 160 * kMiB;
 // The most memory this process has held so far (resident set; getrusage's ru_maxrss).
 std::uint64_t peakResidentBytes();
 
+// The resident set now (/proc/self/statm); 0 when unknown.
+std::uint64_t residentBytes();
+
+// The heap freed between renderers. Studies make renderer after renderer (the sweep's rows, the
+// recommendation's checks), and the driver's and the tracers' threads free into their own malloc
+// arenas, which keep it. Returned to the system after each renderer (malloc_trim), the next one
+// faults every page in again (a third of a default run's CPU on a virtual machine); kept, it may
+// carry the process past its estimate. While a FreedHeapBudget is alive, releaseFreedHeap()
+// returns it only where the resident set plus `headroom` (the largest renderer the job makes, all
+// of it fresh memory) would pass `estimate`; with none alive it always does (docs/reliability.md,
+// "Memory").
+class FreedHeapBudget {
+public:
+    FreedHeapBudget(std::uint64_t estimate, std::uint64_t headroom);
+    ~FreedHeapBudget();
+    FreedHeapBudget(const FreedHeapBudget&) = delete;
+    FreedHeapBudget& operator=(const FreedHeapBudget&) = delete;
+};
+
+// After a renderer is gone (studies/backend.cpp): malloc_trim, unless the budget leaves room.
+// Returns whether it trimmed.
+bool releaseFreedHeap();
+
 // What a job may use: SHADOWLAB_MEMORY_LIMIT_MB when set (for containers whose limit the kernel
 // does not show in /proc/meminfo), else MemAvailable from /proc/meminfo; 0 when unknown.
 std::uint64_t availableMemoryBytes();

@@ -1,7 +1,6 @@
 // studies/backend.cpp: the backends behind BackendRenderer, chosen by scene::Backend.
 #include "studies/backend.h"
 
-#include <malloc.h>
 #include <optional>
 #include <stdexcept>
 
@@ -9,13 +8,12 @@
 #include "raster/renderer.h"
 #include "raytrace/memory.h"
 #include "raytrace/renderer.h"
+#include "scene/memory.h"
 
 namespace shadowlab::studies {
 
-// The driver's and the tracers' many threads each free into their own malloc arena; without a
-// trim, renderers made one after another (sweep rows, the recommendation's checks) leave hundreds
-// of MiB resident that no estimate counts (docs/reliability.md, "Memory").
-BackendRenderer::~BackendRenderer() { malloc_trim(0); }
+// scene::releaseFreedHeap: within a job's budget the next renderer reuses what this one freed.
+BackendRenderer::~BackendRenderer() { scene::releaseFreedHeap(); }
 
 void BackendRenderer::setRasterBiases(const scene::Scene&, double, double) {
     throw std::logic_error("setRasterBiases: only the raster backend has shadow-map biases");
@@ -94,7 +92,7 @@ scene::Frame renderFrame(scene::Backend backend, const scene::Scene& scene, cons
                          const scene::RenderSettings& settings, scene::ChannelMask channels,
                          raster::RenderDebug* debug) {
     scene::Frame frame = renderOnce(backend, scene, plan, settings, channels, debug);
-    malloc_trim(0);  // as after a BackendRenderer: the one-shot renderer is gone here
+    scene::releaseFreedHeap();  // as after a BackendRenderer: the one-shot renderer is gone here
     return frame;
 }
 

@@ -23,8 +23,9 @@ namespace shadowlab::studies {
 // next frame's camera and lights, render() draws into a Frame.
 class BackendRenderer {
 public:
-    // Returns the freed heap to the system (studies/backend.cpp): runs after the backend's members
-    // are gone, so a study's next renderer does not stack on the last one's fragments.
+    // Returns the freed heap to the system unless the job's scene::FreedHeapBudget leaves room for
+    // the next renderer beside it (scene::releaseFreedHeap): runs after the backend's members are
+    // gone, so that the next renderer either reuses their pages or does not stack on them.
     virtual ~BackendRenderer();
     // The next frame's scene: the objects, the number of lights and the resolution must be the
     // constructor's; the camera and the lights may differ. The scene given here (or to

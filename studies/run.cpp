@@ -172,8 +172,61 @@ Json timingsJson(const scene::Frame& f) {
     return t;
 }
 
+namespace {
+// The quick sweep of a run: the default quick grid at half the run's resolution, without raster
+// rows when the run has no raster backend, with the user's threads, device and validation.
+SweepGrid quickGrid(const scene::Scene& scene, const RunStudyOptions& o) {
+    SweepGrid grid = defaultGrid(scene, true);
+    grid.resolution = std::to_string(std::max(16, scene.camera.width / 2)) + "x" +
+                      std::to_string(std::max(16, scene.camera.height / 2));
+    if (!o.raster)
+        std::erase_if(grid.configs, [](const SweepConfig& c) { return c.backend == scene::Backend::Raster; });
+    for (SweepConfig& c : grid.configs) {
+        c.overrides.threads = o.user.threads;
+        c.overrides.device = o.user.device;
+        c.overrides.validate = o.user.validate;
+    }
+    return grid;
+}
+
+// Whether the report shows the raster backend's debug views: where a light has a shadow map.
+bool hasDebugViews(const scene::RenderPlan& plan, const RunStudyOptions& o) {
+    return o.raster && std::any_of(plan.lights.begin(), plan.lights.end(),
+                                   [](const scene::LightPlan& l) { return l.needsShadowTest; });
+}
+}  // namespace
+
 Json memoryJson(std::uint64_t estimate) {
     return {{"peak_mib", scene::peakResidentBytes() / scene::kMiB}, {"estimate_mib", estimate / scene::kMiB}};
+}
+
+RunMemory estimateRunMemory(const scene::Scene& scene, const scene::RenderSettings& settings,
+                            const scene::RenderPlan& plan, const RunStudyOptions& o) {
+    // The reference, the ray-traced and the raster Frames are all held until the report is
+    // written, with a difference image for each method (the half-size sweep needs less).
+    const std::uint64_t pixels = std::uint64_t(scene.camera.width) * std::uint64_t(scene.camera.height);
+    // The raster backend's debug views for the report: its shadow maps read back, and one display
+    // image at a time (a view's bytes hold the maps and the image being written).
+    const bool views = hasDebugViews(plan, o);
+    // One renderer at a time: the run's own at full size, or one of the sweep's at half size (whose
+    // filterable maps compile a compute pipeline the run's filter may not need).
+    const std::uint64_t tracerBytes = estimateMemoryBytes(scene::Backend::Raytrace, scene, plan, settings);
+    std::uint64_t rasterBytes = o.raster ? estimateMemoryBytes(scene::Backend::Raster, scene, plan, settings) : 0;
+    if (o.sweep) {
+        const SweepGrid grid = quickGrid(scene, o);
+        const scene::Scene half = sweepScene(scene, grid);
+        for (const SweepConfig& c : grid.configs) {
+            if (c.backend != scene::Backend::Raster) continue;
+            const scene::RenderSettings s = scene::resolveSettings(half, c.overrides);
+            rasterBytes = std::max(
+                rasterBytes, estimateMemoryBytes(scene::Backend::Raster, half, scene::makeRenderPlan(half, s), s));
+        }
+    }
+    const std::uint64_t estimate = scene::kProgramBytes + scene::sceneBytes(scene) + tracerBytes +
+                                   scene::frameBytes(scene) + rasterBytes + scene::frameWriteBytes(scene) +
+                                   2 * pixels * 3 * sizeof(float) +
+                                   (views ? raster::debugViewBytes(scene, plan, settings.raster, "shadow-map") : 0);
+    return {estimate, std::max(tracerBytes, rasterBytes)};
 }
 
 RunStudyResult runStudy(const scene::Scene& scene, const scene::RenderSettings& settings, const scene::RenderPlan& plan,
@@ -182,22 +235,15 @@ RunStudyResult runStudy(const scene::Scene& scene, const scene::RenderSettings& 
     RunProgress& progress = o.progress ? *o.progress : silent;
     const scene::Budgets budgets = scene.budgets.overriddenBy(o.budgets);
     RunStudyResult result;
-    // The reference, the ray-traced and the raster Frames are all held until the report is
-    // written, with a difference image for each method (the half-size sweep needs less).
-    const std::uint64_t pixels = std::uint64_t(scene.camera.width) * std::uint64_t(scene.camera.height);
-    // The raster backend's debug views for the report: its shadow maps read back, and one display
-    // image at a time (a view's bytes hold the maps and the image being written).
-    const bool views = o.raster && std::any_of(plan.lights.begin(), plan.lights.end(),
-                                               [](const scene::LightPlan& l) { return l.needsShadowTest; });
-    const std::uint64_t estimate = scene::kProgramBytes + scene::sceneBytes(scene) +
-                                   estimateMemoryBytes(scene::Backend::Raytrace, scene, plan, settings) +
-                                   scene::frameBytes(scene) +
-                                   (o.raster ? estimateMemoryBytes(scene::Backend::Raster, scene, plan, settings) : 0) +
-                                   scene::frameWriteBytes(scene) + 2 * pixels * 3 * sizeof(float) +
-                                   (views ? raster::debugViewBytes(scene, plan, settings.raster, "shadow-map") : 0);
+    const RunMemory memory = estimateRunMemory(scene, settings, plan, o);
+    const std::uint64_t estimate = memory.total;
     scene::checkMemory(estimate,
                        "run at " + std::to_string(scene.camera.width) + "x" + std::to_string(scene.camera.height));
     result.memoryEstimate = estimate;
+    const bool views = hasDebugViews(plan, o);
+    // The heap one renderer frees is kept for the next while a whole renderer, none of it reused,
+    // still fits beside it within the estimate.
+    const scene::FreedHeapBudget heapBudget(estimate, memory.largestRenderer);
     fs::create_directories(o.outputDir);
     const scene::FolderLock lock(o.outputDir, "run");
     // The run's files are made in a fresh folder beside the output folder, which they replace as
@@ -299,16 +345,7 @@ RunStudyResult runStudy(const scene::Scene& scene, const scene::RenderSettings& 
         // the report. It starts fresh in a temporary folder (rows of an earlier build must not mix
         // with this one's) that replaces sweep/ in one step when it is complete, so a run killed
         // in the middle leaves the old sweep/ whole.
-        SweepGrid grid = defaultGrid(scene, true);
-        grid.resolution = std::to_string(std::max(16, scene.camera.width / 2)) + "x" +
-                          std::to_string(std::max(16, scene.camera.height / 2));
-        if (!o.raster)
-            std::erase_if(grid.configs, [](const SweepConfig& c) { return c.backend == scene::Backend::Raster; });
-        for (SweepConfig& c : grid.configs) {
-            c.overrides.threads = o.user.threads;
-            c.overrides.device = o.user.device;
-            c.overrides.validate = o.user.validate;
-        }
+        const SweepGrid grid = quickGrid(scene, o);
         SweepOptions options;
         options.outputDir = scene::temporarySibling(dir / "sweep");
         options.progress = [&progress](const SweepProgress& p) { progress.sweep(p); };

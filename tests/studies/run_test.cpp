@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "raster/memory.h"
 #include "scene/loader.h"
 
 namespace shadowlab::studies {
@@ -156,6 +157,42 @@ TEST(RunOutputNames, AreTheBackendsFramesAndImagesAndTheRunsOwnFiles) {
     for (const char* name : {"notes.txt", "raster.txt", "raytrace.exr.bak", "diff-.png", "raster-.png",
                              "heat-raster.jpg", "sweep2", "mask.png", ".shadowlab.lock"})
         EXPECT_FALSE(isRunOutput(name)) << name;
+}
+
+// The estimate counts one renderer at a time, the largest: with the quick sweep, its rows' at half
+// size, among them a filterable map of 2048² (its moment arrays and compute pipeline), which the
+// run's own pcf2x2 frame does not have.
+TEST_F(RunStudy, TheMemoryEstimateCountsTheLargestOfTheSweepsRenderers) {
+    RunStudyOptions o;
+    o.sweep = false;
+    const RunMemory alone = estimateRunMemory(scene, settings, plan, o);
+    const std::uint64_t ownRaster = raster::estimateMemoryBytes(scene, plan, settings.raster);
+    EXPECT_EQ(alone.largestRenderer, ownRaster);  // the 48x27 frame's raster renderer outweighs its tracer
+
+    o.sweep = true;
+    const RunMemory swept = estimateRunMemory(scene, settings, plan, o);
+    scene::Scene half = scene;
+    half.camera.width = 24;  // half of 48x27, at least 16 a side
+    half.camera.height = 16;
+    scene::SettingsOverrides vsm;
+    vsm.filter = "vsm";
+    vsm.shadowMapSize = 2048;
+    const scene::RenderSettings vsmSettings = scene::resolveSettings(half, vsm);
+    const std::uint64_t vsmRaster =
+        raster::estimateMemoryBytes(half, scene::makeRenderPlan(half, vsmSettings), vsmSettings.raster);
+    ASSERT_GT(vsmRaster, ownRaster);
+    EXPECT_GE(swept.largestRenderer, vsmRaster);
+    EXPECT_EQ(swept.total - alone.total, swept.largestRenderer - ownRaster);
+
+    // Without the raster backend the sweep's rows are ray-traced at half size: nothing larger
+    o.raster = false;
+    o.sweep = false;
+    const RunMemory tracerOnly = estimateRunMemory(scene, settings, plan, o);
+    o.sweep = true;
+    EXPECT_EQ(estimateRunMemory(scene, settings, plan, o).total, tracerOnly.total);
+    // (and no raster renderer or debug views in the run itself)
+    EXPECT_EQ(tracerOnly.total,
+              alone.total - ownRaster - raster::debugViewBytes(scene, plan, settings.raster, "shadow-map"));
 }
 
 }  // namespace
