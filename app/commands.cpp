@@ -629,6 +629,9 @@ int sweep(const SweepOptions& o) {
     options.outputDir = o.outputDir;
     options.resume = o.resume;
     options.progress = sweepProgressPrinter();
+    // Row after row: the heap one renderer frees serves the next while the largest still fits.
+    const studies::JobMemory memory = studies::estimateSweepMemory(p.scene, grid, o.common.settings);
+    const scene::FreedHeapBudget heapBudget(memory.total, memory.largestRenderer);
     // Shards share the output folder; each holds the lock of its own shard folder.
     if (o.shard) return sweepShard(o, p.scene, grid, options);
     // One writer per folder: two sweeps appending to one journal would duplicate its keys.

@@ -6,6 +6,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdlib>
 #include <fstream>
@@ -91,6 +92,10 @@ std::atomic<std::uint64_t> budgetHeadroom{0};
 }  // namespace
 
 FreedHeapBudget::FreedHeapBudget(std::uint64_t estimate, std::uint64_t headroom) {
+    // At most what the process holds now and the machine still offers: a job that was not refused
+    // on its estimate (a sweep) keeps no more than fits.
+    if (const std::uint64_t available = availableMemoryBytes(); available > 0)
+        estimate = std::min(estimate, available + residentBytes());
     budgetHeadroom = headroom;
     budgetEstimate = estimate;
 }

@@ -51,8 +51,8 @@ std::uint64_t residentBytes();
 // faults every page in again (a third of a default run's CPU on a virtual machine); kept, it may
 // carry the process past its estimate. While a FreedHeapBudget is alive, releaseFreedHeap()
 // returns it only where the resident set plus `headroom` (the largest renderer the job makes, all
-// of it fresh memory) would pass `estimate`; with none alive it always does (docs/reliability.md,
-// "Memory").
+// of it fresh memory) would pass `estimate` (or what the machine offers, when less); with none alive
+// it always does (docs/reliability.md, "Memory").
 class FreedHeapBudget {
 public:
     FreedHeapBudget(std::uint64_t estimate, std::uint64_t headroom);

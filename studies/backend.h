@@ -64,4 +64,11 @@ scene::Frame renderFrame(scene::Backend backend, const scene::Scene& scene, cons
 std::uint64_t estimateMemoryBytes(scene::Backend backend, const scene::Scene& scene, const scene::RenderPlan& plan,
                                   const scene::RenderSettings& settings);
 
+// A study's memory at its peak, estimated before it renders (`total`), and the largest single
+// renderer it makes, which scene::FreedHeapBudget keeps room for.
+struct JobMemory {
+    std::uint64_t total = 0;
+    std::uint64_t largestRenderer = 0;
+};
+
 }  // namespace shadowlab::studies

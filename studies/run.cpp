@@ -200,7 +200,7 @@ Json memoryJson(std::uint64_t estimate) {
     return {{"peak_mib", scene::peakResidentBytes() / scene::kMiB}, {"estimate_mib", estimate / scene::kMiB}};
 }
 
-RunMemory estimateRunMemory(const scene::Scene& scene, const scene::RenderSettings& settings,
+JobMemory estimateRunMemory(const scene::Scene& scene, const scene::RenderSettings& settings,
                             const scene::RenderPlan& plan, const RunStudyOptions& o) {
     // The reference, the ray-traced and the raster Frames are all held until the report is
     // written, with a difference image for each method (the half-size sweep needs less).
@@ -235,7 +235,7 @@ RunStudyResult runStudy(const scene::Scene& scene, const scene::RenderSettings& 
     RunProgress& progress = o.progress ? *o.progress : silent;
     const scene::Budgets budgets = scene.budgets.overriddenBy(o.budgets);
     RunStudyResult result;
-    const RunMemory memory = estimateRunMemory(scene, settings, plan, o);
+    const JobMemory memory = estimateRunMemory(scene, settings, plan, o);
     const std::uint64_t estimate = memory.total;
     scene::checkMemory(estimate,
                        "run at " + std::to_string(scene.camera.width) + "x" + std::to_string(scene.camera.height));

@@ -66,12 +66,8 @@ struct RunStudyResult {
 // The memory a run holds at its peak, estimated before it renders (docs/reliability.md, "Memory"):
 // the program, the scene, the Frames held until the report, their EXR writing and debug views, and
 // one renderer of each backend, the largest of the run's own at full size and, with the quick sweep,
-// each of its rows' at half size. `largestRenderer` is that largest renderer alone.
-struct RunMemory {
-    std::uint64_t total = 0;
-    std::uint64_t largestRenderer = 0;
-};
-RunMemory estimateRunMemory(const scene::Scene& scene, const scene::RenderSettings& settings,
+// each of its rows' at half size.
+JobMemory estimateRunMemory(const scene::Scene& scene, const scene::RenderSettings& settings,
                             const scene::RenderPlan& plan, const RunStudyOptions& options);
 
 // Renders, measures and writes OUTPUT/{reference,raytrace,raster}.{exr,png}, diff-*.png, heat-*.png,

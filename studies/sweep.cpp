@@ -23,6 +23,7 @@
 #include "scene/frame_io.h"
 #include "scene/input_file.h"
 #include "scene/json_input.h"
+#include "scene/memory.h"
 #include "scene/render_plan.h"
 #include "studies/backend.h"
 #include "studies/machine.h"
@@ -883,6 +884,28 @@ scene::Scene sweepScene(const scene::Scene& baseScene, const SweepGrid& grid) {
         scene.camera.height = h;
     }
     return scene;
+}
+
+JobMemory estimateSweepMemory(const scene::Scene& baseScene, const SweepGrid& grid,
+                              const scene::SettingsOverrides& user) {
+    const scene::Scene scene = sweepScene(baseScene, grid);
+    std::uint64_t largest = 0;
+    auto consider = [&](scene::Backend backend, const scene::SettingsOverrides& overrides) {
+        const scene::RenderSettings s = scene::resolveSettings(scene, overrides);
+        largest = std::max(largest, estimateMemoryBytes(backend, scene, scene::makeRenderPlan(scene, s), s));
+    };
+    consider(scene::Backend::Reference, {});
+    for (const SweepConfig& c : grid.configs) {
+        consider(c.backend, c.overrides);
+        consider(c.backend, user);  // the recommendation's search, in the user's settings
+    }
+    // The reference, a row's frame, the recommendation's defaults and point; along a flicker path
+    // its references, a row's frames and (raster, a camera path) the held view's.
+    const std::uint64_t pathFrames = grid.flicker ? std::uint64_t(std::max(grid.flicker->frames, 0)) : 0;
+    const std::uint64_t frames = 4 + 3 * pathFrames;
+    return {scene::kProgramBytes + scene::sceneBytes(scene) + largest + frames * scene::frameBytes(scene) +
+                scene::frameWriteBytes(scene),
+            largest};
 }
 
 Json journalRow(const SweepRow& row) { return rowToJson(row); }

@@ -17,6 +17,7 @@
 #include "scene/frame.h"
 #include "scene/scene.h"
 #include "scene/settings.h"
+#include "studies/backend.h"
 #include "studies/path.h"
 
 namespace shadowlab::studies {
@@ -143,6 +144,12 @@ SweepResult runSweep(const scene::Scene& scene, const SweepGrid& grid, const Swe
 // The scene a sweep renders: `scene` at the grid's resolution, when it sets one. Throws
 // scene::InputError on a bad resolution.
 scene::Scene sweepScene(const scene::Scene& scene, const SweepGrid& grid);
+
+// The memory a sweep holds at its peak (docs/reliability.md, "Memory"): the program, the scene, the
+// reference and a row's Frames at the sweep's resolution (and the recommendation's), writing the
+// reference, the flicker path's references and frames, and the largest renderer among its rows' and
+// the recommendation's (the rows' backends in the settings `user` gives).
+JobMemory estimateSweepMemory(const scene::Scene& scene, const SweepGrid& grid, const scene::SettingsOverrides& user);
 
 // One journal line's JSON and back (merge reads journals strictly with these); the backend is
 // written as its name (scene::toString). rowFromJournal throws nlohmann::json::exception on a line

@@ -165,12 +165,12 @@ TEST(RunOutputNames, AreTheBackendsFramesAndImagesAndTheRunsOwnFiles) {
 TEST_F(RunStudy, TheMemoryEstimateCountsTheLargestOfTheSweepsRenderers) {
     RunStudyOptions o;
     o.sweep = false;
-    const RunMemory alone = estimateRunMemory(scene, settings, plan, o);
+    const JobMemory alone = estimateRunMemory(scene, settings, plan, o);
     const std::uint64_t ownRaster = raster::estimateMemoryBytes(scene, plan, settings.raster);
     EXPECT_EQ(alone.largestRenderer, ownRaster);  // the 48x27 frame's raster renderer outweighs its tracer
 
     o.sweep = true;
-    const RunMemory swept = estimateRunMemory(scene, settings, plan, o);
+    const JobMemory swept = estimateRunMemory(scene, settings, plan, o);
     scene::Scene half = scene;
     half.camera.width = 24;  // half of 48x27, at least 16 a side
     half.camera.height = 16;
@@ -187,7 +187,7 @@ TEST_F(RunStudy, TheMemoryEstimateCountsTheLargestOfTheSweepsRenderers) {
     // Without the raster backend the sweep's rows are ray-traced at half size: nothing larger
     o.raster = false;
     o.sweep = false;
-    const RunMemory tracerOnly = estimateRunMemory(scene, settings, plan, o);
+    const JobMemory tracerOnly = estimateRunMemory(scene, settings, plan, o);
     o.sweep = true;
     EXPECT_EQ(estimateRunMemory(scene, settings, plan, o).total, tracerOnly.total);
     // (and no raster renderer or debug views in the run itself)

@@ -17,6 +17,8 @@
 
 #include "scene/error.h"
 #include "scene/loader.h"
+#include "scene/memory.h"
+#include "scene/render_plan.h"
 #include "tests/compare/synthetic.h"
 
 namespace shadowlab::studies {
@@ -777,6 +779,38 @@ TEST_F(Sweep, EachRowRendersWithOneRendererAndMeasuresWhatARendererPerFrameMeasu
         EXPECT_GT(a.rows[i].setupMs, 0.0) << a.rows[i].config.label();  // the constructor's
         EXPECT_GT(a.rows[i].frameMs, 0.0) << a.rows[i].config.label();
     }
+}
+
+// A sweep holds one renderer at a time: its estimate counts the largest, whichever row it is, and
+// the Frames a flicker path keeps (its references, a row's frames and the held view's).
+TEST(SweepMemory, CountsTheLargestRowsRendererOnceAndTheFlickerPathsFrames) {
+    const scene::Scene scene = scene::loadScene(scene::findScene("seed"));
+    SweepGrid grid;
+    grid.resolution = "64x36";
+    grid.configs.push_back(SweepConfig{.backend = scene::Backend::Raytrace});
+    const scene::Scene at = sweepScene(scene, grid);
+    auto bytesOf = [&](scene::Backend backend, const scene::SettingsOverrides& overrides) {
+        const scene::RenderSettings s = scene::resolveSettings(at, overrides);
+        return estimateMemoryBytes(backend, at, scene::makeRenderPlan(at, s), s);
+    };
+    const JobMemory traced = estimateSweepMemory(scene, grid, {});
+    EXPECT_EQ(traced.largestRenderer, bytesOf(scene::Backend::Raytrace, {}));
+
+    // A filterable 2048² map (its moment arrays and compute pipeline) outweighs the tracer and the
+    // user's pcf2x2 raster renderer, and replaces the tracer in the total.
+    scene::SettingsOverrides vsm;
+    vsm.filter = "vsm";
+    vsm.shadowMapSize = 2048;
+    grid.configs.push_back(SweepConfig{.backend = scene::Backend::Raster, .overrides = vsm});
+    const JobMemory withVsm = estimateSweepMemory(scene, grid, {});
+    const std::uint64_t vsmBytes = bytesOf(scene::Backend::Raster, vsm);
+    ASSERT_GT(vsmBytes, bytesOf(scene::Backend::Raster, {}));
+    EXPECT_EQ(withVsm.largestRenderer, vsmBytes);
+    EXPECT_EQ(withVsm.total - traced.total, vsmBytes - traced.largestRenderer);
+
+    grid.flicker = defaultFlickerPath();
+    grid.flicker->frames = 8;
+    EXPECT_EQ(estimateSweepMemory(scene, grid, {}).total - withVsm.total, 3 * 8 * scene::frameBytes(at));
 }
 
 }  // namespace
