@@ -162,6 +162,10 @@ void checkExrHeader(const fs::path& file) {
     }
 }
 
+// Frames are read and written a band of this many rows at a time, so that a file costs one band of
+// memory beside the Frame.
+constexpr int kFrameBandRows = 64;
+
 // OpenEXR's standard camera attributes go by other names inside OpenImageIO, which renames them
 // on reading and writing ("worldToCamera" is OIIO's "worldtocamera").
 std::optional<std::string> exrStandardToOiio(const std::string& exrName) {
@@ -189,13 +193,20 @@ void writeAtomically(const fs::path& file, WriteFn&& write) {
     }
 }
 
-void writeImage(const fs::path& file, const ImageSpec& spec, const void* pixels, TypeDesc type) {
+// Opens `file` for an image of `spec`, runs write(out), and closes it; each step's failure is an
+// InputError naming the file.
+template <typename WriteFn>
+void writeImageWith(const fs::path& file, const ImageSpec& spec, WriteFn&& write) {
     auto out = ImageOutput::create(file.string());
     if (!out) throw InputError(file.string() + ": cannot write this image format (" + OIIO::geterror() + ")");
     if (!out->open(file.string(), spec))
         throw InputError(file.string() + ": cannot open for writing: " + out->geterror());
-    if (!out->write_image(type, pixels)) throw InputError(file.string() + ": write failed: " + out->geterror());
+    if (!write(*out)) throw InputError(file.string() + ": write failed: " + out->geterror());
     if (!out->close()) throw InputError(file.string() + ": close failed: " + out->geterror());
+}
+
+void writeImage(const fs::path& file, const ImageSpec& spec, const void* pixels, TypeDesc type) {
+    writeImageWith(file, spec, [&](ImageOutput& out) { return out.write_image(type, pixels); });
 }
 
 std::string encodeTimings(const std::vector<std::pair<std::string, double>>& timings) {
@@ -366,22 +377,35 @@ void writeFrame(const Frame& frame, const fs::path& file) {
             spec.attribute(name, OIIO::TypeMatrix44, &std::get<glm::mat4>(value));
     }
 
+    // Interleaved a band of rows at a time: a whole interleaved copy of a 1080p Frame is 66 MB of
+    // fresh memory to fault in for each file, and a Frame more at the peak; the file is the same.
     const int firstLight = withBlocker ? 8 : 7;
-    std::vector<float> pixels(n * channels);
-    for (std::size_t i = 0; i < n; ++i) {
-        float* p = &pixels[i * channels];
-        p[0] = frame.beauty[3 * i];
-        p[1] = frame.beauty[3 * i + 1];
-        p[2] = frame.beauty[3 * i + 2];
-        p[3] = frame.visibility[i];
-        p[4] = frame.objectId[i];
-        p[5] = frame.ndotl[i];
-        p[6] = frame.depth[i];
-        if (withBlocker) p[7] = frame.blockerId[i];
-        for (std::size_t l = 0; l < lights; ++l) p[firstLight + l] = frame.lightVisibility[l][i];
-        if (withDistance) p[channels - 1] = frame.blockerDistance[i];
-    }
-    writeAtomically(file, [&](const fs::path& tmp) { writeImage(tmp, spec, pixels.data(), TypeDesc::FLOAT); });
+    const int bandRows = std::min(kFrameBandRows, frame.height);
+    std::vector<float> band(std::size_t(frame.width) * std::size_t(bandRows) * std::size_t(channels));
+    auto writeBands = [&](ImageOutput& out) {
+        for (int y0 = 0; y0 < frame.height; y0 += bandRows) {
+            const int y1 = std::min(frame.height, y0 + bandRows);
+            const std::size_t first = std::size_t(y0) * std::size_t(frame.width);
+            const std::size_t count = std::size_t(y1 - y0) * std::size_t(frame.width);
+            for (std::size_t k = 0; k < count; ++k) {
+                const std::size_t i = first + k;
+                float* p = &band[k * channels];
+                p[0] = frame.beauty[3 * i];
+                p[1] = frame.beauty[3 * i + 1];
+                p[2] = frame.beauty[3 * i + 2];
+                p[3] = frame.visibility[i];
+                p[4] = frame.objectId[i];
+                p[5] = frame.ndotl[i];
+                p[6] = frame.depth[i];
+                if (withBlocker) p[7] = frame.blockerId[i];
+                for (std::size_t l = 0; l < lights; ++l) p[firstLight + l] = frame.lightVisibility[l][i];
+                if (withDistance) p[channels - 1] = frame.blockerDistance[i];
+            }
+            if (!out.write_scanlines(y0, y1, 0, TypeDesc::FLOAT, band.data())) return false;
+        }
+        return true;
+    };
+    writeAtomically(file, [&](const fs::path& tmp) { writeImageWith(tmp, spec, writeBands); });
 }
 
 Frame readFrame(const fs::path& file) {
@@ -425,11 +449,10 @@ Frame readFrame(const fs::path& file) {
     // declares a huge image fails there, before gigabytes are allocated (found by fuzzing).
     Frame f;
     const int c = spec.nchannels;
-    constexpr int kBandRows = 64;
     // A tiled file is read a row of tiles at a time (read_tiles needs whole tiles; a band of a
     // tiled file's scanlines crashed OpenImageIO), level 0 of a mip-mapped one.
     const bool tiled = spec.tile_width > 0;
-    const int bandRows = tiled ? std::max(1, spec.tile_height) : kBandRows;
+    const int bandRows = tiled ? std::max(1, spec.tile_height) : kFrameBandRows;
     std::vector<float> band(std::size_t(spec.width) * std::min(bandRows, spec.height) * c);
     for (int y0 = 0; y0 < spec.height; y0 += bandRows) {
         const int y1 = std::min(spec.height, y0 + bandRows);

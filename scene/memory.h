@@ -16,8 +16,10 @@ inline constexpr std::uint64_t kMiB = 1024 * 1024;
 // The bytes a Frame of the scene's camera resolution takes (every AOV, blocker ids, per-light visibility).
 std::uint64_t frameBytes(const Scene& scene);
 
-// What writing that Frame to EXR adds while it runs: an interleaved copy for OpenImageIO and
-// OpenEXR's own line buffers, measured at about 1.75 Frames (docs/reliability.md); counted as 2.
+// What writing that Frame to EXR adds while it runs, and more: the writer interleaves a band of 64
+// rows at a time, 12 MiB at 3840x2160 with OpenEXR's line buffers, but a command's peak comes
+// while it renders, where a 3840x2160 ray-traced render holds about three Frames and the parts
+// above count two; the allowance stays at 2 Frames (docs/reliability.md).
 std::uint64_t frameWriteBytes(const Scene& scene);
 
 // The scene itself: its objects, their names, mesh placements and geometry (each shared

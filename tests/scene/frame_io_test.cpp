@@ -57,6 +57,53 @@ TEST(FrameIo, ExrRoundTripKeepsEveryChannelAttributeAndTimingInOrder) {
     }
 }
 
+// Written a band of rows at a time: a Frame taller than a band (the last one partial), read back
+// whole by OpenImageIO, not by readFrame, has every channel of every pixel where it was.
+TEST(FrameIo, ATallFrameIsWrittenWholeAcrossItsBands) {
+    TempDir dir;
+    Frame f = Frame::allocate(7, 150, true);
+    f.lightVisibility.assign(2, std::vector<float>(f.pixelCount()));
+    f.blockerDistance.resize(f.pixelCount());
+    for (std::size_t i = 0; i < f.pixelCount(); ++i) {
+        for (int c = 0; c < 3; ++c) f.beauty[3 * i + c] = float(i) + 0.1f * float(c);
+        f.visibility[i] = float(i) + 0.3f;
+        f.objectId[i] = float(i) + 0.4f;
+        f.ndotl[i] = float(i) + 0.5f;
+        f.depth[i] = float(i) + 0.6f;
+        f.blockerId[i] = float(i) + 0.7f;
+        f.lightVisibility[0][i] = float(i) + 0.8f;
+        f.lightVisibility[1][i] = float(i) + 0.9f;
+        f.blockerDistance[i] = -float(i);
+    }
+    const auto file = dir.path() / "tall.exr";
+    writeFrame(f, file);
+    auto in = OIIO::ImageInput::open(file.string());
+    ASSERT_TRUE(in);
+    const OIIO::ImageSpec& spec = in->spec();
+    ASSERT_EQ(spec.width, 7);
+    ASSERT_EQ(spec.height, 150);
+    ASSERT_EQ(spec.nchannels, 11);
+    std::vector<float> pixels(f.pixelCount() * 11);
+    ASSERT_TRUE(in->read_image(0, 0, 0, 11, OIIO::TypeDesc::FLOAT, pixels.data()));
+    auto channel = [&](const std::string& name) {
+        return int(std::find(spec.channelnames.begin(), spec.channelnames.end(), name) - spec.channelnames.begin());
+    };
+    const std::vector<std::pair<std::string, const std::vector<float>*>> planes = {
+        {"visibility", &f.visibility},
+        {"object_id", &f.objectId},
+        {"ndotl", &f.ndotl},
+        {"Z", &f.depth},
+        {"blocker_id", &f.blockerId},
+        {"visibility.0", &f.lightVisibility[0]},
+        {"visibility.1", &f.lightVisibility[1]},
+        {"blocker_distance", &f.blockerDistance}};
+    for (std::size_t i = 0; i < f.pixelCount(); ++i) {
+        const float* p = &pixels[11 * i];
+        for (int c = 0; c < 3; ++c) ASSERT_EQ(p[channel(std::string(1, "RGB"[c]))], f.beauty[3 * i + c]) << i;
+        for (const auto& [name, plane] : planes) ASSERT_EQ(p[channel(name)], (*plane)[i]) << name << " " << i;
+    }
+}
+
 TEST(FrameIo, ExrRoundTripKeepsPerLightVisibilityAsVisibilityDotIndexChannels) {
     TempDir dir;
     Frame f = patternFrame(true);
