@@ -2,6 +2,9 @@
 #include "raster/moment_maps.h"
 
 #include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <iterator>
 #include <sstream>
 
 #include "raster/pipeline.h"
@@ -48,7 +51,8 @@ MomentMaps createMomentMaps(const Context& ctx, std::uint32_t size, std::uint32_
     return m;
 }
 
-MomentPipeline createMomentPipeline(const Context& ctx, const ShadowMaps& maps, const MomentMaps& moments) {
+MomentPipeline createMomentPipeline(const Context& ctx, const ShadowMaps& maps, const MomentMaps& moments,
+                                    scene::ShadowFilter filter, const scene::MomentSettings& settings) {
     requireMomentFormat(ctx);
     VkDevice device = ctx.device.get();
     MomentPipeline p;
@@ -79,17 +83,42 @@ MomentPipeline createMomentPipeline(const Context& ctx, const ShadowMaps& maps, 
     p.layout = PipelineLayoutHandle(device, layout);
 
     const ShaderModuleHandle module = createShaderModule(ctx, shaders::momentsCompSpirv());
-    const VkComputePipelineCreateInfo info{
-        .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
-        .stage = {.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-                  .stage = VK_SHADER_STAGE_COMPUTE_BIT,
-                  .module = module.get(),
-                  .pName = "main"},
-        .layout = layout,
+    // moments.comp's specialization constants, in constant_id order: the pass, the filter code, the
+    // blur radius, the maps' side and the three exponents.
+    struct Constants {
+        std::int32_t pass, filter, radius, size;
+        float evsmPositive, evsmNegative, esmExponent;
     };
-    VkPipeline pipeline = VK_NULL_HANDLE;
-    VK_CHECK(vkCreateComputePipelines(device, ctx.pipelineCache.get(), 1, &info, nullptr, &pipeline));
-    p.pipeline = PipelineHandle(device, pipeline);
+    const VkSpecializationMapEntry entries[] = {
+        {0, offsetof(Constants, pass), 4},         {1, offsetof(Constants, filter), 4},
+        {2, offsetof(Constants, radius), 4},       {3, offsetof(Constants, size), 4},
+        {4, offsetof(Constants, evsmPositive), 4}, {5, offsetof(Constants, evsmNegative), 4},
+        {6, offsetof(Constants, esmExponent), 4}};
+    auto create = [&](std::int32_t pass) {
+        const Constants constants{pass,
+                                  std::int32_t(filter),
+                                  std::int32_t((settings.blurWidth - 1) / 2),
+                                  std::int32_t(moments.size),
+                                  float(settings.evsmPositive),
+                                  float(settings.evsmNegative),
+                                  float(settings.esmExponent)};
+        const VkSpecializationInfo specialization{std::uint32_t(std::size(entries)), entries, sizeof constants,
+                                                  &constants};
+        const VkComputePipelineCreateInfo info{
+            .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
+            .stage = {.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+                      .stage = VK_SHADER_STAGE_COMPUTE_BIT,
+                      .module = module.get(),
+                      .pName = "main",
+                      .pSpecializationInfo = &specialization},
+            .layout = layout,
+        };
+        VkPipeline pipeline = VK_NULL_HANDLE;
+        VK_CHECK(vkCreateComputePipelines(device, ctx.pipelineCache.get(), 1, &info, nullptr, &pipeline));
+        return PipelineHandle(device, pipeline);
+    };
+    p.pipeline = create(0);
+    p.blurPipeline = create(1);
 
     p.depthSampler = createNearestSampler(ctx);
     const VkSampler sampler = p.depthSampler.get();
@@ -121,8 +150,7 @@ MomentPipeline createMomentPipeline(const Context& ctx, const ShadowMaps& maps, 
 }
 
 void recordMomentPasses(VkCommandBuffer commands, const MomentPipeline& pipeline, const ShadowMaps& maps,
-                        const MomentMaps& moments, const std::vector<ShadowLayer>& layers, scene::ShadowFilter filter,
-                        const scene::MomentSettings& settings) {
+                        const MomentMaps& moments, const std::vector<ShadowLayer>& layers) {
     if (layers.size() != moments.layers)
         throw RasterError("recordMomentPasses: " + std::to_string(layers.size()) + " layers planned for " +
                           std::to_string(moments.layers) + " moment maps");
@@ -142,18 +170,16 @@ void recordMomentPasses(VkCommandBuffer commands, const MomentPipeline& pipeline
                 {moments.moments.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layerCount, VK_IMAGE_LAYOUT_UNDEFINED,
                  VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_NONE,
                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT}});
-    vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.pipeline.get());
     vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.layout.get(), 0, 1,
                             &pipeline.descriptors.set, 0, nullptr);
     const std::uint32_t groups = (moments.size + kGroup - 1) / kGroup;
     // One dispatch per layer and pass: each layer's own near and far.
     auto dispatch = [&](int pass) {
+        vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE,
+                          pass == 0 ? pipeline.pipeline.get() : pipeline.blurPipeline.get());
         for (std::uint32_t k = 0; k < layerCount; ++k) {
             const LightFrustum& f = layers[k].frustum;
             const shaders::MomentPush push{
-                .info = glm::ivec4(int(filter), pass, (settings.blurWidth - 1) / 2, int(moments.size)),
-                .params = glm::vec4(float(settings.evsmPositive), float(settings.evsmNegative),
-                                    float(settings.esmExponent), 0.0f),
                 .layer = glm::ivec4(int(k), f.perspective ? 1 : 0, 0, 0),
                 .range = f.perspective ? glm::vec4(float(f.near), float(f.far), 0.0f, 0.0f) : glm::vec4(0.0f)};
             vkCmdPushConstants(commands, pipeline.layout.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);

@@ -40,22 +40,24 @@ MomentMaps createMomentMaps(const Context& ctx, std::uint32_t size, std::uint32_
 struct MomentPipeline {
     DescriptorSet descriptors;
     PipelineLayoutHandle layout;
-    PipelineHandle pipeline;
-    SamplerHandle depthSampler;  // NEAREST, for texelFetch of the depth array
+    PipelineHandle pipeline;      // pass 0: the moments, blurred along x
+    PipelineHandle blurPipeline;  // pass 1: blurred along y
+    SamplerHandle depthSampler;   // NEAREST, for texelFetch of the depth array
 };
-// Throws RasterError naming kMomentFormat and the device when the format cannot be a storage
-// image or be filtered linearly.
-MomentPipeline createMomentPipeline(const Context& ctx, const ShadowMaps& maps, const MomentMaps& moments);
+// The two passes for `filter` (a filterable one) with `settings`' blur width and exponents, baked
+// into each pipeline. Throws RasterError naming kMomentFormat and the device when the format
+// cannot be a storage image or be filtered linearly.
+MomentPipeline createMomentPipeline(const Context& ctx, const ShadowMaps& maps, const MomentMaps& moments,
+                                    scene::ShadowFilter filter, const scene::MomentSettings& settings);
 
-// Records both passes for `filter` (a filterable one) after the depth pass: the depth array in
+// Records both of the pipeline's passes after the depth pass: the depth array in
 // SHADER_READ_ONLY_OPTIMAL (written by the depth pass) to moments in SHADER_READ_ONLY_OPTIMAL,
 // ready for the lit pass's fragment shader. `layers` (the array's, in order) says which layers
 // are perspective and their near and far: their moments are of linear depth
 // (d − near)/(far − near), d along the layer's axis; orthographic layers' depths are linear
 // already and kept as stored.
 void recordMomentPasses(VkCommandBuffer commands, const MomentPipeline& pipeline, const ShadowMaps& maps,
-                        const MomentMaps& moments, const std::vector<ShadowLayer>& layers, scene::ShadowFilter filter,
-                        const scene::MomentSettings& settings);
+                        const MomentMaps& moments, const std::vector<ShadowLayer>& layers);
 
 // For --explain and the Frame: the passes and memory the technique adds.
 std::string describeMomentCost(scene::ShadowFilter filter, std::uint32_t size, std::uint32_t layers, int blurWidth);

@@ -876,7 +876,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
         // The transmittance passes test alpha for every caster when the scene has alpha casters.
         const VkDescriptorSetLayout alphaLayout = shadowAlpha ? alpha.descriptors.layout.get() : VK_NULL_HANDLE;
         if (momentMaps.size > 1 && !momentPipeline.pipeline)
-            momentPipeline = createMomentPipeline(ctx, maps, momentMaps);
+            momentPipeline = createMomentPipeline(ctx, maps, momentMaps, settings.filter, settings.moments);
         if (transmit && !transmitPipeline.pipeline) transmitPipeline = createTransmittancePipeline(ctx, alphaLayout);
         if (transmit && !transmitRestPipeline.pipeline)
             transmitRestPipeline = createTransmittanceRestPipeline(ctx, transmittanceMaps, alphaLayout);
@@ -917,7 +917,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                      // A capture shows whole layers (the debug views draw them all).
                      debug && debug->captureShadowMaps ? nullptr : &shadowWindows);
     if (momentPipeline.pipeline)
-        recordMomentPasses(commands, momentPipeline, maps, momentMaps, layers, settings.filter, settings.moments);
+        recordMomentPasses(commands, momentPipeline, maps, momentMaps, layers);
     stamp(commands, 1);
     ctx.submitAndWait(commands);
     frame.timingsMs.emplace_back("shadow_pass", msSince(shadowStart));

@@ -21,7 +21,7 @@
 // Shadow-map layers: a point light has six (its cube faces), a cascaded light four.
 #define SHADOWLAB_MAX_LAYERS (SHADOWLAB_MAX_LIGHTS * 6)
 
-// Filter codes (LightData::filterCode, MomentPush.info.x); the values follow scene::ShadowFilter.
+// Filter codes (LightData::filterCode, moments.comp's kFilter); the values follow scene::ShadowFilter.
 #define SHADOWLAB_FILTER_NONE 0
 #define SHADOWLAB_FILTER_PCF2X2 1
 #define SHADOWLAB_FILTER_PCF 2
@@ -70,10 +70,9 @@ struct TransmitPush {
 
 // Push constants of the moment passes (shaders/moments.comp, raster/moment_maps.h), one
 // dispatch per layer and pass.
+// (The pass, the filter code, the blur radius, the maps' side and the exponents are the pipeline's
+// specialization constants: shaders/moments.comp.)
 struct MomentPush {
-    ivec4 info;   // x: filter code, y: pass (0: moments + blur along x, 1: blur along y), z: blur
-                  // radius in texels, w: the maps' side in texels
-    vec4 params;  // x: EVSM positive exponent, y: EVSM negative exponent, z: ESM exponent
     ivec4 layer;  // x: the array layer this dispatch writes; y: 1 = perspective (spot, cube face):
                   // its stored depths are made linear over `range` first, 0 = orthographic (kept)
     vec4 range;   // perspective layers: x: near, y: far (distances along the layer's axis)
@@ -157,7 +156,7 @@ struct TransmitWindows {
 #ifdef __cplusplus
 static_assert(sizeof(TransmitWindows) == SHADOWLAB_MAX_LAYERS * 16, "TransmitWindows must match std140");
 static_assert(sizeof(ShadowPush) == 64, "ShadowPush must match std430 push constants");
-static_assert(sizeof(MomentPush) == 4 * 16, "MomentPush must match std430 push constants");
+static_assert(sizeof(MomentPush) == 2 * 16, "MomentPush must match std430 push constants");
 static_assert(sizeof(TransmitPush) == 64 + 2 * 16, "TransmitPush must match std430 push constants");
 static_assert(sizeof(PointFace) == 16, "PointFace must match std140 (an array element)");
 // The offsets std140 gives (16-byte groups; pointFaces and lights aligned to 16).

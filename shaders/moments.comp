@@ -15,6 +15,16 @@ layout(set = 0, binding = 1, rgba32f) uniform image2DArray blurredX;
 layout(set = 0, binding = 2, rgba32f) uniform image2DArray moments;
 
 layout(push_constant) uniform Push { MomentPush push; };
+// Baked into each pipeline (raster/moment_maps.cpp): llvmpipe loads a push constant lane by lane
+// wherever it is read, and with the radius known the blur's loop unrolls. The defaults here are
+// no render's (no filter, no blur, no exponent), so that a constant the pipeline does not set shows.
+layout(constant_id = 0) const int kPass = 0;  // 0: moments + blur along x, 1: blur along y
+layout(constant_id = 1) const int kFilter = SHADOWLAB_FILTER_NONE;
+layout(constant_id = 2) const int kRadius = 0;  // blur radius in texels
+layout(constant_id = 3) const int kSize = 1;    // the maps' side in texels
+layout(constant_id = 4) const float kEvsmPositive = 0.0;
+layout(constant_id = 5) const float kEvsmNegative = 0.0;
+layout(constant_id = 6) const float kEsmExponent = 0.0;
 
 // A perspective layer's stored depth z = far/(far − near)·(1 − near/d) of the distance d along
 // its axis, as (d − near)/(far − near): linear in d, so that a gap between caster and receiver
@@ -36,24 +46,24 @@ vec4 momentsOf(float z, int code) {
     if (code == SHADOWLAB_FILTER_EVSM2 || code == SHADOWLAB_FILTER_EVSM4) {
         // Warped to [-1, 1] first, so both exponents act on the same range (Lauritzen & McCool 2008).
         const float w = 2.0 * z - 1.0;
-        const float p = exp(push.params.x * w);
-        const float n = -exp(-push.params.y * w);
+        const float p = exp(kEvsmPositive * w);
+        const float n = -exp(-kEvsmNegative * w);
         return code == SHADOWLAB_FILTER_EVSM2 ? vec4(p, p * p, 0.0, 0.0) : vec4(p, p * p, n, n * n);
     }
-    if (code == SHADOWLAB_FILTER_ESM) return vec4(exp(push.params.z * z), 0.0, 0.0, 0.0);
+    if (code == SHADOWLAB_FILTER_ESM) return vec4(exp(kEsmExponent * z), 0.0, 0.0, 0.0);
     // MSM: the plain powers in 32-bit float (no optimised quantisation: nothing is 16-bit here).
     const float z2 = z * z;
     return vec4(z, z2, z2 * z, z2 * z2);
 }
 
 void main() {
-    const ivec3 size = ivec3(push.info.w, push.info.w, 0);
+    const ivec3 size = ivec3(kSize, kSize, 0);
     const ivec3 at = ivec3(gl_GlobalInvocationID.xy, push.layer.x);
     if (at.x >= size.x || at.y >= size.y) return;
-    const int code = push.info.x;
-    const int radius = push.info.z;
+    const int code = kFilter;
+    const int radius = kRadius;
     vec4 sum = vec4(0.0);
-    if (push.info.y == 0) {
+    if (kPass == 0) {
         for (int k = -radius; k <= radius; ++k) {
             const ivec3 t = ivec3(clamp(at.x + k, 0, size.x - 1), at.y, at.z);
             const float z = texelFetch(depths, t, 0).r;

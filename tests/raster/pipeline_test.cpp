@@ -60,7 +60,9 @@ TEST(RasterPipeline, EveryPipelineARenderAsksForIsCreatedWithoutValidationMessag
         EXPECT_TRUE(createTransmittancePipeline(ctx, layout).pipeline);
         EXPECT_TRUE(createTransmittanceRestPipeline(ctx, transmittance, layout).pipeline);
     }
-    EXPECT_TRUE(createMomentPipeline(ctx, maps, moments).pipeline);
+    const MomentPipeline p = createMomentPipeline(ctx, maps, moments, scene::ShadowFilter::Vsm, {});
+    EXPECT_TRUE(p.pipeline);
+    EXPECT_TRUE(p.blurPipeline);
 
     // The lit pass: every filter once, each beside another option the renderer sets from the plan
     // and the frame's channels (renderer.cpp: the channels pick the targets, the scene's lights the
