@@ -916,8 +916,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                      &transmittancePass, &layerBias, shadowPipeline[1].pipeline ? &shadowPipeline[1] : nullptr,
                      // A capture shows whole layers (the debug views draw them all).
                      debug && debug->captureShadowMaps ? nullptr : &shadowWindows);
-    if (momentPipeline.pipeline)
-        recordMomentPasses(commands, momentPipeline, maps, momentMaps, layers);
+    if (momentPipeline.pipeline) recordMomentPasses(commands, momentPipeline, maps, momentMaps, layers);
     stamp(commands, 1);
     ctx.submitAndWait(commands);
     frame.timingsMs.emplace_back("shadow_pass", msSince(shadowStart));
