@@ -193,20 +193,21 @@ void writeAtomically(const fs::path& file, WriteFn&& write) {
     }
 }
 
-// Opens `file` for an image of `spec`, runs write(out), and closes it; each step's failure is an
-// InputError naming the file.
+// Opens `tmp` (the temporary name `file` is written under) for an image of `spec`, runs write(out),
+// and closes it; each step's failure is an InputError naming `file`, the name the user gave (the
+// temporary is gone by the time the message is read).
 template <typename WriteFn>
-void writeImageWith(const fs::path& file, const ImageSpec& spec, WriteFn&& write) {
-    auto out = ImageOutput::create(file.string());
+void writeImageWith(const fs::path& file, const fs::path& tmp, const ImageSpec& spec, WriteFn&& write) {
+    auto out = ImageOutput::create(tmp.string());
     if (!out) throw InputError(file.string() + ": cannot write this image format (" + OIIO::geterror() + ")");
-    if (!out->open(file.string(), spec))
+    if (!out->open(tmp.string(), spec))
         throw InputError(file.string() + ": cannot open for writing: " + out->geterror());
     if (!write(*out)) throw InputError(file.string() + ": write failed: " + out->geterror());
     if (!out->close()) throw InputError(file.string() + ": close failed: " + out->geterror());
 }
 
-void writeImage(const fs::path& file, const ImageSpec& spec, const void* pixels, TypeDesc type) {
-    writeImageWith(file, spec, [&](ImageOutput& out) { return out.write_image(type, pixels); });
+void writeImage(const fs::path& file, const fs::path& tmp, const ImageSpec& spec, const void* pixels, TypeDesc type) {
+    writeImageWith(file, tmp, spec, [&](ImageOutput& out) { return out.write_image(type, pixels); });
 }
 
 std::string encodeTimings(const std::vector<std::pair<std::string, double>>& timings) {
@@ -244,7 +245,7 @@ void writePng8(const fs::path& file, int width, int height, const std::vector<fl
                               : static_cast<unsigned char>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
     }
     ImageSpec spec(width, height, 3, TypeDesc::UINT8);
-    writeAtomically(file, [&](const fs::path& tmp) { writeImage(tmp, spec, bytes.data(), TypeDesc::UINT8); });
+    writeAtomically(file, [&](const fs::path& tmp) { writeImage(file, tmp, spec, bytes.data(), TypeDesc::UINT8); });
 }
 
 }  // namespace
@@ -405,7 +406,7 @@ void writeFrame(const Frame& frame, const fs::path& file) {
         }
         return true;
     };
-    writeAtomically(file, [&](const fs::path& tmp) { writeImageWith(tmp, spec, writeBands); });
+    writeAtomically(file, [&](const fs::path& tmp) { writeImageWith(file, tmp, spec, writeBands); });
 }
 
 Frame readFrame(const fs::path& file) {

@@ -7,9 +7,10 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
+#include <cstdint>
 #include <cstdlib>
 #include <fstream>
+#include <mutex>
 #include <set>
 #include <sstream>
 #include <variant>
@@ -86,30 +87,43 @@ std::uint64_t residentBytes() {
 }
 
 namespace {
-// The live FreedHeapBudget's figures (0: none). One at a time: studies do not nest.
-std::atomic<std::uint64_t> budgetEstimate{0};
-std::atomic<std::uint64_t> budgetHeadroom{0};
+// The innermost live FreedHeapBudget's figures (estimate 0: none), under budgetMutex (a renderer
+// may end on any thread).
+std::mutex budgetMutex;
+std::uint64_t budgetEstimate = 0;
+std::uint64_t budgetHeadroom = 0;
 }  // namespace
 
 FreedHeapBudget::FreedHeapBudget(std::uint64_t estimate, std::uint64_t headroom) {
     // At most what the process holds now and the machine still offers: a job that was not refused
     // on its estimate (a sweep) keeps no more than fits.
-    if (const std::uint64_t available = availableMemoryBytes(); available > 0)
-        estimate = std::min(estimate, available + residentBytes());
-    budgetHeadroom = headroom;
+    if (const std::uint64_t available = availableMemoryBytes(); available > 0) {
+        const std::uint64_t resident = residentBytes();
+        estimate = std::min(estimate, available > UINT64_MAX - resident ? UINT64_MAX : available + resident);
+    }
+    const std::lock_guard lock(budgetMutex);
+    outerEstimate_ = budgetEstimate;
+    outerHeadroom_ = budgetHeadroom;
     budgetEstimate = estimate;
+    budgetHeadroom = headroom;
 }
 
 FreedHeapBudget::~FreedHeapBudget() {
-    budgetEstimate = 0;
-    budgetHeadroom = 0;
+    const std::lock_guard lock(budgetMutex);
+    budgetEstimate = outerEstimate_;
+    budgetHeadroom = outerHeadroom_;
 }
 
 bool releaseFreedHeap() {
-    const std::uint64_t estimate = budgetEstimate;
+    std::uint64_t estimate = 0, headroom = 0;
+    {
+        const std::lock_guard lock(budgetMutex);
+        estimate = budgetEstimate;
+        headroom = budgetHeadroom;
+    }
     if (estimate > 0) {
         const std::uint64_t resident = residentBytes();
-        if (resident > 0 && resident + budgetHeadroom <= estimate) return false;
+        if (resident > 0 && headroom <= estimate && resident <= estimate - headroom) return false;
     }
     ::malloc_trim(0);
     return true;
@@ -119,7 +133,7 @@ std::uint64_t availableMemoryBytes() {
     if (const char* limit = std::getenv("SHADOWLAB_MEMORY_LIMIT_MB"); limit && *limit) {
         char* end = nullptr;
         const unsigned long long mb = std::strtoull(limit, &end, 10);
-        if (end && *end == '\0' && mb > 0) return mb * kMiB;
+        if (end && *end == '\0' && mb > 0) return mb >= UINT64_MAX / kMiB ? UINT64_MAX : mb * kMiB;
         throw InputError(std::string("SHADOWLAB_MEMORY_LIMIT_MB: expected a positive whole number of MiB, got '") +
                          limit + "'");
     }

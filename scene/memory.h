@@ -50,17 +50,21 @@ std::uint64_t residentBytes();
 // The heap freed between renderers. Studies make renderer after renderer (the sweep's rows, the
 // recommendation's checks), and the driver's and the tracers' threads free into their own malloc
 // arenas, which keep it. Returned to the system after each renderer (malloc_trim), the next one
-// faults every page in again (a third of a default run's CPU on a virtual machine); kept, it may
+// faults every page in again (a quarter of a default run's CPU on a virtual machine); kept, it may
 // carry the process past its estimate. While a FreedHeapBudget is alive, releaseFreedHeap()
 // returns it only where the resident set plus `headroom` (the largest renderer the job makes, all
 // of it fresh memory) would pass `estimate` (or what the machine offers, when less); with none alive
 // it always does (docs/reliability.md, "Memory").
+// Budgets nest: the innermost one decides while it lives, and the outer one again after it.
 class FreedHeapBudget {
 public:
     FreedHeapBudget(std::uint64_t estimate, std::uint64_t headroom);
     ~FreedHeapBudget();
     FreedHeapBudget(const FreedHeapBudget&) = delete;
     FreedHeapBudget& operator=(const FreedHeapBudget&) = delete;
+
+private:
+    std::uint64_t outerEstimate_ = 0, outerHeadroom_ = 0;
 };
 
 // After a renderer is gone (studies/backend.cpp): malloc_trim, unless the budget leaves room.

@@ -126,7 +126,8 @@ public:
         return measured(std::move(f), error, reference, nullptr);
     }
 
-    // Its maps, geometry and pipelines go (and the heap is trimmed: ~BackendRenderer).
+    // Its maps, geometry and pipelines go (and the freed heap with them, unless the job's budget keeps
+    // it for the next: ~BackendRenderer).
     void release() { renderer_.reset(); }
 
 private:

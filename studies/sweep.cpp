@@ -895,10 +895,14 @@ JobMemory estimateSweepMemory(const scene::Scene& baseScene, const SweepGrid& gr
         largest = std::max(largest, estimateMemoryBytes(backend, scene, scene::makeRenderPlan(scene, s), s));
     };
     consider(scene::Backend::Reference, {});
+    bool raster = false, traced = false;
     for (const SweepConfig& c : grid.configs) {
         consider(c.backend, c.overrides);
-        consider(c.backend, user);  // the recommendation's search, in the user's settings
+        (c.backend == scene::Backend::Raster ? raster : traced) = true;
     }
+    // The recommendation's search, in the user's settings, for each backend the rows have.
+    if (raster) consider(scene::Backend::Raster, user);
+    if (traced) consider(scene::Backend::Raytrace, user);
     // The reference, a row's frame, the recommendation's defaults and point; along a flicker path
     // its references, a row's frames and (raster, a camera path) the held view's.
     const std::uint64_t pathFrames = grid.flicker ? std::uint64_t(std::max(grid.flicker->frames, 0)) : 0;
@@ -1040,16 +1044,22 @@ SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const
         row.key = key;
         try {
             const scene::RenderSettings settings = scene::resolveSettings(scene, config.overrides);
-            // One warm-up frame (shader compilation, caches) that is not timed, then the runs.
-            const std::function<scene::Frame()> renderFrame = frameSource(options, scene, settings, config.backend);
-            scene::Frame frame = renderFrame();
-            const double warmUpSetup = frame.timing("setup");
+            // One warm-up frame (shader compilation, caches) that is not timed, then the runs. The
+            // row's renderer goes before the flicker path makes its own: one renderer at a time
+            // (estimateSweepMemory).
+            scene::Frame frame;
+            double warmUpSetup = 0.0;
             std::vector<double> setups, frames;
-            for (int i = 0; i < grid.repetitions; ++i) {
+            {
+                const std::function<scene::Frame()> renderFrame = frameSource(options, scene, settings, config.backend);
                 frame = renderFrame();
-                const double setup = frame.timing("setup");
-                setups.push_back(setup);
-                frames.push_back(frame.totalTimeMs() - setup);
+                warmUpSetup = frame.timing("setup");
+                for (int i = 0; i < grid.repetitions; ++i) {
+                    frame = renderFrame();
+                    const double setup = frame.timing("setup");
+                    setups.push_back(setup);
+                    frames.push_back(frame.totalTimeMs() - setup);
+                }
             }
             row.repetitions = grid.repetitions;
             // A reused renderer paid its setup in the warm-up frame only.

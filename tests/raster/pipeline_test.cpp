@@ -60,9 +60,15 @@ TEST(RasterPipeline, EveryPipelineARenderAsksForIsCreatedWithoutValidationMessag
         EXPECT_TRUE(createTransmittancePipeline(ctx, layout).pipeline);
         EXPECT_TRUE(createTransmittanceRestPipeline(ctx, transmittance, layout).pipeline);
     }
-    const MomentPipeline p = createMomentPipeline(ctx, maps, moments, scene::ShadowFilter::Vsm, {});
-    EXPECT_TRUE(p.pipeline);
-    EXPECT_TRUE(p.blurPipeline);
+    scene::MomentSettings wide;
+    wide.blurWidth = 63;  // the widest blur: the x and y passes unroll 63 taps
+    for (const scene::ShadowFilter f : {scene::ShadowFilter::Vsm, scene::ShadowFilter::Evsm2,
+                                        scene::ShadowFilter::Evsm4, scene::ShadowFilter::Esm, scene::ShadowFilter::Msm})
+        for (const scene::MomentSettings& m : {scene::MomentSettings{}, wide}) {
+            const MomentPipeline p = createMomentPipeline(ctx, maps, moments, f, m);
+            EXPECT_TRUE(p.pipeline) << scene::toString(f) << m.blurWidth;
+            EXPECT_TRUE(p.blurPipeline) << scene::toString(f) << m.blurWidth;
+        }
 
     // The lit pass: every filter once, each beside another option the renderer sets from the plan
     // and the frame's channels (renderer.cpp: the channels pick the targets, the scene's lights the
