@@ -212,16 +212,10 @@ JobMemory estimateRunMemory(const scene::Scene& scene, const scene::RenderSettin
     // filterable maps compile a compute pipeline the run's filter may not need).
     const std::uint64_t tracerBytes = estimateMemoryBytes(scene::Backend::Raytrace, scene, plan, settings);
     std::uint64_t rasterBytes = o.raster ? estimateMemoryBytes(scene::Backend::Raster, scene, plan, settings) : 0;
-    if (o.sweep) {
-        const SweepGrid grid = quickGrid(scene, o);
-        const scene::Scene half = sweepScene(scene, grid);
-        for (const SweepConfig& c : grid.configs) {
-            if (c.backend != scene::Backend::Raster) continue;
-            const scene::RenderSettings s = scene::resolveSettings(half, c.overrides);
-            rasterBytes = std::max(
-                rasterBytes, estimateMemoryBytes(scene::Backend::Raster, half, scene::makeRenderPlan(half, s), s));
-        }
-    }
+    // (The sweep's largest is a raster row's only where the run has the raster backend; its
+    // ray-traced renderers at half size are smaller than the run's own, counted above.)
+    if (o.sweep && o.raster)
+        rasterBytes = std::max(rasterBytes, estimateSweepMemory(scene, quickGrid(scene, o), o.user).largestRenderer);
     const std::uint64_t estimate = scene::kProgramBytes + scene::sceneBytes(scene) + tracerBytes +
                                    scene::frameBytes(scene) + rasterBytes + scene::frameWriteBytes(scene) +
                                    2 * pixels * 3 * sizeof(float) +
