@@ -23,13 +23,15 @@ bool bakesLightConstants(const LitVariant& v) {
                                              v.lightKinds == (1u << SHADOWLAB_LIGHT_DIRECTIONAL));
 }
 
+bool bakesEveryLight(const LitVariant& v) { return v.lightCount > 0 && !bakesLightConstants(v); }
+
 bool usesSunModules(const LitVariant& v) {
     const bool taps = v.filter == scene::ShadowFilter::None || v.filter == scene::ShadowFilter::Pcf2x2;
     return v.sunModules && taps && v.lightTargets == 0 && v.lightCount == 1 &&
            v.lightKinds == (1u << SHADOWLAB_LIGHT_DIRECTIONAL) && !v.transmittance && !v.receiverPlane;
 }
 
-std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUniforms& u) {
+std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUniforms& u, bool everyLight) {
     const shaders::LightData& l = u.lights[0];
     const bool spot = l.kind == SHADOWLAB_LIGHT_SPOT;
     const glm::vec3 place = spot ? l.position : l.towardLight;
@@ -59,6 +61,29 @@ std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUn
         at[13] = d.texelWorldSize;
         at[14] = d.depthPerWorld;
         at[15] = d.depthBiasWorld;
+    }
+    const int bakedLights = everyLight ? std::clamp(u.lightCount, 0, SHADOWLAB_MAX_LIGHTS) : 0;
+    for (std::size_t i = 0; i < std::size_t(bakedLights); ++i) {
+        const shaders::LightData& d = u.lights[i];
+        const glm::vec3 toward = d.kind == SHADOWLAB_LIGHT_DIRECTIONAL ? d.towardLight : d.position;
+        const float slots[kPackedPerLight - 16] = {toward.x,          toward.y,
+                                                   toward.z,          d.layer,
+                                                   d.radiance.x,      d.radiance.y,
+                                                   d.radiance.z,      d.visibilityWeight,
+                                                   d.depthBiasWorld,  d.slopeBiasTexels,
+                                                   d.texelWorldSize,  d.depthPerWorld,
+                                                   d.maxSlopeTan,     d.normalOffsetTexels,
+                                                   float(d.pcfSize),  float(d.kind),
+                                                   d.spotDirection.x, d.spotDirection.y,
+                                                   d.spotDirection.z, d.spotCosCone,
+                                                   d.mapNear,         d.mapFar,
+                                                   d.lightSize,       float(d.cascadeCount)};
+        float* const at = c.data() + 34 + 16 * SHADOWLAB_MAX_CASCADES + kPackedPerLight * i;
+        std::copy(std::begin(slots), std::end(slots), at);
+        for (int column = 0; column < 4; ++column)
+            for (int row = 0; row < 4; ++row) at[24 + 4 * column + row] = d.toShadow[column][row];
+        at[40] = d.pointFaceTan;
+        at[41] = float(d.filterCode);
     }
     return c;
 }
@@ -101,10 +126,15 @@ LitStages litStages(const LitVariant& v, bool alpha) {
             return {vertex, alpha ? shaders::litFragBeautyAlphaTapsSunSpirv() : shaders::litFragBeautyTapsSunSpirv()};
         return {vertex, alpha ? shaders::litFragAlphaTapsSunSpirv() : shaders::litFragTapsSunSpirv()};
     }
-    if (v.specializedLightConstants && bakesLightConstants(v) && v.lightTargets == 0) {
-        // One spot light, or one sun with another filter or a transmittance map: the general
-        // modules without the flat light inputs.
+    if (v.specializedLightConstants) {
+        // One spot light, or one sun with another filter or a transmittance map, or every light
+        // baked in (bakesEveryLight): the general modules without the flat light inputs.
         const auto vertex = alpha ? shaders::litVertAlphaBakedSpirv() : shaders::litVertBakedSpirv();
+        if (v.lightTargets > 0)
+            return {vertex,
+                    taps
+                        ? (alpha ? shaders::litFragLightsAlphaTapsBakedSpirv() : shaders::litFragLightsTapsBakedSpirv())
+                        : (alpha ? shaders::litFragLightsAlphaBakedSpirv() : shaders::litFragLightsBakedSpirv())};
         if (!v.aovTarget)
             return {vertex,
                     taps
@@ -209,7 +239,8 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkD
     // constants as flat vertex outputs (bool), 11..16: the filterable maps' parameters (float bits:
     // minimum variance, bleeding reduction, EVSM exponents, ESM exponent, MSM moment bias). Both
     // stages get them all.
-    // 17: light 0's constants baked in (bool), 18..115: their values (packLightConstants).
+    // 17: the lights' constants baked in (bool), 18..115: light 0's values, 116..467: every light's
+    // (packLightConstants).
     constexpr std::uint32_t kConstants = 18 + kPackedLightConstants;
     const scene::MomentSettings& m = variant.moments;
     std::int32_t constants[kConstants] = {std::int32_t(variant.filter),

@@ -38,8 +38,19 @@ inline constexpr VkFormat kLitDisplayFormat = VK_FORMAT_R8G8B8A8_SRGB;
 // light 0's SHADOWLAB_MAX_CASCADES cascades, its toShadow's first three rows, sliceFar,
 // texelWorldSize, depthPerWorld and depthBiasWorld (zeros where it has none): the values a pipeline
 // with LitVariant::specializedLightConstants bakes (shaders/lit_constants.glsl, constants 18..115).
-inline constexpr std::size_t kPackedLightConstants = 32 + 2 + 16 * SHADOWLAB_MAX_CASCADES;
-std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUniforms& uniforms);
+// Then, for every light i of LitUniforms::lightCount (zeros for the rest), kPackedPerLight values
+// at 98 + kPackedPerLight * i (constants 116 + ..): what lit.frag reads of it where every light is
+// baked in (bakesEveryLight()), in eleven slots of four: the direction toward a directional light
+// or a spot or point light's position, layer; radiance, visibility weight; constant bias, slope
+// bias, texel world size, depth per world unit; slope cap, normal offset, PCF size, kind; spot
+// direction, cone cosine; map near, map far, light size, cascade count; toShadow's four columns;
+// the point faces' tangent, the filter code, 0, 0.
+inline constexpr std::size_t kPackedPerLight = 44;
+inline constexpr std::size_t kPackedLightConstants =
+    32 + 2 + 16 * SHADOWLAB_MAX_CASCADES + kPackedPerLight * SHADOWLAB_MAX_LIGHTS;
+// everyLight false leaves the per-light values zero: where only light 0's are baked, a light's
+// matrix may change (a moving camera) without changing what the pipelines baked.
+std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUniforms& uniforms, bool everyLight);
 
 // What is fixed when the lit pipeline is created (lit.frag's specialization constants and
 // variant): lavapipe executes every branch of a shader, so run-time switches cost as much as
@@ -64,7 +75,8 @@ struct LitVariant {
     bool vertexLightConstants = false;
     // The same values baked into the pipeline as specialization constants (shaders/lit_constants.glsl
     // kSpecializedLightConstants), `lightConstants` from packLightConstants(); lit.vert then writes
-    // no flat outputs for them. Takes effect only where bakesLightConstants().
+    // no flat outputs for them. Takes effect where bakesLightConstants(), and elsewhere bakes every
+    // light's (bakesEveryLight()).
     bool specializedLightConstants = false;
     std::array<float, kPackedLightConstants> lightConstants{};
     // The filterable filters' parameters (specialization constants 11..16; unused by the others).
@@ -82,6 +94,10 @@ bool usesVertexLightCoordinates(const LitVariant& variant);
 // Whether the variant can bake light 0's constants in: where usesVertexLightCoordinates(), or one
 // cascaded directional light without the receiver-plane bias.
 bool bakesLightConstants(const LitVariant& variant);
+// Whether the variant bakes every light's constants in (lit_constants.glsl kEveryLightBaked): with a
+// light, where bakesLightConstants() does not hold (several lights, a point light, the
+// receiver-plane bias).
+bool bakesEveryLight(const LitVariant& variant);
 // Whether the variant has the constants SHADOWLAB_ONE_SUN fixes (lit_constants.glsl), with none or
 // pcf2x2: the *_taps_sun modules (where LitVariant::sunModules asks for them).
 bool usesSunModules(const LitVariant& variant);

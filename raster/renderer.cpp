@@ -209,6 +209,7 @@ struct Renderer::Impl {
     // existing ones baked in; update() turns it off when the values change (RendererOptions::lightConstants).
     bool specializedLightConstants = false;
     bool bakedAtConstruction = false;  // setBiases() bakes the new values in again
+    bool everyLightBaked = false;      // bakesEveryLight() of the lit pipelines, where they bake
     std::array<float, kPackedLightConstants> bakedLightConstants{};
     bool renderIntoFrame = true;       // RendererOptions::renderIntoFrame
     bool transmittanceWindows = true;  // RendererOptions::transmittanceWindows
@@ -624,10 +625,12 @@ void Renderer::Impl::createTargets(const scene::Scene& scene, const RendererOpti
                             .receiverPlane = settings.receiverPlaneBias};
     vertexLightConstants =
         usesVertexLightCoordinates(lights) && options.lightConstants != LightConstants::kUniformBuffer;
-    specializedLightConstants =
-        bakesLightConstants(lights) && options.lightConstants == LightConstants::kSpecialization;
+    // Light 0's alone where it is the one light lit.vert can carry, else every light's.
+    specializedLightConstants = (bakesLightConstants(lights) || bakesEveryLight(lights)) &&
+                                options.lightConstants == LightConstants::kSpecialization;
     bakedAtConstruction = specializedLightConstants;
-    bakedLightConstants = packLightConstants(uniforms);
+    everyLightBaked = bakesEveryLight(lights);
+    bakedLightConstants = packLightConstants(uniforms, everyLightBaked);
     attributes["light_constants"] = specializedLightConstants ? "specialization"
                                     : vertexLightConstants    ? "vertex-outputs"
                                                               : "uniform-buffer";
@@ -757,10 +760,10 @@ void Renderer::Impl::update(const scene::Scene& scene, const scene::Camera& view
         uniforms.cascadeStart = float(splits[0] - viewDepthOffset);
     }
     setLayerLights(scene);
-    const std::array<float, kPackedLightConstants> packed = packLightConstants(uniforms);
+    const std::array<float, kPackedLightConstants> packed = packLightConstants(uniforms, everyLightBaked);
     if (specializedLightConstants && std::memcmp(packed.data(), bakedLightConstants.data(), sizeof packed) != 0) {
         // The values baked into the lit pipelines changed: from now on lit.vert passes them, or
-        // (cascades) the uniform buffer (a moving light or camera would otherwise compile new
+        // (cascades, every light baked) the uniform buffer (a moving light or camera would otherwise compile new
         // pipelines every frame).
         specializedLightConstants = false;
         attributes["light_constants"] = vertexLightConstants ? "vertex-outputs" : "uniform-buffer";
@@ -806,7 +809,7 @@ void Renderer::Impl::setBiases(const scene::Scene& scene, double depthBias, doub
     retireLitPipelines();
     if (bakedAtConstruction) {
         specializedLightConstants = true;
-        bakedLightConstants = packLightConstants(uniforms);
+        bakedLightConstants = packLightConstants(uniforms, everyLightBaked);
         attributes["light_constants"] = "specialization";
     }
 }

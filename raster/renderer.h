@@ -49,6 +49,9 @@ struct RenderDebug {
 // - kVertexOutputs: flat outputs of the vertex shader (lavapipe reads a uniform lane by lane for
 //   every eight pixels, a flat input once per triangle; docs/performance.md);
 // - kUniformBuffer: the uniform buffer.
+// Where no single light's map coordinates come from the vertex shader (several lights, a point
+// light, the receiver-plane bias), kSpecialization bakes every light's constants in and
+// kVertexOutputs reads the uniform buffer; a moving light or camera switches to the buffer then.
 // The frames are the same bit for bit (tests render all three).
 enum class LightConstants { kSpecialization, kVertexOutputs, kUniformBuffer };
 

@@ -99,7 +99,7 @@ vec4 lightSlot(int k) {
 #endif
 }
 vec4 frameSlot(int k) {
-    if (kSpecializedLightConstants) return k == 0 ? vec4(kF00, kF01, kF02, kF03) : vec4(kF10, kF11, kF12, kF13);
+    if (kFrameBakedIn) return k == 0 ? vec4(kF00, kF01, kF02, kF03) : vec4(kF10, kF11, kF12, kF13);
 #ifdef SHADOWLAB_BAKED_LIGHT
     return vec4(0.0);
 #else
@@ -125,7 +125,59 @@ vec4 vertexMapNormal() {
 // Light i's constants: the uniform buffer's, or (kVertexLightConstants: the one light) light 0's as
 // lit.vert packs them, its flat outputs or the same values baked in. The members lit.vert does not
 // pass come from the buffer, and only where code reads them (none does).
+#ifdef SHADOWLAB_BAKED_LIGHT
+#define SHADOWLAB_LIGHT_SLOT_VALUE(i, s) vec4(kB##i##_##s##x, kB##i##_##s##y, kB##i##_##s##z, kB##i##_##s##w)
+#define SHADOWLAB_LIGHT_SLOT_VALUES(i)                                                                          \
+    vec4[11](SHADOWLAB_LIGHT_SLOT_VALUE(i, 0), SHADOWLAB_LIGHT_SLOT_VALUE(i, 1), SHADOWLAB_LIGHT_SLOT_VALUE(i, 2), \
+             SHADOWLAB_LIGHT_SLOT_VALUE(i, 3), SHADOWLAB_LIGHT_SLOT_VALUE(i, 4), SHADOWLAB_LIGHT_SLOT_VALUE(i, 5), \
+             SHADOWLAB_LIGHT_SLOT_VALUE(i, 6), SHADOWLAB_LIGHT_SLOT_VALUE(i, 7), SHADOWLAB_LIGHT_SLOT_VALUE(i, 8), \
+             SHADOWLAB_LIGHT_SLOT_VALUE(i, 9), SHADOWLAB_LIGHT_SLOT_VALUE(i, 10))
+// Light i's baked slots (kEveryLightBaked); i is a constant in each iteration of the unrolled light
+// loop, so the selects fold away.
+vec4[11] bakedLightSlots(int i) {
+    if (i == 0) return SHADOWLAB_LIGHT_SLOT_VALUES(0);
+    if (i == 1) return SHADOWLAB_LIGHT_SLOT_VALUES(1);
+    if (i == 2) return SHADOWLAB_LIGHT_SLOT_VALUES(2);
+    if (i == 3) return SHADOWLAB_LIGHT_SLOT_VALUES(3);
+    if (i == 4) return SHADOWLAB_LIGHT_SLOT_VALUES(4);
+    if (i == 5) return SHADOWLAB_LIGHT_SLOT_VALUES(5);
+    if (i == 6) return SHADOWLAB_LIGHT_SLOT_VALUES(6);
+    return SHADOWLAB_LIGHT_SLOT_VALUES(7);
+}
+// Light i with the members lit.frag reads baked in (raster::packLightConstants' order); the point
+// faces from the buffer, loaded only where a point light reads them.
+LightData bakedLightAt(int i) {
+    LightData light = u.lights[i];
+    const vec4 s[11] = bakedLightSlots(i);
+    light.kind = int(s[3].w);
+    if (light.kind == SHADOWLAB_LIGHT_DIRECTIONAL) light.towardLight = s[0].xyz;
+    else light.position = s[0].xyz;
+    light.layer = s[0].w;
+    light.radiance = s[1].rgb;
+    light.visibilityWeight = s[1].w;
+    light.depthBiasWorld = s[2].x;
+    light.slopeBiasTexels = s[2].y;
+    light.texelWorldSize = s[2].z;
+    light.depthPerWorld = s[2].w;
+    light.maxSlopeTan = s[3].x;
+    light.normalOffsetTexels = s[3].y;
+    light.pcfSize = int(s[3].z);
+    light.spotDirection = s[4].xyz;
+    light.spotCosCone = s[4].w;
+    light.mapNear = s[5].x;
+    light.mapFar = s[5].y;
+    light.lightSize = s[5].z;
+    light.cascadeCount = int(s[5].w);
+    light.toShadow = mat4(s[6], s[7], s[8], s[9]);
+    light.pointFaceTan = s[10].x;
+    light.filterCode = int(s[10].y);
+    return light;
+}
+#endif
 LightData lightAt(int i) {
+#ifdef SHADOWLAB_BAKED_LIGHT
+    if (kEveryLightBaked) return bakedLightAt(i);
+#endif
     if (!kLightFromSlots) return u.lights[i];
     LightData light = u.lights[0];
     const vec4 slot[6] = vec4[](lightSlot(0), lightSlot(1), lightSlot(2), lightSlot(3), lightSlot(4), lightSlot(5));
@@ -151,9 +203,9 @@ LightData lightAt(int i) {
     return light;
 }
 // LitUniforms' members that lit.vert passes with the light.
-vec3 viewForward() { return kLightFromSlots ? frameSlot(0).xyz : u.forward; }
-float ambient() { return kLightFromSlots ? frameSlot(0).w : u.ambient; }
-float mapSize() { return kLightFromSlots ? frameSlot(1).x : u.mapSize; }
+vec3 viewForward() { return kFrameFromSlots ? frameSlot(0).xyz : u.forward; }
+float ambient() { return kFrameFromSlots ? frameSlot(0).w : u.ambient; }
+float mapSize() { return kFrameFromSlots ? frameSlot(1).x : u.mapSize; }
 
 // Cascade c of light `lightIndex`: the uniform buffer's, or (kSpecializedCascades: light 0 is the
 // only light) baked in. c varies per pixel, so the baked values are chosen by selects, where the

@@ -32,8 +32,12 @@
 #include "lit_frag_beauty_taps_sun_map_baked.spv.h"
 #include "lit_frag_lights.spv.h"
 #include "lit_frag_lights_alpha.spv.h"
+#include "lit_frag_lights_alpha_baked.spv.h"
 #include "lit_frag_lights_alpha_taps.spv.h"
+#include "lit_frag_lights_alpha_taps_baked.spv.h"
+#include "lit_frag_lights_baked.spv.h"
 #include "lit_frag_lights_taps.spv.h"
+#include "lit_frag_lights_taps_baked.spv.h"
 #include "lit_frag_taps.spv.h"
 #include "lit_frag_taps_baked.spv.h"
 #include "lit_frag_taps_sun.spv.h"
@@ -112,6 +116,10 @@ std::span<const std::uint32_t> litFragBakedSpirv() { return kLitFragBakedSpv; }
 std::span<const std::uint32_t> litFragAlphaBakedSpirv() { return kLitFragAlphaBakedSpv; }
 std::span<const std::uint32_t> litFragBeautyBakedSpirv() { return kLitFragBeautyBakedSpv; }
 std::span<const std::uint32_t> litFragBeautyAlphaBakedSpirv() { return kLitFragBeautyAlphaBakedSpv; }
+std::span<const std::uint32_t> litFragLightsBakedSpirv() { return kLitFragLightsBakedSpv; }
+std::span<const std::uint32_t> litFragLightsAlphaBakedSpirv() { return kLitFragLightsAlphaBakedSpv; }
+std::span<const std::uint32_t> litFragLightsTapsBakedSpirv() { return kLitFragLightsTapsBakedSpv; }
+std::span<const std::uint32_t> litFragLightsAlphaTapsBakedSpirv() { return kLitFragLightsAlphaTapsBakedSpv; }
 std::span<const std::uint32_t> litVertBakedSpirv() { return kLitVertBakedSpv; }
 std::span<const std::uint32_t> litVertAlphaBakedSpirv() { return kLitVertAlphaBakedSpv; }
 std::span<const std::uint32_t> litVertNoIdBakedSpirv() { return kLitVertNoIdBakedSpv; }

@@ -71,6 +71,11 @@ std::span<const std::uint32_t> litFragBakedSpirv();
 std::span<const std::uint32_t> litFragAlphaBakedSpirv();
 std::span<const std::uint32_t> litFragBeautyBakedSpirv();
 std::span<const std::uint32_t> litFragBeautyAlphaBakedSpirv();
+// The per-light visibility modules (SHADOWLAB_LIGHT_OUTPUTS) for every light's constants baked in.
+std::span<const std::uint32_t> litFragLightsBakedSpirv();
+std::span<const std::uint32_t> litFragLightsAlphaBakedSpirv();
+std::span<const std::uint32_t> litFragLightsTapsBakedSpirv();
+std::span<const std::uint32_t> litFragLightsAlphaTapsBakedSpirv();
 std::span<const std::uint32_t> litVertBakedSpirv();
 std::span<const std::uint32_t> litVertAlphaBakedSpirv();
 std::span<const std::uint32_t> litVertNoIdBakedSpirv();

@@ -362,5 +362,40 @@ TEST(RasterLitPass, OneSpotOrASunOutsideTheSunModulesWithBakedConstantsHasNoFlat
             }
 }
 
+TEST(RasterLitPass, EveryLightIsBakedInWhereNoOneLightComesFromTheVertexShader) {
+    // Several lights, one point light, or the receiver-plane bias: every light's constants baked in
+    // (bakesEveryLight), in the general modules without the flat light slots (6..13); with per-light
+    // visibility targets, the modules that write them (outputs 6 and 7).
+    constexpr std::uint32_t kInput = 1, kOutput = 3;
+    constexpr std::uint32_t dir = 1u << SHADOWLAB_LIGHT_DIRECTIONAL, spot = 1u << SHADOWLAB_LIGHT_SPOT,
+                            point = 1u << SHADOWLAB_LIGHT_POINT;
+    EXPECT_FALSE(bakesEveryLight(LitVariant{.lightKinds = dir}));
+    EXPECT_FALSE(bakesEveryLight(LitVariant{.lightKinds = spot}));
+    EXPECT_FALSE(bakesEveryLight(LitVariant{.lightKinds = dir, .cascades = 3}));
+    EXPECT_FALSE(bakesEveryLight(LitVariant{.lightCount = 0, .lightKinds = 0}));
+    EXPECT_TRUE(bakesEveryLight(LitVariant{.lightKinds = point}));
+    EXPECT_TRUE(bakesEveryLight(LitVariant{.lightKinds = dir, .receiverPlane = true}));
+    EXPECT_TRUE(bakesEveryLight(LitVariant{.lightCount = 2, .lightKinds = dir}));
+    EXPECT_TRUE(bakesEveryLight(LitVariant{.lightCount = 3, .lightKinds = dir | spot | point, .cascades = 4}));
+    for (const scene::ShadowFilter filter : {scene::ShadowFilter::Pcf2x2, scene::ShadowFilter::Pcss})
+        for (const bool alpha : {false, true})
+            for (const std::uint32_t targets : {0u, kLightTargets}) {
+                const std::string what = "filter " + std::to_string(int(filter)) + " alpha " + std::to_string(alpha) +
+                                         " light targets " + std::to_string(targets);
+                const LitVariant v{.filter = filter,
+                                   .lightTargets = targets,
+                                   .lightCount = 3,
+                                   .lightKinds = dir | spot | point,
+                                   .specializedLightConstants = true};
+                const LitStages baked = litStages(v, alpha);
+                for (const std::uint32_t slot : {6u, 12u}) {
+                    EXPECT_FALSE(interfaceLocations(baked.vertex, kOutput).contains(slot)) << what;
+                    EXPECT_FALSE(interfaceLocations(baked.fragment, kInput).contains(slot)) << what;
+                }
+                EXPECT_EQ(interfaceLocations(baked.fragment, kOutput).contains(6u), targets > 0) << what;
+                EXPECT_EQ(interfaceLocations(baked.fragment, kOutput).contains(7u), targets > 0) << what;
+            }
+}
+
 }  // namespace
 }  // namespace shadowlab::raster

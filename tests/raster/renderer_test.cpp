@@ -1429,6 +1429,90 @@ TEST(RasterRenderer, CascadedLightConstantsBakedInGiveTheUniformBuffersFrameBitF
     }
 }
 
+TEST(RasterRenderer, EveryLightsConstantsBakedInGiveTheUniformBuffersFrameBitForBit) {
+    // Where no one light's map coordinates come from lit.vert (several lights, a point light alone,
+    // the receiver-plane bias), the default bakes every light's constants into the lit pipelines
+    // (shaders/lit_constants.glsl kEveryLightBaked) and each light's kind with them. The same floats
+    // in the same arithmetic: every channel, each light's visibility included, the same bit for bit
+    // as the uniform buffer's frame. A member packed into another's place, or a light's values into
+    // another light's, moves that light's shadow or its shading. A sun, a spot and a point light,
+    // each with a size (PCSS reads it) and with the normal offset on; every filter kind; near the
+    // origin and 10^7 units away; the point light alone; the receiver plane; and a cascaded sun
+    // beside the spot (its cascades stay in the buffer).
+    struct Case {
+        const char* name;
+        ShadowFilter filter;
+        double offset;
+    };
+    auto threeLights = [](double offset) {
+        const Vec3 shift(offset, 0.0, -offset);
+        scene::Scene s = sunAt50Degrees(offset);
+        s.lights[0].intensity = 0.7;
+        scene::Light spot;
+        spot.type = scene::LightType::Spot;
+        spot.position = Vec3(2.5, 3.0, 1.5) + shift;
+        spot.direction = glm::normalize(Vec3(-2.5, -2.2, -1.5));
+        spot.coneAngleDegrees = 45.0;
+        spot.radius = 0.1;
+        spot.intensity = 200.0;
+        s.lights.push_back(spot);
+        scene::Light point;
+        point.type = scene::LightType::Point;
+        point.position = Vec3(-2.0, 2.5, 1.0) + shift;
+        point.radius = 0.1;
+        point.intensity = 150.0;
+        s.lights.push_back(point);
+        return s;
+    };
+    auto expectTheSame = [](const scene::Scene& s, const scene::RasterSettings& settings, const std::string& what) {
+        Renderer buffer(s, planFor(s, settings), settings,
+                        RendererOptions{.lightConstants = LightConstants::kUniformBuffer});
+        Renderer baked(s, planFor(s, settings), settings);
+        const scene::Frame a = buffer.render(scene::kAllChannels), b = baked.render(scene::kAllChannels);
+        EXPECT_EQ(a.attributes.at("light_constants"), "uniform-buffer") << what;
+        EXPECT_EQ(b.attributes.at("light_constants"), "specialization") << what;
+        // Each light shadows some of what it lights.
+        ASSERT_EQ(a.lightVisibility.size(), s.lights.size() > 1 ? s.lights.size() : 0u) << what;
+        for (std::size_t k = 0; k < a.lightVisibility.size(); ++k) {
+            std::size_t lit = 0, shadowed = 0;
+            for (const float v : a.lightVisibility[k]) (v > 0.5f ? lit : v == 0.0f ? shadowed : lit) += 1;
+            EXPECT_GT(lit, 500u) << what << ", light " << k;
+            EXPECT_GT(shadowed, 500u) << what << ", light " << k;
+        }
+        if (s.lights.size() == 1) {
+            std::size_t shadowed = 0;
+            for (std::size_t i = 0; i < a.pixelCount(); ++i) shadowed += a.objectId[i] > 0.0f && a.visibility[i] < 0.5f;
+            EXPECT_GT(shadowed, 200u) << what;
+        }
+        test::expectSamePixels(a, b, what);
+        EXPECT_EQ(buffer.validationMessages(), 0);
+        EXPECT_EQ(baked.validationMessages(), 0);
+    };
+    for (const Case c : {Case{"none", ShadowFilter::None, 0.0}, Case{"pcf2x2", ShadowFilter::Pcf2x2, 0.0},
+                         Case{"pcf2x2 far", ShadowFilter::Pcf2x2, 1.0e7}, Case{"pcf", ShadowFilter::Pcf, 0.0},
+                         Case{"poisson", ShadowFilter::Poisson, 0.0}, Case{"pcss", ShadowFilter::Pcss, 0.0},
+                         Case{"pcss far", ShadowFilter::Pcss, 1.0e7}, Case{"vsm", ShadowFilter::Vsm, 0.0}}) {
+        scene::RasterSettings settings = validatedSettings(512, 0.004, 0.5, c.filter);
+        settings.normalOffset = 0.5;
+        expectTheSame(threeLights(c.offset), settings, std::string("three lights, ") + c.name);
+    }
+    scene::Scene point = threeLights(0.0);
+    point.lights.erase(point.lights.begin(), point.lights.begin() + 2);
+    expectTheSame(point, validatedSettings(512, 0.004, 0.5, ShadowFilter::Pcf), "the point light alone");
+    scene::RasterSettings plane = validatedSettings(512, 0.004, 0.5, ShadowFilter::Pcf);
+    plane.receiverPlaneBias = true;
+    expectTheSame(sunAt50Degrees(0.0), plane, "one sun with the receiver plane");
+    scene::Scene longPlane = test::makeLongPlane(320, 180);
+    scene::Light spot = test::spotDown();
+    spot.position = {0, 8, -6};
+    longPlane.lights.push_back(spot);
+    scene::RasterSettings cascaded = validatedSettings(512, 0.0, 1.0, ShadowFilter::Pcf2x2);
+    cascaded.depthBias = scene::defaultDepthBias(longPlane, 512);
+    cascaded.cascades = 3;
+    cascaded.cascadeBlend = 0.2;
+    expectTheSame(longPlane, cascaded, "a cascaded sun and a spot");
+}
+
 // One step of expectSameFramesThroughUpdates: both Renderers update() to `scene` (none for a null
 // one), then render; `baked` reads its light constants from `source`.
 struct UpdateStep {
@@ -1490,10 +1574,34 @@ TEST(RasterRenderer, AnUpdateThatMovesTheCascadesSwitchesToTheUniformBufferWithT
                                     {"after the camera moved", &moved, "uniform-buffer"}});
 }
 
-TEST(RasterRenderer, LightConstantsAreBakedInForOneSunOrSpotWithoutTheReceiverPlane) {
-    // By default lit.frag takes the one light's constants as specialization constants where the
-    // scene has one directional light (one map or cascades) or one spot, and no receiver-plane bias;
-    // a second light or the receiver-plane bias keep the uniform buffer.
+TEST(RasterRenderer, AnUpdateThatMovesEveryBakedLightSwitchesToTheUniformBufferWithTheSameFrames) {
+    // Every light baked in (two lights): the lights' positions and matrices are camera-relative,
+    // so a moved camera changes them, and the Renderer reads the uniform buffer from then on, each
+    // frame the same bit for bit as a Renderer that always did.
+    scene::Scene s = sunAt50Degrees(0.0);
+    scene::Light spot;
+    spot.type = scene::LightType::Spot;
+    spot.position = Vec3(2.5, 3.0, 1.5);
+    spot.direction = glm::normalize(Vec3(-2.5, -2.2, -1.5));
+    spot.coneAngleDegrees = 45.0;
+    spot.intensity = 200.0;
+    s.lights.push_back(spot);
+    const scene::RasterSettings settings = validatedSettings(512, 0.004, 0.5, ShadowFilter::Pcf2x2);
+    Renderer baked(s, planFor(s, settings), settings);
+    Renderer buffer(s, planFor(s, settings), settings,
+                    RendererOptions{.lightConstants = LightConstants::kUniformBuffer});
+    scene::Scene moved = s;
+    moved.camera.position += scene::Vec3(0.6, 0.3, -0.5);
+    expectSameFramesThroughUpdates(baked, buffer,
+                                   {{"before any update", nullptr, "specialization"},
+                                    {"after an update to the same scene", &s, "specialization"},
+                                    {"after the camera moved", &moved, "uniform-buffer"}});
+}
+
+TEST(RasterRenderer, LightConstantsAreBakedInByDefault) {
+    // By default lit.frag takes the lights' constants as specialization constants: the one light's
+    // where the scene has one directional light (one map or cascades) or one spot, and no
+    // receiver-plane bias; every light's with a second light or the receiver-plane bias.
     const scene::RasterSettings settings = validatedSettings(256, 0.01, 1.0, ShadowFilter::Pcf2x2);
     const scene::Scene one = makeScene(SphereOverPlane{});
     auto source = [](const scene::Scene& s, const scene::RasterSettings& r) {
@@ -1512,15 +1620,15 @@ TEST(RasterRenderer, LightConstantsAreBakedInForOneSunOrSpotWithoutTheReceiverPl
     scene::Scene two = one;
     two.lights.push_back(two.lights[0]);
     two.lights[1].direction = lightFromElevation(40.0);
-    EXPECT_EQ(source(two, settings), "uniform-buffer");
+    EXPECT_EQ(source(two, settings), "specialization");
     scene::RasterSettings plane = settings;
     plane.receiverPlaneBias = true;
-    EXPECT_EQ(source(one, plane), "uniform-buffer");
+    EXPECT_EQ(source(one, plane), "specialization");
     scene::RasterSettings cascades = settings;
     cascades.cascades = 3;
     EXPECT_EQ(source(one, cascades), "specialization");
     cascades.receiverPlaneBias = true;
-    EXPECT_EQ(source(one, cascades), "uniform-buffer");
+    EXPECT_EQ(source(one, cascades), "specialization");
 }
 
 TEST(RasterRender, BadPcfSizeIsRejected) {
