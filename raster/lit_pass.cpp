@@ -84,6 +84,10 @@ std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUn
             for (int row = 0; row < 4; ++row) at[24 + 4 * column + row] = d.toShadow[column][row];
         at[40] = d.pointFaceTan;
         at[41] = float(d.filterCode);
+        for (int face = 0; face < 6; ++face) {
+            at[44 + 2 * face] = d.pointFaces[face].near;
+            at[45 + 2 * face] = d.pointFaces[face].far;
+        }
     }
     return c;
 }
@@ -239,7 +243,7 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkD
     // constants as flat vertex outputs (bool), 11..16: the filterable maps' parameters (float bits:
     // minimum variance, bleeding reduction, EVSM exponents, ESM exponent, MSM moment bias). Both
     // stages get them all.
-    // 17: the lights' constants baked in (bool), 18..115: light 0's values, 116..467: every light's
+    // 17: the lights' constants baked in (bool), 18..115: light 0's values, 116..563: every light's
     // (packLightConstants).
     constexpr std::uint32_t kConstants = 18 + kPackedLightConstants;
     const scene::MomentSettings& m = variant.moments;

@@ -40,12 +40,12 @@ inline constexpr VkFormat kLitDisplayFormat = VK_FORMAT_R8G8B8A8_SRGB;
 // with LitVariant::specializedLightConstants bakes (shaders/lit_constants.glsl, constants 18..115).
 // Then, for every light i of LitUniforms::lightCount (zeros for the rest), kPackedPerLight values
 // at 98 + kPackedPerLight * i (constants 116 + ..): what lit.frag reads of it where every light is
-// baked in (bakesEveryLight()), in eleven slots of four: the direction toward a directional light
+// baked in (bakesEveryLight()), in fourteen slots of four: the direction toward a directional light
 // or a spot or point light's position, layer; radiance, visibility weight; constant bias, slope
 // bias, texel world size, depth per world unit; slope cap, normal offset, PCF size, kind; spot
 // direction, cone cosine; map near, map far, light size, cascade count; toShadow's four columns;
-// the point faces' tangent, the filter code, 0, 0.
-inline constexpr std::size_t kPackedPerLight = 44;
+// the point faces' tangent, the filter code, 0, 0; the six point faces' near and far.
+inline constexpr std::size_t kPackedPerLight = 56;
 inline constexpr std::size_t kPackedLightConstants =
     32 + 2 + 16 * SHADOWLAB_MAX_CASCADES + kPackedPerLight * SHADOWLAB_MAX_LIGHTS;
 // everyLight false leaves the per-light values zero: where only light 0's are baked, a light's

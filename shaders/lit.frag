@@ -128,13 +128,14 @@ vec4 vertexMapNormal() {
 #ifdef SHADOWLAB_BAKED_LIGHT
 #define SHADOWLAB_LIGHT_SLOT_VALUE(i, s) vec4(kB##i##_##s##x, kB##i##_##s##y, kB##i##_##s##z, kB##i##_##s##w)
 #define SHADOWLAB_LIGHT_SLOT_VALUES(i)                                                                          \
-    vec4[11](SHADOWLAB_LIGHT_SLOT_VALUE(i, 0), SHADOWLAB_LIGHT_SLOT_VALUE(i, 1), SHADOWLAB_LIGHT_SLOT_VALUE(i, 2), \
+    vec4[14](SHADOWLAB_LIGHT_SLOT_VALUE(i, 0), SHADOWLAB_LIGHT_SLOT_VALUE(i, 1), SHADOWLAB_LIGHT_SLOT_VALUE(i, 2), \
              SHADOWLAB_LIGHT_SLOT_VALUE(i, 3), SHADOWLAB_LIGHT_SLOT_VALUE(i, 4), SHADOWLAB_LIGHT_SLOT_VALUE(i, 5), \
              SHADOWLAB_LIGHT_SLOT_VALUE(i, 6), SHADOWLAB_LIGHT_SLOT_VALUE(i, 7), SHADOWLAB_LIGHT_SLOT_VALUE(i, 8), \
-             SHADOWLAB_LIGHT_SLOT_VALUE(i, 9), SHADOWLAB_LIGHT_SLOT_VALUE(i, 10))
+             SHADOWLAB_LIGHT_SLOT_VALUE(i, 9), SHADOWLAB_LIGHT_SLOT_VALUE(i, 10), SHADOWLAB_LIGHT_SLOT_VALUE(i, 11), \
+             SHADOWLAB_LIGHT_SLOT_VALUE(i, 12), SHADOWLAB_LIGHT_SLOT_VALUE(i, 13))
 // Light i's baked slots (kEveryLightBaked); i is a constant in each iteration of the unrolled light
 // loop, so the selects fold away.
-vec4[11] bakedLightSlots(int i) {
+vec4[14] bakedLightSlots(int i) {
     if (i == 0) return SHADOWLAB_LIGHT_SLOT_VALUES(0);
     if (i == 1) return SHADOWLAB_LIGHT_SLOT_VALUES(1);
     if (i == 2) return SHADOWLAB_LIGHT_SLOT_VALUES(2);
@@ -144,14 +145,15 @@ vec4[11] bakedLightSlots(int i) {
     if (i == 6) return SHADOWLAB_LIGHT_SLOT_VALUES(6);
     return SHADOWLAB_LIGHT_SLOT_VALUES(7);
 }
-// Light i with the members lit.frag reads baked in (raster::packLightConstants' order); the point
-// faces from the buffer, loaded only where a point light reads them.
+// Light i as the uniform buffer holds it, from its baked slots (raster::packLightConstants' order;
+// the members of other kinds are zero there, as in the buffer).
 LightData bakedLightAt(int i) {
-    LightData light = u.lights[i];
-    const vec4 s[11] = bakedLightSlots(i);
+    LightData light;
+    const vec4 s[14] = bakedLightSlots(i);
     light.kind = int(s[3].w);
-    if (light.kind == SHADOWLAB_LIGHT_DIRECTIONAL) light.towardLight = s[0].xyz;
-    else light.position = s[0].xyz;
+    const bool directional = light.kind == SHADOWLAB_LIGHT_DIRECTIONAL;
+    light.towardLight = directional ? s[0].xyz : vec3(0.0);
+    light.position = directional ? vec3(0.0) : s[0].xyz;
     light.layer = s[0].w;
     light.radiance = s[1].rgb;
     light.visibilityWeight = s[1].w;
@@ -171,6 +173,11 @@ LightData bakedLightAt(int i) {
     light.toShadow = mat4(s[6], s[7], s[8], s[9]);
     light.pointFaceTan = s[10].x;
     light.filterCode = int(s[10].y);
+    for (int face = 0; face < 6; ++face) {
+        const vec4 pair = s[11 + face / 2];
+        light.pointFaces[face].near = face % 2 == 0 ? pair.x : pair.z;
+        light.pointFaces[face].far = face % 2 == 0 ? pair.y : pair.w;
+    }
     return light;
 }
 #endif

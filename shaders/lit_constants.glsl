@@ -203,21 +203,21 @@ layout(constant_id = 115) const float kC3_15 = 0.0;
 
 // Every light's constants baked in (kEveryLightBaked), where light 0's alone cannot be: several
 // lights, a point light, the receiver-plane bias. The SHADOWLAB_BAKED_LIGHT modules then read the
-// LightData members lit.frag uses of light i from constants 116 + 44 i ..: eleven slots of four,
+// LightData members lit.frag uses of light i from constants 116 + 56 i ..: fourteen slots of four,
 // packed as raster::packLightConstants packs them, instead of loading them from the uniform buffer
 // lane by lane for every eight pixels; each light's kind becomes a constant too, so the code of the
-// kinds it is not is left out of its unrolled iteration. A point light's faces and the cascades stay
-// in the buffer.
+// kinds it is not is left out of its unrolled iteration. The cascades stay in the buffer.
 #ifdef SHADOWLAB_BAKED_LIGHT
 #define SHADOWLAB_LIGHT_SLOT(i, s)                                                 \
-    layout(constant_id = 116 + 44 * i + 4 * s) const float kB##i##_##s##x = 0.0;     \
-    layout(constant_id = 116 + 44 * i + 4 * s + 1) const float kB##i##_##s##y = 0.0; \
-    layout(constant_id = 116 + 44 * i + 4 * s + 2) const float kB##i##_##s##z = 0.0; \
-    layout(constant_id = 116 + 44 * i + 4 * s + 3) const float kB##i##_##s##w = 0.0;
+    layout(constant_id = 116 + 56 * i + 4 * s) const float kB##i##_##s##x = 0.0;     \
+    layout(constant_id = 116 + 56 * i + 4 * s + 1) const float kB##i##_##s##y = 0.0; \
+    layout(constant_id = 116 + 56 * i + 4 * s + 2) const float kB##i##_##s##z = 0.0; \
+    layout(constant_id = 116 + 56 * i + 4 * s + 3) const float kB##i##_##s##w = 0.0;
 #define SHADOWLAB_LIGHT_SLOTS(i)                                                                                  \
     SHADOWLAB_LIGHT_SLOT(i, 0) SHADOWLAB_LIGHT_SLOT(i, 1) SHADOWLAB_LIGHT_SLOT(i, 2) SHADOWLAB_LIGHT_SLOT(i, 3)   \
     SHADOWLAB_LIGHT_SLOT(i, 4) SHADOWLAB_LIGHT_SLOT(i, 5) SHADOWLAB_LIGHT_SLOT(i, 6) SHADOWLAB_LIGHT_SLOT(i, 7)   \
-    SHADOWLAB_LIGHT_SLOT(i, 8) SHADOWLAB_LIGHT_SLOT(i, 9) SHADOWLAB_LIGHT_SLOT(i, 10)
+    SHADOWLAB_LIGHT_SLOT(i, 8) SHADOWLAB_LIGHT_SLOT(i, 9) SHADOWLAB_LIGHT_SLOT(i, 10) SHADOWLAB_LIGHT_SLOT(i, 11) \
+    SHADOWLAB_LIGHT_SLOT(i, 12) SHADOWLAB_LIGHT_SLOT(i, 13)
 SHADOWLAB_LIGHT_SLOTS(0)
 SHADOWLAB_LIGHT_SLOTS(1)
 SHADOWLAB_LIGHT_SLOTS(2)

@@ -1498,7 +1498,11 @@ TEST(RasterRenderer, EveryLightsConstantsBakedInGiveTheUniformBuffersFrameBitFor
     }
     scene::Scene point = threeLights(0.0);
     point.lights.erase(point.lights.begin(), point.lights.begin() + 2);
-    expectTheSame(point, validatedSettings(512, 0.004, 0.5, ShadowFilter::Pcf), "the point light alone");
+    // Each face fitted to its receivers: six depth ranges of their own, which a face packed in
+    // another's place would change.
+    scene::RasterSettings fitted = validatedSettings(512, 0.004, 0.5, ShadowFilter::Pcf);
+    fitted.fitLightFrustum = true;
+    expectTheSame(point, fitted, "the point light alone");
     scene::RasterSettings plane = validatedSettings(512, 0.004, 0.5, ShadowFilter::Pcf);
     plane.receiverPlaneBias = true;
     expectTheSame(sunAt50Degrees(0.0), plane, "one sun with the receiver plane");
