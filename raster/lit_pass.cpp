@@ -97,8 +97,8 @@ std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUn
 // module into NIR before the specialization constants remove what a pipeline does not run: the full
 // module doubled the lit pipeline's creation); where usesSunModules(), the *_sun modules (*_sun_map
 // with one map and no blend bands, *_baked of those for baked constants); elsewhere the general
-// ones, *_baked where the one light's constants are baked in. lit.vert: the build whose outputs
-// are the fragment shader's inputs.
+// ones, *_baked where the one light's constants are baked in, *_every where every light's are.
+// lit.vert: the build whose outputs are the fragment shader's inputs.
 LitStages litStages(const LitVariant& v, bool alpha) {
     const bool taps = v.filter == scene::ShadowFilter::None || v.filter == scene::ShadowFilter::Pcf2x2;
     if (usesSunModules(v)) {
@@ -130,15 +130,26 @@ LitStages litStages(const LitVariant& v, bool alpha) {
             return {vertex, alpha ? shaders::litFragBeautyAlphaTapsSunSpirv() : shaders::litFragBeautyTapsSunSpirv()};
         return {vertex, alpha ? shaders::litFragAlphaTapsSunSpirv() : shaders::litFragTapsSunSpirv()};
     }
-    if (v.specializedLightConstants) {
-        // One spot light, or one sun with another filter or a transmittance map, or every light
-        // baked in (bakesEveryLight): the general modules without the flat light inputs.
+    if (v.specializedLightConstants && bakesEveryLight(v)) {
+        // Every light baked in: the general modules' *_every builds, without flat light inputs.
         const auto vertex = alpha ? shaders::litVertAlphaBakedSpirv() : shaders::litVertBakedSpirv();
+        if (!v.aovTarget)
+            return {vertex,
+                    taps
+                        ? (alpha ? shaders::litFragBeautyAlphaTapsEverySpirv() : shaders::litFragBeautyTapsEverySpirv())
+                        : (alpha ? shaders::litFragBeautyAlphaEverySpirv() : shaders::litFragBeautyEverySpirv())};
         if (v.lightTargets > 0)
             return {vertex,
                     taps
-                        ? (alpha ? shaders::litFragLightsAlphaTapsBakedSpirv() : shaders::litFragLightsTapsBakedSpirv())
-                        : (alpha ? shaders::litFragLightsAlphaBakedSpirv() : shaders::litFragLightsBakedSpirv())};
+                        ? (alpha ? shaders::litFragLightsAlphaTapsEverySpirv() : shaders::litFragLightsTapsEverySpirv())
+                        : (alpha ? shaders::litFragLightsAlphaEverySpirv() : shaders::litFragLightsEverySpirv())};
+        return {vertex, taps ? (alpha ? shaders::litFragAlphaTapsEverySpirv() : shaders::litFragTapsEverySpirv())
+                             : (alpha ? shaders::litFragAlphaEverySpirv() : shaders::litFragEverySpirv())};
+    }
+    if (v.specializedLightConstants) {
+        // One spot light, or one sun with another filter or a transmittance map: the general
+        // modules without the flat light inputs.
+        const auto vertex = alpha ? shaders::litVertAlphaBakedSpirv() : shaders::litVertBakedSpirv();
         if (!v.aovTarget)
             return {vertex,
                     taps

@@ -125,7 +125,7 @@ vec4 vertexMapNormal() {
 // Light i's constants: the uniform buffer's, or (kVertexLightConstants: the one light) light 0's as
 // lit.vert packs them, its flat outputs or the same values baked in. The members lit.vert does not
 // pass come from the buffer, and only where code reads them (none does).
-#ifdef SHADOWLAB_BAKED_LIGHT
+#ifdef SHADOWLAB_EVERY_LIGHT
 #define SHADOWLAB_LIGHT_SLOT_VALUE(i, s) vec4(kB##i##_##s##x, kB##i##_##s##y, kB##i##_##s##z, kB##i##_##s##w)
 #define SHADOWLAB_LIGHT_SLOT_VALUES(i)                                                                          \
     vec4[14](SHADOWLAB_LIGHT_SLOT_VALUE(i, 0), SHADOWLAB_LIGHT_SLOT_VALUE(i, 1), SHADOWLAB_LIGHT_SLOT_VALUE(i, 2), \
@@ -182,7 +182,7 @@ LightData bakedLightAt(int i) {
 }
 #endif
 LightData lightAt(int i) {
-#ifdef SHADOWLAB_BAKED_LIGHT
+#ifdef SHADOWLAB_EVERY_LIGHT
     if (kEveryLightBaked) return bakedLightAt(i);
 #endif
     if (!kLightFromSlots) return u.lights[i];

@@ -206,8 +206,14 @@ layout(constant_id = 115) const float kC3_15 = 0.0;
 // LightData members lit.frag uses of light i from constants 116 + 56 i ..: fourteen slots of four,
 // packed as raster::packLightConstants packs them, instead of loading them from the uniform buffer
 // lane by lane for every eight pixels; each light's kind becomes a constant too, so the code of the
-// kinds it is not is left out of its unrolled iteration. The cascades stay in the buffer.
-#ifdef SHADOWLAB_BAKED_LIGHT
+// kinds it is not is left out of its unrolled iteration. The cascades stay in the buffer. Only in
+// the *_every modules (SHADOWLAB_EVERY_LIGHT), which raster/lit_pass.cpp picks for that case alone:
+// glslang cannot fold the switch between the one light's constants and these, and in the other
+// modules the code would stay in the SPIR-V lavapipe turns into NIR at every pipeline's creation.
+#ifdef SHADOWLAB_EVERY_LIGHT
+#ifndef SHADOWLAB_BAKED_LIGHT
+#error SHADOWLAB_EVERY_LIGHT goes with SHADOWLAB_BAKED_LIGHT (no flat light inputs)
+#endif
 #define SHADOWLAB_LIGHT_SLOT(i, s)                                                 \
     layout(constant_id = 116 + 56 * i + 4 * s) const float kB##i##_##s##x = 0.0;     \
     layout(constant_id = 116 + 56 * i + 4 * s + 1) const float kB##i##_##s##y = 0.0; \

@@ -10,8 +10,10 @@
 #include "lit_frag.spv.h"
 #include "lit_frag_alpha.spv.h"
 #include "lit_frag_alpha_baked.spv.h"
+#include "lit_frag_alpha_every.spv.h"
 #include "lit_frag_alpha_taps.spv.h"
 #include "lit_frag_alpha_taps_baked.spv.h"
+#include "lit_frag_alpha_taps_every.spv.h"
 #include "lit_frag_alpha_taps_sun.spv.h"
 #include "lit_frag_alpha_taps_sun_map.spv.h"
 #include "lit_frag_alpha_taps_sun_map_baked.spv.h"
@@ -19,27 +21,33 @@
 #include "lit_frag_beauty.spv.h"
 #include "lit_frag_beauty_alpha.spv.h"
 #include "lit_frag_beauty_alpha_baked.spv.h"
+#include "lit_frag_beauty_alpha_every.spv.h"
 #include "lit_frag_beauty_alpha_taps.spv.h"
 #include "lit_frag_beauty_alpha_taps_baked.spv.h"
+#include "lit_frag_beauty_alpha_taps_every.spv.h"
 #include "lit_frag_beauty_alpha_taps_sun.spv.h"
 #include "lit_frag_beauty_alpha_taps_sun_map.spv.h"
 #include "lit_frag_beauty_alpha_taps_sun_map_baked.spv.h"
 #include "lit_frag_beauty_baked.spv.h"
+#include "lit_frag_beauty_every.spv.h"
 #include "lit_frag_beauty_taps.spv.h"
 #include "lit_frag_beauty_taps_baked.spv.h"
+#include "lit_frag_beauty_taps_every.spv.h"
 #include "lit_frag_beauty_taps_sun.spv.h"
 #include "lit_frag_beauty_taps_sun_map.spv.h"
 #include "lit_frag_beauty_taps_sun_map_baked.spv.h"
+#include "lit_frag_every.spv.h"
 #include "lit_frag_lights.spv.h"
 #include "lit_frag_lights_alpha.spv.h"
-#include "lit_frag_lights_alpha_baked.spv.h"
+#include "lit_frag_lights_alpha_every.spv.h"
 #include "lit_frag_lights_alpha_taps.spv.h"
-#include "lit_frag_lights_alpha_taps_baked.spv.h"
-#include "lit_frag_lights_baked.spv.h"
+#include "lit_frag_lights_alpha_taps_every.spv.h"
+#include "lit_frag_lights_every.spv.h"
 #include "lit_frag_lights_taps.spv.h"
-#include "lit_frag_lights_taps_baked.spv.h"
+#include "lit_frag_lights_taps_every.spv.h"
 #include "lit_frag_taps.spv.h"
 #include "lit_frag_taps_baked.spv.h"
+#include "lit_frag_taps_every.spv.h"
 #include "lit_frag_taps_sun.spv.h"
 #include "lit_frag_taps_sun_map.spv.h"
 #include "lit_frag_taps_sun_map_baked.spv.h"
@@ -116,10 +124,18 @@ std::span<const std::uint32_t> litFragBakedSpirv() { return kLitFragBakedSpv; }
 std::span<const std::uint32_t> litFragAlphaBakedSpirv() { return kLitFragAlphaBakedSpv; }
 std::span<const std::uint32_t> litFragBeautyBakedSpirv() { return kLitFragBeautyBakedSpv; }
 std::span<const std::uint32_t> litFragBeautyAlphaBakedSpirv() { return kLitFragBeautyAlphaBakedSpv; }
-std::span<const std::uint32_t> litFragLightsBakedSpirv() { return kLitFragLightsBakedSpv; }
-std::span<const std::uint32_t> litFragLightsAlphaBakedSpirv() { return kLitFragLightsAlphaBakedSpv; }
-std::span<const std::uint32_t> litFragLightsTapsBakedSpirv() { return kLitFragLightsTapsBakedSpv; }
-std::span<const std::uint32_t> litFragLightsAlphaTapsBakedSpirv() { return kLitFragLightsAlphaTapsBakedSpv; }
+std::span<const std::uint32_t> litFragEverySpirv() { return kLitFragEverySpv; }
+std::span<const std::uint32_t> litFragTapsEverySpirv() { return kLitFragTapsEverySpv; }
+std::span<const std::uint32_t> litFragAlphaEverySpirv() { return kLitFragAlphaEverySpv; }
+std::span<const std::uint32_t> litFragAlphaTapsEverySpirv() { return kLitFragAlphaTapsEverySpv; }
+std::span<const std::uint32_t> litFragBeautyEverySpirv() { return kLitFragBeautyEverySpv; }
+std::span<const std::uint32_t> litFragBeautyTapsEverySpirv() { return kLitFragBeautyTapsEverySpv; }
+std::span<const std::uint32_t> litFragBeautyAlphaEverySpirv() { return kLitFragBeautyAlphaEverySpv; }
+std::span<const std::uint32_t> litFragBeautyAlphaTapsEverySpirv() { return kLitFragBeautyAlphaTapsEverySpv; }
+std::span<const std::uint32_t> litFragLightsEverySpirv() { return kLitFragLightsEverySpv; }
+std::span<const std::uint32_t> litFragLightsTapsEverySpirv() { return kLitFragLightsTapsEverySpv; }
+std::span<const std::uint32_t> litFragLightsAlphaEverySpirv() { return kLitFragLightsAlphaEverySpv; }
+std::span<const std::uint32_t> litFragLightsAlphaTapsEverySpirv() { return kLitFragLightsAlphaTapsEverySpv; }
 std::span<const std::uint32_t> litVertBakedSpirv() { return kLitVertBakedSpv; }
 std::span<const std::uint32_t> litVertAlphaBakedSpirv() { return kLitVertAlphaBakedSpv; }
 std::span<const std::uint32_t> litVertNoIdBakedSpirv() { return kLitVertNoIdBakedSpv; }

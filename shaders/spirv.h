@@ -71,11 +71,20 @@ std::span<const std::uint32_t> litFragBakedSpirv();
 std::span<const std::uint32_t> litFragAlphaBakedSpirv();
 std::span<const std::uint32_t> litFragBeautyBakedSpirv();
 std::span<const std::uint32_t> litFragBeautyAlphaBakedSpirv();
-// The per-light visibility modules (SHADOWLAB_LIGHT_OUTPUTS) for every light's constants baked in.
-std::span<const std::uint32_t> litFragLightsBakedSpirv();
-std::span<const std::uint32_t> litFragLightsAlphaBakedSpirv();
-std::span<const std::uint32_t> litFragLightsTapsBakedSpirv();
-std::span<const std::uint32_t> litFragLightsAlphaTapsBakedSpirv();
+// The general modules with every light's constants baked in (SHADOWLAB_EVERY_LIGHT), the AOVs, the
+// beauty alone or the AOVs and per-light visibility (SHADOWLAB_LIGHT_OUTPUTS); go with lit.vert's *_baked.
+std::span<const std::uint32_t> litFragEverySpirv();
+std::span<const std::uint32_t> litFragTapsEverySpirv();
+std::span<const std::uint32_t> litFragAlphaEverySpirv();
+std::span<const std::uint32_t> litFragAlphaTapsEverySpirv();
+std::span<const std::uint32_t> litFragBeautyEverySpirv();
+std::span<const std::uint32_t> litFragBeautyTapsEverySpirv();
+std::span<const std::uint32_t> litFragBeautyAlphaEverySpirv();
+std::span<const std::uint32_t> litFragBeautyAlphaTapsEverySpirv();
+std::span<const std::uint32_t> litFragLightsEverySpirv();
+std::span<const std::uint32_t> litFragLightsTapsEverySpirv();
+std::span<const std::uint32_t> litFragLightsAlphaEverySpirv();
+std::span<const std::uint32_t> litFragLightsAlphaTapsEverySpirv();
 std::span<const std::uint32_t> litVertBakedSpirv();
 std::span<const std::uint32_t> litVertAlphaBakedSpirv();
 std::span<const std::uint32_t> litVertNoIdBakedSpirv();

@@ -365,7 +365,8 @@ TEST(RasterLitPass, OneSpotOrASunOutsideTheSunModulesWithBakedConstantsHasNoFlat
 TEST(RasterLitPass, EveryLightIsBakedInWhereNoOneLightComesFromTheVertexShader) {
     // Several lights, one point light, or the receiver-plane bias: every light's constants baked in
     // (bakesEveryLight), in the general modules without the flat light slots (6..13); with per-light
-    // visibility targets, the modules that write them (outputs 6 and 7).
+    // visibility targets, the modules that write them (outputs 6 and 7); for the beauty alone, the
+    // modules that write only it (output 0).
     constexpr std::uint32_t kInput = 1, kOutput = 3;
     constexpr std::uint32_t dir = 1u << SHADOWLAB_LIGHT_DIRECTIONAL, spot = 1u << SHADOWLAB_LIGHT_SPOT,
                             point = 1u << SHADOWLAB_LIGHT_POINT;
@@ -379,22 +380,26 @@ TEST(RasterLitPass, EveryLightIsBakedInWhereNoOneLightComesFromTheVertexShader) 
     EXPECT_TRUE(bakesEveryLight(LitVariant{.lightCount = 3, .lightKinds = dir | spot | point, .cascades = 4}));
     for (const scene::ShadowFilter filter : {scene::ShadowFilter::Pcf2x2, scene::ShadowFilter::Pcss})
         for (const bool alpha : {false, true})
-            for (const std::uint32_t targets : {0u, kLightTargets}) {
-                const std::string what = "filter " + std::to_string(int(filter)) + " alpha " + std::to_string(alpha) +
-                                         " light targets " + std::to_string(targets);
-                const LitVariant v{.filter = filter,
-                                   .lightTargets = targets,
-                                   .lightCount = 3,
-                                   .lightKinds = dir | spot | point,
-                                   .specializedLightConstants = true};
-                const LitStages baked = litStages(v, alpha);
-                for (const std::uint32_t slot : {6u, 12u}) {
-                    EXPECT_FALSE(interfaceLocations(baked.vertex, kOutput).contains(slot)) << what;
-                    EXPECT_FALSE(interfaceLocations(baked.fragment, kInput).contains(slot)) << what;
+            for (const std::uint32_t targets : {0u, kLightTargets})
+                for (const bool aov : {true, false}) {
+                    const std::string what = "filter " + std::to_string(int(filter)) + " alpha " +
+                                             std::to_string(alpha) + " light targets " + std::to_string(targets) +
+                                             " aov " + std::to_string(aov);
+                    const LitVariant v{.filter = filter,
+                                       .aovTarget = aov,
+                                       .lightTargets = targets,
+                                       .lightCount = 3,
+                                       .lightKinds = dir | spot | point,
+                                       .specializedLightConstants = true};
+                    const LitStages baked = litStages(v, alpha);
+                    for (const std::uint32_t slot : {6u, 12u}) {
+                        EXPECT_FALSE(interfaceLocations(baked.vertex, kOutput).contains(slot)) << what;
+                        EXPECT_FALSE(interfaceLocations(baked.fragment, kInput).contains(slot)) << what;
+                    }
+                    EXPECT_EQ(interfaceLocations(baked.fragment, kOutput).contains(1u), aov) << what;
+                    EXPECT_EQ(interfaceLocations(baked.fragment, kOutput).contains(6u), aov && targets > 0) << what;
+                    EXPECT_EQ(interfaceLocations(baked.fragment, kOutput).contains(7u), aov && targets > 0) << what;
                 }
-                EXPECT_EQ(interfaceLocations(baked.fragment, kOutput).contains(6u), targets > 0) << what;
-                EXPECT_EQ(interfaceLocations(baked.fragment, kOutput).contains(7u), targets > 0) << what;
-            }
 }
 
 }  // namespace

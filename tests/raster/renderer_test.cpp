@@ -1485,6 +1485,10 @@ TEST(RasterRenderer, EveryLightsConstantsBakedInGiveTheUniformBuffersFrameBitFor
             EXPECT_GT(shadowed, 200u) << what;
         }
         test::expectSamePixels(a, b, what);
+        // The beauty alone (float and the display target: the *_every beauty builds).
+        for (const scene::ChannelMask beauty :
+             {scene::kChannelBeauty, scene::kChannelBeauty | scene::kBeautyForDisplay})
+            EXPECT_TRUE(buffer.render(beauty).beauty == baked.render(beauty).beauty) << what << ", beauty " << beauty;
         EXPECT_EQ(buffer.validationMessages(), 0);
         EXPECT_EQ(baked.validationMessages(), 0);
     };
