@@ -20,6 +20,7 @@
 #include "raster/tolerances.h"
 #include "raster/vulkan_error.h"
 #include "scene/camera.h"
+#include "shaders/spirv.h"
 #include "tests/kit/render_checked.h"
 #include "tests/kit/test_scenes.h"
 
@@ -257,6 +258,22 @@ std::set<std::uint32_t> interfaceLocations(std::span<const std::uint32_t> spirv,
     return locations;
 }
 
+// The SpecId decorations of a module's specialization constants (OpDecorate, decoration SpecId = 1).
+std::set<std::uint32_t> specializationIds(std::span<const std::uint32_t> spirv) {
+    constexpr std::uint32_t kOpDecorate = 71, kSpecId = 1;
+    std::set<std::uint32_t> ids;
+    for (std::size_t at = 5; at < spirv.size();) {
+        const std::uint32_t count = spirv[at] >> 16, opcode = spirv[at] & 0xffffu;
+        if (count == 0 || at + count > spirv.size()) {
+            ADD_FAILURE() << "malformed SPIR-V at word " << at;
+            return {};
+        }
+        if (opcode == kOpDecorate && count >= 4 && spirv[at + 2] == kSpecId) ids.insert(spirv[at + 3]);
+        at += count;
+    }
+    return ids;
+}
+
 TEST(RasterLitPass, EachVertexShaderWritesExactlyWhatItsFragmentShaderReads) {
     // lit.frag's inputs must all be lit.vert's outputs (Vulkan's interface rule), and an output no
     // input takes still costs llvmpipe a store per vertex, as a declared input costs it a setup per
@@ -396,10 +413,32 @@ TEST(RasterLitPass, EveryLightIsBakedInWhereNoOneLightComesFromTheVertexShader) 
                         EXPECT_FALSE(interfaceLocations(baked.vertex, kOutput).contains(slot)) << what;
                         EXPECT_FALSE(interfaceLocations(baked.fragment, kInput).contains(slot)) << what;
                     }
+                    // The *_every build itself: it declares every light's constants (the last is 563).
+                    const bool taps = filter == scene::ShadowFilter::Pcf2x2;
+                    const auto expected =
+                        !aov ? (taps ? (alpha ? shaders::litFragBeautyAlphaTapsEverySpirv()
+                                              : shaders::litFragBeautyTapsEverySpirv())
+                                     : (alpha ? shaders::litFragBeautyAlphaEverySpirv()
+                                              : shaders::litFragBeautyEverySpirv()))
+                        : targets > 0
+                            ? (taps ? (alpha ? shaders::litFragLightsAlphaTapsEverySpirv()
+                                             : shaders::litFragLightsTapsEverySpirv())
+                                    : (alpha ? shaders::litFragLightsAlphaEverySpirv()
+                                             : shaders::litFragLightsEverySpirv()))
+                            : (taps ? (alpha ? shaders::litFragAlphaTapsEverySpirv() : shaders::litFragTapsEverySpirv())
+                                    : (alpha ? shaders::litFragAlphaEverySpirv() : shaders::litFragEverySpirv()));
+                    EXPECT_EQ(baked.fragment.data(), expected.data()) << what;
+                    EXPECT_TRUE(specializationIds(baked.fragment).contains(563u)) << what;
                     EXPECT_EQ(interfaceLocations(baked.fragment, kOutput).contains(1u), aov) << what;
                     EXPECT_EQ(interfaceLocations(baked.fragment, kOutput).contains(6u), aov && targets > 0) << what;
                     EXPECT_EQ(interfaceLocations(baked.fragment, kOutput).contains(7u), aov && targets > 0) << what;
                 }
+    // The one-light modules do not carry them (their pipelines' creation would pay for the code).
+    for (const bool alpha : {false, true}) {
+        const LitVariant one{.lightKinds = spot, .specializedLightConstants = true};
+        EXPECT_FALSE(specializationIds(litStages(one, alpha).fragment).contains(116u)) << alpha;
+        EXPECT_TRUE(specializationIds(litStages(one, alpha).fragment).contains(18u)) << alpha;
+    }
 }
 
 }  // namespace

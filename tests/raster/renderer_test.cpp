@@ -1500,6 +1500,24 @@ TEST(RasterRenderer, EveryLightsConstantsBakedInGiveTheUniformBuffersFrameBitFor
         settings.normalOffset = 0.5;
         expectTheSame(threeLights(c.offset), settings, std::string("three lights, ") + c.name);
     }
+    // Eight lights (each unrolled iteration reads its own constants): five more suns around the
+    // sphere, at other elevations and azimuths, with a normal offset and a PCF size of their own
+    // settings' (the same for all lights) but their own map texels and biases.
+    scene::Scene eight = threeLights(0.0);
+    for (int k = 0; k < 5; ++k) {
+        scene::Light sun = eight.lights[0];
+        const double azimuth = glm::radians(40.0 + 65.0 * k), elevation = glm::radians(38.0 + 5.0 * k);
+        sun.direction = -Vec3(std::cos(elevation) * std::cos(azimuth), std::sin(elevation),
+                              std::cos(elevation) * std::sin(azimuth));
+        sun.intensity = 0.2 + 0.1 * k;
+        eight.lights.push_back(sun);
+    }
+    ASSERT_EQ(eight.lights.size(), 8u);  // SHADOWLAB_MAX_LIGHTS
+    expectTheSame(eight, validatedSettings(512, 0.004, 0.5, ShadowFilter::Pcf), "eight lights");
+    // A semi-transparent sphere: the transmittance maps' taps in every light's test.
+    scene::Scene glass = threeLights(0.0);
+    glass.objects[0].material = test::addMaterial(glass, "glass", 0.5);
+    expectTheSame(glass, validatedSettings(512, 0.004, 0.5, ShadowFilter::Pcf2x2), "three lights, a glass sphere");
     scene::Scene point = threeLights(0.0);
     point.lights.erase(point.lights.begin(), point.lights.begin() + 2);
     // Each face fitted to its receivers: six depth ranges of their own, which a face packed in
@@ -1583,9 +1601,9 @@ TEST(RasterRenderer, AnUpdateThatMovesTheCascadesSwitchesToTheUniformBufferWithT
 }
 
 TEST(RasterRenderer, AnUpdateThatMovesEveryBakedLightSwitchesToTheUniformBufferWithTheSameFrames) {
-    // Every light baked in (two lights): the lights' positions and matrices are camera-relative,
-    // so a moved camera changes them, and the Renderer reads the uniform buffer from then on, each
-    // frame the same bit for bit as a Renderer that always did.
+    // Every light baked in (two lights): a moved light changes its baked values, as a moved camera
+    // changes the view axis (baked too) and the maps fitted to the view; the Renderer reads the
+    // uniform buffer from then on, each frame the same bit for bit as a Renderer that always did.
     scene::Scene s = sunAt50Degrees(0.0);
     scene::Light spot;
     spot.type = scene::LightType::Spot;
@@ -1598,11 +1616,14 @@ TEST(RasterRenderer, AnUpdateThatMovesEveryBakedLightSwitchesToTheUniformBufferW
     Renderer baked(s, planFor(s, settings), settings);
     Renderer buffer(s, planFor(s, settings), settings,
                     RendererOptions{.lightConstants = LightConstants::kUniformBuffer});
-    scene::Scene moved = s;
+    scene::Scene spotMoved = s;
+    spotMoved.lights[1].position += scene::Vec3(-0.3, 0.2, 0.1);
+    scene::Scene moved = spotMoved;
     moved.camera.position += scene::Vec3(0.6, 0.3, -0.5);
     expectSameFramesThroughUpdates(baked, buffer,
                                    {{"before any update", nullptr, "specialization"},
                                     {"after an update to the same scene", &s, "specialization"},
+                                    {"after the second light moved", &spotMoved, "uniform-buffer"},
                                     {"after the camera moved", &moved, "uniform-buffer"}});
 }
 
