@@ -99,11 +99,13 @@ TEST(SchemaValidator, RefusesKeywordsItDoesNotImplement) {
 
 // --- the scene schema ----------------------------------------------------------------------
 
+// The scenes under scenes/ and the benchmarks' own under bench/scenes/.
 std::vector<fs::path> shippedScenes() {
     std::vector<fs::path> files;
-    for (const auto& e : fs::recursive_directory_iterator(fs::path(SHADOWLAB_SOURCE_DIR) / "scenes"))
-        if (e.path().extension() == ".json" && !e.path().stem().string().ends_with(".schema"))
-            files.push_back(e.path());
+    for (const char* root : {"scenes", "bench/scenes"})
+        for (const auto& e : fs::recursive_directory_iterator(fs::path(SHADOWLAB_SOURCE_DIR) / root))
+            if (e.path().extension() == ".json" && !e.path().stem().string().ends_with(".schema"))
+                files.push_back(e.path());
     std::sort(files.begin(), files.end());
     return files;
 }
