@@ -232,27 +232,38 @@ TEST(RasterLitPass, TheLightsMapCoordinatesComeFromTheVertexShaderOnlyForOneDire
     EXPECT_FALSE(usesVertexLightCoordinates({.lightKinds = dir | spot}));
 }
 
-// The locations of a SPIR-V module's Input (or Output) variables that carry a Location decoration
-// (built-ins have none), read from the instruction stream as the SPIR-V specification lays it out:
-// a five-word header, then instructions whose first word holds the word count (high 16 bits) and
-// the opcode (low 16): OpDecorate (71) target, decoration (Location = 30), value; OpVariable (59)
-// result type, result id, storage class (Input = 1, Output = 3).
-std::set<std::uint32_t> interfaceLocations(std::span<const std::uint32_t> spirv, std::uint32_t storageClass) {
-    constexpr std::uint32_t kOpDecorate = 71, kOpVariable = 59, kLocation = 30;
-    std::map<std::uint32_t, std::uint32_t> locationOf;
-    std::vector<std::uint32_t> variables;
+// Calls visit(opcode, operands) for each instruction of a SPIR-V module, read as the SPIR-V
+// specification lays it out: a five-word header, then instructions whose first word holds the word
+// count (high 16 bits) and the opcode (low 16). False (and a test failure) where it is malformed.
+template <class Visit>
+bool forEachInstruction(std::span<const std::uint32_t> spirv, Visit visit) {
     for (std::size_t at = 5; at < spirv.size();) {
         const std::uint32_t count = spirv[at] >> 16, opcode = spirv[at] & 0xffffu;
         if (count == 0 || at + count > spirv.size()) {
             ADD_FAILURE() << "malformed SPIR-V at word " << at;
-            return {};
+            return false;
         }
-        if (opcode == kOpDecorate && count >= 4 && spirv[at + 2] == kLocation)
-            locationOf[spirv[at + 1]] = spirv[at + 3];
-        if (opcode == kOpVariable && count >= 4 && spirv[at + 3] == storageClass) variables.push_back(spirv[at + 2]);
+        visit(opcode, spirv.subspan(at + 1, count - 1));
         at += count;
     }
+    return true;
+}
+
+constexpr std::uint32_t kOpDecorate = 71, kOpVariable = 59;
+
+// The locations of a module's Input (or Output) variables that carry a Location decoration
+// (built-ins have none): OpDecorate target, decoration (Location = 30), value; OpVariable result
+// type, result id, storage class (Input = 1, Output = 3).
+std::set<std::uint32_t> interfaceLocations(std::span<const std::uint32_t> spirv, std::uint32_t storageClass) {
+    constexpr std::uint32_t kLocation = 30;
+    std::map<std::uint32_t, std::uint32_t> locationOf;
+    std::vector<std::uint32_t> variables;
+    const bool read = forEachInstruction(spirv, [&](std::uint32_t opcode, std::span<const std::uint32_t> w) {
+        if (opcode == kOpDecorate && w.size() >= 3 && w[1] == kLocation) locationOf[w[0]] = w[2];
+        if (opcode == kOpVariable && w.size() >= 3 && w[2] == storageClass) variables.push_back(w[1]);
+    });
     std::set<std::uint32_t> locations;
+    if (!read) return locations;
     for (std::uint32_t id : variables)
         if (const auto found = locationOf.find(id); found != locationOf.end()) locations.insert(found->second);
     return locations;
@@ -260,17 +271,11 @@ std::set<std::uint32_t> interfaceLocations(std::span<const std::uint32_t> spirv,
 
 // The SpecId decorations of a module's specialization constants (OpDecorate, decoration SpecId = 1).
 std::set<std::uint32_t> specializationIds(std::span<const std::uint32_t> spirv) {
-    constexpr std::uint32_t kOpDecorate = 71, kSpecId = 1;
+    constexpr std::uint32_t kSpecId = 1;
     std::set<std::uint32_t> ids;
-    for (std::size_t at = 5; at < spirv.size();) {
-        const std::uint32_t count = spirv[at] >> 16, opcode = spirv[at] & 0xffffu;
-        if (count == 0 || at + count > spirv.size()) {
-            ADD_FAILURE() << "malformed SPIR-V at word " << at;
-            return {};
-        }
-        if (opcode == kOpDecorate && count >= 4 && spirv[at + 2] == kSpecId) ids.insert(spirv[at + 3]);
-        at += count;
-    }
+    forEachInstruction(spirv, [&](std::uint32_t opcode, std::span<const std::uint32_t> w) {
+        if (opcode == kOpDecorate && w.size() >= 3 && w[1] == kSpecId) ids.insert(w[2]);
+    });
     return ids;
 }
 
