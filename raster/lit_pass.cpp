@@ -52,16 +52,16 @@ std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUn
     std::copy(std::begin(frameSlots), std::end(frameSlots), c.begin() + 24);
     c[32] = u.cascadeStart;
     c[33] = u.cascadeBlendBand;
-    for (std::size_t k = 0; k < SHADOWLAB_MAX_CASCADES; ++k) {
-        const shaders::CascadeData& d = u.cascades[k];
-        float* const at = c.data() + 34 + 16 * k;
+    // A cascade's matrix's first three rows (an orthographic map's last is 0 0 0 1) and the rest.
+    auto packCascade = [](const shaders::CascadeData& d, float* at) {
         for (int row = 0; row < 3; ++row)
             for (int column = 0; column < 4; ++column) at[4 * row + column] = d.toShadow[column][row];
         at[12] = d.sliceFar;
         at[13] = d.texelWorldSize;
         at[14] = d.depthPerWorld;
         at[15] = d.depthBiasWorld;
-    }
+    };
+    for (std::size_t k = 0; k < SHADOWLAB_MAX_CASCADES; ++k) packCascade(u.cascades[k], c.data() + 34 + 16 * k);
     const int bakedLights = everyLight ? std::clamp(u.lightCount, 0, SHADOWLAB_MAX_LIGHTS) : 0;
     for (std::size_t i = 0; i < std::size_t(bakedLights); ++i) {
         const shaders::LightData& d = u.lights[i];
@@ -88,6 +88,10 @@ std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUn
             at[44 + 2 * face] = d.pointFaces[face].near;
             at[45 + 2 * face] = d.pointFaces[face].far;
         }
+        float* const cascades = c.data() + 34 + 16 * SHADOWLAB_MAX_CASCADES + kPackedPerLight * SHADOWLAB_MAX_LIGHTS +
+                                16 * SHADOWLAB_MAX_CASCADES * i;
+        for (std::size_t k = 0; k < SHADOWLAB_MAX_CASCADES; ++k)
+            packCascade(u.cascades[i * SHADOWLAB_MAX_CASCADES + k], cascades + 16 * k);
     }
     return c;
 }
@@ -254,7 +258,7 @@ LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant, VkD
     // constants as flat vertex outputs (bool), 11..16: the filterable maps' parameters (float bits:
     // minimum variance, bleeding reduction, EVSM exponents, ESM exponent, MSM moment bias). Both
     // stages get them all.
-    // 17: the lights' constants baked in (bool), 18..115: light 0's values, 116..563: every light's
+    // 17: the lights' constants baked in (bool), 18..115: light 0's values, 116..563: every light's, 564..1075: every light's cascades
     // (packLightConstants).
     constexpr std::uint32_t kConstants = 18 + kPackedLightConstants;
     const scene::MomentSettings& m = variant.moments;

@@ -45,9 +45,12 @@ inline constexpr VkFormat kLitDisplayFormat = VK_FORMAT_R8G8B8A8_SRGB;
 // bias, texel world size, depth per world unit; slope cap, normal offset, PCF size, kind; spot
 // direction, cone cosine; map near, map far, light size, cascade count; toShadow's four columns;
 // the point faces' tangent, the filter code, 0, 0; the six point faces' near and far.
+// Then each light's SHADOWLAB_MAX_CASCADES cascades, 16 values each as light 0's above (constants
+// 564 + ..; zeros where it has none).
 inline constexpr std::size_t kPackedPerLight = 56;
-inline constexpr std::size_t kPackedLightConstants =
-    32 + 2 + 16 * SHADOWLAB_MAX_CASCADES + kPackedPerLight * SHADOWLAB_MAX_LIGHTS;
+inline constexpr std::size_t kPackedLightConstants = 32 + 2 + 16 * SHADOWLAB_MAX_CASCADES +
+                                                     kPackedPerLight * SHADOWLAB_MAX_LIGHTS +
+                                                     16 * SHADOWLAB_MAX_CASCADES * SHADOWLAB_MAX_LIGHTS;
 // everyLight false leaves the per-light values zero: where only light 0's are baked, a light's
 // matrix may change (a moving camera) without changing what the pipelines baked.
 std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUniforms& uniforms, bool everyLight);

@@ -217,9 +217,60 @@ float mapSize() { return kFrameFromSlots ? frameSlot(1).x : u.mapSize; }
 // Cascade c of light `lightIndex`: the uniform buffer's, or (kSpecializedCascades: light 0 is the
 // only light) baked in. c varies per pixel, so the baked values are chosen by selects, where the
 // buffer's are loaded lane by lane.
-CascadeData cascadeAt(int lightIndex, int c) {
-    if (!kSpecializedCascades) return u.cascades[lightIndex * SHADOWLAB_MAX_CASCADES + c];
+CascadeData cascadeFromRows(vec4 r0, vec4 r1, vec4 r2, vec4 rest) {
     CascadeData d;
+    // (mat4 takes columns: column k is (r0[k], r1[k], r2[k], w row).)
+    d.toShadow = mat4(vec4(r0.x, r1.x, r2.x, 0.0), vec4(r0.y, r1.y, r2.y, 0.0), vec4(r0.z, r1.z, r2.z, 0.0),
+                      vec4(r0.w, r1.w, r2.w, 1.0));
+    d.sliceFar = rest.x;
+    d.texelWorldSize = rest.y;
+    d.depthPerWorld = rest.z;
+    d.depthBiasWorld = rest.w;
+    return d;
+}
+#ifdef SHADOWLAB_EVERY_LIGHT
+#define SHADOWLAB_CASCADE_ROW(i, c, s) vec4(kD##i##_##c##_##s##x, kD##i##_##c##_##s##y, kD##i##_##c##_##s##z, kD##i##_##c##_##s##w)
+#define SHADOWLAB_CASCADE_ROWS(i, c)                                                                \
+    rows = vec4[4](SHADOWLAB_CASCADE_ROW(i, c, 0), SHADOWLAB_CASCADE_ROW(i, c, 1), SHADOWLAB_CASCADE_ROW(i, c, 2), \
+                   SHADOWLAB_CASCADE_ROW(i, c, 3))
+#define SHADOWLAB_PICK_CASCADE(i)     \
+    if (c == 0)                       \
+        SHADOWLAB_CASCADE_ROWS(i, 0); \
+    else if (c == 1)                  \
+        SHADOWLAB_CASCADE_ROWS(i, 1); \
+    else if (c == 2)                  \
+        SHADOWLAB_CASCADE_ROWS(i, 2); \
+    else                              \
+        SHADOWLAB_CASCADE_ROWS(i, 3);
+// Light i's cascade c, baked in (kEveryLightBaked): i is a constant in each unrolled iteration, c
+// varies per pixel and is picked by selects.
+CascadeData bakedCascadeAt(int i, int c) {
+    vec4 rows[4];
+    if (i == 0) {
+        SHADOWLAB_PICK_CASCADE(0)
+    } else if (i == 1) {
+        SHADOWLAB_PICK_CASCADE(1)
+    } else if (i == 2) {
+        SHADOWLAB_PICK_CASCADE(2)
+    } else if (i == 3) {
+        SHADOWLAB_PICK_CASCADE(3)
+    } else if (i == 4) {
+        SHADOWLAB_PICK_CASCADE(4)
+    } else if (i == 5) {
+        SHADOWLAB_PICK_CASCADE(5)
+    } else if (i == 6) {
+        SHADOWLAB_PICK_CASCADE(6)
+    } else {
+        SHADOWLAB_PICK_CASCADE(7)
+    }
+    return cascadeFromRows(rows[0], rows[1], rows[2], rows[3]);
+}
+#endif
+CascadeData cascadeAt(int lightIndex, int c) {
+#ifdef SHADOWLAB_EVERY_LIGHT
+    if (kEveryLightBaked) return bakedCascadeAt(lightIndex, c);
+#endif
+    if (!kSpecializedCascades) return u.cascades[lightIndex * SHADOWLAB_MAX_CASCADES + c];
     vec4 r0, r1, r2, rest;
     if (c == 0) {
         r0 = vec4(kC0_00, kC0_01, kC0_02, kC0_03);
@@ -242,17 +293,11 @@ CascadeData cascadeAt(int lightIndex, int c) {
         r2 = vec4(kC3_08, kC3_09, kC3_10, kC3_11);
         rest = vec4(kC3_12, kC3_13, kC3_14, kC3_15);
     }
-    // (mat4 takes columns: column k is (r0[k], r1[k], r2[k], w row).)
-    d.toShadow = mat4(vec4(r0.x, r1.x, r2.x, 0.0), vec4(r0.y, r1.y, r2.y, 0.0), vec4(r0.z, r1.z, r2.z, 0.0),
-                      vec4(r0.w, r1.w, r2.w, 1.0));
-    d.sliceFar = rest.x;
-    d.texelWorldSize = rest.y;
-    d.depthPerWorld = rest.z;
-    d.depthBiasWorld = rest.w;
-    return d;
+    return cascadeFromRows(r0, r1, r2, rest);
 }
-float cascadeStart() { return kSpecializedCascades ? kCascadeStart : u.cascadeStart; }
-float cascadeBlendBand() { return kSpecializedCascades ? kCascadeBlendBand : u.cascadeBlendBand; }
+const bool kCascadesBaked = !(!kSpecializedCascades && !kEveryLightBaked);
+float cascadeStart() { return kCascadesBaked ? kCascadeStart : u.cascadeStart; }
+float cascadeBlendBand() { return kCascadesBaked ? kCascadeBlendBand : u.cascadeBlendBand; }
 
 // Whether the light is of this kind: constant false for a kind the scene lacks, which removes its
 // code, and constant true where the scene has lights of that kind only, so the kind is not read

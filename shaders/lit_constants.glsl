@@ -206,7 +206,7 @@ layout(constant_id = 115) const float kC3_15 = 0.0;
 // LightData members lit.frag uses of light i from constants 116 + 56 i ..: fourteen slots of four,
 // packed as raster::packLightConstants packs them, instead of loading them from the uniform buffer
 // lane by lane for every eight pixels; each light's kind becomes a constant too, so the code of the
-// kinds it is not is left out of its unrolled iteration. The cascades stay in the buffer. Only in
+// kinds it is not is left out of its unrolled iteration; and each light's cascades. Only in
 // the *_every modules (SHADOWLAB_EVERY_LIGHT), which raster/lit_pass.cpp picks for that case alone:
 // glslang cannot fold the switch between the one light's constants and these, and in the other
 // modules the code would stay in the SPIR-V lavapipe turns into NIR at every pipeline's creation.
@@ -232,8 +232,29 @@ SHADOWLAB_LIGHT_SLOTS(4)
 SHADOWLAB_LIGHT_SLOTS(5)
 SHADOWLAB_LIGHT_SLOTS(6)
 SHADOWLAB_LIGHT_SLOTS(7)
-#if SHADOWLAB_MAX_LIGHTS != 8
-#error one SHADOWLAB_LIGHT_SLOTS line per light
+// Each light's SHADOWLAB_MAX_CASCADES cascades (constants 564 + 64 i + 16 c ..): as kC0_00.. above,
+// toShadow's first three rows, then sliceFar, texelWorldSize, depthPerWorld, depthBiasWorld.
+#define SHADOWLAB_CASCADE_SLOT(i, c, s)                                                                \
+    layout(constant_id = 564 + 64 * i + 16 * c + 4 * s) const float kD##i##_##c##_##s##x = 0.0;     \
+    layout(constant_id = 564 + 64 * i + 16 * c + 4 * s + 1) const float kD##i##_##c##_##s##y = 0.0; \
+    layout(constant_id = 564 + 64 * i + 16 * c + 4 * s + 2) const float kD##i##_##c##_##s##z = 0.0; \
+    layout(constant_id = 564 + 64 * i + 16 * c + 4 * s + 3) const float kD##i##_##c##_##s##w = 0.0;
+#define SHADOWLAB_CASCADE_SLOTS(i, c)                                                              \
+    SHADOWLAB_CASCADE_SLOT(i, c, 0) SHADOWLAB_CASCADE_SLOT(i, c, 1) SHADOWLAB_CASCADE_SLOT(i, c, 2) \
+    SHADOWLAB_CASCADE_SLOT(i, c, 3)
+#define SHADOWLAB_LIGHT_CASCADES(i)                                                                \
+    SHADOWLAB_CASCADE_SLOTS(i, 0) SHADOWLAB_CASCADE_SLOTS(i, 1) SHADOWLAB_CASCADE_SLOTS(i, 2)      \
+    SHADOWLAB_CASCADE_SLOTS(i, 3)
+SHADOWLAB_LIGHT_CASCADES(0)
+SHADOWLAB_LIGHT_CASCADES(1)
+SHADOWLAB_LIGHT_CASCADES(2)
+SHADOWLAB_LIGHT_CASCADES(3)
+SHADOWLAB_LIGHT_CASCADES(4)
+SHADOWLAB_LIGHT_CASCADES(5)
+SHADOWLAB_LIGHT_CASCADES(6)
+SHADOWLAB_LIGHT_CASCADES(7)
+#if SHADOWLAB_MAX_LIGHTS != 8 || SHADOWLAB_MAX_CASCADES != 4
+#error one SHADOWLAB_LIGHT_SLOTS and SHADOWLAB_LIGHT_CASCADES line per light, four cascades each
 #endif
 const bool kEveryLightBaked = kSpecializedLightConstantsAsked && !kSpecializedLightConstants;
 #else

@@ -1537,6 +1537,14 @@ TEST(RasterRenderer, EveryLightsConstantsBakedInGiveTheUniformBuffersFrameBitFor
     cascaded.cascades = 3;
     cascaded.cascadeBlend = 0.2;
     expectTheSame(longPlane, cascaded, "a cascaded sun and a spot");
+    // Two cascaded suns: light 1's cascades (the same slices, its own maps) baked in beside light 0's.
+    scene::Scene twoSuns = test::makeLongPlane(320, 180);
+    scene::Light second = twoSuns.lights[0];
+    second.direction = Vec3(0.8, -1.2, -0.9);
+    second.intensity = 0.6;
+    twoSuns.lights.push_back(second);
+    cascaded.cascades = 4;
+    expectTheSame(twoSuns, cascaded, "two cascaded suns");
 }
 
 // One step of expectSameFramesThroughUpdates: both Renderers update() to `scene` (none for a null
