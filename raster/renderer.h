@@ -52,7 +52,8 @@ struct RenderDebug {
 // Where no single light's map coordinates come from the vertex shader (several lights, a point
 // light, the receiver-plane bias), kSpecialization bakes every light's constants in and
 // kVertexOutputs reads the uniform buffer; a moving light or camera switches to the buffer then.
-// The frames are the same bit for bit (tests render all three).
+// The frames are the same bit for bit (tests render all three); with every light baked in, within
+// a rounding NIR's folding of the constants brings (docs/raster.md, tests bound it).
 enum class LightConstants { kSpecialization, kVertexOutputs, kUniformBuffer };
 
 struct RendererOptions {
