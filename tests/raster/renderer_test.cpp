@@ -879,6 +879,18 @@ scene::Scene sunAt50Degrees(double offset) {
     return makeScene(p, Vec3(offset, 0.0, -offset));
 }
 
+// A spot at (2.5, 3, 1.5) + shift aimed past the sphere of sunAt50Degrees (moved by the same shift)
+// onto the plane: a second light whose shadow falls apart from the sun's. Intensity 200, cone 45°.
+scene::Light spotOverTheSphere(const Vec3& shift = Vec3(0.0)) {
+    scene::Light spot;
+    spot.type = scene::LightType::Spot;
+    spot.position = Vec3(2.5, 3.0, 1.5) + shift;
+    spot.direction = glm::normalize(Vec3(-2.5, -2.2, -1.5));
+    spot.coneAngleDegrees = 45.0;
+    spot.intensity = 200.0;
+    return spot;
+}
+
 TEST(RasterRender, InterpolatedLightCoordinatesMatchThePerFragmentProduct) {
     // With one directional light lit.frag takes the map coordinates interpolated from lit.vert
     // (toShadow·(p, 1) and toShadow₃ₓ₃·n); with a second light it multiplies the interpolated
@@ -1448,13 +1460,8 @@ TEST(RasterRenderer, EveryLightsConstantsBakedInGiveTheUniformBuffersFrameBitFor
         const Vec3 shift(offset, 0.0, -offset);
         scene::Scene s = sunAt50Degrees(offset);
         s.lights[0].intensity = 0.7;
-        scene::Light spot;
-        spot.type = scene::LightType::Spot;
-        spot.position = Vec3(2.5, 3.0, 1.5) + shift;
-        spot.direction = glm::normalize(Vec3(-2.5, -2.2, -1.5));
-        spot.coneAngleDegrees = 45.0;
+        scene::Light spot = spotOverTheSphere(shift);
         spot.radius = 0.1;
-        spot.intensity = 200.0;
         s.lights.push_back(spot);
         scene::Light point;
         point.type = scene::LightType::Point;
@@ -1619,13 +1626,7 @@ TEST(RasterRenderer, EveryLightBakedInDiffersFromTheBufferOnlyByRounding) {
     scene::Scene s = sunAt50Degrees(0.0);
     s.lights[0].color = Vec3(1.0);
     s.lights[0].intensity = 1.0;
-    scene::Light spot;
-    spot.type = scene::LightType::Spot;
-    spot.position = Vec3(2.5, 3.0, 1.5);
-    spot.direction = glm::normalize(Vec3(-2.5, -2.2, -1.5));
-    spot.coneAngleDegrees = 45.0;
-    spot.intensity = 200.0;
-    s.lights.push_back(spot);
+    s.lights.push_back(spotOverTheSphere());
     for (const ShadowFilter filter : {ShadowFilter::Pcf2x2, ShadowFilter::Evsm2}) {
         const scene::RasterSettings settings = validatedSettings(512, 0.004, 0.5, filter);
         Renderer buffer(s, planFor(s, settings), settings,
@@ -1662,13 +1663,7 @@ TEST(RasterRenderer, AnUpdateThatMovesEveryBakedLightSwitchesToTheUniformBufferW
     // changes the view axis (baked too) and the maps fitted to the view; the Renderer reads the
     // uniform buffer from then on, each frame the same bit for bit as a Renderer that always did.
     scene::Scene s = sunAt50Degrees(0.0);
-    scene::Light spot;
-    spot.type = scene::LightType::Spot;
-    spot.position = Vec3(2.5, 3.0, 1.5);
-    spot.direction = glm::normalize(Vec3(-2.5, -2.2, -1.5));
-    spot.coneAngleDegrees = 45.0;
-    spot.intensity = 200.0;
-    s.lights.push_back(spot);
+    s.lights.push_back(spotOverTheSphere());
     const scene::RasterSettings settings = validatedSettings(512, 0.004, 0.5, ShadowFilter::Pcf2x2);
     Renderer baked(s, planFor(s, settings), settings);
     Renderer buffer(s, planFor(s, settings), settings,
