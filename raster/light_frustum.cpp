@@ -909,7 +909,11 @@ double cullReachTexels(const scene::RasterSettings& settings, const scene::Light
     if (settings.filter == scene::ShadowFilter::Pcss && light.type != scene::LightType::Directional &&
         light.radius > 0.0)
         reach += (light.type == scene::LightType::Point ? kCubeWrapReachFactor : 1.0) * kPcssReachFraction * mapSize;
-    return reach;
+    return reach + momentBlurRadius(settings);
+}
+
+int momentBlurRadius(const scene::RasterSettings& settings) {
+    return scene::isFilterable(settings.filter) ? (settings.moments.blurWidth - 1) / 2 : 0;
 }
 
 double lookupOffsetTexels(const scene::RasterSettings& settings) {

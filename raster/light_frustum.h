@@ -233,8 +233,12 @@ inline constexpr double kPcssReachFraction = 1.0 / 16.0;
 // angle, |b| ≤ a), so the reach counts this many times there.
 inline constexpr double kCubeWrapReachFactor = 3.0;
 // How far from its own texel a receiver's shadow test of `light` reads, in texels of a map of
-// mapSize: kCullMarginTexels, plus the PCSS reach for a spot or point light with a radius.
+// mapSize: kCullMarginTexels, plus the PCSS reach for a spot or point light with a radius, plus a
+// filterable map's blur radius (its lookup reads moments blurred over that many depth texels more).
 double cullReachTexels(const scene::RasterSettings& settings, const scene::Light& light, int mapSize);
+// The moment passes' box blur radius in texels for a filterable filter ((blur width − 1) / 2), 0
+// for the others.
+int momentBlurRadius(const scene::RasterSettings& settings);
 
 // The objects drawn into one layer of `light` (f its frustum, receivers those that read it).
 std::vector<bool> layerCasters(const scene::Scene& scene, const scene::RasterSettings& settings,

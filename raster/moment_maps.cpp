@@ -56,6 +56,7 @@ MomentPipeline createMomentPipeline(const Context& ctx, const ShadowMaps& maps, 
     requireMomentFormat(ctx);
     VkDevice device = ctx.device.get();
     MomentPipeline p;
+    p.radius = (settings.blurWidth - 1) / 2;
     const VkDescriptorSetLayoutBinding bindings[] = {
         {.binding = 0,
          .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
@@ -97,7 +98,7 @@ MomentPipeline createMomentPipeline(const Context& ctx, const ShadowMaps& maps, 
     auto create = [&](std::int32_t pass) {
         const Constants constants{pass,
                                   std::int32_t(filter),
-                                  std::int32_t((settings.blurWidth - 1) / 2),
+                                  std::int32_t(p.radius),
                                   std::int32_t(moments.size),
                                   float(settings.evsmPositive),
                                   float(settings.evsmNegative),
@@ -150,10 +151,12 @@ MomentPipeline createMomentPipeline(const Context& ctx, const ShadowMaps& maps, 
 }
 
 void recordMomentPasses(VkCommandBuffer commands, const MomentPipeline& pipeline, const ShadowMaps& maps,
-                        const MomentMaps& moments, const std::vector<ShadowLayer>& layers) {
-    if (layers.size() != moments.layers)
+                        const MomentMaps& moments, const std::vector<ShadowLayer>& layers,
+                        const std::vector<TexelRect>* windows) {
+    if (layers.size() != moments.layers || (windows && windows->size() != layers.size()))
         throw RasterError("recordMomentPasses: " + std::to_string(layers.size()) + " layers planned for " +
-                          std::to_string(moments.layers) + " moment maps");
+                          std::to_string(moments.layers) + " moment maps" +
+                          (windows ? " and " + std::to_string(windows->size()) + " windows" : std::string()));
     const std::uint32_t layerCount = moments.layers;
     // The depth pass's writes (its final barrier made them visible to fragment shaders and copies
     // only) before the x pass's reads; both arrays' previous contents are not needed (UNDEFINED),
@@ -172,18 +175,23 @@ void recordMomentPasses(VkCommandBuffer commands, const MomentPipeline& pipeline
                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT}});
     vkCmdBindDescriptorSets(commands, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline.layout.get(), 0, 1,
                             &pipeline.descriptors.set, 0, nullptr);
-    const std::uint32_t groups = (moments.size + kGroup - 1) / kGroup;
-    // One dispatch per layer and pass: each layer's own near and far.
+    const std::uint32_t size = moments.size;
+    const auto radius = std::uint32_t(pipeline.radius);
+    // One dispatch per layer and pass: each layer's own near and far, and its window.
     auto dispatch = [&](int pass) {
         vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE,
                           pass == 0 ? pipeline.pipeline.get() : pipeline.blurPipeline.get());
         for (std::uint32_t k = 0; k < layerCount; ++k) {
+            const TexelRect lookups = windows ? (*windows)[k] : TexelRect{0, 0, size, size};
+            const TexelRect w = pass == 0 ? grownWithin(lookups, 0, radius, size) : lookups;
+            if (w.empty()) continue;
             const LightFrustum& f = layers[k].frustum;
             const shaders::MomentPush push{
                 .layer = glm::ivec4(int(k), f.perspective ? 1 : 0, 0, 0),
-                .range = f.perspective ? glm::vec4(float(f.near), float(f.far), 0.0f, 0.0f) : glm::vec4(0.0f)};
+                .range = f.perspective ? glm::vec4(float(f.near), float(f.far), 0.0f, 0.0f) : glm::vec4(0.0f),
+                .window = glm::ivec4(int(w.x0), int(w.y0), int(w.x1), int(w.y1))};
             vkCmdPushConstants(commands, pipeline.layout.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-            vkCmdDispatch(commands, groups, groups, 1);
+            vkCmdDispatch(commands, (w.x1 - w.x0 + kGroup - 1) / kGroup, (w.y1 - w.y0 + kGroup - 1) / kGroup, 1);
         }
     };
     dispatch(0);
@@ -203,8 +211,8 @@ std::string describeMomentCost(scene::ShadowFilter filter, std::uint32_t size, s
     std::ostringstream s;
     s.precision(3);
     s << scene::toString(filter) << ": 2 compute passes (moments and a " << blurWidth << "-texel box blur along x, "
-      << "then along y) over " << layers << " layer(s) of " << size << "x" << size << ", and " << kMomentArrays
-      << " RGBA32F moment arrays (" << mib << " MiB)";
+      << "then along y) over the texels the lookups read, at most " << layers << " layer(s) of " << size << "x" << size
+      << ", and " << kMomentArrays << " RGBA32F moment arrays (" << mib << " MiB)";
     return s.str();
 }
 

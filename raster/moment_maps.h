@@ -43,6 +43,7 @@ struct MomentPipeline {
     PipelineHandle pipeline;      // pass 0: the moments, blurred along x
     PipelineHandle blurPipeline;  // pass 1: blurred along y
     SamplerHandle depthSampler;   // NEAREST, for texelFetch of the depth array
+    int radius = 0;               // the blur's, in texels (baked into both pipelines)
 };
 // The two passes for `filter` (a filterable one) with `settings`' blur width and exponents, baked
 // into each pipeline. Throws RasterError naming kMomentFormat and the device when the format
@@ -56,8 +57,14 @@ MomentPipeline createMomentPipeline(const Context& ctx, const ShadowMaps& maps, 
 // are perspective and their near and far: their moments are of linear depth
 // (d − near)/(far − near), d along the layer's axis; orthographic layers' depths are linear
 // already and kept as stored.
+// `windows` (one per layer; null: whole layers) are the texels the lit pass's lookups read
+// (layerLookupWindow): the y pass writes those alone, the x pass those widened by the blur radius
+// along y, and it reads depths within a further radius along x: layerReadWindow, the texels the
+// depth pass drew. Each texel written is the same as a whole layer's (the blur clamps to the map,
+// not to the window), and a lookup reads no other.
 void recordMomentPasses(VkCommandBuffer commands, const MomentPipeline& pipeline, const ShadowMaps& maps,
-                        const MomentMaps& moments, const std::vector<ShadowLayer>& layers);
+                        const MomentMaps& moments, const std::vector<ShadowLayer>& layers,
+                        const std::vector<TexelRect>* windows = nullptr);
 
 // For --explain and the Frame: the passes and memory the technique adds.
 std::string describeMomentCost(scene::ShadowFilter filter, std::uint32_t size, std::uint32_t layers, int blurWidth);

@@ -249,6 +249,8 @@ struct Renderer::Impl {
     std::vector<DepthBiasFactors> layerBias;        // per layer, recordShadowPass's input (settings.hardwareBias)
     // Per layer, the texels its depth pass clears and draws (layerReadWindow); empty: whole layers.
     std::vector<TexelRect> shadowWindows;
+    // Per layer, the texels the lit pass's lookups read (layerLookupWindow): the moment passes'.
+    std::vector<TexelRect> lookupWindows;
     LitPipeline litPipelines[4][2];
     // The same four without the slope bias's lift past its cap (LitVariant::normalOffset false, no
     // alpha test), for the lift-free triangles (draw.litRangesByLift), with the *_sun modules.
@@ -511,11 +513,14 @@ void Renderer::Impl::placeLights(const scene::Scene& scene, const scene::Camera&
                           view.near != scene.camera.near || view.far != scene.camera.far ||
                           view.width != scene.camera.width || view.height != scene.camera.height;
     shadowWindows.clear();
+    lookupWindows.clear();
     std::vector<std::uint64_t> texelsPerLayer;
     for (const ShadowLayer& layer : layers) {
         const auto size = std::uint32_t(layer.frustum.mapSize);
-        const TexelRect w = heldView ? TexelRect{0, 0, size, size} : layerReadWindow(layer);
+        const TexelRect whole{0, 0, size, size};
+        const TexelRect w = heldView ? whole : layerReadWindow(layer);
         shadowWindows.push_back(w);
+        lookupWindows.push_back(heldView ? whole : layerLookupWindow(layer));
         texelsPerLayer.push_back(w.area());
     }
     attributes["shadow_texels_per_layer"] = joined(texelsPerLayer, [](std::uint64_t n) { return std::to_string(n); });
@@ -919,7 +924,9 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                      &transmittancePass, &layerBias, shadowPipeline[1].pipeline ? &shadowPipeline[1] : nullptr,
                      // A capture shows whole layers (the debug views draw them all).
                      debug && debug->captureShadowMaps ? nullptr : &shadowWindows);
-    if (momentPipeline.pipeline) recordMomentPasses(commands, momentPipeline, maps, momentMaps, layers);
+    if (momentPipeline.pipeline)
+        recordMomentPasses(commands, momentPipeline, maps, momentMaps, layers,
+                           debug && debug->captureShadowMaps ? nullptr : &lookupWindows);
     stamp(commands, 1);
     ctx.submitAndWait(commands);
     frame.timingsMs.emplace_back("shadow_pass", msSince(shadowStart));

@@ -57,7 +57,7 @@ std::vector<ShadowLayer> planShadowLayers(const scene::Scene& scene, const scene
         layer.frustum = f;
         layer.matrix = glm::mat4(f.toClip(origin));
         if (window) {
-            layer.readWindow = !scene::isFilterable(settings.filter);
+            layer.blurRadius = momentBlurRadius(settings);
             layer.receivers = layerReceivers;
             layer.cullReachTexels = cullReachTexels(settings, scene.lights[light], f.mapSize);
             layer.cullOffsetTexels = lookupOffsetTexels(settings);
@@ -147,11 +147,23 @@ std::vector<ShadowLayer> planShadowLayers(const scene::Scene& scene, const scene
     return planShadowLayers(scene, plan, settings, scene::cameraBasis(scene.camera).position);
 }
 
+TexelRect grownWithin(const TexelRect& w, std::uint32_t dx, std::uint32_t dy, std::uint32_t size) {
+    if (w.empty()) return w;
+    return TexelRect{w.x0 - std::min(w.x0, dx), w.y0 - std::min(w.y0, dy), std::min(size, w.x1 + dx),
+                     std::min(size, w.y1 + dy)};
+}
+
+TexelRect layerLookupWindow(const ShadowLayer& layer) {
+    const auto size = std::uint32_t(std::max(layer.frustum.mapSize, 1));
+    return receiverTexels(layer.frustum, layer.receivers, layer.cullReachTexels - layer.blurRadius,
+                          layer.cullOffsetTexels)
+        .value_or(TexelRect{0, 0, size, size});
+}
+
 TexelRect layerReadWindow(const ShadowLayer& layer) {
     const auto size = std::uint32_t(std::max(layer.frustum.mapSize, 1));
-    if (!layer.readWindow) return TexelRect{0, 0, size, size};
-    return receiverTexels(layer.frustum, layer.receivers, layer.cullReachTexels, layer.cullOffsetTexels)
-        .value_or(TexelRect{0, 0, size, size});
+    const auto r = std::uint32_t(layer.blurRadius);
+    return grownWithin(layerLookupWindow(layer), r, r, size);
 }
 
 std::vector<bool> layerCastingBoxes(const ShadowLayer& layer, std::span<const scene::Bounds> boxes) {

@@ -58,9 +58,10 @@ struct ShadowLayer {
     // layerReadWindow(); recorded also with a transmittance map, which culls no caster.
     std::vector<scene::Vec3> receivers;
     double cullReachTexels = 0.0, cullOffsetTexels = 0.0;
-    // Whether the depth pass may leave out the texels outside layerReadWindow(): not for filterable
-    // maps, whose moment passes blur every texel of a layer.
-    bool readWindow = false;
+    // A filterable map's box blur radius in texels (the moment passes'; 0 for the others): the
+    // depth pass draws the lookups' texels (layerLookupWindow) widened by it, and cullReachTexels
+    // counts it.
+    int blurRadius = 0;
     // kCascade: the view-depth slice the cascade serves, [splits[index], splits[index + 1]].
     double sliceNear = 0.0, sliceFar = 0.0;
 };
@@ -69,8 +70,15 @@ struct ShadowLayer {
 // caster culling allows: cullReachTexels, cullOffsetTexels). The depth pass clears and draws only
 // these; no lookup reads a texel outside. Empty for a perspective map (spot, cube face) with no
 // receiver in front of it. The whole map where nothing bounds the reads: a layer that records no
-// receivers (settings.cullCasters off, a camera that sees none of the scene) or has no readWindow.
+// receivers (settings.cullCasters off, a camera that sees none of the scene). For a filterable map
+// the texels its moment passes blur into layerLookupWindow(): that window widened by blurRadius.
 TexelRect layerReadWindow(const ShadowLayer& layer);
+// The texels the lit pass's lookups read: layerReadWindow() but for a filterable map, whose lookups
+// read the blurred moments of these alone (the moment passes write no more; moment_maps.h).
+TexelRect layerLookupWindow(const ShadowLayer& layer);
+// `w` widened by dx texels along x and dy along y, within a map of `size` texels (an empty `w`
+// stays empty).
+TexelRect grownWithin(const TexelRect& w, std::uint32_t dx, std::uint32_t dy, std::uint32_t size);
 
 // The layers for `settings` as resolved (resolveAutomaticChoices: cascade count, map size,
 // default bias), in the order the shadow-map array holds them: per light that `plan` gives a

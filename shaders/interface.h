@@ -73,9 +73,10 @@ struct TransmitPush {
 // (The pass, the filter code, the blur radius, the maps' side and the exponents are the pipeline's
 // specialization constants: shaders/moments.comp.)
 struct MomentPush {
-    ivec4 layer;  // x: the array layer this dispatch writes; y: 1 = perspective (spot, cube face):
-                  // its stored depths are made linear over `range` first, 0 = orthographic (kept)
-    vec4 range;   // perspective layers: x: near, y: far (distances along the layer's axis)
+    ivec4 layer;   // x: the array layer this dispatch writes; y: 1 = perspective (spot, cube face):
+                   // its stored depths are made linear over `range` first, 0 = orthographic (kept)
+    vec4 range;    // perspective layers: x: near, y: far (distances along the layer's axis)
+    ivec4 window;  // the texels this dispatch writes: [x, z) x [y, w), within the map
 };
 
 // A point light's cube face: its depth range along the face's axis (each face's is fitted on its
@@ -156,7 +157,7 @@ struct TransmitWindows {
 #ifdef __cplusplus
 static_assert(sizeof(TransmitWindows) == SHADOWLAB_MAX_LAYERS * 16, "TransmitWindows must match std140");
 static_assert(sizeof(ShadowPush) == 64, "ShadowPush must match std430 push constants");
-static_assert(sizeof(MomentPush) == 2 * 16, "MomentPush must match std430 push constants");
+static_assert(sizeof(MomentPush) == 3 * 16, "MomentPush must match std430 push constants");
 static_assert(sizeof(TransmitPush) == 64 + 2 * 16, "TransmitPush must match std430 push constants");
 static_assert(sizeof(PointFace) == 16, "PointFace must match std140 (an array element)");
 // The offsets std140 gives (16-byte groups; pointFaces and lights aligned to 16).

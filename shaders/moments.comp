@@ -3,7 +3,8 @@
 // technique's moments (of linear depth: perspective layers' stored depths are made linear) and
 // averages `width` of them along x into the intermediate array; pass 1 averages `width` of those
 // along y into the moment array the lit pass samples. Texel coordinates are clamped to the map,
-// as the lit pass's clamp-to-edge sampler does.
+// as the lit pass's clamp-to-edge sampler does. Each dispatch writes only its window of the layer
+// (raster/moment_maps.h says which texels that is and why the reads stay within what was drawn).
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #include "interface.h"
@@ -58,8 +59,8 @@ vec4 momentsOf(float z, int code) {
 
 void main() {
     const ivec3 size = ivec3(kSize, kSize, 0);
-    const ivec3 at = ivec3(gl_GlobalInvocationID.xy, push.layer.x);
-    if (at.x >= size.x || at.y >= size.y) return;
+    const ivec3 at = ivec3(ivec2(gl_GlobalInvocationID.xy) + push.window.xy, push.layer.x);
+    if (at.x >= push.window.z || at.y >= push.window.w) return;
     const int code = kFilter;
     const int radius = kRadius;
     vec4 sum = vec4(0.0);

@@ -287,12 +287,13 @@ TEST(RasterCasterCulling, EachCascadeDrawsOnlyTheClustersOfALongMeshThatCanCastO
 
 // A 60 x 60 ground with a sphere at (20, 1, 17) under light along (−1, −2, −1), its shadow around
 // (19.5, 0, 16.5), seen from close by: the camera sees a few units of the ground, the unfitted
-// map spans the ground's bounding sphere (radius ≈ 42, a texel ≈ 0.17 at 512).
-scene::Scene groundSeenFromCloseBy() {
+// map spans the ground's bounding sphere (radius ≈ 42, a texel ≈ 0.17 at 512). The sphere's
+// radius 0.8 unless given (its center then that much above 0.2).
+scene::Scene groundSeenFromCloseBy(double radius = 0.8) {
     test::SphereOverPlane p;
     p.planeSize = 60.0;
-    p.center = {20, 1, 17};
-    p.radius = 0.8;
+    p.center = {20, 0.2 + radius, 17};
+    p.radius = radius;
     p.lightDirection = {-1, -2, -1};
     p.eye = {20, 4, 23};
     p.lookAt = {19, 0, 17};
@@ -319,9 +320,9 @@ struct Windows {
 };
 
 // Renders `s` with the depth pass in each layer's read window (culling on) and with whole layers
-// (culling off), expects the same frames bit for bit with the caster's shadow and lit ground in
-// view.
-Windows windowedAndWhole(const scene::Scene& s, scene::RasterSettings r) {
+// (culling off), expects the same frames bit for bit with the caster's shadow (its blocker id,
+// unless `shadowIds` is false: a shadow too soft for ids) and lit ground in view.
+Windows windowedAndWhole(const scene::Scene& s, scene::RasterSettings r, bool shadowIds = true) {
     const auto texels = [](const scene::Frame& f) {
         std::vector<long long> n;
         std::istringstream in(f.attributes.at("shadow_texels_per_layer"));
@@ -335,8 +336,8 @@ Windows windowedAndWhole(const scene::Scene& s, scene::RasterSettings r) {
     EXPECT_EQ(windowed.visibility, whole.visibility);
     EXPECT_EQ(windowed.beauty, whole.beauty);
     EXPECT_EQ(windowed.blockerId, whole.blockerId);
-    EXPECT_GT(countOf(windowed.blockerId, 1), 100);  // the sphere's shadow is seen
-    EXPECT_GT(countOf(windowed.blockerId, 0), 100);  // and lit ground
+    if (shadowIds) EXPECT_GT(countOf(windowed.blockerId, 1), 100);  // the sphere's shadow is seen
+    EXPECT_GT(countOf(windowed.blockerId, 0), 100);                 // and lit ground
     return {texels(windowed), texels(whole), windowed.attributes, windowed.visibility};
 }
 
@@ -400,11 +401,17 @@ bool rightColumnLit(const std::vector<float>& visibility) {
     return true;
 }
 
-// The edge's two scenes for `light`: windowed and whole the same bit for bit.
-void expectTheEdgeHolds(const scene::Light& light, const scene::Vec3& across, double acrossRadius,
-                        const scene::Vec3& inside, double insideRadius) {
+// The widest kernel without the normal offset (the edge tests: see rightEdgeScene).
+scene::RasterSettings edgeSettings() {
     scene::RasterSettings r = wideReachSettings();
     r.normalOffset = 0.0;
+    return r;
+}
+
+// The edge's two scenes for `light`: windowed and whole the same bit for bit.
+void expectTheEdgeHolds(const scene::Light& light, const scene::Vec3& across, double acrossRadius,
+                        const scene::Vec3& inside, double insideRadius,
+                        const scene::RasterSettings& r = edgeSettings()) {
     {
         SCOPED_TRACE("a shadow across the edge");
         const auto [windowed, whole, attributes, visibility] =
@@ -444,6 +451,82 @@ TEST(RasterCasterCulling, TheWindowsMarginHoldsTheWidestKernelAtTheImagesEdge) {
     spot.direction = glm::normalize(scene::Vec3(-2.53, -8, 0));
     spot.coneAngleDegrees = 20;
     expectTheEdgeHolds(spot, {6.85, 1.2, 0}, 0.6, {8.05 - 1.0, 5, 0}, 0.6);
+}
+
+// VSM with a blur of `width` texels: a lookup reads moments blurred over depths (width − 1)/2
+// texels further than its own texels, which the depth pass must draw (layerReadWindow) and the
+// moment passes must blur from (layerLookupWindow widened along y, then read along x).
+scene::RasterSettings blurSettings(int width) {
+    scene::RasterSettings r = edgeSettings();
+    r.filter = scene::ShadowFilter::Vsm;
+    r.moments.blurWidth = width;
+    return r;
+}
+
+TEST(RasterCasterCulling, AFilterableMapsPassesStayInTheWindowAndTheImageIsUnchanged) {
+    // The ground seen from close by under the sun, a spot and a point light, a 9-texel blur (the
+    // sun's ±0.7 units, under the sphere's shadow of ±1.2): the same frames bit for bit as whole
+    // layers (culling off), drawn into part of each map.
+    SCOPED_TRACE("sun");
+    const scene::Scene sun = groundSeenFromCloseBy(1.2);
+    const auto [sunWindowed, sunWhole, sunAttributes, sunVisibility] = windowedAndWhole(sun, blurSettings(9));
+    ASSERT_EQ(sunWindowed.size(), 1u);
+    EXPECT_LE(sunWindowed[0], 512 * 512 / 10);
+    SCOPED_TRACE("spot");
+    scene::Scene spot = groundSeenFromCloseBy(1.2);
+    spot.lights[0] = test::spotDown();
+    spot.lights[0].position = {20, 8, 17};
+    const auto [spotWindowed, spotWhole, spotAttributes, spotVisibility] = windowedAndWhole(spot, blurSettings(9));
+    ASSERT_EQ(spotWindowed.size(), 1u);
+    EXPECT_LT(spotWindowed[0], 512 * 512);
+    SCOPED_TRACE("point");
+    scene::Scene point = groundSeenFromCloseBy(1.2);
+    point.lights[0].type = scene::LightType::Point;
+    point.lights[0].position = {20, 8, 17};
+    point.lights[0].intensity = 800;
+    const auto [pointWindowed, pointWhole, pointAttributes, pointVisibility] = windowedAndWhole(point, blurSettings(9));
+    ASSERT_EQ(pointWindowed.size(), 6u);
+    EXPECT_EQ(pointWindowed[2], 0);  // +Y: no moment pass either
+    EXPECT_LT(pointWindowed[3], 512 * 512);
+}
+
+TEST(RasterCasterCulling, AFilterableMapsWindowHoldsTheBlurAtTheImagesEdge) {
+    // rightEdgeScene's camera and sun with VSM and the widest blur, 63 texels (±31 texels, about
+    // ±7 units of ground along x): the border pixels' lookups read moments that average depths far
+    // past the margin's slack, and a window without the blur's radius blurs depths no pass drew.
+    // A slab at height 4 over x 8..30 (outside the view) shadows x ≥ 3.9, about two thirds of the
+    // right column's box; a sphere at (−2, 2, 0) shadows x ≤ −1.7, more than the box away from the
+    // edge, which stays lit. The ground's own depth varies across so wide a box (the sun is at 45°),
+    // so VSM's bound leaves these shadows soft: too light for blocker ids.
+    scene::Light sun;
+    sun.direction = glm::normalize(scene::Vec3(-1, -1, 0));
+    sun.intensity = 3.0;
+    const scene::RasterSettings r = blurSettings(63);
+    const auto rightColumn = [](const std::vector<float>& visibility) {
+        std::vector<float> column;
+        for (std::size_t y = 0; y < kEdgeHeight; ++y) column.push_back(visibility[(y + 1) * kEdgeWidth - 1]);
+        return column;
+    };
+    {
+        SCOPED_TRACE("a shadow across the edge");
+        scene::Scene s = test::matteScene({0, 10, 0}, {0, 0, 0}, kEdgeWidth, kEdgeHeight);
+        s.camera.up = {0, 0, -1};
+        s.lights.push_back(sun);
+        test::addBox(s, {8, 4, -15}, {30, 4.1, 15});
+        test::addQuad(s, {0, 0, 0}, {0, 1, 0}, 60, 60);
+        const auto [windowed, whole, attributes, visibility] = windowedAndWhole(s, r, false);
+        ASSERT_EQ(windowed.size(), 1u);
+        EXPECT_LT(windowed[0], whole[0]);
+        const std::vector<float> column = rightColumn(visibility);
+        EXPECT_LT(*std::max_element(column.begin(), column.end()), 0.8f);
+    }
+    SCOPED_TRACE("lit ground across the edge");
+    const auto [windowed, whole, attributes, visibility] =
+        windowedAndWhole(rightEdgeScene(sun, {-2, 2, 0}, 1.6), r, false);
+    ASSERT_EQ(windowed.size(), 1u);
+    EXPECT_LT(windowed[0], whole[0]);
+    EXPECT_TRUE(rightColumnLit(visibility));
+    EXPECT_LT(*std::min_element(visibility.begin(), visibility.end()), 0.9f);  // the sphere's shadow
 }
 
 TEST(RasterCasterCulling, SpotAndPointLightMapsAreDrawnOnlyWhereTheViewReads) {

@@ -210,7 +210,6 @@ ShadowLayer handLayer() {
     l.frustum.farDepth = 10.0;
     l.frustum.mapSize = 1000;
     l.casters = {true};
-    l.readWindow = true;
     l.receivers = {{1, 2, 0}, {3, -1, 5}};
     l.cullReachTexels = 10.5;
     l.cullOffsetTexels = 2.0;
@@ -250,7 +249,6 @@ ShadowLayer handSpotLayer() {
     l.frustum.near = 0.1;
     l.frustum.far = 100.0;
     l.casters = {true};
-    l.readWindow = true;
     l.receivers = {{1, 2, -10}, {3, -1, -5}};
     l.cullReachTexels = 10.3;
     return l;
@@ -271,16 +269,41 @@ TEST(ShadowLayers, APerspectiveMapsReadWindowIsTheReceiversTangentsWidenedByTheR
     EXPECT_EQ(layerReadWindow(across).x0, 537u);
 }
 
+TEST(ShadowLayers, AFilterableMapsDepthPassDrawsTheLookupsTexelsWidenedByTheBlurRadius) {
+    // handLayer()'s receivers with a blur radius of 3 counted in the reach (13.5): the lookups read
+    // what the reach of 10.5 gives (texels 537..662 x 437..612), the moments there blur depths up
+    // to 3 texels further (534..665 x 434..615).
+    ShadowLayer l = handLayer();
+    l.blurRadius = 3;
+    l.cullReachTexels = 13.5;
+    EXPECT_TRUE(same(layerLookupWindow(l), layerReadWindow(handLayer())));
+    const TexelRect w = layerReadWindow(l);
+    EXPECT_TRUE(same(w, TexelRect{534, 434, 666, 616})) << w.x0 << " " << w.y0 << " " << w.x1 << " " << w.y1;
+    // Within the map: a receiver at x = −9.95 (texel 2.5) reads from texel 0, whose moments blur
+    // texels 0..3 (the blur clamps to the map, not past it).
+    l.receivers.push_back({-9.95, 0, 0});
+    EXPECT_EQ(layerLookupWindow(l).x0, 0u);
+    EXPECT_EQ(layerReadWindow(l).x0, 0u);
+    EXPECT_EQ(layerReadWindow(l).x1, 666u);
+    // No receivers: the whole map, whatever the radius.
+    l.receivers.clear();
+    EXPECT_TRUE(same(layerReadWindow(l), TexelRect{0, 0, 1000, 1000}));
+    EXPECT_TRUE(same(layerLookupWindow(l), TexelRect{0, 0, 1000, 1000}));
+}
+
+TEST(ShadowLayers, GrownWithinWidensEachAxisByItsOwnAmountInsideTheMap) {
+    const TexelRect w = grownWithin(TexelRect{2, 10, 50, 60}, 5, 1, 70);
+    EXPECT_TRUE(same(w, TexelRect{0, 9, 55, 61})) << w.x0 << " " << w.y0 << " " << w.x1 << " " << w.y1;
+    EXPECT_TRUE(grownWithin(TexelRect{}, 5, 5, 70).empty());
+    EXPECT_EQ(grownWithin(TexelRect{60, 0, 68, 4}, 5, 5, 70).x1, 70u);  // clamped on the far side
+}
+
 TEST(ShadowLayers, TheReadWindowIsTheWholeMapWhereNothingBoundsTheReads) {
     const TexelRect whole{0, 0, 1000, 1000};
     // Culling off, or the camera sees none of the scene: no receivers recorded.
     ShadowLayer noReceivers = handLayer();
     noReceivers.receivers.clear();
     EXPECT_TRUE(same(layerReadWindow(noReceivers), whole));
-    // A filterable map's moment passes blur every texel.
-    ShadowLayer filterable = handLayer();
-    filterable.readWindow = false;
-    EXPECT_TRUE(same(layerReadWindow(filterable), whole));
     // A layer that culls no caster (a transmittance map) still has its window.
     ShadowLayer everyCaster = handLayer();
     everyCaster.casters.clear();
