@@ -40,9 +40,9 @@ constexpr std::uint64_t kLiftFreeBytesPerTriangle = 3 * (12 + 12) + 3 * 4 + 3 * 
 std::uint64_t viewCullBytes(std::uint64_t triangles, std::uint64_t objects) {
     return (triangles / kViewCullClusterTriangles + objects) * (32 + 48 + 3 * 2 * 12 + 4 * 12);
 }
-// Filterable maps (raster/moment_maps.h): two RGBA32F arrays the size of the shadow maps, and the
-// compute pipeline's compilation, measured on lavapipe (Mesa 22.3) as about 97 MiB above the
-// arrays on the seed scene at 1024² (the arrays alone: 32 bytes a texel, as measured at 4096²).
+// Filterable maps (raster/moment_maps.h): an RGBA32F array the size of the shadow maps and one
+// intermediate layer (momentBytes), and the compute pipeline's compilation, measured on lavapipe
+// (Mesa 22.3) as about 97 MiB above the images on the seed scene at 1024².
 constexpr std::uint64_t kMomentPipelineAllowance = 112 * scene::kMiB;
 }  // namespace
 
@@ -71,7 +71,7 @@ std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::Render
     return kDriverAllowance + scene::frameBytes(scene) + pixels * litBytesPerPixel(scene.lights.size()) +
            layers * texels * (plan.needsTransmittanceMap ? 4 + 4 + 16 : 4 + 4) + triangles * kBytesPerTriangle +
            (scene::isFilterable(settings.filter) && layers > 0
-                ? layers * texels * kMomentBytesPerTexel * kMomentArrays + kMomentPipelineAllowance
+                ? momentBytes(settings.shadowMapSize, layers) + kMomentPipelineAllowance
                 : 0) +
            // Alpha-tested casters: a UV per vertex (every vertex of the scene gets a slot in the
            // UV buffer, 3 · 8 bytes a triangle), the texels and one record per object.

@@ -28,17 +28,21 @@ void requireMomentFormat(const Context& ctx) {
 
 }  // namespace
 
+std::uint64_t momentBytes(std::uint64_t size, std::uint64_t layers) {
+    return size * size * (layers + 1) * kMomentBytesPerTexel;
+}
+
 MomentMaps createMomentMaps(const Context& ctx, std::uint32_t size, std::uint32_t layers) {
     if (size > 1) requireMomentFormat(ctx);
     requireDeviceMemory(
-        ctx, VkDeviceSize(size) * size * layers * kMomentBytesPerTexel * kMomentArrays,
+        ctx, momentBytes(size, layers),
         std::to_string(layers) + " moment map(s) of " + std::to_string(size) + "x" + std::to_string(size));
     MomentMaps m;
     m.size = size;
     m.layers = layers;
     const VkImageUsageFlags usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
-    m.blurredX = createImage(ctx, kMomentFormat, size, size, layers, VK_IMAGE_USAGE_STORAGE_BIT,
-                             VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D_ARRAY);
+    m.blurredX = createImage(ctx, kMomentFormat, size, size, 1, VK_IMAGE_USAGE_STORAGE_BIT, VK_IMAGE_ASPECT_COLOR_BIT,
+                             VK_IMAGE_VIEW_TYPE_2D_ARRAY);
     m.moments = createImage(ctx, kMomentFormat, size, size, layers, usage, VK_IMAGE_ASPECT_COLOR_BIT,
                             VK_IMAGE_VIEW_TYPE_2D_ARRAY);
     // The lit pass's descriptor names the array in SHADER_READ_ONLY_OPTIMAL from the start: a
@@ -167,7 +171,7 @@ void recordMomentPasses(VkCommandBuffer commands, const MomentPipeline& pipeline
                  VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
                  VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                  VK_ACCESS_2_SHADER_SAMPLED_READ_BIT},
-                {moments.blurredX.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layerCount, VK_IMAGE_LAYOUT_UNDEFINED,
+                {moments.blurredX.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
                  VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_NONE,
                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT},
                 {moments.moments.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layerCount, VK_IMAGE_LAYOUT_UNDEFINED,
@@ -177,15 +181,39 @@ void recordMomentPasses(VkCommandBuffer commands, const MomentPipeline& pipeline
                             &pipeline.descriptors.set, 0, nullptr);
     const std::uint32_t size = moments.size;
     const auto radius = std::uint32_t(pipeline.radius);
-    // One dispatch per layer and pass: each layer's own near and far, and its window.
-    auto dispatch = [&](int pass) {
-        vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE,
-                          pass == 0 ? pipeline.pipeline.get() : pipeline.blurPipeline.get());
-        for (std::uint32_t k = 0; k < layerCount; ++k) {
-            const TexelRect lookups = windows ? (*windows)[k] : TexelRect{0, 0, size, size};
+    // Per layer, its x pass and then its y pass, each with the layer's own near and far and its
+    // window; the intermediate layer goes from the x pass's writes to the y pass's reads, and from
+    // those reads to the next layer's writes.
+    const VkImage intermediate = moments.blurredX.image.get();
+    const ImageTransition writtenToRead{intermediate,
+                                        VK_IMAGE_ASPECT_COLOR_BIT,
+                                        1,
+                                        VK_IMAGE_LAYOUT_GENERAL,
+                                        VK_IMAGE_LAYOUT_GENERAL,
+                                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                        VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT};
+    const ImageTransition readToWritten{intermediate,
+                                        VK_IMAGE_ASPECT_COLOR_BIT,
+                                        1,
+                                        VK_IMAGE_LAYOUT_GENERAL,
+                                        VK_IMAGE_LAYOUT_GENERAL,
+                                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT,
+                                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                        VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT};
+    bool intermediateRead = false;  // a y pass has read the intermediate layer since it was written
+    for (std::uint32_t k = 0; k < layerCount; ++k) {
+        const TexelRect lookups = windows ? (*windows)[k] : TexelRect{0, 0, size, size};
+        if (lookups.empty()) continue;
+        const LightFrustum& f = layers[k].frustum;
+        for (int pass = 0; pass < 2; ++pass) {
             const TexelRect w = pass == 0 ? grownWithin(lookups, 0, radius, size) : lookups;
-            if (w.empty()) continue;
-            const LightFrustum& f = layers[k].frustum;
+            if (pass == 0 && intermediateRead) transition(commands, {readToWritten});
+            if (pass == 1) transition(commands, {writtenToRead});
+            vkCmdBindPipeline(commands, VK_PIPELINE_BIND_POINT_COMPUTE,
+                              pass == 0 ? pipeline.pipeline.get() : pipeline.blurPipeline.get());
             const shaders::MomentPush push{
                 .layer = glm::ivec4(int(k), f.perspective ? 1 : 0, 0, 0),
                 .range = f.perspective ? glm::vec4(float(f.near), float(f.far), 0.0f, 0.0f) : glm::vec4(0.0f),
@@ -193,13 +221,8 @@ void recordMomentPasses(VkCommandBuffer commands, const MomentPipeline& pipeline
             vkCmdPushConstants(commands, pipeline.layout.get(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
             vkCmdDispatch(commands, (w.x1 - w.x0 + kGroup - 1) / kGroup, (w.y1 - w.y0 + kGroup - 1) / kGroup, 1);
         }
-    };
-    dispatch(0);
-    transition(commands,
-               {{moments.blurredX.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layerCount, VK_IMAGE_LAYOUT_GENERAL,
-                 VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT}});
-    dispatch(1);
+        intermediateRead = true;
+    }
     transition(commands, {{moments.moments.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, layerCount, VK_IMAGE_LAYOUT_GENERAL,
                            VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                            VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
@@ -207,12 +230,12 @@ void recordMomentPasses(VkCommandBuffer commands, const MomentPipeline& pipeline
 }
 
 std::string describeMomentCost(scene::ShadowFilter filter, std::uint32_t size, std::uint32_t layers, int blurWidth) {
-    const double mib = double(size) * size * layers * kMomentBytesPerTexel * kMomentArrays / (1024.0 * 1024.0);
+    const double mib = double(momentBytes(size, layers)) / (1024.0 * 1024.0);
     std::ostringstream s;
     s.precision(3);
     s << scene::toString(filter) << ": 2 compute passes (moments and a " << blurWidth << "-texel box blur along x, "
       << "then along y) over the texels the lookups read, at most " << layers << " layer(s) of " << size << "x" << size
-      << ", and " << kMomentArrays << " RGBA32F moment arrays (" << mib << " MiB)";
+      << ", an RGBA32F moment array and one intermediate layer (" << mib << " MiB)";
     return s.str();
 }
 

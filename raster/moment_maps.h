@@ -23,12 +23,13 @@ namespace shadowlab::raster {
 inline constexpr VkFormat kMomentFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 inline constexpr std::uint64_t kMomentBytesPerTexel = 16;
 
-// The moment arrays a render holds: the blurred moments (sampled by the lit pass) and the
-// intermediate after the x pass, both size x size x layers.
-inline constexpr std::uint64_t kMomentArrays = 2;
+// The moment images a render holds: the blurred moments (sampled by the lit pass), size x size x
+// layers, and the intermediate after the x pass, one size x size layer that each layer's pair of
+// passes reuses in turn (a layer's y pass reads it before the next layer's x pass writes it).
+std::uint64_t momentBytes(std::uint64_t size, std::uint64_t layers);
 
 struct MomentMaps {
-    Image blurredX;  // moments averaged along x (pass 0), read by pass 1
+    Image blurredX;  // moments averaged along x (pass 0), read by pass 1: one layer
     Image moments;   // the result, sampled by the lit pass (SHADER_READ_ONLY_OPTIMAL after the passes)
     std::uint32_t size = 0;
     std::uint32_t layers = 0;
@@ -51,7 +52,8 @@ struct MomentPipeline {
 MomentPipeline createMomentPipeline(const Context& ctx, const ShadowMaps& maps, const MomentMaps& moments,
                                     scene::ShadowFilter filter, const scene::MomentSettings& settings);
 
-// Records both of the pipeline's passes after the depth pass: the depth array in
+// Records both of the pipeline's passes after the depth pass, layer by layer (the x pass, then the
+// y pass, through the one intermediate layer): the depth array in
 // SHADER_READ_ONLY_OPTIMAL (written by the depth pass) to moments in SHADER_READ_ONLY_OPTIMAL,
 // ready for the lit pass's fragment shader. `layers` (the array's, in order) says which layers
 // are perspective and their near and far: their moments are of linear depth

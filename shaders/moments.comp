@@ -1,8 +1,8 @@
 // shaders/moments.comp: the filterable shadow maps' moments (raster/moment_maps.h), in two
 // passes of a separable box blur, one dispatch per layer. Pass 0 turns each depth texel into the
 // technique's moments (of linear depth: perspective layers' stored depths are made linear) and
-// averages `width` of them along x into the intermediate array; pass 1 averages `width` of those
-// along y into the moment array the lit pass samples. Texel coordinates are clamped to the map,
+// averages `width` of them along x into the intermediate image (one layer, reused by every layer's
+// pair of passes); pass 1 averages `width` of those along y into the moment array the lit pass samples. Texel coordinates are clamped to the map,
 // as the lit pass's clamp-to-edge sampler does. Each dispatch writes only its window of the layer
 // (raster/moment_maps.h says which texels that is and why the reads stay within what was drawn).
 #version 450
@@ -12,7 +12,7 @@
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
 layout(set = 0, binding = 0) uniform sampler2DArray depths;  // the shadow maps (NEAREST, no compare)
-layout(set = 0, binding = 1, rgba32f) uniform image2DArray blurredX;
+layout(set = 0, binding = 1, rgba32f) uniform image2DArray blurredX;  // one layer
 layout(set = 0, binding = 2, rgba32f) uniform image2DArray moments;
 
 layout(push_constant) uniform Push { MomentPush push; };
@@ -70,10 +70,10 @@ void main() {
             const float z = texelFetch(depths, t, 0).r;
             sum += momentsOf(push.layer.y != 0 ? linearDepth(z) : z, code);
         }
-        imageStore(blurredX, at, sum / float(2 * radius + 1));
+        imageStore(blurredX, ivec3(at.xy, 0), sum / float(2 * radius + 1));
     } else {
         for (int k = -radius; k <= radius; ++k)
-            sum += imageLoad(blurredX, ivec3(at.x, clamp(at.y + k, 0, size.y - 1), at.z));
+            sum += imageLoad(blurredX, ivec3(at.x, clamp(at.y + k, 0, size.y - 1), 0));
         imageStore(moments, at, sum / float(2 * radius + 1));
     }
 }
