@@ -1,9 +1,10 @@
 // shaders/moments.comp: the filterable shadow maps' moments (raster/moment_maps.h), in two
-// passes of a separable box blur, one dispatch per layer. Pass 0 turns each depth texel into the
-// technique's moments (of linear depth: perspective layers' stored depths are made linear) and
-// averages `width` of them along x into the intermediate image (one layer, reused by every layer's
-// pair of passes); pass 1 averages `width` of those along y into the moment array the lit pass samples. Texel coordinates are clamped to the map,
-// as the lit pass's clamp-to-edge sampler does. Each dispatch writes only its window of the layer
+// passes of a separable box blur, one dispatch per layer and pass. Pass 0 turns each depth texel
+// into the technique's moments (of linear depth: perspective layers' stored depths are made
+// linear) and averages `width` of them along x into the intermediate image (one layer, which each
+// layer's pair of passes uses in turn); pass 1 averages `width` of those along y into the moment
+// array the lit pass samples. Texel coordinates are clamped to the map, as the lit pass's
+// clamp-to-edge sampler does. Each dispatch writes only its window of the layer
 // (raster/moment_maps.h says which texels that is and why the reads stay within what was drawn).
 #version 450
 #extension GL_GOOGLE_include_directive : require
