@@ -178,7 +178,7 @@ struct Renderer::Impl {
     // Returns true where every attachment is a new plane of the Frame that already holds the
     // background (see there): the lit pass then draws no background.
     bool prepareFrame(scene::Frame& frame, scene::ChannelMask channels, LitOutputs outputs, LitAttachments& attachments,
-                      std::vector<Image>& frameImages, std::array<bool, kLitPlanes>& intoFrame) const;
+                      std::vector<Image>& frameImages, std::array<bool, kLitPlanes>& intoFrame);
     void readPixels(scene::Frame& frame, scene::ChannelMask channels,
                     const std::array<bool, kLitPlanes>& intoFrame) const;
     void readDisplayPixels(scene::Frame& frame) const;
@@ -226,6 +226,9 @@ struct Renderer::Impl {
     DrawGeometry draw;
     ShadowMaps maps;
     LitTargets targets;
+    // Per target of `targets` (the planes, then the light targets): whether a frame has rendered
+    // into it, its pages then faulted in (prepareFrame).
+    std::vector<bool> ownTargetsTouched;
     Readback readback;
     bool timestamps = false;
     QueryPoolHandle queries;
@@ -603,7 +606,9 @@ void Renderer::Impl::createTargets(const scene::Scene& scene, const RendererOpti
     if (moments)
         attributes["moment_maps"] =
             describeMomentCost(settings.filter, mapSize, arrayLayers, settings.moments.blurWidth);
-    targets = createLitTargets(ctx, width, height, lightCount > 1 ? kLightTargets : 0, options.readTargetsInPlace);
+    targets = createLitTargets(ctx, width, height, lightCount > 1 ? std::uint32_t(lightCount + 3) / 4 : 0,
+                               options.readTargetsInPlace);
+    ownTargetsTouched.assign(kLitPlanes + targets.lights.size(), false);
     renderIntoFrame = options.renderIntoFrame;
     sunModules = options.sunModules;
     if (!targets.hostReadable) readback = createReadback(ctx, targets);
@@ -950,7 +955,10 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     std::vector<Image> frameImages;  // over the Frame's vectors, released after this frame
     std::array<bool, kLitPlanes> intoFrame{};
     const bool backgroundInFrame = prepareFrame(frame, channels, outputs, attachments, frameImages, intoFrame);
-    if (debug) debug->backgroundFromFrame = backgroundInFrame;
+    if (debug) {
+        debug->backgroundFromFrame = backgroundInFrame;
+        debug->lightTargets = targets.lights.size();
+    }
     const double prepareMs = msSince(prepareStart);
     const auto litStart = Clock::now();
     const double litCpuStart = processCpuMs();
@@ -1028,15 +1036,8 @@ namespace {
 float* reservePlane(std::vector<float>& v, std::size_t values, std::size_t reserveBytes) {
     const std::size_t capacity = v.capacity();
     v.reserve(std::max(values, (reserveBytes + sizeof(float) - 1) / sizeof(float)));
-#ifdef MADV_POPULATE_WRITE
-    if (v.capacity() != capacity) {
-        // New memory: its pages in one call (Linux 5.14) instead of a fault each as resize()
-        // zeroes them. Nothing changes where the kernel refuses.
-        const auto begin = (reinterpret_cast<std::uintptr_t>(v.data()) + 4095) & ~std::uintptr_t(4095);
-        const auto end = reinterpret_cast<std::uintptr_t>(v.data() + v.capacity()) & ~std::uintptr_t(4095);
-        if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE);
-    }
-#endif
+    // New memory: its pages in one call instead of a fault each as resize() zeroes them.
+    if (v.capacity() != capacity) prefaultPages(v.data(), v.capacity() * sizeof(float));
     return v.data();
 }
 
@@ -1056,7 +1057,7 @@ float* framePlane(std::vector<float>& v, bool wanted, std::size_t pixels, std::s
 
 bool Renderer::Impl::prepareFrame(scene::Frame& frame, scene::ChannelMask channels, LitOutputs outputs,
                                   LitAttachments& attachments, std::vector<Image>& frameImages,
-                                  std::array<bool, kLitPlanes>& intoFrame) const {
+                                  std::array<bool, kLitPlanes>& intoFrame) {
     using namespace scene;
     frame.width = int(width);
     frame.height = int(height);
@@ -1123,10 +1124,23 @@ bool Renderer::Impl::prepareFrame(scene::Frame& frame, scene::ChannelMask channe
         for (std::size_t x = 0; x < width; ++x) std::memcpy(&row[3 * x], &background[0], 3 * sizeof(float));
         for (std::uint32_t y = 0; y < height; ++y) frame.beauty.insert(frame.beauty.end(), row.begin(), row.end());
     }
+    // The Renderer's own targets (never cleared) are read under partly covered blocks before they
+    // are written: their pages are faulted in writable before the first frame that renders them.
+    auto own = [&](const Image& image, std::size_t index) {
+        if (!ownTargetsTouched[index] && image.mapped)
+            prefaultPages(image.mapped, std::size_t(image.rowPitch) * height);
+        ownTargetsTouched[index] = true;
+        attachments.add(image);
+    };
     std::size_t next = 0;
-    for (std::uint32_t p = 0; p < planes; ++p) attachments.add(intoFrame[p] ? frameImages[next++] : targets.planes[p]);
+    for (std::uint32_t p = 0; p < planes; ++p) {
+        if (intoFrame[p])
+            attachments.add(frameImages[next++]);
+        else
+            own(targets.planes[p], p);
+    }
     if (outputs == LitOutputs::kAll)
-        for (const Image& l : targets.lights) attachments.add(l);
+        for (std::size_t t = 0; t < targets.lights.size(); ++t) own(targets.lights[t], kLitPlanes + t);
     frame.lightVisibility.resize((channels & kChannelLightVisibility) && !targets.lights.empty() ? lightCount : 0);
     for (std::vector<float>& v : frame.lightVisibility) framePlane(v, true, n, 1);
     return fresh;

@@ -1,9 +1,12 @@
 // raster/resources.cpp: buffer and image creation, staging uploads, layout transitions.
 #include "raster/resources.h"
 
+#include <cstdint>
 #include <cstring>
 
 #include "raster/vulkan_error.h"
+
+#include <sys/mman.h>
 
 namespace shadowlab::raster {
 
@@ -270,6 +273,18 @@ Image importHostImage(const Context& ctx, VkFormat format, std::uint32_t width, 
     img.mapped = data;
     img.rowPitch = VkDeviceSize(width) * texelBytes;
     return img;
+}
+
+void prefaultPages(const void* data, std::size_t bytes) {
+#ifdef MADV_POPULATE_WRITE
+    // Every page the range touches (both ends are in the same mapping as the range).
+    const auto begin = reinterpret_cast<std::uintptr_t>(data) & ~std::uintptr_t(4095);
+    const auto end = (reinterpret_cast<std::uintptr_t>(data) + bytes + 4095) & ~std::uintptr_t(4095);
+    if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE);
+#else
+    (void)data;
+    (void)bytes;
+#endif
 }
 
 void transition(VkCommandBuffer commands, const std::vector<ImageTransition>& transitions) {

@@ -76,6 +76,14 @@ Image importHostImage(const Context& ctx, VkFormat format, std::uint32_t width, 
 ImageViewHandle createView(const Context& ctx, VkImage image, VkFormat format, VkImageAspectFlags aspect,
                            VkImageViewType viewType, std::uint32_t firstLayer, std::uint32_t layerCount);
 
+// Faults in the pages of `bytes` of host memory from `data` as writable, in one call (Linux 5.14's
+// MADV_POPULATE_WRITE; nothing happens where the kernel refuses), leaving what they hold as it
+// is. For memory the device will write before anything reads it: llvmpipe reads a target's texels
+// under a partly covered block before it writes them, and a page first read maps the shared zero
+// page, to be copied again at the write with a TLB shootdown across the driver's threads (at
+// 1920x1080, 0.3 s of CPU for the per-light targets; docs/performance.md, "Several lights").
+void prefaultPages(const void* data, std::size_t bytes);
+
 // One image layout transition with its execution and memory dependency.
 struct ImageTransition {
     VkImage image;

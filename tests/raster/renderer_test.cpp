@@ -804,45 +804,78 @@ TEST(RasterRender, TwoLightsWeighVisibilityByTheirUnshadowedIrradiance) {
     EXPECT_EQ(f.attributes.at("shadow_maps"), "2");
 }
 
-TEST(RasterRender, TwoLightsKeepEachLightsVisibilityAndCombineThem) {
-    // Light A straight down (intensity 3), light B from 40° elevation (intensity 1), hard
-    // shadows (filter none). On the plane (N = +Y) light i's visibility is 1 where the ray from
-    // the point toward it misses the sphere and 0 where it meets it (closed form), and the total
-    // is the shading rule's weighted mean (w_A v_A + w_B v_B) / (w_A + w_B), w = intensity·N·L:
-    // w_A = 3, w_B = sin 40°.
-    SphereOverPlane p;
-    p.width = 320;
-    p.height = 180;
-    const scene::Scene s = withASecondLightFrom40Degrees(p, 1.0);
-    const scene::Light& b = s.lights[1];
-    SphereOverPlane pb = p;
-    pb.lightDirection = b.direction;
+// Renders the sphere over the plane of `p` under `s`'s lights (hard shadows: filter none) and
+// checks each light's visibility on the plane (N = +Y) against the closed form, 1 where the ray
+// from the point toward the light misses the sphere and 0 where it meets it, and the total against
+// the shading rule's weighted mean Σ w_i v_i / Σ w_i, w_i = intensity_i · N·L_i. The lights are
+// kept four to an RGBA32F target: `targets` is how many the render must have used.
+void expectEachLightsVisibilityAndTheirMean(const SphereOverPlane& p, const scene::Scene& s, std::size_t targets,
+                                            const std::string& name) {
+    const std::size_t n = s.lights.size();
+    std::vector<SphereOverPlane> each(n, p);
+    std::vector<double> w(n);
+    double wSum = 0.0;
+    for (std::size_t l = 0; l < n; ++l) {
+        each[l].lightDirection = s.lights[l].direction;
+        w[l] = s.lights[l].intensity * -glm::normalize(s.lights[l].direction).y;
+        wSum += w[l];
+    }
     const scene::CameraBasis cam = scene::cameraBasis(s.camera);
-    const scene::Frame f = renderValidated(s, validatedSettings(1024, 0.01, 1.0, ShadowFilter::None), "per-light");
-    ASSERT_EQ(f.lightVisibility.size(), 2u);
-    const double wA = 3.0, wB = std::sin(40.0 * kPi / 180.0);
-    std::size_t plane = 0, wrong[2] = {0, 0}, shadowed[2] = {0, 0};
+    RenderDebug debug;
+    const scene::Frame f = renderChecked(s, validatedSettings(1024, 0.01, 1.0, ShadowFilter::None), &debug);
+    writePngToLookAt(f, name);
+    EXPECT_EQ(debug.lightTargets, targets);
+    ASSERT_EQ(f.lightVisibility.size(), n);
+    std::size_t plane = 0;
+    std::vector<std::size_t> wrong(n, 0), shadowed(n, 0);
     for (int y = 0; y < f.height; ++y)
         for (int x = 0; x < f.width; ++x) {
             const PrimaryHit hit = primaryHit(p, cam, x, y);
             const std::size_t i = at(f, x, y);
             if (hit.id != 2 || f.objectId[i] != 2.0f) continue;
             ++plane;
-            const float vA = f.lightVisibility[0][i], vB = f.lightVisibility[1][i];
-            ASSERT_TRUE((vA == 0.0f || vA == 1.0f) && (vB == 0.0f || vB == 1.0f)) << "hard shadows are 0 or 1";
-            ASSERT_NEAR(f.visibility[i], (wA * vA + wB * vB) / (wA + wB), 1e-6) << "pixel " << x << "," << y;
-            const bool shadowA = planePointShadowed(p, hit.p), shadowB = planePointShadowed(pb, hit.p);
-            shadowed[0] += shadowA;
-            shadowed[1] += shadowB;
-            wrong[0] += (vA == 0.0f) != shadowA;
-            wrong[1] += (vB == 0.0f) != shadowB;
+            double mean = 0.0;
+            for (std::size_t l = 0; l < n; ++l) {
+                const float v = f.lightVisibility[l][i];
+                ASSERT_TRUE(v == 0.0f || v == 1.0f) << "hard shadows are 0 or 1: light " << l << ", " << v;
+                mean += w[l] * v / wSum;
+                const bool shadow = planePointShadowed(each[l], hit.p);
+                shadowed[l] += shadow;
+                wrong[l] += (v == 0.0f) != shadow;
+            }
+            ASSERT_NEAR(f.visibility[i], mean, 1e-6) << "pixel " << x << "," << y;
         }
     ASSERT_GT(plane, 5000u);
-    for (int l = 0; l < 2; ++l) {
+    for (std::size_t l = 0; l < n; ++l) {
         EXPECT_GT(shadowed[l], 100u) << "light " << l << " must shadow part of the plane in view";
         // Only texels on the shadow's outline may differ from the closed form.
         EXPECT_LT(double(wrong[l]), 0.1 * double(shadowed[l])) << "light " << l;
     }
+}
+
+TEST(RasterRender, TwoLightsKeepEachLightsVisibilityAndCombineThem) {
+    // Light A straight down (intensity 3), light B from 40° elevation (intensity 1): one target.
+    SphereOverPlane p;
+    p.width = 320;
+    p.height = 180;
+    expectEachLightsVisibilityAndTheirMean(p, withASecondLightFrom40Degrees(p, 1.0), 1, "per-light");
+}
+
+TEST(RasterRender, FiveLightsKeepEachLightsVisibilityInTwoTargets) {
+    // Five suns from around the sphere at 40° to 70° elevation: lights 0 to 3 in the first
+    // target's four components, light 4 in the second target's first.
+    SphereOverPlane p;
+    p.width = 320;
+    p.height = 180;
+    scene::Scene s = withASecondLightFrom40Degrees(p, 1.0);
+    const double elevation[3] = {55.0, 70.0, 45.0}, azimuth[3] = {100.0, 200.0, 290.0}, intensity[3] = {0.8, 0.6, 1.2};
+    for (int k = 0; k < 3; ++k) {
+        scene::Light l = s.lights[1];
+        l.direction = rotation(Vec3(0.0, 1.0, 0.0), azimuth[k]) * lightFromElevation(elevation[k]);
+        l.intensity = intensity[k];
+        s.lights.push_back(l);
+    }
+    expectEachLightsVisibilityAndTheirMean(p, s, 2, "five-lights");
 }
 
 // Light 0's visibility at pixel i in `a` (one light) against `b` (light 0 and a dim one):

@@ -2,7 +2,8 @@
 // validation layer: each is made at the size, in the format and the kind of memory asked for;
 // uploads arrive byte for byte; an image layer holds what was rendered into it through a view of
 // that layer; host-readable images are mapped at their first texel with their row pitch; and too
-// large an allocation is refused, naming what and both sizes.
+// large an allocation is refused, naming what and both sizes; prefaultPages() makes a range's pages
+// present and writable and keeps what they hold.
 #include "raster/resources.h"
 
 #include <cstdint>
@@ -11,6 +12,8 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <sys/mman.h>
+#include <sys/resource.h>
 
 #include "raster/vulkan_error.h"
 #include "tests/kit/render_checked.h"
@@ -236,6 +239,56 @@ TEST(RasterResources, TooLargeAnAllocationIsRefusedNamingWhatAndBothSizes) {
         EXPECT_NE(what.find(std::to_string(largest / kMiB) + " MiB"), std::string::npos) << what;
         EXPECT_NE(what.find(ctx.deviceReport.name), std::string::npos) << what;
     }
+}
+
+// Minor page faults of the calling thread so far.
+long threadMinorFaults() {
+    rusage usage{};
+    getrusage(RUSAGE_THREAD, &usage);
+    return usage.ru_minflt;
+}
+
+// Reads and then writes one byte of every page, as llvmpipe does under a partly covered block.
+void readThenWriteEachPage(volatile unsigned char* bytes, std::size_t pages) {
+    for (std::size_t k = 0; k < pages; ++k) bytes[k * 4096 + 7] = bytes[k * 4096 + 7] + 1;
+}
+
+TEST(RasterResources, PrefaultedPagesTakeNoFaultWhenReadThenWrittenAndKeepWhatTheyHeld) {
+    constexpr std::size_t kPages = 64;
+    auto map = [] {
+        void* p = mmap(nullptr, kPages * 4096, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+        EXPECT_NE(p, MAP_FAILED);
+        return static_cast<unsigned char*>(p);
+    };
+    unsigned char* probe = map();
+#ifdef MADV_POPULATE_WRITE
+    const bool kernelPopulates = madvise(probe, 4096, MADV_POPULATE_WRITE) == 0;
+#else
+    const bool kernelPopulates = false;
+#endif
+    munmap(probe, kPages * 4096);
+    if (!kernelPopulates)
+        GTEST_SKIP() << "this kernel has no MADV_POPULATE_WRITE (Linux 5.14): prefaultPages does nothing";
+
+    // Without: each page faults at the read (the zero page) and again at the write.
+    unsigned char* plain = map();
+    long before = threadMinorFaults();
+    readThenWriteEachPage(plain, kPages);
+    EXPECT_GE(threadMinorFaults() - before, long(kPages)) << "the control must fault";
+    munmap(plain, kPages * 4096);
+
+    // With: a byte already written keeps its value; the range starts inside the first page and
+    // ends inside the last, and every page it touches is present and writable.
+    unsigned char* bytes = map();
+    bytes[3 * 4096 + 11] = 42;
+    prefaultPages(bytes + 100, kPages * 4096 - 200);
+    before = threadMinorFaults();
+    readThenWriteEachPage(bytes, kPages);
+    EXPECT_EQ(threadMinorFaults() - before, 0);
+    EXPECT_EQ(bytes[3 * 4096 + 11], 42);
+    for (std::size_t k = 0; k < kPages; ++k) ASSERT_EQ(bytes[k * 4096 + 7], 1) << "page " << k;
+    EXPECT_EQ(bytes[5 * 4096 + 9], 0);
+    munmap(bytes, kPages * 4096);
 }
 
 }  // namespace
