@@ -133,9 +133,10 @@ raster::RendererOptions rendererOptions() {
             throw std::runtime_error(
                 "SHADOWLAB_BENCH_LIGHT_CONSTANTS: expected uniform, vertex or specialization, got " + which);
     }
-    // SHADOWLAB_BENCH_SUN_MODULES=0: the general lit shader modules where the size-optimized ones
-    // would be used (raster::RendererOptions::sunModules), for comparing the pipelines' creation.
-    if (const char* v = std::getenv("SHADOWLAB_BENCH_SUN_MODULES"); v && std::string(v) == "0") o.sunModules = false;
+    // SHADOWLAB_BENCH_ONE_LIGHT_MODULES=0: the general lit shader modules where the size-optimized ones
+    // would be used (raster::RendererOptions::oneLightModules), for comparing the pipelines' creation.
+    if (const char* v = std::getenv("SHADOWLAB_BENCH_ONE_LIGHT_MODULES"); v && std::string(v) == "0")
+        o.oneLightModules = false;
     // SHADOWLAB_BENCH_VIEW_CULL=0: the lit pass draws every triangle (raster::RendererOptions::viewCull).
     if (const char* v = std::getenv("SHADOWLAB_BENCH_VIEW_CULL"); v && std::string(v) == "0") o.viewCull = false;
     return o;

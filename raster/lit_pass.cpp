@@ -25,10 +25,23 @@ bool bakesLightConstants(const LitVariant& v) {
 
 bool bakesEveryLight(const LitVariant& v) { return v.lightCount > 0 && !bakesLightConstants(v); }
 
-bool usesSunModules(const LitVariant& v) {
+namespace {
+// None or pcf2x2, one light of `kind`, no semi-transparent casters, no receiver plane, no per-light
+// targets, and the size-optimized modules asked for: the constants SHADOWLAB_ONE_SUN, _SPOT and
+// _POINT fix (lit_constants.glsl).
+bool oneLightOfKind(const LitVariant& v, int kind) {
     const bool taps = v.filter == scene::ShadowFilter::None || v.filter == scene::ShadowFilter::Pcf2x2;
-    return v.sunModules && taps && v.lightTargets == 0 && v.lightCount == 1 &&
-           v.lightKinds == (1u << SHADOWLAB_LIGHT_DIRECTIONAL) && !v.transmittance && !v.receiverPlane;
+    return v.oneLightModules && taps && v.lightTargets == 0 && v.lightCount == 1 && v.lightKinds == (1u << kind) &&
+           !v.transmittance && !v.receiverPlane;
+}
+}  // namespace
+
+bool usesSunModules(const LitVariant& v) { return oneLightOfKind(v, SHADOWLAB_LIGHT_DIRECTIONAL); }
+
+bool usesSpotOrPointModule(const LitVariant& v) {
+    return v.specializedLightConstants && v.cascades == 1 &&
+           ((oneLightOfKind(v, SHADOWLAB_LIGHT_SPOT) && bakesLightConstants(v)) ||
+            (oneLightOfKind(v, SHADOWLAB_LIGHT_POINT) && bakesEveryLight(v)));
 }
 
 std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUniforms& u, bool everyLight) {
@@ -100,8 +113,9 @@ std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUn
 // and for none and pcf2x2 the *_taps build without the other filters' code (lavapipe turns all of a
 // module into NIR before the specialization constants remove what a pipeline does not run: the full
 // module doubled the lit pipeline's creation); where usesSunModules(), the *_sun modules (*_sun_map
-// with one map and no blend bands, *_baked of those for baked constants); elsewhere the general
-// ones, *_baked where the one light's constants are baked in, *_every where every light's are.
+// with one map and no blend bands, *_baked of those for baked constants); where
+// usesSpotOrPointModule(), the *_spot or *_point module; elsewhere the general ones, *_baked where
+// the one light's constants are baked in, *_every where every light's are.
 // lit.vert: the build whose outputs are the fragment shader's inputs.
 LitStages litStages(const LitVariant& v, bool alpha) {
     const bool taps = v.filter == scene::ShadowFilter::None || v.filter == scene::ShadowFilter::Pcf2x2;
@@ -133,6 +147,29 @@ LitStages litStages(const LitVariant& v, bool alpha) {
         if (!v.aovTarget)
             return {vertex, alpha ? shaders::litFragBeautyAlphaTapsSunSpirv() : shaders::litFragBeautyTapsSunSpirv()};
         return {vertex, alpha ? shaders::litFragAlphaTapsSunSpirv() : shaders::litFragTapsSunSpirv()};
+    }
+    if (usesSpotOrPointModule(v)) {
+        // One spot (its constants baked in, its map coordinates from lit.vert) or one point light
+        // (every light's constants baked in, no map coordinates from lit.vert: the *_cascades
+        // lit.vert, which writes none): the size-optimized *_spot and *_point modules; the no-id
+        // lit.vert where the fragment shader reads no object id (spirv-opt removed it).
+        const bool noId = !alpha && !v.aovTarget;
+        if (v.lightKinds == (1u << SHADOWLAB_LIGHT_SPOT)) {
+            const auto vertex = alpha  ? shaders::litVertAlphaBakedSpirv()
+                                : noId ? shaders::litVertNoIdBakedSpirv()
+                                       : shaders::litVertBakedSpirv();
+            if (!v.aovTarget)
+                return {vertex,
+                        alpha ? shaders::litFragBeautyAlphaTapsSpotSpirv() : shaders::litFragBeautyTapsSpotSpirv()};
+            return {vertex, alpha ? shaders::litFragAlphaTapsSpotSpirv() : shaders::litFragTapsSpotSpirv()};
+        }
+        const auto vertex = alpha  ? shaders::litVertAlphaCascadesSpirv()
+                            : noId ? shaders::litVertNoIdCascadesSpirv()
+                                   : shaders::litVertCascadesSpirv();
+        if (!v.aovTarget)
+            return {vertex,
+                    alpha ? shaders::litFragBeautyAlphaTapsPointSpirv() : shaders::litFragBeautyTapsPointSpirv()};
+        return {vertex, alpha ? shaders::litFragAlphaTapsPointSpirv() : shaders::litFragTapsPointSpirv()};
     }
     if (v.specializedLightConstants && bakesEveryLight(v)) {
         // Every light baked in: the general modules' *_every builds, without flat light inputs.

@@ -84,11 +84,12 @@ struct LitVariant {
     std::array<float, kPackedLightConstants> lightConstants{};
     // The filterable filters' parameters (specialization constants 11..16; unused by the others).
     scene::MomentSettings moments;
-    // Where the variant allows (none or pcf2x2, one directional light, no semi-transparent casters,
-    // no receiver plane, no per-light targets): the *_sun modules, with those constants fixed in
-    // the source and the code they switch off left out, so that the pipeline is made several times
-    // faster (lavapipe turns the whole module into NIR); false: the general module (tests compare).
-    bool sunModules = true;
+    // Where the variant allows (none or pcf2x2, one light, no semi-transparent casters, no receiver
+    // plane, no per-light targets): the *_sun modules for a directional light, and with baked
+    // constants the *_spot and *_point modules, with those constants fixed in the source and the
+    // code they switch off left out, so that the pipeline is made several times faster (lavapipe
+    // turns the whole module into NIR); false: the general modules (tests compare).
+    bool oneLightModules = true;
 };
 // Whether lit.frag takes light 0's map coordinates from lit.vert (lit_constants.glsl
 // kVertexLightCoordinates, the same condition): one light, directional with one map or a spot, and
@@ -102,8 +103,12 @@ bool bakesLightConstants(const LitVariant& variant);
 // receiver-plane bias).
 bool bakesEveryLight(const LitVariant& variant);
 // Whether the variant has the constants SHADOWLAB_ONE_SUN fixes (lit_constants.glsl), with none or
-// pcf2x2: the *_taps_sun modules (where LitVariant::sunModules asks for them).
+// pcf2x2: the *_taps_sun modules (where LitVariant::oneLightModules asks for them).
 bool usesSunModules(const LitVariant& variant);
+// Whether the variant has the constants SHADOWLAB_ONE_SPOT or SHADOWLAB_ONE_POINT fixes, with none
+// or pcf2x2 and its constants baked in: the *_taps_spot or *_taps_point module (where
+// LitVariant::oneLightModules asks for them).
+bool usesSpotOrPointModule(const LitVariant& variant);
 // The SPIR-V of the lit pipeline's two stages for the variant (with the camera's alpha test or
 // not). Each pair's vertex outputs are exactly its fragment inputs: llvmpipe stores every declared
 // output per vertex and sets up every declared input per triangle, used or not, so the baked-constant

@@ -213,7 +213,7 @@ struct Renderer::Impl {
     std::array<float, kPackedLightConstants> bakedLightConstants{};
     bool renderIntoFrame = true;       // RendererOptions::renderIntoFrame
     bool transmittanceWindows = true;  // RendererOptions::transmittanceWindows
-    bool sunModules = true;            // RendererOptions::sunModules
+    bool oneLightModules = true;       // RendererOptions::oneLightModules
     double setupMs = 0.0;
     double pendingSetupMs = 0.0;  // setup not yet reported in a frame (the constructor's)
 
@@ -344,7 +344,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
     vertexBuffer = uploadBuffer(ctx, geometry.vertices, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
     // Lift-free draws need the *_sun modules (one directional light, none or pcf2x2, no
     // semi-transparent casters, no receiver plane) and no normal offset asked for.
-    liftFreeDraws = options.liftFreeDraws && options.sunModules && scene.lights.size() == 1 &&
+    liftFreeDraws = options.liftFreeDraws && options.oneLightModules && scene.lights.size() == 1 &&
                     scene.lights[0].type == scene::LightType::Directional &&
                     (settings.filter == scene::ShadowFilter::None || settings.filter == scene::ShadowFilter::Pcf2x2) &&
                     !settings.receiverPlaneBias && !planIn.needsTransmittanceMap && settings.normalOffset == 0.0;
@@ -610,7 +610,7 @@ void Renderer::Impl::createTargets(const scene::Scene& scene, const RendererOpti
                                options.readTargetsInPlace);
     ownTargetsTouched.assign(kLitPlanes + targets.lights.size(), false);
     renderIntoFrame = options.renderIntoFrame;
-    sunModules = options.sunModules;
+    oneLightModules = options.oneLightModules;
     if (!targets.hostReadable) readback = createReadback(ctx, targets);
     // How the targets reach the Frame: read in place (lavapipe) or copied into buffers first.
     attributes["readback"] = targets.hostReadable ? "in-place" : "copy";
@@ -864,7 +864,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
                           .specializedLightConstants = specializedLightConstants,
                           .lightConstants = bakedLightConstants,
                           .moments = settings.moments,
-                          .sunModules = sunModules};
+                          .oneLightModules = oneLightModules};
     };
     // The lift-free triangles' pipeline (docs/raster.md "Lift-free draws"): with the *_sun modules
     // only, whose pipelines are made in about 5 ms of CPU, so that it is made with the frame's others.

@@ -73,9 +73,9 @@ struct RendererOptions {
     bool transmittanceWindows = true;
     LightConstants lightConstants = LightConstants::kSpecialization;
     // The lit pass's size-optimized shader modules where the scene allows them
-    // (LitVariant::sunModules); false: the general ones (tests compare the two).
-    bool sunModules = true;
-    // With the size-optimized modules (sunModules), the lit pass draws the triangles on which no
+    // (LitVariant::oneLightModules); false: the general ones (tests compare the two).
+    bool oneLightModules = true;
+    // With the size-optimized modules (oneLightModules), the lit pass draws the triangles on which no
     // fragment takes the slope bias's lift past its cap (raster/lift_free.h) with a pipeline without
     // that path, the rest with it, from the frame after the one that made that pipeline (its shader
     // is compiled at its first draw); the same frames (tests compare). false: every triangle with it.

@@ -9,13 +9,20 @@ layout(constant_id = 1) const bool kBlockerIds = true;  // look up and write the
 // The number of lights (u.lightCount holds the same), so the light loop unrolls and each light's
 // uniforms are loaded from a constant index; and the light kinds present (bit 1 << kind), so
 // the spot and point-light paths are left out of scenes without such lights.
-#ifdef SHADOWLAB_ONE_SUN
+#if defined(SHADOWLAB_ONE_SUN) || defined(SHADOWLAB_ONE_SPOT) || defined(SHADOWLAB_ONE_POINT)
 // (The *_sun variants: one directional light, no semi-transparent casters, no receiver plane;
-// *_sun_map also one map, no cascades. These constants are plain constants there, so spirv-opt
-// drops the code they switch off before lavapipe turns the module into NIR.)
+// *_sun_map also one map, no cascades; *_spot and *_point: one spot or one point light, likewise.
+// These constants are plain constants there, so spirv-opt drops the code they switch off before
+// lavapipe turns the module into NIR.)
 const int kLightCount = 1;
+#if defined(SHADOWLAB_ONE_SPOT)
+const int kLightKinds = 1 << SHADOWLAB_LIGHT_SPOT;
+#elif defined(SHADOWLAB_ONE_POINT)
+const int kLightKinds = 1 << SHADOWLAB_LIGHT_POINT;
+#else
 const int kLightKinds = 1 << SHADOWLAB_LIGHT_DIRECTIONAL;
-#ifdef SHADOWLAB_ONE_MAP
+#endif
+#if defined(SHADOWLAB_ONE_MAP) || !defined(SHADOWLAB_ONE_SUN)
 const int kCascades = 1;
 const bool kCascadeBlend = false;
 #else

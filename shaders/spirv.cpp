@@ -14,6 +14,8 @@
 #include "lit_frag_alpha_taps.spv.h"
 #include "lit_frag_alpha_taps_baked.spv.h"
 #include "lit_frag_alpha_taps_every.spv.h"
+#include "lit_frag_alpha_taps_point.spv.h"
+#include "lit_frag_alpha_taps_spot.spv.h"
 #include "lit_frag_alpha_taps_sun.spv.h"
 #include "lit_frag_alpha_taps_sun_map.spv.h"
 #include "lit_frag_alpha_taps_sun_map_baked.spv.h"
@@ -25,6 +27,8 @@
 #include "lit_frag_beauty_alpha_taps.spv.h"
 #include "lit_frag_beauty_alpha_taps_baked.spv.h"
 #include "lit_frag_beauty_alpha_taps_every.spv.h"
+#include "lit_frag_beauty_alpha_taps_point.spv.h"
+#include "lit_frag_beauty_alpha_taps_spot.spv.h"
 #include "lit_frag_beauty_alpha_taps_sun.spv.h"
 #include "lit_frag_beauty_alpha_taps_sun_map.spv.h"
 #include "lit_frag_beauty_alpha_taps_sun_map_baked.spv.h"
@@ -33,6 +37,8 @@
 #include "lit_frag_beauty_taps.spv.h"
 #include "lit_frag_beauty_taps_baked.spv.h"
 #include "lit_frag_beauty_taps_every.spv.h"
+#include "lit_frag_beauty_taps_point.spv.h"
+#include "lit_frag_beauty_taps_spot.spv.h"
 #include "lit_frag_beauty_taps_sun.spv.h"
 #include "lit_frag_beauty_taps_sun_map.spv.h"
 #include "lit_frag_beauty_taps_sun_map_baked.spv.h"
@@ -48,6 +54,8 @@
 #include "lit_frag_taps.spv.h"
 #include "lit_frag_taps_baked.spv.h"
 #include "lit_frag_taps_every.spv.h"
+#include "lit_frag_taps_point.spv.h"
+#include "lit_frag_taps_spot.spv.h"
 #include "lit_frag_taps_sun.spv.h"
 #include "lit_frag_taps_sun_map.spv.h"
 #include "lit_frag_taps_sun_map_baked.spv.h"
@@ -126,6 +134,14 @@ std::span<const std::uint32_t> litFragBeautyBakedSpirv() { return kLitFragBeauty
 std::span<const std::uint32_t> litFragBeautyAlphaBakedSpirv() { return kLitFragBeautyAlphaBakedSpv; }
 std::span<const std::uint32_t> litFragEverySpirv() { return kLitFragEverySpv; }
 std::span<const std::uint32_t> litFragTapsEverySpirv() { return kLitFragTapsEverySpv; }
+std::span<const std::uint32_t> litFragTapsSpotSpirv() { return kLitFragTapsSpotSpv; }
+std::span<const std::uint32_t> litFragTapsPointSpirv() { return kLitFragTapsPointSpv; }
+std::span<const std::uint32_t> litFragAlphaTapsSpotSpirv() { return kLitFragAlphaTapsSpotSpv; }
+std::span<const std::uint32_t> litFragAlphaTapsPointSpirv() { return kLitFragAlphaTapsPointSpv; }
+std::span<const std::uint32_t> litFragBeautyTapsSpotSpirv() { return kLitFragBeautyTapsSpotSpv; }
+std::span<const std::uint32_t> litFragBeautyTapsPointSpirv() { return kLitFragBeautyTapsPointSpv; }
+std::span<const std::uint32_t> litFragBeautyAlphaTapsSpotSpirv() { return kLitFragBeautyAlphaTapsSpotSpv; }
+std::span<const std::uint32_t> litFragBeautyAlphaTapsPointSpirv() { return kLitFragBeautyAlphaTapsPointSpv; }
 std::span<const std::uint32_t> litFragAlphaEverySpirv() { return kLitFragAlphaEverySpv; }
 std::span<const std::uint32_t> litFragAlphaTapsEverySpirv() { return kLitFragAlphaTapsEverySpv; }
 std::span<const std::uint32_t> litFragBeautyEverySpirv() { return kLitFragBeautyEverySpv; }

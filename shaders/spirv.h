@@ -85,6 +85,17 @@ std::span<const std::uint32_t> litFragLightsEverySpirv();
 std::span<const std::uint32_t> litFragLightsTapsEverySpirv();
 std::span<const std::uint32_t> litFragLightsAlphaEverySpirv();
 std::span<const std::uint32_t> litFragLightsAlphaTapsEverySpirv();
+// One spot or one point light with none or pcf2x2, no semi-transparent casters, no receiver plane
+// (SHADOWLAB_ONE_SPOT, SHADOWLAB_ONE_POINT), optimized for size as the *_sun ones: the *_baked
+// module of a spot, the *_every module of a point light, with their constants baked in.
+std::span<const std::uint32_t> litFragTapsSpotSpirv();
+std::span<const std::uint32_t> litFragTapsPointSpirv();
+std::span<const std::uint32_t> litFragAlphaTapsSpotSpirv();
+std::span<const std::uint32_t> litFragAlphaTapsPointSpirv();
+std::span<const std::uint32_t> litFragBeautyTapsSpotSpirv();
+std::span<const std::uint32_t> litFragBeautyTapsPointSpirv();
+std::span<const std::uint32_t> litFragBeautyAlphaTapsSpotSpirv();
+std::span<const std::uint32_t> litFragBeautyAlphaTapsPointSpirv();
 std::span<const std::uint32_t> litVertBakedSpirv();
 std::span<const std::uint32_t> litVertAlphaBakedSpirv();
 std::span<const std::uint32_t> litVertNoIdBakedSpirv();

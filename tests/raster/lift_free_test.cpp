@@ -211,7 +211,7 @@ TEST(LiftFree, LiftFreeDrawsGiveTheSameFramesBitForBit) {
     scene::RasterSettings plane = pcf;
     plane.receiverPlaneBias = true;
     expectSameFrames(makeScene(oblique), plane, false);
-    expectSameFrames(makeScene(oblique), pcf, false, RendererOptions{.sunModules = false});
+    expectSameFrames(makeScene(oblique), pcf, false, RendererOptions{.oneLightModules = false});
     // Cascades with blend bands (*_sun modules).
     scene::Scene cascaded = makeLongPlane();
     scene::RasterSettings cascades = validatedSettings(512, 0.0, 1.0, ShadowFilter::Pcf2x2);

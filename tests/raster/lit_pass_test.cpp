@@ -284,12 +284,13 @@ TEST(RasterLitPass, EachVertexShaderWritesExactlyWhatItsFragmentShaderReads) {
     // input takes still costs llvmpipe a store per vertex, as a declared input costs it a setup per
     // triangle: so the sets are equal, for every pair litStages() hands out.
     constexpr std::uint32_t kInput = 1, kOutput = 3;
-    constexpr std::uint32_t dir = 1u << SHADOWLAB_LIGHT_DIRECTIONAL, spot = 1u << SHADOWLAB_LIGHT_SPOT;
+    constexpr std::uint32_t dir = 1u << SHADOWLAB_LIGHT_DIRECTIONAL, spot = 1u << SHADOWLAB_LIGHT_SPOT,
+                            point = 1u << SHADOWLAB_LIGHT_POINT;
     int pairs = 0;
     for (const scene::ShadowFilter filter : {scene::ShadowFilter::Pcf2x2, scene::ShadowFilter::Pcf})
         for (const bool aov : {true, false})
             for (const std::uint32_t lightTargets : {0u, kLightTargets})
-                for (const std::uint32_t kinds : {dir, spot, dir | spot})
+                for (const std::uint32_t kinds : {dir, spot, point, dir | spot})
                     for (const std::uint32_t cascades : {1u, 4u})
                         for (const bool blend : {false, true})
                             for (const bool baked : {false, true})
@@ -305,7 +306,7 @@ TEST(RasterLitPass, EachVertexShaderWritesExactlyWhatItsFragmentShaderReads) {
                                                      .cascadeBlend = blend,
                                                      .vertexLightConstants = true,
                                                      .specializedLightConstants = baked,
-                                                     .sunModules = sun};
+                                                     .oneLightModules = sun};
                                         const LitStages stages = litStages(v, alpha);
                                         EXPECT_EQ(interfaceLocations(stages.vertex, kOutput),
                                                   interfaceLocations(stages.fragment, kInput))
@@ -344,6 +345,48 @@ TEST(RasterLitPass, OneSunWithBakedConstantsOrCascadesHasNoFlatLightInterface) {
             EXPECT_TRUE(interfaceLocations(flat.fragment, kInput).contains(6u));
             EXPECT_TRUE(interfaceLocations(flat.vertex, kOutput).contains(12u));
         }
+}
+
+TEST(RasterLitPass, OneSpotOrOnePointLightWithBakedConstantsGetsItsSizeOptimizedModule) {
+    // The *_spot and *_point modules fix one light of that kind, no transmittance, no receiver
+    // plane and one map, and bake the constants in: exactly those variants get them, with none or
+    // pcf2x2, where LitVariant::oneLightModules asks for them.
+    constexpr std::uint32_t spot = 1u << SHADOWLAB_LIGHT_SPOT, point = 1u << SHADOWLAB_LIGHT_POINT;
+    for (const bool alpha : {false, true})
+        for (const bool aov : {true, false})
+            for (const std::uint32_t kind : {spot, point}) {
+                const bool isSpot = kind == spot;
+                const std::span<const std::uint32_t> expected =
+                    isSpot ? (aov ? (alpha ? shaders::litFragAlphaTapsSpotSpirv() : shaders::litFragTapsSpotSpirv())
+                                  : (alpha ? shaders::litFragBeautyAlphaTapsSpotSpirv()
+                                           : shaders::litFragBeautyTapsSpotSpirv()))
+                           : (aov ? (alpha ? shaders::litFragAlphaTapsPointSpirv() : shaders::litFragTapsPointSpirv())
+                                  : (alpha ? shaders::litFragBeautyAlphaTapsPointSpirv()
+                                           : shaders::litFragBeautyTapsPointSpirv()));
+                const LitVariant one{.filter = scene::ShadowFilter::None,
+                                     .aovTarget = aov,
+                                     .lightKinds = kind,
+                                     .specializedLightConstants = true};
+                const std::string what =
+                    std::string(isSpot ? "spot" : "point") + (aov ? ", aov" : ", beauty") + (alpha ? ", alpha" : "");
+                EXPECT_TRUE(usesSpotOrPointModule(one)) << what;
+                EXPECT_EQ(litStages(one, alpha).fragment.data(), expected.data()) << what;
+                LitVariant pcf2x2 = one;
+                pcf2x2.filter = scene::ShadowFilter::Pcf2x2;
+                EXPECT_EQ(litStages(pcf2x2, alpha).fragment.data(), expected.data()) << what;
+                LitVariant notThese[6] = {one, one, one, one, one, one};
+                notThese[0].filter = scene::ShadowFilter::Pcf;
+                notThese[1].oneLightModules = false;
+                notThese[2].specializedLightConstants = false;
+                notThese[3].transmittance = true;
+                notThese[4].receiverPlane = true;
+                notThese[5].lightCount = 2;
+                notThese[5].lightKinds = kind | (1u << SHADOWLAB_LIGHT_DIRECTIONAL);
+                for (int k = 0; k < 6; ++k) {
+                    EXPECT_FALSE(usesSpotOrPointModule(notThese[k])) << what << ", case " << k;
+                    EXPECT_NE(litStages(notThese[k], alpha).fragment.data(), expected.data()) << what << ", case " << k;
+                }
+            }
 }
 
 TEST(RasterLitPass, OneSpotOrASunOutsideTheSunModulesWithBakedConstantsHasNoFlatLightInterface) {
