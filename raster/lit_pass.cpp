@@ -117,59 +117,48 @@ std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUn
 // usesSpotOrPointModule(), the *_spot or *_point module; elsewhere the general ones, *_baked where
 // the one light's constants are baked in, *_every where every light's are.
 // lit.vert: the build whose outputs are the fragment shader's inputs.
+namespace {
+using Spirv = std::span<const std::uint32_t>;
+// Of a family's four lit.frag modules, the one for the variant's outputs (the AOVs or the beauty
+// alone) and the camera's alpha test.
+Spirv fragmentOf(const LitVariant& v, bool alpha, Spirv aovs, Spirv aovsAlpha, Spirv beauty, Spirv beautyAlpha) {
+    return v.aovTarget ? (alpha ? aovsAlpha : aovs) : (alpha ? beautyAlpha : beauty);
+}
+// Of a family's lit.vert builds, the one with the alpha test's coordinates, the no-id one where the
+// size-optimized fragment module reads no object id (the beauty alone without the alpha test:
+// spirv-opt removed the input), or the plain one.
+Spirv vertexOf(const LitVariant& v, bool alpha, Spirv plain, Spirv withAlpha, Spirv noId) {
+    return alpha ? withAlpha : v.aovTarget ? plain : noId;
+}
+}  // namespace
+
 LitStages litStages(const LitVariant& v, bool alpha) {
+    using namespace shaders;
     const bool taps = v.filter == scene::ShadowFilter::None || v.filter == scene::ShadowFilter::Pcf2x2;
     if (usesSunModules(v)) {
-        // The no-id lit.vert where the fragment shader reads no object id (spirv-opt removed it).
-        const bool noId = !alpha && !v.aovTarget;
-        if (v.cascades == 1 && !v.cascadeBlend && v.specializedLightConstants) {
-            const auto vertex = alpha  ? shaders::litVertAlphaBakedSpirv()
-                                : noId ? shaders::litVertNoIdBakedSpirv()
-                                       : shaders::litVertBakedSpirv();
-            if (!v.aovTarget)
-                return {vertex, alpha ? shaders::litFragBeautyAlphaTapsSunMapBakedSpirv()
-                                      : shaders::litFragBeautyTapsSunMapBakedSpirv()};
-            return {vertex,
-                    alpha ? shaders::litFragAlphaTapsSunMapBakedSpirv() : shaders::litFragTapsSunMapBakedSpirv()};
-        }
-        if (v.cascades == 1 && !v.cascadeBlend) {
-            const auto vertex = alpha  ? shaders::litVertAlphaSpirv()
-                                : noId ? shaders::litVertNoIdSpirv()
-                                       : shaders::litVertSpirv();
-            if (!v.aovTarget)
-                return {vertex,
-                        alpha ? shaders::litFragBeautyAlphaTapsSunMapSpirv() : shaders::litFragBeautyTapsSunMapSpirv()};
-            return {vertex, alpha ? shaders::litFragAlphaTapsSunMapSpirv() : shaders::litFragTapsSunMapSpirv()};
-        }
-        const auto vertex = alpha  ? shaders::litVertAlphaCascadesSpirv()
-                            : noId ? shaders::litVertNoIdCascadesSpirv()
-                                   : shaders::litVertCascadesSpirv();
-        if (!v.aovTarget)
-            return {vertex, alpha ? shaders::litFragBeautyAlphaTapsSunSpirv() : shaders::litFragBeautyTapsSunSpirv()};
-        return {vertex, alpha ? shaders::litFragAlphaTapsSunSpirv() : shaders::litFragTapsSunSpirv()};
+        if (v.cascades == 1 && !v.cascadeBlend && v.specializedLightConstants)
+            return {vertexOf(v, alpha, litVertBakedSpirv(), litVertAlphaBakedSpirv(), litVertNoIdBakedSpirv()),
+                    fragmentOf(v, alpha, litFragTapsSunMapBakedSpirv(), litFragAlphaTapsSunMapBakedSpirv(),
+                               litFragBeautyTapsSunMapBakedSpirv(), litFragBeautyAlphaTapsSunMapBakedSpirv())};
+        if (v.cascades == 1 && !v.cascadeBlend)
+            return {vertexOf(v, alpha, litVertSpirv(), litVertAlphaSpirv(), litVertNoIdSpirv()),
+                    fragmentOf(v, alpha, litFragTapsSunMapSpirv(), litFragAlphaTapsSunMapSpirv(),
+                               litFragBeautyTapsSunMapSpirv(), litFragBeautyAlphaTapsSunMapSpirv())};
+        return {vertexOf(v, alpha, litVertCascadesSpirv(), litVertAlphaCascadesSpirv(), litVertNoIdCascadesSpirv()),
+                fragmentOf(v, alpha, litFragTapsSunSpirv(), litFragAlphaTapsSunSpirv(), litFragBeautyTapsSunSpirv(),
+                           litFragBeautyAlphaTapsSunSpirv())};
     }
     if (usesSpotOrPointModule(v)) {
-        // One spot (its constants baked in, its map coordinates from lit.vert) or one point light
-        // (every light's constants baked in, no map coordinates from lit.vert: the *_cascades
-        // lit.vert, which writes none): the size-optimized *_spot and *_point modules; the no-id
-        // lit.vert where the fragment shader reads no object id (spirv-opt removed it).
-        const bool noId = !alpha && !v.aovTarget;
-        if (v.lightKinds == (1u << SHADOWLAB_LIGHT_SPOT)) {
-            const auto vertex = alpha  ? shaders::litVertAlphaBakedSpirv()
-                                : noId ? shaders::litVertNoIdBakedSpirv()
-                                       : shaders::litVertBakedSpirv();
-            if (!v.aovTarget)
-                return {vertex,
-                        alpha ? shaders::litFragBeautyAlphaTapsSpotSpirv() : shaders::litFragBeautyTapsSpotSpirv()};
-            return {vertex, alpha ? shaders::litFragAlphaTapsSpotSpirv() : shaders::litFragTapsSpotSpirv()};
-        }
-        const auto vertex = alpha  ? shaders::litVertAlphaCascadesSpirv()
-                            : noId ? shaders::litVertNoIdCascadesSpirv()
-                                   : shaders::litVertCascadesSpirv();
-        if (!v.aovTarget)
-            return {vertex,
-                    alpha ? shaders::litFragBeautyAlphaTapsPointSpirv() : shaders::litFragBeautyTapsPointSpirv()};
-        return {vertex, alpha ? shaders::litFragAlphaTapsPointSpirv() : shaders::litFragTapsPointSpirv()};
+        // One spot: its constants baked in, its map coordinates from lit.vert. One point light:
+        // every light's constants baked in, no map coordinates from lit.vert, so the *_cascades
+        // lit.vert, which writes none.
+        if (v.lightKinds == (1u << SHADOWLAB_LIGHT_SPOT))
+            return {vertexOf(v, alpha, litVertBakedSpirv(), litVertAlphaBakedSpirv(), litVertNoIdBakedSpirv()),
+                    fragmentOf(v, alpha, litFragTapsSpotSpirv(), litFragAlphaTapsSpotSpirv(),
+                               litFragBeautyTapsSpotSpirv(), litFragBeautyAlphaTapsSpotSpirv())};
+        return {vertexOf(v, alpha, litVertCascadesSpirv(), litVertAlphaCascadesSpirv(), litVertNoIdCascadesSpirv()),
+                fragmentOf(v, alpha, litFragTapsPointSpirv(), litFragAlphaTapsPointSpirv(),
+                           litFragBeautyTapsPointSpirv(), litFragBeautyAlphaTapsPointSpirv())};
     }
     if (v.specializedLightConstants && bakesEveryLight(v)) {
         // Every light baked in: the general modules' *_every builds, without flat light inputs.
