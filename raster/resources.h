@@ -78,10 +78,11 @@ ImageViewHandle createView(const Context& ctx, VkImage image, VkFormat format, V
 
 // Faults in the pages of `bytes` of host memory from `data` as writable, in one call (Linux 5.14's
 // MADV_POPULATE_WRITE; nothing happens where the kernel refuses), leaving what they hold as it
-// is. For memory the device will write before anything reads it: llvmpipe reads a target's texels
-// under a partly covered block before it writes them, and a page first read maps the shared zero
-// page, to be copied again at the write with a TLB shootdown across the driver's threads (at
-// 1920x1080, 0.3 s of CPU for the per-light targets; docs/performance.md, "Several lights").
+// is. For new memory the device will render into: llvmpipe reads a target's texels under a partly
+// covered block before it writes them, and a page first read maps the shared zero page, to be
+// copied again at the write with a TLB shootdown across the driver's threads (at 1920x1080, 0.3 s
+// of CPU for the per-light targets; docs/performance.md, "Several lights"); and for new memory the
+// host is about to fill, one call instead of a fault a page.
 void prefaultPages(const void* data, std::size_t bytes);
 
 // One image layout transition with its execution and memory dependency.
