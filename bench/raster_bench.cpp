@@ -161,6 +161,9 @@ void benchScene(const std::string& label, scene::Scene s, int repeats, std::vect
     overrides.fitLightFrustum = false;
     overrides.cascades = 1;
     if (const char* v = std::getenv("SHADOWLAB_BENCH_CASCADES"); v && *v) overrides.cascades = std::atoi(v);
+    // SHADOWLAB_BENCH_FILTER=name: ours with that shadow filter instead of the scene's (pcf, poisson,
+    // pcss and the moment maps take the general lit modules); the bare baseline keeps its own PCF.
+    if (const char* v = std::getenv("SHADOWLAB_BENCH_FILTER"); v && *v) overrides.filter = v;
     const scene::RenderSettings settings = scene::resolveSettings(s, overrides);
     const scene::RenderPlan plan = scene::makeRenderPlan(s, settings);
 

@@ -125,8 +125,8 @@ Spirv fragmentOf(const LitVariant& v, bool alpha, Spirv aovs, Spirv aovsAlpha, S
     return v.aovTarget ? (alpha ? aovsAlpha : aovs) : (alpha ? beautyAlpha : beauty);
 }
 // Of a family's lit.vert builds, the one with the alpha test's coordinates, the no-id one where the
-// size-optimized fragment module reads no object id (the beauty alone without the alpha test:
-// spirv-opt removed the input), or the plain one.
+// fragment module reads no object id (the beauty alone without the alpha test: spirv-opt's size
+// passes removed the input), or the plain one.
 Spirv vertexOf(const LitVariant& v, bool alpha, Spirv plain, Spirv withAlpha, Spirv noId) {
     return alpha ? withAlpha : v.aovTarget ? plain : noId;
 }
@@ -162,7 +162,7 @@ LitStages litStages(const LitVariant& v, bool alpha) {
     }
     if (v.specializedLightConstants && bakesEveryLight(v)) {
         // Every light baked in: the general modules' *_every builds, without flat light inputs.
-        const auto vertex = alpha ? shaders::litVertAlphaBakedSpirv() : shaders::litVertBakedSpirv();
+        const auto vertex = vertexOf(v, alpha, litVertBakedSpirv(), litVertAlphaBakedSpirv(), litVertNoIdBakedSpirv());
         if (!v.aovTarget)
             return {vertex,
                     taps
@@ -179,7 +179,7 @@ LitStages litStages(const LitVariant& v, bool alpha) {
     if (v.specializedLightConstants) {
         // One spot light, or one sun with another filter or a transmittance map: the general
         // modules without the flat light inputs.
-        const auto vertex = alpha ? shaders::litVertAlphaBakedSpirv() : shaders::litVertBakedSpirv();
+        const auto vertex = vertexOf(v, alpha, litVertBakedSpirv(), litVertAlphaBakedSpirv(), litVertNoIdBakedSpirv());
         if (!v.aovTarget)
             return {vertex,
                     taps
@@ -188,7 +188,7 @@ LitStages litStages(const LitVariant& v, bool alpha) {
         return {vertex, taps ? (alpha ? shaders::litFragAlphaTapsBakedSpirv() : shaders::litFragTapsBakedSpirv())
                              : (alpha ? shaders::litFragAlphaBakedSpirv() : shaders::litFragBakedSpirv())};
     }
-    const auto vertex = alpha ? shaders::litVertAlphaSpirv() : shaders::litVertSpirv();
+    const auto vertex = vertexOf(v, alpha, litVertSpirv(), litVertAlphaSpirv(), litVertNoIdSpirv());
     if (!v.aovTarget)
         return {vertex, taps ? (alpha ? shaders::litFragBeautyAlphaTapsSpirv() : shaders::litFragBeautyTapsSpirv())
                              : (alpha ? shaders::litFragBeautyAlphaSpirv() : shaders::litFragBeautySpirv())};
