@@ -224,8 +224,8 @@ std::size_t litTrianglesDrawn(const DrawGeometry& geometry, bool byLift);
 // slope bias's lift (LitVariant::normalOffset false), which then draws the lift-free ranges of
 // DrawGeometry::litRangesByLift (null: litRanges, every one with the lift where `pipeline` has it).
 // backgroundInAttachments (float targets only): every attachment is in GENERAL and already holds
-// the background's values in every pixel (a new Frame's planes); they are loaded and the
-// background pipeline is not drawn.
+// the background's values in every pixel (a new Frame's planes, per-light targets zeroed on the
+// host); they are loaded and the background pipeline is not drawn.
 void recordLitPass(VkCommandBuffer commands, const LitPipeline& pipeline, const LitBindings& bindings,
                    const LitTargets& targets, const LitAttachments& attachments, const DrawGeometry& geometry,
                    const glm::vec3& background, LitOutputs outputs = LitOutputs::kAll,

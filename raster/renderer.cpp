@@ -175,8 +175,9 @@ struct Renderer::Impl {
     // The Frame's vectors for `channels` sized (the others emptied), and where each plane of the
     // frame's pipeline is rendered: `frameImages` over the Frame's vectors where possible (their
     // planes set in `intoFrame`), the Renderer's own targets for the rest.
-    // Returns true where every attachment is a new plane of the Frame that already holds the
-    // background (see there): the lit pass then draws no background.
+    // Returns true where every attachment already holds the background (see there): a new plane
+    // of the Frame, or a per-light target before its first frame, zeroed on the host. The lit pass
+    // then draws no background.
     bool prepareFrame(scene::Frame& frame, scene::ChannelMask channels, LitOutputs outputs, LitAttachments& attachments,
                       std::vector<Image>& frameImages, std::array<bool, kLitPlanes>& intoFrame);
     void readPixels(scene::Frame& frame, scene::ChannelMask channels,
@@ -186,6 +187,11 @@ struct Renderer::Impl {
         const VkMappedMemoryRange range{
             .sType = VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE, .memory = memory, .size = VK_WHOLE_SIZE};
         VK_CHECK(vkInvalidateMappedMemoryRanges(ctx.device.get(), 1, &range));
+    }
+    void flushMemory(VkDeviceMemory memory) const {
+        const VkMappedMemoryRange range{
+            .sType = VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE, .memory = memory, .size = VK_WHOLE_SIZE};
+        VK_CHECK(vkFlushMappedMemoryRanges(ctx.device.get(), 1, &range));
     }
 
     scene::RasterSettings settings;
@@ -227,7 +233,7 @@ struct Renderer::Impl {
     ShadowMaps maps;
     LitTargets targets;
     // Per target of `targets` (the planes, then the light targets): whether a frame has rendered
-    // into it, its pages then faulted in (prepareFrame).
+    // into it, its pages faulted in or, a light target's under a new Frame, zeroed first (prepareFrame).
     std::vector<bool> ownTargetsTouched;
     Readback readback;
     bool timestamps = false;
@@ -958,6 +964,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     if (debug) {
         debug->backgroundFromFrame = backgroundInFrame;
         debug->lightTargets = targets.lights.size();
+        debug->lightTargetTexels = targets.lights.empty() ? nullptr : targets.lights[0].mapped;
     }
     const double prepareMs = msSince(prepareStart);
     const auto litStart = Clock::now();
@@ -1075,7 +1082,11 @@ bool Renderer::Impl::prepareFrame(scene::Frame& frame, scene::ChannelMask channe
                                           kChannelNdotL,  kChannelDepth,      kChannelBlockerId};
     const std::uint32_t planes = outputs == LitOutputs::kAll ? kLitPlanes : 1;
     // An empty vector is value-initialized whole by resize(): all zeros, the background's AOVs.
-    bool fresh = outputs == LitOutputs::kBeauty || targets.lights.empty();
+    // The per-light targets before their first frame are zeroed on the host below (mapped ones).
+    bool fresh = true;
+    if (outputs == LitOutputs::kAll)
+        for (std::size_t t = 0; t < targets.lights.size(); ++t)
+            fresh = fresh && !ownTargetsTouched[kLitPlanes + t] && targets.lights[t].mapped;
     for (std::uint32_t p = 0; p < kLitPlanes; ++p) {
         const bool wanted = (channels & bits[p]) != 0;
         const bool direct = wanted && p < planes && renderIntoFrame && targets.frameImageBytes[p] > 0;
@@ -1099,15 +1110,20 @@ bool Renderer::Impl::prepareFrame(scene::Frame& frame, scene::ChannelMask channe
         frameImages.push_back(std::move(image));
     }
     if (fresh) {
-        // Every attachment is a new plane of the Frame: its zeros, with the beauty set to the
-        // background color, are the background, and the lit pass draws none (on a first frame its
-        // pipeline's shaders are not compiled then). The images go to GENERAL before the host
-        // writes them, so that the pass's transition (from GENERAL, load) keeps what is written.
+        // Every attachment is a new plane of the Frame or a per-light target before its first
+        // frame: its zeros, with the beauty set to the background color, are the background, and
+        // the lit pass draws none (on a first frame its pipeline's shaders are not compiled then).
+        // The images go to GENERAL before the host writes them, so that the pass's transition
+        // (from GENERAL, load) keeps what is written.
         std::vector<ImageTransition> toGeneral;
-        for (const Image& image : frameImages)
+        auto general = [&](const Image& image) {
             toGeneral.push_back({image.image.get(), VK_IMAGE_ASPECT_COLOR_BIT, 1, VK_IMAGE_LAYOUT_UNDEFINED,
                                  VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
                                  VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_NONE});
+        };
+        for (const Image& image : frameImages) general(image);
+        if (outputs == LitOutputs::kAll)
+            for (const Image& image : targets.lights) general(image);
         VkCommandBuffer commands = ctx.beginCommands();
         transition(commands, toGeneral);
         ctx.submitAndWait(commands);
@@ -1125,10 +1141,17 @@ bool Renderer::Impl::prepareFrame(scene::Frame& frame, scene::ChannelMask channe
         for (std::uint32_t y = 0; y < height; ++y) frame.beauty.insert(frame.beauty.end(), row.begin(), row.end());
     }
     // The Renderer's own targets (never cleared) are read under partly covered blocks before they
-    // are written: their pages are faulted in writable before the first frame that renders them.
+    // are written: their pages are faulted in writable before the first frame that renders them,
+    // a per-light target's by writing its zeros where that frame takes them for the background.
     auto own = [&](const Image& image, std::size_t index) {
-        if (!ownTargetsTouched[index] && image.mapped)
-            prefaultPages(image.mapped, std::size_t(image.rowPitch) * height);
+        const std::size_t bytes = std::size_t(image.rowPitch) * height;
+        if (!ownTargetsTouched[index] && image.mapped) {
+            if (fresh && index >= kLitPlanes) {
+                std::memset(image.mapped, 0, bytes);
+                flushMemory(image.memory.get());
+            } else
+                prefaultPages(image.mapped, bytes);
+        }
         ownTargetsTouched[index] = true;
         attachments.add(image);
     };

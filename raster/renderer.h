@@ -29,8 +29,9 @@ struct RenderDebug {
     std::vector<ShadowLayer> layers;
     std::vector<std::vector<float>> layerDepths;
     std::uint32_t mapSize = 0;
-    // Out: the background came from the Frame (its planes were new: zeros and the background
-    // color) instead of the lit pass's background pipeline.
+    // Out: the background came from the attachments (the Frame's planes were new: zeros and the
+    // background color; the per-light targets, before their first frame, zeroed on the host)
+    // instead of the lit pass's background pipeline.
     bool backgroundFromFrame = false;
     // Out: the triangles the lit pass drew with the pipeline without the slope bias's lift
     // (RendererOptions::liftFreeDraws; 0 in the frame that made that pipeline, a Renderer's first).
@@ -40,6 +41,9 @@ struct RenderDebug {
     // Out: the RGBA32F targets that hold the per-light visibility (one per four lights, none for
     // one light), each rendered with every channel.
     std::size_t lightTargets = 0;
+    // Out: the first per-light target's texels where the host maps them (null otherwise): which
+    // memory the target took.
+    const void* lightTargetTexels = nullptr;
 };
 
 // Where the lit pass's fragment shader reads the one light's constants, where it takes that

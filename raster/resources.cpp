@@ -151,7 +151,7 @@ Image createImage(const Context& ctx, VkFormat format, std::uint32_t width, std:
         vkGetImageSubresourceLayout(device, image, &subresource, &layout);
         void* base = nullptr;
         VK_CHECK(vkMapMemory(device, memory, 0, VK_WHOLE_SIZE, 0, &base));
-        img.mapped = static_cast<const char*>(base) + layout.offset;
+        img.mapped = static_cast<char*>(base) + layout.offset;
         img.rowPitch = layout.rowPitch;
     }
     img.view = createView(ctx, image, format, aspect, viewType, 0, layers);

@@ -27,7 +27,7 @@ struct Image {
     ImageViewHandle view;  // of every layer (2D or 2D array)
     // Host-readable images only (linear tiling, host-visible memory, mapped): the first texel
     // of layer 0 and the bytes from one row to the next.
-    const void* mapped = nullptr;
+    void* mapped = nullptr;
     VkDeviceSize rowPitch = 0;
 };
 

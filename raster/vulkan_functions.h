@@ -59,6 +59,7 @@
     X(vkMapMemory)                               \
     X(vkUnmapMemory)                             \
     X(vkInvalidateMappedMemoryRanges)            \
+    X(vkFlushMappedMemoryRanges)                 \
     X(vkCreateSampler)                           \
     X(vkDestroySampler)                          \
     X(vkCreateShaderModule)                      \

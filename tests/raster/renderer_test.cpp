@@ -3,8 +3,11 @@
 // Set SHADOWLAB_TEST_PNG_DIR to also write each render's beauty image there for a look.
 #include "raster/renderer.h"
 
+#include <malloc.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <initializer_list>
 #include <limits>
@@ -1196,13 +1199,16 @@ TEST(RasterRenderer, RenderingIntoTheFrameReadingTheTargetsInPlaceAndCopyingThem
 }
 
 TEST(RasterRenderer, ANewFrameHoldsTheBackgroundAndAReusedOneGetsTheBackgroundPass) {
-    // Where every lit-pass attachment is a new plane of the Frame, the planes' zeros (resize()
-    // value-initializes) with the beauty set to the background color are the background, and the
-    // background pipeline is not drawn; into a reused Frame (here holding NaN everywhere, so that
-    // a pixel left unwritten shows) and into the Renderer's own targets it is. All give the same
-    // frame bit for bit, and the background pixels are the scene's color with zero AOVs (the
-    // background pass's values, docs/raster.md). Black (nothing to fill) and a color; all channels
-    // and the float beauty; two lights (per-light targets of the Renderer's own: the pass).
+    // Where every lit-pass attachment is a new plane of the Frame (or a per-light target before
+    // its first frame, zeroed on the host), the planes' zeros (resize() value-initializes) with the
+    // beauty set to the background color are the background, and the background pipeline is not
+    // drawn; into a reused Frame (here holding NaN everywhere, so that a pixel left unwritten
+    // shows), into per-light targets a frame has written and into the Renderer's own targets
+    // read back by copies it is. All give the same frame bit for bit, and the background pixels
+    // are the scene's color with zero AOVs, each light's visibility too (the background pass's
+    // values, docs/raster.md). Black (nothing to fill) and a color; all channels and the float
+    // beauty; one light and two (per-light targets); and a new Frame after the camera moved, so
+    // that pixels the targets last held objects in are background now.
     const float nan = std::numeric_limits<float>::quiet_NaN();
     for (const scene::Vec3& color : {scene::Vec3(0.0, 0.0, 0.0), scene::Vec3(0.05, 0.1, 0.2)})
         for (int lights : {1, 2}) {
@@ -1215,7 +1221,7 @@ TEST(RasterRenderer, ANewFrameHoldsTheBackgroundAndAReusedOneGetsTheBackgroundPa
             for (scene::ChannelMask channels : {scene::kAllChannels, scene::kChannelBeauty}) {
                 RenderDebug fromNew, fromReused, fromCopied;
                 const scene::Frame fresh = renderer.render(channels, &fromNew);
-                EXPECT_EQ(fromNew.backgroundFromFrame, lights == 1 || channels == scene::kChannelBeauty);
+                EXPECT_TRUE(fromNew.backgroundFromFrame);
                 scene::Frame reused;
                 for (std::vector<float>* v : {&reused.beauty, &reused.visibility, &reused.objectId, &reused.ndotl,
                                               &reused.depth, &reused.blockerId})
@@ -1236,10 +1242,32 @@ TEST(RasterRenderer, ANewFrameHoldsTheBackgroundAndAReusedOneGetsTheBackgroundPa
                     ASSERT_EQ(fresh.ndotl[i], 0.0f) << i;
                     ASSERT_EQ(fresh.depth[i], 0.0f) << i;
                     ASSERT_EQ(fresh.blockerId[i], 0.0f) << i;
+                    for (const std::vector<float>& light : fresh.lightVisibility) ASSERT_EQ(light[i], 0.0f) << i;
                 }
                 EXPECT_GT(background, 0u) << "the test would not see the background";
                 EXPECT_LT(background, fresh.pixelCount() / 2) << "nor the objects";
+                EXPECT_EQ(fresh.lightVisibility.size(), lights == 1 ? 0u : 2u);
             }
+            // The camera turned aside: the per-light targets hold the last frame's objects where
+            // the new frame's background is, so a new Frame gets the background pass with two lights.
+            const scene::Frame before = renderer.render(scene::kAllChannels);
+            scene::Scene turned = s;
+            turned.camera.lookAt += scene::Vec3(3.0, 0.0, 0.0);
+            renderer.update(turned);
+            copied.update(turned);
+            RenderDebug afterTurn;
+            const scene::Frame moved = renderer.render(scene::kAllChannels, &afterTurn);
+            EXPECT_EQ(afterTurn.backgroundFromFrame, lights == 1);
+            test::expectSamePixels(moved, copied.render(scene::kAllChannels), "after the camera turned, copied");
+            std::size_t litBefore = 0;  // background now, a lit object in the targets' last frame
+            for (std::size_t i = 0; i < moved.pixelCount(); ++i) {
+                if (moved.objectId[i] != 0.0f) continue;
+                for (std::size_t k = 0; k < moved.lightVisibility.size(); ++k) {
+                    ASSERT_EQ(moved.lightVisibility[k][i], 0.0f) << i;
+                    litBefore += before.lightVisibility[k][i] != 0.0f;
+                }
+            }
+            if (lights == 2) EXPECT_GT(litBefore, 100u) << "the turn must uncover pixels the targets held lit";
             // A Frame with one plane from before and the others new: the pass draws the background.
             scene::Frame mixed = renderer.render(scene::kChannelBeauty);
             RenderDebug fromMixed;
@@ -1252,6 +1280,66 @@ TEST(RasterRenderer, ANewFrameHoldsTheBackgroundAndAReusedOneGetsTheBackgroundPa
             EXPECT_EQ(renderer.validationMessages(), 0);
             EXPECT_EQ(copied.validationMessages(), 0);
         }
+}
+
+TEST(RasterRenderer, PerLightTargetsInReusedHeapMemoryStillGiveTheBackgroundZeroVisibility) {
+    // A new Frame's first render takes its per-light targets' background from zeros the host
+    // writes, not from fresh pages: the process keeps the heap a renderer freed for the next
+    // (scene/memory.h), so a target may land on another frame's values. Here the heap holds NaN:
+    // blocks under malloc's mmap threshold (raised to its maximum, so that the targets come from
+    // the heap too), freed but for the highest, which keeps them off the heap's top. The test
+    // checks that the target did take that memory.
+#ifdef __SANITIZE_ADDRESS__
+    GTEST_SKIP() << "AddressSanitizer's allocator is not glibc's";
+#endif
+    const SphereOverPlane p;
+    const scene::Scene s = withASecondLightFrom40Degrees(p, 1.0);
+    const std::size_t targetBytes = std::size_t(s.camera.width) * s.camera.height * 4 * sizeof(float);
+    std::vector<float*> blocks((64u << 20) / targetBytes);  // well past what the Renderer takes first
+    struct Heap {
+        std::vector<float*>& blocks;
+        // Setting either threshold ends glibc's dynamic thresholds in this process: these are
+        // its initial values, for the tests after this one when they share the process.
+        ~Heap() {
+            for (float* b : blocks) std::free(b);
+            ::mallopt(M_MMAP_THRESHOLD, 128 * 1024);
+            ::mallopt(M_TRIM_THRESHOLD, 128 * 1024);
+        }
+    } heap{blocks};
+    ASSERT_EQ(::mallopt(M_MMAP_THRESHOLD, 32 << 20), 1);
+    ASSERT_EQ(::mallopt(M_TRIM_THRESHOLD, 1 << 30), 1);
+    for (float*& b : blocks) {
+        b = static_cast<float*>(std::malloc(targetBytes));
+        ASSERT_NE(b, nullptr);
+        std::fill(b, b + targetBytes / sizeof(float), std::numeric_limits<float>::quiet_NaN());
+    }
+    auto address = [](const void* q) { return reinterpret_cast<std::uintptr_t>(q); };
+    std::swap(
+        *std::max_element(blocks.begin(), blocks.end(), [&](float* x, float* y) { return address(x) < address(y); }),
+        blocks.back());
+    const std::uintptr_t lowest = address(
+        *std::min_element(blocks.begin(), blocks.end(), [&](float* x, float* y) { return address(x) < address(y); }));
+    const std::uintptr_t fence = address(blocks.back());
+    for (std::size_t i = 0; i + 1 < blocks.size(); ++i) {
+        std::free(blocks[i]);
+        blocks[i] = nullptr;
+    }
+    const scene::RasterSettings settings = validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2);
+    Renderer renderer(s, planFor(s, settings), settings);
+    RenderDebug debug;
+    const scene::Frame f = renderer.render(scene::kAllChannels, &debug);
+    ASSERT_GE(address(debug.lightTargetTexels), lowest) << "the target did not take the freed memory";
+    ASSERT_LT(address(debug.lightTargetTexels), fence) << "the target did not take the freed memory";
+    EXPECT_TRUE(debug.backgroundFromFrame);
+    ASSERT_EQ(f.lightVisibility.size(), 2u);
+    std::size_t background = 0;
+    for (std::size_t i = 0; i < f.pixelCount(); ++i) {
+        if (f.objectId[i] != 0.0f) continue;
+        ++background;
+        for (const std::vector<float>& light : f.lightVisibility) ASSERT_EQ(light[i], 0.0f) << i;
+    }
+    EXPECT_GT(background, 0u) << "the test would not see the background";
+    EXPECT_EQ(renderer.validationMessages(), 0);
 }
 
 TEST(RasterRenderer, SizeOptimizedOneLightModulesGiveTheGeneralModulesFramesBitForBit) {
