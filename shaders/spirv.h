@@ -86,7 +86,7 @@ std::span<const std::uint32_t> litFragLightsTapsEverySpirv();
 std::span<const std::uint32_t> litFragLightsAlphaEverySpirv();
 std::span<const std::uint32_t> litFragLightsAlphaTapsEverySpirv();
 // One spot or one point light with none or pcf2x2, no semi-transparent casters, no receiver plane
-// (SHADOWLAB_ONE_SPOT, SHADOWLAB_ONE_POINT), optimized for size as the *_sun ones: the *_baked
+// (SHADOWLAB_ONE_SPOT, SHADOWLAB_ONE_POINT), fixed in the source as the *_sun ones: the *_baked
 // module of a spot, the *_every module of a point light, with their constants baked in.
 std::span<const std::uint32_t> litFragTapsSpotSpirv();
 std::span<const std::uint32_t> litFragTapsPointSpirv();
