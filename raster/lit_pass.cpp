@@ -12,15 +12,15 @@
 
 namespace shadowlab::raster {
 
-bool usesVertexLightCoordinates(const LitVariant& variant) {
+bool hasOneMapLight(const LitVariant& variant) {
     if (variant.lightCount != 1 || variant.receiverPlane) return false;
     return (variant.lightKinds == (1u << SHADOWLAB_LIGHT_DIRECTIONAL) && variant.cascades == 1) ||
            variant.lightKinds == (1u << SHADOWLAB_LIGHT_SPOT);
 }
 
 bool bakesLightConstants(const LitVariant& v) {
-    return usesVertexLightCoordinates(v) || (v.lightCount == 1 && !v.receiverPlane && v.cascades > 1 &&
-                                             v.lightKinds == (1u << SHADOWLAB_LIGHT_DIRECTIONAL));
+    return hasOneMapLight(v) || (v.lightCount == 1 && !v.receiverPlane && v.cascades > 1 &&
+                                 v.lightKinds == (1u << SHADOWLAB_LIGHT_DIRECTIONAL));
 }
 
 bool bakesEveryLight(const LitVariant& v) { return v.lightCount > 0 && !bakesLightConstants(v); }
@@ -75,6 +75,19 @@ std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUn
         at[15] = d.depthBiasWorld;
     };
     for (std::size_t k = 0; k < SHADOWLAB_MAX_CASCADES; ++k) packCascade(u.cascades[k], c.data() + 34 + 16 * k);
+    // One light with one map (hasOneMapLight): cascade 0's first three rows are its toShadow's, and
+    // a spot's last row takes the slots' spare components, as lit.vert packs them (lit.frag
+    // oneMapMatrix forms the map coordinates with them).
+    const bool oneMap = (l.kind == SHADOWLAB_LIGHT_DIRECTIONAL && l.cascadeCount <= 1) || spot;
+    if (u.lightCount == 1 && oneMap)
+        for (int row = 0; row < 3; ++row)
+            for (int column = 0; column < 4; ++column) c[34 + 4 * row + column] = l.toShadow[column][row];
+    if (spot) {
+        c[15] = l.toShadow[0][3];
+        c[23] = l.toShadow[1][3];
+        c[29] = l.toShadow[2][3];
+        c[30] = l.toShadow[3][3];
+    }
     const int bakedLights = everyLight ? std::clamp(u.lightCount, 0, SHADOWLAB_MAX_LIGHTS) : 0;
     for (std::size_t i = 0; i < std::size_t(bakedLights); ++i) {
         const shaders::LightData& d = u.lights[i];
@@ -141,24 +154,21 @@ LitStages litStages(const LitVariant& v, bool alpha) {
                     fragmentOf(v, alpha, litFragTapsSunMapBakedSpirv(), litFragAlphaTapsSunMapBakedSpirv(),
                                litFragBeautyTapsSunMapBakedSpirv(), litFragBeautyAlphaTapsSunMapBakedSpirv())};
         if (v.cascades == 1 && !v.cascadeBlend)
-            return {vertexOf(v, alpha, litVertSpirv(), litVertAlphaSpirv(), litVertNoIdSpirv()),
+            return {vertexOf(v, alpha, litVertSunSpirv(), litVertAlphaSunSpirv(), litVertNoIdSunSpirv()),
                     fragmentOf(v, alpha, litFragTapsSunMapSpirv(), litFragAlphaTapsSunMapSpirv(),
                                litFragBeautyTapsSunMapSpirv(), litFragBeautyAlphaTapsSunMapSpirv())};
-        return {vertexOf(v, alpha, litVertCascadesSpirv(), litVertAlphaCascadesSpirv(), litVertNoIdCascadesSpirv()),
+        return {vertexOf(v, alpha, litVertBakedSpirv(), litVertAlphaBakedSpirv(), litVertNoIdBakedSpirv()),
                 fragmentOf(v, alpha, litFragTapsSunSpirv(), litFragAlphaTapsSunSpirv(), litFragBeautyTapsSunSpirv(),
                            litFragBeautyAlphaTapsSunSpirv())};
     }
     if (usesSpotOrPointModule(v)) {
-        // One spot: its constants baked in, its map coordinates from lit.vert. One point light:
-        // every light's constants baked in, no map coordinates from lit.vert, so the *_cascades
-        // lit.vert, which writes none.
+        // One spot: its constants baked in. One point light: every light's constants baked in.
+        const auto vertex = vertexOf(v, alpha, litVertBakedSpirv(), litVertAlphaBakedSpirv(), litVertNoIdBakedSpirv());
         if (v.lightKinds == (1u << SHADOWLAB_LIGHT_SPOT))
-            return {vertexOf(v, alpha, litVertBakedSpirv(), litVertAlphaBakedSpirv(), litVertNoIdBakedSpirv()),
-                    fragmentOf(v, alpha, litFragTapsSpotSpirv(), litFragAlphaTapsSpotSpirv(),
-                               litFragBeautyTapsSpotSpirv(), litFragBeautyAlphaTapsSpotSpirv())};
-        return {vertexOf(v, alpha, litVertCascadesSpirv(), litVertAlphaCascadesSpirv(), litVertNoIdCascadesSpirv()),
-                fragmentOf(v, alpha, litFragTapsPointSpirv(), litFragAlphaTapsPointSpirv(),
-                           litFragBeautyTapsPointSpirv(), litFragBeautyAlphaTapsPointSpirv())};
+            return {vertex, fragmentOf(v, alpha, litFragTapsSpotSpirv(), litFragAlphaTapsSpotSpirv(),
+                                       litFragBeautyTapsSpotSpirv(), litFragBeautyAlphaTapsSpotSpirv())};
+        return {vertex, fragmentOf(v, alpha, litFragTapsPointSpirv(), litFragAlphaTapsPointSpirv(),
+                                   litFragBeautyTapsPointSpirv(), litFragBeautyAlphaTapsPointSpirv())};
     }
     if (v.specializedLightConstants && bakesEveryLight(v)) {
         // Every light baked in: the general modules' *_every builds, without flat light inputs.

@@ -36,8 +36,12 @@ inline constexpr VkFormat kLitDisplayFormat = VK_FORMAT_R8G8B8A8_SRGB;
 // (the members of LightData that lit.frag reads for that light's kind, LitUniforms' forward, ambient
 // and map size), in that order; then LitUniforms' cascadeStart and cascadeBlendBand and, for each of
 // light 0's SHADOWLAB_MAX_CASCADES cascades, its toShadow's first three rows, sliceFar,
-// texelWorldSize, depthPerWorld and depthBiasWorld (zeros where it has none): the values a pipeline
-// with LitVariant::specializedLightConstants bakes (shaders/lit_constants.glsl, constants 18..115).
+// texelWorldSize, depthPerWorld and depthBiasWorld (zeros where it has none), except that where
+// light 0 is the only light and has one map (a directional light without cascades, or a spot),
+// cascade 0's rows are its toShadow's first three rows, and a spot's last row takes the spare
+// components of the light slots (lit.vert's outLight[3].w and [5].w, outFrame[1].y and .z): the
+// values a pipeline with LitVariant::specializedLightConstants bakes (shaders/lit_constants.glsl,
+// constants 18..115).
 // Then, for every light i of LitUniforms::lightCount (zeros for the rest), kPackedPerLight values
 // at 98 + kPackedPerLight * i (constants 116 + ..): what lit.frag reads of it where every light is
 // baked in (bakesEveryLight()), in fourteen slots of four: the direction toward a directional light
@@ -73,8 +77,7 @@ struct LitVariant {
     bool receiverPlane = false;                // receiver-plane depth bias in every filter tap
     bool cascadeBlend = false;                 // blend bands before the cascade splits (LitUniforms::cascadeBlendBand)
     // Light 0's constants reach lit.frag as flat outputs of lit.vert instead of uniform reads
-    // (shaders/lit_constants.glsl kVertexLightConstants); takes effect only where
-    // usesVertexLightCoordinates().
+    // (shaders/lit_constants.glsl kVertexLightConstants); takes effect only where hasOneMapLight().
     bool vertexLightConstants = false;
     // The same values baked into the pipeline as specialization constants (shaders/lit_constants.glsl
     // kSpecializedLightConstants), `lightConstants` from packLightConstants(); lit.vert then writes
@@ -91,11 +94,11 @@ struct LitVariant {
     // turns the whole module into NIR); false: the general modules (tests compare).
     bool oneLightModules = true;
 };
-// Whether lit.frag takes light 0's map coordinates from lit.vert (lit_constants.glsl
-// kVertexLightCoordinates, the same condition): one light, directional with one map or a spot, and
-// no receiver-plane bias.
-bool usesVertexLightCoordinates(const LitVariant& variant);
-// Whether the variant can bake light 0's constants in: where usesVertexLightCoordinates(), or one
+// Whether the variant's one light has one map (lit_constants.glsl kOneMapLight, the same
+// condition): one light, directional with one map or a spot, and no receiver-plane bias. lit.vert
+// can pass its constants on flat, or the pipeline bake them in with its map matrix.
+bool hasOneMapLight(const LitVariant& variant);
+// Whether the variant can bake light 0's constants in: where hasOneMapLight(), or one
 // cascaded directional light without the receiver-plane bias.
 bool bakesLightConstants(const LitVariant& variant);
 // Whether the variant bakes every light's constants in (lit_constants.glsl kEveryLightBaked): with a

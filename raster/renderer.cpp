@@ -639,8 +639,7 @@ void Renderer::Impl::createTargets(const scene::Scene& scene, const RendererOpti
                             .lightKinds = lightKinds,
                             .cascades = std::uint32_t(cascadesUsed),
                             .receiverPlane = settings.receiverPlaneBias};
-    vertexLightConstants =
-        usesVertexLightCoordinates(lights) && options.lightConstants != LightConstants::kUniformBuffer;
+    vertexLightConstants = hasOneMapLight(lights) && options.lightConstants != LightConstants::kUniformBuffer;
     // Light 0's alone where it is the one light lit.vert can carry, else every light's.
     specializedLightConstants = (bakesLightConstants(lights) || bakesEveryLight(lights)) &&
                                 options.lightConstants == LightConstants::kSpecialization;

@@ -37,18 +37,17 @@ const float kPcssMaxFilterFraction = 1.0 / 8.0;
 layout(location = 0) in vec3 inPosition;  // camera-relative world position
 layout(location = 1) in vec3 inNormal;
 layout(location = 2) flat in uint inObjectId;
-#ifndef SHADOWLAB_NO_VERTEX_LIGHT
-layout(location = 3) in vec4 inLightCoordinates;  // lit.vert: light 0's toShadow · (p, 1)
-layout(location = 4) in vec4 inLightNormal;       // lit.vert: toShadow · (the unnormalized normal, 0)
-#endif
 // The object's albedo (rgb) and 1 − opacity (a), which lit.vert reads from the per-object buffer
 // (binding 1): flat, so the same value as a read here, without a buffer lookup per fragment.
-layout(location = 5) flat in vec4 inAlbedo;
+layout(location = 15) flat in vec4 inAlbedo;
 // kVertexLightConstants: light 0's constants, and LitUniforms' forward, ambient and map size, from
 // lit.vert (lightAt(), viewForward(), ambient(), mapSize()). Not declared in the modules for baked
 // constants (SHADOWLAB_BAKED_LIGHT, lit_constants.glsl): llvmpipe sets up every declared input
 // per triangle, read or not.
 #ifndef SHADOWLAB_BAKED_LIGHT
+#ifndef SHADOWLAB_ONE_SUN
+layout(location = 3) flat in vec4 inMapRows[3];  // kOneMapLight: its toShadow's first three rows
+#endif
 layout(location = 6) flat in vec4 inLight[6];
 layout(location = 12) flat in vec4 inFrame[2];
 #endif
@@ -106,21 +105,34 @@ vec4 frameSlot(int k) {
     return inFrame[k];
 #endif
 }
-// lit.vert's map coordinates of the point and of its normal (read only where
-// kVertexLightCoordinates; not declared in the modules that never read them).
-vec4 vertexMapPoint() {
-#ifdef SHADOWLAB_NO_VERTEX_LIGHT
-    return vec4(0.0);
+// kOneMapLight: light 0's toShadow, its first three rows baked in as cascade 0's
+// (kSpecializedLightConstants) or from lit.vert (in the slots a sun leaves spare where the module
+// is for a sun: lit.vert), a spot's last row in the slots' spare components
+// (raster::packLightConstants), a sun's (0, 0, 0, 1). lit.frag forms the map coordinates with it
+// instead of interpolating lit.vert's, which llvmpipe would store, set up per triangle and
+// interpolate per pixel (docs/performance.md).
+mat4 oneMapMatrix() {
+    vec4 r0 = vec4(0.0), r1 = vec4(0.0), r2 = vec4(0.0);
+    if (kSpecializedLightConstants) {
+        r0 = vec4(kC0_00, kC0_01, kC0_02, kC0_03);
+        r1 = vec4(kC0_04, kC0_05, kC0_06, kC0_07);
+        r2 = vec4(kC0_08, kC0_09, kC0_10, kC0_11);
+    } else {
+#if defined(SHADOWLAB_BAKED_LIGHT)
+#elif defined(SHADOWLAB_ONE_SUN)
+        r0 = inLight[4];
+        r1 = inLight[5];
+        r2 = vec4(inLight[3].w, inFrame[1].yzw);
 #else
-    return inLightCoordinates;
+        r0 = inMapRows[0];
+        r1 = inMapRows[1];
+        r2 = inMapRows[2];
 #endif
-}
-vec4 vertexMapNormal() {
-#ifdef SHADOWLAB_NO_VERTEX_LIGHT
-    return vec4(0.0);
-#else
-    return inLightNormal;
-#endif
+    }
+    const vec4 r3 = kOneSpot ? vec4(lightSlot(3).w, lightSlot(5).w, frameSlot(1).y, frameSlot(1).z) : vec4(0.0, 0.0, 0.0, 1.0);
+    // (mat4 takes columns: column k is (r0[k], r1[k], r2[k], r3[k]).)
+    return mat4(vec4(r0.x, r1.x, r2.x, r3.x), vec4(r0.y, r1.y, r2.y, r3.y), vec4(r0.z, r1.z, r2.z, r3.z),
+                vec4(r0.w, r1.w, r2.w, r3.w));
 }
 // Light i's constants: the uniform buffer's, or (kVertexLightConstants: the one light) light 0's as
 // lit.vert packs them, its flat outputs or the same values baked in. The members lit.vert does not
@@ -188,7 +200,7 @@ LightData lightAt(int i) {
     if (!kLightFromSlots) return u.lights[i];
     LightData light = u.lights[0];
     const vec4 slot[6] = vec4[](lightSlot(0), lightSlot(1), lightSlot(2), lightSlot(3), lightSlot(4), lightSlot(5));
-    if (kVertexSpot) light.position = slot[0].xyz;
+    if (kOneSpot) light.position = slot[0].xyz;
     else light.towardLight = slot[0].xyz;
     light.layer = slot[0].w;
     light.radiance = slot[1].rgb;
@@ -200,13 +212,14 @@ LightData lightAt(int i) {
     light.maxSlopeTan = slot[3].x;
     light.normalOffsetTexels = slot[3].y;
     light.pcfSize = int(slot[3].z);
-    if (kVertexSpot) {
+    if (kOneSpot) {
         light.spotDirection = slot[4].xyz;
         light.spotCosCone = slot[4].w;
         light.mapNear = slot[5].x;
         light.mapFar = slot[5].y;
         light.lightSize = slot[5].z;
     }
+    if (kOneMapLight) light.toShadow = oneMapMatrix();
     return light;
 }
 // LitUniforms' members that lit.vert passes with the light.
@@ -559,9 +572,7 @@ float biasedTap(LightData light, Receiver r, vec2 o, float size, float layer, in
 // Visibility 0..1 of `light` at camera-relative position p with unit normal n (facing the
 // viewer), N·L = ndotl > 0; dpdx, dpdy: p's screen-space derivatives (receiver plane only).
 // `blocker` gets the id of the object that shadowed, if any.
-// nScale: ±1/|inNormal| (the normalization and the flip that made n from inNormal), for
-// kVertexLightCoordinates.
-float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec3 dpdx, vec3 dpdy, inout uint blocker) {
+float shadowTest(LightData light, vec3 p, vec3 n, float ndotl, vec3 dpdx, vec3 dpdy, inout uint blocker) {
     const bool perspective = isPerspective(light);
     const bool point = isKind(light, SHADOWLAB_LIGHT_POINT);
     vec3 axis = light.spotDirection;
@@ -577,9 +588,8 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         light.mapFar = light.pointFaces[face].far;
     }
     // World size of a texel at p: constant for an orthographic map, growing with distance
-    // along the axis for a perspective one. (kVertexSpot: toShadow's w row is that distance,
-    // (axis, −axis·L), so lit.vert's interpolated w is it.)
-    const float axialP = kVertexSpot ? vertexMapPoint().w : dot(p - light.position, axis);
+    // along the axis for a perspective one.
+    const float axialP = dot(p - light.position, axis);
     const float texel = light.texelWorldSize * (perspective ? axialP : 1.0);
     // Normal offset: look the map up from a point moved off the surface along its normal, by the
     // user's k texels plus the slope bias beyond its cap: s·texel·(sin θ − maxTan·cos θ) puts the
@@ -598,22 +608,6 @@ float shadowTest(LightData light, vec3 p, vec3 n, float nScale, float ndotl, vec
         const vec3 d = q - light.position;
         r.axial = dot(d, axis);
         r.uv = 0.5 + 0.5 * vec2(dot(d, right), dot(d, up)) / (r.axial * light.pointFaceTan);
-    } else if (kVertexLightCoordinates) {
-        // toShadow · (p + n·offset, 1) = toShadow · (p, 1) + offset · toShadow · (n, 0), and both
-        // factors are linear in the position and the normal, so they interpolate exactly: lit.vert
-        // computes them per vertex. In float the sum differs from the product of the interpolated
-        // position by rounding at the scale of the map's coordinates (≈1e-7 of its extent), not of
-        // the camera-relative position: far below a texel (2048 of them) and the depth bias.
-        // A spot: offset = k'·texel(p) is not constant (k' depends on the fragment's N·L), but
-        // texel(p) = bias.z·w(p) with w the interpolated (linear) distance along the axis, so
-        // offset · toShadow · (n, 0) is a product of interpolated factors, formed here; the clip coordinates are linear before
-        // the divide, which is done per fragment, and w = (q − L)·axis is the axial distance of the
-        // offset point. Each component rounds at its own scale (x, y ≈ w·(u, v): ≈1e-7 of w, so
-        // ≈1e-7 of the map after the divide; w ≈1e-7 of max(|p|, |L|) camera-relative, against a
-        // bias of half a texel ≈ 1e-3·w at 2048²), as the per-fragment product does.
-        const vec4 s = kNormalOffset ? vertexMapPoint() + (offset * nScale) * vertexMapNormal() : vertexMapPoint();
-        r.uv = kVertexSpot ? s.xy / s.w : s.xy;
-        r.axial = kVertexSpot ? s.w : s.z;
     } else {
         const vec4 s = light.toShadow * vec4(q, 1.0);
         // Orthographic (directional): toShadow's last row is exactly (0, 0, 0, 1), so w = 1 and
@@ -863,7 +857,6 @@ void main() {
     if (alphaCameraSkips(inObjectId, inUv)) discard;  // after the derivatives, which need the quad
 #endif
     vec3 n = normalize(inNormal);
-    float nScale = kVertexLightCoordinates ? inversesqrt(dot(inNormal, inNormal)) : 1.0;
     // Two-sided surfaces, the ray tracer's rule (raytrace/tracer.cpp, surfacePoint): the facet's
     // normal turned toward the viewer, the shading normal into that normal's half-space. Turning
     // the shading normal toward the viewer by itself flips it across the facet where it leans away
@@ -873,10 +866,7 @@ void main() {
     vec3 facet = cross(ex, ey);
     if (dot(facet, inPosition) > 0.0) facet = -facet;
     const float side = dot(facet, facet) > 0.0 ? dot(n, facet) : -dot(n, inPosition);
-    if (side < 0.0) {
-        n = -n;
-        nScale = -nScale;
-    }
+    if (side < 0.0) n = -n;
 
     const vec4 objectAlbedo = inAlbedo;
     const vec3 albedoColor = objectAlbedo.rgb;
@@ -919,12 +909,12 @@ void main() {
         // continue, so that the loop unrolls.)
         if (ndotl > 0.0 && irradiance > 0.0) {
             uint lightBlocker = 0u;
-            float v = light.layer >= 0.0 ? shadowTest(light, inPosition, n, nScale, ndotl, dpdx, dpdy, lightBlocker) : 1.0;
+            float v = light.layer >= 0.0 ? shadowTest(light, inPosition, n, ndotl, dpdx, dpdy, lightBlocker) : 1.0;
             if (kCascadeBlend && cascadeBlend > 0.0) {
                 // (A cascaded light always has a shadow test: cascadeCount > 1 only then.) The blocker
                 // id stays the first cascade's when it found one.
                 uint nextBlocker = 0u;
-                const float vNext = shadowTest(nextCascade, inPosition, n, nScale, ndotl, dpdx, dpdy, nextBlocker);
+                const float vNext = shadowTest(nextCascade, inPosition, n, ndotl, dpdx, dpdy, nextBlocker);
                 v = mix(v, vNext, cascadeBlend);
                 if (lightBlocker == 0u) lightBlocker = nextBlocker;
             }

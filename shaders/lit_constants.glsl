@@ -55,31 +55,28 @@ layout(constant_id = 8) const bool kVisibility = true;
 // default), the lookup point is the surface point itself, and the vertex path's map-space normal
 // is not read (one varying and its arithmetic less per pixel).
 layout(constant_id = 9) const bool kNormalOffset = true;
-// One directional light with one map, or one spot light, and no receiver plane: its map
-// coordinates are interpolated from lit.vert (see shadowTest) instead of a matrix product per
-// fragment.
+// One directional light with one map, or one spot light, and no receiver plane (kOneMapLight): the
+// one light whose constants lit.vert can pass on flat (kVertexLightConstants) or the pipeline can
+// bake in (kSpecializedLightConstants), its map matrix among them.
 // (Written without ||: glslang turns || of specialization constants into a branch and an OpPhi
 // inside a function, which the constant's uses elsewhere cannot see.)
-// SHADOWLAB_NO_VERTEX_LIGHT (the cascaded *_sun modules and their lit.vert): never, so neither
-// stage declares the map coordinates (llvmpipe stores and sets up every declared varying).
-#ifdef SHADOWLAB_NO_VERTEX_LIGHT
-#ifndef SHADOWLAB_BAKED_LIGHT
-#error SHADOWLAB_NO_VERTEX_LIGHT goes with SHADOWLAB_BAKED_LIGHT (no flat light inputs either)
-#endif
-const bool kVertexSpot = false;
-const bool kVertexDirectional = false;
+// The cascaded *_sun modules (SHADOWLAB_ONE_SUN without SHADOWLAB_ONE_MAP): never, fixed here so
+// that spirv-opt drops the code.
+#if defined(SHADOWLAB_ONE_SUN) && !defined(SHADOWLAB_ONE_MAP)
+const bool kOneSpot = false;
+const bool kOneMapSun = false;
 #else
-const bool kVertexSpot = kLightCount == 1 && kLightKinds == (1 << SHADOWLAB_LIGHT_SPOT) && !kReceiverPlane;
-const bool kVertexDirectional = kLightCount == 1 && kLightKinds == (1 << SHADOWLAB_LIGHT_DIRECTIONAL) &&
-                                kCascades == 1 && !kReceiverPlane;
+const bool kOneSpot = kLightCount == 1 && kLightKinds == (1 << SHADOWLAB_LIGHT_SPOT) && !kReceiverPlane;
+const bool kOneMapSun = kLightCount == 1 && kLightKinds == (1 << SHADOWLAB_LIGHT_DIRECTIONAL) && kCascades == 1 &&
+                        !kReceiverPlane;
 #endif
-const bool kVertexLightCoordinates = !(!kVertexSpot && !kVertexDirectional);
+const bool kOneMapLight = !(!kOneSpot && !kOneMapSun);
 const bool kAnyPerspective =
     (kLightKinds & ((1 << SHADOWLAB_LIGHT_SPOT) | (1 << SHADOWLAB_LIGHT_POINT))) != 0;
 // The one light's constants that lit.frag reads (the LightData members its kind uses, less
 // toShadow; the kind itself is a constant there, as kLightKinds has one bit) and LitUniforms'
-// forward, ambient and map size reach lit.frag as flat outputs of lit.vert instead of uniform-buffer reads, where lit.frag takes
-// that light's map coordinates from lit.vert too (kVertexLightCoordinates). lavapipe (Mesa 22.3's
+// forward, ambient and map size reach lit.frag as flat outputs of lit.vert instead of uniform-buffer
+// reads, where that light is kOneMapLight, its toShadow with them (lit.frag oneMapMatrix). lavapipe (Mesa 22.3's
 // llvmpipe) reads a uniform in a fragment shader lane by lane, with a bounds check, for every
 // eight pixels; a flat input is set up once per triangle and then read as a constant
 // (docs/performance.md: less CPU per frame on the seed scene and on Sponza, down to half a pixel
@@ -90,20 +87,20 @@ layout(constant_id = 10) const bool kVertexLightConstantsAsked = false;
 #ifdef SHADOWLAB_BAKED_LIGHT
 const bool kVertexLightConstants = false;
 #else
-const bool kVertexLightConstants = kVertexLightConstantsAsked && kVertexLightCoordinates;
+const bool kVertexLightConstants = kVertexLightConstantsAsked && kOneMapLight;
 #endif
 // The same values baked into the pipeline (raster::LightConstants::kSpecialization): lit.frag reads
 // them as constants 18..49, packed as lit.vert packs outLight[0..5] and outFrame[0..1], and lit.vert
 // writes neither. A flat input costs llvmpipe its setup and 48 bytes per triangle in every bin it
 // touches; a constant costs nothing per triangle, and folds into the arithmetic that reads it.
-// One cascaded directional light, no receiver plane: the same 32 values (no map coordinates from
-// lit.vert then, so no flat inputs either), and the cascades' values below.
+// kOneMapLight: also its map matrix, in cascade 0's constants below. One cascaded directional light,
+// no receiver plane: the same 32 values, and the cascades' values below.
 layout(constant_id = 17) const bool kSpecializedLightConstantsAsked = false;
 const bool kOneCascadedSun = kLightCount == 1 && kLightKinds == (1 << SHADOWLAB_LIGHT_DIRECTIONAL) && kCascades > 1 &&
                              !kReceiverPlane;
 const bool kSpecializedCascades = kSpecializedLightConstantsAsked && kOneCascadedSun;
 const bool kSpecializedLightConstants =
-    !(!(kSpecializedLightConstantsAsked && kVertexLightCoordinates) && !kSpecializedCascades);
+    !(!(kSpecializedLightConstantsAsked && kOneMapLight) && !kSpecializedCascades);
 // lightAt() unpacks the 32 values, from lit.vert or baked in.
 const bool kLightFromSlots = !(!kVertexLightConstants && !kSpecializedLightConstants);
 layout(constant_id = 18) const float kL00 = 0.0;
@@ -141,6 +138,8 @@ layout(constant_id = 49) const float kF13 = 0.0;
 // kSpecializedCascades: LitUniforms' cascadeStart and cascadeBlendBand, then per cascade c of light 0
 // (constants 52 + 16c ..): toShadow's first three rows (an orthographic map's last row is 0 0 0 1),
 // then sliceFar, texelWorldSize, depthPerWorld and depthBiasWorld (raster::packLightConstants).
+// kOneMapLight with kSpecializedLightConstants: cascade 0's first three rows are its toShadow's
+// (lit.frag oneMapMatrix; a spot's last row is in the light slots' spare components).
 layout(constant_id = 50) const float kCascadeStart = 0.0;
 layout(constant_id = 51) const float kCascadeBlendBand = 0.0;
 layout(constant_id = 52) const float kC0_00 = 0.0;

@@ -62,12 +62,12 @@
 #include "lit_vert.spv.h"
 #include "lit_vert_alpha.spv.h"
 #include "lit_vert_alpha_baked.spv.h"
-#include "lit_vert_alpha_cascades.spv.h"
+#include "lit_vert_alpha_sun.spv.h"
 #include "lit_vert_baked.spv.h"
-#include "lit_vert_cascades.spv.h"
 #include "lit_vert_no_id.spv.h"
 #include "lit_vert_no_id_baked.spv.h"
-#include "lit_vert_no_id_cascades.spv.h"
+#include "lit_vert_no_id_sun.spv.h"
+#include "lit_vert_sun.spv.h"
 #include "moments_comp.spv.h"
 #include "shadow_frag.spv.h"
 #include "shadow_frag_alpha.spv.h"
@@ -118,6 +118,9 @@ std::span<const std::uint32_t> litFragAlphaTapsSunMapSpirv() { return kLitFragAl
 std::span<const std::uint32_t> litFragBeautyTapsSunMapSpirv() { return kLitFragBeautyTapsSunMapSpv; }
 std::span<const std::uint32_t> litFragBeautyAlphaTapsSunMapSpirv() { return kLitFragBeautyAlphaTapsSunMapSpv; }
 std::span<const std::uint32_t> litVertNoIdSpirv() { return kLitVertNoIdSpv; }
+std::span<const std::uint32_t> litVertSunSpirv() { return kLitVertSunSpv; }
+std::span<const std::uint32_t> litVertAlphaSunSpirv() { return kLitVertAlphaSunSpv; }
+std::span<const std::uint32_t> litVertNoIdSunSpirv() { return kLitVertNoIdSunSpv; }
 std::span<const std::uint32_t> litFragTapsSunMapBakedSpirv() { return kLitFragTapsSunMapBakedSpv; }
 std::span<const std::uint32_t> litFragAlphaTapsSunMapBakedSpirv() { return kLitFragAlphaTapsSunMapBakedSpv; }
 std::span<const std::uint32_t> litFragBeautyTapsSunMapBakedSpirv() { return kLitFragBeautyTapsSunMapBakedSpv; }
@@ -155,9 +158,6 @@ std::span<const std::uint32_t> litFragLightsAlphaTapsEverySpirv() { return kLitF
 std::span<const std::uint32_t> litVertBakedSpirv() { return kLitVertBakedSpv; }
 std::span<const std::uint32_t> litVertAlphaBakedSpirv() { return kLitVertAlphaBakedSpv; }
 std::span<const std::uint32_t> litVertNoIdBakedSpirv() { return kLitVertNoIdBakedSpv; }
-std::span<const std::uint32_t> litVertCascadesSpirv() { return kLitVertCascadesSpv; }
-std::span<const std::uint32_t> litVertAlphaCascadesSpirv() { return kLitVertAlphaCascadesSpv; }
-std::span<const std::uint32_t> litVertNoIdCascadesSpirv() { return kLitVertNoIdCascadesSpv; }
 std::span<const std::uint32_t> backgroundVertSpirv() { return kBackgroundVertSpv; }
 std::span<const std::uint32_t> backgroundFragSpirv() { return kBackgroundFragSpv; }
 std::span<const std::uint32_t> backgroundFragBeautySpirv() { return kBackgroundFragBeautySpv; }

@@ -56,9 +56,14 @@ std::span<const std::uint32_t> litFragBeautyAlphaTapsSunMapSpirv();
 // lit.vert without the object id output, for the *_sun beauty-only shaders without the alpha
 // test (which do not read it, and spirv-opt removes the input).
 std::span<const std::uint32_t> litVertNoIdSpirv();
+// lit.vert for the *_sun_map modules with the light's constants from lit.vert (SHADOWLAB_ONE_SUN):
+// the map matrix's rows in the slots a sun leaves spare, no outputs of their own.
+std::span<const std::uint32_t> litVertSunSpirv();
+std::span<const std::uint32_t> litVertAlphaSunSpirv();
+std::span<const std::uint32_t> litVertNoIdSunSpirv();
 // The *_sun_map and the general modules for the light's constants baked in (SHADOWLAB_BAKED_LIGHT:
-// no flat light inputs), and lit.vert without those outputs to go with them (*_baked); lit.vert without any
-// light output for the cascaded *_sun modules (*_cascades), which read none.
+// no flat light inputs), and lit.vert without those outputs to go with them (*_baked), which the
+// cascaded *_sun modules take too.
 std::span<const std::uint32_t> litFragTapsSunMapBakedSpirv();
 std::span<const std::uint32_t> litFragAlphaTapsSunMapBakedSpirv();
 std::span<const std::uint32_t> litFragBeautyTapsSunMapBakedSpirv();
@@ -99,9 +104,6 @@ std::span<const std::uint32_t> litFragBeautyAlphaTapsPointSpirv();
 std::span<const std::uint32_t> litVertBakedSpirv();
 std::span<const std::uint32_t> litVertAlphaBakedSpirv();
 std::span<const std::uint32_t> litVertNoIdBakedSpirv();
-std::span<const std::uint32_t> litVertCascadesSpirv();
-std::span<const std::uint32_t> litVertAlphaCascadesSpirv();
-std::span<const std::uint32_t> litVertNoIdCascadesSpirv();
 // The lit pass's background (pixels no object covers): a triangle over the image, and the values
 // for the float targets of the AOV, beauty-only and per-light variants.
 std::span<const std::uint32_t> backgroundVertSpirv();

@@ -216,20 +216,20 @@ TEST(RasterLitPass, TargetsLargerThanTheDeviceAllowsAreRefusedNamingTheLimit) {
     }
 }
 
-TEST(RasterLitPass, TheLightsMapCoordinatesComeFromTheVertexShaderOnlyForOneDirectionalMapOrOneSpot) {
-    // lit.vert interpolates toShadow·p for light 0, which is right only when that one matrix serves
-    // every fragment: one light, directional with a single map or a spot, and no receiver plane
-    // (which needs each tap's own plane depth). Points pick a cube face per fragment, cascades a map.
+TEST(RasterLitPass, OnlyOneDirectionalMapOrOneSpotIsTheOneMapLight) {
+    // Light 0's constants and its one map matrix are baked in (or passed on flat) only when that one
+    // matrix serves every fragment: one light, directional with a single map or a spot, and no
+    // receiver plane (which bakes every light's). Points pick a cube face per fragment, cascades a map.
     constexpr std::uint32_t dir = 1u << SHADOWLAB_LIGHT_DIRECTIONAL, spot = 1u << SHADOWLAB_LIGHT_SPOT,
                             point = 1u << SHADOWLAB_LIGHT_POINT;
-    EXPECT_TRUE(usesVertexLightCoordinates({.lightKinds = dir}));
-    EXPECT_TRUE(usesVertexLightCoordinates({.lightKinds = spot}));
-    EXPECT_FALSE(usesVertexLightCoordinates({.lightKinds = point}));
-    EXPECT_FALSE(usesVertexLightCoordinates({.lightKinds = dir, .cascades = 3}));
-    EXPECT_TRUE(usesVertexLightCoordinates({.lightKinds = spot, .cascades = 3}));  // cascades are directional only
-    EXPECT_FALSE(usesVertexLightCoordinates({.lightCount = 2, .lightKinds = dir}));
-    EXPECT_FALSE(usesVertexLightCoordinates({.lightKinds = spot, .receiverPlane = true}));
-    EXPECT_FALSE(usesVertexLightCoordinates({.lightKinds = dir | spot}));
+    EXPECT_TRUE(hasOneMapLight({.lightKinds = dir}));
+    EXPECT_TRUE(hasOneMapLight({.lightKinds = spot}));
+    EXPECT_FALSE(hasOneMapLight({.lightKinds = point}));
+    EXPECT_FALSE(hasOneMapLight({.lightKinds = dir, .cascades = 3}));
+    EXPECT_TRUE(hasOneMapLight({.lightKinds = spot, .cascades = 3}));  // cascades are directional only
+    EXPECT_FALSE(hasOneMapLight({.lightCount = 2, .lightKinds = dir}));
+    EXPECT_FALSE(hasOneMapLight({.lightKinds = spot, .receiverPlane = true}));
+    EXPECT_FALSE(hasOneMapLight({.lightKinds = dir | spot}));
 }
 
 // Calls visit(opcode, operands) for each instruction of a SPIR-V module, read as the SPIR-V
@@ -320,10 +320,9 @@ TEST(RasterLitPass, EachVertexShaderWritesExactlyWhatItsFragmentShaderReads) {
 }
 
 TEST(RasterLitPass, OneSunWithBakedConstantsOrCascadesHasNoFlatLightInterface) {
-    // lit.vert's flat light constants sit at locations 6..13 (outLight[6], outFrame[2]) and light
-    // 0's map coordinates at 3 and 4. One sun with its constants baked in reads neither constant
-    // slot; a cascaded sun reads neither those nor the coordinates (a matrix per cascade). Neither
-    // stage may declare what the pipeline does not read.
+    // lit.vert's flat light constants sit at locations 3..13 (outMapRows[3], outLight[6],
+    // outFrame[2]). One sun with its constants baked in reads none of them, nor does a cascaded sun
+    // (a matrix per cascade). Neither stage may declare what the pipeline does not read.
     constexpr std::uint32_t kInput = 1, kOutput = 3;
     constexpr std::uint32_t dir = 1u << SHADOWLAB_LIGHT_DIRECTIONAL;
     for (const bool alpha : {false, true})
@@ -336,12 +335,16 @@ TEST(RasterLitPass, OneSunWithBakedConstantsOrCascadesHasNoFlatLightInterface) {
                 EXPECT_FALSE(interfaceLocations(oneMap.fragment, kInput).contains(slot)) << slot;
                 EXPECT_FALSE(interfaceLocations(cascaded.fragment, kInput).contains(slot)) << slot;
             }
-            EXPECT_TRUE(interfaceLocations(oneMap.fragment, kInput).contains(3u));  // the coordinates stay
-            for (const std::uint32_t slot : {3u, 4u})
-                EXPECT_FALSE(interfaceLocations(cascaded.fragment, kInput).contains(slot)) << slot;
-            // The flat-output path keeps them: lit.frag reads them there.
+            for (const LitStages* stages : {&oneMap, &cascaded}) {
+                EXPECT_FALSE(interfaceLocations(stages->vertex, kOutput).contains(3u));
+                EXPECT_FALSE(interfaceLocations(stages->fragment, kInput).contains(3u));
+            }
+            // The flat-output path keeps them: lit.frag reads them there, the map matrix's rows in
+            // the slots a sun leaves spare (no locations 3..5 of their own).
             const LitStages flat =
                 litStages({.aovTarget = aov, .lightKinds = dir, .vertexLightConstants = true}, alpha);
+            EXPECT_FALSE(interfaceLocations(flat.vertex, kOutput).contains(3u));
+            EXPECT_FALSE(interfaceLocations(flat.fragment, kInput).contains(3u));
             EXPECT_TRUE(interfaceLocations(flat.fragment, kInput).contains(6u));
             EXPECT_TRUE(interfaceLocations(flat.vertex, kOutput).contains(12u));
         }
@@ -392,8 +395,7 @@ TEST(RasterLitPass, OneSpotOrOnePointLightWithBakedConstantsGetsItsSizeOptimized
 TEST(RasterLitPass, OneSpotOrASunOutsideTheSunModulesWithBakedConstantsHasNoFlatLightInterface) {
     // The general modules (a spot light; a sun with a wide kernel, a filterable map or a
     // transmittance map) bake the one light's constants in too: then neither stage declares the
-    // flat slots (6..13), and the map coordinates (3, 4) stay. With the constants from the vertex
-    // shader both keep them.
+    // flat slots (3..13). With the constants from the vertex shader both keep them.
     constexpr std::uint32_t kInput = 1, kOutput = 3;
     constexpr std::uint32_t dir = 1u << SHADOWLAB_LIGHT_DIRECTIONAL, spot = 1u << SHADOWLAB_LIGHT_SPOT;
     struct Case {
@@ -416,14 +418,15 @@ TEST(RasterLitPass, OneSpotOrASunOutsideTheSunModulesWithBakedConstantsHasNoFlat
                              .transmittance = c.transmittance,
                              .specializedLightConstants = true};
                 const LitStages baked = litStages(v, alpha);
-                for (const std::uint32_t slot : {6u, 12u}) {
+                for (const std::uint32_t slot : {3u, 6u, 12u}) {
                     EXPECT_FALSE(interfaceLocations(baked.vertex, kOutput).contains(slot)) << what;
                     EXPECT_FALSE(interfaceLocations(baked.fragment, kInput).contains(slot)) << what;
                 }
-                EXPECT_TRUE(interfaceLocations(baked.fragment, kInput).contains(3u)) << what;
                 v.specializedLightConstants = false;
                 v.vertexLightConstants = true;
-                EXPECT_TRUE(interfaceLocations(litStages(v, alpha).fragment, kInput).contains(6u)) << what;
+                const LitStages flat = litStages(v, alpha);
+                EXPECT_TRUE(interfaceLocations(flat.fragment, kInput).contains(3u)) << what;
+                EXPECT_TRUE(interfaceLocations(flat.fragment, kInput).contains(6u)) << what;
             }
 }
 
