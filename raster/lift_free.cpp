@@ -6,8 +6,7 @@
 // t|m|, so N·L ≥ t; with nₖ·l ≤ −t|nₖ| the same bound holds for −N·L. A fragment either has
 // N·L ≤ −t (no light, no shadow test) or N·L ≥ t > 1/√(1 + maxTan²), where sin θ − maxTan·cos θ < 0
 // and the lift is exactly 0: with no normal offset asked for, the offset is 0·texel = 0 and the
-// lookup point p + 0·n (or the map coordinates plus 0 times the interpolated map-space normal) is
-// the one the pipeline without the lift uses, bit for bit. Tests render both.
+// lookup point p + 0·n is the one the pipeline without the lift uses, bit for bit. Tests render both.
 #include "raster/lift_free.h"
 
 #include <cmath>

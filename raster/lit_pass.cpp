@@ -82,7 +82,7 @@ std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUn
     if (u.lightCount == 1 && oneMap)
         for (int row = 0; row < 3; ++row)
             for (int column = 0; column < 4; ++column) c[34 + 4 * row + column] = l.toShadow[column][row];
-    if (spot) {
+    if (u.lightCount == 1 && spot) {
         c[15] = l.toShadow[0][3];
         c[23] = l.toShadow[1][3];
         c[29] = l.toShadow[2][3];

@@ -55,8 +55,9 @@ inline constexpr std::size_t kPackedPerLight = 56;
 inline constexpr std::size_t kPackedLightConstants = 32 + 2 + 16 * SHADOWLAB_MAX_CASCADES +
                                                      kPackedPerLight * SHADOWLAB_MAX_LIGHTS +
                                                      16 * SHADOWLAB_MAX_CASCADES * SHADOWLAB_MAX_LIGHTS;
-// everyLight false leaves the per-light values zero: where only light 0's are baked, a light's
-// matrix may change (a moving camera) without changing what the pipelines baked.
+// everyLight false leaves the per-light values zero: where only light 0's are baked, a change of
+// what those modules do not read (a point face's range, another light) must not take a Renderer off
+// its baked pipelines, which Renderer::update decides by comparing the packed values.
 std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUniforms& uniforms, bool everyLight);
 
 // What is fixed when the lit pipeline is created (lit.frag's specialization constants and

@@ -46,9 +46,9 @@ struct RenderDebug {
     const void* lightTargetTexels = nullptr;
 };
 
-// Where the lit pass's fragment shader reads the one light's constants, where it takes that
-// light's map coordinates from the vertex shader (one directional light with one map, or one
-// spot; shaders/lit_constants.glsl):
+// Where the lit pass's fragment shader reads the one light's constants and map matrix, where there
+// is one light with one map (a directional light without cascades, or a spot;
+// shaders/lit_constants.glsl kOneMapLight):
 // - kSpecialization (the default): baked into the lit pipelines as specialization constants, which
 //   cost nothing per triangle or pixel. A Renderer whose update() changes them (a moving light or
 //   camera) switches to kVertexOutputs for the rest of its life, compiling those pipelines once,
@@ -56,9 +56,10 @@ struct RenderDebug {
 // - kVertexOutputs: flat outputs of the vertex shader (lavapipe reads a uniform lane by lane for
 //   every eight pixels, a flat input once per triangle; docs/performance.md);
 // - kUniformBuffer: the uniform buffer.
-// Where no single light's map coordinates come from the vertex shader (several lights, a point
-// light, the receiver-plane bias), kSpecialization bakes every light's constants in and
-// kVertexOutputs reads the uniform buffer; a moving light or camera switches to the buffer then.
+// Where there is no such light (several lights, a point light, the receiver-plane bias; one
+// cascaded sun bakes its own values and its cascades'), kSpecialization bakes every light's
+// constants in and kVertexOutputs reads the uniform buffer; a moving light or camera switches to
+// the buffer then.
 // The frames are the same bit for bit (tests render all three); with every light baked in, within
 // a rounding NIR's folding of the constants brings (docs/raster.md, tests bound it).
 enum class LightConstants { kSpecialization, kVertexOutputs, kUniformBuffer };

@@ -29,10 +29,11 @@ layout(location = 15) flat out vec4 outAlbedo;
 // lit_vert*_sun builds (SHADOWLAB_ONE_SUN, for the *_sun_map modules) put the rows in the slots a
 // sun leaves spare (outLight[4], outLight[5], then outLight[3].w and outFrame[1].yzw) instead of
 // three flat outputs more, which llvmpipe would set up per triangle (lit.frag oneMapMatrix).
-// (Locations 0..15 with the alpha test's coordinates, 64 components counted by whole locations:
-// the most every Vulkan device must take, maxVertexOutputComponents and maxFragmentInputComponents.)
-// Neither is declared in the variants for lit.frag's modules without them (SHADOWLAB_BAKED_LIGHT:
-// lit_constants.glsl), since llvmpipe stores every declared output.
+// (The general build with the alpha test's coordinates declares locations 0..15, 64 components
+// counted by whole locations: the most every Vulkan device must take, maxVertexOutputComponents and
+// maxFragmentInputComponents; the *_sun builds 13.) None of them is declared in the variants for
+// lit.frag's modules without them (SHADOWLAB_BAKED_LIGHT: lit_constants.glsl), since llvmpipe
+// stores every declared output.
 #ifndef SHADOWLAB_BAKED_LIGHT
 #ifndef SHADOWLAB_ONE_SUN
 layout(location = 3) flat out vec4 outMapRows[3];

@@ -52,8 +52,7 @@ layout(constant_id = 7) const bool kCascadeBlend = false;
 // beauty and the 8-bit display target), which leaves out the weighting and the division per pixel.
 layout(constant_id = 8) const bool kVisibility = true;
 // A normal offset is set (LightData::normalOffsetTexels, the same for every light): off (the
-// default), the lookup point is the surface point itself, and the vertex path's map-space normal
-// is not read (one varying and its arithmetic less per pixel).
+// default), the lookup point is the surface point itself, and the offset's arithmetic is left out.
 layout(constant_id = 9) const bool kNormalOffset = true;
 // One directional light with one map, or one spot light, and no receiver plane (kOneMapLight): the
 // one light whose constants lit.vert can pass on flat (kVertexLightConstants) or the pipeline can
@@ -63,6 +62,9 @@ layout(constant_id = 9) const bool kNormalOffset = true;
 // The cascaded *_sun modules (SHADOWLAB_ONE_SUN without SHADOWLAB_ONE_MAP): never, fixed here so
 // that spirv-opt drops the code.
 #if defined(SHADOWLAB_ONE_SUN) && !defined(SHADOWLAB_ONE_MAP)
+#ifndef SHADOWLAB_BAKED_LIGHT
+#error the cascaded *_sun modules go with SHADOWLAB_BAKED_LIGHT: no lit.vert build passes them flat light values
+#endif
 const bool kOneSpot = false;
 const bool kOneMapSun = false;
 #else
@@ -73,10 +75,10 @@ const bool kOneMapSun = kLightCount == 1 && kLightKinds == (1 << SHADOWLAB_LIGHT
 const bool kOneMapLight = !(!kOneSpot && !kOneMapSun);
 const bool kAnyPerspective =
     (kLightKinds & ((1 << SHADOWLAB_LIGHT_SPOT) | (1 << SHADOWLAB_LIGHT_POINT))) != 0;
-// The one light's constants that lit.frag reads (the LightData members its kind uses, less
-// toShadow; the kind itself is a constant there, as kLightKinds has one bit) and LitUniforms'
-// forward, ambient and map size reach lit.frag as flat outputs of lit.vert instead of uniform-buffer
-// reads, where that light is kOneMapLight, its toShadow with them (lit.frag oneMapMatrix). lavapipe (Mesa 22.3's
+// The one light's constants that lit.frag reads (the LightData members its kind uses; the kind
+// itself is a constant there, as kLightKinds has one bit), LitUniforms' forward, ambient and map
+// size, and its toShadow (lit.frag oneMapMatrix) reach lit.frag as flat outputs of lit.vert
+// instead of uniform-buffer reads, where that light is kOneMapLight. lavapipe (Mesa 22.3's
 // llvmpipe) reads a uniform in a fragment shader lane by lane, with a bounds check, for every
 // eight pixels; a flat input is set up once per triangle and then read as a constant
 // (docs/performance.md: less CPU per frame on the seed scene and on Sponza, down to half a pixel
@@ -90,7 +92,8 @@ const bool kVertexLightConstants = false;
 const bool kVertexLightConstants = kVertexLightConstantsAsked && kOneMapLight;
 #endif
 // The same values baked into the pipeline (raster::LightConstants::kSpecialization): lit.frag reads
-// them as constants 18..49, packed as lit.vert packs outLight[0..5] and outFrame[0..1], and lit.vert
+// them as constants 18..49, packed as lit.vert packs outLight[0..5] and outFrame[0..1] (but for the
+// matrix's rows, which the lit_vert*_sun builds put in a sun's spare components), and lit.vert
 // writes neither. A flat input costs llvmpipe its setup and 48 bytes per triangle in every bin it
 // touches; a constant costs nothing per triangle, and folds into the arithmetic that reads it.
 // kOneMapLight: also its map matrix, in cascade 0's constants below. One cascaded directional light,

@@ -216,6 +216,47 @@ TEST(RasterLitPass, TargetsLargerThanTheDeviceAllowsAreRefusedNamingTheLimit) {
     }
 }
 
+TEST(RasterLitPass, PackedConstantsCarryTheOneMapLightsMatrix) {
+    // lit.frag (oneMapMatrix) reads the one-map light's toShadow from cascade 0's three rows
+    // (packed values 34..45, constants 52..63) and a spot's last row from the light slots' spare
+    // components (values 15, 23, 29 and 30: outLight[3].w, outLight[5].w, outFrame[1].y and .z);
+    // a change of the matrix alone must change the packed values, which Renderer::update compares
+    // to leave the baked pipelines. A matrix whose every entry differs shows a misplaced one.
+    shaders::LitUniforms u{};
+    u.lightCount = 1;
+    u.mapSize = 2048.0f;
+    for (int column = 0; column < 4; ++column)
+        for (int row = 0; row < 4; ++row) u.lights[0].toShadow[column][row] = float(1 + 4 * column + row);
+    for (const int kind : {SHADOWLAB_LIGHT_DIRECTIONAL, SHADOWLAB_LIGHT_SPOT}) {
+        u.lights[0].kind = kind;
+        const auto c = packLightConstants(u, false);
+        for (int row = 0; row < 3; ++row)
+            for (int column = 0; column < 4; ++column)
+                EXPECT_EQ(c[std::size_t(34 + 4 * row + column)], float(1 + 4 * column + row)) << row << column;
+        const bool spot = kind == SHADOWLAB_LIGHT_SPOT;
+        EXPECT_EQ(c[15], spot ? 4.0f : 0.0f);
+        EXPECT_EQ(c[23], spot ? 8.0f : 0.0f);
+        EXPECT_EQ(c[29], spot ? 12.0f : 0.0f);
+        EXPECT_EQ(c[30], spot ? 16.0f : 0.0f);
+        EXPECT_EQ(c[28], 2048.0f);  // the map size keeps its slot
+        shaders::LitUniforms moved = u;
+        moved.lights[0].toShadow[3][0] += 1.0f;  // a translation: only the matrix differs
+        EXPECT_NE(packLightConstants(moved, false), c);
+    }
+    // A cascaded sun's cascade 0 keeps its own values; with two lights nothing is light 0's alone.
+    u.lights[0].kind = SHADOWLAB_LIGHT_DIRECTIONAL;
+    u.lights[0].cascadeCount = 3;
+    u.cascades[0].toShadow[0][0] = 99.0f;
+    EXPECT_EQ(packLightConstants(u, false)[34], 99.0f);
+    u.lights[0].cascadeCount = 0;
+    u.lightCount = 2;
+    u.lights[0].kind = SHADOWLAB_LIGHT_SPOT;
+    const auto two = packLightConstants(u, false);
+    EXPECT_EQ(two[34], 99.0f);
+    EXPECT_EQ(two[15], 0.0f);
+    EXPECT_EQ(two[30], 0.0f);
+}
+
 TEST(RasterLitPass, OnlyOneDirectionalMapOrOneSpotIsTheOneMapLight) {
     // Light 0's constants and its one map matrix are baked in (or passed on flat) only when that one
     // matrix serves every fragment: one light, directional with a single map or a spot, and no
@@ -430,9 +471,9 @@ TEST(RasterLitPass, OneSpotOrASunOutsideTheSunModulesWithBakedConstantsHasNoFlat
             }
 }
 
-TEST(RasterLitPass, EveryLightIsBakedInWhereNoOneLightComesFromTheVertexShader) {
+TEST(RasterLitPass, EveryLightIsBakedInWhereThereIsNoOneMapLight) {
     // Several lights, one point light, or the receiver-plane bias: every light's constants baked in
-    // (bakesEveryLight), in the general modules without the flat light slots (6..13); with per-light
+    // (bakesEveryLight), in the general modules without the flat light slots (3..13); with per-light
     // visibility targets, the modules that write them (outputs 6 and 7); for the beauty alone, the
     // modules that write only it (output 0).
     constexpr std::uint32_t kInput = 1, kOutput = 3;
@@ -460,7 +501,7 @@ TEST(RasterLitPass, EveryLightIsBakedInWhereNoOneLightComesFromTheVertexShader) 
                                        .lightKinds = dir | spot | point,
                                        .specializedLightConstants = true};
                     const LitStages baked = litStages(v, alpha);
-                    for (const std::uint32_t slot : {6u, 12u}) {
+                    for (const std::uint32_t slot : {3u, 6u, 12u}) {
                         EXPECT_FALSE(interfaceLocations(baked.vertex, kOutput).contains(slot)) << what;
                         EXPECT_FALSE(interfaceLocations(baked.fragment, kInput).contains(slot)) << what;
                     }

@@ -895,8 +895,9 @@ struct LightZeroAgreement {
     }
 };
 
-// The scene `one` rendered alone and with `dim` added (a second light takes lit.frag off the
-// interpolated map-coordinate path, onto the per-fragment product), normal offset 1.5 texels.
+// The scene `one` rendered alone and with `dim` added (a second light takes lit.frag from the one
+// light's baked matrix, cascade 0's constants, to every light's baked values, each light's own
+// slots), normal offset 1.5 texels.
 std::pair<scene::Frame, scene::Frame> aloneAndWithADimLight(const scene::Scene& one, const scene::Light& dim,
                                                             scene::RasterSettings settings) {
     settings.normalOffset = 1.5;
@@ -929,15 +930,18 @@ scene::Light spotOverTheSphere(const Vec3& shift = Vec3(0.0)) {
     return spot;
 }
 
-TEST(RasterRender, InterpolatedLightCoordinatesMatchThePerFragmentProduct) {
-    // With one directional light lit.frag takes the map coordinates interpolated from lit.vert
-    // (toShadow·(p, 1) and toShadow₃ₓ₃·n); with a second light it multiplies the interpolated
-    // position by toShadow per fragment. Light 0's visibility must agree between the two (the
-    // second light is a dim copy from elsewhere, so light 0's map is the same), near the origin
-    // and 10^7 units from it (camera-relative floats), with the normal offset on and a slope bias
-    // small enough that the offset decides the shadow's edge. The two sums round differently at
-    // the map coordinates' own scale (≈1e-7 of the map, 2e-4 of a texel here): pcf2x2's bilinear
-    // weights move by that much, and at most a few edge texels may flip.
+TEST(RasterRender, OneMapLightsBakedMatrixMatchesEveryLightsBakedValues) {
+    // With one directional light lit.frag forms the map coordinates with that light's matrix as
+    // the one-map light's baked rows (kOneMapLight: cascade 0's constants, packLightConstants);
+    // with a second light, with every light's baked values (each light's own slots, the *_every
+    // modules). Both multiply the normal-offset point by toShadow per fragment, so light 0's
+    // visibility must agree between the two (the second light is a dim copy from elsewhere, so
+    // light 0's map is the same), near the origin and 10^7 units from it (camera-relative floats),
+    // with the normal offset on and a slope bias small enough that the offset decides the shadow's
+    // edge: a row or column of either packing out of place moves the shadow. The bounds leave room
+    // for Mesa's NIR folding the two modules' constants into their arithmetic in different orders
+    // (rounding at the map coordinates' scale, ≈1e-7 of the map): pcf2x2's bilinear weights may move
+    // by that much, and at most a few edge texels may flip.
     for (const double offset : {0.0, 1.0e7})
         for (ShadowFilter filter : {ShadowFilter::None, ShadowFilter::Pcf2x2, ShadowFilter::Poisson}) {
             scene::Scene one = sunAt50Degrees(offset);
@@ -962,19 +966,17 @@ TEST(RasterRender, InterpolatedLightCoordinatesMatchThePerFragmentProduct) {
         }
 }
 
-TEST(RasterRender, InterpolatedSpotLightCoordinatesMatchThePerFragmentProduct) {
-    // The same comparison for one spot light: lit.vert interpolates toShadow·(p, 1) and
-    // toShadow·(N, 0) (all four rows), lit.frag scales the second by k·texel(p) with texel(p) =
-    // texelWorldSize·w(p), adds, and divides by w; with a second (dim) spot it multiplies the normal-offset
-    // point by toShadow per fragment. Algebraically the same (clip coordinates are linear in the
-    // point, and the offset's two factors each in the position and the normal), so light 0's
-    // visibility must agree up to rounding at the map's scale: the divided (u, v) ≈1e-7 of the map,
-    // < 1e-4 of a 512² texel, so pcf2x2's weights move by ≲ 1e-4 and at most a few edge texels may
-    // flip. The spot shines at ≈40° to the plane, so the offset (along the plane's normal) moves
-    // u, v as well as the axial distance; PCSS (a light of radius 0.1) also takes the axial
-    // distance and the texel size into its blocker search and kernel width. Near the origin and
-    // 10^7 units away. (An offset 10% too long in the interpolated path flips 8 (none) to 195
-    // (pcss) pixels here.)
+TEST(RasterRender, OneSpotsBakedMatrixMatchesEveryLightsBakedValues) {
+    // The same comparison for one spot light: alone, its matrix's first three rows are cascade 0's
+    // constants and its last row (the perspective divide's w) rides in the light slots' spare
+    // components; with a second (dim) spot, every light's values are baked in their own slots.
+    // Both multiply the normal-offset point by toShadow per fragment and divide by w, so light 0's
+    // visibility must agree up to the rounding of constants folded in different orders: the divided
+    // (u, v) ≈1e-7 of the map, < 1e-4 of a 512² texel, so pcf2x2's weights move by ≲ 1e-4 and at
+    // most a few edge texels may flip. The spot shines at ≈40° to the plane, so the offset (along
+    // the plane's normal) moves u, v as well as the axial distance; PCSS (a light of radius 0.1)
+    // also takes the axial distance and the texel size into its blocker search and kernel width.
+    // Near the origin and 10^7 units away.
     // The closed form (the unshifted scene: the pixels see the same) counts the plane pixels well
     // inside the cone whose segment to the light meets the sphere, so the comparison covers a shadow.
     const SphereOverPlane base{.width = 320, .height = 180};
@@ -1342,6 +1344,14 @@ TEST(RasterRenderer, PerLightTargetsInReusedHeapMemoryStillGiveTheBackgroundZero
     EXPECT_EQ(renderer.validationMessages(), 0);
 }
 
+// `s` with a 1x1 alpha-masked checkered quad (half its texels cut out) `height` above the origin,
+// facing up: an alpha-tested caster.
+scene::Scene withAlphaLeaf(scene::Scene s, double height) {
+    s.materials.push_back(alphaMaterial("leaf", scene::AlphaMode::Mask, checkerTexture(2, 1.0f, 0.0f)));
+    addQuad(s, Vec3(0, height, 0), Vec3(0, 1, 0), 1, 1, 1);
+    return s;
+}
+
 TEST(RasterRenderer, SizeOptimizedOneLightModulesGiveTheGeneralModulesFramesBitForBit) {
     // One light with none or pcf2x2 gets its kind's modules (*_sun, *_spot, *_point: constants
     // fixed in the source, spirv-opt's size passes); the general *_taps modules, built with the same
@@ -1354,11 +1364,6 @@ TEST(RasterRenderer, SizeOptimizedOneLightModulesGiveTheGeneralModulesFramesBitF
     cascades.depthBias = scene::defaultDepthBias(cascaded, 512);
     cascades.cascades = 3;
     cascades.cascadeBlend = 0.3;
-    auto withLeaf = [](scene::Scene s, double height) {
-        s.materials.push_back(alphaMaterial("leaf", scene::AlphaMode::Mask, checkerTexture(2, 1.0f, 0.0f)));
-        addQuad(s, Vec3(0, height, 0), Vec3(0, 1, 0), 1, 1, 1);
-        return s;
-    };
     const scene::Scene sun = makeScene(SphereOverPlane{});
     scene::Scene point = makeScene(SphereOverPlane{});
     point.lights[0].type = scene::LightType::Point;
@@ -1374,15 +1379,15 @@ TEST(RasterRenderer, SizeOptimizedOneLightModulesGiveTheGeneralModulesFramesBitF
         {"sun none", sun, none},
         {"sun normal offset", sun, offset},
         {"sun cascades", cascaded, cascades},
-        {"sun alpha-tested caster", withLeaf(sun, 2.0), pcf2x2},
+        {"sun alpha-tested caster", withAlphaLeaf(sun, 2.0), pcf2x2},
         {"spot pcf2x2", spot, pcf2x2},
         {"spot none", spot, none},
         {"spot normal offset", spot, offset},
-        {"spot alpha-tested caster", withLeaf(spot, 2.5), pcf2x2},
+        {"spot alpha-tested caster", withAlphaLeaf(spot, 2.5), pcf2x2},
         {"point pcf2x2", point, pcf2x2},
         {"point none", point, none},
         {"point normal offset", point, offset},
-        {"point alpha-tested caster", withLeaf(point, 2.5), pcf2x2}};
+        {"point alpha-tested caster", withAlphaLeaf(point, 2.5), pcf2x2}};
     for (const auto& [what, s, settings] : cases) {
         Renderer sized(s, planFor(s, settings), settings);
         Renderer general(s, planFor(s, settings), settings, RendererOptions{.oneLightModules = false});
@@ -1538,6 +1543,38 @@ TEST(RasterRenderer, LightConstantsFromTheVertexShaderOrBakedInGiveTheSameFrameB
                     EXPECT_TRUE(display[0].beauty == display[2].beauty) << what << ", display target, baked in";
                 }
             }
+}
+
+TEST(RasterRenderer, AlphaTestedCastersGiveTheSameFramesFromEveryLightConstantSource) {
+    // The alpha-tested pipelines pair their own lit.vert builds with the light's constants and map
+    // matrix from each source: lit_vert_alpha_sun (the matrix in the slots a sun leaves spare) with
+    // the *_sun_map modules, lit_vert_alpha (the matrix in locations of its own, every location a
+    // device must take) with the general ones, lit_vert_alpha_baked with the baked ones. Every
+    // channel of the all-channel, float-beauty and display frames the same bit for bit. Only the
+    // alpha-tested object takes those pipelines, so the leaf lies just above the plane in the
+    // sphere's shadow, where its own lookups decide what it shows.
+    const scene::Scene sun = withAlphaLeaf(makeScene(SphereOverPlane{}), 0.05);
+    const scene::Scene spot =
+        withAlphaLeaf(withSpot(makeScene(SphereOverPlane{}), Vec3(2, 5, 2), Vec3(-2, -5, -2)), 0.05);
+    const std::tuple<const char*, scene::Scene, ShadowFilter> cases[] = {{"sun pcf2x2", sun, ShadowFilter::Pcf2x2},
+                                                                         {"sun pcf", sun, ShadowFilter::Pcf},
+                                                                         {"spot pcf2x2", spot, ShadowFilter::Pcf2x2}};
+    for (const auto& [what, s, filter] : cases) {
+        const scene::RasterSettings settings = validatedSettings(512, 0.01, 1.0, filter);
+        for (const scene::ChannelMask channels :
+             {scene::kAllChannels, scene::kChannelBeauty, scene::kChannelBeauty | scene::kBeautyForDisplay}) {
+            const auto frames = withEveryLightConstantSource(s, settings, channels);
+            EXPECT_EQ(frames[1].attributes.at("light_constants"), "vertex-outputs") << what;
+            test::expectSamePixels(frames[1], frames[0], std::string(what) + ": flat inputs against the buffer");
+            test::expectSamePixels(frames[2], frames[0], std::string(what) + ": baked against the buffer");
+            if (channels != scene::kAllChannels) continue;
+            std::size_t leafShadowed = 0;  // the leaf is the last object added: the highest id
+            const float leaf = *std::max_element(frames[0].objectId.begin(), frames[0].objectId.end());
+            for (std::size_t i = 0; i < frames[0].pixelCount(); ++i)
+                leafShadowed += frames[0].visibility[i] < 0.5f && frames[0].objectId[i] == leaf;
+            EXPECT_GT(leafShadowed, 10u) << what << ": the sphere must shadow the leaf";
+        }
+    }
 }
 
 TEST(RasterRenderer, CascadedLightConstantsBakedInGiveTheUniformBuffersFrameBitForBit) {
