@@ -105,6 +105,11 @@ vec4 frameSlot(int k) {
     return inFrame[k];
 #endif
 }
+// The matrix with rows r0..r3 (mat4 takes columns: column k is (r0[k], r1[k], r2[k], r3[k])).
+mat4 matrixFromRows(vec4 r0, vec4 r1, vec4 r2, vec4 r3) {
+    return mat4(vec4(r0.x, r1.x, r2.x, r3.x), vec4(r0.y, r1.y, r2.y, r3.y), vec4(r0.z, r1.z, r2.z, r3.z),
+                vec4(r0.w, r1.w, r2.w, r3.w));
+}
 // kOneMapLight: light 0's toShadow, its first three rows baked in as cascade 0's
 // (kSpecializedLightConstants) or from lit.vert (in the slots a sun leaves spare where the module
 // is for a sun: lit.vert), a spot's last row in the slots' spare components
@@ -130,9 +135,7 @@ mat4 oneMapMatrix() {
 #endif
     }
     const vec4 r3 = kOneSpot ? vec4(lightSlot(3).w, lightSlot(5).w, frameSlot(1).y, frameSlot(1).z) : vec4(0.0, 0.0, 0.0, 1.0);
-    // (mat4 takes columns: column k is (r0[k], r1[k], r2[k], r3[k]).)
-    return mat4(vec4(r0.x, r1.x, r2.x, r3.x), vec4(r0.y, r1.y, r2.y, r3.y), vec4(r0.z, r1.z, r2.z, r3.z),
-                vec4(r0.w, r1.w, r2.w, r3.w));
+    return matrixFromRows(r0, r1, r2, r3);
 }
 // Light i's constants: the uniform buffer's, or (kVertexLightConstants: the one light) light 0's as
 // lit.vert packs them, its flat outputs or the same values baked in. The members lit.vert does not
@@ -232,9 +235,7 @@ float mapSize() { return kFrameFromSlots ? frameSlot(1).x : u.mapSize; }
 // buffer's are loaded lane by lane.
 CascadeData cascadeFromRows(vec4 r0, vec4 r1, vec4 r2, vec4 rest) {
     CascadeData d;
-    // (mat4 takes columns: column k is (r0[k], r1[k], r2[k], w row).)
-    d.toShadow = mat4(vec4(r0.x, r1.x, r2.x, 0.0), vec4(r0.y, r1.y, r2.y, 0.0), vec4(r0.z, r1.z, r2.z, 0.0),
-                      vec4(r0.w, r1.w, r2.w, 1.0));
+    d.toShadow = matrixFromRows(r0, r1, r2, vec4(0.0, 0.0, 0.0, 1.0));  // an orthographic map's last row
     d.sliceFar = rest.x;
     d.texelWorldSize = rest.y;
     d.depthPerWorld = rest.z;

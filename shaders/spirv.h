@@ -53,8 +53,8 @@ std::span<const std::uint32_t> litFragTapsSunMapSpirv();
 std::span<const std::uint32_t> litFragAlphaTapsSunMapSpirv();
 std::span<const std::uint32_t> litFragBeautyTapsSunMapSpirv();
 std::span<const std::uint32_t> litFragBeautyAlphaTapsSunMapSpirv();
-// lit.vert without the object id output, for the *_sun beauty-only shaders without the alpha
-// test (which do not read it, and spirv-opt removes the input).
+// lit.vert without the object id output, for the beauty-only shaders without the alpha test
+// (which do not read it: spirv-opt's size passes remove the input).
 std::span<const std::uint32_t> litVertNoIdSpirv();
 // lit.vert for the *_sun_map modules with the light's constants from lit.vert (SHADOWLAB_ONE_SUN):
 // the map matrix's rows in the slots a sun leaves spare, no outputs of their own.
