@@ -158,7 +158,11 @@ void benchScene(const std::string& label, scene::Scene s, int repeats, std::vect
     // SHADOWLAB_BENCH_CASCADES=N: N cascades instead (the command line's default for a large view
     // is 4), to compare two builds or light-constant sources of ours on that path; the bare
     // baseline still draws one map, so the ratio to it is not like for like.
-    overrides.fitLightFrustum = false;
+    // SHADOWLAB_BENCH_MOVING (below) keeps the maps fitted to the view, as a user's run does, so
+    // that a camera move changes them.
+    const char* movingName = std::getenv("SHADOWLAB_BENCH_MOVING");
+    const bool moving = movingName && *movingName;
+    if (!moving) overrides.fitLightFrustum = false;
     overrides.cascades = 1;
     if (const char* v = std::getenv("SHADOWLAB_BENCH_CASCADES"); v && *v) overrides.cascades = std::atoi(v);
     // SHADOWLAB_BENCH_FILTER=name: ours with that shadow filter instead of the scene's (pcf, poisson,
@@ -244,6 +248,39 @@ void benchScene(const std::string& label, scene::Scene s, int repeats, std::vect
         for (std::size_t i = 0; i < rgb.size() / 3; ++i)
             for (int c = 0; c < 3; ++c) rgb[3 * i + c] = float(rgba[4 * i + c]) / 255.0f;
         scene::writePngDisplay(fs::path(dir) / (label + "-bare.png"), width, height, rgb);
+    }
+
+    // SHADOWLAB_BENCH_MOVING=all|beauty: only ours, `repeats` frames with the camera orbiting the
+    // look-at point about the vertical by SHADOWLAB_BENCH_MOVING_STEP degrees a frame (default 0.25),
+    // each an update() and a frame of those channels: what a camera path costs, where the values
+    // baked into the lit pipelines change every frame (docs/performance.md, "A moving camera").
+    if (moving) {
+        const std::string which = movingName;
+        if (which != "all" && which != "beauty")
+            throw std::runtime_error("SHADOWLAB_BENCH_MOVING: expected all or beauty, got " + which);
+        const char* stepName = std::getenv("SHADOWLAB_BENCH_MOVING_STEP");
+        const double step = glm::radians(stepName && *stepName ? std::atof(stepName) : 0.25);
+        const scene::Vec3 offset = s.camera.position - s.camera.lookAt;
+        Series series;
+        scene::Frame into;
+        scene::Scene moved = s;
+        for (int i = 1; i <= repeats; ++i) {
+            const double c = std::cos(step * i), sn = std::sin(step * i);
+            moved.camera.position =
+                s.camera.lookAt + scene::Vec3(c * offset.x + sn * offset.z, offset.y, -sn * offset.x + c * offset.z);
+            const double cpu = cpuMs();
+            ours.update(moved);
+            ours.render(into, which == "all" ? scene::kAllChannels : scene::kChannelBeauty);
+            series.add("cpu_update_and_frame", cpuMs() - cpu);
+            addOurs(series, into);
+        }
+        std::printf("\n=== %s moving (%s): %d frames, light constants after the first update: %s ===\n", label.c_str(),
+                    which.c_str(), repeats, into.attributes["light_constants"].c_str());
+        for (const char* stage : {"cpu_update_and_frame", "cpu_shadow_pass", "cpu_lit_pass"}) {
+            const auto [lo, hi] = series.range(stage);
+            std::printf("  %-22s %7.1f (%.1f-%.1f)\n", stage, series.med(stage), lo, hi);
+        }
+        return;
     }
 
     // SHADOWLAB_BENCH_PROFILE=all|no-ids|beauty|png|bare|bare-srgb|bare-aovs: only that series, `repeats` frames,
