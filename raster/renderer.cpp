@@ -337,8 +337,27 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
     background = glm::vec3(scene.background);
     attributes["device"] = ctx.deviceReport.name;
 
-    // UVs and alpha records also where only the camera reads alpha (untextured BLEND).
-    SceneGeometry geometry = tessellateScene(scene, origin, scene.hasCameraAlpha());
+    // Which objects' alpha tests can cut, per material (a texture is scanned once): the depth
+    // pass's (MASK) and the camera's; a test that never cuts is left out (idleAlphaTestsLeftOut).
+    std::map<const scene::Material*, std::pair<bool, bool>> alphaTests;
+    auto testsOf = [&](const scene::Material& m) {
+        auto [it, added] = alphaTests.try_emplace(&m);
+        if (added) {
+            const bool all = !options.idleAlphaTestsLeftOut;
+            it->second = {m.alphaMode == scene::AlphaMode::Mask && (all || m.alphaCanFallBelow(m.alphaCutoff)),
+                          m.alphaMode != scene::AlphaMode::Opaque && (all || m.alphaCanFallBelow(m.cameraCutoff()))};
+        }
+        return it->second;
+    };
+    bool alphaTested = false;
+    for (const scene::Object& o : scene.objects) {
+        const auto [depth, camera] = testsOf(scene.materialOf(o));
+        alphaTested |= depth || camera;
+    }
+    // UVs and alpha records where a test can cut (an untextured BLEND one only for the camera), or
+    // where the transmittance passes read alpha.
+    const bool alphaData = alphaTested || (planIn.needsTransmittanceMap && scene.hasAlphaCasters());
+    SceneGeometry geometry = tessellateScene(scene, origin, alphaData);
     std::vector<TransparentDraw> transparentDraws;
     std::uint32_t opaqueIndexCount = ~0u;
     if (planIn.needsTransmittanceMap) transparentDraws = separateTransparent(scene, geometry, opaqueIndexCount);
@@ -366,12 +385,11 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
     indexBuffer = uploadBuffer(ctx, geometry.indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
     draw = DrawGeometry{vertexBuffer.buffer.get(), indexBuffer.buffer.get(), std::uint32_t(geometry.indices.size()),
                         opaqueIndexCount, transparentDraws};
-    if (scene.hasCameraAlpha()) {
+    if (alphaData) {
         alpha = createAlphaCasters(ctx, scene, geometry);
         draw.uvs = alpha.uvs.buffer.get();
         draw.alphaSet = alpha.descriptors.set;
         shadowAlpha = scene.hasAlphaCasters();
-        if (shadowAlpha) attributes["alpha_casters"] = "alpha-tested in the depth pass";  // only where there are some
     }
     // Each object's triangles in the index buffer (reordered with a transmittance map: the opaque
     // objects' first, in object order, then each semi-transparent one's) and the objects in that
@@ -386,8 +404,8 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
         DrawObject d{.object = std::uint32_t(o),
                      .first = objectFirstIndex[o],
                      .count = objectFirstIndex[o + 1] - objectFirstIndex[o],
-                     .depthAlpha = shadowAlpha && m.alphaMode == scene::AlphaMode::Mask,
-                     .cameraAlpha = m.alphaMode != scene::AlphaMode::Opaque,
+                     .depthAlpha = shadowAlpha && testsOf(m).first,
+                     .cameraAlpha = testsOf(m).second,
                      .depthPass = true};
         if (planIn.needsTransmittanceMap && !m.opaque()) {
             if (d.count == 0) continue;                                // (separateTransparent makes no draw for it)
@@ -403,6 +421,8 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
         drawObjects.push_back(d);
     }
     drawObjects.insert(drawObjects.end(), transparentObjects.begin(), transparentObjects.end());
+    if (std::any_of(drawObjects.begin(), drawObjects.end(), [](const DrawObject& d) { return d.depthAlpha; }))
+        attributes["alpha_casters"] = "alpha-tested in the depth pass";  // only where a test can cut
     for (const DrawObject& d : drawObjects) {
         if (!draw.litRanges.empty() && draw.litRanges.back().alpha == d.cameraAlpha &&
             draw.litRanges.back().first + draw.litRanges.back().count == d.first)

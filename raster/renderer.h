@@ -88,6 +88,11 @@ struct RendererOptions {
     // The lit pass leaves out runs of triangles whose box lies outside the camera's clip volume
     // (raster/view_cull.h); the same frames (tests compare). false: it draws every triangle.
     bool viewCull = true;
+    // Objects whose alpha can never cut (scene::Material::alphaCanFallBelow: a constant alpha at or
+    // above the cutoff, or a texture whose every texel passes) take the depth and lit pipelines
+    // without the alpha test, which llvmpipe then need not compile; the same frames (tests
+    // compare). false: every MASK caster and every MASK or BLEND surface is alpha-tested.
+    bool idleAlphaTestsLeftOut = true;
 };
 
 // A reusable raster renderer for one scene and its settings: the constructor does the setup

@@ -119,13 +119,13 @@ struct Shading {
     std::vector<int> blocker;
 };
 
-// Objects whose shadow can have holes: MASK with a texture or an alpha below its cutoff, BLEND,
+// Objects whose shadow can have holes: MASK whose alpha can fall below its cutoff, BLEND,
 // opacity < 1.
 std::vector<int> seeThroughObjects(const scene::Scene& scene) {
     std::vector<int> out;
     for (std::size_t i = 0; i < scene.objects.size(); ++i) {
         const scene::Material& m = scene.materialOf(scene.objects[i]);
-        const bool mask = m.alphaMode == scene::AlphaMode::Mask && (m.alphaTextured() || m.alphaFactor < m.alphaCutoff);
+        const bool mask = m.alphaMode == scene::AlphaMode::Mask && m.alphaCanFallBelow(m.alphaCutoff);
         if (!m.opaque() || mask) out.push_back(int(i));
     }
     return out;

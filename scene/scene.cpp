@@ -53,17 +53,21 @@ bool Scene::allOpaque() const {
     return true;
 }
 
+bool Material::alphaCanFallBelow(double cutoff) const {
+    float lowest = 1.0f;  // the texture's alpha (1 without one)
+    if (alphaTextured()) {
+        if (alphaTexture->alpha.empty()) return true;
+        lowest = *std::min_element(alphaTexture->alpha.begin(), alphaTexture->alpha.end());
+    }
+    // Rounding is monotonic, so the smallest texel gives the smallest product in either precision.
+    return float(alphaFactor) * lowest < float(cutoff) || alphaFactor * double(lowest) < cutoff;
+}
+
 bool Scene::hasAlphaCasters() const {
     for (const Object& o : objects) {
         const Material& m = materialOf(o);
         if (m.alphaMode == AlphaMode::Mask || (m.alphaMode == AlphaMode::Blend && m.alphaTexture)) return true;
     }
-    return false;
-}
-
-bool Scene::hasCameraAlpha() const {
-    for (const Object& o : objects)
-        if (materialOf(o).alphaMode != AlphaMode::Opaque) return true;
     return false;
 }
 

@@ -112,6 +112,11 @@ struct Material {
     // Mask / blend decisions for any hit; `texAlpha` is the texture's alpha there (1 without).
     double alphaAt(double texAlpha) const { return alphaFactor * texAlpha; }
     bool masked(double texAlpha) const { return alphaMode == AlphaMode::Mask && alphaAt(texAlpha) < alphaCutoff; }
+    // Whether alpha(uv) can fall below `cutoff` anywhere: false where alpha is a constant at or
+    // above it, or the texture's smallest texel times the factor is, both in float (the shaders'
+    // and the float tracer's product) and in double (the reference's). A test against that cutoff
+    // can then never fire, and a pass may leave it out.
+    bool alphaCanFallBelow(double cutoff) const;
     // The alpha below which the camera looks through a texel (no test for OPAQUE: -1).
     double cameraCutoff() const {
         return alphaMode == AlphaMode::Mask ? alphaCutoff : alphaMode == AlphaMode::Blend ? kBlendVisibleAlpha : -1.0;
@@ -351,12 +356,9 @@ struct Scene {
 
     const Material& materialOf(const Object& o) const { return materials[o.material]; }
     bool allOpaque() const;
-    // Some object's material is MASK, or BLEND with a texture: the raster backend then reads
-    // alpha per fragment (raster/alpha_casters.h).
+    // Some object's material is MASK, or BLEND with a texture: the raster backend's depth and
+    // transmittance passes may then read alpha per fragment (raster/alpha_casters.h).
     bool hasAlphaCasters() const;
-    // Some object's material is MASK or BLEND: the raster lit pass then tests alpha per
-    // fragment as camera rays do (Material::cameraSkips).
-    bool hasCameraAlpha() const;
     Bounds bounds() const;  // of every object
 };
 

@@ -66,3 +66,57 @@ TEST(ShadowDefaults, RayBiasIsOneKeyInEitherForm) {
     EXPECT_EQ(b.rayBias, 0.001);
     EXPECT_FALSE(b.robustRayOffset.value_or(false));
 }
+
+// --- alpha tests that can never fire --------------------------------------------------------
+
+namespace {
+
+scene::Material maskMaterial(double factor, double cutoff, std::vector<float> texels = {}) {
+    scene::Material m;
+    m.alphaMode = scene::AlphaMode::Mask;
+    m.alphaFactor = factor;
+    m.alphaCutoff = cutoff;
+    if (!texels.empty()) {
+        auto t = std::make_shared<scene::AlphaTexture>();
+        t->width = int(texels.size());
+        t->height = 1;
+        t->alpha = std::move(texels);
+        m.alphaTexture = t;
+    }
+    return m;
+}
+
+}  // namespace
+
+TEST(MaterialAlpha, AConstantAlphaFallsBelowACutoffOnlyWhenItIsBelowIt) {
+    // Without a texture alpha(uv) is the factor everywhere (glTF baseColorFactor[3]).
+    EXPECT_FALSE(maskMaterial(1.0, 0.5).alphaCanFallBelow(0.5));
+    EXPECT_FALSE(maskMaterial(0.5, 0.5).alphaCanFallBelow(0.5));  // at the cutoff is not below it
+    EXPECT_TRUE(maskMaterial(0.4, 0.5).alphaCanFallBelow(0.5));
+    EXPECT_TRUE(maskMaterial(0.0, 0.5).alphaCanFallBelow(0.5));
+}
+
+TEST(MaterialAlpha, ATextureFallsBelowWhereItsSmallestTexelTimesTheFactorDoes) {
+    EXPECT_FALSE(maskMaterial(1.0, 0.5, {1.0f, 0.9f, 0.5f}).alphaCanFallBelow(0.5));
+    EXPECT_TRUE(maskMaterial(1.0, 0.5, {1.0f, 0.49f, 1.0f}).alphaCanFallBelow(0.5));
+    EXPECT_TRUE(maskMaterial(0.5, 0.5, {1.0f, 0.9f}).alphaCanFallBelow(0.5));   // 0.45 < 0.5
+    EXPECT_FALSE(maskMaterial(0.8, 0.5, {0.7f, 1.0f}).alphaCanFallBelow(0.5));  // 0.56
+    // An OPAQUE material ignores its texture: alpha is the factor.
+    scene::Material opaque = maskMaterial(1.0, 0.5, {0.0f});
+    opaque.alphaMode = scene::AlphaMode::Opaque;
+    EXPECT_FALSE(opaque.alphaCanFallBelow(0.5));
+}
+
+TEST(MaterialAlpha, EitherPrecisionsProductBelowTheCutoffCounts) {
+    // The texel 0.7f is 0.699999988: in float it equals the cutoff 0.7 rounded to float, so the
+    // shaders' test passes it, but the reference's double product is below 0.7 and cuts it.
+    EXPECT_LT(double(0.7f), 0.7);
+    EXPECT_FALSE(0.7f < float(0.7));
+    EXPECT_TRUE(maskMaterial(1.0, 0.7, {0.7f}).alphaCanFallBelow(0.7));
+    // The other way round: 0.228225 · (200/255) is 0.179000003 in double, at or above a cutoff
+    // of 0.179, but the float product rounds to 0.17899999 below float(0.179).
+    const float texel = 200.0f / 255.0f;
+    EXPECT_GE(0.228225 * double(texel), 0.179);
+    EXPECT_LT(float(0.228225) * texel, float(0.179));
+    EXPECT_TRUE(maskMaterial(0.228225, 0.179, {texel}).alphaCanFallBelow(0.179));
+}
