@@ -147,6 +147,17 @@ raster::RendererOptions rendererOptions() {
 // no second bare renderer holding another copy of the triangles.
 void benchScene(const std::string& label, scene::Scene s, int repeats, std::vector<fs::path>& caches,
                 bool scaling = false) {
+    // SHADOWLAB_BENCH_CUTTING_ALPHA=1: every MASK material takes a 2x2 checker of alpha 1 and 0, so
+    // that its alpha test can cut and ours draws it with the alpha-tested pipelines (Sponza's MASK
+    // materials have no texture and take the plain ones; docs/performance.md, "Latest figures").
+    if (const char* v = std::getenv("SHADOWLAB_BENCH_CUTTING_ALPHA"); v && std::string(v) == "1") {
+        auto checker = std::make_shared<scene::AlphaTexture>();
+        checker->file = "bench-checker";
+        checker->width = checker->height = 2;
+        checker->alpha = {1.0f, 0.0f, 0.0f, 1.0f};
+        for (scene::Material& m : s.materials)
+            if (m.alphaMode == scene::AlphaMode::Mask) m.alphaTexture = checker;
+    }
     const char* noFresh = std::getenv("SHADOWLAB_BENCH_NO_FRESH");
     const bool skipFresh = scaling || (noFresh && std::string(noFresh) == "1");
     const auto [width, height] = benchResolution();
