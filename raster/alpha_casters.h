@@ -2,7 +2,8 @@
 // and textured BLEND casters: a second vertex buffer of texture coordinates, one alpha record
 // per object id and every alpha texture's texels, in two storage buffers read by
 // shaders/alpha.glsl (set 0 in the depth pass and the first transmittance pass, set 1 in the
-// second). Made only for scenes that have such casters (scene::Scene::hasAlphaCasters).
+// second). Made only where some object's alpha test can cut (scene::Material::alphaCanFallBelow)
+// or the transmittance passes read alpha (raster/renderer.cpp).
 #pragma once
 
 #include "raster/geometry.h"

@@ -139,8 +139,9 @@ struct LitPipeline {
     PipelineLayoutHandle backgroundLayout;
     PipelineHandle background;
 };
-// alphaSetLayout (raster/alpha_casters.h; VK_NULL_HANDLE: none): scenes with MASK or BLEND
-// materials, whose texels the camera looks through as camera rays do (docs/raster.md).
+// alphaSetLayout (raster/alpha_casters.h; VK_NULL_HANDLE: none): the pipeline for MASK or BLEND
+// surfaces whose alpha can cut, whose texels the camera looks through as camera rays do
+// (docs/raster.md).
 // background: the scene's background color (linear), for the background pipeline; withBackground
 // false makes none (a pipeline that only draws triangles, e.g. the lift-free one).
 LitPipeline createLitPipeline(const Context& ctx, const LitVariant& variant = {},

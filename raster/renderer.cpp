@@ -227,8 +227,8 @@ struct Renderer::Impl {
     Context ctx;
     Buffer vertexBuffer;
     Buffer indexBuffer;
-    AlphaCasters alpha;        // MASK or BLEND materials only (set == VK_NULL_HANDLE otherwise)
-    bool shadowAlpha = false;  // the shadow passes test alpha too (scene::Scene::hasAlphaCasters)
+    AlphaCasters alpha;        // where an alpha test can cut (set == VK_NULL_HANDLE otherwise)
+    bool shadowAlpha = false;  // with alpha data: the shadow passes may test alpha too (hasAlphaCasters)
     DrawGeometry draw;
     ShadowMaps maps;
     LitTargets targets;
@@ -298,8 +298,8 @@ struct Renderer::Impl {
     struct DrawObject {
         std::uint32_t object = 0;
         std::uint32_t first = 0, count = 0;
-        bool depthAlpha = false;   // a MASK caster: the depth pass's alpha-tested pipeline
-        bool cameraAlpha = false;  // MASK or BLEND: the lit pass's alpha-tested pipeline
+        bool depthAlpha = false;   // a MASK caster that can cut: the depth pass's alpha-tested pipeline
+        bool cameraAlpha = false;  // MASK or BLEND that can cut: the lit pass's alpha-tested pipeline
         bool depthPass = true;     // drawn by the depth pass (not a semi-transparent caster)
     };
     std::vector<DrawObject> drawObjects;
@@ -337,8 +337,8 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
     background = glm::vec3(scene.background);
     attributes["device"] = ctx.deviceReport.name;
 
-    // Which objects' alpha tests can cut, per material (a texture is scanned once): the depth
-    // pass's (MASK) and the camera's; a test that never cuts is left out (idleAlphaTestsLeftOut).
+    // Which objects' alpha tests can cut, per material: the depth pass's (MASK) and the camera's; a
+    // test that never cuts is left out (idleAlphaTestsLeftOut).
     std::map<const scene::Material*, std::pair<bool, bool>> alphaTests;
     auto testsOf = [&](const scene::Material& m) {
         auto [it, added] = alphaTests.try_emplace(&m);
@@ -421,7 +421,8 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
         drawObjects.push_back(d);
     }
     drawObjects.insert(drawObjects.end(), transparentObjects.begin(), transparentObjects.end());
-    if (std::any_of(drawObjects.begin(), drawObjects.end(), [](const DrawObject& d) { return d.depthAlpha; }))
+    if (std::any_of(drawObjects.begin(), drawObjects.end(),
+                    [](const DrawObject& d) { return d.depthAlpha && d.depthPass; }))
         attributes["alpha_casters"] = "alpha-tested in the depth pass";  // only where a test can cut
     for (const DrawObject& d : drawObjects) {
         if (!draw.litRanges.empty() && draw.litRanges.back().alpha == d.cameraAlpha &&
@@ -1052,6 +1053,9 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
             for (const IndexRange& r : *litDrawRanges(draw, true))
                 debug->liftFreeTriangles += r.liftFree ? r.count / 3 : 0;
         debug->litTriangles = litTrianglesDrawn(draw, byLift);
+        debug->alphaTestedLitTriangles = 0;
+        if (const std::vector<IndexRange>* ranges = litDrawRanges(draw, byLift))
+            for (const IndexRange& r : *ranges) debug->alphaTestedLitTriangles += r.alpha ? r.count / 3 : 0;
     }
 }
 

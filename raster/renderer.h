@@ -38,6 +38,9 @@ struct RenderDebug {
     std::size_t liftFreeTriangles = 0;
     // Out: the triangles the lit pass drew (all but those RendererOptions::viewCull left out).
     std::size_t litTriangles = 0;
+    // Out: of those, the triangles drawn with the alpha-tested pipeline (surfaces whose alpha can
+    // cut, RendererOptions::idleAlphaTestsLeftOut).
+    std::size_t alphaTestedLitTriangles = 0;
     // Out: the RGBA32F targets that hold the per-light visibility (one per four lights, none for
     // one light), each rendered with every channel.
     std::size_t lightTargets = 0;

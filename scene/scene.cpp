@@ -54,6 +54,9 @@ bool Scene::allOpaque() const {
 }
 
 bool Material::alphaCanFallBelow(double cutoff) const {
+    // The loaders keep the factor and texels in [0, 1]; outside it (a scene made in code) a
+    // negative factor turns the largest texel into the smallest product: no claim then.
+    if (!(alphaFactor >= 0.0 && alphaFactor <= 1.0)) return true;
     float lowest = 1.0f;  // the texture's alpha (1 without one)
     if (alphaTextured()) {
         if (alphaTexture->alpha.empty()) return true;

@@ -115,7 +115,7 @@ struct Material {
     // Whether alpha(uv) can fall below `cutoff` anywhere: false where alpha is a constant at or
     // above it, or the texture's smallest texel times the factor is, both in float (the shaders'
     // and the float tracer's product) and in double (the reference's). A test against that cutoff
-    // can then never fire, and a pass may leave it out.
+    // can then never fire, and a pass may leave it out. (A factor outside [0, 1]: always true.)
     bool alphaCanFallBelow(double cutoff) const;
     // The alpha below which the camera looks through a texel (no test for OPAQUE: -1).
     double cameraCutoff() const {

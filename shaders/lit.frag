@@ -74,7 +74,7 @@ layout(location = 7) out vec4 outLights1;
 
 #include "lit_constants.glsl"
 #ifdef SHADOWLAB_ALPHA
-// The *_alpha variants (scenes with MASK or BLEND materials): the camera looks through what
+// The *_alpha variants (MASK or BLEND surfaces whose alpha can cut): the camera looks through what
 // camera rays skip (shaders/alpha.glsl alphaCameraSkips), so the AOVs describe the surface behind.
 #define SHADOWLAB_ALPHA_SET 1
 #include "alpha.glsl"

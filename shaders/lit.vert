@@ -42,7 +42,7 @@ layout(location = 6) flat out vec4 outLight[6];
 layout(location = 12) flat out vec4 outFrame[2];
 #endif
 #ifdef SHADOWLAB_ALPHA
-// The lit_vert_alpha variant (scenes with MASK or BLEND materials): the texture coordinates of
+// The lit_vert_alpha variant (MASK or BLEND surfaces whose alpha can cut): the texture coordinates of
 // vertex binding 1 for lit.frag's alpha test.
 layout(location = 3) in vec2 inUv;
 layout(location = 14) out vec2 outUv;

@@ -1361,25 +1361,31 @@ scene::Scene withLeaf(scene::Scene s, double height, scene::Material m) {
 
 TEST(RasterRenderer, AlphaTestsThatCanNeverCutAreLeftOutAndTheFramesStayTheSame) {
     // A MASK material whose alpha never falls below its cutoff (no texture and a factor at or
-    // above it, or a texture whose every texel passes) and a BLEND one of constant alpha at or
-    // above the camera's cutoff: their triangles take the pipelines without the alpha test, in
-    // the depth pass and the lit pass, and the frames are the alpha-tested pipelines' bit for bit
+    // above it, or a texture whose every texel passes) and a BLEND one never below the camera's
+    // cutoff: their triangles take the pipelines without the alpha test, in the depth pass and the
+    // lit pass, and the frames are the alpha-tested pipelines' bit for bit
     // (RendererOptions::idleAlphaTestsLeftOut false). Every channel of the all-channel,
-    // float-beauty and display frames; a sun, a spot and a point light (their modules differ).
-    // The leaf hangs over the sphere, so its whole square shadows what lies below.
+    // float-beauty and display frames, each rendered twice (the second frame draws the lift-free
+    // triangles, the plain leaf's among them, with their own pipeline); a sun, a spot and a point
+    // light (their modules differ). The leaf hangs over the sphere, so its square shadows what lies
+    // below. The textured BLEND leaf still needs its texels in the transmittance passes (1 −
+    // opacity · alpha per texel), though the camera's test is left out.
     const scene::Scene sun = makeScene(SphereOverPlane{});
     const scene::Scene spot = withSpot(makeScene(SphereOverPlane{}), Vec3(2, 5, 2), Vec3(-2, -5, -2));
     scene::Scene point = makeScene(SphereOverPlane{});
     point.lights[0].type = scene::LightType::Point;
     point.lights[0].position = Vec3(1.5, 5.0, 1.0);
     point.lights[0].intensity = 300;
-    scene::Material opaqueTexels = alphaMaterial("leaf", scene::AlphaMode::Mask, checkerTexture(2, 1.0f, 0.6f));
+    const scene::Material opaqueTexels = alphaMaterial("leaf", scene::AlphaMode::Mask, checkerTexture(2, 1.0f, 0.6f));
     scene::Material blend = alphaMaterial("leaf", scene::AlphaMode::Blend, nullptr);
     blend.opacity = 0.6;
+    scene::Material blendTexels = alphaMaterial("leaf", scene::AlphaMode::Blend, checkerTexture(2, 1.0f, 0.6f));
+    blendTexels.opacity = 0.6;
     const std::tuple<const char*, scene::Scene> cases[] = {
         {"sun, MASK without a texture", withLeaf(sun, 2.0, alphaMaterial("leaf", scene::AlphaMode::Mask, nullptr))},
         {"sun, MASK with every texel above the cutoff", withLeaf(sun, 2.0, opaqueTexels)},
         {"sun, BLEND without a texture", withLeaf(sun, 2.0, blend)},
+        {"sun, BLEND with every texel above the camera's cutoff", withLeaf(sun, 2.0, blendTexels)},
         {"spot, MASK with every texel above the cutoff", withLeaf(spot, 2.5, opaqueTexels)},
         {"point, MASK with every texel above the cutoff", withLeaf(point, 2.5, opaqueTexels)}};
     const scene::RasterSettings settings = validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2);
@@ -1387,26 +1393,33 @@ TEST(RasterRenderer, AlphaTestsThatCanNeverCutAreLeftOutAndTheFramesStayTheSame)
         Renderer leftOut(s, planFor(s, settings), settings);
         Renderer tested(s, planFor(s, settings), settings, RendererOptions{.idleAlphaTestsLeftOut = false});
         for (const scene::ChannelMask channels :
-             {scene::kAllChannels, scene::kChannelBeauty, scene::kChannelBeauty | scene::kBeautyForDisplay}) {
-            const scene::Frame a = tested.render(channels), b = leftOut.render(channels);
-            test::expectSamePixels(b, a, std::string(what) + ": without the alpha tests against with them");
-            if (channels != scene::kAllChannels) continue;
-            const bool mask = s.materials.back().alphaMode == scene::AlphaMode::Mask;
-            EXPECT_EQ(a.attributes.count("alpha_casters"), mask ? 1u : 0u) << what;
-            EXPECT_EQ(b.attributes.count("alpha_casters"), 0u) << what;
-            std::size_t shadowedBelow = 0;  // the leaf (the highest id) shadows what lies under it
-            const float leaf = *std::max_element(a.objectId.begin(), a.objectId.end());
-            for (std::size_t i = 0; i < a.pixelCount(); ++i)
-                shadowedBelow += a.visibility[i] < 0.5f && a.objectId[i] != 0.0f && a.objectId[i] != leaf;
-            EXPECT_GT(shadowedBelow, 100u) << what << ": the frame must hold the leaf's shadow";
-        }
+             {scene::kAllChannels, scene::kChannelBeauty, scene::kChannelBeauty | scene::kBeautyForDisplay})
+            for (int repeat = 0; repeat < 2; ++repeat) {
+                RenderDebug testedDebug, leftOutDebug;
+                const scene::Frame a = tested.render(channels, &testedDebug),
+                                   b = leftOut.render(channels, &leftOutDebug);
+                test::expectSamePixels(b, a, std::string(what) + ": without the alpha tests against with them");
+                EXPECT_GT(testedDebug.alphaTestedLitTriangles, 0u) << what;
+                EXPECT_EQ(leftOutDebug.alphaTestedLitTriangles, 0u) << what;
+                if (channels != scene::kAllChannels || repeat > 0) continue;
+                const bool mask = s.materials.back().alphaMode == scene::AlphaMode::Mask;
+                EXPECT_EQ(a.attributes.count("alpha_casters"), mask ? 1u : 0u) << what;
+                EXPECT_EQ(b.attributes.count("alpha_casters"), 0u) << what;
+                std::size_t shadowedBelow = 0;  // the leaf (the highest id) shadows what lies under it
+                const float leaf = *std::max_element(a.objectId.begin(), a.objectId.end());
+                for (std::size_t i = 0; i < a.pixelCount(); ++i)
+                    shadowedBelow += a.visibility[i] < 0.5f && a.objectId[i] != 0.0f && a.objectId[i] != leaf;
+                EXPECT_GT(shadowedBelow, 100u) << what << ": the frame must hold the leaf's shadow";
+            }
         EXPECT_EQ(leftOut.validationMessages(), 0) << what;
         EXPECT_EQ(tested.validationMessages(), 0) << what;
     }
-    // Where a texel can cut, the test stays: the checkered leaf is alpha-tested in the depth pass.
+    // Where a texel can cut, the tests stay: the checkered leaf is alpha-tested in both passes.
     const scene::Scene cut = withAlphaLeaf(sun, 2.0);
     Renderer renderer(cut, planFor(cut, settings), settings);
-    EXPECT_EQ(renderer.render().attributes.count("alpha_casters"), 1u);
+    RenderDebug debug;
+    EXPECT_EQ(renderer.render(scene::kAllChannels, &debug).attributes.count("alpha_casters"), 1u);
+    EXPECT_GT(debug.alphaTestedLitTriangles, 0u);
 }
 
 TEST(RasterRenderer, SizeOptimizedOneLightModulesGiveTheGeneralModulesFramesBitForBit) {

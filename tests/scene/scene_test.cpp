@@ -101,6 +101,10 @@ TEST(MaterialAlpha, ATextureFallsBelowWhereItsSmallestTexelTimesTheFactorDoes) {
     EXPECT_TRUE(maskMaterial(1.0, 0.5, {1.0f, 0.49f, 1.0f}).alphaCanFallBelow(0.5));
     EXPECT_TRUE(maskMaterial(0.5, 0.5, {1.0f, 0.9f}).alphaCanFallBelow(0.5));   // 0.45 < 0.5
     EXPECT_FALSE(maskMaterial(0.8, 0.5, {0.7f, 1.0f}).alphaCanFallBelow(0.5));  // 0.56
+    // Outside the loaders' [0, 1] (a scene made in code) no claim is made: with a factor of −1 the
+    // texel 1 gives −1, below a cutoff of 0, although the smallest texel's product (0) is not.
+    EXPECT_TRUE(maskMaterial(-1.0, 0.0, {0.0f, 1.0f}).alphaCanFallBelow(0.0));
+    EXPECT_TRUE(maskMaterial(2.0, 0.5, {1.0f}).alphaCanFallBelow(0.5));
     // An OPAQUE material ignores its texture: alpha is the factor.
     scene::Material opaque = maskMaterial(1.0, 0.5, {0.0f});
     opaque.alphaMode = scene::AlphaMode::Opaque;
