@@ -343,9 +343,10 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
     auto testsOf = [&](const scene::Material& m) {
         auto [it, added] = alphaTests.try_emplace(&m);
         if (added) {
-            const bool all = !options.idleAlphaTestsLeftOut;
-            it->second = {m.alphaMode == scene::AlphaMode::Mask && (all || m.alphaCanFallBelow(m.alphaCutoff)),
-                          m.alphaMode != scene::AlphaMode::Opaque && (all || m.alphaCanFallBelow(m.cameraCutoff()))};
+            // (MASK's camera cutoff is its alpha cutoff: one answer serves both passes.)
+            const bool cuts = !options.idleAlphaTestsLeftOut || m.alphaCanFallBelow(m.cameraCutoff());
+            it->second = {m.alphaMode == scene::AlphaMode::Mask && cuts,
+                          m.alphaMode != scene::AlphaMode::Opaque && cuts};
         }
         return it->second;
     };

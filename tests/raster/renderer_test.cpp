@@ -366,6 +366,14 @@ scene::Scene withSpot(scene::Scene s, const Vec3& position, const Vec3& directio
     return s;
 }
 
+// `s` with its first light a point light at `position` (intensity 300, as withSpot's).
+scene::Scene withPoint(scene::Scene s, const Vec3& position) {
+    s.lights[0].type = scene::LightType::Point;
+    s.lights[0].position = position;
+    s.lights[0].intensity = 300;
+    return s;
+}
+
 TEST(RasterHardwareBias, SpotAndPointMapsKeepTheShaderBiasAndCascadesTakeTheirOwnFactors) {
     // Perspective depth is not linear in distance, so one constant factor cannot be one world bias:
     // spot and point layers keep the shader's bias (factors 0, the same pixels as without the
@@ -1372,10 +1380,7 @@ TEST(RasterRenderer, AlphaTestsThatCanNeverCutAreLeftOutAndTheFramesStayTheSame)
     // opacity · alpha per texel), though the camera's test is left out.
     const scene::Scene sun = makeScene(SphereOverPlane{});
     const scene::Scene spot = withSpot(makeScene(SphereOverPlane{}), Vec3(2, 5, 2), Vec3(-2, -5, -2));
-    scene::Scene point = makeScene(SphereOverPlane{});
-    point.lights[0].type = scene::LightType::Point;
-    point.lights[0].position = Vec3(1.5, 5.0, 1.0);
-    point.lights[0].intensity = 300;
+    const scene::Scene point = withPoint(makeScene(SphereOverPlane{}), Vec3(1.5, 5.0, 1.0));
     const scene::Material opaqueTexels = alphaMaterial("leaf", scene::AlphaMode::Mask, checkerTexture(2, 1.0f, 0.6f));
     scene::Material blend = alphaMaterial("leaf", scene::AlphaMode::Blend, nullptr);
     blend.opacity = 0.6;
@@ -1435,10 +1440,7 @@ TEST(RasterRenderer, SizeOptimizedOneLightModulesGiveTheGeneralModulesFramesBitF
     cascades.cascades = 3;
     cascades.cascadeBlend = 0.3;
     const scene::Scene sun = makeScene(SphereOverPlane{});
-    scene::Scene point = makeScene(SphereOverPlane{});
-    point.lights[0].type = scene::LightType::Point;
-    point.lights[0].position = Vec3(1.5, 5.0, 1.0);
-    point.lights[0].intensity = 300;
+    const scene::Scene point = withPoint(makeScene(SphereOverPlane{}), Vec3(1.5, 5.0, 1.0));
     const scene::Scene spot = withSpot(makeScene(SphereOverPlane{}), Vec3(2, 5, 2), Vec3(-2, -5, -2));
     scene::RasterSettings offset = validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2);
     offset.normalOffset = 1.0;
