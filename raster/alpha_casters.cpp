@@ -71,4 +71,28 @@ AlphaCasters createAlphaCasters(const Context& ctx, const scene::Scene& scene, c
     return a;
 }
 
+AlphaPlan planAlpha(const scene::Scene& scene, bool transmittance, bool idleTestsLeftOut) {
+    AlphaPlan plan;
+    plan.byMaterial.resize(scene.materials.size());
+    std::vector<bool> used(scene.materials.size(), false);
+    for (const scene::Object& o : scene.objects) used[std::size_t(o.material)] = true;
+    bool anyDepth = false, anyCamera = false, texturedBlend = false;
+    for (std::size_t i = 0; i < scene.materials.size(); ++i) {
+        if (!used[i]) continue;
+        const scene::Material& m = scene.materials[i];
+        // (MASK's camera cutoff is its alpha cutoff: one answer serves both passes.)
+        const bool cuts = !idleTestsLeftOut || m.alphaCanFallBelow(m.cameraCutoff());
+        AlphaTests& t = plan.byMaterial[i];
+        t.depth = m.alphaMode == scene::AlphaMode::Mask && cuts;
+        t.camera = m.alphaMode != scene::AlphaMode::Opaque && cuts;
+        anyDepth |= t.depth;
+        anyCamera |= t.camera;
+        // A textured BLEND caster lets 1 − opacity·alpha(uv) through: read whatever its texels.
+        texturedBlend |= m.alphaMode == scene::AlphaMode::Blend && m.alphaTextured();
+    }
+    plan.shadowsRead = anyDepth || (transmittance && texturedBlend);
+    plan.data = anyCamera || plan.shadowsRead;
+    return plan;
+}
+
 }  // namespace shadowlab::raster

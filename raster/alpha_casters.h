@@ -3,7 +3,7 @@
 // per object id and every alpha texture's texels, in two storage buffers read by
 // shaders/alpha.glsl (set 0 in the depth pass and the first transmittance pass, set 1 in the
 // second). Made only where some object's alpha test can cut (scene::Material::alphaCanFallBelow)
-// or the transmittance passes read alpha (raster/renderer.cpp).
+// or the transmittance passes read alpha (planAlpha).
 #pragma once
 
 #include "raster/geometry.h"
@@ -11,7 +11,29 @@
 #include "raster/resources.h"
 #include "scene/scene.h"
 
+#include <vector>
+
 namespace shadowlab::raster {
+
+// Which passes test a material's alpha: the depth pass a MASK caster's, the lit pass (the
+// camera's) a MASK or BLEND surface's.
+struct AlphaTests {
+    bool depth = false;
+    bool camera = false;
+};
+
+// What a Renderer makes and runs for the scene's alpha; the memory estimate reads the same.
+struct AlphaPlan {
+    std::vector<AlphaTests> byMaterial;  // per scene material (those no object uses: none)
+    bool shadowsRead = false;            // the depth or transmittance passes read alpha per fragment
+    bool data = false;                   // UVs and alpha records are made (AlphaCasters)
+};
+
+// `transmittance`: the scene has a transmittance pass (RenderPlan::needsTransmittanceMap), which
+// reads a textured BLEND caster's alpha and tests a MASK one's. `idleTestsLeftOut`
+// (RendererOptions::idleAlphaTestsLeftOut): a test whose alpha can never fall below its cutoff is
+// left out; false tests every MASK and BLEND material.
+AlphaPlan planAlpha(const scene::Scene& scene, bool transmittance, bool idleTestsLeftOut = true);
 
 struct AlphaCasters {
     Buffer uvs;                 // vertex binding 1, one vec2 per vertex of SceneGeometry

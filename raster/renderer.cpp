@@ -228,7 +228,7 @@ struct Renderer::Impl {
     Buffer vertexBuffer;
     Buffer indexBuffer;
     AlphaCasters alpha;        // where an alpha test can cut (set == VK_NULL_HANDLE otherwise)
-    bool shadowAlpha = false;  // with alpha data: the shadow passes may test alpha too (hasAlphaCasters)
+    bool shadowAlpha = false;  // the depth or transmittance passes read alpha (AlphaPlan::shadowsRead)
     DrawGeometry draw;
     ShadowMaps maps;
     LitTargets targets;
@@ -338,26 +338,10 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
     attributes["device"] = ctx.deviceReport.name;
 
     // Which objects' alpha tests can cut, per material: the depth pass's (MASK) and the camera's; a
-    // test that never cuts is left out (idleAlphaTestsLeftOut).
-    std::map<const scene::Material*, std::pair<bool, bool>> alphaTests;
-    auto testsOf = [&](const scene::Material& m) {
-        auto [it, added] = alphaTests.try_emplace(&m);
-        if (added) {
-            // (MASK's camera cutoff is its alpha cutoff: one answer serves both passes.)
-            const bool cuts = !options.idleAlphaTestsLeftOut || m.alphaCanFallBelow(m.cameraCutoff());
-            it->second = {m.alphaMode == scene::AlphaMode::Mask && cuts,
-                          m.alphaMode != scene::AlphaMode::Opaque && cuts};
-        }
-        return it->second;
-    };
-    bool alphaTested = false;
-    for (const scene::Object& o : scene.objects) {
-        const auto [depth, camera] = testsOf(scene.materialOf(o));
-        alphaTested |= depth || camera;
-    }
-    // UVs and alpha records where a test can cut (an untextured BLEND one only for the camera), or
-    // where the transmittance passes read alpha.
-    const bool alphaData = alphaTested || (planIn.needsTransmittanceMap && scene.hasAlphaCasters());
+    // test that never cuts is left out (idleAlphaTestsLeftOut). UVs and alpha records only where a
+    // test can cut, or where the transmittance passes read a textured BLEND caster's alpha.
+    const AlphaPlan alphaPlan = planAlpha(scene, planIn.needsTransmittanceMap, options.idleAlphaTestsLeftOut);
+    const bool alphaData = alphaPlan.data;
     SceneGeometry geometry = tessellateScene(scene, origin, alphaData);
     std::vector<TransparentDraw> transparentDraws;
     std::uint32_t opaqueIndexCount = ~0u;
@@ -390,7 +374,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
         alpha = createAlphaCasters(ctx, scene, geometry);
         draw.uvs = alpha.uvs.buffer.get();
         draw.alphaSet = alpha.descriptors.set;
-        shadowAlpha = scene.hasAlphaCasters();
+        shadowAlpha = alphaPlan.shadowsRead;
     }
     // Each object's triangles in the index buffer (reordered with a transmittance map: the opaque
     // objects' first, in object order, then each semi-transparent one's) and the objects in that
@@ -402,11 +386,12 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
     std::vector<DrawObject> transparentObjects;
     for (std::size_t o = 0; o < objectCount; ++o) {
         const scene::Material& m = scene.materialOf(scene.objects[o]);
+        const AlphaTests tests = alphaPlan.byMaterial[std::size_t(scene.objects[o].material)];
         DrawObject d{.object = std::uint32_t(o),
                      .first = objectFirstIndex[o],
                      .count = objectFirstIndex[o + 1] - objectFirstIndex[o],
-                     .depthAlpha = shadowAlpha && testsOf(m).first,
-                     .cameraAlpha = testsOf(m).second,
+                     .depthAlpha = tests.depth,
+                     .cameraAlpha = tests.camera,
                      .depthPass = true};
         if (planIn.needsTransmittanceMap && !m.opaque()) {
             if (d.count == 0) continue;                                // (separateTransparent makes no draw for it)
@@ -913,7 +898,7 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
             if ((a ? depthAlpha : needDepthPlain) && !shadowPipeline[a].pipeline)
                 shadowPipeline[a] = createShadowPipeline(ctx, wantIds, settings.hardwareBias,
                                                          a ? alpha.descriptors.layout.get() : VK_NULL_HANDLE);
-        // The transmittance passes test alpha for every caster when the scene has alpha casters.
+        // The transmittance passes read alpha for every caster when some caster's alpha counts there.
         const VkDescriptorSetLayout alphaLayout = shadowAlpha ? alpha.descriptors.layout.get() : VK_NULL_HANDLE;
         if (momentMaps.size > 1 && !momentPipeline.pipeline)
             momentPipeline = createMomentPipeline(ctx, maps, momentMaps, settings.filter, settings.moments);

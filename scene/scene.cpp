@@ -66,14 +66,6 @@ bool Material::alphaCanFallBelow(double cutoff) const {
     return float(alphaFactor) * lowest < float(cutoff) || alphaFactor * double(lowest) < cutoff;
 }
 
-bool Scene::hasAlphaCasters() const {
-    for (const Object& o : objects) {
-        const Material& m = materialOf(o);
-        if (m.alphaMode == AlphaMode::Mask || (m.alphaMode == AlphaMode::Blend && m.alphaTexture)) return true;
-    }
-    return false;
-}
-
 Bounds Scene::bounds() const {
     Bounds b;
     for (const Object& o : objects) b.extend(boundsOf(o.shape));

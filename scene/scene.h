@@ -356,9 +356,6 @@ struct Scene {
 
     const Material& materialOf(const Object& o) const { return materials[o.material]; }
     bool allOpaque() const;
-    // Some object's material is MASK, or BLEND with a texture: the raster backend's depth and
-    // transmittance passes may then read alpha per fragment (raster/alpha_casters.h).
-    bool hasAlphaCasters() const;
     Bounds bounds() const;  // of every object
 };
 

@@ -57,7 +57,9 @@ void main() {
 #ifdef SHADOWLAB_ALPHA
     if (alphaMasked(inObjectId, inUv)) discard;
     const AlphaRecord alpha = alphaRecords[inObjectId];
-    outTransmittance = alpha.params.x == 2.0 ? 1.0 - alpha.params.w * alphaAt(inObjectId, inUv) : inParams.x;
+    // (An untextured caster's is inParams.x, as without the variant: rounded once from the double.)
+    outTransmittance =
+        alpha.params.x == 2.0 && alpha.texture.y > 0u ? 1.0 - alpha.params.w * alphaAt(inObjectId, inUv) : inParams.x;
 #else
     outTransmittance = inParams.x;
 #endif

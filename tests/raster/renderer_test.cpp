@@ -1377,7 +1377,8 @@ TEST(RasterRenderer, AlphaTestsThatCanNeverCutAreLeftOutAndTheFramesStayTheSame)
     // triangles, the plain leaf's among them, with their own pipeline); a sun, a spot and a point
     // light (their modules differ). The leaf hangs over the sphere, so its square shadows what lies
     // below. The textured BLEND leaf still needs its texels in the transmittance passes (1 −
-    // opacity · alpha per texel), though the camera's test is left out.
+    // opacity · alpha per texel), though the camera's test is left out; a MASK leaf that cannot
+    // cut under a BLEND pane needs none.
     const scene::Scene sun = makeScene(SphereOverPlane{});
     const scene::Scene spot = withSpot(makeScene(SphereOverPlane{}), Vec3(2, 5, 2), Vec3(-2, -5, -2));
     const scene::Scene point = withPoint(makeScene(SphereOverPlane{}), Vec3(1.5, 5.0, 1.0));
@@ -1391,6 +1392,9 @@ TEST(RasterRenderer, AlphaTestsThatCanNeverCutAreLeftOutAndTheFramesStayTheSame)
         {"sun, MASK with every texel above the cutoff", withLeaf(sun, 2.0, opaqueTexels)},
         {"sun, BLEND without a texture", withLeaf(sun, 2.0, blend)},
         {"sun, BLEND with every texel above the camera's cutoff", withLeaf(sun, 2.0, blendTexels)},
+        // (no alpha data at all: the transmittance passes take their plain pipelines too)
+        {"sun, MASK without a texture under a BLEND pane",
+         withLeaf(withLeaf(sun, 2.5, blend), 2.0, alphaMaterial("leaf", scene::AlphaMode::Mask, nullptr))},
         {"spot, MASK with every texel above the cutoff", withLeaf(spot, 2.5, opaqueTexels)},
         {"point, MASK with every texel above the cutoff", withLeaf(point, 2.5, opaqueTexels)}};
     const scene::RasterSettings settings = validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2);
