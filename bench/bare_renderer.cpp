@@ -51,6 +51,7 @@ struct BareRenderer::Impl {
     std::uint32_t width = 0, height = 0, mapSize = 0, indexCount = 0;
     bool hardwarePcf = false;
     bool aovs = false;
+    bool floatTarget = false;  // BareTarget::Aovs or FloatBeauty: the float beauty, never cleared or read back
     VkFormat beautyFormat = VK_FORMAT_UNDEFINED;
     glm::mat4 lightMatrix{1.0f};
     double setupMs = 0;
@@ -79,8 +80,9 @@ BareRenderer::BareRenderer(const scene::Scene& scene, const scene::RasterSetting
     m.height = std::uint32_t(scene.camera.height);
     m.mapSize = std::uint32_t(settings.shadowMapSize);
     m.aovs = target == BareTarget::Aovs;
+    m.floatTarget = m.aovs || target == BareTarget::FloatBeauty;
     VkFormat colorFormat = target == BareTarget::Srgb ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
-    if (m.aovs) {
+    if (m.floatTarget) {
         // The beauty format ours renders into (RGB32F where the device renders to it).
         VkFormatProperties rgb{};
         vkGetPhysicalDeviceFormatProperties(ctx.physicalDevice, kLitBeautyFormat, &rgb);
@@ -334,13 +336,13 @@ BareTimings BareRenderer::render(std::vector<std::uint8_t>& rgba) {
                      VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, depthStages,
                      VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, depthStages,
                      VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT}});
-    // The AOV floor clears no color target (ours clears none of its float targets either: its
-    // background pass writes them, which the floor leaves out).
+    // The float floors clear no color target (ours clears none of its float targets either: its
+    // background pass writes them, which the floors leave out).
     std::vector<VkRenderingAttachmentInfo> colorAttachments{
         {.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
          .imageView = m.color.view.get(),
          .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-         .loadOp = m.aovs ? VK_ATTACHMENT_LOAD_OP_DONT_CARE : VK_ATTACHMENT_LOAD_OP_CLEAR,
+         .loadOp = m.floatTarget ? VK_ATTACHMENT_LOAD_OP_DONT_CARE : VK_ATTACHMENT_LOAD_OP_CLEAR,
          .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
          .clearValue = {.color = {.float32 = {0, 0, 0, 1}}}}};
     if (m.aovs)
@@ -382,7 +384,7 @@ BareTimings BareRenderer::render(std::vector<std::uint8_t>& rgba) {
     ctx.submitAndWait(cb);
     t.litPass = msSince(start);
     t.cpuLitPass = cpuMs() - cpuStart;
-    if (m.aovs) return t;  // the floor's planes stay on the device (ours renders into the Frame)
+    if (m.floatTarget) return t;  // the floors' targets stay on the device (ours renders into the Frame)
 
     start = Clock::now();
     cb = ctx.beginCommands();

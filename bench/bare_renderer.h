@@ -32,6 +32,9 @@ enum class BareTarget {
     // cleared and not read back, and an R32_UINT blocker-id map in the depth pass: what any
     // renderer filling a Frame's channels has to write.
     Aovs,
+    // The float RGB beauty alone (the same format, not cleared and not read back): what any
+    // renderer of `render --channels beauty` writes, against ours' float-beauty frame.
+    FloatBeauty,
 };
 
 class BareRenderer {
@@ -41,7 +44,7 @@ public:
                  BareTarget target = BareTarget::Unorm);
     ~BareRenderer();
     // One frame: both passes and the readback into an RGBA8 image (row 0 on top; BareTarget::Aovs
-    // reads nothing back and leaves `rgba` as it is).
+    // and FloatBeauty read nothing back and leave `rgba` as it is).
     BareTimings render(std::vector<std::uint8_t>& rgba);
     double setupMs() const;
     std::string pcfKind() const;  // "hardware (LINEAR compare sampler)" or "gather"

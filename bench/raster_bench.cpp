@@ -241,11 +241,16 @@ void benchScene(const std::string& label, scene::Scene s, int repeats, std::vect
     // the all-channel frame, so that its ratio to the bare one splits into what the AOV contract
     // costs any renderer and what our design adds on top.
     std::optional<bench::BareRenderer> aovFloor;
+    // The bare passes writing the float beauty alone (bench::BareTarget::FloatBeauty): the floor
+    // under ours' float-beauty frame, which writes 12 bytes a pixel where the bare one writes 4.
+    std::optional<bench::BareRenderer> beautyFloor;
     if (!scaling) {
         bareSrgb.emplace(s, settings.raster, bench::BareTarget::Srgb);
         bareSrgb->render(rgba);
         aovFloor.emplace(s, settings.raster, bench::BareTarget::Aovs);
         aovFloor->render(rgba);
+        beautyFloor.emplace(s, settings.raster, bench::BareTarget::FloatBeauty);
+        beautyFloor->render(rgba);
     }
 
     std::printf(
@@ -294,7 +299,7 @@ void benchScene(const std::string& label, scene::Scene s, int repeats, std::vect
         return;
     }
 
-    // SHADOWLAB_BENCH_PROFILE=all|no-ids|beauty|png|bare|bare-srgb|bare-aovs: only that series, `repeats` frames,
+    // SHADOWLAB_BENCH_PROFILE=all|no-ids|beauty|png|bare|bare-srgb|bare-aovs|bare-beauty: only that series, `repeats` frames,
     // nothing printed: a process to run under `perf record` (docs/performance.md).
     if (const char* profile = std::getenv("SHADOWLAB_BENCH_PROFILE"); profile && *profile) {
         const std::string which = profile;
@@ -314,9 +319,12 @@ void benchScene(const std::string& label, scene::Scene s, int repeats, std::vect
                 bareSrgb->render(rgba);
             else if (which == "bare-aovs" && aovFloor)
                 aovFloor->render(rgba);
+            else if (which == "bare-beauty" && beautyFloor)
+                beautyFloor->render(rgba);
             else
                 throw std::runtime_error(
-                    "SHADOWLAB_BENCH_PROFILE: expected all, no-ids, beauty, png, bare, bare-srgb or bare-aovs, got " +
+                    "SHADOWLAB_BENCH_PROFILE: expected all, no-ids, beauty, png, bare, bare-srgb, bare-aovs or "
+                    "bare-beauty, got " +
                     which);
         }
         return;
@@ -326,7 +334,7 @@ void benchScene(const std::string& label, scene::Scene s, int repeats, std::vect
     // (what compare reads), ours with the float beauty only, ours for a PNG (`render -o x.png`:
     // the beauty into the 8-bit sRGB target), the bare renderer. Each keeps its frame between
     // repetitions, as the bare renderer keeps its image.
-    Series all, beauty, png, fresh, base, baseSrgb, baseAovs;
+    Series all, beauty, png, fresh, base, baseSrgb, baseAovs, baseBeauty;
     scene::Frame allFrame, beautyFrame, pngFrame;
     for (int i = 0; i < repeats; ++i) {
         double c = cpuMs();
@@ -359,6 +367,12 @@ void benchScene(const std::string& label, scene::Scene s, int repeats, std::vect
             const bench::BareTimings ta = aovFloor->render(rgba);
             baseAovs.add("cpu_per_frame", cpuMs() - c);
             addBare(baseAovs, ta);
+        }
+        if (beautyFloor) {
+            c = cpuMs();
+            const bench::BareTimings tb = beautyFloor->render(rgba);
+            baseBeauty.add("cpu_per_frame", cpuMs() - c);
+            addBare(baseBeauty, tb);
         }
     }
 
@@ -420,6 +434,14 @@ void benchScene(const std::string& label, scene::Scene s, int repeats, std::vect
             range(baseAovs, "cpu_per_frame").c_str(), baseAovs.med("cpu_per_frame") / base.med("cpu_per_frame"),
             baseAovs.med("per_frame") / base.med("per_frame"), all.med("cpu_per_frame") / baseAovs.med("cpu_per_frame"),
             all.med("per_frame") / baseAovs.med("per_frame"));
+        std::printf(
+            "  bare writing the float beauty (its floor): cpu_shadow_pass %s, cpu_lit_pass %s, cpu_per_frame %s; "
+            "floor / bare: cpu %.2f, wall %.2f; float beauty / floor: cpu %.2f, wall %.2f\n",
+            range(baseBeauty, "cpu_shadow_pass").c_str(), range(baseBeauty, "cpu_lit_pass").c_str(),
+            range(baseBeauty, "cpu_per_frame").c_str(), baseBeauty.med("cpu_per_frame") / base.med("cpu_per_frame"),
+            baseBeauty.med("per_frame") / base.med("per_frame"),
+            beauty.med("cpu_per_frame") / baseBeauty.med("cpu_per_frame"),
+            beauty.med("per_frame") / baseBeauty.med("per_frame"));
     }
     if (!skipFresh)
         std::printf("  ours (all channels) into a new Frame each time: per_frame %.1f, readback %.1f\n",
