@@ -76,7 +76,7 @@ AlphaPlan planAlpha(const scene::Scene& scene, bool transmittance, bool idleTest
     plan.byMaterial.resize(scene.materials.size());
     std::vector<bool> used(scene.materials.size(), false);
     for (const scene::Object& o : scene.objects) used[std::size_t(o.material)] = true;
-    bool anyDepth = false, anyCamera = false, texturedBlend = false;
+    bool anyDepth = false, anyCamera = false, transmittanceReads = false;
     for (std::size_t i = 0; i < scene.materials.size(); ++i) {
         if (!used[i]) continue;
         const scene::Material& m = scene.materials[i];
@@ -87,11 +87,12 @@ AlphaPlan planAlpha(const scene::Scene& scene, bool transmittance, bool idleTest
         t.camera = m.alphaMode != scene::AlphaMode::Opaque && cuts;
         anyDepth |= t.depth;
         anyCamera |= t.camera;
-        // A textured BLEND caster lets 1 − opacity·alpha(uv) through: read whatever its texels.
-        texturedBlend |= m.alphaMode == scene::AlphaMode::Blend && m.alphaTextured();
+        // The transmittance passes draw the semi-transparent casters: a MASK one's test where it can
+        // cut, a textured BLEND one's 1 − opacity·alpha(uv) whatever its texels.
+        if (!m.opaque()) transmittanceReads |= t.depth || (m.alphaMode == scene::AlphaMode::Blend && m.alphaTextured());
     }
-    plan.shadowsRead = anyDepth || (transmittance && texturedBlend);
-    plan.data = anyCamera || plan.shadowsRead;
+    plan.transmittanceReads = transmittance && transmittanceReads;
+    plan.data = anyDepth || anyCamera || plan.transmittanceReads;
     return plan;
 }
 

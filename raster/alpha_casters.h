@@ -25,12 +25,13 @@ struct AlphaTests {
 // What a Renderer makes and runs for the scene's alpha; the memory estimate reads the same.
 struct AlphaPlan {
     std::vector<AlphaTests> byMaterial;  // per scene material (those no object uses: none)
-    bool shadowsRead = false;            // the depth or transmittance passes read alpha per fragment
+    bool transmittanceReads = false;     // the transmittance passes take their alpha shaders
     bool data = false;                   // UVs and alpha records are made (AlphaCasters)
 };
 
-// `transmittance`: the scene has a transmittance pass (RenderPlan::needsTransmittanceMap), which
-// reads a textured BLEND caster's alpha and tests a MASK one's. `idleTestsLeftOut`
+// `transmittance`: the scene has the transmittance passes (RenderPlan::needsTransmittanceMap), which
+// draw the semi-transparent casters: they read a textured BLEND caster's alpha and test a MASK
+// one's (opacity under 1), in one pipeline for all of them. `idleTestsLeftOut`
 // (RendererOptions::idleAlphaTestsLeftOut): a test whose alpha can never fall below its cutoff is
 // left out; false tests every MASK and BLEND material.
 AlphaPlan planAlpha(const scene::Scene& scene, bool transmittance, bool idleTestsLeftOut = true);

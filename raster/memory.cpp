@@ -74,10 +74,11 @@ std::uint64_t estimateMemoryBytes(const scene::Scene& scene, const scene::Render
            (scene::isFilterable(settings.filter) && layers > 0
                 ? momentBytes(settings.shadowMapSize, layers) + kMomentPipelineAllowance
                 : 0) +
-           // Alpha data where the renderer makes it: a UV per vertex (every vertex of the scene gets
-           // a slot in the UV buffer, 3 · 8 bytes a triangle), the texels and one record per object.
+           // Alpha data where the renderer makes it (with the default RendererOptions): a UV per
+           // vertex (every vertex of the scene gets a slot in the UV buffer, 3 · 8 bytes a
+           // triangle), the texels and one record per object id (0 unused).
            (planAlpha(scene, plan.needsTransmittanceMap).data
-                ? triangles * 24 + scene::alphaTextureBytes(scene) + scene.objects.size() * 32
+                ? triangles * 24 + scene::alphaTextureBytes(scene) + (scene.objects.size() + 1) * 32
                 : 0) +
            scene.objects.size() * scene::kBackendBytesPerObject + viewCullBytes(triangles, scene.objects.size()) +
            (scene.lights.size() == 1 && scene.lights[0].type == scene::LightType::Directional &&

@@ -227,8 +227,8 @@ struct Renderer::Impl {
     Context ctx;
     Buffer vertexBuffer;
     Buffer indexBuffer;
-    AlphaCasters alpha;        // where an alpha test can cut (set == VK_NULL_HANDLE otherwise)
-    bool shadowAlpha = false;  // the depth or transmittance passes read alpha (AlphaPlan::shadowsRead)
+    AlphaCasters alpha;          // where an alpha test can cut (set == VK_NULL_HANDLE otherwise)
+    bool transmitAlpha = false;  // the transmittance passes' alpha shaders (AlphaPlan::transmittanceReads)
     DrawGeometry draw;
     ShadowMaps maps;
     LitTargets targets;
@@ -374,7 +374,7 @@ Renderer::Impl::Impl(const scene::Scene& scene, const scene::RenderPlan& planIn,
         alpha = createAlphaCasters(ctx, scene, geometry);
         draw.uvs = alpha.uvs.buffer.get();
         draw.alphaSet = alpha.descriptors.set;
-        shadowAlpha = alphaPlan.shadowsRead;
+        transmitAlpha = alphaPlan.transmittanceReads;
     }
     // Each object's triangles in the index buffer (reordered with a transmittance map: the opaque
     // objects' first, in object order, then each semi-transparent one's) and the objects in that
@@ -898,8 +898,9 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
             if ((a ? depthAlpha : needDepthPlain) && !shadowPipeline[a].pipeline)
                 shadowPipeline[a] = createShadowPipeline(ctx, wantIds, settings.hardwareBias,
                                                          a ? alpha.descriptors.layout.get() : VK_NULL_HANDLE);
-        // The transmittance passes read alpha for every caster when some caster's alpha counts there.
-        const VkDescriptorSetLayout alphaLayout = shadowAlpha ? alpha.descriptors.layout.get() : VK_NULL_HANDLE;
+        // One transmittance pipeline for every semi-transparent caster: with the alpha shaders where
+        // one of them needs alpha (AlphaPlan::transmittanceReads).
+        const VkDescriptorSetLayout alphaLayout = transmitAlpha ? alpha.descriptors.layout.get() : VK_NULL_HANDLE;
         if (momentMaps.size > 1 && !momentPipeline.pipeline)
             momentPipeline = createMomentPipeline(ctx, maps, momentMaps, settings.filter, settings.moments);
         if (transmit && !transmitPipeline.pipeline) transmitPipeline = createTransmittancePipeline(ctx, alphaLayout);
@@ -969,6 +970,8 @@ void Renderer::Impl::render(scene::Frame& frame, scene::ChannelMask channels, co
     const bool backgroundInFrame = prepareFrame(frame, channels, outputs, attachments, frameImages, intoFrame);
     if (debug) {
         debug->backgroundFromFrame = backgroundInFrame;
+        debug->alphaData = draw.alphaSet != VK_NULL_HANDLE;
+        debug->transmittanceAlpha = transmit && transmitPipeline.alpha;
         debug->lightTargets = targets.lights.size();
         debug->lightTargetTexels = targets.lights.empty() ? nullptr : targets.lights[0].mapped;
     }

@@ -41,6 +41,10 @@ struct RenderDebug {
     // Out: of those, the triangles drawn with the alpha-tested pipeline (surfaces whose alpha can
     // cut, RendererOptions::idleAlphaTestsLeftOut).
     std::size_t alphaTestedLitTriangles = 0;
+    // Out: the Renderer made UVs and alpha records (raster::planAlpha: some test can cut, or the
+    // transmittance passes read alpha), and the transmittance passes ran their alpha shaders.
+    bool alphaData = false;
+    bool transmittanceAlpha = false;
     // Out: the RGBA32F targets that hold the per-light visibility (one per four lights, none for
     // one light), each rendered with every channel.
     std::size_t lightTargets = 0;

@@ -24,6 +24,13 @@ scene::Scene withLeaf(const scene::Material& m, double height = 2.0) {
     return s;
 }
 
+// A MASK material of opacity 0.5 (a semi-transparent caster: drawn by the transmittance passes).
+scene::Material semiMaskOf(std::shared_ptr<const scene::AlphaTexture> tex = nullptr) {
+    scene::Material m = alphaMaterial("leaf", scene::AlphaMode::Mask, std::move(tex));
+    m.opacity = 0.5;
+    return m;
+}
+
 scene::Material blendOf(double factor, std::shared_ptr<const scene::AlphaTexture> tex = nullptr) {
     scene::Material m = alphaMaterial("leaf", scene::AlphaMode::Blend, std::move(tex));
     m.alphaFactor = factor;
@@ -36,10 +43,11 @@ TEST(AlphaPlan, EachPassTestsAlphaOnlyWhereItCanCut) {
         scene::Material material;
         bool transmittance;
         AlphaTests tests;
-        bool shadowsRead, data;
+        bool transmittanceReads, data;
     };
     const Case cases[] = {
-        // MASK: alpha 1 never falls below the cutoff 0.5; a checker texel 0 does.
+        // MASK: alpha 1 never falls below the cutoff 0.5; a checker texel 0 does. An opaque MASK
+        // caster is drawn by the depth pass only, a semi-transparent one by the transmittance passes.
         {"MASK without a texture",
          alphaMaterial("leaf", scene::AlphaMode::Mask, nullptr),
          true,
@@ -48,9 +56,22 @@ TEST(AlphaPlan, EachPassTestsAlphaOnlyWhereItCanCut) {
          false},
         {"MASK with texels 1 and 0",
          alphaMaterial("leaf", scene::AlphaMode::Mask, checkerTexture(2, 1.0f, 0.0f)),
+         true,
+         {true, true},
          false,
+         true},
+        {"MASK of opacity 0.5 without a texture", semiMaskOf(), true, {false, false}, false, false},
+        {"MASK of opacity 0.5 with texels 1 and 0",
+         semiMaskOf(checkerTexture(2, 1.0f, 0.0f)),
+         true,
          {true, true},
          true,
+         true},
+        {"MASK of opacity 0.5 with texels 1 and 0, no transmittance passes",
+         semiMaskOf(checkerTexture(2, 1.0f, 0.0f)),
+         false,
+         {true, true},
+         false,
          true},
         // BLEND: the camera looks through alpha under 0.5 (0.3 does, 0.6 does not); the depth pass
         // never tests it.
@@ -78,15 +99,17 @@ TEST(AlphaPlan, EachPassTestsAlphaOnlyWhereItCanCut) {
         EXPECT_EQ(plan.byMaterial.back().depth, c.tests.depth) << c.what;
         EXPECT_EQ(plan.byMaterial.back().camera, c.tests.camera) << c.what;
         EXPECT_FALSE(plan.byMaterial.front().depth || plan.byMaterial.front().camera) << c.what << ": the opaque plane";
-        EXPECT_EQ(plan.shadowsRead, c.shadowsRead) << c.what;
+        EXPECT_EQ(plan.transmittanceReads, c.transmittanceReads) << c.what;
         EXPECT_EQ(plan.data, c.data) << c.what;
         // With idle tests kept, every MASK material is tested in both passes, every BLEND one by
-        // the camera, and the shadow passes read a MASK caster's alpha.
+        // the camera, and the transmittance passes read a semi-transparent MASK caster's alpha.
         const AlphaPlan all = planAlpha(s, c.transmittance, false);
         const scene::AlphaMode mode = c.material.alphaMode;
         EXPECT_EQ(all.byMaterial.back().depth, mode == scene::AlphaMode::Mask) << c.what;
         EXPECT_TRUE(all.byMaterial.back().camera) << c.what;
-        EXPECT_EQ(all.shadowsRead, mode == scene::AlphaMode::Mask || c.shadowsRead) << c.what;
+        EXPECT_EQ(all.transmittanceReads,
+                  c.transmittanceReads || (c.transmittance && mode == scene::AlphaMode::Mask && !c.material.opaque()))
+            << c.what;
         EXPECT_TRUE(all.data) << c.what;
     }
 }
@@ -96,7 +119,7 @@ TEST(AlphaPlan, AMaterialNoObjectUsesPlansNothing) {
     s.materials.push_back(alphaMaterial("unused", scene::AlphaMode::Mask, checkerTexture(2, 1.0f, 0.0f)));
     const AlphaPlan plan = planAlpha(s, true);
     EXPECT_FALSE(plan.byMaterial.back().depth || plan.byMaterial.back().camera);
-    EXPECT_FALSE(plan.shadowsRead);
+    EXPECT_FALSE(plan.transmittanceReads);
     EXPECT_FALSE(plan.data);
 }
 
@@ -105,11 +128,12 @@ TEST(AlphaPlan, TheMemoryEstimateCountsTheAlphaDataWhereTheRendererMakesIt) {
     auto estimate = [&](const scene::Scene& s) { return estimateMemoryBytes(s, test::planFor(s, settings), settings); };
     // A BLEND leaf the camera looks through (alpha 0.3) gets UVs and alpha records; one it cannot
     // (0.6) none. Both are semi-transparent casters, so everything else is the same: the difference
-    // is at least one record per object and a UV for each vertex of the quad's two triangles.
+    // is at least one record per object id (and the unused 0) and a UV for each vertex of the
+    // quad's two triangles.
     const scene::Scene seen = withLeaf(blendOf(0.3)), unseen = withLeaf(blendOf(0.6));
     ASSERT_TRUE(test::planFor(seen, settings).needsTransmittanceMap);
     ASSERT_TRUE(test::planFor(unseen, settings).needsTransmittanceMap);
-    EXPECT_GE(estimate(seen) - estimate(unseen), seen.objects.size() * 32 + 2 * 24);
+    EXPECT_GE(estimate(seen) - estimate(unseen), (seen.objects.size() + 1) * 32 + 2 * 24);
     // A MASK leaf that cannot cut, under a BLEND pane (transmittance passes): the alpha data is
     // left out, so it costs what an opaque leaf does.
     auto underPane = [](scene::Material leaf) {

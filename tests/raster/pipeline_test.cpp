@@ -38,7 +38,7 @@ TEST(RasterPipeline, EveryPipelineARenderAsksForIsCreatedWithoutValidationMessag
     test::ValidatedContext vc;
     const Context& ctx = vc.get();
     const scene::Scene s = alphaScene();
-    ASSERT_TRUE(planAlpha(s, false).shadowsRead);
+    ASSERT_TRUE(planAlpha(s, false).data);
     const SceneGeometry g = tessellateScene(s, s.camera.position, true);
     const AlphaCasters alpha = createAlphaCasters(ctx, s, g);
     const VkDescriptorSetLayout alphaLayout = alpha.descriptors.layout.get();

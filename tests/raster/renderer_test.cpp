@@ -17,6 +17,7 @@
 
 #include <gtest/gtest.h>
 
+#include "raster/alpha_casters.h"
 #include "raster/cascades.h"
 #include "scene/frame_io.h"
 #include "tests/kit/render_checked.h"
@@ -1385,6 +1386,8 @@ TEST(RasterRenderer, AlphaTestsThatCanNeverCutAreLeftOutAndTheFramesStayTheSame)
     const scene::Material opaqueTexels = alphaMaterial("leaf", scene::AlphaMode::Mask, checkerTexture(2, 1.0f, 0.6f));
     scene::Material blend = alphaMaterial("leaf", scene::AlphaMode::Blend, nullptr);
     blend.opacity = 0.6;
+    scene::Material semiMask = alphaMaterial("leaf", scene::AlphaMode::Mask, nullptr);
+    semiMask.opacity = 0.6;
     scene::Material blendTexels = alphaMaterial("leaf", scene::AlphaMode::Blend, checkerTexture(2, 1.0f, 0.6f));
     blendTexels.opacity = 0.6;
     const std::tuple<const char*, scene::Scene> cases[] = {
@@ -1395,6 +1398,8 @@ TEST(RasterRenderer, AlphaTestsThatCanNeverCutAreLeftOutAndTheFramesStayTheSame)
         // (no alpha data at all: the transmittance passes take their plain pipelines too)
         {"sun, MASK without a texture under a BLEND pane",
          withLeaf(withLeaf(sun, 2.5, blend), 2.0, alphaMaterial("leaf", scene::AlphaMode::Mask, nullptr))},
+        // (drawn by the transmittance passes, which the alpha tests would put on their alpha shaders)
+        {"sun, MASK of opacity 0.6 without a texture", withLeaf(sun, 2.0, semiMask)},
         {"spot, MASK with every texel above the cutoff", withLeaf(spot, 2.5, opaqueTexels)},
         {"point, MASK with every texel above the cutoff", withLeaf(point, 2.5, opaqueTexels)}};
     const scene::RasterSettings settings = validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2);
@@ -1411,7 +1416,23 @@ TEST(RasterRenderer, AlphaTestsThatCanNeverCutAreLeftOutAndTheFramesStayTheSame)
                 EXPECT_GT(testedDebug.alphaTestedLitTriangles, 0u) << what;
                 EXPECT_EQ(leftOutDebug.alphaTestedLitTriangles, 0u) << what;
                 if (channels != scene::kAllChannels || repeat > 0) continue;
-                const bool mask = s.materials.back().alphaMode == scene::AlphaMode::Mask;
+                // Each Renderer makes the alpha data and shaders its plan names, and the plan
+                // without the alpha tests none where no test can cut.
+                const bool transmittance = planFor(s, settings).needsTransmittanceMap;
+                const AlphaPlan plan = planAlpha(s, transmittance), all = planAlpha(s, transmittance, false);
+                EXPECT_EQ(leftOutDebug.alphaData, plan.data) << what;
+                EXPECT_EQ(leftOutDebug.transmittanceAlpha, plan.transmittanceReads) << what;
+                EXPECT_EQ(testedDebug.alphaData, all.data) << what;
+                EXPECT_EQ(testedDebug.transmittanceAlpha, all.transmittanceReads) << what;
+                const scene::Material& leafMaterial = s.materials.back();
+                const bool texturedBlend =
+                    leafMaterial.alphaMode == scene::AlphaMode::Blend && leafMaterial.alphaTexture;
+                const bool semiTransparentMask =
+                    leafMaterial.alphaMode == scene::AlphaMode::Mask && !leafMaterial.opaque();
+                EXPECT_EQ(plan.data, texturedBlend && transmittance) << what;
+                EXPECT_EQ(all.transmittanceReads, transmittance && (texturedBlend || semiTransparentMask)) << what;
+                // (the attribute names the depth pass's test: an opaque MASK caster's)
+                const bool mask = s.materials.back().alphaMode == scene::AlphaMode::Mask && s.materials.back().opaque();
                 EXPECT_EQ(a.attributes.count("alpha_casters"), mask ? 1u : 0u) << what;
                 EXPECT_EQ(b.attributes.count("alpha_casters"), 0u) << what;
                 std::size_t shadowedBelow = 0;  // the leaf (the highest id) shadows what lies under it
@@ -1429,6 +1450,39 @@ TEST(RasterRenderer, AlphaTestsThatCanNeverCutAreLeftOutAndTheFramesStayTheSame)
     RenderDebug debug;
     EXPECT_EQ(renderer.render(scene::kAllChannels, &debug).attributes.count("alpha_casters"), 1u);
     EXPECT_GT(debug.alphaTestedLitTriangles, 0u);
+}
+
+TEST(RasterRenderer, AnUntexturedBlendCastersTransmittanceIsItsConstantUnderTheAlphaShadersToo) {
+    // A BLEND pane of opacity 0.6 lets float(1 − 0.6) = 0.40000001 through, rounded once from
+    // double as the plain transmittance shaders write it. A textured BLEND leaf under the ground
+    // (seen by no one, shadowing nothing in view) puts the transmittance passes on their alpha
+    // shaders, where the float product 1 − 0.6f would give 0.39999998; the same leaf untextured
+    // does not. The frames must be the same bit for bit: the pane's shadow does not depend on
+    // which shaders some other caster needs.
+    scene::Material pane = alphaMaterial("pane", scene::AlphaMode::Blend, nullptr);
+    pane.opacity = 0.6;
+    auto withHiddenLeaf = [&](std::shared_ptr<const scene::AlphaTexture> texels) {
+        scene::Scene s = withLeaf(makeScene(SphereOverPlane{}), 2.5, pane);
+        scene::Material leaf = alphaMaterial("leaf", scene::AlphaMode::Blend, std::move(texels));
+        leaf.opacity = 0.5;
+        return withLeaf(s, -3.0, leaf);
+    };
+    const scene::Scene textured = withHiddenLeaf(checkerTexture(2, 1.0f, 0.6f)), plain = withHiddenLeaf(nullptr);
+    const scene::RasterSettings settings = validatedSettings(512, 0.01, 1.0, ShadowFilter::Pcf2x2);
+    Renderer withAlpha(textured, planFor(textured, settings), settings);
+    Renderer without(plain, planFor(plain, settings), settings);
+    RenderDebug alphaDebug, plainDebug;
+    const scene::Frame a = withAlpha.render(scene::kAllChannels, &alphaDebug);
+    const scene::Frame b = without.render(scene::kAllChannels, &plainDebug);
+    ASSERT_TRUE(alphaDebug.transmittanceAlpha);
+    ASSERT_FALSE(plainDebug.transmittanceAlpha);
+    test::expectSamePixels(a, b, "with the alpha shaders against without");
+    const float constant = float(1.0 - 0.6);
+    ASSERT_NE(constant, 1.0f - 0.6f);
+    EXPECT_GT(std::count(b.visibility.begin(), b.visibility.end(), constant), 100)
+        << "the frame must hold the pane's shadow";
+    EXPECT_EQ(withAlpha.validationMessages(), 0);
+    EXPECT_EQ(without.validationMessages(), 0);
 }
 
 TEST(RasterRenderer, SizeOptimizedOneLightModulesGiveTheGeneralModulesFramesBitForBit) {
