@@ -65,6 +65,14 @@ inline void addQuad(scene::Scene& s, const Vec3& c, const Vec3& n, double sizeU,
     s.objects.push_back(o);
 }
 
+// `s` with a 1x1 quad of material `m` (added as the last material) `height` above the origin,
+// facing up: a leaf over a test scene.
+inline scene::Scene withLeaf(scene::Scene s, double height, scene::Material m) {
+    s.materials.push_back(std::move(m));
+    addQuad(s, Vec3(0, height, 0), Vec3(0, 1, 0), 1, 1, int(s.materials.size()) - 1);
+    return s;
+}
+
 // A horizontal quad (normal +y) named `name`: for +y, quadAxes gives u = +x and v = −z, so its
 // size is (x extent, z extent).
 inline scene::Object horizontalQuad(const std::string& name, const Vec3& center, double sizeX, double sizeZ,

@@ -14,14 +14,10 @@ namespace {
 
 using test::alphaMaterial;
 using test::checkerTexture;
-using test::Vec3;
 
 // The sphere over the plane with a 1x1 quad of material `m` above it (the last material).
 scene::Scene withLeaf(const scene::Material& m, double height = 2.0) {
-    scene::Scene s = test::makeScene(test::SphereOverPlane{});
-    s.materials.push_back(m);
-    test::addQuad(s, Vec3(0, height, 0), Vec3(0, 1, 0), 1, 1, int(s.materials.size()) - 1);
-    return s;
+    return test::withLeaf(test::makeScene(test::SphereOverPlane{}), height, m);
 }
 
 // A MASK material of opacity 0.5 (a semi-transparent caster: drawn by the transmittance passes).
@@ -136,12 +132,7 @@ TEST(AlphaPlan, TheMemoryEstimateCountsTheAlphaDataWhereTheRendererMakesIt) {
     EXPECT_GE(estimate(seen) - estimate(unseen), (seen.objects.size() + 1) * 32 + 2 * 24);
     // A MASK leaf that cannot cut, under a BLEND pane (transmittance passes): the alpha data is
     // left out, so it costs what an opaque leaf does.
-    auto underPane = [](scene::Material leaf) {
-        scene::Scene s = withLeaf(blendOf(0.6), 2.5);
-        s.materials.push_back(std::move(leaf));
-        test::addQuad(s, Vec3(0, 2, 0), Vec3(0, 1, 0), 1, 1, int(s.materials.size()) - 1);
-        return s;
-    };
+    auto underPane = [](scene::Material leaf) { return test::withLeaf(withLeaf(blendOf(0.6), 2.5), 2.0, leaf); };
     const scene::Scene idleMask = underPane(alphaMaterial("leaf", scene::AlphaMode::Mask, nullptr));
     const scene::Scene opaque = underPane(alphaMaterial("leaf", scene::AlphaMode::Opaque, nullptr));
     EXPECT_EQ(estimate(idleMask), estimate(opaque));

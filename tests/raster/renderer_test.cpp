@@ -1356,16 +1356,7 @@ TEST(RasterRenderer, PerLightTargetsInReusedHeapMemoryStillGiveTheBackgroundZero
 // `s` with a 1x1 alpha-masked checkered quad (half its texels cut out) `height` above the origin,
 // facing up: an alpha-tested caster.
 scene::Scene withAlphaLeaf(scene::Scene s, double height) {
-    s.materials.push_back(alphaMaterial("leaf", scene::AlphaMode::Mask, checkerTexture(2, 1.0f, 0.0f)));
-    addQuad(s, Vec3(0, height, 0), Vec3(0, 1, 0), 1, 1, 1);
-    return s;
-}
-
-// `s` with a 1x1 quad of material `m` `height` above the origin, facing up.
-scene::Scene withLeaf(scene::Scene s, double height, scene::Material m) {
-    s.materials.push_back(std::move(m));
-    addQuad(s, Vec3(0, height, 0), Vec3(0, 1, 0), 1, 1, int(s.materials.size()) - 1);
-    return s;
+    return withLeaf(std::move(s), height, alphaMaterial("leaf", scene::AlphaMode::Mask, checkerTexture(2, 1.0f, 0.0f)));
 }
 
 TEST(RasterRenderer, AlphaTestsThatCanNeverCutAreLeftOutAndTheFramesStayTheSame) {
