@@ -45,9 +45,13 @@ bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && 
 // rather than silently reshaped: "nan" or "inf" numbers (read as 0), and face indices beyond
 // the 32-bit range (wrapped to other, possibly valid, vertices). Lines are read as tinyobjloader
 // reads them, after leading spaces and tabs.
-void checkObjText(const std::string& text, const fs::path& file, const fs::path& sceneFile, const JsonPath& path) {
+// A positive vertex index may name a vertex defined further down, so it is checked against the
+// file's count: where one exceeds it, a second pass (`vertexLimit`) names the first such line.
+void checkObjText(const std::string& text, const fs::path& file, const fs::path& sceneFile, const JsonPath& path,
+                  std::size_t vertexLimit = SIZE_MAX) {
     std::size_t vertices = 0, texcoords = 0, normals = 0;
     std::size_t lineNo = 0;
+    long long largest = 0;
     for (std::size_t begin = 0; begin < text.size();) {
         std::size_t end = text.find('\n', begin);
         if (end == std::string::npos) end = text.size();
@@ -98,10 +102,17 @@ void checkObjText(const std::string& text, const fs::path& file, const fs::path&
                         fail(sceneFile, path, file,
                              at() + "face index " + excerpt(number) + " is out of range (" + std::to_string(defined) +
                                  " " + what + " defined so far)");
+                    if (part == 0 && std::uint64_t(std::max(index, 0LL)) > vertexLimit)
+                        fail(sceneFile, path, file,
+                             at() + "face index " + excerpt(number) + " is out of range (" +
+                                 std::to_string(vertexLimit) + " vertices in the file)");
+                    if (part == 0) largest = std::max(largest, index);
                 }
             }
         }
     }
+    if (vertexLimit == SIZE_MAX && std::uint64_t(largest) > vertices)
+        checkObjText(text, file, sceneFile, path, vertices);
 }
 
 // OBJ material libraries name other files, which tinyobjloader would open itself (a FIFO hung
@@ -309,15 +320,16 @@ void normalize(std::vector<double>& values, int componentType, const std::string
 // zeros where it has none, with a sparse accessor's replacements applied (glTF 2.0, 3.6.2.3:
 // `count` strictly increasing indices into the accessor, and as many packed values), and
 // normalized integers mapped to -1..1 or 0..1.
+// `referrer`: the JSON path of the property that names the accessor, for the error where it names none.
 std::vector<double> readAccessor(const tinygltf::Model& model, int accessorIndex, int components, const fs::path& file,
-                                 const fs::path& sceneFile, const JsonPath& path) {
+                                 const fs::path& sceneFile, const JsonPath& path, const std::string& referrer) {
     const std::string at = "accessors[" + std::to_string(accessorIndex) + "]";
     auto bad = [&](const std::string& where, const std::string& what) {
         fail(sceneFile, path, file, where + ": " + what);
     };
     if (accessorIndex < 0 || std::size_t(accessorIndex) >= model.accessors.size())
         fail(sceneFile, path, file,
-             "accessor " + std::to_string(accessorIndex) + " does not exist (" +
+             referrer + ": names accessor " + std::to_string(accessorIndex) + ", which does not exist (" +
                  std::to_string(model.accessors.size()) + " accessors)");
     const auto& acc = model.accessors[std::size_t(accessorIndex)];
     const int nComp = tinygltf::GetNumComponentsInType(acc.type);
@@ -417,7 +429,7 @@ void collectCameraAnimations(const tinygltf::Model& model, const std::map<int, s
                 fail(sceneFile, path, file,
                      sat + ".interpolation: expected LINEAR, STEP or CUBICSPLINE, got '" +
                          excerpt(sampler.interpolation) + "'");
-            curve.times = readAccessor(model, sampler.input, 1, file, sceneFile, path);
+            curve.times = readAccessor(model, sampler.input, 1, file, sceneFile, path, sat + ".input");
             if (curve.times.empty()) fail(sceneFile, path, file, sat + ".input: has no keys");
             for (std::size_t k = 0; k < curve.times.size(); ++k)
                 if (!std::isfinite(curve.times[k]) || (k > 0 && !(curve.times[k] > curve.times[k - 1])))
@@ -425,7 +437,8 @@ void collectCameraAnimations(const tinygltf::Model& model, const std::map<int, s
                          sat + ".input: key times must be finite and increasing (key " + std::to_string(k) + ")");
             const bool rotation = ch.target_path == "rotation";
             const int components = rotation ? 4 : 3;
-            const std::vector<double> v = readAccessor(model, sampler.output, components, file, sceneFile, path);
+            const std::vector<double> v =
+                readAccessor(model, sampler.output, components, file, sceneFile, path, sat + ".output");
             const std::size_t perKey = curve.interpolation == AnimationCurve::Interpolation::CubicSpline ? 3 : 1;
             if (v.size() != curve.times.size() * perKey * std::size_t(components))
                 fail(sceneFile, path, file,
@@ -596,26 +609,27 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
         const auto& prim = model.meshes[meshIndex].primitives[primIndex];
         if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != -1) continue;  // points/lines cast nothing
         if (material != -2 && prim.material != material) continue;
+        const std::string primAt =
+            "meshes[" + std::to_string(meshIndex) + "].primitives[" + std::to_string(primIndex) + "]";
         const auto pos = prim.attributes.find("POSITION");
-        if (pos == prim.attributes.end()) fail(sceneFile, path, file, "a primitive has no POSITION");
-        const std::vector<double> p = readAccessor(model, pos->second, 3, file, sceneFile, path);
+        if (pos == prim.attributes.end()) fail(sceneFile, path, file, primAt + ".attributes: has no POSITION");
+        const std::vector<double> p =
+            readAccessor(model, pos->second, 3, file, sceneFile, path, primAt + ".attributes.POSITION");
         const std::size_t count = p.size() / 3;
         std::vector<double> n;
         if (const auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
-            n = readAccessor(model, it->second, 3, file, sceneFile, path);
+            n = readAccessor(model, it->second, 3, file, sceneFile, path, primAt + ".attributes.NORMAL");
             if (n.size() != p.size()) n.clear();
         }
         std::vector<double> uv;
         if (uvSet >= 0) {
             const std::string name = "TEXCOORD_" + std::to_string(uvSet);
             const auto it = prim.attributes.find(name);
-            const std::string at =
-                "meshes[" + std::to_string(meshIndex) + "].primitives[" + std::to_string(primIndex) + "]";
             if (it == prim.attributes.end())
-                fail(sceneFile, path, file, at + ": has no " + name + ", which its material's alpha texture needs");
-            uv = readAccessor(model, it->second, 2, file, sceneFile, path);
+                fail(sceneFile, path, file, primAt + ": has no " + name + ", which its material's alpha texture needs");
+            uv = readAccessor(model, it->second, 2, file, sceneFile, path, primAt + ".attributes." + name);
             if (uv.size() != 2 * count)
-                fail(sceneFile, path, file, at + ": " + name + " has not one element per vertex");
+                fail(sceneFile, path, file, primAt + ": " + name + " has not one element per vertex");
             for (std::size_t i = 0; i < uv.size(); i += 2) {
                 // KHR_texture_transform moves where the alpha is sampled; both backends
                 // interpolate these per-vertex coordinates, and the transform is affine.
@@ -623,7 +637,7 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
                 uv[i] = t.x;
                 uv[i + 1] = t.y;
                 if (!std::isfinite(t.x) || !std::isfinite(t.y))
-                    fail(sceneFile, path, file, at + ": " + name + " holds a non-finite value");
+                    fail(sceneFile, path, file, primAt + ": " + name + " holds a non-finite value");
             }
         }
         std::vector<double> idx;
@@ -641,7 +655,7 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
                              std::to_string(ia.componentType));
                 if (ia.normalized) fail(sceneFile, path, file, iaAt + ".normalized: indices must not be normalized");
             }
-            idx = readAccessor(model, prim.indices, 1, file, sceneFile, path);
+            idx = readAccessor(model, prim.indices, 1, file, sceneFile, path, primAt + ".indices");
         } else {
             idx.resize(count);
             for (std::size_t i = 0; i < count; ++i) idx[i] = double(i);
@@ -656,7 +670,9 @@ void appendGltfMesh(const tinygltf::Model& model, int meshIndex, TriangleMesh& o
                          " vertices)");
         for (std::size_t i = 0; i < count; ++i)
             if (!finite(Vec3(p[3 * i], p[3 * i + 1], p[3 * i + 2])))
-                fail(sceneFile, path, file, "a vertex is not finite");
+                fail(sceneFile, path, file,
+                     "meshes[" + std::to_string(meshIndex) + "].primitives[" + std::to_string(primIndex) +
+                         "].attributes.POSITION: vertex " + std::to_string(i) + " is not finite");
         const bool flat = n.empty();
         const std::size_t added = flat ? corners : count;
         if (out.positions.size() + added > std::size_t(UINT32_MAX))
@@ -834,6 +850,52 @@ std::string bufferFileProblem(std::string_view json, const std::string& baseDir)
     return "";
 }
 
+// Where tinygltf refused a file: the first accessor a mesh primitive or an animation sampler names
+// that the file does not hold, by its JSON path ("" if none). tinygltf's own message names
+// neither the primitive nor the property.
+std::string accessorReferenceProblem(std::string_view json) {
+    const nlohmann::json doc = nlohmann::json::parse(json, nullptr, false);
+    if (!doc.is_object()) return "";
+    const std::size_t accessors =
+        doc.contains("accessors") && doc["accessors"].is_array() ? doc["accessors"].size() : 0;
+    auto check = [&](const nlohmann::json& value, const std::string& at) -> std::string {
+        if (!value.is_number_integer()) return "";
+        const std::int64_t index = value.get<std::int64_t>();
+        if (index >= 0 && std::uint64_t(index) < accessors) return "";
+        return at + ": names accessor " + std::to_string(index) + ", which does not exist (" +
+               std::to_string(accessors) + " accessors)";
+    };
+    auto array = [&](const nlohmann::json& parent, const char* key) -> const nlohmann::json* {
+        return parent.is_object() && parent.contains(key) && parent[key].is_array() ? &parent[key] : nullptr;
+    };
+    if (const nlohmann::json* meshes = array(doc, "meshes"))
+        for (std::size_t m = 0; m < meshes->size(); ++m)
+            if (const nlohmann::json* prims = array((*meshes)[m], "primitives"))
+                for (std::size_t p = 0; p < prims->size(); ++p) {
+                    const nlohmann::json& prim = (*prims)[p];
+                    if (!prim.is_object()) continue;
+                    const std::string at = "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(p) + "]";
+                    if (prim.contains("attributes") && prim["attributes"].is_object())
+                        for (const auto& [name, value] : prim["attributes"].items())
+                            if (std::string problem = check(value, at + ".attributes." + name); !problem.empty())
+                                return problem;
+                    if (prim.contains("indices"))
+                        if (std::string problem = check(prim["indices"], at + ".indices"); !problem.empty())
+                            return problem;
+                }
+    if (const nlohmann::json* animations = array(doc, "animations"))
+        for (std::size_t a = 0; a < animations->size(); ++a)
+            if (const nlohmann::json* samplers = array((*animations)[a], "samplers"))
+                for (std::size_t k = 0; k < samplers->size(); ++k) {
+                    const std::string at = "animations[" + std::to_string(a) + "].samplers[" + std::to_string(k) + "]";
+                    for (const char* key : {"input", "output"})
+                        if ((*samplers)[k].is_object() && (*samplers)[k].contains(key))
+                            if (std::string problem = check((*samplers)[k][key], at + "." + key); !problem.empty())
+                                return problem;
+                }
+    return "";
+}
+
 // `decodedBytes`: what decoding compressed geometry added to the file's buffers.
 void loadGltf(const fs::path& file, const std::string& fileBytes, std::vector<RawInstance>& out,
               const fs::path& sceneFile, const JsonPath& path, GltfExtras* extras, const MeshRequest& request,
@@ -869,6 +931,8 @@ void loadGltf(const fs::path& file, const std::string& fileBytes, std::vector<Ra
     if (!ok) {
         if (const std::string problem = bufferFileProblem(gltfJsonChunk(fileBytes, binary), files.baseDir);
             !problem.empty())
+            fail(sceneFile, path, file, problem);
+        if (const std::string problem = accessorReferenceProblem(gltfJsonChunk(fileBytes, binary)); !problem.empty())
             fail(sceneFile, path, file, problem);
         fail(sceneFile, path, file, "not a readable glTF file: " + excerpt(err.empty() ? warn : err, 400));
     }

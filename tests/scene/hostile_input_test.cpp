@@ -242,6 +242,25 @@ TEST(GltfAccessor, OffsetsCountsAndStridesThatWrapOrOverrunAreErrorsWithTheirPat
     EXPECT_FALSE(e.empty());
 }
 
+TEST(GltfAccessor, AnAccessorThatDoesNotExistIsNamedByThePropertyThatNamesIt) {
+    // tinygltf refuses a missing indices accessor itself; POSITION and NORMAL reach our reader.
+    // Either way the error names the primitive's property, not only the number.
+    const char* pos =
+        "meshes[0].primitives[0].attributes.POSITION: names accessor 5, which does not exist (1 accessors)";
+    EXPECT_NE(gltfError([](Json& g) { g["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = 5; }).find(pos),
+              std::string::npos);
+    std::string e = gltfError([](Json& g) { g["meshes"][0]["primitives"][0]["indices"] = 1; });
+    EXPECT_NE(e.find("meshes[0].primitives[0].indices: names accessor 1, which does not exist (1 accessors)"),
+              std::string::npos)
+        << e;
+    e = gltfError([](Json& g) { g["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = 3; });
+    EXPECT_NE(e.find("meshes[0].primitives[0].attributes.NORMAL: names accessor 3, which does not exist"),
+              std::string::npos)
+        << e;
+    e = gltfError([](Json& g) { g["meshes"][0]["primitives"][0]["attributes"].erase("POSITION"); });
+    EXPECT_NE(e.find("meshes[0].primitives[0].attributes: has no POSITION"), std::string::npos) << e;
+}
+
 // The triangle with a sparse accessor moving vertex 2 from (0, 1, 0) to `moved` (buffer: the
 // 36 bytes of positions, one uint32 index at 36, 12 bytes of value at 40).
 Json sparseTriangle(std::uint32_t index, const float moved[3]) {
@@ -290,6 +309,13 @@ TEST(ObjIndex, IndicesBeyondThe32BitRangeAreErrorsNamingTheLine) {
         EXPECT_NE(e.find("line 4: face index"), std::string::npos) << face << ": " << e;
         EXPECT_NE(e.find("out of range (3 vertices defined so far)"), std::string::npos) << face << ": " << e;
     }
+    // A positive index past the file's vertices is named at its line; one naming a vertex
+    // defined further down the file is not an error.
+    dir.write("far.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 7\nf 1 3 9\n");
+    const std::string e = errorOf([&] { scene::loadScene(dir.write("far.json", meshScene("far.obj"))); });
+    EXPECT_NE(e.find("line 5: face index 7 is out of range (3 vertices in the file)"), std::string::npos) << e;
+    dir.write("ahead.obj", "v 0 0 0\nf 1 2 3\nv 1 0 0\nv 0 1 0\n");
+    EXPECT_EQ(errorOf([&] { scene::loadScene(dir.write("ahead.json", meshScene("ahead.obj"))); }), "");
 }
 
 // ---- non-finite values wherever they enter ----------------------------------------------
