@@ -17,6 +17,11 @@ namespace shadowlab::compare {
 
 namespace {
 
+// Two methods whose wrong-pixel rates lie within this ratio are called about as close to the
+// reference, not ranked: a difference that small moves with a texel's rounding or a pixel of
+// view, and the images show no winner.
+constexpr double kSameErrorRatio = 1.1;
+
 std::string methodTitle(const std::string& label) {
     if (label == "raster") return "The shadow map (raster)";
     if (label == "raytrace") return "The ray tracer (raytrace)";
@@ -580,10 +585,15 @@ std::string describeFindings(const ReportInput& in) {
         const auto worst = std::max_element(in.methods.begin(), in.methods.end(), [](const auto& a, const auto& b) {
             return a.metrics.mismatchRate < b.metrics.mismatchRate;
         });
-        if (worst->metrics.mismatchRate > best->metrics.mismatchRate) {
-            std::string t = "Overall, " + shortTitle(best->label) + " is closer to the reference (" +
-                            formatPercent(best->metrics.mismatchRate) + " against " +
-                            formatPercent(worst->metrics.mismatchRate) + " wrong)";
+        const double b = best->metrics.mismatchRate, w = worst->metrics.mismatchRate;
+        const auto [bt, wt] = formatPercentsApart(b, w);
+        if (w > b && w <= kSameErrorRatio * b) {
+            lines.push_back("Overall, " + shortTitle(best->label) + " and " + shortTitle(worst->label) +
+                            " are about as close to the reference as each other (" + bt + " and " + wt +
+                            " wrong, within a tenth of each other).");
+        } else if (w > b) {
+            std::string t = "Overall, " + shortTitle(best->label) + " is closer to the reference (" + bt + " against " +
+                            wt + " wrong)";
             const std::string r = ratio(best->metrics.methodTiming.totalMs, worst->metrics.methodTiming.totalMs);
             if (!r.empty()) t += " and " + r + " " + shortTitle(worst->label);
             lines.push_back(t + ".");

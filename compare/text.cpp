@@ -40,6 +40,16 @@ std::string formatPercent(double rate) {
     return printf1("%.2g%%", p);
 }
 
+std::pair<std::string, std::string> formatPercentsApart(double a, double b) {
+    std::string x = formatPercent(a), y = formatPercent(b);
+    for (const char* format : {"%.2g%%", "%.3g%%"})
+        if (x == y && a != b) {
+            x = printf1(format, 100.0 * a);
+            y = printf1(format, 100.0 * b);
+        }
+    return {x, y};
+}
+
 std::string formatDuration(double ms) {
     if (!std::isfinite(ms)) return "n/a";
     if (ms >= 1000.0) return printf1("%.3g s", ms / 1000.0);

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <string>
+#include <utility>
 
 namespace shadowlab::compare {
 
@@ -12,6 +13,9 @@ std::string formatCount(std::size_t n);
 // A rate in 0..1 as a percentage that never rounds a non-zero rate to "0%":
 // 0 -> "0%", 0.0000123 -> "0.0012%", 0.0082 -> "0.82%", 0.5 -> "50.0%", 1 -> "100%".
 std::string formatPercent(double rate);
+// Two rates as formatPercent prints them, with more significant digits where those print alike
+// and the rates differ (so a sentence never ranks two equal-looking numbers).
+std::pair<std::string, std::string> formatPercentsApart(double a, double b);
 // Milliseconds with a unit that keeps 3 significant digits: "0.412 ms", "87.3 ms", "1.25 s".
 std::string formatDuration(double ms);
 // A method's run time: "not recorded" where the frame records none (a mask another renderer wrote).

@@ -123,6 +123,30 @@ TEST(Report, FindingsNameTheDominantErrorAndWhere) {
     EXPECT_NE(overall.find("the ray tracer is closer"), std::string::npos) << overall;
 }
 
+TEST(Report, FindingsRankNoMethodWhoseErrorIsWithinATenthOfTheOthers) {
+    ReportInput in = syntheticRun();
+    auto overall = [&] {
+        std::istringstream lines(describeFindings(in));
+        std::string line, last;
+        while (std::getline(lines, line))
+            if (line.rfind("Overall", 0) == 0) last = line;
+        return last;
+    };
+    // 0.0486% and 0.0526% both print as 0.05%: no winner, and the digits that tell them apart.
+    in.methods[0].metrics.mismatchRate = 0.000486;
+    in.methods[1].metrics.mismatchRate = 0.000526;
+    std::string text = overall();
+    EXPECT_NE(text.find("about as close to the reference as each other"), std::string::npos) << text;
+    EXPECT_NE(text.find("(0.049% and 0.053% wrong"), std::string::npos) << text;
+    EXPECT_EQ(text.find("is closer"), std::string::npos) << text;
+    // 11% apart: ranked, with digits that differ although both round to 0.05% at two decimals.
+    in.methods[1].metrics.mismatchRate = 0.000499;
+    in.methods[0].metrics.mismatchRate = 0.000451;
+    text = overall();
+    EXPECT_NE(text.find("the ray tracer is closer to the reference (0.045% against 0.05% wrong)"), std::string::npos)
+        << text;
+}
+
 TEST(Report, FindingsSayAThinShadowLostToTheBiasIsBiasAndARayTracerDoesNotAlias) {
     // Reference: two columns of shadow on a lit floor (N·L = 0.5), the blocker 0.01 away along
     // the ray. A shadow map (texel 0.01, bias 0.005, slope 1; D = 0.005 + 5·0.01·√3 = 0.092 at
