@@ -202,11 +202,10 @@ std::string BiasSeries::describe() const {
     if (!window.stiff) {
         s += std::string(momentKind(kind) ? "parameter window " : "bias window ") + compare::formatShort(window.lo) +
              " .. " + compare::formatShort(window.hi) + " (" + limit + ", " + std::to_string(window.acceptableSamples) +
-             " sample" + (window.acceptableSamples == 1 ? "" : "s") + "); recommended " +
-             compare::formatShort(recommended);
-        if (window.lo != window.hi)
-            s += std::string(" (") + (logSpaced && window.lo > 0.0 ? "geometric" : "arithmetic") + " middle)";
-        return s + ".";
+             " sample" + (window.acceptableSamples == 1 ? "" : "s") + "); ";
+        if (window.lo == window.hi) return s + "one sampled value, " + compare::formatShort(recommended) + ".";
+        return s + "its " + (logSpaced && window.lo > 0.0 ? "geometric" : "arithmetic") + " middle, " +
+               compare::formatShort(recommended) + ", leaves the most room either way on this slice.";
     }
     return s + "stiff: no sampled value keeps " + limit + ". At the best compromise, " +
            compare::formatShort(window.bestBias) + ", " + artifactName(dominant, kind) + " dominates (" +

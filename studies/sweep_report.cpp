@@ -184,7 +184,7 @@ std::vector<bool> frontRows(const std::vector<SweepRow>& rows) {
 compare::ScatterPlot biasSeriesPlot(const BiasSeries& s) {
     compare::ScatterPlot p = biasPlot(s.samples, s.window, s.name() + " (" + s.unit() + ")", s.logSpaced);
     if (!s.window.stiff) {
-        if (!p.bands.empty()) p.bands.front().label = "window · recommended " + compare::formatShort(s.recommended);
+        if (!p.bands.empty()) p.bands.front().label = "window · middle " + compare::formatShort(s.recommended);
         p.markers.push_back({s.recommended, ""});
     } else {
         p.markers.push_back({s.recommended, "best compromise"});
@@ -413,7 +413,11 @@ std::vector<std::string> describeSweep(const SweepReportInput& in, const AutoBia
         }
         lines.push_back(s);
     }
-    for (const std::string& note : bias.notes) lines.push_back(note);
+    // The probe slices' picks are the block only when nothing was searched in the configuration
+    // the user runs; otherwise that search's notes say what the block holds and why (the slices'
+    // windows stay under their plots below), so the findings never name two recommendations.
+    if (!in.recommendation)
+        for (const std::string& note : bias.notes) lines.push_back(note);
     if (const Machines machines = machinesOf(in.rows); machines.list.size() > 1) {
         std::string s = "The rows were timed on " + std::to_string(machines.list.size()) + " different machines (";
         for (std::size_t m = 0; m < machines.list.size(); ++m)

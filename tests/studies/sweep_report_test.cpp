@@ -37,7 +37,7 @@ std::string readText(const fs::path& file) {
 // A sweep of both backends with known answers:
 // - raster map sizes: 512 is fastest (2 ms) but 3% wrong; 1024 is the fastest under 1% (4 ms,
 //   0.5%); 4096 pcf2x2 is the most accurate (0.03%, 20 ms);
-// - a depth-bias series with a window at 0.002 .. 0.008 (log-spaced: recommended 0.004);
+// - a depth-bias series with a window at 0.002 .. 0.008 (log-spaced: its middle 0.004);
 // - the ray tracer: a ray-bias series that is stiff (acne dominates) and never under 1%, and
 //   robust offsets in float that pass;
 // - one raster configuration that failed.
@@ -87,8 +87,10 @@ TEST(SweepReport, WritesThePagePlotsAndTheShadowBlock) {
     EXPECT_DOUBLE_EQ(block.at("depth_bias").get<double>(), 0.004);
     EXPECT_EQ(block.at("ray_bias"), "robust");
     EXPECT_EQ(readText(dir / "error-time.svg").rfind("<svg", 0), 0u);
-    // The depth plot shades the window and names the recommended value; the ray plot is stiff.
-    EXPECT_NE(readText(dir / "bias-depth.svg").find("recommended 0.004"), std::string::npos);
+    // The depth plot shades the window and names its middle; the ray plot is stiff.
+    EXPECT_NE(readText(dir / "bias-depth.svg").find("middle 0.004"), std::string::npos);
+    // Without a search in the user's configuration the page's findings give the probe slice's pick.
+    EXPECT_NE(readText(dir / "report.html").find("On the probe slice"), std::string::npos);
     EXPECT_NE(readText(dir / "bias-ray.svg").find("stiff"), std::string::npos);
 }
 
@@ -241,6 +243,11 @@ TEST(SweepReport, AVerifiedRecommendationIsWhatTheFileAndThePageHold) {
     EXPECT_DOUBLE_EQ(file.at("measured").at("raster").at("mismatch_rate_gain").get<double>(), 0.004 - 0.001);
     const std::string html = readText(dir / "report.html");
     EXPECT_NE(html.find("At 320x180 the searched point gains 0.3%."), std::string::npos);
+    // One recommendation: the probe slice's pick is not offered beside the searched block, and
+    // the slice's window text under its plot names a middle, not a recommendation.
+    EXPECT_EQ(html.find("On the probe slice"), std::string::npos);
+    EXPECT_EQ(html.find("recommended 0.004"), std::string::npos);
+    EXPECT_NE(html.find("its geometric middle, 0.004, leaves the most room"), std::string::npos);
     EXPECT_NE(html.find(compare::escapeHtml(r.shadowBlock.dump(2))), std::string::npos);
     EXPECT_EQ(summarizeSweep(in, "sweep/report.html").shadowBlockJson, r.shadowBlock.dump(2));
 }
