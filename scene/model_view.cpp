@@ -303,6 +303,12 @@ void applySunOption(Scene& scene, const std::string& text) {
         l.direction = sunDirection(az, el);
         scene.origin.chooseSun = false;
         recordChoice(scene, "sun", "azimuth " + fmt(az) + ", elevation " + fmt(el) + " degrees (--sun)");
+        // Allowed (light from below is a case to study), but rarely meant: say what it gives.
+        if (el < 0.0)
+            scene.origin.notes.push_back("--sun " + text + ": the elevation " + fmt(el) +
+                                         " puts the sun below the horizon, so faces turned up get no light and "
+                                         "a ground shows no shadow; a sun above would be elevation " +
+                                         fmt(-el));
         return;
     }
     throw InputError("--sun " + text + ": the scene has no directional light to point");

@@ -341,6 +341,14 @@ TEST(ModelView, SunOptionPointsTheDirectionalLightAndRefusesBadText) {
     applySunOption(s, "90,30");
     expectNear(s.lights[0].direction, {-std::sqrt(3.0) / 2, -0.5, 0});
     EXPECT_FALSE(s.origin.chooseSun);
+    EXPECT_TRUE(s.origin.notes.empty());
+    // A sun below the horizon is allowed, with a note that says what it gives.
+    Scene below = s;
+    applySunOption(below, "0,-30");
+    expectNear(below.lights[0].direction, {0, 0.5, -std::sqrt(3.0) / 2});
+    ASSERT_EQ(below.origin.notes.size(), 1u);
+    EXPECT_NE(below.origin.notes[0].find("below the horizon"), std::string::npos) << below.origin.notes[0];
+    EXPECT_NE(below.origin.notes[0].find("elevation 30"), std::string::npos) << below.origin.notes[0];
     for (const char* bad : {"90", "90;30", "a,b", "0,95", "0,-91", "1,2,3"})
         EXPECT_THROW(applySunOption(s, bad), InputError) << bad;
     Scene point = s;
