@@ -448,6 +448,7 @@ Comparison compareFrames(const Frame& method, const Frame& reference, const Comp
     const Contact contact = contactOf(method, options);
     m.pointSampled = !attribute(method, "ray_bias").empty() && attribute(method, "texel_world_size").empty();
     m.hasBlockerDistance = contact.known() && reference.blockerDistance.size() == n && reference.blockerId.size() == n;
+    m.hasReferenceBlockerIds = reference.blockerId.size() == n;
     // Perspective maps' texels at each pixel's distance: its position from the method's depths and
     // the camera either frame records (the same camera: compare refuses two different ones).
     const bool methodCamera = method.typedAttributes.count("worldToNDC") > 0;
@@ -544,6 +545,11 @@ Comparison compareFrames(const Frame& method, const Frame& reference, const Comp
                 ++m.missedShadow;
                 ++obj.missedShadow;
                 if (nearEdge[i]) ++m.missedShadowNearEdge;
+                if (m.hasReferenceBlockerIds && std::isfinite(reference.blockerId[i]) &&
+                    roundId(reference.blockerId[i]) == roundId(idr) && nr < kTerminatorNdotL) {
+                    ++m.terminatorMissed;
+                    ++obj.terminatorMissed;
+                }
                 // The reference's blocker, by its distance from the receiver: within the contact
                 // distance, a bias leak; farther and away from the reference's shadow edges,
                 // bleeding (near an edge it is the edge's aliasing). Without a blocker neither.
@@ -593,6 +599,7 @@ Comparison compareFrames(const Frame& method, const Frame& reference, const Comp
     if (std::isinf(m.contactDistance)) m.contactDistance = contact.at(1.0f, contact.texelAt(nullptr));  // none counted
     m.bleedingRate = rate(m.bleeding, m.counted);
     m.biasLeakRate = rate(m.biasLeak, m.counted);
+    m.terminatorMissedRate = rate(m.terminatorMissed, m.counted);
     m.aliasingPixels = m.pointSampled ? 0 : m.falseShadowNearEdge + m.missedShadowNearEdge - m.biasLeakNearEdge;
     m.biasErrorPixels = wrong - m.aliasingPixels;
     m.aliasingRate = rate(m.aliasingPixels, m.counted);
@@ -618,7 +625,8 @@ nlohmann::json toJson(const Metrics& m) {
                              {"counted", o.counted},
                              {"false_shadow", o.falseShadow},
                              {"missed_shadow", o.missedShadow},
-                             {"self_shadow_acne", o.selfShadowAcne}});
+                             {"self_shadow_acne", o.selfShadowAcne},
+                             {"terminator_missed", o.terminatorMissed}});
     nlohmann::json j = {
         {"width", m.width},
         {"height", m.height},
@@ -683,6 +691,12 @@ nlohmann::json toJson(const Metrics& m) {
     } else {
         j["self_shadow_acne"] = nullptr;
         j["self_shadow_acne_rate"] = nullptr;
+    }
+    j["terminator_missed"] = nullptr;
+    j["terminator_missed_rate"] = nullptr;
+    if (m.hasReferenceBlockerIds) {
+        j["terminator_missed"] = m.terminatorMissed;
+        j["terminator_missed_rate"] = m.terminatorMissedRate;
     }
     // Without the reference's blocker distances (older frames) bleeding is unknown, not zero.
     for (const char* k :

@@ -76,6 +76,7 @@ struct ObjectErrors {
     std::size_t falseShadow = 0;
     std::size_t missedShadow = 0;
     std::size_t selfShadowAcne = 0;
+    std::size_t terminatorMissed = 0;
 };
 
 // The square window of the image with the most wrong (false + missed shadow) pixels; the
@@ -141,6 +142,14 @@ struct Metrics {
     double contactDistance = 0.0;
     std::size_t bleeding = 0, biasLeak = 0;
     double bleedingRate = 0.0, biasLeakRate = 0.0;  // over counted
+
+    // Missed shadow at a smooth-shaded mesh's terminator: the reference's blocker is the receiver's
+    // own object and its N·L is below kTerminatorNdotL (the reference's facets shadowing their
+    // neighbours, which offsets along the shading normal and a map's bias hide). Needs the
+    // reference's blocker ids; unknown, not zero, without them.
+    bool hasReferenceBlockerIds = false;
+    std::size_t terminatorMissed = 0;
+    double terminatorMissedRate = 0.0;  // over counted
 
     // Edge-aware split of the wrong pixels: within edgeRadius pixels of a reference shadow
     // boundary they are aliasing (a resolution problem), elsewhere bias error. Two exceptions:

@@ -158,7 +158,22 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
         } else {
             parts.push_back("no false shadow");
         }
-        if (m.missedShadow > 0) {
+        const bool terminator = double(m.terminatorMissed) > kMostlyShare * double(m.missedShadow);
+        if (m.missedShadow > 0 && terminator) {
+            // The reference's own faceting, not a leak a viewer of the method's image would see.
+            std::string f = formatPercent(m.missedShadowRate) + " missed shadow, " +
+                            formatPercent(double(m.terminatorMissed) / double(m.missedShadow)) +
+                            " of it at a smooth-shaded mesh's terminator";
+            const std::string on =
+                dominantObject(in, m, m.terminatorMissed, [](const ObjectErrors& o) { return o.terminatorMissed; });
+            if (!on.empty()) f += " on " + on;
+            f += " (N·L below " + formatShort(kTerminatorNdotL) +
+                 ", the receiver shadowed by its own surface): there the reference's flat facets shadow their "
+                 "neighbours while the interpolated normal still faces the light, and the method's offset along "
+                 "that normal lifts the point out of it, as renderers do on purpose; a tessellation effect rather "
+                 "than a leak";
+            parts.push_back(f);
+        } else if (m.missedShadow > 0) {
             std::string f = formatPercent(m.missedShadowRate) + " missed shadow (light leaking or peter-panning";
             const std::string on =
                 dominantObject(in, m, m.missedShadow, [](const ObjectErrors& o) { return o.missedShadow; });
@@ -178,6 +193,11 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
                          : " (" + formatPercent(double(m.bleeding) / double(m.missedShadow)) +
                                " of it light bleeding, farther than " + formatShort(m.contactDistance) +
                                " from its blocker)";
+            if (m.terminatorMissed > 0 && double(m.terminatorMissed) >= kNotableShare * double(m.missedShadow))
+                f += "; " + formatPercent(double(m.terminatorMissed) / double(m.missedShadow)) +
+                     " of it lies at a smooth-shaded mesh's terminator (the receiver shadowed by its own surface at "
+                     "N·L below " +
+                     formatShort(kTerminatorNdotL) + "), where the reference's flat facets shadow their neighbours";
             parts.push_back(f);
         } else {
             parts.push_back("no missed shadow");

@@ -171,6 +171,40 @@ TEST(CompareFrames, WithoutMethodBlockerIdsSelfAcneIsUnknownNotZero) {
     EXPECT_EQ(summaryLine(k).find("self acne"), std::string::npos);
 }
 
+TEST(CompareFrames, MissedShadowWhereTheReceiverBlocksItselfAtGrazingLightIsTheTerminator) {
+    // Every pixel on object 1 and lit in the method; the reference's blocker and N·L decide:
+    //   0: missed, blocked by itself at N·L 0.1        -> terminator
+    //   1: missed, blocked by itself at N·L 0.5        -> not (too far from grazing)
+    //   2: missed, blocked by object 2 at N·L 0.1      -> not (another caster)
+    //   3: both shadowed, blocked by itself at 0.1     -> not (no error)
+    //   4: missed, blocked by itself just under 0.2    -> terminator
+    const std::vector<Px> px = {{1, 1, 0.1f, 0.1f, 1, 0},
+                                {1, 1, 0.5f, 0.5f, 1, 0},
+                                {1, 1, 0.1f, 0.1f, 1, 0},
+                                {1, 1, 0.1f, 0.1f, 0, 0, 1},
+                                {1, 1, 0.19f, 0.19f, 1, 0}};
+    auto [m, r] = framesFrom(px);
+    r.blockerId = {1, 1, 2, 1, 1};
+    const Metrics k = compareFrames(m, r).metrics;
+    EXPECT_TRUE(k.hasReferenceBlockerIds);
+    EXPECT_EQ(k.missedShadow, 4u);
+    EXPECT_EQ(k.terminatorMissed, 2u);
+    EXPECT_DOUBLE_EQ(k.terminatorMissedRate, 2.0 / 5.0);
+    ASSERT_EQ(k.perObject.size(), 1u);
+    EXPECT_EQ(k.perObject[0].terminatorMissed, 2u);
+    const auto j = toJson(k);
+    EXPECT_EQ(j.at("terminator_missed"), 2);
+    EXPECT_EQ(j.at("per_object").at(0).at("terminator_missed"), 2);
+
+    // A reference without blocker ids (an older frame, or an engine's): unknown, not zero.
+    r.blockerId.clear();
+    const Metrics u = compareFrames(m, r).metrics;
+    EXPECT_FALSE(u.hasReferenceBlockerIds);
+    EXPECT_EQ(u.terminatorMissed, 0u);
+    EXPECT_TRUE(toJson(u).at("terminator_missed").is_null());
+    EXPECT_TRUE(toJson(u).at("terminator_missed_rate").is_null());
+}
+
 TEST(CompareFrames, NothingCountedGivesZeroRatesAndUnitIoU) {
     const auto [m, r] = framesFrom({{0, 0, 0, 0, 1, 1}, {1, 2, 0.5f, 0.5f, 1, 1}});
     const Metrics k = compareFrames(m, r).metrics;
