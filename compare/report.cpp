@@ -169,9 +169,10 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
             if (!on.empty()) f += " on " + on;
             f += " (N·L below " + formatShort(kTerminatorNdotL) +
                  ", the receiver shadowed by its own surface): there the reference's flat facets shadow their "
-                 "neighbours while the interpolated normal still faces the light, and the method's offset along "
-                 "that normal lifts the point out of it, as renderers do on purpose; a tessellation effect rather "
-                 "than a leak";
+                 "neighbours while the interpolated normal still faces the light, and " +
+                 std::string(m.pointSampled ? "the ray's offset along that normal lifts the point out of it"
+                                            : "the map's bias reaches past the neighbouring facet") +
+                 ", as renderers mean to; a tessellation effect rather than a leak";
             parts.push_back(f);
         } else if (m.missedShadow > 0) {
             std::string f = formatPercent(m.missedShadowRate) + " missed shadow (light leaking or peter-panning";
