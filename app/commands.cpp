@@ -7,6 +7,7 @@
 
 #include <unistd.h>
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -412,10 +413,19 @@ int compareFiles(const CompareOptions& o) {
     if (o.heat && o.heat->extension() != ".png")
         throw scene::InputError(o.heat->string() + ": the heat map must be a .png");
     const scene::Budgets budgets = parseBudgets(o.budgets);
-    const bool maskOnly = o.maskChannel || o.maskInvert || o.maskSrgb || scene::looksLikeMask(o.method);
+    // Only an EXR can be a Frame: any other file is read as a mask, which names the formats it takes.
+    std::string methodExt = o.method.extension().string();
+    for (char& ch : methodExt) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    const bool maskOnly =
+        o.maskChannel || o.maskInvert || o.maskSrgb || methodExt != ".exr" || scene::looksLikeMask(o.method);
+    if (maskOnly && budgets[scene::BudgetKind::MaxBleeding])
+        throw scene::InputError(o.method.string() +
+                                ": --max-bleeding: a shadow mask records no bias or texel size, so light bleeding "
+                                "cannot be told from bias leaks (use --max-missed-shadow)");
     const scene::Frame reference = readingInput(o.reference.string(), [&] { return scene::readFrame(o.reference); });
     const scene::Frame method =
-        maskOnly ? scene::frameFromMask(scene::readShadowMask(o.method, {o.maskChannel, o.maskInvert, o.maskSrgb}),
+        maskOnly ? scene::frameFromMask(scene::readShadowMask(o.method, {o.maskChannel, o.maskInvert, o.maskSrgb,
+                                                                         reference.width, reference.height}),
                                         reference, o.method)
                  : readingInput(o.method.string(), [&] { return scene::readFrame(o.method); });
     if (const std::string d = scene::describeIdentityDifference(method, reference); !d.empty()) {

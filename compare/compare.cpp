@@ -362,7 +362,10 @@ nlohmann::json toJson(const FrameHealth& h) {
 nlohmann::json toJson(const Timing& t) {
     nlohmann::json stages = nlohmann::json::array();
     for (const auto& [name, ms] : t.stagesMs) stages.push_back({{"stage", name}, {"ms", ms}});
-    return {{"total_ms", t.totalMs}, {"stages", stages}};
+    // A frame that records no stage (an external mask) has no run time: null, not 0 ms.
+    nlohmann::json total = nullptr;
+    if (!t.stagesMs.empty()) total = t.totalMs;
+    return {{"total_ms", total}, {"stages", stages}};
 }
 
 }  // namespace

@@ -33,6 +33,14 @@ std::string formatPercent(double rate) {
     const double p = rate * 100.0;
     const double a = std::fabs(p);
     if (rate == 1.0) return "100%";
+    // Short of all, never "100.0%": as many decimals as show that some pixels are left.
+    if (rate < 1.0 && p >= 99.95) {
+        for (int d = 2; d < 9; ++d) {
+            const std::string format = "%." + std::to_string(d) + "f%%";
+            if (const std::string s = printf1(format.c_str(), p); s.rfind("100", 0) != 0) return s;
+        }
+        return ">99.999999%";
+    }
     if (a >= 10.0) return printf1("%.1f%%", p);
     if (a >= 0.01) return printf1("%.2f%%", p);
     // Below 0.01% keep two significant digits so a single wrong pixel in a large image still

@@ -31,12 +31,27 @@ bool looksLikeMask(const std::filesystem::path& file) {
     if (ext != ".exr") return false;
     auto in = OIIO::ImageInput::open(file.string());
     if (!in) return false;
+    // A Frame has a beauty and the reference-side channels beside its visibility; an engine's
+    // one-channel EXR may well call its channel "visibility" and is still a mask.
     const auto& names = in->spec().channelnames;
-    return std::find(names.begin(), names.end(), "visibility") == names.end();
+    const auto has = [&](const char* n) { return std::find(names.begin(), names.end(), n) != names.end(); };
+    return names.size() == 1 || !(has("visibility") && has("object_id"));
+}
+
+void checkMaskFileType(const std::filesystem::path& file) {
+    std::string ext = file.extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (ext == ".png" || ext == ".exr") return;
+    throw InputError(file.string() + ": a shadow mask is read from a .png or an .exr" +
+                     std::string(ext == ".jpg" || ext == ".jpeg"
+                                     ? " (JPEG's lossy coding moves a mask's values along every shadow edge)"
+                                     : "") +
+                     "; save the mask as one of those");
 }
 
 ShadowMask readShadowMask(const std::filesystem::path& file, const MaskOptions& o) {
     if (!std::filesystem::exists(file)) throw InputError(file.string() + ": no such file");
+    checkMaskFileType(file);
     auto in = OIIO::ImageInput::open(file.string());
     if (!in) throw InputError(file.string() + ": not a readable image: " + OIIO::geterror());
     const OIIO::ImageSpec spec = in->spec();
@@ -44,6 +59,11 @@ ShadowMask readShadowMask(const std::filesystem::path& file, const MaskOptions& 
         spec.height > kMaxResolution || std::int64_t(spec.width) * spec.height > kMaxPixels || spec.nchannels > 64)
         throw InputError(file.string() + ": not a 2D image of at most " + std::to_string(kMaxResolution) +
                          " pixels a side and 64 channels");
+    // The size first: a mask of another size is the wrong image, whatever its values.
+    if (o.expectedWidth > 0 && (spec.width != o.expectedWidth || spec.height != o.expectedHeight))
+        throw InputError(file.string() + ": the mask is " + std::to_string(spec.width) + "x" +
+                         std::to_string(spec.height) + ", the reference " + std::to_string(o.expectedWidth) + "x" +
+                         std::to_string(o.expectedHeight) + " (render both from the same camera and size)");
     std::string names;
     for (const std::string& n : spec.channelnames) names += (names.empty() ? "" : ", ") + n;
     int channel = 0;

@@ -13,9 +13,10 @@
 namespace shadowlab::scene {
 
 struct MaskOptions {
-    std::optional<std::string> channel;  // the channel to read; none: the file must have exactly one
-    bool invert = false;                 // the file stores 1 = shadowed, 0 = lit
-    bool srgb = false;                   // values are sRGB-encoded (decoded to linear before use)
+    std::optional<std::string> channel;         // the channel to read; none: the file must have exactly one
+    bool invert = false;                        // the file stores 1 = shadowed, 0 = lit
+    bool srgb = false;                          // values are sRGB-encoded (decoded to linear before use)
+    int expectedWidth = 0, expectedHeight = 0;  // the reference's size, checked before the values; 0: any
 };
 
 struct ShadowMask {
@@ -24,9 +25,13 @@ struct ShadowMask {
     std::string channel;            // the channel read
 };
 
-// True when `file` is an image without a "visibility" channel: not a Frame, so a mask (a PNG, a
-// single-channel EXR). False for a file that cannot be opened (readFrame then says why).
+// True when `file` is not a Frame, so a mask: a PNG, or an EXR with one channel (whatever its
+// name) or without a Frame's "visibility" and "object_id" channels. False for a file that cannot
+// be opened (readFrame then says why).
 bool looksLikeMask(const std::filesystem::path& file);
+
+// Throws InputError unless `file` is a .png or an .exr, the formats a mask is read from.
+void checkMaskFileType(const std::filesystem::path& file);
 
 // Throws InputError naming the file and what is wrong: unreadable, no such channel (listing the
 // channels), several channels and none chosen, a value outside 0..1 or not finite (its pixel).

@@ -154,6 +154,15 @@ TEST(AppGates, AnotherEnginesMaskIsGradedWithTheReferencesIdsAndNdotL) {
     ASSERT_EQ(said.exitCode, 0) << said.err;
     EXPECT_NE((said.out + said.err).find("run time not recorded (reference "), std::string::npos)
         << said.out << said.err;
+    EXPECT_TRUE(b["method_timing"]["total_ms"].is_null()) << b["method_timing"];
+    EXPECT_FALSE(a["method_timing"]["total_ms"].is_null());
+    // A mask records no bias or texel size: a bleeding budget is refused for that reason.
+    const auto bleeding =
+        runShadowlab({"compare", png.string(), f.reference.string(), "-o", (dir.path() / "d.png").string(),
+                      "--mask-channel", "R", "--max-bleeding", "1%"});
+    EXPECT_EQ(bleeding.exitCode, 2);
+    EXPECT_NE(bleeding.err.find("--max-bleeding: a shadow mask records no bias or texel size"), std::string::npos)
+        << bleeding.err;
     // A mask of several channels needs one chosen; a wrong name lists the channels.
     auto r = runShadowlab({"compare", png.string(), f.reference.string(), "-o", (dir.path() / "d.png").string()});
     EXPECT_EQ(r.exitCode, 2);

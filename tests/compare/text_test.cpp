@@ -25,6 +25,14 @@ TEST(FormatPercent, NeverRoundsANonZeroRateToZero) {
     EXPECT_EQ(formatPercent(std::nan("")), "n/a");
 }
 
+TEST(FormatPercent, NeverRoundsARateShortOfAllToAHundred) {
+    // 36,742 of 36,744 pixels: 99.99456%, which "%.1f" would print as 100.0%.
+    EXPECT_EQ(formatPercent(36742.0 / 36744.0), "99.99%");
+    // One pixel short of a 1280x720 image: 99.999891%.
+    EXPECT_EQ(formatPercent(921599.0 / 921600.0), "99.9999%");
+    EXPECT_EQ(formatPercent(0.9994), "99.9%");
+}
+
 TEST(FormatDuration, PicksAUnitWithThreeSignificantDigits) {
     EXPECT_EQ(formatDuration(0.4123), "0.412 ms");
     EXPECT_EQ(formatDuration(87.34), "87.3 ms");

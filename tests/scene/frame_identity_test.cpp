@@ -297,5 +297,49 @@ TEST(ShadowMask, ASingleChannelExrIsAMaskAndAFrameIsNot) {
     EXPECT_FALSE(looksLikeMask(dir.path() / "missing.exr"));
 }
 
+TEST(ShadowMask, AnEnginesOneChannelNamedVisibilityIsAMaskAndItsSizeIsCheckedBeforeItsValues) {
+    TempDir dir;
+    const auto exr = dir.path() / "engine.exr";
+    {
+        auto out = OIIO::ImageOutput::create(exr.string());
+        ASSERT_TRUE(out);
+        OIIO::ImageSpec spec(3, 1, 1, OIIO::TypeDesc::FLOAT);
+        spec.channelnames = {"visibility"};
+        ASSERT_TRUE(out->open(exr.string(), spec));
+        const float v[3] = {1.0f, -0.00005f, 0.0f};  // a resampled mask's undershoot
+        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, v));
+        out->close();
+    }
+    EXPECT_TRUE(looksLikeMask(exr));
+    // Against a 2x1 reference the size is what is wrong, not the value at pixel (1, 0).
+    MaskOptions o;
+    o.expectedWidth = 2;
+    o.expectedHeight = 1;
+    try {
+        readShadowMask(exr, o);
+        ADD_FAILURE() << "a 3x1 mask read against a 2x1 reference";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("the mask is 3x1, the reference 2x1"), std::string::npos) << e.what();
+    }
+    o.expectedWidth = 3;
+    try {
+        readShadowMask(exr, o);
+        ADD_FAILURE() << "a value below 0 read";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("pixel (1, 0)"), std::string::npos) << e.what();
+    }
+    // Only PNG and EXR: a JPEG is refused by its name, with the reason.
+    const auto jpg = dir.path() / "mask.jpg";
+    std::ofstream(jpg) << "not read";
+    try {
+        readShadowMask(jpg, {});
+        ADD_FAILURE() << "a JPEG mask read";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("mask.jpg: a shadow mask is read from a .png or an .exr (JPEG"),
+                  std::string::npos)
+            << e.what();
+    }
+}
+
 }  // namespace
 }  // namespace shadowlab::scene
