@@ -145,7 +145,14 @@ CheckSuite loadSuite(const fs::path& file) {
                 throw SceneError(file, p / "backend", "expected raster or raytrace, got '" + name + "'");
             k.backend = *b;
         }
-        if (c.contains("device")) k.device = stringAt(file, c["device"], p / "device");
+        if (c.contains("device")) {
+            k.device = stringAt(file, c["device"], p / "device");
+            // A ray-traced case renders on no Vulkan device: a device there is a mistake to name.
+            if (k.backend != scene::Backend::Raster)
+                throw SceneError(file, p / "device",
+                                 "a Vulkan device applies to a raster case; this case's backend is "
+                                 "raytrace (remove \"device\", or set \"backend\": \"raster\")");
+        }
         k.scene = scene::loadScene(k.sceneFile);
         const Json* res = c.contains("resolution") ? &c["resolution"]
                           : defaultResolution      ? &*defaultResolution

@@ -108,7 +108,13 @@ CasePart casePart(const CheckSuite& suite, const CheckCase& c, const CaseResult&
                               : drift)
           << " | " << compare::formatDuration(1000.0 * r.seconds) << " |\n";
     } else {
-        m << "| | | | | | " << cell(r.error.substr(0, 120)) << " | |\n";
+        // The error in the row's comment column, cut at a word within 120 characters; "Why" has it whole.
+        std::string shown = r.error;
+        if (shown.size() > 120) {
+            const std::size_t space = shown.rfind(' ', 110);
+            shown = shown.substr(0, space == std::string::npos ? 110 : space) + " … (see Why)";
+        }
+        m << "| | | | | | " << cell(shown) << " | |\n";
     }
     p.row = m.str();
 

@@ -1,10 +1,12 @@
 // tests/studies/check_test.cpp: reading a check suite (studies/check.cpp).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
 #include "studies/check.h"
+#include "studies/check_report.h"
 
 using namespace shadowlab;
 namespace fs = std::filesystem;
@@ -29,5 +31,39 @@ TEST(CheckSuite, ACasesSettingsReachItsScene) {
     EXPECT_EQ(s.minVariance, 0.01);
     EXPECT_EQ(s.bleedReduction, 0.3);
     EXPECT_EQ(s.shadowMapSize, 512);
+    fs::remove_all(dir);
+}
+
+// An error's row keeps the table's columns and cuts a long message at a word, pointing to "Why",
+// which holds it whole.
+TEST(CheckSummary, ALongErrorIsCutAtAWordInItsRowAndWholeUnderWhy) {
+    const fs::path dir = fs::path(testing::TempDir()) / "check_summary_error";
+    fs::create_directories(dir);
+    const fs::path suiteFile = dir / "suite.json";
+    {
+        std::ofstream out(suiteFile);
+        out << R"({"cases": [{"name": "a", "scene": ")" << SHADOWLAB_SOURCE_DIR << R"(/scenes/seed.json"}]})";
+    }
+    const studies::CheckSuite suite = studies::loadSuite(suiteFile);
+    studies::CaseResult r;
+    r.name = "a";
+    r.verdict = studies::CaseVerdict::Error;
+    std::string error;
+    for (int i = 0; i < 30; ++i) error += "word" + std::to_string(i) + " ";  // 203 characters
+    error += "END";
+    r.error = error;
+    const std::string md = studies::markdownSummary(suite, {r}, false);
+    const auto rowStart = md.find("| a |");
+    ASSERT_NE(rowStart, std::string::npos) << md;
+    const std::string row = md.substr(rowStart, md.find('\n', rowStart) - rowStart);
+    EXPECT_EQ(std::count(row.begin(), row.end(), '|'), 13) << row;  // 12 cells
+    EXPECT_NE(row.find(" … (see Why)"), std::string::npos) << row;
+    EXPECT_EQ(row.find("END"), std::string::npos) << row;
+    // The cut falls between words: the text before the ellipsis ends with a whole word.
+    const std::size_t cut = row.find(" … (see Why)");
+    EXPECT_NE(row.substr(0, cut).find("word16"), std::string::npos) << row;  // the last space within 110
+    EXPECT_EQ(row.find("word17"), std::string::npos) << row;
+    EXPECT_NE(md.find("- `a`: error: " + error.substr(0, 20)), std::string::npos) << md;
+    EXPECT_NE(md.find("END\n"), std::string::npos) << md;
     fs::remove_all(dir);
 }
