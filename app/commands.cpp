@@ -407,6 +407,43 @@ int render(const RenderOptions& o) {
     return 0;
 }
 
+namespace {
+
+// A mask read upside down (row 0 at the bottom, as a GL read-back gives it) or with 1 = shadowed
+// is wrong nearly everywhere; said as such rather than only as a large false shadow. Empty when
+// neither reading is much closer: under half the error, where the error is over 20%.
+std::string maskReadingHint(const scene::ShadowMask& mask, const scene::Frame& reference, const fs::path& file,
+                            double mismatchRate) {
+    if (!(mismatchRate > 0.2)) return {};
+    struct Reading {
+        bool flip, invert;
+        const char* what;
+    };
+    std::string best;
+    double bestRate = 0.5 * mismatchRate;
+    for (const Reading& r : {Reading{true, false, "flipped vertically (row 0 at the bottom, as glReadPixels gives it)"},
+                             Reading{false, true, "inverted (1 = shadowed: --mask-invert)"},
+                             Reading{true, true, "flipped vertically and inverted"}}) {
+        scene::ShadowMask m = mask;
+        for (int y = 0; r.flip && y < m.height / 2; ++y)
+            std::swap_ranges(m.visibility.begin() + std::ptrdiff_t(y) * m.width,
+                             m.visibility.begin() + std::ptrdiff_t(y + 1) * m.width,
+                             m.visibility.begin() + std::ptrdiff_t(m.height - 1 - y) * m.width);
+        if (r.invert)
+            for (float& v : m.visibility) v = 1.0f - v;
+        const double rate =
+            compare::compareFrames(scene::frameFromMask(m, reference, file), reference).metrics.mismatchRate;
+        if (rate < bestRate) {
+            bestRate = rate;
+            best = std::string("read ") + r.what + ", this mask would be " + compare::formatPercent(rate) +
+                   " wrong instead of " + compare::formatPercent(mismatchRate);
+        }
+    }
+    return best;
+}
+
+}  // namespace
+
 int compareFiles(const CompareOptions& o) {
     if (o.output.extension() != ".png")
         throw scene::InputError(o.output.string() + ": the difference image must be a .png");
@@ -423,11 +460,12 @@ int compareFiles(const CompareOptions& o) {
                                 ": --max-bleeding: a shadow mask records no bias or texel size, so light bleeding "
                                 "cannot be told from bias leaks (use --max-missed-shadow)");
     const scene::Frame reference = readingInput(o.reference.string(), [&] { return scene::readFrame(o.reference); });
-    const scene::Frame method =
-        maskOnly ? scene::frameFromMask(scene::readShadowMask(o.method, {o.maskChannel, o.maskInvert, o.maskSrgb,
-                                                                         reference.width, reference.height}),
-                                        reference, o.method)
-                 : readingInput(o.method.string(), [&] { return scene::readFrame(o.method); });
+    std::optional<scene::ShadowMask> mask;
+    if (maskOnly)
+        mask = scene::readShadowMask(o.method,
+                                     {o.maskChannel, o.maskInvert, o.maskSrgb, reference.width, reference.height});
+    const scene::Frame method = mask ? scene::frameFromMask(*mask, reference, o.method)
+                                     : readingInput(o.method.string(), [&] { return scene::readFrame(o.method); });
     if (const std::string d = scene::describeIdentityDifference(method, reference); !d.empty()) {
         if (!o.allowDifferentScene)
             throw scene::InputError(o.method.string() + " vs " + o.reference.string() + ": " + d +
@@ -445,13 +483,16 @@ int compareFiles(const CompareOptions& o) {
     }
     scene::writePngDisplay(o.output, c.width, c.height, c.diffRgb);
     if (o.heat) scene::writePngDisplay(*o.heat, c.width, c.height, c.heatRgb);
+    const std::string hint = mask ? maskReadingHint(*mask, reference, o.method, c.metrics.mismatchRate) : "";
     if (o.json) {
         Json j = compare::toJson(c.metrics);
         if (!checks.empty()) j["budgets"] = compare::toJson(checks);
+        if (mask) j["mask_hint"] = hint.empty() ? Json(nullptr) : Json(hint);
         std::cout << j.dump(2) << "\n";
     } else {
         std::cout << compare::summaryLine(c.metrics) << "\n";
     }
+    if (!hint.empty()) std::cerr << "shadowlab: hint: " << o.method.string() << ": " << hint << "\n";
     return reportBudgets(o.method.filename().string(), checks) ? kExitBudgetBroken : 0;
 }
 

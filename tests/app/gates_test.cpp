@@ -163,6 +163,31 @@ TEST(AppGates, AnotherEnginesMaskIsGradedWithTheReferencesIdsAndNdotL) {
     EXPECT_EQ(bleeding.exitCode, 2);
     EXPECT_NE(bleeding.err.find("--max-bleeding: a shadow mask records no bias or texel size"), std::string::npos)
         << bleeding.err;
+    // Read upside down (as glReadPixels returns rows) or inverted, the mask is wrong nearly everywhere:
+    // a hint says which reading agrees. A mask read as it was written gets none.
+    std::vector<float> flipped(acne.visibility.size() * 3), invertedGray;
+    for (int y = 0; y < acne.height; ++y)
+        for (int x = 0; x < acne.width; ++x)
+            for (int c = 0; c < 3; ++c)
+                flipped[3 * (std::size_t(acne.height - 1 - y) * acne.width + x) + c] =
+                    acne.visibility[std::size_t(y) * acne.width + x];
+    for (float v : acne.visibility) invertedGray.insert(invertedGray.end(), {1.0f - v, 1.0f - v, 1.0f - v});
+    const auto flippedPng = dir.path() / "flipped.png", invertedPng = dir.path() / "inverted.png";
+    scene::writePngDisplay(flippedPng, acne.width, acne.height, flipped);
+    scene::writePngDisplay(invertedPng, acne.width, acne.height, invertedGray);
+    const auto up = runShadowlab({"compare", flippedPng.string(), f.reference.string(), "-o",
+                                  (dir.path() / "f.png").string(), "--mask-channel", "R"});
+    EXPECT_EQ(up.exitCode, 0) << up.err;
+    EXPECT_NE(up.err.find("hint: " + flippedPng.string() + ": read flipped vertically"), std::string::npos)
+        << up.out << up.err;
+    const auto inverse = runShadowlab({"compare", invertedPng.string(), f.reference.string(), "-o",
+                                       (dir.path() / "g.png").string(), "--mask-channel", "R", "--json"});
+    EXPECT_EQ(inverse.exitCode, 0) << inverse.err;
+    EXPECT_NE(inverse.err.find("read inverted (1 = shadowed: --mask-invert)"), std::string::npos) << inverse.err;
+    EXPECT_NE(nlohmann::json::parse(inverse.out)["mask_hint"].get<std::string>().find("read inverted"),
+              std::string::npos);
+    EXPECT_TRUE(b["mask_hint"].is_null()) << b["mask_hint"];
+    EXPECT_EQ(said.err.find("hint:"), std::string::npos) << said.err;
     // A mask of several channels needs one chosen; a wrong name lists the channels.
     auto r = runShadowlab({"compare", png.string(), f.reference.string(), "-o", (dir.path() / "d.png").string()});
     EXPECT_EQ(r.exitCode, 2);
