@@ -716,6 +716,10 @@ nlohmann::json toJson(const Metrics& m) {
     return j;
 }
 
+bool softErrorDominates(const Metrics& m) {
+    return m.softErrorRate > kNotableSoftErrorRate && m.softErrorPixels > m.falseShadow + m.missedShadow;
+}
+
 std::string summaryLine(const Metrics& m) {
     std::string s = "counted " + formatCount(m.counted) + " px: false shadow " + formatPercent(m.falseShadowRate);
     if (m.hasBlockerIds) s += " (self acne " + formatPercent(m.selfShadowAcneRate) + ")";
@@ -723,12 +727,19 @@ std::string summaryLine(const Metrics& m) {
          formatFixed(m.shadowIoU, 3) + ", mean |dV| " + formatFixed(m.meanAbsVisibilityError, 4) + " (penumbra " +
          formatFixed(m.meanAbsVisibilityErrorPenumbra, 3) + " over " + formatCount(m.penumbraPixels) +
          " px), off by > " + formatFixed(kSoftErrorTolerance, 2) + " within tau " + formatCount(m.softErrorPixels) +
-         " px, silhouette " + formatPercent(m.silhouetteMismatchRate) + ", run time " +
-         formatRunTime(m.methodTiming.totalMs) + " (reference " + formatRunTime(m.referenceTiming.totalMs) + ")";
+         " px (" + formatPercent(m.softErrorRate) + "), silhouette " + formatPercent(m.silhouetteMismatchRate) +
+         ", run time " + formatRunTime(m.methodTiming.totalMs) + " (reference " +
+         formatRunTime(m.referenceTiming.totalMs) + ")";
     const std::size_t bad = m.methodHealth.total() + m.referenceHealth.total();
     if (bad > 0)
         s += ", NON-FINITE values: method " + formatCount(m.methodHealth.total()) + ", reference " +
              formatCount(m.referenceHealth.total());
+    // Filtered acne and wrong penumbrae stay under tau: where they outnumber the wrong pixels the
+    // mismatch and the IoU read clean while the image is not, so the line says so.
+    if (softErrorDominates(m))
+        s += "; SOFT ERROR dominates: " + formatPercent(m.softErrorRate) +
+             " of the counted pixels are partly wrong (filtered acne, a penumbra of the wrong width), more than "
+             "the mismatch counts: judge this frame by mean |dV|";
     return s;
 }
 

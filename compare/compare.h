@@ -227,8 +227,12 @@ std::array<float, 3> heatColor(float absError);
 Comparison compareFrames(const scene::Frame& method, const scene::Frame& reference, const CompareOptions& options = {});
 
 nlohmann::json toJson(const Metrics& metrics);
+// True when the pixels off by more than kSoftErrorTolerance without crossing τ are a notable share
+// (kNotableSoftErrorRate) and outnumber the wrong ones: the classes then understate the error.
+bool softErrorDominates(const Metrics& metrics);
 // One line for a terminal, e.g.
-// "counted 301234 px: false shadow 0.82% (self acne 0.80%), missed 0.10%, IoU 0.981, ..."
+// "counted 301234 px: false shadow 0.82% (self acne 0.80%), missed 0.10%, IoU 0.981, ...", ending
+// in "SOFT ERROR dominates: ..." where softErrorDominates.
 std::string summaryLine(const Metrics& metrics);
 
 }  // namespace shadowlab::compare

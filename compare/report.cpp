@@ -87,15 +87,14 @@ std::string describeContinuous(const Metrics& m) {
         s += " and by " + formatFixed(m.meanAbsVisibilityErrorPenumbra, 3) + " over the reference's penumbra (" +
              formatCount(m.penumbraPixels) + " px where 0 < V < 1)";
     s += ".";
-    const std::size_t wrong = m.falseShadow + m.missedShadow;
     if (m.softErrorPixels > 0) {
         s += " " + formatCount(m.softErrorPixels) + " px (" + formatPercent(m.softErrorRate) +
              ") are off by more than " + formatShort(kSoftErrorTolerance) + " without crossing τ";
         if (m.softErrorRate <= kNotableSoftErrorRate)
             s += ".";
         else
-            s += m.softErrorPixels > wrong ? ": soft-shadow error dominates, and the mismatch rate does not show it."
-                                           : ": soft-shadow error beside the wrong pixels.";
+            s += softErrorDominates(m) ? ": soft-shadow error dominates, and the mismatch rate does not show it."
+                                       : ": soft-shadow error beside the wrong pixels.";
     }
     for (const LightError& l : m.perLight)
         if (l.softErrorPixels > 0 || l.meanAbsVisibilityErrorPenumbra > kSoftErrorTolerance)
@@ -136,8 +135,15 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
         s = who + " has no pixel wrong by more than τ = " + formatShort(kVisibilityTolerance) + " among the " +
             formatCount(m.counted) + " counted pixels, so the classes call it agreement, but it does not match.";
     } else {
-        s = who + " disagrees with the reference on " + formatPercent(m.mismatchRate) + " of the " +
-            formatCount(m.counted) + " counted pixels: ";
+        s = softErrorDominates(m)
+                // Lead with what a viewer sees: partial darkening under τ outnumbers the wrong pixels.
+                ? who + " is partly wrong on " + formatPercent(m.softErrorRate) + " of the " + formatCount(m.counted) +
+                      " counted pixels (off by more than " + formatShort(kSoftErrorTolerance) +
+                      " without crossing τ: filtered acne, or a penumbra of the wrong width), which the mismatch "
+                      "rate does not count; outright it disagrees with the reference on " +
+                      formatPercent(m.mismatchRate) + ": "
+                : who + " disagrees with the reference on " + formatPercent(m.mismatchRate) + " of the " +
+                      formatCount(m.counted) + " counted pixels: ";
         std::vector<std::string> parts;
         if (m.falseShadow > 0) {
             std::string f = formatPercent(m.falseShadowRate) + " false shadow";
@@ -612,6 +618,15 @@ std::string describeFindings(const ReportInput& in) {
             lines.push_back("Overall, " + shortTitle(best->label) + " and " + shortTitle(worst->label) +
                             " are about as close to the reference as each other (" + bt + " and " + wt +
                             " wrong, within a tenth of each other).");
+        } else if (w > b && softErrorDominates(best->metrics) &&
+                   best->metrics.meanAbsVisibilityError > worst->metrics.meanAbsVisibilityError) {
+            // Fewer wrong pixels, but more partial error: the count alone would name the wrong winner.
+            lines.push_back("Overall, " + shortTitle(best->label) + " gets fewer pixels wrong outright (" + bt +
+                            " against " + wt + "), but " + shortTitle(worst->label) +
+                            " is closer to the reference by mean |ΔV| (" +
+                            formatFixed(worst->metrics.meanAbsVisibilityError, 4) + " against " +
+                            formatFixed(best->metrics.meanAbsVisibilityError, 4) + "): most of " +
+                            shortTitle(best->label) + "'s error is partial shadow that the count misses.");
         } else if (w > b) {
             std::string t = "Overall, " + shortTitle(best->label) + " is closer to the reference (" + bt + " against " +
                             wt + " wrong)";

@@ -242,6 +242,46 @@ TEST(Report, FindingsCallMissedShadowAtAMeshsOwnTerminatorATessellationEffect) {
         << text;
 }
 
+TEST(Report, FindingsLeadWithPartialShadowWhereItOutnumbersTheWrongPixels) {
+    // Reference: a lit floor. The shadow map darkens every pixel to V = 0.6 (filtered acne: |ΔV|
+    // 0.4, past 0.25 but not past τ) and shadows 2 of them outright: 0.5% wrong, mean |ΔV| about
+    // (398·0.4 + 2)/400 = 0.403. The ray tracer shadows 10 pixels outright and nothing else: 2.5%
+    // wrong, mean |ΔV| 0.025. By the wrong pixels the map wins; by what a viewer sees it does not.
+    const scene::Frame ref = test::uniformFrame(20, 20, 1, 0.5f, 1);
+    scene::Frame map = test::uniformFrame(20, 20, 1, 0.5f, 0.6f), ray = test::uniformFrame(20, 20, 1, 0.5f, 1);
+    map.visibility[0] = map.visibility[1] = 0.0f;
+    for (int i = 0; i < 10; ++i) ray.visibility[std::size_t(40 * i)] = 0.0f;
+    map.attributes = {{"backend", "raster"}, {"texel_world_size", "0.01"}, {"depth_bias", "0.005"}};
+    ray.attributes = {{"backend", "raytrace"}, {"ray_bias", "0.001"}};
+    ReportInput in;
+    in.sceneName = "floor";
+    in.objectNames = {"floor"};
+    in.reference = {"reference", "reference.png", ref};
+    in.methods.push_back({"raytrace", "raytrace.png", "diff-raytrace.png", ray, compareFrames(ray, ref).metrics});
+    in.methods.push_back({"raster", "raster.png", "diff-raster.png", map, compareFrames(map, ref).metrics});
+    const Metrics& mm = in.methods[1].metrics;
+    ASSERT_EQ(mm.softErrorPixels, 398u);
+    ASSERT_TRUE(softErrorDominates(mm));
+    ASSERT_FALSE(softErrorDominates(in.methods[0].metrics));
+    std::istringstream lines(describeFindings(in));
+    std::string rayText, mapText, overall;
+    std::getline(lines, rayText);
+    std::getline(lines, mapText);
+    std::getline(lines, overall);
+    EXPECT_EQ(rayText.find("partly wrong"), std::string::npos) << rayText;
+    EXPECT_EQ(
+        mapText.rfind("The shadow map (raster) is partly wrong on " + formatPercent(398.0 / 400.0) + " of the 400", 0),
+        0u)
+        << mapText;
+    EXPECT_NE(mapText.find("outright it disagrees with the reference on 0.50%"), std::string::npos) << mapText;
+    EXPECT_NE(overall.find("the shadow map gets fewer pixels wrong outright (0.50% against 2.50%), but the ray "
+                           "tracer is closer to the reference by mean |ΔV|"),
+              std::string::npos)
+        << overall;
+    EXPECT_NE(summaryLine(mm).find("SOFT ERROR dominates"), std::string::npos) << summaryLine(mm);
+    EXPECT_EQ(summaryLine(in.methods[0].metrics).find("SOFT ERROR"), std::string::npos);
+}
+
 TEST(Report, FindingsSayAnExactMatchAndAFailure) {
     ReportInput in = syntheticRun();
     in.methods.resize(1);
