@@ -193,13 +193,26 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
                      " with the light head-on, more at grazing light): a caster that close to its receiver is lost "
                      "to the bias and the map's texels" +
                      cappedMapText(rm.frame);
-            else if (m.hasBlockerDistance && m.bleeding > 0)
-                f += double(m.bleeding) > kMostlyShare * double(m.missedShadow)
-                         ? ", mostly light bleeding (" + formatPercent(double(m.bleeding) / double(m.missedShadow)) +
-                               " of it farther than " + formatShort(m.contactDistance) + " from its blocker)"
-                         : " (" + formatPercent(double(m.bleeding) / double(m.missedShadow)) +
-                               " of it light bleeding, farther than " + formatShort(m.contactDistance) +
-                               " from its blocker)";
+            else {
+                // A minority by count can still be what a viewer sees first: a shadow detached from
+                // where a thin caster meets the ground is a few pixels against long aliased edges.
+                if (m.hasBlockerDistance && !m.pointSampled && m.biasLeak > 0 &&
+                    double(m.biasLeak) >= kNotableShare * double(m.missedShadow))
+                    f += ", " + formatPercent(double(m.biasLeak) / double(m.missedShadow)) + " of it (" +
+                         formatCount(m.biasLeak) + " px) within the contact distance of its blocker (" +
+                         formatShort(m.contactDistance) +
+                         " with the light head-on, more at grazing light): peter-panning, the shadow cut "
+                         "off where its caster meets the receiver, lost to the bias and the map's texels" +
+                         cappedMapText(rm.frame);
+                if (m.hasBlockerDistance && m.bleeding > 0)
+                    f += double(m.bleeding) > kMostlyShare * double(m.missedShadow)
+                             ? ", mostly light bleeding (" +
+                                   formatPercent(double(m.bleeding) / double(m.missedShadow)) + " of it farther than " +
+                                   formatShort(m.contactDistance) + " from its blocker)"
+                             : " (" + formatPercent(double(m.bleeding) / double(m.missedShadow)) +
+                                   " of it light bleeding, farther than " + formatShort(m.contactDistance) +
+                                   " from its blocker)";
+            }
             if (m.terminatorMissed > 0 && double(m.terminatorMissed) >= kNotableShare * double(m.missedShadow))
                 f += "; " + formatPercent(double(m.terminatorMissed) / double(m.missedShadow)) +
                      " of it lies at a smooth-shaded mesh's terminator (the receiver shadowed by its own surface at "
@@ -224,9 +237,12 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
                                           : ".";
         } else {
             const double nearShare = double(m.aliasingPixels) / double(wrong);
+            const bool notableLeak =
+                m.hasBlockerDistance && m.biasLeak > 0 && double(m.biasLeak) >= kNotableShare * double(m.missedShadow);
             if (nearShare > kMostlyShare)
                 s += " Most wrong pixels (" + formatPercent(nearShare) + ") lie" + within +
-                     ": edge aliasing rather than bias.";
+                     (notableLeak ? ": edge aliasing, beside the bias's peter-panning above."
+                                  : ": edge aliasing rather than bias.");
             else if (m.aliasingPixels > 0)
                 s += " " + formatPercent(1.0 - nearShare) +
                      " of the wrong pixels are bias error (away from shadow edges" +

@@ -282,6 +282,47 @@ TEST(Report, FindingsLeadWithPartialShadowWhereItOutnumbersTheWrongPixels) {
     EXPECT_EQ(summaryLine(in.methods[0].metrics).find("SOFT ERROR"), std::string::npos);
 }
 
+TEST(Report, FindingsNamePeterPanningThatIsAMinorityOfTheMissedShadow) {
+    // Reference: a lit floor (N·L 0.5) with two shadows the shadow map misses whole. Columns 2-3
+    // are a thin caster's contact shadow, its blocker 0.01 away (within the contact distance
+    // D = 0.005 + 5·0.01·√3 = 0.092): 40 px of bias leak. Columns 8-12 are a far caster's shadow
+    // (blocker 5 away): 100 px, of which column 10 lies more than 2 px from the shadow's edges
+    // (20 px of bleeding) and the rest next to them. The leak is 40 of 140 missed pixels, 28.6%:
+    // short of most, but a fifth or more, so it is named as the peter-panning it is.
+    scene::Frame ref = test::uniformFrame(20, 20, 1, 0.5f, 1);
+    ref.blockerId.assign(ref.pixelCount(), 0.0f);
+    ref.blockerDistance.assign(ref.pixelCount(), 0.0f);
+    for (int y = 0; y < 20; ++y)
+        for (int x = 0; x < 20; ++x) {
+            const bool contact = x == 2 || x == 3, far = x >= 8 && x <= 12;
+            if (!contact && !far) continue;
+            const std::size_t i = std::size_t(y) * 20 + x;
+            ref.visibility[i] = 0.0f;
+            ref.blockerId[i] = 2.0f;
+            ref.blockerDistance[i] = contact ? 0.01f : 5.0f;
+        }
+    scene::Frame map = test::uniformFrame(20, 20, 1, 0.5f, 1);
+    map.attributes = {
+        {"backend", "raster"}, {"texel_world_size", "0.01"}, {"depth_bias", "0.005"}, {"slope_bias", "1"}};
+    ReportInput in;
+    in.sceneName = "poles";
+    in.objectNames = {"ground", "pole"};
+    in.reference = {"reference", "reference.png", ref};
+    in.methods.push_back({"raster", "raster.png", "diff-raster.png", map, compareFrames(map, ref).metrics});
+    const Metrics& m = in.methods[0].metrics;
+    ASSERT_EQ(m.missedShadow, 140u);
+    ASSERT_EQ(m.biasLeak, 40u);
+    std::istringstream lines(describeFindings(in));
+    std::string text;
+    std::getline(lines, text);
+    EXPECT_NE(text.find(formatPercent(40.0 / 140.0) + " of it (40 px) within the contact distance of its blocker"),
+              std::string::npos)
+        << text;
+    EXPECT_NE(text.find("peter-panning, the shadow cut off where its caster meets the receiver"), std::string::npos)
+        << text;
+    EXPECT_EQ(text.find("rather than bias"), std::string::npos) << text;
+}
+
 TEST(Report, FindingsSayAnExactMatchAndAFailure) {
     ReportInput in = syntheticRun();
     in.methods.resize(1);
