@@ -95,6 +95,7 @@ void chooseView(scene::Scene& s, const SceneOptions* o) {
     if (o && o->camera) scene::applyCameraOption(s, *o->camera);
     scene::applyGround(s, o ? o->ground : std::nullopt);
     if (o && o->sun) scene::applySunOption(s, *o->sun);
+    scene::fitGroundToSun(s);
     raytrace::chooseViewAndSun(s, o && o->settings.threads ? *o->settings.threads : 0);
     // A camera that frames none of the objects renders only background, which would compare as
     // a perfect agreement: say so.

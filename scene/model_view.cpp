@@ -19,6 +19,12 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegrees = kPi / 180.0;
 // framedWithShadow: the points it must show stay this factor inside the image's half-extents.
 constexpr double kShadowFrameMargin = 1.1;
+// The added ground's side (extent + 3 heights) holds the shadow of a sun this high or higher
+// (a shadow 1/tan 35° = 1.43 heights long).
+constexpr double kGroundSunElevation = 35.0;
+// A lower sun given by the user grows the ground to hold its shadow, down to this elevation
+// (5.7 heights); lower still, holding it all would leave the model a speck in the framed view.
+constexpr double kGroundSunFloor = 10.0;
 
 std::string describeCamera(const std::vector<FileCamera>& cameras, std::size_t i) {
     const FileCamera& c = cameras[i];
@@ -231,6 +237,38 @@ void addGround(Scene& scene) {
     quadAxes(q.normal, q.uAxis, q.vAxis);
     scene.materials.push_back({"ground", {0.75, 0.75, 0.75}, 1.0});
     scene.objects.push_back({"ground", q, int(scene.materials.size()) - 1});
+    scene.origin.addedGround = int(scene.objects.size()) - 1;
+}
+
+void fitGroundToSun(Scene& scene) {
+    if (scene.origin.addedGround < 0 || scene.origin.chooseSun) return;
+    const auto sun = std::find_if(scene.lights.begin(), scene.lights.end(),
+                                  [](const Light& l) { return l.type == LightType::Directional; });
+    if (sun == scene.lights.end()) return;
+    const double elevation = sunAngles(sun->direction).y;
+    if (!(elevation > 0.0) || elevation >= kGroundSunElevation) return;
+    Quad& q = std::get<Quad>(scene.objects[std::size_t(scene.origin.addedGround)].shape);
+    const Bounds b = scene.origin.modelBounds;
+    const Vec3 e = b.extent();
+    const double reach = e.y / std::tan(std::max(elevation, kGroundSunFloor) * kDegrees);
+    const double side = std::max(e.x, e.z) + 2.0 * reach;
+    if (side > q.size.x) {
+        const double before = q.size.x;
+        q.size = {side, side};
+        fitNearFarToBounds(scene);
+        for (auto& [key, text] : scene.origin.choices)
+            if (key == "ground")
+                text = "a " + fmt(side) + " x " + fmt(side) + text.substr(std::min(text.find(" quad"), text.size())) +
+                       ", grown from " + fmt(before) + " to hold the shadow of a sun " + fmt(elevation) + " degrees up";
+    }
+    if (elevation < kGroundSunFloor)
+        scene.origin.notes.push_back(
+            "the sun " + fmt(elevation) + " degrees up casts the model's shadow " +
+            fmt(e.y / std::tan(elevation * kDegrees)) + " from its base (" +
+            fmt(1.0 / std::tan(elevation * kDegrees), "%.3g") +
+            " model heights); the added ground holds the shadow of a sun " + fmt(kGroundSunFloor) +
+            " degrees or more up (side " + fmt(q.size.x) +
+            "), so past it the shadow runs off the ground's edge: give the scene a ground of its own to see all of it");
 }
 
 void fitNearFarToBounds(Scene& scene) {

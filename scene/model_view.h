@@ -59,6 +59,12 @@ void addGround(Scene& scene);
 // 0.1, so a scene a few centimetres across is not clipped away. No-op otherwise.
 void fitNearFarToBounds(Scene& scene);
 
+// A ground addGround added, grown to hold the model's shadow under the scene's sun where it is
+// lower than the 35 degrees the ground's default side holds (down to 10 degrees: 5.7 model
+// heights of shadow; below that a note says the shadow runs off the ground's edge). No-op without
+// an added ground, without a directional light, or while the sun is still to be searched.
+void fitGroundToSun(Scene& scene);
+
 // Whether a ground is added and why: `option` (--ground / --no-ground), else the file's "ground"
 // key, else on for a glTF given as the scene that has no ground of its own (hasOwnGround), off
 // for a JSON scene (its author composed it). Records the choice in scene.origin.choices.

@@ -319,6 +319,7 @@ struct SceneOrigin {
     bool farFromBounds = false;
     bool nearFromBounds = false;  // nor "near": fitted with far (fitNearFarToBounds)
     Bounds modelBounds;           // the objects without an added ground (what a view frames)
+    int addedGround = -1;         // index in objects of the ground addGround added, else -1
     // ("view", "searched: ..."), ("sun", ...), ("ground", ...): printed by --explain, recorded
     // in every Frame as attributes "choice.view", "choice.sun", ...
     std::vector<std::pair<std::string, std::string>> choices;

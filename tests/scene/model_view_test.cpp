@@ -147,6 +147,54 @@ TEST(ModelView, AModelWithoutAFloorGetsAGroundJustBelowIt) {
     EXPECT_EQ(s.materials[std::size_t(s.objects.back().material)].name, "ground");
 }
 
+TEST(ModelView, ALowSunGrowsTheAddedGroundToHoldTheModelsShadow) {
+    test::TempDir dir;
+    const Scene loaded = loadScene(dir.write("box.gltf", test::cameraBoxGltf(false)));
+    auto groundSide = [](const Scene& s) { return std::get<Quad>(s.objects.back().shape).size.x; };
+    // The box spans [0,1] x [0,0.5] x [0,0.25]; its ground's side is 2.5 (above).
+    Scene high = loaded;
+    applyGround(high, std::nullopt);
+    applySunOption(high, "0,50");
+    fitGroundToSun(high);
+    EXPECT_DOUBLE_EQ(groundSide(high), 2.5);  // 0.5 / tan 50° = 0.42 fits the default
+    // 20° up: the shadow reaches 0.5 / tan 20° = 1.3737 from the base, on every side.
+    Scene low = loaded;
+    applyGround(low, std::nullopt);
+    applySunOption(low, "0,20");
+    fitGroundToSun(low);
+    EXPECT_NEAR(groundSide(low), 1.0 + 2.0 * 0.5 / std::tan(20.0 * kPi / 180.0), 1e-9);
+    EXPECT_TRUE(low.origin.notes.empty());
+    bool said = false;
+    for (const auto& [key, text] : low.origin.choices)
+        said |= key == "ground" &&
+                text.find("grown from 2.5 to hold the shadow of a sun 20 degrees up") != std::string::npos;
+    EXPECT_TRUE(said);
+    // 4° up: grown only to what a 10° sun needs (1 + 2 · 0.5 / tan 10° = 6.671), with a note that the
+    // shadow, 0.5 / tan 4° = 7.15 long, runs past it.
+    Scene grazing = loaded;
+    applyGround(grazing, std::nullopt);
+    applySunOption(grazing, "0,4");
+    fitGroundToSun(grazing);
+    EXPECT_NEAR(groundSide(grazing), 1.0 + 2.0 * 0.5 / std::tan(10.0 * kPi / 180.0), 1e-9);
+    ASSERT_EQ(grazing.origin.notes.size(), 1u);
+    EXPECT_NE(grazing.origin.notes[0].find("shadow 7.15 from its base"), std::string::npos) << grazing.origin.notes[0];
+    EXPECT_NE(grazing.origin.notes[0].find("runs off the ground's edge"), std::string::npos);
+    // No added ground, or a sun still to be searched (it is searched at 35° or more): nothing.
+    Scene none = loaded;
+    applyGround(none, false);
+    applySunOption(none, "0,4");
+    const std::size_t objects = none.objects.size();
+    fitGroundToSun(none);
+    EXPECT_EQ(none.objects.size(), objects);
+    EXPECT_TRUE(none.origin.notes.empty());
+    Scene searched = loaded;
+    applyGround(searched, std::nullopt);
+    searched.lights[0].direction = sunDirection(0, 4);
+    ASSERT_TRUE(searched.origin.chooseSun);
+    fitGroundToSun(searched);
+    EXPECT_DOUBLE_EQ(groundSide(searched), 2.5);
+}
+
 TEST(ModelView, NoGroundWhenAskedOrWhenTheModelHasAFloor) {
     test::TempDir dir;
     Scene s = loadScene(dir.write("box.gltf", test::cameraBoxGltf(false)));
