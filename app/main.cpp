@@ -2,6 +2,7 @@
 // subcommand, and turns every failure into one message and a non-zero exit code:
 //   1  a render or device failure, 2  bad input (scene, frame, command line),
 //   3  a method broke an error budget (compare, run, check).
+#include <csignal>
 #include <cstdio>
 #include <iostream>
 #include <string>
@@ -134,6 +135,10 @@ void addBudgetOptions(CLI::App& cmd, shadowlab::app::BudgetOptions& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    // The files are the product, the terminal lines are not: a log piped into a reader that quits
+    // early (`| head`) must not kill a render before its output is renamed into place, so a write
+    // to a closed pipe fails quietly instead of raising SIGPIPE.
+    std::signal(SIGPIPE, SIG_IGN);
     CLI::App app{
         "shadowlab: renders a scene with a Vulkan shadow map and a CPU ray tracer and shows,\n"
         "with difference images and numbers, how each gets its shadows wrong against a\n"

@@ -1,5 +1,9 @@
 // tests/app/outputs_test.cpp: where outputs go: `run -o` naming a file, `render -o` into a missing
 // folder, a model format shadowlab does not read, and a run folder left from an earlier run.
+#include <sys/wait.h>
+
+#include <cstdlib>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -21,6 +25,29 @@ TEST(Outputs, RunIntoAFileExitsTwoWithAClearMessageAndLeavesTheFile) {
     EXPECT_EQ(r.err.find("filesystem error"), std::string::npos) << r.err;
     EXPECT_EQ(test::slurpFile(file), "mine");
     EXPECT_EQ(dir.fileCount(), 1u);
+}
+
+TEST(Outputs, AReaderThatQuitsEarlyDoesNotStopTheRenderWritingItsFile) {
+    // `true` reads nothing and exits, so what shadowlab writes to the pipe goes nowhere: the render
+    // must still finish and write its file. Its status is bash's PIPESTATUS[0]: 0 where only the
+    // progress lines were lost, 1 where the --json answer the caller asked for was (stderr says so).
+    TempDir dir;
+    auto runPiped = [&](const std::string& args, const std::string& redirect) {
+        const std::string cmd = "bash -c " + test::shellQuote(test::shellQuote(SHADOWLAB_EXE) + " " + args + " " +
+                                                              redirect + " | true; exit ${PIPESTATUS[0]}");
+        const int status = std::system(cmd.c_str());
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    };
+    const auto a = dir.path() / "a.png", b = dir.path() / "b.png", err = dir.path() / "err.txt";
+    EXPECT_EQ(runPiped("render seed --resolution 32x18 -o " + test::shellQuote(a.string()), "2>&1"), 0);
+    EXPECT_TRUE(fs::is_regular_file(a));
+    EXPECT_EQ(runPiped("render seed --resolution 32x18 --json -o " + test::shellQuote(b.string()),
+                       "2>" + test::shellQuote(err.string())),
+              1);
+    EXPECT_TRUE(fs::is_regular_file(b));
+    EXPECT_NE(test::slurpFile(err).find("writing to standard output failed: Broken pipe"), std::string::npos)
+        << test::slurpFile(err);
+    EXPECT_EQ(dir.fileCount(), 3u);  // no temporary left beside them
 }
 
 TEST(Outputs, RenderIntoAMissingFolderCreatesItAndSaysSo) {
