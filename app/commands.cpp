@@ -414,7 +414,7 @@ namespace {
 // is wrong nearly everywhere; said as such rather than only as a large false shadow. Empty when
 // neither reading is much closer: under half the error, where the error is over 20%.
 std::string maskReadingHint(const scene::ShadowMask& mask, const scene::Frame& reference, const fs::path& file,
-                            double mismatchRate) {
+                            double mismatchRate, bool invertGiven) {
     if (!(mismatchRate > 0.2)) return {};
     struct Reading {
         bool flip, invert;
@@ -422,9 +422,11 @@ std::string maskReadingHint(const scene::ShadowMask& mask, const scene::Frame& r
     };
     std::string best;
     double bestRate = 0.5 * mismatchRate;
+    // The mask as read has --mask-invert applied already: inverting it again means dropping the flag.
+    const char* inverted = invertGiven ? "without --mask-invert (1 = lit)" : "inverted (1 = shadowed: --mask-invert)";
+    const std::string flippedInverted = std::string("flipped vertically and ") + inverted;
     for (const Reading& r : {Reading{true, false, "flipped vertically (row 0 at the bottom, as glReadPixels gives it)"},
-                             Reading{false, true, "inverted (1 = shadowed: --mask-invert)"},
-                             Reading{true, true, "flipped vertically and inverted"}}) {
+                             Reading{false, true, inverted}, Reading{true, true, flippedInverted.c_str()}}) {
         scene::ShadowMask m = mask;
         for (int y = 0; r.flip && y < m.height / 2; ++y)
             std::swap_ranges(m.visibility.begin() + std::ptrdiff_t(y) * m.width,
@@ -484,7 +486,8 @@ int compareFiles(const CompareOptions& o) {
     }
     scene::writePngDisplay(o.output, c.width, c.height, c.diffRgb);
     if (o.heat) scene::writePngDisplay(*o.heat, c.width, c.height, c.heatRgb);
-    const std::string hint = mask ? maskReadingHint(*mask, reference, o.method, c.metrics.mismatchRate) : "";
+    const std::string hint =
+        mask ? maskReadingHint(*mask, reference, o.method, c.metrics.mismatchRate, o.maskInvert) : "";
     if (o.json) {
         Json j = compare::toJson(c.metrics);
         if (!checks.empty()) j["budgets"] = compare::toJson(checks);

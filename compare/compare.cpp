@@ -548,8 +548,9 @@ Comparison compareFrames(const Frame& method, const Frame& reference, const Comp
                 ++m.missedShadow;
                 ++obj.missedShadow;
                 if (nearEdge[i]) ++m.missedShadowNearEdge;
-                if (m.hasReferenceBlockerIds && std::isfinite(reference.blockerId[i]) &&
-                    roundId(reference.blockerId[i]) == roundId(idr) && nr < kTerminatorNdotL) {
+                const bool terminator = m.hasReferenceBlockerIds && std::isfinite(reference.blockerId[i]) &&
+                                        roundId(reference.blockerId[i]) == roundId(idr) && nr < kTerminatorNdotL;
+                if (terminator) {
                     ++m.terminatorMissed;
                     ++obj.terminatorMissed;
                 }
@@ -560,6 +561,7 @@ Comparison compareFrames(const Frame& method, const Frame& reference, const Comp
                     std::isfinite(reference.blockerDistance[i])) {
                     if (double(reference.blockerDistance[i]) <= contactAt(i, nr)) {
                         ++m.biasLeak;
+                        if (terminator) ++m.terminatorBiasLeak;
                         if (nearEdge[i]) ++m.biasLeakNearEdge;
                     } else if (!nearEdge[i] && !m.pointSampled) {  // bleeding is a filter's; a ray has none
                         ++m.bleeding;

@@ -150,6 +150,9 @@ struct Metrics {
     bool hasReferenceBlockerIds = false;
     std::size_t terminatorMissed = 0;
     double terminatorMissedRate = 0.0;  // over counted
+    // Of the bias leaks, those at the terminator: a facet's neighbour is always within the
+    // contact distance, so the findings keep them out of the peter-panning they name.
+    std::size_t terminatorBiasLeak = 0;
 
     // Edge-aware split of the wrong pixels: within edgeRadius pixels of a reference shadow
     // boundary they are aliasing (a resolution problem), elsewhere bias error. Two exceptions:

@@ -21,6 +21,10 @@ namespace {
 // reference, not ranked: a difference that small moves with a texel's rounding or a pixel of
 // view, and the images show no winner.
 constexpr double kSameErrorRatio = 1.1;
+// Mean |ΔV| that overrides the wrong-pixel ranking: at least twice the other's and more than this
+// apart (below it both print alike and neither is visibly worse).
+constexpr double kMeanDisagreeRatio = 2.0;
+constexpr double kMeanDisagreeMin = 0.0005;
 
 std::string methodTitle(const std::string& label) {
     if (label == "raster") return "The shadow map (raster)";
@@ -144,6 +148,14 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
                       formatPercent(m.mismatchRate) + ": "
                 : who + " disagrees with the reference on " + formatPercent(m.mismatchRate) + " of the " +
                       formatCount(m.counted) + " counted pixels: ";
+        // Missed shadow's causes, each pixel named once: the terminator's pixels are bias leaks too
+        // (a facet's neighbour is within any contact distance), so peter-panning leaves them out.
+        const bool terminatorMost = double(m.terminatorMissed) > kMostlyShare * double(m.missedShadow);
+        const std::size_t leak = m.biasLeak - std::min(m.biasLeak, m.terminatorBiasLeak);
+        const bool mapLeaks = m.hasBlockerDistance && !m.pointSampled && !terminatorMost;
+        const bool leakMost = mapLeaks && double(leak) > kMostlyShare * double(m.missedShadow);
+        const bool leakNotable =
+            mapLeaks && !leakMost && leak > 0 && double(leak) >= kNotableShare * double(m.missedShadow);
         std::vector<std::string> parts;
         if (m.falseShadow > 0) {
             std::string f = formatPercent(m.falseShadowRate) + " false shadow";
@@ -164,8 +176,7 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
         } else {
             parts.push_back("no false shadow");
         }
-        const bool terminator = double(m.terminatorMissed) > kMostlyShare * double(m.missedShadow);
-        if (m.missedShadow > 0 && terminator) {
+        if (m.missedShadow > 0 && terminatorMost) {
             // The reference's own faceting, not a leak a viewer of the method's image would see.
             std::string f = formatPercent(m.missedShadowRate) + " missed shadow, " +
                             formatPercent(double(m.terminatorMissed) / double(m.missedShadow)) +
@@ -187,8 +198,8 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
             f += on.empty() ? ")" : ", mostly on " + on + ")";
             // Near its blocker, a missed shadow is the bias's and the texel grid's; far from it, the
             // filter's (light bleeding).
-            if (m.hasBlockerDistance && !m.pointSampled && double(m.biasLeak) > kMostlyShare * double(m.missedShadow))
-                f += ", " + formatPercent(double(m.biasLeak) / double(m.missedShadow)) +
+            if (leakMost)
+                f += ", " + formatPercent(double(leak) / double(m.missedShadow)) +
                      " of it within the contact distance of its blocker (" + formatShort(m.contactDistance) +
                      " with the light head-on, more at grazing light): a caster that close to its receiver is lost "
                      "to the bias and the map's texels" +
@@ -196,11 +207,9 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
             else {
                 // A minority by count can still be what a viewer sees first: a shadow detached from
                 // where a thin caster meets the ground is a few pixels against long aliased edges.
-                if (m.hasBlockerDistance && !m.pointSampled && m.biasLeak > 0 &&
-                    double(m.biasLeak) >= kNotableShare * double(m.missedShadow))
-                    f += ", " + formatPercent(double(m.biasLeak) / double(m.missedShadow)) + " of it (" +
-                         formatCount(m.biasLeak) + " px) within the contact distance of its blocker (" +
-                         formatShort(m.contactDistance) +
+                if (leakNotable)
+                    f += ", " + formatPercent(double(leak) / double(m.missedShadow)) + " of it (" + formatCount(leak) +
+                         " px) within the contact distance of its blocker (" + formatShort(m.contactDistance) +
                          " with the light head-on, more at grazing light): peter-panning, the shadow cut "
                          "off where its caster meets the receiver, lost to the bias and the map's texels" +
                          cappedMapText(rm.frame);
@@ -237,11 +246,9 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
                                           : ".";
         } else {
             const double nearShare = double(m.aliasingPixels) / double(wrong);
-            const bool notableLeak =
-                m.hasBlockerDistance && m.biasLeak > 0 && double(m.biasLeak) >= kNotableShare * double(m.missedShadow);
             if (nearShare > kMostlyShare)
                 s += " Most wrong pixels (" + formatPercent(nearShare) + ") lie" + within +
-                     (notableLeak ? ": edge aliasing, beside the bias's peter-panning above."
+                     (leakNotable ? ": edge aliasing, beside the bias's peter-panning above."
                                   : ": edge aliasing rather than bias.");
             else if (m.aliasingPixels > 0)
                 s += " " + formatPercent(1.0 - nearShare) +
@@ -630,19 +637,24 @@ std::string describeFindings(const ReportInput& in) {
         });
         const double b = best->metrics.mismatchRate, w = worst->metrics.mismatchRate;
         const auto [bt, wt] = formatPercentsApart(b, w);
-        if (w > b && w <= kSameErrorRatio * b) {
+        // Mean |ΔV| clearly the other way (twice, and by more than 0.0005): the wrong-pixel count
+        // alone would name, or tie, the method a viewer sees as the worse one.
+        const double mb = best->metrics.meanAbsVisibilityError, mw = worst->metrics.meanAbsVisibilityError;
+        if (w > b && mb >= kMeanDisagreeRatio * mw && mb - mw > kMeanDisagreeMin) {
+            int d = 4;
+            while (d < 8 && formatFixed(mb, d) == formatFixed(mw, d)) ++d;
+            lines.push_back(
+                "Overall, " + shortTitle(best->label) + " gets fewer pixels wrong outright (" + bt + " against " + wt +
+                "), but " + shortTitle(worst->label) + " is closer to the reference by mean |ΔV| (" +
+                formatFixed(mw, d) + " against " + formatFixed(mb, d) + "): " +
+                (softErrorDominates(best->metrics)
+                     ? "most of " + shortTitle(best->label) + "'s error is partial shadow that the count misses."
+                     : shortTitle(best->label) + "'s visibility is off over more of the image by less than "
+                                                 "τ, which the count does not see."));
+        } else if (w > b && w <= kSameErrorRatio * b) {
             lines.push_back("Overall, " + shortTitle(best->label) + " and " + shortTitle(worst->label) +
                             " are about as close to the reference as each other (" + bt + " and " + wt +
                             " wrong, within a tenth of each other).");
-        } else if (w > b && softErrorDominates(best->metrics) &&
-                   best->metrics.meanAbsVisibilityError > worst->metrics.meanAbsVisibilityError) {
-            // Fewer wrong pixels, but more partial error: the count alone would name the wrong winner.
-            lines.push_back("Overall, " + shortTitle(best->label) + " gets fewer pixels wrong outright (" + bt +
-                            " against " + wt + "), but " + shortTitle(worst->label) +
-                            " is closer to the reference by mean |ΔV| (" +
-                            formatFixed(worst->metrics.meanAbsVisibilityError, 4) + " against " +
-                            formatFixed(best->metrics.meanAbsVisibilityError, 4) + "): most of " +
-                            shortTitle(best->label) + "'s error is partial shadow that the count misses.");
         } else if (w > b) {
             std::string t = "Overall, " + shortTitle(best->label) + " is closer to the reference (" + bt + " against " +
                             wt + " wrong)";

@@ -111,8 +111,12 @@ CasePart casePart(const CheckSuite& suite, const CheckCase& c, const CaseResult&
         // The error in the row's comment column, cut at a word within 120 characters; "Why" has it whole.
         std::string shown = r.error;
         if (shown.size() > 120) {
-            const std::size_t space = shown.rfind(' ', 110);
-            shown = shown.substr(0, space == std::string::npos ? 110 : space) + " … (see Why)";
+            std::size_t cut = shown.rfind(' ', 110);
+            if (cut == std::string::npos || cut == 0) {
+                cut = 110;  // no word to end on: at a character, not inside a UTF-8 sequence
+                while (cut > 0 && (static_cast<unsigned char>(shown[cut]) & 0xC0) == 0x80) --cut;
+            }
+            shown = shown.substr(0, cut) + " … (see Why)";
         }
         m << "| | | | | | " << cell(shown) << " | |\n";
     }

@@ -187,6 +187,10 @@ TEST(AppGates, AnotherEnginesMaskIsGradedWithTheReferencesIdsAndNdotL) {
     EXPECT_NE(nlohmann::json::parse(inverse.out)["mask_hint"].get<std::string>().find("read inverted"),
               std::string::npos);
     EXPECT_TRUE(b["mask_hint"].is_null()) << b["mask_hint"];
+    // --mask-invert on a mask that was 1 = lit: the hint is to drop the flag, not to add it.
+    const auto twice = runShadowlab({"compare", png.string(), f.reference.string(), "-o",
+                                     (dir.path() / "h.png").string(), "--mask-channel", "R", "--mask-invert"});
+    EXPECT_NE(twice.err.find("read without --mask-invert (1 = lit)"), std::string::npos) << twice.err;
     EXPECT_EQ(said.err.find("hint:"), std::string::npos) << said.err;
     // A mask of several channels needs one chosen; a wrong name lists the channels.
     auto r = runShadowlab({"compare", png.string(), f.reference.string(), "-o", (dir.path() / "d.png").string()});

@@ -1,13 +1,14 @@
 // tests/app/outputs_test.cpp: where outputs go: `run -o` naming a file, `render -o` into a missing
 // folder, a model format shadowlab does not read, and a run folder left from an earlier run.
-#include <sys/wait.h>
-
-#include <cstdlib>
+#include <fcntl.h>
+#include <spawn.h>
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "tests/app/cli.h"
+#include "tests/app/subprocess.h"
 
 namespace shadowlab {
 namespace {
@@ -27,23 +28,40 @@ TEST(Outputs, RunIntoAFileExitsTwoWithAClearMessageAndLeavesTheFile) {
     EXPECT_EQ(dir.fileCount(), 1u);
 }
 
+// Runs shadowlab with its standard output (and its standard error, unless `errFile` is given) on
+// a pipe whose reading end is closed before the program starts: every write to it fails, as
+// when a reader (`| head`) has quit. The exit status, or -1 for a signal.
+int runIntoClosedPipe(const std::vector<std::string>& args, const fs::path* errFile) {
+    int fds[2];
+    if (::pipe(fds) != 0) return -2;
+    ::close(fds[0]);
+    std::string exe = SHADOWLAB_EXE;
+    std::vector<std::string> copy = args;
+    std::vector<char*> argv{exe.data()};
+    for (auto& a : copy) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_adddup2(&actions, fds[1], 1);
+    if (errFile)
+        posix_spawn_file_actions_addopen(&actions, 2, errFile->c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    else
+        posix_spawn_file_actions_adddup2(&actions, fds[1], 2);
+    pid_t pid = -1;
+    const int rc = posix_spawn(&pid, exe.c_str(), &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    ::close(fds[1]);
+    return rc == 0 ? test::waitFor(pid) : -2;
+}
+
 TEST(Outputs, AReaderThatQuitsEarlyDoesNotStopTheRenderWritingItsFile) {
-    // `true` reads nothing and exits, so what shadowlab writes to the pipe goes nowhere: the render
-    // must still finish and write its file. Its status is bash's PIPESTATUS[0]: 0 where only the
-    // progress lines were lost, 1 where the --json answer the caller asked for was (stderr says so).
+    // The render must still finish and write its file: exit 0 where only the progress lines were
+    // lost, 1 where the --json answer the caller asked for was (stderr says so).
     TempDir dir;
-    auto runPiped = [&](const std::string& args, const std::string& redirect) {
-        const std::string cmd = "bash -c " + test::shellQuote(test::shellQuote(SHADOWLAB_EXE) + " " + args + " " +
-                                                              redirect + " | true; exit ${PIPESTATUS[0]}");
-        const int status = std::system(cmd.c_str());
-        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    };
     const auto a = dir.path() / "a.png", b = dir.path() / "b.png", err = dir.path() / "err.txt";
-    EXPECT_EQ(runPiped("render seed --resolution 32x18 -o " + test::shellQuote(a.string()), "2>&1"), 0);
+    EXPECT_EQ(runIntoClosedPipe({"render", "seed", "--resolution", "32x18", "-o", a.string()}, nullptr), 0);
     EXPECT_TRUE(fs::is_regular_file(a));
-    EXPECT_EQ(runPiped("render seed --resolution 32x18 --json -o " + test::shellQuote(b.string()),
-                       "2>" + test::shellQuote(err.string())),
-              1);
+    EXPECT_EQ(runIntoClosedPipe({"render", "seed", "--resolution", "32x18", "--json", "-o", b.string()}, &err), 1);
     EXPECT_TRUE(fs::is_regular_file(b));
     EXPECT_NE(test::slurpFile(err).find("writing to standard output failed: Broken pipe"), std::string::npos)
         << test::slurpFile(err);

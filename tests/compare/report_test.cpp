@@ -240,6 +240,24 @@ TEST(Report, FindingsCallMissedShadowAtAMeshsOwnTerminatorATessellationEffect) {
     EXPECT_NE(text.find("; " + formatPercent(1.0 / 3.0) + " of it lies at a smooth-shaded mesh's terminator"),
               std::string::npos)
         << text;
+
+    // From a shadow map, with the reference's blocker distances: the terminator's facets are 0.001
+    // from their receivers, within any contact distance, and the post's shadow 5 away. The
+    // terminator's pixels are not named a second time as peter-panning: no bias leak is left once
+    // they are set aside.
+    ref.blockerDistance.assign(ref.pixelCount(), 0.0f);
+    for (std::size_t i = 0; i < ref.pixelCount(); ++i)
+        if (ref.blockerId[i] > 0) ref.blockerDistance[i] = ref.blockerId[i] == 1.0f ? 0.001f : 5.0f;
+    map.attributes["slope_bias"] = "1";
+    in.reference.frame = ref;
+    in.methods[0] = {"raster", "raster.png", "diff-raster.png", map, compareFrames(map, ref).metrics};
+    ASSERT_EQ(in.methods[0].metrics.biasLeak, 80u);  // the 4 terminator columns
+    ASSERT_EQ(in.methods[0].metrics.terminatorBiasLeak, 80u);
+    text = firstLine();
+    EXPECT_NE(text.find("of it lies at a smooth-shaded mesh's terminator"), std::string::npos) << text;
+    EXPECT_EQ(text.find("peter-panning, the shadow cut off"), std::string::npos) << text;
+    EXPECT_EQ(text.find("within the contact distance of its blocker"), std::string::npos) << text;
+    EXPECT_EQ(text.find("beside the bias's peter-panning"), std::string::npos) << text;
 }
 
 TEST(Report, FindingsLeadWithPartialShadowWhereItOutnumbersTheWrongPixels) {
@@ -280,6 +298,23 @@ TEST(Report, FindingsLeadWithPartialShadowWhereItOutnumbersTheWrongPixels) {
         << overall;
     EXPECT_NE(summaryLine(mm).find("SOFT ERROR dominates"), std::string::npos) << summaryLine(mm);
     EXPECT_EQ(summaryLine(in.methods[0].metrics).find("SOFT ERROR"), std::string::npos);
+
+    // Off by 0.2 everywhere instead: under the 0.25 of soft error too, so no pixel is counted as
+    // partly wrong, but the mean |ΔV| ((398·0.2 + 2)/400 = 0.204) is still 8 times the ray tracer's.
+    scene::Frame dim = test::uniformFrame(20, 20, 1, 0.5f, 0.8f);
+    dim.visibility[0] = dim.visibility[1] = 0.0f;
+    dim.attributes = map.attributes;
+    in.methods[1] = {"raster", "raster.png", "diff-raster.png", dim, compareFrames(dim, ref).metrics};
+    ASSERT_EQ(in.methods[1].metrics.softErrorPixels, 0u);
+    std::istringstream again(describeFindings(in));
+    std::getline(again, rayText);
+    std::getline(again, mapText);
+    std::getline(again, overall);
+    EXPECT_NE(overall.find("gets fewer pixels wrong outright (0.50% against 2.50%), but the ray tracer is closer to "
+                           "the reference by mean |ΔV| (0.0250 against 0.2040)"),
+              std::string::npos)
+        << overall;
+    EXPECT_NE(overall.find("off over more of the image by less than τ"), std::string::npos) << overall;
 }
 
 TEST(Report, FindingsNamePeterPanningThatIsAMinorityOfTheMissedShadow) {

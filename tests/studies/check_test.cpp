@@ -65,5 +65,16 @@ TEST(CheckSummary, ALongErrorIsCutAtAWordInItsRowAndWholeUnderWhy) {
     EXPECT_EQ(row.find("word17"), std::string::npos) << row;
     EXPECT_NE(md.find("- `a`: error: " + error.substr(0, 20)), std::string::npos) << md;
     EXPECT_NE(md.find("END\n"), std::string::npos) << md;
+    // No space to cut at (a long path of two-byte characters): cut between characters, never
+    // inside one, so the summary stays valid UTF-8.
+    r.error = "x";  // then 'é' = C3 A9 from byte 1: byte 110 is the second byte of one
+    for (int i = 0; i < 80; ++i) r.error += "é";
+    const std::string md2 = studies::markdownSummary(suite, {r}, false);
+    const auto at = md2.find("| a |");
+    const std::string row2 = md2.substr(at, md2.find('\n', at) - at);
+    const std::size_t ellipsis = row2.find(" … (see Why)");
+    ASSERT_NE(ellipsis, std::string::npos) << row2;
+    const std::string kept = row2.substr(0, ellipsis);
+    EXPECT_EQ(kept.substr(kept.size() - 2), "é") << kept;
     fs::remove_all(dir);
 }
