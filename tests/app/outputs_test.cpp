@@ -35,23 +35,15 @@ int runIntoClosedPipe(const std::vector<std::string>& args, const fs::path* errF
     int fds[2];
     if (::pipe(fds) != 0) return -2;
     ::close(fds[0]);
-    std::string exe = SHADOWLAB_EXE;
-    std::vector<std::string> copy = args;
-    std::vector<char*> argv{exe.data()};
-    for (auto& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_adddup2(&actions, fds[1], 1);
-    if (errFile)
-        posix_spawn_file_actions_addopen(&actions, 2, errFile->c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    else
-        posix_spawn_file_actions_adddup2(&actions, fds[1], 2);
-    pid_t pid = -1;
-    const int rc = posix_spawn(&pid, exe.c_str(), &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
+    const pid_t pid = test::spawnShadowlab(args, [&](posix_spawn_file_actions_t& actions) {
+        posix_spawn_file_actions_adddup2(&actions, fds[1], 1);
+        if (errFile)
+            posix_spawn_file_actions_addopen(&actions, 2, errFile->c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        else
+            posix_spawn_file_actions_adddup2(&actions, fds[1], 2);
+    });
     ::close(fds[1]);
-    return rc == 0 ? test::waitFor(pid) : -2;
+    return pid > 0 ? test::waitFor(pid) : -2;
 }
 
 TEST(Outputs, AReaderThatQuitsEarlyDoesNotStopTheRenderWritingItsFile) {

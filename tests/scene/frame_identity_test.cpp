@@ -274,19 +274,19 @@ TEST(ShadowMask, PngLinearSrgbAndInvertedDecodeToVisibility) {
     EXPECT_THROW(frameFromMask(lin, Frame::allocate(3, 1, false), png), InputError);
 }
 
+// A one-row EXR of one float channel `name` holding `values`, as another engine might write it.
+bool writeOneChannelExr(const std::filesystem::path& file, const std::string& name, const std::vector<float>& values) {
+    auto out = OIIO::ImageOutput::create(file.string());
+    if (!out) return false;
+    OIIO::ImageSpec spec(int(values.size()), 1, 1, OIIO::TypeDesc::FLOAT);
+    spec.channelnames = {name};
+    return out->open(file.string(), spec) && out->write_image(OIIO::TypeDesc::FLOAT, values.data()) && out->close();
+}
+
 TEST(ShadowMask, ASingleChannelExrIsAMaskAndAFrameIsNot) {
     TempDir dir;
     const auto exr = dir.path() / "mask.exr";
-    {
-        auto out = OIIO::ImageOutput::create(exr.string());
-        ASSERT_TRUE(out);
-        OIIO::ImageSpec spec(2, 1, 1, OIIO::TypeDesc::FLOAT);
-        spec.channelnames = {"shadow"};
-        ASSERT_TRUE(out->open(exr.string(), spec));
-        const float v[2] = {0.25f, 1.0f};
-        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, v));
-        out->close();
-    }
+    ASSERT_TRUE(writeOneChannelExr(exr, "shadow", {0.25f, 1.0f}));
     EXPECT_TRUE(looksLikeMask(exr));
     const ShadowMask m = readShadowMask(exr, {});
     EXPECT_EQ(m.channel, "shadow");
@@ -300,16 +300,7 @@ TEST(ShadowMask, ASingleChannelExrIsAMaskAndAFrameIsNot) {
 TEST(ShadowMask, AnEnginesOneChannelNamedVisibilityIsAMaskAndItsSizeIsCheckedBeforeItsValues) {
     TempDir dir;
     const auto exr = dir.path() / "engine.exr";
-    {
-        auto out = OIIO::ImageOutput::create(exr.string());
-        ASSERT_TRUE(out);
-        OIIO::ImageSpec spec(3, 1, 1, OIIO::TypeDesc::FLOAT);
-        spec.channelnames = {"visibility"};
-        ASSERT_TRUE(out->open(exr.string(), spec));
-        const float v[3] = {1.0f, -0.00005f, 0.0f};  // a resampled mask's undershoot
-        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, v));
-        out->close();
-    }
+    ASSERT_TRUE(writeOneChannelExr(exr, "visibility", {1.0f, -0.00005f, 0.0f}));  // a resampled mask's undershoot
     EXPECT_TRUE(looksLikeMask(exr));
     // Against a 2x1 reference the size is what is wrong, not the value at pixel (1, 0).
     MaskOptions o;
