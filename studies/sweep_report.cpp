@@ -429,7 +429,12 @@ std::vector<std::string> describeSweep(const SweepReportInput& in, const AutoBia
     if (in.recommendation)
         for (const std::string& note : in.recommendation->notes) lines.push_back(note);
     else
-        lines.push_back("The block below is the probe slice's and was not measured against your defaults.");
+        // A merge of shards has the rows only: the search renders the scene in the user's
+        // configuration, which happens where a sweep runs whole, not where shards are joined.
+        lines.push_back(
+            "The block below is the probe slice's and was not measured against your defaults: the search "
+            "in your configuration renders the scene, which a merge of shards does not; `shadowlab run " +
+            (in.scenePath.empty() ? std::string("SCENE") : in.scenePath) + "` with the shards' options searches it.");
     std::size_t failed = 0;
     for (const SweepRow& r : in.rows) failed += usable(r) ? 0 : 1;
     if (failed > 0)

@@ -64,6 +64,16 @@ TEST(ShardedSweep, ThreeProcessesAtOnceMergeToTheUnshardedSweep) {
     EXPECT_EQ(studies::verdictDifferences(whole, merged), std::vector<std::string>{});
     for (const char* f : {"report.html", "results.csv", "error-time.svg", "recommended-shadow.json", "reference.png"})
         EXPECT_TRUE(fs::exists(dir.path() / "sh" / f)) << f;
+    // The one difference: the unsharded sweep searched its block in the user's configuration
+    // (measured against the defaults); the merge has the rows only, and its page says so.
+    auto read = [](const fs::path& f) {
+        std::ifstream in(f);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    EXPECT_FALSE(Json::parse(read(dir.path() / "whole" / "recommended-shadow.json"))["measured"].is_null());
+    EXPECT_TRUE(Json::parse(read(dir.path() / "sh" / "recommended-shadow.json"))["measured"].is_null());
+    EXPECT_NE(read(dir.path() / "sh" / "report.html").find("which a merge of shards does not"), std::string::npos);
+    EXPECT_EQ(read(dir.path() / "whole" / "report.html").find("which a merge of shards does not"), std::string::npos);
     // One reference for the three shards, beside them, not one in each.
     for (int k = 0; k < 3; ++k)
         EXPECT_FALSE(fs::exists(dir.path() / "sh" / ("shard-" + std::to_string(k) + "-of-3") / "reference.exr"));
