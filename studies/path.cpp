@@ -486,6 +486,59 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
     }
     const std::string svg = compare::renderSvg(plot);
     scene::writeTextAtomic(dir / "flicker.svg", svg);
+
+    // Error per frame: which frames get shadows wrong, and how, beside how they change.
+    compare::ScatterPlot errorPlot;
+    errorPlot.title = "Wrong pixels per frame";
+    errorPlot.x.title = "frame";
+    errorPlot.x.min = 0.0;
+    errorPlot.x.max = double(std::max<std::size_t>(refs.size(), 2) - 1);
+    errorPlot.x.integer = true;
+    errorPlot.y.title = "mismatch rate";
+    errorPlot.y.percent = true;
+    errorPlot.y.min = 0.0;
+    std::string errorText;
+    for (std::size_t mi = 0; mi < result.methods.size(); ++mi) {
+        const PathMethod& m = result.methods[mi];
+        if (m.metrics.empty()) continue;
+        compare::PlotSeries series;
+        series.name = m.name;
+        const bool heldView = m.name == heldViewName();
+        series.color = compare::backendColor(heldView ? nameOf(scene::Backend::Raster) + " held view" : m.name, mi);
+        series.connect = true;
+        series.dashed = heldView;
+        std::size_t best = 0, worst = 0;
+        for (std::size_t t = 0; t < m.metrics.size(); ++t) {
+            const compare::Metrics& x = m.metrics[t];
+            series.points.push_back({double(t), x.mismatchRate, "",
+                                     m.name + " frame " + std::to_string(t) + ": " +
+                                         compare::formatCount(x.falseShadow) + " false, " +
+                                         compare::formatCount(x.missedShadow) + " missed"});
+            if (x.mismatchRate < m.metrics[best].mismatchRate) best = t;
+            if (x.mismatchRate > m.metrics[worst].mismatchRate) worst = t;
+        }
+        errorPlot.series.push_back(series);
+        if (heldView) continue;  // the held view's frames are not the path's
+        const compare::Metrics& w0 = m.metrics[worst];
+        const bool missed = w0.missedShadow > w0.falseShadow;
+        errorText +=
+            "<p><b>" + compare::escapeHtml(m.name) + "</b>: " +
+            (m.metrics[worst].mismatchRate == m.metrics[best].mismatchRate
+                 ? compare::formatPercent(w0.mismatchRate) + " wrong in every frame"
+                 : compare::formatPercent(m.metrics[best].mismatchRate) + " wrong at frame " + std::to_string(best) +
+                       ", up to " + compare::formatPercent(w0.mismatchRate) + " at frame " + std::to_string(worst)) +
+            "; that frame has " + compare::formatCount(w0.falseShadow) + " false and " +
+            compare::formatCount(w0.missedShadow) + " missed shadow pixels, " +
+            (w0.falseShadow + w0.missedShadow == 0 ? std::string("none wrong")
+             : !missed                             ? std::string("mostly false (acne or over-darkening)")
+             : 2 * w0.terminatorMissed > w0.missedShadow
+                 ? "mostly missed, " + compare::formatCount(w0.terminatorMissed) +
+                       " of them at a smooth-shaded mesh's terminator (a tessellation effect: docs/compare.md)"
+                 : std::string("mostly missed (light leaking or peter-panning)")) +
+            " (<code>frames/" + frameName(int(worst), m.name) + "</code>).</p>\n";
+    }
+    const std::string errorSvg = compare::renderSvg(errorPlot);
+    scene::writeTextAtomic(dir / "error.svg", errorSvg);
     scene::writeTextAtomic(dir / "metrics.json", toJson(result).dump(2) + "\n");
 
     // The report.
@@ -526,7 +579,7 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
     html << "</table>\n<p>Setup is paid once for the path (the raster Renderer with its device, buffers and "
             "pipelines; the ray tracer's acceleration structure); per frame is the rest (the raster update of the "
             "light frusta and uniforms included).</p>\n";
-    html << svg << "\n<h2>Animations</h2>\n" << gifs;
+    html << svg << "\n<h2>Error per frame</h2>\n" << errorText << errorSvg << "\n<h2>Animations</h2>\n" << gifs;
     if (!zooms.empty()) html << "<h2>Worst frame pair</h2>\n" << zooms;
     html << "<p>Every figure: <a href=\"metrics.json\">metrics.json</a>; the frames: <code>frames/</code>.</p>"
             "</body></html>\n";

@@ -14,6 +14,7 @@
 
 #include "compare/compare.h"
 #include "compare/temporal.h"
+#include "compare/text.h"
 #include "raster/light_frustum.h"
 #include "raster/renderer.h"
 #include "raytrace/renderer.h"
@@ -373,9 +374,27 @@ TEST(PathFolder, WritesEveryOutputResumesWithoutRenderingAgainAndRefusesAnotherP
     ASSERT_EQ(first.methods.size(), 2u);  // a light path has no held view
     EXPECT_EQ(first.methods[0].name, "raster");
     EXPECT_EQ(first.referenceTemporal.totalFlicker, 0u);  // zero by definition
-    for (const char* f : {"report.html", "metrics.json", "flicker.svg", "raster.gif", "raytrace.gif", "frames.jsonl",
-                          "path.json", "frames/0002-raster.exr", "frames/0002-reference.exr"})
+    for (const char* f : {"report.html", "metrics.json", "flicker.svg", "error.svg", "raster.gif", "raytrace.gif",
+                          "frames.jsonl", "path.json", "frames/0002-raster.exr", "frames/0002-reference.exr"})
         EXPECT_TRUE(fs::exists(dir / f)) << f;
+    // The report says, per method, its best and worst frame by wrong pixels and what the worst holds:
+    // the figures are the frames' own metrics, read back here.
+    {
+        std::ifstream in(dir / "report.html");
+        const std::string html((std::istreambuf_iterator<char>(in)), {});
+        const auto& ms = first.methods[0].metrics;
+        std::size_t worst = 0;
+        for (std::size_t t = 0; t < ms.size(); ++t)
+            if (ms[t].mismatchRate > ms[worst].mismatchRate) worst = t;
+        const std::string expected = "; that frame has " + compare::formatCount(ms[worst].falseShadow) + " false and " +
+                                     compare::formatCount(ms[worst].missedShadow) + " missed shadow pixels";
+        EXPECT_NE(html.find("<h2>Error per frame</h2>"), std::string::npos);
+        const std::size_t at = html.find("<b>raster</b>: ");
+        ASSERT_NE(at, std::string::npos);
+        const std::string paragraph = html.substr(at, html.find("</p>", at) - at);
+        EXPECT_NE(paragraph.find(expected), std::string::npos) << paragraph;
+        EXPECT_NE(paragraph.find("frames/000" + std::to_string(worst) + "-raster.exr"), std::string::npos) << paragraph;
+    }
     // Again without --resume: refused, nothing rendered.
     EXPECT_THROW(runPath(base, settings, spec, options), scene::InputError);
     // Resumed: every frame comes from the journal and the figures are the same.
