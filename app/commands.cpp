@@ -7,7 +7,6 @@
 
 #include <unistd.h>
 #include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -38,6 +37,7 @@
 #include "scene/frame_identity.h"
 #include "scene/frame_io.h"
 #include "scene/gltf_export.h"
+#include "scene/input_file.h"
 #include "scene/loader.h"
 #include "scene/mask_io.h"
 #include "scene/memory.h"
@@ -319,8 +319,7 @@ private:
 // with the view, sun and ground they would choose, since another engine renders it from the
 // file alone and its shadows are graded against this scene's reference.
 int exportScene(const ExportOptions& o) {
-    std::string ext = o.output.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+    const std::string ext = scene::lowercaseExtension(o.output);
     if (ext != ".glb" && ext != ".gltf")
         throw scene::InputError(o.output.string() + ": unknown export type '" + o.output.extension().string() +
                                 "' (use .glb or .gltf)");
@@ -454,10 +453,8 @@ int compareFiles(const CompareOptions& o) {
         throw scene::InputError(o.heat->string() + ": the heat map must be a .png");
     const scene::Budgets budgets = parseBudgets(o.budgets);
     // Only an EXR can be a Frame: any other file is read as a mask, which names the formats it takes.
-    std::string methodExt = o.method.extension().string();
-    for (char& ch : methodExt) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-    const bool maskOnly =
-        o.maskChannel || o.maskInvert || o.maskSrgb || methodExt != ".exr" || scene::looksLikeMask(o.method);
+    const bool maskOnly = o.maskChannel || o.maskInvert || o.maskSrgb ||
+                          scene::lowercaseExtension(o.method) != ".exr" || scene::looksLikeMask(o.method);
     if (maskOnly && budgets[scene::BudgetKind::MaxBleeding])
         throw scene::InputError(o.method.string() +
                                 ": --max-bleeding: a shadow mask records no bias or texel size, so light bleeding "

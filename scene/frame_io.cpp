@@ -334,8 +334,7 @@ void writeTextAtomic(const fs::path& file, const std::string& text) {
 }
 
 void writeFrame(const Frame& frame, const fs::path& file) {
-    std::string ext = file.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+    const std::string ext = lowercaseExtension(file);
     if (ext == ".png") {
         writePngLinear(file, frame.width, frame.height, frame.beauty);
         return;

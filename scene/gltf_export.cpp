@@ -17,6 +17,7 @@
 
 #include "scene/error.h"
 #include "scene/frame_io.h"
+#include "scene/input_file.h"
 #include "scene/mesh_loader.h"
 
 namespace shadowlab::scene {
@@ -200,11 +201,6 @@ int wrapCode(TextureWrap w) {
     return w == TextureWrap::ClampToEdge ? 33071 : w == TextureWrap::MirroredRepeat ? 33648 : 10497;
 }
 
-std::string lower(std::string s) {
-    std::transform(s.begin(), s.end(), s.begin(), ::tolower);
-    return s;
-}
-
 }  // namespace
 
 double uvSphereSagitta(int segments, int rings) {
@@ -221,7 +217,7 @@ double uvSphereSagitta(int segments, int rings) {
 }
 
 ExportResult exportGltf(const Scene& scene, const fs::path& file, const ExportOptions& options) {
-    const std::string ext = lower(file.extension().string());
+    const std::string ext = lowercaseExtension(file);
     if (ext != ".glb" && ext != ".gltf")
         throw InputError(file.string() + ": unknown export type '" + ext + "' (use .glb or .gltf)");
     if (!(options.tolerance > 0.0 && options.tolerance < 0.5))
@@ -259,7 +255,7 @@ ExportResult exportGltf(const Scene& scene, const fs::path& file, const ExportOp
         const AlphaTexture* t = m.alphaTexture.get();
         const auto key = std::make_pair(t, wrapCode(t->wrapS) * 65536 + wrapCode(t->wrapT));
         if (const auto it = textureIndex.find(key); it != textureIndex.end()) return it->second;
-        const std::string text = lower(t->file.extension().string());
+        const std::string text = lowercaseExtension(t->file);
         const char* mime = text == ".png" ? "image/png" : text == ".jpg" || text == ".jpeg" ? "image/jpeg" : nullptr;
         if (!mime)
             throw InputError(t->file.string() + ": material '" + m.name +

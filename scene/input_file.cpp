@@ -4,6 +4,7 @@
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 
@@ -64,6 +65,12 @@ private:
 };
 
 }  // namespace
+
+std::string lowercaseExtension(const fs::path& file) {
+    std::string ext = file.extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return ext;
+}
 
 std::uint64_t checkInputFile(const fs::path& file, std::uint64_t maxBytes) {
     struct stat st {};

@@ -35,6 +35,10 @@ private:
     std::string problem_;
 };
 
+// `file`'s extension ("." included) in lower case: every reader and writer tells a format by it,
+// and "MODEL.GLB" is a .glb.
+std::string lowercaseExtension(const std::filesystem::path& file);
+
 // Checks that `file` is a regular file (after following symlinks) of at most `maxBytes` bytes,
 // for readers that must open it themselves (OpenImageIO); returns its size. Throws InputFileError.
 std::uint64_t checkInputFile(const std::filesystem::path& file, std::uint64_t maxBytes);

@@ -857,8 +857,7 @@ bool isOtherModelFormat(const std::string& ext) {
 }  // namespace
 
 Scene loadScene(const fs::path& file) {
-    std::string ext = file.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+    const std::string ext = lowercaseExtension(file);
     // Told by its name before any byte is read: a .ply read as JSON would be a parse error.
     if (isOtherModelFormat(ext))
         throw SceneError(file, {},

@@ -2,7 +2,6 @@
 #include "scene/mask_io.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdint>
 
@@ -10,6 +9,7 @@
 
 #include "scene/error.h"
 #include "scene/frame_io.h"
+#include "scene/input_file.h"
 #include "scene/loader.h"
 
 namespace shadowlab::scene {
@@ -25,8 +25,7 @@ float srgbToLinear(float e) {  // IEC 61966-2-1
 bool looksLikeMask(const std::filesystem::path& file) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(file, ec)) return false;
-    std::string ext = file.extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    const std::string ext = lowercaseExtension(file);
     if (ext == ".png") return true;
     if (ext != ".exr") return false;
     auto in = OIIO::ImageInput::open(file.string());
@@ -39,8 +38,7 @@ bool looksLikeMask(const std::filesystem::path& file) {
 }
 
 void checkMaskFileType(const std::filesystem::path& file) {
-    std::string ext = file.extension().string();
-    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    const std::string ext = lowercaseExtension(file);
     if (ext == ".png" || ext == ".exr") return;
     throw InputError(file.string() + ": a shadow mask is read from a .png or an .exr" +
                      std::string(ext == ".jpg" || ext == ".jpeg"

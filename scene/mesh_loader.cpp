@@ -900,8 +900,7 @@ std::string accessorReferenceProblem(std::string_view json) {
 void loadGltf(const fs::path& file, const std::string& fileBytes, std::vector<RawInstance>& out,
               const fs::path& sceneFile, const JsonPath& path, GltfExtras* extras, const MeshRequest& request,
               std::uint64_t& decodedBytes) {
-    std::string ext = file.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+    const std::string ext = lowercaseExtension(file);
     const bool binary = ext == ".glb";
     // tinygltf parses extras and extensions recursively: nesting is bounded before it sees them.
     if (binary)
@@ -1058,8 +1057,7 @@ std::vector<MeshInstance> readMeshFile(const fs::path& meshFile, const fs::path&
     }
     if (bytes.empty()) fail(sceneFile, path, meshFile, "is empty (0 bytes)");
     std::vector<RawInstance> raw;
-    std::string ext = meshFile.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+    const std::string ext = lowercaseExtension(meshFile);
     loadBytes = ext == ".obj" || ext == ".ply"
                     ? 4 * std::uint64_t(bytes.size())
                     : 5 * std::uint64_t(bytes.size()) + 2 * jsonTreeBytes(gltfJsonChunk(bytes, ext == ".glb"));

@@ -520,17 +520,20 @@ void measurePath(PathResult& result, const fs::path& dir, const std::string& sce
         errorPlot.series.push_back(series);
         if (heldView) continue;  // the held view's frames are not the path's
         const compare::Metrics& w0 = m.metrics[worst];
-        const bool missed = w0.missedShadow > w0.falseShadow;
+        if (w0.falseShadow + w0.missedShadow == 0) {
+            errorText += "<p><b>" + compare::escapeHtml(m.name) + "</b>: no wrong pixel in any frame.</p>\n";
+            continue;
+        }
+        const std::string worstName = "frame " + std::to_string(worst);
         errorText +=
             "<p><b>" + compare::escapeHtml(m.name) + "</b>: " +
-            (m.metrics[worst].mismatchRate == m.metrics[best].mismatchRate
+            (w0.mismatchRate == m.metrics[best].mismatchRate
                  ? compare::formatPercent(w0.mismatchRate) + " wrong in every frame"
                  : compare::formatPercent(m.metrics[best].mismatchRate) + " wrong at frame " + std::to_string(best) +
-                       ", up to " + compare::formatPercent(w0.mismatchRate) + " at frame " + std::to_string(worst)) +
-            "; that frame has " + compare::formatCount(w0.falseShadow) + " false and " +
+                       ", up to " + compare::formatPercent(w0.mismatchRate) + " at " + worstName) +
+            "; " + worstName + " has " + compare::formatCount(w0.falseShadow) + " false and " +
             compare::formatCount(w0.missedShadow) + " missed shadow pixels, " +
-            (w0.falseShadow + w0.missedShadow == 0 ? std::string("none wrong")
-             : !missed                             ? std::string("mostly false (acne or over-darkening)")
+            (w0.missedShadow <= w0.falseShadow ? std::string("mostly false (acne or over-darkening)")
              : 2 * w0.terminatorMissed > w0.missedShadow
                  ? "mostly missed, " + compare::formatCount(w0.terminatorMissed) +
                        " of them at a smooth-shaded mesh's terminator (a tessellation effect: docs/compare.md)"

@@ -84,6 +84,13 @@ TEST(InputFile, NonRegularFilesAreRefusedByKindBeforeTheyAreOpened) {
     EXPECT_NE(e.find("named pipe"), std::string::npos) << e;
 }
 
+TEST(InputFile, AFormatIsToldByItsExtensionInAnyCase) {
+    EXPECT_EQ(scene::lowercaseExtension("dir.v2/MODEL.GLB"), ".glb");
+    EXPECT_EQ(scene::lowercaseExtension("mask.Png"), ".png");
+    EXPECT_EQ(scene::lowercaseExtension("frame.exr"), ".exr");
+    EXPECT_EQ(scene::lowercaseExtension("dir.v2/noextension"), "");
+}
+
 TEST(InputFile, SizeIsBoundedBeforeReadingAndSymlinksAreFollowed) {
     TempDir dir;
     const fs::path big = dir.write("big.json", std::string(2000, ' '));

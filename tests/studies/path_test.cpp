@@ -386,7 +386,8 @@ TEST(PathFolder, WritesEveryOutputResumesWithoutRenderingAgainAndRefusesAnotherP
         std::size_t worst = 0;
         for (std::size_t t = 0; t < ms.size(); ++t)
             if (ms[t].mismatchRate > ms[worst].mismatchRate) worst = t;
-        const std::string expected = "; that frame has " + compare::formatCount(ms[worst].falseShadow) + " false and " +
+        const std::string expected = "; frame " + std::to_string(worst) + " has " +
+                                     compare::formatCount(ms[worst].falseShadow) + " false and " +
                                      compare::formatCount(ms[worst].missedShadow) + " missed shadow pixels";
         EXPECT_NE(html.find("<h2>Error per frame</h2>"), std::string::npos);
         const std::size_t at = html.find("<b>raster</b>: ");
