@@ -15,6 +15,7 @@
 #include "raster/vulkan_error.h"
 #include "scene/backend.h"
 #include "scene/error.h"
+#include "studies/shard.h"
 
 namespace {
 
@@ -317,6 +318,7 @@ int main(int argc, char** argv) {
     auto* infoCmd = app.add_subcommand("info", "Vulkan devices, driver and API versions, lavapipe or not");
     infoCmd->add_flag("--validate", infoValidate, "Also check that the validation layer loads");
 
+    shadowlab::studies::setCommandLine(std::vector<std::string>(argv, argv + argc));
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

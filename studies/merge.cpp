@@ -76,35 +76,6 @@ std::vector<ShardFolder> findShards(const std::vector<fs::path>& inputs) {
     return shards;
 }
 
-std::string quoteArg(const std::string& s) {
-    if (s.find_first_of(" \t'\"$\\") == std::string::npos) return s;
-    std::string q = "'";
-    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-}
-
-// Links src to dst (same file system), or copies it; through a temporary name either way.
-void placeFile(const fs::path& src, const fs::path& dst) {
-    std::error_code ec;
-    if (fs::exists(dst, ec) && fs::equivalent(src, dst, ec)) return;
-    fs::create_directories(dst.parent_path());
-    const fs::path tmp = scene::temporarySibling(dst);
-    fs::create_hard_link(src, tmp, ec);
-    if (ec) {
-        ec.clear();
-        fs::copy_file(src, tmp, fs::copy_options::overwrite_existing, ec);
-        if (ec) {
-            fs::remove(tmp, ec);
-            throw scene::InputError(dst.string() + ": cannot copy " + src.string() + " here");
-        }
-    }
-    fs::rename(tmp, dst, ec);
-    if (ec) {
-        fs::remove(tmp, ec);
-        throw scene::InputError(dst.string() + ": cannot write");
-    }
-}
-
 // The row as compared between sweeps: what timing measures (the row's times, the stage times in
 // its metrics, the GPU pass times in its settings, the machine) and where images are left out.
 Json comparable(const SweepRow& r) {
@@ -184,10 +155,20 @@ MergedSweep readShards(const std::vector<fs::path>& inputs) {
         }
     }
 
-    // Everything that is missing, in one message, each shard with the command that completes it.
+    // Everything that is missing, in one message, each shard with the command that completes it: a
+    // shard's own recorded command line, else the scene and folder with the grid left to the user.
     std::vector<std::string> problems;
     const fs::path base = shards.front().dir.parent_path();
     const std::string scene = quoteArg(m.identity.scene);
+    std::vector<fs::path> dirs;
+    for (const ShardFolder& s : shards) dirs.push_back(s.dir);
+    const std::vector<std::string> recorded = recordedShardCommand(dirs);
+    auto command = [&](int k, bool resume) {
+        const std::string c = shardCommandText(recorded, {k, m.shardCount}, resume);
+        if (!c.empty()) return "`" + c + "`";
+        return "`shadowlab sweep " + scene + " -o " + quoteArg(base.string()) + " --shard " + std::to_string(k) + "/" +
+               std::to_string(m.shardCount) + (resume ? " --resume" : "") + "` and the same grid options";
+    };
     for (int k = 0; k < m.shardCount; ++k) {
         std::size_t total = 0, missing = 0;
         for (std::size_t i = 0; i < keys.size(); ++i)
@@ -198,14 +179,11 @@ MergedSweep readShards(const std::vector<fs::path>& inputs) {
         const std::string name = std::to_string(k) + "/" + std::to_string(m.shardCount);
         if (!present.count(k)) {
             problems.push_back("shard " + name + " is missing (no " + shardFolderName({k, m.shardCount}) +
-                               " among the inputs; " + std::to_string(total) +
-                               " rows): render it with `shadowlab sweep " + scene + " -o " + quoteArg(base.string()) +
-                               " --shard " + name + "` and the same grid options");
+                               " among the inputs; " + std::to_string(total) + " rows): render it with " +
+                               command(k, false));
         } else if (missing > 0) {
             problems.push_back("shard " + name + " is unfinished (" + std::to_string(missing) + " of " +
-                               std::to_string(total) + " rows missing): finish it with `shadowlab sweep " + scene +
-                               " -o " + quoteArg(base.string()) + " --shard " + name +
-                               " --resume` and the same grid options");
+                               std::to_string(total) + " rows missing): finish it with " + command(k, true));
         }
     }
     if (!problems.empty()) {

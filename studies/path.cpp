@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <map>
 #include <set>
@@ -125,7 +126,11 @@ Json manifestOf(const scene::Scene& base, const PathSpec& spec, double amount, c
             {nameOf(scene::Backend::Raytrace), o.raytrace},
             {"held_view", o.heldView},
             {"settings",
-             {{"shadow_map_size", r.shadowMapSize},
+             // "auto": nobody chose a size, so each view gets the one its receivers need (at most
+             // the default; raster/light_frustum.h); every frame's EXR holds the size it used.
+             {{"shadow_map_size", r.shadowMapSizeIsDefault && r.shadowMapSize == scene::kDefaultShadowMapSize
+                                      ? Json("auto")
+                                      : Json(r.shadowMapSize)},
               {"filter", scene::toString(r.filter)},
               {"pcf_size", r.pcfSize},
               {"depth_bias", r.depthBias},
@@ -355,6 +360,7 @@ Json pathIdentity(const scene::Scene& base, const Json& manifest) {
 
 Json pathShardManifest(const scene::Scene& base, const Json& manifest, const Shard& shard, int frames) {
     return {{"program", "shadowlab"},
+            {"command", commandLine()},
             {"study", "path"},
             {"scene", base.file.string()},
             {"identity", pathIdentity(base, manifest)},
@@ -659,6 +665,11 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
     std::unique_ptr<BackendRenderer> rasterRenderer, tracer, reference;
     std::map<std::string, double> setupMs;
     std::map<std::string, std::vector<double>> times;
+    // Progress counts this process's frames (a shard's, not the path's) and estimates the time
+    // left from the frames rendered here (resumed ones cost nothing).
+    const auto start = std::chrono::steady_clock::now();
+    std::size_t finishedHere = 0, renderedHere = 0, toRender = 0;
+    for (int t : mine) toRender += done.count(t) ? 0 : 1;
     for (int t = 0; t < result.frames; ++t) {
         if (!mine.count(t)) continue;
         if (done.count(t)) {
@@ -667,6 +678,7 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
             const Json setups = j.value("setup_ms", Json::object());  // kept: items() refers to it
             for (const auto& [name, ms] : setups.items()) setupMs[name] = ms.get<double>();
             ++result.resumedFrames;
+            ++finishedHere;
             continue;
         }
         const scene::Scene& s = scenes[std::size_t(t)];
@@ -707,7 +719,13 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
         for (const auto& [name, ms] : line["setup_ms"].items())
             if (ms.get<double>() > 0.0 || !setupMs.count(name)) setupMs[name] = ms.get<double>();
         appendLine(journal, line.dump());
-        if (options.progress) options.progress("frame " + std::to_string(t + 1) + "/" + std::to_string(result.frames));
+        ++finishedHere;
+        ++renderedHere;
+        if (options.progress) {
+            const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            options.progress(pathProgressLine(t, result.frames, finishedHere, sharded ? mine.size() : 0,
+                                              elapsed / double(renderedHere) * double(toRender - renderedHere)));
+        }
     }
     if (sharded) return result;  // measured by mergePathShards, from every shard's frames
     measurePath(result, dir, base.file.string(), names, setupMs, times);
@@ -741,6 +759,18 @@ Json toJson(const PathResult& r) {
               {"frame_ms", r.referenceFrameMs},
               {"temporal", toJson(r.referenceTemporal)}}},
             {"methods", methods}};
+}
+
+std::string pathProgressLine(int frame, int frames, std::size_t shardDone, std::size_t shardFrames,
+                             double secondsLeft) {
+    const int eta = int(std::max(0.0, secondsLeft) + 0.5);
+    char text[160];
+    if (shardFrames > 0)
+        std::snprintf(text, sizeof text, "frame %d/%d (%zu of %zu in this shard), ETA %dm%02ds", frame + 1, frames,
+                      shardDone, shardFrames, eta / 60, eta % 60);
+    else
+        std::snprintf(text, sizeof text, "frame %d/%d, ETA %dm%02ds", frame + 1, frames, eta / 60, eta % 60);
+    return text;
 }
 
 std::vector<int> pathShardFrames(int frames, int index, int count) {
@@ -782,30 +812,6 @@ std::string identityDifference(const Json& a, const Json& b) {
     for (const auto& [key, value] : b.items())
         if (!a.contains(key)) return key + " (none) vs " + value.dump();
     return "";
-}
-
-// Links src to dst (same file system) or copies it, through a temporary name.
-void placeFile(const fs::path& src, const fs::path& dst) {
-    std::error_code ec;
-    if (fs::exists(dst, ec) && fs::equivalent(src, dst, ec)) return;
-    const fs::path tmp = scene::temporarySibling(dst);
-    fs::create_hard_link(src, tmp, ec);
-    if (ec) {
-        ec.clear();
-        fs::copy_file(src, tmp, fs::copy_options::overwrite_existing, ec);
-        if (ec) {
-            fs::remove(tmp, ec);
-            throw scene::InputError(dst.string() + ": cannot copy " + src.string() + " here");
-        }
-    }
-    fs::rename(tmp, dst);
-}
-
-std::string quoted(const std::string& s) {
-    if (s.find_first_of(" \t'\"$\\") == std::string::npos) return s;
-    std::string q = "'";
-    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
 }
 
 }  // namespace
@@ -889,9 +895,17 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
             }
         }
     }
-    // Every missing or unfinished shard, in one message, with the command that completes it.
+    // Every missing or unfinished shard, in one message, with the command that completes it: a
+    // shard's own recorded command line, else the scene and folder with the options left to the user.
     std::vector<std::string> problems;
-    const std::string scene = quoted(sceneFile.empty() ? std::string("SCENE") : sceneFile);
+    const std::string scene = quoteArg(sceneFile.empty() ? std::string("SCENE") : sceneFile);
+    const std::vector<std::string> recorded = recordedShardCommand(merged.shardDirs);
+    auto command = [&](int k, bool resume) {
+        const std::string c = shardCommandText(recorded, {k, merged.shardCount}, resume);
+        if (!c.empty()) return "`" + c + "`";
+        return "`shadowlab path " + scene + " -o " + quoteArg(base.string()) + " --shard " + std::to_string(k) + "/" +
+               std::to_string(merged.shardCount) + (resume ? " --resume" : "") + "` and the same path options";
+    };
     for (int k = 0; k < merged.shardCount; ++k) {
         const std::vector<int> want = pathShardFrames(frames, k, merged.shardCount);
         std::size_t missing = 0;
@@ -900,13 +914,10 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
         const std::string name = std::to_string(k) + "/" + std::to_string(merged.shardCount);
         if (!shardOf.count(k))
             problems.push_back("shard " + name + " is missing (no " + shardFolderName({k, merged.shardCount}) +
-                               "): render it with `shadowlab path " + scene + " -o " + quoted(base.string()) +
-                               " --shard " + name + "` and the same path options");
+                               "): render it with " + command(k, false));
         else
             problems.push_back("shard " + name + " is unfinished (" + std::to_string(missing) + " of " +
-                               std::to_string(want.size()) + " frames missing): finish it with `shadowlab path " +
-                               scene + " -o " + quoted(base.string()) + " --shard " + name +
-                               " --resume` and the same path options");
+                               std::to_string(want.size()) + " frames missing): finish it with " + command(k, true));
     }
     if (!problems.empty()) {
         std::string what = "merge: the path is incomplete:";
@@ -957,7 +968,7 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
     result.amount = manifest.at("amount").get<double>();
     result.spec.amount = result.amount;
     result.frames = frames;
-    result.resumedFrames = frames;
+    result.resumedFrames = 0;  // a merge renders nothing, so nothing was resumed
     measurePath(result, out, sceneFile, names, setupMs, times);
     return merged;
 }

@@ -106,6 +106,10 @@ nlohmann::json toJson(const PathResult& result);
 // The frames shard K of N renders: t with t mod N = K, in order (none when K ≥ frames).
 std::vector<int> pathShardFrames(int frames, int index, int count);
 
+// A path's progress line after `frame` (0-based) of `frames`: "frame 5/12, ETA 1m05s", and for a
+// shard (shardFrames > 0) "frame 11/12 (6 of 6 in this shard), ETA 0m00s".
+std::string pathProgressLine(int frame, int frames, std::size_t shardDone, std::size_t shardFrames, double secondsLeft);
+
 // True when the inputs hold shards of a path (a shard.json naming a path study).
 bool holdsPathShards(const std::vector<std::filesystem::path>& inputs);
 

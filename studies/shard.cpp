@@ -156,8 +156,82 @@ std::string identityDifference(const SweepIdentity& a, const SweepIdentity& b) {
     return "";
 }
 
+namespace {
+std::vector<std::string>& processCommandLine() {
+    static std::vector<std::string> line;
+    return line;
+}
+}  // namespace
+
+void setCommandLine(std::vector<std::string> arguments) { processCommandLine() = std::move(arguments); }
+const std::vector<std::string>& commandLine() { return processCommandLine(); }
+
+std::vector<std::string> recordedShardCommand(const std::vector<fs::path>& dirs) {
+    for (const fs::path& d : dirs) {
+        std::ifstream in(d / "shard.json");
+        const Json j = Json::parse(in, nullptr, false);
+        if (!j.is_object() || !j.contains("command") || !j["command"].is_array()) continue;
+        std::vector<std::string> out;
+        for (const Json& a : j["command"])
+            if (a.is_string()) out.push_back(a.get<std::string>());
+        if (!out.empty()) return out;
+    }
+    return {};
+}
+
+std::string shardCommandText(const std::vector<std::string>& command, const Shard& shard, bool resume) {
+    const std::string value = std::to_string(shard.index) + "/" + std::to_string(shard.count);
+    std::string text = "shadowlab";
+    bool named = false;
+    for (std::size_t i = 1; i < command.size(); ++i) {
+        const std::string& a = command[i];
+        if (a == "--resume") continue;
+        if (a == "--shard" && i + 1 < command.size()) {
+            text += " --shard " + value;
+            named = true;
+            ++i;
+        } else if (a.rfind("--shard=", 0) == 0) {
+            text += " --shard=" + value;
+            named = true;
+        } else {
+            text += " " + quoteArg(a);
+        }
+    }
+    if (command.empty() || !named) return "";
+    return resume ? text + " --resume" : text;
+}
+
+std::string quoteArg(const std::string& s) {
+    if (!s.empty() && s.find_first_of(" \t'\"$\\`;&|<>()*?#~") == std::string::npos) return s;
+    std::string q = "'";
+    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+void placeFile(const fs::path& src, const fs::path& dst) {
+    std::error_code ec;
+    if (fs::exists(dst, ec) && fs::equivalent(src, dst, ec)) return;
+    fs::create_directories(dst.parent_path());
+    const fs::path tmp = scene::temporarySibling(dst);
+    fs::create_hard_link(src, tmp, ec);
+    if (ec) {
+        ec.clear();
+        fs::copy_file(src, tmp, fs::copy_options::overwrite_existing, ec);
+        if (ec) {
+            fs::remove(tmp, ec);
+            throw scene::InputError(dst.string() + ": cannot copy " + src.string() + " here");
+        }
+    }
+    fs::rename(tmp, dst, ec);
+    if (ec) {
+        fs::remove(tmp, ec);
+        throw scene::InputError(dst.string() + ": cannot write");
+    }
+}
+
 Json shardManifest(const SweepIdentity& id, const Shard& shard) {
     return {{"program", "shadowlab"},
+            {"command", commandLine()},
             {"version", id.version},
             {"scene", id.scene},
             {"scene_hash", id.sceneHash},

@@ -58,6 +58,22 @@ std::string fileHash(const std::filesystem::path& file);
 // scene file or mesh)"); empty when they are of one sweep.
 std::string identityDifference(const SweepIdentity& a, const SweepIdentity& b);
 
+// This process's command line (main sets it), recorded as "command" in every shard manifest so
+// that merge can name the exact command that renders a missing or unfinished shard.
+void setCommandLine(std::vector<std::string> arguments);
+const std::vector<std::string>& commandLine();
+// The "command" recorded in the first of `dirs`' shard.json that has one; empty when none does.
+std::vector<std::string> recordedShardCommand(const std::vector<std::filesystem::path>& dirs);
+// `command` (a shard's recorded command line) for `shard`: its --shard value replaced, --resume
+// dropped or added, the program named "shadowlab", each argument quoted for a POSIX shell; empty
+// when `command` is, or names no --shard.
+std::string shardCommandText(const std::vector<std::string>& command, const Shard& shard, bool resume);
+// `s` quoted for a POSIX shell when it is empty or holds a character the shell reads specially.
+std::string quoteArg(const std::string& s);
+// Links src to dst (same file system) or copies it, through a temporary name; creates dst's
+// folder. Throws scene::InputError naming dst when it cannot.
+void placeFile(const std::filesystem::path& src, const std::filesystem::path& dst);
+
 // DIR/shard-K-of-N/shard.json.
 nlohmann::json shardManifest(const SweepIdentity& identity, const Shard& shard);
 // Throws scene::InputError naming the file and the field when the manifest is not one.

@@ -17,6 +17,7 @@
 #include "scene/error.h"
 #include "scene/loader.h"
 #include "studies/path.h"
+#include "studies/shard.h"
 #include "studies/sweep.h"
 #include "tests/kit/render_checked.h"
 #include "tests/kit/test_scenes.h"
@@ -146,6 +147,25 @@ TEST(PathShards, MergedShardsMeasureExactlyWhatTheUnshardedPathMeasures) {
     EXPECT_EQ(measured(again.result).dump(1), measured(unsharded).dump(1));
 }
 
+TEST(PathShards, ProgressCountsTheShardsOwnFramesWithTheTimeLeft) {
+    EXPECT_EQ(pathProgressLine(4, 12, 5, 0, 65.4), "frame 5/12, ETA 1m05s");
+    EXPECT_EQ(pathProgressLine(10, 12, 6, 6, 0.0), "frame 11/12 (6 of 6 in this shard), ETA 0m00s");
+    // Shard 1 of 2 of a five-frame path renders frames 1 and 3: its lines count 1 and 2 of 2.
+    const scene::Scene base = slantedSphere(24, 16);
+    PathSpec spec;
+    spec.kind = PathKind::SunAzimuth;
+    spec.frames = 5;
+    const TempFolder dir("path-progress");
+    PathRunOptions o = shardOptions(dir.path, 1, 2);
+    o.raster = false;
+    std::vector<std::string> lines;
+    o.progress = [&](const std::string& line) { lines.push_back(line); };
+    runPath(base, settingsFor(base, 64), spec, o);
+    ASSERT_EQ(lines.size(), 2u);
+    EXPECT_EQ(lines[0].rfind("frame 2/5 (1 of 2 in this shard), ETA ", 0), 0u) << lines[0];
+    EXPECT_EQ(lines[1], "frame 4/5 (2 of 2 in this shard), ETA 0m00s");
+}
+
 TEST(PathShards, AShardOfAnotherPathIsRefusedAndAMissingOrUnfinishedShardIsNamed) {
     const scene::Scene base = slantedSphere(32, 18);
     const scene::RenderSettings settings = settingsFor(base, 64);
@@ -154,14 +174,20 @@ TEST(PathShards, AShardOfAnotherPathIsRefusedAndAMissingOrUnfinishedShardIsNamed
     spec.frames = 3;
     const TempFolder dir("path-refuse");
     runPath(base, settings, spec, shardOptions(dir.path, 0, 3));
+    // Shard 2 recorded the command line it was run with (main does this): merge repeats it.
+    setCommandLine(
+        {"shadowlab", "path", "s.json", "--kind", "sun-azimuth", "--frames", "3", "--shard", "2/3", "-o", "d"});
     runPath(base, settings, spec, shardOptions(dir.path, 2, 3));
+    setCommandLine({});
     try {
         mergePathShards({dir.path}, dir.path);
         FAIL() << "merged without shard 1";
     } catch (const scene::InputError& e) {
         const std::string what = e.what();
         EXPECT_NE(what.find("shard 1/3 is missing"), std::string::npos) << what;
-        EXPECT_NE(what.find("--shard 1/3"), std::string::npos) << what;
+        EXPECT_NE(what.find("render it with `shadowlab path s.json --kind sun-azimuth --frames 3 --shard 1/3 -o d`"),
+                  std::string::npos)
+            << what;
     }
     EXPECT_FALSE(fs::exists(dir.path / "metrics.json"));  // nothing written
     // Shard 1 started but its only frame's journal line is torn: unfinished, finished with --resume.

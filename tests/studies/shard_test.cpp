@@ -192,6 +192,25 @@ TEST(ShardSplit, ParsesKOfNAndRejectsWhatIsNot) {
     EXPECT_EQ(shardFolderName({2, 4}), "shard-2-of-4");
 }
 
+TEST(ShardCommand, ReplacesTheShardKeepsEveryOtherArgumentAndQuotesForAShell) {
+    const std::vector<std::string> cmd = {
+        "/opt/bin/shadowlab", "sweep", "my scene.gltf", "--grid", "g.json", "--shard", "0/4", "-o", "out", "--resume"};
+    EXPECT_EQ(shardCommandText(cmd, {3, 4}, false), "shadowlab sweep 'my scene.gltf' --grid g.json --shard 3/4 -o out");
+    EXPECT_EQ(shardCommandText(cmd, {1, 4}, true),
+              "shadowlab sweep 'my scene.gltf' --grid g.json --shard 1/4 -o out --resume");
+    EXPECT_EQ(shardCommandText({"shadowlab", "path", "s.json", "--shard=2/3", "-o", "p"}, {0, 3}, false),
+              "shadowlab path s.json --shard=0/3 -o p");
+    // Nothing to go on: no command, or one without --shard.
+    EXPECT_EQ(shardCommandText({}, {0, 2}, false), "");
+    EXPECT_EQ(shardCommandText({"shadowlab", "sweep", "s.json", "-o", "x"}, {0, 2}, false), "");
+    // What a POSIX shell reads specially is quoted; a quote inside is closed, escaped, reopened.
+    EXPECT_EQ(quoteArg("plain/path-1.json"), "plain/path-1.json");
+    EXPECT_EQ(quoteArg(""), "''");
+    EXPECT_EQ(quoteArg("a$b"), "'a$b'");
+    EXPECT_EQ(quoteArg("it's"), "'it'\\''s'");
+    EXPECT_EQ(quoteArg("x;rm"), "'x;rm'");
+}
+
 TEST(ShardMerge, EqualsTheUnshardedRunAndRendersTheReferenceOnce) {
     Folder f;
     const scene::Scene scene = scene::loadScene(writeScene(f.path / "scene"));
@@ -308,9 +327,26 @@ TEST(ShardMerge, NamesAMissingShardAndAnUnfinishedOneWithTheCommandsThatComplete
     std::ofstream(journal, std::ios::binary) << first;
     const std::string e = errorOf([&] { readShards({f.path / "s"}); });
     EXPECT_NE(e.find("shard 1/3 is missing"), std::string::npos) << e;
-    EXPECT_NE(e.find("--shard 1/3`"), std::string::npos) << e;
+    EXPECT_NE(e.find("--shard 1/3` and the same grid options"), std::string::npos) << e;
     EXPECT_NE(e.find("shard 2/3 is unfinished (2 of 3 rows missing)"), std::string::npos) << e;
     EXPECT_NE(e.find("--shard 2/3 --resume"), std::string::npos) << e;
+
+    // A shard that recorded its command line: the message repeats it, grid options and all.
+    setCommandLine({"shadowlab", "sweep", "scene.json", "--grid", "my grid.json", "--shard", "2/3", "-o", "s"});
+    runShard(scene, g, {2, 3}, [&] {
+        SweepOptions r = options(f.path / "s", fake);
+        r.resume = true;
+        return r;
+    }());
+    std::ofstream(journal, std::ios::binary) << first;  // stopped after its first row again
+    setCommandLine({});
+    const std::string named = errorOf([&] { readShards({f.path / "s"}); });
+    EXPECT_NE(named.find("render it with `shadowlab sweep scene.json --grid 'my grid.json' --shard 1/3 -o s`"),
+              std::string::npos)
+        << named;
+    EXPECT_NE(named.find("finish it with `shadowlab sweep scene.json --grid 'my grid.json' --shard 2/3 -o s --resume`"),
+              std::string::npos)
+        << named;
 
     // The unfinished shard resumed renders only its two missing rows; then the merge is whole.
     SweepOptions o = options(f.path / "s", fake);
