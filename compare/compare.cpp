@@ -508,11 +508,19 @@ Comparison compareFrames(const Frame& method, const Frame& reference, const Comp
             const double e = std::fabs(double(vm) - double(vr));
             sumAbs += e;
             m.maxAbsVisibilityError = std::max(m.maxAbsVisibilityError, e);
-            if (isPenumbra(vr)) {
+            // With several lights a point in one light's shadow has a fractional combined V: the
+            // penumbra is where some light's own visibility is partial.
+            bool refPenumbra = lightSum.empty() && isPenumbra(vr);
+            for (std::size_t l = 0; l < lightSum.size() && !refPenumbra; ++l)
+                refPenumbra = isPenumbra(reference.lightVisibility[l][i]);
+            if (refPenumbra) {
                 ++m.penumbraPixels;
                 sumAbsPenumbra += e;
             }
-            if (e > kSoftErrorTolerance && e <= kVisibilityTolerance) ++m.softErrorPixels;
+            if (e > kSoftErrorTolerance && e <= kVisibilityTolerance) {
+                ++m.softErrorPixels;
+                if (nearEdge[i]) ++m.softErrorNearEdge;
+            }
             const auto heat = heatColor(float(e));
             std::copy(heat.begin(), heat.end(), out.heatRgb.begin() + 3 * std::ptrdiff_t(i));
             for (std::size_t l = 0; l < lightSum.size(); ++l) {
@@ -525,6 +533,11 @@ Comparison compareFrames(const Frame& method, const Frame& reference, const Comp
                     lightPenumbraSum[l] += el;
                 }
                 if (el > kSoftErrorTolerance && el <= kVisibilityTolerance) ++le.softErrorPixels;
+                if (std::isfinite(lm) && std::isfinite(lr)) {
+                    const PixelClass lc = classifyCounted(lm, lr);
+                    le.falseShadow += lc == PixelClass::FalseShadow;
+                    le.missedShadow += lc == PixelClass::MissedShadow;
+                }
                 const auto lh = heatColor(float(el));
                 std::copy(lh.begin(), lh.end(), out.lightHeatRgb[l].begin() + 3 * std::ptrdiff_t(i));
             }
@@ -653,6 +666,7 @@ nlohmann::json toJson(const Metrics& m) {
         {"soft_error_pixels", m.softErrorPixels},
         {"soft_error_rate", m.softErrorRate},
         {"soft_error_tolerance", kSoftErrorTolerance},
+        {"soft_error_near_edge", m.softErrorNearEdge},
         {"shadowed_method", m.shadowedMethod},
         {"shadowed_reference", m.shadowedReference},
         {"shadowed_intersection", m.shadowedIntersection},
@@ -687,7 +701,9 @@ nlohmann::json toJson(const Metrics& m) {
                           {"mean_abs_visibility_error", l.meanAbsVisibilityError},
                           {"penumbra_pixels", l.penumbraPixels},
                           {"mean_abs_visibility_error_penumbra", l.meanAbsVisibilityErrorPenumbra},
-                          {"soft_error_pixels", l.softErrorPixels}});
+                          {"soft_error_pixels", l.softErrorPixels},
+                          {"false_shadow", l.falseShadow},
+                          {"missed_shadow", l.missedShadow}});
     j["per_light"] = lights;
     // Without blocker ids self-shadow acne is unknown, not zero.
     if (m.hasBlockerIds) {
@@ -719,7 +735,15 @@ nlohmann::json toJson(const Metrics& m) {
 }
 
 bool softErrorDominates(const Metrics& m) {
-    return m.softErrorRate > kNotableSoftErrorRate && m.softErrorPixels > m.falseShadow + m.missedShadow;
+    const std::size_t away = m.softErrorPixels - std::min(m.softErrorPixels, m.softErrorNearEdge);
+    return m.counted > 0 && double(away) / double(m.counted) > kNotableSoftErrorRate &&
+           away > m.falseShadow + m.missedShadow;
+}
+
+std::size_t perLightWrong(const Metrics& m) {
+    std::size_t n = 0;
+    for (const LightError& l : m.perLight) n += l.falseShadow + l.missedShadow;
+    return n;
 }
 
 std::string summaryLine(const Metrics& m) {
@@ -729,19 +753,27 @@ std::string summaryLine(const Metrics& m) {
          formatFixed(m.shadowIoU, 3) + ", mean |dV| " + formatFixed(m.meanAbsVisibilityError, 4) + " (penumbra " +
          formatFixed(m.meanAbsVisibilityErrorPenumbra, 3) + " over " + formatCount(m.penumbraPixels) +
          " px), off by > " + formatFixed(kSoftErrorTolerance, 2) + " within tau " + formatCount(m.softErrorPixels) +
-         " px (" + formatPercent(m.softErrorRate) + "), silhouette " + formatPercent(m.silhouetteMismatchRate) +
-         ", run time " + formatRunTime(m.methodTiming.totalMs) + " (reference " +
-         formatRunTime(m.referenceTiming.totalMs) + ")";
+         " px (" + formatPercent(m.softErrorRate) + ", " + formatCount(m.softErrorNearEdge) +
+         " at shadow edges), silhouette " + formatPercent(m.silhouetteMismatchRate) + ", run time " +
+         formatRunTime(m.methodTiming.totalMs) + " (reference " + formatRunTime(m.referenceTiming.totalMs) + ")";
     const std::size_t bad = m.methodHealth.total() + m.referenceHealth.total();
     if (bad > 0)
         s += ", NON-FINITE values: method " + formatCount(m.methodHealth.total()) + ", reference " +
              formatCount(m.referenceHealth.total());
     // Filtered acne and wrong penumbrae stay under tau: where they outnumber the wrong pixels the
     // mismatch and the IoU read clean while the image is not, so the line says so.
+    const std::size_t lightWrong = perLightWrong(m);
+    const bool lightsHide = m.perLight.size() > 1 && lightWrong > m.falseShadow + m.missedShadow;
     if (softErrorDominates(m))
-        s += "; SOFT ERROR dominates: " + formatPercent(m.softErrorRate) +
-             " of the counted pixels are partly wrong (filtered acne, a penumbra of the wrong width), more than "
-             "the mismatch counts: judge this frame by mean |dV|";
+        s += "; SOFT ERROR dominates: " +
+             formatPercent(double(m.softErrorPixels - m.softErrorNearEdge) / double(m.counted)) +
+             " of the counted pixels are partly wrong away from the shadow edges (" +
+             (lightsHide ? "one light's shadow wrong where another still reaches"
+                         : "filtered acne, a penumbra of the wrong width") +
+             "), more than the mismatch counts: judge this frame by mean |dV|";
+    if (lightsHide)
+        s += "; PER LIGHT " + formatCount(lightWrong) + " px wrong outright in the lights' own channels, more than " +
+             "the combined mask's " + formatCount(m.falseShadow + m.missedShadow);
     return s;
 }
 

@@ -95,6 +95,9 @@ struct LightError {
     std::size_t penumbraPixels = 0;
     double meanAbsVisibilityErrorPenumbra = 0.0;
     std::size_t softErrorPixels = 0;
+    // Counted pixels whose own channel crosses τ: this light's shadow wrong outright, which the
+    // combined visibility may not count where another light still reaches the point.
+    std::size_t falseShadow = 0, missedShadow = 0;
 };
 
 struct Metrics {
@@ -181,7 +184,10 @@ struct Metrics {
     double meanAbsVisibilityErrorPenumbra = 0.0;  // mean |V_M − V_R| over them; 0 when none
     // Counted pixels with kSoftErrorTolerance < |V_M − V_R| ≤ τ: wrong, but agreeing in class.
     std::size_t softErrorPixels = 0;
-    double softErrorRate = 0.0;        // over counted
+    double softErrorRate = 0.0;  // over counted
+    // Of softErrorPixels, those within edgeRadius of the reference's shadow edges: a filter's blur
+    // of a hard edge (pcf2x2 softens every edge by a texel), not a wrong penumbra or banding.
+    std::size_t softErrorNearEdge = 0;
     std::vector<LightError> perLight;  // one per light when both frames have per-light channels
 
     std::string methodBackend, referenceBackend;  // Frame attribute "backend", if any
@@ -230,9 +236,14 @@ std::array<float, 3> heatColor(float absError);
 Comparison compareFrames(const scene::Frame& method, const scene::Frame& reference, const CompareOptions& options = {});
 
 nlohmann::json toJson(const Metrics& metrics);
-// True when the pixels off by more than kSoftErrorTolerance without crossing τ are a notable share
-// (kNotableSoftErrorRate) and outnumber the wrong ones: the classes then understate the error.
+// True when the pixels off by more than kSoftErrorTolerance without crossing τ away from the
+// reference's shadow edges are a notable share (kNotableSoftErrorRate) and outnumber the wrong
+// ones: the classes then understate the error. (At the edges it is the filter's blur.)
 bool softErrorDominates(const Metrics& metrics);
+// The pixels wrong outright in each light's own channel, summed over the lights (0 without
+// per-light channels): more than the combined mask's wrong pixels when one light's shadow is lost
+// or added where another light still reaches the point.
+std::size_t perLightWrong(const Metrics& metrics);
 // One line for a terminal, e.g.
 // "counted 301234 px: false shadow 0.82% (self acne 0.80%), missed 0.10%, IoU 0.981, ...", ending
 // in "SOFT ERROR dominates: ..." where softErrorDominates.

@@ -94,18 +94,34 @@ std::string describeContinuous(const Metrics& m) {
     if (m.softErrorPixels > 0) {
         s += " " + formatCount(m.softErrorPixels) + " px (" + formatPercent(m.softErrorRate) +
              ") are off by more than " + formatShort(kSoftErrorTolerance) + " without crossing τ";
-        if (m.softErrorRate <= kNotableSoftErrorRate)
+        if (m.softErrorNearEdge > 0)
+            s += " (" + formatCount(m.softErrorNearEdge) + " of them within " + std::to_string(m.edgeRadius) +
+                 " px of the reference's shadow edges, where a filter blurs a hard edge)";
+        if (m.softErrorRate <= kNotableSoftErrorRate || m.softErrorNearEdge == m.softErrorPixels)
             s += ".";
         else
             s += softErrorDominates(m) ? ": soft-shadow error dominates, and the mismatch rate does not show it."
                                        : ": soft-shadow error beside the wrong pixels.";
     }
+    const std::size_t lightWrong = perLightWrong(m);
+    if (m.perLight.size() > 1 && lightWrong > m.falseShadow + m.missedShadow)
+        s += " Per light, " + formatCount(lightWrong) + " px are wrong outright, more than the " +
+             formatCount(m.falseShadow + m.missedShadow) +
+             " the combined visibility counts: where one light's shadow is lost or added, another light still "
+             "reaches the point and the combined value moves by less than τ, so judge each light by its own "
+             "channel.";
     for (const LightError& l : m.perLight)
-        if (l.softErrorPixels > 0 || l.meanAbsVisibilityErrorPenumbra > kSoftErrorTolerance)
+        if (l.softErrorPixels > 0 || l.falseShadow + l.missedShadow > 0 ||
+            l.meanAbsVisibilityErrorPenumbra > kSoftErrorTolerance)
             s += " Light " + std::to_string(l.light) + ": mean |ΔV| " + formatFixed(l.meanAbsVisibilityError, 4) +
                  (l.penumbraPixels ? ", " + formatFixed(l.meanAbsVisibilityErrorPenumbra, 3) + " over its penumbra"
                                    : "") +
-                 ", " + formatCount(l.softErrorPixels) + " px off by more than " + formatShort(kSoftErrorTolerance) +
+                 (l.falseShadow + l.missedShadow > 0 ? ", " + formatCount(l.falseShadow) + " px false shadow and " +
+                                                           formatCount(l.missedShadow) + " px missed in its own channel"
+                                                     : "") +
+                 (l.softErrorPixels > 0 ? ", " + formatCount(l.softErrorPixels) + " px off by more than " +
+                                              formatShort(kSoftErrorTolerance) + " within τ"
+                                        : "") +
                  ".";
     return s;
 }
@@ -132,19 +148,30 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
         s = who +
             " has no pixel to compare: no visible point faces the light in both frames "
             "on the same object.";
-    } else if (m.falseShadow + m.missedShadow == 0 && m.softErrorRate <= kNotableSoftErrorRate) {
+    } else if (m.falseShadow + m.missedShadow == 0 && perLightWrong(m) == 0 &&
+               double(m.softErrorPixels - m.softErrorNearEdge) <= kNotableSoftErrorRate * double(m.counted)) {
         s = who + " matches the reference on all " + formatCount(m.counted) + " counted pixels (mean |ΔV| " +
-            formatFixed(m.meanAbsVisibilityError, 4) + ").";
+            formatFixed(m.meanAbsVisibilityError, 4) + ")";
+        s += m.softErrorNearEdge > 0
+                 ? " but for its filter's blur along the shadow edges (" + formatCount(m.softErrorNearEdge) +
+                       " px off by more than " + formatShort(kSoftErrorTolerance) + " there, within τ)."
+                 : ".";
     } else if (m.falseShadow + m.missedShadow == 0) {
         s = who + " has no pixel wrong by more than τ = " + formatShort(kVisibilityTolerance) + " among the " +
-            formatCount(m.counted) + " counted pixels, so the classes call it agreement, but it does not match.";
+            formatCount(m.counted) + " counted pixels, so the classes call it agreement, but it does not match" +
+            (m.perLight.size() > 1 && perLightWrong(m) > 0
+                 ? ": one light's shadow is wrong outright where another light still reaches the point."
+                 : ".");
     } else {
         s = softErrorDominates(m)
                 // Lead with what a viewer sees: partial darkening under τ outnumbers the wrong pixels.
                 ? who + " is partly wrong on " + formatPercent(m.softErrorRate) + " of the " + formatCount(m.counted) +
                       " counted pixels (off by more than " + formatShort(kSoftErrorTolerance) +
-                      " without crossing τ: filtered acne, or a penumbra of the wrong width), which the mismatch "
-                      "rate does not count; outright it disagrees with the reference on " +
+                      " without crossing τ: " +
+                      (m.perLight.size() > 1 && perLightWrong(m) > m.falseShadow + m.missedShadow
+                           ? "one light's shadow wrong outright where another light still reaches the point"
+                           : "filtered acne, or a penumbra of the wrong width") +
+                      "), which the mismatch rate does not count; outright it disagrees with the reference on " +
                       formatPercent(m.mismatchRate) + ": "
                 : who + " disagrees with the reference on " + formatPercent(m.mismatchRate) + " of the " +
                       formatCount(m.counted) + " counted pixels: ";

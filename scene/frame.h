@@ -43,7 +43,8 @@ struct Frame {
     std::vector<float> beauty;      // linear RGB, 3 floats per pixel
     std::vector<float> visibility;  // 0..1, 1 = fully lit; the shadow test before shading
     std::vector<float> objectId;    // 0 = background, else object index + 1 (exact up to 2^24)
-    std::vector<float> ndotl;       // N·L at the primary hit (max over lights), 0 on background
+    std::vector<float> ndotl;       // N·L at the primary hit (max over the lights that reach it; -1 where none
+                                    // does), 0 on background
     std::vector<float> depth;       // view depth along the camera's forward axis, 0 on background
     // Object id (index + 1) of the first blocker the shadow test found, 0 = none. Empty when
     // the backend cannot tell.

@@ -905,7 +905,9 @@ void main() {
             irradiance = 1.0;
         }
         const float ndotl = dot(n, l);
-        maxNdotL = max(maxNdotL, ndotl);
+        // A light that does not reach the point (outside a spot's cone) has no N·L to give: where
+        // none reaches, ndotl stays -1 and compare counts the pixel as it counts a back face.
+        maxNdotL = max(maxNdotL, irradiance > 0.0 ? ndotl : -1.0);
         // No light (N·L <= 0, outside a spot's cone): visibility 0, weight 0. (An if, not a
         // continue, so that the loop unrolls.)
         if (ndotl > 0.0 && irradiance > 0.0) {

@@ -31,9 +31,11 @@ Measured measure(const scene::Frame& method, const scene::Frame& reference);
 // The search's order: a is strictly better than b with less mismatch, or as much and less mean
 // |ΔV|. A failed measurement is never better.
 bool better(const Measured& a, const Measured& b);
-// A candidate replaces the defaults only when it is better AND its mean |ΔV| is no larger: with a
-// filter, a bias can trade a few wrong pixels for a wide band of partial acne the classes do not
-// see (mean |ΔV| many times the defaults'), which must not count as a gain.
+// A candidate replaces the defaults only when neither its mismatch nor its mean |ΔV| is larger
+// (with a filter, a bias can trade a few wrong pixels for a wide band of partial acne the classes
+// do not see, which must not count as a gain) AND one of them falls by a tenth and by at least
+// kMaterialGain (a rate, or a mean |ΔV|): less is sampling noise, not a reason to change settings.
+inline constexpr double kMaterialGain = 1e-4;
 bool beats(const Measured& candidate, const Measured& defaults);
 
 // One searched raster point. `defaults` is the user's configuration untouched: its biases are

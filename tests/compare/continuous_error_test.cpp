@@ -144,6 +144,83 @@ TEST(ContinuousError, PerLightChannelsGiveEachLightsOwnError) {
     EXPECT_EQ(toJson(c.metrics)["per_light"].size(), 2u);
 }
 
+TEST(ContinuousError, OneLightsLostShadowWhereAnotherLightStillReachesIsNamedPerLight) {
+    // Two hard lights of equal weight on 4×1: the reference has light 0 blocked (combined V 0.5),
+    // the method lost that shadow (combined 1). |ΔV| = 0.5 is not beyond τ, so the combined mask
+    // counts no wrong pixel; light 0's own channel misses all 4. Neither light has a penumbra.
+    Frame m = Frame::allocate(4, 1, false), r = Frame::allocate(4, 1, false);
+    m.lightVisibility.assign(2, std::vector<float>(4, 1.0f));
+    r.lightVisibility.assign(2, std::vector<float>(4, 1.0f));
+    for (int i = 0; i < 4; ++i) {
+        m.objectId[i] = r.objectId[i] = 1.0f;
+        m.ndotl[i] = r.ndotl[i] = 1.0f;
+        r.lightVisibility[0][i] = 0.0f;
+        r.visibility[i] = 0.5f;
+        m.visibility[i] = 1.0f;
+        for (int ch = 0; ch < 3; ++ch) r.beauty[3 * i + ch] = m.beauty[3 * i + ch] = 0.3f;
+    }
+    const Metrics mt = compareFrames(m, r).metrics;
+    EXPECT_EQ(mt.missedShadow, 0u);
+    EXPECT_EQ(mt.penumbraPixels, 0u);
+    ASSERT_EQ(mt.perLight.size(), 2u);
+    EXPECT_EQ(mt.perLight[0].missedShadow, 4u);
+    EXPECT_EQ(mt.perLight[0].falseShadow, 0u);
+    EXPECT_EQ(mt.perLight[1].missedShadow + mt.perLight[1].falseShadow, 0u);
+    EXPECT_EQ(perLightWrong(mt), 4u);
+    EXPECT_EQ(toJson(mt)["per_light"][0]["missed_shadow"], 4);
+    ReportInput in;
+    in.methods.push_back({"raster", "raster.png", "diff-raster.png", m, mt});
+    const std::string text = describeFindings(in);
+    EXPECT_EQ(text.find("matches the reference"), std::string::npos) << text;
+    EXPECT_NE(text.find("Per light, 4 px are wrong outright, more than the 0 the combined visibility counts"),
+              std::string::npos)
+        << text;
+    EXPECT_NE(text.find("0 px false shadow and 4 px missed in its own channel"), std::string::npos) << text;
+    EXPECT_NE(text.find("one light's shadow is wrong outright where another light still reaches the point"),
+              std::string::npos)
+        << text;
+    EXPECT_NE(summaryLine(mt).find("PER LIGHT 4 px wrong outright"), std::string::npos) << summaryLine(mt);
+}
+
+TEST(ContinuousError, AFiltersBlurOfAHardEdgeIsNotSoftErrorThatDominates) {
+    // 40×20 on one lit object: the reference is 0 left of x = 20 and 1 from it (a hard edge); the
+    // method blurs the two columns beside the edge to 0.3 and 0.7, as a 2×2 PCF does: 40 soft-error
+    // pixels (5%), all at the edge.
+    const int w = 40, h = 20;
+    Frame r = Frame::allocate(w, h, false);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const std::size_t i = std::size_t(y) * w + x;
+            r.objectId[i] = 1.0f;
+            r.ndotl[i] = 0.5f;
+            r.visibility[i] = x < 20 ? 0.0f : 1.0f;
+            for (int ch = 0; ch < 3; ++ch) r.beauty[3 * i + ch] = 0.3f;
+        }
+    Frame blurred = r, banded = r;
+    for (int y = 0; y < h; ++y) {
+        blurred.visibility[std::size_t(y) * w + 19] = 0.3f;
+        blurred.visibility[std::size_t(y) * w + 20] = 0.7f;
+        banded.visibility[std::size_t(y) * w + 30] = 0.7f;  // ten pixels into the light: not the edge's
+        banded.visibility[std::size_t(y) * w + 31] = 0.7f;
+    }
+    const Metrics mb = compareFrames(blurred, r).metrics;
+    EXPECT_EQ(mb.softErrorPixels, 40u);
+    EXPECT_EQ(mb.softErrorNearEdge, 40u);
+    EXPECT_FALSE(softErrorDominates(mb));
+    EXPECT_EQ(summaryLine(mb).find("SOFT ERROR"), std::string::npos) << summaryLine(mb);
+    ReportInput in;
+    in.methods.push_back({"raster", "raster.png", "diff-raster.png", blurred, mb});
+    const std::string text = describeFindings(in);
+    EXPECT_NE(text.find("matches the reference on all 800 counted pixels"), std::string::npos) << text;
+    EXPECT_NE(text.find("but for its filter's blur along the shadow edges (40 px"), std::string::npos) << text;
+    // The same count of soft error away from the edge dominates.
+    const Metrics ma = compareFrames(banded, r).metrics;
+    EXPECT_EQ(ma.softErrorPixels, 40u);
+    EXPECT_EQ(ma.softErrorNearEdge, 0u);
+    EXPECT_TRUE(softErrorDominates(ma));
+    EXPECT_NE(summaryLine(ma).find("SOFT ERROR dominates: 5.00%"), std::string::npos) << summaryLine(ma);
+}
+
 TEST(ContinuousError, FindingsNameSoftShadowErrorWhenItDominatesAndDoNotSayAgree) {
     const auto [m, r] = penumbraPair(8, 4, 0.375f);
     ReportInput in;

@@ -90,6 +90,40 @@ TEST(ReferenceRender, TwoLightsKeepEachLightsVisibilityAndCombineThem) {
                     .lightVisibility.empty());
 }
 
+TEST(ReferenceRender, APointOutsideEverySpotsConeHasNoNdotLSoCompareLeavesItOut) {
+    // The seed's light made a spot 4 above the plane pointing down, cone 25°: plane points at an
+    // angle past the cone get no light, so ndotl is -1 there (as on a back face); inside it ndotl
+    // is the closed-form N·L toward the spot.
+    scene::Scene s = test::seedScene();
+    const Vec3 spot(0.3, 4.0, 0.2);
+    s.lights[0].type = scene::LightType::Spot;
+    s.lights[0].position = spot;
+    s.lights[0].direction = Vec3(0, -1, 0);
+    s.lights[0].coneAngleDegrees = 25.0;
+    s.lights[0].intensity = 100.0;
+    const scene::Frame f = renderReference(s, test::planFor(s), test::biasSettings(0, scene::Precision::Double));
+    const double cosCone = std::cos(25.0 * 3.14159265358979323846 / 180.0);
+    int outside = 0, inside = 0;
+    for (int y = 0; y < f.height; ++y)
+        for (int x = 0; x < f.width; ++x) {
+            const std::size_t i = std::size_t(y) * f.width + x;
+            const Analytic a = test::analyticPixel(s, {}, x, y);
+            if (a.kind != Analytic::Plane || f.objectId[i] != 2.0f) continue;
+            const Vec3 toLight = glm::normalize(spot - a.p);
+            const double cosAngle = toLight.y;  // dot(-toLight, (0, -1, 0)): the angle off the axis
+            if (cosAngle < cosCone - 0.01) {
+                ++outside;
+                ASSERT_EQ(f.ndotl[i], -1.0f) << "pixel " << x << "," << y;
+                ASSERT_EQ(f.visibility[i], 0.0f) << "pixel " << x << "," << y;
+            } else if (cosAngle > cosCone + 0.01) {
+                ++inside;
+                ASSERT_NEAR(f.ndotl[i], toLight.y, 1e-4) << "pixel " << x << "," << y;
+            }
+        }
+    EXPECT_GT(outside, 1000);
+    EXPECT_GT(inside, 1000);
+}
+
 // Counts plane pixels that are lit in closed form but have visibility 0 in the frame.
 int falseShadowsOnPlane(const scene::Scene& s, const test::Placement& at, const scene::Frame& f, int& litPlanePixels) {
     int acne = 0;
