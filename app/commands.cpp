@@ -157,8 +157,11 @@ Prepared prepare(const SceneOptions& o) {
     if (o.explain)
         std::cerr
             << "render plan for " << p.scene.file.string() << ":\n"
-            << p.plan.explain() << studies::explainAutomaticChoices(p.scene, p.plan, p.settings.raster)
-            << "raster bias: constant " << p.settings.raster.depthBias << " world units"
+            << p.plan.explain()
+            << studies::explainAutomaticChoices(p.scene, p.plan, p.settings.raster)
+            // The bias for the map size chosen per view (what the layers and the Frame hold).
+            << "raster bias: constant "
+            << raster::resolveAutomaticChoices(p.scene, p.settings.raster, &p.plan).depthBias << " world units"
             << (p.settings.raster.depthBiasIsDefault
                     ? (p.settings.raster.fitLightFrustum
                            ? " (default: half a texel of each map as fitted or cascaded; this value for a "
@@ -319,13 +322,7 @@ private:
 // with the view, sun and ground they would choose, since another engine renders it from the
 // file alone and its shadows are graded against this scene's reference.
 int exportScene(const ExportOptions& o) {
-    const std::string ext = scene::lowercaseExtension(o.output);
-    if (ext != ".glb" && ext != ".gltf")
-        throw scene::InputError(o.output.string() + ": unknown export type '" + o.output.extension().string() +
-                                "' (use .glb or .gltf)");
-    if (!(o.tolerance > 0.0 && o.tolerance < 0.5))
-        throw scene::InputError("--tolerance: must be in (0, 0.5) (a fraction of a sphere's radius), got " +
-                                std::to_string(o.tolerance));
+    scene::checkExportOptions(o.output, {o.tolerance});
     checkOutputFile(o.output);
     scene::Scene s = readingInput(o.common.scene, [&] { return scene::loadScene(scene::findScene(o.common.scene)); });
     if (o.common.resolution) applyResolution(s, *o.common.resolution);
@@ -758,6 +755,18 @@ int check(const CheckOptions& o) {
         std::cerr << "shadowlab: check shard " << shard->index << "/" << shard->count << ": " << suite.cases.size()
                   << " of " << fullSuite.cases.size() << " cases\n";
     }
+    // The output folder is replaced as a whole once every case has run: refused now, before any
+    // work, when that would take the user's own files or inputs with it.
+    std::vector<fs::path> inputs = {o.suite};
+    if (baselineFile) inputs.push_back(*baselineFile);
+    for (const auto& c : fullSuite.cases) inputs.push_back(c.sceneFile);
+    if (shard) {
+        checkOutputFolder(o.outputDir);
+        checkReplacedFolder(o.outputDir / studies::shardFolderName(*shard), inputs, "shard.json");
+    } else {
+        checkReplacedFolder(o.outputDir, inputs, "junit.xml");
+    }
+    if (o.updateBaseline) checkOutputFile(*baselineFile, "--update-baseline");
     std::cerr << "shadowlab: check " << suite.name << ": " << suite.cases.size() << " cases"
               << (baseline ? " against " + baselineFile->string() : std::string(" without a baseline")) << "\n";
     const auto results =

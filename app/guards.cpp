@@ -53,6 +53,31 @@ void checkOutputFolder(const fs::path& dir, const std::string& option) {
     checkParent(dir, option);
 }
 
+void checkReplacedFolder(const fs::path& dir, const std::vector<fs::path>& inputs, const std::string& marker,
+                         const std::string& option) {
+    checkOutputFolder(dir, option);
+    std::error_code ec;
+    const fs::path target = fs::weakly_canonical(fs::absolute(dir), ec);
+    // Is `p` the target or inside it? (Both canonical, compared part by part.)
+    auto within = [&](const fs::path& p) {
+        const fs::path q = fs::weakly_canonical(fs::absolute(p), ec);
+        auto t = target.begin(), e = target.end();
+        auto i = q.begin();
+        for (; t != e && i != q.end(); ++t, ++i)
+            if (*t != *i) return false;
+        return t == e;
+    };
+    const std::string why = ": this command replaces its output folder as a whole, so name a folder of its own";
+    if (within(fs::current_path(ec)))
+        throw scene::InputError(option + " " + dir.string() + ": is the working folder or holds it" + why);
+    for (const fs::path& input : inputs)
+        if (!input.empty() && within(input))
+            throw scene::InputError(option + " " + dir.string() + ": holds the input " + input.string() + why);
+    if (fs::is_directory(dir, ec) && !fs::is_empty(dir, ec) && !fs::exists(dir / marker, ec))
+        throw scene::InputError(option + " " + dir.string() + ": holds files that no earlier run wrote (no " + marker +
+                                ")" + why + ", or empty this one");
+}
+
 int finishStandardOutput(int status) {
     errno = 0;
     std::cout.flush();

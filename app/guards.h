@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 #include <system_error>
+#include <vector>
 
 #include "scene/error.h"
 
@@ -41,6 +42,13 @@ void checkOutputFile(const std::filesystem::path& file, const std::string& optio
 // An output folder (`-o DIR`): a folder or nothing yet, and its nearest existing parent a
 // writable folder.
 void checkOutputFolder(const std::filesystem::path& dir, const std::string& option = "-o");
+
+// A folder a command replaces as a whole (`check -o DIR`): checkOutputFolder's rules, and it must
+// not be the working folder or hold it, nor hold any of `inputs`, and an existing folder with
+// entries must hold `marker` (a file an earlier run of the command wrote), so that no folder of the
+// user's own is replaced. Throws InputError naming `option`, the folder and the reason.
+void checkReplacedFolder(const std::filesystem::path& dir, const std::vector<std::filesystem::path>& inputs,
+                         const std::string& marker, const std::string& option = "-o");
 
 // Flushes standard output and returns `status`, or prints why the write failed (a full disk,
 // a closed pipe) and returns 1: results that did not reach their reader are a failure.

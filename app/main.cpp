@@ -105,9 +105,11 @@ void addSceneOptions(CLI::App& cmd, SceneOptions& o) {
                    "raster: blend each cascade into the next over this fraction of its slice before the split, "
                    "0..0.5 (default 0: switch abruptly)");
     cmd.add_option("--device", s.device, "raster: Vulkan device index or name part (default: lavapipe)");
-    cmd.add_option("--ray-bias", s.rayBias,
-                   "raytrace: shadow-ray offset along the normal in world units, or 'robust' "
-                   "(default: 1e-4 of the scene's size)");
+    cmd.add_option(
+        "--ray-bias", s.rayBias,
+        "raytrace: shadow-ray offset along the normal in world units, or 'robust' "
+        "(default: half a pixel's footprint at each point, at most 1e-4 of the scene's size and at least 16 float "
+        "steps of its largest coordinate)");
     cmd.add_option("--precision", s.precision, "raytrace: float|double (default float)");
     cmd.add_option("--samples", s.samples, "raytrace: shadow samples per pixel for area lights (default 16)");
     cmd.add_option("--threads", s.threads, "raytrace: worker threads, 0 = all cores (default 0)");

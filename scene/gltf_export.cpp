@@ -11,7 +11,10 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <sstream>
 
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
 #include <glm/gtc/quaternion.hpp>
 #include <nlohmann/json.hpp>
 
@@ -216,12 +219,46 @@ double uvSphereSagitta(int segments, int rings) {
     return worst;
 }
 
-ExportResult exportGltf(const Scene& scene, const fs::path& file, const ExportOptions& options) {
+void checkExportOptions(const fs::path& file, const ExportOptions& options) {
     const std::string ext = lowercaseExtension(file);
     if (ext != ".glb" && ext != ".gltf")
-        throw InputError(file.string() + ": unknown export type '" + ext + "' (use .glb or .gltf)");
-    if (!(options.tolerance > 0.0 && options.tolerance < 0.5))
-        throw InputError("--tolerance: must be in (0, 0.5) (a fraction of a sphere's radius)");
+        throw InputError(file.string() + ": unknown export type '" + file.extension().string() +
+                         "' (use .glb or .gltf)");
+    if (!(options.tolerance >= kMinExportTolerance && options.tolerance < 0.5)) {
+        std::ostringstream got;
+        got << options.tolerance;
+        throw InputError(
+            "--tolerance: must be in [1e-05, 0.5) (a fraction of a sphere's radius; finer needs more "
+            "than 250,000 triangles a sphere), got " +
+            got.str());
+    }
+}
+
+namespace {
+
+// The alpha shadowlab samples as an RGBA PNG (white, with that alpha): what another engine needs
+// to cut the same shadow, whatever the source was (an image inside a glTF, WebP, a file since
+// moved).
+std::vector<unsigned char> alphaPng(const AlphaTexture& t, const std::string& material) {
+    std::vector<unsigned char> bytes;
+    OIIO::Filesystem::IOVecOutput proxy(bytes);
+    auto out = OIIO::ImageOutput::create("alpha.png", &proxy);
+    std::vector<unsigned char> pixels(std::size_t(t.width) * std::size_t(t.height) * 4, 255);
+    for (std::size_t i = 0; i < t.alpha.size(); ++i)
+        pixels[4 * i + 3] = (unsigned char)std::lround(std::clamp(t.alpha[i], 0.0f, 1.0f) * 255.0f);
+    const OIIO::ImageSpec spec(t.width, t.height, 4, OIIO::TypeDesc::UINT8);
+    if (!out || !out->open("alpha.png", spec) || !out->write_image(OIIO::TypeDesc::UINT8, pixels.data()) ||
+        !out->close())
+        throw InputError("material '" + material + "': cannot encode its alpha texture as PNG" +
+                         (out ? ": " + out->geterror() : std::string()));
+    return bytes;
+}
+
+}  // namespace
+
+ExportResult exportGltf(const Scene& scene, const fs::path& file, const ExportOptions& options) {
+    checkExportOptions(file, options);
+    const std::string ext = lowercaseExtension(file);
 
     // The coarsest UV sphere within the tolerance: a single chord of angle θ has sagitta
     // 1 − cos(θ/2); the middle of a cell is deeper than its edges, so the count is raised until
@@ -255,14 +292,19 @@ ExportResult exportGltf(const Scene& scene, const fs::path& file, const ExportOp
         const AlphaTexture* t = m.alphaTexture.get();
         const auto key = std::make_pair(t, wrapCode(t->wrapS) * 65536 + wrapCode(t->wrapT));
         if (const auto it = textureIndex.find(key); it != textureIndex.end()) return it->second;
+        // A PNG or JPEG file on disk is embedded as it is (colour and all); anything else (an image
+        // inside a glTF, WebP) as the alpha shadowlab decoded from it.
         const std::string text = lowercaseExtension(t->file);
         const char* mime = text == ".png" ? "image/png" : text == ".jpg" || text == ".jpeg" ? "image/jpeg" : nullptr;
-        if (!mime)
-            throw InputError(t->file.string() + ": material '" + m.name +
-                             "' reads an alpha texture that glTF cannot hold (glTF images are PNG or JPEG)");
-        std::ifstream in(t->file, std::ios::binary);
-        const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-        if (!in && !in.eof()) throw InputError(t->file.string() + ": cannot read the alpha texture to embed it");
+        std::vector<unsigned char> bytes;
+        std::error_code ec;
+        if (mime && fs::is_regular_file(t->file, ec)) {
+            const std::string read = readInputFile(t->file, kMaxMeshFileBytes);
+            bytes.assign(read.begin(), read.end());
+        } else {
+            bytes = alphaPng(*t, m.name);
+            mime = "image/png";
+        }
         doc["images"].push_back({{"bufferView", buffer.view(bytes.data(), bytes.size())}, {"mimeType", mime}});
         doc["samplers"].push_back({{"wrapS", wrapCode(t->wrapS)},
                                    {"wrapT", wrapCode(t->wrapT)},

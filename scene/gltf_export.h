@@ -16,6 +16,15 @@ struct ExportOptions {
     double tolerance = 1e-3;
 };
 
+// The finest tolerance: a UV sphere then has about π²/(4·1e-5) ≈ 250,000 triangles, and no
+// shadow map or pixel of a sane view resolves a sagitta of 1e-5 of the radius. (Below it the
+// count grows without bound: 1e-8 took 13 GB before it was stopped.)
+inline constexpr double kMinExportTolerance = 1e-5;
+
+// Throws InputError for an extension other than .glb or .gltf, or a tolerance outside
+// [kMinExportTolerance, 0.5), naming the option and the value.
+void checkExportOptions(const std::filesystem::path& file, const ExportOptions& options);
+
 struct ExportResult {
     double achievedTolerance = 0.0;  // the largest measured sagitta / radius over all spheres (0: none)
     std::size_t triangles = 0;

@@ -2,6 +2,7 @@
 #include "scene/json_input.h"
 
 #include "scene/error.h"
+#include "scene/input_file.h"
 #include "scene/memory.h"
 
 namespace shadowlab::scene {
@@ -131,6 +132,18 @@ nlohmann::json parseJsonText(const std::filesystem::path& file, std::string_view
             file, {}, "invalid JSON near " + lineColumn(text, e.byte == 0 ? 0 : e.byte - 1) + ": " + parserMessage(e));
     } catch (const nlohmann::json::exception& e) {
         throw SceneError(file, {}, "invalid JSON: " + parserMessage(e) + " (numbers must be finite)");
+    }
+}
+
+nlohmann::json readJsonFile(const std::filesystem::path& file) {
+    return parseJsonText(file, readInputFile(file, kMaxJsonFileBytes));
+}
+
+nlohmann::json readJsonFileOrNull(const std::filesystem::path& file) {
+    try {
+        return readJsonFile(file);
+    } catch (const std::exception&) {
+        return nullptr;
     }
 }
 

@@ -37,6 +37,13 @@ std::uint64_t jsonTreeBytes(std::string_view text);
 // become SceneError with the line and column. For files other than scenes (grids).
 nlohmann::json parseJsonText(const std::filesystem::path& file, std::string_view text);
 
+// `file` read with readInputFile (a folder, a FIFO or a device refused before it is opened, so
+// that no read waits for a writer; at most kMaxJsonFileBytes) and parsed with parseJsonText.
+// Throws InputFileError for the file, SceneError for its text.
+nlohmann::json readJsonFile(const std::filesystem::path& file);
+// The same, or null where it throws: for probing what a folder holds (which kind of shard).
+nlohmann::json readJsonFileOrNull(const std::filesystem::path& file);
+
 // "line L, column C" of a byte offset.
 std::string lineColumn(std::string_view text, std::size_t byte);
 

@@ -833,7 +833,18 @@ Scene loadModelScene(const fs::path& file) {
         scene.origin.chooseSun = true;
         scene.origin.choices.emplace_back("sun", "a default sun (the file has no light)");
     } else {
-        scene.origin.choices.emplace_back("sun", std::to_string(scene.lights.size()) + " light(s) from the file");
+        // Named by kind: "sun" would call a spot one. ("1 spot and 2 point lights from the file")
+        int count[3] = {0, 0, 0};
+        for (const Light& l : scene.lights) ++count[int(l.type)];
+        const char* kinds[3] = {"directional", "point", "spot"};
+        std::vector<std::string> parts;
+        for (int k : {0, 2, 1})
+            if (count[k] > 0) parts.push_back(std::to_string(count[k]) + " " + kinds[k]);
+        std::string text;
+        for (std::size_t i = 0; i < parts.size(); ++i)
+            text += (i == 0 ? "" : i + 1 == parts.size() ? " and " : ", ") + parts[i];
+        scene.origin.choices.emplace_back("lights",
+                                          text + (scene.lights.size() == 1 ? " light" : " lights") + " from the file");
     }
     checkSceneExtent(scene, false);
     scene.loadBytes = extras.loadBytes;

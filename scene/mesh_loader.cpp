@@ -8,6 +8,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -767,6 +768,18 @@ void collectCameraAndLight(const tinygltf::Model& model, const tinygltf::Node& n
     if (l.color.size() == 3) light.color = Vec3(l.color[0], l.color[1], l.color[2]);
     light.intensity = l.intensity;
     light.outerConeRadians = l.spot.outerConeAngle;
+    // glTF's range cuts a light off (smoothly) at a distance; shadowlab's lights reach every
+    // distance at 1/d². Said once per light, since it brightens what lies beyond.
+    if (l.range > 0 && std::isfinite(l.range)) {
+        char range[32];
+        std::snprintf(range, sizeof range, "%g", l.range);
+        const std::string note = "extensions.KHR_lights_punctual.lights[" + std::to_string(index) + "].range " +
+                                 std::string(range) +
+                                 " is not applied: shadowlab's point and spot lights fall off as 1/d² at every "
+                                 "distance, so points beyond the range are lit (in every backend and the reference "
+                                 "alike, so the shadows compare the same)";
+        if (std::find(out.notes.begin(), out.notes.end(), note) == out.notes.end()) out.notes.push_back(note);
+    }
     if (l.extras.IsObject() && l.extras.Has("shadowlab") && l.extras.Get("shadowlab").Has("radius") &&
         l.extras.Get("shadowlab").Get("radius").IsNumber())
         light.radius = l.extras.Get("shadowlab").Get("radius").GetNumberAsDouble();

@@ -9,6 +9,7 @@
 
 #include "scene/backend.h"
 #include "scene/error.h"
+#include "scene/json_input.h"
 #include "scene/loader.h"
 #include "scene/settings.h"
 #include "studies/sweep.h"
@@ -22,17 +23,7 @@ using Json = nlohmann::json;
 using scene::JsonPath;
 using scene::SceneError;
 
-Json parseFile(const fs::path& file) {
-    std::ifstream in(file);
-    if (!in) throw SceneError(file, {}, "no such file or not readable");
-    try {
-        return Json::parse(in);
-    } catch (const Json::exception& e) {
-        std::string what = e.what();
-        if (const auto p = what.find("] "); p != std::string::npos) what = what.substr(p + 2);
-        throw SceneError(file, {}, "invalid JSON: " + what);
-    }
-}
+Json parseFile(const fs::path& file) { return scene::readJsonFile(file); }
 
 void checkKeys(const fs::path& file, const Json& node, const JsonPath& path,
                std::initializer_list<const char*> allowed) {

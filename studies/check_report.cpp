@@ -12,6 +12,7 @@
 #include "compare/text.h"
 #include "scene/error.h"
 #include "scene/frame_io.h"
+#include "scene/json_input.h"
 
 namespace shadowlab::studies {
 
@@ -352,12 +353,10 @@ namespace {
 namespace fs = std::filesystem;
 
 nlohmann::json readJson(const fs::path& file, const std::string& what) {
-    std::ifstream in(file);
-    if (!in) throw scene::InputError(file.string() + ": cannot read the " + what);
     try {
-        return nlohmann::json::parse(in);
-    } catch (const nlohmann::json::exception& e) {
-        throw scene::InputError(file.string() + ": not a " + what + " (invalid JSON: " + e.what() + ")");
+        return scene::readJsonFile(file);
+    } catch (const scene::SceneError& e) {
+        throw scene::InputError(std::string(e.what()) + " (the " + what + ")");
     }
 }
 
@@ -429,8 +428,7 @@ bool holdsCheckShards(const std::vector<fs::path>& inputs) {
         std::error_code ec;
         if (!fs::is_directory(input, ec)) continue;
         for (const fs::path& d : shardFolders(input)) {
-            std::ifstream in(d / "shard.json");
-            const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+            const nlohmann::json j = scene::readJsonFileOrNull(d / "shard.json");
             return j.is_object() && j.contains("check_suite_hash");
         }
     }

@@ -12,6 +12,7 @@
 #include "scene/append_line.h"
 #include "scene/error.h"
 #include "scene/frame_io.h"
+#include "scene/json_input.h"
 #include "studies/auto_bias.h"
 #include "studies/machine.h"
 
@@ -317,11 +318,10 @@ std::vector<std::string> verdictDifferences(const std::vector<SweepRow>& a, cons
 
 std::vector<SweepRow> readResults(const fs::path& dir) {
     const fs::path file = dir / "results.json";
-    std::ifstream in(file);
-    if (!in) throw scene::InputError(file.string() + ": cannot read");
+    const Json all = scene::readJsonFile(file);
     std::vector<SweepRow> rows;
     try {
-        for (const Json& j : Json::parse(in)) rows.push_back(rowFromJournal(j));
+        for (const Json& j : all) rows.push_back(rowFromJournal(j));
     } catch (const std::exception& e) {  // JSON that is not rows, or a backend no build has
         throw scene::InputError(file.string() + ": not a sweep's results (" + std::string(e.what()) + ")");
     }

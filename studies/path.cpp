@@ -25,6 +25,7 @@
 #include "scene/camera_animation.h"
 #include "scene/error.h"
 #include "scene/frame_io.h"
+#include "scene/json_input.h"
 #include "scene/render_plan.h"
 #include "studies/backend.h"
 #include "studies/shard.h"
@@ -622,11 +623,10 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
     if (fs::exists(journal, ec) && !options.resume)
         throw scene::InputError(dir.string() + ": already holds a path (frames.jsonl); use --resume to continue it");
     if (options.resume && fs::exists(manifestFile, ec)) {
-        std::ifstream in(manifestFile);
         Json old;
         try {
-            in >> old;
-        } catch (const std::exception&) {
+            old = scene::readJsonFile(manifestFile);
+        } catch (const scene::SceneError&) {
             throw scene::InputError(manifestFile.string() + ": unreadable; remove the folder to start again");
         }
         if (old != manifest)
@@ -643,13 +643,12 @@ PathResult runPath(const scene::Scene& base, const scene::RenderSettings& settin
     // Finished frames: the journal's lines (a torn last line is dropped and the journal rewritten).
     std::map<int, Json> done;
     if (options.resume && fs::exists(journal, ec)) {
-        std::ifstream in(journal);
-        std::string line, kept;
-        while (std::getline(in, line)) {
+        std::string kept;
+        for (const scene::JournalLine& l : scene::readJournalLines(journal)) {
             try {
-                const Json j = Json::parse(line);
+                const Json j = Json::parse(l.text);
                 done[j.at("frame").get<int>()] = j;
-                kept += line + "\n";
+                kept += l.text + "\n";
             } catch (const std::exception&) {
                 break;  // a kill in the middle of the last write
             }
@@ -794,16 +793,6 @@ std::vector<fs::path> pathShardFolders(const fs::path& input) {
     return dirs;
 }
 
-Json readJsonFile(const fs::path& file) {
-    std::ifstream in(file);
-    if (!in) throw scene::InputError(file.string() + ": cannot read");
-    try {
-        return Json::parse(in);
-    } catch (const Json::exception& e) {
-        throw scene::InputError(file.string() + ": not JSON (" + std::string(e.what()) + ")");
-    }
-}
-
 // The first field in which two path identities differ, in words; empty when they are one path's.
 std::string identityDifference(const Json& a, const Json& b) {
     for (const auto& [key, value] : a.items())
@@ -821,8 +810,7 @@ bool holdsPathShards(const std::vector<fs::path>& inputs) {
         std::error_code ec;
         if (!fs::is_directory(input, ec)) continue;
         for (const fs::path& d : pathShardFolders(input)) {
-            std::ifstream in(d / "shard.json");
-            const Json j = Json::parse(in, nullptr, false);
+            const Json j = scene::readJsonFileOrNull(d / "shard.json");
             return j.is_object() && j.value("study", "") == "path";
         }
     }
@@ -846,7 +834,7 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
         if (base.empty()) base = dirs.size() == 1 && dirs.front() == input ? input.parent_path() : input;
         for (const fs::path& d : dirs) {
             const fs::path file = d / "shard.json";
-            const Json j = readJsonFile(file);
+            const Json j = scene::readJsonFile(file);
             if (!j.is_object() || j.value("study", "") != "path" || !j.contains("identity") || !j.contains("shard") ||
                 !j.contains("frames"))
                 throw scene::InputError(file.string() +
@@ -859,7 +847,7 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
                 frames = j["frames"].get<int>();
                 merged.shardCount = count;
                 firstDir = d;
-                manifest = readJsonFile(d / "path.json");
+                manifest = scene::readJsonFile(d / "path.json");
             } else if (const std::string diff = identityDifference(identity, j["identity"]); !diff.empty()) {
                 throw scene::InputError(d.string() + ": a shard of another path than " + firstDir.string() + " (" +
                                         diff + ")");
@@ -984,7 +972,7 @@ std::vector<std::string> pathDifferences(const fs::path& a, const fs::path& b) {
             for (Json& v : j) strip(v);
         }
     };
-    Json ja = readJsonFile(a / "metrics.json"), jb = readJsonFile(b / "metrics.json");
+    Json ja = scene::readJsonFile(a / "metrics.json"), jb = scene::readJsonFile(b / "metrics.json");
     strip(ja);
     strip(jb);
     std::vector<std::string> out;

@@ -20,6 +20,7 @@
 
 #include "scene/error.h"
 #include "scene/frame_io.h"
+#include "scene/json_input.h"
 #include "scene/settings.h"
 #include "studies/machine.h"
 
@@ -168,8 +169,7 @@ const std::vector<std::string>& commandLine() { return processCommandLine(); }
 
 std::vector<std::string> recordedShardCommand(const std::vector<fs::path>& dirs) {
     for (const fs::path& d : dirs) {
-        std::ifstream in(d / "shard.json");
-        const Json j = Json::parse(in, nullptr, false);
+        const Json j = scene::readJsonFileOrNull(d / "shard.json");
         if (!j.is_object() || !j.contains("command") || !j["command"].is_array()) continue;
         std::vector<std::string> out;
         for (const Json& a : j["command"])
@@ -243,14 +243,7 @@ Json shardManifest(const SweepIdentity& id, const Shard& shard) {
 }
 
 void readShardManifest(const fs::path& file, SweepIdentity& id, Shard& shard) {
-    std::ifstream in(file);
-    if (!in) throw scene::InputError(file.string() + ": cannot read the shard manifest");
-    Json j;
-    try {
-        j = Json::parse(in);
-    } catch (const Json::exception& e) {
-        throw scene::InputError(file.string() + ": not a shard manifest (invalid JSON: " + e.what() + ")");
-    }
+    const Json j = scene::readJsonFile(file);
     const char* field = "";
     try {
         field = "program";

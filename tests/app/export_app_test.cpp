@@ -43,9 +43,13 @@ TEST(ExportApp, ABadSceneNamesFileAndPathAndWritesNothing) {
     EXPECT_EQ(r.exitCode, 2) << r.err;
     EXPECT_NE(r.err.find("objects[0].radius"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir.path() / "x.glb"));
-    const auto t = runShadowlab({"export", "seed", "--tolerance", "0", "-o", (dir.path() / "y.glb").string()});
-    EXPECT_EQ(t.exitCode, 2) << t.err;
-    EXPECT_FALSE(fs::exists(dir.path() / "y.glb"));
+    // Out of range, and finer than any view resolves (it would grow without bound): refused at once.
+    for (const char* tol : {"0", "0.5", "1e-300", "9e-6"}) {
+        const auto t = runShadowlab({"export", "seed", "--tolerance", tol, "-o", (dir.path() / "y.glb").string()});
+        EXPECT_EQ(t.exitCode, 2) << tol << ": " << t.err;
+        EXPECT_NE(t.err.find("--tolerance: must be in [1e-05, 0.5)"), std::string::npos) << t.err;
+        EXPECT_FALSE(fs::exists(dir.path() / "y.glb"));
+    }
 }
 
 TEST(ExportApp, UvSphereSagittaMatchesTheChordFormulaAtTheEquator) {
@@ -89,6 +93,36 @@ TEST(ExportApp, AnExportLoadsBackWithTheSceneCameraSizeAndLights) {
             }
         }
     }
+}
+
+TEST(ExportApp, AnAlphaTextureThatIsNoFileIsEmbeddedAsThePngOfItsAlpha) {
+    // The foliage's leaf as if it had come from inside a glTF (a name, not a file): the export
+    // embeds the decoded alpha as a PNG, which loads back texel for texel (to 1/255).
+    scene::Scene s = scene::loadScene(scene::findScene("foliage"));
+    const scene::AlphaTexture* original = nullptr;
+    for (scene::Material& m : s.materials)
+        if (m.alphaTexture) {
+            auto inside = std::make_shared<scene::AlphaTexture>(*m.alphaTexture);
+            inside->file = "model.gltf#images[0]";
+            m.alphaTexture = inside;
+            original = inside.get();
+        }
+    ASSERT_TRUE(original);
+    TempDir dir;
+    const fs::path out = dir.path() / "leaf.glb";
+    scene::exportGltf(s, out);
+    const scene::Scene back = scene::loadScene(out);
+    int textured = 0;
+    for (const scene::Material& m : back.materials) {
+        if (!m.alphaTexture) continue;
+        ++textured;
+        EXPECT_EQ(m.alphaMode, scene::AlphaMode::Mask);
+        ASSERT_EQ(m.alphaTexture->width, original->width);
+        ASSERT_EQ(m.alphaTexture->height, original->height);
+        for (std::size_t i = 0; i < original->alpha.size(); ++i)
+            ASSERT_NEAR(m.alphaTexture->alpha[i], original->alpha[i], 0.5 / 255.0 + 1e-6) << "texel " << i;
+    }
+    EXPECT_GT(textured, 0);
 }
 
 TEST(ExportApp, TheReferenceOfAnExportAgreesWithTheSceneWithinTheTessellation) {

@@ -74,6 +74,38 @@ TEST(HostileApp, AFifoGivenToCompareIsRefusedNotWaitedOn) {
     EXPECT_NE(r.err.find("pipe.exr: is a named pipe"), std::string::npos) << r.err;
 }
 
+TEST(HostileApp, AFifoOrAFolderWhereCheckMergeOrAResumeReadsJsonIsRefusedNotWaitedOn) {
+    ::alarm(120);
+    TempDir dir;
+    const fs::path pipe = dir.path() / "pipe.json";
+    ASSERT_EQ(::mkfifo(pipe.c_str(), 0600), 0);
+    std::ofstream(dir.path() / "suite.json")
+        << R"({"baseline": "pipe.json", "cases": [{"name": "a", "scene": "seed", "backend": "raytrace"}]})";
+    // A check shard folder whose shard.json is a FIFO, and a path folder whose path.json is one.
+    fs::create_directories(dir.path() / "shards" / "shard-0-of-2");
+    ASSERT_EQ(::mkfifo((dir.path() / "shards" / "shard-0-of-2" / "shard.json").c_str(), 0600), 0);
+    fs::create_directories(dir.path() / "p");
+    std::ofstream(dir.path() / "p" / "frames.jsonl") << "";
+    ASSERT_EQ(::mkfifo((dir.path() / "p" / "path.json").c_str(), 0600), 0);
+    const std::string out = " -o " + (dir.path() / "out").string();
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"check " + pipe.string() + out, "pipe.json: is a named pipe"},
+        {"check " + (dir.path() / "suite.json").string() + out, "pipe.json: is a named pipe"},
+        {"check " + (dir.path() / "suite.json").string() + " --baseline " + dir.path().string() + out,
+         ": is a folder, not a file"},
+        {"merge " + (dir.path() / "shards").string(), "shard.json: is a named pipe"},
+        {"path seed --resolution 16x9 --frames 2 --resume -o " + (dir.path() / "p").string(),
+         "path.json: is a named pipe"},
+    };
+    for (const auto& [command, says] : cases) {
+        const Outcome r = run(command);
+        EXPECT_EQ(r.exitCode, 2) << command << ": " << r.err;
+        EXPECT_NE(r.err.find(says), std::string::npos) << command << ": " << r.err;
+    }
+    ::alarm(0);
+    EXPECT_FALSE(fs::exists(dir.path() / "out"));
+}
+
 TEST(HostileApp, ASecondWriterOfAFolderIsRefusedNamingTheFirst) {
     TempDir dir;
     const scene::FolderLock held(dir.path(), "test");

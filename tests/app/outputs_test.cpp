@@ -1,5 +1,6 @@
 // tests/app/outputs_test.cpp: where outputs go: `run -o` naming a file, `render -o` into a missing
-// folder, a model format shadowlab does not read, and a run folder left from an earlier run.
+// folder, a model format shadowlab does not read, a run folder left from an earlier run, and the
+// folders `check` replaces as a whole.
 #include <fcntl.h>
 #include <spawn.h>
 #include <unistd.h>
@@ -7,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "app/guards.h"
 #include "tests/app/cli.h"
 #include "tests/app/subprocess.h"
 
@@ -141,6 +143,43 @@ TEST(Outputs, ARunRemovesWhatTheEarlierRunWroteAndThisOneDoesNotButNothingElse) 
     std::sort(files.begin(), files.end());
     EXPECT_EQ(files, (std::vector<std::string>{"diff-raytrace.png", "heat-raytrace.png", "metrics.json", "raytrace.exr",
                                                "raytrace.png", "reference.exr", "reference.png", "report.html"}));
+}
+
+TEST(Outputs, CheckReplacesOnlyAFolderOfItsOwnAndRefusesBeforeRunning) {
+    TempDir dir;
+    const fs::path suite = dir.write("suites/suite.json", R"({"resolution": "48x27", "cases": [
+        {"name": "a", "scene": "seed", "backend": "raytrace", "settings": {"ray_bias": "robust"}}]})");
+    const fs::path mine = dir.write("mine.txt", "mine");
+    const fs::path foreign = dir.write("notes/todo.txt", "keep");
+    auto refused = [&](const fs::path& out, const std::string& why, const std::vector<std::string>& extra = {}) {
+        std::vector<std::string> args = {"check", suite.string(), "-o", out.string()};
+        args.insert(args.end(), extra.begin(), extra.end());
+        const std::size_t before = dir.fileCount();
+        const auto r = runShadowlab(args);
+        EXPECT_EQ(r.exitCode, 2) << out << ": " << r.err;
+        EXPECT_NE(r.err.find(why), std::string::npos) << r.err;
+        EXPECT_EQ(r.err.find("[1/1]"), std::string::npos) << "ran a case first: " << r.err;
+        EXPECT_EQ(dir.fileCount(), before) << out;
+    };
+    refused(mine, "is a file, not a folder");
+    refused(suite.parent_path(), "holds the input " + suite.string());
+    refused(dir.path(), "holds the input");
+    refused(foreign.parent_path(), "holds files that no earlier run wrote (no junit.xml)");
+    refused(dir.path() / "out", "--update-baseline " + (mine / "b.json").string(),
+            {"--update-baseline", "--baseline", (mine / "b.json").string()});
+    EXPECT_EQ(test::slurpFile(mine), "mine");
+    EXPECT_EQ(test::slurpFile(foreign), "keep");
+    // A folder of its own: written, then replaced by the next run.
+    const fs::path out = dir.path() / "out";
+    ASSERT_EQ(runShadowlab({"check", suite.string(), "-o", out.string()}).exitCode, 0);
+    ASSERT_TRUE(fs::exists(out / "junit.xml"));
+    const auto again = runShadowlab({"check", suite.string(), "-o", out.string()});
+    EXPECT_EQ(again.exitCode, 0) << again.err;
+    // The working folder, or one that holds it, is never replaced (checked without running check
+    // there, so that a broken guard cannot empty the test's own folder).
+    EXPECT_THROW(app::checkReplacedFolder(fs::current_path(), {}, "junit.xml"), scene::InputError);
+    EXPECT_THROW(app::checkReplacedFolder(fs::current_path().parent_path(), {}, "junit.xml"), scene::InputError);
+    EXPECT_NO_THROW(app::checkReplacedFolder(out, {suite}, "junit.xml"));
 }
 
 }  // namespace

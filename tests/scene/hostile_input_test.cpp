@@ -368,6 +368,27 @@ TEST(Values, GltfLightsGetTheChecksJsonLightsGet) {
     EXPECT_NE(e.find("lights[0].intensity: intensity times colour is 1e+308"), std::string::npos) << e;
 }
 
+TEST(Values, AGltfLightsRangeIsNotAppliedAndANoteSaysSoOnce) {
+    TempDir dir;
+    dir.write("t.bin", triangleBytes());
+    Json g = triangleGltf("t.bin", 36);
+    g["extensionsUsed"] = {"KHR_lights_punctual"};
+    g["extensions"] = {{"KHR_lights_punctual", {{"lights", {{{"type", "point"}, {"intensity", 5}, {"range", 3}}}}}}};
+    g["nodes"][0]["extensions"] = {{"KHR_lights_punctual", {{"light", 0}}}};
+    g["nodes"].push_back({{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});  // one light, two nodes
+    g["scenes"][0]["nodes"].push_back(int(g["nodes"].size()) - 1);
+    const scene::Scene s = scene::loadScene(dir.write("t.gltf", g.dump()));
+    EXPECT_EQ(s.lights.size(), 2u);
+    int notes = 0;
+    for (const std::string& n : s.origin.notes)
+        notes += n.find("KHR_lights_punctual.lights[0].range 3 is not applied") != std::string::npos;
+    EXPECT_EQ(notes, 1);
+    // Without a range, no note.
+    g["extensions"]["KHR_lights_punctual"]["lights"][0].erase("range");
+    for (const std::string& n : scene::loadScene(dir.write("u.gltf", g.dump())).origin.notes)
+        EXPECT_EQ(n.find("range"), std::string::npos) << n;
+}
+
 TEST(Values, GltfNodeTransformsThatOverflowAreErrors) {
     const std::string e = gltfError([](Json& g) {
         g["nodes"] = {{{"children", {1}}, {"scale", {1e200, 1e200, 1e200}}}, {{"mesh", 0}, {"scale", {1e200, 1, 1}}}};
