@@ -266,14 +266,31 @@ std::function<void(const studies::SweepProgress&)> sweepProgressPrinter() {
 
 // `render -o` into a missing folder: created once the input is known to be good, and the user is
 // told (docs/decisions.md, "Output paths"); app::checkOutputFile has refused what cannot be used.
-void createOutputFolder(const fs::path& output) {
-    if (!output.has_parent_path()) return;
-    std::error_code ec;
-    if (fs::is_directory(output.parent_path(), ec)) return;
-    fs::create_directories(output.parent_path());
-    std::cerr << "shadowlab: created the folder " << output.parent_path().string() << " for "
-              << output.filename().string() << "\n";
-}
+// The folders it made are removed again, if still empty, when the command ends: a render that
+// fails late (out of device memory, a full disk) leaves nothing behind.
+class CreatedFolders {
+public:
+    explicit CreatedFolders(const fs::path& output) {
+        if (!output.has_parent_path()) return;
+        std::error_code ec;
+        if (fs::is_directory(output.parent_path(), ec)) return;
+        for (fs::path p = output.parent_path(); !p.empty() && !fs::exists(p, ec); p = p.parent_path())
+            made_.push_back(p);
+        fs::create_directories(output.parent_path());
+        std::cerr << "shadowlab: created the folder " << output.parent_path().string() << " for "
+                  << output.filename().string() << "\n";
+    }
+    CreatedFolders(const CreatedFolders&) = delete;
+    CreatedFolders& operator=(const CreatedFolders&) = delete;
+    ~CreatedFolders() {
+        std::error_code ec;
+        for (const fs::path& p : made_)  // deepest first; a folder that holds the output stays
+            if (fs::is_directory(p, ec) && fs::is_empty(p, ec)) fs::remove(p, ec);
+    }
+
+private:
+    std::vector<fs::path> made_;
+};
 
 scene::Budgets parseBudgets(const BudgetOptions& o) {
     scene::Budgets b;
@@ -329,7 +346,7 @@ int exportScene(const ExportOptions& o) {
     chooseView(s, &o.common);
     for (const std::string& note : s.origin.notes) std::cerr << "shadowlab: note: " << note << "\n";
     if (o.common.explain) std::cerr << scene::explainOrigin(s);
-    createOutputFolder(o.output);
+    const CreatedFolders folders(o.output);
     Stage stage("exporting " + s.file.filename().string());
     const scene::ExportResult r = scene::exportGltf(s, o.output, {o.tolerance});
     char tol[32];
@@ -362,7 +379,7 @@ int render(const RenderOptions& o) {
                                      : "rendering " + std::to_string(p.scene.camera.width) + "x" +
                                            std::to_string(p.scene.camera.height) + " with " + backendName);
     // Only once the input is known to be good may the output's folder be created.
-    createOutputFolder(o.output);
+    const CreatedFolders folders(o.output);
     if (o.view) {
         Stage stage("rendering the " + *o.view + " view of " + p.scene.file.filename().string());
         raster::RenderDebug debug;
@@ -448,6 +465,15 @@ int compareFiles(const CompareOptions& o) {
         throw scene::InputError(o.output.string() + ": the difference image must be a .png");
     if (o.heat && o.heat->extension() != ".png")
         throw scene::InputError(o.heat->string() + ": the heat map must be a .png");
+    // Both outputs checked before anything is read or written, so that one cannot be written
+    // and the other refused.
+    checkOutputFile(o.output, "-o");
+    if (o.heat) {
+        checkOutputFile(*o.heat, "--heat");
+        std::error_code ec;
+        if (fs::weakly_canonical(fs::absolute(*o.heat), ec) == fs::weakly_canonical(fs::absolute(o.output), ec))
+            throw scene::InputError("--heat " + o.heat->string() + ": names the same file as -o");
+    }
     const scene::Budgets budgets = parseBudgets(o.budgets);
     // Only an EXR can be a Frame: any other file is read as a mask, which names the formats it takes.
     const bool maskOnly = o.maskChannel || o.maskInvert || o.maskSrgb ||
@@ -478,8 +504,12 @@ int compareFiles(const CompareOptions& o) {
     } catch (const scene::InputError& e) {
         throw scene::InputError(o.method.string() + " vs " + o.reference.string() + ": " + e.what());
     }
+    const CreatedFolders folders(o.output);
     scene::writePngDisplay(o.output, c.width, c.height, c.diffRgb);
-    if (o.heat) scene::writePngDisplay(*o.heat, c.width, c.height, c.heatRgb);
+    if (o.heat) {
+        const CreatedFolders heatFolders(*o.heat);
+        scene::writePngDisplay(*o.heat, c.width, c.height, c.heatRgb);
+    }
     const std::string hint =
         mask ? maskReadingHint(*mask, reference, o.method, c.metrics.mismatchRate, o.maskInvert) : "";
     if (o.json) {

@@ -323,8 +323,16 @@ int main(int argc, char** argv) {
     shadowlab::studies::setCommandLine(std::vector<std::string>(argv, argv + argc));
     try {
         app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e) == 0 ? 0 : 2;
+        // The parser's words with the program's prefix, as every other error has it.
+        std::cerr << "shadowlab: error: " << e.what() << "\nRun with --help for more information.\n";
+        return 2;
     }
 
     try {

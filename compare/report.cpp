@@ -748,6 +748,10 @@ std::string renderReportHtml(const ReportInput& in) {
         o << "<div>" << figure(rm.label, formatDuration(rm.frame.totalTimeMs()), rm.png, rm.frame, nullptr)
           << settingsLine(rm.frame) << "</div>\n";
     o << "</div>\n";
+    if (in.displayExposure != 1.0)
+        o << "<p>The images are scaled by " << formatShort(in.displayExposure)
+          << " for display: at full value more than 1% of the reference's visible surface would be white. The "
+             "EXR frames keep the rendered values.</p>\n";
 
     o << "<h2>Difference to the reference</h2>\n<div class=\"grid\" style=\"" << gridStyle << "\">\n";
     o << "<div>" << legendHtml() << "</div>\n";

@@ -82,6 +82,8 @@ struct ReportInput {
     std::vector<std::string> warnings;
     // The quick sweep `run` renders into DIR/sweep/; absent: no sweep section.
     std::optional<SweepSummary> sweep;
+    // The factor the images were scaled by for display (scene::displayExposure); 1: none.
+    double displayExposure = 1.0;
 };
 
 // The page as a string (what writeReport writes), for tests and other pages.

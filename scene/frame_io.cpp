@@ -316,8 +316,28 @@ float srgbCodeToLinear(std::uint8_t code) {
     return table[code];
 }
 
-void writePngLinear(const fs::path& file, int width, int height, const std::vector<float>& rgb) {
-    writePng8(file, width, height, rgb, true);
+void writePngLinear(const fs::path& file, int width, int height, const std::vector<float>& rgb, double exposure) {
+    if (exposure == 1.0) {
+        writePng8(file, width, height, rgb, true);
+        return;
+    }
+    std::vector<float> scaled(rgb.size());
+    for (std::size_t i = 0; i < rgb.size(); ++i) scaled[i] = float(double(rgb[i]) * exposure);
+    writePng8(file, width, height, scaled, true);
+}
+
+double displayExposure(const Frame& frame) {
+    std::vector<float> luminance;
+    for (std::size_t i = 0; i < frame.pixelCount() && 3 * i + 2 < frame.beauty.size(); ++i)
+        if (i < frame.objectId.size() && frame.objectId[i] > 0.0f) {
+            const float y =
+                0.2126f * frame.beauty[3 * i] + 0.7152f * frame.beauty[3 * i + 1] + 0.0722f * frame.beauty[3 * i + 2];
+            if (std::isfinite(y)) luminance.push_back(y);
+        }
+    if (luminance.empty()) return 1.0;
+    const auto p99 = luminance.begin() + std::ptrdiff_t(0.99 * double(luminance.size() - 1));
+    std::nth_element(luminance.begin(), p99, luminance.end());
+    return *p99 > 1.0f ? 1.0 / double(*p99) : 1.0;
 }
 
 void writePngDisplay(const fs::path& file, int width, int height, const std::vector<float>& rgb) {

@@ -21,7 +21,14 @@ std::string lightVisibilityChannel(std::size_t light);
 Frame readFrame(const std::filesystem::path& file);
 
 // An 8-bit sRGB PNG from linear RGB floats (3 per pixel), written atomically.
-void writePngLinear(const std::filesystem::path& file, int width, int height, const std::vector<float>& linearRgb);
+// `exposure` multiplies the linear values before encoding (displayExposure).
+void writePngLinear(const std::filesystem::path& file, int width, int height, const std::vector<float>& linearRgb,
+                    double exposure = 1.0);
+// The factor that keeps a report's images readable under bright lights: 1, or where more than 1%
+// of the frame's visible surface would clip to white, the one that puts that 99th percentile of
+// luminance at 1. (A glTF point light of tens of thousands of candela washed out every object and
+// shadow; one factor from the reference is used for every image of a report, so they compare.)
+double displayExposure(const Frame& frame);
 // An 8-bit PNG from already display-encoded RGB floats in 0..1 (diff images, plots).
 void writePngDisplay(const std::filesystem::path& file, int width, int height, const std::vector<float>& rgb);
 

@@ -900,6 +900,9 @@ fs::path findScene(const std::string& nameOrPath) {
     const fs::path dir = scenesDirectory();
     for (const fs::path& candidate : {dir / nameOrPath, dir / (nameOrPath + ".json")})
         if (fs::is_regular_file(candidate, ec)) return candidate;
+    // Something is there but is no file (a folder, a FIFO, a device, a symbolic-link loop): say
+    // what, rather than that there is no such file.
+    if (fs::exists(fs::symlink_status(asGiven, ec))) checkInputFile(asGiven, kMaxMeshFileBytes);
     std::set<std::string> names;
     for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator();
          it.increment(ec))

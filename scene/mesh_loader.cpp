@@ -3,6 +3,7 @@
 #include "scene/ply_loader.h"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cerrno>
 #include <climits>
@@ -46,13 +47,15 @@ bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && 
 // rather than silently reshaped: "nan" or "inf" numbers (read as 0), and face indices beyond
 // the 32-bit range (wrapped to other, possibly valid, vertices). Lines are read as tinyobjloader
 // reads them, after leading spaces and tabs.
-// A positive vertex index may name a vertex defined further down, so it is checked against the
-// file's count: where one exceeds it, a second pass (`vertexLimit`) names the first such line.
+// A positive index may name a vertex (texture coordinate, normal) defined further down, so it is
+// checked against the file's count: where one exceeds it, a second pass (`limits`: vertices,
+// texture coordinates, normals) names the first such line. A vertex needs three coordinates and a
+// face three corners: tinyobjloader drops a shorter face, or reads a missing coordinate as 0.
 void checkObjText(const std::string& text, const fs::path& file, const fs::path& sceneFile, const JsonPath& path,
-                  std::size_t vertexLimit = SIZE_MAX) {
+                  const std::array<std::size_t, 3>& limits = {SIZE_MAX, SIZE_MAX, SIZE_MAX}) {
     std::size_t vertices = 0, texcoords = 0, normals = 0;
     std::size_t lineNo = 0;
-    long long largest = 0;
+    std::array<long long, 3> largest = {0, 0, 0};
     for (std::size_t begin = 0; begin < text.size();) {
         std::size_t end = text.find('\n', begin);
         if (end == std::string::npos) end = text.size();
@@ -64,12 +67,15 @@ void checkObjText(const std::string& text, const fs::path& file, const fs::path&
         auto at = [&] { return "line " + std::to_string(lineNo) + ": "; };
         const std::size_t space = line.find_first_of(" \t");
         const std::string_view keyword = line.substr(0, space);
+        if (line == "f") fail(sceneFile, path, file, at() + "a face of 0 corners (a face needs 3 or more)");
         if (space == std::string_view::npos) continue;
         std::istringstream fields{std::string(line.substr(space + 1))};
         std::string token;
         if (keyword == "v" || keyword == "vn" || keyword == "vt") {
             (keyword == "v" ? vertices : keyword == "vn" ? normals : texcoords) += 1;
+            int coordinates = 0;
             for (int i = 0; i < 3 && fields >> token; ++i) {
+                ++coordinates;
                 char* stop = nullptr;
                 const double v = std::strtod(token.c_str(), &stop);
                 if (stop == token.c_str() || *stop != '\0' || !std::isfinite(v))
@@ -80,8 +86,14 @@ void checkObjText(const std::string& text, const fs::path& file, const fs::path&
                                                 : "texture") +
                              " coordinate '" + excerpt(token) + "' is not a finite number");
             }
+            if ((keyword == "v" || keyword == "vn") && coordinates < 3)
+                fail(sceneFile, path, file,
+                     at() + (keyword == "v" ? "a vertex" : "a normal") + " of " + std::to_string(coordinates) +
+                         " coordinate" + (coordinates == 1 ? "" : "s") + " (it needs x, y and z)");
         } else if (keyword == "f" || keyword == "l" || keyword == "p") {
+            int corners = 0;
             while (fields >> token) {
+                ++corners;
                 // v, v/vt, v//vn or v/vt/vn; each counted from 1, or back from the latest when negative.
                 std::size_t part = 0;
                 for (std::size_t from = 0; from <= token.size(); ++part) {
@@ -103,17 +115,23 @@ void checkObjText(const std::string& text, const fs::path& file, const fs::path&
                         fail(sceneFile, path, file,
                              at() + "face index " + excerpt(number) + " is out of range (" + std::to_string(defined) +
                                  " " + what + " defined so far)");
-                    if (part == 0 && std::uint64_t(std::max(index, 0LL)) > vertexLimit)
+                    if (part < 3 && std::uint64_t(std::max(index, 0LL)) > limits[part])
                         fail(sceneFile, path, file,
                              at() + "face index " + excerpt(number) + " is out of range (" +
-                                 std::to_string(vertexLimit) + " vertices in the file)");
-                    if (part == 0) largest = std::max(largest, index);
+                                 std::to_string(limits[part]) + " " + what + " in the file)");
+                    if (part < 3) largest[part] = std::max(largest[part], index);
                 }
             }
+            if (keyword == "f" && corners < 3)
+                fail(sceneFile, path, file,
+                     at() + "a face of " + std::to_string(corners) + " corner" + (corners == 1 ? "" : "s") +
+                         " (a face needs 3 or more)");
         }
     }
-    if (vertexLimit == SIZE_MAX && std::uint64_t(largest) > vertices)
-        checkObjText(text, file, sceneFile, path, vertices);
+    const std::array<std::size_t, 3> counts = {vertices, texcoords, normals};
+    if (limits[0] == SIZE_MAX && (std::uint64_t(largest[0]) > vertices || std::uint64_t(largest[1]) > texcoords ||
+                                  std::uint64_t(largest[2]) > normals))
+        checkObjText(text, file, sceneFile, path, counts);
 }
 
 // OBJ material libraries name other files, which tinyobjloader would open itself (a FIFO hung

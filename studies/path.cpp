@@ -925,26 +925,38 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
     if (fs::exists(out / "frames.jsonl", ec) && !fs::exists(out / "merge.json", ec))
         throw scene::InputError(out.string() + ": holds an unsharded path; merge into another folder");
 
-    // The merged folder: the frames linked (or copied), the journal in frame order, the manifest.
-    fs::create_directories(out / "frames");
+    // The merged folder: the frames linked (or copied), the journal in frame order, the manifest,
+    // then the measurement. All of it is made in a staging folder inside `out` and moved into place
+    // only once everything was measured: a damaged frame found while measuring leaves `out` as it was.
+    fs::create_directories(out);
+    const fs::path stage = scene::temporarySibling(out / "merge");
+    struct Staging {
+        fs::path dir;
+        bool committed = false;
+        ~Staging() {
+            std::error_code ec;
+            if (!committed) fs::remove_all(dir, ec);
+        }
+    } staging{stage};
+    fs::create_directories(stage / "frames");
     std::map<std::string, double> setupMs;
     std::map<std::string, std::vector<double>> times;
     std::string journal;
     for (const auto& [t, entry] : lines) {
         for (const std::string& name : all)
-            placeFile(entry.first / "frames" / frameName(t, name), out / "frames" / frameName(t, name));
+            placeFile(entry.first / "frames" / frameName(t, name), stage / "frames" / frameName(t, name));
         journal += entry.second.dump() + "\n";
         for (const auto& [name, ms] : entry.second.at("frame_ms").items()) times[name].push_back(ms.get<double>());
         const Json setups = entry.second.value("setup_ms", Json::object());
         for (const auto& [name, ms] : setups.items())
             if (ms.get<double>() > 0.0 || !setupMs.count(name)) setupMs[name] = ms.get<double>();
     }
-    scene::writeTextAtomic(out / "frames.jsonl", journal);
-    scene::writeTextAtomic(out / "path.json", manifest.dump(2) + "\n");
+    scene::writeTextAtomic(stage / "frames.jsonl", journal);
+    scene::writeTextAtomic(stage / "path.json", manifest.dump(2) + "\n");
     Json dirs = Json::array();
     for (const fs::path& d : merged.shardDirs) dirs.push_back(d.string());
     scene::writeTextAtomic(
-        out / "merge.json",
+        stage / "merge.json",
         Json{{"shards", merged.shardCount}, {"folders", dirs}, {"duplicates", merged.duplicates}}.dump(2) + "\n");
 
     PathResult& result = merged.result;
@@ -957,7 +969,15 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
     result.spec.amount = result.amount;
     result.frames = frames;
     result.resumedFrames = 0;  // a merge renders nothing, so nothing was resumed
-    measurePath(result, out, sceneFile, names, setupMs, times);
+    measurePath(result, stage, sceneFile, names, setupMs, times);
+    // The commit: each staged entry replaces its namesake (an earlier merge's).
+    for (const auto& e : fs::directory_iterator(stage)) {
+        const fs::path target = out / e.path().filename();
+        fs::remove_all(target);
+        fs::rename(e.path(), target);
+    }
+    fs::remove(stage);
+    staging.committed = true;
     return merged;
 }
 

@@ -5,6 +5,7 @@
 // nothing beats them, so the recommendation never loses (docs/sweep.md "The recommendation").
 #pragma once
 
+#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
@@ -26,10 +27,16 @@ struct Measured {
     double mismatchRate = 0.0, falseShadowRate = 0.0, missedShadowRate = 0.0;
     double shadowIoU = 1.0, meanAbsVisibilityError = 0.0;
     double softErrorRate = 0.0;  // off by more than 0.25 without crossing τ (compare.h)
+    // Missed shadow at a smooth-shaded mesh's terminator (compare.h): the reference's facets
+    // shadowing their neighbours, which a renderer's offset or bias is meant to hide. The search
+    // and beats() judge the rest (judgedRate), so that no setting is recommended for bringing the
+    // faceted terminator back.
+    double terminatorMissedRate = 0.0;
+    double judgedRate() const { return std::max(0.0, mismatchRate - terminatorMissedRate); }
 };
 Measured measure(const scene::Frame& method, const scene::Frame& reference);
-// The search's order: a is strictly better than b with less mismatch, or as much and less mean
-// |ΔV|. A failed measurement is never better.
+// The search's order: a is strictly better than b with less mismatch (judgedRate: the terminator's
+// left out), or as much and less mean |ΔV|. A failed measurement is never better.
 bool better(const Measured& a, const Measured& b);
 // A candidate replaces the defaults only when neither its mismatch nor its mean |ΔV| is larger
 // (with a filter, a bias can trade a few wrong pixels for a wide band of partial acne the classes

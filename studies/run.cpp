@@ -271,7 +271,12 @@ RunStudyResult runStudy(const scene::Scene& scene, const scene::RenderSettings& 
     const scene::Frame reference = renderForOutput(scene, plan, settings, scene::Backend::Reference);
     const std::string referenceName = scene::toString(scene::Backend::Reference);
     scene::writeFrame(reference, dir / (referenceName + ".exr"));
-    scene::writePngLinear(dir / (referenceName + ".png"), reference.width, reference.height, reference.beauty);
+    // One exposure for every image of the report, from the reference (the EXRs keep the values).
+    const double exposure = scene::displayExposure(reference);
+    report.displayExposure = exposure;
+    metrics["display_exposure"] = exposure;
+    scene::writePngLinear(dir / (referenceName + ".png"), reference.width, reference.height, reference.beauty,
+                          exposure);
     written.insert(written.end(), {referenceName + ".exr", referenceName + ".png"});
     progress.end("");
     metrics[referenceName] = {{"timings_ms", timingsJson(reference)}, {"attributes", reference.attributes}};
@@ -300,7 +305,7 @@ RunStudyResult runStudy(const scene::Scene& scene, const scene::RenderSettings& 
         }
         defaultsFrame[isRaster] = frame;
         scene::writeFrame(frame, dir / (backend + ".exr"));
-        scene::writePngLinear(dir / (backend + ".png"), frame.width, frame.height, frame.beauty);
+        scene::writePngLinear(dir / (backend + ".png"), frame.width, frame.height, frame.beauty, exposure);
         const compare::Comparison c = compare::compareFrames(frame, reference);
         scene::writePngDisplay(dir / ("diff-" + backend + ".png"), c.width, c.height, c.diffRgb);
         written.insert(written.end(), {backend + ".exr", backend + ".png", "diff-" + backend + ".png"});

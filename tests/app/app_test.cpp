@@ -199,13 +199,15 @@ TEST_P(BadInput, OneClearErrorNonZeroExitNothingWritten) {
     const auto scene = dir.write("bad.json", R"({"camera": {"position": [0,2,6], "look_at": [0,0,0]},
         "materials": {"m": {}}, "lights": [{"type": "directional", "direction": [0,0,0]}],
         "objects": [{"type": "sphere", "center": [0,1,0], "radius": 1, "material": "m"}]})");
-    std::vector<std::string> args;
+    std::vector<std::string> args;  // OUTDIRPARENT: the test's folder; UNDERBAD: a path under the BAD file
     for (const auto& a : GetParam().args)
-        args.push_back(a == "OUT"      ? (dir.path() / "out" / "x.exr").string()
-                       : a == "OUTPNG" ? (dir.path() / "out" / "x.png").string()
-                       : a == "OUTDIR" ? (dir.path() / "out").string()
-                       : a == "BAD"    ? scene.string()
-                                       : a);
+        args.push_back(a == "OUT"            ? (dir.path() / "out" / "x.exr").string()
+                       : a == "OUTPNG"       ? (dir.path() / "out" / "x.png").string()
+                       : a == "OUTDIR"       ? (dir.path() / "out").string()
+                       : a == "BAD"          ? scene.string()
+                       : a == "OUTDIRPARENT" ? dir.path().string()
+                       : a == "UNDERBAD"     ? (scene / "d.png").string()
+                                             : a);
     const std::size_t before = dir.fileCount();
     const Result r = shadowlab(args);
     EXPECT_NE(r.exitCode, 0);
@@ -256,6 +258,15 @@ INSTANTIATE_TEST_SUITE_P(
                {"path", "seed", "--camera-animation", "-o", "OUTDIR"},
                "has no animation that moves a camera"},
         BadRun{"path_bad_shard", {"path", "seed", "--shard", "2/2", "-o", "OUTDIR"}, "--shard"},
+        BadRun{"cli_parse_error",
+               {"render", "seed", "--shadow-map-size", "1e9", "-o", "OUT"},
+               "shadowlab: error: Could not convert"},
+        BadRun{"no_subcommand", {"bogus"}, "shadowlab: error: "},
+        BadRun{"scene_is_a_folder", {"render", "OUTDIRPARENT", "-o", "OUT"}, ": is a folder, not a file"},
+        BadRun{"heat_is_the_diff",
+               {"compare", "BAD", "BAD", "-o", "OUTPNG", "--heat", "OUTPNG"},
+               "names the same file as -o"},
+        BadRun{"compare_under_a_file", {"compare", "BAD", "BAD", "-o", "UNDERBAD"}, "is a file, not a folder"},
         BadRun{"sweep_bad_flicker_kind",
                {"sweep", "seed", "--quick", "--flicker", "spiral", "-o", "OUTDIR"},
                "--kind: expected orbit|"}),

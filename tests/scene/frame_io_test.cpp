@@ -153,6 +153,30 @@ TEST(FrameIo, PngIsSrgbEncodedBeauty) {
     EXPECT_NEAR(px[5], 128, 1);
 }
 
+TEST(FrameIo, DisplayExposurePutsTheBrightestPercentOfTheSurfaceAtOneAndNeverBrightens) {
+    // 200 pixels: 100 background (ignored, however bright), 100 on objects of gray luminance
+    // 0.5 (98 of them) and 8 (2). The 99th percentile of the 100 (index 98 after sorting) is 8.
+    Frame f = Frame::allocate(200, 1, false);
+    for (std::size_t i = 0; i < 200; ++i) {
+        const float v = i < 100 ? 50.0f : i < 198 ? 0.5f : 8.0f;
+        f.objectId[i] = i < 100 ? 0.0f : 1.0f;
+        f.beauty[3 * i] = f.beauty[3 * i + 1] = f.beauty[3 * i + 2] = v;
+    }
+    EXPECT_DOUBLE_EQ(displayExposure(f), 1.0 / 8.0);
+    // A dim frame is left as it is.
+    for (std::size_t i = 198; i < 200; ++i) f.beauty[3 * i] = f.beauty[3 * i + 1] = f.beauty[3 * i + 2] = 0.9f;
+    EXPECT_DOUBLE_EQ(displayExposure(f), 1.0);
+    // The PNG of 0.5 scaled by 0.5 is that of 0.25: sRGB(0.25) = 1.055·0.25^(1/2.4) − 0.055 = 0.5371 -> 137.
+    TempDir dir;
+    writePngLinear(dir.path() / "x.png", 1, 1, std::vector<float>(3, 0.5f), 0.5);
+    auto in = OIIO::ImageInput::open((dir.path() / "x.png").string());
+    ASSERT_TRUE(in);
+    unsigned char px[3];
+    ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, px));
+    EXPECT_EQ(px[0], 137);
+    EXPECT_EQ(px[2], 137);
+}
+
 TEST(FrameIo, EverySrgbCodeDecodesToALinearValueThatEncodesBackToIt) {
     // What a frame from an 8-bit sRGB target holds (kBeautyForDisplay): code k -> linear -> the
     // PNG writer's code must be k again, and the linear value must be the sRGB curve's inverse

@@ -323,6 +323,31 @@ TEST(ObjIndex, IndicesBeyondThe32BitRangeAreErrorsNamingTheLine) {
     EXPECT_NE(e.find("line 5: face index 7 is out of range (3 vertices in the file)"), std::string::npos) << e;
     dir.write("ahead.obj", "v 0 0 0\nf 1 2 3\nv 1 0 0\nv 0 1 0\n");
     EXPECT_EQ(errorOf([&] { scene::loadScene(dir.write("ahead.json", meshScene("ahead.obj"))); }), "");
+    // The same for texture coordinates and normals: one past the file's count is named.
+    dir.write("vt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/1 3/90000000\n");
+    const std::string t = errorOf([&] { scene::loadScene(dir.write("vt.json", meshScene("vt.obj"))); });
+    EXPECT_NE(t.find("line 5: face index 90000000 is out of range (1 texture coordinates in the file)"),
+              std::string::npos)
+        << t;
+}
+
+TEST(ObjIndex, AFaceOfFewerThanThreeCornersOrAVertexOfFewerThanThreeCoordinatesIsAnError) {
+    TempDir dir;
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"f 1 2", "line 5: a face of 2 corners (a face needs 3 or more)"},
+        {"f 1", "line 5: a face of 1 corner "},
+        {"f", "line 5: a face of 0 corners"},
+        {"v 0 0", "line 5: a vertex of 2 coordinates (it needs x, y and z)"},
+        {"vn 0 1", "line 5: a normal of 2 coordinates"},
+    };
+    for (const auto& [line, says] : cases) {
+        dir.write("short.obj", kTriangleObj + line + "\n");
+        const std::string e = errorOf([&] { scene::loadScene(dir.write("short.json", meshScene("short.obj"))); });
+        EXPECT_NE(e.find(says), std::string::npos) << line << ": " << e;
+    }
+    // Texture coordinates may have one or two; a vertex may carry w or a colour.
+    dir.write("ok.obj", "v 0 0 0 1\nv 1 0 0 0.5 0.5 0.5\nv 0 1 0\nvt 0\nf 1/1 2/1 3/1\n");
+    EXPECT_EQ(errorOf([&] { scene::loadScene(dir.write("ok.json", meshScene("ok.obj"))); }), "");
 }
 
 // ---- non-finite values wherever they enter ----------------------------------------------

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <set>
 
 #include <unistd.h>
@@ -164,6 +165,34 @@ TEST(PathShards, ProgressCountsTheShardsOwnFramesWithTheTimeLeft) {
     ASSERT_EQ(lines.size(), 2u);
     EXPECT_EQ(lines[0].rfind("frame 2/5 (1 of 2 in this shard), ETA ", 0), 0u) << lines[0];
     EXPECT_EQ(lines[1], "frame 4/5 (2 of 2 in this shard), ETA 0m00s");
+}
+
+TEST(PathShards, ADamagedFrameFoundWhileMeasuringLeavesTheMergedFolderAsItWas) {
+    const scene::Scene base = slantedSphere(24, 16);
+    PathSpec spec;
+    spec.kind = PathKind::SunAzimuth;
+    spec.frames = 2;
+    const TempFolder dir("path-damaged");
+    for (int k = 0; k < 2; ++k) {
+        PathRunOptions o = shardOptions(dir.path, k, 2);
+        o.raster = false;
+        runPath(base, settingsFor(base, 64), spec, o);
+    }
+    // Shard 1's ray-traced frame cut to its first 2000 bytes (a copy that stopped half-way).
+    fs::path damaged;
+    for (const auto& e : fs::directory_iterator(dir.path / "shard-1-of-2" / "frames"))
+        if (e.path().filename().string().find("raytrace") != std::string::npos) damaged = e.path();
+    ASSERT_FALSE(damaged.empty());
+    {
+        std::ifstream in(damaged, std::ios::binary);
+        std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        fs::remove(damaged);  // a new file, not the one the merge would link
+        std::ofstream(damaged, std::ios::binary) << all.substr(0, 2000);
+    }
+    EXPECT_ANY_THROW(mergePathShards({dir.path}, dir.path));
+    std::set<std::string> left;
+    for (const auto& e : fs::directory_iterator(dir.path)) left.insert(e.path().filename().string());
+    EXPECT_EQ(left, (std::set<std::string>{"shard-0-of-2", "shard-1-of-2"}));
 }
 
 TEST(PathShards, AShardOfAnotherPathIsRefusedAndAMissingOrUnfinishedShardIsNamed) {
