@@ -792,9 +792,10 @@ int check(const CheckOptions& o) {
     for (const auto& c : fullSuite.cases) inputs.push_back(c.sceneFile);
     if (shard) {
         checkOutputFolder(o.outputDir);
-        checkReplacedFolder(o.outputDir / studies::shardFolderName(*shard), inputs, "shard.json");
+        checkReplacedFolder(o.outputDir / studies::shardFolderName(*shard), inputs, "shard.json",
+                            "\"check_suite_hash\"");
     } else {
-        checkReplacedFolder(o.outputDir, inputs, "junit.xml");
+        checkReplacedFolder(o.outputDir, inputs, "junit.xml", "<testsuites name=\"shadowlab check\"");
     }
     if (o.updateBaseline) checkOutputFile(*baselineFile, "--update-baseline");
     std::cerr << "shadowlab: check " << suite.name << ": " << suite.cases.size() << " cases"
@@ -848,6 +849,8 @@ int check(const CheckOptions& o) {
             if (fs::exists(*baselineFile)) old = studies::loadBaseline(*baselineFile);
         } catch (const scene::SceneError&) {
             // A damaged baseline is being replaced.
+        } catch (const scene::InputError&) {
+            // So is one that cannot be read as a file (its writability was checked before the cases).
         }
         for (const studies::CaseResult& r : results) {
             if (r.metrics)

@@ -7,6 +7,8 @@
 #include <cstring>
 #include <iostream>
 
+#include "scene/input_file.h"
+
 namespace shadowlab::app {
 
 namespace {
@@ -54,7 +56,7 @@ void checkOutputFolder(const fs::path& dir, const std::string& option) {
 }
 
 void checkReplacedFolder(const fs::path& dir, const std::vector<fs::path>& inputs, const std::string& marker,
-                         const std::string& option) {
+                         const std::string& signature, const std::string& option) {
     checkOutputFolder(dir, option);
     std::error_code ec;
     const fs::path target = fs::weakly_canonical(fs::absolute(dir), ec);
@@ -73,9 +75,17 @@ void checkReplacedFolder(const fs::path& dir, const std::vector<fs::path>& input
     for (const fs::path& input : inputs)
         if (!input.empty() && within(input))
             throw scene::InputError(option + " " + dir.string() + ": holds the input " + input.string() + why);
-    if (fs::is_directory(dir, ec) && !fs::is_empty(dir, ec) && !fs::exists(dir / marker, ec))
-        throw scene::InputError(option + " " + dir.string() + ": holds files that no earlier run wrote (no " + marker +
-                                ")" + why + ", or empty this one");
+    if (!fs::is_directory(dir, ec) || fs::is_empty(dir, ec)) return;
+    std::string text;
+    try {
+        text = scene::readInputFile(dir / marker, 1 << 20);
+    } catch (const std::exception&) {
+        text.clear();  // absent, not a file, or too large: not what this command writes
+    }
+    if (text.find(signature) == std::string::npos)
+        throw scene::InputError(option + " " + dir.string() +
+                                ": holds files that no earlier run of this command wrote (no " + marker +
+                                " of its own)" + why + ", or empty this one");
 }
 
 int finishStandardOutput(int status) {

@@ -45,10 +45,11 @@ void checkOutputFolder(const std::filesystem::path& dir, const std::string& opti
 
 // A folder a command replaces as a whole (`check -o DIR`): checkOutputFolder's rules, and it must
 // not be the working folder or hold it, nor hold any of `inputs`, and an existing folder with
-// entries must hold `marker` (a file an earlier run of the command wrote), so that no folder of the
-// user's own is replaced. Throws InputError naming `option`, the folder and the reason.
+// entries must hold the file `marker` with `signature` in it (what an earlier run of the command
+// wrote: another tool's junit.xml, or a sweep's shard.json, is not that), so that no folder of
+// the user's own is replaced. Throws InputError naming `option`, the folder and the reason.
 void checkReplacedFolder(const std::filesystem::path& dir, const std::vector<std::filesystem::path>& inputs,
-                         const std::string& marker, const std::string& option = "-o");
+                         const std::string& marker, const std::string& signature, const std::string& option = "-o");
 
 // Flushes standard output and returns `status`, or prints why the write failed (a full disk,
 // a closed pipe) and returns 1: results that did not reach their reader are a failure.

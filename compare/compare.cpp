@@ -523,6 +523,7 @@ Comparison compareFrames(const Frame& method, const Frame& reference, const Comp
             }
             const auto heat = heatColor(float(e));
             std::copy(heat.begin(), heat.end(), out.heatRgb.begin() + 3 * std::ptrdiff_t(i));
+            bool someLightWrong = false;
             for (std::size_t l = 0; l < lightSum.size(); ++l) {
                 const float lm = method.lightVisibility[l][i], lr = reference.lightVisibility[l][i];
                 const double el = std::isfinite(lm) && std::isfinite(lr) ? std::fabs(double(lm) - double(lr)) : 1.0;
@@ -537,10 +538,12 @@ Comparison compareFrames(const Frame& method, const Frame& reference, const Comp
                     const PixelClass lc = classifyCounted(lm, lr);
                     le.falseShadow += lc == PixelClass::FalseShadow;
                     le.missedShadow += lc == PixelClass::MissedShadow;
+                    someLightWrong = someLightWrong || lc == PixelClass::FalseShadow || lc == PixelClass::MissedShadow;
                 }
                 const auto lh = heatColor(float(el));
                 std::copy(lh.begin(), lh.end(), out.lightHeatRgb[l].begin() + 3 * std::ptrdiff_t(i));
             }
+            m.perLightWrongPixels += someLightWrong;
             const bool shM = vm <= kVisibilityTolerance, shR = vr <= kVisibilityTolerance;
             m.shadowedMethod += shM;
             m.shadowedReference += shR;
@@ -667,6 +670,7 @@ nlohmann::json toJson(const Metrics& m) {
         {"soft_error_rate", m.softErrorRate},
         {"soft_error_tolerance", kSoftErrorTolerance},
         {"soft_error_near_edge", m.softErrorNearEdge},
+        {"per_light_wrong_pixels", m.perLightWrongPixels},
         {"shadowed_method", m.shadowedMethod},
         {"shadowed_reference", m.shadowedReference},
         {"shadowed_intersection", m.shadowedIntersection},
@@ -740,11 +744,7 @@ bool softErrorDominates(const Metrics& m) {
            away > m.falseShadow + m.missedShadow;
 }
 
-std::size_t perLightWrong(const Metrics& m) {
-    std::size_t n = 0;
-    for (const LightError& l : m.perLight) n += l.falseShadow + l.missedShadow;
-    return n;
-}
+std::size_t perLightWrong(const Metrics& m) { return m.perLightWrongPixels; }
 
 std::string summaryLine(const Metrics& m) {
     std::string s = "counted " + formatCount(m.counted) + " px: false shadow " + formatPercent(m.falseShadowRate);

@@ -188,6 +188,8 @@ struct Metrics {
     // Of softErrorPixels, those within edgeRadius of the reference's shadow edges: a filter's blur
     // of a hard edge (pcf2x2 softens every edge by a texel), not a wrong penumbra or banding.
     std::size_t softErrorNearEdge = 0;
+    // Counted pixels where some light's own channel crosses τ (each pixel once, however many lights).
+    std::size_t perLightWrongPixels = 0;
     std::vector<LightError> perLight;  // one per light when both frames have per-light channels
 
     std::string methodBackend, referenceBackend;  // Frame attribute "backend", if any
@@ -240,7 +242,7 @@ nlohmann::json toJson(const Metrics& metrics);
 // reference's shadow edges are a notable share (kNotableSoftErrorRate) and outnumber the wrong
 // ones: the classes then understate the error. (At the edges it is the filter's blur.)
 bool softErrorDominates(const Metrics& metrics);
-// The pixels wrong outright in each light's own channel, summed over the lights (0 without
+// The pixels wrong outright in some light's own channel (Metrics::perLightWrongPixels; 0 without
 // per-light channels): more than the combined mask's wrong pixels when one light's shadow is lost
 // or added where another light still reaches the point.
 std::size_t perLightWrong(const Metrics& metrics);

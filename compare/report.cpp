@@ -97,11 +97,13 @@ std::string describeContinuous(const Metrics& m) {
         if (m.softErrorNearEdge > 0)
             s += " (" + formatCount(m.softErrorNearEdge) + " of them within " + std::to_string(m.edgeRadius) +
                  " px of the reference's shadow edges, where a filter blurs a hard edge)";
-        if (m.softErrorRate <= kNotableSoftErrorRate || m.softErrorNearEdge == m.softErrorPixels)
+        const double away = double(m.softErrorPixels - std::min(m.softErrorPixels, m.softErrorNearEdge));
+        if (away <= kNotableSoftErrorRate * double(m.counted))
             s += ".";
+        else if (softErrorDominates(m))
+            s += ": soft-shadow error dominates, and the mismatch rate does not show it.";
         else
-            s += softErrorDominates(m) ? ": soft-shadow error dominates, and the mismatch rate does not show it."
-                                       : ": soft-shadow error beside the wrong pixels.";
+            s += m.falseShadow + m.missedShadow > 0 ? ": soft-shadow error beside the wrong pixels." : ".";
     }
     const std::size_t lightWrong = perLightWrong(m);
     if (m.perLight.size() > 1 && lightWrong > m.falseShadow + m.missedShadow)
@@ -165,9 +167,12 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
     } else {
         s = softErrorDominates(m)
                 // Lead with what a viewer sees: partial darkening under τ outnumbers the wrong pixels.
-                ? who + " is partly wrong on " + formatPercent(m.softErrorRate) + " of the " + formatCount(m.counted) +
-                      " counted pixels (off by more than " + formatShort(kSoftErrorTolerance) +
-                      " without crossing τ: " +
+                ? who + " is partly wrong on " +
+                      formatPercent(double(m.softErrorPixels - std::min(m.softErrorPixels, m.softErrorNearEdge)) /
+                                    double(m.counted)) +
+                      " of the " + formatCount(m.counted) +
+                      " counted pixels away from the shadow edges (off by more than " +
+                      formatShort(kSoftErrorTolerance) + " without crossing τ: " +
                       (m.perLight.size() > 1 && perLightWrong(m) > m.falseShadow + m.missedShadow
                            ? "one light's shadow wrong outright where another light still reaches the point"
                            : "filtered acne, or a penumbra of the wrong width") +

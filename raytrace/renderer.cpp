@@ -145,9 +145,10 @@ scene::Frame renderT(const scene::Scene& scene, const scene::RenderPlan& plan, c
             const scene::LightSample<scene::Vec3> ls = scene::sampleLight(light, p);
             const double ndotl = glm::dot(ns, ls.toLight);
             // Only lights that reach the point (lit.frag does the same): outside every spot's cone
-            // ndotl is -1, so compare leaves the pixel out as it does a back face.
-            maxNdotL = std::max(maxNdotL, ls.irradiance > 0 ? ndotl : -1.0);
-            if (!(ndotl > 0) || !(ls.irradiance > 0)) continue;  // visibility 0, weight 0
+            // ndotl is -1, so compare leaves the pixel out as it does a back face. Reaching is
+            // geometric, as in lit.frag: a light of intensity 0 is still tested, with weight 0.
+            maxNdotL = std::max(maxNdotL, ls.reaches ? ndotl : -1.0);
+            if (!(ndotl > 0) || !ls.reaches) continue;  // visibility 0, weight 0
             double v = 1.0;
             if (needsShadowTest[li]) {
                 Rng rng(sampleSeed(i, int(li)));

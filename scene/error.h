@@ -68,4 +68,12 @@ public:
     explicit InputError(const std::string& what) : std::runtime_error(excerpt(what, kMaxErrorMessage)) {}
 };
 
+// A result that could not be written once the work was done (a full disk, a folder that went
+// away): a failure, exit 1, not bad input. (An output path known to be unusable before any work
+// is an InputError, exit 2.)
+class OutputError : public std::runtime_error {
+public:
+    explicit OutputError(const std::string& what) : std::runtime_error(excerpt(what, kMaxErrorMessage)) {}
+};
+
 }  // namespace shadowlab::scene

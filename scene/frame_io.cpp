@@ -194,16 +194,16 @@ void writeAtomically(const fs::path& file, WriteFn&& write) {
 }
 
 // Opens `tmp` (the temporary name `file` is written under) for an image of `spec`, runs write(out),
-// and closes it; each step's failure is an InputError naming `file`, the name the user gave (the
+// and closes it; each step's failure is an OutputError naming `file`, the name the user gave (the
 // temporary is gone by the time the message is read).
 template <typename WriteFn>
 void writeImageWith(const fs::path& file, const fs::path& tmp, const ImageSpec& spec, WriteFn&& write) {
     auto out = ImageOutput::create(tmp.string());
     if (!out) throw InputError(file.string() + ": cannot write this image format (" + OIIO::geterror() + ")");
     if (!out->open(tmp.string(), spec))
-        throw InputError(file.string() + ": cannot open for writing: " + out->geterror());
-    if (!write(*out)) throw InputError(file.string() + ": write failed: " + out->geterror());
-    if (!out->close()) throw InputError(file.string() + ": close failed: " + out->geterror());
+        throw OutputError(file.string() + ": cannot open for writing: " + out->geterror());
+    if (!write(*out)) throw OutputError(file.string() + ": write failed: " + out->geterror());
+    if (!out->close()) throw OutputError(file.string() + ": close failed: " + out->geterror());
 }
 
 void writeImage(const fs::path& file, const fs::path& tmp, const ImageSpec& spec, const void* pixels, TypeDesc type) {
@@ -349,7 +349,7 @@ void writeTextAtomic(const fs::path& file, const std::string& text) {
         std::ofstream out(tmp, std::ios::binary);
         out << text;
         out.close();
-        if (!out) throw InputError(file.string() + ": cannot write");
+        if (!out) throw OutputError(file.string() + ": cannot write");
     });
 }
 

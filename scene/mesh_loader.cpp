@@ -47,10 +47,12 @@ bool finite(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && 
 // rather than silently reshaped: "nan" or "inf" numbers (read as 0), and face indices beyond
 // the 32-bit range (wrapped to other, possibly valid, vertices). Lines are read as tinyobjloader
 // reads them, after leading spaces and tabs.
-// A positive index may name a vertex (texture coordinate, normal) defined further down, so it is
-// checked against the file's count: where one exceeds it, a second pass (`limits`: vertices,
-// texture coordinates, normals) names the first such line. A vertex needs three coordinates and a
-// face three corners: tinyobjloader drops a shorter face, or reads a missing coordinate as 0.
+// A positive vertex index may name a vertex defined further down, so it is checked against the
+// file's count: where one exceeds it, a second pass (`limits`: vertices, texture coordinates,
+// normals) names the first such line. (A texture coordinate or normal index past the file's is not
+// an error: the mesh then goes without UVs or normals, as readObj does, and still casts.) A vertex
+// needs three coordinates and a face three corners: tinyobjloader drops a shorter face, or reads
+// a missing coordinate as 0.
 void checkObjText(const std::string& text, const fs::path& file, const fs::path& sceneFile, const JsonPath& path,
                   const std::array<std::size_t, 3>& limits = {SIZE_MAX, SIZE_MAX, SIZE_MAX}) {
     std::size_t vertices = 0, texcoords = 0, normals = 0;
@@ -128,10 +130,8 @@ void checkObjText(const std::string& text, const fs::path& file, const fs::path&
                          " (a face needs 3 or more)");
         }
     }
-    const std::array<std::size_t, 3> counts = {vertices, texcoords, normals};
-    if (limits[0] == SIZE_MAX && (std::uint64_t(largest[0]) > vertices || std::uint64_t(largest[1]) > texcoords ||
-                                  std::uint64_t(largest[2]) > normals))
-        checkObjText(text, file, sceneFile, path, counts);
+    if (limits[0] == SIZE_MAX && std::uint64_t(largest[0]) > vertices)
+        checkObjText(text, file, sceneFile, path, {vertices, SIZE_MAX, SIZE_MAX});
 }
 
 // OBJ material libraries name other files, which tinyobjloader would open itself (a FIFO hung
@@ -881,6 +881,130 @@ std::string bufferFileProblem(std::string_view json, const std::string& baseDir)
     return "";
 }
 
+// What tinygltf reads leniently, checked on the file's JSON once tinygltf has accepted it: a
+// value of the wrong type it drops without a word (indices "0" read the primitive without its
+// indices, a transform of strings placed the node at the origin) and values out of the range the
+// glTF 2.0 specification gives. The first problem, by its JSON path ("" if none).
+std::string gltfValueProblem(std::string_view json) {
+    const nlohmann::json doc = nlohmann::json::parse(json, nullptr, false);
+    if (!doc.is_object()) return "";
+    auto count = [&](const char* key) {
+        return doc.contains(key) && doc[key].is_array() ? doc[key].size() : std::size_t(0);
+    };
+    auto items = [&](const nlohmann::json& parent, const char* key) -> const nlohmann::json* {
+        return parent.is_object() && parent.contains(key) && parent[key].is_array() ? &parent[key] : nullptr;
+    };
+    // An index into the top-level array `of` (its entries named `one`); "" when it is one.
+    auto index = [&](const nlohmann::json& v, const std::string& at, const char* of, const char* one) -> std::string {
+        if (!v.is_number_integer() || v.get<std::int64_t>() < 0)
+            return at + ": must be an index (a whole number >= 0), got " + describeJson(v);
+        if (std::uint64_t(v.get<std::int64_t>()) >= count(of))
+            return at + ": names " + std::string(one) + " " + std::to_string(v.get<std::int64_t>()) +
+                   ", which does not exist (" + std::to_string(count(of)) + " " + of + ")";
+        return "";
+    };
+    auto numbers = [&](const nlohmann::json& v, const std::string& at, std::size_t n) -> std::string {
+        bool ok = v.is_array() && v.size() == n;
+        for (std::size_t i = 0; ok && i < n; ++i) ok = v[i].is_number() && std::isfinite(v[i].get<double>());
+        return ok ? "" : at + ": must be an array of " + std::to_string(n) + " finite numbers, got " + describeJson(v);
+    };
+    auto number = [&](const nlohmann::json& v, const std::string& at, double lo, double hi, bool loOpen,
+                      const char* range) -> std::string {
+        const bool ok = v.is_number() && std::isfinite(v.get<double>()) &&
+                        (loOpen ? v.get<double>() > lo : v.get<double>() >= lo) && v.get<double>() <= hi;
+        return ok ? "" : at + ": must be a number " + range + ", got " + describeJson(v);
+    };
+    const double inf = std::numeric_limits<double>::infinity(), pi = 3.14159265358979323846;
+    std::string p;
+    if (doc.contains("scene") && !(p = index(doc["scene"], "scene", "scenes", "scene")).empty()) return p;
+    if (const nlohmann::json* meshes = items(doc, "meshes"))
+        for (std::size_t m = 0; m < meshes->size(); ++m)
+            if (const nlohmann::json* prims = items((*meshes)[m], "primitives"))
+                for (std::size_t k = 0; k < prims->size(); ++k) {
+                    const nlohmann::json& prim = (*prims)[k];
+                    const std::string at = "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(k) + "]";
+                    if (!prim.is_object()) continue;
+                    if (prim.contains("indices") &&
+                        !(p = index(prim["indices"], at + ".indices", "accessors", "accessor")).empty())
+                        return p;
+                    if (prim.contains("attributes") && prim["attributes"].is_object())
+                        for (const auto& [name, value] : prim["attributes"].items())
+                            if (!(p = index(value, at + ".attributes." + name, "accessors", "accessor")).empty())
+                                return p;
+                    if (prim.contains("material") &&
+                        !(p = index(prim["material"], at + ".material", "materials", "material")).empty())
+                        return p;
+                    if (prim.contains("mode") && !(prim["mode"].is_number_integer() && prim["mode"].get<int>() >= 0 &&
+                                                   prim["mode"].get<int>() <= 6))
+                        return at +
+                               ".mode: must be 0 to 6 (points, lines, line loop, line strip, triangles, "
+                               "triangle strip, triangle fan), got " +
+                               describeJson(prim["mode"]);
+                }
+    if (const nlohmann::json* nodes = items(doc, "nodes"))
+        for (std::size_t n = 0; n < nodes->size(); ++n) {
+            const nlohmann::json& node = (*nodes)[n];
+            if (!node.is_object()) continue;
+            const std::string at = "nodes[" + std::to_string(n) + "]";
+            const std::pair<const char*, std::size_t> shapes[] = {
+                {"matrix", 16}, {"translation", 3}, {"rotation", 4}, {"scale", 3}};
+            for (const auto& [key, n3] : shapes)
+                if (node.contains(key) && !(p = numbers(node[key], at + "." + key, n3)).empty()) return p;
+            const std::pair<const char*, const char*> refs[] = {
+                {"mesh", "meshes"}, {"camera", "cameras"}, {"skin", "skins"}};
+            for (const auto& [key, of] : refs)
+                if (node.contains(key) && !(p = index(node[key], at + "." + key, of, key)).empty()) return p;
+        }
+    if (const nlohmann::json* cameras = items(doc, "cameras"))
+        for (std::size_t c = 0; c < cameras->size(); ++c) {
+            const nlohmann::json& cam = (*cameras)[c];
+            if (!cam.is_object() || !cam.contains("perspective") || !cam["perspective"].is_object()) continue;
+            const nlohmann::json& per = cam["perspective"];
+            const std::string at = "cameras[" + std::to_string(c) + "].perspective";
+            if (per.contains("yfov") &&
+                !(p = number(per["yfov"], at + ".yfov", 0.0, pi, true, "in (0, π) radians")).empty())
+                return p;
+            if (per.contains("znear") && !(p = number(per["znear"], at + ".znear", 0.0, inf, true, "> 0")).empty())
+                return p;
+            if (per.contains("aspectRatio") &&
+                !(p = number(per["aspectRatio"], at + ".aspectRatio", 0.0, inf, true, "> 0")).empty())
+                return p;
+        }
+    if (const nlohmann::json* materials = items(doc, "materials"))
+        for (std::size_t m = 0; m < materials->size(); ++m) {
+            const nlohmann::json& mat = (*materials)[m];
+            if (!mat.is_object()) continue;
+            const std::string at = "materials[" + std::to_string(m) + "]";
+            if (mat.contains("alphaCutoff") &&
+                !(p = number(mat["alphaCutoff"], at + ".alphaCutoff", 0.0, inf, false, ">= 0")).empty())
+                return p;
+            if (mat.contains("pbrMetallicRoughness") && mat["pbrMetallicRoughness"].is_object() &&
+                mat["pbrMetallicRoughness"].contains("baseColorFactor") &&
+                !(p = numbers(mat["pbrMetallicRoughness"]["baseColorFactor"],
+                              at + ".pbrMetallicRoughness.baseColorFactor", 4))
+                     .empty())
+                return p;
+        }
+    if (doc.contains("extensions") && doc["extensions"].is_object() &&
+        doc["extensions"].contains("KHR_lights_punctual"))
+        if (const nlohmann::json* lights = items(doc["extensions"]["KHR_lights_punctual"], "lights"))
+            for (std::size_t l = 0; l < lights->size(); ++l) {
+                const nlohmann::json& light = (*lights)[l];
+                if (!light.is_object()) continue;
+                const std::string at = "extensions.KHR_lights_punctual.lights[" + std::to_string(l) + "]";
+                // Its range is the light checks' (scene::lightProblem, after the conversion); the type here.
+                if (light.contains("intensity") && !light["intensity"].is_number())
+                    return at + ".intensity: must be a number, got " + describeJson(light["intensity"]);
+                if (light.contains("color") && !(p = numbers(light["color"], at + ".color", 3)).empty()) return p;
+                if (light.contains("spot") && light["spot"].is_object() && light["spot"].contains("outerConeAngle") &&
+                    !(p = number(light["spot"]["outerConeAngle"], at + ".spot.outerConeAngle", 0.0, pi / 2, true,
+                                 "in (0, π/2] radians"))
+                         .empty())
+                    return p;
+            }
+    return "";
+}
+
 // Where tinygltf refused a file: the first accessor a mesh primitive or an animation sampler names
 // that the file does not hold, by its JSON path ("" if none). tinygltf's own message names
 // neither the primitive nor the property.
@@ -966,6 +1090,8 @@ void loadGltf(const fs::path& file, const std::string& fileBytes, std::vector<Ra
             fail(sceneFile, path, file, problem);
         fail(sceneFile, path, file, "not a readable glTF file: " + excerpt(err.empty() ? warn : err, 400));
     }
+    if (const std::string problem = gltfValueProblem(gltfJsonChunk(fileBytes, binary)); !problem.empty())
+        fail(sceneFile, path, file, problem);
     prepared.rewritten.clear();
     prepared.rewritten.shrink_to_fit();
     try {

@@ -120,7 +120,8 @@ CheckSuite loadSuite(const fs::path& file) {
         if (!c.contains("scene")) throw SceneError(file, p / "scene", "is required");
         const std::string sceneName = stringAt(file, c["scene"], p / "scene");
         // A path beside the suite, or a shipped scene's name.
-        if (fs::exists(dir / sceneName)) {
+        std::error_code ec;
+        if (fs::is_regular_file(dir / sceneName, ec)) {
             k.sceneFile = dir / sceneName;
         } else {
             try {

@@ -380,6 +380,7 @@ std::vector<fs::path> shardFolders(const fs::path& input) {
 nlohmann::json toJson(const CheckShardManifest& m) {
     return {{"program", "shadowlab"},
             {"command", commandLine()},
+            {"cwd", commandDirectory()},
             {"version", m.version},
             {"check_suite", m.suite},
             {"check_suite_name", m.suiteName},
@@ -478,12 +479,12 @@ MergedCheck readCheckShards(const std::vector<fs::path>& inputs) {
     const CheckShardManifest& id = merged.identity;
     std::vector<fs::path> dirs;
     for (const auto& [k, entry] : byIndex) dirs.push_back(entry.first);
-    const std::vector<std::string> recorded = recordedShardCommand(dirs);
+    const RecordedCommand recorded = recordedShardCommand(dirs);
     std::string missing;
     for (int k = 0; k < id.shard.count; ++k) {
         if (byIndex.count(k)) continue;
         const Shard s{k, id.shard.count};
-        std::string command = shardCommandText(recorded, s, false);
+        std::string command = shardCommandText(recorded.args, s, false, recorded.cwd);
         if (command.empty())
             command = "shadowlab check " + quoteArg(id.suite) + " --shard " + std::to_string(k) + "/" +
                       std::to_string(s.count) + " -o " + quoteArg(outputDir.string());

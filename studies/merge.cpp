@@ -163,9 +163,9 @@ MergedSweep readShards(const std::vector<fs::path>& inputs) {
     const std::string scene = quoteArg(m.identity.scene);
     std::vector<fs::path> dirs;
     for (const ShardFolder& s : shards) dirs.push_back(s.dir);
-    const std::vector<std::string> recorded = recordedShardCommand(dirs);
+    const RecordedCommand recorded = recordedShardCommand(dirs);
     auto command = [&](int k, bool resume) {
-        const std::string c = shardCommandText(recorded, {k, m.shardCount}, resume);
+        const std::string c = shardCommandText(recorded.args, {k, m.shardCount}, resume, recorded.cwd);
         if (!c.empty()) return "`" + c + "`";
         return "`shadowlab sweep " + scene + " -o " + quoteArg(base.string()) + " --shard " + std::to_string(k) + "/" +
                std::to_string(m.shardCount) + (resume ? " --resume" : "") + "` and the same grid options";

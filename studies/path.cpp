@@ -362,6 +362,7 @@ Json pathIdentity(const scene::Scene& base, const Json& manifest) {
 Json pathShardManifest(const scene::Scene& base, const Json& manifest, const Shard& shard, int frames) {
     return {{"program", "shadowlab"},
             {"command", commandLine()},
+            {"cwd", commandDirectory()},
             {"study", "path"},
             {"scene", base.file.string()},
             {"identity", pathIdentity(base, manifest)},
@@ -887,9 +888,9 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
     // shard's own recorded command line, else the scene and folder with the options left to the user.
     std::vector<std::string> problems;
     const std::string scene = quoteArg(sceneFile.empty() ? std::string("SCENE") : sceneFile);
-    const std::vector<std::string> recorded = recordedShardCommand(merged.shardDirs);
+    const RecordedCommand recorded = recordedShardCommand(merged.shardDirs);
     auto command = [&](int k, bool resume) {
-        const std::string c = shardCommandText(recorded, {k, merged.shardCount}, resume);
+        const std::string c = shardCommandText(recorded.args, {k, merged.shardCount}, resume, recorded.cwd);
         if (!c.empty()) return "`" + c + "`";
         return "`shadowlab path " + scene + " -o " + quoteArg(base.string()) + " --shard " + std::to_string(k) + "/" +
                std::to_string(merged.shardCount) + (resume ? " --resume" : "") + "` and the same path options";
@@ -928,16 +929,19 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
     // The merged folder: the frames linked (or copied), the journal in frame order, the manifest,
     // then the measurement. All of it is made in a staging folder inside `out` and moved into place
     // only once everything was measured: a damaged frame found while measuring leaves `out` as it was.
+    const bool outExisted = fs::exists(out, ec);
     fs::create_directories(out);
     const fs::path stage = scene::temporarySibling(out / "merge");
     struct Staging {
-        fs::path dir;
-        bool committed = false;
+        fs::path dir, out;
+        bool removeOut = false, committed = false;
         ~Staging() {
             std::error_code ec;
-            if (!committed) fs::remove_all(dir, ec);
+            if (committed) return;
+            fs::remove_all(dir, ec);
+            if (removeOut && fs::is_empty(out, ec)) fs::remove(out, ec);
         }
-    } staging{stage};
+    } staging{stage, out, !outExisted};
     fs::create_directories(stage / "frames");
     std::map<std::string, double> setupMs;
     std::map<std::string, std::vector<double>> times;

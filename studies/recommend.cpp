@@ -286,7 +286,7 @@ void tryLargerMap(const RecommendOptions& o, const scene::Scene& scene, const sc
         notes.push_back("For the shadow map, " + asked + "a " + std::to_string(larger) + " map gives " +
                         percentPair(v.largerMap, v.defaults) +
                         (biasesWon
-                             ? " and beats the searched biases' " + compare::formatPercent(v.recommended.mismatchRate)
+                             ? " and beats the searched biases' " + compare::formatPercent(v.recommended.judgedRate())
                              : std::string()) +
                         " at " + sizeText(scene) +
                         ", for four times the texels of each map and more render time. The block recommends "
@@ -319,8 +319,9 @@ Json Recommendation::toJson() const {
                   {"defaults", measuredJson(v.defaults)},
                   {"tried", v.searched ? measuredJson(v.tried) : Json(nullptr)},
                   {"recommended", measuredJson(v.recommended)}};
+        // The gain judged (the terminator's missed shadow left out, as beats() judges), never < 0.
         j["mismatch_rate_gain"] = v.defaults.ok && v.recommended.ok
-                                      ? Json(v.defaults.mismatchRate - v.recommended.mismatchRate)
+                                      ? Json(v.defaults.judgedRate() - v.recommended.judgedRate())
                                       : Json(nullptr);
         if (withPoints) {
             j["searched_points"] = points.size();
@@ -462,7 +463,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
             block["slope_bias"] = best.slopeBias;
             r.notes.push_back("At " + r.resolution + ", " + v.candidate + " gives " +
                               percentPair(v.recommended, v.defaults) + ": " +
-                              compare::formatPercent(v.defaults.mismatchRate - v.recommended.mismatchRate) +
+                              compare::formatPercent(v.defaults.judgedRate() - v.recommended.judgedRate()) +
                               " of the counted pixels fewer wrong. The block recommends it.");
         } else {
             if (user.depthBias) block["depth_bias"] = *user.depthBias;

@@ -162,24 +162,35 @@ std::vector<std::string>& processCommandLine() {
     static std::vector<std::string> line;
     return line;
 }
+std::string& processDirectory() {
+    static std::string dir;
+    return dir;
+}
 }  // namespace
 
-void setCommandLine(std::vector<std::string> arguments) { processCommandLine() = std::move(arguments); }
+void setCommandLine(std::vector<std::string> arguments) {
+    processCommandLine() = std::move(arguments);
+    std::error_code ec;
+    processDirectory() = processCommandLine().empty() ? std::string() : fs::current_path(ec).string();
+}
 const std::vector<std::string>& commandLine() { return processCommandLine(); }
+std::string commandDirectory() { return processDirectory(); }
 
-std::vector<std::string> recordedShardCommand(const std::vector<fs::path>& dirs) {
+RecordedCommand recordedShardCommand(const std::vector<fs::path>& dirs) {
     for (const fs::path& d : dirs) {
         const Json j = scene::readJsonFileOrNull(d / "shard.json");
         if (!j.is_object() || !j.contains("command") || !j["command"].is_array()) continue;
-        std::vector<std::string> out;
+        RecordedCommand out;
         for (const Json& a : j["command"])
-            if (a.is_string()) out.push_back(a.get<std::string>());
-        if (!out.empty()) return out;
+            if (a.is_string()) out.args.push_back(a.get<std::string>());
+        if (j.contains("cwd") && j["cwd"].is_string()) out.cwd = j["cwd"].get<std::string>();
+        if (!out.args.empty()) return out;
     }
     return {};
 }
 
-std::string shardCommandText(const std::vector<std::string>& command, const Shard& shard, bool resume) {
+std::string shardCommandText(const std::vector<std::string>& command, const Shard& shard, bool resume,
+                             const std::string& cwd) {
     const std::string value = std::to_string(shard.index) + "/" + std::to_string(shard.count);
     std::string text = "shadowlab";
     bool named = false;
@@ -198,11 +209,14 @@ std::string shardCommandText(const std::vector<std::string>& command, const Shar
         }
     }
     if (command.empty() || !named) return "";
-    return resume ? text + " --resume" : text;
+    if (resume) text += " --resume";
+    std::error_code ec;
+    if (!cwd.empty() && fs::path(cwd) != fs::current_path(ec)) text = "cd " + quoteArg(cwd) + " && " + text;
+    return text;
 }
 
 std::string quoteArg(const std::string& s) {
-    if (!s.empty() && s.find_first_of(" \t'\"$\\`;&|<>()*?#~") == std::string::npos) return s;
+    if (!s.empty() && s.find_first_of(" \t\n'\"$\\`;&|<>()*?#~[]{}!") == std::string::npos) return s;
     std::string q = "'";
     for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
     return q + "'";
@@ -219,19 +233,20 @@ void placeFile(const fs::path& src, const fs::path& dst) {
         fs::copy_file(src, tmp, fs::copy_options::overwrite_existing, ec);
         if (ec) {
             fs::remove(tmp, ec);
-            throw scene::InputError(dst.string() + ": cannot copy " + src.string() + " here");
+            throw scene::OutputError(dst.string() + ": cannot copy " + src.string() + " here");
         }
     }
     fs::rename(tmp, dst, ec);
     if (ec) {
         fs::remove(tmp, ec);
-        throw scene::InputError(dst.string() + ": cannot write");
+        throw scene::OutputError(dst.string() + ": cannot write");
     }
 }
 
 Json shardManifest(const SweepIdentity& id, const Shard& shard) {
     return {{"program", "shadowlab"},
             {"command", commandLine()},
+            {"cwd", commandDirectory()},
             {"version", id.version},
             {"scene", id.scene},
             {"scene_hash", id.sceneHash},
@@ -333,7 +348,7 @@ scene::Frame sharedReference(const fs::path& dir, const scene::Scene& scene,
             ::close(fd);
             if (!wrote) {
                 fs::remove(lock, ec);
-                throw scene::InputError(lock.string() + ": cannot write (disk full?)");
+                throw scene::OutputError(lock.string() + ": cannot write (disk full?)");
             }
             // Refresh the lock while rendering, so waiting shards can tell a live holder from a dead one.
             std::atomic<bool> stop{false};

@@ -58,16 +58,24 @@ std::string fileHash(const std::filesystem::path& file);
 // scene file or mesh)"); empty when they are of one sweep.
 std::string identityDifference(const SweepIdentity& a, const SweepIdentity& b);
 
-// This process's command line (main sets it), recorded as "command" in every shard manifest so
-// that merge can name the exact command that renders a missing or unfinished shard.
+// This process's command line and working folder (main sets them), recorded as "command" and
+// "cwd" in every shard manifest so that merge can name the exact command that renders a missing or
+// unfinished shard.
 void setCommandLine(std::vector<std::string> arguments);
 const std::vector<std::string>& commandLine();
-// The "command" recorded in the first of `dirs`' shard.json that has one; empty when none does.
-std::vector<std::string> recordedShardCommand(const std::vector<std::filesystem::path>& dirs);
+std::string commandDirectory();  // the working folder when setCommandLine ran; "" before
+struct RecordedCommand {
+    std::vector<std::string> args;
+    std::string cwd;  // where it ran; relative paths in args are relative to it
+};
+// The command recorded in the first of `dirs`' shard.json that has one; empty args when none does.
+RecordedCommand recordedShardCommand(const std::vector<std::filesystem::path>& dirs);
 // `command` (a shard's recorded command line) for `shard`: its --shard value replaced, --resume
-// dropped or added, the program named "shadowlab", each argument quoted for a POSIX shell; empty
-// when `command` is, or names no --shard.
-std::string shardCommandText(const std::vector<std::string>& command, const Shard& shard, bool resume);
+// dropped or added, the program named "shadowlab", each argument quoted for a POSIX shell, and
+// "cd CWD && " in front when it ran in another folder than this process; empty when `command` is,
+// or names no --shard.
+std::string shardCommandText(const std::vector<std::string>& command, const Shard& shard, bool resume,
+                             const std::string& cwd = "");
 // `s` quoted for a POSIX shell when it is empty or holds a character the shell reads specially.
 std::string quoteArg(const std::string& s);
 // Links src to dst (same file system) or copies it, through a temporary name; creates dst's

@@ -1082,6 +1082,8 @@ SweepResult runSweep(const scene::Scene& baseScene, const SweepGrid& grid, const
             }
         } catch (const scene::InputError&) {
             throw;
+        } catch (const scene::OutputError&) {
+            throw;  // a full disk fails the sweep, not one row after another
         } catch (const std::exception& e) {
             row.error = e.what();
             row.metrics = nullptr;

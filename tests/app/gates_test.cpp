@@ -383,6 +383,8 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         BadSuite{"not_json", "{", "", "suite.json: invalid JSON"},
         BadSuite{"no_cases", "{}", "", "suite.json: cases: is required"},
+        BadSuite{"scene_is_a_folder", R"({"cases": [{"name": "a", "scene": ".", "backend": "raytrace"}]})", "",
+                 "suite.json: cases[0].scene: .: is a folder, not a file"},
         BadSuite{"unknown_key", std::string(R"({"casez": [], "cases": [)") + kCase + "]}", "",
                  "suite.json: casez: unknown key"},
         BadSuite{"duplicate_name", std::string(R"({"cases": [)") + kCase + "," + kCase + "]}", "",

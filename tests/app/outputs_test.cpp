@@ -164,7 +164,10 @@ TEST(Outputs, CheckReplacesOnlyAFolderOfItsOwnAndRefusesBeforeRunning) {
     refused(mine, "is a file, not a folder");
     refused(suite.parent_path(), "holds the input " + suite.string());
     refused(dir.path(), "holds the input");
-    refused(foreign.parent_path(), "holds files that no earlier run wrote (no junit.xml)");
+    refused(foreign.parent_path(), "holds files that no earlier run of this command wrote (no junit.xml of its own)");
+    // Another tool's junit.xml does not make a folder check's own.
+    const fs::path otherTool = dir.write("ci/junit.xml", "<testsuites name=\"pytest\"></testsuites>");
+    refused(otherTool.parent_path(), "(no junit.xml of its own)");
     refused(dir.path() / "out", "--update-baseline " + (mine / "b.json").string(),
             {"--update-baseline", "--baseline", (mine / "b.json").string()});
     EXPECT_EQ(test::slurpFile(mine), "mine");
@@ -177,9 +180,10 @@ TEST(Outputs, CheckReplacesOnlyAFolderOfItsOwnAndRefusesBeforeRunning) {
     EXPECT_EQ(again.exitCode, 0) << again.err;
     // The working folder, or one that holds it, is never replaced (checked without running check
     // there, so that a broken guard cannot empty the test's own folder).
-    EXPECT_THROW(app::checkReplacedFolder(fs::current_path(), {}, "junit.xml"), scene::InputError);
-    EXPECT_THROW(app::checkReplacedFolder(fs::current_path().parent_path(), {}, "junit.xml"), scene::InputError);
-    EXPECT_NO_THROW(app::checkReplacedFolder(out, {suite}, "junit.xml"));
+    const std::string mark = "<testsuites name=\"shadowlab check\"";
+    EXPECT_THROW(app::checkReplacedFolder(fs::current_path(), {}, "junit.xml", mark), scene::InputError);
+    EXPECT_THROW(app::checkReplacedFolder(fs::current_path().parent_path(), {}, "junit.xml", mark), scene::InputError);
+    EXPECT_NO_THROW(app::checkReplacedFolder(out, {suite}, "junit.xml", mark));
 }
 
 }  // namespace

@@ -122,6 +122,11 @@ TEST(ReferenceRender, APointOutsideEverySpotsConeHasNoNdotLSoCompareLeavesItOut)
         }
     EXPECT_GT(outside, 1000);
     EXPECT_GT(inside, 1000);
+    // Reaching is the cone's geometry, as in lit.frag, not the intensity: a spot of intensity 0
+    // gives the same ndotl.
+    s.lights[0].intensity = 0.0;
+    const scene::Frame dark = renderReference(s, test::planFor(s), test::biasSettings(0, scene::Precision::Double));
+    EXPECT_EQ(dark.ndotl, f.ndotl);
 }
 
 // Counts plane pixels that are lit in closed form but have visibility 0 in the frame.

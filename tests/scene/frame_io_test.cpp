@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
@@ -151,6 +152,28 @@ TEST(FrameIo, PngIsSrgbEncodedBeauty) {
     EXPECT_EQ(px[3], 188);
     EXPECT_EQ(px[4], 255);
     EXPECT_NEAR(px[5], 128, 1);
+}
+
+TEST(FrameIo, AResultThatCannotBeWrittenIsAnOutputErrorNotBadInput) {
+    // A folder that went away after the outputs were checked stands for a full disk: the program
+    // exits 1 (a failure), not 2 (bad input), and names the file.
+    TempDir dir;
+    const auto gone = dir.path() / "gone" / "x";
+    Frame f = Frame::allocate(2, 1, false);
+    for (const auto& write : std::vector<std::function<void()>>{
+             [&] { writeTextAtomic(gone.string() + ".json", "{}"); },
+             [&] { writeFrame(f, gone.string() + ".exr"); },
+             [&] { writePngLinear(gone.string() + ".png", 2, 1, f.beauty); },
+         }) {
+        try {
+            write();
+            ADD_FAILURE() << "wrote into a missing folder";
+        } catch (const OutputError& e) {
+            EXPECT_NE(std::string(e.what()).find((dir.path() / "gone").string()), std::string::npos) << e.what();
+        } catch (const std::exception& e) {
+            ADD_FAILURE() << "not an OutputError: " << e.what();
+        }
+    }
 }
 
 TEST(FrameIo, DisplayExposurePutsTheBrightestPercentOfTheSurfaceAtOneAndNeverBrightens) {

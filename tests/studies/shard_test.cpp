@@ -209,6 +209,15 @@ TEST(ShardCommand, ReplacesTheShardKeepsEveryOtherArgumentAndQuotesForAShell) {
     EXPECT_EQ(quoteArg("a$b"), "'a$b'");
     EXPECT_EQ(quoteArg("it's"), "'it'\\''s'");
     EXPECT_EQ(quoteArg("x;rm"), "'x;rm'");
+    for (const char* special : {"a{1,2}", "a[0]", "hey!", "two\nlines"})
+        EXPECT_EQ(quoteArg(special), "'" + std::string(special) + "'");
+    // Run in another folder: its relative paths hold there, so the command goes there first.
+    EXPECT_EQ(
+        shardCommandText({"shadowlab", "path", "s.json", "--shard", "0/2", "-o", "p"}, {1, 2}, false, "/no/such/place"),
+        "cd /no/such/place && shadowlab path s.json --shard 1/2 -o p");
+    EXPECT_EQ(shardCommandText({"shadowlab", "path", "s.json", "--shard", "0/2", "-o", "p"}, {1, 2}, false,
+                               fs::current_path().string()),
+              "shadowlab path s.json --shard 1/2 -o p");
 }
 
 TEST(ShardMerge, EqualsTheUnshardedRunAndRendersTheReferenceOnce) {
