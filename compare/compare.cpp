@@ -746,6 +746,11 @@ bool softErrorDominates(const Metrics& m) {
 
 std::size_t perLightWrong(const Metrics& m) { return m.perLightWrongPixels; }
 
+bool lightsHideWrongPixels(const Metrics& m) {
+    return m.perLight.size() > 1 && m.perLightWrongPixels > m.falseShadow + m.missedShadow &&
+           double(m.perLightWrongPixels) > kNotableSoftErrorRate * double(m.counted);
+}
+
 std::string summaryLine(const Metrics& m) {
     std::string s = "counted " + formatCount(m.counted) + " px: false shadow " + formatPercent(m.falseShadowRate);
     if (m.hasBlockerIds) s += " (self acne " + formatPercent(m.selfShadowAcneRate) + ")";
@@ -763,7 +768,7 @@ std::string summaryLine(const Metrics& m) {
     // Filtered acne and wrong penumbrae stay under tau: where they outnumber the wrong pixels the
     // mismatch and the IoU read clean while the image is not, so the line says so.
     const std::size_t lightWrong = perLightWrong(m);
-    const bool lightsHide = m.perLight.size() > 1 && lightWrong > m.falseShadow + m.missedShadow;
+    const bool lightsHide = lightsHideWrongPixels(m);
     if (softErrorDominates(m))
         s += "; SOFT ERROR dominates: " +
              formatPercent(double(m.softErrorPixels - m.softErrorNearEdge) / double(m.counted)) +

@@ -246,6 +246,10 @@ bool softErrorDominates(const Metrics& metrics);
 // per-light channels): more than the combined mask's wrong pixels when one light's shadow is lost
 // or added where another light still reaches the point.
 std::size_t perLightWrong(const Metrics& metrics);
+// True when, with several lights, those pixels outnumber the combined mask's wrong ones and are a
+// notable share (more than kNotableSoftErrorRate of the counted pixels): then the words say that
+// one light's shadow hides under another. A few such pixels are a ray tracer's edge noise.
+bool lightsHideWrongPixels(const Metrics& metrics);
 // One line for a terminal, e.g.
 // "counted 301234 px: false shadow 0.82% (self acne 0.80%), missed 0.10%, IoU 0.981, ...", ending
 // in "SOFT ERROR dominates: ..." where softErrorDominates.

@@ -106,7 +106,7 @@ std::string describeContinuous(const Metrics& m) {
             s += m.falseShadow + m.missedShadow > 0 ? ": soft-shadow error beside the wrong pixels." : ".";
     }
     const std::size_t lightWrong = perLightWrong(m);
-    if (m.perLight.size() > 1 && lightWrong > m.falseShadow + m.missedShadow)
+    if (lightsHideWrongPixels(m))
         s += " Per light, " + formatCount(lightWrong) + " px are wrong outright, more than the " +
              formatCount(m.falseShadow + m.missedShadow) +
              " the combined visibility counts: where one light's shadow is lost or added, another light still "
@@ -150,7 +150,7 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
         s = who +
             " has no pixel to compare: no visible point faces the light in both frames "
             "on the same object.";
-    } else if (m.falseShadow + m.missedShadow == 0 && perLightWrong(m) == 0 &&
+    } else if (m.falseShadow + m.missedShadow == 0 && !lightsHideWrongPixels(m) &&
                double(m.softErrorPixels - m.softErrorNearEdge) <= kNotableSoftErrorRate * double(m.counted)) {
         s = who + " matches the reference on all " + formatCount(m.counted) + " counted pixels (mean |ΔV| " +
             formatFixed(m.meanAbsVisibilityError, 4) + ")";
@@ -161,7 +161,7 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
     } else if (m.falseShadow + m.missedShadow == 0) {
         s = who + " has no pixel wrong by more than τ = " + formatShort(kVisibilityTolerance) + " among the " +
             formatCount(m.counted) + " counted pixels, so the classes call it agreement, but it does not match" +
-            (m.perLight.size() > 1 && perLightWrong(m) > 0
+            (lightsHideWrongPixels(m)
                  ? ": one light's shadow is wrong outright where another light still reaches the point."
                  : ".");
     } else {
@@ -173,7 +173,7 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
                       " of the " + formatCount(m.counted) +
                       " counted pixels away from the shadow edges (off by more than " +
                       formatShort(kSoftErrorTolerance) + " without crossing τ: " +
-                      (m.perLight.size() > 1 && perLightWrong(m) > m.falseShadow + m.missedShadow
+                      (lightsHideWrongPixels(m)
                            ? "one light's shadow wrong outright where another light still reaches the point"
                            : "filtered acne, or a penumbra of the wrong width") +
                       "), which the mismatch rate does not count; outright it disagrees with the reference on " +
