@@ -524,6 +524,9 @@ MergedCheck readCheckShards(const std::vector<fs::path>& inputs) {
             std::error_code ec;
             if (!fs::exists(dir / "cases" / (p.name + ".json"), ec))
                 throw scene::InputError((dir / "cases" / (p.name + ".json")).string() + ": missing");
+            // Read before anything is written: a case file cut short (a copy that stopped) is
+            // refused here rather than copied into the merged folder as broken JSON.
+            readJson(dir / "cases" / (p.name + ".json"), "case result");
             parts.emplace(p.name, std::make_pair(p, dir / "cases"));
         }
     }

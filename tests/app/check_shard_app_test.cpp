@@ -3,6 +3,7 @@
 // its exit code; shards of another suite or split refused; missing shards named; nothing written
 // by a refused merge.
 #include <filesystem>
+#include <fstream>
 #include <regex>
 #include <set>
 
@@ -154,8 +155,20 @@ TEST(CheckShardApp, AMissingShardIsNamedWithTheCommandThatWritesIt) {
     EXPECT_EQ(r.err.find("shard 0/3 ("), std::string::npos) << r.err;  // only the missing one
     EXPECT_FALSE(fs::exists(out / "junit.xml"));
     EXPECT_FALSE(fs::exists(out / "cases"));
-    // Rendered now, the merge goes through.
+    // Rendered now, the merge goes through; but first a case file of shard 0 cut short (a copy
+    // that stopped) is refused by name, with nothing written.
     ASSERT_NE(runShadowlab({"check", suite.string(), "--shard", "1/3", "-o", out.string()}).exitCode, 2);
+    fs::path caseFile;
+    for (const auto& e : fs::directory_iterator(out / "shard-0-of-3" / "cases"))
+        if (e.path().extension() == ".json") caseFile = e.path();
+    ASSERT_FALSE(caseFile.empty());
+    const std::string whole = slurpFile(caseFile);
+    std::ofstream(caseFile, std::ios::binary | std::ios::trunc) << whole.substr(0, whole.size() / 2);
+    const auto cut = runShadowlab({"merge", out.string()});
+    EXPECT_EQ(cut.exitCode, 2) << cut.err;
+    EXPECT_NE(cut.err.find(caseFile.string() + ": invalid JSON"), std::string::npos) << cut.err;
+    EXPECT_FALSE(fs::exists(out / "junit.xml"));
+    std::ofstream(caseFile, std::ios::binary | std::ios::trunc) << whole;
     const auto m = runShadowlab({"merge", out.string()});
     EXPECT_EQ(m.exitCode, 1) << m.err;
     EXPECT_TRUE(fs::exists(out / "junit.xml"));
