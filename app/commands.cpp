@@ -264,34 +264,6 @@ std::function<void(const studies::SweepProgress&)> sweepProgressPrinter() {
     };
 }
 
-// `render -o` into a missing folder: created once the input is known to be good, and the user is
-// told (docs/decisions.md, "Output paths"); app::checkOutputFile has refused what cannot be used.
-// The folders it made are removed again, if still empty, when the command ends: a render that
-// fails late (out of device memory, a full disk) leaves nothing behind.
-class CreatedFolders {
-public:
-    explicit CreatedFolders(const fs::path& output) {
-        if (!output.has_parent_path()) return;
-        std::error_code ec;
-        if (fs::is_directory(output.parent_path(), ec)) return;
-        for (fs::path p = output.parent_path(); !p.empty() && !fs::exists(p, ec); p = p.parent_path())
-            made_.push_back(p);
-        fs::create_directories(output.parent_path());
-        std::cerr << "shadowlab: created the folder " << output.parent_path().string() << " for "
-                  << output.filename().string() << "\n";
-    }
-    CreatedFolders(const CreatedFolders&) = delete;
-    CreatedFolders& operator=(const CreatedFolders&) = delete;
-    ~CreatedFolders() {
-        std::error_code ec;
-        for (const fs::path& p : made_)  // deepest first; a folder that holds the output stays
-            if (fs::is_directory(p, ec) && fs::is_empty(p, ec)) fs::remove(p, ec);
-    }
-
-private:
-    std::vector<fs::path> made_;
-};
-
 scene::Budgets parseBudgets(const BudgetOptions& o) {
     scene::Budgets b;
     for (int k = 0; k < scene::kBudgetKindCount; ++k) {

@@ -55,6 +55,22 @@ void checkOutputFolder(const fs::path& dir, const std::string& option) {
     checkParent(dir, option);
 }
 
+CreatedFolders::CreatedFolders(const fs::path& output) {
+    if (!output.has_parent_path()) return;
+    std::error_code ec;
+    if (fs::is_directory(output.parent_path(), ec)) return;
+    for (fs::path p = output.parent_path(); !p.empty() && !fs::exists(p, ec); p = p.parent_path()) made_.push_back(p);
+    fs::create_directories(output.parent_path());
+    std::cerr << "shadowlab: created the folder " << output.parent_path().string() << " for "
+              << output.filename().string() << "\n";
+}
+
+CreatedFolders::~CreatedFolders() {
+    std::error_code ec;
+    for (const fs::path& p : made_)  // a folder that holds the output (or anything) stays
+        if (fs::is_directory(p, ec) && fs::is_empty(p, ec)) fs::remove(p, ec);
+}
+
 void checkReplacedFolder(const fs::path& dir, const std::vector<fs::path>& inputs, const std::string& marker,
                          const std::string& signature, const std::string& option) {
     checkOutputFolder(dir, option);

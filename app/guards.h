@@ -43,6 +43,21 @@ void checkOutputFile(const std::filesystem::path& file, const std::string& optio
 // writable folder.
 void checkOutputFolder(const std::filesystem::path& dir, const std::string& option = "-o");
 
+// `render -o` into a missing folder: created once the input is known to be good, and the user is
+// told on stderr (docs/decisions.md, "Output paths"); checkOutputFile has refused what cannot be
+// used. The folders it made are removed again, if still empty, when it goes out of scope: a
+// command that fails late (out of device memory, a full disk) leaves nothing behind.
+class CreatedFolders {
+public:
+    explicit CreatedFolders(const std::filesystem::path& output);
+    CreatedFolders(const CreatedFolders&) = delete;
+    CreatedFolders& operator=(const CreatedFolders&) = delete;
+    ~CreatedFolders();
+
+private:
+    std::vector<std::filesystem::path> made_;  // deepest first
+};
+
 // A folder a command replaces as a whole (`check -o DIR`): checkOutputFolder's rules, and it must
 // not be the working folder or hold it, nor hold any of `inputs`, and an existing folder with
 // entries must hold the file `marker` with `signature` in it (what an earlier run of the command

@@ -739,12 +739,14 @@ nlohmann::json toJson(const Metrics& m) {
 }
 
 bool softErrorDominates(const Metrics& m) {
-    const std::size_t away = m.softErrorPixels - std::min(m.softErrorPixels, m.softErrorNearEdge);
+    const std::size_t away = softErrorAwayFromEdges(m);
     return m.counted > 0 && double(away) / double(m.counted) > kNotableSoftErrorRate &&
            away > m.falseShadow + m.missedShadow;
 }
 
-std::size_t perLightWrong(const Metrics& m) { return m.perLightWrongPixels; }
+std::size_t softErrorAwayFromEdges(const Metrics& m) {
+    return m.softErrorPixels - std::min(m.softErrorPixels, m.softErrorNearEdge);
+}
 
 bool lightsHideWrongPixels(const Metrics& m) {
     return m.perLight.size() > 1 && m.perLightWrongPixels > m.falseShadow + m.missedShadow &&
@@ -767,11 +769,10 @@ std::string summaryLine(const Metrics& m) {
              formatCount(m.referenceHealth.total());
     // Filtered acne and wrong penumbrae stay under tau: where they outnumber the wrong pixels the
     // mismatch and the IoU read clean while the image is not, so the line says so.
-    const std::size_t lightWrong = perLightWrong(m);
+    const std::size_t lightWrong = m.perLightWrongPixels;
     const bool lightsHide = lightsHideWrongPixels(m);
     if (softErrorDominates(m))
-        s += "; SOFT ERROR dominates: " +
-             formatPercent(double(m.softErrorPixels - m.softErrorNearEdge) / double(m.counted)) +
+        s += "; SOFT ERROR dominates: " + formatPercent(double(softErrorAwayFromEdges(m)) / double(m.counted)) +
              " of the counted pixels are partly wrong away from the shadow edges (" +
              (lightsHide ? "one light's shadow wrong where another still reaches"
                          : "filtered acne, a penumbra of the wrong width") +

@@ -242,11 +242,11 @@ nlohmann::json toJson(const Metrics& metrics);
 // reference's shadow edges are a notable share (kNotableSoftErrorRate) and outnumber the wrong
 // ones: the classes then understate the error. (At the edges it is the filter's blur.)
 bool softErrorDominates(const Metrics& metrics);
-// The pixels wrong outright in some light's own channel (Metrics::perLightWrongPixels; 0 without
-// per-light channels): more than the combined mask's wrong pixels when one light's shadow is lost
-// or added where another light still reaches the point.
-std::size_t perLightWrong(const Metrics& metrics);
-// True when, with several lights, those pixels outnumber the combined mask's wrong ones and are a
+// Soft-error pixels away from the reference's shadow edges (softErrorPixels − softErrorNearEdge):
+// the partial shadow a filter's blur of a hard edge does not explain.
+std::size_t softErrorAwayFromEdges(const Metrics& metrics);
+// True when, with several lights, the pixels wrong in some light's own channel
+// (Metrics::perLightWrongPixels) outnumber the combined mask's wrong ones and are a
 // notable share (more than kNotableSoftErrorRate of the counted pixels): then the words say that
 // one light's shadow hides under another. A few such pixels are a ray tracer's edge noise.
 bool lightsHideWrongPixels(const Metrics& metrics);

@@ -97,7 +97,7 @@ std::string describeContinuous(const Metrics& m) {
         if (m.softErrorNearEdge > 0)
             s += " (" + formatCount(m.softErrorNearEdge) + " of them within " + std::to_string(m.edgeRadius) +
                  " px of the reference's shadow edges, where a filter blurs a hard edge)";
-        const double away = double(m.softErrorPixels - std::min(m.softErrorPixels, m.softErrorNearEdge));
+        const double away = double(softErrorAwayFromEdges(m));
         if (away <= kNotableSoftErrorRate * double(m.counted))
             s += ".";
         else if (softErrorDominates(m))
@@ -105,7 +105,7 @@ std::string describeContinuous(const Metrics& m) {
         else
             s += m.falseShadow + m.missedShadow > 0 ? ": soft-shadow error beside the wrong pixels." : ".";
     }
-    const std::size_t lightWrong = perLightWrong(m);
+    const std::size_t lightWrong = m.perLightWrongPixels;
     if (lightsHideWrongPixels(m))
         s += " Per light, " + formatCount(lightWrong) + " px are wrong outright, more than the " +
              formatCount(m.falseShadow + m.missedShadow) +
@@ -151,7 +151,7 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
             " has no pixel to compare: no visible point faces the light in both frames "
             "on the same object.";
     } else if (m.falseShadow + m.missedShadow == 0 && !lightsHideWrongPixels(m) &&
-               double(m.softErrorPixels - m.softErrorNearEdge) <= kNotableSoftErrorRate * double(m.counted)) {
+               double(softErrorAwayFromEdges(m)) <= kNotableSoftErrorRate * double(m.counted)) {
         s = who + " matches the reference on all " + formatCount(m.counted) + " counted pixels (mean |ΔV| " +
             formatFixed(m.meanAbsVisibilityError, 4) + ")";
         s += m.softErrorNearEdge > 0
@@ -167,9 +167,7 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
     } else {
         s = softErrorDominates(m)
                 // Lead with what a viewer sees: partial darkening under τ outnumbers the wrong pixels.
-                ? who + " is partly wrong on " +
-                      formatPercent(double(m.softErrorPixels - std::min(m.softErrorPixels, m.softErrorNearEdge)) /
-                                    double(m.counted)) +
+                ? who + " is partly wrong on " + formatPercent(double(softErrorAwayFromEdges(m)) / double(m.counted)) +
                       " of the " + formatCount(m.counted) +
                       " counted pixels away from the shadow edges (off by more than " +
                       formatShort(kSoftErrorTolerance) + " without crossing τ: " +

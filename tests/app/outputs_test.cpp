@@ -4,6 +4,7 @@
 #include <fcntl.h>
 #include <spawn.h>
 #include <unistd.h>
+#include <fstream>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -143,6 +144,25 @@ TEST(Outputs, ARunRemovesWhatTheEarlierRunWroteAndThisOneDoesNotButNothingElse) 
     std::sort(files.begin(), files.end());
     EXPECT_EQ(files, (std::vector<std::string>{"diff-raytrace.png", "heat-raytrace.png", "metrics.json", "raytrace.exr",
                                                "raytrace.png", "reference.exr", "reference.png", "report.html"}));
+}
+
+TEST(Outputs, FoldersMadeForAnOutputAreRemovedAgainWhenNothingWasWrittenIntoThem) {
+    TempDir dir;
+    const fs::path out = dir.path() / "a" / "b" / "x.png";
+    {
+        const app::CreatedFolders made(out);
+        EXPECT_TRUE(fs::is_directory(out.parent_path()));
+    }  // the command failed before writing x.png
+    EXPECT_FALSE(fs::exists(dir.path() / "a"));
+    {
+        const app::CreatedFolders made(out);
+        std::ofstream(out) << "png";
+    }
+    EXPECT_TRUE(fs::exists(out));
+    // A folder that existed is never removed, even empty.
+    fs::remove(out);
+    { const app::CreatedFolders made(out); }
+    EXPECT_TRUE(fs::is_directory(out.parent_path()));
 }
 
 TEST(Outputs, CheckReplacesOnlyAFolderOfItsOwnAndRefusesBeforeRunning) {
