@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <numeric>
 
 // SSE2 intrinsics: baseline on x86-64, the only target the builders are written for.
@@ -416,7 +417,13 @@ struct BinsF {
 inline __m128 centroid2(const PrimRefF& r) { return _mm_add_ps(r.lo, r.hi); }
 
 struct FastBuilder {
+    // The references, and a second array as large: a range is partitioned from the one that
+    // holds it into the other (the same positions), so its children live in the other one.
+    // A leaf's references are copied back into `refs`, which ends in the leaves' order.
     std::vector<PrimRefF>& refs;
+    PrimRefF* spare;
+
+    PrimRefF* buffer(bool inSpare) const { return inSpare ? spare : refs.data(); }
 
     // Bin of each axis for doubled centroid c: (c − lo)·scale, clamped to [0, bins − 1].
     struct Binner {
@@ -435,10 +442,10 @@ struct FastBuilder {
         }
     };
 
-    void bin(std::uint32_t begin, std::uint32_t end, const Binner& binner, BinsF& result) const {
+    static void bin(const PrimRefF* src, std::uint32_t begin, std::uint32_t end, const Binner& binner, BinsF& result) {
         auto body = [&](std::uint32_t b, std::uint32_t e, BinsF& out) {
             for (std::uint32_t i = b; i < e; ++i) {
-                const PrimRefF& r = refs[i];
+                const PrimRefF& r = src[i];
                 alignas(16) std::int32_t k[4];
                 _mm_store_si128(reinterpret_cast<__m128i*>(k), binner(centroid2(r)));
                 for (int axis = 0; axis < 3; ++axis) {
@@ -463,20 +470,74 @@ struct FastBuilder {
             });
     }
 
-    void rangeBounds(std::uint32_t begin, std::uint32_t end, BoxF& all, BoxF& cb) const {
+    static void rangeBounds(const PrimRefF* src, std::uint32_t begin, std::uint32_t end, BoxF& all, BoxF& cb) {
         all = BoxF{};
         cb = BoxF{};
         for (std::uint32_t i = begin; i < end; ++i) {
-            all.extend(refs[i].lo, refs[i].hi);
-            const __m128 c = centroid2(refs[i]);
+            all.extend(src[i].lo, src[i].hi);
+            const __m128 c = centroid2(src[i]);
             cb.extend(c, c);
         }
     }
 
-    int build(std::vector<BvhNode>& nodes, std::uint32_t begin, std::uint32_t end, int depth, const BoxF& all,
-              const BoxF& cb) {
-        const std::uint32_t node = std::uint32_t(nodes.size());
-        nodes.emplace_back();
+    // Moves src[begin, end) into dst[begin, end): the references whose centroid's bin on `axis`
+    // is at most `lastLeftBin` to the front in their order, the others to the back in reverse
+    // order, and finds each side's centroid bounds. Branch-free: which side a reference takes
+    // is as good as random to a branch predictor. Returns the first right one's position.
+    static std::uint32_t partition(const PrimRefF* src, PrimRefF* dst, std::uint32_t begin, std::uint32_t end,
+                                   const Binner& binner, int axis, int lastLeftBin, BoxF& leftC, BoxF& rightC) {
+        alignas(16) float lo[4], scale[4];
+        _mm_store_ps(lo, binner.lo);
+        _mm_store_ps(scale, binner.scale);
+        // The bin is ⌊(c − lo)·scale⌋ clamped to [0, bins − 1] (Binner): at most lastLeftBin
+        // exactly when the same product is below lastLeftBin + 1.
+        const float a = lo[axis], sc = scale[axis], limit = float(lastLeftBin + 1);
+        // Added to a centroid before it meets a side's minimum (maximum: subtracted): +inf
+        // keeps it out of the side it does not take, 0 lets it in.
+        const __m128 away[2] = {_mm_set1_ps(std::numeric_limits<float>::infinity()), _mm_setzero_ps()};
+        __m128 lLo = leftC.lo, lHi = leftC.hi, rLo = rightC.lo, rHi = rightC.hi;
+        std::uint32_t l = begin, h = end;  // the next left slot; one past the next right slot
+        for (std::uint32_t i = begin; i < end; ++i) {
+            const __m128 rl = src[i].lo, rh = src[i].hi;
+            const __m128 c = _mm_add_ps(rl, rh);
+            const float ca =
+                _mm_cvtss_f32(axis == 0 ? c : (axis == 1 ? _mm_shuffle_ps(c, c, 1) : _mm_shuffle_ps(c, c, 2)));
+            const int left = !((ca - a) * sc >= limit);  // (as Binner's clamp, NaN goes left)
+            PrimRefF* out = dst + (left ? l : h - 1);
+            out->lo = rl;
+            out->hi = rh;
+            l += left;
+            h -= 1 - left;
+            const __m128 toL = away[left], toR = away[1 - left];
+            lLo = _mm_min_ps(lLo, _mm_add_ps(c, toL));
+            lHi = _mm_max_ps(lHi, _mm_sub_ps(c, toL));
+            rLo = _mm_min_ps(rLo, _mm_add_ps(c, toR));
+            rHi = _mm_max_ps(rHi, _mm_sub_ps(c, toR));
+        }
+        leftC = BoxF{lLo, lHi};
+        rightC = BoxF{rLo, rHi};
+        return l;
+    }
+
+    void makeLeaf(BvhNode& leaf, std::uint32_t begin, std::uint32_t end, bool inSpare) const {
+        if (inSpare) std::copy(spare + begin, spare + end, refs.data() + begin);
+        leaf.offset = begin;
+        leaf.count = std::uint16_t(end - begin);
+        leaf.axis = 0;
+    }
+
+    struct Built {
+        int depth = 0;            // the deepest level
+        std::uint32_t nodes = 0;  // slots used
+    };
+
+    // Writes the subtree over the references [begin, end) at nodes[node], its first child at
+    // node + 1 and its second at `offset`, each further node at `next`, counting up. A subtree
+    // of m references has at most 2m − 1 nodes, so two built in parallel take disjoint slots
+    // if the second starts 2m − 1 after the first; the slots left between are closed up once,
+    // at the end (FastBuildAccess::build), not at every parallel level.
+    Built build(BvhNode* nodes, std::uint32_t node, std::uint32_t& next, std::uint32_t begin, std::uint32_t end,
+                int depth, bool inSpare, const BoxF& all, const BoxF& cb) {
         alignas(16) float l[4], h[4];
         _mm_store_ps(l, all.lo);
         _mm_store_ps(h, all.hi);
@@ -484,11 +545,13 @@ struct FastBuilder {
             nodes[node].lo[k] = l[k];
             nodes[node].hi[k] = h[k];
         }
+        nodes[node].pad = 0;
         const std::uint32_t count = end - begin;
         if (count <= kBvhMinSplitCount) {
-            Builder::makeLeaf(nodes, node, begin, end);
-            return depth;
+            makeLeaf(nodes[node], begin, end, inSpare);
+            return {depth, 1};
         }
+        PrimRefF* src = buffer(inSpare);
         alignas(16) float cl[4], ch[4];
         _mm_store_ps(cl, cb.lo);
         _mm_store_ps(ch, cb.hi);
@@ -497,7 +560,7 @@ struct FastBuilder {
         const Binner binner(cb);
         BinsF bins;
         if (depth < kBvhSahMaxDepth) {
-            bin(begin, end, binner, bins);
+            bin(src, begin, end, binner, bins);
             for (int axis = 0; axis < 3; ++axis) {
                 if (!(ch[axis] > cl[axis])) continue;
                 const auto& bb = bins.bounds[axis];
@@ -532,42 +595,18 @@ struct FastBuilder {
         const double splitCost =
             area > 0 ? kBvhTraversalCost + double(bestCost) / double(area) : std::numeric_limits<double>::infinity();
         if (count <= kBvhMaxLeafCount && (bestAxis < 0 || splitCost >= Builder::blocks(count))) {
-            Builder::makeLeaf(nodes, node, begin, end);
-            return depth;
+            makeLeaf(nodes[node], begin, end, inSpare);
+            return {depth, 1};
         }
         std::uint32_t mid;
         int axis;
+        bool childInSpare = inSpare;
         BoxF leftAll, rightAll, leftC, rightC;
         if (bestAxis >= 0) {
             axis = bestAxis;
-            PrimRefF* first = refs.data() + begin;
-            PrimRefF* last = refs.data() + end;
-            auto goesLeft = [&](__m128 c) {
-                alignas(16) std::int32_t k[4];
-                _mm_store_si128(reinterpret_cast<__m128i*>(k), binner(c));
-                return k[axis] <= bestBin;
-            };
-            // Hoare partition, each reference's centroid added to its side as it is classified.
-            while (first < last) {
-                const __m128 c = centroid2(*first);
-                if (goesLeft(c)) {
-                    leftC.extend(c, c);
-                    ++first;
-                    continue;
-                }
-                --last;
-                const __m128 d = centroid2(*last);
-                if (goesLeft(d)) {
-                    leftC.extend(d, d);
-                    rightC.extend(c, c);
-                    std::swap(*first, *last);
-                    ++first;
-                }
-                // else *last stays right; *first is reclassified next round (same answer)
-                else
-                    rightC.extend(d, d);
-            }
-            mid = std::uint32_t(first - refs.data());
+            childInSpare = !inSpare;
+            PrimRefF* dst = buffer(childInSpare);
+            mid = partition(src, dst, begin, end, binner, axis, bestBin, leftC, rightC);
             for (int b = 0; b <= bestBin; ++b) leftAll.extend(bins.bounds[axis][b]);
             for (int b = bestBin + 1; b < kBvhBins; ++b) rightAll.extend(bins.bounds[axis][b]);
         } else {
@@ -579,35 +618,34 @@ struct FastBuilder {
                 _mm_store_ps(c, centroid2(r));
                 return c[axis];
             };
-            std::nth_element(refs.data() + begin, refs.data() + mid, refs.data() + end,
+            std::nth_element(src + begin, src + mid, src + end,
                              [&](const PrimRefF& a, const PrimRefF& b) { return key(a) < key(b); });
-            rangeBounds(begin, mid, leftAll, leftC);
-            rangeBounds(mid, end, rightAll, rightC);
+            rangeBounds(src, begin, mid, leftAll, leftC);
+            rangeBounds(src, mid, end, rightAll, rightC);
         }
-        int deepest;
+        Built left, right;
         std::uint32_t second;
         if (count >= kBvhParallelCount) {
-            std::vector<BvhNode> right;
-            int dl = 0, dr = 0;
-            tbb::parallel_invoke([&] { dl = build(nodes, begin, mid, depth + 1, leftAll, leftC); },
-                                 [&] {
-                                     right.reserve(2 * std::size_t(end - mid));
-                                     dr = build(right, mid, end, depth + 1, rightAll, rightC);
-                                 });
-            second = std::uint32_t(nodes.size());
-            for (BvhNode& n : right)
-                if (n.count == 0) n.offset += second;
-            nodes.insert(nodes.end(), right.begin(), right.end());
-            deepest = std::max(dl, dr);
+            second = node + 2 * (mid - begin);
+            tbb::parallel_invoke(
+                [&] {
+                    std::uint32_t nextLeft = node + 2;
+                    left = build(nodes, node + 1, nextLeft, begin, mid, depth + 1, childInSpare, leftAll, leftC);
+                },
+                [&] {
+                    std::uint32_t nextRight = second + 1;
+                    right = build(nodes, second, nextRight, mid, end, depth + 1, childInSpare, rightAll, rightC);
+                });
         } else {
-            const int dl = build(nodes, begin, mid, depth + 1, leftAll, leftC);
-            second = std::uint32_t(nodes.size());
-            deepest = std::max(dl, build(nodes, mid, end, depth + 1, rightAll, rightC));
+            ++next;  // (node + 1)
+            left = build(nodes, node + 1, next, begin, mid, depth + 1, childInSpare, leftAll, leftC);
+            second = next++;
+            right = build(nodes, second, next, mid, end, depth + 1, childInSpare, rightAll, rightC);
         }
         nodes[node].offset = second;
         nodes[node].count = 0;
         nodes[node].axis = std::uint8_t(axis);
-        return deepest;
+        return {std::max(left.depth, right.depth), 1 + left.nodes + right.nodes};
     }
 };
 
@@ -931,12 +969,32 @@ Bvh Bvh::buildFast(const std::vector<scene::Bounds>& primitiveBounds, const std:
 Bvh FastBuildAccess::build(std::vector<PrimRefF>& refs) {
     Bvh bvh;
     const std::size_t n = refs.size();
-    FastBuilder b{refs};
+    // (Neither is zeroed: a slot is written before it is read, and most node slots never are.)
+    const std::unique_ptr<PrimRefF[]> spare(new PrimRefF[n]);
+    const std::unique_ptr<BvhNode[]> slots(new BvhNode[2 * n - 1]);
+    FastBuilder b{refs, spare.get()};
     BoxF all, cb;
-    b.rangeBounds(0, std::uint32_t(n), all, cb);
-    bvh.nodes_.reserve(2 * n);
-    bvh.depth_ = b.build(bvh.nodes_, 0, std::uint32_t(n), 0, all, cb);
-    bvh.nodes_.shrink_to_fit();
+    FastBuilder::rangeBounds(refs.data(), 0, std::uint32_t(n), all, cb);
+    std::uint32_t next = 1;
+    const FastBuilder::Built built = b.build(slots.get(), 0, next, 0, std::uint32_t(n), 0, false, all, cb);
+    bvh.depth_ = built.depth;
+    // Pack the used slots in depth-first order (first child next, as Bvh::build lays them out).
+    bvh.nodes_.reserve(built.nodes);
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> pending;  // (second child's slot, its parent's index)
+    std::uint32_t slot = 0;
+    for (;;) {
+        const std::uint32_t index = std::uint32_t(bvh.nodes_.size());
+        bvh.nodes_.push_back(slots[slot]);
+        if (bvh.nodes_.back().count == 0) {
+            pending.emplace_back(bvh.nodes_.back().offset, index);
+            ++slot;
+            continue;
+        }
+        if (pending.empty()) break;
+        slot = pending.back().first;
+        bvh.nodes_[pending.back().second].offset = std::uint32_t(bvh.nodes_.size());
+        pending.pop_back();
+    }
     bvh.primitives_.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
         alignas(16) float lo[4];

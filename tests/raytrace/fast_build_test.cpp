@@ -3,6 +3,7 @@
 // answers are the same on its tree and on the reference's (double-built) tree, exact ties
 // included: a tie goes to the lowest triangle index whatever the tree's order.
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <random>
@@ -66,6 +67,52 @@ TEST(FastBuild, HoldsEveryPrimitiveOnceInsideItsNodesBoxes) {
     }
     EXPECT_EQ(leafPrims, boxes.size());
     for (std::size_t p = 0; p < seen.size(); ++p) ASSERT_EQ(seen[p], 1) << p;
+}
+
+// A node's box is exactly what it holds: a leaf's, the union of its primitives' boxes rounded
+// outward to float; an interior node's, the union of its children's. A child's box comes from
+// its parent's bins and its centroid bounds from the partition, across the two arrays the
+// partitions move the references between: the box must be the tight one, not merely one that
+// contains it.
+TEST(FastBuild, NodeBoxesAreTheUnionsOfWhatTheyHold) {
+    const auto boxes = randomBoxes(60000, 11);
+    const Bvh bvh = Bvh::buildFast(boxes);
+    auto down = [](double x) {
+        const float f = float(x);
+        return double(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+    };
+    auto up = [](double x) {
+        const float f = float(x);
+        return double(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+    };
+    const auto& nodes = bvh.nodes();
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+        const BvhNode& n = nodes[i];
+        float lo[3], hi[3];
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = std::numeric_limits<float>::infinity();
+            hi[k] = -std::numeric_limits<float>::infinity();
+        }
+        if (n.count > 0) {
+            for (std::uint32_t s = n.offset; s < n.offset + n.count; ++s) {
+                const scene::Bounds& b = boxes[bvh.primitives()[s]];
+                for (int k = 0; k < 3; ++k) {
+                    lo[k] = std::min(lo[k], down(b.min[k]));
+                    hi[k] = std::max(hi[k], up(b.max[k]));
+                }
+            }
+        } else {
+            for (const std::size_t c : {i + 1, std::size_t(n.offset)})
+                for (int k = 0; k < 3; ++k) {
+                    lo[k] = std::min(lo[k], nodes[c].lo[k]);
+                    hi[k] = std::max(hi[k], nodes[c].hi[k]);
+                }
+        }
+        for (int k = 0; k < 3; ++k) {
+            ASSERT_EQ(n.lo[k], lo[k]) << "node " << i << " axis " << k;
+            ASSERT_EQ(n.hi[k], hi[k]) << "node " << i << " axis " << k;
+        }
+    }
 }
 
 // Appends triangle (a, b, c) with three vertices of its own.
