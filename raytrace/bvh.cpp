@@ -417,6 +417,10 @@ struct BinsF {
 inline __m128 centroid2(const PrimRefF& r) { return _mm_add_ps(r.lo, r.hi); }
 
 struct FastBuilder {
+    // Ranges binned with two sets of bins (bin): below this, merging the second set costs more
+    // than it saves.
+    static constexpr std::uint32_t kBinPairsFrom = 64;
+
     // The references, and a second array as large: a range is partitioned from the one that
     // holds it into the other (the same positions), so its children live in the other one.
     // A leaf's references are copied back into `refs`, which ends in the leaves' order.
@@ -443,16 +447,33 @@ struct FastBuilder {
     };
 
     static void bin(const PrimRefF* src, std::uint32_t begin, std::uint32_t end, const Binner& binner, BinsF& result) {
+        auto add = [&](const PrimRefF& r, BinsF& out) {
+            const __m128i k = binner(centroid2(r));
+            const int k0 = _mm_cvtsi128_si32(k), k1 = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 0x55)),
+                      k2 = _mm_cvtsi128_si32(_mm_shuffle_epi32(k, 0xaa));
+            ++out.count[0][k0];
+            ++out.count[1][k1];
+            ++out.count[2][k2];
+            out.bounds[0][k0].extend(r.lo, r.hi);
+            out.bounds[1][k1].extend(r.lo, r.hi);
+            out.bounds[2][k2].extend(r.lo, r.hi);
+        };
         auto body = [&](std::uint32_t b, std::uint32_t e, BinsF& out) {
-            for (std::uint32_t i = b; i < e; ++i) {
-                const PrimRefF& r = src[i];
-                alignas(16) std::int32_t k[4];
-                _mm_store_si128(reinterpret_cast<__m128i*>(k), binner(centroid2(r)));
-                for (int axis = 0; axis < 3; ++axis) {
-                    ++out.count[axis][k[axis]];
-                    out.bounds[axis][k[axis]].extend(r.lo, r.hi);
-                }
+            if (e - b < kBinPairsFrom) {
+                for (std::uint32_t i = b; i < e; ++i) add(src[i], out);
+                return;
             }
+            // Neighbouring references often fall in the same bins: alternating between two
+            // sets of bins lets one's update start before the other's store lands. (Unions and
+            // counts: the merged bins are the same.)
+            BinsF odd;
+            std::uint32_t i = b;
+            for (; i + 1 < e; i += 2) {
+                add(src[i], out);
+                add(src[i + 1], odd);
+            }
+            if (i < e) add(src[i], out);
+            out.add(odd);
         };
         if (end - begin < kBvhParallelCount) {
             body(begin, end, result);
@@ -679,28 +700,28 @@ namespace shadowlab::raytrace {
 namespace {
 
 // roundDown<float> / roundUp<float> (real.h) with the step to the neighbouring float taken on
-// the bits instead of by std::nextafter, a library call that was most of a reference's cost.
-// For every non-NaN float r: the next float down is bits − 1 above zero, bits + 1 below it, and
-// the smallest negative subnormal from ±0 (and the next up mirrors it).
+// the bits instead of by std::nextafter, a library call that was most of a reference's cost,
+// and without a branch: whether float(x) rounded up is as good as random. For every non-NaN
+// float r, the next float down is bits − 1 above zero and bits + 1 below it (from −0: the
+// smallest negative subnormal); the next up mirrors it. float(x) is +0 only for x ≥ 0, never
+// above x, and −0 only for x ≤ 0, never below it, so the sign bit picks the step.
 float floatDown(double x) {
-    float r = float(x);
-    if (double(r) > x) {
-        std::uint32_t bits;
-        std::memcpy(&bits, &r, sizeof bits);
-        bits = r > 0 ? bits - 1 : (r < 0 ? bits + 1 : 0x80000001u);
-        std::memcpy(&r, &bits, sizeof r);
-    }
-    return r;
+    const float r = float(x);
+    std::uint32_t bits;
+    std::memcpy(&bits, &r, sizeof bits);
+    bits += std::uint32_t(double(r) > x) * ((bits >> 31) * 2u - 1u);  // sign 1: +1, 0: −1
+    float down;
+    std::memcpy(&down, &bits, sizeof down);
+    return down;
 }
 float floatUp(double x) {
-    float r = float(x);
-    if (double(r) < x) {
-        std::uint32_t bits;
-        std::memcpy(&bits, &r, sizeof bits);
-        bits = r > 0 ? bits + 1 : (r < 0 ? bits - 1 : 0x00000001u);
-        std::memcpy(&r, &bits, sizeof r);
-    }
-    return r;
+    const float r = float(x);
+    std::uint32_t bits;
+    std::memcpy(&bits, &r, sizeof bits);
+    bits += std::uint32_t(double(r) < x) * (1u - (bits >> 31) * 2u);  // sign 0: +1, 1: −1
+    float up;
+    std::memcpy(&up, &bits, sizeof up);
+    return up;
 }
 
 PrimRefF floatRef(const scene::Bounds& b, std::uint32_t index) {
