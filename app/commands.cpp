@@ -374,20 +374,30 @@ int render(const RenderOptions& o) {
         for (const std::string& w : studies::hardFilterWarnings(p.scene, p.settings.raster))
             std::cerr << "shadowlab: warning: " << w << "\n";
     Stage stage("rendering " + p.scene.file.filename().string() + " with " + backendName);
-    // A PNG holds the beauty only, in 8-bit sRGB: the raster backend then renders nothing else,
-    // into an 8-bit sRGB target.
-    const scene::Frame frame = studies::renderForOutput(
-        p.scene, p.plan, p.settings, o.backend,
-        ext == ".png" ? scene::kChannelBeauty | scene::kBeautyForDisplay : scene::kAllChannels);
-    scene::writeFrame(frame, o.output);
-    stage.done(std::to_string(frame.width) + "x" + std::to_string(frame.height) + " -> " + o.output.string() + ", " +
-               memoryLine(estimate));
+    // A PNG is for looking at: the float beauty, scaled as run's report images are where more
+    // than 1% of the scene would clip (bright glTF lights wash out every object and shadow); the
+    // object ids say which pixels are the scene's.
+    const bool png = ext == ".png";
+    const scene::Frame frame =
+        studies::renderForOutput(p.scene, p.plan, p.settings, o.backend,
+                                 png ? scene::kChannelBeauty | scene::kChannelObjectId : scene::kAllChannels);
+    const double exposure = png ? scene::displayExposure(frame) : 1.0;
+    if (png)
+        scene::writePngLinear(o.output, frame.width, frame.height, frame.beauty, exposure);
+    else
+        scene::writeFrame(frame, o.output);
+    stage.done(std::to_string(frame.width) + "x" + std::to_string(frame.height) + " -> " + o.output.string() +
+               (exposure != 1.0 ? ", scaled by " + compare::formatShort(exposure) +
+                                      " for display (unscaled, over 1% of the scene would be white)"
+                                : "") +
+               ", " + memoryLine(estimate));
     if (o.common.json) {
         Json j = {{"backend", backendName},
                   {"output", o.output.string()},
                   {"timings_ms", studies::timingsJson(frame)},
                   {"attributes", frame.attributes},
                   {"memory", studies::memoryJson(estimate)}};
+        if (png) j["display_exposure"] = exposure;
         std::cout << j.dump(2) << "\n";
     }
     return 0;

@@ -2,13 +2,17 @@
 // seed scene writes every output with sane metrics; bad input gets one clear error, a non-zero
 // exit and writes nothing.
 #include <sys/wait.h>
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "scene/frame_io.h"
 #include "tests/app/cli.h"
 #include "tests/scene/test_files.h"
 
@@ -151,6 +155,71 @@ TEST(App, RenderWritesTheRequestedFrame) {
                                 (dir.path() / "h.png").string()});
     ASSERT_EQ(h.exitCode, 0) << h.err;
     EXPECT_EQ(pngSize(dir.path() / "h.png"), std::make_pair(32, 18));
+}
+
+// A PNG's 8-bit RGB codes, row by row (empty when it cannot be read).
+std::vector<unsigned char> pngCodes(const std::filesystem::path& file) {
+    auto in = OIIO::ImageInput::open(file.string());
+    if (!in || in->spec().nchannels < 3) return {};
+    const OIIO::ImageSpec spec = in->spec();
+    std::vector<unsigned char> codes(std::size_t(spec.width) * spec.height * 3);
+    if (!in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, codes.data())) return {};
+    return codes;
+}
+
+// A light forty times the seed's: `render -o x.png` is for looking at, so the PNG is scaled as
+// run's report images are (by 1 / the 99th percentile of the scene's luminance) instead of
+// clipping every lit pixel to white; the EXR keeps the values. Expected codes are computed here
+// from the EXR's beauty and ids.
+TEST(App, APngOfABrightSceneIsScaledForDisplay) {
+    TempDir dir;
+    const auto file = dir.write("bright.json", R"({"camera": {"position": [0, 2, 6], "look_at": [0, 0.7, 0]},
+        "lights": [{"type": "directional", "direction": [-1, -2, -1], "intensity": 56}],
+        "materials": {"m": {"albedo": [0.8, 0.7, 0.6]}},
+        "objects": [{"type": "sphere", "center": [0, 1, 0], "radius": 1, "material": "m"},
+                    {"type": "quad", "center": [0, 0, 0], "normal": [0, 1, 0], "size": [20, 20], "material": "m"}]})");
+    const auto exr = dir.path() / "bright.exr";
+    const Result e =
+        shadowlab({"render", file.string(), "--backend", "raytrace", "--resolution", "64x36", "-o", exr.string()});
+    ASSERT_EQ(e.exitCode, 0) << e.err;
+    const scene::Frame frame = scene::readFrame(exr);
+    std::vector<float> luminance;
+    for (std::size_t i = 0; i < frame.pixelCount(); ++i)
+        if (frame.objectId[i] > 0)
+            luminance.push_back(0.2126f * frame.beauty[3 * i] + 0.7152f * frame.beauty[3 * i + 1] +
+                                0.0722f * frame.beauty[3 * i + 2]);
+    ASSERT_GT(luminance.size(), 1000u);
+    std::sort(luminance.begin(), luminance.end());
+    const float p99 = luminance[std::size_t(0.99 * double(luminance.size() - 1))];
+    ASSERT_GT(p99, 5.0f);  // unscaled, most lit pixels would be white
+
+    const auto png = dir.path() / "bright.png";
+    const Result r = shadowlab(
+        {"render", file.string(), "--backend", "raytrace", "--resolution", "64x36", "-o", png.string(), "--json"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    EXPECT_NE(r.err.find("for display"), std::string::npos) << r.err;
+    EXPECT_NEAR(nlohmann::json::parse(r.out).at("display_exposure").get<double>(), 1.0 / p99, 1e-6 / p99);
+    const std::vector<unsigned char> codes = pngCodes(png);
+    ASSERT_EQ(codes.size(), 3 * frame.pixelCount());
+    int differ = 0;
+    for (std::size_t i = 0; i < codes.size(); ++i)
+        differ += std::abs(int(codes[i]) - int(scene::linearToSrgbCode(frame.beauty[i] / p99))) > 1;
+    EXPECT_EQ(differ, 0);
+
+    // The raster backend's PNG is scaled alike: about 1% of the scene's pixels reach white, not all.
+    const auto rasterPng = dir.path() / "bright-raster.png";
+    const Result g = shadowlab({"render", file.string(), "--backend", "raster", "--resolution", "64x36", "--validate",
+                                "-o", rasterPng.string()});
+    ASSERT_EQ(g.exitCode, 0) << g.err;
+    const std::vector<unsigned char> rasterCodes = pngCodes(rasterPng);
+    ASSERT_EQ(rasterCodes.size(), 3 * frame.pixelCount());
+    int white = 0, scene = 0;
+    for (std::size_t i = 0; i < frame.pixelCount(); ++i)
+        if (frame.objectId[i] > 0) {
+            ++scene;
+            white += rasterCodes[3 * i] == 255 && rasterCodes[3 * i + 1] == 255 && rasterCodes[3 * i + 2] == 255;
+        }
+    EXPECT_LT(white, scene / 20) << white << " of " << scene;
 }
 
 TEST(App, MemoryIsEstimatedBeforeRenderingAndBoundsThePeak) {
