@@ -931,6 +931,7 @@ MergedPath mergePathShards(const std::vector<fs::path>& inputs, const fs::path& 
     // only once everything was measured: a damaged frame found while measuring leaves `out` as it was.
     const bool outExisted = fs::exists(out, ec);
     fs::create_directories(out);
+    scene::removeStaleTemporaries(out);  // a staging folder a killed merge left behind
     const fs::path stage = scene::temporarySibling(out / "merge");
     struct Staging {
         fs::path dir, out;

@@ -3,6 +3,7 @@
 // refused; a missing or unfinished shard named with its command), paths from a glTF camera
 // animation written by the test, the scene's "path" block as a spec, and the sweep's flicker axis
 // on lavapipe (snapped against unsnapped fitted maps in the held view).
+#include <sys/wait.h>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -167,7 +168,7 @@ TEST(PathShards, ProgressCountsTheShardsOwnFramesWithTheTimeLeft) {
     EXPECT_EQ(lines[1], "frame 4/5 (2 of 2 in this shard), ETA 0m00s");
 }
 
-TEST(PathShards, ADamagedFrameFoundWhileMeasuringLeavesTheMergedFolderAsItWas) {
+TEST(PathShards, ADamagedFrameFoundWhileMeasuringLeavesTheMergedFolderAsItWasAndAKilledMergesStagingIsCleared) {
     const scene::Scene base = slantedSphere(24, 16);
     PathSpec spec;
     spec.kind = PathKind::SunAzimuth;
@@ -189,10 +190,22 @@ TEST(PathShards, ADamagedFrameFoundWhileMeasuringLeavesTheMergedFolderAsItWas) {
         fs::remove(damaged);  // a new file, not the one the merge would link
         std::ofstream(damaged, std::ios::binary) << all.substr(0, 2000);
     }
+    // The staging folders of two earlier merges: one whose process is gone (killed), which this
+    // merge clears away, and one of a live process (this one stands in for it), which it keeps.
+    const pid_t child = ::fork();
+    if (child == 0) ::_exit(0);
+    ASSERT_GT(child, 0);
+    ::waitpid(child, nullptr, 0);
+    const std::string killed = ".merge.tmp-" + std::to_string(child) + "-0";
+    const std::string live = ".merge.tmp-" + std::to_string(::getpid()) + "-99";
+    for (const std::string& stage : {killed, live}) {
+        fs::create_directories(dir.path / stage / "frames");
+        std::ofstream(dir.path / stage / "merge.json") << "{}";
+    }
     EXPECT_ANY_THROW(mergePathShards({dir.path}, dir.path));
     std::set<std::string> left;
     for (const auto& e : fs::directory_iterator(dir.path)) left.insert(e.path().filename().string());
-    EXPECT_EQ(left, (std::set<std::string>{"shard-0-of-2", "shard-1-of-2"}));
+    EXPECT_EQ(left, (std::set<std::string>{"shard-0-of-2", "shard-1-of-2", live}));
 }
 
 TEST(PathShards, AShardOfAnotherPathIsRefusedAndAMissingOrUnfinishedShardIsNamed) {
