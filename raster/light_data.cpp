@@ -72,6 +72,9 @@ shaders::LightData lightData(const scene::Light& light, int index, const std::ve
         l.position = glm::vec3(light.position - origin);
         l.spotDirection = glm::vec3(glm::normalize(light.direction));
         l.spotCosCone = float(std::cos(light.coneAngleDegrees * kPi / 180.0));
+        l.spotCosInner = light.innerConeAngleDegrees < light.coneAngleDegrees
+                             ? float(std::cos(light.innerConeAngleDegrees * kPi / 180.0))
+                             : l.spotCosCone;
         l.mapNear = float(f.near);
         l.mapFar = float(f.far);
         l.lightSize = float(2.0 * light.radius);

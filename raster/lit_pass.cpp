@@ -87,6 +87,7 @@ std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUn
         c[23] = l.toShadow[1][3];
         c[29] = l.toShadow[2][3];
         c[30] = l.toShadow[3][3];
+        c[31] = l.spotCosInner;  // (the last spare component, lit.vert's outFrame[1].w)
     }
     const int bakedLights = everyLight ? std::clamp(u.lightCount, 0, SHADOWLAB_MAX_LIGHTS) : 0;
     for (std::size_t i = 0; i < std::size_t(bakedLights); ++i) {
@@ -110,6 +111,7 @@ std::array<float, kPackedLightConstants> packLightConstants(const shaders::LitUn
             for (int row = 0; row < 4; ++row) at[24 + 4 * column + row] = d.toShadow[column][row];
         at[40] = d.pointFaceTan;
         at[41] = float(d.filterCode);
+        at[42] = d.spotCosInner;
         for (int face = 0; face < 6; ++face) {
             at[44 + 2 * face] = d.pointFaces[face].near;
             at[45 + 2 * face] = d.pointFaces[face].far;

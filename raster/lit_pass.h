@@ -39,7 +39,8 @@ inline constexpr VkFormat kLitDisplayFormat = VK_FORMAT_R8G8B8A8_SRGB;
 // texelWorldSize, depthPerWorld and depthBiasWorld (zeros where it has none), except that where
 // light 0 is the only light and has one map (a directional light without cascades, or a spot),
 // cascade 0's rows are its toShadow's first three rows, and a spot's last row takes the spare
-// components of the light slots (lit.vert's outLight[3].w and [5].w, outFrame[1].y and .z): the
+// components of the light slots (lit.vert's outLight[3].w and [5].w, outFrame[1].y and .z) and its
+// inner cone's cosine the last one (outFrame[1].w): the
 // values a pipeline with LitVariant::specializedLightConstants bakes (shaders/lit_constants.glsl,
 // constants 18..115).
 // Then, for every light i of LitUniforms::lightCount (zeros for the rest), kPackedPerLight values
@@ -48,7 +49,8 @@ inline constexpr VkFormat kLitDisplayFormat = VK_FORMAT_R8G8B8A8_SRGB;
 // or a spot or point light's position, layer; radiance, visibility weight; constant bias, slope
 // bias, texel world size, depth per world unit; slope cap, normal offset, PCF size, kind; spot
 // direction, cone cosine; map near, map far, light size, cascade count; toShadow's four columns;
-// the point faces' tangent, the filter code, 0, 0; the six point faces' near and far.
+// the point faces' tangent, the filter code, the spot's inner cone cosine, 0; the six point faces'
+// near and far.
 // Then each light's SHADOWLAB_MAX_CASCADES cascades, 16 values each as light 0's above (constants
 // 564 + ..; zeros where it has none).
 inline constexpr std::size_t kPackedPerLight = 56;

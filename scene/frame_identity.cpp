@@ -67,6 +67,8 @@ std::uint64_t digestOf(const Scene& scene, std::vector<std::shared_ptr<const voi
         h.value(int(l.type));
         h.vec(l.direction), h.vec(l.position), h.vec(l.color);
         h.value(l.intensity), h.value(l.radius), h.value(l.coneAngleDegrees);
+        // (Only a soft edge is hashed: a hard cone's scene keeps the identity it had.)
+        if (l.type == LightType::Spot && l.innerConeAngleDegrees < l.coneAngleDegrees) h.value(l.innerConeAngleDegrees);
     }
     h.value(scene.objects.size());
     for (const Object& o : scene.objects) {
@@ -194,6 +196,8 @@ void recordIdentity(Frame& frame, const Scene& scene) {
             frame.typedAttributes[k + "radius"] = float(l.radius);
         }
         if (l.type == LightType::Spot) frame.typedAttributes[k + "cone_angle"] = float(l.coneAngleDegrees);
+        if (l.type == LightType::Spot && l.innerConeAngleDegrees < l.coneAngleDegrees)
+            frame.typedAttributes[k + "inner_cone_angle"] = float(l.innerConeAngleDegrees);
     }
 }
 

@@ -412,8 +412,11 @@ ExportResult exportGltf(const Scene& scene, const fs::path& file, const ExportOp
             node["translation"] = vecJson(l.position);
             if (l.type == LightType::Spot) {
                 const double outer = l.coneAngleDegrees * kPi / 180.0;
-                // Shadowlab's cone is hard; glTF needs inner < outer, so inner is just inside it.
-                gl["spot"] = {{"outerConeAngle", outer}, {"innerConeAngle", outer * (1.0 - 1e-3)}};
+                // glTF needs inner < outer: a hard cone's inner angle is just inside it.
+                const double inner = l.innerConeAngleDegrees < l.coneAngleDegrees
+                                         ? l.innerConeAngleDegrees * kPi / 180.0
+                                         : outer * (1.0 - 1e-3);
+                gl["spot"] = {{"outerConeAngle", outer}, {"innerConeAngle", inner}};
             }
         }
         if (l.radius > 0) gl["extras"] = {{"shadowlab", {{"radius", l.radius}}}};

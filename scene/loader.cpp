@@ -249,13 +249,15 @@ Camera readCamera(const Reader& r, const Json& node, const JsonPath& path) {
 }
 
 Light readLight(const Reader& r, const Json& node, const JsonPath& path) {
-    r.checkKeys(node, path, {"type", "direction", "position", "color", "intensity", "radius", "cone_angle", "name"});
+    r.checkKeys(
+        node, path,
+        {"type", "direction", "position", "color", "intensity", "radius", "cone_angle", "inner_cone_angle", "name"});
     Light l;
     const std::string type = r.string(r.require(node, path, "type"), path / "type");
     if (type == "directional") {
         l.type = LightType::Directional;
         l.direction = r.direction(r.require(node, path, "direction"), path / "direction");
-        for (const char* key : {"position", "radius", "cone_angle"})
+        for (const char* key : {"position", "radius", "cone_angle", "inner_cone_angle"})
             if (node.contains(key)) r.fail(path / key, "does not apply to a directional light");
     } else if (type == "point" || type == "spot") {
         l.type = type == "point" ? LightType::Point : LightType::Spot;
@@ -270,8 +272,15 @@ Light readLight(const Reader& r, const Json& node, const JsonPath& path) {
             if (!(l.coneAngleDegrees > 0.0 && l.coneAngleDegrees < 90.0))
                 r.fail(path / "cone_angle",
                        "must be in (0, 90) degrees (half-angle), got " + describe(node["cone_angle"]));
+            if (node.contains("inner_cone_angle")) {
+                l.innerConeAngleDegrees = r.number(node["inner_cone_angle"], path / "inner_cone_angle");
+                if (!(l.innerConeAngleDegrees >= 0.0 && l.innerConeAngleDegrees <= l.coneAngleDegrees))
+                    r.fail(path / "inner_cone_angle", "must be in [0, cone_angle] = [0, " +
+                                                          describe(node["cone_angle"]) + "] degrees, got " +
+                                                          describe(node["inner_cone_angle"]));
+            }
         } else {
-            for (const char* key : {"direction", "cone_angle"})
+            for (const char* key : {"direction", "cone_angle", "inner_cone_angle"})
                 if (node.contains(key)) r.fail(path / key, "does not apply to a point light");
         }
     } else {
@@ -812,8 +821,11 @@ Scene loadModelScene(const fs::path& file) {
             // glTF point intensity is in candela (irradiance I/d²); ours is I/(4π d²).
             light.intensity = 4.0 * kPi * l.intensity;
             if (extras.shadowlabExport && l.radius > 0 && std::isfinite(l.radius)) light.radius = l.radius;
-            if (light.type == LightType::Spot)
+            if (light.type == LightType::Spot) {
                 light.coneAngleDegrees = std::clamp(l.outerConeRadians * 180.0 / kPi, 0.1, 89.9);
+                // glTF's default inner angle is 0: the falloff starts on the axis.
+                light.innerConeAngleDegrees = std::clamp(l.innerConeRadians * 180.0 / kPi, 0.0, light.coneAngleDegrees);
+            }
         }
         // The checks a JSON light gets, at the glTF light's path (its position and direction
         // come from its node).

@@ -786,6 +786,7 @@ void collectCameraAndLight(const tinygltf::Model& model, const tinygltf::Node& n
     if (l.color.size() == 3) light.color = Vec3(l.color[0], l.color[1], l.color[2]);
     light.intensity = l.intensity;
     light.outerConeRadians = l.spot.outerConeAngle;
+    light.innerConeRadians = l.spot.innerConeAngle;
     // glTF's range cuts a light off (smoothly) at a distance; shadowlab's lights reach every
     // distance at 1/d². Said once per light, since it brightens what lies beyond.
     if (l.range > 0 && std::isfinite(l.range)) {
@@ -1001,6 +1002,16 @@ std::string gltfValueProblem(std::string_view json) {
                                  "in (0, π/2] radians"))
                          .empty())
                     return p;
+                if (light.contains("spot") && light["spot"].is_object() && light["spot"].contains("innerConeAngle")) {
+                    const nlohmann::json& spot = light["spot"];
+                    const double outer = spot.contains("outerConeAngle") && spot["outerConeAngle"].is_number()
+                                             ? spot["outerConeAngle"].get<double>()
+                                             : pi / 4;  // the specification's default
+                    if (!(p = number(spot["innerConeAngle"], at + ".spot.innerConeAngle", 0.0, outer, false,
+                                     "in [0, outerConeAngle] radians"))
+                             .empty())
+                        return p;
+                }
             }
     return "";
 }

@@ -33,6 +33,7 @@ struct GltfLight {
     Vec3 position{0, 0, 0}, direction{0, 0, -1}, color{1, 1, 1};
     double intensity = 1.0;         // lux (directional) or candela (point, spot)
     double outerConeRadians = 0.0;  // spot
+    double innerConeRadians = 0.0;  // spot
     double radius = 0.0;            // extras.shadowlab.radius of a shadowlab export (a spherical light)
 };
 struct GltfExtras {

@@ -140,6 +140,10 @@ struct Light {
     double intensity = 1.0;
     double radius = 0.0;            // point/spot: > 0 makes a spherical area light (soft shadows)
     double coneAngleDegrees = 0.0;  // spot: half-angle of the cone
+    // Spot: full intensity within this half-angle, falling to 0 at coneAngleDegrees along
+    // KHR_lights_punctual's curve (scene/shading.h spotFalloff). At or above coneAngleDegrees (the
+    // default) the cone's edge is hard.
+    double innerConeAngleDegrees = 90.0;
 };
 
 struct Sphere {

@@ -43,6 +43,8 @@ ValueProblem lightProblem(const Light& l) {
     }
     if (l.type == LightType::Spot && !(l.coneAngleDegrees > 0 && l.coneAngleDegrees < 90))
         return {"cone_angle", "must be in (0, 90) degrees, got " + number(l.coneAngleDegrees)};
+    if (l.type == LightType::Spot && !(l.innerConeAngleDegrees >= 0))
+        return {"inner_cone_angle", "must be >= 0 degrees, got " + number(l.innerConeAngleDegrees)};
     return {};
 }
 

@@ -118,7 +118,10 @@ struct LightData {
     // one map. Point: zero here; lit.frag sets them to the face it reads (pointFaces).
     float mapNear;
     float mapFar;
-    float pointFaceTan;       // point: tan of each cube face's half field of view (> 1: the faces overlap)
+    float pointFaceTan;  // point: tan of each cube face's half field of view (> 1: the faces overlap)
+    // spot: cosine of the inner cone's half-angle, within which it is at full intensity (scene::Light
+    // innerConeAngleDegrees); at or below spotCosCone the edge is hard
+    float spotCosInner;
     PointFace pointFaces[6];  // point: face k = 0..5, +X −X +Y −Y +Z −Z (layer + k)
 };
 
@@ -168,7 +171,8 @@ static_assert(offsetof(LightData, radiance) == 112 && offsetof(LightData, visibi
 static_assert(offsetof(LightData, depthBiasWorld) == 128 && offsetof(LightData, depthPerWorld) == 140);
 static_assert(offsetof(LightData, maxSlopeTan) == 144 && offsetof(LightData, pcfSize) == 156);
 static_assert(offsetof(LightData, kind) == 160 && offsetof(LightData, mapFar) == 172);
-static_assert(offsetof(LightData, pointFaceTan) == 176 && offsetof(LightData, pointFaces) == 192);
+static_assert(offsetof(LightData, pointFaceTan) == 176 && offsetof(LightData, spotCosInner) == 180 &&
+              offsetof(LightData, pointFaces) == 192);
 static_assert(sizeof(LightData) == 192 + 6 * 16, "LightData must match std140");
 static_assert(offsetof(CascadeData, sliceFar) == 64 && offsetof(CascadeData, depthBiasWorld) == 76);
 static_assert(sizeof(CascadeData) == 64 + 16, "CascadeData must match std140");

@@ -188,6 +188,7 @@ LightData bakedLightAt(int i) {
     light.toShadow = mat4(s[6], s[7], s[8], s[9]);
     light.pointFaceTan = s[10].x;
     light.filterCode = int(s[10].y);
+    light.spotCosInner = s[10].z;
     for (int face = 0; face < 6; ++face) {
         const vec4 pair = s[11 + face / 2];
         light.pointFaces[face].near = face % 2 == 0 ? pair.x : pair.z;
@@ -221,6 +222,7 @@ LightData lightAt(int i) {
         light.mapNear = slot[5].x;
         light.mapFar = slot[5].y;
         light.lightSize = slot[5].z;
+        light.spotCosInner = frameSlot(1).w;
     }
     if (kOneMapLight) light.toShadow = oneMapMatrix();
     return light;
@@ -892,14 +894,23 @@ void main() {
             light = cascadeOf(light, i, inPosition, nextCascade, cascadeBlend);
         vec3 l;
         float irradiance;  // relative to radiance: 1 for directional lights
+        bool reaches = true;
         if (isPerspective(light)) {
-            // scene/shading.h: intensity / (4π d²); a spot is dark outside its cone.
+            // scene/shading.h: intensity / (4π d²); a spot is dark outside its cone and falls off
+            // between its inner and outer cone (spotFalloff).
             const vec3 toLight = light.position - inPosition;
             const float d2 = dot(toLight, toLight);
             l = toLight * inversesqrt(d2);
-            const bool outsideCone =
-                isKind(light, SHADOWLAB_LIGHT_SPOT) && dot(-l, light.spotDirection) < light.spotCosCone;
-            irradiance = outsideCone ? 0.0 : 1.0 / (4.0 * kPi * d2);
+            irradiance = 1.0 / (4.0 * kPi * d2);
+            if (isKind(light, SHADOWLAB_LIGHT_SPOT)) {
+                const float cosAngle = dot(-l, light.spotDirection);
+                reaches = cosAngle >= light.spotCosCone;
+                if (light.spotCosInner > light.spotCosCone) {
+                    const float t = clamp((cosAngle - light.spotCosCone) / (light.spotCosInner - light.spotCosCone), 0.0, 1.0);
+                    irradiance *= t * t;
+                }
+                if (!reaches) irradiance = 0.0;
+            }
         } else {
             l = light.towardLight;
             irradiance = 1.0;
@@ -907,10 +918,10 @@ void main() {
         const float ndotl = dot(n, l);
         // A light that does not reach the point (outside a spot's cone) has no N·L to give: where
         // none reaches, ndotl stays -1 and compare counts the pixel as it counts a back face.
-        maxNdotL = max(maxNdotL, irradiance > 0.0 ? ndotl : -1.0);
+        maxNdotL = max(maxNdotL, reaches ? ndotl : -1.0);
         // No light (N·L <= 0, outside a spot's cone): visibility 0, weight 0. (An if, not a
         // continue, so that the loop unrolls.)
-        if (ndotl > 0.0 && irradiance > 0.0) {
+        if (ndotl > 0.0 && reaches) {
             uint lightBlocker = 0u;
             float v = light.layer >= 0.0 ? shadowTest(light, inPosition, n, ndotl, dpdx, dpdy, lightBlocker) : 1.0;
             if (kCascadeBlend && cascadeBlend > 0.0) {

@@ -75,7 +75,7 @@ void main() {
 #else
         for (int r = 0; r < 3; ++r) outMapRows[r] = rows[r];
         const vec4 spare = kOneSpot ? rows[3] : vec4(0.0);  // a spot's last row
-        outFrame[1] = vec4(u.mapSize, spare.zw, 0.0);
+        outFrame[1] = vec4(u.mapSize, spare.zw, kOneSpot ? light.spotCosInner : 0.0);
 #endif
         outLight[0] = vec4(kOneSpot ? light.position : light.towardLight, light.layer);
         outLight[1] = vec4(light.radiance, light.visibilityWeight);

@@ -219,12 +219,14 @@ TEST(RasterLitPass, TargetsLargerThanTheDeviceAllowsAreRefusedNamingTheLimit) {
 TEST(RasterLitPass, PackedConstantsCarryTheOneMapLightsMatrix) {
     // lit.frag (oneMapMatrix) reads the one-map light's toShadow from cascade 0's three rows
     // (packed values 34..45, constants 52..63) and a spot's last row from the light slots' spare
-    // components (values 15, 23, 29 and 30: outLight[3].w, outLight[5].w, outFrame[1].y and .z);
+    // components (values 15, 23, 29 and 30: outLight[3].w, outLight[5].w, outFrame[1].y and .z),
+    // its inner cone's cosine from the last (value 31, outFrame[1].w);
     // a change of the matrix alone must change the packed values, which Renderer::update compares
     // to leave the baked pipelines. A matrix whose every entry differs shows a misplaced one.
     shaders::LitUniforms u{};
     u.lightCount = 1;
     u.mapSize = 2048.0f;
+    u.lights[0].spotCosInner = 0.875f;  // a spot's inner cone: value 31, outFrame[1].w
     for (int column = 0; column < 4; ++column)
         for (int row = 0; row < 4; ++row) u.lights[0].toShadow[column][row] = float(1 + 4 * column + row);
     for (const int kind : {SHADOWLAB_LIGHT_DIRECTIONAL, SHADOWLAB_LIGHT_SPOT}) {
@@ -238,6 +240,7 @@ TEST(RasterLitPass, PackedConstantsCarryTheOneMapLightsMatrix) {
         EXPECT_EQ(c[23], spot ? 8.0f : 0.0f);
         EXPECT_EQ(c[29], spot ? 12.0f : 0.0f);
         EXPECT_EQ(c[30], spot ? 16.0f : 0.0f);
+        EXPECT_EQ(c[31], spot ? 0.875f : 0.0f);
         EXPECT_EQ(c[28], 2048.0f);  // the map size keeps its slot
         shaders::LitUniforms moved = u;
         moved.lights[0].toShadow[3][0] += 1.0f;  // a translation: only the matrix differs
@@ -255,6 +258,7 @@ TEST(RasterLitPass, PackedConstantsCarryTheOneMapLightsMatrix) {
     EXPECT_EQ(two[34], 99.0f);
     EXPECT_EQ(two[15], 0.0f);
     EXPECT_EQ(two[30], 0.0f);
+    EXPECT_EQ(two[31], 0.0f);
 }
 
 TEST(RasterLitPass, OnlyOneDirectionalMapOrOneSpotIsTheOneMapLight) {

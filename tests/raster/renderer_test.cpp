@@ -697,6 +697,39 @@ TEST(RasterBlockerId, ShadowedPlanePixelsNameTheSphereAndAcneNamesThePlaneItself
     }
 }
 
+TEST(RasterSpotLight, AnInnerConeFallsOffAsKhrLightsPunctualSays) {
+    // The same spot with an inner cone of 15° inside its 40°: the lit plane's beauty is
+    // I/(4π d²)·N·L times KHR_lights_punctual's falloff, ((cos θ − cos 40°) / (cos 15° − cos 40°))²
+    // clamped to [0, 1], computed here; the shadow is the hard cone's (the falloff shades, it
+    // does not move what is lit), so where the plane is lit the visibility stays 1.
+    SphereOverPlane p;
+    p.width = 320;
+    p.height = 180;
+    scene::Scene s = makeScene(p);
+    const Vec3 lightPos(0.3, 4.0, 0.2);
+    s.lights[0].type = scene::LightType::Spot;
+    s.lights[0].position = lightPos;
+    s.lights[0].direction = Vec3(0, -1, 0);
+    s.lights[0].coneAngleDegrees = 40.0;
+    s.lights[0].innerConeAngleDegrees = 15.0;
+    s.lights[0].intensity = 300.0;
+    const scene::Frame f = renderValidated(s, validatedSettings(1024, 0.01, 1.0, ShadowFilter::Pcf2x2), "spot-inner");
+    const double cosOuter = std::cos(40.0 * kPi / 180.0), cosInner = std::cos(15.0 * kPi / 180.0);
+    int full = 0, ramp = 0;
+    forEachPlanePixel(p, s, f, [&](std::size_t i, const Vec3& q) {
+        const Vec3 toLight = lightPos - q;
+        const double cosAngle = glm::dot(-glm::normalize(toLight), Vec3(0, -1, 0));
+        if (cosAngle < cosOuter + 0.01 || f.visibility[i] != 1.0f) return;  // the rim, or shadowed
+        const double t = std::clamp((cosAngle - cosOuter) / (cosInner - cosOuter), 0.0, 1.0);
+        (t < 1.0 ? ramp : full) += 1;
+        const double d2 = glm::dot(toLight, toLight);
+        const double ndotl = toLight.y / std::sqrt(d2);
+        EXPECT_NEAR(f.beauty[3 * i], 0.8 * 300.0 / (4 * kPi * d2) * ndotl * t * t + 0.05 * 0.8, 2e-4) << i;
+    });
+    EXPECT_GT(full, 300);
+    EXPECT_GT(ramp, 3000);
+}
+
 TEST(RasterSpotLight, PerspectiveShadowMatchesTheClosedForm) {
     // A spot 4 units above the plane pointing down, cone 40°, over a floating sphere. Closed
     // form: a plane point inside the cone is shadowed when the segment to the light meets the
@@ -1628,6 +1661,7 @@ TEST(RasterRenderer, LightConstantsFromTheVertexShaderOrBakedInGiveTheSameFrameB
                     l.position = Vec3(2.5, 3.0, 1.5) + shift;
                     l.direction = glm::normalize(Vec3(-2.5, -2.2, -1.5));
                     l.coneAngleDegrees = 45.0;
+                    l.innerConeAngleDegrees = 30.0;  // (its cosine rides in a spare slot of its own)
                     l.radius = 0.1;
                     l.intensity = 300.0;
                 }
@@ -1771,6 +1805,7 @@ TEST(RasterRenderer, EveryLightsConstantsBakedInGiveTheUniformBuffersFrameBitFor
         s.lights[0].intensity = 0.7;
         scene::Light spot = spotOverTheSphere(shift);
         spot.radius = 0.1;
+        spot.innerConeAngleDegrees = 0.5 * spot.coneAngleDegrees;
         s.lights.push_back(spot);
         scene::Light point;
         point.type = scene::LightType::Point;

@@ -129,6 +129,44 @@ TEST(ReferenceRender, APointOutsideEverySpotsConeHasNoNdotLSoCompareLeavesItOut)
     EXPECT_EQ(dark.ndotl, f.ndotl);
 }
 
+TEST(ReferenceRender, ASpotsInnerConeFallsOffAsKhrLightsPunctualSaysAndLeavesTheShadowAlone) {
+    // The spot above with an inner cone of 18° inside its 25°: a plane point's beauty is the hard
+    // spot's times ((cos θ − cos 25°) / (cos 18° − cos 25°))² clamped to [0, 1] (the curve of
+    // KHR_lights_punctual's README), computed here; visibility, ndotl and blockers do not change.
+    scene::Scene s = test::seedScene();
+    const Vec3 spot(0.3, 4.0, 0.2);
+    s.lights[0].type = scene::LightType::Spot;
+    s.lights[0].position = spot;
+    s.lights[0].direction = Vec3(0, -1, 0);
+    s.lights[0].coneAngleDegrees = 25.0;
+    s.lights[0].intensity = 100.0;
+    const auto settings = test::biasSettings(0, scene::Precision::Double);
+    const scene::Frame hard = renderReference(s, test::planFor(s), settings);
+    s.lights[0].innerConeAngleDegrees = 18.0;
+    const scene::Frame soft = renderReference(s, test::planFor(s), settings);
+    EXPECT_EQ(soft.visibility, hard.visibility);
+    EXPECT_EQ(soft.ndotl, hard.ndotl);
+    EXPECT_EQ(soft.blockerId, hard.blockerId);
+    const double kPi = 3.14159265358979323846;
+    const double cosOuter = std::cos(25.0 * kPi / 180.0), cosInner = std::cos(18.0 * kPi / 180.0);
+    const double ambient = s.ambient * s.materialOf(s.objects[1]).albedo.r;  // the ground's (object id 2)
+    int ramp = 0, full = 0;
+    for (int y = 0; y < soft.height; ++y)
+        for (int x = 0; x < soft.width; ++x) {
+            const std::size_t i = std::size_t(y) * soft.width + x;
+            const Analytic a = test::analyticPixel(s, {}, x, y);
+            if (a.kind != Analytic::Plane || soft.objectId[i] != 2.0f || !(hard.beauty[3 * i] > ambient + 1e-6))
+                continue;
+            const double cosAngle = glm::normalize(spot - a.p).y;
+            const double t = std::clamp((cosAngle - cosOuter) / (cosInner - cosOuter), 0.0, 1.0);
+            (t < 1.0 ? ramp : full) += 1;
+            ASSERT_NEAR(soft.beauty[3 * i] - ambient, (hard.beauty[3 * i] - ambient) * t * t, 1e-5)
+                << "pixel " << x << "," << y;
+        }
+    EXPECT_GT(ramp, 500);
+    EXPECT_GT(full, 100);
+}
+
 // Counts plane pixels that are lit in closed form but have visibility 0 in the frame.
 int falseShadowsOnPlane(const scene::Scene& s, const test::Placement& at, const scene::Frame& f, int& litPlanePixels) {
     int acne = 0;

@@ -298,6 +298,54 @@ TEST(SceneLoader, GltfCamerasAndPunctualLightsAreUsed) {
     // Candela to our convention: irradiance I/d² = ours/(4π d²).
     EXPECT_NEAR(s.lights[0].intensity, 4.0 * 3.14159265358979 * 10.0, 1e-9);
     EXPECT_NEAR(s.lights[0].coneAngleDegrees, 0.5 * 180.0 / 3.14159265358979, 1e-9);
+    // No innerConeAngle: the specification's default 0, a falloff from the axis.
+    EXPECT_EQ(s.lights[0].innerConeAngleDegrees, 0.0);
+    // A given one is used, one past the outer angle is an error at its path.
+    std::ifstream original(dir.path() / "t.gltf");
+    std::string withInner((std::istreambuf_iterator<char>(original)), std::istreambuf_iterator<char>());
+    withInner.replace(withInner.find(R"("outerConeAngle": 0.5)"), 21,
+                      R"("outerConeAngle": 0.5, "innerConeAngle": 0.25)");
+    dir.write("inner.gltf", withInner);
+    EXPECT_NEAR(loadScene(dir.path() / "inner.gltf").lights[0].innerConeAngleDegrees, 0.25 * 180.0 / 3.14159265358979,
+                1e-9);
+    std::string pastOuter = withInner;
+    pastOuter.replace(pastOuter.find("0.25"), 4, "0.75");
+    dir.write("past.gltf", pastOuter);
+    try {
+        loadScene(dir.path() / "past.gltf");
+        ADD_FAILURE() << "an innerConeAngle past the outer one loaded";
+    } catch (const SceneError& e) {
+        EXPECT_NE(std::string(e.what()).find("extensions.KHR_lights_punctual.lights[0].spot.innerConeAngle"),
+                  std::string::npos)
+            << e.what();
+    }
+}
+
+TEST(SceneLoader, ASpotsInnerConeAngleIsReadAndChecked) {
+    TempDir dir;
+    auto scene = [&](const std::string& light) {
+        return R"({"camera": {"position": [0, 2, 6], "look_at": [0, 0, 0]}, "materials": {"m": {}},
+                   "objects": [{"type": "sphere", "center": [0, 1, 0], "radius": 1, "material": "m"}],
+                   "lights": [)" +
+               light + "]}";
+    };
+    const std::string spot = R"({"type": "spot", "position": [0, 4, 0], "direction": [0, -1, 0], "cone_angle": 30)";
+    EXPECT_EQ(loadScene(dir.write("hard.json", scene(spot + "}"))).lights[0].innerConeAngleDegrees, 90.0);
+    EXPECT_EQ(
+        loadScene(dir.write("soft.json", scene(spot + R"(, "inner_cone_angle": 12})"))).lights[0].innerConeAngleDegrees,
+        12.0);
+    for (const auto& [light, what] : std::vector<std::pair<std::string, std::string>>{
+             {spot + R"(, "inner_cone_angle": 31})", "lights[0].inner_cone_angle: must be in [0, cone_angle]"},
+             {spot + R"(, "inner_cone_angle": -1})", "lights[0].inner_cone_angle: must be in [0, cone_angle]"},
+             {R"({"type": "point", "position": [0, 4, 0], "inner_cone_angle": 10})",
+              "lights[0].inner_cone_angle: does not apply to a point light"}}) {
+        try {
+            loadScene(dir.write("bad.json", scene(light)));
+            ADD_FAILURE() << light;
+        } catch (const SceneError& e) {
+            EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+        }
+    }
 }
 
 TEST(SceneLoader, RejectsAMissingFileAndAFolder) {
