@@ -392,16 +392,33 @@ std::string figure(const std::string& caption, const std::string& note, const st
     return o.str();
 }
 
-// The settings a frame was rendered with, on one line under its image: every attribute except
-// those already shown elsewhere (backend is the caption, scene and version are in the header).
+// The settings that decide a frame's shadows, on one line under its image, fractions to three
+// digits; every attribute, in full, is in the Settings section at the end.
 std::string settingsLine(const FrameInfo& f) {
+    static const char* const kKeys[] = {"shadow_map_size", "filter",   "depth_bias", "slope_bias", "normal_offset",
+                                        "shadow_maps",     "ray_bias", "precision",  "samples"};
     std::string line;
-    for (const auto& [key, value] : f.attributes) {
-        if (key == "backend" || key == "scene" || key == "version") continue;
-        const std::string v = value.size() > 48 ? value.substr(0, 45) + "..." : value;
-        line += (line.empty() ? "" : " · ") + key + " " + v;
+    for (const char* key : kKeys) {
+        const auto it = f.attributes.find(key);
+        if (it == f.attributes.end()) continue;
+        std::string v = it->second;
+        char* end = nullptr;
+        const double number = std::strtod(v.c_str(), &end);
+        if (!v.empty() && end == v.c_str() + v.size() && std::isfinite(number) && number != std::floor(number))
+            v = formatShort(number);  // (whole numbers, a map size, stay as they are)
+        line += (line.empty() ? "" : " · ") + std::string(key) + " " + v;
     }
     return line.empty() ? "" : "<div class=\"small settings\">" + escapeHtml(line) + "</div>";
+}
+
+// Why the scene is seen and lit as it is (the view, sun, lights and ground the program chose,
+// the reference frame's choice.* attributes), in full.
+std::string choicesHtml(const FrameInfo& f) {
+    std::string items;
+    for (const auto& [key, value] : f.attributes)
+        if (key.rfind("choice.", 0) == 0)
+            items += "<li><b>" + escapeHtml(key.substr(7)) + "</b>: " + escapeHtml(value) + "</li>";
+    return items.empty() ? "" : "<ul class=\"small choices\">" + items + "</ul>\n";
 }
 
 // A square crop of `png` showing the hotspot window, scaled up with hard pixel edges. Pure CSS:
@@ -524,9 +541,14 @@ std::string metricsTable(const ReportInput& in) {
         });
     row(
         "IoU of shadowed areas", [&](const Metrics& m) { return plain(formatFixed(m.shadowIoU, 4)); }, "key");
-    row("wrong near a shadow edge (aliasing)",
-        [&](const Metrics& m) { return countCell(m.aliasingPixels, m.aliasingRate); });
-    row("wrong away from edges (bias)",
+    // A ray tracer samples each pixel's own point: it has no aliasing, and every wrong pixel, near
+    // an edge or not, is its offset's and precision's (the summary gives the share near edges).
+    row("aliasing <span class=\"small\">(wrong near a shadow edge, from the map's texels)</span>",
+        [&](const Metrics& m) {
+            return m.pointSampled ? plain("none <span class=\"small\">(point-sampled)</span>")
+                                  : countCell(m.aliasingPixels, m.aliasingRate);
+        });
+    row("bias error <span class=\"small\">(the other wrong pixels)</span>",
         [&](const Metrics& m) { return countCell(m.biasErrorPixels, m.biasErrorRate); });
     row("silhouette mismatch <span class=\"small\">(of all pixels)</span>",
         [&](const Metrics& m) { return countCell(m.silhouetteMismatch, m.silhouetteMismatchRate); });
@@ -750,7 +772,7 @@ std::string renderReportHtml(const ReportInput& in) {
     for (const auto& rm : in.methods)
         o << "<div>" << figure(rm.label, formatDuration(rm.frame.totalTimeMs()), rm.png, rm.frame, nullptr)
           << settingsLine(rm.frame) << "</div>\n";
-    o << "</div>\n";
+    o << "</div>\n" << choicesHtml(ref);
     if (in.displayExposure != 1.0)
         o << "<p>The images are scaled by " << formatShort(in.displayExposure)
           << " for display: at full value more than 1% of the reference's visible surface would be white. The "
@@ -815,9 +837,12 @@ std::string renderReportHtml(const ReportInput& in) {
 
     if (!in.methods.empty()) {
         o << "<h2>Metrics</h2>\n" << metricsTable(in);
-        o << "<p class=\"small\">Rates are over counted pixels unless noted. Aliasing counts wrong pixels within "
+        o << "<p class=\"small\">Rates are over counted pixels unless noted. Aliasing counts a shadow map's wrong "
+             "pixels within "
           << in.methods.front().metrics.edgeRadius
-          << " px of a shadow edge in the reference; bias error counts the rest.</p>\n";
+          << " px of a shadow edge in the reference, but for missed shadow whose blocker lies within the contact "
+             "distance (a bias leak, lost whole to the bias); bias error counts the rest. A ray tracer tests each "
+             "pixel's own point, so all of its wrong pixels are bias error, near an edge or not.</p>\n";
     }
 
     o << "<h2>Error against run time</h2>\n<div class=\"plotrow\"><div>" << errorTimeSvg(in) << "</div><div>"

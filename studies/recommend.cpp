@@ -207,8 +207,8 @@ std::string percentPair(const Measured& a, const Measured& b) {
                     compare::formatFixed(b.shadowIoU, 3) + ")";
     if (a.terminatorMissedRate > 0.0 || b.terminatorMissedRate > 0.0)
         s += "; " + compare::formatPercent(a.judgedRate()) + " against " + compare::formatPercent(b.judgedRate()) +
-             " without the missed shadow at smooth meshes' terminators, which renderers mean to leave and the "
-             "recommendation does not chase";
+             " without the missed shadow at smooth meshes' terminators (renderers mean to leave it, and the "
+             "recommendation does not chase it)";
     return s;
 }
 
@@ -225,6 +225,7 @@ Measured measure(const scene::Frame& method, const scene::Frame& reference) {
     m.meanAbsVisibilityError = k.meanAbsVisibilityError;
     m.softErrorRate = k.softErrorRate;
     m.terminatorMissedRate = k.hasReferenceBlockerIds ? k.terminatorMissedRate : 0.0;
+    m.timeMs = method.totalTimeMs();
     return m;
 }
 
@@ -283,15 +284,15 @@ void tryLargerMap(const RecommendOptions& o, const scene::Scene& scene, const sc
                               std::to_string(int(std::ceil(needed))) + ": ";
     const bool biasesWon = v.beatsDefaults;
     if (beats(v.largerMap, v.recommended)) {
-        notes.push_back("For the shadow map, " + asked + "a " + std::to_string(larger) + " map gives " +
-                        percentPair(v.largerMap, v.defaults) +
-                        (biasesWon
-                             ? " and beats the searched biases' " + compare::formatPercent(v.recommended.judgedRate())
-                             : std::string()) +
-                        " at " + sizeText(scene) +
-                        ", for four times the texels of each map and more render time. The block recommends "
-                        "shadow_map_size " +
-                        std::to_string(larger) + (biasesWon ? " in place of the biases." : "."));
+        notes.push_back(
+            "For the shadow map, " + asked + "a " + std::to_string(larger) + " map gives " +
+            percentPair(v.largerMap, v.defaults) +
+            (biasesWon ? ", and it beats the searched biases' " + compare::formatPercent(v.recommended.judgedRate())
+                       : std::string()) +
+            " at " + sizeText(scene) +
+            ", for four times the texels of each map and more render time. The block recommends "
+            "shadow_map_size " +
+            std::to_string(larger) + (biasesWon ? " in place of the biases." : "."));
         v.largerMapRecommended = true;
         v.beatsDefaults = true;
         v.recommended = v.largerMap;
@@ -510,9 +511,10 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
         if (v.beatsDefaults) {
             setRayBias(block, *ov.rayBias);
             if (ov.precision) block["precision"] = *ov.precision;
-            r.notes.push_back("For the ray tracer, " + v.candidate + " gives " +
-                              percentPair(v.recommended, v.defaults) + " at " + r.resolution +
-                              ". The block recommends it.");
+            r.notes.push_back(
+                "For the ray tracer, " + v.candidate + " gives " + percentPair(v.recommended, v.defaults) + " at " +
+                r.resolution + ", in " + compare::formatDuration(v.recommended.timeMs) + " against the defaults' " +
+                compare::formatDuration(v.defaults.timeMs) + " (one render each). The block recommends it.");
         } else {
             if (user.rayBias) setRayBias(block, *user.rayBias);
             if (user.precision) block["precision"] = *user.precision;

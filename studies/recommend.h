@@ -32,6 +32,7 @@ struct Measured {
     // and beats() judge the rest (judgedRate), so that no setting is recommended for bringing the
     // faceted terminator back.
     double terminatorMissedRate = 0.0;
+    double timeMs = 0.0;  // the render's total time (one render: a rough figure)
     double judgedRate() const { return std::max(0.0, mismatchRate - terminatorMissedRate); }
 };
 Measured measure(const scene::Frame& method, const scene::Frame& reference);

@@ -41,6 +41,13 @@ std::string number(double v) {
     return buf;
 }
 
+// For labels people read: four significant digits (a row's key keeps every digit).
+std::string shortNumber(double v) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.4g", v);
+    return buf;
+}
+
 double median(std::vector<double> v) {
     if (v.empty()) return 0.0;
     std::sort(v.begin(), v.end());
@@ -238,13 +245,19 @@ std::string SweepConfig::label() const {
     const auto& o = overrides;
     if (o.shadowMapSize) parts.push_back("map " + std::to_string(*o.shadowMapSize));
     if (o.filter) parts.push_back(*o.filter);
-    if (o.depthBias) parts.push_back("depth bias " + number(*o.depthBias));
-    if (o.slopeBias) parts.push_back("slope bias " + number(*o.slopeBias));
-    if (o.rayBias) parts.push_back(*o.rayBias == "robust" ? "robust offset" : "ray bias " + *o.rayBias);
+    if (o.depthBias) parts.push_back("depth bias " + shortNumber(*o.depthBias));
+    if (o.slopeBias) parts.push_back("slope bias " + shortNumber(*o.slopeBias));
+    if (o.rayBias) {
+        char* end = nullptr;
+        const double v = std::strtod(o.rayBias->c_str(), &end);
+        parts.push_back(*o.rayBias == "robust"                       ? "robust offset"
+                        : end && *end == '\0' && !o.rayBias->empty() ? "ray bias " + shortNumber(v)
+                                                                     : "ray bias " + *o.rayBias);
+    }
     if (o.precision) parts.push_back(*o.precision);
     if (o.samples) parts.push_back(std::to_string(*o.samples) + " samples");
     if (o.pcfSize) parts.push_back("pcf size " + std::to_string(*o.pcfSize));
-    if (o.normalOffset) parts.push_back("normal offset " + number(*o.normalOffset));
+    if (o.normalOffset) parts.push_back("normal offset " + shortNumber(*o.normalOffset));
     if (o.receiverPlaneBias) parts.push_back(*o.receiverPlaneBias ? "receiver-plane bias" : "no receiver-plane bias");
     if (o.hardwareBias) parts.push_back(*o.hardwareBias ? "hardware bias" : "shader bias");
     if (o.fitLightFrustum) parts.push_back(*o.fitLightFrustum ? "fitted frustum" : "bounds frustum");

@@ -103,6 +103,35 @@ TEST(Report, ShowsEachMethodsMetricsAndTimings) {
     EXPECT_EQ(count(html, "<svg"), 1u);
 }
 
+TEST(Report, ImagesCarryTheirShadowSettingsAndThePagesChoicesInFull) {
+    // Under each image, one line of the settings that decide its shadows (not every attribute,
+    // cut off: those are in the Settings section), fractions to three digits, whole numbers as
+    // they are; the program's choices of view and sun whole, once; a ray tracer's aliasing cell
+    // says it has none rather than a 0 that reads as "all its error is away from edges".
+    ReportInput in = syntheticRun();
+    const std::string why =
+        "searched, from outside, azimuth 30, elevation 20 degrees (the best of 576 view x sun "
+        "pairs at 64x36, then moved back to hold the whole shadow)";
+    in.reference.frame.attributes["choice.view"] = why;
+    in.reference.frame.attributes["scene_hash"] = "56a073b50afe5bcb";
+    in.methods[1].frame.attributes["shadow_map_size"] = "2048";
+    in.methods[1].frame.attributes["depth_bias"] = "0.000305175781";
+    in.methods[1].frame.attributes["gpu_lit_pass_ms"] = "182.879232";
+    in.methods[0].frame.attributes["ray_bias"] = "0.000339756029";
+    in.methods[0].metrics.pointSampled = true;
+    const std::string html = renderReportHtml(in);
+    const std::string images =
+        html.substr(html.find("<h2>Images</h2>"), html.find("<h2>Difference") - html.find("<h2>Images</h2>"));
+    EXPECT_NE(images.find("shadow_map_size 2048 · depth_bias 0.000305"), std::string::npos) << images;
+    EXPECT_NE(images.find("ray_bias 0.00034"), std::string::npos) << images;
+    EXPECT_EQ(images.find("gpu_lit_pass_ms"), std::string::npos) << images;
+    EXPECT_EQ(images.find("scene_hash"), std::string::npos) << images;
+    EXPECT_EQ(images.find("..."), std::string::npos) << images;
+    EXPECT_NE(images.find("<b>view</b>: " + why), std::string::npos) << images;
+    EXPECT_NE(html.find("gpu_lit_pass_ms"), std::string::npos);  // in the Settings section
+    EXPECT_NE(html.find("none <span class=\"small\">(point-sampled)</span>"), std::string::npos);
+}
+
 TEST(Report, FindingsNameTheDominantErrorAndWhere) {
     const ReportInput in = syntheticRun();
     // Construction: the shadow map's lit floor gets 8% acne speckles blocked by the floor
