@@ -383,23 +383,38 @@ std::string sweepFlickerSvg(const SweepReportInput& in) {
     return compare::renderSvg(plot);
 }
 
+// How much more missed shadow (a rate over counted pixels) than the most accurate row a row
+// may have and still be named the fastest good one: about a pixel in a thousand, the noise of
+// a shadow edge's rounding between settings, far below a crevice's lost shadow.
+constexpr double kSweepShadowLossSlack = 0.001;
+
 std::vector<std::string> describeSweep(const SweepReportInput& in, const AutoBias& bias) {
     std::vector<std::string> lines;
+    // Missed shadow but at smooth meshes' terminators (which renderers mean to leave).
+    auto missed = [](const SweepRow& r) {
+        const double all = r.rate("missed_shadow_rate"), terminator = r.rate("terminator_missed_rate");
+        return (std::isfinite(all) ? all : 0.0) - (std::isfinite(terminator) ? terminator : 0.0);
+    };
     for (const scene::Backend backend : backendsOf(in.rows)) {
+        const Extremes e = extremesOf(in.rows, backend);
+        // The fastest row under the mismatch bar that loses no more shadow than the most accurate
+        // one (within kSweepShadowLossSlack): a constant bias of a tenth of the model erases the
+        // shadows in its crevices yet stays under the bar where a lit ground fills the image.
         const SweepRow* fastest = nullptr;
+        const double mostMissed = e.best >= 0 ? missed(in.rows[e.best]) + kSweepShadowLossSlack : 0.0;
         for (const SweepRow& r : in.rows)
             if (r.config.backend == backend && usable(r) &&
-                r.rate("mismatch_rate") <= compare::kSweepGoodMismatchRate &&
+                r.rate("mismatch_rate") <= compare::kSweepGoodMismatchRate && missed(r) <= mostMissed &&
                 (!fastest || r.frameMs < fastest->frameMs))
                 fastest = &r;
-        const Extremes e = extremesOf(in.rows, backend);
         std::string s = "For " + backendTitle(backend) + ", ";
         if (e.best < 0) {
             s += "no configuration rendered.";
         } else if (fastest) {
             s += "the fastest configuration under " + compare::formatPercent(compare::kSweepGoodMismatchRate) +
-                 " mismatch is " + rowTitle(*fastest) + ": " + compare::formatDuration(fastest->frameMs) +
-                 " per frame, " + compare::formatPercent(fastest->rate("mismatch_rate")) + " wrong.";
+                 " mismatch that misses no more shadow than the most accurate one is " + rowTitle(*fastest) + ": " +
+                 compare::formatDuration(fastest->frameMs) + " per frame, " +
+                 compare::formatPercent(fastest->rate("mismatch_rate")) + " wrong.";
             const SweepRow& b = in.rows[e.best];
             if (&b != fastest)
                 s += " The most accurate, " + rowTitle(b) + ", has " + compare::formatPercent(b.rate("mismatch_rate")) +
@@ -407,9 +422,9 @@ std::vector<std::string> describeSweep(const SweepReportInput& in, const AutoBia
         } else {
             const SweepRow& b = in.rows[e.best];
             s += "no configuration stays under " + compare::formatPercent(compare::kSweepGoodMismatchRate) +
-                 " mismatch; the most accurate, " + rowTitle(b) + ", has " +
-                 compare::formatPercent(b.rate("mismatch_rate")) + " at " + compare::formatDuration(b.frameMs) +
-                 " per frame.";
+                 " mismatch without missing more shadow than the most accurate; the most accurate, " + rowTitle(b) +
+                 ", has " + compare::formatPercent(b.rate("mismatch_rate")) + " at " +
+                 compare::formatDuration(b.frameMs) + " per frame.";
         }
         lines.push_back(s);
     }
