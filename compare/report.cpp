@@ -509,8 +509,18 @@ std::string metricsTable(const ReportInput& in) {
         [&](const Metrics& m) { return countCell(m.missedShadow, m.missedShadowRate); });
     row("&nbsp;&nbsp;of which light bleeding (blocker far)",
         [&](const Metrics& m) { return m.hasBlockerDistance ? countCell(m.bleeding, m.bleedingRate) : plain("n/a"); });
-    row("&nbsp;&nbsp;of which bias leak (blocker within the contact distance)",
-        [&](const Metrics& m) { return m.hasBlockerDistance ? countCell(m.biasLeak, m.biasLeakRate) : plain("n/a"); });
+    row("&nbsp;&nbsp;of which at a smooth mesh's terminator <span class=\"small\">(a tessellation effect)</span>",
+        [&](const Metrics& m) {
+            return m.hasReferenceBlockerIds ? countCell(m.terminatorMissed, m.terminatorMissedRate) : plain("n/a");
+        });
+    // A facet's neighbour is always within the contact distance: the terminator's missed shadow is
+    // counted apart, not as leaks.
+    row("&nbsp;&nbsp;of which bias leak (blocker within the contact distance, terminators aside)",
+        [&](const Metrics& m) {
+            if (!m.hasBlockerDistance) return plain("n/a");
+            const std::size_t leaks = m.biasLeak - std::min(m.biasLeak, m.terminatorBiasLeak);
+            return countCell(leaks, double(leaks) / std::max<double>(1, m.counted));
+        });
     row("agree, lit",
         [&](const Metrics& m) { return countCell(m.agreeLit, double(m.agreeLit) / std::max<double>(1, m.counted)); });
     row("agree, shadow", [&](const Metrics& m) {

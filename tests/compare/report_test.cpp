@@ -287,6 +287,16 @@ TEST(Report, FindingsCallMissedShadowAtAMeshsOwnTerminatorATessellationEffect) {
     EXPECT_EQ(text.find("peter-panning, the shadow cut off"), std::string::npos) << text;
     EXPECT_EQ(text.find("within the contact distance of its blocker"), std::string::npos) << text;
     EXPECT_EQ(text.find("beside the bias's peter-panning"), std::string::npos) << text;
+    // The metrics table says the same: the 80 terminator pixels in their own row, none of them a
+    // bias leak.
+    const std::string html = renderReportHtml(in);
+    const std::string table = html.substr(html.find("<table class=\"metrics\">"));
+    const auto rowOf = [&](const std::string& name) {
+        const std::size_t at = table.find(name);
+        return at == std::string::npos ? std::string() : table.substr(at, table.find("</tr>", at) - at);
+    };
+    EXPECT_NE(rowOf("at a smooth mesh's terminator").find("<td>80<"), std::string::npos) << table;
+    EXPECT_NE(rowOf("terminators aside").find("<td>0<"), std::string::npos) << table;
 }
 
 TEST(Report, FindingsLeadWithPartialShadowWhereItOutnumbersTheWrongPixels) {
