@@ -144,6 +144,20 @@ TEST(AutoBias, AStiffSeriesNamesPeterPanningWhenMissedShadowDominates) {
     EXPECT_NE(s->describe().find("peter-panning"), std::string::npos);
 }
 
+TEST(AutoBias, MissedShadowAtTerminatorsBoundsNoWindow) {
+    // Of each row's missed shadow 0.008 lies at smooth meshes' terminators (renderers leave it at
+    // every bias, and the recommendation does not judge it): without it the 2-texel row is
+    // within the window's 0.1% on both sides; counted as leaks, the series would be stiff.
+    std::vector<SweepRow> rows = {slopeRow(1, 0.02, 0.009), slopeRow(2, 0.0005, 0.0085), slopeRow(4, 0, 0.05)};
+    const AutoBias asLeaks = recommendBias(rows);
+    ASSERT_NE(asLeaks.primary("slope"), nullptr);
+    EXPECT_TRUE(asLeaks.primary("slope")->window.stiff);
+    for (SweepRow& r : rows) r.metrics["terminator_missed_rate"] = 0.008;
+    const AutoBias judged = recommendBias(rows);
+    ASSERT_NE(judged.primary("slope"), nullptr);
+    EXPECT_FALSE(judged.primary("slope")->window.stiff);
+}
+
 TEST(AutoBias, PrefersTheRasterBiasKindWithTheWiderWindow) {
     // Depth: one clean sample; slope: three. The slope bias wins, the depth bias stays at 0
     // as it was when the slope series was measured.
