@@ -161,11 +161,14 @@ Prepared prepare(const SceneOptions& o) {
             << studies::explainAutomaticChoices(p.scene, p.plan, p.settings.raster)
             // The bias for the map size chosen per view (what the layers and the Frame hold).
             << "raster bias: constant "
+            << (p.settings.raster.depthBiasIsDefault && p.settings.raster.fitLightFrustum
+                    ? "half a texel of each map as fitted or cascaded (the default; each map's value is on its L "
+                      "line below), "
+                    : "")
             << raster::resolveAutomaticChoices(p.scene, p.settings.raster, &p.plan).depthBias << " world units"
             << (p.settings.raster.depthBiasIsDefault
                     ? (p.settings.raster.fitLightFrustum
-                           ? " (default: half a texel of each map as fitted or cascaded; this value for a "
-                             "bounding-sphere map and spot and point maps)"
+                           ? " for a bounding-sphere map and spot and point maps"
                            : " (default: half a texel of the bounding-sphere map; of each cascade's with cascades)")
                     : "")
             << ", slope " << p.settings.raster.slopeBias << " texels x tan(angle to light), "

@@ -421,7 +421,9 @@ TEST(App, ExplainSaysWhereTheBiasIsApplied) {
     r = shadowlab({"render", "seed", "--backend", "raster", "--explain", "--resolution", "96x54", "--hardware-bias",
                    "--normal-offset", "0.5", "-o", out});
     ASSERT_EQ(r.exitCode, 0) << r.err;
-    EXPECT_NE(r.err.find("(default: half a texel of each map as fitted or cascaded"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("half a texel of each map as fitted or cascaded (the default; each map's value is on its L"),
+              std::string::npos)
+        << r.err;
     EXPECT_NE(r.err.find("through the rasterizer's depth-bias state"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("spot and point maps only: the rasterizer's slope term is not capped"), std::string::npos)
         << r.err;
