@@ -697,22 +697,29 @@ TEST(RasterBlockerId, ShadowedPlanePixelsNameTheSphereAndAcneNamesThePlaneItself
     }
 }
 
+// A spot 4 units above SphereOverPlane's plane at 320x180, pointing down, cone 40°, intensity 300.
+const Vec3 kSpotOverPlane(0.3, 4.0, 0.2);
+scene::Scene underSpot(SphereOverPlane& p) {
+    p.width = 320;
+    p.height = 180;
+    scene::Scene s = makeScene(p);
+    s.lights[0].type = scene::LightType::Spot;
+    s.lights[0].position = kSpotOverPlane;
+    s.lights[0].direction = Vec3(0, -1, 0);
+    s.lights[0].coneAngleDegrees = 40.0;
+    s.lights[0].intensity = 300.0;
+    return s;
+}
+
 TEST(RasterSpotLight, AnInnerConeFallsOffAsKhrLightsPunctualSays) {
     // The same spot with an inner cone of 15° inside its 40°: the lit plane's beauty is
     // I/(4π d²)·N·L times KHR_lights_punctual's falloff, ((cos θ − cos 40°) / (cos 15° − cos 40°))²
     // clamped to [0, 1], computed here; the shadow is the hard cone's (the falloff shades, it
     // does not move what is lit), so where the plane is lit the visibility stays 1.
     SphereOverPlane p;
-    p.width = 320;
-    p.height = 180;
-    scene::Scene s = makeScene(p);
-    const Vec3 lightPos(0.3, 4.0, 0.2);
-    s.lights[0].type = scene::LightType::Spot;
-    s.lights[0].position = lightPos;
-    s.lights[0].direction = Vec3(0, -1, 0);
-    s.lights[0].coneAngleDegrees = 40.0;
+    scene::Scene s = underSpot(p);
+    const Vec3 lightPos = kSpotOverPlane;
     s.lights[0].innerConeAngleDegrees = 15.0;
-    s.lights[0].intensity = 300.0;
     const scene::Frame f = renderValidated(s, validatedSettings(1024, 0.01, 1.0, ShadowFilter::Pcf2x2), "spot-inner");
     const double cosOuter = std::cos(40.0 * kPi / 180.0), cosInner = std::cos(15.0 * kPi / 180.0);
     int full = 0, ramp = 0;
@@ -735,16 +742,9 @@ TEST(RasterSpotLight, PerspectiveShadowMatchesTheClosedForm) {
     // form: a plane point inside the cone is shadowed when the segment to the light meets the
     // sphere; its irradiance is I/(4π d²) (scene/shading.h).
     SphereOverPlane p;
-    p.width = 320;
-    p.height = 180;
-    scene::Scene s = makeScene(p);
-    const Vec3 lightPos(0.3, 4.0, 0.2);
+    const scene::Scene s = underSpot(p);
+    const Vec3 lightPos = kSpotOverPlane;
     const double cone = 40.0;
-    s.lights[0].type = scene::LightType::Spot;
-    s.lights[0].position = lightPos;
-    s.lights[0].direction = Vec3(0, -1, 0);
-    s.lights[0].coneAngleDegrees = cone;
-    s.lights[0].intensity = 300.0;
     const scene::Frame f = renderValidated(s, validatedSettings(1024, 0.01, 1.0, ShadowFilter::Pcf2x2), "spot");
     const double cosCone = std::cos(cone * kPi / 180.0);
     int counted = 0, shadowed = 0, wrong = 0, dark = 0;

@@ -90,17 +90,24 @@ TEST(ReferenceRender, TwoLightsKeepEachLightsVisibilityAndCombineThem) {
                     .lightVisibility.empty());
 }
 
+// The seed's light made a spot 4 above the plane pointing down, cone 25°, intensity 100.
+const Vec3 kSpotOverSeed(0.3, 4.0, 0.2);
+scene::Scene seedUnderSpot() {
+    scene::Scene s = test::seedScene();
+    s.lights[0].type = scene::LightType::Spot;
+    s.lights[0].position = kSpotOverSeed;
+    s.lights[0].direction = Vec3(0, -1, 0);
+    s.lights[0].coneAngleDegrees = 25.0;
+    s.lights[0].intensity = 100.0;
+    return s;
+}
+
 TEST(ReferenceRender, APointOutsideEverySpotsConeHasNoNdotLSoCompareLeavesItOut) {
     // The seed's light made a spot 4 above the plane pointing down, cone 25°: plane points at an
     // angle past the cone get no light, so ndotl is -1 there (as on a back face); inside it ndotl
     // is the closed-form N·L toward the spot.
-    scene::Scene s = test::seedScene();
-    const Vec3 spot(0.3, 4.0, 0.2);
-    s.lights[0].type = scene::LightType::Spot;
-    s.lights[0].position = spot;
-    s.lights[0].direction = Vec3(0, -1, 0);
-    s.lights[0].coneAngleDegrees = 25.0;
-    s.lights[0].intensity = 100.0;
+    const Vec3 spot = kSpotOverSeed;
+    scene::Scene s = seedUnderSpot();
     const scene::Frame f = renderReference(s, test::planFor(s), test::biasSettings(0, scene::Precision::Double));
     const double cosCone = std::cos(25.0 * 3.14159265358979323846 / 180.0);
     int outside = 0, inside = 0;
@@ -133,13 +140,8 @@ TEST(ReferenceRender, ASpotsInnerConeFallsOffAsKhrLightsPunctualSaysAndLeavesThe
     // The spot above with an inner cone of 18° inside its 25°: a plane point's beauty is the hard
     // spot's times ((cos θ − cos 25°) / (cos 18° − cos 25°))² clamped to [0, 1] (the curve of
     // KHR_lights_punctual's README), computed here; visibility, ndotl and blockers do not change.
-    scene::Scene s = test::seedScene();
-    const Vec3 spot(0.3, 4.0, 0.2);
-    s.lights[0].type = scene::LightType::Spot;
-    s.lights[0].position = spot;
-    s.lights[0].direction = Vec3(0, -1, 0);
-    s.lights[0].coneAngleDegrees = 25.0;
-    s.lights[0].intensity = 100.0;
+    const Vec3 spot = kSpotOverSeed;
+    scene::Scene s = seedUnderSpot();
     const auto settings = test::biasSettings(0, scene::Precision::Double);
     const scene::Frame hard = renderReference(s, test::planFor(s), settings);
     s.lights[0].innerConeAngleDegrees = 18.0;
