@@ -91,6 +91,7 @@ std::map<std::string, std::size_t> cppOffsets() {
         SHADOWLAB_MEMBER(LightData, mapNear),
         SHADOWLAB_MEMBER(LightData, mapFar),
         SHADOWLAB_MEMBER(LightData, pointFaceTan),
+        SHADOWLAB_MEMBER(LightData, spotCosInner),
     };
     const std::vector<std::pair<std::string, std::size_t>> face = {SHADOWLAB_MEMBER(PointFace, near),
                                                                    SHADOWLAB_MEMBER(PointFace, far)};
