@@ -3,6 +3,7 @@
 // difference image. See docs/compare.md for the rules and the colors.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <map>
@@ -156,6 +157,7 @@ struct Metrics {
     // Of the bias leaks, those at the terminator: a facet's neighbour is always within the
     // contact distance, so the findings keep them out of the peter-panning they name.
     std::size_t terminatorBiasLeak = 0;
+    std::size_t biasLeakBesideTerminator() const { return biasLeak - std::min(biasLeak, terminatorBiasLeak); }
 
     // Edge-aware split of the wrong pixels: within edgeRadius pixels of a reference shadow
     // boundary they are aliasing (a resolution problem), elsewhere bias error. Two exceptions:

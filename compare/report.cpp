@@ -181,7 +181,7 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
         // Missed shadow's causes, each pixel named once: the terminator's pixels are bias leaks too
         // (a facet's neighbour is within any contact distance), so peter-panning leaves them out.
         const bool terminatorMost = double(m.terminatorMissed) > kMostlyShare * double(m.missedShadow);
-        const std::size_t leak = m.biasLeak - std::min(m.biasLeak, m.terminatorBiasLeak);
+        const std::size_t leak = m.biasLeakBesideTerminator();
         const bool mapLeaks = m.hasBlockerDistance && !m.pointSampled && !terminatorMost;
         const bool leakMost = mapLeaks && double(leak) > kMostlyShare * double(m.missedShadow);
         const bool leakNotable =
@@ -518,7 +518,7 @@ std::string metricsTable(const ReportInput& in) {
     row("&nbsp;&nbsp;of which bias leak (blocker within the contact distance, terminators aside)",
         [&](const Metrics& m) {
             if (!m.hasBlockerDistance) return plain("n/a");
-            const std::size_t leaks = m.biasLeak - std::min(m.biasLeak, m.terminatorBiasLeak);
+            const std::size_t leaks = m.biasLeakBesideTerminator();
             return countCell(leaks, double(leaks) / std::max<double>(1, m.counted));
         });
     row("agree, lit",

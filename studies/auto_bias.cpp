@@ -14,14 +14,6 @@ namespace shadowlab::studies {
 
 namespace {
 
-// A row's missed shadow but at smooth meshes' terminators (compare.h terminatorMissed): the
-// reference's facets shadowing their neighbours, which a renderer's offset or bias hides on
-// purpose at any bias, so it is no leak that bounds a window (the recommendation judges the same).
-double missedButTerminator(const SweepRow& r) {
-    const double terminator = r.rate("terminator_missed_rate");
-    return r.rate("missed_shadow_rate") - (std::isfinite(terminator) ? terminator : 0.0);
-}
-
 using Json = nlohmann::json;
 
 // The filterable maps' parameter series, in the order their notes appear, with the scene-file
@@ -248,7 +240,7 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
         std::map<std::pair<scene::Backend, std::string>, std::size_t> index;  // by backend and context
         for (const SweepRow& r : rows) {
             if (r.config.biasKind != kind || !r.error.empty() || !std::isfinite(r.config.biasValue)) continue;
-            const double f = r.rate("false_shadow_rate"), m = missedButTerminator(r);
+            const double f = r.rate("false_shadow_rate"), m = r.missedBesideTerminatorRate();
             if (!std::isfinite(f) || !std::isfinite(m)) continue;
             const Json context = contextOf(r.config, kindKey(kind));
             const std::pair<scene::Backend, std::string> groupKey{r.config.backend, context.dump()};
@@ -269,7 +261,7 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
         for (const SweepRow& r : rows) {
             if (r.config.biasKind == kind || !r.error.empty()) continue;
             const std::optional<double> bias = biasOf(r.config, kind);
-            const double f = r.rate("false_shadow_rate"), m = missedButTerminator(r);
+            const double f = r.rate("false_shadow_rate"), m = r.missedBesideTerminatorRate();
             if (!bias || !std::isfinite(f) || !std::isfinite(m)) continue;
             const auto it = index.find({r.config.backend, contextOf(r.config, kindKey(kind)).dump()});
             if (it == index.end()) continue;

@@ -240,7 +240,7 @@ std::string SweepConfig::key() const {
     return k;
 }
 
-std::string SweepConfig::label() const {
+std::string SweepConfig::settingsText() const {
     std::vector<std::string> parts;
     const auto& o = overrides;
     if (o.shadowMapSize) parts.push_back("map " + std::to_string(*o.shadowMapSize));
@@ -271,10 +271,14 @@ std::string SweepConfig::label() const {
     if (o.esmExponent) parts.push_back("esm exponent " + number(*o.esmExponent));
     if (o.momentBias) parts.push_back("moment bias " + number(*o.momentBias));
     if (o.blurWidth) parts.push_back("blur " + std::to_string(*o.blurWidth));
-    std::string s = std::string(scene::toString(backend)) + ":";
-    for (std::size_t i = 0; i < parts.size(); ++i) s += (i ? ", " : " ") + parts[i];
-    if (parts.empty()) s += " defaults";
+    std::string s;
+    for (std::size_t i = 0; i < parts.size(); ++i) s += (i ? ", " : "") + parts[i];
     return s;
+}
+
+std::string SweepConfig::label() const {
+    const std::string settings = settingsText();
+    return std::string(scene::toString(backend)) + ": " + (settings.empty() ? "defaults" : settings);
 }
 
 double SweepRow::temporalValue(const char* name, bool held) const {
@@ -307,6 +311,11 @@ double SweepRow::rate(const char* name) const {
     if (!metrics.is_object() || !metrics.contains(name) || !metrics[name].is_number())
         return std::numeric_limits<double>::quiet_NaN();
     return metrics[name].get<double>();
+}
+
+double SweepRow::missedBesideTerminatorRate() const {
+    const double all = rate("missed_shadow_rate"), terminator = rate("terminator_missed_rate");
+    return all - (std::isfinite(terminator) ? terminator : 0.0);
 }
 
 SweepGrid defaultGrid(const scene::Scene& scene, bool quick) {

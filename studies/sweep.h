@@ -35,6 +35,9 @@ struct SweepConfig {
     std::string key() const;
     // Short text for tables and plot tooltips, e.g. "map 1024, none, depth 0.01, slope 0".
     std::string label() const;
+    // label() without the backend: the settings it overrides, numbers to 4 significant digits
+    // (the key keeps every digit); empty for the defaults.
+    std::string settingsText() const;
 };
 
 // The filterable maps' parameters as sweep axes and grid-file keys (docs/sweep.md):
@@ -98,6 +101,11 @@ struct SweepRow {
     nlohmann::json temporal;
 
     double rate(const char* name) const;  // a metrics rate, NaN when absent
+    // Missed shadow but at smooth meshes' terminators (compare.h terminatorMissed; NaN without a
+    // missed-shadow rate):
+    // the faceted shadow a renderer's offset or bias hides on purpose at every setting, which
+    // neither the bias windows nor the sweep's summary count as a leak.
+    double missedBesideTerminatorRate() const;
     // A temporal figure (`held`: of the raster held view), NaN when absent.
     double temporalValue(const char* name, bool held = false) const;
 };

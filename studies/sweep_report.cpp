@@ -34,42 +34,8 @@ std::string ms(double v) {
     return buf;
 }
 
-// SweepConfig::label() without the backend (it has its own column and heading) and with 4
-// significant digits: bias series are log-spaced, so 4 digits tell every sample apart, while
-// the label's 9 digits (kept exact for the resume key) are noise on a page.
-std::string settingsOf(const SweepRow& r) {
-    auto num = [](double v) {
-        char buf[32];
-        std::snprintf(buf, sizeof buf, "%.4g", v);
-        return std::string(buf);
-    };
-    const auto& o = r.config.overrides;
-    std::vector<std::string> parts;
-    if (o.shadowMapSize) parts.push_back("map " + std::to_string(*o.shadowMapSize));
-    if (o.filter) parts.push_back(*o.filter);
-    if (o.depthBias) parts.push_back("depth bias " + num(*o.depthBias));
-    if (o.slopeBias) parts.push_back("slope bias " + num(*o.slopeBias));
-    if (o.rayBias) {
-        char* end = nullptr;
-        const double v = std::strtod(o.rayBias->c_str(), &end);
-        parts.push_back(*o.rayBias == "robust" ? std::string("robust offset")
-                        : end && *end == '\0'  ? "ray bias " + num(v)
-                                               : "ray bias " + *o.rayBias);
-    }
-    if (o.precision) parts.push_back(*o.precision);
-    if (o.samples) parts.push_back(std::to_string(*o.samples) + " samples");
-    // Every setting a row may override, as label() lists them: rows that differ only here
-    // (cascades, frustum fit, hardware bias) would otherwise read the same.
-    if (o.pcfSize) parts.push_back("pcf size " + std::to_string(*o.pcfSize));
-    if (o.normalOffset) parts.push_back("normal offset " + num(*o.normalOffset));
-    if (o.receiverPlaneBias) parts.push_back(*o.receiverPlaneBias ? "receiver-plane bias" : "no receiver-plane bias");
-    if (o.hardwareBias) parts.push_back(*o.hardwareBias ? "hardware bias" : "shader bias");
-    if (o.fitLightFrustum) parts.push_back(*o.fitLightFrustum ? "fitted frustum" : "bounds frustum");
-    if (o.cascades) parts.push_back(std::to_string(*o.cascades) + (*o.cascades == 1 ? " cascade" : " cascades"));
-    std::string s;
-    for (std::size_t i = 0; i < parts.size(); ++i) s += (i ? ", " : "") + parts[i];
-    return s;
-}
+// A row's settings without the backend (it has its own column and heading).
+std::string settingsOf(const SweepRow& r) { return r.config.settingsText(); }
 
 std::vector<scene::Backend> backendsOf(const std::vector<SweepRow>& rows) {
     std::vector<scene::Backend> b;
@@ -390,22 +356,18 @@ constexpr double kSweepShadowLossSlack = 0.001;
 
 std::vector<std::string> describeSweep(const SweepReportInput& in, const AutoBias& bias) {
     std::vector<std::string> lines;
-    // Missed shadow but at smooth meshes' terminators (which renderers mean to leave).
-    auto missed = [](const SweepRow& r) {
-        const double all = r.rate("missed_shadow_rate"), terminator = r.rate("terminator_missed_rate");
-        return (std::isfinite(all) ? all : 0.0) - (std::isfinite(terminator) ? terminator : 0.0);
-    };
     for (const scene::Backend backend : backendsOf(in.rows)) {
         const Extremes e = extremesOf(in.rows, backend);
         // The fastest row under the mismatch bar that loses no more shadow than the most accurate
         // one (within kSweepShadowLossSlack): a constant bias of a tenth of the model erases the
         // shadows in its crevices yet stays under the bar where a lit ground fills the image.
         const SweepRow* fastest = nullptr;
-        const double mostMissed = e.best >= 0 ? missed(in.rows[e.best]) + kSweepShadowLossSlack : 0.0;
+        const double mostMissed =
+            e.best >= 0 ? in.rows[e.best].missedBesideTerminatorRate() + kSweepShadowLossSlack : 0.0;
         for (const SweepRow& r : in.rows)
             if (r.config.backend == backend && usable(r) &&
-                r.rate("mismatch_rate") <= compare::kSweepGoodMismatchRate && missed(r) <= mostMissed &&
-                (!fastest || r.frameMs < fastest->frameMs))
+                r.rate("mismatch_rate") <= compare::kSweepGoodMismatchRate &&
+                r.missedBesideTerminatorRate() <= mostMissed && (!fastest || r.frameMs < fastest->frameMs))
                 fastest = &r;
         std::string s = "For " + backendTitle(backend) + ", ";
         if (e.best < 0) {

@@ -1,6 +1,7 @@
 // tests/app/export_app_test.cpp: `shadowlab export`: bad input is one clear error with exit 2 and
 // nothing written; an export loaded back as the scene keeps its camera, image size and lights and
 // renders the reference's shadows within what the tessellation allows.
+#include <algorithm>
 #include <fstream>
 
 #include <gtest/gtest.h>
@@ -65,8 +66,17 @@ TEST(ExportApp, UvSphereSagittaMatchesTheChordFormulaAtTheEquator) {
 
 TEST(ExportApp, AnExportLoadsBackWithTheSceneCameraSizeAndLights) {
     TempDir dir;
-    for (const char* name : {"seed", "lesson/spot-light", "lesson/spherical-light"}) {
-        const fs::path out = dir.path() / (std::string(name).substr(std::string(name).rfind('/') + 1) + ".glb");
+    // A spot that falls off from 12° to its 30° cone: its inner angle goes out as innerConeAngle.
+    const std::string soft = dir.write("soft-spot.json", R"({"camera": {"position": [0, 2, 6], "look_at": [0, 0.5, 0]},
+            "lights": [{"type": "spot", "position": [1, 5, 1], "direction": [-1, -5, -1], "cone_angle": 30,
+                        "inner_cone_angle": 12, "intensity": 500}],
+            "materials": {"m": {}},
+            "objects": [{"type": "sphere", "center": [0, 1, 0], "radius": 1, "material": "m"},
+                        {"type": "quad", "center": [0, 0, 0], "normal": [0, 1, 0], "size": [8, 8], "material": "m"}]})")
+                                 .string();
+    for (const std::string& name :
+         {std::string("seed"), std::string("lesson/spot-light"), std::string("lesson/spherical-light"), soft}) {
+        const fs::path out = dir.path() / (fs::path(name).stem().string() + ".glb");
         const auto r = runShadowlab({"export", name, "-o", out.string()});
         ASSERT_EQ(r.exitCode, 0) << r.err;
         const scene::Scene a = scene::loadScene(scene::findScene(name));
@@ -84,6 +94,10 @@ TEST(ExportApp, AnExportLoadsBackWithTheSceneCameraSizeAndLights) {
             EXPECT_EQ(int(b.lights[i].type), int(a.lights[i].type)) << name;
             EXPECT_NEAR(b.lights[i].intensity, a.lights[i].intensity, 1e-9 * a.lights[i].intensity) << name;
             EXPECT_NEAR(b.lights[i].coneAngleDegrees, a.lights[i].coneAngleDegrees, 1e-9) << name;
+            if (a.lights[i].type == scene::LightType::Spot)  // (a hard cone's inner angle just inside it)
+                EXPECT_NEAR(b.lights[i].innerConeAngleDegrees,
+                            std::min(a.lights[i].innerConeAngleDegrees, 0.999 * a.lights[i].coneAngleDegrees), 1e-9)
+                    << name;
             EXPECT_NEAR(b.lights[i].radius, a.lights[i].radius, 1e-12) << name;
             if (a.lights[i].type != scene::LightType::Point) {
                 EXPECT_NEAR(glm::length(b.lights[i].direction - a.lights[i].direction), 0.0, 1e-9) << name;

@@ -328,15 +328,18 @@ inline void boxUnderADownwardCamera(scene::Scene& s, int height) {
 // A spot at (0, 8, 0) straight down, cone 60° (the map's half-angle 61.2°, tan ≈ 1.82), intensity
 // 800. Its map's basis (setBasis: the axis is vertical, so right = dir × X) is right = +z, up = +x:
 // u = z/d, v = x/d with d = 8 − y.
-inline scene::Light spotDown() {
+// A spot at `position` pointing straight down (−y), a hard cone of this half-angle.
+inline scene::Light spotPointingDown(const scene::Vec3& position, double coneDegrees, double intensity) {
     scene::Light l;
     l.type = scene::LightType::Spot;
-    l.position = {0, 8, 0};
+    l.position = position;
     l.direction = {0, -1, 0};
-    l.coneAngleDegrees = 60;
-    l.intensity = 800;
+    l.coneAngleDegrees = coneDegrees;
+    l.intensity = intensity;
     return l;
 }
+
+inline scene::Light spotDown() { return spotPointingDown({0, 8, 0}, 60, 800); }
 
 // Raster settings with every automatic choice already made (as resolveAutomaticChoices leaves
 // them): a square map of `mapSize`, one cascade, depth bias 0.01 and slope bias 1.5.

@@ -703,11 +703,7 @@ scene::Scene underSpot(SphereOverPlane& p) {
     p.width = 320;
     p.height = 180;
     scene::Scene s = makeScene(p);
-    s.lights[0].type = scene::LightType::Spot;
-    s.lights[0].position = kSpotOverPlane;
-    s.lights[0].direction = Vec3(0, -1, 0);
-    s.lights[0].coneAngleDegrees = 40.0;
-    s.lights[0].intensity = 300.0;
+    s.lights[0] = test::spotPointingDown(kSpotOverPlane, 40.0, 300.0);
     return s;
 }
 

@@ -94,11 +94,7 @@ TEST(ReferenceRender, TwoLightsKeepEachLightsVisibilityAndCombineThem) {
 const Vec3 kSpotOverSeed(0.3, 4.0, 0.2);
 scene::Scene seedUnderSpot() {
     scene::Scene s = test::seedScene();
-    s.lights[0].type = scene::LightType::Spot;
-    s.lights[0].position = kSpotOverSeed;
-    s.lights[0].direction = Vec3(0, -1, 0);
-    s.lights[0].coneAngleDegrees = 25.0;
-    s.lights[0].intensity = 100.0;
+    s.lights[0] = test::spotPointingDown(kSpotOverSeed, 25.0, 100.0);
     return s;
 }
 
