@@ -15,6 +15,7 @@
 #include "raster/vulkan_error.h"
 #include "scene/backend.h"
 #include "scene/error.h"
+#include "scene/interrupt.h"
 #include "studies/shard.h"
 
 namespace {
@@ -142,6 +143,8 @@ int main(int argc, char** argv) {
     // early (`| head`) must not kill a render before its output is renamed into place, so a write
     // to a closed pipe fails quietly instead of raising SIGPIPE.
     std::signal(SIGPIPE, SIG_IGN);
+    // Ctrl-C in the middle of a run leaves no hidden staging folder behind.
+    shadowlab::scene::removeTemporariesOnInterrupt();
     CLI::App app{
         "shadowlab: renders a scene with a Vulkan shadow map and a CPU ray tracer and shows,\n"
         "with difference images and numbers, how each gets its shadows wrong against a\n"

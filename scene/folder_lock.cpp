@@ -11,6 +11,7 @@
 #include <system_error>
 
 #include "scene/error.h"
+#include "scene/interrupt.h"
 
 namespace shadowlab::scene {
 
@@ -43,6 +44,7 @@ FolderLock::FolderLock(const fs::path& dir, const std::string& what) : file_(dir
                 // The PID is only for the message: a lock without it is still a lock.
             }
             fd_ = fd;
+            noteLockOnInterrupt(fd_, file_);
             return;
         }
         ::close(fd);
@@ -52,6 +54,7 @@ FolderLock::FolderLock(const fs::path& dir, const std::string& what) : file_(dir
 
 FolderLock::~FolderLock() {
     if (fd_ < 0) return;
+    forgetLockOnInterrupt(fd_);
     struct stat held {
     }, named{};
     if (::fstat(fd_, &held) == 0 && ::lstat(file_.c_str(), &named) == 0 && held.st_ino == named.st_ino)

@@ -24,6 +24,7 @@
 
 #include "scene/error.h"
 #include "scene/input_file.h"
+#include "scene/interrupt.h"
 #include "scene/loader.h"
 
 namespace shadowlab::scene {
@@ -253,12 +254,12 @@ void writePng8(const fs::path& file, int width, int height, const std::vector<fl
 fs::path temporarySibling(const fs::path& file) {
     static std::atomic<unsigned> counter{0};
     const fs::path dir = file.has_parent_path() ? file.parent_path() : fs::path(".");
+    noteTemporaryFolder(dir);
     // (appended piece by piece: GCC 12 warns falsely, -Wrestrict, on the chained operator+)
     std::string name = ".";
     name += file.stem().string();
     name += ".tmp-";
-    name += std::to_string(::getpid());
-    name += '-';
+    name += temporaryTag();
     name += std::to_string(counter++);
     name += file.extension().string();
     return dir / name;

@@ -35,8 +35,9 @@ void writePngDisplay(const std::filesystem::path& file, int width, int height, c
 // Writes `text` to `file` through a temporary name and a rename.
 void writeTextAtomic(const std::filesystem::path& file, const std::string& text);
 
-// A fresh temporary name beside `file` (".stem.tmp-PID-N.ext"), the scheme every atomic write
-// here uses; a folder gets the same kind of name (".name.tmp-PID-N").
+// A fresh temporary name beside `file` (".stem.tmp-PID-TOKEN-N.ext", temporaryTag in interrupt.h),
+// the scheme every atomic write here uses; a folder gets the same kind of name. Notes the folder
+// for removeTemporariesOnInterrupt.
 std::filesystem::path temporarySibling(const std::filesystem::path& file);
 
 // Removes the temporaries in `dir` (files or folders named as above) whose writing process is

@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <functional>
 
+#include <unistd.h>
+
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 
@@ -224,6 +226,22 @@ TEST(FrameIo, WritesLeaveNoTemporaryFilesBehind) {
     writeFrame(patternFrame(false), dir.path() / "a.exr");  // replaces in place
     writeTextAtomic(dir.path() / "m.json", "{}\n");
     EXPECT_EQ(dir.fileCount(), 2u);
+}
+
+TEST(FrameIo, TemporaryNamesCarryThePidFirstThenAProcessTokenThenACount) {
+    const std::string a = temporarySibling("out/a.exr").filename().string();
+    const std::string b = temporarySibling("out/a.exr").filename().string();
+    EXPECT_NE(a, b);
+    // ".a.tmp-PID-TOKEN-N.exr": the PID where removeStaleTemporaries reads it, TOKEN 8 hex digits.
+    const std::string head = ".a.tmp-" + std::to_string(::getpid()) + "-";
+    ASSERT_EQ(a.rfind(head, 0), 0u) << a;
+    ASSERT_GT(a.size(), head.size() + 9);
+    const std::string token = a.substr(head.size(), 8);
+    EXPECT_EQ(token.find_first_not_of("0123456789abcdef"), std::string::npos) << a;
+    EXPECT_EQ(a[head.size() + 8], '-') << a;
+    EXPECT_EQ(b.substr(head.size(), 8), token);  // one token per process
+    EXPECT_EQ(a.substr(a.size() - 4), ".exr");
+    EXPECT_EQ(temporarySibling("out/a.exr").parent_path(), std::filesystem::path("out"));
 }
 
 TEST(FrameIo, ReadingAnImageWithoutTheAovsNamesTheMissingChannel) {
