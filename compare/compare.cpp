@@ -579,7 +579,9 @@ Comparison compareFrames(const Frame& method, const Frame& reference, const Comp
                         ++m.biasLeak;
                         if (terminator) ++m.terminatorBiasLeak;
                         if (nearEdge[i]) ++m.biasLeakNearEdge;
-                    } else if (!nearEdge[i] && !m.pointSampled) {  // bleeding is a filter's; a ray has none
+                    } else if (!nearEdge[i] && !m.pointSampled && !terminator) {
+                        // Bleeding is a filter's (a ray has none), and the terminator's faceted
+                        // shadow is counted apart, whatever its blocker's distance.
                         ++m.bleeding;
                     }
                 }

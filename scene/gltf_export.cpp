@@ -415,7 +415,7 @@ ExportResult exportGltf(const Scene& scene, const fs::path& file, const ExportOp
                 // glTF needs inner < outer: a hard cone's inner angle is just inside it.
                 const double inner = l.innerConeAngleDegrees < l.coneAngleDegrees
                                          ? l.innerConeAngleDegrees * kPi / 180.0
-                                         : outer * (1.0 - 1e-3);
+                                         : outer * kExportHardConeInnerRatio;
                 gl["spot"] = {{"outerConeAngle", outer}, {"innerConeAngle", inner}};
             }
         }

@@ -21,6 +21,11 @@ struct ExportOptions {
 // count grows without bound: 1e-8 took 13 GB before it was stopped.)
 inline constexpr double kMinExportTolerance = 1e-5;
 
+// glTF needs a spot's innerConeAngle below its outerConeAngle: an export writes a hard cone's
+// inner angle as this fraction of the outer one, and loading a shadowlab export reads an inner
+// angle at or above it back as hard, so the round trip keeps the cone's edge hard.
+inline constexpr double kExportHardConeInnerRatio = 1.0 - 1e-3;
+
 // Throws InputError for an extension other than .glb or .gltf, or a tolerance outside
 // [kMinExportTolerance, 0.5), naming the option and the value.
 void checkExportOptions(const std::filesystem::path& file, const ExportOptions& options);

@@ -14,6 +14,7 @@
 
 #include "scene/budgets.h"
 #include "scene/error.h"
+#include "scene/gltf_export.h"
 #include "scene/input_file.h"
 #include "scene/json_input.h"
 #include "scene/memory.h"
@@ -825,6 +826,10 @@ Scene loadModelScene(const fs::path& file) {
                 light.coneAngleDegrees = std::clamp(l.outerConeRadians * 180.0 / kPi, 0.1, 89.9);
                 // glTF's default inner angle is 0: the falloff starts on the axis.
                 light.innerConeAngleDegrees = std::clamp(l.innerConeRadians * 180.0 / kPi, 0.0, light.coneAngleDegrees);
+                // A shadowlab export's hard cone (its inner angle written just inside the outer).
+                if (extras.shadowlabExport &&
+                    l.innerConeRadians >= l.outerConeRadians * kExportHardConeInnerRatio * (1.0 - 1e-12))
+                    light.innerConeAngleDegrees = Light{}.innerConeAngleDegrees;
             }
         }
         // The checks a JSON light gets, at the glTF light's path (its position and direction

@@ -292,7 +292,8 @@ AutoBias recommendBias(const std::vector<SweepRow>& rows, double threshold) {
         if (r.config.backend != scene::Backend::Raytrace ||
             r.config.overrides.rayBias != std::optional<std::string>("robust") || !r.error.empty())
             continue;
-        const double f = r.rate("false_shadow_rate"), m = r.rate("missed_shadow_rate");
+        // Judged as the bias windows are: the terminator's faceted shadow left out.
+        const double f = r.rate("false_shadow_rate"), m = r.missedBesideTerminatorRate();
         if (!std::isfinite(f) || !std::isfinite(m)) continue;
         out.robust.push_back(
             {r.config.overrides.precision.value_or(""), f, m, r.frameMs, f <= threshold && m <= threshold});

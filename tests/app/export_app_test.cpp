@@ -94,10 +94,9 @@ TEST(ExportApp, AnExportLoadsBackWithTheSceneCameraSizeAndLights) {
             EXPECT_EQ(int(b.lights[i].type), int(a.lights[i].type)) << name;
             EXPECT_NEAR(b.lights[i].intensity, a.lights[i].intensity, 1e-9 * a.lights[i].intensity) << name;
             EXPECT_NEAR(b.lights[i].coneAngleDegrees, a.lights[i].coneAngleDegrees, 1e-9) << name;
-            if (a.lights[i].type == scene::LightType::Spot)  // (a hard cone's inner angle just inside it)
-                EXPECT_NEAR(b.lights[i].innerConeAngleDegrees,
-                            std::min(a.lights[i].innerConeAngleDegrees, 0.999 * a.lights[i].coneAngleDegrees), 1e-9)
-                    << name;
+            if (a.lights[i].type == scene::LightType::Spot) {  // a hard cone comes back hard, and the same
+                EXPECT_NEAR(b.lights[i].innerConeAngleDegrees, a.lights[i].innerConeAngleDegrees, 1e-9) << name;
+            }
             EXPECT_NEAR(b.lights[i].radius, a.lights[i].radius, 1e-12) << name;
             if (a.lights[i].type != scene::LightType::Point) {
                 EXPECT_NEAR(glm::length(b.lights[i].direction - a.lights[i].direction), 0.0, 1e-9) << name;

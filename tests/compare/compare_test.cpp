@@ -414,6 +414,14 @@ TEST(EdgeAwareError, AThinShadowLostWholeToTheBiasIsABiasLeakNotAliasing) {
     miss.visibility[10 * 20 + 5] = 1.0f;
     miss.attributes = m.attributes;  // the shadow map's
     EXPECT_EQ(compareFrames(miss, wide).metrics.bleeding, 1u);
+    // The same pixel at the receiver's own terminator (blocked by itself, N·L 0.1 in the
+    // reference) is the faceted shadow counted apart, not bleeding, however far its blocker.
+    Frame own = wide;
+    own.blockerId[10 * 20 + 5] = 1.0f;
+    own.ndotl[10 * 20 + 5] = 0.1f;
+    const Metrics terminator = compareFrames(miss, own).metrics;
+    EXPECT_EQ(terminator.terminatorMissed, 1u);
+    EXPECT_EQ(terminator.bleeding, 0u);
     miss.attributes = {{"ray_bias", "0.001"}};
     const Metrics ray = compareFrames(miss, wide).metrics;
     EXPECT_TRUE(ray.pointSampled);

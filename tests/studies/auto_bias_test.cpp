@@ -158,6 +158,20 @@ TEST(AutoBias, MissedShadowAtTerminatorsBoundsNoWindow) {
     EXPECT_FALSE(judged.primary("slope")->window.stiff);
 }
 
+TEST(AutoBias, RobustOffsetsAreJudgedWithoutTheTerminatorAsTheWindowsAre) {
+    // Robust offsets that miss 0.5% of the pixels, all at smooth meshes' terminators (where a
+    // float offset along the shading normal and the reference's facets part), pass as the
+    // ray-bias window's rows would; the same miss elsewhere fails them.
+    std::vector<SweepRow> rows = {rayRow(0, kBad, 0), rayRow(1e-4, 0, 0), rayRow(1e-2, 0, kBad),
+                                  robustRow("float", 0, 0.005, 50.0)};
+    EXPECT_EQ(recommendBias(rows).robustPick(), nullptr);
+    rows[3].metrics["terminator_missed_rate"] = 0.005;
+    const AutoBias judged = recommendBias(rows);
+    ASSERT_NE(judged.robustPick(), nullptr);
+    EXPECT_EQ(judged.shadowBlock.at("ray_bias"), "robust");
+    EXPECT_DOUBLE_EQ(judged.robustPick()->missedShadowRate, 0.0);
+}
+
 TEST(AutoBias, PrefersTheRasterBiasKindWithTheWiderWindow) {
     // Depth: one clean sample; slope: three. The slope bias wins, the depth bias stays at 0
     // as it was when the slope series was measured.
