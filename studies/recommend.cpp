@@ -282,32 +282,79 @@ void tryLargerMap(const RecommendOptions& o, const scene::Scene& scene, const sc
     const std::string asked = "the default caps the map at " + std::to_string(size) +
                               " texels where the receivers and casters ask for " +
                               std::to_string(int(std::ceil(needed))) + ": ";
-    const bool biasesWon = v.beatsDefaults;
+    const bool biasesWon = v.beatsDefaults;  // the searched biases or a normal offset
     if (beats(v.largerMap, v.recommended)) {
         notes.push_back(
             "For the shadow map, " + asked + "a " + std::to_string(larger) + " map gives " +
             percentPair(v.largerMap, v.defaults) +
-            (biasesWon ? ", and it beats the searched biases' " + compare::formatPercent(v.recommended.judgedRate())
+            (biasesWon ? ", and it beats the searched settings' " + compare::formatPercent(v.recommended.judgedRate())
                        : std::string()) +
             " at " + sizeText(scene) +
             ", for four times the texels of each map and more render time. The block recommends "
             "shadow_map_size " +
-            std::to_string(larger) + (biasesWon ? " in place of the biases." : "."));
+            std::to_string(larger) + (biasesWon ? " in place of them." : "."));
         v.largerMapRecommended = true;
         v.beatsDefaults = true;
         v.recommended = v.largerMap;
         block.erase("depth_bias");
         block.erase("slope_bias");
+        block.erase("normal_offset");
+        v.normalOffsetRecommended = 0.0;
         if (o.user.depthBias) block["depth_bias"] = *o.user.depthBias;
         if (o.user.slopeBias) block["slope_bias"] = *o.user.slopeBias;
         block["shadow_map_size"] = larger;
     } else {
         notes.push_back("For the shadow map, " + asked + "a " + std::to_string(larger) + " map " +
                         (v.largerMap.ok ? "gives " + percentPair(v.largerMap, v.defaults) + ", no better than " +
-                                              (biasesWon ? "the searched biases" : "the defaults")
+                                              (biasesWon ? "the searched settings" : "the defaults")
                                         : "failed (" + v.largerMap.error + ")") +
                         ": the block keeps the size.");
     }
+}
+
+// Normal offset on top of what the block recommends so far (`biases`: the searched depth and
+// slope bias when they won). Near a curved mesh's terminator the surface bends away within a
+// texel's footprint faster than the slope bias's tangent plane assumes, so its own map texels
+// shadow it (a solid band, not a speckle) at every bias that keeps thin casters' shadows; moving
+// the lookup a fraction of a texel off the surface clears it (docs/sweep.md "The recommendation").
+void tryNormalOffset(const RecommendOptions& o, const scene::Scene& scene, const scene::Frame& reference,
+                     const BiasPoint* biases, Verified& v, Json& block, std::vector<std::string>& notes) {
+    if (o.user.normalOffset || !v.recommended.ok || o.normalOffsetSteps.empty()) return;
+    scene::SettingsOverrides ov = o.user;
+    if (biases) {
+        ov.depthBias = biases->depthBias;
+        ov.slopeBias = biases->slopeBias;
+    }
+    int best = -1;
+    for (const double k : o.normalOffsetSteps) {
+        ov.normalOffset = k;
+        v.normalOffsets.emplace_back(k, measureRender(o, scene, ov, scene::Backend::Raster, reference));
+        const Measured& m = v.normalOffsets.back().second;
+        if (beats(m, best < 0 ? v.recommended : v.normalOffsets[std::size_t(best)].second))
+            best = int(v.normalOffsets.size()) - 1;
+    }
+    std::string tried;
+    for (const auto& [k, m] : v.normalOffsets)
+        tried += (tried.empty() ? "" : ", ") + compare::formatShort(k) + " texel" + (k == 1.0 ? "" : "s") + ": " +
+                 (m.ok ? compare::formatPercent(m.judgedRate()) : "failed");
+    const std::string base = biases ? "the searched biases" : "the defaults";
+    if (best < 0) {
+        notes.push_back("For the shadow map, a normal offset on top of " + base + " is no better (" + tried +
+                        " wrong without the terminator, against " + compare::formatPercent(v.recommended.judgedRate()) +
+                        "): the block adds none.");
+        return;
+    }
+    const auto& [k, m] = v.normalOffsets[std::size_t(best)];
+    notes.push_back("For the shadow map, a normal offset of " + compare::formatShort(k) + " texel" +
+                    (k == 1.0 ? "" : "s") + " on top of " + base + " gives " + percentPair(m, v.defaults) + " at " +
+                    sizeText(scene) + " (of the offsets tried, " + tried +
+                    " wrong without the terminator): it lifts the lookup off curved receivers near their terminators, "
+                    "whose own texels "
+                    "shadow them past any slope bias. The block recommends it.");
+    v.normalOffsetRecommended = k;
+    v.beatsDefaults = true;
+    v.recommended = m;
+    block["normal_offset"] = k;
 }
 
 }  // namespace
@@ -326,6 +373,12 @@ Json Recommendation::toJson() const {
                                       : Json(nullptr);
         if (withPoints) {
             j["searched_points"] = points.size();
+            Json offsets = Json::array();
+            for (const auto& [k, m] : v.normalOffsets)
+                offsets.push_back({{"normal_offset", k}, {"measured", measuredJson(m)}});
+            j["normal_offsets"] = offsets;
+            j["normal_offset_recommended"] =
+                v.normalOffsetRecommended > 0 ? Json(v.normalOffsetRecommended) : Json(nullptr);
             j["larger_map"] = v.largerMapSize > 0 ? Json{{"shadow_map_size", v.largerMapSize},
                                                          {"measured", measuredJson(v.largerMap)},
                                                          {"recommended", v.largerMapRecommended}}
@@ -486,6 +539,7 @@ Recommendation recommendShadow(const scene::Scene& searchScene, const scene::Fra
                       ", not better in every respect: the block keeps the defaults.";
             r.notes.push_back("For the shadow map, " + why);
         }
+        tryNormalOffset(o, scene, reference, v.beatsDefaults ? &best : nullptr, v, block, r.notes);
         tryLargerMap(o, scene, reference, rasterDefaults ? *rasterDefaults : fullDefaults, v, block, r.notes);
     }
 

@@ -69,6 +69,10 @@ struct Verified {
     int largerMapSize = 0;
     Measured largerMap;
     bool largerMapRecommended = false;
+    // Raster: the normal offsets tried on top of the biases recommended so far (texels; empty where
+    // the user set one), what each measured, and the one recommended (0: none).
+    std::vector<std::pair<double, Measured>> normalOffsets;
+    double normalOffsetRecommended = 0.0;
 };
 
 // Twice the default size: four times its texels and memory, about 1.7 times the raster frame's
@@ -89,6 +93,10 @@ struct RecommendOptions {
     // Where the user set no map size and the default capped it below what the receivers ask for
     // (the frame's shadow_map_size_needed), the next power of two up to this size is tried too.
     int largestMapSize = kLargestRecommendedMapSize;
+    // Normal offsets (texels) tried at the requested resolution on top of the recommended biases,
+    // where the user set none: a grazing receiver on a curved mesh self-shadows past any slope bias
+    // that keeps thin casters' shadows (docs/sweep.md "The recommendation"). Empty: not tried.
+    std::vector<double> normalOffsetSteps{0.5, 1.0};
 };
 
 struct Recommendation {

@@ -59,6 +59,12 @@ struct Fake {
     double neededMap = 0.0;
     bool neededEvenWhenSet = false;  // report it at a size the user set too (the guard is the caller's)
     int smallMapFloor = 0;
+    // A curved receiver's terminator band: this many wrong pixels at every bias unless the lookup
+    // moves at least bandClearedAt texels along the normal; each texel of offset beyond that
+    // loses offsetCost pixels of contact shadow.
+    int grazingBand = 0;
+    double bandClearedAt = 0.5;
+    int offsetCost = 10;
     int renders = 0;
     scene::Frame operator()(const scene::Scene& s, const scene::RenderSettings& settings, scene::Backend backend) {
         ++renders;
@@ -69,6 +75,9 @@ struct Fake {
             wrong = octaves(settings.raster.depthBias, depthTarget) + octaves(settings.raster.slopeBias, slopeTarget);
             if (w == loseAtWidth && !settings.raster.depthBiasIsDefault) wrong = w;
             if (settings.raster.shadowMapSize <= 2048) wrong += smallMapFloor;
+            const double offset = settings.raster.normalOffset;
+            wrong += offset >= bandClearedAt ? int(std::lround(offsetCost * (offset - bandClearedAt) / bandClearedAt))
+                                             : grazingBand;
         } else {
             wrong = settings.raytrace.robustOffset ? 0 : 3;
         }
@@ -218,6 +227,56 @@ TEST(Recommend, ALargerMapIsNotTriedWhereNothingIsCappedOrTheUserSetTheSize) {
         EXPECT_EQ(r.raster.largerMapSize, 0) << "user size " << userSize;
         EXPECT_EQ(r.shadowBlock.value("shadow_map_size", 0), userSize ? 2048 : 0);
     }
+}
+
+// The biases are at the fake's optimum, but 15 px of terminator band stay at every bias: half a
+// texel of normal offset clears them (0 px), one texel clears them and costs 10 px of contact
+// shadow. The block adds normal_offset 0.5 and nothing else; with the user's own offset, or
+// without the band, no offset is recommended.
+TEST(Recommend, ANormalOffsetIsRecommendedWhereItClearsWhatNoBiasDoes) {
+    const scene::Scene s = fakeScene(1000);
+    const double b0 = scene::resolveSettings(s, {}).raster.depthBias;
+    auto make = [&](int band) {
+        auto fake = std::make_shared<Fake>();
+        fake->depthTarget = b0;
+        fake->slopeTarget = 1.0;
+        fake->grazingBand = band;
+        return fake;
+    };
+    RecommendOptions o = fakeOptions(make(15));
+    o.raytrace = false;
+    const scene::Frame ref = row(1000, 0);
+    const Recommendation r = recommendShadow(s, ref, s, ref, nullptr, nullptr, Json::object(), o);
+    EXPECT_FALSE(r.raster.searched);  // no bias beats the defaults: the band is at every bias
+    EXPECT_DOUBLE_EQ(r.raster.defaults.mismatchRate, 0.015);
+    ASSERT_EQ(r.raster.normalOffsets.size(), 2u);
+    EXPECT_DOUBLE_EQ(r.raster.normalOffsets[0].second.mismatchRate, 0.0);   // 0.5 texel
+    EXPECT_DOUBLE_EQ(r.raster.normalOffsets[1].second.mismatchRate, 0.01);  // 1 texel: 10 px lost
+    EXPECT_EQ(r.raster.normalOffsetRecommended, 0.5);
+    EXPECT_TRUE(r.raster.beatsDefaults);
+    EXPECT_DOUBLE_EQ(r.raster.recommended.mismatchRate, 0.0);
+    EXPECT_EQ(r.shadowBlock.at("normal_offset"), 0.5);
+    EXPECT_FALSE(r.shadowBlock.contains("depth_bias"));
+    const Json file = r.toJson();
+    EXPECT_EQ(file["measured"]["raster"]["normal_offset_recommended"], 0.5);
+    EXPECT_EQ(file["measured"]["raster"]["normal_offsets"].size(), 2u);
+    bool said = false;
+    for (const std::string& n : r.notes) said = said || n.find("normal offset of 0.5 texels") != std::string::npos;
+    EXPECT_TRUE(said);
+
+    RecommendOptions own = fakeOptions(make(15));
+    own.raytrace = false;
+    own.user.normalOffset = 0.25;  // below what clears the band: the user's, not replaced
+    const Recommendation u = recommendShadow(s, ref, s, ref, nullptr, nullptr, Json::object(), own);
+    EXPECT_TRUE(u.raster.normalOffsets.empty());
+    EXPECT_EQ(u.shadowBlock.at("normal_offset"), 0.25);
+
+    RecommendOptions clean = fakeOptions(make(0));
+    clean.raytrace = false;
+    const Recommendation c = recommendShadow(s, ref, s, ref, nullptr, nullptr, Json::object(), clean);
+    EXPECT_EQ(c.raster.normalOffsets.size(), 2u);
+    EXPECT_EQ(c.raster.normalOffsetRecommended, 0.0);
+    EXPECT_FALSE(c.shadowBlock.contains("normal_offset"));
 }
 
 // A larger map whose default bias is off the optimum (10 px) loses to defaults at 0 px: kept out.
