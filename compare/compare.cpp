@@ -558,6 +558,7 @@ Comparison compareFrames(const Frame& method, const Frame& reference, const Comp
                     roundId(method.blockerId[i]) == roundId(idr)) {
                     ++m.selfShadowAcne;
                     ++obj.selfShadowAcne;
+                    if (nr < kTerminatorNdotL) ++m.selfShadowAcneGrazing;
                 }
                 if (nearEdge[i]) ++m.falseShadowNearEdge;
             } else if (c == PixelClass::MissedShadow) {
@@ -715,9 +716,11 @@ nlohmann::json toJson(const Metrics& m) {
     if (m.hasBlockerIds) {
         j["self_shadow_acne"] = m.selfShadowAcne;
         j["self_shadow_acne_rate"] = m.selfShadowAcneRate;
+        j["self_shadow_acne_grazing"] = m.selfShadowAcneGrazing;
     } else {
         j["self_shadow_acne"] = nullptr;
         j["self_shadow_acne_rate"] = nullptr;
+        j["self_shadow_acne_grazing"] = nullptr;
     }
     j["terminator_missed"] = nullptr;
     j["terminator_missed_rate"] = nullptr;

@@ -132,6 +132,10 @@ struct Metrics {
     bool hasBlockerIds = false;
     std::size_t selfShadowAcne = 0;
     double selfShadowAcneRate = 0.0;  // over counted
+    // Of it, pixels lit near grazing (the reference's N·L below kTerminatorNdotL): a curved
+    // receiver bending away from its own map texels faster than the slope bias's tangent plane
+    // follows, which a normal offset clears where a larger bias would cost contact shadows.
+    std::size_t selfShadowAcneGrazing = 0;
 
     // Missed shadow split by the reference's blocker distance (Frame::blockerDistance): bias
     // leaks where the blocker is within the contact distance of the receiver (thresholds.h

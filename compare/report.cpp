@@ -194,6 +194,12 @@ std::string describeMethod(const ReportInput& in, const ReportMethod& rm) {
                 const std::string on =
                     dominantObject(in, m, m.selfShadowAcne, [](const ObjectErrors& o) { return o.selfShadowAcne; });
                 if (!on.empty()) f += " on " + on;
+                if (double(m.selfShadowAcneGrazing) > kMostlyShare * double(m.selfShadowAcne))
+                    f += " (" + formatPercent(double(m.selfShadowAcneGrazing) / double(m.selfShadowAcne)) +
+                         " of it lit near grazing, N·L below " + formatShort(kTerminatorNdotL) +
+                         ", where a curved surface bends away from its own map texels faster than the slope "
+                         "bias follows; a normal offset of a fraction of a texel clears it without the contact "
+                         "shadows a larger bias loses)";
             } else {
                 if (m.hasBlockerIds && m.selfShadowAcne > 0)
                     f += " (" + formatPercent(double(m.selfShadowAcne) / double(m.falseShadow)) +

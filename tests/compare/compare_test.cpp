@@ -161,6 +161,25 @@ TEST(CompareFrames, MetricsOfAHandBuiltRowEqualHandCounts) {
     EXPECT_EQ(k.perObject[1].missedShadow, 1u);
 }
 
+TEST(CompareFrames, SelfAcneLitNearGrazingIsCountedApart) {
+    // Four false-shadow pixels, each blocked by its own object in the method:
+    //   0: N·L 0.1 in the reference   -> grazing
+    //   1: N·L 0.19                    -> grazing
+    //   2: N·L 0.5                     -> not
+    //   3: N·L 0.1, blocked by object 2 -> not acne at all
+    const auto [m, r] = framesFrom({{1, 1, 0.1f, 0.1f, 0, 1, 1},
+                                    {1, 1, 0.19f, 0.19f, 0, 1, 1},
+                                    {1, 1, 0.5f, 0.5f, 0, 1, 1},
+                                    {1, 1, 0.1f, 0.1f, 0, 1, 2}});
+    const Metrics k = compareFrames(m, r).metrics;
+    EXPECT_EQ(k.falseShadow, 4u);
+    EXPECT_EQ(k.selfShadowAcne, 3u);
+    EXPECT_EQ(k.selfShadowAcneGrazing, 2u);
+    EXPECT_EQ(toJson(k).at("self_shadow_acne_grazing"), 2);
+    const auto [m2, r2] = framesFrom({{1, 1, 0.1f, 0.1f, 0, 1}}, /*withBlocker=*/false);
+    EXPECT_TRUE(toJson(compareFrames(m2, r2).metrics).at("self_shadow_acne_grazing").is_null());
+}
+
 TEST(CompareFrames, WithoutMethodBlockerIdsSelfAcneIsUnknownNotZero) {
     const auto [m, r] = framesFrom({{1, 1, 0.5f, 0.5f, 0, 1}}, /*withBlocker=*/false);
     const Metrics k = compareFrames(m, r).metrics;

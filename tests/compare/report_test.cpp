@@ -221,6 +221,35 @@ TEST(Report, FindingsSayAThinShadowLostToTheBiasIsBiasAndARayTracerDoesNotAlias)
     EXPECT_EQ(mapText.find("--shadow-map-size"), std::string::npos) << mapText;
 }
 
+TEST(Report, FindingsNameANormalOffsetWhereTheAcneIsLitNearGrazing) {
+    // A shadow map darkens columns 0-5 of a lit mesh (id 1) with its own texels (blocker id 1):
+    // self-shadow acne. At N·L 0.1 it is the grazing band a normal offset clears; at 0.6 it is
+    // plain acne, and the sentence says nothing of grazing.
+    for (const float ndotl : {0.1f, 0.6f}) {
+        scene::Frame ref = test::uniformFrame(20, 20, 1, ndotl, 1);
+        ref.blockerId.assign(ref.pixelCount(), 0.0f);
+        scene::Frame map = test::uniformFrame(20, 20, 1, ndotl, 1);
+        map.blockerId.assign(map.pixelCount(), 0.0f);
+        for (int y = 0; y < 20; ++y)
+            for (int x = 0; x <= 5; ++x) {
+                map.visibility[std::size_t(y) * 20 + x] = 0.0f;
+                map.blockerId[std::size_t(y) * 20 + x] = 1.0f;
+            }
+        map.attributes = {{"backend", "raster"}, {"texel_world_size", "0.01"}, {"depth_bias", "0.005"}};
+        ReportInput in;
+        in.sceneName = "bumper";
+        in.objectNames = {"truck"};
+        in.reference = {"reference", "reference.png", ref};
+        in.methods.push_back({"raster", "raster.png", "diff-raster.png", map, compareFrames(map, ref).metrics});
+        std::istringstream lines(describeFindings(in));
+        std::string text;
+        std::getline(lines, text);
+        EXPECT_NE(text.find("mostly self-shadow acne on truck"), std::string::npos) << text;
+        EXPECT_EQ(text.find("(100% of it lit near grazing") != std::string::npos, ndotl < 0.2f) << text;
+        EXPECT_EQ(text.find("normal offset") != std::string::npos, ndotl < 0.2f) << text;
+    }
+}
+
 TEST(Report, FindingsCallMissedShadowAtAMeshsOwnTerminatorATessellationEffect) {
     // Reference: a mesh (id 1) at grazing light, N·L 0.1, whose columns 4-7 are shadowed by the
     // mesh itself (its flat facets); a ray tracer offsets along the interpolated normal and
