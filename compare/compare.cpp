@@ -729,8 +729,8 @@ nlohmann::json toJson(const Metrics& m) {
         j["terminator_missed_rate"] = m.terminatorMissedRate;
     }
     // Without the reference's blocker distances (older frames) bleeding is unknown, not zero.
-    for (const char* k :
-         {"bleeding", "bias_leak", "bias_leak_near_edge", "bleeding_rate", "bias_leak_rate", "contact_distance"})
+    for (const char* k : {"bleeding", "bias_leak", "bias_leak_near_edge", "bleeding_rate", "bias_leak_rate",
+                          "contact_distance", "bias_leak_beside_terminator", "bias_leak_beside_terminator_rate"})
         j[k] = nullptr;
     if (m.hasBlockerDistance) {
         j["bleeding"] = m.bleeding;
@@ -738,6 +738,9 @@ nlohmann::json toJson(const Metrics& m) {
         j["bias_leak_near_edge"] = m.biasLeakNearEdge;
         j["bleeding_rate"] = m.bleedingRate;
         j["bias_leak_rate"] = m.biasLeakRate;
+        // What the report's "bias leak, terminators aside" row and the findings count.
+        j["bias_leak_beside_terminator"] = m.biasLeakBesideTerminator();
+        j["bias_leak_beside_terminator_rate"] = double(m.biasLeakBesideTerminator()) / std::max<double>(1, m.counted);
         j["contact_distance"] = m.contactDistance;
     }
     return j;

@@ -46,6 +46,9 @@ void removeLocks() {
     }
 }
 
+std::array<std::array<char, kPathBytes>, 4> created{};
+std::atomic<std::size_t> createdCount{0};
+
 void say(const char* text) { [[maybe_unused]] const ssize_t n = ::write(2, text, std::strlen(text)); }
 
 extern "C" void onInterrupt(int sig) {
@@ -55,7 +58,7 @@ extern "C" void onInterrupt(int sig) {
     for (const int other : {SIGINT, SIGTERM, SIGHUP}) ::sigaction(other, &plain, nullptr);
     const std::size_t count = folderCount.load(std::memory_order_acquire);
     if (count > 0) {
-        say("\nshadowlab: interrupted; removing the files not yet finished\n");
+        say("\nshadowlab: interrupted; removing this run's unfinished output (what was in place stays)\n");
         // find F1 F2 ... -mindepth 1 -maxdepth 1 -name PATTERN -exec rm -rf -- {} +
         std::array<const char*, kFolders + 16> argv{};
         std::size_t a = 0;
@@ -79,6 +82,7 @@ extern "C" void onInterrupt(int sig) {
         }
     }
     removeLocks();
+    for (std::size_t i = 0; i < createdCount.load(std::memory_order_acquire); ++i) ::rmdir(created[i].data());
     // The default action is back: the process ends by the signal it got.
     ::raise(sig);
 }
@@ -114,6 +118,17 @@ void noteTemporaryFolder(const std::filesystem::path& folder) {
     if (count == kFolders) return;
     std::memcpy(folders[count].data(), path.c_str(), path.size() + 1);
     folderCount.store(count + 1, std::memory_order_release);
+}
+
+void noteCreatedFolderOnInterrupt(const std::filesystem::path& folder) {
+    std::error_code ec;
+    const std::string path = std::filesystem::absolute(folder, ec).string();
+    if (ec || path.size() >= kPathBytes) return;
+    const std::lock_guard<std::mutex> guard(noting);
+    const std::size_t count = createdCount.load(std::memory_order_relaxed);
+    if (count == created.size()) return;
+    std::memcpy(created[count].data(), path.c_str(), path.size() + 1);
+    createdCount.store(count + 1, std::memory_order_release);
 }
 
 void noteLockOnInterrupt(int fd, const std::filesystem::path& file) {

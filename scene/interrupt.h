@@ -29,4 +29,8 @@ std::string temporaryTag();
 void noteLockOnInterrupt(int fd, const std::filesystem::path& file);
 void forgetLockOnInterrupt(int fd);
 
+// An output folder this process created: removed on an interrupt if it is then empty (rmdir), so a
+// first run stopped early leaves no empty folder behind. At most four.
+void noteCreatedFolderOnInterrupt(const std::filesystem::path& folder);
+
 }  // namespace shadowlab::scene

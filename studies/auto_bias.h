@@ -69,7 +69,8 @@ struct AutoBias {
 
     // The series of a kind with the most samples (first seen on a tie), nullptr when none.
     const BiasSeries* primary(const std::string& kind) const;
-    // The best passing robust row (fastest), nullptr when none passes.
+    // The passing robust row to recommend: float's where it passes, else the scene default's, else
+    // double's (never by run time, which is noise between them); nullptr when none passes.
     const RobustResult* robustPick() const;
 };
 

@@ -18,6 +18,7 @@
 #include "scene/frame_identity.h"
 #include "scene/frame_io.h"
 #include "scene/input_file.h"
+#include "scene/interrupt.h"
 #include "scene/memory.h"
 #include "studies/auto_bias.h"
 #include "studies/backend.h"
@@ -238,7 +239,7 @@ RunStudyResult runStudy(const scene::Scene& scene, const scene::RenderSettings& 
     // The heap one renderer frees is kept for the next while a whole renderer, none of it reused,
     // still fits beside it within the estimate.
     const scene::FreedHeapBudget heapBudget(estimate, memory.largestRenderer);
-    fs::create_directories(o.outputDir);
+    if (fs::create_directories(o.outputDir)) scene::noteCreatedFolderOnInterrupt(o.outputDir);
     const scene::FolderLock lock(o.outputDir, "run");
     // The run's files are made in a fresh folder beside the output folder, which they replace as
     // a set once all are written (the commit at the end): a folder never mixes two runs, and a run that

@@ -145,28 +145,37 @@ TEST(RunKill, CtrlCInTheMiddleRemovesTheStagingFolderAndKeepsTheEarlierRun) {
     const std::set<std::string> expected = outputs(out);
     const std::string report = bytesOf(out / "report.html");
 
-    // A longer run, interrupted once its staging folder holds files.
-    const pid_t pid = test::spawnShadowlab(args("640x360"));
-    ASSERT_GT(pid, 0);
-    std::string staging = ".";  // (appended piece by piece: GCC 12 warns falsely, -Wrestrict, on a chain of +)
-    staging += out.filename().string();
-    staging += ".tmp-";
-    staging += std::to_string(pid);
-    staging += '-';
-    bool staged = false;
-    for (int wait = 0; wait < 600 && !staged; ++wait) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(50));
-        for (const auto& e : fs::directory_iterator(dir.path()))
-            if (e.path().filename().string().rfind(staging, 0) == 0 && !fs::is_empty(e.path())) staged = true;
-    }
-    ::kill(pid, SIGINT);
-    int status = 0;
-    ::waitpid(pid, &status, 0);
-    ASSERT_TRUE(staged) << "the run never staged a file";
+    // A longer run into `folder`, interrupted once its staging folder holds files: its exit status.
+    auto interrupted = [&](const fs::path& folder) {
+        const pid_t pid = test::spawnShadowlab({"run", "seed", "-o", folder.string(), "--resolution", "640x360"});
+        EXPECT_GT(pid, 0);
+        std::string staging = ".";  // (appended piece by piece: GCC 12 warns falsely, -Wrestrict, on a chain of +)
+        staging += folder.filename().string();
+        staging += ".tmp-";
+        staging += std::to_string(pid);
+        staging += '-';
+        bool staged = false;
+        for (int wait = 0; wait < 600 && !staged; ++wait) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(50));
+            for (const auto& e : fs::directory_iterator(dir.path()))
+                if (e.path().filename().string().rfind(staging, 0) == 0 && !fs::is_empty(e.path())) staged = true;
+        }
+        ::kill(pid, SIGINT);
+        int status = 0;
+        ::waitpid(pid, &status, 0);
+        EXPECT_TRUE(staged) << "the run never staged a file";
+        return status;
+    };
+    const int status = interrupted(out);
     EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT) << "status " << status;
     EXPECT_TRUE(temporaries(dir.path()).empty()) << temporaries(dir.path()).front();
     EXPECT_EQ(outputs(out), expected);
     EXPECT_EQ(bytesOf(out / "report.html"), report);
+    // A first run into a folder it made leaves no empty folder behind.
+    const fs::path fresh = dir.path() / "fresh";
+    interrupted(fresh);
+    EXPECT_FALSE(fs::exists(fresh));
+    EXPECT_TRUE(temporaries(dir.path()).empty()) << temporaries(dir.path()).front();
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "compare/compare.h"
 #include "compare/text.h"
 #include "tests/compare/synthetic.h"
 
@@ -326,6 +327,11 @@ TEST(Report, FindingsCallMissedShadowAtAMeshsOwnTerminatorATessellationEffect) {
     };
     EXPECT_NE(rowOf("at a smooth mesh's terminator").find("<td>80<"), std::string::npos) << table;
     EXPECT_NE(rowOf("terminators aside").find("<td>0<"), std::string::npos) << table;
+    // And the metrics JSON: bias_leak holds both, bias_leak_beside_terminator the row's count.
+    const auto j = toJson(in.methods[0].metrics);
+    EXPECT_EQ(j.at("bias_leak"), 80);
+    EXPECT_EQ(j.at("bias_leak_beside_terminator"), 0);
+    EXPECT_EQ(j.at("bias_leak_beside_terminator_rate"), 0.0);
 }
 
 TEST(Report, FindingsLeadWithPartialShadowWhereItOutnumbersTheWrongPixels) {

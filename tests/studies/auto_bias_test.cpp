@@ -194,7 +194,13 @@ TEST(AutoBias, RecommendsRobustOffsetsWhenTheyPass) {
                                   robustRow("float", kOk, 0, 50.0), robustRow("double", 0, 0, 80.0)};
     const AutoBias a = recommendBias(rows);
     EXPECT_EQ(a.shadowBlock.at("ray_bias"), "robust");
-    EXPECT_EQ(a.shadowBlock.at("precision"), "float");  // both pass; float is faster
+    EXPECT_EQ(a.shadowBlock.at("precision"), "float");  // both pass: float, the tracer's own
+    // Float is chosen by precision, not time: a double row timed faster (noise) does not flip it.
+    std::vector<SweepRow> timed = rows;
+    timed[4] = robustRow("double", 0, 0, 40.0);
+    EXPECT_EQ(recommendBias(timed).shadowBlock.at("precision"), "float");
+    timed[3] = robustRow("float", kBad, 0, 50.0);  // float fails: double
+    EXPECT_EQ(recommendBias(timed).shadowBlock.at("precision"), "double");
     ASSERT_NE(a.robustPick(), nullptr);
     bool said = false;
     for (const auto& n : a.notes) said = said || n.find("\"ray_bias\": \"robust\"") != std::string::npos;
