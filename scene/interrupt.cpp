@@ -49,6 +49,24 @@ void removeLocks() {
 std::array<std::array<char, kPathBytes>, 4> created{};
 std::atomic<std::size_t> createdCount{0};
 
+// Copies `path`, made absolute (so that no folder name is taken for one of find's options), into
+// the next free slot for the handler to read; a path already there, too long or past the last
+// slot is left out (removeStaleTemporaries on the next run is the fallback).
+template <std::size_t N>
+void notePath(std::array<std::array<char, kPathBytes>, N>& slots, std::atomic<std::size_t>& count,
+              const std::filesystem::path& path) {
+    std::error_code ec;
+    const std::string text = std::filesystem::absolute(path, ec).string();
+    if (ec || text.size() >= kPathBytes) return;
+    const std::lock_guard<std::mutex> guard(noting);
+    const std::size_t n = count.load(std::memory_order_relaxed);
+    for (std::size_t i = 0; i < n; ++i)
+        if (text == slots[i].data()) return;
+    if (n == N) return;
+    std::memcpy(slots[n].data(), text.c_str(), text.size() + 1);
+    count.store(n + 1, std::memory_order_release);
+}
+
 void say(const char* text) { [[maybe_unused]] const ssize_t n = ::write(2, text, std::strlen(text)); }
 
 extern "C" void onInterrupt(int sig) {
@@ -106,30 +124,10 @@ void removeTemporariesOnInterrupt() {
 }
 
 void noteTemporaryFolder(const std::filesystem::path& folder) {
-    std::error_code ec;  // absolute, so that no folder name is taken for one of find's options
-    const std::string path =
-        std::filesystem::absolute(folder.empty() ? std::filesystem::path(".") : folder, ec).string();
-    if (ec) return;
-    if (path.size() >= kPathBytes) return;
-    const std::lock_guard<std::mutex> guard(noting);
-    const std::size_t count = folderCount.load(std::memory_order_relaxed);
-    for (std::size_t i = 0; i < count; ++i)
-        if (path == folders[i].data()) return;
-    if (count == kFolders) return;
-    std::memcpy(folders[count].data(), path.c_str(), path.size() + 1);
-    folderCount.store(count + 1, std::memory_order_release);
+    notePath(folders, folderCount, folder.empty() ? std::filesystem::path(".") : folder);
 }
 
-void noteCreatedFolderOnInterrupt(const std::filesystem::path& folder) {
-    std::error_code ec;
-    const std::string path = std::filesystem::absolute(folder, ec).string();
-    if (ec || path.size() >= kPathBytes) return;
-    const std::lock_guard<std::mutex> guard(noting);
-    const std::size_t count = createdCount.load(std::memory_order_relaxed);
-    if (count == created.size()) return;
-    std::memcpy(created[count].data(), path.c_str(), path.size() + 1);
-    createdCount.store(count + 1, std::memory_order_release);
-}
+void noteCreatedFolderOnInterrupt(const std::filesystem::path& folder) { notePath(created, createdCount, folder); }
 
 void noteLockOnInterrupt(int fd, const std::filesystem::path& file) {
     const std::string path = file.string();

@@ -300,8 +300,10 @@ void tryLargerMap(const RecommendOptions& o, const scene::Scene& scene, const sc
         block.erase("slope_bias");
         block.erase("normal_offset");
         v.normalOffsetRecommended = 0.0;
+        // The user's own values stay: the larger map was rendered with them.
         if (o.user.depthBias) block["depth_bias"] = *o.user.depthBias;
         if (o.user.slopeBias) block["slope_bias"] = *o.user.slopeBias;
+        if (o.user.normalOffset) block["normal_offset"] = *o.user.normalOffset;
         block["shadow_map_size"] = larger;
     } else {
         notes.push_back("For the shadow map, " + asked + "a " + std::to_string(larger) + " map " +

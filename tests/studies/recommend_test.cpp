@@ -207,6 +207,13 @@ TEST(Recommend, ALargerMapIsRecommendedWhereTheDefaultSizeCapsWhatTheReceiversAs
     EXPECT_EQ(r.shadowBlock.at("shadow_map_size"), 4096);
     EXPECT_FALSE(r.shadowBlock.contains("depth_bias"));
     EXPECT_EQ(r.toJson()["measured"]["raster"]["larger_map"]["shadow_map_size"], 4096);
+    // A normal offset of the user's own (which costs the fake nothing) stays in the block beside
+    // the larger map, which was rendered with it.
+    o.user.normalOffset = 0.5;
+    const Recommendation own = recommendShadow(s, ref, s, ref, nullptr, nullptr, Json::object(), o);
+    EXPECT_TRUE(own.raster.largerMapRecommended);
+    EXPECT_EQ(own.shadowBlock.at("shadow_map_size"), 4096);
+    EXPECT_EQ(own.shadowBlock.at("normal_offset"), 0.5);
 }
 
 TEST(Recommend, ALargerMapIsNotTriedWhereNothingIsCappedOrTheUserSetTheSize) {
